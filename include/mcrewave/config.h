@@ -1,0 +1,54 @@
+// The YAML configuration of an mcrewave run.
+//
+// Every key is declared once, in a table in src/config.cpp, with its type, its
+// default, its unit and a one-line description; loading, validation, the
+// `--set key.path=value` overrides and the commented default config
+// (DefaultConfigYaml) all come from that table. Values are SI units. Enums are
+// written by name (see types.h).
+//
+// Sections and keys (defaults in brackets):
+//   model: length [1 m], section [1e-4 m^2], density [800 kg/m^3],
+//          modulus [200e9 Pa], elements [100], mass [consistent | lumped]
+//   load:  kind [half_sine], amplitude [1000 N], duration [1e-4 s]
+//   time:  window [0.63e-3 s], step [0.36e-6 s], theta [0.5]
+//   data:  source [synthetic | csv], path [""], truth [finite_element | modal],
+//          truth_refinement [4], snr [.inf], seed [1]
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mcrewave/bar_model.h"
+#include "mcrewave/experiment.h"
+
+namespace mcrewave {
+
+struct Config {
+  std::string source_path;  // the file the config was read from ("" for defaults)
+  BarProperties model;
+  LoadOptions load;
+  TimeOptions time;
+  DataOptions data;
+};
+
+// Reads a config file, applies the overrides ("key.path=value", each parsed as a
+// YAML scalar and validated exactly as the same key in the file), and validates
+// everything before any computation. A relative data.path is resolved against
+// the config file's folder. Throws InputError with one message naming the file,
+// the line (for keys from the file) or the override, the key, and what was
+// expected: unknown keys (with the nearest valid key suggested), wrong types,
+// out-of-range values, a missing or unreadable file, malformed YAML.
+Config LoadConfig(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// The same from YAML text; `name` stands for the file name in messages.
+Config ParseConfig(const std::string& yaml_text, const std::string& name,
+                   const std::vector<std::string>& overrides = {});
+
+// A complete config with every key at its default, each commented with its unit
+// and meaning; ParseConfig(DefaultConfigYaml(), ...) gives the default Config.
+std::string DefaultConfigYaml();
+
+// The config as resolved (every key, current values) in YAML, for summaries.
+std::string ConfigToYaml(const Config& config);
+
+}  // namespace mcrewave

@@ -1,0 +1,105 @@
+// Solvers of the coupled direct / retrograde MCRE system for one trial modulus
+// (docs/discrete_mcre.md). All return the same (U, W) for the same discrete
+// problem, to their tolerance:
+//
+//   all_at_once          the whole space-time system (D1, D2, R1, R2, R3) assembled
+//                        sparse and solved by sparse LU; independent of the sweeps;
+//                        the reference on small cases; refuses large problems.
+//   relaxation           the paper's waveform relaxation (eq. 17-19) with a fixed
+//                        coefficient omega: one retrograde and one direct sweep per
+//                        iteration, the direct one driven by omega W_new + (1-omega) W.
+//   adaptive_relaxation  the same, omega = 2 / (a_min + a_max) from a Lanczos
+//                        estimate of the extreme eigenvalues a of A = I - G, with a
+//                        safeguard that re-estimates a_max from observed growth.
+//   conjugate_gradient   CG on A W = c in the inner product <.,.>_P where A is
+//                        self-adjoint positive definite: one retrograde and one
+//                        direct sweep per iteration, no coefficient to tune.
+//
+// The iterative solvers stop on the relative residual ||c - A W||_P / ||c||_P
+// (the same measure for all; c = T(0)), or when ||c - A W||_P falls to the
+// round-off floor 1e-12 ||W_u||_P, W_u the retrograde response to the displacement
+// data alone (c is a difference of two such responses, which cancel for data
+// consistent with the model). Non-convergence and divergence are
+// reported in the summary, never returned as numbers: the solution is usable only
+// when summary.IsSolutionUsable().
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mcrewave/mcre_problem.h"
+
+namespace mcrewave {
+
+enum class CoupledSolverType {
+  kAllAtOnce,
+  kRelaxation,
+  kAdaptiveRelaxation,
+  kConjugateGradient,
+};
+const char* CoupledSolverTypeToString(CoupledSolverType type);
+bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type);
+
+enum class TerminationType {
+  kConvergence,    // the residual reached the tolerance
+  kNoConvergence,  // the iteration limit was reached first
+  kDivergence,     // the residual grew (or became non-finite): the iteration diverges
+  kFailure,        // refused or broke down (problem too large, singular system...)
+};
+const char* TerminationTypeToString(TerminationType type);
+
+struct CoupledSolverOptions {
+  CoupledSolverType type = CoupledSolverType::kConjugateGradient;
+  // Stopping test on ||c - A W||_P / ||c||_P (the paper used 1e-4).
+  double tolerance = 1e-8;
+  // Iterations (sweep pairs) allowed to the iterative solvers.
+  int max_iterations = 5000;
+  // omega of the fixed-coefficient relaxation, in (0, 2).
+  double relaxation_coefficient = 0.5;
+  // Lanczos steps of the adaptive relaxation's spectrum estimate (2 sweeps each).
+  int spectrum_estimation_steps = 12;
+  // The Lanczos estimate of a_max is multiplied by this factor before omega is chosen.
+  double spectrum_safety_factor = 1.05;
+  // A relative residual this many times above the smallest seen means divergence.
+  double divergence_factor = 1e3;
+  // The all-at-once solver refuses systems with more unknowns than this.
+  long max_all_at_once_unknowns = 1'500'000;
+
+  bool IsValid(std::string* error) const;
+};
+
+struct CoupledSolverSummary {
+  CoupledSolverType type = CoupledSolverType::kConjugateGradient;
+  TerminationType termination = TerminationType::kFailure;
+  std::string message = "not run";
+  int iterations = -1;               // sweep pairs of the main iteration
+  long sweeps = -1;                  // every direct or retrograde sweep, estimation included
+  double relative_residual = -1.0;   // final ||c - A W||_P / ||c||_P
+  std::vector<double> residual_history;  // relative residual per iteration
+  double relaxation_coefficient = -1.0;  // omega used by the relaxation solvers
+  double spectrum_min = -1.0;        // estimated a_min of A = I - G (adaptive only)
+  double spectrum_max = -1.0;        // estimated a_max of A = I - G (adaptive only)
+  int safeguard_restarts = 0;        // adaptive only: omega re-chosen after growth
+  double wall_time_s = -1.0;
+
+  bool IsSolutionUsable() const { return termination == TerminationType::kConvergence; }
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+struct CoupledSolution {
+  Matrix displacement;  // U, n x (m + 1) [m]
+  Matrix retrograde;    // W, n x (m + 1) [m]
+  double cost = -1.0;           // e^2(E) [J s]
+  double cost_gradient = 0.0;   // de^2/dE [J s / Pa]
+};
+
+// Solves the coupled problem at the problem's current modulus. initial_retrograde
+// (nullable) is the initial guess W^(0) of the iterative solvers (warm start, e.g.
+// the previous E's solution); it must have the problem's shape. Precondition:
+// options.IsValid(). The solution's fields are meaningful only when the summary
+// says so.
+CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, McreProblem* problem,
+                                  const Matrix* initial_retrograde, CoupledSolution* solution);
+
+}  // namespace mcrewave

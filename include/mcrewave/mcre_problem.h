@@ -1,0 +1,95 @@
+// The time-discrete coupled direct / retrograde MCRE problem for one trial
+// modulus (docs/discrete_mcre.md; formulation.md sections 2 and 3).
+//
+// Fields are stored as n x (m + 1) matrices, column j = time t_j = j h:
+// U (displacement), W (retrograde field, the constitutive gap). The problem owns
+// one ThetaIntegrator, factorised once per modulus (SetModulus), and offers the
+// two sweeps that every coupled solver is built from:
+//
+//   DirectSweep:      W -> U,  (D1, D2) forward with the force F~ - (K + B/alpha) W
+//   RetrogradeSweep:  U -> W,  (R1, R2) backward with the force c_j beta (B U_j - U~_j),
+//                              then W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j
+//
+// and the inner product <x, y>_P in which the reduced operator A = I - G is
+// self-adjoint, the cost e^2 and its derivative de^2/dE.
+#pragma once
+
+#include "mcrewave/bar_model.h"
+#include "mcrewave/measurement.h"
+#include "mcrewave/theta_integrator.h"
+
+namespace mcrewave {
+
+// Dimensionless weights of the data terms (formulation.md section 2):
+//   beta = w_u S E0 / L [N/m],  alpha = w_f L / (S E0) [m/N],
+// so that every term of J is an energy [J] and e^2 is in [J s].
+struct McreWeights {
+  double displacement_weight = 1.0;  // w_u
+  double force_weight = 1.0;         // w_f
+  bool IsValid(std::string* error) const;
+};
+
+class McreProblem {
+ public:
+  // Keeps references to model and data: both must outlive the problem.
+  // reference_modulus is E0 of the weights [Pa]; theta of the time scheme.
+  // Precondition: data.num_steps() >= 1, weights valid, theta in [0, 1].
+  McreProblem(const BarModel& model, const MeasurementSet& data, const McreWeights& weights,
+              double reference_modulus, double theta);
+
+  // Sets the trial modulus E [Pa] and refactorises the integrator (once per E).
+  void SetModulus(double modulus);
+  double modulus() const { return modulus_; }
+
+  int num_nodes() const { return model_.num_nodes(); }
+  int num_steps() const { return data_.num_steps(); }
+  double time_step() const { return data_.time_step; }
+  double theta() const { return theta_; }
+  double alpha() const { return alpha_; }  // force weight [m/N]
+  double beta() const { return beta_; }    // displacement weight [N/m]
+  const BarModel& model() const { return model_; }
+  const MeasurementSet& data() const { return data_; }
+  // A zero field of the problem's shape, n x (m + 1).
+  Matrix ZeroField() const { return Matrix::Zero(num_nodes(), num_steps() + 1); }
+  // Quadrature weight c_j (1/2 at both ends, 1 inside).
+  double QuadratureWeight(int j) const { return (j == 0 || j == num_steps()) ? 0.5 : 1.0; }
+
+  // W -> U. With include_data the force data F~ enter; without, the sweep is the
+  // linear part only. U is resized if needed (outside the time loop).
+  void DirectSweep(const Matrix& retrograde, bool include_data, Matrix* displacement);
+  // U -> W. With include_data the displacement data U~ enter.
+  void RetrogradeSweep(const Matrix& displacement, bool include_data, Matrix* retrograde);
+  // The affine map T(W) = RetrogradeSweep(DirectSweep(W)) with the data: two sweeps.
+  // displacement receives DirectSweep(W).
+  void FixedPointMap(const Matrix& retrograde, Matrix* displacement, Matrix* image);
+  // The linear part: G W = T(W) - T(0); two sweeps. scratch_displacement is work space.
+  void ApplyIterationMap(const Matrix& retrograde, Matrix* scratch_displacement, Matrix* image);
+
+  // <x, y>_P = sum_j c_j h x_j^T (K + B/alpha) y_j.
+  double InnerProduct(const Matrix& x, const Matrix& y);
+  double Norm(const Matrix& x) { return std::sqrt(std::max(0.0, InnerProduct(x, x))); }
+
+  // e^2 = sum_j c_j h [1/2 W^T K W + W^T B W / (2 alpha) + beta/2 |B U - U~|^2]  [J s].
+  double Cost(const Matrix& displacement, const Matrix& retrograde);
+  // de^2/dE = -(1/(2E)) sum_j c_j h W_j^T K (W_j + 2 U_j)  [J s / Pa].
+  double CostGradient(const Matrix& displacement, const Matrix& retrograde);
+
+  // Number of sweeps (direct + retrograde) run since construction.
+  long sweep_count() const { return sweep_count_; }
+
+ private:
+  const BarModel& model_;
+  const MeasurementSet& data_;
+  double theta_;
+  double alpha_;
+  double beta_;
+  double modulus_ = 0.0;
+  ThetaIntegrator integrator_;
+  SymmetricBandMatrix unit_stiffness_;  // K1
+  long sweep_count_ = 0;
+  // Scratch, allocated in the constructor.
+  Vector force_now_, force_next_, omega_previous_, product_;
+  Vector rest_state_;  // zero: the initial state of the direct sweep, the final one of the retrograde
+};
+
+}  // namespace mcrewave

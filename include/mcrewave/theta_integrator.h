@@ -1,0 +1,141 @@
+// The theta-method time integrator of the structural system
+//
+//     M u'' + K u = f(t),
+//
+// written in first-order form x = (v, u), v = u' (second source document,
+// formulation.md section 5):
+//
+//     [M 0] x' = [0 -K] x + [f]        i.e.  Mx x' = A x + b + r.
+//     [0 I]      [I  0]     [0]
+//
+// Scheme, with f_theta the theta-weighted force of the step (the caller's input):
+//
+//     (Mx - h theta A) x_{k+1} = (Mx + h (1 - theta) A) x_k + h (f_theta, 0).
+//
+// The iteration matrix W = Mx - h theta A = [M, h theta K; -h theta I, I] is
+// factorised once in Init through its Schur complement
+//
+//     S = M + h^2 theta^2 K           (symmetric positive definite, banded),
+//
+// so a step is, with the free state formed first and the input added after,
+//
+//     rhs_free = M v_k - h K (u_k + h theta (1 - theta) v_k)      (free state)
+//     S v_{k+1} = rhs_free + h f_theta                              (input)
+//     u_{k+1}   = u_k + h (1 - theta) v_k + h theta v_{k+1}.
+//
+// By linearity v_{k+1} = S^-1 rhs_free + S^-1 h f_theta: the input's effect is
+// added to the free state's right-hand side and both go through one solve.
+// theta = 1/2 is the trapezoidal rule (second order, energy conserving); theta = 1
+// is backward Euler (first order).
+//
+// The same integrator runs the retrograde problem in reversed time
+// tau = T - t: SweepBackward starts from a final state and steps from index m down
+// to 0; the "velocity" it carries is then du/dtau = -du/dt. The integrator knows
+// nothing of MCRE: the caller forms f_theta for each step.
+#pragma once
+
+#include <utility>
+
+#include "mcrewave/band_matrix.h"
+#include "mcrewave/types.h"
+
+namespace mcrewave {
+
+struct ThetaIntegratorOptions {
+  double time_step = 0.36e-6;  // h [s]
+  double theta = 0.5;          // implicitness, in [0, 1]; 1/2 = trapezoidal
+
+  bool IsValid(std::string* error) const;
+};
+
+class ThetaIntegrator {
+ public:
+  // Builds and factorises S = M + h^2 theta^2 K and allocates every scratch vector.
+  // M must be SPD and K symmetric positive semi-definite, both banded. Call again
+  // (re-initialise) whenever K (the modulus), h or theta changes. Throws
+  // std::runtime_error if S is not positive definite.
+  void Init(const SparseMatrix& mass, const SparseMatrix& stiffness,
+            const ThetaIntegratorOptions& options);
+
+  // One step from (v_k, u_k) with the theta-weighted force f_theta of the step.
+  // Writes (v_next, u_next); they must not alias the inputs. No allocation.
+  void Step(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref<const Vector>& u_k,
+            const Eigen::Ref<const Vector>& force_theta, Eigen::Ref<Vector> v_next,
+            Eigen::Ref<Vector> u_next);
+
+  // Runs num_steps steps forward in time from (v0, u0).
+  //   forcing(k, f): writes into f (an Eigen::Ref<Vector> of size n) the force
+  //                  f_theta of the step t_k -> t_{k+1};
+  //   observer(k, v, u): called for k = 0, ..., num_steps with the state at t_k.
+  template <typename Forcing, typename Observer>
+  void SweepForward(int num_steps, const Eigen::Ref<const Vector>& v0,
+                    const Eigen::Ref<const Vector>& u0, Forcing&& forcing, Observer&& observer);
+
+  // Runs num_steps steps backward in time from the final state (v_T, u_T) at
+  // t_m = T, with v = du/dtau = -du/dt.
+  //   forcing(k, f): the force f_theta of the step t_{k+1} -> t_k (k = m-1 .. 0);
+  //   observer(k, v, u): called for k = num_steps, ..., 0.
+  template <typename Forcing, typename Observer>
+  void SweepBackward(int num_steps, const Eigen::Ref<const Vector>& v_final,
+                     const Eigen::Ref<const Vector>& u_final, Forcing&& forcing,
+                     Observer&& observer);
+
+  int size() const { return static_cast<int>(mass_.size()); }
+  const ThetaIntegratorOptions& options() const { return options_; }
+  const SymmetricBandMatrix& mass() const { return mass_; }
+  const SymmetricBandMatrix& stiffness() const { return stiffness_; }
+  // Number of factorisations of the iteration matrix since construction.
+  int factorization_count() const { return factorization_count_; }
+
+ private:
+  template <typename Forcing, typename Observer>
+  void Sweep(int num_steps, int first, int direction, const Eigen::Ref<const Vector>& v_start,
+             const Eigen::Ref<const Vector>& u_start, Forcing&& forcing, Observer&& observer);
+
+  ThetaIntegratorOptions options_;
+  SymmetricBandMatrix mass_;       // M
+  SymmetricBandMatrix stiffness_;  // K
+  BandLdlt iteration_matrix_;      // LDL^T of S = M + h^2 theta^2 K
+  int factorization_count_ = 0;
+  // Scratch, allocated in Init.
+  Vector shifted_displacement_;  // u_k + h theta (1 - theta) v_k
+  Vector force_;                 // f_theta handed to forcing()
+  Vector v_[2], u_[2];           // double buffer of the state
+};
+
+template <typename Forcing, typename Observer>
+void ThetaIntegrator::Sweep(int num_steps, int first, int direction,
+                            const Eigen::Ref<const Vector>& v_start,
+                            const Eigen::Ref<const Vector>& u_start, Forcing&& forcing,
+                            Observer&& observer) {
+  v_[0] = v_start;
+  u_[0] = u_start;
+  int k = first;
+  observer(k, static_cast<const Vector&>(v_[0]), static_cast<const Vector&>(u_[0]));
+  for (int s = 0; s < num_steps; ++s) {
+    const int cur = s & 1, nxt = cur ^ 1;
+    // Forward: step k -> k+1 has index k. Backward: step k -> k-1 has index k-1.
+    forcing(direction > 0 ? k : k - 1, Eigen::Ref<Vector>(force_));
+    Step(v_[cur], u_[cur], force_, v_[nxt], u_[nxt]);
+    k += direction;
+    observer(k, static_cast<const Vector&>(v_[nxt]), static_cast<const Vector&>(u_[nxt]));
+  }
+}
+
+template <typename Forcing, typename Observer>
+void ThetaIntegrator::SweepForward(int num_steps, const Eigen::Ref<const Vector>& v0,
+                                   const Eigen::Ref<const Vector>& u0, Forcing&& forcing,
+                                   Observer&& observer) {
+  Sweep(num_steps, 0, +1, v0, u0, std::forward<Forcing>(forcing),
+        std::forward<Observer>(observer));
+}
+
+template <typename Forcing, typename Observer>
+void ThetaIntegrator::SweepBackward(int num_steps, const Eigen::Ref<const Vector>& v_final,
+                                    const Eigen::Ref<const Vector>& u_final, Forcing&& forcing,
+                                    Observer&& observer) {
+  Sweep(num_steps, num_steps, -1, v_final, u_final, std::forward<Forcing>(forcing),
+        std::forward<Observer>(observer));
+}
+
+}  // namespace mcrewave

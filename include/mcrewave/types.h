@@ -1,0 +1,57 @@
+// Common types of mcrewave: linear algebra aliases, the enums that travel through
+// YAML as names (each with a to/from-string pair, as Ceres' types.h), and the
+// exception that reports bad user input.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <stdexcept>
+#include <string>
+
+namespace mcrewave {
+
+using Vector = Eigen::VectorXd;
+using Matrix = Eigen::MatrixXd;
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+// Bad user input (config, CSV, command-line option). The message names the file,
+// the key or line, and what was expected. Thrown at load time and caught once in
+// identify's main; never used for programmer errors (those are asserts).
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Mass matrix of the bar elements.
+enum class MassType {
+  kConsistent,  // consistent linear-element mass (rho S h_e / 6) [2 1; 1 2]
+  kLumped,      // row-sum lumped mass (rho S h_e / 2) diag(1, 1)
+};
+const char* MassTypeToString(MassType type);
+// Returns false (and leaves *type unchanged) when name is not a MassType name.
+bool StringToMassType(const std::string& name, MassType* type);
+
+// Shape of the shock load applied at x = L.
+enum class LoadKind {
+  kHalfSine,  // F(t) = F0 sin(pi t / t_load) for t <= t_load, 0 after
+};
+const char* LoadKindToString(LoadKind kind);
+bool StringToLoadKind(const std::string& name, LoadKind* kind);
+
+// Where the measurements come from.
+enum class DataSource {
+  kSynthetic,  // simulated on a truth discretisation, then noise is added
+  kCsv,        // read from a measurement CSV file (t,u0,uL,f0,fL)
+};
+const char* DataSourceToString(DataSource source);
+bool StringToDataSource(const std::string& name, DataSource* source);
+
+// The "truth" that synthetic measurements are sampled from.
+enum class TruthModel {
+  kFiniteElement,  // the FE + theta model on a mesh and step refined by truth_refinement
+  kModal,          // the exact solution of the continuous bar (modal superposition)
+};
+const char* TruthModelToString(TruthModel model);
+bool StringToTruthModel(const std::string& name, TruthModel* model);
+
+}  // namespace mcrewave

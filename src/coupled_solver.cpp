@@ -1,0 +1,138 @@
+#include "mcrewave/coupled_solver.h"
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+#include "coupled_solver_internal.h"
+
+namespace mcrewave {
+namespace {
+
+constexpr std::array<std::pair<CoupledSolverType, const char*>, 4> kSolverTypes{{
+    {CoupledSolverType::kAllAtOnce, "all_at_once"},
+    {CoupledSolverType::kRelaxation, "relaxation"},
+    {CoupledSolverType::kAdaptiveRelaxation, "adaptive_relaxation"},
+    {CoupledSolverType::kConjugateGradient, "conjugate_gradient"},
+}};
+
+}  // namespace
+
+const char* CoupledSolverTypeToString(CoupledSolverType type) {
+  for (const auto& [value, name] : kSolverTypes) {
+    if (value == type) return name;
+  }
+  return "unknown";
+}
+
+bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type) {
+  for (const auto& [value, n] : kSolverTypes) {
+    if (name == n) {
+      *type = value;
+      return true;
+    }
+  }
+  return false;
+}
+
+const char* TerminationTypeToString(TerminationType type) {
+  switch (type) {
+    case TerminationType::kConvergence:
+      return "convergence";
+    case TerminationType::kNoConvergence:
+      return "no_convergence";
+    case TerminationType::kDivergence:
+      return "divergence";
+    case TerminationType::kFailure:
+      return "failure";
+  }
+  return "unknown";
+}
+
+bool CoupledSolverOptions::IsValid(std::string* error) const {
+  std::ostringstream why;
+  if (!(tolerance > 0.0 && tolerance < 1.0)) {
+    why << "inner.tolerance must lie in (0, 1), got " << tolerance;
+  } else if (max_iterations < 1) {
+    why << "inner.max_iterations must be at least 1, got " << max_iterations;
+  } else if (!(relaxation_coefficient > 0.0 && relaxation_coefficient < 2.0)) {
+    why << "inner.omega must lie in (0, 2), got " << relaxation_coefficient;
+  } else if (spectrum_estimation_steps < 2) {
+    why << "inner.spectrum_steps must be at least 2, got " << spectrum_estimation_steps;
+  } else if (!(spectrum_safety_factor >= 1.0 && std::isfinite(spectrum_safety_factor))) {
+    why << "inner.spectrum_safety_factor must be at least 1, got " << spectrum_safety_factor;
+  } else if (!(divergence_factor > 1.0)) {
+    why << "inner.divergence_factor must be above 1, got " << divergence_factor;
+  } else if (max_all_at_once_unknowns < 1) {
+    why << "inner.max_all_at_once_unknowns must be positive, got " << max_all_at_once_unknowns;
+  } else {
+    return true;
+  }
+  if (error != nullptr) *error = why.str();
+  return false;
+}
+
+std::string CoupledSolverSummary::BriefReport() const {
+  std::ostringstream out;
+  out << CoupledSolverTypeToString(type) << ": " << TerminationTypeToString(termination) << ", "
+      << iterations << " iterations, " << sweeps << " sweeps, relative residual "
+      << relative_residual << ", " << wall_time_s << " s";
+  return out.str();
+}
+
+std::string CoupledSolverSummary::FullReport() const {
+  std::ostringstream out;
+  out << "Coupled direct/retrograde solve\n"
+      << "  method                 " << CoupledSolverTypeToString(type) << "\n"
+      << "  termination            " << TerminationTypeToString(termination) << "\n"
+      << "  message                " << message << "\n"
+      << "  iterations             " << iterations << "\n"
+      << "  sweeps                 " << sweeps << "\n"
+      << "  relative residual      " << relative_residual << "\n";
+  if (relaxation_coefficient > 0.0) {
+    out << "  relaxation coefficient " << relaxation_coefficient << "\n";
+  }
+  if (spectrum_max > 0.0) {
+    out << "  spectrum of I - G      [" << spectrum_min << ", " << spectrum_max << "]\n"
+        << "  safeguard restarts     " << safeguard_restarts << "\n";
+  }
+  out << "  wall time              " << wall_time_s << " s\n";
+  return out.str();
+}
+
+CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, McreProblem* problem,
+                                  const Matrix* initial_retrograde, CoupledSolution* solution) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  const long sweeps_before = problem->sweep_count();
+  CoupledSolverSummary summary;
+  summary.type = options.type;
+  std::string why;
+  if (!options.IsValid(&why)) {
+    summary.message = "invalid options: " + why;
+    return summary;
+  }
+  switch (options.type) {
+    case CoupledSolverType::kAllAtOnce:
+      internal::SolveAllAtOnce(options, problem, solution, &summary);
+      break;
+    case CoupledSolverType::kRelaxation:
+    case CoupledSolverType::kAdaptiveRelaxation:
+      internal::SolveByRelaxation(options, problem, initial_retrograde, solution, &summary);
+      break;
+    case CoupledSolverType::kConjugateGradient:
+      internal::SolveByConjugateGradient(options, problem, initial_retrograde, solution, &summary);
+      break;
+  }
+  if (summary.IsSolutionUsable()) {
+    solution->cost = problem->Cost(solution->displacement, solution->retrograde);
+    solution->cost_gradient = problem->CostGradient(solution->displacement, solution->retrograde);
+  }
+  summary.sweeps = problem->sweep_count() - sweeps_before;
+  summary.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace mcrewave

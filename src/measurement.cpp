@@ -1,0 +1,177 @@
+#include "mcrewave/measurement.h"
+
+#include <array>
+#include <cassert>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "mcrewave/file_util.h"
+
+namespace mcrewave {
+namespace {
+
+constexpr int kNumColumns = 5;
+constexpr std::array<const char*, kNumColumns> kColumnNames = {"t", "u0", "uL", "f0", "fL"};
+constexpr char kHeader[] = "t,u0,uL,f0,fL";
+// Largest accepted |step - mean step| / mean step.
+constexpr double kStepTolerance = 1e-6;
+
+// `line` without trailing spaces, tabs and carriage returns (Windows line ends).
+std::string StripLineEnd(const std::string& line) {
+  const std::size_t last = line.find_last_not_of(" \t\r");
+  return last == std::string::npos ? "" : line.substr(0, last + 1);
+}
+
+// Parses a whole field (surrounding spaces allowed) as a number with strtod;
+// false when anything else is left over or the field is empty.
+bool ParseNumber(const std::string& field, double* value) {
+  const char* begin = field.c_str();
+  char* end = nullptr;
+  *value = std::strtod(begin, &end);
+  if (end == begin) return false;
+  while (*end == ' ' || *end == '\t') ++end;
+  return *end == '\0';
+}
+
+// Formats "%g" with the default 6 significant digits, for messages.
+std::string Short(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", value);
+  return text;
+}
+
+// The step of t_0 + k h that reproduces every time of the file exactly, searched
+// among the doubles within a few ulps of the mean step; the mean step itself when
+// none does. This makes a file written by WriteMeasurementCsv read back bit for bit.
+double ExactStep(const std::vector<double>& times, double mean_step) {
+  double candidate = mean_step;
+  for (int ulp = 0; ulp < 4; ++ulp) candidate = std::nextafter(candidate, 0.0);
+  for (int trial = 0; trial < 9; ++trial, candidate = std::nextafter(candidate, HUGE_VAL)) {
+    bool reproduces_all = true;
+    for (std::size_t k = 0; k < times.size() && reproduces_all; ++k) {
+      reproduces_all = times[0] + static_cast<double>(k) * candidate == times[k];
+    }
+    if (reproduces_all) return candidate;
+  }
+  return mean_step;
+}
+
+}  // namespace
+
+MeasurementSet ReadMeasurementCsv(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) {
+    throw InputError("cannot read measurement file " + path + ": " + std::strerror(errno));
+  }
+  auto fail = [&path](long line_number, const std::string& what) {
+    throw InputError(path + ":" + std::to_string(line_number) + ": " + what);
+  };
+
+  std::array<std::vector<double>, kNumColumns> columns;
+  std::string line;
+  std::vector<std::string> fields;  // the fields of the current row
+  long line_number = 0;
+  long first_blank_line = 0;  // first empty line seen so far, 0 if none
+  while (std::getline(file, line)) {
+    ++line_number;
+    line = StripLineEnd(line);
+    if (line_number == 1) {
+      if (line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // UTF-8 byte order mark
+      if (line != kHeader) {
+        fail(1, std::string("expected the header '") + kHeader + "', got '" + line + "'");
+      }
+      continue;
+    }
+    if (line.empty()) {
+      if (first_blank_line == 0) first_blank_line = line_number;
+      continue;
+    }
+    if (first_blank_line != 0) fail(first_blank_line, "empty line between data rows");
+
+    fields.clear();
+    for (std::size_t field_start = 0;;) {
+      const std::size_t comma = line.find(',', field_start);
+      fields.push_back(line.substr(field_start, comma - field_start));
+      if (comma == std::string::npos) break;
+      field_start = comma + 1;
+    }
+    if (fields.size() != kNumColumns) {
+      fail(line_number, "expected " + std::to_string(kNumColumns) + " columns, got " +
+                            std::to_string(fields.size()));
+    }
+    std::array<double, kNumColumns> row;
+    for (int column = 0; column < kNumColumns; ++column) {
+      if (!ParseNumber(fields[column], &row[column])) {
+        fail(line_number, std::string("column '") + kColumnNames[column] + "': '" + fields[column] +
+                              "' is not a number");
+      }
+      if (!std::isfinite(row[column])) {
+        fail(line_number, std::string("column '") + kColumnNames[column] + "': '" + fields[column] +
+                              "' is not a finite number");
+      }
+    }
+    if (!columns[0].empty() && !(row[0] > columns[0].back())) {
+      fail(line_number, "time is not strictly increasing (t = " + Short(row[0]) + " s after " +
+                            Short(columns[0].back()) + " s)");
+    }
+    for (int c = 0; c < kNumColumns; ++c) columns[c].push_back(row[c]);
+  }
+  if (file.bad()) {
+    throw InputError("cannot read measurement file " + path + ": " + std::strerror(errno));
+  }
+  if (line_number == 0) {
+    fail(1, std::string("expected the header '") + kHeader + "', got an empty file");
+  }
+
+  const std::vector<double>& times = columns[0];
+  const std::size_t rows = times.size();
+  if (rows < 2) {
+    fail(line_number, "expected at least 2 data rows, got " + std::to_string(rows));
+  }
+  const double mean_step = (times.back() - times.front()) / static_cast<double>(rows - 1);
+  for (std::size_t k = 1; k < rows; ++k) {
+    const double step = times[k] - times[k - 1];
+    if (std::abs(step - mean_step) > kStepTolerance * mean_step) {
+      fail(static_cast<long>(k) + 2, "time step " + Short(step) +
+                                         " s differs from the file's mean step " +
+                                         Short(mean_step) + " s by more than 1e-6 relative");
+    }
+  }
+
+  MeasurementSet measurements;
+  measurements.start_time = times.front();
+  measurements.time_step = ExactStep(times, mean_step);
+  auto to_vector = [](const std::vector<double>& values) {
+    return Vector(
+        Eigen::Map<const Vector>(values.data(), static_cast<Eigen::Index>(values.size())));
+  };
+  measurements.u0 = to_vector(columns[1]);
+  measurements.uL = to_vector(columns[2]);
+  measurements.f0 = to_vector(columns[3]);
+  measurements.fL = to_vector(columns[4]);
+  return measurements;
+}
+
+void WriteMeasurementCsv(const MeasurementSet& measurements, const std::string& path) {
+  const int samples = measurements.num_samples();
+  assert(measurements.uL.size() == samples && measurements.f0.size() == samples &&
+         measurements.fL.size() == samples);
+  std::string content = std::string(kHeader) + "\n";
+  content.reserve(content.size() + static_cast<std::size_t>(samples) * 5 * 25);
+  char row[5 * 32];
+  for (int k = 0; k < samples; ++k) {
+    const int length = std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g,%.17g\n",
+                                     measurements.Time(k), measurements.u0[k], measurements.uL[k],
+                                     measurements.f0[k], measurements.fL[k]);
+    content.append(row, static_cast<std::size_t>(length));
+  }
+  WriteFileAtomically(path, content);
+}
+
+}  // namespace mcrewave

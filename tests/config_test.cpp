@@ -1,0 +1,350 @@
+#include "mcrewave/config.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "mcrewave/types.h"
+
+namespace mcrewave {
+namespace {
+
+// Every key of the two configs is equal (NaN never occurs in a valid config).
+void ExpectSameConfig(const Config& expected, const Config& actual) {
+  EXPECT_EQ(expected.model.length, actual.model.length);
+  EXPECT_EQ(expected.model.section, actual.model.section);
+  EXPECT_EQ(expected.model.density, actual.model.density);
+  EXPECT_EQ(expected.model.modulus, actual.model.modulus);
+  EXPECT_EQ(expected.model.elements, actual.model.elements);
+  EXPECT_EQ(expected.model.mass, actual.model.mass);
+  EXPECT_EQ(expected.load.kind, actual.load.kind);
+  EXPECT_EQ(expected.load.amplitude, actual.load.amplitude);
+  EXPECT_EQ(expected.load.duration, actual.load.duration);
+  EXPECT_EQ(expected.time.window, actual.time.window);
+  EXPECT_EQ(expected.time.step, actual.time.step);
+  EXPECT_EQ(expected.time.theta, actual.time.theta);
+  EXPECT_EQ(expected.data.source, actual.data.source);
+  EXPECT_EQ(expected.data.path, actual.data.path);
+  EXPECT_EQ(expected.data.truth, actual.data.truth);
+  EXPECT_EQ(expected.data.truth_refinement, actual.data.truth_refinement);
+  EXPECT_EQ(expected.data.snr, actual.data.snr);
+  EXPECT_EQ(expected.data.seed, actual.data.seed);
+}
+
+// Runs `action`, which must throw InputError whose message contains every one of
+// `fragments`.
+void ExpectInputError(const std::function<void()>& action,
+                      const std::vector<std::string>& fragments) {
+  try {
+    action();
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    for (const std::string& fragment : fragments) {
+      EXPECT_NE(message.find(fragment), std::string::npos)
+          << "message: " << message << "\nlacks: " << fragment;
+    }
+    return;
+  }
+  ADD_FAILURE() << "no InputError thrown";
+}
+
+// Writes config files into a fresh directory of its own.
+class ConfigFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    directory_ =
+        std::filesystem::path(::testing::TempDir()) /
+        ("mcrewave_config_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(directory_);
+    std::filesystem::create_directories(directory_);
+  }
+  void TearDown() override { std::filesystem::remove_all(directory_); }
+
+  // Writes `content` to `name` in the test directory; returns its path.
+  std::string WriteFile(const std::string& name, const std::string& content) const {
+    const std::string path = (directory_ / name).string();
+    std::ofstream(path, std::ios::binary) << content;
+    return path;
+  }
+
+  // Writes `content` as config.yaml and expects LoadConfig to throw an InputError
+  // whose message names the file, `line` and every one of `fragments`.
+  void ExpectLoadError(const std::string& content, int line,
+                       std::vector<std::string> fragments) const {
+    const std::string path = WriteFile("config.yaml", content);
+    fragments.push_back(path + ":" + std::to_string(line) + ": ");
+    ExpectInputError([&path] { LoadConfig(path); }, fragments);
+  }
+
+  std::filesystem::path directory_;
+};
+
+TEST(ConfigTest, DefaultOptionsAreValid) {
+  const Config config;
+  std::string error;
+  EXPECT_TRUE(config.model.IsValid(&error)) << error;
+  EXPECT_TRUE(config.load.IsValid(&error)) << error;
+  EXPECT_TRUE(config.time.IsValid(&error)) << error;
+  EXPECT_TRUE(config.data.IsValid(&error)) << error;
+  EXPECT_EQ(config.time.NumSteps(), 1750);
+}
+
+TEST(ConfigTest, DefaultConfigYamlParsesToTheDefaultConfig) {
+  const std::string yaml = DefaultConfigYaml();
+  ExpectSameConfig(Config{}, ParseConfig(yaml, "default.yaml"));
+  for (const char* line : {"model:", "load:", "time:", "data:", "  length: 1", "# [m] ",
+                           "  snr: .inf", "  density: 800", "(consistent | lumped)"}) {
+    EXPECT_NE(yaml.find(line), std::string::npos) << yaml << "\nlacks " << line;
+  }
+}
+
+TEST(ConfigTest, DefaultConfigYamlCommentsEveryKey) {
+  const std::string yaml = DefaultConfigYaml();
+  int keys = 0;
+  std::size_t begin = 0;
+  while (begin < yaml.size()) {
+    const std::size_t end = yaml.find('\n', begin);
+    const std::string line = yaml.substr(begin, end - begin);
+    begin = end + 1;
+    if (line.rfind("  ", 0) != 0) continue;  // comments and section lines
+    ++keys;
+    EXPECT_NE(line.find(" # "), std::string::npos) << line;
+  }
+  EXPECT_GE(keys, 18);
+}
+
+TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
+  Config config;
+  config.model.length = 0.1 + 0.2;
+  config.model.section = 1.0 / 3.0 * 1e-4;
+  config.model.density = 7850.000000000001;
+  config.model.modulus = 2.1e11;
+  config.model.elements = 437;
+  config.model.mass = MassType::kLumped;
+  config.load.amplitude = -12.5;
+  config.load.duration = 2.0 / 3.0 * 1e-4;
+  config.time.window = 1e-3;
+  config.time.step = 1e-6;
+  config.time.theta = 0.6;
+  config.data.source = DataSource::kCsv;
+  config.data.path = "dir with spaces/quote\"s and \\ back: # x.csv";
+  config.data.truth = TruthModel::kModal;
+  config.data.truth_refinement = 64;
+  config.data.snr = 2.5;
+  config.data.seed = std::numeric_limits<std::uint64_t>::max();
+  const std::string yaml = ConfigToYaml(config);
+  ExpectSameConfig(config, ParseConfig(yaml, "resolved.yaml"));
+  EXPECT_NE(yaml.find("mass: lumped"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("truth: modal"), std::string::npos) << yaml;
+
+  config.data.snr = std::numeric_limits<double>::infinity();
+  const std::string infinite_snr = ConfigToYaml(config);
+  EXPECT_NE(infinite_snr.find("snr: .inf"), std::string::npos) << infinite_snr;
+  ExpectSameConfig(config, ParseConfig(infinite_snr, "resolved.yaml"));
+}
+
+TEST(ConfigTest, PaperBarConfigLoads) {
+  const std::string path = std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar.yaml";
+  const Config config = LoadConfig(path);
+  Config expected;
+  expected.data.snr = 2.5;
+  ExpectSameConfig(expected, config);
+  EXPECT_EQ(config.source_path, path);
+  EXPECT_EQ(config.time.NumSteps(), 1750);
+}
+
+TEST(ConfigTest, EmptyTextAndEmptySectionsGiveDefaults) {
+  ExpectSameConfig(Config{}, ParseConfig("", "empty.yaml"));
+  ExpectSameConfig(Config{}, ParseConfig("model:\ndata:\n", "sections.yaml"));
+}
+
+TEST(ConfigTest, InfiniteSnrIsAccepted) {
+  EXPECT_EQ(ParseConfig("data:\n  snr: .inf\n", "a.yaml").data.snr,
+            std::numeric_limits<double>::infinity());
+}
+
+TEST(ConfigTest, OverridesApplyAfterTheFile) {
+  const Config config = ParseConfig("model:\n  elements: 50\n", "a.yaml",
+                                    {"model.elements=200", "model.mass=lumped", "data.snr=.inf",
+                                     "data.seed=42", "time.theta=1", "data.path=run/m.csv"});
+  EXPECT_EQ(config.model.elements, 200);
+  EXPECT_EQ(config.model.mass, MassType::kLumped);
+  EXPECT_EQ(config.data.snr, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(config.data.seed, 42u);
+  EXPECT_EQ(config.time.theta, 1.0);
+  EXPECT_EQ(config.data.path, "run/m.csv");
+}
+
+TEST(ConfigTest, OverrideWithWrongTypeNamesTheOverride) {
+  ExpectInputError([] { ParseConfig("", "a.yaml", {"model.elements=abc"}); },
+                   {"--set model.elements=abc: expected a positive integer, got 'abc'"});
+  ExpectInputError([] { ParseConfig("", "a.yaml", {"model.length=abc"}); },
+                   {"--set model.length=abc: expected a number (in m), got 'abc'"});
+  ExpectInputError([] { ParseConfig("", "a.yaml", {"model.length="}); },
+                   {"--set model.length=: expected a number (in m), got nothing"});
+}
+
+TEST(ConfigTest, OverrideOutOfRangeNamesTheOverride) {
+  ExpectInputError([] { ParseConfig("time:\n  theta: 0.5\n", "a.yaml", {"time.theta=2"}); },
+                   {"--set time.theta=2: ", "time.theta"});
+}
+
+TEST(ConfigTest, OverrideWithoutEqualsSignIsRejected) {
+  ExpectInputError([] { ParseConfig("", "a.yaml", {"model.elements"}); },
+                   {"--set model.elements: ", "key.path=value"});
+}
+
+TEST(ConfigTest, OverrideOfUnknownKeySuggestsTheNearestKey) {
+  ExpectInputError([] { ParseConfig("", "a.yaml", {"model.lenght=2"}); },
+                   {"--set model.lenght=2: unknown key 'model.lenght'; did you mean "
+                    "'model.length'?"});
+}
+
+TEST(ConfigTest, ParseConfigNamesTheGivenName) {
+  ExpectInputError([] { ParseConfig("model:\n  length: abc\n", "my.yaml"); },
+                   {"my.yaml:2: model.length: expected a number (in m), got 'abc'"});
+}
+
+TEST_F(ConfigFileTest, RelativeDataPathIsResolvedAgainstTheConfigFolder) {
+  WriteFile("measured.csv", "t,u0,uL,f0,fL\n");
+  const std::string text = "data:\n  source: csv\n  path: measured.csv\n";
+  const Config config = LoadConfig(WriteFile("config.yaml", text));
+  EXPECT_EQ(config.data.path, (directory_ / "measured.csv").string());
+  EXPECT_EQ(ParseConfig(text, "config.yaml").data.path, "measured.csv");
+}
+
+TEST_F(ConfigFileTest, AbsoluteDataPathIsKept) {
+  const std::string csv = WriteFile("measured.csv", "t,u0,uL,f0,fL\n");
+  const Config config =
+      LoadConfig(WriteFile("config.yaml", "data:\n  source: csv\n  path: " + csv + "\n"));
+  EXPECT_EQ(config.data.path, csv);
+}
+
+TEST_F(ConfigFileTest, MissingConfigFile) {
+  const std::string path = (directory_ / "absent.yaml").string();
+  ExpectInputError([&path] { LoadConfig(path); },
+                   {"cannot read config file " + path + ": No such file or directory"});
+}
+
+TEST_F(ConfigFileTest, UnknownKeySuggestsTheNearestKey) {
+  ExpectLoadError("model:\n  lenght: 2\n", 2,
+                  {"unknown key 'model.lenght'; did you mean 'model.length'?"});
+}
+
+TEST_F(ConfigFileTest, UnknownSectionSuggestsTheNearestSection) {
+  ExpectLoadError("model:\n  length: 2\nmodle:\n  length: 1\n", 3,
+                  {"unknown section 'modle'; did you mean 'model'?"});
+}
+
+TEST_F(ConfigFileTest, StringGivenForNumber) {
+  ExpectLoadError("model:\n  length: abc\n", 2,
+                  {"model.length: expected a number (in m), got 'abc'"});
+}
+
+TEST_F(ConfigFileTest, ListGivenForNumber) {
+  ExpectLoadError("load:\n  amplitude: [1, 2]\n", 2,
+                  {"load.amplitude: expected a number (in N), got a list"});
+}
+
+TEST_F(ConfigFileTest, FractionGivenForInteger) {
+  ExpectLoadError("model:\n  elements: 1.5\n", 2,
+                  {"model.elements: expected a positive integer, got '1.5'"});
+}
+
+TEST_F(ConfigFileTest, NegativeLength) {
+  ExpectLoadError("model:\n  section: 1e-4\n  length: -1\n", 3,
+                  {"model.length must be a finite positive number, got -1"});
+}
+
+TEST_F(ConfigFileTest, ZeroElements) {
+  ExpectLoadError("model:\n  elements: 0\n", 2,
+                  {"model.elements: expected a positive integer, got '0'"});
+}
+
+TEST_F(ConfigFileTest, ThetaOutOfRange) {
+  ExpectLoadError("time:\n  theta: 1.5\n", 2, {"time.theta must lie in [0, 1], got 1.5"});
+}
+
+TEST_F(ConfigFileTest, StepNotDividingWindow) {
+  ExpectLoadError("time:\n  window: 1e-3\n  step: 0.3e-3\n", 2,
+                  {"time.window", "time.step", "whole number"});
+}
+
+TEST_F(ConfigFileTest, ZeroSnr) {
+  ExpectLoadError("data:\n  snr: 0\n", 2, {"data.snr must be positive"});
+}
+
+TEST_F(ConfigFileTest, NanSnr) {
+  ExpectLoadError("data:\n  snr: .nan\n", 2, {"data.snr: expected a number, got '.nan'"});
+}
+
+TEST_F(ConfigFileTest, NanLength) {
+  ExpectLoadError("model:\n  length: .NaN\n", 2, {"model.length: expected a number (in m)"});
+}
+
+TEST_F(ConfigFileTest, UnknownEnumNameListsTheNames) {
+  ExpectLoadError("model:\n  mass: diagonal\n", 2,
+                  {"model.mass: expected one of 'consistent', 'lumped', got 'diagonal'"});
+}
+
+TEST_F(ConfigFileTest, NegativeSeed) {
+  ExpectLoadError("data:\n  seed: -1\n", 2, {"data.seed: expected an integer", "got '-1'"});
+}
+
+TEST_F(ConfigFileTest, TruthRefinementOutOfRange) {
+  ExpectLoadError("data:\n  truth_refinement: 65\n", 2,
+                  {"data.truth_refinement must be an integer in [1, 64], got 65"});
+}
+
+TEST_F(ConfigFileTest, CsvSourceWithoutPath) {
+  ExpectLoadError("data:\n  source: csv\n", 2, {"data.path must name a measurement CSV file"});
+}
+
+TEST_F(ConfigFileTest, CsvPathToMissingFile) {
+  ExpectLoadError(
+      "data:\n  source: csv\n  path: missing.csv\n", 3,
+      {"data.path: cannot read measurement file '" + (directory_ / "missing.csv").string() + "'",
+       "No such file or directory"});
+}
+
+TEST_F(ConfigFileTest, CsvPathOverrideToMissingFileNamesTheOverride) {
+  const std::string path = WriteFile("config.yaml", "data:\n  source: csv\n  path: a.csv\n");
+  ExpectInputError([&path] { LoadConfig(path, {"data.path=/nonexistent/b.csv"}); },
+                   {"--set data.path=/nonexistent/b.csv: data.path: cannot read measurement "
+                    "file '/nonexistent/b.csv'"});
+}
+
+TEST_F(ConfigFileTest, MalformedYaml) {
+  ExpectLoadError("model:\n  length: 1\n  section: [1, 2\nload:\n", 4, {"malformed YAML"});
+}
+
+TEST_F(ConfigFileTest, SectionThatIsNotAMap) {
+  ExpectLoadError("data:\n  seed: 3\nmodel: 3\n", 3,
+                  {"model: expected a map of keys (length, section", "got '3'"});
+}
+
+TEST_F(ConfigFileTest, TopLevelThatIsNotAMap) {
+  ExpectLoadError("- model\n- load\n", 1,
+                  {"expected a map of sections (model, load, time, data)", "got a list"});
+}
+
+TEST_F(ConfigFileTest, DuplicateKey) {
+  ExpectLoadError("model:\n  length: 1\n  length: 2\n", 3,
+                  {"duplicate key 'model.length' (first given on line 2)"});
+}
+
+TEST_F(ConfigFileTest, DuplicateSection) {
+  ExpectLoadError("model:\n  length: 1\nmodel:\n  elements: 2\n", 3,
+                  {"duplicate section 'model' (first given on line 1)"});
+}
+
+}  // namespace
+}  // namespace mcrewave

@@ -1,0 +1,122 @@
+// End-to-end tests of the identify binary: it is run as a user runs it.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "mcrewave/measurement.h"
+
+namespace mcrewave {
+namespace {
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+RunResult RunIdentify(const std::string& arguments) {
+  const std::string command = std::string(MCREWAVE_IDENTIFY_BINARY) + " " + arguments + " 2>&1";
+  RunResult result;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return result;
+  char buffer[4096];
+  while (fgets(buffer, sizeof buffer, pipe) != nullptr) result.output += buffer;
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+std::string SourcePath(const std::string& relative) {
+  return std::string(MCREWAVE_SOURCE_DIR) + "/" + relative;
+}
+
+std::string FreshDirectory(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+TEST(IdentifyTest, HelpAndVersion) {
+  const RunResult help = RunIdentify("--help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.output.find("simulate"), std::string::npos) << help.output;
+  const RunResult version = RunIdentify("--version");
+  EXPECT_EQ(version.exit_code, 0);
+  EXPECT_NE(version.output.find("mcrewave"), std::string::npos) << version.output;
+}
+
+TEST(IdentifyTest, PrintsADefaultConfigThatSimulateAccepts) {
+  const std::string dir = FreshDirectory("identify_default_config");
+  const RunResult printed = RunIdentify("--print-default-config > " + dir + "/default.yaml");
+  ASSERT_EQ(printed.exit_code, 0) << printed.output;
+  const RunResult simulated =
+      RunIdentify("simulate " + dir + "/default.yaml --set time.window=0.036e-3 -o " + dir +
+                  "/out.csv");
+  EXPECT_EQ(simulated.exit_code, 0) << simulated.output;
+  EXPECT_EQ(ReadMeasurementCsv(dir + "/out.csv").num_samples(), 101);
+}
+
+TEST(IdentifyTest, SimulateWritesTheMeasurementSetOfThePaperCase) {
+  const std::string dir = FreshDirectory("identify_simulate");
+  const std::string csv = dir + "/paper.csv";
+  const RunResult run = RunIdentify("simulate " + SourcePath("configs/paper_bar.yaml") +
+                                    " --set data.truth_refinement=1 --output " + csv);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const MeasurementSet measurements = ReadMeasurementCsv(csv);
+  EXPECT_EQ(measurements.num_samples(), 1751);
+  EXPECT_NEAR(measurements.time_step, 0.36e-6, 1e-15);
+  // The load is a half sine of 1 kN for 0.1 ms, with noise at SNR 2.5 on top: its
+  // peak sample is within a few noise levels of 1 kN.
+  EXPECT_GT(measurements.fL.maxCoeff(), 900.0);
+  EXPECT_LT(measurements.fL.maxCoeff(), 2500.0);
+  // Nothing but the result is left in the folder (no temporary file).
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    EXPECT_EQ(entry.path().filename(), "paper.csv");
+    ++files;
+  }
+  EXPECT_EQ(files, 1);
+  // The same config and seed give the same file.
+  const std::string again = dir + "/again.csv";
+  ASSERT_EQ(RunIdentify("simulate " + SourcePath("configs/paper_bar.yaml") +
+                        " --set data.truth_refinement=1 --output " + again)
+                .exit_code,
+            0);
+  EXPECT_EQ(ReadMeasurementCsv(again).uL, measurements.uL);
+}
+
+TEST(IdentifyTest, BadConfigFailsWithOneLineNamingFileLineAndKeyAndWritesNothing) {
+  const std::string dir = FreshDirectory("identify_bad_config");
+  const std::string config = dir + "/bad.yaml";
+  std::ofstream(config) << "model:\n  elements: 100\n  lenght: 2\n";
+  const RunResult run = RunIdentify("simulate " + config + " -o " + dir + "/out.csv");
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.output.find(config + ":3"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("model.length"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out.csv"));
+}
+
+TEST(IdentifyTest, BadOverrideAndMissingConfigAreRefused) {
+  const RunResult override_run = RunIdentify("simulate " + SourcePath("configs/paper_bar.yaml") +
+                                             " --set time.theta=2 -o /tmp/never.csv");
+  EXPECT_EQ(override_run.exit_code, 2);
+  EXPECT_NE(override_run.output.find("time.theta"), std::string::npos) << override_run.output;
+  const RunResult missing = RunIdentify("simulate /nonexistent/config.yaml -o /tmp/never.csv");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.output.find("/nonexistent/config.yaml"), std::string::npos);
+}
+
+TEST(IdentifyTest, UnwritableOutputIsReportedNotCrashed) {
+  const RunResult run = RunIdentify("simulate " + SourcePath("configs/paper_bar.yaml") +
+                                    " --set data.truth_refinement=1 -o /nonexistent/dir/out.csv");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.output.find("cannot write /nonexistent/dir/out.csv"), std::string::npos)
+      << run.output;
+}
+
+}  // namespace
+}  // namespace mcrewave

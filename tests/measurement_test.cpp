@@ -1,0 +1,186 @@
+#include "mcrewave/measurement.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "mcrewave/types.h"
+
+namespace mcrewave {
+namespace {
+
+// Writes measurement files into a fresh directory of its own.
+class MeasurementTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    directory_ =
+        std::filesystem::path(::testing::TempDir()) /
+        ("mcrewave_measurement_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(directory_);
+    std::filesystem::create_directories(directory_);
+  }
+  void TearDown() override { std::filesystem::remove_all(directory_); }
+
+  std::string PathOf(const std::string& name) const { return (directory_ / name).string(); }
+
+  // Writes `content` byte for byte to `name`; returns its path.
+  std::string WriteFile(const std::string& name, const std::string& content) const {
+    const std::string path = PathOf(name);
+    std::ofstream(path, std::ios::binary) << content;
+    return path;
+  }
+
+  // Writes `content` as data.csv and expects ReadMeasurementCsv to throw an
+  // InputError whose message starts with "<path>:<line>: " and contains `what`.
+  void ExpectReadError(const std::string& content, int line, const std::string& what) const {
+    const std::string path = WriteFile("data.csv", content);
+    try {
+      ReadMeasurementCsv(path);
+      ADD_FAILURE() << "no InputError thrown for:\n" << content;
+    } catch (const InputError& error) {
+      const std::string message = error.what();
+      EXPECT_EQ(message.rfind(path + ":" + std::to_string(line) + ": ", 0), 0u) << message;
+      EXPECT_NE(message.find(what), std::string::npos) << message << "\nlacks: " << what;
+    }
+  }
+
+  std::filesystem::path directory_;
+};
+
+// A set whose values exercise full precision: irrational-looking, tiny, huge, signed.
+MeasurementSet MakeSet(int samples, double start_time, double time_step) {
+  MeasurementSet set;
+  set.start_time = start_time;
+  set.time_step = time_step;
+  set.u0.resize(samples);
+  set.uL.resize(samples);
+  set.f0.resize(samples);
+  set.fL.resize(samples);
+  for (int k = 0; k < samples; ++k) {
+    set.u0[k] = std::sin(0.1 * k) * 1e-7 / 3.0;
+    set.uL[k] = -std::exp(-0.01 * k) * 1e-300;
+    set.f0[k] = std::cos(0.37 * k) * 1e3 + 1e-9;
+    set.fL[k] = (k % 7) * 123456789.123456789 - 1.0 / (k + 1.0);
+  }
+  return set;
+}
+
+void ExpectBitwiseEqual(const Vector& expected, const Vector& actual) {
+  ASSERT_EQ(expected.size(), actual.size());
+  for (Eigen::Index k = 0; k < expected.size(); ++k) {
+    ASSERT_EQ(expected[k], actual[k]) << "entry " << k;
+  }
+}
+
+TEST_F(MeasurementTest, WriteThenReadIsExact) {
+  for (const auto& [start_time, time_step] :
+       std::vector<std::pair<double, double>>{{0.0, 0.36e-6}, {1.25e-3, 1.0 / 3.0 * 1e-6}}) {
+    const MeasurementSet written = MakeSet(1751, start_time, time_step);
+    const std::string path = PathOf("round_trip.csv");
+    WriteMeasurementCsv(written, path);
+    const MeasurementSet read = ReadMeasurementCsv(path);
+    EXPECT_EQ(read.start_time, written.start_time);
+    EXPECT_EQ(read.time_step, written.time_step);
+    ExpectBitwiseEqual(written.u0, read.u0);
+    ExpectBitwiseEqual(written.uL, read.uL);
+    ExpectBitwiseEqual(written.f0, read.f0);
+    ExpectBitwiseEqual(written.fL, read.fL);
+  }
+}
+
+TEST_F(MeasurementTest, WrittenFileStartsWithTheHeader) {
+  const std::string path = PathOf("header.csv");
+  WriteMeasurementCsv(MakeSet(3, 0.0, 1e-6), path);
+  std::ifstream file(path);
+  std::string first_line;
+  std::getline(file, first_line);
+  EXPECT_EQ(first_line, "t,u0,uL,f0,fL");
+}
+
+TEST_F(MeasurementTest, WindowsLineEndsByteOrderMarkAndSpacesAreAccepted) {
+  const std::string path = WriteFile(
+      "windows.csv",
+      "\xEF\xBB\xBFt,u0,uL,f0,fL \r\n0, 1,2 ,3,4\r\n1e-6,5,6,7,8\r\n2e-6,9,10,11,12\r\n\r\n\r\n");
+  const MeasurementSet set = ReadMeasurementCsv(path);
+  ASSERT_EQ(set.num_samples(), 3);
+  EXPECT_EQ(set.start_time, 0.0);
+  EXPECT_DOUBLE_EQ(set.time_step, 1e-6);
+  EXPECT_EQ(set.u0[0], 1.0);
+  EXPECT_EQ(set.uL[0], 2.0);
+  EXPECT_EQ(set.f0[2], 11.0);
+  EXPECT_EQ(set.fL[2], 12.0);
+}
+
+TEST_F(MeasurementTest, BadHeader) {
+  ExpectReadError("time,u\n0,1,2,3,4\n1,1,2,3,4\n", 1,
+                  "expected the header 't,u0,uL,f0,fL', got 'time,u'");
+}
+
+TEST_F(MeasurementTest, EmptyFile) {
+  ExpectReadError("", 1, "expected the header 't,u0,uL,f0,fL', got an empty file");
+}
+
+TEST_F(MeasurementTest, WrongColumnCount) {
+  ExpectReadError("t,u0,uL,f0,fL\n0,1,2,3,4\n1,1,2,3\n", 3, "expected 5 columns, got 4");
+  ExpectReadError("t,u0,uL,f0,fL\n0,1,2,3,4\n1,1,2,3,4,5\n", 3, "expected 5 columns, got 6");
+}
+
+TEST_F(MeasurementTest, NonNumber) {
+  ExpectReadError("t,u0,uL,f0,fL\n0,1,2,3,4\n1,1,2x,3,4\n", 3, "column 'uL': '2x' is not a number");
+  ExpectReadError("t,u0,uL,f0,fL\n0,1,,3,4\n1,1,2,3,4\n", 2, "column 'uL': '' is not a number");
+}
+
+TEST_F(MeasurementTest, NanValue) {
+  ExpectReadError("t,u0,uL,f0,fL\n0,1,2,3,4\n1,1,2,nan,4\n", 3,
+                  "column 'f0': 'nan' is not a finite number");
+}
+
+TEST_F(MeasurementTest, InfiniteValue) {
+  ExpectReadError("t,u0,uL,f0,fL\n0,1,2,3,4\n1,1,2,3,-inf\n", 3,
+                  "column 'fL': '-inf' is not a finite number");
+  ExpectReadError("t,u0,uL,f0,fL\n0,1e999,2,3,4\n1,1,2,3,4\n", 2,
+                  "column 'u0': '1e999' is not a finite number");
+}
+
+TEST_F(MeasurementTest, TimeNotIncreasing) {
+  ExpectReadError("t,u0,uL,f0,fL\n0,1,2,3,4\n1,1,2,3,4\n2,1,2,3,4\n2,1,2,3,4\n", 5,
+                  "time is not strictly increasing");
+}
+
+TEST_F(MeasurementTest, NonUniformTime) {
+  ExpectReadError("t,u0,uL,f0,fL\n0,1,2,3,4\n1,1,2,3,4\n2,1,2,3,4\n3.5,1,2,3,4\n", 3,
+                  "time step 1 s differs from the file's mean step 1.16667 s by more than 1e-6 "
+                  "relative");
+}
+
+TEST_F(MeasurementTest, OnlyOneRow) {
+  ExpectReadError("t,u0,uL,f0,fL\n0,1,2,3,4\n", 2, "expected at least 2 data rows, got 1");
+}
+
+TEST_F(MeasurementTest, HeaderOnly) {
+  ExpectReadError("t,u0,uL,f0,fL\n", 1, "expected at least 2 data rows, got 0");
+}
+
+TEST_F(MeasurementTest, EmptyLineBetweenRows) {
+  ExpectReadError("t,u0,uL,f0,fL\n0,1,2,3,4\n\n1,1,2,3,4\n", 3, "empty line");
+}
+
+TEST_F(MeasurementTest, MissingFile) {
+  const std::string path = PathOf("absent.csv");
+  try {
+    ReadMeasurementCsv(path);
+    ADD_FAILURE() << "no InputError thrown";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "cannot read measurement file " + path + ": No such file or directory");
+  }
+}
+
+}  // namespace
+}  // namespace mcrewave

@@ -1,0 +1,60 @@
+// Small MCRE problems shared by the tests of the coupled solvers.
+#pragma once
+
+#include <memory>
+
+#include "mcrewave/bar_model.h"
+#include "mcrewave/mcre_problem.h"
+#include "mcrewave/simulation.h"
+
+namespace mcrewave::testing {
+
+// A bar with `elements` elements and a time grid of `steps` steps of the
+// paper's Courant number c h / h_e = 0.57, the window scaled accordingly.
+struct SmallCase {
+  BarProperties bar;
+  LoadOptions load;
+  TimeOptions time;
+  DataOptions data;
+};
+
+inline SmallCase MakeSmallCase(int elements, int steps, double snr, int truth_refinement) {
+  SmallCase c;
+  c.bar.elements = elements;
+  c.time.step = 0.36e-6 * 100.0 / elements;
+  c.time.window = c.time.step * steps;
+  c.load.duration = 0.1e-3 * c.time.window / 0.63e-3;
+  c.data.snr = snr;
+  c.data.seed = 7;
+  c.data.truth_refinement = truth_refinement;
+  return c;
+}
+
+// Owns the model, the data and the problem built on them.
+struct ProblemBundle {
+  ProblemBundle(const SmallCase& c, const McreWeights& weights, double theta = 0.5)
+      : model(c.bar),
+        data(MakeSyntheticMeasurements(c.bar, c.load, [&] {
+               TimeOptions t = c.time;
+               t.theta = theta;
+               return t;
+             }(), c.data)),
+        problem(model, data, weights, c.bar.modulus, theta) {}
+  BarModel model;
+  MeasurementSet data;
+  McreProblem problem;
+};
+
+inline McreWeights Weights(double w_u, double w_f) {
+  McreWeights weights;
+  weights.displacement_weight = w_u;
+  weights.force_weight = w_f;
+  return weights;
+}
+
+// ||a - b|| / ||b|| (Frobenius).
+inline double RelativeDifference(const Matrix& a, const Matrix& b) {
+  return (a - b).norm() / b.norm();
+}
+
+}  // namespace mcrewave::testing
