@@ -66,6 +66,32 @@ void SymmetricBandMatrix::MultiplyAdd(double alpha, const Eigen::Ref<const Vecto
   }
 }
 
+void SymmetricBandMatrix::MultiplyPairAdd(const SymmetricBandMatrix& a,
+                                          const Eigen::Ref<const Vector>& x, double beta,
+                                          const SymmetricBandMatrix& b,
+                                          const Eigen::Ref<const Vector>& z, double gamma,
+                                          const Eigen::Ref<const Vector>& f,
+                                          Eigen::Ref<Vector> y) {
+  const int n = a.size();
+  assert(b.size() == n && x.size() == n && z.size() == n && f.size() == n && y.size() == n);
+  if (a.half_bandwidth() == 1 && b.half_bandwidth() == 1) {
+    // Tridiagonal fast path, both products in one pass:
+    //   y_i = sum_{j=i-1..i+1} (A_ij x_j + beta B_ij z_j) + gamma f_i.
+    const double* da = a.lower_.data();
+    const double* db = b.lower_.data();
+    for (int i = 0; i < n; ++i) {
+      double s = da[2 * i] * x[i] + beta * db[2 * i] * z[i];
+      if (i > 0) s += da[2 * i + 1] * x[i - 1] + beta * db[2 * i + 1] * z[i - 1];
+      if (i + 1 < n) s += da[2 * i + 3] * x[i + 1] + beta * db[2 * i + 3] * z[i + 1];
+      y[i] = s + gamma * f[i];
+    }
+    return;
+  }
+  a.Multiply(x, y);
+  b.MultiplyAdd(beta, z, y);
+  y += gamma * f;
+}
+
 bool BandLdlt::Compute(const SymmetricBandMatrix& matrix) {
   const int n = matrix.size();
   const int p = matrix.half_bandwidth();
@@ -91,6 +117,7 @@ bool BandLdlt::Compute(const SymmetricBandMatrix& matrix) {
       unit_lower_.lower(i - j, i) = lij / dj;
     }
   }
+  inverse_diagonal_ = diagonal_.cwiseInverse();
   ok_ = true;
   return true;
 }
@@ -99,13 +126,31 @@ void BandLdlt::SolveInPlace(Eigen::Ref<Vector> x) const {
   assert(ok_ && x.size() == size());
   const int n = size();
   const int p = unit_lower_.half_bandwidth();
+  if (p == 1) {
+    // Tridiagonal fast path (Thomas algorithm on the LDL^T factors):
+    //   y_i = b_i - l_i y_{i-1},  z_i = y_i / D_i,  x_i = z_i - l_{i+1} x_{i+1}.
+    const double* l = unit_lower_.lower_data();  // l_i = L(i, i-1) at l[2 i + 1]
+    const double* inverse_d = inverse_diagonal_.data();
+    double previous = x[0];
+    for (int i = 1; i < n; ++i) {
+      previous = x[i] - l[2 * i + 1] * previous;
+      x[i] = previous;
+    }
+    double next = x[n - 1] * inverse_d[n - 1];
+    x[n - 1] = next;
+    for (int i = n - 2; i >= 0; --i) {
+      next = x[i] * inverse_d[i] - l[2 * (i + 1) + 1] * next;
+      x[i] = next;
+    }
+    return;
+  }
   // L y = b (forward), z = D^-1 y, L^T x = z (backward).
   for (int i = 1; i < n; ++i) {
     double s = x[i];
     for (int k = std::max(0, i - p); k < i; ++k) s -= unit_lower_.lower(i - k, i) * x[k];
     x[i] = s;
   }
-  for (int i = 0; i < n; ++i) x[i] /= diagonal_[i];
+  for (int i = 0; i < n; ++i) x[i] *= inverse_diagonal_[i];
   for (int i = n - 2; i >= 0; --i) {
     double s = x[i];
     for (int k = i + 1; k <= std::min(n - 1, i + p); ++k) s -= unit_lower_.lower(k - i, k) * x[k];

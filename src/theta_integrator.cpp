@@ -27,17 +27,18 @@ void ThetaIntegrator::Init(const SparseMatrix& mass, const SparseMatrix& stiffne
   options_ = options;
   mass_ = SymmetricBandMatrix(mass);
   stiffness_ = SymmetricBandMatrix(stiffness);
-  const double h_theta = options.time_step * options.theta;
-  // S = M + h^2 theta^2 K.
+  const double h = options.time_step, theta = options.theta;
+  // S = M + h^2 theta^2 K,  R = M - h^2 theta (1 - theta) K.
   const SymmetricBandMatrix schur =
-      SymmetricBandMatrix::LinearCombination(1.0, mass_, h_theta * h_theta, stiffness_);
+      SymmetricBandMatrix::LinearCombination(1.0, mass_, h * h * theta * theta, stiffness_);
+  free_state_matrix_ = SymmetricBandMatrix::LinearCombination(
+      1.0, mass_, -h * h * theta * (1.0 - theta), stiffness_);
   ++factorization_count_;
   if (!iteration_matrix_.Compute(schur)) {
     throw std::runtime_error(
         "theta integrator: the iteration matrix M + h^2 theta^2 K is not positive definite");
   }
   const int n = size();
-  shifted_displacement_ = Vector::Zero(n);
   force_ = Vector::Zero(n);
   for (int b = 0; b < 2; ++b) {
     v_[b] = Vector::Zero(n);
@@ -50,12 +51,10 @@ void ThetaIntegrator::Step(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref
                            Eigen::Ref<Vector> u_next) {
   const double h = options_.time_step;
   const double theta = options_.theta;
-  // Free state: rhs = M v_k - h K (u_k + h theta (1 - theta) v_k).
-  shifted_displacement_ = u_k + (h * theta * (1.0 - theta)) * v_k;
-  mass_.Multiply(v_k, v_next);
-  stiffness_.MultiplyAdd(-h, shifted_displacement_, v_next);
-  // Input: rhs += h f_theta; then S v_{k+1} = rhs.
-  v_next += h * force_theta;
+  // Free state and input: rhs = R v_k - h K u_k + h f_theta.
+  SymmetricBandMatrix::MultiplyPairAdd(free_state_matrix_, v_k, -h, stiffness_, u_k, h,
+                                       force_theta, v_next);
+  // S v_{k+1} = rhs.
   iteration_matrix_.SolveInPlace(v_next);
   // u_{k+1} = u_k + h (1 - theta) v_k + h theta v_{k+1}.
   u_next = u_k + (h * (1.0 - theta)) * v_k + (h * theta) * v_next;

@@ -22,6 +22,8 @@ class SymmetricBandMatrix {
   int half_bandwidth() const { return static_cast<int>(lower_.rows()) - 1; }
   double& lower(int d, int i) { return lower_(d, i); }
   double lower(int d, int i) const { return lower_(d, i); }
+  // The band storage, column-major (p + 1) x n: lower(d, i) at [i (p + 1) + d].
+  const double* lower_data() const { return lower_.data(); }
 
   // this = a * x + b * y, entry-wise on the bands (same size and bandwidth assumed
   // only up to the larger bandwidth of the two).
@@ -32,6 +34,12 @@ class SymmetricBandMatrix {
   void Multiply(const Eigen::Ref<const Vector>& x, Eigen::Ref<Vector> y) const;
   // y += alpha A x. No allocation; y must not alias x.
   void MultiplyAdd(double alpha, const Eigen::Ref<const Vector>& x, Eigen::Ref<Vector> y) const;
+  // y = A x + beta B z + gamma f in one pass (a time step's right-hand side). A and B
+  // of the same size. No allocation; y must not alias x, z or f.
+  static void MultiplyPairAdd(const SymmetricBandMatrix& a, const Eigen::Ref<const Vector>& x,
+                              double beta, const SymmetricBandMatrix& b,
+                              const Eigen::Ref<const Vector>& z, double gamma,
+                              const Eigen::Ref<const Vector>& f, Eigen::Ref<Vector> y);
 
  private:
   Matrix lower_;  // (p + 1) x n
@@ -52,6 +60,7 @@ class BandLdlt {
  private:
   SymmetricBandMatrix unit_lower_;  // L, unit diagonal not stored (lower(0, .) unused)
   Vector diagonal_;                 // D
+  Vector inverse_diagonal_;         // D^-1, so that a solve has no division
   bool ok_ = false;
 };
 

@@ -19,9 +19,12 @@
 //
 // so a step is, with the free state formed first and the input added after,
 //
-//     rhs_free = M v_k - h K (u_k + h theta (1 - theta) v_k)      (free state)
-//     S v_{k+1} = rhs_free + h f_theta                              (input)
+//     rhs_free = R v_k - h K u_k,  R = M - h^2 theta (1 - theta) K    (free state)
+//     S v_{k+1} = rhs_free + h f_theta                               (input)
 //     u_{k+1}   = u_k + h (1 - theta) v_k + h theta v_{k+1}.
+//
+// (Substituting u_{k+1} from the second block row into the first gives
+// rhs_free = M v_k - h K (u_k + h theta (1 - theta) v_k).)
 //
 // By linearity v_{k+1} = S^-1 rhs_free + S^-1 h f_theta: the input's effect is
 // added to the free state's right-hand side and both go through one solve.
@@ -93,12 +96,12 @@ class ThetaIntegrator {
              const Eigen::Ref<const Vector>& u_start, Forcing&& forcing, Observer&& observer);
 
   ThetaIntegratorOptions options_;
-  SymmetricBandMatrix mass_;       // M
-  SymmetricBandMatrix stiffness_;  // K
-  BandLdlt iteration_matrix_;      // LDL^T of S = M + h^2 theta^2 K
+  SymmetricBandMatrix mass_;               // M
+  SymmetricBandMatrix stiffness_;          // K
+  SymmetricBandMatrix free_state_matrix_;  // R = M - h^2 theta (1 - theta) K
+  BandLdlt iteration_matrix_;              // LDL^T of S = M + h^2 theta^2 K
   int factorization_count_ = 0;
   // Scratch, allocated in Init.
-  Vector shifted_displacement_;  // u_k + h theta (1 - theta) v_k
   Vector force_;                 // f_theta handed to forcing()
   Vector v_[2], u_[2];           // double buffer of the state
 };
