@@ -56,8 +56,7 @@ ScanResult ScanOmega(McreProblem* problem) {
     const int cap = best_sweeps == std::numeric_limits<long>::max()
                         ? 20000
                         : static_cast<int>(best_sweeps);  // iterations = sweeps / 2
-    const CoupledSolverSummary summary =
-        Run(CoupledSolverType::kRelaxation, problem, omega, cap);
+    const CoupledSolverSummary summary = Run(CoupledSolverType::kRelaxation, problem, omega, cap);
     if (summary.IsSolutionUsable() && summary.sweeps < best_sweeps) {
       best_sweeps = summary.sweeps;
       best = {omega, summary};
@@ -74,8 +73,7 @@ double SecondsOfOneDirectSweep(McreProblem* problem) {
   const int repeats = 20;
   const auto start = std::chrono::steady_clock::now();
   for (int i = 0; i < repeats; ++i) problem->DirectSweep(field, true, &displacement);
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() /
-         repeats;
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / repeats;
 }
 
 }  // namespace
@@ -84,16 +82,16 @@ int main(int argc, char** argv) {
   const bool skip_all_at_once = argc > 1 && std::strcmp(argv[1], "--skip-all-at-once") == 0;
   mcrewave::BarProperties bar;  // the paper's bar, 100 elements
   mcrewave::LoadOptions load;
-  mcrewave::TimeOptions time;   // 0.63 ms, 0.36 us, 1750 steps
+  mcrewave::TimeOptions time;  // 0.63 ms, 0.36 us, 1750 steps
   const mcrewave::BarModel model(bar);
   const double reference = bar.modulus;
 
   {
     const auto start = std::chrono::steady_clock::now();
     mcrewave::SimulateClampedBar(bar, load, time);
-    std::printf("one clamped direct simulation of the paper's case: %.2f ms\n",
-                1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-                          .count());
+    std::printf(
+        "one clamped direct simulation of the paper's case: %.2f ms\n",
+        1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   std::printf("\n%-5s %-6s | %-22s | %-16s | %-16s | %-7s %-7s\n", "SNR", "E/Eref",
               "best fixed omega", "adaptive", "Krylov (CG)", "adapt/", "best/");
@@ -112,16 +110,17 @@ int main(int argc, char** argv) {
       const ScanResult scan = ScanOmega(&problem);
       const CoupledSolverSummary adaptive = Run(CoupledSolverType::kAdaptiveRelaxation, &problem);
       const CoupledSolverSummary krylov = Run(CoupledSolverType::kConjugateGradient, &problem);
-      std::printf("%-5g %-6.2f | %7.4f %6ld %7.3f | %6ld %9.3f | %6ld %9.4f | %-7.2f %-7.1f\n",
-                  snr, factor, scan.omega, scan.summary.sweeps, scan.summary.wall_time_s,
+      std::printf("%-5g %-6.2f | %7.4f %6ld %7.3f | %6ld %9.3f | %6ld %9.4f | %-7.2f %-7.1f\n", snr,
+                  factor, scan.omega, scan.summary.sweeps, scan.summary.wall_time_s,
                   adaptive.sweeps, adaptive.wall_time_s, krylov.sweeps, krylov.wall_time_s,
                   static_cast<double>(adaptive.sweeps) / scan.summary.sweeps,
                   static_cast<double>(scan.summary.sweeps) / krylov.sweeps);
-      std::printf("%-14s   in direct sweeps: best omega %.0f, adaptive %.0f, Krylov %.1f; "
-                  "adaptive omega %.4f from a_max %.2f\n",
-                  "", scan.summary.wall_time_s / sweep_seconds,
-                  adaptive.wall_time_s / sweep_seconds, krylov.wall_time_s / sweep_seconds,
-                  adaptive.relaxation_coefficient, adaptive.spectrum_max);
+      std::printf(
+          "%-14s   in direct sweeps: best omega %.0f, adaptive %.0f, Krylov %.1f; "
+          "adaptive omega %.4f from a_max %.2f\n",
+          "", scan.summary.wall_time_s / sweep_seconds, adaptive.wall_time_s / sweep_seconds,
+          krylov.wall_time_s / sweep_seconds, adaptive.relaxation_coefficient,
+          adaptive.spectrum_max);
     }
     if (std::isinf(snr)) continue;
     // Warm start after a change of E by 1 %, 0.1 % and 0.01 % (SNR 2.5).
@@ -135,20 +134,22 @@ int main(int argc, char** argv) {
            {CoupledSolverType::kConjugateGradient, CoupledSolverType::kAdaptiveRelaxation}) {
         const CoupledSolverSummary cold = Run(type, &problem);
         const CoupledSolverSummary warm = Run(type, &problem, 0.5, 20000, &previous.retrograde);
-        std::printf("warm start after a %g %% change of E, %-19s: %4ld sweeps (cold %4ld), "
-                    "initial relative residual %.2e\n",
-                    100.0 * change, mcrewave::CoupledSolverTypeToString(type), warm.sweeps,
-                    cold.sweeps, warm.residual_history.front());
+        std::printf(
+            "warm start after a %g %% change of E, %-19s: %4ld sweeps (cold %4ld), "
+            "initial relative residual %.2e\n",
+            100.0 * change, mcrewave::CoupledSolverTypeToString(type), warm.sweeps, cold.sweeps,
+            warm.residual_history.front());
       }
     }
     if (!skip_all_at_once) {
       problem.SetModulus(0.8 * reference);
       const CoupledSolverSummary krylov = Run(CoupledSolverType::kConjugateGradient, &problem);
       const CoupledSolverSummary all_at_once = Run(CoupledSolverType::kAllAtOnce, &problem);
-      std::printf("\nall-at-once at SNR 2.5, 0.8 E_ref: %s\n  = %.0f direct sweeps; "
-                  "Krylov is %.0fx faster\n",
-                  all_at_once.BriefReport().c_str(), all_at_once.wall_time_s / sweep_seconds,
-                  all_at_once.wall_time_s / krylov.wall_time_s);
+      std::printf(
+          "\nall-at-once at SNR 2.5, 0.8 E_ref: %s\n  = %.0f direct sweeps; "
+          "Krylov is %.0fx faster\n",
+          all_at_once.BriefReport().c_str(), all_at_once.wall_time_s / sweep_seconds,
+          all_at_once.wall_time_s / krylov.wall_time_s);
     }
   }
   std::printf("\none direct sweep of the MCRE problem: %.3f ms\n", 1e3 * sweep_seconds);

@@ -35,8 +35,8 @@ constexpr int kGridPoints = 41;
 constexpr double kGridLow = 0.8, kGridHigh = 1.2;
 
 struct CurveFacts {
-  double minimiser = 0.0;   // E / E_ref
-  double curvature = 0.0;   // E^2 e2'' / e2 at the minimum
+  double minimiser = 0.0;  // E / E_ref
+  double curvature = 0.0;  // E^2 e2'' / e2 at the minimum
   int local_minima = 0;
   std::vector<double> costs;
 };
@@ -125,8 +125,8 @@ int main(int argc, char** argv) {
   table << "w_u,w_f,a_max,cg_sweeps,adaptive_sweeps,noise_free_error,snr2.5_mean_abs_error,"
            "snr2.5_max_abs_error,snr2.5_mean_local_minima,snr2.5_mean_relative_curvature\n";
   curves_csv << "w_u,w_f,seed,E_over_Eref,cost\n";
-  std::printf("%-6s %-5s | %8s %6s %8s | %10s | %10s %10s %7s %10s\n", "w_u", "w_f", "a_max",
-              "CG", "adaptive", "bias", "mean|err|", "max|err|", "minima", "curvature");
+  std::printf("%-6s %-5s | %8s %6s %8s | %10s | %10s %10s %7s %10s\n", "w_u", "w_f", "a_max", "CG",
+              "adaptive", "bias", "mean|err|", "max|err|", "minima", "curvature");
   table.precision(6);
   for (std::size_t p = 0; p < weight_pairs.size(); ++p) {
     const auto& [w_u, w_f] = weight_pairs[p];
@@ -151,18 +151,18 @@ int main(int argc, char** argv) {
       sum_minima += facts.local_minima;
       sum_curvature += facts.curvature;
     }
-    std::printf("%-6g %-5g | %8.2f %6ld %8ld | %+9.4f%% | %9.3f%% %9.3f%% %7.2f %10.1f\n", w_u,
-                w_f, a_max, cg.sweeps, adaptive.sweeps, 100.0 * (noise_free.minimiser - 1.0),
+    std::printf("%-6g %-5g | %8.2f %6ld %8ld | %+9.4f%% | %9.3f%% %9.3f%% %7.2f %10.1f\n", w_u, w_f,
+                a_max, cg.sweeps, adaptive.sweeps, 100.0 * (noise_free.minimiser - 1.0),
                 100.0 * sum_error / seeds, 100.0 * max_error, sum_minima / seeds,
                 sum_curvature / seeds);
-    table << w_u << ',' << w_f << ',' << a_max << ',' << cg.sweeps << ',' << adaptive.sweeps
-          << ',' << noise_free.minimiser - 1.0 << ',' << sum_error / seeds << ',' << max_error
-          << ',' << sum_minima / seeds << ',' << sum_curvature / seeds << '\n';
+    table << w_u << ',' << w_f << ',' << a_max << ',' << cg.sweeps << ',' << adaptive.sweeps << ','
+          << noise_free.minimiser - 1.0 << ',' << sum_error / seeds << ',' << max_error << ','
+          << sum_minima / seeds << ',' << sum_curvature / seeds << '\n';
     for (std::size_t d = 0; d < data_sets.size(); ++d) {
       const CurveFacts& facts = curves[p * data_sets.size() + d];
       for (int i = 0; i < kGridPoints; ++i) {
-        curves_csv << w_u << ',' << w_f << ',' << d << ',' << GridFactor(i) << ','
-                   << facts.costs[i] << '\n';
+        curves_csv << w_u << ',' << w_f << ',' << d << ',' << GridFactor(i) << ',' << facts.costs[i]
+                   << '\n';
       }
     }
   }

@@ -61,8 +61,7 @@ void SolveAllAtOnce(const CoupledSolverOptions& options, McreProblem* problem,
   if (system.size() > options.max_all_at_once_unknowns) {
     std::ostringstream why;
     why << "the all-at-once system has " << system.size() << " unknowns (5 n (m + 1), n = " << n
-        << " nodes, m = " << m << " steps), above the limit of "
-        << options.max_all_at_once_unknowns
+        << " nodes, m = " << m << " steps), above the limit of " << options.max_all_at_once_unknowns
         << " (inner.max_all_at_once_unknowns); use an iterative solver";
     summary->message = why.str();
     return;

@@ -24,8 +24,7 @@ SymmetricBandMatrix::SymmetricBandMatrix(const SparseMatrix& matrix) {
 }
 
 SymmetricBandMatrix SymmetricBandMatrix::LinearCombination(double a, const SymmetricBandMatrix& x,
-                                                           double b,
-                                                           const SymmetricBandMatrix& y) {
+                                                           double b, const SymmetricBandMatrix& y) {
   assert(x.size() == y.size());
   SymmetricBandMatrix result;
   const int p = std::max(x.half_bandwidth(), y.half_bandwidth());
@@ -70,8 +69,7 @@ void SymmetricBandMatrix::MultiplyPairAdd(const SymmetricBandMatrix& a,
                                           const Eigen::Ref<const Vector>& x, double beta,
                                           const SymmetricBandMatrix& b,
                                           const Eigen::Ref<const Vector>& z, double gamma,
-                                          const Eigen::Ref<const Vector>& f,
-                                          Eigen::Ref<Vector> y) {
+                                          const Eigen::Ref<const Vector>& f, Eigen::Ref<Vector> y) {
   const int n = a.size();
   assert(b.size() == n && x.size() == n && z.size() == n && f.size() == n && y.size() == n);
   if (a.half_bandwidth() == 1 && b.half_bandwidth() == 1) {

@@ -182,8 +182,8 @@ void SolveByRelaxation(const CoupledSolverOptions& options, McreProblem* problem
         return;
       }
       ++summary->safeguard_restarts;
-      spectrum_max = options.spectrum_safety_factor *
-                     std::max(1.2 * spectrum_max, (1.0 + growth) / omega);
+      spectrum_max =
+          options.spectrum_safety_factor * std::max(1.2 * spectrum_max, (1.0 + growth) / omega);
       summary->spectrum_max = spectrum_max;
       omega = 2.0 / (summary->spectrum_min + spectrum_max);
       summary->relaxation_coefficient = omega;
@@ -198,8 +198,8 @@ void SolveByRelaxation(const CoupledSolverOptions& options, McreProblem* problem
       summary->termination = TerminationType::kDivergence;
       summary->message = "the relaxation diverges: the relative residual grew from " +
                          Scientific(best_residual) + " to " + Scientific(relative) +
-                         " by iteration " + std::to_string(iteration) + "; omega = " +
-                         Scientific(omega) +
+                         " by iteration " + std::to_string(iteration) +
+                         "; omega = " + Scientific(omega) +
                          " is above the convergence limit 2 / (1 - lambda_min(G)): use a "
                          "smaller omega, adaptive_relaxation or conjugate_gradient";
       return;

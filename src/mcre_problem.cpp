@@ -163,8 +163,7 @@ double McreProblem::CostGradient(const Matrix& displacement, const Matrix& retro
   for (int j = 0; j <= m; ++j) {
     // W_j^T K1 (W_j + 2 U_j), with K = E K1 so that -(1/(2E)) W^T K (.) = -(1/2) W^T K1 (.).
     unit_stiffness_.Multiply(retrograde.col(j), product_);
-    sum += QuadratureWeight(j) * h *
-           product_.dot(retrograde.col(j) + 2.0 * displacement.col(j));
+    sum += QuadratureWeight(j) * h * product_.dot(retrograde.col(j) + 2.0 * displacement.col(j));
   }
   return -0.5 * sum;
 }

@@ -52,8 +52,8 @@ void ThetaIntegrator::Step(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref
   const double h = options_.time_step;
   const double theta = options_.theta;
   // Free state and input: rhs = R v_k - h K u_k + h f_theta.
-  SymmetricBandMatrix::MultiplyPairAdd(free_state_matrix_, v_k, -h, stiffness_, u_k, h,
-                                       force_theta, v_next);
+  SymmetricBandMatrix::MultiplyPairAdd(free_state_matrix_, v_k, -h, stiffness_, u_k, h, force_theta,
+                                       v_next);
   // S v_{k+1} = rhs.
   iteration_matrix_.SolveInPlace(v_next);
   // u_{k+1} = u_k + h (1 - theta) v_k + h theta v_{k+1}.

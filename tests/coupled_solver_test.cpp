@@ -94,8 +94,7 @@ TEST_P(SolverAgreementTest, AgreesWithAllAtOnce) {
   CoupledSolverOptions options = Options(param.type, 1e-12);
   if (param.type == CoupledSolverType::kRelaxation) {
     // A fixed omega inside the convergence range, from the adaptive estimate.
-    const Solved adaptive =
-        Solve(Options(CoupledSolverType::kAdaptiveRelaxation, 1e-4), &problem);
+    const Solved adaptive = Solve(Options(CoupledSolverType::kAdaptiveRelaxation, 1e-4), &problem);
     options.relaxation_coefficient = 0.9 * adaptive.summary.relaxation_coefficient;
   }
   const Solved solved = Solve(options, &problem);
@@ -153,8 +152,7 @@ TEST(CostCurveTest, InverseCrimeDataHaveTheirMinimumAtTheReferenceModulus) {
       best = i;
     }
   }
-  EXPECT_EQ(best, 20) << "minimum of the 41-point curve at E = " << 0.5 + best * 0.025
-                      << " E_ref";
+  EXPECT_EQ(best, 20) << "minimum of the 41-point curve at E = " << 0.5 + best * 0.025 << " E_ref";
 }
 
 TEST(CostCurveTest, ExactSolutionDataIdentifyTheModulusWithinOnePercent) {
@@ -247,8 +245,8 @@ TEST(DivergenceTest, PaperCaseWithOmegaOneIsReportedAsDivergingAndAdaptiveConver
   const Solved adaptive = Solve(Options(CoupledSolverType::kAdaptiveRelaxation, 1e-8), &problem);
   EXPECT_TRUE(adaptive.summary.IsSolutionUsable()) << adaptive.summary.FullReport();
   // Its omega lies inside the convergence range 2 / a_max of the estimate.
-  EXPECT_LT(adaptive.summary.relaxation_coefficient, 2.0 / (adaptive.summary.spectrum_max /
-                                                            options.spectrum_safety_factor));
+  EXPECT_LT(adaptive.summary.relaxation_coefficient,
+            2.0 / (adaptive.summary.spectrum_max / options.spectrum_safety_factor));
 }
 
 }  // namespace

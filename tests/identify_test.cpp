@@ -53,9 +53,8 @@ TEST(IdentifyTest, PrintsADefaultConfigThatSimulateAccepts) {
   const std::string dir = FreshDirectory("identify_default_config");
   const RunResult printed = RunIdentify("--print-default-config > " + dir + "/default.yaml");
   ASSERT_EQ(printed.exit_code, 0) << printed.output;
-  const RunResult simulated =
-      RunIdentify("simulate " + dir + "/default.yaml --set time.window=0.036e-3 -o " + dir +
-                  "/out.csv");
+  const RunResult simulated = RunIdentify(
+      "simulate " + dir + "/default.yaml --set time.window=0.036e-3 -o " + dir + "/out.csv");
   EXPECT_EQ(simulated.exit_code, 0) << simulated.output;
   EXPECT_EQ(ReadMeasurementCsv(dir + "/out.csv").num_samples(), 101);
 }

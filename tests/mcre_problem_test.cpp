@@ -71,8 +71,7 @@ TEST(McreProblemTest, ConsistentDataGiveZeroCostAtZeroRetrogradeField) {
   Matrix displacement, image;
   problem.FixedPointMap(zero, &displacement, &image);
   // The free bar driven by the measured forces reproduces the clamped motion...
-  EXPECT_LT(displacement.row(0).cwiseAbs().maxCoeff(),
-            1e-9 * bundle.data.uL.cwiseAbs().maxCoeff());
+  EXPECT_LT(displacement.row(0).cwiseAbs().maxCoeff(), 1e-9 * bundle.data.uL.cwiseAbs().maxCoeff());
   EXPECT_LT((displacement.row(16).transpose() - bundle.data.uL).cwiseAbs().maxCoeff(),
             1e-9 * bundle.data.uL.cwiseAbs().maxCoeff());
   // ...so T(0) = 0 and the cost vanishes.

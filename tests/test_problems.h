@@ -34,11 +34,14 @@ inline SmallCase MakeSmallCase(int elements, int steps, double snr, int truth_re
 struct ProblemBundle {
   ProblemBundle(const SmallCase& c, const McreWeights& weights, double theta = 0.5)
       : model(c.bar),
-        data(MakeSyntheticMeasurements(c.bar, c.load, [&] {
-               TimeOptions t = c.time;
-               t.theta = theta;
-               return t;
-             }(), c.data)),
+        data(MakeSyntheticMeasurements(
+            c.bar, c.load,
+            [&] {
+              TimeOptions t = c.time;
+              t.theta = theta;
+              return t;
+            }(),
+            c.data)),
         problem(model, data, weights, c.bar.modulus, theta) {}
   BarModel model;
   MeasurementSet data;

@@ -13,11 +13,11 @@
 namespace mcrewave {
 
 struct BarProperties {
-  double length = 1.0;           // L [m]
-  double section = 1e-4;         // S [m^2]
-  double density = 800.0;        // rho [kg/m^3]
-  double modulus = 200e9;        // E [Pa], the reference (or initial) modulus
-  int elements = 100;            // N, number of linear elements
+  double length = 1.0;     // L [m]
+  double section = 1e-4;   // S [m^2]
+  double density = 800.0;  // rho [kg/m^3]
+  double modulus = 200e9;  // E [Pa], the reference (or initial) modulus
+  int elements = 100;      // N, number of linear elements
   MassType mass = MassType::kConsistent;
 
   // True when every value is usable; otherwise writes the reason to *error.
@@ -33,8 +33,8 @@ class BarModel {
   int num_elements() const { return properties_.elements; }
   int num_nodes() const { return properties_.elements + 1; }
   double element_length() const { return properties_.length / properties_.elements; }  // [m]
-  int left_node() const { return 0; }                                  // x = 0
-  int right_node() const { return properties_.elements; }              // x = L
+  int left_node() const { return 0; }                                                  // x = 0
+  int right_node() const { return properties_.elements; }                              // x = L
 
   // Mass matrix M [kg], symmetric positive definite, tridiagonal.
   const SparseMatrix& mass() const { return mass_; }

@@ -40,11 +40,11 @@ struct TimeOptions {
 // Gaussian white noise is added at the given SNR (see noise.h for the definition).
 struct DataOptions {
   DataSource source = DataSource::kSynthetic;
-  std::string path;                                       // CSV file when source = csv
-  TruthModel truth = TruthModel::kFiniteElement;          // synthetic only
-  int truth_refinement = 4;                               // mesh and step refined by this factor
-  double snr = std::numeric_limits<double>::infinity();   // inf = no noise
-  std::uint64_t seed = 1;                                 // noise seed
+  std::string path;                                      // CSV file when source = csv
+  TruthModel truth = TruthModel::kFiniteElement;         // synthetic only
+  int truth_refinement = 4;                              // mesh and step refined by this factor
+  double snr = std::numeric_limits<double>::infinity();  // inf = no noise
+  std::uint64_t seed = 1;                                // noise seed
 
   bool IsValid(std::string* error) const;
 };

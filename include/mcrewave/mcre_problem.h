@@ -95,7 +95,8 @@ class McreProblem {
   long sweep_count_ = 0;
   // Scratch, allocated in the constructor.
   Vector force_now_, force_next_, omega_previous_, product_;
-  Vector rest_state_;  // zero: the initial state of the direct sweep, the final one of the retrograde
+  Vector
+      rest_state_;  // zero: the initial state of the direct sweep, the final one of the retrograde
 };
 
 }  // namespace mcrewave

@@ -102,8 +102,8 @@ class ThetaIntegrator {
   BandLdlt iteration_matrix_;              // LDL^T of S = M + h^2 theta^2 K
   int factorization_count_ = 0;
   // Scratch, allocated in Init.
-  Vector force_;                 // f_theta handed to forcing()
-  Vector v_[2], u_[2];           // double buffer of the state
+  Vector force_;        // f_theta handed to forcing()
+  Vector v_[2], u_[2];  // double buffer of the state
 };
 
 template <typename Forcing, typename Observer>
@@ -129,8 +129,7 @@ template <typename Forcing, typename Observer>
 void ThetaIntegrator::SweepForward(int num_steps, const Eigen::Ref<const Vector>& v0,
                                    const Eigen::Ref<const Vector>& u0, Forcing&& forcing,
                                    Observer&& observer) {
-  Sweep(num_steps, 0, +1, v0, u0, std::forward<Forcing>(forcing),
-        std::forward<Observer>(observer));
+  Sweep(num_steps, 0, +1, v0, u0, std::forward<Forcing>(forcing), std::forward<Observer>(observer));
 }
 
 template <typename Forcing, typename Observer>
