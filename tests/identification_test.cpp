@@ -1,0 +1,286 @@
+// Tests of the outer loop (Identify) on objectives made for the purpose: every
+// algorithm of both optimisers finds a known minimum within bounds; the traps
+// of NLopt are guarded (an exception in the objective is reported with its
+// message, the best point seen is the one reported, limits are honoured); and
+// the options name their keys when invalid.
+#include "mcrewave/identification.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+namespace mcrewave {
+namespace {
+
+// A scripted objective: cost(x) from a function of x, with its derivative;
+// records every x; throws or fails on a chosen evaluation.
+class ScriptedObjective : public ModulusObjective {
+ public:
+  ScriptedObjective(std::function<double(double)> cost, std::function<double(double)> derivative)
+      : cost_(std::move(cost)), derivative_(std::move(derivative)) {}
+
+  double modulus_scale() const override { return scale; }
+  bool Evaluate(const double* parameters, double* cost, double* gradient) override {
+    const double x = parameters[0];
+    evaluated.push_back(x);
+    const int count = static_cast<int>(evaluated.size());
+    if (count == throw_at) throw std::runtime_error("disk on fire at evaluation " +
+                                                    std::to_string(count));
+    if (count == fail_at) {
+      message_ = "the inner solve diverged (scripted)";
+      return false;
+    }
+    if (delay_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(delay_s));
+    *cost = cost_(x);
+    if (gradient != nullptr) gradient[0] = derivative_(x);
+    return true;
+  }
+  std::string error_message() const override { return message_; }
+
+  double scale = 1e9;
+  int throw_at = -1;
+  int fail_at = -1;
+  double delay_s = 0.0;
+  std::vector<double> evaluated;
+
+ private:
+  std::function<double(double)> cost_;
+  std::function<double(double)> derivative_;
+  std::string message_;
+};
+
+// (x - 1.3)^2 + 0.5, minimum at x = 1.3 (E = 1.3 GPa with scale 1e9).
+ScriptedObjective Parabola(double minimum = 1.3) {
+  return ScriptedObjective([minimum](double x) { return (x - minimum) * (x - minimum) + 0.5; },
+                           [minimum](double x) { return 2.0 * (x - minimum); });
+}
+
+IdentificationOptions Options(OptimizerType optimizer, OuterAlgorithm algorithm) {
+  IdentificationOptions options;
+  options.optimizer = optimizer;
+  options.algorithm = algorithm;
+  options.lower_bound = 0.5e9;
+  options.upper_bound = 2.5e9;
+  options.initial = 1.0e9;
+  options.relative_tolerance = 1e-8;
+  options.max_evaluations = 200;
+  options.max_time = 60.0;
+  return options;
+}
+
+using Case = std::tuple<OptimizerType, OuterAlgorithm>;
+
+class EveryAlgorithmTest : public ::testing::TestWithParam<Case> {};
+
+TEST_P(EveryAlgorithmTest, FindsTheMinimumOfAParabola) {
+  const auto [optimizer, algorithm] = GetParam();
+  ScriptedObjective objective = Parabola();
+  const IdentificationSummary summary = Identify(Options(optimizer, algorithm), &objective);
+  EXPECT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+  EXPECT_NEAR(summary.modulus, 1.3e9, 1e-5 * 1.3e9) << summary.FullReport();
+  EXPECT_NEAR(summary.cost, 0.5, 1e-9);
+  EXPECT_EQ(summary.evaluations, static_cast<int>(objective.evaluated.size()));
+  EXPECT_EQ(summary.gradient_evaluations > 0, UsesGradient(optimizer, algorithm));
+  EXPECT_EQ(summary.algorithm, ResolveAlgorithm(optimizer, algorithm));
+  for (const double x : objective.evaluated) {
+    EXPECT_GE(x, 0.5);
+    EXPECT_LE(x, 2.5);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    NloptAndCeres, EveryAlgorithmTest,
+    ::testing::Values(Case{OptimizerType::kNlopt, OuterAlgorithm::kDefault},
+                      Case{OptimizerType::kNlopt, OuterAlgorithm::kCobyla},
+                      Case{OptimizerType::kNlopt, OuterAlgorithm::kSbplx},
+                      Case{OptimizerType::kNlopt, OuterAlgorithm::kMma},
+                      Case{OptimizerType::kNlopt, OuterAlgorithm::kLbfgs},
+                      Case{OptimizerType::kCeres, OuterAlgorithm::kDefault},
+                      Case{OptimizerType::kCeres, OuterAlgorithm::kBfgs}),
+    [](const ::testing::TestParamInfo<Case>& info) {
+      return std::string(OptimizerTypeToString(std::get<0>(info.param))) + "_" +
+             OuterAlgorithmToString(std::get<1>(info.param));
+    });
+
+TEST(IdentificationTest, CeresNeedsFewerEvaluationsThanBobyqaOnASmoothMinimum) {
+  ScriptedObjective for_nlopt = Parabola();
+  ScriptedObjective for_ceres = Parabola();
+  const IdentificationSummary nlopt =
+      Identify(Options(OptimizerType::kNlopt, OuterAlgorithm::kDefault), &for_nlopt);
+  const IdentificationSummary ceres =
+      Identify(Options(OptimizerType::kCeres, OuterAlgorithm::kDefault), &for_ceres);
+  ASSERT_TRUE(nlopt.IsSolutionUsable() && ceres.IsSolutionUsable());
+  EXPECT_LT(ceres.evaluations, nlopt.evaluations);
+  EXPECT_NEAR(ceres.modulus, nlopt.modulus, 1e-6 * nlopt.modulus);
+}
+
+TEST(IdentificationTest, MinimumBeyondABoundStaysInsideTheBounds) {
+  for (const OptimizerType optimizer : {OptimizerType::kNlopt, OptimizerType::kCeres}) {
+    ScriptedObjective objective = Parabola(3.0);
+    const IdentificationSummary summary =
+        Identify(Options(optimizer, OuterAlgorithm::kDefault), &objective);
+    EXPECT_LE(summary.modulus, 2.5e9) << summary.FullReport();
+    EXPECT_GT(summary.modulus, 0.99 * 2.5e9) << summary.FullReport();
+    for (const double x : objective.evaluated) EXPECT_LE(x, 2.5);
+  }
+}
+
+TEST(IdentificationTest, ExceptionInTheObjectiveUnderNloptKeepsItsMessageAndTheBestPoint) {
+  ScriptedObjective objective = Parabola();
+  objective.throw_at = 6;
+  const IdentificationSummary summary =
+      Identify(Options(OptimizerType::kNlopt, OuterAlgorithm::kBobyqa), &objective);
+  EXPECT_EQ(summary.termination, TerminationType::kFailure);
+  EXPECT_FALSE(summary.IsSolutionUsable());
+  EXPECT_NE(summary.message.find("the objective threw: disk on fire at evaluation 6"),
+            std::string::npos)
+      << summary.message;
+  // NLopt stopped at once, and the best of the first five is reported.
+  ASSERT_EQ(objective.evaluated.size(), 6u);
+  double best_x = objective.evaluated[0];
+  for (int i = 1; i < 5; ++i) {
+    if (std::abs(objective.evaluated[i] - 1.3) < std::abs(best_x - 1.3)) {
+      best_x = objective.evaluated[i];
+    }
+  }
+  EXPECT_DOUBLE_EQ(summary.modulus, best_x * 1e9);
+}
+
+TEST(IdentificationTest, ExceptionInTheObjectiveUnderCeresKeepsItsMessage) {
+  ScriptedObjective objective = Parabola();
+  objective.throw_at = 3;
+  const IdentificationSummary summary =
+      Identify(Options(OptimizerType::kCeres, OuterAlgorithm::kDefault), &objective);
+  EXPECT_EQ(summary.termination, TerminationType::kFailure);
+  EXPECT_NE(summary.message.find("disk on fire at evaluation 3"), std::string::npos)
+      << summary.message;
+  EXPECT_EQ(objective.evaluated.size(), 3u);
+  EXPECT_GT(summary.modulus, 0.0);
+}
+
+TEST(IdentificationTest, FailedEvaluationStopsWithTheObjectiveMessage) {
+  for (const OptimizerType optimizer : {OptimizerType::kNlopt, OptimizerType::kCeres}) {
+    ScriptedObjective objective = Parabola();
+    objective.fail_at = 4;
+    const IdentificationSummary summary =
+        Identify(Options(optimizer, OuterAlgorithm::kDefault), &objective);
+    EXPECT_EQ(summary.termination, TerminationType::kFailure) << summary.FullReport();
+    EXPECT_NE(summary.message.find("the inner solve diverged (scripted)"), std::string::npos)
+        << summary.message;
+    EXPECT_EQ(objective.evaluated.size(), 4u);
+  }
+}
+
+TEST(IdentificationTest, FailureAtTheFirstEvaluationLeavesNoModulus) {
+  ScriptedObjective objective = Parabola();
+  objective.fail_at = 1;
+  const IdentificationSummary summary =
+      Identify(Options(OptimizerType::kNlopt, OuterAlgorithm::kDefault), &objective);
+  EXPECT_FALSE(summary.IsSolutionUsable());
+  EXPECT_EQ(summary.modulus, -1.0);
+}
+
+TEST(IdentificationTest, EvaluationLimitIsHonouredAndTheBestPointReported) {
+  for (const OptimizerType optimizer : {OptimizerType::kNlopt, OptimizerType::kCeres}) {
+    // A narrow minimum far from the start: not reached in 5 evaluations.
+    ScriptedObjective objective(
+        [](double x) { return 1.0 - std::exp(-std::pow((x - 2.2) / 0.01, 2)) + 0.1 * x; },
+        [](double x) {
+          return 2.0 * (x - 2.2) / 1e-4 * std::exp(-std::pow((x - 2.2) / 0.01, 2)) + 0.1;
+        });
+    IdentificationOptions options = Options(optimizer, OuterAlgorithm::kDefault);
+    options.max_evaluations = 5;
+    const IdentificationSummary summary = Identify(options, &objective);
+    EXPECT_EQ(summary.termination, TerminationType::kNoConvergence) << summary.FullReport();
+    EXPECT_NE(summary.message.find("outer.max_evaluations (5)"), std::string::npos)
+        << summary.message;
+    EXPECT_LE(objective.evaluated.size(), 5u);
+    // The cost decreases with x away from 2.2: the best point is the least x seen.
+    double least = objective.evaluated[0];
+    for (const double x : objective.evaluated) least = std::min(least, x);
+    EXPECT_DOUBLE_EQ(summary.modulus, least * 1e9);
+  }
+}
+
+TEST(IdentificationTest, TimeLimitIsHonoured) {
+  for (const OptimizerType optimizer : {OptimizerType::kNlopt, OptimizerType::kCeres}) {
+    ScriptedObjective objective = Parabola();
+    objective.delay_s = 0.02;
+    IdentificationOptions options = Options(optimizer, OuterAlgorithm::kDefault);
+    options.max_time = 0.1;
+    const IdentificationSummary summary = Identify(options, &objective);
+    EXPECT_EQ(summary.termination, TerminationType::kNoConvergence) << summary.FullReport();
+    EXPECT_LT(summary.wall_time_s, 0.1 + 0.1);
+    EXPECT_LE(objective.evaluated.size(), 7u);
+  }
+}
+
+TEST(IdentificationOptionsTest, DefaultsAreValid) {
+  std::string why;
+  EXPECT_TRUE(IdentificationOptions().IsValid(&why)) << why;
+}
+
+TEST(IdentificationOptionsTest, InvalidOptionsNameTheirKeys) {
+  const std::vector<std::pair<std::function<void(IdentificationOptions*)>, std::string>> cases = {
+      {[](IdentificationOptions* o) { o->lower_bound = 0.0; }, "outer.lower_bound"},
+      {[](IdentificationOptions* o) { o->upper_bound = o->lower_bound; }, "outer.upper_bound"},
+      {[](IdentificationOptions* o) { o->initial = o->upper_bound; }, "outer.initial"},
+      {[](IdentificationOptions* o) { o->relative_tolerance = 0.0; }, "outer.relative_tolerance"},
+      {[](IdentificationOptions* o) { o->max_evaluations = 1; }, "outer.max_evaluations"},
+      {[](IdentificationOptions* o) { o->max_time = -1.0; }, "outer.max_time"},
+      {[](IdentificationOptions* o) {
+         o->optimizer = OptimizerType::kCeres;
+         o->algorithm = OuterAlgorithm::kCobyla;
+       },
+       "outer.algorithm 'cobyla' is not available with outer.optimizer 'ceres'; choose default, "
+       "lbfgs or bfgs"},
+  };
+  for (const auto& [spoil, fragment] : cases) {
+    IdentificationOptions options;
+    spoil(&options);
+    std::string why;
+    EXPECT_FALSE(options.IsValid(&why)) << fragment;
+    EXPECT_NE(why.find(fragment), std::string::npos) << why;
+  }
+}
+
+TEST(IdentificationOptionsTest, NamesRoundTrip) {
+  for (const OptimizerType type : {OptimizerType::kNlopt, OptimizerType::kCeres}) {
+    OptimizerType parsed;
+    ASSERT_TRUE(StringToOptimizerType(OptimizerTypeToString(type), &parsed));
+    EXPECT_EQ(parsed, type);
+  }
+  for (const OuterAlgorithm algorithm :
+       {OuterAlgorithm::kDefault, OuterAlgorithm::kBobyqa, OuterAlgorithm::kCobyla,
+        OuterAlgorithm::kSbplx, OuterAlgorithm::kMma, OuterAlgorithm::kLbfgs,
+        OuterAlgorithm::kBfgs}) {
+    OuterAlgorithm parsed;
+    ASSERT_TRUE(StringToOuterAlgorithm(OuterAlgorithmToString(algorithm), &parsed));
+    EXPECT_EQ(parsed, algorithm);
+  }
+  OuterAlgorithm unchanged = OuterAlgorithm::kBfgs;
+  EXPECT_FALSE(StringToOuterAlgorithm("newton", &unchanged));
+  EXPECT_EQ(unchanged, OuterAlgorithm::kBfgs);
+}
+
+TEST(IdentificationTest, InvalidOptionsAreReportedNotRun) {
+  ScriptedObjective objective = Parabola();
+  IdentificationOptions options;
+  options.initial = 1.0;
+  const IdentificationSummary summary = Identify(options, &objective);
+  EXPECT_EQ(summary.termination, TerminationType::kFailure);
+  EXPECT_NE(summary.message.find("invalid options: outer.initial"), std::string::npos)
+      << summary.message;
+  EXPECT_TRUE(objective.evaluated.empty());
+}
+
+}  // namespace
+}  // namespace mcrewave

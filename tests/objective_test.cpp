@@ -1,0 +1,146 @@
+// Tests of the outer loop's objective: McreObjective evaluates e^2(E) scaled,
+// with or without the adjoint gradient, warm-starts, records every evaluation,
+// keeps the best, and reports an unusable inner solve as false with a message.
+#include "mcrewave/objective.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "test_problems.h"
+
+namespace mcrewave {
+namespace {
+
+using testing::MakeSmallCase;
+
+// A small noisy case: 20 elements, 120 steps, SNR 20, truth refined twice.
+class ObjectiveTest : public ::testing::Test {
+ protected:
+  ObjectiveTest()
+      : case_(MakeSmallCase(20, 120, 20.0, 2)),
+        model_(case_.bar),
+        data_(MakeSyntheticMeasurements(case_.bar, case_.load, case_.time, case_.data)) {}
+
+  McreObjective MakeObjective(const CoupledSolverOptions& inner = CoupledSolverOptions()) const {
+    return McreObjective(model_, data_, McreOptions(), case_.time.theta, inner, kScale);
+  }
+
+  static constexpr double kScale = 160e9;  // E per unit of x [Pa]
+  testing::SmallCase case_;
+  BarModel model_;
+  MeasurementSet data_;
+};
+
+TEST(McreOptionsTest, DefaultsAreValidAndBadValuesNameTheirKey) {
+  std::string why;
+  McreOptions options;
+  EXPECT_TRUE(options.IsValid(&why)) << why;
+  options.reference_modulus = 0.0;
+  EXPECT_FALSE(options.IsValid(&why));
+  EXPECT_NE(why.find("mcre.reference_modulus"), std::string::npos) << why;
+  options = McreOptions();
+  options.weights.displacement_weight = -1.0;
+  EXPECT_FALSE(options.IsValid(&why));
+  EXPECT_NE(why.find("mcre.w_u"), std::string::npos) << why;
+}
+
+TEST_F(ObjectiveTest, CostIsTheScaledMcreCostWithOrWithoutGradient) {
+  McreObjective objective = MakeObjective();
+  const double x = 1.2;
+  double cost_alone = -1.0;
+  ASSERT_TRUE(objective.Evaluate(&x, &cost_alone, nullptr)) << objective.error_message();
+  double cost = -1.0;
+  double gradient = 0.0;
+  ASSERT_TRUE(objective.Evaluate(&x, &cost, &gradient)) << objective.error_message();
+
+  ASSERT_EQ(objective.evaluations().size(), 2u);
+  const ObjectiveEvaluation& first = objective.evaluations()[0];
+  const ObjectiveEvaluation& second = objective.evaluations()[1];
+  EXPECT_FALSE(first.gradient_requested);
+  EXPECT_TRUE(second.gradient_requested);
+  EXPECT_DOUBLE_EQ(first.modulus, x * kScale);
+  EXPECT_TRUE(first.usable && second.usable);
+  // cost = e^2 / J_rest, gradient = de^2/dE * E_scale / J_rest
+  EXPECT_NEAR(cost_alone, first.cost / objective.rest_cost(), 1e-15);
+  EXPECT_NEAR(cost, cost_alone, 1e-8 * cost);
+  EXPECT_NEAR(gradient, second.cost_gradient * kScale / objective.rest_cost(),
+              1e-12 * std::abs(gradient));
+  // The bar at rest is admissible for every E: 0 <= e^2 <= J_rest.
+  EXPECT_GT(cost, 0.0);
+  EXPECT_LT(cost, 1.0);
+}
+
+TEST_F(ObjectiveTest, GradientMatchesCentralDifferencesOfTheScaledCost) {
+  CoupledSolverOptions inner;
+  inner.tolerance = 1e-12;
+  McreObjective objective = MakeObjective(inner);
+  const double x = 1.1;
+  const double step = 1e-4;
+  double cost = 0.0;
+  double gradient = 0.0;
+  ASSERT_TRUE(objective.Evaluate(&x, &cost, &gradient));
+  const double x_plus = x + step;
+  const double x_minus = x - step;
+  double cost_plus = 0.0;
+  double cost_minus = 0.0;
+  ASSERT_TRUE(objective.Evaluate(&x_plus, &cost_plus, nullptr));
+  ASSERT_TRUE(objective.Evaluate(&x_minus, &cost_minus, nullptr));
+  const double difference = (cost_plus - cost_minus) / (2.0 * step);
+  EXPECT_NEAR(gradient, difference, 1e-5 * std::abs(gradient));
+}
+
+TEST_F(ObjectiveTest, WarmStartFromThePreviousSolutionSavesIterations) {
+  McreObjective cold = MakeObjective();
+  McreObjective warm = MakeObjective();
+  const double start = 1.25;
+  const double next = 1.2501;
+  double cost = 0.0;
+  ASSERT_TRUE(warm.Evaluate(&start, &cost, nullptr));
+  ASSERT_TRUE(warm.Evaluate(&next, &cost, nullptr));
+  ASSERT_TRUE(cold.Evaluate(&next, &cost, nullptr));
+  EXPECT_LT(warm.evaluations()[1].inner.iterations, cold.evaluations()[0].inner.iterations);
+}
+
+TEST_F(ObjectiveTest, KeepsTheBestEvaluationAndItsSolution) {
+  McreObjective objective = MakeObjective();
+  double cost = 0.0;
+  for (const double x : {0.8, 1.25, 1.6}) ASSERT_TRUE(objective.Evaluate(&x, &cost, nullptr));
+  // The data were made with E = 200 GPa = 1.25 E_scale.
+  EXPECT_EQ(objective.best_index(), 1);
+  EXPECT_EQ(objective.best_solution().cost, objective.evaluations()[1].cost);
+  EXPECT_EQ(objective.best_solution().displacement.cols(), data_.num_samples());
+  EXPECT_GT(objective.total_sweeps(), 0);
+}
+
+TEST_F(ObjectiveTest, NonPositiveParameterIsRefusedWithAMessage) {
+  McreObjective objective = MakeObjective();
+  double cost = 0.0;
+  const double x = -0.5;
+  EXPECT_FALSE(objective.Evaluate(&x, &cost, nullptr));
+  EXPECT_NE(objective.error_message().find("not a positive finite number"), std::string::npos)
+      << objective.error_message();
+  EXPECT_TRUE(objective.evaluations().empty());
+}
+
+TEST_F(ObjectiveTest, UnusableInnerSolveReturnsFalseAndKeepsTheSolverMessage) {
+  CoupledSolverOptions inner;
+  inner.max_iterations = 1;
+  inner.tolerance = 1e-14;
+  McreObjective objective = MakeObjective(inner);
+  double cost = 0.0;
+  double gradient = 0.0;
+  const double x = 1.0;
+  EXPECT_FALSE(objective.Evaluate(&x, &cost, &gradient));
+  EXPECT_NE(objective.error_message().find("not usable"), std::string::npos)
+      << objective.error_message();
+  EXPECT_NE(objective.error_message().find("no_convergence"), std::string::npos)
+      << objective.error_message();
+  ASSERT_EQ(objective.evaluations().size(), 1u);
+  EXPECT_FALSE(objective.evaluations()[0].usable);
+  EXPECT_EQ(objective.best_index(), -1);
+}
+
+}  // namespace
+}  // namespace mcrewave
