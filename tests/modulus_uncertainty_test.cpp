@@ -1,0 +1,126 @@
+// Tests of the uncertainty figure's pieces: the noise levels estimated from the
+// data, the slope of de^2/dE, and the first-order standard deviation (linear in
+// the noise level, unavailable without curvature or noise).
+#include "mcrewave/modulus_uncertainty.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "mcrewave/noise.h"
+#include "test_problems.h"
+
+namespace mcrewave {
+namespace {
+
+using testing::MakeSmallCase;
+
+TEST(UncertaintyOptionsTest, SamplesAreChecked) {
+  std::string why;
+  UncertaintyOptions options;
+  EXPECT_TRUE(options.IsValid(&why)) << why;
+  options.samples = 1;
+  EXPECT_FALSE(options.IsValid(&why));
+  EXPECT_NE(why.find("uncertainty.samples"), std::string::npos) << why;
+}
+
+TEST(DifferenceNoiseLevelsTest, RecoversTheNoiseAddedToSmoothSignals) {
+  // The paper's sampling: 1751 samples of a smooth signal, noise at SNR 5.
+  testing::SmallCase c = MakeSmallCase(100, 1750, std::numeric_limits<double>::infinity(), 1);
+  MeasurementSet data = MakeSyntheticMeasurements(c.bar, c.load, c.time, c.data);
+  const double displacement_std = RootMeanSquare(data.uL) / 5.0;
+  const double force_std = RootMeanSquare(data.fL) / 5.0;
+  AddMeasurementNoise(5.0, 11, &data);
+  const NoiseLevels levels = DifferenceNoiseLevels(data);
+  EXPECT_NEAR(levels.displacement_std, displacement_std, 0.05 * displacement_std);
+  EXPECT_NEAR(levels.force_std, force_std, 0.05 * force_std);
+}
+
+TEST(CostGradientSlopeTest, FitsTheSlopeWithinTheWindow) {
+  // g = 3e-30 (E - 2e11) inside +- 5 %, wild outside (must be ignored).
+  std::vector<CostCurvePoint> curve;
+  for (double modulus = 1.5e11; modulus <= 2.5e11; modulus += 0.05e11) {
+    CostCurvePoint point;
+    point.modulus = modulus;
+    point.usable = true;
+    point.cost_gradient = std::abs(modulus - 2e11) <= 0.1e11 ? 3e-30 * (modulus - 2e11) : 1.0;
+    curve.push_back(point);
+  }
+  int points = 0;
+  EXPECT_NEAR(CostGradientSlope(curve, 2e11, 0.05, &points), 3e-30, 1e-42);
+  EXPECT_EQ(points, 5);
+  std::vector<CostCurvePoint> one(1);
+  one[0].usable = true;
+  EXPECT_EQ(CostGradientSlope(one, 2e11, 0.05, &points), 0.0);
+}
+
+// At the minimum of e^2 for a small noisy case.
+class ModulusUncertaintyTest : public ::testing::Test {
+ protected:
+  ModulusUncertaintyTest()
+      : case_(MakeSmallCase(20, 120, 20.0, 2)),
+        model_(case_.bar),
+        data_(MakeSyntheticMeasurements(case_.bar, case_.load, case_.time, case_.data)),
+        problem_(model_, data_, McreOptions().weights, McreOptions().reference_modulus,
+                 case_.time.theta) {
+    problem_.SetModulus(kModulus);
+    SolveCoupled(CoupledSolverOptions(), &problem_, nullptr, &solution_);
+  }
+
+  ModulusUncertainty Estimate(const NoiseLevels& noise, double curvature) {
+    UncertaintyOptions options;
+    options.samples = 4;
+    return EstimateModulusUncertainty(options, model_, data_, McreOptions(), case_.time.theta,
+                                      CoupledSolverOptions(), kModulus, solution_, noise, curvature,
+                                      5);
+  }
+
+  static constexpr double kModulus = 200e9;
+  testing::SmallCase case_;
+  BarModel model_;
+  MeasurementSet data_;
+  McreProblem problem_;
+  CoupledSolution solution_;
+};
+
+TEST_F(ModulusUncertaintyTest, IsLinearInTheNoiseLevelAndInverseInTheCurvature) {
+  const NoiseLevels noise{1e-7, 1.0};
+  const ModulusUncertainty base = Estimate(noise, 1e-30);
+  ASSERT_TRUE(base.available) << base.message;
+  EXPECT_GT(base.std_dev, 0.0);
+  EXPECT_EQ(base.samples, 4);
+  EXPECT_GT(base.sweeps, 0);
+  EXPECT_NEAR(base.relative_std_dev, base.std_dev / kModulus, 1e-15);
+  // The same draws at twice the noise: dE is linear in the noise.
+  const ModulusUncertainty doubled = Estimate(NoiseLevels{2e-7, 2.0}, 1e-30);
+  EXPECT_NEAR(doubled.std_dev, 2.0 * base.std_dev, 1e-6 * base.std_dev);
+  const ModulusUncertainty stiffer = Estimate(noise, 2e-30);
+  EXPECT_NEAR(stiffer.std_dev, 0.5 * base.std_dev, 1e-9 * base.std_dev);
+}
+
+TEST_F(ModulusUncertaintyTest, NotAvailableWithoutCurvatureOrNoise) {
+  const ModulusUncertainty flat = Estimate(NoiseLevels{1e-7, 1.0}, 0.0);
+  EXPECT_FALSE(flat.available);
+  EXPECT_NE(flat.message.find("not convex"), std::string::npos) << flat.message;
+  const ModulusUncertainty quiet = Estimate(NoiseLevels{0.0, 0.0}, 1e-30);
+  EXPECT_FALSE(quiet.available);
+  EXPECT_NE(quiet.message.find("no noise"), std::string::npos) << quiet.message;
+}
+
+TEST_F(ModulusUncertaintyTest, MisfitLevelsAreTheRmsEndMisfits) {
+  const NoiseLevels misfit = MisfitLevels(data_, solution_, problem_.alpha());
+  const int last = model_.right_node();
+  double sum = 0.0;
+  for (int j = 0; j < data_.num_samples(); ++j) {
+    sum += std::pow(solution_.displacement(0, j) - data_.u0[j], 2) +
+           std::pow(solution_.displacement(last, j) - data_.uL[j], 2);
+  }
+  EXPECT_NEAR(misfit.displacement_std, std::sqrt(sum / (2.0 * data_.num_samples())),
+              1e-12 * misfit.displacement_std);
+  EXPECT_GT(misfit.force_std, 0.0);
+}
+
+}  // namespace
+}  // namespace mcrewave
