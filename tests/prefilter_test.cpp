@@ -1,0 +1,134 @@
+// Tests of the zero-phase low-pass pre-filter.
+#include "mcrewave/prefilter.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "mcrewave/simulation.h"
+
+namespace mcrewave {
+namespace {
+
+constexpr double kSampleRate = 1.0 / 0.36e-6;  // the paper's sampling rate [Hz]
+constexpr int kSamples = 1751;
+
+double Time(int k) { return k / kSampleRate; }
+
+TEST(PrefilterOptionsTest, DefaultOptionsAreValidAndBadOnesRefused) {
+  std::string why;
+  EXPECT_TRUE(PrefilterOptions().IsValid(&why)) << why;
+  PrefilterOptions options;
+  options.order = 3;
+  EXPECT_FALSE(options.IsValid(&why));
+  EXPECT_NE(why.find("prefilter.order"), std::string::npos);
+  options = PrefilterOptions();
+  options.cutoff_frequency = -1.0;
+  EXPECT_FALSE(options.IsValid(&why));
+  EXPECT_NE(why.find("prefilter.cutoff_frequency"), std::string::npos);
+}
+
+TEST(ZeroPhaseLowPassTest, GainIsOneHalfAtTheCutoffAndOneAtZero) {
+  const ZeroPhaseLowPass filter(100e3, kSampleRate, 4);
+  EXPECT_NEAR(filter.Gain(0.0), 1.0, 1e-15);
+  EXPECT_NEAR(filter.Gain(100e3), 0.5, 1e-12);
+  EXPECT_LT(filter.Gain(400e3), 1e-4);
+}
+
+TEST(ZeroPhaseLowPassTest, PassesABandLimitedSignalUnchanged) {
+  // Sines at up to a quarter of the cut-off, with an offset and a non-zero value and
+  // slope at both ends of the record.
+  const double cutoff = 100e3;
+  const ZeroPhaseLowPass filter(cutoff, kSampleRate, 4);
+  Vector signal(kSamples);
+  for (int k = 0; k < kSamples; ++k) {
+    const double t = Time(k);
+    signal[k] = 0.3 + std::sin(2 * M_PI * 7.9e3 * t + 0.4) + 0.5 * std::sin(2 * M_PI * 23.7e3 * t) +
+                0.2 * std::cos(2 * M_PI * 25e3 * t);
+  }
+  const Vector filtered = filter.Apply(signal);
+  const double error = (filtered - signal).cwiseAbs().maxCoeff() / signal.cwiseAbs().maxCoeff();
+  EXPECT_LT(error, 1e-3) << "max relative change " << error;
+}
+
+TEST(ZeroPhaseLowPassTest, AddsNoDelay) {
+  // A Gaussian pulse whose spectrum reaches past the cut-off: the filtered pulse is
+  // lower and wider but centred on the same time (zero phase), to 1e-3 samples.
+  const ZeroPhaseLowPass filter(50e3, kSampleRate, 4);
+  Vector pulse(kSamples);
+  const double centre = 800.3, width = 6.0;  // samples
+  for (int k = 0; k < kSamples; ++k) {
+    pulse[k] = std::exp(-0.5 * std::pow((k - centre) / width, 2));
+  }
+  const Vector filtered = filter.Apply(pulse);
+  double moment = 0.0, mass = 0.0;
+  for (int k = 0; k < kSamples; ++k) {
+    moment += k * filtered[k];
+    mass += filtered[k];
+  }
+  EXPECT_LT(filtered.maxCoeff(), 0.9);
+  EXPECT_NEAR(moment / mass, centre, 1e-3);
+  // A causal (one-pass) filter would delay it by several samples; check the
+  // peak sample too.
+  Eigen::Index peak = 0;
+  filtered.maxCoeff(&peak);
+  EXPECT_EQ(peak, 800);
+}
+
+TEST(ZeroPhaseLowPassTest, RemovesMostOfTheWhiteNoise) {
+  // White noise of unit variance keeps about 2 * (effective band) / fs of its power.
+  const double cutoff = 100e3;
+  const ZeroPhaseLowPass filter(cutoff, kSampleRate, 4);
+  std::mt19937_64 engine(3);
+  std::normal_distribution<double> normal;
+  Vector noise(20000);
+  for (double& value : noise) value = normal(engine);
+  const Vector filtered = filter.Apply(noise);
+  const double kept = filtered.squaredNorm() / noise.squaredNorm();
+  // Equivalent noise bandwidth of |H1|^2 for N = 4 is fc (pi / (2 N)) / sin(pi / (2 N)).
+  const double expected = 2.0 * cutoff * (M_PI / 8.0) / std::sin(M_PI / 8.0) / kSampleRate;
+  EXPECT_NEAR(kept, expected, 0.15 * expected);
+}
+
+TEST(PrefilterTest, CutoffDerivedFromTheLoadLiesAboveItsSpectrum) {
+  // The paper's case: a 0.1 ms half sine (main lobe below 15 kHz).
+  BarProperties bar;
+  LoadOptions load;
+  TimeOptions time;
+  DataOptions data;
+  data.truth_refinement = 1;
+  for (double snr : {std::numeric_limits<double>::infinity(), 2.5}) {
+    data.snr = snr;
+    const MeasurementSet measurements = MakeSyntheticMeasurements(bar, load, time, data);
+    const double cutoff = EstimateCutoffFrequency(measurements);
+    EXPECT_GT(cutoff, 30e3) << "SNR " << snr;
+    EXPECT_LT(cutoff, 300e3) << "SNR " << snr;
+  }
+}
+
+TEST(PrefilterTest, DisabledLeavesTheDataAndEnabledFiltersEveryChannel) {
+  BarProperties bar;
+  LoadOptions load;
+  TimeOptions time;
+  DataOptions data;
+  data.truth_refinement = 1;
+  data.snr = 2.5;
+  const MeasurementSet noisy = MakeSyntheticMeasurements(bar, load, time, data);
+  data.snr = std::numeric_limits<double>::infinity();
+  const MeasurementSet clean = MakeSyntheticMeasurements(bar, load, time, data);
+  PrefilterOptions options;
+  EXPECT_EQ(PrefilterMeasurements(noisy, options).uL, noisy.uL);
+  options.enabled = true;
+  double cutoff = 0.0;
+  const MeasurementSet filtered = PrefilterMeasurements(noisy, options, &cutoff);
+  EXPECT_GT(cutoff, 0.0);
+  // Every channel is much closer to the noise-free one after filtering.
+  EXPECT_LT((filtered.uL - clean.uL).norm(), 0.5 * (noisy.uL - clean.uL).norm());
+  EXPECT_LT((filtered.u0 - clean.u0).norm(), 0.5 * (noisy.u0 - clean.u0).norm());
+  EXPECT_LT((filtered.fL - clean.fL).norm(), 0.5 * (noisy.fL - clean.fL).norm());
+  EXPECT_LT((filtered.f0 - clean.f0).norm(), 0.5 * (noisy.f0 - clean.f0).norm());
+}
+
+}  // namespace
+}  // namespace mcrewave
