@@ -2,15 +2,18 @@
 # Regenerates results/weights/: how the MCRE weights w_u, w_f change the
 # conditioning of the coupled problem and the identification on the paper's case
 # (weights.csv, cost_curves.csv, cost_curves.png). About 5 minutes on 2 cores.
-# Usage: scripts/weights_study.sh [seeds]   (default 4 noise seeds at SNR 2.5)
+# Usage: scripts/weights_study.sh [seeds]     (default 4 noise seeds at SNR 2.5)
+#        scripts/weights_study.sh --plot-only  (redraw the figure from the CSVs)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${MCREWAVE_BUILD_DIR:-$root/build}"
 out="$root/results/weights"
 
-bash "$root/scripts/build.sh" > /dev/null
-mkdir -p "$out"
-"$build_dir/bench/weights_benchmark" "$out" "${1:-4}"
+if [ "${1:-}" != "--plot-only" ]; then
+  bash "$root/scripts/build.sh" > /dev/null
+  mkdir -p "$out"
+  "$build_dir/bench/weights_benchmark" "$out" "${1:-4}"
+fi
 
 # Normalised cost curves e^2 / min e^2 of noise seed 1 at SNR 2.5, one per weight pair.
 work="$(mktemp -d)"
@@ -30,8 +33,8 @@ set output "$out/cost_curves.png.tmp"
 set title "Cost curves on the paper's case, SNR 2.5 (seed 1), data from the 4x finer truth"
 set xlabel "E / E_{ref}"
 set ylabel "e^2(E) / min e^2"
-set logscale y
 set key top center
+set yrange [*:*]
 set grid
 plot $plot_list
 GNUPLOT
