@@ -74,24 +74,25 @@ ValueType<double> Number() {
   return type;
 }
 
-// A decimal integer >= 1 that fits an int; "1.5" and "1e3" are not integers.
-ValueType<int> PositiveInteger() {
-  ValueType<int> type;
+// A decimal integer >= 1 that fits Int; "1.5" and "1e3" are not integers.
+template <typename Int>
+ValueType<Int> PositiveInteger() {
+  ValueType<Int> type;
   type.expected = "a positive integer";
-  type.read = [](const YAML::Node& node, int* value) {
+  type.read = [](const YAML::Node& node, Int* value) {
     if (!node.IsScalar() || node.Scalar().empty()) return false;
     const std::string& text = node.Scalar();
     errno = 0;
     char* end = nullptr;
     const long long parsed = std::strtoll(text.c_str(), &end, 10);
     if (errno != 0 || *end != '\0' || std::isspace(static_cast<unsigned char>(text[0])) ||
-        parsed < 1 || parsed > std::numeric_limits<int>::max()) {
+        parsed < 1 || parsed > std::numeric_limits<Int>::max()) {
       return false;
     }
-    *value = static_cast<int>(parsed);
+    *value = static_cast<Int>(parsed);
     return true;
   };
-  type.write = [](const int& value) { return std::to_string(value); };
+  type.write = [](const Int& value) { return std::to_string(value); };
   return type;
 }
 
@@ -133,6 +134,21 @@ ValueType<std::string> Text() {
     emitter << YAML::DoubleQuoted << value;
     return std::string(emitter.c_str());
   };
+  return type;
+}
+
+// true or false (YAML also accepts yes/no, on/off).
+ValueType<bool> Boolean() {
+  ValueType<bool> type;
+  type.expected = "true or false";
+  type.read = [](const YAML::Node& node, bool* value) {
+    if (!node.IsScalar()) return false;
+    bool parsed;
+    if (!YAML::convert<bool>::decode(node, parsed)) return false;
+    *value = parsed;
+    return true;
+  };
+  type.write = [](const bool& value) { return std::string(value ? "true" : "false"); };
   return type;
 }
 
@@ -191,6 +207,39 @@ Key MakeKey(const char* path, Section Config::*section, T Section::*field, const
   return key;
 }
 
+// The row of key `path` stored in config.*section.*part.*field (a struct inside
+// a section, e.g. mcre.weights.displacement_weight).
+template <typename Section, typename Part, typename T>
+Key MakeKey(const char* path, Section Config::*section, Part Section::*part, T Part::*field,
+            const ValueType<T>& type, const char* unit, const char* description) {
+  Key key;
+  key.path = path;
+  key.unit = unit;
+  key.description = description;
+  key.choices = type.choices;
+  key.expected = type.expected + (key.unit.empty() ? "" : " (in " + key.unit + ")");
+  key.read = [section, part, field, read = type.read](const YAML::Node& node, Config* config) {
+    return read(node, &((config->*section).*part.*field));
+  };
+  key.write = [section, part, field, write = type.write](const Config& config) {
+    return write((config.*section).*part.*field);
+  };
+  return key;
+}
+
+// Every CoupledSolverType, in the order of the enum: the values whose name is
+// known to CoupledSolverTypeToString, from the first (the enum is contiguous
+// from 0), so that a solver added to coupled_solver.h is accepted here as well.
+std::vector<CoupledSolverType> AllCoupledSolverTypes() {
+  std::vector<CoupledSolverType> types;
+  for (int value = 0;; ++value) {
+    const auto type = static_cast<CoupledSolverType>(value);
+    if (std::string(CoupledSolverTypeToString(type)) == "unknown") break;
+    types.push_back(type);
+  }
+  return types;
+}
+
 // Every key of the config, in the order of the written config. Defaults are those
 // of a default-constructed Config. To add a key, add a row (and the field to its
 // section struct); to add a section, also add its struct to Config and its
@@ -205,7 +254,7 @@ const std::vector<Key>& KeyTable() {
               "density rho"),
       MakeKey("model.modulus", &Config::model, &BarProperties::modulus, Number(), "Pa",
               "Young's modulus E of the reference (or initial) model"),
-      MakeKey("model.elements", &Config::model, &BarProperties::elements, PositiveInteger(), "",
+      MakeKey("model.elements", &Config::model, &BarProperties::elements, PositiveInteger<int>(), "",
               "number N of linear finite elements"),
       MakeKey("model.mass", &Config::model, &BarProperties::mass,
               EnumByName<MassType>({MassType::kConsistent, MassType::kLumped}, MassTypeToString,
@@ -235,12 +284,76 @@ const std::vector<Key>& KeyTable() {
                                      TruthModelToString, StringToTruthModel),
               "", "truth sampled by the synthetic data"),
       MakeKey("data.truth_refinement", &Config::data, &DataOptions::truth_refinement,
-              PositiveInteger(), "",
+              PositiveInteger<int>(), "",
               "mesh and step refinement of the finite_element truth, in [1, 64]"),
       MakeKey("data.snr", &Config::data, &DataOptions::snr, Number(), "",
               "signal-to-noise ratio of the synthetic noise (.inf: no noise)"),
       MakeKey("data.seed", &Config::data, &DataOptions::seed, UnsignedInteger(), "",
               "seed of the noise generator"),
+      MakeKey("mcre.w_u", &Config::mcre, &McreOptions::weights, &McreWeights::displacement_weight,
+              Number(), "", "displacement weight: beta = w_u S E0 / L"),
+      MakeKey("mcre.w_f", &Config::mcre, &McreOptions::weights, &McreWeights::force_weight,
+              Number(), "", "force weight: alpha = w_f L / (S E0)"),
+      MakeKey("mcre.reference_modulus", &Config::mcre, &McreOptions::reference_modulus, Number(),
+              "Pa", "E0 of the weights: a fixed nominal modulus, not the unknown"),
+      MakeKey("inner.method", &Config::inner, &CoupledSolverOptions::type,
+              EnumByName<CoupledSolverType>(AllCoupledSolverTypes(), CoupledSolverTypeToString,
+                                            StringToCoupledSolverType),
+              "", "solver of the coupled direct/retrograde problem for one E"),
+      MakeKey("inner.tolerance", &Config::inner, &CoupledSolverOptions::tolerance, Number(), "",
+              "stop when ||c - A W||_P / ||c||_P falls below this, in (0, 1)"),
+      MakeKey("inner.max_iterations", &Config::inner, &CoupledSolverOptions::max_iterations,
+              PositiveInteger<int>(), "", "sweep pairs allowed to one iterative solve"),
+      MakeKey("inner.omega", &Config::inner, &CoupledSolverOptions::relaxation_coefficient,
+              Number(), "", "relaxation coefficient of method relaxation, in (0, 2)"),
+      MakeKey("inner.spectrum_steps", &Config::inner,
+              &CoupledSolverOptions::spectrum_estimation_steps, PositiveInteger<int>(), "",
+              "Lanczos steps of adaptive_relaxation's spectrum estimate, at least 2"),
+      MakeKey("inner.spectrum_safety_factor", &Config::inner,
+              &CoupledSolverOptions::spectrum_safety_factor, Number(), "",
+              "adaptive_relaxation: factor (>= 1) on the estimated largest eigenvalue"),
+      MakeKey("inner.divergence_factor", &Config::inner, &CoupledSolverOptions::divergence_factor,
+              Number(), "", "a residual this many times above the least seen is divergence"),
+      MakeKey("inner.max_all_at_once_unknowns", &Config::inner,
+              &CoupledSolverOptions::max_all_at_once_unknowns, PositiveInteger<long>(), "",
+              "all_at_once refuses systems with more unknowns"),
+      MakeKey("outer.optimizer", &Config::outer, &IdentificationOptions::optimizer,
+              EnumByName<OptimizerType>({OptimizerType::kNlopt, OptimizerType::kCeres},
+                                        OptimizerTypeToString, StringToOptimizerType),
+              "", "outer optimiser of e^2(E)"),
+      MakeKey("outer.algorithm", &Config::outer, &IdentificationOptions::algorithm,
+              EnumByName<OuterAlgorithm>(
+                  {OuterAlgorithm::kDefault, OuterAlgorithm::kBobyqa, OuterAlgorithm::kCobyla,
+                   OuterAlgorithm::kSbplx, OuterAlgorithm::kMma, OuterAlgorithm::kLbfgs,
+                   OuterAlgorithm::kBfgs},
+                  OuterAlgorithmToString, StringToOuterAlgorithm),
+              "",
+              "default: bobyqa (nlopt) or lbfgs (ceres); nlopt: bobyqa, cobyla, sbplx, mma, "
+              "lbfgs; ceres: lbfgs, bfgs"),
+      MakeKey("outer.lower_bound", &Config::outer, &IdentificationOptions::lower_bound, Number(),
+              "Pa", "least modulus searched, > 0"),
+      MakeKey("outer.upper_bound", &Config::outer, &IdentificationOptions::upper_bound, Number(),
+              "Pa", "largest modulus searched"),
+      MakeKey("outer.initial", &Config::outer, &IdentificationOptions::initial, Number(), "Pa",
+              "start of the search, strictly inside the bounds; also the scale of E"),
+      MakeKey("outer.relative_tolerance", &Config::outer,
+              &IdentificationOptions::relative_tolerance, Number(), "",
+              "stop when a step changes E by less than this fraction of E"),
+      MakeKey("outer.max_evaluations", &Config::outer, &IdentificationOptions::max_evaluations,
+              PositiveInteger<int>(), "", "e^2 evaluations allowed to the outer loop, at least 2"),
+      MakeKey("outer.max_time", &Config::outer, &IdentificationOptions::max_time, Number(), "s",
+              "wall time allowed to the outer loop"),
+      MakeKey("uncertainty.samples", &Config::uncertainty, &UncertaintyOptions::samples,
+              PositiveInteger<int>(), "",
+              "noise draws of the first-order std of E, in [2, 1000]"),
+      MakeKey("uncertainty.seed", &Config::uncertainty, &UncertaintyOptions::seed,
+              UnsignedInteger(), "", "seed of those noise draws"),
+      MakeKey("output.folder", &Config::output, &OutputOptions::folder, Text(), "",
+              "results folder of identify run, relative to the working directory"),
+      MakeKey("output.figures", &Config::output, &OutputOptions::figures, Boolean(), "",
+              "also draw the PNG figures with gnuplot"),
+      MakeKey("output.curve_points", &Config::output, &OutputOptions::curve_points,
+              PositiveInteger<int>(), "", "points of the cost curve e^2(E), in [5, 1000]"),
   };
   return table;
 }
@@ -263,6 +376,11 @@ const std::vector<SectionValidator>& SectionValidators() {
       ValidatorOf(&Config::load),
       ValidatorOf(&Config::time),
       ValidatorOf(&Config::data),
+      ValidatorOf(&Config::mcre),
+      ValidatorOf(&Config::inner),
+      ValidatorOf(&Config::outer),
+      ValidatorOf(&Config::uncertainty),
+      ValidatorOf(&Config::output),
   };
   return validators;
 }
@@ -572,6 +690,20 @@ std::string WriteYaml(const Config& config, bool with_comments) {
 }
 
 }  // namespace
+
+bool OutputOptions::IsValid(std::string* error) const {
+  std::string why;
+  if (folder.empty()) {
+    why = "output.folder must name a folder";
+  } else if (curve_points < 5 || curve_points > 1000) {
+    why = "output.curve_points must be an integer in [5, 1000], got " +
+          std::to_string(curve_points);
+  } else {
+    return true;
+  }
+  if (error != nullptr) *error = why;
+  return false;
+}
 
 Config ParseConfig(const std::string& yaml_text, const std::string& name,
                    const std::vector<std::string>& overrides) {

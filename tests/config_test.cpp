@@ -36,6 +36,30 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.data.truth_refinement, actual.data.truth_refinement);
   EXPECT_EQ(expected.data.snr, actual.data.snr);
   EXPECT_EQ(expected.data.seed, actual.data.seed);
+  EXPECT_EQ(expected.mcre.weights.displacement_weight, actual.mcre.weights.displacement_weight);
+  EXPECT_EQ(expected.mcre.weights.force_weight, actual.mcre.weights.force_weight);
+  EXPECT_EQ(expected.mcre.reference_modulus, actual.mcre.reference_modulus);
+  EXPECT_EQ(expected.inner.type, actual.inner.type);
+  EXPECT_EQ(expected.inner.tolerance, actual.inner.tolerance);
+  EXPECT_EQ(expected.inner.max_iterations, actual.inner.max_iterations);
+  EXPECT_EQ(expected.inner.relaxation_coefficient, actual.inner.relaxation_coefficient);
+  EXPECT_EQ(expected.inner.spectrum_estimation_steps, actual.inner.spectrum_estimation_steps);
+  EXPECT_EQ(expected.inner.spectrum_safety_factor, actual.inner.spectrum_safety_factor);
+  EXPECT_EQ(expected.inner.divergence_factor, actual.inner.divergence_factor);
+  EXPECT_EQ(expected.inner.max_all_at_once_unknowns, actual.inner.max_all_at_once_unknowns);
+  EXPECT_EQ(expected.outer.optimizer, actual.outer.optimizer);
+  EXPECT_EQ(expected.outer.algorithm, actual.outer.algorithm);
+  EXPECT_EQ(expected.outer.lower_bound, actual.outer.lower_bound);
+  EXPECT_EQ(expected.outer.upper_bound, actual.outer.upper_bound);
+  EXPECT_EQ(expected.outer.initial, actual.outer.initial);
+  EXPECT_EQ(expected.outer.relative_tolerance, actual.outer.relative_tolerance);
+  EXPECT_EQ(expected.outer.max_evaluations, actual.outer.max_evaluations);
+  EXPECT_EQ(expected.outer.max_time, actual.outer.max_time);
+  EXPECT_EQ(expected.uncertainty.samples, actual.uncertainty.samples);
+  EXPECT_EQ(expected.uncertainty.seed, actual.uncertainty.seed);
+  EXPECT_EQ(expected.output.folder, actual.output.folder);
+  EXPECT_EQ(expected.output.figures, actual.output.figures);
+  EXPECT_EQ(expected.output.curve_points, actual.output.curve_points);
 }
 
 // Runs `action`, which must throw InputError whose message contains every one of
@@ -100,7 +124,8 @@ TEST(ConfigTest, DefaultOptionsAreValid) {
 TEST(ConfigTest, DefaultConfigYamlParsesToTheDefaultConfig) {
   const std::string yaml = DefaultConfigYaml();
   ExpectSameConfig(Config{}, ParseConfig(yaml, "default.yaml"));
-  for (const char* line : {"model:", "load:", "time:", "data:", "  length: 1", "# [m] ",
+  for (const char* line : {"model:", "load:", "time:", "data:", "mcre:", "inner:", "outer:",
+                           "uncertainty:", "output:", "  length: 1", "# [m] ",
                            "  snr: .inf", "  density: 800", "(consistent | lumped)"}) {
     EXPECT_NE(yaml.find(line), std::string::npos) << yaml << "\nlacks " << line;
   }
@@ -118,7 +143,7 @@ TEST(ConfigTest, DefaultConfigYamlCommentsEveryKey) {
     ++keys;
     EXPECT_NE(line.find(" # "), std::string::npos) << line;
   }
-  EXPECT_GE(keys, 18);
+  EXPECT_GE(keys, 40);
 }
 
 TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
@@ -140,10 +165,37 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   config.data.truth_refinement = 64;
   config.data.snr = 2.5;
   config.data.seed = std::numeric_limits<std::uint64_t>::max();
+  config.mcre.weights.displacement_weight = 0.3;
+  config.mcre.weights.force_weight = 1.0 / 7.0;
+  config.mcre.reference_modulus = 70e9;
+  config.inner.type = CoupledSolverType::kAdaptiveRelaxation;
+  config.inner.tolerance = 1e-11;
+  config.inner.max_iterations = 123;
+  config.inner.relaxation_coefficient = 0.7;
+  config.inner.spectrum_estimation_steps = 9;
+  config.inner.spectrum_safety_factor = 1.2;
+  config.inner.divergence_factor = 50.0;
+  config.inner.max_all_at_once_unknowns = 3'000'000'000L;
+  config.outer.optimizer = OptimizerType::kCeres;
+  config.outer.algorithm = OuterAlgorithm::kBfgs;
+  config.outer.lower_bound = 1e9;
+  config.outer.upper_bound = 1e12;
+  config.outer.initial = 1.0 / 3.0 * 1e11;
+  config.outer.relative_tolerance = 1e-9;
+  config.outer.max_evaluations = 17;
+  config.outer.max_time = 0.5;
+  config.uncertainty.samples = 3;
+  config.uncertainty.seed = 99;
+  config.output.folder = "out dir/run #1";
+  config.output.figures = false;
+  config.output.curve_points = 7;
   const std::string yaml = ConfigToYaml(config);
   ExpectSameConfig(config, ParseConfig(yaml, "resolved.yaml"));
   EXPECT_NE(yaml.find("mass: lumped"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("truth: modal"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("method: adaptive_relaxation"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("optimizer: ceres"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("figures: false"), std::string::npos) << yaml;
 
   config.data.snr = std::numeric_limits<double>::infinity();
   const std::string infinite_snr = ConfigToYaml(config);
@@ -156,9 +208,36 @@ TEST(ConfigTest, PaperBarConfigLoads) {
   const Config config = LoadConfig(path);
   Config expected;
   expected.data.snr = 2.5;
+  expected.output.folder = "results/paper_bar";
   ExpectSameConfig(expected, config);
   EXPECT_EQ(config.source_path, path);
   EXPECT_EQ(config.time.NumSteps(), 1750);
+}
+
+TEST(ConfigTest, QuickAndMeasuredCsvConfigsLoad) {
+  const Config quick = LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/quick.yaml");
+  EXPECT_EQ(quick.model.elements, 25);
+  EXPECT_EQ(quick.time.NumSteps(), 300);
+  EXPECT_EQ(quick.data.snr, 20.0);
+  const Config measured =
+      LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/measured_csv.yaml");
+  EXPECT_EQ(measured.data.source, DataSource::kCsv);
+  EXPECT_EQ(measured.outer.optimizer, OptimizerType::kCeres);
+}
+
+TEST(ConfigTest, BooleanAcceptsTheYamlSpellings) {
+  EXPECT_FALSE(ParseConfig("output:\n  figures: no\n", "a.yaml").output.figures);
+  EXPECT_TRUE(ParseConfig("output:\n  figures: yes\n", "a.yaml").output.figures);
+  EXPECT_FALSE(ParseConfig("", "a.yaml", {"output.figures=false"}).output.figures);
+}
+
+TEST(ConfigTest, EveryCoupledSolverIsAnInnerMethod) {
+  for (const char* name : {"all_at_once", "relaxation", "adaptive_relaxation",
+                           "conjugate_gradient"}) {
+    CoupledSolverType type;
+    ASSERT_TRUE(StringToCoupledSolverType(name, &type));
+    EXPECT_EQ(ParseConfig("", "a.yaml", {std::string("inner.method=") + name}).inner.type, type);
+  }
 }
 
 TEST(ConfigTest, EmptyTextAndEmptySectionsGiveDefaults) {
@@ -333,7 +412,9 @@ TEST_F(ConfigFileTest, SectionThatIsNotAMap) {
 
 TEST_F(ConfigFileTest, TopLevelThatIsNotAMap) {
   ExpectLoadError("- model\n- load\n", 1,
-                  {"expected a map of sections (model, load, time, data)", "got a list"});
+                  {"expected a map of sections (model, load, time, data, mcre, inner, outer, "
+                   "uncertainty, output)",
+                   "got a list"});
 }
 
 TEST_F(ConfigFileTest, DuplicateKey) {

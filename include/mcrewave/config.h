@@ -13,15 +13,46 @@
 //   time:  window [0.63e-3 s], step [0.36e-6 s], theta [0.5]
 //   data:  source [synthetic | csv], path [""], truth [finite_element | modal],
 //          truth_refinement [4], snr [.inf], seed [1]
+//   mcre:  w_u [0.01], w_f [1], reference_modulus [200e9 Pa] (E0 of the weights;
+//          objective.h)
+//   inner: method [conjugate_gradient | all_at_once | relaxation | adaptive_relaxation
+//          | any other CoupledSolverType], tolerance [1e-8], max_iterations [5000],
+//          omega [0.5], spectrum_steps [12], spectrum_safety_factor [1.05],
+//          divergence_factor [1e3], max_all_at_once_unknowns [1500000]
+//          (CoupledSolverOptions, coupled_solver.h)
+//   outer: optimizer [nlopt | ceres], algorithm [default | bobyqa | cobyla | sbplx |
+//          mma | lbfgs | bfgs], lower_bound [100e9 Pa], upper_bound [400e9 Pa],
+//          initial [160e9 Pa], relative_tolerance [1e-7], max_evaluations [100],
+//          max_time [600 s] (IdentificationOptions, identification.h)
+//   uncertainty: samples [16], seed [1] (modulus_uncertainty.h)
+//   output: folder ["results/identify"], figures [true], curve_points [41]
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "mcrewave/bar_model.h"
+#include "mcrewave/coupled_solver.h"
 #include "mcrewave/experiment.h"
+#include "mcrewave/identification.h"
+#include "mcrewave/modulus_uncertainty.h"
+#include "mcrewave/objective.h"
 
 namespace mcrewave {
+
+// The `output:` section: where `identify run` writes its results and what.
+struct OutputOptions {
+  // Results folder; a relative path is taken from the working directory (not
+  // from the config's folder); `identify run --output` replaces it.
+  std::string folder = "results/identify";
+  // Write the PNG figures (gnuplot) beside the CSV files.
+  bool figures = true;
+  // Points of the cost curve e^2(E) computed around the identified modulus.
+  int curve_points = 41;
+
+  // Valid when folder is not empty and curve_points is in [5, 1000].
+  bool IsValid(std::string* error) const;
+};
 
 struct Config {
   std::string source_path;  // the file the config was read from ("" for defaults)
@@ -29,6 +60,11 @@ struct Config {
   LoadOptions load;
   TimeOptions time;
   DataOptions data;
+  McreOptions mcre;
+  CoupledSolverOptions inner;
+  IdentificationOptions outer;
+  UncertaintyOptions uncertainty;
+  OutputOptions output;
 };
 
 // Reads a config file, applies the overrides ("key.path=value", each parsed as a
