@@ -5,33 +5,52 @@
 // simulates the reference experiment that produces such measurements.
 //
 // Sample runs:
+//   identify run configs/paper_bar.yaml --output results/main
+//   identify run configs/quick.yaml --set outer.optimizer=ceres --output /tmp/quick -v
+//   identify run configs/measured_csv.yaml -q
 //   identify simulate configs/paper_bar.yaml --output measurements.csv
 //   identify simulate configs/paper_bar.yaml --set data.snr=.inf --output clean.csv
 //   identify simulate configs/paper_bar.yaml --set model.elements=400 --output fine.csv
 //   identify --print-default-config > my_config.yaml
 //
 // Description:
+//   `run` reads a YAML config, gets the measurements (synthetic, or the CSV file
+//   of data.path, which must be on the config's time grid), identifies E by
+//   minimising the MCRE cost e^2(E) with the outer optimiser of `outer:` (NLopt
+//   or Ceres) over coupled direct/retrograde solves by the method of `inner:`,
+//   then computes the cost curve around the identified E and an uncertainty
+//   figure, and writes summary.yaml, CSV files and PNG figures into the output
+//   folder (include/mcrewave/results.h), each file atomically and only at the
+//   end. One progress line per outer evaluation at the default level.
+//
 //   `simulate` reads a YAML config (see include/mcrewave/config.h or
 //   --print-default-config), simulates the bar clamped at x = 0 and hit by a
 //   half-sine load at x = L on the truth discretisation of `data:`, samples the
 //   four channels (u0, uL, f0, fL) on the model's time grid, adds white noise at
 //   the configured SNR and writes the measurement CSV (t,u0,uL,f0,fL).
 //
-// Exit code 0 on success; otherwise one line on stderr saying why and exit code
-// 2 for bad input (config, CSV, options) or 1 for a failed computation.
+// Exit code 0 on success (for `run`: a converged identification); otherwise one
+// line on stderr saying why and exit code 2 for bad input (config, CSV, options,
+// an output folder that cannot be created) or 1 for a failed computation.
 
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <unistd.h>
+
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <string>
 #include <vector>
 
 #include "mcrewave/config.h"
+#include "mcrewave/identification_run.h"
 #include "mcrewave/measurement.h"
 #include "mcrewave/noise.h"
+#include "mcrewave/results.h"
 #include "mcrewave/simulation.h"
 #include "mcrewave/version.h"
 
@@ -42,6 +61,82 @@ struct SimulateArguments {
   std::vector<std::string> overrides;
   std::string output_path;
 };
+
+struct RunArguments {
+  std::string config_path;
+  std::vector<std::string> overrides;
+  std::string output_folder;  // "" = output.folder of the config
+};
+
+// Log levels of -v and -q; info (one line per outer evaluation) otherwise.
+struct Verbosity {
+  bool verbose = false;
+  bool quiet = false;
+  void Apply() const {
+    spdlog::set_level(verbose ? spdlog::level::debug
+                              : (quiet ? spdlog::level::warn : spdlog::level::info));
+  }
+};
+
+// Throws InputError when `folder` cannot be created or written to: checked
+// before any computation, so that a bad --output costs nothing.
+void CheckOutputFolder(const std::string& folder) {
+  namespace fs = std::filesystem;
+  fs::path existing = fs::absolute(folder);
+  std::error_code error;
+  while (!fs::exists(existing, error) && existing.has_parent_path() &&
+         existing.parent_path() != existing) {
+    existing = existing.parent_path();
+  }
+  if (fs::exists(existing, error) && !fs::is_directory(existing, error)) {
+    throw mcrewave::InputError("output folder " + folder + ": " + existing.string() +
+                               " is not a folder");
+  }
+  if (::access(existing.c_str(), W_OK | X_OK) != 0) {
+    throw mcrewave::InputError("output folder " + folder + ": cannot write in " +
+                               existing.string());
+  }
+}
+
+int RunIdentify(const RunArguments& arguments) {
+  // 1. Read and validate the config and the output folder (nothing is computed
+  //    or written if either is invalid).
+  mcrewave::Config config = mcrewave::LoadConfig(arguments.config_path, arguments.overrides);
+  if (!arguments.output_folder.empty()) config.output.folder = arguments.output_folder;
+  CheckOutputFolder(config.output.folder);
+
+  // 2. The measurements, checked against the model's time grid.
+  const mcrewave::MeasurementSet data = mcrewave::LoadMeasurements(config);
+  spdlog::info("config {}: {} elements, {} steps of {:.4g} s; data {} ({} samples)",
+               arguments.config_path, config.model.elements, config.time.NumSteps(),
+               config.time.step,
+               config.data.source == mcrewave::DataSource::kCsv ? config.data.path
+                                                                 : std::string("synthetic"),
+               data.num_samples());
+
+  // 3. Identify E, then the cost curve and the uncertainty figure.
+  const mcrewave::IdentificationRun run = mcrewave::RunIdentification(config, data);
+  if (!run.IsUsable()) {
+    std::fprintf(stderr, "error: identification failed: %s\n", run.outer.message.c_str());
+    return 1;
+  }
+
+  // 4. Write the results, each file atomically.
+  const std::vector<std::string> files =
+      mcrewave::WriteIdentificationResults(run, config.output.folder, config.output.figures);
+  if (run.reference_known) {
+    spdlog::info("identified E = {:.9g} Pa (reference {:.9g} Pa, relative error {:.3e}) in {} "
+                 "evaluations, {:.2f} s",
+                 run.identified_modulus(), config.model.modulus,
+                 (run.identified_modulus() - config.model.modulus) / config.model.modulus,
+                 run.outer.evaluations, run.wall_time_s);
+  } else {
+    spdlog::info("identified E = {:.9g} Pa in {} evaluations, {:.2f} s", run.identified_modulus(),
+                 run.outer.evaluations, run.wall_time_s);
+  }
+  spdlog::info("wrote {} files to {}", files.size(), config.output.folder);
+  return 0;
+}
 
 int RunSimulate(const SimulateArguments& arguments) {
   using Clock = std::chrono::steady_clock;
@@ -80,7 +175,22 @@ int main(int argc, char** argv) {
   app.add_flag("--print-default-config", print_default_config,
                "Print a fully commented default config and exit");
 
+  RunArguments run;
+  Verbosity run_verbosity;
+  CLI::App* run_command =
+      app.add_subcommand("run", "Identify E from the measurements of a config; write the results");
+  run_command->add_option("config", run.config_path, "YAML config file")->required();
+  run_command->add_option("--set", run.overrides,
+                          "Override a config key: --set key.path=value (repeatable)");
+  run_command->add_option("-o,--output", run.output_folder,
+                          "Results folder (replaces output.folder of the config)");
+  CLI::Option* run_verbose =
+      run_command->add_flag("-v,--verbose", run_verbosity.verbose, "Log every inner solve too");
+  run_command->add_flag("-q,--quiet", run_verbosity.quiet, "Log warnings and errors only")
+      ->excludes(run_verbose);
+
   SimulateArguments simulate;
+  Verbosity simulate_verbosity;
   CLI::App* simulate_command =
       app.add_subcommand("simulate", "Simulate the experiment and write a measurement CSV");
   simulate_command->add_option("config", simulate.config_path, "YAML config file")->required();
@@ -88,6 +198,10 @@ int main(int argc, char** argv) {
                                "Override a config key: --set key.path=value (repeatable)");
   simulate_command->add_option("-o,--output", simulate.output_path, "Measurement CSV to write")
       ->required();
+  CLI::Option* simulate_verbose =
+      simulate_command->add_flag("-v,--verbose", simulate_verbosity.verbose, "Log more");
+  simulate_command->add_flag("-q,--quiet", simulate_verbosity.quiet, "Log warnings and errors only")
+      ->excludes(simulate_verbose);
 
   try {
     app.parse(argc, argv);
@@ -100,7 +214,14 @@ int main(int argc, char** argv) {
       std::cout << mcrewave::DefaultConfigYaml();
       return 0;
     }
-    if (simulate_command->parsed()) return RunSimulate(simulate);
+    if (run_command->parsed()) {
+      run_verbosity.Apply();
+      return RunIdentify(run);
+    }
+    if (simulate_command->parsed()) {
+      simulate_verbosity.Apply();
+      return RunSimulate(simulate);
+    }
     std::cerr << app.help();
     return 1;
   } catch (const mcrewave::InputError& error) {

@@ -1,49 +1,26 @@
 // End-to-end tests of the identify binary: it is run as a user runs it.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include "identify_binary.h"
 #include "mcrewave/measurement.h"
 
 namespace mcrewave {
 namespace {
 
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-RunResult RunIdentify(const std::string& arguments) {
-  const std::string command = std::string(MCREWAVE_IDENTIFY_BINARY) + " " + arguments + " 2>&1";
-  RunResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  char buffer[4096];
-  while (fgets(buffer, sizeof buffer, pipe) != nullptr) result.output += buffer;
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
-
-std::string SourcePath(const std::string& relative) {
-  return std::string(MCREWAVE_SOURCE_DIR) + "/" + relative;
-}
-
-std::string FreshDirectory(const std::string& name) {
-  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / name;
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
-}
+using testing::FreshDirectory;
+using testing::RunIdentify;
+using testing::RunResult;
+using testing::SourcePath;
 
 TEST(IdentifyTest, HelpAndVersion) {
   const RunResult help = RunIdentify("--help");
   EXPECT_EQ(help.exit_code, 0);
   EXPECT_NE(help.output.find("simulate"), std::string::npos) << help.output;
+  EXPECT_NE(help.output.find("run"), std::string::npos) << help.output;
   const RunResult version = RunIdentify("--version");
   EXPECT_EQ(version.exit_code, 0);
   EXPECT_NE(version.output.find("mcrewave"), std::string::npos) << version.output;

@@ -1,0 +1,74 @@
+// One identification as `identify run` performs it, from a validated Config to
+// everything the results show, before anything is written (results.h writes).
+//
+//   1. LoadMeasurements: synthetic data (data.source: synthetic) or the CSV file,
+//      checked against the model's time grid.
+//   2. Identify (identification.h) on an McreObjective (objective.h) with
+//      x = E / outer.initial.
+//   3. At the identified E*: the cost curve e^2(E) on output.curve_points points
+//      around E*, warm-started point to point, and the uncertainty figure
+//      (modulus_uncertainty.h).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mcrewave/config.h"
+#include "mcrewave/identification.h"
+#include "mcrewave/measurement.h"
+#include "mcrewave/modulus_uncertainty.h"
+#include "mcrewave/objective.h"
+
+namespace mcrewave {
+
+// The measurements of config.data: MakeSyntheticMeasurements, or the CSV file
+// data.path. Throws InputError naming the file when a CSV is malformed (see
+// ReadMeasurementCsv) or does not match the model's time grid: its time step must
+// equal time.step and its sample count time.window / time.step + 1 (both to
+// 1e-6 relative).
+MeasurementSet LoadMeasurements(const Config& config);
+
+// Everything one identification computed.
+struct IdentificationRun {
+  Config config;
+  MeasurementSet data;
+  // Synthetic data: they were made with E = config.model.modulus, the reference
+  // the identified modulus is compared with. False for CSV data.
+  bool reference_known = false;
+  // The noise levels the uncertainty draws, and where they come from:
+  // "synthetic_snr" (the levels the synthetic noise was drawn with) or
+  // "data_differences" (DifferenceNoiseLevels: CSV data, or no synthetic noise).
+  NoiseLevels noise;
+  std::string noise_source;
+  NoiseLevels estimated_noise;  // DifferenceNoiseLevels(data), always
+  NoiseLevels misfit;           // RMS misfits at the optimum (MisfitLevels)
+
+  IdentificationSummary outer;
+  // The optimiser's evaluations, in order; evaluations[best_index] is the one
+  // at the identified E, and `solution` its coupled solution.
+  std::vector<ObjectiveEvaluation> evaluations;
+  int best_index = -1;
+  CoupledSolution solution;
+  double alpha = 0.0;      // force weight used [m/N]
+  double beta = 0.0;       // displacement weight used [N/m]
+  double rest_cost = 0.0;  // J_rest, the cost scale [J s]
+  long sweeps = 0;         // sweeps of the optimiser's evaluations
+
+  std::vector<CostCurvePoint> cost_curve;  // ascending E
+  long cost_curve_sweeps = 0;
+  ModulusUncertainty uncertainty;
+  double wall_time_s = -1.0;  // the whole of RunIdentification
+
+  // The outer loop converged; only then are the fields after `outer` filled.
+  bool IsUsable() const { return outer.IsSolutionUsable(); }
+  double identified_modulus() const { return outer.modulus; }
+  // e^2 at the identified E [J s].
+  double cost() const { return best_index >= 0 ? evaluations[best_index].cost : -1.0; }
+};
+
+// Runs steps 2 and 3 on measurements made by LoadMeasurements(config).
+// Precondition: config valid (as LoadConfig returns it). Never throws for a
+// failed identification: see IsUsable() and outer.message.
+IdentificationRun RunIdentification(const Config& config, const MeasurementSet& data);
+
+}  // namespace mcrewave

@@ -1,0 +1,177 @@
+#include "mcrewave/identification_run.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "mcrewave/noise.h"
+#include "mcrewave/simulation.h"
+
+namespace mcrewave {
+namespace {
+
+// Relative agreement asked of a CSV's time grid with the config's.
+constexpr double kGridTolerance = 1e-6;
+
+// The moduli of the cost curve, ascending: `points` moduli evenly spaced over
+// the window E* +- kCurvatureWindow E*; when the optimiser's evaluations reach
+// farther, half of them over the span of the evaluations instead and the other
+// half over the window, so the curve shows both the optimiser's path and the
+// neighbourhood of E*. Clipped to the bounds.
+std::vector<double> CostCurveModuli(const Config& config, const IdentificationRun& run) {
+  const double center = run.identified_modulus();
+  const double lower = config.outer.lower_bound;
+  const double upper = config.outer.upper_bound;
+  const double window_low = std::max(lower, center * (1.0 - kCurvatureWindow));
+  const double window_high = std::min(upper, center * (1.0 + kCurvatureWindow));
+  double span_low = window_low;
+  double span_high = window_high;
+  for (const ObjectiveEvaluation& evaluation : run.evaluations) {
+    span_low = std::min(span_low, evaluation.modulus);
+    span_high = std::max(span_high, evaluation.modulus);
+  }
+  const int points = config.output.curve_points;
+  const bool wider = span_low < window_low || span_high > window_high;
+  const int span_points = wider ? points / 2 : 0;
+  std::vector<double> moduli;
+  for (int i = 0; i < span_points; ++i) {
+    moduli.push_back(span_low + (span_high - span_low) * i / (span_points - 1.0));
+  }
+  const int window_points = points - span_points;
+  for (int i = 0; i < window_points; ++i) {
+    moduli.push_back(window_low + (window_high - window_low) * i / (window_points - 1.0));
+  }
+  std::sort(moduli.begin(), moduli.end());
+  return moduli;
+}
+
+// The cost curve at CostCurveModuli, each solve warm-started from the previous
+// point's (the first from the solution at E*).
+std::vector<CostCurvePoint> ComputeCostCurve(const Config& config, const BarModel& model,
+                                             const MeasurementSet& data,
+                                             const IdentificationRun& run, long* sweeps) {
+  const double center = run.identified_modulus();
+  const std::vector<double> moduli = CostCurveModuli(config, run);
+  spdlog::info("cost curve: {} points over [{:.6g}, {:.6g}] Pa", moduli.size(), moduli.front(),
+               moduli.back());
+
+  McreObjective objective(model, data, config.mcre, config.time.theta, config.inner, center);
+  objective.SetWarmStart(run.solution.retrograde);
+  std::vector<CostCurvePoint> curve;
+  for (const double modulus : moduli) {
+    const ObjectiveEvaluation& evaluation = objective.EvaluateModulus(modulus);
+    CostCurvePoint point;
+    point.modulus = modulus;
+    point.usable = evaluation.usable;
+    point.cost = evaluation.cost;
+    point.cost_gradient = evaluation.cost_gradient;
+    if (!point.usable) {
+      spdlog::warn("cost curve: the coupled solve at E = {:.6g} Pa is not usable ({})", modulus,
+                   evaluation.inner.BriefReport());
+    }
+    curve.push_back(point);
+  }
+  *sweeps = objective.total_sweeps();
+  return curve;
+}
+
+std::string Number(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+}  // namespace
+
+MeasurementSet LoadMeasurements(const Config& config) {
+  if (config.data.source == DataSource::kSynthetic) {
+    return MakeSyntheticMeasurements(config.model, config.load, config.time, config.data);
+  }
+  const std::string& path = config.data.path;
+  MeasurementSet data = ReadMeasurementCsv(path);
+  const std::string config_name = config.source_path.empty() ? "the config" : config.source_path;
+  if (std::abs(data.time_step - config.time.step) > kGridTolerance * config.time.step) {
+    throw InputError(path + ": time step " + Number(data.time_step) + " s differs from time.step " +
+                     Number(config.time.step) + " s of " + config_name +
+                     "; the model runs on the data's time grid");
+  }
+  const int expected_samples = config.time.NumSteps() + 1;
+  if (data.num_samples() != expected_samples) {
+    throw InputError(
+        path + ": " + std::to_string(data.num_samples()) +
+        " samples, but time.window / time.step + 1 = " + std::to_string(expected_samples) + " in " +
+        config_name + " (time.window " + Number(config.time.window) + " s)");
+  }
+  return data;
+}
+
+IdentificationRun RunIdentification(const Config& config, const MeasurementSet& data) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  IdentificationRun run;
+  run.config = config;
+  run.data = data;
+  run.reference_known = config.data.source == DataSource::kSynthetic;
+
+  // 1. The outer loop.
+  const BarModel model(config.model);
+  McreObjective objective(model, run.data, config.mcre, config.time.theta, config.inner,
+                          config.outer.initial);
+  run.alpha = objective.problem().alpha();
+  run.beta = objective.problem().beta();
+  run.rest_cost = objective.rest_cost();
+  spdlog::info(
+      "identifying E with {}/{} from {:.6g} Pa in [{:.6g}, {:.6g}] Pa; inner {}",
+      OptimizerTypeToString(config.outer.optimizer),
+      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
+      config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
+      CoupledSolverTypeToString(config.inner.type));
+  run.outer = Identify(config.outer, &objective);
+  run.evaluations = objective.evaluations();
+  run.sweeps = objective.total_sweeps();
+  spdlog::info("{}", run.outer.BriefReport());
+  if (!run.IsUsable()) {
+    run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
+    return run;
+  }
+  run.best_index = objective.best_index();
+  run.solution = objective.best_solution();
+
+  // 2. The cost curve around E*.
+  run.cost_curve = ComputeCostCurve(config, model, run.data, run, &run.cost_curve_sweeps);
+
+  // 3. The uncertainty figure: noise levels known for synthetic data with noise,
+  // estimated from the data's second differences otherwise.
+  run.misfit = MisfitLevels(run.data, run.solution, run.alpha);
+  run.estimated_noise = DifferenceNoiseLevels(run.data);
+  if (run.reference_known && std::isfinite(config.data.snr)) {
+    const MeasurementSet truth = SimulateTruth(config.model, config.load, config.time, config.data);
+    // std = RMS(signal) / SNR (noise.h)
+    run.noise.displacement_std = RootMeanSquare(truth.uL) / config.data.snr;
+    run.noise.force_std = RootMeanSquare(truth.fL) / config.data.snr;
+    run.noise_source = "synthetic_snr";
+  } else {
+    run.noise = run.estimated_noise;
+    run.noise_source = "data_differences";
+  }
+  int curvature_points = 0;
+  const double curvature = CostGradientSlope(run.cost_curve, run.identified_modulus(),
+                                             kCurvatureWindow, &curvature_points);
+  run.uncertainty = EstimateModulusUncertainty(
+      config.uncertainty, model, run.data, config.mcre, config.time.theta, config.inner,
+      run.identified_modulus(), run.solution, run.noise, curvature, curvature_points);
+  if (run.uncertainty.available) {
+    spdlog::info("uncertainty: std(E) = {:.4g} Pa ({:.3g} %) over {} noise draws",
+                 run.uncertainty.std_dev, 100.0 * run.uncertainty.relative_std_dev,
+                 run.uncertainty.samples);
+  } else {
+    spdlog::warn("uncertainty not available: {}", run.uncertainty.message);
+  }
+  run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return run;
+}
+
+}  // namespace mcrewave

@@ -1,0 +1,453 @@
+#include "mcrewave/results.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <spdlog/spdlog.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "mcrewave/file_util.h"
+#include "mcrewave/version.h"
+
+extern char** environ;
+
+namespace mcrewave {
+namespace {
+
+// The meaning of the uncertainty figure, written beside it.
+constexpr const char* kUncertaintyMeaning =
+    "first-order standard deviation of the identified E under fresh white measurement noise of "
+    "the levels below: std over the noise draws of -dg/k, dg the change of de^2/dE at E caused "
+    "by one draw, k the slope of de^2/dE over E +- 5 %; indicative only when it is not small "
+    "against that 5 %";
+
+// The shortest decimal text that reads back as exactly `value` ("null" for NaN,
+// ".inf" for infinities, YAML spelling).
+std::string Format(double value) {
+  if (std::isnan(value)) return "null";
+  if (std::isinf(value)) return value > 0 ? ".inf" : "-.inf";
+  char text[64];
+  for (int precision = 1; precision <= 17; ++precision) {
+    std::snprintf(text, sizeof(text), "%.*g", precision, value);
+    if (std::strtod(text, nullptr) == value) break;
+  }
+  return text;
+}
+
+std::string Quoted(const std::string& text) {
+  YAML::Emitter emitter;
+  emitter << YAML::DoubleQuoted << text;
+  return emitter.c_str();
+}
+
+// YAML lines "key: value  # comment", the comments aligned per block.
+class YamlWriter {
+ public:
+  void Line(int indent, const std::string& key, const std::string& value,
+            const std::string& comment = "") {
+    lines_.push_back({std::string(2 * indent, ' ') + key + ":" + (value.empty() ? "" : " " + value),
+                      comment});
+  }
+  void Number(int indent, const std::string& key, double value, const std::string& comment = "") {
+    Line(indent, key, Format(value), comment);
+  }
+  void Integer(int indent, const std::string& key, long value, const std::string& comment = "") {
+    Line(indent, key, std::to_string(value), comment);
+  }
+  void Text(int indent, const std::string& key, const std::string& value,
+            const std::string& comment = "") {
+    Line(indent, key, Quoted(value), comment);
+  }
+  void Raw(const std::string& text) { lines_.push_back({text, ""}); }
+
+  std::string str() const {
+    // Comments aligned after the longest commented line of at most kAlignLimit
+    // characters; longer lines keep theirs two spaces after the text.
+    constexpr std::size_t kAlignLimit = 60;
+    std::size_t width = 0;
+    for (const auto& [text, comment] : lines_) {
+      if (!comment.empty() && text.size() <= kAlignLimit) width = std::max(width, text.size());
+    }
+    std::string out;
+    for (const auto& [text, comment] : lines_) {
+      out += text;
+      if (!comment.empty()) {
+        out += std::string(text.size() < width ? width - text.size() + 2 : 2, ' ') + "# " + comment;
+      }
+      out += "\n";
+    }
+    return out;
+  }
+
+ private:
+  std::vector<std::pair<std::string, std::string>> lines_;
+};
+
+// ---------------------------------------------------------------------------
+// CSV files.
+
+std::string EvaluationsCsv(const IdentificationRun& run) {
+  std::string csv =
+      "evaluation,modulus,cost,cost_gradient,gradient_requested,usable,inner_iterations,sweeps,"
+      "relative_residual\n";
+  char row[512];
+  for (std::size_t i = 0; i < run.evaluations.size(); ++i) {
+    const ObjectiveEvaluation& e = run.evaluations[i];
+    std::snprintf(row, sizeof(row), "%zu,%.17g,%.17g,%.17g,%d,%d,%d,%ld,%.6g\n", i + 1, e.modulus,
+                  e.usable ? e.cost : NAN, e.usable ? e.cost_gradient : NAN,
+                  e.gradient_requested ? 1 : 0, e.usable ? 1 : 0, e.inner.iterations,
+                  e.inner.sweeps, e.inner.relative_residual);
+    csv += row;
+  }
+  return csv;
+}
+
+std::string CostCurveCsv(const IdentificationRun& run) {
+  std::string csv = "modulus,cost,cost_gradient,usable\n";
+  char row[256];
+  for (const CostCurvePoint& point : run.cost_curve) {
+    std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%d\n", point.modulus,
+                  point.usable ? point.cost : NAN, point.usable ? point.cost_gradient : NAN,
+                  point.usable ? 1 : 0);
+    csv += row;
+  }
+  return csv;
+}
+
+// Measured and model channels at both ends; the model force at the ends is
+// F = F~ - B W / alpha.
+std::string EndsCsv(const IdentificationRun& run) {
+  const MeasurementSet& data = run.data;
+  const Matrix& displacement = run.solution.displacement;
+  const Matrix& retrograde = run.solution.retrograde;
+  const int last = static_cast<int>(displacement.rows()) - 1;
+  std::string csv =
+      "t,u0_measured,u0_model,uL_measured,uL_model,f0_measured,f0_model,fL_measured,fL_model\n";
+  char row[512];
+  for (int j = 0; j < data.num_samples(); ++j) {
+    // f_model = f~ - w_end / alpha
+    const double f0_model = data.f0[j] - retrograde(0, j) / run.alpha;
+    const double fL_model = data.fL[j] - retrograde(last, j) / run.alpha;
+    std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+                  data.Time(j), data.u0[j], displacement(0, j), data.uL[j], displacement(last, j),
+                  data.f0[j], f0_model, data.fL[j], fL_model);
+    csv += row;
+  }
+  return csv;
+}
+
+std::string InnerResidualCsv(const IdentificationRun& run) {
+  std::string csv = "iteration,relative_residual\n";
+  char row[128];
+  const std::vector<double>& history = run.evaluations[run.best_index].inner.residual_history;
+  for (std::size_t i = 0; i < history.size(); ++i) {
+    std::snprintf(row, sizeof(row), "%zu,%.17g\n", i + 1, history[i]);
+    csv += row;
+  }
+  return csv;
+}
+
+// ---------------------------------------------------------------------------
+// Figures.
+
+// A gnuplot single-quoted string ('' stands for one quote).
+std::string GnuplotString(const std::string& text) {
+  std::string quoted = "'";
+  for (char c : text) quoted += c == '\'' ? std::string("''") : std::string(1, c);
+  return quoted + "'";
+}
+
+std::string PngTerminal() {
+  return "set terminal pngcairo size 1000,700 enhanced font 'sans,11'\nset datafile separator ','\n"
+         "set key top right\nset grid\n";
+}
+
+std::string CostCurveScript(const IdentificationRun& run, const std::string& folder) {
+  const double identified = run.identified_modulus() / 1e9;
+  const std::string curve = GnuplotString(folder + "/cost_curve.csv");
+  const std::string evaluations = GnuplotString(folder + "/evaluations.csv");
+  std::ostringstream script;
+  script << PngTerminal() << "set terminal pngcairo size 1000,1000\n"
+         << "set multiplot layout 2,1 title 'MCRE cost curve e^2(E); identified E = "
+         << identified << " GPa (dashed)'\n"
+         << "set xlabel 'E [GPa]'\nset ylabel 'e^2 [J s]'\nset format y '%.3g'\n"
+         << "set arrow 1 from " << identified << ", graph 0 to " << identified
+         << ", graph 1 nohead dashtype 2 lc rgb '#555555'\n";
+  // Top: everything; bottom: the window E* +- 5 % where the uncertainty's k is fitted.
+  const double low = identified * (1.0 - kCurvatureWindow);
+  const double high = identified * (1.0 + kCurvatureWindow);
+  for (int panel = 0; panel < 2; ++panel) {
+    if (panel == 0) {
+      script << "set title 'over the optimiser evaluations'\n";
+    } else {
+      script << "set title 'within 5 % of the identified E'\nset xrange [" << low << ":" << high
+             << "]\n";
+    }
+    script << "plot " << curve
+           << " skip 1 using ($1/1e9):($4 > 0 ? $2 : 1/0) with linespoints pt 7 ps 0.5 lw 2 "
+              "title 'e^2(E), cost curve', "
+           << evaluations
+           << " skip 1 using ($2/1e9):($6 > 0 ? $3 : 1/0) with points pt 6 ps 1.5 lc rgb 'red' "
+              "title 'optimiser evaluations'\n";
+  }
+  script << "unset multiplot\n";
+  return script.str();
+}
+
+std::string EndsScript(const std::string& folder) {
+  const std::string csv = GnuplotString(folder + "/ends.csv");
+  std::ostringstream script;
+  script << PngTerminal() << "set terminal pngcairo size 1200,900\nset multiplot layout 2,2 "
+         << "title 'Measured and model end quantities at the identified modulus'\n"
+         << "set xlabel 't [ms]'\n";
+  struct Panel {
+    const char* title;
+    const char* unit;
+    int measured;  // column of the measured value
+    double scale;
+  };
+  const Panel panels[] = {{"u_0 (x = 0)", "u [um]", 2, 1e6},
+                          {"u_L (x = L)", "u [um]", 4, 1e6},
+                          {"f_0 (x = 0, clamp reaction)", "f [N]", 6, 1.0},
+                          {"f_L (x = L, load)", "f [N]", 8, 1.0}};
+  for (const Panel& panel : panels) {
+    script << "set title '" << panel.title << "'\nset ylabel '" << panel.unit << "'\n"
+           << "plot " << csv << " skip 1 using ($1*1e3):($" << panel.measured << "*"
+           << panel.scale << ") with lines lc rgb '#aaaaaa' title 'measured', " << csv
+           << " skip 1 using ($1*1e3):($" << panel.measured + 1 << "*" << panel.scale
+           << ") with lines lw 2 lc rgb '#1f4e9c' title 'model'\n";
+  }
+  script << "unset multiplot\n";
+  return script.str();
+}
+
+std::string InnerResidualScript(const IdentificationRun& run, const std::string& folder) {
+  std::ostringstream script;
+  script << PngTerminal()
+         << "set title 'Inner solver: relative residual ||c - A W||_P / ||c||_P at the "
+            "identified modulus'\n"
+            "set xlabel 'iteration (sweep pair)'\nset ylabel 'relative residual'\n"
+            "set logscale y\nset format y '10^{%T}'\n"
+         << "plot " << GnuplotString(folder + "/inner_residual.csv")
+         << " skip 1 using 1:2 with linespoints pt 7 ps 0.6 lw 2 title 'relative residual', "
+         << run.config.inner.tolerance << " with lines dashtype 2 lc rgb '#555555' "
+         << "title 'inner.tolerance'\n";
+  return script.str();
+}
+
+// Runs gnuplot on `script` (which must draw to `temporary_png`); its output goes
+// to `log_path`. Returns "" on success, else why it failed; sets
+// *gnuplot_missing when gnuplot is not on the PATH.
+std::string RunGnuplot(const std::string& script_path, const std::string& log_path,
+                       bool* gnuplot_missing) {
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  std::string program = "gnuplot";
+  std::vector<char*> arguments{program.data(), const_cast<char*>(script_path.c_str()), nullptr};
+  pid_t pid = 0;
+  const int spawn_error =
+      posix_spawnp(&pid, "gnuplot", &actions, nullptr, arguments.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawn_error != 0) {
+    *gnuplot_missing = spawn_error == ENOENT;
+    return std::string("cannot run gnuplot: ") + std::strerror(spawn_error);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) return std::string("waiting for gnuplot: ") + std::strerror(errno);
+  }
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return "";
+  std::ifstream log(log_path);
+  std::string first_line;
+  std::getline(log, first_line);
+  return "gnuplot failed" + (first_line.empty() ? std::string() : ": " + first_line);
+}
+
+// Draws one figure to folder/name.png through a temporary PNG renamed at the
+// end. Returns "" on success, else why not.
+std::string DrawFigure(const std::string& folder, const std::string& name,
+                       const std::string& script_body, bool* gnuplot_missing) {
+  const std::string suffix = ".tmp." + std::to_string(::getpid());
+  const std::string png = folder + "/" + name + ".png";
+  const std::string temporary_png = png + suffix;
+  const std::string script_path = folder + "/" + name + ".gp" + suffix;
+  const std::string log_path = folder + "/" + name + ".log" + suffix;
+  {
+    std::ofstream script(script_path);
+    script << "set output " << GnuplotString(temporary_png) << "\n" << script_body;
+    if (!script) return "cannot write " + script_path;
+  }
+  std::string why = RunGnuplot(script_path, log_path, gnuplot_missing);
+  if (why.empty() && std::rename(temporary_png.c_str(), png.c_str()) != 0) {
+    why = "cannot write " + png + ": " + std::strerror(errno);
+  }
+  std::remove(script_path.c_str());
+  std::remove(log_path.c_str());
+  std::remove(temporary_png.c_str());
+  return why;
+}
+
+}  // namespace
+
+std::string SummaryYaml(const IdentificationRun& run) {
+  const IdentificationSummary& outer = run.outer;
+  const double identified = run.identified_modulus();
+  const double reference = run.reference_known ? run.config.model.modulus : NAN;
+  YamlWriter yaml;
+  yaml.Raw("# mcrewave identify run: the modulus E identified by minimising the MCRE cost e^2(E)");
+  if (!run.config.source_path.empty()) yaml.Raw("# config: " + run.config.source_path);
+  yaml.Text(0, "version", kVersion, "mcrewave version");
+  yaml.Number(0, "identified_modulus", identified, "[Pa] E minimising e^2");
+  yaml.Number(0, "reference_modulus", reference,
+              "[Pa] E the synthetic data were made with (null: unknown, CSV data)");
+  yaml.Number(0, "relative_error", run.reference_known ? (identified - reference) / reference : NAN,
+              "(identified - reference) / reference (null when unknown)");
+  yaml.Number(0, "cost", run.cost(), "[J s] e^2 at the identified modulus");
+  yaml.Integer(0, "evaluations", outer.evaluations, "e^2 evaluations of the outer optimiser");
+  yaml.Integer(0, "sweeps", run.sweeps, "direct + retrograde sweeps of those evaluations");
+  yaml.Number(0, "wall_time_s", run.wall_time_s,
+              "[s] identification, cost curve and uncertainty (not the data)");
+
+  const ModulusUncertainty& uncertainty = run.uncertainty;
+  yaml.Line(0, "uncertainty", "");
+  yaml.Number(1, "modulus_std_dev", uncertainty.available ? uncertainty.std_dev : NAN,
+              "[Pa] null when not available (see message)");
+  yaml.Number(1, "relative_std_dev", uncertainty.available ? uncertainty.relative_std_dev : NAN,
+              "modulus_std_dev / identified_modulus");
+  yaml.Text(1, "meaning", kUncertaintyMeaning);
+  yaml.Text(1, "message", uncertainty.message);
+  yaml.Number(1, "curvature", uncertainty.curvature,
+              "[J s/Pa^2] k, least-squares slope of de^2/dE over E +- 5 %");
+  yaml.Integer(1, "curvature_points", uncertainty.curvature_points, "cost-curve points of k");
+  yaml.Integer(1, "samples", uncertainty.samples, "noise draws");
+  yaml.Number(1, "noise_std_displacement", run.noise.displacement_std, "[m] drawn on u0 and uL");
+  yaml.Number(1, "noise_std_force", run.noise.force_std, "[N] drawn on f0 and fL");
+  yaml.Text(1, "noise_source", run.noise_source,
+            "synthetic_snr: the data's own noise; data_differences: estimated from the data");
+  yaml.Number(1, "estimated_noise_std_displacement", run.estimated_noise.displacement_std,
+              "[m] from the second differences of the data (MAD)");
+  yaml.Number(1, "estimated_noise_std_force", run.estimated_noise.force_std,
+              "[N] from the second differences of the data (MAD)");
+  yaml.Number(1, "misfit_rms_displacement", run.misfit.displacement_std,
+              "[m] RMS of U - u~ at both ends, at the optimum");
+  yaml.Number(1, "misfit_rms_force", run.misfit.force_std,
+              "[N] RMS of F - f~ = -W / alpha at both ends, at the optimum");
+  yaml.Integer(1, "sweeps", uncertainty.sweeps, "of the noise solves");
+
+  yaml.Line(0, "optimizer", "");
+  yaml.Text(1, "name", OptimizerTypeToString(outer.optimizer));
+  yaml.Text(1, "algorithm", OuterAlgorithmToString(outer.algorithm));
+  yaml.Text(1, "termination", TerminationTypeToString(outer.termination));
+  yaml.Text(1, "message", outer.message);
+  yaml.Text(1, "optimizer_message", outer.optimizer_message, "the optimiser's own words");
+  yaml.Number(1, "initial_modulus", outer.initial_modulus, "[Pa]");
+  yaml.Integer(1, "evaluations", outer.evaluations);
+  yaml.Integer(1, "gradient_evaluations", outer.gradient_evaluations,
+               "of which with the adjoint gradient");
+  yaml.Integer(1, "iterations", outer.iterations, "Ceres iterations (-1: NLopt)");
+  yaml.Number(1, "scaled_cost", outer.cost, "e^2 / cost_scale at the identified modulus");
+  yaml.Number(1, "cost_scale", run.rest_cost,
+              "[J s] J_rest, the functional of the bar left at rest (>= e^2 for every E)");
+  yaml.Number(1, "wall_time_s", outer.wall_time_s, "[s]");
+
+  long inner_iterations = 0;
+  int max_inner_iterations = 0;
+  double inner_time = 0.0;
+  for (const ObjectiveEvaluation& evaluation : run.evaluations) {
+    inner_iterations += std::max(0, evaluation.inner.iterations);
+    max_inner_iterations = std::max(max_inner_iterations, evaluation.inner.iterations);
+    inner_time += std::max(0.0, evaluation.inner.wall_time_s);
+  }
+  const CoupledSolverSummary& best_inner = run.evaluations[run.best_index].inner;
+  yaml.Line(0, "inner", "");
+  yaml.Text(1, "method", CoupledSolverTypeToString(run.config.inner.type));
+  yaml.Integer(1, "solves", static_cast<long>(run.evaluations.size()),
+               "coupled solves of the optimiser");
+  yaml.Integer(1, "iterations", inner_iterations, "sweep pairs over those solves");
+  yaml.Integer(1, "max_iterations_one_solve", max_inner_iterations);
+  yaml.Integer(1, "sweeps", run.sweeps);
+  yaml.Number(1, "wall_time_s", inner_time, "[s] in those solves");
+  yaml.Integer(1, "iterations_at_optimum", best_inner.iterations,
+               "of the solve at the identified modulus");
+  yaml.Number(1, "relative_residual_at_optimum", best_inner.relative_residual);
+
+  yaml.Line(0, "weights", "");
+  yaml.Number(1, "alpha", run.alpha, "[m/N] force weight w_f L / (S E0)");
+  yaml.Number(1, "beta", run.beta, "[N/m] displacement weight w_u S E0 / L");
+
+  yaml.Line(0, "cost_curve", "");
+  yaml.Integer(1, "points", static_cast<long>(run.cost_curve.size()));
+  yaml.Number(1, "lowest_modulus", run.cost_curve.empty() ? NAN : run.cost_curve.front().modulus,
+              "[Pa]");
+  yaml.Number(1, "highest_modulus", run.cost_curve.empty() ? NAN : run.cost_curve.back().modulus,
+              "[Pa]");
+  yaml.Integer(1, "sweeps", run.cost_curve_sweeps);
+  yaml.Integer(0, "total_sweeps", run.sweeps + run.cost_curve_sweeps + uncertainty.sweeps,
+               "optimiser, cost curve and uncertainty");
+
+  yaml.Line(0, "config", "", "as resolved (every key)");
+  std::istringstream config(ConfigToYaml(run.config));
+  for (std::string line; std::getline(config, line);) yaml.Raw("  " + line);
+  return yaml.str();
+}
+
+std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run,
+                                                    const std::string& folder, bool figures) {
+  std::error_code error;
+  std::filesystem::create_directories(folder, error);
+  if (error) throw std::runtime_error("cannot create folder " + folder + ": " + error.message());
+
+  std::vector<std::string> written;
+  auto write = [&](const std::string& name, const std::string& content) {
+    const std::string path = folder + "/" + name;
+    WriteFileAtomically(path, content);
+    written.push_back(path);
+  };
+  write("evaluations.csv", EvaluationsCsv(run));
+  write("cost_curve.csv", CostCurveCsv(run));
+  write("ends.csv", EndsCsv(run));
+  write("inner_residual.csv", InnerResidualCsv(run));
+
+  if (figures) {
+    bool gnuplot_missing = false;
+    const std::pair<std::string, std::string> drawings[] = {
+        {"cost_curve", CostCurveScript(run, folder)},
+        {"ends", EndsScript(folder)},
+        {"inner_residual", InnerResidualScript(run, folder)},
+    };
+    for (const auto& [name, script] : drawings) {
+      const std::string why = DrawFigure(folder, name, script, &gnuplot_missing);
+      if (gnuplot_missing) {
+        spdlog::warn("gnuplot not found on the PATH: figures skipped (the CSV files are written)");
+        break;
+      }
+      if (!why.empty()) {
+        spdlog::warn("figure {}.png skipped: {}", name, why);
+        continue;
+      }
+      written.push_back(folder + "/" + name + ".png");
+    }
+  }
+  // The summary last: its presence says the folder is complete.
+  write("summary.yaml", SummaryYaml(run));
+  return written;
+}
+
+}  // namespace mcrewave

@@ -1,0 +1,53 @@
+// Running the identify binary from the tests, as a user runs it.
+#pragma once
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace mcrewave::testing {
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+// Runs `identify <arguments>` through the shell (arguments may redirect).
+inline RunResult RunIdentify(const std::string& arguments) {
+  const std::string command = std::string(MCREWAVE_IDENTIFY_BINARY) + " " + arguments + " 2>&1";
+  RunResult result;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return result;
+  char buffer[4096];
+  while (fgets(buffer, sizeof buffer, pipe) != nullptr) result.output += buffer;
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+// A path in the source tree.
+inline std::string SourcePath(const std::string& relative) {
+  return std::string(MCREWAVE_SOURCE_DIR) + "/" + relative;
+}
+
+// An empty directory of the test's own under the test temporary directory.
+inline std::string FreshDirectory(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+inline std::string ReadText(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  std::ostringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+}  // namespace mcrewave::testing

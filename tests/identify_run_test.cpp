@@ -1,0 +1,343 @@
+// End-to-end tests of `identify run`: the binary is run as a user runs it, on
+// configs/quick.yaml (SNR 20, about a second) and configs/measured_csv.yaml, and
+// on one bad config or bad CSV per class of mistake.
+//
+// Documented tolerance: on configs/quick.yaml the identified E is within 1 % of
+// the 200 GPa of the synthetic data (measured: +0.22 %, with an uncertainty
+// figure of 0.36 %; over 12 noise seeds the spread is 0.36 %), and NLopt and
+// Ceres agree to 1e-6 relative.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "identify_binary.h"
+
+namespace mcrewave {
+namespace {
+
+using testing::FreshDirectory;
+using testing::ReadText;
+using testing::RunIdentify;
+using testing::RunResult;
+using testing::SourcePath;
+
+namespace fs = std::filesystem;
+
+// The top-level scalar keys of a summary.yaml ("key: value  # comment").
+std::map<std::string, std::string> TopLevelValues(const std::string& yaml) {
+  std::map<std::string, std::string> values;
+  std::istringstream lines(yaml);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.empty() || line[0] == ' ' || line[0] == '#') continue;
+    const std::size_t colon = line.find(':');
+    if (colon == std::string::npos) continue;
+    std::string value = line.substr(colon + 1);
+    value = value.substr(0, value.find('#'));
+    value.erase(0, value.find_first_not_of(' '));
+    value.erase(value.find_last_not_of(' ') + 1);
+    values[line.substr(0, colon)] = value;
+  }
+  return values;
+}
+
+// Files whose name says they are temporary.
+int TemporaryFiles(const std::string& folder) {
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    if (entry.path().filename().string().find(".tmp") != std::string::npos) ++count;
+  }
+  return count;
+}
+
+struct QuickRun {
+  RunResult result;
+  std::string folder;
+  std::map<std::string, std::string> summary;
+};
+
+QuickRun RunQuick(const std::string& name, const std::string& extra = "") {
+  QuickRun run;
+  run.folder = FreshDirectory(name) + "/results";
+  run.result =
+      RunIdentify("run " + SourcePath("configs/quick.yaml") + " --output " + run.folder + extra);
+  if (fs::exists(run.folder + "/summary.yaml")) {
+    run.summary = TopLevelValues(ReadText(run.folder + "/summary.yaml"));
+  }
+  return run;
+}
+
+TEST(IdentifyRunTest, QuickConfigIdentifiesEAndWritesEveryResult) {
+  const QuickRun run = RunQuick("identify_run_quick");
+  ASSERT_EQ(run.result.exit_code, 0) << run.result.output;
+  // One progress line per outer evaluation at the default level.
+  EXPECT_NE(run.result.output.find("nlopt evaluation 1: E = 1.6e+11 Pa"), std::string::npos)
+      << run.result.output;
+  for (const char* key : {"version", "identified_modulus", "reference_modulus", "relative_error",
+                          "cost", "evaluations", "sweeps", "wall_time_s", "uncertainty",
+                          "optimizer", "inner", "config"}) {
+    EXPECT_EQ(run.summary.count(key), 1u) << "summary.yaml lacks " << key;
+  }
+  EXPECT_EQ(run.summary.at("reference_modulus"), "2e+11");
+  const double identified = std::stod(run.summary.at("identified_modulus"));
+  const double relative_error = std::stod(run.summary.at("relative_error"));
+  EXPECT_NEAR(relative_error, (identified - 200e9) / 200e9, 1e-12);
+  EXPECT_LT(std::abs(relative_error), 0.01);
+  EXPECT_GT(std::stoi(run.summary.at("evaluations")), 2);
+  EXPECT_GT(std::stol(run.summary.at("sweeps")), 0);
+  const std::string summary = ReadText(run.folder + "/summary.yaml");
+  EXPECT_NE(summary.find("  modulus_std_dev: "), std::string::npos) << summary;
+  EXPECT_NE(summary.find("  meaning: \"first-order standard deviation"), std::string::npos);
+  EXPECT_NE(summary.find("    elements: 25"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("termination: \"convergence\""), std::string::npos) << summary;
+
+  for (const char* file : {"summary.yaml", "evaluations.csv", "cost_curve.csv", "ends.csv",
+                           "inner_residual.csv", "cost_curve.png", "ends.png",
+                           "inner_residual.png"}) {
+    EXPECT_TRUE(fs::exists(run.folder + "/" + file)) << file << "\n" << run.result.output;
+  }
+  EXPECT_EQ(TemporaryFiles(run.folder), 0);
+  // ends.csv: a header and one row per sample (301).
+  const std::string ends = ReadText(run.folder + "/ends.csv");
+  EXPECT_EQ(ends.rfind("t,u0_measured,u0_model,uL_measured,uL_model,f0_measured,f0_model,", 0),
+            0u);
+  EXPECT_EQ(std::count(ends.begin(), ends.end(), '\n'), 302);
+}
+
+TEST(IdentifyRunTest, CeresAgreesWithNloptInFewerEvaluations) {
+  const QuickRun nlopt = RunQuick("identify_run_nlopt", " --set output.figures=false -q");
+  const QuickRun ceres =
+      RunQuick("identify_run_ceres", " --set outer.optimizer=ceres --set output.figures=false -q");
+  ASSERT_EQ(nlopt.result.exit_code, 0) << nlopt.result.output;
+  ASSERT_EQ(ceres.result.exit_code, 0) << ceres.result.output;
+  const double e_nlopt = std::stod(nlopt.summary.at("identified_modulus"));
+  const double e_ceres = std::stod(ceres.summary.at("identified_modulus"));
+  EXPECT_NEAR(e_ceres, e_nlopt, 1e-6 * e_nlopt);
+  EXPECT_LT(std::stoi(ceres.summary.at("evaluations")), std::stoi(nlopt.summary.at("evaluations")));
+  EXPECT_FALSE(fs::exists(nlopt.folder + "/cost_curve.png"));
+}
+
+TEST(IdentifyRunTest, TheSameRunTwiceGivesTheSameNumbers) {
+  const QuickRun first = RunQuick("identify_run_first", " --set output.figures=false -q");
+  const QuickRun second = RunQuick("identify_run_second", " --set output.figures=false -q");
+  ASSERT_EQ(first.result.exit_code, 0) << first.result.output;
+  ASSERT_EQ(second.result.exit_code, 0) << second.result.output;
+  for (const char* key : {"identified_modulus", "relative_error", "cost", "evaluations", "sweeps"}) {
+    EXPECT_EQ(first.summary.at(key), second.summary.at(key)) << key;
+  }
+  for (const char* file : {"evaluations.csv", "cost_curve.csv", "ends.csv"}) {
+    EXPECT_EQ(ReadText(first.folder + "/" + file), ReadText(second.folder + "/" + file)) << file;
+  }
+  // -q: no progress lines.
+  EXPECT_EQ(first.result.output.find("[info]"), std::string::npos) << first.result.output;
+}
+
+TEST(IdentifyRunTest, MeasuredCsvConfigFindsTheModulusTheFileWasMadeWith) {
+  const std::string folder = FreshDirectory("identify_run_csv") + "/results";
+  const RunResult run = RunIdentify("run " + SourcePath("configs/measured_csv.yaml") +
+                                    " --set output.figures=false -o " + folder);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const auto summary = TopLevelValues(ReadText(folder + "/summary.yaml"));
+  // The file was made with E = 210 GPa (exact solution, SNR 20): see the config.
+  EXPECT_NEAR(std::stod(summary.at("identified_modulus")), 210e9, 0.01 * 210e9);
+  EXPECT_EQ(summary.at("reference_modulus"), "null");
+  EXPECT_EQ(summary.at("relative_error"), "null");
+  EXPECT_NE(ReadText(folder + "/summary.yaml").find("noise_source: \"data_differences\""),
+            std::string::npos);
+}
+
+TEST(IdentifyRunTest, VerboseLogsEveryInnerSolve) {
+  const QuickRun run = RunQuick("identify_run_verbose", " --set output.figures=false -v");
+  ASSERT_EQ(run.result.exit_code, 0) << run.result.output;
+  EXPECT_NE(run.result.output.find("[debug] e^2("), std::string::npos) << run.result.output;
+}
+
+TEST(IdentifyRunTest, DefaultConfigIsAcceptedByRun) {
+  const std::string dir = FreshDirectory("identify_run_default_config");
+  ASSERT_EQ(RunIdentify("--print-default-config > " + dir + "/default.yaml").exit_code, 0);
+  const std::string defaults = ReadText(dir + "/default.yaml");
+  for (const char* section : {"\nmcre:\n", "\ninner:\n", "\nouter:\n", "\nuncertainty:\n",
+                              "\noutput:\n", "(nlopt | ceres)"}) {
+    EXPECT_NE(defaults.find(section), std::string::npos) << section;
+  }
+  const RunResult run = RunIdentify(
+      "run " + dir + "/default.yaml -q -o " + dir + "/results --set model.elements=20 " +
+      "--set time.window=0.1728e-3 --set time.step=1.44e-6 --set output.figures=false " +
+      "--set output.curve_points=5 --set uncertainty.samples=2");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_TRUE(fs::exists(dir + "/results/summary.yaml"));
+}
+
+TEST(IdentifyRunTest, UnconvergedIdentificationExitsWithOneAndWritesNothing) {
+  const std::string folder = FreshDirectory("identify_run_unconverged") + "/results";
+  const RunResult run = RunIdentify("run " + SourcePath("configs/quick.yaml") +
+                                    " --set outer.max_evaluations=2 -q -o " + folder);
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("error: identification failed: outer.max_evaluations (2) reached "
+                            "before convergence"),
+            std::string::npos)
+      << run.output;
+  EXPECT_FALSE(fs::exists(folder));
+}
+
+TEST(IdentifyRunTest, UnusableInnerSolveExitsWithOneNamingTheSolver) {
+  const std::string folder = FreshDirectory("identify_run_inner_failure") + "/results";
+  const RunResult run =
+      RunIdentify("run " + SourcePath("configs/quick.yaml") +
+                  " --set inner.max_iterations=1 --set inner.tolerance=1e-14 -q -o " + folder);
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  EXPECT_NE(run.output.find("error: identification failed: the coupled solve at E = 1.6e+11 Pa "
+                            "is not usable: conjugate_gradient: no_convergence"),
+            std::string::npos)
+      << run.output;
+  EXPECT_FALSE(fs::exists(folder));
+}
+
+// ---------------------------------------------------------------------------
+// Bad input: one case per class of mistake. Each writes `config` (with {csv}
+// standing for the path of `csv`, when given) and runs `identify run` on it with
+// `arguments`; expects the exit code, every fragment of the message ({config}
+// and {csv} replaced by the paths) on one line, and no output folder.
+
+struct BadInput {
+  const char* name;
+  const char* config;
+  const char* csv;        // content of data.csv, or nullptr
+  const char* arguments;  // extra command-line arguments
+  int exit_code;
+  std::vector<std::string> fragments;
+};
+
+// The quick case's time grid: 300 steps of 1.44 us.
+constexpr const char* kCsvGrid = "time:\n  window: 0.432e-3\n  step: 1.44e-6\n";
+
+// A CSV on a uniform grid of `samples` samples of step `step`.
+std::string UniformCsv(int samples, double step) {
+  std::string csv = "t,u0,uL,f0,fL\n";
+  char row[128];
+  for (int k = 0; k < samples; ++k) {
+    std::snprintf(row, sizeof(row), "%.17g,0,%.6g,%.6g,%.6g\n", k * step, 1e-6 * std::sin(0.1 * k),
+                  -100.0 * std::sin(0.05 * k), 100.0 * std::sin(0.05 * k));
+    csv += row;
+  }
+  return csv;
+}
+
+std::string Replace(std::string text, const std::string& from, const std::string& to) {
+  for (std::size_t at = text.find(from); at != std::string::npos;
+       at = text.find(from, at + to.size())) {
+    text.replace(at, from.size(), to);
+  }
+  return text;
+}
+
+class BadInputTest : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(BadInputTest, IsRefusedWithOneClearLineAndNothingWritten) {
+  const BadInput& bad = GetParam();
+  const std::string dir = FreshDirectory(std::string("identify_run_bad_") + bad.name);
+  const std::string config = dir + "/config.yaml";
+  const std::string csv = dir + "/data.csv";
+  const std::string folder = dir + "/results";
+  if (bad.csv != nullptr) {
+    std::ofstream(csv) << (std::string(bad.csv) == "uniform:301:2e-6"   ? UniformCsv(301, 2e-6)
+                           : std::string(bad.csv) == "uniform:101"      ? UniformCsv(101, 1.44e-6)
+                                                                        : std::string(bad.csv));
+  }
+  std::ofstream(config) << Replace(bad.config, "{csv}", csv);
+  const RunResult run = RunIdentify("run " + config + " -o " + Replace(bad.arguments, "{dir}", dir) +
+                                    (std::string(bad.arguments).empty() ? folder : ""));
+  EXPECT_EQ(run.exit_code, bad.exit_code) << run.output;
+  const std::size_t error_line = run.output.find("error: ");
+  ASSERT_NE(error_line, std::string::npos) << run.output;
+  const std::string line = run.output.substr(error_line, run.output.find('\n', error_line) -
+                                                             error_line);
+  for (const std::string& fragment : bad.fragments) {
+    const std::string expected = Replace(Replace(fragment, "{config}", config), "{csv}", csv);
+    EXPECT_NE(line.find(expected), std::string::npos) << "line: " << line
+                                                      << "\nlacks: " << expected;
+  }
+  EXPECT_FALSE(fs::exists(folder));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Classes, BadInputTest,
+    ::testing::Values(
+        BadInput{"unknown_key", "outer:\n  optimiser: ceres\n", nullptr, "", 2,
+                 {"{config}:2: unknown key 'outer.optimiser'; did you mean 'outer.optimizer'?"}},
+        BadInput{"unknown_section", "outr:\n  initial: 1e11\n", nullptr, "", 2,
+                 {"{config}:1: unknown section 'outr'; did you mean 'outer'?"}},
+        BadInput{"unknown_optimizer", "outer:\n  optimizer: scipy\n", nullptr, "", 2,
+                 {"{config}:2: outer.optimizer: expected one of 'nlopt', 'ceres', got 'scipy'"}},
+        BadInput{"algorithm_of_the_other_optimizer",
+                 "outer:\n  optimizer: ceres\n  algorithm: bobyqa\n", nullptr, "", 2,
+                 {"{config}:3: outer.algorithm 'bobyqa' is not available with outer.optimizer "
+                  "'ceres'; choose default, lbfgs or bfgs"}},
+        BadInput{"non_positive_bound", "outer:\n  lower_bound: -1e9\n", nullptr, "", 2,
+                 {"{config}:2: outer.lower_bound must be a finite positive modulus"}},
+        BadInput{"crossed_bounds", "outer:\n  lower_bound: 300e9\n  upper_bound: 200e9\n",
+                 nullptr, "", 2,
+                 {"{config}:3: outer.upper_bound (2e+11 Pa) must be finite and above "
+                  "outer.lower_bound (3e+11 Pa)"}},
+        BadInput{"initial_outside_bounds", "outer:\n  initial: 500e9\n", nullptr, "", 2,
+                 {"{config}:2: outer.initial (5e+11 Pa) must lie strictly between"}},
+        BadInput{"too_few_evaluations", "outer:\n  max_evaluations: 1\n", nullptr, "", 2,
+                 {"{config}:2: outer.max_evaluations must be at least 2, got 1"}},
+        BadInput{"unknown_inner_method", "inner:\n  method: gauss_seidel\n", nullptr, "", 2,
+                 {"{config}:2: inner.method: expected one of 'all_at_once', 'relaxation', "
+                  "'adaptive_relaxation', 'conjugate_gradient'",
+                  "got 'gauss_seidel'"}},
+        BadInput{"inner_tolerance_out_of_range", "inner:\n  tolerance: 2\n", nullptr, "", 2,
+                 {"{config}:2: inner.tolerance must lie in (0, 1), got 2"}},
+        BadInput{"non_positive_weight", "mcre:\n  w_u: 0\n", nullptr, "", 2,
+                 {"{config}:2: mcre.w_u must be a finite positive number, got 0"}},
+        BadInput{"negative_reference_modulus", "mcre:\n  reference_modulus: -2e11\n", nullptr,
+                 "", 2, {"{config}:2: mcre.reference_modulus must be a finite positive"}},
+        BadInput{"boolean_expected", "output:\n  figures: maybe\n", nullptr, "", 2,
+                 {"{config}:2: output.figures: expected true or false, got 'maybe'"}},
+        BadInput{"too_few_curve_points", "output:\n  curve_points: 3\n", nullptr, "", 2,
+                 {"{config}:2: output.curve_points must be an integer in [5, 1000], got 3"}},
+        BadInput{"too_few_uncertainty_samples", "uncertainty:\n  samples: 1\n", nullptr, "", 2,
+                 {"{config}:2: uncertainty.samples must be an integer in [2, 1000], got 1"}},
+        BadInput{"zero_time_step", "time:\n  step: 0\n", nullptr, "", 2,
+                 {"{config}:2: time.step must be a finite positive number of seconds, got 0"}},
+        BadInput{"non_positive_snr", "data:\n  snr: -3\n", nullptr, "", 2,
+                 {"{config}:2: data.snr must be positive"}},
+        BadInput{"theta_override_out_of_range", "", nullptr,
+                 "{dir}/results --set time.theta=1.5", 2,
+                 {"--set time.theta=1.5: time.theta must lie in [0, 1], got 1.5"}},
+        BadInput{"override_without_value", "", nullptr, "{dir}/results --set outer.initial", 2,
+                 {"--set outer.initial: expected key.path=value"}},
+        BadInput{"missing_csv", "data:\n  source: csv\n  path: absent.csv\n", nullptr, "", 2,
+                 {"{config}:3: data.path: cannot read measurement file", "absent.csv",
+                  "No such file or directory"}},
+        BadInput{"csv_time_step_differs", "time:\n  window: 0.432e-3\n  step: 1.44e-6\n"
+                                          "data:\n  source: csv\n  path: {csv}\n",
+                 "uniform:301:2e-6", "", 2,
+                 {"{csv}: time step 2e-06 s differs from time.step 1.44e-06 s of {config}"}},
+        BadInput{"csv_sample_count_differs", "time:\n  window: 0.432e-3\n  step: 1.44e-6\n"
+                                             "data:\n  source: csv\n  path: {csv}\n",
+                 "uniform:101", "", 2,
+                 {"{csv}: 101 samples, but time.window / time.step + 1 = 301 in {config}"}},
+        BadInput{"csv_bad_header", "data:\n  source: csv\n  path: {csv}\n",
+                 "t,u0,uL,f0\n0,0,0,0\n1,0,0,0\n", "", 2, {"{csv}:1: "}},
+        BadInput{"csv_not_a_number",
+                 "data:\n  source: csv\n  path: {csv}\n",
+                 "t,u0,uL,f0,fL\n0,0,0,0,0\n1e-6,0,abc,0,0\n2e-6,0,0,0,0\n", "", 2,
+                 {"{csv}:3: "}},
+        BadInput{"csv_non_uniform_time", "data:\n  source: csv\n  path: {csv}\n",
+                 "t,u0,uL,f0,fL\n0,0,0,0,0\n1e-6,0,0,0,0\n3e-6,0,0,0,0\n", "", 2,
+                 {"{csv}:"}},
+        BadInput{"output_under_a_file", "", "not a folder", "{dir}/data.csv/results", 2,
+                 {"output folder {csv}/results: {csv} is not a folder"}}),
+    [](const ::testing::TestParamInfo<BadInput>& info) { return std::string(info.param.name); });
+
+}  // namespace
+}  // namespace mcrewave
