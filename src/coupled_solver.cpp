@@ -11,11 +11,14 @@
 namespace mcrewave {
 namespace {
 
-constexpr std::array<std::pair<CoupledSolverType, const char*>, 4> kSolverTypes{{
+constexpr std::array<std::pair<CoupledSolverType, const char*>, 7> kSolverTypes{{
     {CoupledSolverType::kAllAtOnce, "all_at_once"},
     {CoupledSolverType::kRelaxation, "relaxation"},
     {CoupledSolverType::kAdaptiveRelaxation, "adaptive_relaxation"},
     {CoupledSolverType::kConjugateGradient, "conjugate_gradient"},
+    {CoupledSolverType::kRiccati, "riccati"},
+    {CoupledSolverType::kSingleShooting, "single_shooting"},
+    {CoupledSolverType::kMultipleShooting, "multiple_shooting"},
 }};
 
 }  // namespace
@@ -67,6 +70,13 @@ bool CoupledSolverOptions::IsValid(std::string* error) const {
     why << "inner.divergence_factor must be above 1, got " << divergence_factor;
   } else if (max_all_at_once_unknowns < 1) {
     why << "inner.max_all_at_once_unknowns must be positive, got " << max_all_at_once_unknowns;
+  } else if (max_dense_solver_bytes < 1) {
+    why << "inner.max_dense_solver_bytes must be positive, got " << max_dense_solver_bytes;
+  } else if (!(shooting_condition_limit > 1.0)) {
+    why << "inner.shooting_condition_limit must be above 1, got " << shooting_condition_limit;
+  } else if (!(shooting_segment_growth > 1.0 && std::isfinite(shooting_segment_growth))) {
+    why << "inner.shooting_segment_growth must be a finite number above 1, got "
+        << shooting_segment_growth;
   } else {
     return true;
   }
@@ -98,6 +108,13 @@ std::string CoupledSolverSummary::FullReport() const {
     out << "  spectrum of I - G      [" << spectrum_min << ", " << spectrum_max << "]\n"
         << "  safeguard restarts     " << safeguard_restarts << "\n";
   }
+  if (shooting_segments > 0) {
+    out << "  shooting segments      " << shooting_segments << "\n"
+        << "  shooting condition     " << shooting_condition_number << "\n";
+  }
+  if (multiply_accumulates >= 0.0) {
+    out << "  multiply-accumulates   " << multiply_accumulates << "\n";
+  }
   out << "  wall time              " << wall_time_s << " s\n";
   return out.str();
 }
@@ -124,6 +141,13 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, McreProbl
       break;
     case CoupledSolverType::kConjugateGradient:
       internal::SolveByConjugateGradient(options, problem, initial_retrograde, solution, &summary);
+      break;
+    case CoupledSolverType::kRiccati:
+      internal::SolveByRiccati(options, problem, solution, &summary);
+      break;
+    case CoupledSolverType::kSingleShooting:
+    case CoupledSolverType::kMultipleShooting:
+      internal::SolveByShooting(options, problem, solution, &summary);
       break;
   }
   if (summary.IsSolutionUsable()) {

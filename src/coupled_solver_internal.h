@@ -17,5 +17,9 @@ void SolveByRelaxation(const CoupledSolverOptions& options, McreProblem* problem
 void SolveByConjugateGradient(const CoupledSolverOptions& options, McreProblem* problem,
                               const Matrix* initial_retrograde, CoupledSolution* solution,
                               CoupledSolverSummary* summary);
+void SolveByRiccati(const CoupledSolverOptions& options, McreProblem* problem,
+                    CoupledSolution* solution, CoupledSolverSummary* summary);
+void SolveByShooting(const CoupledSolverOptions& options, McreProblem* problem,
+                     CoupledSolution* solution, CoupledSolverSummary* summary);
 
 }  // namespace mcrewave::internal

@@ -14,10 +14,23 @@
 //   conjugate_gradient   CG on A W = c in the inner product <.,.>_P where A is
 //                        self-adjoint positive definite: one retrograde and one
 //                        direct sweep per iteration, no coefficient to tune.
+//   riccati              the discrete Riccati sweep Z_k = P_k Y_k + q_k (dense 2n x 2n
+//                        P_k) backward from the final condition, then the state
+//                        forward (docs/riccati_shooting.md); refuses when its storage
+//                        would exceed max_dense_solver_bytes.
+//   single_shooting      the initial retrograde state Z_0 from the fundamental matrix
+//                        of the coupled recursion; fails (never returns garbage) when
+//                        the shooting matrix is too ill-conditioned.
+//   multiple_shooting    the same on segments whose length follows the measured growth
+//                        rate of the recursion, joined by continuity (robust variant).
+//
+// The last three are direct: they report the same relative residual, computed
+// afterwards from 5 sweeps, and converge when it meets the tolerance (or the
+// round-off floor below).
 //
 // The iterative solvers stop on the relative residual ||c - A W||_P / ||c||_P
 // (the same measure for all; c = T(0)), or when ||c - A W||_P falls to the
-// round-off floor 1e-12 ||W_u||_P, W_u the retrograde response to the displacement
+// round-off floor 1e-11 ||W_u||_P, W_u the retrograde response to the displacement
 // data alone (c is a difference of two such responses, which cancel for data
 // consistent with the model). Non-convergence and divergence are
 // reported in the summary, never returned as numbers: the solution is usable only
@@ -36,6 +49,9 @@ enum class CoupledSolverType {
   kRelaxation,
   kAdaptiveRelaxation,
   kConjugateGradient,
+  kRiccati,
+  kSingleShooting,
+  kMultipleShooting,
 };
 const char* CoupledSolverTypeToString(CoupledSolverType type);
 bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type);
@@ -64,6 +80,15 @@ struct CoupledSolverOptions {
   double divergence_factor = 1e3;
   // The all-at-once solver refuses systems with more unknowns than this.
   long max_all_at_once_unknowns = 1'500'000;
+  // The Riccati and shooting solvers refuse when their dense storage
+  // (docs/riccati_shooting.md) would exceed this many bytes.
+  long max_dense_solver_bytes = 2L << 30;
+  // Shooting fails when the 2-norm condition number of its (equilibrated) shooting
+  // matrix exceeds this, or is not finite.
+  double shooting_condition_limit = 1e14;
+  // Multiple shooting ends a segment when the largest of its fundamental solutions
+  // (started from unit states in energy coordinates) has grown by this factor.
+  double shooting_segment_growth = 100.0;
 
   bool IsValid(std::string* error) const;
 };
@@ -81,6 +106,14 @@ struct CoupledSolverSummary {
   double spectrum_max = -1.0;        // estimated a_max of A = I - G (adaptive only)
   int safeguard_restarts = 0;        // adaptive only: omega re-chosen after growth
   double wall_time_s = -1.0;
+  // Riccati and shooting only: multiply-accumulates of the method itself (the
+  // residual check excluded), counted as include/mcrewave/operation_counts.h says.
+  double multiply_accumulates = -1.0;
+  // Single shooting: 2-norm condition number of the equilibrated shooting matrix.
+  // Multiple shooting: max |r_ii| / min |r_ii| of the QR factor of the global
+  // system, a lower bound of its condition number.
+  double shooting_condition_number = -1.0;
+  int shooting_segments = -1;        // shooting only: number of segments
 
   bool IsSolutionUsable() const { return termination == TerminationType::kConvergence; }
   std::string BriefReport() const;
