@@ -58,8 +58,8 @@ class YamlWriter {
  public:
   void Line(int indent, const std::string& key, const std::string& value,
             const std::string& comment = "") {
-    lines_.push_back({std::string(2 * indent, ' ') + key + ":" + (value.empty() ? "" : " " + value),
-                      comment});
+    lines_.push_back(
+        {std::string(2 * indent, ' ') + key + ":" + (value.empty() ? "" : " " + value), comment});
   }
   void Number(int indent, const std::string& key, double value, const std::string& comment = "") {
     Line(indent, key, Format(value), comment);
@@ -180,12 +180,13 @@ std::string CostCurveScript(const IdentificationRun& run, const std::string& fol
   const std::string curve = GnuplotString(folder + "/cost_curve.csv");
   const std::string evaluations = GnuplotString(folder + "/evaluations.csv");
   std::ostringstream script;
-  script << PngTerminal() << "set terminal pngcairo size 1000,1000\n"
-         << "set multiplot layout 2,1 title 'MCRE cost curve e^2(E); identified E = "
-         << identified << " GPa (dashed)'\n"
-         << "set xlabel 'E [GPa]'\nset ylabel 'e^2 [J s]'\nset format y '%.3g'\n"
-         << "set arrow 1 from " << identified << ", graph 0 to " << identified
-         << ", graph 1 nohead dashtype 2 lc rgb '#555555'\n";
+  script
+      << PngTerminal() << "set terminal pngcairo size 1000,1000\n"
+      << "set multiplot layout 2,1 title 'MCRE cost curve e^2(E); identified E = " << identified
+      << " GPa (dashed)'\n"
+      << "set xlabel 'E [GPa]'\nset ylabel 'e^2 [J s]'\nset format y '%.5g'\nset key top center\n"
+      << "set arrow 1 from " << identified << ", graph 0 to " << identified
+      << ", graph 1 nohead dashtype 2 lc rgb '#555555'\n";
   // Top: everything; bottom: the window E* +- 5 % where the uncertainty's k is fitted.
   const double low = identified * (1.0 - kCurvatureWindow);
   const double high = identified * (1.0 + kCurvatureWindow);
@@ -225,8 +226,8 @@ std::string EndsScript(const std::string& folder) {
                           {"f_L (x = L, load)", "f [N]", 8, 1.0}};
   for (const Panel& panel : panels) {
     script << "set title '" << panel.title << "'\nset ylabel '" << panel.unit << "'\n"
-           << "plot " << csv << " skip 1 using ($1*1e3):($" << panel.measured << "*"
-           << panel.scale << ") with lines lc rgb '#aaaaaa' title 'measured', " << csv
+           << "plot " << csv << " skip 1 using ($1*1e3):($" << panel.measured << "*" << panel.scale
+           << ") with lines lc rgb '#aaaaaa' title 'measured', " << csv
            << " skip 1 using ($1*1e3):($" << panel.measured + 1 << "*" << panel.scale
            << ") with lines lw 2 lc rgb '#1f4e9c' title 'model'\n";
   }
