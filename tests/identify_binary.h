@@ -17,9 +17,11 @@ struct RunResult {
   std::string output;  // stdout and stderr together
 };
 
-// Runs `identify <arguments>` through the shell (arguments may redirect).
-inline RunResult RunIdentify(const std::string& arguments) {
-  const std::string command = std::string(MCREWAVE_IDENTIFY_BINARY) + " " + arguments + " 2>&1";
+// Runs `identify <arguments>` through the shell (arguments may redirect), with
+// `environment` ("NAME=value ...", may be empty) set for it.
+inline RunResult RunIdentify(const std::string& arguments, const std::string& environment = "") {
+  const std::string command =
+      environment + " " + std::string(MCREWAVE_IDENTIFY_BINARY) + " " + arguments + " 2>&1";
   RunResult result;
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return result;

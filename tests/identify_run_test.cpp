@@ -80,9 +80,9 @@ TEST(IdentifyRunTest, QuickConfigIdentifiesEAndWritesEveryResult) {
   // One progress line per outer evaluation at the default level.
   EXPECT_NE(run.result.output.find("nlopt evaluation 1: E = 1.6e+11 Pa"), std::string::npos)
       << run.result.output;
-  for (const char* key : {"version", "identified_modulus", "reference_modulus", "relative_error",
-                          "cost", "evaluations", "sweeps", "wall_time_s", "uncertainty",
-                          "optimizer", "inner", "config"}) {
+  for (const char* key :
+       {"version", "identified_modulus", "reference_modulus", "relative_error", "cost",
+        "evaluations", "sweeps", "wall_time_s", "uncertainty", "optimizer", "inner", "config"}) {
     EXPECT_EQ(run.summary.count(key), 1u) << "summary.yaml lacks " << key;
   }
   EXPECT_EQ(run.summary.at("reference_modulus"), "2e+11");
@@ -98,16 +98,15 @@ TEST(IdentifyRunTest, QuickConfigIdentifiesEAndWritesEveryResult) {
   EXPECT_NE(summary.find("    elements: 25"), std::string::npos) << summary;
   EXPECT_NE(summary.find("termination: \"convergence\""), std::string::npos) << summary;
 
-  for (const char* file : {"summary.yaml", "evaluations.csv", "cost_curve.csv", "ends.csv",
-                           "inner_residual.csv", "cost_curve.png", "ends.png",
-                           "inner_residual.png"}) {
+  for (const char* file :
+       {"summary.yaml", "evaluations.csv", "cost_curve.csv", "ends.csv", "inner_residual.csv",
+        "cost_curve.png", "ends.png", "inner_residual.png"}) {
     EXPECT_TRUE(fs::exists(run.folder + "/" + file)) << file << "\n" << run.result.output;
   }
   EXPECT_EQ(TemporaryFiles(run.folder), 0);
   // ends.csv: a header and one row per sample (301).
   const std::string ends = ReadText(run.folder + "/ends.csv");
-  EXPECT_EQ(ends.rfind("t,u0_measured,u0_model,uL_measured,uL_model,f0_measured,f0_model,", 0),
-            0u);
+  EXPECT_EQ(ends.rfind("t,u0_measured,u0_model,uL_measured,uL_model,f0_measured,f0_model,", 0), 0u);
   EXPECT_EQ(std::count(ends.begin(), ends.end(), '\n'), 302);
 }
 
@@ -129,7 +128,8 @@ TEST(IdentifyRunTest, TheSameRunTwiceGivesTheSameNumbers) {
   const QuickRun second = RunQuick("identify_run_second", " --set output.figures=false -q");
   ASSERT_EQ(first.result.exit_code, 0) << first.result.output;
   ASSERT_EQ(second.result.exit_code, 0) << second.result.output;
-  for (const char* key : {"identified_modulus", "relative_error", "cost", "evaluations", "sweeps"}) {
+  for (const char* key :
+       {"identified_modulus", "relative_error", "cost", "evaluations", "sweeps"}) {
     EXPECT_EQ(first.summary.at(key), second.summary.at(key)) << key;
   }
   for (const char* file : {"evaluations.csv", "cost_curve.csv", "ends.csv"}) {
@@ -151,6 +151,21 @@ TEST(IdentifyRunTest, MeasuredCsvConfigFindsTheModulusTheFileWasMadeWith) {
   EXPECT_EQ(summary.at("relative_error"), "null");
   EXPECT_NE(ReadText(folder + "/summary.yaml").find("noise_source: \"data_differences\""),
             std::string::npos);
+}
+
+TEST(IdentifyRunTest, WithoutGnuplotTheFiguresAreSkippedWithAWarning) {
+  const std::string folder = FreshDirectory("identify_run_no_gnuplot") + "/results";
+  const RunResult run =
+      RunIdentify("run " + SourcePath("configs/quick.yaml") + " -o " + folder, "PATH=/nonexistent");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("[warning] gnuplot not found on the PATH: figures skipped (the CSV "
+                            "files are written)"),
+            std::string::npos)
+      << run.output;
+  EXPECT_TRUE(fs::exists(folder + "/summary.yaml"));
+  EXPECT_TRUE(fs::exists(folder + "/cost_curve.csv"));
+  EXPECT_FALSE(fs::exists(folder + "/cost_curve.png"));
+  EXPECT_EQ(TemporaryFiles(folder), 0);
 }
 
 TEST(IdentifyRunTest, VerboseLogsEveryInnerSolve) {
@@ -247,22 +262,23 @@ TEST_P(BadInputTest, IsRefusedWithOneClearLineAndNothingWritten) {
   const std::string csv = dir + "/data.csv";
   const std::string folder = dir + "/results";
   if (bad.csv != nullptr) {
-    std::ofstream(csv) << (std::string(bad.csv) == "uniform:301:2e-6"   ? UniformCsv(301, 2e-6)
-                           : std::string(bad.csv) == "uniform:101"      ? UniformCsv(101, 1.44e-6)
-                                                                        : std::string(bad.csv));
+    std::ofstream(csv) << (std::string(bad.csv) == "uniform:301:2e-6" ? UniformCsv(301, 2e-6)
+                           : std::string(bad.csv) == "uniform:101"    ? UniformCsv(101, 1.44e-6)
+                                                                      : std::string(bad.csv));
   }
   std::ofstream(config) << Replace(bad.config, "{csv}", csv);
-  const RunResult run = RunIdentify("run " + config + " -o " + Replace(bad.arguments, "{dir}", dir) +
-                                    (std::string(bad.arguments).empty() ? folder : ""));
+  const RunResult run =
+      RunIdentify("run " + config + " -o " + Replace(bad.arguments, "{dir}", dir) +
+                  (std::string(bad.arguments).empty() ? folder : ""));
   EXPECT_EQ(run.exit_code, bad.exit_code) << run.output;
   const std::size_t error_line = run.output.find("error: ");
   ASSERT_NE(error_line, std::string::npos) << run.output;
-  const std::string line = run.output.substr(error_line, run.output.find('\n', error_line) -
-                                                             error_line);
+  const std::string line =
+      run.output.substr(error_line, run.output.find('\n', error_line) - error_line);
   for (const std::string& fragment : bad.fragments) {
     const std::string expected = Replace(Replace(fragment, "{config}", config), "{csv}", csv);
-    EXPECT_NE(line.find(expected), std::string::npos) << "line: " << line
-                                                      << "\nlacks: " << expected;
+    EXPECT_NE(line.find(expected), std::string::npos)
+        << "line: " << line << "\nlacks: " << expected;
   }
   EXPECT_FALSE(fs::exists(folder));
 }
@@ -270,72 +286,168 @@ TEST_P(BadInputTest, IsRefusedWithOneClearLineAndNothingWritten) {
 INSTANTIATE_TEST_SUITE_P(
     Classes, BadInputTest,
     ::testing::Values(
-        BadInput{"unknown_key", "outer:\n  optimiser: ceres\n", nullptr, "", 2,
+        BadInput{"unknown_key",
+                 "outer:\n  optimiser: ceres\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:2: unknown key 'outer.optimiser'; did you mean 'outer.optimizer'?"}},
-        BadInput{"unknown_section", "outr:\n  initial: 1e11\n", nullptr, "", 2,
+        BadInput{"unknown_section",
+                 "outr:\n  initial: 1e11\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:1: unknown section 'outr'; did you mean 'outer'?"}},
-        BadInput{"unknown_optimizer", "outer:\n  optimizer: scipy\n", nullptr, "", 2,
+        BadInput{"unknown_optimizer",
+                 "outer:\n  optimizer: scipy\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:2: outer.optimizer: expected one of 'nlopt', 'ceres', got 'scipy'"}},
         BadInput{"algorithm_of_the_other_optimizer",
-                 "outer:\n  optimizer: ceres\n  algorithm: bobyqa\n", nullptr, "", 2,
+                 "outer:\n  optimizer: ceres\n  algorithm: bobyqa\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:3: outer.algorithm 'bobyqa' is not available with outer.optimizer "
                   "'ceres'; choose default, lbfgs or bfgs"}},
-        BadInput{"non_positive_bound", "outer:\n  lower_bound: -1e9\n", nullptr, "", 2,
+        BadInput{"non_positive_bound",
+                 "outer:\n  lower_bound: -1e9\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:2: outer.lower_bound must be a finite positive modulus"}},
-        BadInput{"crossed_bounds", "outer:\n  lower_bound: 300e9\n  upper_bound: 200e9\n",
-                 nullptr, "", 2,
+        BadInput{"crossed_bounds",
+                 "outer:\n  lower_bound: 300e9\n  upper_bound: 200e9\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:3: outer.upper_bound (2e+11 Pa) must be finite and above "
                   "outer.lower_bound (3e+11 Pa)"}},
-        BadInput{"initial_outside_bounds", "outer:\n  initial: 500e9\n", nullptr, "", 2,
+        BadInput{"initial_outside_bounds",
+                 "outer:\n  initial: 500e9\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:2: outer.initial (5e+11 Pa) must lie strictly between"}},
-        BadInput{"too_few_evaluations", "outer:\n  max_evaluations: 1\n", nullptr, "", 2,
+        BadInput{"too_few_evaluations",
+                 "outer:\n  max_evaluations: 1\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:2: outer.max_evaluations must be at least 2, got 1"}},
-        BadInput{"unknown_inner_method", "inner:\n  method: gauss_seidel\n", nullptr, "", 2,
+        BadInput{"unknown_inner_method",
+                 "inner:\n  method: gauss_seidel\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:2: inner.method: expected one of 'all_at_once', 'relaxation', "
                   "'adaptive_relaxation', 'conjugate_gradient'",
                   "got 'gauss_seidel'"}},
-        BadInput{"inner_tolerance_out_of_range", "inner:\n  tolerance: 2\n", nullptr, "", 2,
+        BadInput{"inner_tolerance_out_of_range",
+                 "inner:\n  tolerance: 2\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:2: inner.tolerance must lie in (0, 1), got 2"}},
-        BadInput{"non_positive_weight", "mcre:\n  w_u: 0\n", nullptr, "", 2,
+        BadInput{"non_positive_weight",
+                 "mcre:\n  w_u: 0\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:2: mcre.w_u must be a finite positive number, got 0"}},
-        BadInput{"negative_reference_modulus", "mcre:\n  reference_modulus: -2e11\n", nullptr,
-                 "", 2, {"{config}:2: mcre.reference_modulus must be a finite positive"}},
-        BadInput{"boolean_expected", "output:\n  figures: maybe\n", nullptr, "", 2,
+        BadInput{"negative_reference_modulus",
+                 "mcre:\n  reference_modulus: -2e11\n",
+                 nullptr,
+                 "",
+                 2,
+                 {"{config}:2: mcre.reference_modulus must be a finite positive"}},
+        BadInput{"boolean_expected",
+                 "output:\n  figures: maybe\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:2: output.figures: expected true or false, got 'maybe'"}},
-        BadInput{"too_few_curve_points", "output:\n  curve_points: 3\n", nullptr, "", 2,
+        BadInput{"too_few_curve_points",
+                 "output:\n  curve_points: 3\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:2: output.curve_points must be an integer in [5, 1000], got 3"}},
-        BadInput{"too_few_uncertainty_samples", "uncertainty:\n  samples: 1\n", nullptr, "", 2,
+        BadInput{"too_few_uncertainty_samples",
+                 "uncertainty:\n  samples: 1\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:2: uncertainty.samples must be an integer in [2, 1000], got 1"}},
-        BadInput{"zero_time_step", "time:\n  step: 0\n", nullptr, "", 2,
+        BadInput{"zero_time_step",
+                 "time:\n  step: 0\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:2: time.step must be a finite positive number of seconds, got 0"}},
-        BadInput{"non_positive_snr", "data:\n  snr: -3\n", nullptr, "", 2,
+        BadInput{"non_positive_snr",
+                 "data:\n  snr: -3\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:2: data.snr must be positive"}},
-        BadInput{"theta_override_out_of_range", "", nullptr,
-                 "{dir}/results --set time.theta=1.5", 2,
+        BadInput{"theta_override_out_of_range",
+                 "",
+                 nullptr,
+                 "{dir}/results --set time.theta=1.5",
+                 2,
                  {"--set time.theta=1.5: time.theta must lie in [0, 1], got 1.5"}},
-        BadInput{"override_without_value", "", nullptr, "{dir}/results --set outer.initial", 2,
+        BadInput{"override_without_value",
+                 "",
+                 nullptr,
+                 "{dir}/results --set outer.initial",
+                 2,
                  {"--set outer.initial: expected key.path=value"}},
-        BadInput{"missing_csv", "data:\n  source: csv\n  path: absent.csv\n", nullptr, "", 2,
+        BadInput{"missing_csv",
+                 "data:\n  source: csv\n  path: absent.csv\n",
+                 nullptr,
+                 "",
+                 2,
                  {"{config}:3: data.path: cannot read measurement file", "absent.csv",
                   "No such file or directory"}},
-        BadInput{"csv_time_step_differs", "time:\n  window: 0.432e-3\n  step: 1.44e-6\n"
-                                          "data:\n  source: csv\n  path: {csv}\n",
-                 "uniform:301:2e-6", "", 2,
+        BadInput{"csv_time_step_differs",
+                 "time:\n  window: 0.432e-3\n  step: 1.44e-6\n"
+                 "data:\n  source: csv\n  path: {csv}\n",
+                 "uniform:301:2e-6",
+                 "",
+                 2,
                  {"{csv}: time step 2e-06 s differs from time.step 1.44e-06 s of {config}"}},
-        BadInput{"csv_sample_count_differs", "time:\n  window: 0.432e-3\n  step: 1.44e-6\n"
-                                             "data:\n  source: csv\n  path: {csv}\n",
-                 "uniform:101", "", 2,
+        BadInput{"csv_sample_count_differs",
+                 "time:\n  window: 0.432e-3\n  step: 1.44e-6\n"
+                 "data:\n  source: csv\n  path: {csv}\n",
+                 "uniform:101",
+                 "",
+                 2,
                  {"{csv}: 101 samples, but time.window / time.step + 1 = 301 in {config}"}},
-        BadInput{"csv_bad_header", "data:\n  source: csv\n  path: {csv}\n",
-                 "t,u0,uL,f0\n0,0,0,0\n1,0,0,0\n", "", 2, {"{csv}:1: "}},
+        BadInput{"csv_bad_header",
+                 "data:\n  source: csv\n  path: {csv}\n",
+                 "t,u0,uL,f0\n0,0,0,0\n1,0,0,0\n",
+                 "",
+                 2,
+                 {"{csv}:1: "}},
         BadInput{"csv_not_a_number",
                  "data:\n  source: csv\n  path: {csv}\n",
-                 "t,u0,uL,f0,fL\n0,0,0,0,0\n1e-6,0,abc,0,0\n2e-6,0,0,0,0\n", "", 2,
+                 "t,u0,uL,f0,fL\n0,0,0,0,0\n1e-6,0,abc,0,0\n2e-6,0,0,0,0\n",
+                 "",
+                 2,
                  {"{csv}:3: "}},
-        BadInput{"csv_non_uniform_time", "data:\n  source: csv\n  path: {csv}\n",
-                 "t,u0,uL,f0,fL\n0,0,0,0,0\n1e-6,0,0,0,0\n3e-6,0,0,0,0\n", "", 2,
+        BadInput{"csv_non_uniform_time",
+                 "data:\n  source: csv\n  path: {csv}\n",
+                 "t,u0,uL,f0,fL\n0,0,0,0,0\n1e-6,0,0,0,0\n3e-6,0,0,0,0\n",
+                 "",
+                 2,
                  {"{csv}:"}},
-        BadInput{"output_under_a_file", "", "not a folder", "{dir}/data.csv/results", 2,
+        BadInput{"output_under_a_file",
+                 "",
+                 "not a folder",
+                 "{dir}/data.csv/results",
+                 2,
                  {"output folder {csv}/results: {csv} is not a folder"}}),
     [](const ::testing::TestParamInfo<BadInput>& info) { return std::string(info.param.name); });
 
