@@ -69,7 +69,7 @@ class DiscreteMcreOperators {
 
   // Energy coordinates of a state pair (displacement-like a, velocity-like b):
   // (Lp^T a, Lm^T b) with Kp = Lp Lp^T, M = Lm Lm^T, so that the squared 2-norm of the
-  // coordinates is a^T Kp b + b^T M b, an energy [J]. The trapezoidal step of the
+  // coordinates is a^T Kp a + b^T M b, an energy [J]. The trapezoidal step of the
   // uncoupled bar conserves it up to the end springs B / alpha.
   void ToEnergyCoordinates(const Eigen::Ref<const Vector>& displacement_like,
                            const Eigen::Ref<const Vector>& velocity_like,
