@@ -254,8 +254,8 @@ const std::vector<Key>& KeyTable() {
               "density rho"),
       MakeKey("model.modulus", &Config::model, &BarProperties::modulus, Number(), "Pa",
               "Young's modulus E of the reference (or initial) model"),
-      MakeKey("model.elements", &Config::model, &BarProperties::elements, PositiveInteger<int>(), "",
-              "number N of linear finite elements"),
+      MakeKey("model.elements", &Config::model, &BarProperties::elements, PositiveInteger<int>(),
+              "", "number N of linear finite elements"),
       MakeKey("model.mass", &Config::model, &BarProperties::mass,
               EnumByName<MassType>({MassType::kConsistent, MassType::kLumped}, MassTypeToString,
                                    StringToMassType),
@@ -317,6 +317,15 @@ const std::vector<Key>& KeyTable() {
       MakeKey("inner.max_all_at_once_unknowns", &Config::inner,
               &CoupledSolverOptions::max_all_at_once_unknowns, PositiveInteger<long>(), "",
               "all_at_once refuses systems with more unknowns"),
+      MakeKey("inner.max_dense_solver_bytes", &Config::inner,
+              &CoupledSolverOptions::max_dense_solver_bytes, PositiveInteger<long>(), "bytes",
+              "riccati and multiple_shooting refuse to store more"),
+      MakeKey("inner.shooting_condition_limit", &Config::inner,
+              &CoupledSolverOptions::shooting_condition_limit, Number(), "",
+              "shooting fails above this condition number of its matrix (> 1)"),
+      MakeKey("inner.shooting_segment_growth", &Config::inner,
+              &CoupledSolverOptions::shooting_segment_growth, Number(), "",
+              "multiple_shooting: growth (> 1) of the fastest solution per segment"),
       MakeKey("outer.optimizer", &Config::outer, &IdentificationOptions::optimizer,
               EnumByName<OptimizerType>({OptimizerType::kNlopt, OptimizerType::kCeres},
                                         OptimizerTypeToString, StringToOptimizerType),
@@ -344,8 +353,7 @@ const std::vector<Key>& KeyTable() {
       MakeKey("outer.max_time", &Config::outer, &IdentificationOptions::max_time, Number(), "s",
               "wall time allowed to the outer loop"),
       MakeKey("uncertainty.samples", &Config::uncertainty, &UncertaintyOptions::samples,
-              PositiveInteger<int>(), "",
-              "noise draws of the first-order std of E, in [2, 1000]"),
+              PositiveInteger<int>(), "", "noise draws of the first-order std of E, in [2, 1000]"),
       MakeKey("uncertainty.seed", &Config::uncertainty, &UncertaintyOptions::seed,
               UnsignedInteger(), "", "seed of those noise draws"),
       MakeKey("output.folder", &Config::output, &OutputOptions::folder, Text(), "",
@@ -372,15 +380,9 @@ SectionValidator ValidatorOf(Section Config::*section) {
 // One entry per section of Config, in the order of the checks.
 const std::vector<SectionValidator>& SectionValidators() {
   static const std::vector<SectionValidator> validators = {
-      ValidatorOf(&Config::model),
-      ValidatorOf(&Config::load),
-      ValidatorOf(&Config::time),
-      ValidatorOf(&Config::data),
-      ValidatorOf(&Config::mcre),
-      ValidatorOf(&Config::inner),
-      ValidatorOf(&Config::outer),
-      ValidatorOf(&Config::uncertainty),
-      ValidatorOf(&Config::output),
+      ValidatorOf(&Config::model), ValidatorOf(&Config::load),        ValidatorOf(&Config::time),
+      ValidatorOf(&Config::data),  ValidatorOf(&Config::mcre),        ValidatorOf(&Config::inner),
+      ValidatorOf(&Config::outer), ValidatorOf(&Config::uncertainty), ValidatorOf(&Config::output),
   };
   return validators;
 }
@@ -696,8 +698,8 @@ bool OutputOptions::IsValid(std::string* error) const {
   if (folder.empty()) {
     why = "output.folder must name a folder";
   } else if (curve_points < 5 || curve_points > 1000) {
-    why = "output.curve_points must be an integer in [5, 1000], got " +
-          std::to_string(curve_points);
+    why =
+        "output.curve_points must be an integer in [5, 1000], got " + std::to_string(curve_points);
   } else {
     return true;
   }

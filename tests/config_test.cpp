@@ -47,6 +47,9 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.inner.spectrum_safety_factor, actual.inner.spectrum_safety_factor);
   EXPECT_EQ(expected.inner.divergence_factor, actual.inner.divergence_factor);
   EXPECT_EQ(expected.inner.max_all_at_once_unknowns, actual.inner.max_all_at_once_unknowns);
+  EXPECT_EQ(expected.inner.max_dense_solver_bytes, actual.inner.max_dense_solver_bytes);
+  EXPECT_EQ(expected.inner.shooting_condition_limit, actual.inner.shooting_condition_limit);
+  EXPECT_EQ(expected.inner.shooting_segment_growth, actual.inner.shooting_segment_growth);
   EXPECT_EQ(expected.outer.optimizer, actual.outer.optimizer);
   EXPECT_EQ(expected.outer.algorithm, actual.outer.algorithm);
   EXPECT_EQ(expected.outer.lower_bound, actual.outer.lower_bound);
@@ -124,9 +127,9 @@ TEST(ConfigTest, DefaultOptionsAreValid) {
 TEST(ConfigTest, DefaultConfigYamlParsesToTheDefaultConfig) {
   const std::string yaml = DefaultConfigYaml();
   ExpectSameConfig(Config{}, ParseConfig(yaml, "default.yaml"));
-  for (const char* line : {"model:", "load:", "time:", "data:", "mcre:", "inner:", "outer:",
-                           "uncertainty:", "output:", "  length: 1", "# [m] ",
-                           "  snr: .inf", "  density: 800", "(consistent | lumped)"}) {
+  for (const char* line :
+       {"model:", "load:", "time:", "data:", "mcre:", "inner:", "outer:", "uncertainty:", "output:",
+        "  length: 1", "# [m] ", "  snr: .inf", "  density: 800", "(consistent | lumped)"}) {
     EXPECT_NE(yaml.find(line), std::string::npos) << yaml << "\nlacks " << line;
   }
 }
@@ -176,6 +179,9 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   config.inner.spectrum_safety_factor = 1.2;
   config.inner.divergence_factor = 50.0;
   config.inner.max_all_at_once_unknowns = 3'000'000'000L;
+  config.inner.max_dense_solver_bytes = 1L << 33;
+  config.inner.shooting_condition_limit = 1e12;
+  config.inner.shooting_segment_growth = 1e3;
   config.outer.optimizer = OptimizerType::kCeres;
   config.outer.algorithm = OuterAlgorithm::kBfgs;
   config.outer.lower_bound = 1e9;
@@ -232,8 +238,8 @@ TEST(ConfigTest, BooleanAcceptsTheYamlSpellings) {
 }
 
 TEST(ConfigTest, EveryCoupledSolverIsAnInnerMethod) {
-  for (const char* name : {"all_at_once", "relaxation", "adaptive_relaxation",
-                           "conjugate_gradient"}) {
+  for (const char* name : {"all_at_once", "relaxation", "adaptive_relaxation", "conjugate_gradient",
+                           "riccati", "single_shooting", "multiple_shooting"}) {
     CoupledSolverType type;
     ASSERT_TRUE(StringToCoupledSolverType(name, &type));
     EXPECT_EQ(ParseConfig("", "a.yaml", {std::string("inner.method=") + name}).inner.type, type);
