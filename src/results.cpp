@@ -149,10 +149,19 @@ std::string EndsCsv(const IdentificationRun& run) {
   return csv;
 }
 
+// The relative residual per iteration of the solve at the identified E; for the
+// direct solvers (no iteration history) their one final residual.
+std::vector<double> InnerResidualHistory(const IdentificationRun& run) {
+  const CoupledSolverSummary& inner = run.evaluations[run.best_index].inner;
+  if (!inner.residual_history.empty()) return inner.residual_history;
+  if (inner.relative_residual >= 0.0) return {inner.relative_residual};
+  return {};
+}
+
 std::string InnerResidualCsv(const IdentificationRun& run) {
   std::string csv = "iteration,relative_residual\n";
   char row[128];
-  const std::vector<double>& history = run.evaluations[run.best_index].inner.residual_history;
+  const std::vector<double> history = InnerResidualHistory(run);
   for (std::size_t i = 0; i < history.size(); ++i) {
     std::snprintf(row, sizeof(row), "%zu,%.17g\n", i + 1, history[i]);
     csv += row;
@@ -428,11 +437,13 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
 
   if (figures) {
     bool gnuplot_missing = false;
-    const std::pair<std::string, std::string> drawings[] = {
+    std::vector<std::pair<std::string, std::string>> drawings = {
         {"cost_curve", CostCurveScript(run, folder)},
         {"ends", EndsScript(folder)},
-        {"inner_residual", InnerResidualScript(run, folder)},
     };
+    if (!InnerResidualHistory(run).empty()) {
+      drawings.emplace_back("inner_residual", InnerResidualScript(run, folder));
+    }
     for (const auto& [name, script] : drawings) {
       const std::string why = DrawFigure(folder, name, script, &gnuplot_missing);
       if (gnuplot_missing) {

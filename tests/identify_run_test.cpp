@@ -123,6 +123,19 @@ TEST(IdentifyRunTest, CeresAgreesWithNloptInFewerEvaluations) {
   EXPECT_FALSE(fs::exists(nlopt.folder + "/cost_curve.png"));
 }
 
+TEST(IdentifyRunTest, ADirectInnerSolverGivesTheSameModulus) {
+  const QuickRun cg = RunQuick("identify_run_cg", " --set output.figures=false -q");
+  const QuickRun riccati =
+      RunQuick("identify_run_riccati", " --set inner.method=riccati --set output.figures=false -q");
+  ASSERT_EQ(cg.result.exit_code, 0) << cg.result.output;
+  ASSERT_EQ(riccati.result.exit_code, 0) << riccati.result.output;
+  const double e_cg = std::stod(cg.summary.at("identified_modulus"));
+  EXPECT_NEAR(std::stod(riccati.summary.at("identified_modulus")), e_cg, 1e-6 * e_cg);
+  // No iteration history: the file holds the solver's one final residual.
+  const std::string residual = ReadText(riccati.folder + "/inner_residual.csv");
+  EXPECT_EQ(std::count(residual.begin(), residual.end(), '\n'), 2) << residual;
+}
+
 TEST(IdentifyRunTest, TheSameRunTwiceGivesTheSameNumbers) {
   const QuickRun first = RunQuick("identify_run_first", " --set output.figures=false -q");
   const QuickRun second = RunQuick("identify_run_second", " --set output.figures=false -q");
