@@ -21,7 +21,9 @@
 //   then computes the cost curve around the identified E and an uncertainty
 //   figure, and writes summary.yaml, CSV files and PNG figures into the output
 //   folder (include/mcrewave/results.h), each file atomically and only at the
-//   end. One progress line per outer evaluation at the default level.
+//   end. One progress line per outer evaluation at the default level. SIGINT,
+//   SIGTERM or SIGHUP stop a run at once, but not while it writes its results:
+//   an interrupted run leaves the earlier results of its folder as they were.
 //
 //   `simulate` reads a YAML config (see include/mcrewave/config.h or
 //   --print-default-config), simulates the bar clamped at x = 0 and hit by a
@@ -40,10 +42,12 @@
 
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mcrewave/config.h"
@@ -78,6 +82,44 @@ struct Verbosity {
   }
 };
 
+// SIGINT, SIGTERM and SIGHUP end the process at once, except while results are
+// being written: then the signal is held until every file is in place, so an
+// interrupted run leaves either the earlier results or the complete new ones, and
+// no temporary file. The handler may run on any thread (Ceres' pool).
+volatile std::sig_atomic_t writing_results = 0;
+volatile std::sig_atomic_t held_signal = 0;
+
+extern "C" void HoldSignalWhileWriting(int signal_number) {
+  if (writing_results != 0) {
+    held_signal = signal_number;
+    return;
+  }
+  std::signal(signal_number, SIG_DFL);
+  std::raise(signal_number);
+}
+
+void InstallSignalHandlers() {
+  struct sigaction action = {};
+  action.sa_handler = HoldSignalWhileWriting;
+  sigemptyset(&action.sa_mask);
+  for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) sigaction(signal_number, &action, nullptr);
+}
+
+// While it lives, the signals above are held; a held one is raised at its end.
+class ResultsBeingWritten {
+ public:
+  ResultsBeingWritten() { writing_results = 1; }
+  ~ResultsBeingWritten() {
+    writing_results = 0;
+    if (held_signal != 0) {
+      std::signal(held_signal, SIG_DFL);
+      std::raise(held_signal);
+    }
+  }
+  ResultsBeingWritten(const ResultsBeingWritten&) = delete;
+  ResultsBeingWritten& operator=(const ResultsBeingWritten&) = delete;
+};
+
 // Throws InputError when `folder` cannot be created or written to: checked
 // before any computation, so that a bad --output costs nothing.
 void CheckOutputFolder(const std::string& folder) {
@@ -98,6 +140,26 @@ void CheckOutputFolder(const std::string& folder) {
   }
 }
 
+// Why `modulus` cannot be reported: it lies on a bound of the search (within
+// kOnBoundTolerance relative), where e^2 has no minimum but only its least value
+// inside the bounds; "" when it lies inside.
+constexpr double kOnBoundTolerance = 1e-6;
+std::string OnBoundMessage(double modulus, const mcrewave::IdentificationOptions& outer) {
+  const std::pair<double, const char*> bounds[] = {{outer.lower_bound, "outer.lower_bound"},
+                                                   {outer.upper_bound, "outer.upper_bound"}};
+  for (const auto& [bound, key] : bounds) {
+    if (std::abs(modulus - bound) <= kOnBoundTolerance * bound) {
+      char message[512];
+      std::snprintf(message, sizeof(message),
+                    "E = %.6g Pa lies on %s (%.6g Pa): e^2 has no minimum inside the bounds; "
+                    "widen them, or check the units of the data (SI: m and N)",
+                    modulus, key, bound);
+      return message;
+    }
+  }
+  return "";
+}
+
 int RunIdentify(const RunArguments& arguments) {
   // 1. Read and validate the config and the output folder (nothing is computed
   //    or written if either is invalid).
@@ -107,6 +169,9 @@ int RunIdentify(const RunArguments& arguments) {
 
   // 2. The measurements, checked against the model's time grid.
   const mcrewave::MeasurementSet data = mcrewave::LoadMeasurements(config);
+  if (config.data.source == mcrewave::DataSource::kCsv) {
+    mcrewave::CheckMeasurementChannels(data, config.data.path);
+  }
   spdlog::info("config {}: {} elements, {} steps of {:.4g} s; data {} ({} samples)",
                arguments.config_path, config.model.elements, config.time.NumSteps(),
                config.time.step,
@@ -120,10 +185,18 @@ int RunIdentify(const RunArguments& arguments) {
     std::fprintf(stderr, "error: identification failed: %s\n", run.outer.message.c_str());
     return 1;
   }
+  const std::string on_bound = OnBoundMessage(run.identified_modulus(), config.outer);
+  if (!on_bound.empty()) {
+    std::fprintf(stderr, "error: identification failed: %s\n", on_bound.c_str());
+    return 1;
+  }
 
   // 4. Write the results, each file atomically.
-  const std::vector<std::string> files =
-      mcrewave::WriteIdentificationResults(run, config.output.folder, config.output.figures);
+  std::vector<std::string> files;
+  {
+    const ResultsBeingWritten held;
+    files = mcrewave::WriteIdentificationResults(run, config.output.folder, config.output.figures);
+  }
   if (run.reference_known) {
     spdlog::info("identified E = {:.9g} Pa (reference {:.9g} Pa, relative error {:.3e}) in {} "
                  "evaluations, {:.2f} s",
@@ -154,7 +227,10 @@ int RunSimulate(const SimulateArguments& arguments) {
       mcrewave::MakeSyntheticMeasurements(config.model, config.load, config.time, config.data);
 
   // 3. Write the measurement set atomically.
-  mcrewave::WriteMeasurementCsv(measurements, arguments.output_path);
+  {
+    const ResultsBeingWritten held;
+    mcrewave::WriteMeasurementCsv(measurements, arguments.output_path);
+  }
 
   // 4. Brief report.
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
@@ -209,6 +285,7 @@ int main(int argc, char** argv) {
     return app.exit(error);
   }
 
+  InstallSignalHandlers();
   try {
     if (print_default_config) {
       std::cout << mcrewave::DefaultConfigYaml();

@@ -7,6 +7,7 @@ packages=(
   cmake g++ make
   libeigen3-dev libnlopt-cxx-dev libceres-dev libyaml-cpp-dev libspdlog-dev
   libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox
+  clang libclang-rt-14-dev
 )
 
 missing=()

@@ -1,8 +1,20 @@
 #!/usr/bin/env bash
-# Set up, build, and run the whole test suite with ctest.
+# Set up, build, and run the whole test suite with ctest; then build it again
+# with AddressSanitizer + UndefinedBehaviorSanitizer (clang, into build-sanitize/
+# or $MCREWAVE_SANITIZE_BUILD_DIR), run it there, and fuzz both parsers for
+# $MCREWAVE_FUZZ_SECONDS (default 30) seconds each (fuzz/README.md).
+# Tests labelled `long` are left out of the sanitizer pass (see tests/CMakeLists.txt).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${MCREWAVE_BUILD_DIR:-$root/build}"
+sanitize_dir="${MCREWAVE_SANITIZE_BUILD_DIR:-$root/build-sanitize}"
 
 bash "$root/scripts/build.sh"
 ctest --test-dir "$build_dir" --output-on-failure -j "$(nproc)"
+
+cmake -S "$root" -B "$sanitize_dir" -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_CXX_COMPILER=clang++ -DMCREWAVE_BUILD_FUZZERS=ON
+cmake --build "$sanitize_dir" -j "$(nproc)"
+export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+ctest --test-dir "$sanitize_dir" --output-on-failure -j "$(nproc)" --label-exclude long
+bash "$root/scripts/fuzz.sh" "$sanitize_dir" "${MCREWAVE_FUZZ_SECONDS:-30}"

@@ -51,6 +51,15 @@ class SpaceTimeAssembler {
   std::vector<Eigen::Triplet<double>> entries_;
 };
 
+// Bytes of the assembled system alone, a lower bound of what the solve needs: each
+// row has at least 3 entries per coupled block (the 3-point stencil of M and K)
+// in 3 blocks, stored as triplets (16 bytes) and then compressed (12 bytes), plus
+// the right-hand side and solution.
+double MatrixBytesLowerBound(long unknowns) {
+  const double entries = 9.0 * static_cast<double>(unknowns);
+  return entries * (16.0 + 12.0) + 2.0 * sizeof(double) * static_cast<double>(unknowns);
+}
+
 }  // namespace
 
 void SolveAllAtOnce(const CoupledSolverOptions& options, McreProblem* problem,
@@ -61,8 +70,11 @@ void SolveAllAtOnce(const CoupledSolverOptions& options, McreProblem* problem,
   if (system.size() > options.max_all_at_once_unknowns) {
     std::ostringstream why;
     why << "the all-at-once system has " << system.size() << " unknowns (5 n (m + 1), n = " << n
-        << " nodes, m = " << m << " steps), above the limit of " << options.max_all_at_once_unknowns
-        << " (inner.max_all_at_once_unknowns); use an iterative solver";
+        << " nodes, m = " << m << " steps) and would need more than "
+        << static_cast<long long>(MatrixBytesLowerBound(system.size()))
+        << " bytes (its matrix alone; the LU factors need more), above the limit of "
+        << options.max_all_at_once_unknowns
+        << " unknowns (inner.max_all_at_once_unknowns); use an iterative solver";
     summary->message = why.str();
     return;
   }

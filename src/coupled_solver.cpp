@@ -72,6 +72,8 @@ bool CoupledSolverOptions::IsValid(std::string* error) const {
     why << "inner.max_all_at_once_unknowns must be positive, got " << max_all_at_once_unknowns;
   } else if (max_dense_solver_bytes < 1) {
     why << "inner.max_dense_solver_bytes must be positive, got " << max_dense_solver_bytes;
+  } else if (max_field_bytes < 1) {
+    why << "inner.max_field_bytes must be positive, got " << max_field_bytes;
   } else if (!(shooting_condition_limit > 1.0)) {
     why << "inner.shooting_condition_limit must be above 1, got " << shooting_condition_limit;
   } else if (!(shooting_segment_growth > 1.0 && std::isfinite(shooting_segment_growth))) {
@@ -129,6 +131,22 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, McreProbl
   std::string why;
   if (!options.IsValid(&why)) {
     summary.message = "invalid options: " + why;
+    return summary;
+  }
+  const bool iterative = options.type == CoupledSolverType::kRelaxation ||
+                         options.type == CoupledSolverType::kAdaptiveRelaxation ||
+                         options.type == CoupledSolverType::kConjugateGradient;
+  const double field_bytes = static_cast<double>(kIterativeSolverFields) * sizeof(double) *
+                             problem->num_nodes() * (problem->num_steps() + 1.0);
+  if (iterative && field_bytes > static_cast<double>(options.max_field_bytes)) {
+    std::ostringstream refusal;
+    refusal << CoupledSolverTypeToString(options.type) << " needs "
+            << static_cast<long long>(field_bytes) << " bytes (" << kIterativeSolverFields
+            << " fields of n x (m + 1) doubles, n = " << problem->num_nodes()
+            << " nodes, m = " << problem->num_steps() << " steps), above the limit of "
+            << options.max_field_bytes
+            << " bytes (inner.max_field_bytes); use fewer elements or a shorter window";
+    summary.message = refusal.str();
     return summary;
   }
   switch (options.type) {

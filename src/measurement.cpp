@@ -1,5 +1,6 @@
 #include "mcrewave/measurement.h"
 
+#include <algorithm>
 #include <array>
 #include <cassert>
 #include <cerrno>
@@ -11,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <spdlog/spdlog.h>
+
 #include "mcrewave/file_util.h"
 
 namespace mcrewave {
@@ -21,6 +24,8 @@ constexpr std::array<const char*, kNumColumns> kColumnNames = {"t", "u0", "uL", 
 constexpr char kHeader[] = "t,u0,uL,f0,fL";
 // Largest accepted |step - mean step| / mean step.
 constexpr double kStepTolerance = 1e-6;
+// A progress line every this many rows (large files).
+constexpr std::size_t kProgressRows = 250000;
 
 // `line` without trailing spaces, tabs and carriage returns (Windows line ends).
 std::string StripLineEnd(const std::string& line) {
@@ -69,6 +74,10 @@ MeasurementSet ReadMeasurementCsv(const std::string& path) {
   if (!file) {
     throw InputError("cannot read measurement file " + path + ": " + std::strerror(errno));
   }
+  return ParseMeasurementCsv(file, path);
+}
+
+MeasurementSet ParseMeasurementCsv(std::istream& file, const std::string& path) {
   auto fail = [&path](long line_number, const std::string& what) {
     throw InputError(path + ":" + std::to_string(line_number) + ": " + what);
   };
@@ -121,6 +130,9 @@ MeasurementSet ReadMeasurementCsv(const std::string& path) {
                             Short(columns[0].back()) + " s)");
     }
     for (int c = 0; c < kNumColumns; ++c) columns[c].push_back(row[c]);
+    if (columns[0].size() % kProgressRows == 0) {
+      spdlog::info("{}: read {} rows", path, columns[0].size());
+    }
   }
   if (file.bad()) {
     throw InputError("cannot read measurement file " + path + ": " + std::strerror(errno));
@@ -135,6 +147,10 @@ MeasurementSet ReadMeasurementCsv(const std::string& path) {
     fail(line_number, "expected at least 2 data rows, got " + std::to_string(rows));
   }
   const double mean_step = (times.back() - times.front()) / static_cast<double>(rows - 1);
+  if (!std::isfinite(mean_step)) {
+    fail(line_number, "time span " + Short(times.front()) + " s to " + Short(times.back()) +
+                          " s is too wide for a double");
+  }
   for (std::size_t k = 1; k < rows; ++k) {
     const double step = times[k] - times[k - 1];
     if (std::abs(step - mean_step) > kStepTolerance * mean_step) {
@@ -151,11 +167,51 @@ MeasurementSet ReadMeasurementCsv(const std::string& path) {
     return Vector(
         Eigen::Map<const Vector>(values.data(), static_cast<Eigen::Index>(values.size())));
   };
+  // Each column is freed once copied: at most one column is held twice.
   measurements.u0 = to_vector(columns[1]);
+  columns[1] = {};
   measurements.uL = to_vector(columns[2]);
+  columns[2] = {};
   measurements.f0 = to_vector(columns[3]);
+  columns[3] = {};
   measurements.fL = to_vector(columns[4]);
   return measurements;
+}
+
+void CheckMeasurementChannels(const MeasurementSet& measurements, const std::string& name) {
+  const Vector* channels[] = {&measurements.u0, &measurements.uL, &measurements.f0,
+                              &measurements.fL};
+  for (int c = 0; c < 4; ++c) {
+    const Vector& x = *channels[c];
+    const std::string column = std::string("column '") + kColumnNames[c + 1] + "'";
+    const double peak = x.size() > 0 ? x.cwiseAbs().maxCoeff() : 0.0;
+    if (peak == 0.0 && c > 0) {
+      throw InputError(name + ":2: " + column +
+                       " is zero on every row: a dead channel (only u0, at the clamped end, "
+                       "may be zero)");
+    }
+    const Eigen::Index samples = x.size();
+    if (samples < 3) continue;
+    const Vector second_differences =
+        x.head(samples - 2) - 2.0 * x.segment(1, samples - 2) + x.tail(samples - 2);
+    std::vector<double> magnitudes(second_differences.data(),
+                                   second_differences.data() + second_differences.size());
+    for (double& magnitude : magnitudes) magnitude = std::abs(magnitude);
+    std::nth_element(magnitudes.begin(), magnitudes.begin() + magnitudes.size() / 2,
+                     magnitudes.end());
+    const double noise_level = 1.4826 * magnitudes[magnitudes.size() / 2];
+    const double threshold = std::max(kOutlierNoiseFactor * noise_level, 0.5 * peak);
+    Eigen::Index worst = 0;  // the sample k + 1 of the largest |second difference|
+    const double largest = second_differences.cwiseAbs().maxCoeff(&worst);
+    if (largest > threshold) {
+      throw InputError(name + ":" + std::to_string(worst + 3) + ": " + column + ": " +
+                       Short(x[worst + 1]) + " is an outlier: its second difference " +
+                       Short(second_differences[worst]) + " is above " +
+                       Short(kOutlierNoiseFactor) + " times the channel's noise level " +
+                       Short(noise_level) + " and half its peak " + Short(peak) +
+                       "; repair or remove the file's outliers");
+    }
+  }
 }
 
 void WriteMeasurementCsv(const MeasurementSet& measurements, const std::string& path) {

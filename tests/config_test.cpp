@@ -48,6 +48,7 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.inner.divergence_factor, actual.inner.divergence_factor);
   EXPECT_EQ(expected.inner.max_all_at_once_unknowns, actual.inner.max_all_at_once_unknowns);
   EXPECT_EQ(expected.inner.max_dense_solver_bytes, actual.inner.max_dense_solver_bytes);
+  EXPECT_EQ(expected.inner.max_field_bytes, actual.inner.max_field_bytes);
   EXPECT_EQ(expected.inner.shooting_condition_limit, actual.inner.shooting_condition_limit);
   EXPECT_EQ(expected.inner.shooting_segment_growth, actual.inner.shooting_segment_growth);
   EXPECT_EQ(expected.outer.optimizer, actual.outer.optimizer);
@@ -180,6 +181,7 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   config.inner.divergence_factor = 50.0;
   config.inner.max_all_at_once_unknowns = 3'000'000'000L;
   config.inner.max_dense_solver_bytes = 1L << 33;
+  config.inner.max_field_bytes = 1L << 34;
   config.inner.shooting_condition_limit = 1e12;
   config.inner.shooting_segment_growth = 1e3;
   config.outer.optimizer = OptimizerType::kCeres;

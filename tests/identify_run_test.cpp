@@ -243,9 +243,6 @@ struct BadInput {
   std::vector<std::string> fragments;
 };
 
-// The quick case's time grid: 300 steps of 1.44 us.
-constexpr const char* kCsvGrid = "time:\n  window: 0.432e-3\n  step: 1.44e-6\n";
-
 // A CSV on a uniform grid of `samples` samples of step `step`.
 std::string UniformCsv(int samples, double step) {
   std::string csv = "t,u0,uL,f0,fL\n";

@@ -171,6 +171,59 @@ TEST_F(MeasurementTest, EmptyLineBetweenRows) {
   ExpectReadError("t,u0,uL,f0,fL\n0,1,2,3,4\n\n1,1,2,3,4\n", 3, "empty line");
 }
 
+// Found while writing the CSV fuzzer: finite times whose span overflows a double
+// gave an infinite time step.
+TEST_F(MeasurementTest, TimeSpanTooWideForADouble) {
+  ExpectReadError("t,u0,uL,f0,fL\n-1e308,0,0,0,0\n1e308,0,0,0,0\n", 3,
+                  "time span -1e+308 s to 1e+308 s is too wide for a double");
+}
+
+// A smooth set with the clamped end's u0 at zero, as `identify simulate` writes
+// clean data.
+MeasurementSet SmoothSet(int samples) {
+  MeasurementSet set;
+  set.time_step = 1e-6;
+  set.u0 = Vector::Zero(samples);
+  set.uL.resize(samples);
+  set.f0.resize(samples);
+  set.fL.resize(samples);
+  for (int k = 0; k < samples; ++k) {
+    set.uL[k] = 1e-6 * std::sin(0.05 * k);
+    set.f0[k] = -1e3 * std::sin(0.03 * k);
+    set.fL[k] = 1e3 * std::sin(0.03 * k);
+  }
+  return set;
+}
+
+TEST(MeasurementChannelsTest, SmoothDataWithAZeroClampDisplacementPass) {
+  EXPECT_NO_THROW(CheckMeasurementChannels(SmoothSet(300), "smooth.csv"));
+}
+
+TEST(MeasurementChannelsTest, DeadChannelIsNamed) {
+  MeasurementSet set = SmoothSet(300);
+  set.f0.setZero();
+  try {
+    CheckMeasurementChannels(set, "dead.csv");
+    ADD_FAILURE() << "no InputError thrown";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "dead.csv:2: column 'f0' is zero on every row: a dead channel (only u0, at the "
+              "clamped end, may be zero)");
+  }
+}
+
+TEST(MeasurementChannelsTest, OutlierIsNamedWithItsLine) {
+  MeasurementSet set = SmoothSet(300);
+  set.uL[100] = 5e-6;  // five times the peak; sample 100 is on line 102
+  try {
+    CheckMeasurementChannels(set, "spike.csv");
+    ADD_FAILURE() << "no InputError thrown";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_EQ(message.rfind("spike.csv:102: column 'uL': 5e-06 is an outlier", 0), 0u) << message;
+  }
+}
+
 TEST_F(MeasurementTest, MissingFile) {
   const std::string path = PathOf("absent.csv");
   try {

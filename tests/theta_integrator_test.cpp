@@ -165,7 +165,8 @@ class DenseFirstOrderTheta {
 class ThetaIntegratorBarTest : public ::testing::TestWithParam<std::tuple<double, MassType>> {};
 
 TEST_P(ThetaIntegratorBarTest, MatchesTheDenseFirstOrderIntegrator) {
-  const auto [theta, mass_type] = GetParam();
+  const double theta = std::get<0>(GetParam());
+  const MassType mass_type = std::get<1>(GetParam());
   BarProperties properties;
   properties.elements = 10;
   properties.mass = mass_type;

@@ -56,6 +56,11 @@ enum class CoupledSolverType {
 const char* CoupledSolverTypeToString(CoupledSolverType type);
 bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type);
 
+// Fields of n x (m + 1) doubles an iterative solve holds at once: its iterates U
+// and W, residual, search direction, image and scratch, the start's right-hand
+// side and data response, and the caller's warm start and zero field.
+constexpr int kIterativeSolverFields = 10;
+
 enum class TerminationType {
   kConvergence,    // the residual reached the tolerance
   kNoConvergence,  // the iteration limit was reached first
@@ -83,6 +88,10 @@ struct CoupledSolverOptions {
   // The Riccati and shooting solvers refuse when their dense storage
   // (docs/riccati_shooting.md) would exceed this many bytes.
   long max_dense_solver_bytes = 2L << 30;
+  // The iterative solvers (relaxation, adaptive_relaxation, conjugate_gradient)
+  // refuse when the fields they hold at once (kIterativeSolverFields fields of
+  // n x (m + 1) doubles) would exceed this many bytes.
+  long max_field_bytes = 2L << 30;
   // Shooting fails when the 2-norm condition number of its (equilibrated) shooting
   // matrix exceeds this, or is not finite.
   double shooting_condition_limit = 1e14;
