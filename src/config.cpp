@@ -96,6 +96,20 @@ ValueType<Int> PositiveInteger() {
   return type;
 }
 
+// A decimal integer >= 0 that fits int (0 often means "off").
+ValueType<int> NonNegativeInteger() {
+  ValueType<int> type = PositiveInteger<int>();
+  type.expected = "an integer >= 0";
+  type.read = [](const YAML::Node& node, int* value) {
+    if (node.IsScalar() && node.Scalar() == "0") {
+      *value = 0;
+      return true;
+    }
+    return PositiveInteger<int>().read(node, value);
+  };
+  return type;
+}
+
 // A decimal integer in [0, 2^64 - 1].
 ValueType<std::uint64_t> UnsignedInteger() {
   ValueType<std::uint64_t> type;
@@ -355,6 +369,23 @@ const std::vector<Key>& KeyTable() {
               PositiveInteger<int>(), "", "e^2 evaluations allowed to the outer loop, at least 2"),
       MakeKey("outer.max_time", &Config::outer, &IdentificationOptions::max_time, Number(), "s",
               "wall time allowed to the outer loop"),
+      MakeKey("outer.scan_points", &Config::outer, &IdentificationOptions::scan_points,
+              NonNegativeInteger(), "",
+              "moduli of the global scan over the bounds before the local search; 0: none"),
+      MakeKey("outer.scan_tolerance", &Config::outer, &IdentificationOptions::scan_tolerance,
+              Number(), "", "relative residual of the scan's inner solves, in (0, 1)"),
+      MakeKey("outer.scan_threads", &Config::outer, &IdentificationOptions::scan_threads,
+              PositiveInteger<int>(), "", "threads of the scan, in [1, 64]"),
+      MakeKey("outer.refine_candidates", &Config::outer,
+              &IdentificationOptions::refine_candidates, PositiveInteger<int>(), "",
+              "lowest sampled minima of the scan refined by the local optimiser"),
+      MakeKey("prefilter.enabled", &Config::prefilter, &PrefilterOptions::enabled, Boolean(), "",
+              "zero-phase Butterworth low-pass of the four measured channels"),
+      MakeKey("prefilter.cutoff_frequency", &Config::prefilter,
+              &PrefilterOptions::cutoff_frequency, Number(), "Hz",
+              "cut-off of the pre-filter; 0: derived from the measured load"),
+      MakeKey("prefilter.order", &Config::prefilter, &PrefilterOptions::order,
+              PositiveInteger<int>(), "", "Butterworth order of one pass, even, in [2, 12]"),
       MakeKey("uncertainty.samples", &Config::uncertainty, &UncertaintyOptions::samples,
               PositiveInteger<int>(), "", "noise draws of the first-order std of E, in [2, 1000]"),
       MakeKey("uncertainty.seed", &Config::uncertainty, &UncertaintyOptions::seed,
@@ -385,7 +416,8 @@ const std::vector<SectionValidator>& SectionValidators() {
   static const std::vector<SectionValidator> validators = {
       ValidatorOf(&Config::model), ValidatorOf(&Config::load),        ValidatorOf(&Config::time),
       ValidatorOf(&Config::data),  ValidatorOf(&Config::mcre),        ValidatorOf(&Config::inner),
-      ValidatorOf(&Config::outer), ValidatorOf(&Config::uncertainty), ValidatorOf(&Config::output),
+      ValidatorOf(&Config::outer), ValidatorOf(&Config::prefilter),
+      ValidatorOf(&Config::uncertainty), ValidatorOf(&Config::output),
   };
   return validators;
 }

@@ -2,11 +2,17 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <exception>
+#include <limits>
+#include <memory>
 #include <sstream>
+#include <thread>
 #include <utility>
+#include <vector>
 
 #include "identification_internal.h"
 
@@ -122,6 +128,14 @@ bool IdentificationOptions::IsValid(std::string* error) const {
     why << "outer.max_evaluations must be at least 2, got " << max_evaluations;
   } else if (!(max_time > 0.0)) {
     why << "outer.max_time must be a positive number of seconds, got " << max_time;
+  } else if (!(scan_points == 0 || (scan_points >= 3 && scan_points <= 100000))) {
+    why << "outer.scan_points must be 0 (no scan) or in [3, 100000], got " << scan_points;
+  } else if (!(scan_tolerance > 0.0 && scan_tolerance < 1.0)) {
+    why << "outer.scan_tolerance must lie in (0, 1), got " << scan_tolerance;
+  } else if (!(scan_threads >= 1 && scan_threads <= 64)) {
+    why << "outer.scan_threads must lie in [1, 64], got " << scan_threads;
+  } else if (!(refine_candidates >= 1 && refine_candidates <= 100)) {
+    why << "outer.refine_candidates must lie in [1, 100], got " << refine_candidates;
   } else if (!IsAlgorithmAvailable(optimizer, algorithm)) {
     why << "outer.algorithm '" << OuterAlgorithmToString(algorithm)
         << "' is not available with outer.optimizer '" << OptimizerTypeToString(optimizer)
@@ -138,6 +152,10 @@ std::string IdentificationSummary::BriefReport() const {
   out << OptimizerTypeToString(optimizer) << "/" << OuterAlgorithmToString(algorithm) << ": "
       << TerminationTypeToString(termination) << ", E = " << modulus << " Pa after " << evaluations
       << " evaluations (" << gradient_evaluations << " with gradient), " << wall_time_s << " s";
+  if (!scan_moduli.empty()) {
+    out << "; scan of " << scan_moduli.size() << " points saw " << local_minima
+        << " local minima, scaled cost gap " << cost_gap;
+  }
   return out.str();
 }
 
@@ -154,6 +172,15 @@ std::string IdentificationSummary::FullReport() const {
       << "  scaled cost            " << cost << "\n"
       << "  evaluations            " << evaluations << "\n"
       << "  with gradient          " << gradient_evaluations << "\n";
+  if (!scan_moduli.empty()) {
+    out << "  scan points            " << scan_moduli.size() << " over [" << scan_moduli.front()
+        << ", " << scan_moduli.back() << "] Pa\n"
+        << "  scan local minima      " << local_minima << "\n"
+        << "  second minimum         " << second_modulus << " Pa\n"
+        << "  scaled cost gap        " << cost_gap << "\n"
+        << "  refinements            " << refinements << "\n"
+        << "  scan wall time         " << scan_wall_time_s << " s\n";
+  }
   if (iterations >= 0) out << "  iterations             " << iterations << "\n";
   out << "  wall time              " << wall_time_s << " s\n";
   return out.str();
@@ -246,16 +273,15 @@ void GuardedObjective::FillSummary(IdentificationSummary* summary) const {
 
 }  // namespace internal
 
-IdentificationSummary Identify(const IdentificationOptions& options, ModulusObjective* objective) {
+namespace {
+
+// One local search from options.initial within options' bounds.
+IdentificationSummary MinimizeLocally(const IdentificationOptions& options,
+                                      ModulusObjective* objective) {
   IdentificationSummary summary;
   summary.optimizer = options.optimizer;
   summary.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm);
   summary.initial_modulus = options.initial;
-  std::string why;
-  if (!options.IsValid(&why)) {
-    summary.message = "invalid options: " + why;
-    return summary;
-  }
   internal::GuardedObjective guarded(options, objective);
   if (options.optimizer == OptimizerType::kNlopt) {
     internal::MinimizeWithNlopt(options, &guarded, &summary);
@@ -267,6 +293,182 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
     summary.termination = TerminationType::kFailure;
     summary.message = "no usable evaluation of the objective";
   }
+  return summary;
+}
+
+// Scaled cost at x, NaN when the evaluation fails or throws (why written to
+// *failure).
+double ScanCost(ModulusObjective* objective, double x, std::string* failure) {
+  double cost = std::numeric_limits<double>::quiet_NaN();
+  try {
+    if (!objective->Evaluate(&x, &cost, nullptr)) {
+      *failure = objective->error_message();
+      cost = std::numeric_limits<double>::quiet_NaN();
+    } else if (!std::isfinite(cost)) {
+      *failure = "the objective returned a non-finite cost";
+      cost = std::numeric_limits<double>::quiet_NaN();
+    }
+  } catch (const std::exception& error) {
+    *failure = std::string("the objective threw: ") + error.what();
+    cost = std::numeric_limits<double>::quiet_NaN();
+  } catch (...) {
+    *failure = "the objective threw an exception that is not a std::exception";
+    cost = std::numeric_limits<double>::quiet_NaN();
+  }
+  return cost;
+}
+
+// The scaled costs at xs: block b of scan_threads contiguous blocks evaluated in
+// order by copy b of the objective on its own thread (or all on `objective`
+// when it offers no copy). *first_failure: why the lowest failed sample failed.
+std::vector<double> ScanCosts(const IdentificationOptions& options, ModulusObjective* objective,
+                              const std::vector<double>& xs, std::string* first_failure) {
+  const int points = static_cast<int>(xs.size());
+  std::vector<double> costs(xs.size(), std::numeric_limits<double>::quiet_NaN());
+  std::vector<std::unique_ptr<ModulusObjective>> copies;
+  const int blocks = std::min(options.scan_threads, points);
+  for (int b = 0; b < blocks; ++b) {
+    std::unique_ptr<ModulusObjective> copy = objective->CloneForScan(options.scan_tolerance);
+    if (copy == nullptr) break;
+    copies.push_back(std::move(copy));
+  }
+  std::vector<std::string> failures(xs.size());
+  if (static_cast<int>(copies.size()) < blocks) {
+    for (int i = 0; i < points; ++i) costs[i] = ScanCost(objective, xs[i], &failures[i]);
+  } else {
+  // Block b holds the points [b P / B, (b + 1) P / B).
+    auto run_block = [&](int b) {
+      for (int i = b * points / blocks; i < (b + 1) * points / blocks; ++i) {
+        costs[i] = ScanCost(copies[b].get(), xs[i], &failures[i]);
+      }
+    };
+    std::vector<std::thread> threads;
+    for (int b = 1; b < blocks; ++b) threads.emplace_back(run_block, b);
+    run_block(0);
+    for (std::thread& thread : threads) thread.join();
+  }
+  for (const std::string& failure : failures) {
+    if (!failure.empty()) {
+      *first_failure = failure;
+      break;
+    }
+  }
+  return costs;
+}
+
+// Indices of the sampled local minima of costs, lowest cost first: usable
+// samples below each usable neighbour (an end needs only its one neighbour).
+std::vector<int> SampledMinima(const std::vector<double>& costs) {
+  const int n = static_cast<int>(costs.size());
+  std::vector<int> minima;
+  for (int i = 0; i < n; ++i) {
+    if (!std::isfinite(costs[i])) continue;
+    const bool below_left = i == 0 || !std::isfinite(costs[i - 1]) || costs[i] < costs[i - 1];
+    const bool below_right =
+        i == n - 1 || !std::isfinite(costs[i + 1]) || costs[i] <= costs[i + 1];
+    if (below_left && below_right) minima.push_back(i);
+  }
+  std::stable_sort(minima.begin(), minima.end(),
+                   [&](int a, int b) { return costs[a] < costs[b]; });
+  return minima;
+}
+
+}  // namespace
+
+IdentificationSummary Identify(const IdentificationOptions& options, ModulusObjective* objective) {
+  IdentificationSummary summary;
+  summary.optimizer = options.optimizer;
+  summary.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm);
+  summary.initial_modulus = options.initial;
+  std::string why;
+  if (!options.IsValid(&why)) {
+    summary.message = "invalid options: " + why;
+    return summary;
+  }
+  if (options.scan_points == 0) return MinimizeLocally(options, objective);
+
+  const auto start = std::chrono::steady_clock::now();
+  const double scale = objective->modulus_scale();
+  const double x_lower = options.lower_bound / scale;
+  const double x_upper = options.upper_bound / scale;
+  const int points = options.scan_points;
+  std::vector<double> xs(points);
+  for (int i = 0; i < points; ++i) {
+    // x_i = x_lo (x_hi / x_lo)^(i / (P - 1)): evenly spaced in log E, so that
+    // bounds over decades still get samples near every modulus.
+    xs[i] = x_lower * std::pow(x_upper / x_lower, i / (points - 1.0));
+  }
+  std::string scan_failure;
+  const std::vector<double> costs = ScanCosts(options, objective, xs, &scan_failure);
+  const std::vector<int> minima = SampledMinima(costs);
+  const double scan_wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  spdlog::info("scan of {} moduli over [{:.6g}, {:.6g}] Pa: {} sampled local minima, {:.3g} s",
+               points, options.lower_bound, options.upper_bound, minima.size(), scan_wall_time_s);
+
+  // Local refinements of the lowest sampled minima, each within the bracket of
+  // its neighbouring scan points.
+  std::vector<IdentificationSummary> refined;
+  const int candidates = std::min<int>(options.refine_candidates, static_cast<int>(minima.size()));
+  for (int k = 0; k < candidates; ++k) {
+    const int i = minima[k];
+    IdentificationOptions local = options;
+    local.lower_bound = xs[std::max(i - 1, 0)] * scale;
+    local.upper_bound = xs[std::min(i + 1, points - 1)] * scale;
+    // Start at the sample, moved strictly inside the bracket at an end of the scan.
+    const double width = local.upper_bound - local.lower_bound;
+    local.initial = std::clamp(xs[i] * scale, local.lower_bound + 1e-3 * width,
+                               local.upper_bound - 1e-3 * width);
+    spdlog::info("refining sampled minimum {} at E = {:.6g} Pa within [{:.6g}, {:.6g}] Pa", k + 1,
+                 xs[i] * scale, local.lower_bound, local.upper_bound);
+    refined.push_back(MinimizeLocally(local, objective));
+  }
+
+  // The usable refinement of least cost; the first refinement's failure if none is.
+  int best = -1;
+  for (int k = 0; k < static_cast<int>(refined.size()); ++k) {
+    if (refined[k].IsSolutionUsable() && (best < 0 || refined[k].cost < refined[best].cost)) {
+      best = k;
+    }
+  }
+  if (best >= 0) {
+    summary = refined[best];
+  } else if (!refined.empty()) {
+    summary = refined.front();
+  } else {
+    summary.termination = TerminationType::kFailure;
+    summary.message = "no usable evaluation in the scan of the bounds: " + scan_failure;
+  }
+  summary.initial_modulus = options.initial;
+  summary.evaluations = 0;
+  summary.gradient_evaluations = 0;
+  for (const IdentificationSummary& local : refined) {
+    summary.evaluations += local.evaluations;
+    summary.gradient_evaluations += local.gradient_evaluations;
+  }
+  summary.refinements = static_cast<int>(refined.size());
+  for (const double x : xs) summary.scan_moduli.push_back(x * scale);
+  summary.scan_costs = costs;
+  summary.scan_evaluations = points;
+  summary.local_minima = static_cast<int>(minima.size());
+  // The second valley: its refined cost when refined, else its sampled cost.
+  if (minima.size() >= 2 && best >= 0) {
+    double second_cost = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < static_cast<int>(minima.size()); ++k) {
+      const bool was_refined = k < static_cast<int>(refined.size());
+      if (k == best || (was_refined && !refined[k].IsSolutionUsable())) continue;
+      const double cost = was_refined ? refined[k].cost : costs[minima[k]];
+      const double modulus = was_refined ? refined[k].modulus : xs[minima[k]] * scale;
+      if (cost < second_cost) {
+        second_cost = cost;
+        summary.second_modulus = modulus;
+      }
+    }
+    if (std::isfinite(second_cost)) summary.cost_gap = second_cost - summary.cost;
+  }
+  summary.scan_wall_time_s = scan_wall_time_s;
+  summary.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }
 

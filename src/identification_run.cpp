@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "mcrewave/noise.h"
+#include "mcrewave/prefilter.h"
 #include "mcrewave/simulation.h"
 
 namespace mcrewave {
@@ -113,10 +114,15 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
   const auto start = Clock::now();
   IdentificationRun run;
   run.config = config;
-  run.data = data;
   run.reference_known = config.data.source == DataSource::kSynthetic;
+  run.data = PrefilterMeasurements(data, config.prefilter, &run.prefilter_cutoff);
+  if (config.prefilter.enabled) {
+    spdlog::info("pre-filter: zero-phase Butterworth of order {} (x2), cut-off {:.6g} Hz{}",
+                 config.prefilter.order, run.prefilter_cutoff,
+                 config.prefilter.cutoff_frequency > 0.0 ? "" : " (derived from the load)");
+  }
 
-  // 1. The outer loop.
+  // The outer loop.
   const BarModel model(config.model);
   McreObjective objective(model, run.data, config.mcre, config.time.theta, config.inner,
                           config.outer.initial);
@@ -140,13 +146,13 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
   run.best_index = objective.best_index();
   run.solution = objective.best_solution();
 
-  // 2. The cost curve around E*.
+  // The cost curve around E*.
   run.cost_curve = ComputeCostCurve(config, model, run.data, run, &run.cost_curve_sweeps);
 
-  // 3. The uncertainty figure: noise levels known for synthetic data with noise,
+  // The uncertainty figure: noise levels known for synthetic data with noise,
   // estimated from the data's second differences otherwise.
   run.misfit = MisfitLevels(run.data, run.solution, run.alpha);
-  run.estimated_noise = DifferenceNoiseLevels(run.data);
+  run.estimated_noise = DifferenceNoiseLevels(data);
   if (run.reference_known && std::isfinite(config.data.snr)) {
     const MeasurementSet truth = SimulateTruth(config.model, config.load, config.time, config.data);
     // std = RMS(signal) / SNR (noise.h)

@@ -4,6 +4,7 @@
 
 #include <cassert>
 #include <cmath>
+#include <memory>
 #include <sstream>
 #include <utility>
 
@@ -24,7 +25,11 @@ bool McreOptions::IsValid(std::string* error) const {
 McreObjective::McreObjective(const BarModel& model, const MeasurementSet& data,
                              const McreOptions& mcre, double theta,
                              const CoupledSolverOptions& inner, double modulus_scale)
-    : problem_(model, data, mcre.weights, mcre.reference_modulus, theta),
+    : model_(model),
+      data_(data),
+      mcre_(mcre),
+      theta_(theta),
+      problem_(model, data, mcre.weights, mcre.reference_modulus, theta),
       inner_(inner),
       modulus_scale_(modulus_scale) {
   assert(mcre.IsValid(nullptr) && inner.IsValid(nullptr) && modulus_scale > 0.0);
@@ -38,6 +43,12 @@ McreObjective::McreObjective(const BarModel& model, const MeasurementSet& data,
                   (data.f0[j] * data.f0[j] + data.fL[j] * data.fL[j]);
   }
   rest_cost_ = problem_.Cost(zero, zero) + force_part;
+}
+
+std::unique_ptr<ModulusObjective> McreObjective::CloneForScan(double inner_tolerance) const {
+  CoupledSolverOptions inner = inner_;
+  inner.tolerance = inner_tolerance;
+  return std::make_unique<McreObjective>(model_, data_, mcre_, theta_, inner, modulus_scale_);
 }
 
 void McreObjective::SetWarmStart(const Matrix& retrograde) {

@@ -375,7 +375,28 @@ std::string SummaryYaml(const IdentificationRun& run) {
   yaml.Number(1, "scaled_cost", outer.cost, "e^2 / cost_scale at the identified modulus");
   yaml.Number(1, "cost_scale", run.rest_cost,
               "[J s] J_rest, the functional of the bar left at rest (>= e^2 for every E)");
-  yaml.Number(1, "wall_time_s", outer.wall_time_s, "[s]");
+  yaml.Number(1, "wall_time_s", outer.wall_time_s, "[s] scan and refinements");
+
+  yaml.Line(0, "scan", "", "global scan of e^2 over the bounds (outer.scan_points)");
+  yaml.Integer(1, "points", static_cast<long>(outer.scan_moduli.size()), "0: no scan");
+  yaml.Integer(1, "local_minima", outer.local_minima, "sampled local minima of e^2 seen");
+  yaml.Number(1, "second_modulus", outer.second_modulus > 0.0 ? outer.second_modulus : NAN,
+              "[Pa] the second-lowest minimum (null: fewer than two)");
+  yaml.Number(1, "scaled_cost_gap", outer.cost_gap,
+              "e^2 / cost_scale of the second-lowest minimum minus the lowest");
+  yaml.Number(1, "cost_gap", outer.cost_gap * run.rest_cost, "[J s] the same gap of e^2");
+  yaml.Integer(1, "refinements", outer.refinements, "local searches from the lowest minima");
+  yaml.Number(1, "wall_time_s", outer.scan_wall_time_s, "[s] of the scan");
+
+  yaml.Line(0, "prefilter", "", "zero-phase low-pass of the measurements (prefilter.*)");
+  yaml.Line(1, "enabled", run.config.prefilter.enabled ? "true" : "false");
+  yaml.Number(1, "cutoff_frequency", run.config.prefilter.enabled ? run.prefilter_cutoff : NAN,
+              "[Hz] cut-off used (null: off)");
+  yaml.Text(1, "cutoff_source",
+            !run.config.prefilter.enabled                   ? "off"
+            : run.config.prefilter.cutoff_frequency > 0.0 ? "config"
+                                                          : "derived_from_load",
+            "config: prefilter.cutoff_frequency; derived_from_load: EstimateCutoffFrequency");
 
   long inner_iterations = 0;
   int max_inner_iterations = 0;

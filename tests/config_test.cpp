@@ -9,6 +9,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mcrewave/types.h"
@@ -59,6 +60,13 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.outer.relative_tolerance, actual.outer.relative_tolerance);
   EXPECT_EQ(expected.outer.max_evaluations, actual.outer.max_evaluations);
   EXPECT_EQ(expected.outer.max_time, actual.outer.max_time);
+  EXPECT_EQ(expected.outer.scan_points, actual.outer.scan_points);
+  EXPECT_EQ(expected.outer.scan_tolerance, actual.outer.scan_tolerance);
+  EXPECT_EQ(expected.outer.scan_threads, actual.outer.scan_threads);
+  EXPECT_EQ(expected.outer.refine_candidates, actual.outer.refine_candidates);
+  EXPECT_EQ(expected.prefilter.enabled, actual.prefilter.enabled);
+  EXPECT_EQ(expected.prefilter.cutoff_frequency, actual.prefilter.cutoff_frequency);
+  EXPECT_EQ(expected.prefilter.order, actual.prefilter.order);
   EXPECT_EQ(expected.uncertainty.samples, actual.uncertainty.samples);
   EXPECT_EQ(expected.uncertainty.seed, actual.uncertainty.seed);
   EXPECT_EQ(expected.output.folder, actual.output.folder);
@@ -132,6 +140,31 @@ TEST(ConfigTest, DefaultConfigYamlParsesToTheDefaultConfig) {
        {"model:", "load:", "time:", "data:", "mcre:", "inner:", "outer:", "uncertainty:", "output:",
         "  length: 1", "# [m] ", "  snr: .inf", "  density: 800", "(consistent | lumped)"}) {
     EXPECT_NE(yaml.find(line), std::string::npos) << yaml << "\nlacks " << line;
+  }
+}
+
+TEST(ConfigTest, ScanAndPrefilterKeysAreReadAndChecked) {
+  const Config config = ParseConfig("outer:\n  scan_points: 0\n  refine_candidates: 3\n"
+                                    "prefilter:\n  enabled: true\n  cutoff_frequency: 50e3\n"
+                                    "  order: 6\n",
+                                    "scan.yaml");
+  EXPECT_EQ(config.outer.scan_points, 0);
+  EXPECT_EQ(config.outer.refine_candidates, 3);
+  EXPECT_TRUE(config.prefilter.enabled);
+  EXPECT_EQ(config.prefilter.cutoff_frequency, 50e3);
+  EXPECT_EQ(config.prefilter.order, 6);
+  for (const auto& [override_text, key] : std::vector<std::pair<std::string, std::string>>{
+           {"outer.scan_points=2", "outer.scan_points"},
+           {"outer.scan_points=-1", "outer.scan_points"},
+           {"outer.scan_tolerance=1.5", "outer.scan_tolerance"},
+           {"prefilter.order=3", "prefilter.order"},
+           {"prefilter.cutoff_frequency=-1", "prefilter.cutoff_frequency"}}) {
+    try {
+      ParseConfig("", "scan.yaml", {override_text});
+      ADD_FAILURE() << override_text << " was accepted";
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find(key), std::string::npos) << error.what();
+    }
   }
 }
 
@@ -421,7 +454,7 @@ TEST_F(ConfigFileTest, SectionThatIsNotAMap) {
 TEST_F(ConfigFileTest, TopLevelThatIsNotAMap) {
   ExpectLoadError("- model\n- load\n", 1,
                   {"expected a map of sections (model, load, time, data, mcre, inner, outer, "
-                   "uncertainty, output)",
+                   "prefilter, uncertainty, output)",
                    "got a list"});
 }
 

@@ -73,6 +73,7 @@ IdentificationOptions Options(OptimizerType optimizer, OuterAlgorithm algorithm)
   options.relative_tolerance = 1e-8;
   options.max_evaluations = 200;
   options.max_time = 60.0;
+  options.scan_points = 0;  // the local optimisers alone (global_search_test.cpp: the scan)
   return options;
 }
 

@@ -77,8 +77,10 @@ QuickRun RunQuick(const std::string& name, const std::string& extra = "") {
 TEST(IdentifyRunTest, QuickConfigIdentifiesEAndWritesEveryResult) {
   const QuickRun run = RunQuick("identify_run_quick");
   ASSERT_EQ(run.result.exit_code, 0) << run.result.output;
-  // One progress line per outer evaluation at the default level.
-  EXPECT_NE(run.result.output.find("nlopt evaluation 1: E = 1.6e+11 Pa"), std::string::npos)
+  // The scan, then one progress line per evaluation of the local refinement.
+  EXPECT_NE(run.result.output.find("scan of 41 moduli over [1e+11, 4e+11] Pa"), std::string::npos)
+      << run.result.output;
+  EXPECT_NE(run.result.output.find("nlopt evaluation 1: E = "), std::string::npos)
       << run.result.output;
   for (const char* key :
        {"version", "identified_modulus", "reference_modulus", "relative_error", "cost",
@@ -97,6 +99,11 @@ TEST(IdentifyRunTest, QuickConfigIdentifiesEAndWritesEveryResult) {
   EXPECT_NE(summary.find("  meaning: \"first-order standard deviation"), std::string::npos);
   EXPECT_NE(summary.find("    elements: 25"), std::string::npos) << summary;
   EXPECT_NE(summary.find("termination: \"convergence\""), std::string::npos) << summary;
+  EXPECT_NE(summary.find("scan:"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("  local_minima: "), std::string::npos) << summary;
+  EXPECT_NE(summary.find("  scaled_cost_gap: "), std::string::npos) << summary;
+  EXPECT_NE(summary.find("prefilter:"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("  cutoff_frequency: "), std::string::npos) << summary;
 
   for (const char* file :
        {"summary.yaml", "evaluations.csv", "cost_curve.csv", "ends.csv", "inner_residual.csv",
@@ -221,8 +228,9 @@ TEST(IdentifyRunTest, UnusableInnerSolveExitsWithOneNamingTheSolver) {
       RunIdentify("run " + SourcePath("configs/quick.yaml") +
                   " --set inner.max_iterations=1 --set inner.tolerance=1e-14 -q -o " + folder);
   EXPECT_EQ(run.exit_code, 1) << run.output;
-  EXPECT_NE(run.output.find("error: identification failed: the coupled solve at E = 1.6e+11 Pa "
-                            "is not usable: conjugate_gradient: no_convergence"),
+  EXPECT_NE(run.output.find("error: identification failed: no usable evaluation in the scan of "
+                            "the bounds: the coupled solve at E = 1e+11 Pa is not usable: "
+                            "conjugate_gradient: no_convergence"),
             std::string::npos)
       << run.output;
   EXPECT_FALSE(fs::exists(folder));

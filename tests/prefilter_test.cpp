@@ -118,6 +118,7 @@ TEST(PrefilterTest, DisabledLeavesTheDataAndEnabledFiltersEveryChannel) {
   data.snr = std::numeric_limits<double>::infinity();
   const MeasurementSet clean = MakeSyntheticMeasurements(bar, load, time, data);
   PrefilterOptions options;
+  options.enabled = false;
   EXPECT_EQ(PrefilterMeasurements(noisy, options).uL, noisy.uL);
   options.enabled = true;
   double cutoff = 0.0;

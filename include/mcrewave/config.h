@@ -26,7 +26,12 @@
 //   outer: optimizer [nlopt | ceres], algorithm [default | bobyqa | cobyla | sbplx |
 //          mma | lbfgs | bfgs], lower_bound [100e9 Pa], upper_bound [400e9 Pa],
 //          initial [160e9 Pa], relative_tolerance [1e-7], max_evaluations [100],
-//          max_time [600 s] (IdentificationOptions, identification.h)
+//          max_time [600 s], scan_points [41], scan_tolerance [1e-5],
+//          scan_threads [2], refine_candidates [2] (IdentificationOptions,
+//          identification.h)
+//   prefilter: enabled [true], cutoff_frequency [0 Hz: derived from the data],
+//          order [4] (PrefilterOptions, prefilter.h; applied to the measurements
+//          before the identification)
 //   uncertainty: samples [16], seed [1] (modulus_uncertainty.h)
 //   output: folder ["results/identify"], figures [true], curve_points [41]
 #pragma once
@@ -40,6 +45,7 @@
 #include "mcrewave/identification.h"
 #include "mcrewave/modulus_uncertainty.h"
 #include "mcrewave/objective.h"
+#include "mcrewave/prefilter.h"
 
 namespace mcrewave {
 
@@ -66,6 +72,7 @@ struct Config {
   McreOptions mcre;
   CoupledSolverOptions inner;
   IdentificationOptions outer;
+  PrefilterOptions prefilter;
   UncertaintyOptions uncertainty;
   OutputOptions output;
 };

@@ -17,9 +17,25 @@
 //
 // Both see the same objective: x = E / E_scale of order 1 (E_scale =
 // objective->modulus_scale()) and the cost scaled by the objective.
+//
+// Global search (scan_points > 0, the default): e^2(E) of noisy data is rugged
+// (the noise shifts the model's resonances in and out of phase with it as E
+// changes, docs/robustness.md), so a local optimiser started anywhere stops in
+// the nearest valley. Identify first evaluates the cost on scan_points moduli
+// evenly spaced in log E over [lower_bound, upper_bound] (copies of the objective at the
+// loose inner tolerance scan_tolerance, on scan_threads threads, each thread a
+// fixed contiguous block warm-started point to point: the result depends on the
+// options, never on timing), counts the local minima of those samples, and then
+// refines the refine_candidates lowest of them with the local optimiser, each
+// bracketed by its two neighbouring scan points (a sampled minimum c_i < c_{i-1},
+// c_{i+1} of a continuous cost holds a local minimum strictly between them). The
+// refined minimum of least cost is the result. scan_points = 0 keeps the local
+// search from `initial` alone.
 #pragma once
 
+#include <limits>
 #include <string>
+#include <vector>
 
 #include "mcrewave/coupled_solver.h"
 #include "mcrewave/objective.h"
@@ -66,10 +82,24 @@ struct IdentificationOptions {
   int max_evaluations = 100;
   // Wall time allowed to the outer loop [s]; reaching it is not convergence.
   double max_time = 600.0;
+  // Moduli of the global scan, evenly spaced in log E over the bounds (ends
+  // included); 0: no scan, local search from `initial` only. 41 over the default
+  // bounds is a step of 3.5 % in E, under a third of the spacing of the valleys
+  // measured at SNR 2.5 (docs/robustness.md).
+  int scan_points = 41;
+  // Relative residual asked of the inner solves of the scan (the refinement uses
+  // the objective's own, inner.tolerance): the scan only ranks valleys.
+  double scan_tolerance = 1e-5;
+  // Threads of the scan (each its own copy of the objective).
+  int scan_threads = 2;
+  // Lowest sampled minima refined by the local optimiser.
+  int refine_candidates = 2;
 
   // Valid when 0 < lower_bound < initial < upper_bound (finite),
-  // relative_tolerance in (0, 0.1), max_evaluations >= 2, max_time > 0, and the
-  // algorithm exists for the optimiser. Messages name the outer.* keys.
+  // relative_tolerance in (0, 0.1), max_evaluations >= 2, max_time > 0, the
+  // algorithm exists for the optimiser, scan_points is 0 or in [3, 100000],
+  // scan_tolerance in (0, 1), scan_threads in [1, 64] and refine_candidates in
+  // [1, 100]. Messages name the outer.* keys.
   bool IsValid(std::string* error) const;
 };
 
@@ -88,6 +118,19 @@ struct IdentificationSummary {
   std::string optimizer_message;  // the optimiser's own word on why it stopped
   double wall_time_s = -1.0;
 
+  // The global scan (empty / zero when scan_points = 0).
+  std::vector<double> scan_moduli;  // [Pa], ascending
+  std::vector<double> scan_costs;   // scaled cost at scan_moduli (NaN: not usable)
+  int scan_evaluations = 0;         // scan evaluations, not counted in `evaluations`
+  int local_minima = 0;             // sampled local minima of scan_costs (ends included)
+  // Scaled cost of the second-lowest minimum minus the lowest, both refined
+  // when refined (NaN with fewer than two minima): a small gap says a second
+  // valley nearly as deep, i.e. a fragile identification.
+  double cost_gap = std::numeric_limits<double>::quiet_NaN();
+  double second_modulus = -1.0;  // [Pa] the second-lowest minimum (-1: none)
+  int refinements = 0;           // local refinements run
+  double scan_wall_time_s = 0.0;
+
   // Convergence: a tolerance was met (NLopt xtol/ftol or roundoff-limited;
   // Ceres convergence). Limits reached, a failed evaluation or an exception in
   // the objective are not usable.
@@ -96,10 +139,14 @@ struct IdentificationSummary {
   std::string FullReport() const;
 };
 
-// Minimises the objective from x0 = options.initial / objective->modulus_scale()
-// within the bounds. Never throws for what the objective does: an exception
-// thrown by the objective ends the run with termination kFailure and its what()
-// in the message. Precondition: options.IsValid().
+// Minimises the objective within the bounds: with scan_points > 0 the scan and
+// refinements described above (the scan on objective->CloneForScan copies when
+// the objective offers them, else on the objective itself in one thread), else
+// from x0 = options.initial / objective->modulus_scale(). max_evaluations and
+// max_time hold for each local refinement. Never throws for what the objective
+// does: an exception thrown by the objective ends the run (or, in the scan,
+// makes that sample unusable) with termination kFailure and its what() in the
+// message. Precondition: options.IsValid().
 IdentificationSummary Identify(const IdentificationOptions& options, ModulusObjective* objective);
 
 }  // namespace mcrewave

@@ -3,9 +3,10 @@
 //
 //   1. LoadMeasurements: synthetic data (data.source: synthetic) or the CSV file,
 //      checked against the model's time grid.
-//   2. Identify (identification.h) on an McreObjective (objective.h) with
-//      x = E / outer.initial.
-//   3. At the identified E*: the cost curve e^2(E) on output.curve_points points
+//   2. The pre-filter (prefilter.h) of the measurements when prefilter.enabled.
+//   3. Identify (identification.h) on an McreObjective (objective.h) with
+//      x = E / outer.initial: the global scan and local refinements.
+//   4. At the identified E*: the cost curve e^2(E) on output.curve_points points
 //      around E*, warm-started point to point, and the uncertainty figure
 //      (modulus_uncertainty.h).
 #pragma once
@@ -31,7 +32,10 @@ MeasurementSet LoadMeasurements(const Config& config);
 // Everything one identification computed.
 struct IdentificationRun {
   Config config;
+  // The measurements the MCRE compared with: pre-filtered when prefilter.enabled.
   MeasurementSet data;
+  // The pre-filter's cut-off frequency [Hz] (given or derived); 0 when off.
+  double prefilter_cutoff = 0.0;
   // Synthetic data: they were made with E = config.model.modulus, the reference
   // the identified modulus is compared with. False for CSV data.
   bool reference_known = false;
@@ -40,7 +44,10 @@ struct IdentificationRun {
   // "data_differences" (DifferenceNoiseLevels: CSV data, or no synthetic noise).
   NoiseLevels noise;
   std::string noise_source;
-  NoiseLevels estimated_noise;  // DifferenceNoiseLevels(data), always
+  // DifferenceNoiseLevels of the measurements as given (before the pre-filter).
+  // The uncertainty draws white noise of `noise` on the channels, unfiltered:
+  // with the pre-filter on, it overstates the spread (conservative).
+  NoiseLevels estimated_noise;
   NoiseLevels misfit;           // RMS misfits at the optimum (MisfitLevels)
 
   IdentificationSummary outer;
@@ -66,7 +73,7 @@ struct IdentificationRun {
   double cost() const { return best_index >= 0 ? evaluations[best_index].cost : -1.0; }
 };
 
-// Runs steps 2 and 3 on measurements made by LoadMeasurements(config).
+// Runs steps 2 to 4 on measurements made by LoadMeasurements(config).
 // Precondition: config valid (as LoadConfig returns it). Never throws for a
 // failed identification: see IsUsable() and outer.message.
 IdentificationRun RunIdentification(const Config& config, const MeasurementSet& data);

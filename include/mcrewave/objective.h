@@ -9,6 +9,7 @@
 // warm-started from the previous usable solution and records what it did.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,15 @@ class ModulusObjective {
 
   // Why the last failed Evaluate failed ("" when none failed).
   virtual std::string error_message() const = 0;
+
+  // An independent objective of the same cost (same scale, same cost scaling),
+  // its inner solves run to the relative tolerance inner_tolerance, usable on
+  // another thread while this one is not evaluated; null when the objective
+  // cannot be copied (the default).
+  virtual std::unique_ptr<ModulusObjective> CloneForScan(double inner_tolerance) const {
+    (void)inner_tolerance;
+    return nullptr;
+  }
 };
 
 // The `mcre:` section of the config: the weights of the data terms and the
@@ -74,6 +84,9 @@ class McreObjective : public ModulusObjective {
   // coupled solve is not usable (the solver's message is kept).
   bool Evaluate(const double* parameters, double* cost, double* gradient) override;
   std::string error_message() const override { return error_message_; }
+  // A new McreObjective on the same model, data and weights with
+  // inner.tolerance = inner_tolerance (its evaluations are its own).
+  std::unique_ptr<ModulusObjective> CloneForScan(double inner_tolerance) const override;
 
   // Evaluates e^2 and de^2/dE at modulus E [Pa] (> 0) and records it; returns the
   // record. Evaluate calls this.
@@ -103,6 +116,10 @@ class McreObjective : public ModulusObjective {
   McreProblem& problem() { return problem_; }
 
  private:
+  const BarModel& model_;
+  const MeasurementSet& data_;
+  McreOptions mcre_;
+  double theta_;
   McreProblem problem_;
   CoupledSolverOptions inner_;
   double modulus_scale_;

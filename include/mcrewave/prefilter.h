@@ -25,7 +25,10 @@
 namespace mcrewave {
 
 struct PrefilterOptions {
-  bool enabled = false;
+  // On by default: at SNR 2.5 on the paper's case it takes the share of noise
+  // seeds identifying E within +-2 % from 78 % to 96 %, with no noise-free bias
+  // (docs/robustness.md).
+  bool enabled = true;
   // Cut-off frequency [Hz]; 0 derives it from the data (EstimateCutoffFrequency).
   double cutoff_frequency = 0.0;
   int order = 4;  // Butterworth order of one pass, even, 2..12
