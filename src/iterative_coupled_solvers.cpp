@@ -16,7 +16,8 @@ namespace {
 
 // The state every iterative solver starts from: W^(0), U = Direct(W^(0)),
 // r = T(W^(0)) - W^(0), ||c||_P, and the round-off floor of the residual. Costs 3
-// sweeps, 5 when W^(0) != 0 (c is then computed separately).
+// sweeps, 5 when W^(0) != 0 (c is then computed separately). When c = 0 the
+// solution (W = 0) is set and the summary says so.
 struct StartingPoint {
   double rhs_norm = 0.0;  // ||c||_P
   // ||r||_P below this is round-off: c = T(0) is the difference of the retrograde
@@ -24,6 +25,7 @@ struct StartingPoint {
   // data are consistent with the model; the floor is kRoundOffFloor times the
   // response to the displacement data alone, W_u = Retrograde(0) with the data.
   double residual_floor = 0.0;
+  bool solved = false;  // c = 0: the solution W = 0 is already in place
 };
 
 // Measured: on the paper's case with noise-free data at E_ref and w_u = 1
@@ -32,13 +34,14 @@ struct StartingPoint {
 // floor only acts on data consistent with the model to about 1e-3 or better.
 constexpr double kRoundOffFloor = 1e-11;
 
-StartingPoint Start(McreProblem* problem, const Matrix* initial_retrograde, Matrix* retrograde,
-                    Matrix* displacement, Matrix* residual) {
+StartingPoint Start(McreProblem* problem, const Matrix* initial_retrograde,
+                    CoupledSolution* solution, Matrix* residual, CoupledSolverSummary* summary) {
   StartingPoint start;
+  Matrix& retrograde = solution->retrograde;
   const bool zero_start =
       initial_retrograde == nullptr || initial_retrograde->cwiseAbs().maxCoeff() == 0.0;
-  *retrograde = zero_start ? problem->ZeroField() : *initial_retrograde;
-  problem->FixedPointMap(*retrograde, displacement, residual);
+  retrograde = zero_start ? problem->ZeroField() : *initial_retrograde;
+  problem->FixedPointMap(retrograde, &solution->displacement, residual);
   if (zero_start) {
     // T(0) = c.
     start.rhs_norm = problem->Norm(*residual);
@@ -50,7 +53,19 @@ StartingPoint Start(McreProblem* problem, const Matrix* initial_retrograde, Matr
   Matrix displacement_data_response;
   problem->RetrogradeSweep(problem->ZeroField(), true, &displacement_data_response);
   start.residual_floor = kRoundOffFloor * problem->Norm(displacement_data_response);
-  *residual -= *retrograde;
+  *residual -= retrograde;
+  summary->iterations = 0;
+  if (start.rhs_norm == 0.0) {
+    // c = 0: W = 0 is the solution (and U = Direct(0) already when W^(0) = 0).
+    if (!zero_start) {
+      retrograde.setZero();
+      problem->DirectSweep(retrograde, true, &solution->displacement);
+    }
+    summary->termination = TerminationType::kConvergence;
+    summary->relative_residual = 0.0;
+    summary->message = "the data are matched exactly: c = T(0) = 0";
+    start.solved = true;
+  }
   return start;
 }
 
@@ -115,15 +130,8 @@ void SolveByRelaxation(const CoupledSolverOptions& options, McreProblem* problem
   Matrix& retrograde = solution->retrograde;
   Matrix& displacement = solution->displacement;
   Matrix residual;
-  const StartingPoint start =
-      Start(problem, initial_retrograde, &retrograde, &displacement, &residual);
-  summary->iterations = 0;
-  if (start.rhs_norm == 0.0) {
-    summary->termination = TerminationType::kConvergence;
-    summary->relative_residual = 0.0;
-    summary->message = "the data are matched exactly: c = T(0) = 0";
-    return;
-  }
+  const StartingPoint start = Start(problem, initial_retrograde, solution, &residual, summary);
+  if (start.solved) return;
 
   double omega = options.relaxation_coefficient;
   double spectrum_max = 0.0;
@@ -224,15 +232,8 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, McreProblem* 
   Matrix& retrograde = solution->retrograde;
   Matrix& displacement = solution->displacement;
   Matrix residual;
-  const StartingPoint start =
-      Start(problem, initial_retrograde, &retrograde, &displacement, &residual);
-  summary->iterations = 0;
-  if (start.rhs_norm == 0.0) {
-    summary->termination = TerminationType::kConvergence;
-    summary->relative_residual = 0.0;
-    summary->message = "the data are matched exactly: c = T(0) = 0";
-    return;
-  }
+  const StartingPoint start = Start(problem, initial_retrograde, solution, &residual, summary);
+  if (start.solved) return;
   Matrix direction = residual;
   Matrix image, scratch;
   double rho = problem->InnerProduct(residual, residual);

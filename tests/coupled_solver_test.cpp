@@ -14,33 +14,16 @@
 namespace mcrewave {
 namespace {
 
+using testing::Compare;
+using testing::kReferenceModulus;
 using testing::MakeSmallCase;
+using testing::Options;
 using testing::ProblemBundle;
-using testing::RelativeDifference;
+using testing::Solve;
+using testing::Solved;
 using testing::Weights;
 
-constexpr double kReferenceModulus = 200e9;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-
-CoupledSolverOptions Options(CoupledSolverType type, double tolerance) {
-  CoupledSolverOptions options;
-  options.type = type;
-  options.tolerance = tolerance;
-  options.max_iterations = 20000;
-  return options;
-}
-
-struct Solved {
-  CoupledSolverSummary summary;
-  CoupledSolution solution;
-};
-
-Solved Solve(const CoupledSolverOptions& options, McreProblem* problem,
-             const Matrix* initial = nullptr) {
-  Solved solved;
-  solved.summary = SolveCoupled(options, problem, initial, &solved.solution);
-  return solved;
-}
 
 TEST(CoupledSolverOptionsTest, DefaultOptionsAreValid) {
   std::string why;
@@ -99,10 +82,10 @@ TEST_P(SolverAgreementTest, AgreesWithAllAtOnce) {
   }
   const Solved solved = Solve(options, &problem);
   ASSERT_TRUE(solved.summary.IsSolutionUsable()) << solved.summary.FullReport();
-  EXPECT_LT(RelativeDifference(solved.solution.displacement, reference.solution.displacement),
-            1e-8);
-  EXPECT_LT(RelativeDifference(solved.solution.retrograde, reference.solution.retrograde), 1e-8);
-  EXPECT_NEAR(solved.solution.cost, reference.solution.cost, 1e-8 * reference.solution.cost);
+  const testing::Agreement agreement = Compare(solved, reference);
+  EXPECT_LT(agreement.displacement, 1e-8);
+  EXPECT_LT(agreement.retrograde, 1e-8);
+  EXPECT_LT(agreement.cost, 1e-8);
   EXPECT_NEAR(solved.solution.cost_gradient, reference.solution.cost_gradient,
               1e-7 * std::abs(reference.solution.cost_gradient));
   EXPECT_GT(solved.summary.sweeps, 0);

@@ -12,31 +12,15 @@
 namespace mcrewave {
 namespace {
 
+using testing::Compare;
+using testing::kReferenceModulus;
 using testing::MakeSmallCase;
+using testing::Options;
 using testing::ProblemBundle;
 using testing::RelativeDifference;
+using testing::Solve;
+using testing::Solved;
 using testing::Weights;
-
-constexpr double kReferenceModulus = 200e9;
-
-CoupledSolverOptions Options(CoupledSolverType type, double tolerance) {
-  CoupledSolverOptions options;
-  options.type = type;
-  options.tolerance = tolerance;
-  options.max_iterations = 20000;
-  return options;
-}
-
-struct Solved {
-  CoupledSolverSummary summary;
-  CoupledSolution solution;
-};
-
-Solved Solve(const CoupledSolverOptions& options, McreProblem* problem) {
-  Solved solved;
-  solved.summary = SolveCoupled(options, problem, nullptr, &solved.solution);
-  return solved;
-}
 
 TEST(RiccatiSolverTypeTest, NewNamesRoundTrip) {
   for (CoupledSolverType type : {CoupledSolverType::kRiccati, CoupledSolverType::kSingleShooting,
@@ -84,18 +68,13 @@ TEST_P(RiccatiAgreementTest, AgreesWithAllAtOnceToOneInOneHundredMillion) {
 
   const Solved riccati = Solve(Options(CoupledSolverType::kRiccati, 1e-10), &problem);
   ASSERT_TRUE(riccati.summary.IsSolutionUsable()) << riccati.summary.FullReport();
-  const double u_difference =
-      RelativeDifference(riccati.solution.displacement, reference.solution.displacement);
-  const double w_difference =
-      RelativeDifference(riccati.solution.retrograde, reference.solution.retrograde);
-  const double cost_difference =
-      std::abs(riccati.solution.cost - reference.solution.cost) / reference.solution.cost;
+  const testing::Agreement agreement = Compare(riccati, reference);
   std::cout << "riccati vs all_at_once (w_u " << param.w_u << ", theta " << param.theta << "): U "
-            << u_difference << ", W " << w_difference << ", e^2 " << cost_difference
-            << ", residual " << riccati.summary.relative_residual << "\n";
-  EXPECT_LT(u_difference, 1e-8);
-  EXPECT_LT(w_difference, 1e-8);
-  EXPECT_LT(cost_difference, 1e-8);
+            << agreement.displacement << ", W " << agreement.retrograde << ", e^2 "
+            << agreement.cost << ", residual " << riccati.summary.relative_residual << "\n";
+  EXPECT_LT(agreement.displacement, 1e-8);
+  EXPECT_LT(agreement.retrograde, 1e-8);
+  EXPECT_LT(agreement.cost, 1e-8);
   EXPECT_NEAR(riccati.solution.cost_gradient, reference.solution.cost_gradient,
               1e-7 * std::abs(reference.solution.cost_gradient));
   EXPECT_GT(riccati.summary.multiply_accumulates, 0.0);

@@ -13,41 +13,14 @@
 namespace mcrewave {
 namespace {
 
+using testing::Compare;
+using testing::kReferenceModulus;
 using testing::MakeSmallCase;
+using testing::Options;
 using testing::ProblemBundle;
-using testing::RelativeDifference;
+using testing::Solve;
+using testing::Solved;
 using testing::Weights;
-
-constexpr double kReferenceModulus = 200e9;
-
-CoupledSolverOptions Options(CoupledSolverType type, double tolerance) {
-  CoupledSolverOptions options;
-  options.type = type;
-  options.tolerance = tolerance;
-  options.max_iterations = 20000;
-  return options;
-}
-
-struct Solved {
-  CoupledSolverSummary summary;
-  CoupledSolution solution;
-};
-
-Solved Solve(const CoupledSolverOptions& options, McreProblem* problem) {
-  Solved solved;
-  solved.summary = SolveCoupled(options, problem, nullptr, &solved.solution);
-  return solved;
-}
-
-struct Agreement {
-  double displacement, retrograde, cost;
-};
-
-Agreement Compare(const Solved& solved, const Solved& reference) {
-  return {RelativeDifference(solved.solution.displacement, reference.solution.displacement),
-          RelativeDifference(solved.solution.retrograde, reference.solution.retrograde),
-          std::abs(solved.solution.cost - reference.solution.cost) / reference.solution.cost};
-}
 
 struct AgreementCase {
   double w_u;
@@ -68,7 +41,7 @@ TEST_P(ShootingAgreementTest, AgreesWithAllAtOnceToOneInOneHundredMillion) {
   ASSERT_TRUE(reference.summary.IsSolutionUsable()) << reference.summary.FullReport();
   const Solved shooting = Solve(Options(param.type, 1e-10), &problem);
   ASSERT_TRUE(shooting.summary.IsSolutionUsable()) << shooting.summary.FullReport();
-  const Agreement agreement = Compare(shooting, reference);
+  const testing::Agreement agreement = Compare(shooting, reference);
   std::cout << CoupledSolverTypeToString(param.type) << " vs all_at_once (w_u " << param.w_u
             << ", theta " << param.theta << ", " << param.steps << " steps): U "
             << agreement.displacement << ", W " << agreement.retrograde << ", e^2 "
@@ -116,7 +89,7 @@ TEST(ShootingBreakdownTest, LongWindowFailsSingleShootingWhileMultipleShootingAn
        {CoupledSolverType::kMultipleShooting, CoupledSolverType::kRiccati}) {
     const Solved solved = Solve(Options(type, 1e-8), &problem);
     ASSERT_TRUE(solved.summary.IsSolutionUsable()) << solved.summary.FullReport();
-    const Agreement agreement = Compare(solved, reference);
+    const testing::Agreement agreement = Compare(solved, reference);
     std::cout << CoupledSolverTypeToString(type) << " on 1600 steps vs all_at_once: U "
               << agreement.displacement << ", W " << agreement.retrograde << ", e^2 "
               << agreement.cost << "\n";

@@ -1,9 +1,11 @@
 // Small MCRE problems shared by the tests of the coupled solvers.
 #pragma once
 
+#include <cmath>
 #include <memory>
 
 #include "mcrewave/bar_model.h"
+#include "mcrewave/coupled_solver.h"
 #include "mcrewave/mcre_problem.h"
 #include "mcrewave/simulation.h"
 
@@ -58,6 +60,39 @@ inline McreWeights Weights(double w_u, double w_f) {
 // ||a - b|| / ||b|| (Frobenius).
 inline double RelativeDifference(const Matrix& a, const Matrix& b) {
   return (a - b).norm() / b.norm();
+}
+
+constexpr double kReferenceModulus = 200e9;  // E_ref of the small cases [Pa]
+
+inline CoupledSolverOptions Options(CoupledSolverType type, double tolerance) {
+  CoupledSolverOptions options;
+  options.type = type;
+  options.tolerance = tolerance;
+  options.max_iterations = 20000;
+  return options;
+}
+
+struct Solved {
+  CoupledSolverSummary summary;
+  CoupledSolution solution;
+};
+
+inline Solved Solve(const CoupledSolverOptions& options, McreProblem* problem,
+                    const Matrix* initial = nullptr) {
+  Solved solved;
+  solved.summary = SolveCoupled(options, problem, initial, &solved.solution);
+  return solved;
+}
+
+// Relative differences of a solution from a reference in U, W and e^2.
+struct Agreement {
+  double displacement, retrograde, cost;
+};
+
+inline Agreement Compare(const Solved& solved, const Solved& reference) {
+  return {RelativeDifference(solved.solution.displacement, reference.solution.displacement),
+          RelativeDifference(solved.solution.retrograde, reference.solution.retrograde),
+          std::abs(solved.solution.cost - reference.solution.cost) / reference.solution.cost};
 }
 
 }  // namespace mcrewave::testing
