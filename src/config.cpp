@@ -294,7 +294,7 @@ const std::vector<Key>& KeyTable() {
       MakeKey("data.path", &Config::data, &DataOptions::path, Text(), "",
               "measurement CSV (t,u0,uL,f0,fL) if source is csv; relative to this file"),
       MakeKey("data.truth", &Config::data, &DataOptions::truth,
-              EnumByName<TruthModel>({TruthModel::kFiniteElement, TruthModel::kModal},
+              EnumByName<TruthModel>({TruthModel::kFiniteElement, TruthModel::kExact},
                                      TruthModelToString, StringToTruthModel),
               "", "truth sampled by the synthetic data"),
       MakeKey("data.truth_refinement", &Config::data, &DataOptions::truth_refinement,

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "coupled_solver_internal.h"
+#include "enum_names.h"
 
 namespace mcrewave {
 namespace {
@@ -24,20 +25,11 @@ constexpr std::array<std::pair<CoupledSolverType, const char*>, 7> kSolverTypes{
 }  // namespace
 
 const char* CoupledSolverTypeToString(CoupledSolverType type) {
-  for (const auto& [value, name] : kSolverTypes) {
-    if (value == type) return name;
-  }
-  return "unknown";
+  return internal::ToName(kSolverTypes, type);
 }
 
 bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type) {
-  for (const auto& [value, n] : kSolverTypes) {
-    if (name == n) {
-      *type = value;
-      return true;
-    }
-  }
-  return false;
+  return internal::FromName(kSolverTypes, name, type);
 }
 
 const char* TerminationTypeToString(TerminationType type) {

@@ -42,12 +42,12 @@ double LoadImpulse(const LoadOptions& load, double time) {
 
 }  // namespace
 
-ModalBarSolution::ModalBarSolution(const BarProperties& bar, const LoadOptions& load)
+ExactBarSolution::ExactBarSolution(const BarProperties& bar, const LoadOptions& load)
     : bar_(bar), load_(load) {
   assert(load.kind == LoadKind::kHalfSine);
 }
 
-double ModalBarSolution::Displacement(double x, double time) const {
+double ExactBarSolution::Displacement(double x, double time) const {
   assert(x >= 0.0 && x <= bar_.length);
   const double wave_speed = std::sqrt(bar_.modulus / bar_.density);
   const double impedance = bar_.density * wave_speed * bar_.section;
@@ -68,7 +68,7 @@ double ModalBarSolution::Displacement(double x, double time) const {
   return displacement;
 }
 
-double ModalBarSolution::ClampForce(double time) const {
+double ExactBarSolution::ClampForce(double time) const {
   const double travel_time = bar_.length / std::sqrt(bar_.modulus / bar_.density);
   double force = 0.0;
   double sign = 1.0;
@@ -82,7 +82,7 @@ double ModalBarSolution::ClampForce(double time) const {
   return force;
 }
 
-MeasurementSet ModalBarSolution::Sample(const TimeOptions& time) const {
+MeasurementSet ExactBarSolution::Sample(const TimeOptions& time) const {
   const int num_samples = time.NumSteps() + 1;
   MeasurementSet out;
   out.start_time = 0.0;

@@ -14,10 +14,14 @@
 #include <utility>
 #include <vector>
 
+#include "enum_names.h"
 #include "identification_internal.h"
 
 namespace mcrewave {
 namespace {
+
+using internal::FromName;
+using internal::ToName;
 
 constexpr std::array<std::pair<OptimizerType, const char*>, 2> kOptimizerTypes{{
     {OptimizerType::kNlopt, "nlopt"},
@@ -33,26 +37,6 @@ constexpr std::array<std::pair<OuterAlgorithm, const char*>, 7> kOuterAlgorithms
     {OuterAlgorithm::kLbfgs, "lbfgs"},
     {OuterAlgorithm::kBfgs, "bfgs"},
 }};
-
-template <typename Enum, std::size_t N>
-const char* ToName(const std::array<std::pair<Enum, const char*>, N>& table, Enum value) {
-  for (const auto& [v, name] : table) {
-    if (v == value) return name;
-  }
-  return "unknown";
-}
-
-template <typename Enum, std::size_t N>
-bool FromName(const std::array<std::pair<Enum, const char*>, N>& table, const std::string& name,
-              Enum* value) {
-  for (const auto& [v, n] : table) {
-    if (name == n) {
-      *value = v;
-      return true;
-    }
-  }
-  return false;
-}
 
 // "a, b or c": the algorithms the optimiser offers, for messages.
 std::string AvailableAlgorithms(OptimizerType optimizer) {

@@ -96,7 +96,7 @@ MeasurementSet SimulateClampedBar(const BarProperties& bar, const LoadOptions& l
 
 MeasurementSet SimulateTruth(const BarProperties& bar, const LoadOptions& load,
                              const TimeOptions& time, const DataOptions& data) {
-  if (data.truth == TruthModel::kModal) return ModalBarSolution(bar, load).Sample(time);
+  if (data.truth == TruthModel::kExact) return ExactBarSolution(bar, load).Sample(time);
   BarProperties fine = bar;
   fine.elements = bar.elements * data.truth_refinement;
   return SimulateClamped(fine, load, time, data.truth_refinement);

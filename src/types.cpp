@@ -3,29 +3,15 @@
 #include <array>
 #include <utility>
 
+#include "enum_names.h"
+
 namespace mcrewave {
 namespace {
 
-// One table per enum: the only place where a name is tied to a value.
-template <typename Enum, std::size_t N>
-const char* ToName(const std::array<std::pair<Enum, const char*>, N>& table, Enum value) {
-  for (const auto& [v, name] : table) {
-    if (v == value) return name;
-  }
-  return "unknown";
-}
+using internal::FromName;
+using internal::ToName;
 
-template <typename Enum, std::size_t N>
-bool FromName(const std::array<std::pair<Enum, const char*>, N>& table, const std::string& name,
-              Enum* value) {
-  for (const auto& [v, n] : table) {
-    if (name == n) {
-      *value = v;
-      return true;
-    }
-  }
-  return false;
-}
+// One table per enum: the only place where a name is tied to a value.
 
 constexpr std::array<std::pair<MassType, const char*>, 2> kMassTypes{
     {{MassType::kConsistent, "consistent"}, {MassType::kLumped, "lumped"}}};
@@ -34,7 +20,7 @@ constexpr std::array<std::pair<LoadKind, const char*>, 1> kLoadKinds{
 constexpr std::array<std::pair<DataSource, const char*>, 2> kDataSources{
     {{DataSource::kSynthetic, "synthetic"}, {DataSource::kCsv, "csv"}}};
 constexpr std::array<std::pair<TruthModel, const char*>, 2> kTruthModels{
-    {{TruthModel::kFiniteElement, "finite_element"}, {TruthModel::kModal, "modal"}}};
+    {{TruthModel::kFiniteElement, "finite_element"}, {TruthModel::kExact, "exact"}}};
 
 }  // namespace
 

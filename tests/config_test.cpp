@@ -198,7 +198,7 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   config.time.theta = 0.6;
   config.data.source = DataSource::kCsv;
   config.data.path = "dir with spaces/quote\"s and \\ back: # x.csv";
-  config.data.truth = TruthModel::kModal;
+  config.data.truth = TruthModel::kExact;
   config.data.truth_refinement = 64;
   config.data.snr = 2.5;
   config.data.seed = std::numeric_limits<std::uint64_t>::max();
@@ -233,7 +233,7 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   const std::string yaml = ConfigToYaml(config);
   ExpectSameConfig(config, ParseConfig(yaml, "resolved.yaml"));
   EXPECT_NE(yaml.find("mass: lumped"), std::string::npos) << yaml;
-  EXPECT_NE(yaml.find("truth: modal"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("truth: exact"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("method: adaptive_relaxation"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("optimizer: ceres"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("figures: false"), std::string::npos) << yaml;

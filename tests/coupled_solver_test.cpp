@@ -139,11 +139,11 @@ TEST(CostCurveTest, InverseCrimeDataHaveTheirMinimumAtTheReferenceModulus) {
 }
 
 TEST(CostCurveTest, ExactSolutionDataIdentifyTheModulusWithinOnePercent) {
-  // The paper's case at 100 elements, noise-free data from the exact (modal)
+  // The paper's case at 100 elements, noise-free data from the exact
   // solution: the minimiser of e^2, found by golden-section search, is the
   // discretisation bias only.
   testing::SmallCase paper = MakeSmallCase(100, 1750, kInfinity, 1);
-  paper.data.truth = TruthModel::kModal;
+  paper.data.truth = TruthModel::kExact;
   ProblemBundle bundle(paper, Weights(0.01, 1.0));
   McreProblem& problem = bundle.problem;
   const CoupledSolverOptions options = Options(CoupledSolverType::kConjugateGradient, 1e-8);

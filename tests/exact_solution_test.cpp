@@ -99,10 +99,10 @@ double Simpson(Function&& f, double a, double b, int intervals) {
   return sum * dx / 3.0;
 }
 
-TEST(ModalBarSolutionTest, AgreesWithTheModalSeries) {
+TEST(ExactBarSolutionTest, AgreesWithTheModalSeries) {
   const BarProperties bar;
   const LoadOptions load;
-  const ModalBarSolution exact(bar, load);
+  const ExactBarSolution exact(bar, load);
   const ModalSeries modal(bar, load, 20000);
   const double static_displacement = load.amplitude * bar.length / (bar.modulus * bar.section);
   double max_u_error = 0.0, max_f_error = 0.0, max_u = 0.0, max_f = 0.0;
@@ -126,12 +126,12 @@ TEST(ModalBarSolutionTest, AgreesWithTheModalSeries) {
   EXPECT_LT(max_f_error, 1e-7 * max_f);
 }
 
-TEST(ModalBarSolutionTest, AgreesWithTheModalSeriesInsideTheBarAndAtResonance) {
+TEST(ExactBarSolutionTest, AgreesWithTheModalSeriesInsideTheBarAndAtResonance) {
   const BarProperties bar;
   LoadOptions load;
   // pi / t_load = omega_1 = pi c / (2 L): the first mode is driven at resonance.
   load.duration = 2.0 * bar.length / WaveSpeed(bar);
-  const ModalBarSolution exact(bar, load);
+  const ExactBarSolution exact(bar, load);
   const ModalSeries modal(bar, load, 20000);
   const double scale = std::abs(exact.Displacement(bar.length, load.duration));
   for (double x : {0.1, 0.37, 0.5, 0.81}) {
@@ -142,10 +142,10 @@ TEST(ModalBarSolutionTest, AgreesWithTheModalSeriesInsideTheBarAndAtResonance) {
   }
 }
 
-TEST(ModalBarSolutionTest, SatisfiesTheBoundaryConditions) {
+TEST(ExactBarSolutionTest, SatisfiesTheBoundaryConditions) {
   const BarProperties bar;
   const LoadOptions load;
-  const ModalBarSolution exact(bar, load);
+  const ExactBarSolution exact(bar, load);
   const double stiffness = bar.modulus * bar.section;
   const double dx = 1e-4 * bar.length;
   for (double t : {0.2e-4, 0.5e-4, 0.8e-4, 2.0e-4, 4.5e-4}) {
@@ -160,12 +160,12 @@ TEST(ModalBarSolutionTest, SatisfiesTheBoundaryConditions) {
   }
 }
 
-TEST(ModalBarSolutionTest, MomentumOfTheBarEqualsTheImpulseOfTheEndForces) {
+TEST(ExactBarSolutionTest, MomentumOfTheBarEqualsTheImpulseOfTheEndForces) {
   // d/dt int_0^L rho S u_t dx = F(t) + f0(t): the momentum at t (u_t by central
   // differences, Simpson in x) equals int_0^t (F + f0) ds (Simpson in time).
   const BarProperties bar;
   const LoadOptions load;
-  const ModalBarSolution exact(bar, load);
+  const ExactBarSolution exact(bar, load);
   const double dt = 1e-9;
   const double total_impulse = 2.0 * load.amplitude * load.duration / M_PI;
   for (double t : {0.9e-4, 2.7e-4, 4.4e-4, 6.3e-4}) {
@@ -182,7 +182,7 @@ TEST(ModalBarSolutionTest, MomentumOfTheBarEqualsTheImpulseOfTheEndForces) {
   }
 }
 
-TEST(ModalBarSolutionTest, SlowLoadGivesTheStaticResponse) {
+TEST(ExactBarSolutionTest, SlowLoadGivesTheStaticResponse) {
   // A load 2000 times longer than the transit time L / c: near its peak the bar is in
   // static equilibrium under the current load, uL = F(t) L / (E S), u(L / 4) = uL / 4 and
   // f0 = -F(t), up to the free vibration started by the load's initial slope
@@ -195,7 +195,7 @@ TEST(ModalBarSolutionTest, SlowLoadGivesTheStaticResponse) {
   const double c = WaveSpeed(bar);
   const double transit = bar.length / c;
   load.duration = 2000.0 * transit;
-  const ModalBarSolution exact(bar, load);
+  const ExactBarSolution exact(bar, load);
   const double stiffness = bar.modulus * bar.section;
   const double slope = load.amplitude * M_PI / load.duration;
   const double f0_amplitude = slope * bar.length / c;
@@ -218,10 +218,10 @@ TEST(ModalBarSolutionTest, SlowLoadGivesTheStaticResponse) {
   EXPECT_LT(f0_amplitude, 2e-3 * load.amplitude);
 }
 
-TEST(ModalBarSolutionTest, NothingHappensBeforeTheWaveArrives) {
+TEST(ExactBarSolutionTest, NothingHappensBeforeTheWaveArrives) {
   const BarProperties bar;
   const LoadOptions load;
-  const ModalBarSolution exact(bar, load);
+  const ExactBarSolution exact(bar, load);
   const double transit = bar.length / WaveSpeed(bar);
   for (int i = 0; i < 100; ++i) {
     const double t = 0.999 * transit * i / 99.0;
@@ -234,13 +234,13 @@ TEST(ModalBarSolutionTest, NothingHappensBeforeTheWaveArrives) {
   EXPECT_LT(exact.ClampForce(1.001 * transit), 0.0);
 }
 
-TEST(ModalBarSolutionTest, SampleHoldsTheFourChannels) {
+TEST(ExactBarSolutionTest, SampleHoldsTheFourChannels) {
   const BarProperties bar;
   const LoadOptions load;
   TimeOptions time;
   time.window = 1e-4;
   time.step = 1e-6;
-  const ModalBarSolution exact(bar, load);
+  const ExactBarSolution exact(bar, load);
   const MeasurementSet samples = exact.Sample(time);
   ASSERT_EQ(samples.num_samples(), 101);
   EXPECT_EQ(samples.start_time, 0.0);

@@ -64,7 +64,7 @@ constexpr double kFilterWidth = 4e-6;  // sigma [s], fixed under refinement
 
 ChannelErrors ErrorsAgainstExact(const MeasurementSet& simulated, const BarProperties& bar,
                                  const LoadOptions& load, const TimeOptions& time) {
-  const MeasurementSet exact = ModalBarSolution(bar, load).Sample(time);
+  const MeasurementSet exact = ExactBarSolution(bar, load).Sample(time);
   EXPECT_EQ(simulated.num_samples(), exact.num_samples());
   const Vector uL_error = simulated.uL - exact.uL;
   const Vector f0_error = simulated.f0 - exact.f0;
@@ -257,11 +257,11 @@ TEST(SimulationTest, RefinedTruthIsCloserToTheExactSolution) {
   const MeasurementSet same_grid = SimulateTruth(bar, load, time, data);
   EXPECT_EQ(same_grid.uL, SimulateClampedBar(bar, load, time).uL);
 
-  // The modal truth is the exact solution.
-  data.truth = TruthModel::kModal;
-  const MeasurementSet modal = SimulateTruth(bar, load, time, data);
-  EXPECT_EQ(modal.uL, ModalBarSolution(bar, load).Sample(time).uL);
-  EXPECT_EQ(modal.f0, ModalBarSolution(bar, load).Sample(time).f0);
+  // The exact truth is ExactBarSolution itself.
+  data.truth = TruthModel::kExact;
+  const MeasurementSet exact_truth = SimulateTruth(bar, load, time, data);
+  EXPECT_EQ(exact_truth.uL, ExactBarSolution(bar, load).Sample(time).uL);
+  EXPECT_EQ(exact_truth.f0, ExactBarSolution(bar, load).Sample(time).f0);
 }
 
 // Sample mean and standard deviation of a vector.
@@ -278,7 +278,7 @@ TEST(NoiseTest, NoiseLevelMatchesTheSnr) {
   TimeOptions time;
   time.window = 6.3e-3;
   DataOptions data;
-  data.truth = TruthModel::kModal;
+  data.truth = TruthModel::kExact;
   const MeasurementSet clean = SimulateTruth(bar, load, time, data);
   for (double snr : {5.0, 40.0}) {
     MeasurementSet noisy = clean;
@@ -310,7 +310,7 @@ TEST(NoiseTest, SeedDecidesTheNoise) {
   const LoadOptions load;
   const TimeOptions time;
   DataOptions data;
-  data.truth = TruthModel::kModal;
+  data.truth = TruthModel::kExact;
   data.snr = 20.0;
   data.seed = 3;
   const MeasurementSet first = MakeSyntheticMeasurements(bar, load, time, data);
@@ -338,7 +338,7 @@ TEST(NoiseTest, InfiniteSnrAddsNothing) {
   const LoadOptions load;
   const TimeOptions time;
   DataOptions data;
-  data.truth = TruthModel::kModal;
+  data.truth = TruthModel::kExact;
   const MeasurementSet clean = SimulateTruth(bar, load, time, data);
   MeasurementSet same = clean;
   AddMeasurementNoise(std::numeric_limits<double>::infinity(), 11, &same);

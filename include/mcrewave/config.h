@@ -11,7 +11,7 @@
 //          modulus [200e9 Pa], elements [100], mass [consistent | lumped]
 //   load:  kind [half_sine], amplitude [1000 N], duration [1e-4 s]
 //   time:  window [0.63e-3 s], step [0.36e-6 s], theta [0.5]
-//   data:  source [synthetic | csv], path [""], truth [finite_element | modal],
+//   data:  source [synthetic | csv], path [""], truth [finite_element | exact],
 //          truth_refinement [4], snr [.inf], seed [1]
 //   mcre:  w_u [0.01], w_f [1], reference_modulus [200e9 Pa] (E0 of the weights;
 //          objective.h)

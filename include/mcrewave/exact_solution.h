@@ -11,10 +11,10 @@
 
 namespace mcrewave {
 
-class ModalBarSolution {
+class ExactBarSolution {
  public:
   // bar.elements and bar.mass are ignored (the solution is continuous).
-  ModalBarSolution(const BarProperties& bar, const LoadOptions& load);
+  ExactBarSolution(const BarProperties& bar, const LoadOptions& load);
 
   // u(x, t) [m].
   double Displacement(double x, double time) const;

@@ -35,7 +35,7 @@ struct TimeOptions {
 };
 
 // Where the measurements come from. Synthetic data are computed on a "truth"
-// (a finer FE discretisation, or the exact modal solution: never the identifying
+// (a finer FE discretisation, or the exact solution: never the identifying
 // model's own grid unless truth_refinement = 1), sampled at t_k = k h, then
 // Gaussian white noise is added at the given SNR (see noise.h for the definition).
 struct DataOptions {

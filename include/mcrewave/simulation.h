@@ -21,7 +21,7 @@ MeasurementSet SimulateClampedBar(const BarProperties& bar, const LoadOptions& l
 
 // The noise-free "truth" sampled on the model's grid t_k = k h: the clamped
 // simulation on a mesh and step refined by data.truth_refinement (every r-th step
-// kept), or the exact modal solution.
+// kept), or the exact solution (exact_solution.h).
 MeasurementSet SimulateTruth(const BarProperties& bar, const LoadOptions& load,
                              const TimeOptions& time, const DataOptions& data);
 

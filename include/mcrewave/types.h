@@ -49,7 +49,7 @@ bool StringToDataSource(const std::string& name, DataSource* source);
 // The "truth" that synthetic measurements are sampled from.
 enum class TruthModel {
   kFiniteElement,  // the FE + theta model on a mesh and step refined by truth_refinement
-  kModal,          // the exact solution of the continuous bar (modal superposition)
+  kExact,          // the exact solution of the continuous bar (d'Alembert's reflected pulses)
 };
 const char* TruthModelToString(TruthModel model);
 bool StringToTruthModel(const std::string& name, TruthModel* model);
