@@ -16,7 +16,10 @@
 // Goal (paper_bar.yaml): Identify <= 0.5 CPU s, so that a robustness study of 400
 // identifications fits in 2 minutes on 2 cores.
 //
-// Usage: identification_benchmark [--repeats N] [CONFIG.yaml ...]
+// Usage: identification_benchmark [--repeats N] [--identify-only] [--set key=value ...]
+//                                 [CONFIG.yaml ...]
+//   --identify-only: (a) only, e.g. under valgrind --tool=callgrind;
+//   --set: config overrides as in `identify run --set`, e.g. --set data.seed=3.
 
 #include <sys/resource.h>
 
@@ -145,17 +148,22 @@ std::pair<double, double> SweepStepSeconds(const mcrewave::Config& config,
 int main(int argc, char** argv) {
   spdlog::set_level(spdlog::level::warn);
   int repeats = 3;
-  std::vector<std::string> paths;
+  bool identify_only = false;
+  std::vector<std::string> paths, overrides;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--repeats") == 0 && i + 1 < argc) {
       repeats = std::max(1, std::atoi(argv[++i]));
+    } else if (std::strcmp(argv[i], "--identify-only") == 0) {
+      identify_only = true;
+    } else if (std::strcmp(argv[i], "--set") == 0 && i + 1 < argc) {
+      overrides.emplace_back(argv[++i]);
     } else {
       paths.emplace_back(argv[i]);
     }
   }
   if (paths.empty()) paths = {"configs/paper_bar.yaml", "configs/quick.yaml"};
   for (const std::string& path : paths) {
-    const mcrewave::Config config = mcrewave::LoadConfig(path);
+    const mcrewave::Config config = mcrewave::LoadConfig(path, overrides);
     const mcrewave::MeasurementSet measured = mcrewave::LoadMeasurements(config);
     double cutoff = 0.0;
     const mcrewave::MeasurementSet data =
@@ -174,6 +182,7 @@ int main(int argc, char** argv) {
         "refinements %d evaluations / %ld sweeps\n",
         best.cpu_s, best.modulus, best.usable ? "converged" : "NOT USABLE", best.scan_evaluations,
         best.scan_sweeps, best.evaluations, best.refinement_sweeps);
+    if (identify_only) continue;
 
     double run_cpu = std::numeric_limits<double>::infinity();
     mcrewave::IdentificationRun run;
