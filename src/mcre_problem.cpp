@@ -28,11 +28,11 @@ McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
   beta_ = weights.displacement_weight * bar.section * reference_modulus / bar.length;
   alpha_ = weights.force_weight * bar.length / (bar.section * reference_modulus);
   const int n = model.num_nodes();
-  force_now_ = Vector::Zero(n);
-  force_next_ = Vector::Zero(n);
-  omega_previous_ = Vector::Zero(n);
-  product_ = Vector::Zero(n);
-  rest_state_ = Vector::Zero(n);
+  for (int b = 0; b < 2; ++b) {
+    velocity_[b] = Vector::Zero(n);
+    omega_[b] = Vector::Zero(n);
+  }
+  shift_ = Vector::Zero(n);
   SetModulus(bar.modulus);
 }
 
@@ -50,29 +50,26 @@ void McreProblem::DirectSweep(const Matrix& retrograde, bool include_data, Matri
   const int n = num_nodes(), m = num_steps(), last = n - 1;
   assert(retrograde.rows() == n && retrograde.cols() == m + 1);
   displacement->resize(n, m + 1);
-  const SymmetricBandMatrix& stiffness = integrator_.stiffness();
   const double inverse_alpha = 1.0 / alpha_;
-  // g_j = F~_j - (K + B/alpha) W_j, written into `force`.
-  auto nodal_force = [&](int j, Vector& force) {
-    stiffness.Multiply(retrograde.col(j), force);
-    force = -force;
-    force[0] -= inverse_alpha * retrograde(0, j);
-    force[last] -= inverse_alpha * retrograde(last, j);
+  // From rest: U_0 = V_0 = 0.
+  displacement->col(0).setZero();
+  velocity_[0].setZero();
+  for (int k = 0; k < m; ++k) {
+    const int current = k & 1, next = current ^ 1;
+    // The force of step t_k -> t_{k+1}, f_theta = theta g_{k+1} + (1 - theta) g_k with
+    // g_j = F~_j - (K + B/alpha) W_j, is by linearity
+    //   f_theta = -K W_theta + (F~_theta - B W_theta / alpha),
+    //   W_theta = theta W_{k+1} + (1 - theta) W_k.
+    shift_ = theta_ * retrograde.col(k + 1) + (1.0 - theta_) * retrograde.col(k);
+    double f0 = -inverse_alpha * shift_[0];
+    double fL = -inverse_alpha * shift_[last];
     if (include_data) {
-      force[0] += data_.f0[j];
-      force[last] += data_.fL[j];
+      f0 += theta_ * data_.f0[k + 1] + (1.0 - theta_) * data_.f0[k];
+      fL += theta_ * data_.fL[k + 1] + (1.0 - theta_) * data_.fL[k];
     }
-  };
-  nodal_force(0, force_now_);
-  integrator_.SweepForward(
-      m, rest_state_, rest_state_,
-      [&](int k, Eigen::Ref<Vector> force) {
-        // f_theta = theta g_{k+1} + (1 - theta) g_k.
-        nodal_force(k + 1, force_next_);
-        force = theta_ * force_next_ + (1.0 - theta_) * force_now_;
-        force_now_.swap(force_next_);
-      },
-      [&](int k, const Vector&, const Vector& u) { displacement->col(k) = u; });
+    integrator_.StepWithEndLoads(velocity_[current], displacement->col(k), shift_, f0, fL,
+                                 velocity_[next], displacement->col(k + 1));
+  }
   ++sweep_count_;
 }
 
@@ -81,32 +78,27 @@ void McreProblem::RetrogradeSweep(const Matrix& displacement, bool include_data,
   const int n = num_nodes(), m = num_steps(), last = n - 1;
   assert(displacement.rows() == n && displacement.cols() == m + 1);
   retrograde->resize(n, m + 1);
-  integrator_.SweepBackward(
-      m, rest_state_, rest_state_,
-      [&](int k, Eigen::Ref<Vector> force) {
-        // Step t_{k+1} -> t_k carries the force c_{k+1} beta (B U_{k+1} - U~_{k+1}) (R2).
-        const int j = k + 1;
-        const double weight = QuadratureWeight(j) * beta_;
-        force.setZero();
-        force[0] = weight * displacement(0, j);
-        force[last] = weight * displacement(last, j);
-        if (include_data) {
-          force[0] -= weight * data_.u0[j];
-          force[last] -= weight * data_.uL[j];
-        }
-      },
-      [&](int j, const Vector&, const Vector& omega) {
-        // W_{j+1} = (theta omega_j + (1 - theta) omega_{j+1}) / c_{j+1}  (R3), omega_m = 0.
-        if (j < m) {
-          retrograde->col(j + 1) =
-              (theta_ * omega + (1.0 - theta_) * omega_previous_) / QuadratureWeight(j + 1);
-        }
-        if (j == 0) {
-          // W_0 = (1 - theta) omega_0 / c_0 (omega_{-1} = 0).
-          retrograde->col(0) = ((1.0 - theta_) / QuadratureWeight(0)) * omega;
-        }
-        omega_previous_ = omega;
-      });
+  // From rest at T: (v_m, omega_m) = (0, 0), in reversed time.
+  velocity_[0].setZero();
+  omega_[0].setZero();
+  for (int j = m, s = 0; j > 0; --j, ++s) {
+    const int current = s & 1, next = current ^ 1;
+    // Step t_j -> t_{j-1} carries the force c_j beta (B U_j - U~_j) (R2).
+    const double weight = QuadratureWeight(j) * beta_;
+    double f0 = weight * displacement(0, j);
+    double fL = weight * displacement(last, j);
+    if (include_data) {
+      f0 -= weight * data_.u0[j];
+      fL -= weight * data_.uL[j];
+    }
+    integrator_.StepWithEndLoads(velocity_[current], omega_[current], f0, fL, velocity_[next],
+                                 omega_[next]);
+    // W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j  (R3), omega_m = 0.
+    retrograde->col(j) = (theta_ * omega_[next] + (1.0 - theta_) * omega_[current]) /
+                         QuadratureWeight(j);
+  }
+  // W_0 = (1 - theta) omega_0 / c_0 (omega_{-1} = 0).
+  retrograde->col(0) = ((1.0 - theta_) / QuadratureWeight(0)) * omega_[m & 1];
   ++sweep_count_;
 }
 
@@ -128,8 +120,7 @@ double McreProblem::InnerProduct(const Matrix& x, const Matrix& y) {
   double sum = 0.0;
   for (int j = 0; j <= m; ++j) {
     // x_j^T (K + B/alpha) y_j.
-    stiffness.Multiply(y.col(j), product_);
-    double term = x.col(j).dot(product_);
+    double term = stiffness.BilinearForm(x.col(j).data(), y.col(j).data());
     term += (x(0, j) * y(0, j) + x(last, j) * y(last, j)) / alpha_;
     sum += QuadratureWeight(j) * h * term;
   }
@@ -142,8 +133,8 @@ double McreProblem::Cost(const Matrix& displacement, const Matrix& retrograde) {
   const SymmetricBandMatrix& stiffness = integrator_.stiffness();
   double sum = 0.0;
   for (int j = 0; j <= m; ++j) {
-    stiffness.Multiply(retrograde.col(j), product_);
-    const double gap = 0.5 * retrograde.col(j).dot(product_);
+    const double* w = retrograde.col(j).data();
+    const double gap = 0.5 * stiffness.BilinearForm(w, w);
     const double force_misfit =
         (retrograde(0, j) * retrograde(0, j) + retrograde(last, j) * retrograde(last, j)) /
         (2.0 * alpha_);
@@ -162,8 +153,10 @@ double McreProblem::CostGradient(const Matrix& displacement, const Matrix& retro
   double sum = 0.0;
   for (int j = 0; j <= m; ++j) {
     // W_j^T K1 (W_j + 2 U_j), with K = E K1 so that -(1/(2E)) W^T K (.) = -(1/2) W^T K1 (.).
-    unit_stiffness_.Multiply(retrograde.col(j), product_);
-    sum += QuadratureWeight(j) * h * product_.dot(retrograde.col(j) + 2.0 * displacement.col(j));
+    const double* w = retrograde.col(j).data();
+    const double* u = displacement.col(j).data();
+    sum += QuadratureWeight(j) * h *
+           (unit_stiffness_.BilinearForm(w, w) + 2.0 * unit_stiffness_.BilinearForm(w, u));
   }
   return -0.5 * sum;
 }

@@ -34,11 +34,29 @@ void ThetaIntegrator::Init(const SparseMatrix& mass, const SparseMatrix& stiffne
   free_state_matrix_ = SymmetricBandMatrix::LinearCombination(
       1.0, mass_, -h * h * theta * (1.0 - theta), stiffness_);
   ++factorization_count_;
-  if (!iteration_matrix_.Compute(schur)) {
+  tridiagonal_ = schur.half_bandwidth() <= 1 && free_state_matrix_.half_bandwidth() <= 1;
+  const bool factorised =
+      tridiagonal_ ? tridiagonal_factor_.Compute(schur) : iteration_matrix_.Compute(schur);
+  if (!factorised) {
     throw std::runtime_error(
         "theta integrator: the iteration matrix M + h^2 theta^2 K is not positive definite");
   }
   const int n = size();
+  if (tridiagonal_) {
+    free_diagonal_.resize(n);
+    free_sub_ = Vector::Zero(n);
+    stiffness_diagonal_.resize(n);
+    stiffness_sub_ = Vector::Zero(n);
+    for (int i = 0; i < n; ++i) {
+      free_diagonal_[i] = free_state_matrix_.lower(0, i);
+      stiffness_diagonal_[i] = -h * stiffness_.lower(0, i);
+      if (i > 0 && free_state_matrix_.half_bandwidth() == 1) {
+        free_sub_[i] = free_state_matrix_.lower(1, i);
+      }
+      if (i > 0 && stiffness_.half_bandwidth() == 1) stiffness_sub_[i] = -h * stiffness_.lower(1, i);
+    }
+    shifted_ = Vector::Zero(n);
+  }
   force_ = Vector::Zero(n);
   for (int b = 0; b < 2; ++b) {
     v_[b] = Vector::Zero(n);
@@ -46,9 +64,57 @@ void ThetaIntegrator::Init(const SparseMatrix& mass, const SparseMatrix& stiffne
   }
 }
 
+template <bool kForceVector>
+void ThetaIntegrator::TridiagonalStep(const double* v_k, const double* u_k, const double* z,
+                                      const double* force, double f0, double fL, double* v_next,
+                                      double* u_next) {
+  const int n = size();
+  const double h = options_.time_step;
+  const double theta = options_.theta;
+  const double* s = u_k;
+  if (z != nullptr) {
+    double* shifted = shifted_.data();
+    for (int i = 0; i < n; ++i) shifted[i] = u_k[i] + z[i];
+    s = shifted;
+  }
+  const double* rd = free_diagonal_.data();
+  const double* rs = free_sub_.data();
+  const double* kd = stiffness_diagonal_.data();
+  const double* ks = stiffness_sub_.data();
+  // rhs_i = (R v_k)_i + (-h K s)_i + h f_i, rows 1..n-2 without tests, then the ends.
+  for (int i = 1; i < n - 1; ++i) {
+    double rhs = rd[i] * v_k[i] + rs[i] * v_k[i - 1] + rs[i + 1] * v_k[i + 1] + kd[i] * s[i] +
+                 ks[i] * s[i - 1] + ks[i + 1] * s[i + 1];
+    if constexpr (kForceVector) rhs += h * force[i];
+    v_next[i] = rhs;
+  }
+  const int last = n - 1;
+  double first_row = rd[0] * v_k[0] + kd[0] * s[0];
+  if (n > 1) {
+    first_row += rs[1] * v_k[1] + ks[1] * s[1];
+    double last_row = rd[last] * v_k[last] + rs[last] * v_k[last - 1] + kd[last] * s[last] +
+                      ks[last] * s[last - 1];
+    if constexpr (kForceVector) last_row += h * force[last];
+    v_next[last] = last_row + h * fL;
+  }
+  if constexpr (kForceVector) first_row += h * force[0];
+  v_next[0] = first_row + h * f0;
+  if (n == 1) v_next[0] += h * fL;
+  // S v_{k+1} = rhs.
+  tridiagonal_factor_.SolveInPlace(v_next);
+  // u_{k+1} = u_k + h (1 - theta) v_k + h theta v_{k+1}.
+  const double a = h * (1.0 - theta), b = h * theta;
+  for (int i = 0; i < n; ++i) u_next[i] = u_k[i] + a * v_k[i] + b * v_next[i];
+}
+
 void ThetaIntegrator::Step(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref<const Vector>& u_k,
                            const Eigen::Ref<const Vector>& force_theta, Eigen::Ref<Vector> v_next,
                            Eigen::Ref<Vector> u_next) {
+  if (tridiagonal_) {
+    TridiagonalStep<true>(v_k.data(), u_k.data(), nullptr, force_theta.data(), 0.0, 0.0,
+                          v_next.data(), u_next.data());
+    return;
+  }
   const double h = options_.time_step;
   const double theta = options_.theta;
   // Free state and input: rhs = R v_k - h K u_k + h f_theta.
@@ -58,6 +124,38 @@ void ThetaIntegrator::Step(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref
   iteration_matrix_.SolveInPlace(v_next);
   // u_{k+1} = u_k + h (1 - theta) v_k + h theta v_{k+1}.
   u_next = u_k + (h * (1.0 - theta)) * v_k + (h * theta) * v_next;
+}
+
+void ThetaIntegrator::StepWithEndLoads(const Eigen::Ref<const Vector>& v_k,
+                                       const Eigen::Ref<const Vector>& u_k,
+                                       const Eigen::Ref<const Vector>& z, double f0, double fL,
+                                       Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next) {
+  assert(z.size() == u_k.size());
+  if (tridiagonal_) {
+    TridiagonalStep<false>(v_k.data(), u_k.data(), z.data(), nullptr, f0, fL, v_next.data(),
+                           u_next.data());
+    return;
+  }
+  // f_theta = -K z + f0 e_0 + fL e_{n-1}, formed in force_.
+  stiffness_.Multiply(z, force_);
+  force_ = -force_;
+  force_[0] += f0;
+  force_[size() - 1] += fL;
+  Step(v_k, u_k, force_, v_next, u_next);
+}
+
+void ThetaIntegrator::StepWithEndLoads(const Eigen::Ref<const Vector>& v_k,
+                                       const Eigen::Ref<const Vector>& u_k, double f0, double fL,
+                                       Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next) {
+  if (tridiagonal_) {
+    TridiagonalStep<false>(v_k.data(), u_k.data(), nullptr, nullptr, f0, fL, v_next.data(),
+                           u_next.data());
+    return;
+  }
+  force_.setZero();
+  force_[0] += f0;
+  force_[size() - 1] += fL;
+  Step(v_k, u_k, force_, v_next, u_next);
 }
 
 }  // namespace mcrewave

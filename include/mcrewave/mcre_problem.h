@@ -94,9 +94,8 @@ class McreProblem {
   SymmetricBandMatrix unit_stiffness_;  // K1
   long sweep_count_ = 0;
   // Scratch, allocated in the constructor.
-  Vector force_now_, force_next_, omega_previous_, product_;
-  Vector
-      rest_state_;  // zero: the initial state of the direct sweep, the final one of the retrograde
+  Vector velocity_[2], omega_[2];  // double buffers of the sweeps' velocity and omega
+  Vector shift_;                   // W_theta of the direct sweep's step
 };
 
 }  // namespace mcrewave
