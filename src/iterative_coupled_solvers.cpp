@@ -38,21 +38,24 @@ StartingPoint Start(McreProblem* problem, const Matrix* initial_retrograde,
                     CoupledSolution* solution, Matrix* residual, CoupledSolverSummary* summary) {
   StartingPoint start;
   Matrix& retrograde = solution->retrograde;
+  McreProblem::SolverWorkspace& work = problem->workspace();
   const bool zero_start =
       initial_retrograde == nullptr || initial_retrograde->cwiseAbs().maxCoeff() == 0.0;
-  retrograde = zero_start ? problem->ZeroField() : *initial_retrograde;
+  if (zero_start) {
+    retrograde.setZero(problem->num_nodes(), problem->num_steps() + 1);
+  } else {
+    retrograde = *initial_retrograde;
+  }
   problem->FixedPointMap(retrograde, &solution->displacement, residual);
   if (zero_start) {
     // T(0) = c.
     start.rhs_norm = problem->Norm(*residual);
   } else {
-    Matrix scratch_displacement, rhs;
-    problem->FixedPointMap(problem->ZeroField(), &scratch_displacement, &rhs);
-    start.rhs_norm = problem->Norm(rhs);
+    problem->FixedPointMap(work.zero, &work.scratch, &work.rhs);
+    start.rhs_norm = problem->Norm(work.rhs);
   }
-  Matrix displacement_data_response;
-  problem->RetrogradeSweep(problem->ZeroField(), true, &displacement_data_response);
-  start.residual_floor = kRoundOffFloor * problem->Norm(displacement_data_response);
+  problem->RetrogradeSweep(work.zero, true, &work.data_response);
+  start.residual_floor = kRoundOffFloor * problem->Norm(work.data_response);
   *residual -= retrograde;
   summary->iterations = 0;
   if (start.rhs_norm == 0.0) {
@@ -129,7 +132,7 @@ void SolveByRelaxation(const CoupledSolverOptions& options, McreProblem* problem
   const bool adaptive = options.type == CoupledSolverType::kAdaptiveRelaxation;
   Matrix& retrograde = solution->retrograde;
   Matrix& displacement = solution->displacement;
-  Matrix residual;
+  Matrix& residual = problem->workspace().residual;
   const StartingPoint start = Start(problem, initial_retrograde, solution, &residual, summary);
   if (start.solved) return;
 
@@ -231,14 +234,20 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, McreProblem* 
                               CoupledSolverSummary* summary) {
   Matrix& retrograde = solution->retrograde;
   Matrix& displacement = solution->displacement;
-  Matrix residual;
+  McreProblem::SolverWorkspace& work = problem->workspace();
+  Matrix& residual = work.residual;
   const StartingPoint start = Start(problem, initial_retrograde, solution, &residual, summary);
   if (start.solved) return;
-  Matrix direction = residual;
-  Matrix image, scratch;
+  Matrix& direction = work.direction;
+  Matrix& image = work.image;
+  Matrix& scratch = work.scratch;
+  direction = residual;
   double rho = problem->InnerProduct(residual, residual);
   constexpr int kMaxVerifiedRestarts = 5;
   int restarts = 0;
+  // Whether `residual` is the true residual T(W) - W with U = Direct(W): after the
+  // start and after a verification, not after a CG step (recursive residual).
+  bool residual_is_true = true;
   for (int iteration = 0;; ++iteration) {
     double relative = std::sqrt(std::max(rho, 0.0)) / start.rhs_norm;
     if (!std::isfinite(relative)) {
@@ -248,15 +257,19 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, McreProblem* 
       return;
     }
     if (Converged(start, relative, options.tolerance)) {
-      // Verify with the true residual T(W) - W (2 sweeps); this also leaves
-      // U = Direct(W) consistent with W.
-      problem->FixedPointMap(retrograde, &displacement, &residual);
-      residual -= retrograde;
-      rho = problem->InnerProduct(residual, residual);
-      relative = std::sqrt(std::max(rho, 0.0)) / start.rhs_norm;
+      if (!residual_is_true) {
+        // Verify with the true residual T(W) - W (2 sweeps); this also leaves
+        // U = Direct(W) consistent with W.
+        problem->FixedPointMap(retrograde, &displacement, &residual);
+        residual -= retrograde;
+        rho = problem->InnerProduct(residual, residual);
+        relative = std::sqrt(std::max(rho, 0.0)) / start.rhs_norm;
+        residual_is_true = true;
+      }
       summary->relative_residual = relative;
       if (Converged(start, relative, options.tolerance)) {
         summary->residual_history.push_back(relative);
+        summary->iterations = iteration;  // CG steps taken
         summary->termination = TerminationType::kConvergence;
         summary->message = ConvergenceMessage(start, relative, options.tolerance);
         return;
@@ -292,6 +305,7 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, McreProblem* 
     const double step = rho / curvature;
     retrograde += step * direction;
     residual -= step * image;
+    residual_is_true = false;
     const double rho_next = problem->InnerProduct(residual, residual);
     direction = residual + (rho_next / rho) * direction;
     rho = rho_next;

@@ -102,6 +102,13 @@ void McreProblem::RetrogradeSweep(const Matrix& displacement, bool include_data,
   ++sweep_count_;
 }
 
+McreProblem::SolverWorkspace& McreProblem::workspace() {
+  if (workspace_.zero.rows() != num_nodes() || workspace_.zero.cols() != num_steps() + 1) {
+    workspace_.zero = ZeroField();
+  }
+  return workspace_;
+}
+
 void McreProblem::FixedPointMap(const Matrix& retrograde, Matrix* displacement, Matrix* image) {
   DirectSweep(retrograde, true, displacement);
   RetrogradeSweep(*displacement, true, image);
