@@ -282,4 +282,63 @@ void TwistedTridiagonalLdlt::SolveInPlace(double* x) const {
   }
 }
 
+template <int B>
+void TwistedTridiagonalLdlt::SolveInPlace(double* const (&x)[B]) const {
+  assert(ok_);
+  const int n = size();
+  const int k = middle_;
+  const double* l = top_.data();
+  const double* m = bottom_.data();
+  const double* inverse_pivot = inverse_pivot_.data();
+  // The recurrences of the single solve, once per right-hand side b.
+  double up[B], down[B], middle[B];
+  for (int b = 0; b < B; ++b) {
+    up[b] = x[b][0];
+    down[b] = x[b][n - 1];
+  }
+  int i = 1, j = n - 2;
+  for (; i < k; ++i, --j) {
+    for (int b = 0; b < B; ++b) {
+      up[b] = x[b][i] - l[i] * up[b];
+      down[b] = x[b][j] - m[j] * down[b];
+      x[b][i] = up[b];
+      x[b][j] = down[b];
+    }
+  }
+  for (; j > k; --j) {
+    for (int b = 0; b < B; ++b) {
+      down[b] = x[b][j] - m[j] * down[b];
+      x[b][j] = down[b];
+    }
+  }
+  for (int b = 0; b < B; ++b) {
+    middle[b] = x[b][k];
+    if (k > 0) middle[b] -= l[k] * up[b];
+    if (k < n - 1) middle[b] -= m[k] * down[b];
+    middle[b] *= inverse_pivot[k];
+    x[b][k] = middle[b];
+    up[b] = middle[b];
+    down[b] = middle[b];
+  }
+  i = k - 1;
+  j = k + 1;
+  for (; i >= 0; --i, ++j) {
+    for (int b = 0; b < B; ++b) {
+      up[b] = x[b][i] * inverse_pivot[i] - l[i + 1] * up[b];
+      down[b] = x[b][j] * inverse_pivot[j] - m[j - 1] * down[b];
+      x[b][i] = up[b];
+      x[b][j] = down[b];
+    }
+  }
+  for (; j < n; ++j) {
+    for (int b = 0; b < B; ++b) {
+      down[b] = x[b][j] * inverse_pivot[j] - m[j - 1] * down[b];
+      x[b][j] = down[b];
+    }
+  }
+}
+
+template void TwistedTridiagonalLdlt::SolveInPlace<2>(double* const (&x)[2]) const;
+template void TwistedTridiagonalLdlt::SolveInPlace<3>(double* const (&x)[3]) const;
+
 }  // namespace mcrewave

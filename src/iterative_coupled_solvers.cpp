@@ -16,8 +16,9 @@ namespace {
 
 // The state every iterative solver starts from: W^(0), U = Direct(W^(0)),
 // r = T(W^(0)) - W^(0), ||c||_P, and the round-off floor of the residual. Costs 3
-// sweeps, 5 when W^(0) != 0 (c is then computed separately). When c = 0 the
-// solution (W = 0) is set and the summary says so.
+// sweeps, 5 when W^(0) != 0 (c is then computed separately), run as one batch of
+// direct sweeps and one of retrograde sweeps. When c = 0 the solution (W = 0) is
+// set and the summary says so.
 struct StartingPoint {
   double rhs_norm = 0.0;  // ||c||_P
   // ||r||_P below this is round-off: c = T(0) is the difference of the retrograde
@@ -41,20 +42,22 @@ StartingPoint Start(McreProblem* problem, const Matrix* initial_retrograde,
   McreProblem::SolverWorkspace& work = problem->workspace();
   const bool zero_start =
       initial_retrograde == nullptr || initial_retrograde->cwiseAbs().maxCoeff() == 0.0;
+  // T(W^(0)) = Retrograde(U), U = Direct(W^(0)); c = T(0); W_u = Retrograde(0): the
+  // sweeps of the same direction run batched (DirectSweepsWithData).
   if (zero_start) {
     retrograde.setZero(problem->num_nodes(), problem->num_steps() + 1);
-  } else {
-    retrograde = *initial_retrograde;
-  }
-  problem->FixedPointMap(retrograde, &solution->displacement, residual);
-  if (zero_start) {
+    problem->DirectSweepsWithData({nullptr}, {&solution->displacement});
+    problem->RetrogradeSweepsWithData({&solution->displacement, nullptr},
+                                      {residual, &work.data_response});
     // T(0) = c.
     start.rhs_norm = problem->Norm(*residual);
   } else {
-    problem->FixedPointMap(work.zero, &work.scratch, &work.rhs);
+    retrograde = *initial_retrograde;
+    problem->DirectSweepsWithData({&retrograde, nullptr}, {&solution->displacement, &work.scratch});
+    problem->RetrogradeSweepsWithData({&solution->displacement, &work.scratch, nullptr},
+                                      {residual, &work.rhs, &work.data_response});
     start.rhs_norm = problem->Norm(work.rhs);
   }
-  problem->RetrogradeSweep(work.zero, true, &work.data_response);
   start.residual_floor = kRoundOffFloor * problem->Norm(work.data_response);
   *residual -= retrograde;
   summary->iterations = 0;

@@ -33,6 +33,9 @@ McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
     omega_[b] = Vector::Zero(n);
   }
   shift_ = Vector::Zero(n);
+  batch_velocity_ = Matrix::Zero(n, 2 * ThetaIntegrator::kMaxBatch);
+  batch_state_ = Matrix::Zero(n, 2 * ThetaIntegrator::kMaxBatch);
+  batch_shift_ = Matrix::Zero(n, ThetaIntegrator::kMaxBatch);
   SetModulus(bar.modulus);
 }
 
@@ -107,6 +110,133 @@ McreProblem::SolverWorkspace& McreProblem::workspace() {
     workspace_.zero = ZeroField();
   }
   return workspace_;
+}
+
+template <int B>
+void McreProblem::DirectSweeps(const Matrix* const (&retrograde)[B],
+                               Matrix* const (&displacement)[B]) {
+  const int n = num_nodes(), m = num_steps(), last = n - 1;
+  const double inverse_alpha = 1.0 / alpha_;
+  for (int b = 0; b < B; ++b) {
+    assert(retrograde[b] == nullptr ||
+           (retrograde[b]->rows() == n && retrograde[b]->cols() == m + 1));
+    displacement[b]->resize(n, m + 1);
+    displacement[b]->col(0).setZero();
+    batch_velocity_.col(2 * b).setZero();
+  }
+  for (int k = 0; k < m; ++k) {
+    const int current = k & 1, next = current ^ 1;
+    const double* v_k[B];
+    const double* u_k[B];
+    const double* z[B];
+    double f0[B], fL[B];
+    double* v_next[B];
+    double* u_next[B];
+    for (int b = 0; b < B; ++b) {
+      // As DirectSweep: f_theta = -K W_theta + (F~_theta - B W_theta / alpha).
+      f0[b] = theta_ * data_.f0[k + 1] + (1.0 - theta_) * data_.f0[k];
+      fL[b] = theta_ * data_.fL[k + 1] + (1.0 - theta_) * data_.fL[k];
+      z[b] = nullptr;
+      if (retrograde[b] != nullptr) {
+        batch_shift_.col(b) =
+            theta_ * retrograde[b]->col(k + 1) + (1.0 - theta_) * retrograde[b]->col(k);
+        f0[b] = -inverse_alpha * batch_shift_(0, b) + f0[b];
+        fL[b] = -inverse_alpha * batch_shift_(last, b) + fL[b];
+        z[b] = batch_shift_.col(b).data();
+      }
+      v_k[b] = batch_velocity_.col(2 * b + current).data();
+      v_next[b] = batch_velocity_.col(2 * b + next).data();
+      u_k[b] = displacement[b]->col(k).data();
+      u_next[b] = displacement[b]->col(k + 1).data();
+    }
+    integrator_.StepsWithEndLoads<B>(v_k, u_k, z, f0, fL, v_next, u_next);
+  }
+  sweep_count_ += B;
+}
+
+template <int B>
+void McreProblem::RetrogradeSweeps(const Matrix* const (&displacement)[B],
+                                   Matrix* const (&retrograde)[B]) {
+  const int n = num_nodes(), m = num_steps(), last = n - 1;
+  for (int b = 0; b < B; ++b) {
+    assert(displacement[b] == nullptr ||
+           (displacement[b]->rows() == n && displacement[b]->cols() == m + 1));
+    retrograde[b]->resize(n, m + 1);
+    batch_velocity_.col(2 * b).setZero();
+    batch_state_.col(2 * b).setZero();
+  }
+  const double* no_shift[B] = {};
+  for (int j = m, step = 0; j > 0; --j, ++step) {
+    const int current = step & 1, next = current ^ 1;
+    const double* v_k[B];
+    const double* omega_k[B];
+    double f0[B], fL[B];
+    double* v_next[B];
+    double* omega_next[B];
+    // As RetrogradeSweep: the force c_j beta (B U_j - U~_j) on step t_j -> t_{j-1}.
+    const double weight = QuadratureWeight(j) * beta_;
+    for (int b = 0; b < B; ++b) {
+      f0[b] = displacement[b] != nullptr ? weight * (*displacement[b])(0, j) : 0.0;
+      fL[b] = displacement[b] != nullptr ? weight * (*displacement[b])(last, j) : 0.0;
+      f0[b] -= weight * data_.u0[j];
+      fL[b] -= weight * data_.uL[j];
+      v_k[b] = batch_velocity_.col(2 * b + current).data();
+      v_next[b] = batch_velocity_.col(2 * b + next).data();
+      omega_k[b] = batch_state_.col(2 * b + current).data();
+      omega_next[b] = batch_state_.col(2 * b + next).data();
+    }
+    integrator_.StepsWithEndLoads<B>(v_k, omega_k, no_shift, f0, fL, v_next, omega_next);
+    for (int b = 0; b < B; ++b) {
+      retrograde[b]->col(j) = (theta_ * batch_state_.col(2 * b + next) +
+                               (1.0 - theta_) * batch_state_.col(2 * b + current)) /
+                              QuadratureWeight(j);
+    }
+  }
+  for (int b = 0; b < B; ++b) {
+    retrograde[b]->col(0) =
+        ((1.0 - theta_) / QuadratureWeight(0)) * batch_state_.col(2 * b + (m & 1));
+  }
+  sweep_count_ += B;
+}
+
+void McreProblem::DirectSweepsWithData(const std::vector<const Matrix*>& retrograde,
+                                       const std::vector<Matrix*>& displacement) {
+  assert(retrograde.size() == displacement.size());
+  switch (retrograde.size()) {
+    case 1:
+      DirectSweep(retrograde[0] != nullptr ? *retrograde[0] : workspace().zero, true,
+                  displacement[0]);
+      return;
+    case 2:
+      DirectSweeps<2>({retrograde[0], retrograde[1]}, {displacement[0], displacement[1]});
+      return;
+    case 3:
+      DirectSweeps<3>({retrograde[0], retrograde[1], retrograde[2]},
+                      {displacement[0], displacement[1], displacement[2]});
+      return;
+    default:
+      assert(false && "1 to kMaxBatch sweeps at once");
+  }
+}
+
+void McreProblem::RetrogradeSweepsWithData(const std::vector<const Matrix*>& displacement,
+                                           const std::vector<Matrix*>& retrograde) {
+  assert(retrograde.size() == displacement.size());
+  switch (displacement.size()) {
+    case 1:
+      RetrogradeSweep(displacement[0] != nullptr ? *displacement[0] : workspace().zero, true,
+                      retrograde[0]);
+      return;
+    case 2:
+      RetrogradeSweeps<2>({displacement[0], displacement[1]}, {retrograde[0], retrograde[1]});
+      return;
+    case 3:
+      RetrogradeSweeps<3>({displacement[0], displacement[1], displacement[2]},
+                          {retrograde[0], retrograde[1], retrograde[2]});
+      return;
+    default:
+      assert(false && "1 to kMaxBatch sweeps at once");
+  }
 }
 
 void McreProblem::FixedPointMap(const Matrix& retrograde, Matrix* displacement, Matrix* image) {

@@ -56,6 +56,7 @@ void ThetaIntegrator::Init(const SparseMatrix& mass, const SparseMatrix& stiffne
       if (i > 0 && stiffness_.half_bandwidth() == 1) stiffness_sub_[i] = -h * stiffness_.lower(1, i);
     }
     shifted_ = Vector::Zero(n);
+    shifted_batch_ = Matrix::Zero(n, kMaxBatch);
   }
   force_ = Vector::Zero(n);
   for (int b = 0; b < 2; ++b) {
@@ -65,15 +66,13 @@ void ThetaIntegrator::Init(const SparseMatrix& mass, const SparseMatrix& stiffne
 }
 
 template <bool kForceVector>
-void ThetaIntegrator::TridiagonalStep(const double* v_k, const double* u_k, const double* z,
-                                      const double* force, double f0, double fL, double* v_next,
-                                      double* u_next) {
+void ThetaIntegrator::TridiagonalRightHandSide(const double* v_k, const double* u_k,
+                                               const double* z, const double* force, double f0,
+                                               double fL, double* shifted, double* v_next) const {
   const int n = size();
   const double h = options_.time_step;
-  const double theta = options_.theta;
   const double* s = u_k;
   if (z != nullptr) {
-    double* shifted = shifted_.data();
     for (int i = 0; i < n; ++i) shifted[i] = u_k[i] + z[i];
     s = shifted;
   }
@@ -100,12 +99,66 @@ void ThetaIntegrator::TridiagonalStep(const double* v_k, const double* u_k, cons
   if constexpr (kForceVector) first_row += h * force[0];
   v_next[0] = first_row + h * f0;
   if (n == 1) v_next[0] += h * fL;
-  // S v_{k+1} = rhs.
-  tridiagonal_factor_.SolveInPlace(v_next);
+}
+
+void ThetaIntegrator::UpdateDisplacement(const double* u_k, const double* v_k,
+                                         const double* v_next, double* u_next) const {
   // u_{k+1} = u_k + h (1 - theta) v_k + h theta v_{k+1}.
-  const double a = h * (1.0 - theta), b = h * theta;
+  const int n = size();
+  const double a = options_.time_step * (1.0 - options_.theta);
+  const double b = options_.time_step * options_.theta;
   for (int i = 0; i < n; ++i) u_next[i] = u_k[i] + a * v_k[i] + b * v_next[i];
 }
+
+template <bool kForceVector>
+void ThetaIntegrator::TridiagonalStep(const double* v_k, const double* u_k, const double* z,
+                                      const double* force, double f0, double fL, double* v_next,
+                                      double* u_next) {
+  TridiagonalRightHandSide<kForceVector>(v_k, u_k, z, force, f0, fL, shifted_.data(), v_next);
+  // S v_{k+1} = rhs.
+  tridiagonal_factor_.SolveInPlace(v_next);
+  UpdateDisplacement(u_k, v_k, v_next, u_next);
+}
+
+template <int B>
+void ThetaIntegrator::StepsWithEndLoads(const double* const (&v_k)[B],
+                                        const double* const (&u_k)[B],
+                                        const double* const (&z)[B], const double (&f0)[B],
+                                        const double (&fL)[B], double* const (&v_next)[B],
+                                        double* const (&u_next)[B]) {
+  static_assert(B >= 2 && B <= kMaxBatch, "2 or 3 steps at once");
+  const int n = size();
+  if (!tridiagonal_) {
+    for (int b = 0; b < B; ++b) {
+      using ConstMap = Eigen::Map<const Vector>;
+      Eigen::Map<Vector> v_out(v_next[b], n), u_out(u_next[b], n);
+      if (z[b] != nullptr) {
+        StepWithEndLoads(ConstMap(v_k[b], n), ConstMap(u_k[b], n), ConstMap(z[b], n), f0[b],
+                         fL[b], v_out, u_out);
+      } else {
+        StepWithEndLoads(ConstMap(v_k[b], n), ConstMap(u_k[b], n), f0[b], fL[b], v_out, u_out);
+      }
+    }
+    return;
+  }
+  for (int b = 0; b < B; ++b) {
+    TridiagonalRightHandSide<false>(v_k[b], u_k[b], z[b], nullptr, f0[b], fL[b],
+                                    shifted_batch_.col(b).data(), v_next[b]);
+  }
+  tridiagonal_factor_.SolveInPlace<B>(v_next);
+  for (int b = 0; b < B; ++b) UpdateDisplacement(u_k[b], v_k[b], v_next[b], u_next[b]);
+}
+
+template void ThetaIntegrator::StepsWithEndLoads<2>(const double* const (&)[2],
+                                                    const double* const (&)[2],
+                                                    const double* const (&)[2],
+                                                    const double (&)[2], const double (&)[2],
+                                                    double* const (&)[2], double* const (&)[2]);
+template void ThetaIntegrator::StepsWithEndLoads<3>(const double* const (&)[3],
+                                                    const double* const (&)[3],
+                                                    const double* const (&)[3],
+                                                    const double (&)[3], const double (&)[3],
+                                                    double* const (&)[3], double* const (&)[3]);
 
 void ThetaIntegrator::Step(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref<const Vector>& u_k,
                            const Eigen::Ref<const Vector>& force_theta, Eigen::Ref<Vector> v_next,

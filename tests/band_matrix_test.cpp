@@ -160,6 +160,25 @@ TEST(TwistedTridiagonalLdltTest, SolveMatchesTheDenseLdlt) {
   }
 }
 
+TEST(TwistedTridiagonalLdltTest, BatchedSolvesMatchSingleSolvesExactly) {
+  std::mt19937_64 engine(5);
+  for (int n : {1, 2, 3, 4, 7, 50, 101}) {
+    TwistedTridiagonalLdlt factor;
+    ASSERT_TRUE(factor.Compute(SymmetricBandMatrix(RandomBandMatrix(n, 1, true, &engine))));
+    const Vector b0 = Vector::Random(n), b1 = Vector::Random(n), b2 = Vector::Random(n);
+    Vector x0 = b0, x1 = b1, x2 = b2;
+    factor.SolveInPlace<3>({x0.data(), x1.data(), x2.data()});
+    Vector y0 = b0, y1 = b1;
+    factor.SolveInPlace<2>({y0.data(), y1.data()});
+    for (const auto& [batched, rhs] : {std::pair<Vector, Vector>{x0, b0}, {x1, b1}, {x2, b2},
+                                       {y0, b0}, {y1, b1}}) {
+      Vector single = rhs;
+      factor.SolveInPlace(single);
+      EXPECT_EQ((batched - single).cwiseAbs().maxCoeff(), 0.0) << "n = " << n;
+    }
+  }
+}
+
 TEST(TwistedTridiagonalLdltTest, AgreesWithBandLdltOnTheThetaIterationMatrixOfTheBar) {
   const BarModel model{BarProperties{}};
   const double h_theta = 0.36e-6 * 0.5;

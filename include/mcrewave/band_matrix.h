@@ -97,6 +97,11 @@ class TwistedTridiagonalLdlt {
   void SolveInPlace(Eigen::Ref<Vector> x) const { SolveInPlace(x.data()); }
   // The same on size() contiguous doubles.
   void SolveInPlace(double* x) const;
+  // B right-hand sides at once (size() contiguous doubles each, distinct arrays),
+  // their recurrences interleaved: the same results as B solves, in about the
+  // latency of one. Instantiated for B = 2 and 3.
+  template <int B>
+  void SolveInPlace(double* const (&x)[B]) const;
 
  private:
   int middle_ = 0;        // k

@@ -14,6 +14,8 @@
 // self-adjoint, the cost e^2 and its derivative de^2/dE.
 #pragma once
 
+#include <vector>
+
 #include "mcrewave/bar_model.h"
 #include "mcrewave/measurement.h"
 #include "mcrewave/theta_integrator.h"
@@ -65,6 +67,15 @@ class McreProblem {
   void DirectSweep(const Matrix& retrograde, bool include_data, Matrix* displacement);
   // U -> W. With include_data the displacement data U~ enter.
   void RetrogradeSweep(const Matrix& displacement, bool include_data, Matrix* retrograde);
+  // Up to ThetaIntegrator::kMaxBatch sweeps with the data at once, sweep b from
+  // inputs[b] (null: the zero field) into outputs[b] (resized); the time steps of the
+  // sweeps run interleaved, for the cost of fewer than that many sweeps, and give
+  // the results of the single sweeps bit for bit. Counted as that many sweeps.
+  // Outputs distinct from every input.
+  void DirectSweepsWithData(const std::vector<const Matrix*>& retrograde,
+                            const std::vector<Matrix*>& displacement);
+  void RetrogradeSweepsWithData(const std::vector<const Matrix*>& displacement,
+                                const std::vector<Matrix*>& retrograde);
   // The affine map T(W) = RetrogradeSweep(DirectSweep(W)) with the data: two sweeps.
   // displacement receives DirectSweep(W).
   void FixedPointMap(const Matrix& retrograde, Matrix* displacement, Matrix* image);
@@ -95,6 +106,11 @@ class McreProblem {
   SolverWorkspace& workspace();
 
  private:
+  template <int B>
+  void DirectSweeps(const Matrix* const (&retrograde)[B], Matrix* const (&displacement)[B]);
+  template <int B>
+  void RetrogradeSweeps(const Matrix* const (&displacement)[B], Matrix* const (&retrograde)[B]);
+
   const BarModel& model_;
   const MeasurementSet& data_;
   double theta_;
@@ -108,6 +124,8 @@ class McreProblem {
   // Scratch, allocated in the constructor.
   Vector velocity_[2], omega_[2];  // double buffers of the sweeps' velocity and omega
   Vector shift_;                   // W_theta of the direct sweep's step
+  // The same for the batched sweeps: columns [2 b, 2 b + 1] of sweep b's double buffers.
+  Matrix batch_velocity_, batch_state_, batch_shift_;
 };
 
 }  // namespace mcrewave

@@ -87,6 +87,18 @@ class ThetaIntegrator {
                         double f0, double fL, Eigen::Ref<Vector> v_next,
                         Eigen::Ref<Vector> u_next);
 
+  // B independent steps at once (B = 2 or 3), step b as StepWithEndLoads from
+  // (v_k[b], u_k[b]) with z[b] (null: none), f0[b], fL[b]; all arrays of size()
+  // contiguous doubles, outputs distinct from every input. The tridiagonal solves
+  // run interleaved (about the latency of one); the results are those of B single
+  // steps, bit for bit.
+  static constexpr int kMaxBatch = 3;
+  template <int B>
+  void StepsWithEndLoads(const double* const (&v_k)[B], const double* const (&u_k)[B],
+                         const double* const (&z)[B], const double (&f0)[B],
+                         const double (&fL)[B], double* const (&v_next)[B],
+                         double* const (&u_next)[B]);
+
   // Runs num_steps steps forward in time from (v0, u0).
   //   forcing(k, f): writes into f (an Eigen::Ref<Vector> of size n) the force
   //                  f_theta of the step t_k -> t_{k+1};
@@ -122,6 +134,14 @@ class ThetaIntegrator {
   template <bool kForceVector>
   void TridiagonalStep(const double* v_k, const double* u_k, const double* z, const double* force,
                        double f0, double fL, double* v_next, double* u_next);
+  // The parts of TridiagonalStep: rhs into v_next (shifted: scratch for u_k + z),
+  // and u_next = u_k + h (1 - theta) v_k + h theta v_next.
+  template <bool kForceVector>
+  void TridiagonalRightHandSide(const double* v_k, const double* u_k, const double* z,
+                                const double* force, double f0, double fL, double* shifted,
+                                double* v_next) const;
+  void UpdateDisplacement(const double* u_k, const double* v_k, const double* v_next,
+                          double* u_next) const;
 
   ThetaIntegratorOptions options_;
   SymmetricBandMatrix mass_;               // M
@@ -136,6 +156,7 @@ class ThetaIntegrator {
   Vector free_diagonal_, free_sub_;            // R
   Vector stiffness_diagonal_, stiffness_sub_;  // -h K
   Vector shifted_;                             // scratch: s = u_k + z
+  Matrix shifted_batch_;                       // the same for StepsWithEndLoads, n x kMaxBatch
   int factorization_count_ = 0;
   // Scratch, allocated in Init.
   Vector force_;        // f_theta handed to forcing()
