@@ -16,8 +16,9 @@ namespace {
 
 // The state every iterative solver starts from: W^(0), U = Direct(W^(0)),
 // r = T(W^(0)) - W^(0), ||c||_P, and the round-off floor of the residual. Costs 3
-// sweeps, 5 when W^(0) != 0 (c is then computed separately). When c = 0 the
-// solution (W = 0) is set and the summary says so.
+// sweeps, 5 when W^(0) != 0 (c is then computed separately), run as one batch of
+// direct sweeps and one of retrograde sweeps. When c = 0 the solution (W = 0) is
+// set and the summary says so.
 struct StartingPoint {
   double rhs_norm = 0.0;  // ||c||_P
   // ||r||_P below this is round-off: c = T(0) is the difference of the retrograde
@@ -38,21 +39,26 @@ StartingPoint Start(McreProblem* problem, const Matrix* initial_retrograde,
                     CoupledSolution* solution, Matrix* residual, CoupledSolverSummary* summary) {
   StartingPoint start;
   Matrix& retrograde = solution->retrograde;
+  McreProblem::SolverWorkspace& work = problem->workspace();
   const bool zero_start =
       initial_retrograde == nullptr || initial_retrograde->cwiseAbs().maxCoeff() == 0.0;
-  retrograde = zero_start ? problem->ZeroField() : *initial_retrograde;
-  problem->FixedPointMap(retrograde, &solution->displacement, residual);
+  // T(W^(0)) = Retrograde(U), U = Direct(W^(0)); c = T(0); W_u = Retrograde(0): the
+  // sweeps of the same direction run batched (DirectSweepsWithData).
   if (zero_start) {
+    retrograde.setZero(problem->num_nodes(), problem->num_steps() + 1);
+    problem->DirectSweepsWithData({nullptr}, {&solution->displacement});
+    problem->RetrogradeSweepsWithData({&solution->displacement, nullptr},
+                                      {residual, &work.data_response});
     // T(0) = c.
     start.rhs_norm = problem->Norm(*residual);
   } else {
-    Matrix scratch_displacement, rhs;
-    problem->FixedPointMap(problem->ZeroField(), &scratch_displacement, &rhs);
-    start.rhs_norm = problem->Norm(rhs);
+    retrograde = *initial_retrograde;
+    problem->DirectSweepsWithData({&retrograde, nullptr}, {&solution->displacement, &work.scratch});
+    problem->RetrogradeSweepsWithData({&solution->displacement, &work.scratch, nullptr},
+                                      {residual, &work.rhs, &work.data_response});
+    start.rhs_norm = problem->Norm(work.rhs);
   }
-  Matrix displacement_data_response;
-  problem->RetrogradeSweep(problem->ZeroField(), true, &displacement_data_response);
-  start.residual_floor = kRoundOffFloor * problem->Norm(displacement_data_response);
+  start.residual_floor = kRoundOffFloor * problem->Norm(work.data_response);
   *residual -= retrograde;
   summary->iterations = 0;
   if (start.rhs_norm == 0.0) {
@@ -129,7 +135,7 @@ void SolveByRelaxation(const CoupledSolverOptions& options, McreProblem* problem
   const bool adaptive = options.type == CoupledSolverType::kAdaptiveRelaxation;
   Matrix& retrograde = solution->retrograde;
   Matrix& displacement = solution->displacement;
-  Matrix residual;
+  Matrix& residual = problem->workspace().residual;
   const StartingPoint start = Start(problem, initial_retrograde, solution, &residual, summary);
   if (start.solved) return;
 
@@ -231,14 +237,20 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, McreProblem* 
                               CoupledSolverSummary* summary) {
   Matrix& retrograde = solution->retrograde;
   Matrix& displacement = solution->displacement;
-  Matrix residual;
+  McreProblem::SolverWorkspace& work = problem->workspace();
+  Matrix& residual = work.residual;
   const StartingPoint start = Start(problem, initial_retrograde, solution, &residual, summary);
   if (start.solved) return;
-  Matrix direction = residual;
-  Matrix image, scratch;
+  Matrix& direction = work.direction;
+  Matrix& image = work.image;
+  Matrix& scratch = work.scratch;
+  direction = residual;
   double rho = problem->InnerProduct(residual, residual);
   constexpr int kMaxVerifiedRestarts = 5;
   int restarts = 0;
+  // Whether `residual` is the true residual T(W) - W with U = Direct(W): after the
+  // start and after a verification, not after a CG step (recursive residual).
+  bool residual_is_true = true;
   for (int iteration = 0;; ++iteration) {
     double relative = std::sqrt(std::max(rho, 0.0)) / start.rhs_norm;
     if (!std::isfinite(relative)) {
@@ -248,15 +260,19 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, McreProblem* 
       return;
     }
     if (Converged(start, relative, options.tolerance)) {
-      // Verify with the true residual T(W) - W (2 sweeps); this also leaves
-      // U = Direct(W) consistent with W.
-      problem->FixedPointMap(retrograde, &displacement, &residual);
-      residual -= retrograde;
-      rho = problem->InnerProduct(residual, residual);
-      relative = std::sqrt(std::max(rho, 0.0)) / start.rhs_norm;
+      if (!residual_is_true) {
+        // Verify with the true residual T(W) - W (2 sweeps); this also leaves
+        // U = Direct(W) consistent with W.
+        problem->FixedPointMap(retrograde, &displacement, &residual);
+        residual -= retrograde;
+        rho = problem->InnerProduct(residual, residual);
+        relative = std::sqrt(std::max(rho, 0.0)) / start.rhs_norm;
+        residual_is_true = true;
+      }
       summary->relative_residual = relative;
       if (Converged(start, relative, options.tolerance)) {
         summary->residual_history.push_back(relative);
+        summary->iterations = iteration;  // CG steps taken
         summary->termination = TerminationType::kConvergence;
         summary->message = ConvergenceMessage(start, relative, options.tolerance);
         return;
@@ -292,6 +308,7 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, McreProblem* 
     const double step = rho / curvature;
     retrograde += step * direction;
     residual -= step * image;
+    residual_is_true = false;
     const double rho_next = problem->InnerProduct(residual, residual);
     direction = residual + (rho_next / rho) * direction;
     rho = rho_next;

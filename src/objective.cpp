@@ -55,6 +55,9 @@ void McreObjective::SetWarmStart(const Matrix& retrograde) {
   assert(retrograde.rows() == problem_.num_nodes() &&
          retrograde.cols() == problem_.num_steps() + 1);
   warm_start_ = retrograde;
+  warm_start_modulus_ = 0.0;
+  previous_start_.resize(0, 0);
+  previous_start_modulus_ = 0.0;
 }
 
 const ObjectiveEvaluation& McreObjective::EvaluateModulus(double modulus, bool gradient_requested) {
@@ -64,19 +67,40 @@ const ObjectiveEvaluation& McreObjective::EvaluateModulus(double modulus, bool g
   record.modulus = modulus;
   record.gradient_requested = gradient_requested;
   const Matrix* initial = warm_start_.size() > 0 ? &warm_start_ : nullptr;
+  if (initial != nullptr && previous_start_.size() > 0 &&
+      previous_start_modulus_ != warm_start_modulus_) {
+    // t = (E - E1) / (E1 - E0);  W^(0) = W(E1) + t (W(E1) - W(E0)).
+    const double t =
+        (modulus - warm_start_modulus_) / (warm_start_modulus_ - previous_start_modulus_);
+    if (std::abs(t) <= kMaxExtrapolation) {
+      initial_ = warm_start_ + t * (warm_start_ - previous_start_);
+      initial = &initial_;
+    }
+  }
   record.inner = SolveCoupled(inner_, &problem_, initial, &solution_);
   record.usable = record.inner.IsSolutionUsable();
   if (record.usable) {
     record.cost = solution_.cost;
     record.cost_gradient = solution_.cost_gradient;
+    // The last two usable solutions; one set by SetWarmStart (modulus unknown) is
+    // not extrapolated from.
+    if (warm_start_.size() > 0 && warm_start_modulus_ > 0.0) {
+      previous_start_.swap(warm_start_);
+      previous_start_modulus_ = warm_start_modulus_;
+    } else {
+      previous_start_.resize(0, 0);
+    }
     warm_start_ = solution_.retrograde;
+    warm_start_modulus_ = modulus;
     if (best_index_ < 0 || record.cost < evaluations_[best_index_].cost) {
       best_index_ = static_cast<int>(evaluations_.size());
       best_solution_ = solution_;
     }
   }
-  spdlog::debug("e^2({:.9g} Pa) = {:.9g} J s, de^2/dE = {:.6g} J s/Pa; inner {}", modulus,
-                record.cost, record.cost_gradient, record.inner.BriefReport());
+  spdlog::debug("e^2({:.9g} Pa) = {:.9g} J s, de^2/dE = {:.6g} J s/Pa; inner {} (from {:.3g})",
+                modulus, record.cost, record.cost_gradient, record.inner.BriefReport(),
+                record.inner.residual_history.empty() ? -1.0
+                                                      : record.inner.residual_history.front());
   evaluations_.push_back(std::move(record));
   return evaluations_.back();
 }

@@ -59,6 +59,21 @@ TEST_P(BandMatrixTest, MultiplyMatchesTheDenseProduct) {
   }
 }
 
+TEST_P(BandMatrixTest, BilinearFormMatchesTheDenseOne) {
+  const int p = GetParam();
+  std::mt19937_64 engine(314 + p);
+  for (int n : {1, 2, 3, 4, 7, 50, 101}) {
+    const SparseMatrix sparse = RandomBandMatrix(n, p, false, &engine);
+    const SymmetricBandMatrix band(sparse);
+    const Vector x = Vector::Random(n);
+    const Vector y = Vector::Random(n);
+    const double expected = x.dot(Matrix(sparse) * y);
+    const double scale = x.cwiseAbs().dot(Matrix(sparse).cwiseAbs() * y.cwiseAbs());
+    EXPECT_NEAR(band.BilinearForm(x, y), expected, 1e-14 * scale) << "n = " << n;
+    EXPECT_NEAR(band.BilinearForm(y, x), expected, 1e-14 * scale) << "n = " << n;
+  }
+}
+
 TEST_P(BandMatrixTest, LinearCombinationMatchesTheDenseOne) {
   const int p = GetParam();
   std::mt19937_64 engine(7 + p);
@@ -126,6 +141,79 @@ TEST(BandLdltTest, RejectsAnIndefiniteMatrix) {
   EXPECT_TRUE(factor.ok());
   EXPECT_FALSE(factor.Compute(SymmetricBandMatrix(-identity)));
   EXPECT_FALSE(factor.ok());
+}
+
+TEST(TwistedTridiagonalLdltTest, SolveMatchesTheDenseLdlt) {
+  std::mt19937_64 engine(99);
+  // Odd and even sizes: the two eliminations have equal lengths or differ by one.
+  for (int n : {1, 2, 3, 4, 5, 8, 50, 101, 400}) {
+    const SparseMatrix sparse = RandomBandMatrix(n, 1, true, &engine);
+    TwistedTridiagonalLdlt factor;
+    ASSERT_TRUE(factor.Compute(SymmetricBandMatrix(sparse))) << "n = " << n;
+    EXPECT_TRUE(factor.ok());
+    EXPECT_EQ(factor.size(), n);
+    const Vector b = Vector::Random(n);
+    Vector x = b;
+    factor.SolveInPlace(x);
+    EXPECT_LT(RelativeError(x, Matrix(sparse).ldlt().solve(b)), 1e-12) << "n = " << n;
+    EXPECT_LT(RelativeError(Matrix(sparse) * x, b), 1e-14) << "n = " << n;
+  }
+}
+
+TEST(TwistedTridiagonalLdltTest, BatchedSolvesMatchSingleSolvesExactly) {
+  std::mt19937_64 engine(5);
+  for (int n : {1, 2, 3, 4, 7, 50, 101}) {
+    TwistedTridiagonalLdlt factor;
+    ASSERT_TRUE(factor.Compute(SymmetricBandMatrix(RandomBandMatrix(n, 1, true, &engine))));
+    const Vector b0 = Vector::Random(n), b1 = Vector::Random(n), b2 = Vector::Random(n);
+    Vector x0 = b0, x1 = b1, x2 = b2;
+    factor.SolveInPlace<3>({x0.data(), x1.data(), x2.data()});
+    Vector y0 = b0, y1 = b1;
+    factor.SolveInPlace<2>({y0.data(), y1.data()});
+    for (const auto& [batched, rhs] : {std::pair<Vector, Vector>{x0, b0}, {x1, b1}, {x2, b2},
+                                       {y0, b0}, {y1, b1}}) {
+      Vector single = rhs;
+      factor.SolveInPlace(single);
+      EXPECT_EQ((batched - single).cwiseAbs().maxCoeff(), 0.0) << "n = " << n;
+    }
+  }
+}
+
+TEST(TwistedTridiagonalLdltTest, AgreesWithBandLdltOnTheThetaIterationMatrixOfTheBar) {
+  const BarModel model{BarProperties{}};
+  const double h_theta = 0.36e-6 * 0.5;
+  const SymmetricBandMatrix schur(model.mass() + (h_theta * h_theta) *
+                                                     model.Stiffness(model.properties().modulus));
+  BandLdlt thomas;
+  TwistedTridiagonalLdlt twisted;
+  ASSERT_TRUE(thomas.Compute(schur));
+  ASSERT_TRUE(twisted.Compute(schur));
+  const Vector b = Vector::Random(model.num_nodes());
+  Vector x_thomas = b, x_twisted = b;
+  thomas.SolveInPlace(x_thomas);
+  twisted.SolveInPlace(x_twisted);
+  EXPECT_LT(RelativeError(x_twisted, x_thomas), 1e-14);
+}
+
+TEST(TwistedTridiagonalLdltTest, RejectsAnIndefiniteMatrix) {
+  // [[1 2 0], [2 1 0], [0 0 1]]: eigenvalues -1, 1, 3; the middle pivot is 1 - 4 < 0.
+  SparseMatrix indefinite(3, 3);
+  std::vector<Eigen::Triplet<double>> entries{
+      {0, 0, 1.0}, {1, 1, 1.0}, {2, 2, 1.0}, {0, 1, 2.0}, {1, 0, 2.0}};
+  indefinite.setFromTriplets(entries.begin(), entries.end());
+  TwistedTridiagonalLdlt factor;
+  EXPECT_FALSE(factor.Compute(SymmetricBandMatrix(indefinite)));
+  EXPECT_FALSE(factor.ok());
+  // The indefinite block at the bottom end: caught by the bottom elimination.
+  SparseMatrix bottom(5, 5);
+  std::vector<Eigen::Triplet<double>> bottom_entries{
+      {0, 0, 1.0}, {1, 1, 1.0}, {2, 2, 1.0}, {3, 3, 1.0}, {4, 4, 1.0}, {4, 3, 2.0}, {3, 4, 2.0}};
+  bottom.setFromTriplets(bottom_entries.begin(), bottom_entries.end());
+  EXPECT_FALSE(factor.Compute(SymmetricBandMatrix(bottom)));
+  SparseMatrix identity(4, 4);
+  identity.setIdentity();
+  EXPECT_TRUE(factor.Compute(SymmetricBandMatrix(identity)));
+  EXPECT_TRUE(factor.ok());
 }
 
 }  // namespace

@@ -62,6 +62,46 @@ TEST_P(IterationMapTest, IsSelfAdjointAndNegativeInPInnerProduct) {
 
 INSTANTIATE_TEST_SUITE_P(Theta, IterationMapTest, ::testing::Values(0.5, 0.75, 1.0));
 
+// The batched sweeps (the coupled solvers' start) give the single sweeps' results
+// bit for bit, for 2 and 3 fields, zero inputs (null) included, odd and even n.
+class BatchedSweepsTest : public ::testing::TestWithParam<int> {};
+
+TEST_P(BatchedSweepsTest, MatchTheSingleSweepsExactly) {
+  ProblemBundle bundle(MakeSmallCase(GetParam(), 40, 5.0, 2), Weights(0.3, 1.0));
+  McreProblem& problem = bundle.problem;
+  problem.SetModulus(1.1 * 200e9);
+  const Matrix zero = problem.ZeroField();
+  const Matrix w1 = RandomField(problem, 3), w2 = RandomField(problem, 4);
+  Matrix u1, u2, u3, expected;
+  const long sweeps = problem.sweep_count();
+  problem.DirectSweepsWithData({&w1, nullptr, &w2}, {&u1, &u2, &u3});
+  EXPECT_EQ(problem.sweep_count(), sweeps + 3);
+  problem.DirectSweep(w1, true, &expected);
+  EXPECT_EQ((u1 - expected).cwiseAbs().maxCoeff(), 0.0);
+  problem.DirectSweep(zero, true, &expected);
+  EXPECT_EQ((u2 - expected).cwiseAbs().maxCoeff(), 0.0);
+  problem.DirectSweep(w2, true, &expected);
+  EXPECT_EQ((u3 - expected).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_GT(u3.cwiseAbs().maxCoeff(), 0.0);
+
+  Matrix r1, r2, r3;
+  problem.RetrogradeSweepsWithData({&u1, &u3, nullptr}, {&r1, &r2, &r3});
+  problem.RetrogradeSweep(u1, true, &expected);
+  EXPECT_EQ((r1 - expected).cwiseAbs().maxCoeff(), 0.0);
+  problem.RetrogradeSweep(u3, true, &expected);
+  EXPECT_EQ((r2 - expected).cwiseAbs().maxCoeff(), 0.0);
+  problem.RetrogradeSweep(zero, true, &expected);
+  EXPECT_EQ((r3 - expected).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_GT(r3.cwiseAbs().maxCoeff(), 0.0);
+
+  problem.RetrogradeSweepsWithData({nullptr, &u2}, {&r1, &r2});
+  EXPECT_EQ((r1 - expected).cwiseAbs().maxCoeff(), 0.0);
+  problem.RetrogradeSweep(u2, true, &expected);
+  EXPECT_EQ((r2 - expected).cwiseAbs().maxCoeff(), 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Elements, BatchedSweepsTest, ::testing::Values(9, 12));
+
 TEST(McreProblemTest, ConsistentDataGiveZeroCostAtZeroRetrogradeField) {
   // Inverse crime: data from the model's own discretisation, no noise.
   ProblemBundle bundle(MakeSmallCase(16, 120, std::numeric_limits<double>::infinity(), 1),

@@ -14,6 +14,8 @@
 // self-adjoint, the cost e^2 and its derivative de^2/dE.
 #pragma once
 
+#include <vector>
+
 #include "mcrewave/bar_model.h"
 #include "mcrewave/measurement.h"
 #include "mcrewave/theta_integrator.h"
@@ -65,6 +67,15 @@ class McreProblem {
   void DirectSweep(const Matrix& retrograde, bool include_data, Matrix* displacement);
   // U -> W. With include_data the displacement data U~ enter.
   void RetrogradeSweep(const Matrix& displacement, bool include_data, Matrix* retrograde);
+  // Up to ThetaIntegrator::kMaxBatch sweeps with the data at once, sweep b from
+  // inputs[b] (null: the zero field) into outputs[b] (resized); the time steps of the
+  // sweeps run interleaved, for the cost of fewer than that many sweeps, and give
+  // the results of the single sweeps bit for bit. Counted as that many sweeps.
+  // Outputs distinct from every input.
+  void DirectSweepsWithData(const std::vector<const Matrix*>& retrograde,
+                            const std::vector<Matrix*>& displacement);
+  void RetrogradeSweepsWithData(const std::vector<const Matrix*>& displacement,
+                                const std::vector<Matrix*>& retrograde);
   // The affine map T(W) = RetrogradeSweep(DirectSweep(W)) with the data: two sweeps.
   // displacement receives DirectSweep(W).
   void FixedPointMap(const Matrix& retrograde, Matrix* displacement, Matrix* image);
@@ -83,7 +94,23 @@ class McreProblem {
   // Number of sweeps (direct + retrograde) run since construction.
   long sweep_count() const { return sweep_count_; }
 
+  // Work fields of the iterative coupled solvers, kept with the problem between
+  // solves so that a solve on a problem solved before allocates no field (a fresh
+  // n x (m + 1) field costs its page faults, measured at about 15 % of an
+  // identification's CPU time). Each is resized by its user; `zero` is the zero
+  // field, never written.
+  struct SolverWorkspace {
+    Matrix residual, direction, image, scratch, rhs, data_response;
+    Matrix zero;
+  };
+  SolverWorkspace& workspace();
+
  private:
+  template <int B>
+  void DirectSweeps(const Matrix* const (&retrograde)[B], Matrix* const (&displacement)[B]);
+  template <int B>
+  void RetrogradeSweeps(const Matrix* const (&displacement)[B], Matrix* const (&retrograde)[B]);
+
   const BarModel& model_;
   const MeasurementSet& data_;
   double theta_;
@@ -93,10 +120,12 @@ class McreProblem {
   ThetaIntegrator integrator_;
   SymmetricBandMatrix unit_stiffness_;  // K1
   long sweep_count_ = 0;
+  SolverWorkspace workspace_;
   // Scratch, allocated in the constructor.
-  Vector force_now_, force_next_, omega_previous_, product_;
-  Vector
-      rest_state_;  // zero: the initial state of the direct sweep, the final one of the retrograde
+  Vector velocity_[2], omega_[2];  // double buffers of the sweeps' velocity and omega
+  Vector shift_;                   // W_theta of the direct sweep's step
+  // The same for the batched sweeps: columns [2 b, 2 b + 1] of sweep b's double buffers.
+  Matrix batch_velocity_, batch_state_, batch_shift_;
 };
 
 }  // namespace mcrewave

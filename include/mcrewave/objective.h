@@ -6,7 +6,14 @@
 // gradient, and false (never a made-up number) when the value cannot be had.
 // McreObjective implements it with an McreProblem and the coupled solver of
 // coupled_solver.h: each evaluation sets E, solves the coupled problem
-// warm-started from the previous usable solution and records what it did.
+// warm-started from the previous usable solutions and records what it did.
+//
+// Warm start: with the last two usable solutions W(E1) (last) and W(E0) at
+// E0 != E1, the next solve at E starts from the linear extrapolation
+//   W^(0) = W(E1) + t (W(E1) - W(E0)),  t = (E - E1) / (E1 - E0),
+// when |t| <= kMaxExtrapolation (W depends smoothly on E between resonances; a
+// scan step or a local optimiser's step is then much closer to the line through the
+// last two solutions than to the last one); otherwise from W(E1) alone.
 #pragma once
 
 #include <memory>
@@ -110,8 +117,12 @@ class McreObjective : public ModulusObjective {
   long total_sweeps() const { return problem_.sweep_count(); }
 
   // The next evaluation starts its inner iteration from this retrograde field
-  // (shape of problem().ZeroField()) instead of the last usable solution.
+  // (shape of problem().ZeroField()) instead of the last usable solutions; later
+  // evaluations extrapolate from it once they have a second solution.
   void SetWarmStart(const Matrix& retrograde);
+
+  // Largest |t| of the extrapolated warm start (above: the last solution alone).
+  static constexpr double kMaxExtrapolation = 2.0;
 
   McreProblem& problem() { return problem_; }
 
@@ -128,7 +139,11 @@ class McreObjective : public ModulusObjective {
   int best_index_ = -1;
   CoupledSolution best_solution_;
   CoupledSolution solution_;  // of the last evaluation
-  Matrix warm_start_;         // empty: start from zero
+  Matrix warm_start_;         // W(E1), the last usable solution; empty: start from zero
+  double warm_start_modulus_ = 0.0;  // E1 [Pa]; 0 when W(E1) was set by SetWarmStart
+  Matrix previous_start_;            // W(E0), the one before; empty: none
+  double previous_start_modulus_ = 0.0;  // E0 [Pa]
+  Matrix initial_;                   // the extrapolated W^(0)
   std::string error_message_;
 };
 

@@ -28,6 +28,17 @@
 //
 // By linearity v_{k+1} = S^-1 rhs_free + S^-1 h f_theta: the input's effect is
 // added to the free state's right-hand side and both go through one solve.
+//
+// Tridiagonal M and K (linear elements, the bar's case) take a fast path: the
+// right-hand side in one branch-free pass over the bands, S solved by the twisted
+// factorisation of band_matrix.h (two independent recurrences of n/2 steps), u
+// updated in one more pass. Other bandwidths use SymmetricBandMatrix and BandLdlt.
+// Both solve the same system; they differ by round-off.
+//
+// StepWithEndLoads takes a force of the form the MCRE sweeps need without forming
+// it: f_theta = -K z + f0 e_0 + fL e_{n-1} (z optional), so that
+//   rhs = R v_k - h K (u_k + z) + h (f0 e_0 + fL e_{n-1})
+// is one pass.
 // theta = 1/2 is the trapezoidal rule (second order, energy conserving); theta = 1
 // is backward Euler (first order).
 //
@@ -66,6 +77,28 @@ class ThetaIntegrator {
             const Eigen::Ref<const Vector>& force_theta, Eigen::Ref<Vector> v_next,
             Eigen::Ref<Vector> u_next);
 
+  // One step with the force f_theta = -K z + f0 e_0 + fL e_{n-1} [N] (z [m], same
+  // size as u_k) or, without z, f_theta = f0 e_0 + fL e_{n-1}. Same contract as
+  // Step otherwise.
+  void StepWithEndLoads(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref<const Vector>& u_k,
+                        const Eigen::Ref<const Vector>& z, double f0, double fL,
+                        Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next);
+  void StepWithEndLoads(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref<const Vector>& u_k,
+                        double f0, double fL, Eigen::Ref<Vector> v_next,
+                        Eigen::Ref<Vector> u_next);
+
+  // B independent steps at once (B = 2 or 3), step b as StepWithEndLoads from
+  // (v_k[b], u_k[b]) with z[b] (null: none), f0[b], fL[b]; all arrays of size()
+  // contiguous doubles, outputs distinct from every input. The tridiagonal solves
+  // run interleaved (about the latency of one); the results are those of B single
+  // steps, bit for bit.
+  static constexpr int kMaxBatch = 3;
+  template <int B>
+  void StepsWithEndLoads(const double* const (&v_k)[B], const double* const (&u_k)[B],
+                         const double* const (&z)[B], const double (&f0)[B],
+                         const double (&fL)[B], double* const (&v_next)[B],
+                         double* const (&u_next)[B]);
+
   // Runs num_steps steps forward in time from (v0, u0).
   //   forcing(k, f): writes into f (an Eigen::Ref<Vector> of size n) the force
   //                  f_theta of the step t_k -> t_{k+1};
@@ -95,11 +128,35 @@ class ThetaIntegrator {
   void Sweep(int num_steps, int first, int direction, const Eigen::Ref<const Vector>& v_start,
              const Eigen::Ref<const Vector>& u_start, Forcing&& forcing, Observer&& observer);
 
+  // The tridiagonal fast path: rhs = R v_k - h K s + h f (f: the full force when
+  // kForceVector, else only f0 e_0 + fL e_{n-1}), solve, u update. s = u_k + z when
+  // z is not null, else u_k.
+  template <bool kForceVector>
+  void TridiagonalStep(const double* v_k, const double* u_k, const double* z, const double* force,
+                       double f0, double fL, double* v_next, double* u_next);
+  // The parts of TridiagonalStep: rhs into v_next (shifted: scratch for u_k + z),
+  // and u_next = u_k + h (1 - theta) v_k + h theta v_next.
+  template <bool kForceVector>
+  void TridiagonalRightHandSide(const double* v_k, const double* u_k, const double* z,
+                                const double* force, double f0, double fL, double* shifted,
+                                double* v_next) const;
+  void UpdateDisplacement(const double* u_k, const double* v_k, const double* v_next,
+                          double* u_next) const;
+
   ThetaIntegratorOptions options_;
   SymmetricBandMatrix mass_;               // M
   SymmetricBandMatrix stiffness_;          // K
   SymmetricBandMatrix free_state_matrix_;  // R = M - h^2 theta (1 - theta) K
-  BandLdlt iteration_matrix_;              // LDL^T of S = M + h^2 theta^2 K
+  BandLdlt iteration_matrix_;              // LDL^T of S = M + h^2 theta^2 K (bandwidth > 1)
+  // The tridiagonal fast path (half bandwidth <= 1).
+  bool tridiagonal_ = false;
+  TwistedTridiagonalLdlt tridiagonal_factor_;  // S
+  // The bands of R and -h K: diagonal [i] = row i, sub-diagonal [i] = (i, i-1)
+  // ([0] unused).
+  Vector free_diagonal_, free_sub_;            // R
+  Vector stiffness_diagonal_, stiffness_sub_;  // -h K
+  Vector shifted_;                             // scratch: s = u_k + z
+  Matrix shifted_batch_;                       // the same for StepsWithEndLoads, n x kMaxBatch
   int factorization_count_ = 0;
   // Scratch, allocated in Init.
   Vector force_;        // f_theta handed to forcing()

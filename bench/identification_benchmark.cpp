@@ -1,0 +1,219 @@
+// CPU cost of one identification, as `identify run` does it, and of one sweep step.
+//
+// For each config (default: configs/paper_bar.yaml and configs/quick.yaml, paths
+// relative to the working directory) it loads the data exactly as `identify run`
+// does (synthetic data, pre-filter) and reports:
+//   (a) Identify alone (scan + bracketed refinements, the outer options of the
+//       config): the identified E, the evaluations of the scan and of the
+//       refinements, their sweeps, and the CPU time (user + system of the whole
+//       process, so the scan's threads count);
+//   (b) RunIdentification (Identify, then the cost curve and the uncertainty of
+//       `identify run`, without writing files): CPU time and sweeps;
+//   (c) one direct and one retrograde sweep of the config's problem at E_ref: CPU
+//       time per time step.
+// CPU times, not wall times: the machine is shared. Repeats take the minimum.
+//
+// Goal (paper_bar.yaml): Identify <= 0.5 CPU s, so that a robustness study of 400
+// identifications fits in 2 minutes on 2 cores.
+//
+// Usage: identification_benchmark [--repeats N] [--identify-only] [--set key=value ...]
+//                                 [CONFIG.yaml ...]
+//   --identify-only: (a) only, e.g. under valgrind --tool=callgrind;
+//   --set: config overrides as in `identify run --set`, e.g. --set data.seed=3.
+
+#include <sys/resource.h>
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mcrewave/config.h"
+#include "mcrewave/identification.h"
+#include "mcrewave/identification_run.h"
+#include "mcrewave/objective.h"
+#include "mcrewave/prefilter.h"
+
+namespace {
+
+// User + system CPU time of the process, all threads [s].
+double ProcessCpuSeconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
+// CPU time of the calling thread [s].
+double ThreadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+// An McreObjective whose scan copies add their sweeps to a shared counter when
+// they are destroyed (Identify destroys them after the scan).
+class CountingObjective : public mcrewave::ModulusObjective {
+ public:
+  CountingObjective(mcrewave::McreObjective* objective, std::atomic<long>* scan_sweeps)
+      : objective_(objective), scan_sweeps_(scan_sweeps) {}
+  CountingObjective(std::unique_ptr<mcrewave::McreObjective> owned, std::atomic<long>* scan_sweeps)
+      : owned_(std::move(owned)), objective_(owned_.get()), scan_sweeps_(scan_sweeps) {}
+  ~CountingObjective() override {
+    if (owned_ != nullptr) *scan_sweeps_ += owned_->total_sweeps();
+  }
+  double modulus_scale() const override { return objective_->modulus_scale(); }
+  bool Evaluate(const double* parameters, double* cost, double* gradient) override {
+    return objective_->Evaluate(parameters, cost, gradient);
+  }
+  std::string error_message() const override { return objective_->error_message(); }
+  std::unique_ptr<ModulusObjective> CloneForScan(double inner_tolerance) const override {
+    std::unique_ptr<ModulusObjective> copy = objective_->CloneForScan(inner_tolerance);
+    auto* mcre = dynamic_cast<mcrewave::McreObjective*>(copy.get());
+    if (mcre == nullptr) return nullptr;
+    copy.release();
+    return std::make_unique<CountingObjective>(std::unique_ptr<mcrewave::McreObjective>(mcre),
+                                               scan_sweeps_);
+  }
+
+ private:
+  std::unique_ptr<mcrewave::McreObjective> owned_;
+  mcrewave::McreObjective* objective_;
+  std::atomic<long>* scan_sweeps_;
+};
+
+struct IdentifyFigures {
+  double cpu_s = std::numeric_limits<double>::infinity();
+  double modulus = -1.0;
+  int scan_evaluations = 0;
+  int evaluations = 0;
+  long scan_sweeps = 0;
+  long refinement_sweeps = 0;
+  bool usable = false;
+};
+
+IdentifyFigures IdentifyOnce(const mcrewave::Config& config, const mcrewave::MeasurementSet& data) {
+  IdentifyFigures figures;
+  const mcrewave::BarModel model(config.model);
+  mcrewave::McreObjective objective(model, data, config.mcre, config.time.theta, config.inner,
+                                    config.outer.initial);
+  std::atomic<long> scan_sweeps{0};
+  CountingObjective counting(&objective, &scan_sweeps);
+  const double start = ProcessCpuSeconds();
+  const mcrewave::IdentificationSummary summary = mcrewave::Identify(config.outer, &counting);
+  figures.cpu_s = ProcessCpuSeconds() - start;
+  figures.modulus = summary.modulus;
+  figures.scan_evaluations = summary.scan_evaluations;
+  figures.evaluations = summary.evaluations;
+  figures.scan_sweeps = scan_sweeps;
+  figures.refinement_sweeps = objective.total_sweeps();
+  figures.usable = summary.IsSolutionUsable();
+  return figures;
+}
+
+// CPU seconds per time step of a direct and of a retrograde sweep at E_ref, and of
+// one direct sweep of a batch of 3 (DirectSweepsWithData).
+struct SweepStepTimes {
+  double direct = 0.0, retrograde = 0.0, batched_direct = 0.0;
+};
+
+SweepStepTimes SweepStepSeconds(const mcrewave::Config& config,
+                                           const mcrewave::MeasurementSet& data) {
+  const mcrewave::BarModel model(config.model);
+  mcrewave::McreProblem problem(model, data, config.mcre.weights, config.mcre.reference_modulus,
+                                config.time.theta);
+  problem.SetModulus(config.model.modulus);
+  mcrewave::Matrix retrograde = problem.ZeroField(), displacement;
+  problem.DirectSweep(retrograde, true, &displacement);
+  problem.RetrogradeSweep(displacement, true, &retrograde);
+  const int repeats = std::max(5, 200000 / problem.num_steps());
+  double direct = std::numeric_limits<double>::infinity();
+  double backward = std::numeric_limits<double>::infinity();
+  double batched = std::numeric_limits<double>::infinity();
+  mcrewave::Matrix u1, u2;
+  for (int round = 0; round < 3; ++round) {
+    double start = ThreadCpuSeconds();
+    for (int i = 0; i < repeats; ++i) problem.DirectSweep(retrograde, true, &displacement);
+    direct = std::min(direct, (ThreadCpuSeconds() - start) / repeats);
+    start = ThreadCpuSeconds();
+    for (int i = 0; i < repeats; ++i) problem.RetrogradeSweep(displacement, true, &retrograde);
+    backward = std::min(backward, (ThreadCpuSeconds() - start) / repeats);
+    start = ThreadCpuSeconds();
+    for (int i = 0; i < repeats; i += 3) {
+      problem.DirectSweepsWithData({&retrograde, nullptr, &retrograde}, {&displacement, &u1, &u2});
+    }
+    batched = std::min(batched, (ThreadCpuSeconds() - start) / (3 * ((repeats + 2) / 3)));
+  }
+  const double steps = problem.num_steps();
+  return {direct / steps, backward / steps, batched / steps};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  spdlog::set_level(spdlog::level::warn);
+  int repeats = 3;
+  bool identify_only = false;
+  std::vector<std::string> paths, overrides;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--repeats") == 0 && i + 1 < argc) {
+      repeats = std::max(1, std::atoi(argv[++i]));
+    } else if (std::strcmp(argv[i], "--identify-only") == 0) {
+      identify_only = true;
+    } else if (std::strcmp(argv[i], "--set") == 0 && i + 1 < argc) {
+      overrides.emplace_back(argv[++i]);
+    } else {
+      paths.emplace_back(argv[i]);
+    }
+  }
+  if (paths.empty()) paths = {"configs/paper_bar.yaml", "configs/quick.yaml"};
+  for (const std::string& path : paths) {
+    const mcrewave::Config config = mcrewave::LoadConfig(path, overrides);
+    const mcrewave::MeasurementSet measured = mcrewave::LoadMeasurements(config);
+    double cutoff = 0.0;
+    const mcrewave::MeasurementSet data =
+        mcrewave::PrefilterMeasurements(measured, config.prefilter, &cutoff);
+    std::printf("%s: %d nodes, %d steps, scan %d points on %d threads\n", path.c_str(),
+                config.model.elements + 1, config.time.NumSteps(), config.outer.scan_points,
+                config.outer.scan_threads);
+
+    IdentifyFigures best;
+    for (int r = 0; r < repeats; ++r) {
+      const IdentifyFigures figures = IdentifyOnce(config, data);
+      if (figures.cpu_s < best.cpu_s) best = figures;
+    }
+    std::printf(
+        "  Identify:          %.3f CPU s, E = %.10e Pa (%s), scan %d evaluations / %ld sweeps, "
+        "refinements %d evaluations / %ld sweeps\n",
+        best.cpu_s, best.modulus, best.usable ? "converged" : "NOT USABLE", best.scan_evaluations,
+        best.scan_sweeps, best.evaluations, best.refinement_sweeps);
+    if (identify_only) continue;
+    const SweepStepTimes step = SweepStepSeconds(config, data);
+    std::printf(
+        "  sweep step:        direct %.3f us, retrograde %.3f us, direct in a batch of 3 %.3f us "
+        "(CPU per time step and sweep)\n",
+        1e6 * step.direct, 1e6 * step.retrograde, 1e6 * step.batched_direct);
+
+    double run_cpu = std::numeric_limits<double>::infinity();
+    mcrewave::IdentificationRun run;
+    for (int r = 0; r < repeats; ++r) {
+      const double start = ProcessCpuSeconds();
+      run = mcrewave::RunIdentification(config, measured);
+      run_cpu = std::min(run_cpu, ProcessCpuSeconds() - start);
+    }
+    std::printf(
+        "  RunIdentification: %.3f CPU s, E = %.10e Pa, sweeps: refinements %ld, cost curve %ld, "
+        "uncertainty %ld\n",
+        run_cpu, run.identified_modulus(), run.sweeps, run.cost_curve_sweeps,
+        run.uncertainty.sweeps);
+  }
+  return 0;
+}
