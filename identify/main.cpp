@@ -256,9 +256,10 @@ int RunStudy(const StudyArguments& arguments) {
   const std::string& folder = config.study.folder;
   const bool figures = config.study.figures;
   const mcrewave::StudyKind kind = config.study.kind;
-  mcrewave::StudyProgressLogger()->info("config {}: {} elements, {} steps of {:.4g} s; study {} into {}",
-               arguments.config_path, config.model.elements, config.time.NumSteps(),
-               config.time.step, mcrewave::StudyKindToString(kind), folder);
+  mcrewave::StudyProgressLogger()->info(
+      "config {}: {} elements, {} steps of {:.4g} s; study {} into {}", arguments.config_path,
+      config.model.elements, config.time.NumSteps(), config.time.step,
+      mcrewave::StudyKindToString(kind), folder);
 
   // 2. Each selected study: compute, then write its folder.
   if (mcrewave::StudySelected(kind, mcrewave::StudyKind::kRobustness)) {

@@ -63,8 +63,8 @@ class Progress {
     const double elapsed = SecondsSince(start_);
     // left = elapsed / done * (total - done)
     const double left = elapsed / done_ * (total_ - done_);
-    StudyProgressLogger()->info("{}: {} / {} runs, {} elapsed, about {} left", what_, done_,
-                                total_, Duration(elapsed), Duration(left));
+    StudyProgressLogger()->info("{}: {} / {} runs, {} elapsed, about {} left", what_, done_, total_,
+                                Duration(elapsed), Duration(left));
   }
 
  private:
@@ -79,8 +79,7 @@ class Progress {
 // next index not yet taken, and progress->RunDone() after each. The tasks must
 // write only their own results (by index). The first exception a task throws is
 // rethrown once every thread has stopped (the others stop taking new indices).
-void ParallelFor(int count, int threads, const std::function<void(int)>& task,
-                 Progress* progress) {
+void ParallelFor(int count, int threads, const std::function<void(int)>& task, Progress* progress) {
   std::atomic<int> next{0};
   std::atomic<bool> failed{false};
   std::exception_ptr first_error;
@@ -243,8 +242,8 @@ const char* StudyKindToString(StudyKind kind) {
 }
 
 bool StringToStudyKind(const std::string& name, StudyKind* kind) {
-  for (StudyKind candidate : {StudyKind::kRobustness, StudyKind::kRelaxation,
-                              StudyKind::kCostCurves, StudyKind::kAll}) {
+  for (StudyKind candidate :
+       {StudyKind::kRobustness, StudyKind::kRelaxation, StudyKind::kCostCurves, StudyKind::kAll}) {
     if (name == StudyKindToString(candidate)) {
       *kind = candidate;
       return true;
@@ -356,8 +355,8 @@ RobustnessStudy RunRobustnessStudy(const Config& config) {
       [&](int i) {
         RobustnessRun& run = study.runs[i];
         const MeasurementSet measured = NoisyMeasurements(truth, run.snr, run.seed);
-        const IdentificationRun identification = IdentifyOnOneThread(
-            config, measured, run.snr, run.seed, &run.converged, &run.message);
+        const IdentificationRun identification =
+            IdentifyOnOneThread(config, measured, run.snr, run.seed, &run.converged, &run.message);
         const IdentificationSummary& outer = identification.outer;
         run.evaluations = outer.evaluations + outer.scan_evaluations;
         run.scan_evaluations = outer.scan_evaluations;
@@ -393,7 +392,8 @@ RobustnessStudy RunRobustnessStudy(const Config& config) {
       statistics.mean_error = sum / errors.size();
       // sample standard deviation: sqrt(sum (e - mean)^2 / (n - 1)); 0 for one run
       double squares = 0.0;
-      for (const double e : errors) squares += (e - statistics.mean_error) * (e - statistics.mean_error);
+      for (const double e : errors)
+        squares += (e - statistics.mean_error) * (e - statistics.mean_error);
       statistics.std_error = errors.size() > 1 ? std::sqrt(squares / (errors.size() - 1.0)) : 0.0;
       statistics.quantile_025 = Quantile(errors, 0.025);
       statistics.quantile_975 = Quantile(errors, 0.975);
@@ -411,10 +411,10 @@ std::string RobustnessRunsCsv(const RobustnessStudy& study) {
   csv << "snr,snr_index,seed,converged,identified_modulus,relative_error,evaluations,"
          "scan_evaluations,sweeps,local_minima\n";
   for (const RobustnessRun& run : study.runs) {
-    csv << Csv(run.snr) << "," << run.snr_index << "," << run.seed << ","
-        << (run.converged ? 1 : 0) << "," << Csv(run.identified_modulus) << ","
-        << Csv(run.relative_error) << "," << run.evaluations << "," << run.scan_evaluations << ","
-        << run.sweeps << "," << run.local_minima << "\n";
+    csv << Csv(run.snr) << "," << run.snr_index << "," << run.seed << "," << (run.converged ? 1 : 0)
+        << "," << Csv(run.identified_modulus) << "," << Csv(run.relative_error) << ","
+        << run.evaluations << "," << run.scan_evaluations << "," << run.sweeps << ","
+        << run.local_minima << "\n";
   }
   return csv.str();
 }
@@ -493,8 +493,8 @@ std::string RobustnessSummary(const RobustnessStudy& study) {
        << "within [" << Percent(lowest->quantile_025) << ", " << Percent(lowest->quantile_975)
        << "].\n";
   }
-  md << "- " << study.runs.size() << " identifications in " << Duration(study.wall_time_s)
-     << " on " << study.threads << " threads.\n\n";
+  md << "- " << study.runs.size() << " identifications in " << Duration(study.wall_time_s) << " on "
+     << study.threads << " threads.\n\n";
   return md.str();
 }
 
@@ -502,11 +502,10 @@ std::string RobustnessSummary(const RobustnessStudy& study) {
 
 std::vector<std::string> WriteRobustnessResults(const RobustnessStudy& study,
                                                 const std::string& folder, bool figures) {
-  return WriteStudyFolder(folder,
-                          {{"runs.csv", RobustnessRunsCsv(study)},
-                           {"statistics.csv", RobustnessStatisticsCsv(study)}},
-                          {{"robustness", RobustnessScript(study, folder)}}, figures,
-                          RobustnessSummary(study));
+  return WriteStudyFolder(
+      folder,
+      {{"runs.csv", RobustnessRunsCsv(study)}, {"statistics.csv", RobustnessStatisticsCsv(study)}},
+      {{"robustness", RobustnessScript(study, folder)}}, figures, RobustnessSummary(study));
 }
 
 // ---------------------------------------------------------------------------
@@ -619,7 +618,8 @@ RelaxationStudy RunRelaxationStudy(const Config& config) {
         }
 
         // The reference solves to inner.tolerance, with their residual histories.
-        auto record = [&](CoupledSolverType type, double omega, const CoupledSolverSummary& summary) {
+        auto record = [&](CoupledSolverType type, double omega,
+                          const CoupledSolverSummary& summary) {
           ResidualHistory history;
           history.case_index = c;
           history.method = type;
@@ -628,8 +628,9 @@ RelaxationStudy RunRelaxationStudy(const Config& config) {
           histories[c].push_back(history);
         };
         if (!std::isnan(relaxation_case.omega_fastest)) {
-          const CoupledSolverSummary fixed = solve(
-              CoupledSolverType::kRelaxation, relaxation_case.omega_fastest, config.inner.tolerance);
+          const CoupledSolverSummary fixed =
+              solve(CoupledSolverType::kRelaxation, relaxation_case.omega_fastest,
+                    config.inner.tolerance);
           relaxation_case.fixed_sweeps = fixed.sweeps;
           record(CoupledSolverType::kRelaxation, relaxation_case.omega_fastest, fixed);
         }
@@ -677,8 +678,8 @@ std::string RelaxationSweepsCsv(const RelaxationStudy& study) {
          "relative_residual,predicted_iterations\n";
   for (const RelaxationPoint& p : study.points) {
     const RelaxationCase& r = study.cases[p.case_index];
-    csv << p.case_index << "," << Csv(r.snr) << "," << Csv(r.modulus_factor) << ","
-        << Csv(p.omega) << "," << TerminationTypeToString(p.termination) << ","
+    csv << p.case_index << "," << Csv(r.snr) << "," << Csv(r.modulus_factor) << "," << Csv(p.omega)
+        << "," << TerminationTypeToString(p.termination) << ","
         << (p.termination == TerminationType::kConvergence ? 1 : 0) << "," << p.iterations << ","
         << p.sweeps << "," << Csv(p.relative_residual) << "," << p.predicted_iterations << "\n";
   }
@@ -704,7 +705,8 @@ std::string ResidualsCsv(const RelaxationStudy& study) {
 std::vector<double> Distinct(const RelaxationStudy& study, double RelaxationCase::*field) {
   std::vector<double> values;
   for (const RelaxationCase& r : study.cases) {
-    if (std::find(values.begin(), values.end(), r.*field) == values.end()) values.push_back(r.*field);
+    if (std::find(values.begin(), values.end(), r.*field) == values.end())
+      values.push_back(r.*field);
   }
   return values;
 }
@@ -718,7 +720,8 @@ std::string SweepsScript(const RelaxationStudy& study, const std::string& folder
          << ",620 enhanced font 'sans,10'\n"
          << "set multiplot layout 1," << factors.size()
          << " title 'Sweeps of the fixed-omega relaxation to a relative residual of "
-         << Brief(study.tolerance) << " (lines: measured, dashed: predicted from the spectrum; "
+         << Brief(study.tolerance)
+         << " (lines: measured, dashed: predicted from the spectrum; "
             "arrows: 2/a_{max} solid, adaptive omega dotted)'\n"
          << "set xlabel '{/Symbol w}'\nset ylabel 'sweeps'\nset logscale y\nset key top right\n";
   // The omega axis holds the grid and every marked omega.
@@ -838,7 +841,8 @@ std::string RelaxationSummary(const RelaxationStudy& study) {
     double largest_converged = std::numeric_limits<double>::quiet_NaN();
     for (const RelaxationPoint& p : study.points) {
       if (p.case_index == static_cast<int>(c) && p.termination == TerminationType::kConvergence) {
-        largest_converged = std::isnan(largest_converged) ? p.omega : std::max(largest_converged, p.omega);
+        largest_converged =
+            std::isnan(largest_converged) ? p.omega : std::max(largest_converged, p.omega);
       }
     }
     md << "| " << SnrText(r.snr) << " | " << Brief(r.modulus_factor) << " | "
@@ -849,8 +853,8 @@ std::string RelaxationSummary(const RelaxationStudy& study) {
   }
   md << "\nSweeps of the last column to inner.tolerance, each from W = 0 (the adaptive "
         "relaxation's include its spectrum estimate). "
-     << study.cases.size() << " cases in " << Duration(study.wall_time_s) << " on "
-     << study.threads << " threads.\n\n";
+     << study.cases.size() << " cases in " << Duration(study.wall_time_s) << " on " << study.threads
+     << " threads.\n\n";
   return md.str();
 }
 
@@ -886,9 +890,10 @@ CostCurveStudy RunCostCurveStudy(const Config& config) {
   }
   const MeasurementSet truth = SimulateStudyTruth(config);
   const BarModel model(config.model);
-  StudyProgressLogger()->info("cost curves: {} curves of {} points, each with an identification, "
-                              "on {} threads",
-                              study.curves.size(), options.cost_curve_points, study.threads);
+  StudyProgressLogger()->info(
+      "cost curves: {} curves of {} points, each with an identification, "
+      "on {} threads",
+      study.curves.size(), options.cost_curve_points, study.threads);
   Progress progress("cost curves", static_cast<int>(study.curves.size()));
   ParallelFor(
       static_cast<int>(study.curves.size()), study.threads,
@@ -896,8 +901,8 @@ CostCurveStudy RunCostCurveStudy(const Config& config) {
         CostCurveRun& curve = study.curves[i];
         const MeasurementSet measured = NoisyMeasurements(truth, curve.snr, curve.seed);
         std::string message;
-        const IdentificationRun identification =
-            IdentifyOnOneThread(config, measured, curve.snr, curve.seed, &curve.converged, &message);
+        const IdentificationRun identification = IdentifyOnOneThread(
+            config, measured, curve.snr, curve.seed, &curve.converged, &message);
         if (curve.converged) {
           curve.identified_modulus = identification.identified_modulus();
           curve.identified_cost = identification.cost();
@@ -909,9 +914,9 @@ CostCurveStudy RunCostCurveStudy(const Config& config) {
         McreObjective objective(model, identification.data, config.mcre, config.time.theta,
                                 config.inner, study.reference_modulus);
         for (int k = 0; k < options.cost_curve_points; ++k) {
-          const double factor = options.cost_curve_low + (options.cost_curve_high -
-                                                          options.cost_curve_low) *
-                                                             k / (options.cost_curve_points - 1.0);
+          const double factor =
+              options.cost_curve_low + (options.cost_curve_high - options.cost_curve_low) * k /
+                                           (options.cost_curve_points - 1.0);
           const ObjectiveEvaluation& evaluation =
               objective.EvaluateModulus(factor * study.reference_modulus, false);
           curve.moduli.push_back(factor * study.reference_modulus);
@@ -979,8 +984,8 @@ std::string CostCurvesScript(const CostCurveStudy& study, const std::string& fol
       const std::string colour = Colour(colour_index++);
       std::ostringstream line, point;
       line << curves << " skip 1 using ($1 == " << i << " ? $5 : 1/0):6 with lines lw 2 lc rgb '"
-           << colour << "' title '" << (std::isinf(snr) ? std::string("no noise")
-                                                        : "seed " + std::to_string(curve.seed))
+           << colour << "' title '"
+           << (std::isinf(snr) ? std::string("no noise") : "seed " + std::to_string(curve.seed))
            << "'";
       point << minima << " skip 1 using ($1 == " << i << " && $4 == 1 ? $6 : 1/0):8 with points "
             << "pt 6 ps 2 lw 2 lc rgb '" << colour << "' notitle";
@@ -1011,7 +1016,8 @@ std::string CostCurvesSummary(const CostCurveStudy& study) {
                            : std::string("not converged"))
        << " | " << Percent(curve.relative_error) << " | " << LocalMinima(curve.costs) << " |\n";
   }
-  md << "\n" << study.curves.size() << " curves in " << Duration(study.wall_time_s) << " on "
+  md << "\n"
+     << study.curves.size() << " curves in " << Duration(study.wall_time_s) << " on "
      << study.threads << " threads.\n\n";
   return md.str();
 }
@@ -1020,10 +1026,9 @@ std::string CostCurvesSummary(const CostCurveStudy& study) {
 
 std::vector<std::string> WriteCostCurveResults(const CostCurveStudy& study,
                                                const std::string& folder, bool figures) {
-  return WriteStudyFolder(folder,
-                          {{"curves.csv", CurvesCsv(study)}, {"minima.csv", MinimaCsv(study)}},
-                          {{"cost_curves", CostCurvesScript(study, folder)}}, figures,
-                          CostCurvesSummary(study));
+  return WriteStudyFolder(
+      folder, {{"curves.csv", CurvesCsv(study)}, {"minima.csv", MinimaCsv(study)}},
+      {{"cost_curves", CostCurvesScript(study, folder)}}, figures, CostCurvesSummary(study));
 }
 
 std::string WriteStudiesReadme(const std::string& folder) {

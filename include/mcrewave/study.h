@@ -117,11 +117,11 @@ struct RobustnessRun {
   bool converged = false;
   std::string message;  // why not, when not converged
   double identified_modulus = std::numeric_limits<double>::quiet_NaN();  // [Pa]
-  double relative_error = std::numeric_limits<double>::quiet_NaN();  // (E* - E_ref) / E_ref
+  double relative_error = std::numeric_limits<double>::quiet_NaN();      // (E* - E_ref) / E_ref
   int evaluations = 0;       // outer evaluations, scan included
   int scan_evaluations = 0;  // of which in the global scan
-  long sweeps = 0;           // inner sweeps of the local refinements (the scan's copies not counted)
-  int local_minima = 0;      // sampled local minima of the scan
+  long sweeps = 0;       // inner sweeps of the local refinements (the scan's copies not counted)
+  int local_minima = 0;  // sampled local minima of the scan
 };
 
 struct RobustnessStatistics {
@@ -139,8 +139,8 @@ struct RobustnessStatistics {
 };
 
 struct RobustnessStudy {
-  double reference_modulus = 0.0;  // E_ref [Pa]
-  std::vector<RobustnessRun> runs;  // SNR by SNR, seeds ascending
+  double reference_modulus = 0.0;                // E_ref [Pa]
+  std::vector<RobustnessRun> runs;               // SNR by SNR, seeds ascending
   std::vector<RobustnessStatistics> statistics;  // one per SNR, in robustness_snr order
   int threads = 0;
   double wall_time_s = 0.0;
@@ -194,9 +194,9 @@ struct ResidualHistory {
 };
 
 struct RelaxationStudy {
-  double tolerance = 0.0;  // of the grid's solves
-  std::vector<RelaxationCase> cases;  // SNR by SNR, moduli in the config's order
-  std::vector<RelaxationPoint> points;  // case by case, omega ascending
+  double tolerance = 0.0;                  // of the grid's solves
+  std::vector<RelaxationCase> cases;       // SNR by SNR, moduli in the config's order
+  std::vector<RelaxationPoint> points;     // case by case, omega ascending
   std::vector<ResidualHistory> histories;  // case by case: fixed, adaptive, CG
   int threads = 0;
   double wall_time_s = 0.0;
@@ -210,7 +210,7 @@ RelaxationStudy RunRelaxationStudy(const Config& config);
 
 struct CostCurveRun {
   double snr = 0.0;
-  std::uint64_t seed = 0;  // 0 at SNR inf
+  std::uint64_t seed = 0;      // 0 at SNR inf
   std::vector<double> moduli;  // [Pa], ascending
   std::vector<double> costs;   // e^2 [J s] (NaN where the coupled solve is not usable)
   bool converged = false;      // of the identification on the same data
