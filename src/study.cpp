@@ -218,6 +218,13 @@ int LocalMinima(const std::vector<double>& values) {
   return minima;
 }
 
+// "plot a, b, c\n": one gnuplot plot command of the given plot elements.
+std::string PlotCommand(const std::vector<std::string>& plots) {
+  std::string command = "plot ";
+  for (std::size_t i = 0; i < plots.size(); ++i) command += (i == 0 ? "" : ", ") + plots[i];
+  return command + "\n";
+}
+
 // Gnuplot colours of the curves, by index.
 std::string Colour(int index) {
   static const char* const colours[] = {"#1f4e9c", "#d62728", "#2ca02c", "#ff7f0e",
@@ -754,9 +761,7 @@ std::string SweepsScript(const RelaxationStudy& study, const std::string& folder
       plots.push_back(measured.str());
       plots.push_back(predicted.str());
     }
-    script << "plot ";
-    for (std::size_t i = 0; i < plots.size(); ++i) script << (i == 0 ? "" : ", ") << plots[i];
-    script << "\n";
+    script << PlotCommand(plots);
   }
   script << "unset multiplot\n";
   return script.str();
@@ -811,9 +816,7 @@ std::string ResidualsScript(const RelaxationStudy& study, const std::string& fol
            << Colour(colour_index++) << "' title '" << title << "'";
       plots.push_back(plot.str());
     }
-    script << "plot ";
-    for (std::size_t i = 0; i < plots.size(); ++i) script << (i == 0 ? "" : ", ") << plots[i];
-    script << "\n";
+    script << PlotCommand(plots);
   }
   script << "unset multiplot\n";
   return script.str();
@@ -992,9 +995,7 @@ std::string CostCurvesScript(const CostCurveStudy& study, const std::string& fol
       plots.push_back(line.str());
       plots.push_back(point.str());
     }
-    script << "plot ";
-    for (std::size_t i = 0; i < plots.size(); ++i) script << (i == 0 ? "" : ", ") << plots[i];
-    script << "\n";
+    script << PlotCommand(plots);
   }
   script << "unset multiplot\n";
   return script.str();
