@@ -36,6 +36,7 @@
 #include "mcrewave/objective.h"
 #include "mcrewave/prefilter.h"
 #include "mcrewave/simulation.h"
+#include "mcrewave/study.h"
 
 namespace {
 
@@ -81,15 +82,6 @@ Outcome IdentifyOnce(const mcrewave::BarModel& model, const mcrewave::Measuremen
   outcome.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return outcome;
-}
-
-// The q-quantile of values (linear interpolation between order statistics).
-double Quantile(std::vector<double> values, double q) {
-  std::sort(values.begin(), values.end());
-  const double position = q * (values.size() - 1.0);
-  const std::size_t below = static_cast<std::size_t>(std::floor(position));
-  const std::size_t above = std::min(below + 1, values.size() - 1);
-  return values[below] + (position - below) * (values[above] - values[below]);
 }
 
 }  // namespace
@@ -201,8 +193,8 @@ int main(int argc, char** argv) {
       }
       double mean = 0.0;
       for (const double e : errors) mean += e / errors.size();
-      const double low = errors.empty() ? NAN : Quantile(errors, 0.025);
-      const double high = errors.empty() ? NAN : Quantile(errors, 0.975);
+      const double low = errors.empty() ? NAN : mcrewave::Quantile(errors, 0.025);
+      const double high = errors.empty() ? NAN : mcrewave::Quantile(errors, 0.975);
       const double share = static_cast<double>(within) / count;
       table << settings[s].name << "," << snrs[k] << "," << count << "," << bias << "," << mean
             << "," << low << "," << high << "," << share << "," << minima / count << ","

@@ -11,6 +11,8 @@
 //   identify simulate configs/paper_bar.yaml --output measurements.csv
 //   identify simulate configs/paper_bar.yaml --set data.snr=.inf --output clean.csv
 //   identify simulate configs/paper_bar.yaml --set model.elements=400 --output fine.csv
+//   identify study configs/studies.yaml --output results
+//   identify study configs/studies.yaml --set study.kind=robustness --set study.robustness_seeds=10
 //   identify --print-default-config > my_config.yaml
 //
 // Description:
@@ -30,6 +32,13 @@
 //   half-sine load at x = L on the truth discretisation of `data:`, samples the
 //   four channels (u0, uL, f0, fL) on the model's time grid, adds white noise at
 //   the configured SNR and writes the measurement CSV (t,u0,uL,f0,fL).
+//
+//   `study` reads a YAML config and runs the studies of its `study:` section
+//   (include/mcrewave/study.h): robustness over SNR and noise seeds, the
+//   relaxation coefficient, cost curves; each into a subfolder of the output
+//   folder (CSV files, PNG figures, summary.md), then a README.md gathering the
+//   summaries. Runs spread over study.threads threads; one progress line per
+//   completed run with the time left (-v: the identifications' own lines too).
 //
 // Exit code 0 on success (for `run`: a converged identification); otherwise one
 // line on stderr saying why and exit code 2 for bad input (config, CSV, options,
@@ -56,6 +65,7 @@
 #include "mcrewave/noise.h"
 #include "mcrewave/results.h"
 #include "mcrewave/simulation.h"
+#include "mcrewave/study.h"
 #include "mcrewave/version.h"
 
 namespace {
@@ -64,6 +74,12 @@ struct SimulateArguments {
   std::string config_path;
   std::vector<std::string> overrides;
   std::string output_path;
+};
+
+struct StudyArguments {
+  std::string config_path;
+  std::vector<std::string> overrides;
+  std::string output_folder;  // "" = study.folder of the config
 };
 
 struct RunArguments {
@@ -79,6 +95,12 @@ struct Verbosity {
   void Apply() const {
     spdlog::set_level(verbose ? spdlog::level::debug
                               : (quiet ? spdlog::level::warn : spdlog::level::info));
+  }
+  // For `study`: the progress lines at info (warn with -q); the many
+  // identifications' own lines only with -v.
+  void ApplyToStudy() const {
+    spdlog::set_level(verbose ? spdlog::level::info : spdlog::level::warn);
+    mcrewave::StudyProgressLogger()->set_level(quiet ? spdlog::level::warn : spdlog::level::info);
   }
 };
 
@@ -140,26 +162,6 @@ void CheckOutputFolder(const std::string& folder) {
   }
 }
 
-// Why `modulus` cannot be reported: it lies on a bound of the search (within
-// kOnBoundTolerance relative), where e^2 has no minimum but only its least value
-// inside the bounds; "" when it lies inside.
-constexpr double kOnBoundTolerance = 1e-6;
-std::string OnBoundMessage(double modulus, const mcrewave::IdentificationOptions& outer) {
-  const std::pair<double, const char*> bounds[] = {{outer.lower_bound, "outer.lower_bound"},
-                                                   {outer.upper_bound, "outer.upper_bound"}};
-  for (const auto& [bound, key] : bounds) {
-    if (std::abs(modulus - bound) <= kOnBoundTolerance * bound) {
-      char message[512];
-      std::snprintf(message, sizeof(message),
-                    "E = %.6g Pa lies on %s (%.6g Pa): e^2 has no minimum inside the bounds; "
-                    "widen them, or check the units of the data (SI: m and N)",
-                    modulus, key, bound);
-      return message;
-    }
-  }
-  return "";
-}
-
 int RunIdentify(const RunArguments& arguments) {
   // 1. Read and validate the config and the output folder (nothing is computed
   //    or written if either is invalid).
@@ -185,7 +187,8 @@ int RunIdentify(const RunArguments& arguments) {
     std::fprintf(stderr, "error: identification failed: %s\n", run.outer.message.c_str());
     return 1;
   }
-  const std::string on_bound = OnBoundMessage(run.identified_modulus(), config.outer);
+  const std::string on_bound =
+      mcrewave::ModulusOnBoundMessage(run.identified_modulus(), config.outer);
   if (!on_bound.empty()) {
     std::fprintf(stderr, "error: identification failed: %s\n", on_bound.c_str());
     return 1;
@@ -241,6 +244,48 @@ int RunSimulate(const SimulateArguments& arguments) {
   return 0;
 }
 
+int RunStudy(const StudyArguments& arguments) {
+  // 1. Read and validate the config and the output folder.
+  mcrewave::Config config = mcrewave::LoadConfig(arguments.config_path, arguments.overrides);
+  if (!arguments.output_folder.empty()) config.study.folder = arguments.output_folder;
+  if (config.data.source != mcrewave::DataSource::kSynthetic) {
+    throw mcrewave::InputError(arguments.config_path +
+                               ": data.source: the studies need synthetic data, got 'csv'");
+  }
+  CheckOutputFolder(config.study.folder);
+  const std::string& folder = config.study.folder;
+  const bool figures = config.study.figures;
+  const mcrewave::StudyKind kind = config.study.kind;
+  mcrewave::StudyProgressLogger()->info(
+      "config {}: {} elements, {} steps of {:.4g} s; study {} into {}", arguments.config_path,
+      config.model.elements, config.time.NumSteps(), config.time.step,
+      mcrewave::StudyKindToString(kind), folder);
+
+  // 2. Each selected study: compute, then write its folder.
+  if (mcrewave::StudySelected(kind, mcrewave::StudyKind::kRobustness)) {
+    const mcrewave::RobustnessStudy study = mcrewave::RunRobustnessStudy(config);
+    const ResultsBeingWritten held;
+    mcrewave::WriteRobustnessResults(study, folder + "/robustness", figures);
+  }
+  if (mcrewave::StudySelected(kind, mcrewave::StudyKind::kRelaxation)) {
+    const mcrewave::RelaxationStudy study = mcrewave::RunRelaxationStudy(config);
+    const ResultsBeingWritten held;
+    mcrewave::WriteRelaxationResults(study, folder + "/relaxation", figures);
+  }
+  if (mcrewave::StudySelected(kind, mcrewave::StudyKind::kCostCurves)) {
+    const mcrewave::CostCurveStudy study = mcrewave::RunCostCurveStudy(config);
+    const ResultsBeingWritten held;
+    mcrewave::WriteCostCurveResults(study, folder + "/cost_curves", figures);
+  }
+
+  // 3. The README gathering the studies' summaries.
+  {
+    const ResultsBeingWritten held;
+    mcrewave::StudyProgressLogger()->info("wrote {}", mcrewave::WriteStudiesReadme(folder));
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -279,6 +324,20 @@ int main(int argc, char** argv) {
   simulate_command->add_flag("-q,--quiet", simulate_verbosity.quiet, "Log warnings and errors only")
       ->excludes(simulate_verbose);
 
+  StudyArguments study;
+  Verbosity study_verbosity;
+  CLI::App* study_command = app.add_subcommand(
+      "study", "Run the studies of the config's study: section; write CSV files and figures");
+  study_command->add_option("config", study.config_path, "YAML config file")->required();
+  study_command->add_option("--set", study.overrides,
+                            "Override a config key: --set key.path=value (repeatable)");
+  study_command->add_option("-o,--output", study.output_folder,
+                            "Results folder (replaces study.folder of the config)");
+  CLI::Option* study_verbose = study_command->add_flag(
+      "-v,--verbose", study_verbosity.verbose, "Log the identifications' own lines too");
+  study_command->add_flag("-q,--quiet", study_verbosity.quiet, "Log warnings and errors only")
+      ->excludes(study_verbose);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
@@ -294,6 +353,10 @@ int main(int argc, char** argv) {
     if (run_command->parsed()) {
       run_verbosity.Apply();
       return RunIdentify(run);
+    }
+    if (study_command->parsed()) {
+      study_verbosity.ApplyToStudy();
+      return RunStudy(study);
     }
     if (simulate_command->parsed()) {
       simulate_verbosity.Apply();

@@ -166,6 +166,40 @@ ValueType<bool> Boolean() {
   return type;
 }
 
+// A YAML list of numbers ([.inf, 20, 2.5]); a single number is a list of one.
+// NaN is refused; ranges are checked by the sections' IsValid.
+ValueType<std::vector<double>> NumberList() {
+  ValueType<std::vector<double>> type;
+  type.expected = "a list of numbers, e.g. [.inf, 20, 2.5]";
+  type.read = [](const YAML::Node& node, std::vector<double>* value) {
+    const ValueType<double> number = Number();
+    std::vector<double> parsed;
+    if (node.IsScalar()) {
+      double single;
+      if (!number.read(node, &single)) return false;
+      parsed.push_back(single);
+    } else if (node.IsSequence()) {
+      for (const YAML::Node& element : node) {
+        double element_value;
+        if (!number.read(element, &element_value)) return false;
+        parsed.push_back(element_value);
+      }
+    } else {
+      return false;
+    }
+    *value = parsed;
+    return true;
+  };
+  type.write = [](const std::vector<double>& value) {
+    std::string text = "[";
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      text += (i == 0 ? "" : ", ") + FormatNumber(value[i]);
+    }
+    return text + "]";
+  };
+  return type;
+}
+
 // An enum written by name, with the to/from-string pair of types.h; `values`
 // lists every value (for the messages and the commented config).
 template <typename Enum>
@@ -396,6 +430,44 @@ const std::vector<Key>& KeyTable() {
               "also draw the PNG figures with gnuplot"),
       MakeKey("output.curve_points", &Config::output, &OutputOptions::curve_points,
               PositiveInteger<int>(), "", "points of the cost curve e^2(E), in [5, 1000]"),
+      MakeKey("study.kind", &Config::study, &StudyOptions::kind,
+              EnumByName<StudyKind>({StudyKind::kRobustness, StudyKind::kRelaxation,
+                                     StudyKind::kCostCurves, StudyKind::kAll},
+                                    StudyKindToString, StringToStudyKind),
+              "", "which study `identify study` runs (study.h)"),
+      MakeKey("study.folder", &Config::study, &StudyOptions::folder, Text(), "",
+              "results folder of identify study (a subfolder per study), relative to the "
+              "working directory"),
+      MakeKey("study.threads", &Config::study, &StudyOptions::threads, NonNegativeInteger(), "",
+              "threads running the studies' runs, in [0, 256]; 0: every core"),
+      MakeKey("study.figures", &Config::study, &StudyOptions::figures, Boolean(), "",
+              "also draw the studies' PNG figures with gnuplot"),
+      MakeKey("study.robustness_snr", &Config::study, &StudyOptions::robustness_snr,
+              NumberList(), "", "robustness: SNRs of the noise (.inf: none), each > 0"),
+      MakeKey("study.robustness_seeds", &Config::study, &StudyOptions::robustness_seeds,
+              PositiveInteger<int>(), "", "robustness: noise seeds 1..N per finite SNR"),
+      MakeKey("study.relaxation_snr", &Config::study, &StudyOptions::relaxation_snr, NumberList(),
+              "", "relaxation: SNRs of the data (noise seed data.seed)"),
+      MakeKey("study.relaxation_moduli", &Config::study, &StudyOptions::relaxation_moduli,
+              NumberList(), "", "relaxation: trial moduli E / model.modulus, in (0, 10]"),
+      MakeKey("study.omega_min", &Config::study, &StudyOptions::omega_min, Number(), "",
+              "relaxation: least omega of the grid, > 0"),
+      MakeKey("study.omega_max", &Config::study, &StudyOptions::omega_max, Number(), "",
+              "relaxation: largest omega of the grid, < 2"),
+      MakeKey("study.omega_points", &Config::study, &StudyOptions::omega_points,
+              PositiveInteger<int>(), "", "relaxation: omegas of the grid, in [2, 1000]"),
+      MakeKey("study.relaxation_tolerance", &Config::study, &StudyOptions::relaxation_tolerance,
+              Number(), "", "relaxation: relative residual the grid's solves reach, in (0, 1)"),
+      MakeKey("study.cost_curve_snr", &Config::study, &StudyOptions::cost_curve_snr, NumberList(),
+              "", "cost curves: SNRs of the data"),
+      MakeKey("study.cost_curve_seeds", &Config::study, &StudyOptions::cost_curve_seeds,
+              PositiveInteger<int>(), "", "cost curves: noise seeds 1..N per finite SNR"),
+      MakeKey("study.cost_curve_points", &Config::study, &StudyOptions::cost_curve_points,
+              PositiveInteger<int>(), "", "cost curves: moduli of each curve, in [3, 10000]"),
+      MakeKey("study.cost_curve_low", &Config::study, &StudyOptions::cost_curve_low, Number(), "",
+              "cost curves: least E / model.modulus, > 0"),
+      MakeKey("study.cost_curve_high", &Config::study, &StudyOptions::cost_curve_high, Number(),
+              "", "cost curves: largest E / model.modulus"),
   };
   return table;
 }
@@ -418,6 +490,7 @@ const std::vector<SectionValidator>& SectionValidators() {
       ValidatorOf(&Config::data),  ValidatorOf(&Config::mcre),        ValidatorOf(&Config::inner),
       ValidatorOf(&Config::outer), ValidatorOf(&Config::prefilter),
       ValidatorOf(&Config::uncertainty), ValidatorOf(&Config::output),
+      ValidatorOf(&Config::study),
   };
   return validators;
 }

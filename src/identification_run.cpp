@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <utility>
 #include <sstream>
 
 #include "mcrewave/noise.h"
@@ -109,7 +111,7 @@ MeasurementSet LoadMeasurements(const Config& config) {
   return data;
 }
 
-IdentificationRun RunIdentification(const Config& config, const MeasurementSet& data) {
+IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& data) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   IdentificationRun run;
@@ -122,7 +124,6 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
                  config.prefilter.cutoff_frequency > 0.0 ? "" : " (derived from the load)");
   }
 
-  // The outer loop.
   const BarModel model(config.model);
   McreObjective objective(model, run.data, config.mcre, config.time.theta, config.inner,
                           config.outer.initial);
@@ -139,12 +140,20 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
   run.evaluations = objective.evaluations();
   run.sweeps = objective.total_sweeps();
   spdlog::info("{}", run.outer.BriefReport());
-  if (!run.IsUsable()) {
-    run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
-    return run;
+  if (run.IsUsable()) {
+    run.best_index = objective.best_index();
+    run.solution = objective.best_solution();
   }
-  run.best_index = objective.best_index();
-  run.solution = objective.best_solution();
+  run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return run;
+}
+
+IdentificationRun RunIdentification(const Config& config, const MeasurementSet& data) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  IdentificationRun run = IdentifyModulus(config, data);
+  if (!run.IsUsable()) return run;
+  const BarModel model(config.model);
 
   // The cost curve around E*.
   run.cost_curve = ComputeCostCurve(config, model, run.data, run, &run.cost_curve_sweeps);
@@ -178,6 +187,22 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
   }
   run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return run;
+}
+
+std::string ModulusOnBoundMessage(double modulus, const IdentificationOptions& outer) {
+  const std::pair<double, const char*> bounds[] = {{outer.lower_bound, "outer.lower_bound"},
+                                                   {outer.upper_bound, "outer.upper_bound"}};
+  for (const auto& [bound, key] : bounds) {
+    if (std::abs(modulus - bound) <= kOnBoundTolerance * bound) {
+      char message[512];
+      std::snprintf(message, sizeof(message),
+                    "E = %.6g Pa lies on %s (%.6g Pa): e^2 has no minimum inside the bounds; "
+                    "widen them, or check the units of the data (SI: m and N)",
+                    modulus, key, bound);
+      return message;
+    }
+  }
+  return "";
 }
 
 }  // namespace mcrewave

@@ -1,19 +1,13 @@
 #include "mcrewave/results.h"
 
-#include <fcntl.h>
-#include <spawn.h>
 #include <spdlog/spdlog.h>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -21,8 +15,6 @@
 
 #include "mcrewave/file_util.h"
 #include "mcrewave/version.h"
-
-extern char** environ;
 
 namespace mcrewave {
 namespace {
@@ -172,25 +164,13 @@ std::string InnerResidualCsv(const IdentificationRun& run) {
 // ---------------------------------------------------------------------------
 // Figures.
 
-// A gnuplot single-quoted string ('' stands for one quote).
-std::string GnuplotString(const std::string& text) {
-  std::string quoted = "'";
-  for (char c : text) quoted += c == '\'' ? std::string("''") : std::string(1, c);
-  return quoted + "'";
-}
-
-std::string PngTerminal() {
-  return "set terminal pngcairo size 1000,700 enhanced font 'sans,11'\nset datafile separator ','\n"
-         "set key top right\nset grid\n";
-}
-
 std::string CostCurveScript(const IdentificationRun& run, const std::string& folder) {
   const double identified = run.identified_modulus() / 1e9;
   const std::string curve = GnuplotString(folder + "/cost_curve.csv");
   const std::string evaluations = GnuplotString(folder + "/evaluations.csv");
   std::ostringstream script;
   script
-      << PngTerminal() << "set terminal pngcairo size 1000,1000\n"
+      << GnuplotPngTerminal() << "set terminal pngcairo size 1000,1000\n"
       << "set multiplot layout 2,1 title 'MCRE cost curve e^2(E); identified E = " << identified
       << " GPa (dashed)'\n"
       << "set xlabel 'E [GPa]'\nset ylabel 'e^2 [J s]'\nset format y '%.5g'\nset key top center\n"
@@ -220,7 +200,7 @@ std::string CostCurveScript(const IdentificationRun& run, const std::string& fol
 std::string EndsScript(const std::string& folder) {
   const std::string csv = GnuplotString(folder + "/ends.csv");
   std::ostringstream script;
-  script << PngTerminal() << "set terminal pngcairo size 1200,900\nset multiplot layout 2,2 "
+  script << GnuplotPngTerminal() << "set terminal pngcairo size 1200,900\nset multiplot layout 2,2 "
          << "title 'Measured and model end quantities at the identified modulus'\n"
          << "set xlabel 't [ms]'\n";
   struct Panel {
@@ -246,7 +226,7 @@ std::string EndsScript(const std::string& folder) {
 
 std::string InnerResidualScript(const IdentificationRun& run, const std::string& folder) {
   std::ostringstream script;
-  script << PngTerminal()
+  script << GnuplotPngTerminal()
          << "set title 'Inner solver: relative residual ||c - A W||_P / ||c||_P at the "
             "identified modulus'\n"
             "set xlabel 'iteration (sweep pair)'\nset ylabel 'relative residual'\n"
@@ -256,62 +236,6 @@ std::string InnerResidualScript(const IdentificationRun& run, const std::string&
          << run.config.inner.tolerance << " with lines dashtype 2 lc rgb '#555555' "
          << "title 'inner.tolerance'\n";
   return script.str();
-}
-
-// Runs gnuplot on `script` (which must draw to `temporary_png`); its output goes
-// to `log_path`. Returns "" on success, else why it failed; sets
-// *gnuplot_missing when gnuplot is not on the PATH.
-std::string RunGnuplot(const std::string& script_path, const std::string& log_path,
-                       bool* gnuplot_missing) {
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  std::string program = "gnuplot";
-  std::vector<char*> arguments{program.data(), const_cast<char*>(script_path.c_str()), nullptr};
-  pid_t pid = 0;
-  const int spawn_error =
-      posix_spawnp(&pid, "gnuplot", &actions, nullptr, arguments.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (spawn_error != 0) {
-    *gnuplot_missing = spawn_error == ENOENT;
-    return std::string("cannot run gnuplot: ") + std::strerror(spawn_error);
-  }
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) return std::string("waiting for gnuplot: ") + std::strerror(errno);
-  }
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return "";
-  std::ifstream log(log_path);
-  std::string first_line;
-  std::getline(log, first_line);
-  return "gnuplot failed" + (first_line.empty() ? std::string() : ": " + first_line);
-}
-
-// Draws one figure to folder/name.png through a temporary PNG renamed at the
-// end. Returns "" on success, else why not.
-std::string DrawFigure(const std::string& folder, const std::string& name,
-                       const std::string& script_body, bool* gnuplot_missing) {
-  const std::string suffix = ".tmp." + std::to_string(::getpid());
-  const std::string png = folder + "/" + name + ".png";
-  const std::string temporary_png = png + suffix;
-  const std::string script_path = folder + "/" + name + ".gp" + suffix;
-  const std::string log_path = folder + "/" + name + ".log" + suffix;
-  {
-    std::ofstream script(script_path);
-    script << "set output " << GnuplotString(temporary_png) << "\n" << script_body;
-    if (!script) return "cannot write " + script_path;
-  }
-  std::string why = RunGnuplot(script_path, log_path, gnuplot_missing);
-  if (why.empty() && std::rename(temporary_png.c_str(), png.c_str()) != 0) {
-    why = "cannot write " + png + ": " + std::strerror(errno);
-  }
-  std::remove(script_path.c_str());
-  std::remove(log_path.c_str());
-  std::remove(temporary_png.c_str());
-  return why;
 }
 
 }  // namespace
@@ -466,7 +390,7 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
       drawings.emplace_back("inner_residual", InnerResidualScript(run, folder));
     }
     for (const auto& [name, script] : drawings) {
-      const std::string why = DrawFigure(folder, name, script, &gnuplot_missing);
+      const std::string why = DrawGnuplotFigure(folder, name, script, &gnuplot_missing);
       if (gnuplot_missing) {
         spdlog::warn("gnuplot not found on the PATH: figures skipped (the CSV files are written)");
         break;

@@ -72,6 +72,23 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.output.folder, actual.output.folder);
   EXPECT_EQ(expected.output.figures, actual.output.figures);
   EXPECT_EQ(expected.output.curve_points, actual.output.curve_points);
+  EXPECT_EQ(expected.study.kind, actual.study.kind);
+  EXPECT_EQ(expected.study.folder, actual.study.folder);
+  EXPECT_EQ(expected.study.threads, actual.study.threads);
+  EXPECT_EQ(expected.study.figures, actual.study.figures);
+  EXPECT_EQ(expected.study.robustness_snr, actual.study.robustness_snr);
+  EXPECT_EQ(expected.study.robustness_seeds, actual.study.robustness_seeds);
+  EXPECT_EQ(expected.study.relaxation_snr, actual.study.relaxation_snr);
+  EXPECT_EQ(expected.study.relaxation_moduli, actual.study.relaxation_moduli);
+  EXPECT_EQ(expected.study.omega_min, actual.study.omega_min);
+  EXPECT_EQ(expected.study.omega_max, actual.study.omega_max);
+  EXPECT_EQ(expected.study.omega_points, actual.study.omega_points);
+  EXPECT_EQ(expected.study.relaxation_tolerance, actual.study.relaxation_tolerance);
+  EXPECT_EQ(expected.study.cost_curve_snr, actual.study.cost_curve_snr);
+  EXPECT_EQ(expected.study.cost_curve_seeds, actual.study.cost_curve_seeds);
+  EXPECT_EQ(expected.study.cost_curve_points, actual.study.cost_curve_points);
+  EXPECT_EQ(expected.study.cost_curve_low, actual.study.cost_curve_low);
+  EXPECT_EQ(expected.study.cost_curve_high, actual.study.cost_curve_high);
 }
 
 // Runs `action`, which must throw InputError whose message contains every one of
@@ -230,6 +247,11 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   config.output.folder = "out dir/run #1";
   config.output.figures = false;
   config.output.curve_points = 7;
+  config.study.kind = StudyKind::kCostCurves;
+  config.study.threads = 3;
+  config.study.robustness_snr = {std::numeric_limits<double>::infinity(), 1.0 / 3.0, 2.5};
+  config.study.relaxation_moduli = {0.1 + 0.2};
+  config.study.cost_curve_high = 1.0 / 7.0 + 1.0;
   const std::string yaml = ConfigToYaml(config);
   ExpectSameConfig(config, ParseConfig(yaml, "resolved.yaml"));
   EXPECT_NE(yaml.find("mass: lumped"), std::string::npos) << yaml;
@@ -237,6 +259,8 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   EXPECT_NE(yaml.find("method: adaptive_relaxation"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("optimizer: ceres"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("figures: false"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("kind: cost_curves"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("robustness_snr: [.inf, "), std::string::npos) << yaml;
 
   config.data.snr = std::numeric_limits<double>::infinity();
   const std::string infinite_snr = ConfigToYaml(config);
@@ -454,7 +478,7 @@ TEST_F(ConfigFileTest, SectionThatIsNotAMap) {
 TEST_F(ConfigFileTest, TopLevelThatIsNotAMap) {
   ExpectLoadError("- model\n- load\n", 1,
                   {"expected a map of sections (model, load, time, data, mcre, inner, outer, "
-                   "prefilter, uncertainty, output)",
+                   "prefilter, uncertainty, output, study)",
                    "got a list"});
 }
 

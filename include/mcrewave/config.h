@@ -34,6 +34,14 @@
 //          before the identification)
 //   uncertainty: samples [16], seed [1] (modulus_uncertainty.h)
 //   output: folder ["results/identify"], figures [true], curve_points [41]
+//   study: kind [all | robustness | relaxation | cost_curves], folder ["results"],
+//          threads [0: every core], figures [true], robustness_snr
+//          [[.inf, 20, 10, 5, 2.5]], robustness_seeds [100], relaxation_snr
+//          [[.inf, 10, 2.5]], relaxation_moduli [[0.8, 1, 1.2]], omega_min [0.005],
+//          omega_max [0.1], omega_points [20], relaxation_tolerance [1e-4],
+//          cost_curve_snr [[.inf, 10, 2.5]], cost_curve_seeds [3],
+//          cost_curve_points [41], cost_curve_low [0.8], cost_curve_high [1.2]
+//          (StudyOptions, study.h; used by `identify study` only)
 #pragma once
 
 #include <string>
@@ -46,6 +54,7 @@
 #include "mcrewave/modulus_uncertainty.h"
 #include "mcrewave/objective.h"
 #include "mcrewave/prefilter.h"
+#include "mcrewave/study.h"
 
 namespace mcrewave {
 
@@ -75,6 +84,7 @@ struct Config {
   PrefilterOptions prefilter;
   UncertaintyOptions uncertainty;
   OutputOptions output;
+  StudyOptions study;
 };
 
 // Reads a config file, applies the overrides ("key.path=value", each parsed as a

@@ -73,6 +73,17 @@ struct IdentificationRun {
   double cost() const { return best_index >= 0 ? evaluations[best_index].cost : -1.0; }
 };
 
+// Runs steps 2 and 3 on measurements made by LoadMeasurements(config): the
+// fields up to `solution` (and wall_time_s); no cost curve, no uncertainty.
+// Precondition: config valid. Never throws for a failed identification.
+IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& data);
+
+// Why `modulus` [Pa] cannot be reported as identified: it lies on a bound of
+// the search (within kOnBoundTolerance relative), where e^2 has no minimum but
+// only its least value inside the bounds; "" when it lies inside.
+constexpr double kOnBoundTolerance = 1e-6;
+std::string ModulusOnBoundMessage(double modulus, const IdentificationOptions& outer);
+
 // Runs steps 2 to 4 on measurements made by LoadMeasurements(config).
 // Precondition: config valid (as LoadConfig returns it). Never throws for a
 // failed identification: see IsUsable() and outer.message.

@@ -1,0 +1,126 @@
+// End-to-end tests of `identify study`: the binary run as a user runs it on a
+// tiny config (every study, 2 SNRs, 2 seeds), and on bad `study:` values.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "identify_binary.h"
+
+namespace mcrewave {
+namespace {
+
+using testing::FreshDirectory;
+using testing::ReadText;
+using testing::RunIdentify;
+using testing::RunResult;
+
+namespace fs = std::filesystem;
+
+// The paper's bar on 12 elements, 150 steps; every study at 2 SNRs, 2 seeds.
+constexpr const char* kTinyStudyConfig = R"(model: {elements: 12}
+time: {window: 0.45e-3, step: 3e-6}
+outer: {scan_points: 15, relative_tolerance: 1e-6}
+study:
+  threads: 2
+  robustness_snr: [.inf, 10]
+  robustness_seeds: 2
+  relaxation_snr: [.inf, 10]
+  relaxation_moduli: [1]
+  omega_min: 0.05
+  omega_max: 0.4
+  omega_points: 4
+  cost_curve_snr: [.inf, 10]
+  cost_curve_seeds: 2
+  cost_curve_points: 11
+  cost_curve_low: 0.9
+  cost_curve_high: 1.1
+)";
+
+std::string WriteConfig(const std::string& directory, const std::string& text) {
+  const std::string path = directory + "/study.yaml";
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(IdentifyStudyTest, EveryStudyWritesItsFilesFiguresAndTheReadme) {
+  const std::string directory = FreshDirectory("identify_study_all");
+  const std::string config = WriteConfig(directory, kTinyStudyConfig);
+  const std::string folder = directory + "/results";
+  const RunResult result = RunIdentify("study " + config + " --output " + folder);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  // Progress lines with the time left; the identifications' own lines hidden.
+  EXPECT_NE(result.output.find("robustness: 3 / 3 runs"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("left"), std::string::npos) << result.output;
+  EXPECT_EQ(result.output.find("evaluation 1:"), std::string::npos) << result.output;
+
+  for (const char* file :
+       {"robustness/runs.csv", "robustness/statistics.csv", "robustness/summary.md",
+        "relaxation/cases.csv", "relaxation/sweeps.csv", "relaxation/residuals.csv",
+        "relaxation/summary.md", "cost_curves/curves.csv", "cost_curves/minima.csv",
+        "cost_curves/summary.md", "README.md"}) {
+    EXPECT_TRUE(fs::exists(folder + "/" + file)) << file;
+  }
+  if (result.output.find("gnuplot not found") == std::string::npos) {
+    for (const char* figure : {"robustness/robustness.png", "relaxation/sweeps_vs_omega.png",
+                               "relaxation/residuals.png", "cost_curves/cost_curves.png"}) {
+      ASSERT_TRUE(fs::exists(folder + "/" + figure)) << figure;
+      EXPECT_GT(fs::file_size(folder + "/" + figure), 10000u) << figure;
+    }
+  }
+  const std::string readme = ReadText(folder + "/README.md");
+  for (const char* section : {"## Robustness", "## Relaxation coefficient", "## Cost curves"}) {
+    EXPECT_NE(readme.find(section), std::string::npos) << section;
+  }
+  EXPECT_NE(readme.find("| inf | 1 | 100 % |"), std::string::npos) << readme;
+  for (const auto& entry : fs::recursive_directory_iterator(folder)) {
+    EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+  }
+}
+
+TEST(IdentifyStudyTest, OneKindRunsThatStudyOnly) {
+  const std::string directory = FreshDirectory("identify_study_one");
+  const std::string config = WriteConfig(directory, kTinyStudyConfig);
+  const std::string folder = directory + "/results";
+  const RunResult result = RunIdentify("study " + config + " --set study.kind=cost_curves " +
+                                       "--set study.figures=false -q --output " + folder);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(result.output, "");
+  EXPECT_TRUE(fs::exists(folder + "/cost_curves/minima.csv"));
+  EXPECT_FALSE(fs::exists(folder + "/cost_curves/cost_curves.png"));
+  EXPECT_FALSE(fs::exists(folder + "/robustness"));
+  EXPECT_FALSE(fs::exists(folder + "/relaxation"));
+}
+
+TEST(IdentifyStudyTest, BadStudyValuesStopBeforeAnyComputation) {
+  const std::string directory = FreshDirectory("identify_study_bad");
+  std::string text = kTinyStudyConfig;
+  text.replace(text.find("omega_points: 4"), 15, "omega_points: 1");
+  const std::string config = WriteConfig(directory, text);
+  const std::string folder = directory + "/results";
+  RunResult result = RunIdentify("study " + config + " --output " + folder);
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find(config + ":12: study.omega_points must lie in [2, 1000], got 1"),
+            std::string::npos)
+      << result.output;
+  result = RunIdentify("study " + config + " --set study.omega_points=4 --set " +
+                       "'study.robustness_snr=[20, 0]' --output " + folder);
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("--set study.robustness_snr=[20, 0]: study.robustness_snr must "
+                               "hold SNRs > 0"),
+            std::string::npos)
+      << result.output;
+  result = RunIdentify("study " + config + " --set study.omega_points=4 --set study.kind=every " +
+                       "--output " + folder);
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(
+      result.output.find("--set study.kind=every: expected one of 'robustness', 'relaxation', "
+                         "'cost_curves', 'all', got 'every'"),
+      std::string::npos)
+      << result.output;
+  EXPECT_FALSE(fs::exists(folder));
+}
+
+}  // namespace
+}  // namespace mcrewave
