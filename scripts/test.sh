@@ -2,7 +2,7 @@
 # Set up, build, and run the whole test suite with ctest; then build it again
 # with AddressSanitizer + UndefinedBehaviorSanitizer (clang, into build-sanitize/
 # or $MCREWAVE_SANITIZE_BUILD_DIR), run it there, and fuzz both parsers for
-# $MCREWAVE_FUZZ_SECONDS (default 20) seconds each (fuzz/README.md).
+# $MCREWAVE_FUZZ_SECONDS (default 15) seconds each (fuzz/README.md).
 # The benchmarks are not built here (scripts/main.sh and the study scripts build
 # them). The sanitizer build is optimised at -O1 (faster to compile; its tests
 # check memory and undefined behaviour, the Release pass checks the numbers), and
@@ -23,4 +23,4 @@ cmake --build "$sanitize_dir" -j "$(nproc)"
 export ASAN_OPTIONS=exitcode=86
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1:exitcode=87
 ctest --test-dir "$sanitize_dir" --output-on-failure -j "$(nproc)" --label-exclude long
-bash "$root/scripts/fuzz.sh" "$sanitize_dir" "${MCREWAVE_FUZZ_SECONDS:-20}"
+bash "$root/scripts/fuzz.sh" "$sanitize_dir" "${MCREWAVE_FUZZ_SECONDS:-15}"

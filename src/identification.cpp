@@ -163,6 +163,7 @@ std::string IdentificationSummary::FullReport() const {
         << "  second minimum         " << second_modulus << " Pa\n"
         << "  scaled cost gap        " << cost_gap << "\n"
         << "  refinements            " << refinements << "\n"
+        << "  scan sweeps            " << scan_sweeps << "\n"
         << "  scan wall time         " << scan_wall_time_s << " s\n";
   }
   if (iterations >= 0) out << "  iterations             " << iterations << "\n";
@@ -304,9 +305,11 @@ double ScanCost(ModulusObjective* objective, double x, std::string* failure) {
 
 // The scaled costs at xs: block b of scan_threads contiguous blocks evaluated in
 // order by copy b of the objective on its own thread (or all on `objective`
-// when it offers no copy). *first_failure: why the lowest failed sample failed.
+// when it offers no copy). *first_failure: why the lowest failed sample failed;
+// *sweeps: the inner sweeps the scan ran.
 std::vector<double> ScanCosts(const IdentificationOptions& options, ModulusObjective* objective,
-                              const std::vector<double>& xs, std::string* first_failure) {
+                              const std::vector<double>& xs, std::string* first_failure,
+                              long* sweeps) {
   const int points = static_cast<int>(xs.size());
   std::vector<double> costs(xs.size(), std::numeric_limits<double>::quiet_NaN());
   std::vector<std::unique_ptr<ModulusObjective>> copies;
@@ -318,7 +321,9 @@ std::vector<double> ScanCosts(const IdentificationOptions& options, ModulusObjec
   }
   std::vector<std::string> failures(xs.size());
   if (static_cast<int>(copies.size()) < blocks) {
+    const long sweeps_before = objective->sweeps();
     for (int i = 0; i < points; ++i) costs[i] = ScanCost(objective, xs[i], &failures[i]);
+    *sweeps = objective->sweeps() - sweeps_before;
   } else {
   // Block b holds the points [b P / B, (b + 1) P / B).
     auto run_block = [&](int b) {
@@ -330,6 +335,8 @@ std::vector<double> ScanCosts(const IdentificationOptions& options, ModulusObjec
     for (int b = 1; b < blocks; ++b) threads.emplace_back(run_block, b);
     run_block(0);
     for (std::thread& thread : threads) thread.join();
+    *sweeps = 0;
+    for (const std::unique_ptr<ModulusObjective>& copy : copies) *sweeps += copy->sweeps();
   }
   for (const std::string& failure : failures) {
     if (!failure.empty()) {
@@ -383,7 +390,8 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
     xs[i] = x_lower * std::pow(x_upper / x_lower, i / (points - 1.0));
   }
   std::string scan_failure;
-  const std::vector<double> costs = ScanCosts(options, objective, xs, &scan_failure);
+  long scan_sweeps = 0;
+  const std::vector<double> costs = ScanCosts(options, objective, xs, &scan_failure, &scan_sweeps);
   const std::vector<int> minima = SampledMinima(costs);
   const double scan_wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -434,6 +442,7 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
   for (const double x : xs) summary.scan_moduli.push_back(x * scale);
   summary.scan_costs = costs;
   summary.scan_evaluations = points;
+  summary.scan_sweeps = scan_sweeps;
   summary.local_minima = static_cast<int>(minima.size());
   // The second valley: its refined cost when refined, else its sampled cost.
   if (minima.size() >= 2 && best >= 0) {

@@ -77,7 +77,7 @@ std::vector<CostCurvePoint> ComputeCostCurve(const Config& config, const BarMode
     }
     curve.push_back(point);
   }
-  *sweeps = objective.total_sweeps();
+  *sweeps = objective.sweeps();
   return curve;
 }
 
@@ -138,7 +138,7 @@ IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& da
       CoupledSolverTypeToString(config.inner.type));
   run.outer = Identify(config.outer, &objective);
   run.evaluations = objective.evaluations();
-  run.sweeps = objective.total_sweeps();
+  run.sweeps = objective.sweeps();
   spdlog::info("{}", run.outer.BriefReport());
   if (run.IsUsable()) {
     run.best_index = objective.best_index();

@@ -310,6 +310,7 @@ std::string SummaryYaml(const IdentificationRun& run) {
               "e^2 / cost_scale of the second-lowest minimum minus the lowest");
   yaml.Number(1, "cost_gap", outer.cost_gap * run.rest_cost, "[J s] the same gap of e^2");
   yaml.Integer(1, "refinements", outer.refinements, "local searches from the lowest minima");
+  yaml.Integer(1, "sweeps", outer.scan_sweeps, "direct + retrograde sweeps of the scan");
   yaml.Number(1, "wall_time_s", outer.scan_wall_time_s, "[s] of the scan");
 
   yaml.Line(0, "prefilter", "", "zero-phase low-pass of the measurements (prefilter.*)");
@@ -354,8 +355,9 @@ std::string SummaryYaml(const IdentificationRun& run) {
   yaml.Number(1, "highest_modulus", run.cost_curve.empty() ? NAN : run.cost_curve.back().modulus,
               "[Pa]");
   yaml.Integer(1, "sweeps", run.cost_curve_sweeps);
-  yaml.Integer(0, "total_sweeps", run.sweeps + run.cost_curve_sweeps + uncertainty.sweeps,
-               "optimiser, cost curve and uncertainty");
+  yaml.Integer(0, "total_sweeps",
+               run.outer.scan_sweeps + run.sweeps + run.cost_curve_sweeps + uncertainty.sweeps,
+               "scan, optimiser, cost curve and uncertainty");
 
   yaml.Line(0, "config", "", "as resolved (every key)");
   std::istringstream config(ConfigToYaml(run.config));

@@ -367,7 +367,7 @@ RobustnessStudy RunRobustnessStudy(const Config& config) {
         const IdentificationSummary& outer = identification.outer;
         run.evaluations = outer.evaluations + outer.scan_evaluations;
         run.scan_evaluations = outer.scan_evaluations;
-        run.sweeps = identification.sweeps;
+        run.sweeps = identification.sweeps + outer.scan_sweeps;
         run.local_minima = outer.local_minima;
         if (run.converged) {
           run.identified_modulus = identification.identified_modulus();
@@ -481,8 +481,7 @@ std::string RobustnessSummary(const RobustnessStudy& study) {
        << Brief(s.mean_evaluations, 4) << " | " << Brief(s.mean_sweeps, 5) << " |\n";
   }
   md << "\nEvaluations: outer evaluations of e^2 (the scan's included), means over all runs; "
-        "sweeps: inner sweeps of the local refinements (the scan runs on copies of the objective "
-        "whose sweeps are not counted).\n\n";
+        "sweeps: inner sweeps of the scan and the local refinements.\n\n";
   for (const RobustnessStatistics& s : study.statistics) {
     if (std::isinf(s.snr)) {
       md << "- SNR inf: error " << Percent(s.mean_error)

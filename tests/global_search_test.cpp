@@ -116,6 +116,9 @@ TEST(GlobalSearchTest, ScanResultsDoNotDependOnTheThreads) {
     const IdentificationSummary summary = Identify(options, &objective);
     ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
     moduli.push_back(summary.modulus);
+    // The scan runs on copies of the objective; their sweeps are counted, at
+    // least one retrograde and one direct sweep per scan point.
+    EXPECT_GE(summary.scan_sweeps, 2L * options.scan_points) << summary.FullReport();
   }
   EXPECT_NEAR(moduli[0] / moduli[1], 1.0, 1e-6);
 }

@@ -111,7 +111,7 @@ TEST_F(ObjectiveTest, KeepsTheBestEvaluationAndItsSolution) {
   EXPECT_EQ(objective.best_index(), 1);
   EXPECT_EQ(objective.best_solution().cost, objective.evaluations()[1].cost);
   EXPECT_EQ(objective.best_solution().displacement.cols(), data_.num_samples());
-  EXPECT_GT(objective.total_sweeps(), 0);
+  EXPECT_GT(objective.sweeps(), 0);
 }
 
 TEST_F(ObjectiveTest, NonPositiveParameterIsRefusedWithAMessage) {

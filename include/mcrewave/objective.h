@@ -52,6 +52,10 @@ class ModulusObjective {
     (void)inner_tolerance;
     return nullptr;
   }
+
+  // Inner sweeps (direct + retrograde) of every evaluation so far; 0 when the
+  // objective has no inner solver (the default).
+  virtual long sweeps() const { return 0; }
 };
 
 // The `mcre:` section of the config: the weights of the data terms and the
@@ -114,7 +118,7 @@ class McreObjective : public ModulusObjective {
   // The coupled solution of evaluations()[best_index()] (empty when none).
   const CoupledSolution& best_solution() const { return best_solution_; }
   // Sweeps (direct + retrograde) of every evaluation.
-  long total_sweeps() const { return problem_.sweep_count(); }
+  long sweeps() const override { return problem_.sweep_count(); }
 
   // The next evaluation starts its inner iteration from this retrograde field
   // (shape of problem().ZeroField()) instead of the last usable solutions; later
