@@ -76,8 +76,9 @@ class BandLdlt {
 // upward (UDU^T), and the two meet at row k:
 //
 //   top     d_0 = a_0,          l_i = s_i / d_{i-1},      d_i = a_i - l_i s_i,          i = 1..k-1
-//   bottom  e_{n-1} = a_{n-1},  m_i = s_{i+1} / e_{i+1},  e_i = a_i - m_i s_{i+1},      i = n-2..k+1
-//   middle  l_k = s_k / d_{k-1},  m_k = s_{k+1} / e_{k+1},  g_k = a_k - l_k s_k - m_k s_{k+1}.
+//   bottom  e_{n-1} = a_{n-1},  m_i = s_{i+1} / e_{i+1},  e_i = a_i - m_i s_{i+1},      i =
+//   n-2..k+1 middle  l_k = s_k / d_{k-1},  m_k = s_{k+1} / e_{k+1},  g_k = a_k - l_k s_k - m_k
+//   s_{k+1}.
 //
 // A solve runs the two eliminations and then the two back-substitutions side by
 // side: two independent recurrences of about n/2 steps each instead of the one

@@ -106,14 +106,14 @@ struct CoupledSolverSummary {
   CoupledSolverType type = CoupledSolverType::kConjugateGradient;
   TerminationType termination = TerminationType::kFailure;
   std::string message = "not run";
-  int iterations = -1;               // sweep pairs of the main iteration
-  long sweeps = -1;                  // every direct or retrograde sweep, estimation included
-  double relative_residual = -1.0;   // final ||c - A W||_P / ||c||_P
+  int iterations = -1;                   // sweep pairs of the main iteration
+  long sweeps = -1;                      // every direct or retrograde sweep, estimation included
+  double relative_residual = -1.0;       // final ||c - A W||_P / ||c||_P
   std::vector<double> residual_history;  // relative residual per iteration
   double relaxation_coefficient = -1.0;  // omega used by the relaxation solvers
-  double spectrum_min = -1.0;        // estimated a_min of A = I - G (adaptive only)
-  double spectrum_max = -1.0;        // estimated a_max of A = I - G (adaptive only)
-  int safeguard_restarts = 0;        // adaptive only: omega re-chosen after growth
+  double spectrum_min = -1.0;            // estimated a_min of A = I - G (adaptive only)
+  double spectrum_max = -1.0;            // estimated a_max of A = I - G (adaptive only)
+  int safeguard_restarts = 0;            // adaptive only: omega re-chosen after growth
   double wall_time_s = -1.0;
   // Riccati and shooting only: multiply-accumulates of the method itself (the
   // residual check excluded), counted as include/mcrewave/operation_counts.h says.
@@ -122,7 +122,7 @@ struct CoupledSolverSummary {
   // Multiple shooting: max |r_ii| / min |r_ii| of the QR factor of the global
   // system, a lower bound of its condition number.
   double shooting_condition_number = -1.0;
-  int shooting_segments = -1;        // shooting only: number of segments
+  int shooting_segments = -1;  // shooting only: number of segments
 
   bool IsSolutionUsable() const { return termination == TerminationType::kConvergence; }
   std::string BriefReport() const;
@@ -130,10 +130,10 @@ struct CoupledSolverSummary {
 };
 
 struct CoupledSolution {
-  Matrix displacement;  // U, n x (m + 1) [m]
-  Matrix retrograde;    // W, n x (m + 1) [m]
-  double cost = -1.0;           // e^2(E) [J s]
-  double cost_gradient = 0.0;   // de^2/dE [J s / Pa]
+  Matrix displacement;         // U, n x (m + 1) [m]
+  Matrix retrograde;           // W, n x (m + 1) [m]
+  double cost = -1.0;          // e^2(E) [J s]
+  double cost_gradient = 0.0;  // de^2/dE [J s / Pa]
 };
 
 // Solves the coupled problem at the problem's current modulus. initial_retrograde

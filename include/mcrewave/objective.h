@@ -142,12 +142,12 @@ class McreObjective : public ModulusObjective {
   std::vector<ObjectiveEvaluation> evaluations_;
   int best_index_ = -1;
   CoupledSolution best_solution_;
-  CoupledSolution solution_;  // of the last evaluation
-  Matrix warm_start_;         // W(E1), the last usable solution; empty: start from zero
-  double warm_start_modulus_ = 0.0;  // E1 [Pa]; 0 when W(E1) was set by SetWarmStart
-  Matrix previous_start_;            // W(E0), the one before; empty: none
+  CoupledSolution solution_;             // of the last evaluation
+  Matrix warm_start_;                    // W(E1), the last usable solution; empty: start from zero
+  double warm_start_modulus_ = 0.0;      // E1 [Pa]; 0 when W(E1) was set by SetWarmStart
+  Matrix previous_start_;                // W(E0), the one before; empty: none
   double previous_start_modulus_ = 0.0;  // E0 [Pa]
-  Matrix initial_;                   // the extrapolated W^(0)
+  Matrix initial_;                       // the extrapolated W^(0)
   std::string error_message_;
 };
 

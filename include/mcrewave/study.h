@@ -120,8 +120,8 @@ struct RobustnessRun {
   double relative_error = std::numeric_limits<double>::quiet_NaN();      // (E* - E_ref) / E_ref
   int evaluations = 0;       // outer evaluations, scan included
   int scan_evaluations = 0;  // of which in the global scan
-  long sweeps = 0;       // inner sweeps of the scan and the local refinements
-  int local_minima = 0;  // sampled local minima of the scan
+  long sweeps = 0;           // inner sweeps of the scan and the local refinements
+  int local_minima = 0;      // sampled local minima of the scan
 };
 
 struct RobustnessStatistics {

@@ -84,8 +84,7 @@ class ThetaIntegrator {
                         const Eigen::Ref<const Vector>& z, double f0, double fL,
                         Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next);
   void StepWithEndLoads(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref<const Vector>& u_k,
-                        double f0, double fL, Eigen::Ref<Vector> v_next,
-                        Eigen::Ref<Vector> u_next);
+                        double f0, double fL, Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next);
 
   // B independent steps at once (B = 2 or 3), step b as StepWithEndLoads from
   // (v_k[b], u_k[b]) with z[b] (null: none), f0[b], fL[b]; all arrays of size()
@@ -95,9 +94,8 @@ class ThetaIntegrator {
   static constexpr int kMaxBatch = 3;
   template <int B>
   void StepsWithEndLoads(const double* const (&v_k)[B], const double* const (&u_k)[B],
-                         const double* const (&z)[B], const double (&f0)[B],
-                         const double (&fL)[B], double* const (&v_next)[B],
-                         double* const (&u_next)[B]);
+                         const double* const (&z)[B], const double (&f0)[B], const double (&fL)[B],
+                         double* const (&v_next)[B], double* const (&u_next)[B]);
 
   // Runs num_steps steps forward in time from (v0, u0).
   //   forcing(k, f): writes into f (an Eigen::Ref<Vector> of size n) the force
