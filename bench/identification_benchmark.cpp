@@ -21,12 +21,10 @@
 //   --identify-only: (a) only, e.g. under valgrind --tool=callgrind;
 //   --set: config overrides as in `identify run --set`, e.g. --set data.seed=3.
 
+#include <spdlog/spdlog.h>
 #include <sys/resource.h>
 
-#include <spdlog/spdlog.h>
-
 #include <algorithm>
-#include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -59,37 +57,6 @@ double ThreadCpuSeconds() {
   return t.tv_sec + 1e-9 * t.tv_nsec;
 }
 
-// An McreObjective whose scan copies add their sweeps to a shared counter when
-// they are destroyed (Identify destroys them after the scan).
-class CountingObjective : public mcrewave::ModulusObjective {
- public:
-  CountingObjective(mcrewave::McreObjective* objective, std::atomic<long>* scan_sweeps)
-      : objective_(objective), scan_sweeps_(scan_sweeps) {}
-  CountingObjective(std::unique_ptr<mcrewave::McreObjective> owned, std::atomic<long>* scan_sweeps)
-      : owned_(std::move(owned)), objective_(owned_.get()), scan_sweeps_(scan_sweeps) {}
-  ~CountingObjective() override {
-    if (owned_ != nullptr) *scan_sweeps_ += owned_->total_sweeps();
-  }
-  double modulus_scale() const override { return objective_->modulus_scale(); }
-  bool Evaluate(const double* parameters, double* cost, double* gradient) override {
-    return objective_->Evaluate(parameters, cost, gradient);
-  }
-  std::string error_message() const override { return objective_->error_message(); }
-  std::unique_ptr<ModulusObjective> CloneForScan(double inner_tolerance) const override {
-    std::unique_ptr<ModulusObjective> copy = objective_->CloneForScan(inner_tolerance);
-    auto* mcre = dynamic_cast<mcrewave::McreObjective*>(copy.get());
-    if (mcre == nullptr) return nullptr;
-    copy.release();
-    return std::make_unique<CountingObjective>(std::unique_ptr<mcrewave::McreObjective>(mcre),
-                                               scan_sweeps_);
-  }
-
- private:
-  std::unique_ptr<mcrewave::McreObjective> owned_;
-  mcrewave::McreObjective* objective_;
-  std::atomic<long>* scan_sweeps_;
-};
-
 struct IdentifyFigures {
   double cpu_s = std::numeric_limits<double>::infinity();
   double modulus = -1.0;
@@ -105,16 +72,14 @@ IdentifyFigures IdentifyOnce(const mcrewave::Config& config, const mcrewave::Mea
   const mcrewave::BarModel model(config.model);
   mcrewave::McreObjective objective(model, data, config.mcre, config.time.theta, config.inner,
                                     config.outer.initial);
-  std::atomic<long> scan_sweeps{0};
-  CountingObjective counting(&objective, &scan_sweeps);
   const double start = ProcessCpuSeconds();
-  const mcrewave::IdentificationSummary summary = mcrewave::Identify(config.outer, &counting);
+  const mcrewave::IdentificationSummary summary = mcrewave::Identify(config.outer, &objective);
   figures.cpu_s = ProcessCpuSeconds() - start;
   figures.modulus = summary.modulus;
   figures.scan_evaluations = summary.scan_evaluations;
   figures.evaluations = summary.evaluations;
-  figures.scan_sweeps = scan_sweeps;
-  figures.refinement_sweeps = objective.total_sweeps();
+  figures.scan_sweeps = summary.scan_sweeps;
+  figures.refinement_sweeps = objective.sweeps();
   figures.usable = summary.IsSolutionUsable();
   return figures;
 }
@@ -126,7 +91,7 @@ struct SweepStepTimes {
 };
 
 SweepStepTimes SweepStepSeconds(const mcrewave::Config& config,
-                                           const mcrewave::MeasurementSet& data) {
+                                const mcrewave::MeasurementSet& data) {
   const mcrewave::BarModel model(config.model);
   mcrewave::McreProblem problem(model, data, config.mcre.weights, config.mcre.reference_modulus,
                                 config.time.theta);

@@ -45,10 +45,9 @@
 // an output folder that cannot be created) or 1 for a failed computation.
 
 #include <spdlog/spdlog.h>
-
-#include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -178,7 +177,7 @@ int RunIdentify(const RunArguments& arguments) {
                arguments.config_path, config.model.elements, config.time.NumSteps(),
                config.time.step,
                config.data.source == mcrewave::DataSource::kCsv ? config.data.path
-                                                                 : std::string("synthetic"),
+                                                                : std::string("synthetic"),
                data.num_samples());
 
   // 3. Identify E, then the cost curve and the uncertainty figure.
@@ -201,11 +200,12 @@ int RunIdentify(const RunArguments& arguments) {
     files = mcrewave::WriteIdentificationResults(run, config.output.folder, config.output.figures);
   }
   if (run.reference_known) {
-    spdlog::info("identified E = {:.9g} Pa (reference {:.9g} Pa, relative error {:.3e}) in {} "
-                 "evaluations, {:.2f} s",
-                 run.identified_modulus(), config.model.modulus,
-                 (run.identified_modulus() - config.model.modulus) / config.model.modulus,
-                 run.outer.evaluations, run.wall_time_s);
+    spdlog::info(
+        "identified E = {:.9g} Pa (reference {:.9g} Pa, relative error {:.3e}) in {} "
+        "evaluations, {:.2f} s",
+        run.identified_modulus(), config.model.modulus,
+        (run.identified_modulus() - config.model.modulus) / config.model.modulus,
+        run.outer.evaluations, run.wall_time_s);
   } else {
     spdlog::info("identified E = {:.9g} Pa in {} evaluations, {:.2f} s", run.identified_modulus(),
                  run.outer.evaluations, run.wall_time_s);
@@ -301,8 +301,11 @@ int main(int argc, char** argv) {
   CLI::App* run_command =
       app.add_subcommand("run", "Identify E from the measurements of a config; write the results");
   run_command->add_option("config", run.config_path, "YAML config file")->required();
-  run_command->add_option("--set", run.overrides,
-                          "Override a config key: --set key.path=value (repeatable)");
+  run_command
+      ->add_option("--set", run.overrides,
+                   "Override a config key: --set key.path=value (repeatable)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   run_command->add_option("-o,--output", run.output_folder,
                           "Results folder (replaces output.folder of the config)");
   CLI::Option* run_verbose =
@@ -315,8 +318,11 @@ int main(int argc, char** argv) {
   CLI::App* simulate_command =
       app.add_subcommand("simulate", "Simulate the experiment and write a measurement CSV");
   simulate_command->add_option("config", simulate.config_path, "YAML config file")->required();
-  simulate_command->add_option("--set", simulate.overrides,
-                               "Override a config key: --set key.path=value (repeatable)");
+  simulate_command
+      ->add_option("--set", simulate.overrides,
+                   "Override a config key: --set key.path=value (repeatable)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   simulate_command->add_option("-o,--output", simulate.output_path, "Measurement CSV to write")
       ->required();
   CLI::Option* simulate_verbose =
@@ -329,19 +335,26 @@ int main(int argc, char** argv) {
   CLI::App* study_command = app.add_subcommand(
       "study", "Run the studies of the config's study: section; write CSV files and figures");
   study_command->add_option("config", study.config_path, "YAML config file")->required();
-  study_command->add_option("--set", study.overrides,
-                            "Override a config key: --set key.path=value (repeatable)");
+  study_command
+      ->add_option("--set", study.overrides,
+                   "Override a config key: --set key.path=value (repeatable)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   study_command->add_option("-o,--output", study.output_folder,
                             "Results folder (replaces study.folder of the config)");
-  CLI::Option* study_verbose = study_command->add_flag(
-      "-v,--verbose", study_verbosity.verbose, "Log the identifications' own lines too");
+  CLI::Option* study_verbose = study_command->add_flag("-v,--verbose", study_verbosity.verbose,
+                                                       "Log the identifications' own lines too");
   study_command->add_flag("-q,--quiet", study_verbosity.quiet, "Log warnings and errors only")
       ->excludes(study_verbose);
 
   try {
     app.parse(argc, argv);
+  } catch (const CLI::Success& help_or_version) {
+    return app.exit(help_or_version);
   } catch (const CLI::ParseError& error) {
-    return app.exit(error);
+    // Bad command-line options are bad input: one line, exit code 2.
+    std::fprintf(stderr, "error: %s (see identify --help)\n", error.what());
+    return 2;
   }
 
   InstallSignalHandlers();

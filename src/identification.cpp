@@ -28,7 +28,7 @@ constexpr std::array<std::pair<OptimizerType, const char*>, 2> kOptimizerTypes{{
     {OptimizerType::kCeres, "ceres"},
 }};
 
-constexpr std::array<std::pair<OuterAlgorithm, const char*>, 7> kOuterAlgorithms{{
+constexpr std::array<std::pair<OuterAlgorithm, const char*>, 8> kOuterAlgorithms{{
     {OuterAlgorithm::kDefault, "default"},
     {OuterAlgorithm::kBobyqa, "bobyqa"},
     {OuterAlgorithm::kCobyla, "cobyla"},
@@ -36,6 +36,7 @@ constexpr std::array<std::pair<OuterAlgorithm, const char*>, 7> kOuterAlgorithms
     {OuterAlgorithm::kMma, "mma"},
     {OuterAlgorithm::kLbfgs, "lbfgs"},
     {OuterAlgorithm::kBfgs, "bfgs"},
+    {OuterAlgorithm::kBrent, "brent"},
 }};
 
 // "a, b or c": the algorithms the optimiser offers, for messages.
@@ -73,6 +74,7 @@ bool IsAlgorithmAvailable(OptimizerType optimizer, OuterAlgorithm algorithm) {
     case OuterAlgorithm::kCobyla:
     case OuterAlgorithm::kSbplx:
     case OuterAlgorithm::kMma:
+    case OuterAlgorithm::kBrent:
       return optimizer == OptimizerType::kNlopt;
     case OuterAlgorithm::kBfgs:
       return optimizer == OptimizerType::kCeres;
@@ -110,6 +112,9 @@ bool IdentificationOptions::IsValid(std::string* error) const {
     why << "outer.relative_tolerance must lie in (0, 0.1), got " << relative_tolerance;
   } else if (max_evaluations < 2) {
     why << "outer.max_evaluations must be at least 2, got " << max_evaluations;
+  } else if (scan_points > 0 && max_evaluations < scan_points + 2) {
+    why << "outer.max_evaluations (" << max_evaluations << ") must exceed outer.scan_points ("
+        << scan_points << ") by at least 2: the scan's evaluations count in it";
   } else if (!(max_time > 0.0)) {
     why << "outer.max_time must be a positive number of seconds, got " << max_time;
   } else if (!(scan_points == 0 || (scan_points >= 3 && scan_points <= 100000))) {
@@ -228,11 +233,12 @@ bool GuardedObjective::Evaluate(double x, double* cost, double* gradient) {
   }
   if (gradient != nullptr) {
     spdlog::info(
-        "{} evaluation {}: E = {:.9g} Pa, cost {:.9g}, gradient {:.3e}; best E = {:.9g} Pa",
+        "{} evaluation {}: E = {:.9g} Pa, cost e^2/J_rest {:.9g}, gradient {:.3e}; best E = {:.9g} "
+        "Pa",
         OptimizerTypeToString(options_.optimizer), evaluations_, modulus, *cost, gradient[0],
         best_x_ * objective_->modulus_scale());
   } else {
-    spdlog::info("{} evaluation {}: E = {:.9g} Pa, cost {:.9g}; best E = {:.9g} Pa",
+    spdlog::info("{} evaluation {}: E = {:.9g} Pa, cost e^2/J_rest {:.9g}; best E = {:.9g} Pa",
                  OptimizerTypeToString(options_.optimizer), evaluations_, modulus, *cost,
                  best_x_ * objective_->modulus_scale());
   }
@@ -268,7 +274,9 @@ IdentificationSummary MinimizeLocally(const IdentificationOptions& options,
   summary.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm);
   summary.initial_modulus = options.initial;
   internal::GuardedObjective guarded(options, objective);
-  if (options.optimizer == OptimizerType::kNlopt) {
+  if (summary.algorithm == OuterAlgorithm::kBrent) {
+    internal::MinimizeWithBrent(options, &guarded, &summary);
+  } else if (options.optimizer == OptimizerType::kNlopt) {
     internal::MinimizeWithNlopt(options, &guarded, &summary);
   } else {
     internal::MinimizeWithCeres(options, &guarded, &summary);
@@ -303,15 +311,29 @@ double ScanCost(ModulusObjective* objective, double x, std::string* failure) {
   return cost;
 }
 
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
 // The scaled costs at xs: block b of scan_threads contiguous blocks evaluated in
 // order by copy b of the objective on its own thread (or all on `objective`
-// when it offers no copy). *first_failure: why the lowest failed sample failed;
+// when it offers no copy). Samples not reached within options.max_time of
+// `start` stay NaN. *first_failure: why the lowest failed sample failed;
 // *sweeps: the inner sweeps the scan ran.
 std::vector<double> ScanCosts(const IdentificationOptions& options, ModulusObjective* objective,
-                              const std::vector<double>& xs, std::string* first_failure,
-                              long* sweeps) {
+                              const std::vector<double>& xs, Clock::time_point start,
+                              std::string* first_failure, long* sweeps) {
   const int points = static_cast<int>(xs.size());
   std::vector<double> costs(xs.size(), std::numeric_limits<double>::quiet_NaN());
+  auto scan_cost = [&](ModulusObjective* evaluated, int i, std::string* failure) {
+    if (SecondsSince(start) >= options.max_time) {
+      *failure = "outer.max_time reached during the scan";
+      return std::numeric_limits<double>::quiet_NaN();
+    }
+    return ScanCost(evaluated, xs[i], failure);
+  };
   std::vector<std::unique_ptr<ModulusObjective>> copies;
   const int blocks = std::min(options.scan_threads, points);
   for (int b = 0; b < blocks; ++b) {
@@ -322,13 +344,13 @@ std::vector<double> ScanCosts(const IdentificationOptions& options, ModulusObjec
   std::vector<std::string> failures(xs.size());
   if (static_cast<int>(copies.size()) < blocks) {
     const long sweeps_before = objective->sweeps();
-    for (int i = 0; i < points; ++i) costs[i] = ScanCost(objective, xs[i], &failures[i]);
+    for (int i = 0; i < points; ++i) costs[i] = scan_cost(objective, i, &failures[i]);
     *sweeps = objective->sweeps() - sweeps_before;
   } else {
-  // Block b holds the points [b P / B, (b + 1) P / B).
+    // Block b holds the points [b P / B, (b + 1) P / B).
     auto run_block = [&](int b) {
       for (int i = b * points / blocks; i < (b + 1) * points / blocks; ++i) {
-        costs[i] = ScanCost(copies[b].get(), xs[i], &failures[i]);
+        costs[i] = scan_cost(copies[b].get(), i, &failures[i]);
       }
     };
     std::vector<std::thread> threads;
@@ -355,12 +377,10 @@ std::vector<int> SampledMinima(const std::vector<double>& costs) {
   for (int i = 0; i < n; ++i) {
     if (!std::isfinite(costs[i])) continue;
     const bool below_left = i == 0 || !std::isfinite(costs[i - 1]) || costs[i] < costs[i - 1];
-    const bool below_right =
-        i == n - 1 || !std::isfinite(costs[i + 1]) || costs[i] <= costs[i + 1];
+    const bool below_right = i == n - 1 || !std::isfinite(costs[i + 1]) || costs[i] <= costs[i + 1];
     if (below_left && below_right) minima.push_back(i);
   }
-  std::stable_sort(minima.begin(), minima.end(),
-                   [&](int a, int b) { return costs[a] < costs[b]; });
+  std::stable_sort(minima.begin(), minima.end(), [&](int a, int b) { return costs[a] < costs[b]; });
   return minima;
 }
 
@@ -378,7 +398,7 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
   }
   if (options.scan_points == 0) return MinimizeLocally(options, objective);
 
-  const auto start = std::chrono::steady_clock::now();
+  const Clock::time_point start = Clock::now();
   const double scale = objective->modulus_scale();
   const double x_lower = options.lower_bound / scale;
   const double x_upper = options.upper_bound / scale;
@@ -391,20 +411,41 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
   }
   std::string scan_failure;
   long scan_sweeps = 0;
-  const std::vector<double> costs = ScanCosts(options, objective, xs, &scan_failure, &scan_sweeps);
+  const std::vector<double> costs =
+      ScanCosts(options, objective, xs, start, &scan_failure, &scan_sweeps);
   const std::vector<int> minima = SampledMinima(costs);
-  const double scan_wall_time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double scan_wall_time_s = SecondsSince(start);
   spdlog::info("scan of {} moduli over [{:.6g}, {:.6g}] Pa: {} sampled local minima, {:.3g} s",
                points, options.lower_bound, options.upper_bound, minima.size(), scan_wall_time_s);
 
   // Local refinements of the lowest sampled minima, each within the bracket of
-  // its neighbouring scan points.
+  // its neighbouring scan points and with what the scan and the earlier
+  // refinements left of max_evaluations and max_time.
   std::vector<IdentificationSummary> refined;
+  std::string limit_message;
+  int evaluations_used = points;
+  // Which limit stopped the search, in the user's terms.
+  auto limit_reached = [&](const std::string& when) {
+    std::ostringstream why;
+    if (evaluations_used + 2 > options.max_evaluations) {
+      why << "outer.max_evaluations (" << options.max_evaluations << ", the scan's " << points
+          << " included) reached " << when;
+    } else {
+      why << "outer.max_time (" << options.max_time << " s) reached " << when;
+    }
+    return why.str();
+  };
   const int candidates = std::min<int>(options.refine_candidates, static_cast<int>(minima.size()));
-  for (int k = 0; k < candidates; ++k) {
+  for (int k = 0; k < candidates && limit_message.empty(); ++k) {
     const int i = minima[k];
     IdentificationOptions local = options;
+    local.max_evaluations = options.max_evaluations - evaluations_used;
+    local.max_time = options.max_time - SecondsSince(start);
+    if (local.max_evaluations < 2 || !(local.max_time > 0.0)) {
+      limit_message =
+          limit_reached("before sampled minimum " + std::to_string(k + 1) + " was refined");
+      break;
+    }
     local.lower_bound = xs[std::max(i - 1, 0)] * scale;
     local.upper_bound = xs[std::min(i + 1, points - 1)] * scale;
     // Start at the sample, moved strictly inside the bracket at an end of the scan.
@@ -414,6 +455,10 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
     spdlog::info("refining sampled minimum {} at E = {:.6g} Pa within [{:.6g}, {:.6g}] Pa", k + 1,
                  xs[i] * scale, local.lower_bound, local.upper_bound);
     refined.push_back(MinimizeLocally(local, objective));
+    evaluations_used += refined.back().evaluations;
+    if (refined.back().termination == TerminationType::kNoConvergence) {
+      limit_message = limit_reached("before convergence");
+    }
   }
 
   // The usable refinement of least cost; the first refinement's failure if none is.
@@ -430,6 +475,14 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
   } else {
     summary.termination = TerminationType::kFailure;
     summary.message = "no usable evaluation in the scan of the bounds: " + scan_failure;
+  }
+  if (SecondsSince(start) >= options.max_time && limit_message.empty() && refined.empty()) {
+    limit_message = "outer.max_time reached during the scan of the bounds";
+  }
+  if (!limit_message.empty()) {
+    // A limit reached is not convergence, whatever an earlier refinement found.
+    summary.termination = TerminationType::kNoConvergence;
+    summary.message = limit_message;
   }
   summary.initial_modulus = options.initial;
   summary.evaluations = 0;
@@ -460,8 +513,7 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
     if (std::isfinite(second_cost)) summary.cost_gap = second_cost - summary.cost;
   }
   summary.scan_wall_time_s = scan_wall_time_s;
-  summary.wall_time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.wall_time_s = SecondsSince(start);
   return summary;
 }
 

@@ -62,5 +62,7 @@ void MinimizeWithNlopt(const IdentificationOptions& options, GuardedObjective* o
                        IdentificationSummary* summary);
 void MinimizeWithCeres(const IdentificationOptions& options, GuardedObjective* objective,
                        IdentificationSummary* summary);
+void MinimizeWithBrent(const IdentificationOptions& options, GuardedObjective* objective,
+                       IdentificationSummary* summary);
 
 }  // namespace mcrewave::internal

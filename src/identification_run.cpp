@@ -6,8 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <utility>
 #include <sstream>
+#include <utility>
 
 #include "mcrewave/noise.h"
 #include "mcrewave/prefilter.h"
@@ -157,6 +157,11 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
 
   // The cost curve around E*.
   run.cost_curve = ComputeCostCurve(config, model, run.data, run, &run.cost_curve_sweeps);
+
+  // The inner solver's convergence at E* from W = 0.
+  McreObjective cold(model, run.data, config.mcre, config.time.theta, config.inner,
+                     run.identified_modulus());
+  run.cold_solve = cold.EvaluateModulus(run.identified_modulus()).inner;
 
   // The uncertainty figure: noise levels known for synthetic data with noise,
   // estimated from the data's second differences otherwise.

@@ -141,10 +141,10 @@ std::string EndsCsv(const IdentificationRun& run) {
   return csv;
 }
 
-// The relative residual per iteration of the solve at the identified E; for the
-// direct solvers (no iteration history) their one final residual.
+// The relative residual per iteration of the solve from W = 0 at the identified
+// E; for the direct solvers (no iteration history) their one final residual.
 std::vector<double> InnerResidualHistory(const IdentificationRun& run) {
-  const CoupledSolverSummary& inner = run.evaluations[run.best_index].inner;
+  const CoupledSolverSummary& inner = run.cold_solve;
   if (!inner.residual_history.empty()) return inner.residual_history;
   if (inner.relative_residual >= 0.0) return {inner.relative_residual};
   return {};
@@ -197,7 +197,7 @@ std::string CostCurveScript(const IdentificationRun& run, const std::string& fol
   return script.str();
 }
 
-std::string EndsScript(const std::string& folder) {
+std::string EndsScript(const IdentificationRun& run, const std::string& folder) {
   const std::string csv = GnuplotString(folder + "/ends.csv");
   std::ostringstream script;
   script << GnuplotPngTerminal() << "set terminal pngcairo size 1200,900\nset multiplot layout 2,2 "
@@ -216,7 +216,8 @@ std::string EndsScript(const std::string& folder) {
   for (const Panel& panel : panels) {
     script << "set title '" << panel.title << "'\nset ylabel '" << panel.unit << "'\n"
            << "plot " << csv << " skip 1 using ($1*1e3):($" << panel.measured << "*" << panel.scale
-           << ") with lines lc rgb '#aaaaaa' title 'measured', " << csv
+           << ") with lines lc rgb '#aaaaaa' title '"
+           << (run.config.prefilter.enabled ? "measured, pre-filtered" : "measured") << "', " << csv
            << " skip 1 using ($1*1e3):($" << panel.measured + 1 << "*" << panel.scale
            << ") with lines lw 2 lc rgb '#1f4e9c' title 'model'\n";
   }
@@ -226,9 +227,10 @@ std::string EndsScript(const std::string& folder) {
 
 std::string InnerResidualScript(const IdentificationRun& run, const std::string& folder) {
   std::ostringstream script;
-  script << GnuplotPngTerminal()
-         << "set title 'Inner solver: relative residual ||c - A W||_P / ||c||_P at the "
-            "identified modulus'\n"
+  script << GnuplotPngTerminal() << "set title 'Inner solver ("
+         << CoupledSolverTypeToString(run.config.inner.type)
+         << "): relative residual ||c - A W||_P / ||c||_P from W = 0 at the identified "
+            "modulus'\n"
             "set xlabel 'iteration (sweep pair)'\nset ylabel 'relative residual'\n"
             "set logscale y\nset format y '10^{%T}'\n"
          << "plot " << GnuplotString(folder + "/inner_residual.csv")
@@ -318,7 +320,7 @@ std::string SummaryYaml(const IdentificationRun& run) {
   yaml.Number(1, "cutoff_frequency", run.config.prefilter.enabled ? run.prefilter_cutoff : NAN,
               "[Hz] cut-off used (null: off)");
   yaml.Text(1, "cutoff_source",
-            !run.config.prefilter.enabled                   ? "off"
+            !run.config.prefilter.enabled                 ? "off"
             : run.config.prefilter.cutoff_frequency > 0.0 ? "config"
                                                           : "derived_from_load",
             "config: prefilter.cutoff_frequency; derived_from_load: EstimateCutoffFrequency");
@@ -343,6 +345,8 @@ std::string SummaryYaml(const IdentificationRun& run) {
   yaml.Integer(1, "iterations_at_optimum", best_inner.iterations,
                "of the solve at the identified modulus");
   yaml.Number(1, "relative_residual_at_optimum", best_inner.relative_residual);
+  yaml.Integer(1, "iterations_from_zero_at_optimum", run.cold_solve.iterations,
+               "of a solve from W = 0 at the identified modulus (inner_residual.csv)");
 
   yaml.Line(0, "weights", "");
   yaml.Number(1, "alpha", run.alpha, "[m/N] force weight w_f L / (S E0)");
@@ -386,7 +390,7 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
     bool gnuplot_missing = false;
     std::vector<std::pair<std::string, std::string>> drawings = {
         {"cost_curve", CostCurveScript(run, folder)},
-        {"ends", EndsScript(folder)},
+        {"ends", EndsScript(run, folder)},
     };
     if (!InnerResidualHistory(run).empty()) {
       drawings.emplace_back("inner_residual", InnerResidualScript(run, folder));

@@ -161,10 +161,11 @@ TEST(ConfigTest, DefaultConfigYamlParsesToTheDefaultConfig) {
 }
 
 TEST(ConfigTest, ScanAndPrefilterKeysAreReadAndChecked) {
-  const Config config = ParseConfig("outer:\n  scan_points: 0\n  refine_candidates: 3\n"
-                                    "prefilter:\n  enabled: true\n  cutoff_frequency: 50e3\n"
-                                    "  order: 6\n",
-                                    "scan.yaml");
+  const Config config = ParseConfig(
+      "outer:\n  scan_points: 0\n  refine_candidates: 3\n"
+      "prefilter:\n  enabled: true\n  cutoff_frequency: 50e3\n"
+      "  order: 6\n",
+      "scan.yaml");
   EXPECT_EQ(config.outer.scan_points, 0);
   EXPECT_EQ(config.outer.refine_candidates, 3);
   EXPECT_TRUE(config.prefilter.enabled);
@@ -240,7 +241,7 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   config.outer.upper_bound = 1e12;
   config.outer.initial = 1.0 / 3.0 * 1e11;
   config.outer.relative_tolerance = 1e-9;
-  config.outer.max_evaluations = 17;
+  config.outer.max_evaluations = 67;
   config.outer.max_time = 0.5;
   config.uncertainty.samples = 3;
   config.uncertainty.seed = 99;

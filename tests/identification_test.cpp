@@ -32,8 +32,8 @@ class ScriptedObjective : public ModulusObjective {
     const double x = parameters[0];
     evaluated.push_back(x);
     const int count = static_cast<int>(evaluated.size());
-    if (count == throw_at) throw std::runtime_error("disk on fire at evaluation " +
-                                                    std::to_string(count));
+    if (count == throw_at)
+      throw std::runtime_error("disk on fire at evaluation " + std::to_string(count));
     if (count == fail_at) {
       message_ = "the inner solve diverged (scripted)";
       return false;
@@ -97,19 +97,19 @@ TEST_P(EveryAlgorithmTest, FindsTheMinimumOfAParabola) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    NloptAndCeres, EveryAlgorithmTest,
-    ::testing::Values(Case{OptimizerType::kNlopt, OuterAlgorithm::kDefault},
-                      Case{OptimizerType::kNlopt, OuterAlgorithm::kCobyla},
-                      Case{OptimizerType::kNlopt, OuterAlgorithm::kSbplx},
-                      Case{OptimizerType::kNlopt, OuterAlgorithm::kMma},
-                      Case{OptimizerType::kNlopt, OuterAlgorithm::kLbfgs},
-                      Case{OptimizerType::kCeres, OuterAlgorithm::kDefault},
-                      Case{OptimizerType::kCeres, OuterAlgorithm::kBfgs}),
-    [](const ::testing::TestParamInfo<Case>& info) {
-      return std::string(OptimizerTypeToString(std::get<0>(info.param))) + "_" +
-             OuterAlgorithmToString(std::get<1>(info.param));
-    });
+INSTANTIATE_TEST_SUITE_P(NloptAndCeres, EveryAlgorithmTest,
+                         ::testing::Values(Case{OptimizerType::kNlopt, OuterAlgorithm::kDefault},
+                                           Case{OptimizerType::kNlopt, OuterAlgorithm::kCobyla},
+                                           Case{OptimizerType::kNlopt, OuterAlgorithm::kSbplx},
+                                           Case{OptimizerType::kNlopt, OuterAlgorithm::kMma},
+                                           Case{OptimizerType::kNlopt, OuterAlgorithm::kLbfgs},
+                                           Case{OptimizerType::kNlopt, OuterAlgorithm::kBrent},
+                                           Case{OptimizerType::kCeres, OuterAlgorithm::kDefault},
+                                           Case{OptimizerType::kCeres, OuterAlgorithm::kBfgs}),
+                         [](const ::testing::TestParamInfo<Case>& info) {
+                           return std::string(OptimizerTypeToString(std::get<0>(info.param))) +
+                                  "_" + OuterAlgorithmToString(std::get<1>(info.param));
+                         });
 
 TEST(IdentificationTest, CeresNeedsFewerEvaluationsThanBobyqaOnASmoothMinimum) {
   ScriptedObjective for_nlopt = Parabola();
@@ -224,6 +224,35 @@ TEST(IdentificationTest, TimeLimitIsHonoured) {
   }
 }
 
+TEST(IdentificationTest, EvaluationLimitCountsTheScanAndCoversEveryRefinement) {
+  for (const OptimizerType optimizer : {OptimizerType::kNlopt, OptimizerType::kCeres}) {
+    ScriptedObjective objective = Parabola();
+    IdentificationOptions options = Options(optimizer, OuterAlgorithm::kDefault);
+    options.scan_points = 11;
+    options.max_evaluations = 14;  // 3 left to the refinement: not enough to 1e-8
+    const IdentificationSummary summary = Identify(options, &objective);
+    EXPECT_EQ(summary.termination, TerminationType::kNoConvergence) << summary.FullReport();
+    EXPECT_NE(summary.message.find("outer.max_evaluations (14, the scan's 11 included) reached"),
+              std::string::npos)
+        << summary.message;
+    EXPECT_EQ(objective.evaluated.size(), 14u);
+    EXPECT_EQ(summary.scan_evaluations + summary.evaluations, 14);
+  }
+}
+
+TEST(IdentificationTest, TimeLimitCoversTheScan) {
+  ScriptedObjective objective = Parabola();
+  objective.delay_s = 0.02;
+  IdentificationOptions options = Options(OptimizerType::kNlopt, OuterAlgorithm::kDefault);
+  options.scan_points = 41;
+  options.max_time = 0.1;
+  const IdentificationSummary summary = Identify(options, &objective);
+  EXPECT_EQ(summary.termination, TerminationType::kNoConvergence) << summary.FullReport();
+  EXPECT_NE(summary.message.find("outer.max_time"), std::string::npos) << summary.message;
+  EXPECT_LT(summary.wall_time_s, 0.1 + 0.1);
+  EXPECT_LE(objective.evaluated.size(), 7u);
+}
+
 TEST(IdentificationOptionsTest, DefaultsAreValid) {
   std::string why;
   EXPECT_TRUE(IdentificationOptions().IsValid(&why)) << why;
@@ -237,6 +266,8 @@ TEST(IdentificationOptionsTest, InvalidOptionsNameTheirKeys) {
       {[](IdentificationOptions* o) { o->relative_tolerance = 0.0; }, "outer.relative_tolerance"},
       {[](IdentificationOptions* o) { o->max_evaluations = 1; }, "outer.max_evaluations"},
       {[](IdentificationOptions* o) { o->max_time = -1.0; }, "outer.max_time"},
+      {[](IdentificationOptions* o) { o->max_evaluations = o->scan_points + 1; },
+       "outer.max_evaluations (42) must exceed outer.scan_points (41) by at least 2"},
       {[](IdentificationOptions* o) {
          o->optimizer = OptimizerType::kCeres;
          o->algorithm = OuterAlgorithm::kCobyla;

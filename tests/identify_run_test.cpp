@@ -213,10 +213,10 @@ TEST(IdentifyRunTest, DefaultConfigIsAcceptedByRun) {
 TEST(IdentifyRunTest, UnconvergedIdentificationExitsWithOneAndWritesNothing) {
   const std::string folder = FreshDirectory("identify_run_unconverged") + "/results";
   const RunResult run = RunIdentify("run " + SourcePath("configs/quick.yaml") +
-                                    " --set outer.max_evaluations=2 -q -o " + folder);
+                                    " --set outer.max_evaluations=44 -q -o " + folder);
   EXPECT_EQ(run.exit_code, 1) << run.output;
-  EXPECT_NE(run.output.find("error: identification failed: outer.max_evaluations (2) reached "
-                            "before convergence"),
+  EXPECT_NE(run.output.find("error: identification failed: outer.max_evaluations (44, the "
+                            "scan's 41 included) reached before convergence"),
             std::string::npos)
       << run.output;
   EXPECT_FALSE(fs::exists(folder));

@@ -24,8 +24,8 @@
 //          shooting_segment_growth [100]
 //          (CoupledSolverOptions, coupled_solver.h)
 //   outer: optimizer [nlopt | ceres], algorithm [default | bobyqa | cobyla | sbplx |
-//          mma | lbfgs | bfgs], lower_bound [100e9 Pa], upper_bound [400e9 Pa],
-//          initial [160e9 Pa], relative_tolerance [1e-7], max_evaluations [100],
+//          mma | lbfgs | bfgs | brent], lower_bound [100e9 Pa], upper_bound [400e9 Pa],
+//          initial [160e9 Pa], relative_tolerance [1e-7], max_evaluations [150],
 //          max_time [600 s], scan_points [41], scan_tolerance [1e-4],
 //          scan_threads [2], refine_candidates [2] (IdentificationOptions,
 //          identification.h)

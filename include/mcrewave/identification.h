@@ -58,6 +58,7 @@ enum class OuterAlgorithm {
   kMma,      // nlopt: method of moving asymptotes, adjoint gradient, bounded
   kLbfgs,    // nlopt or ceres: limited-memory BFGS, adjoint gradient
   kBfgs,     // ceres: dense BFGS, adjoint gradient
+  kBrent,    // under nlopt: Brent's bounded 1-D minimiser (mcrewave's own), derivative-free
 };
 const char* OuterAlgorithmToString(OuterAlgorithm algorithm);
 bool StringToOuterAlgorithm(const std::string& name, OuterAlgorithm* algorithm);
@@ -78,9 +79,11 @@ struct IdentificationOptions {
   // Stop when a step changes E by less than this fraction of E (NLopt xtol_rel;
   // Ceres parameter_tolerance on x).
   double relative_tolerance = 1e-7;
-  // e^2 evaluations allowed; reaching the limit is not convergence.
-  int max_evaluations = 100;
-  // Wall time allowed to the outer loop [s]; reaching it is not convergence.
+  // e^2 evaluations allowed to the whole identification, the scan's included;
+  // reaching the limit is not convergence.
+  int max_evaluations = 150;
+  // Wall time allowed to the whole identification (scan and refinements) [s];
+  // reaching it is not convergence.
   double max_time = 600.0;
   // Moduli of the global scan, evenly spaced in log E over the bounds (ends
   // included); 0: no scan, local search from `initial` only. 41 over the default
@@ -98,7 +101,8 @@ struct IdentificationOptions {
   int refine_candidates = 2;
 
   // Valid when 0 < lower_bound < initial < upper_bound (finite),
-  // relative_tolerance in (0, 0.1), max_evaluations >= 2, max_time > 0, the
+  // relative_tolerance in (0, 0.1), max_evaluations >= 2 (and >= scan_points + 2
+  // with a scan), max_time > 0, the
   // algorithm exists for the optimiser, scan_points is 0 or in [3, 100000],
   // scan_tolerance in (0, 1), scan_threads in [1, 64] and refine_candidates in
   // [1, 100]. Messages name the outer.* keys.
@@ -146,7 +150,10 @@ struct IdentificationSummary {
 // refinements described above (the scan on objective->CloneForScan copies when
 // the objective offers them, else on the objective itself in one thread), else
 // from x0 = options.initial / objective->modulus_scale(). max_evaluations and
-// max_time hold for each local refinement. Never throws for what the objective
+// max_time hold for the whole identification: each refinement gets what the
+// scan and the earlier refinements left, and a limit reached anywhere makes the
+// result kNoConvergence (samples the scan could not reach in time stay NaN).
+// Never throws for what the objective
 // does: an exception thrown by the objective ends the run (or, in the scan,
 // makes that sample unusable) with termination kFailure and its what() in the
 // message. Precondition: options.IsValid().

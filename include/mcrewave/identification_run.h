@@ -48,7 +48,7 @@ struct IdentificationRun {
   // The uncertainty draws white noise of `noise` on the channels, unfiltered:
   // with the pre-filter on, it overstates the spread (conservative).
   NoiseLevels estimated_noise;
-  NoiseLevels misfit;           // RMS misfits at the optimum (MisfitLevels)
+  NoiseLevels misfit;  // RMS misfits at the optimum (MisfitLevels)
 
   IdentificationSummary outer;
   // The optimiser's evaluations, in order; evaluations[best_index] is the one
@@ -63,6 +63,10 @@ struct IdentificationRun {
 
   std::vector<CostCurvePoint> cost_curve;  // ascending E
   long cost_curve_sweeps = 0;
+  // A coupled solve at the identified E from W = 0, for the inner solver's
+  // convergence history (the optimiser's solves are warm-started: the one at E*
+  // takes few iterations, often none).
+  CoupledSolverSummary cold_solve;
   ModulusUncertainty uncertainty;
   double wall_time_s = -1.0;  // the whole of RunIdentification
 

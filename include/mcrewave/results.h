@@ -14,8 +14,9 @@
 //   ends.csv            measured and model end displacements and forces at the
 //                       identified E; model force F = F~ - B W / alpha
 //                       (docs/discrete_mcre.md section 2)
-//   inner_residual.csv  relative residual per inner iteration of the evaluation
-//                       at the identified E (direct solvers: their final residual)
+//   inner_residual.csv  relative residual per inner iteration of a solve from
+//                       W = 0 at the identified E (direct solvers: their final
+//                       residual)
 //   cost_curve.png, ends.png, inner_residual.png   the same drawn by gnuplot
 //                       (pngcairo), when figures are asked for (inner_residual.png
 //                       only when there is a residual to draw)
