@@ -304,7 +304,7 @@ int main(int argc, char** argv) {
   run_command
       ->add_option("--set", run.overrides,
                    "Override a config key: --set key.path=value (repeatable)")
-      ->expected(1)
+      ->allow_extra_args(false)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   run_command->add_option("-o,--output", run.output_folder,
                           "Results folder (replaces output.folder of the config)");
@@ -321,7 +321,7 @@ int main(int argc, char** argv) {
   simulate_command
       ->add_option("--set", simulate.overrides,
                    "Override a config key: --set key.path=value (repeatable)")
-      ->expected(1)
+      ->allow_extra_args(false)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   simulate_command->add_option("-o,--output", simulate.output_path, "Measurement CSV to write")
       ->required();
@@ -338,7 +338,7 @@ int main(int argc, char** argv) {
   study_command
       ->add_option("--set", study.overrides,
                    "Override a config key: --set key.path=value (repeatable)")
-      ->expected(1)
+      ->allow_extra_args(false)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   study_command->add_option("-o,--output", study.output_folder,
                             "Results folder (replaces study.folder of the config)");

@@ -210,6 +210,9 @@ bool GuardedObjective::Evaluate(double x, double* cost, double* gradient) {
     if (usable && !std::isfinite(*cost)) {
       usable = false;
       stop_message_ = "the objective returned a non-finite cost";
+    } else if (usable && gradient != nullptr && !std::isfinite(*gradient)) {
+      usable = false;
+      stop_message_ = "the objective returned a non-finite gradient";
     } else if (!usable) {
       stop_message_ = objective_->error_message();
     }
@@ -370,14 +373,16 @@ std::vector<double> ScanCosts(const IdentificationOptions& options, ModulusObjec
 }
 
 // Indices of the sampled local minima of costs, lowest cost first: usable
-// samples below each usable neighbour (an end needs only its one neighbour).
+// samples below each neighbour (an end needs only its one neighbour). A failed
+// (NaN) neighbour is no evidence of a minimum: a sample beside one is not listed.
 std::vector<int> SampledMinima(const std::vector<double>& costs) {
   const int n = static_cast<int>(costs.size());
   std::vector<int> minima;
   for (int i = 0; i < n; ++i) {
     if (!std::isfinite(costs[i])) continue;
-    const bool below_left = i == 0 || !std::isfinite(costs[i - 1]) || costs[i] < costs[i - 1];
-    const bool below_right = i == n - 1 || !std::isfinite(costs[i + 1]) || costs[i] <= costs[i + 1];
+    // Comparisons with NaN are false: a failed neighbour fails the test.
+    const bool below_left = i == 0 || costs[i] < costs[i - 1];
+    const bool below_right = i == n - 1 || costs[i] <= costs[i + 1];
     if (below_left && below_right) minima.push_back(i);
   }
   std::stable_sort(minima.begin(), minima.end(), [&](int a, int b) { return costs[a] < costs[b]; });
@@ -415,6 +420,12 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
       ScanCosts(options, objective, xs, start, &scan_failure, &scan_sweeps);
   const std::vector<int> minima = SampledMinima(costs);
   const double scan_wall_time_s = SecondsSince(start);
+  const int scan_failures = static_cast<int>(
+      std::count_if(costs.begin(), costs.end(), [](double cost) { return !std::isfinite(cost); }));
+  if (scan_failures > 0) {
+    spdlog::warn("scan: {} of {} samples have no usable cost (first: {})", scan_failures, points,
+                 scan_failure);
+  }
   spdlog::info("scan of {} moduli over [{:.6g}, {:.6g}] Pa: {} sampled local minima, {:.3g} s",
                points, options.lower_bound, options.upper_bound, minima.size(), scan_wall_time_s);
 
@@ -459,6 +470,16 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
     if (refined.back().termination == TerminationType::kNoConvergence) {
       limit_message = limit_reached("before convergence");
     }
+  }  // A refinement that failed leaves its valley unknown: no result is reported
+  // over it, whatever the other refinements found.
+  std::string refinement_failure;
+  for (int k = 0; k < static_cast<int>(refined.size()); ++k) {
+    if (refined[k].termination == TerminationType::kFailure && refinement_failure.empty()) {
+      std::ostringstream why;
+      why << "the refinement of sampled minimum " << k + 1 << " (E = " << xs[minima[k]] * scale
+          << " Pa) failed: " << refined[k].message;
+      refinement_failure = why.str();
+    }
   }
 
   // The usable refinement of least cost; the first refinement's failure if none is.
@@ -472,9 +493,18 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
     summary = refined[best];
   } else if (!refined.empty()) {
     summary = refined.front();
-  } else {
+  } else if (scan_failures == points) {
     summary.termination = TerminationType::kFailure;
     summary.message = "no usable evaluation in the scan of the bounds: " + scan_failure;
+  } else if (limit_message.empty()) {
+    summary.termination = TerminationType::kFailure;
+    summary.message = "the scan saw no minimum between usable samples (" +
+                      std::to_string(scan_failures) + " of " + std::to_string(points) +
+                      " samples failed; first: " + scan_failure + ")";
+  }
+  if (!refinement_failure.empty()) {
+    summary.termination = TerminationType::kFailure;
+    summary.message = refinement_failure;
   }
   if (SecondsSince(start) >= options.max_time && limit_message.empty() && refined.empty()) {
     limit_message = "outer.max_time reached during the scan of the bounds";
@@ -496,6 +526,7 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
   summary.scan_costs = costs;
   summary.scan_evaluations = points;
   summary.scan_sweeps = scan_sweeps;
+  summary.scan_failures = scan_failures;
   summary.local_minima = static_cast<int>(minima.size());
   // The second valley: its refined cost when refined, else its sampled cost.
   if (minima.size() >= 2 && best >= 0) {

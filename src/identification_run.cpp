@@ -141,8 +141,23 @@ IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& da
   run.sweeps = objective.sweeps();
   spdlog::info("{}", run.outer.BriefReport());
   if (run.IsUsable()) {
+    // Every field reported belongs to the identified E: the objective's best
+    // evaluation is at E* unless another evaluation went lower; then E* is
+    // solved once more (warm-started).
     run.best_index = objective.best_index();
     run.solution = objective.best_solution();
+    if (run.evaluations[run.best_index].modulus != run.identified_modulus()) {
+      const ObjectiveEvaluation& at_optimum = objective.EvaluateModulus(run.identified_modulus());
+      if (!at_optimum.usable) {
+        run.outer.termination = TerminationType::kFailure;
+        run.outer.message =
+            "the coupled solve at the identified E is not usable: " + at_optimum.inner.message;
+      }
+      run.evaluations = objective.evaluations();
+      run.sweeps = objective.sweeps();
+      run.best_index = static_cast<int>(run.evaluations.size()) - 1;
+      run.solution = objective.last_solution();
+    }
   }
   run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return run;

@@ -306,6 +306,7 @@ std::string SummaryYaml(const IdentificationRun& run) {
   yaml.Line(0, "scan", "", "global scan of e^2 over the bounds (outer.scan_points)");
   yaml.Integer(1, "points", static_cast<long>(outer.scan_moduli.size()), "0: no scan");
   yaml.Integer(1, "local_minima", outer.local_minima, "sampled local minima of e^2 seen");
+  yaml.Integer(1, "failed_points", outer.scan_failures, "samples without a usable cost");
   yaml.Number(1, "second_modulus", outer.second_modulus > 0.0 ? outer.second_modulus : NAN,
               "[Pa] the second-lowest minimum (null: fewer than two)");
   yaml.Number(1, "scaled_cost_gap", outer.cost_gap,

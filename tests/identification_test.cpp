@@ -34,7 +34,7 @@ class ScriptedObjective : public ModulusObjective {
     const int count = static_cast<int>(evaluated.size());
     if (count == throw_at)
       throw std::runtime_error("disk on fire at evaluation " + std::to_string(count));
-    if (count == fail_at) {
+    if (count == fail_at || (fails && fails(count, x))) {
       message_ = "the inner solve diverged (scripted)";
       return false;
     }
@@ -48,6 +48,7 @@ class ScriptedObjective : public ModulusObjective {
   double scale = 1e9;
   int throw_at = -1;
   int fail_at = -1;
+  std::function<bool(int count, double x)> fails;  // also fail where this says so
   double delay_s = 0.0;
   std::vector<double> evaluated;
 
@@ -251,6 +252,57 @@ TEST(IdentificationTest, TimeLimitCoversTheScan) {
   EXPECT_NE(summary.message.find("outer.max_time"), std::string::npos) << summary.message;
   EXPECT_LT(summary.wall_time_s, 0.1 + 0.1);
   EXPECT_LE(objective.evaluated.size(), 7u);
+}
+
+// Scan of 11 log-spaced points on [0.5, 2.5]: 0.5, 0.587, 0.690, 0.810, 0.951,
+// 1.117, 1.312, 1.541, 1.810, 2.126, 2.5.
+IdentificationOptions ScanOptions(OptimizerType optimizer) {
+  IdentificationOptions options = Options(optimizer, OuterAlgorithm::kDefault);
+  options.scan_points = 11;
+  return options;
+}
+
+TEST(IdentificationTest, AFailedScanSampleIsNoEvidenceOfAMinimum) {
+  // The parabola decreases up to 1.3; the sample at 0.810 fails, so 0.690 is
+  // below its left neighbour only: not a minimum.
+  ScriptedObjective objective = Parabola();
+  objective.fail_at = 4;
+  const IdentificationSummary summary = Identify(ScanOptions(OptimizerType::kNlopt), &objective);
+  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+  EXPECT_EQ(summary.scan_failures, 1);
+  EXPECT_TRUE(std::isnan(summary.scan_costs[3]));
+  EXPECT_EQ(summary.local_minima, 1);
+  EXPECT_EQ(summary.refinements, 1);
+  EXPECT_NEAR(summary.modulus, 1.3e9, 1e-5 * 1.3e9);
+}
+
+TEST(IdentificationTest, AFailedRefinementOfAnyValleyFailsTheIdentification) {
+  for (const OptimizerType optimizer : {OptimizerType::kNlopt, OptimizerType::kCeres}) {
+    // Two valleys: the deeper at x = 2, the other at x = 0.8, refined second;
+    // every evaluation below x = 1 after the scan fails.
+    ScriptedObjective objective(
+        [](double x) { return std::min((x - 0.8) * (x - 0.8) + 0.1, (x - 2.0) * (x - 2.0)); },
+        [](double x) {
+          return (x - 0.8) * (x - 0.8) + 0.1 < (x - 2.0) * (x - 2.0) ? 2.0 * (x - 0.8)
+                                                                     : 2.0 * (x - 2.0);
+        });
+    objective.fails = [](int count, double x) { return count > 11 && x < 1.0; };
+    const IdentificationSummary summary = Identify(ScanOptions(optimizer), &objective);
+    EXPECT_EQ(summary.local_minima, 2);
+    EXPECT_EQ(summary.termination, TerminationType::kFailure) << summary.FullReport();
+    EXPECT_NE(summary.message.find("the refinement of sampled minimum 2"), std::string::npos)
+        << summary.message;
+    EXPECT_NE(summary.message.find("scripted"), std::string::npos) << summary.message;
+  }
+}
+
+TEST(IdentificationTest, ANonFiniteGradientStopsTheSearch) {
+  ScriptedObjective objective([](double x) { return (x - 1.3) * (x - 1.3); },
+                              [](double) { return std::nan(""); });
+  const IdentificationSummary summary =
+      Identify(Options(OptimizerType::kCeres, OuterAlgorithm::kDefault), &objective);
+  EXPECT_EQ(summary.termination, TerminationType::kFailure) << summary.FullReport();
+  EXPECT_NE(summary.message.find("non-finite gradient"), std::string::npos) << summary.message;
 }
 
 TEST(IdentificationOptionsTest, DefaultsAreValid) {

@@ -1,9 +1,12 @@
 // End-to-end tests of the identify binary: it is run as a user runs it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "identify_binary.h"
 #include "mcrewave/measurement.h"
@@ -24,6 +27,30 @@ TEST(IdentifyTest, HelpAndVersion) {
   const RunResult version = RunIdentify("--version");
   EXPECT_EQ(version.exit_code, 0);
   EXPECT_NE(version.output.find("mcrewave"), std::string::npos) << version.output;
+}
+
+TEST(IdentifyTest, BadCommandLinesExitWithTwoAndOneLine) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"run", "config is required"},
+      {"bogus", "bogus"},
+      {"run " + SourcePath("configs/quick.yaml") + " -v -q", "--verbose excludes --quiet"},
+      {"simulate " + SourcePath("configs/quick.yaml"), "--output is required"},
+  };
+  for (const auto& [arguments, reason] : cases) {
+    const RunResult run = RunIdentify(arguments);
+    EXPECT_EQ(run.exit_code, 2) << arguments << "\n" << run.output;
+    EXPECT_EQ(run.output.rfind("error: ", 0), 0u) << run.output;
+    EXPECT_NE(run.output.find(reason), std::string::npos) << run.output;
+    EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << run.output;
+  }
+}
+
+TEST(IdentifyTest, OverridesMayComeBeforeTheConfig) {
+  const std::string dir = FreshDirectory("identify_set_first");
+  const RunResult run = RunIdentify("simulate --set time.window=0.144e-3 --set data.snr=.inf " +
+                                    SourcePath("configs/quick.yaml") + " -o " + dir + "/out.csv");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(ReadMeasurementCsv(dir + "/out.csv").num_samples(), 101);
 }
 
 TEST(IdentifyTest, PrintsADefaultConfigThatSimulateAccepts) {

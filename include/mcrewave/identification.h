@@ -129,6 +129,7 @@ struct IdentificationSummary {
   std::vector<double> scan_costs;   // scaled cost at scan_moduli (NaN: not usable)
   int scan_evaluations = 0;         // scan evaluations, not counted in `evaluations`
   long scan_sweeps = 0;             // inner sweeps of the scan (its copies' or the objective's)
+  int scan_failures = 0;            // scan samples without a usable cost (NaN in scan_costs)
   int local_minima = 0;             // sampled local minima of scan_costs (ends included)
   // Scaled cost of the second-lowest minimum minus the lowest, both refined
   // when refined (NaN with fewer than two minima): a small gap says a second

@@ -117,6 +117,8 @@ class McreObjective : public ModulusObjective {
   int best_index() const { return best_index_; }
   // The coupled solution of evaluations()[best_index()] (empty when none).
   const CoupledSolution& best_solution() const { return best_solution_; }
+  // The coupled solution of the last evaluation (valid when it was usable).
+  const CoupledSolution& last_solution() const { return solution_; }
   // Sweeps (direct + retrograde) of every evaluation.
   long sweeps() const override { return problem_.sweep_count(); }
 
