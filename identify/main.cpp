@@ -186,11 +186,13 @@ int RunIdentify(const RunArguments& arguments) {
     std::fprintf(stderr, "error: identification failed: %s\n", run.outer.message.c_str());
     return 1;
   }
-  const std::string on_bound =
-      mcrewave::ModulusOnBoundMessage(run.identified_modulus(), config.outer);
-  if (!on_bound.empty()) {
-    std::fprintf(stderr, "error: identification failed: %s\n", on_bound.c_str());
-    return 1;
+  for (const std::string& unusable :
+       {mcrewave::ModulusOnBoundMessage(run.identified_modulus(), config.outer),
+        mcrewave::ImplausibleMisfitMessage(run)}) {
+    if (!unusable.empty()) {
+      std::fprintf(stderr, "error: identification failed: %s\n", unusable.c_str());
+      return 1;
+    }
   }
 
   // 4. Write the results, each file atomically.

@@ -225,4 +225,34 @@ std::string ModulusOnBoundMessage(double modulus, const IdentificationOptions& o
   return "";
 }
 
+std::string ImplausibleMisfitMessage(const IdentificationRun& run) {
+  const MeasurementSet& data = run.data;
+  // RMS over both ends: sqrt((|a|^2 + |b|^2) / (2 samples)).
+  auto both_ends_rms = [&](const Vector& a, const Vector& b) {
+    return std::sqrt((a.squaredNorm() + b.squaredNorm()) / (2.0 * data.num_samples()));
+  };
+  struct QuantityType {
+    const char* name;
+    const char* unit;
+    double misfit;
+    double measured;
+  };
+  const QuantityType types[] = {
+      {"displacements", "m", run.misfit.displacement_std, both_ends_rms(data.u0, data.uL)},
+      {"forces", "N", run.misfit.force_std, both_ends_rms(data.f0, data.fL)}};
+  for (const QuantityType& type : types) {
+    if (!(type.misfit <= kImplausibleMisfitFactor * type.measured)) {
+      char message[512];
+      std::snprintf(message, sizeof(message),
+                    "at E = %.6g Pa the model misses the measured end %s by an RMS of %.4g %s, "
+                    "%.3g times their own RMS (%.4g %s): it explains nothing of them; check the "
+                    "units of the data (SI: m and N) and the model's geometry and density",
+                    run.identified_modulus(), type.name, type.misfit, type.unit,
+                    type.misfit / type.measured, type.measured, type.unit);
+      return message;
+    }
+  }
+  return "";
+}
+
 }  // namespace mcrewave

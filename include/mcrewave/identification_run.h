@@ -88,6 +88,17 @@ IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& da
 constexpr double kOnBoundTolerance = 1e-6;
 std::string ModulusOnBoundMessage(double modulus, const IdentificationOptions& outer);
 
+// Why the identified E cannot be reported: at E* the model misses the measured
+// displacements (or forces) by an RMS misfit (run.misfit) above
+// kImplausibleMisfitFactor times the RMS of those measurements (run.data, both
+// ends), i.e. it explains nothing of them, as data in wrong units or from
+// another structure give, whatever the bounds; "" otherwise. Measured: correct
+// data at SNR 2.5 to inf give misfits below their RMS; a channel scaled by 1e6
+// gives 1e4 to 1e6 times it. Precondition: run.IsUsable() and RunIdentification
+// ran (run.misfit is set).
+constexpr double kImplausibleMisfitFactor = 10.0;
+std::string ImplausibleMisfitMessage(const IdentificationRun& run);
+
 // Runs steps 2 to 4 on measurements made by LoadMeasurements(config).
 // Precondition: config valid (as LoadConfig returns it). Never throws for a
 // failed identification: see IsUsable() and outer.message.
