@@ -1,23 +1,24 @@
 // Robustness of the identification at low SNR on the paper's case (100 elements,
 // 1750 steps, data from the 4x finer truth plus white noise): the distribution
 // over noise seeds of the error of the identified E against settings of the
-// method (the MCRE weight w_u, the zero-phase pre-filter with its derived
-// cut-off, the global scan against a local search from outer.initial).
+// method (the MCRE weights w_u and w_f, the zero-phase pre-filter with its
+// derived cut-off, the global scan and its density against a local search from
+// outer.initial).
 //
 // Each identification is Identify (identification.h) as `identify run` calls
 // it, with the outer defaults except scan_threads = 1 (the two cores run two
-// identifications at a time instead) and relative_tolerance = 1e-6. Per setting and SNR it reports the mean
-// error, the 2.5 % and 97.5 % quantiles (the 95 % band), the share of seeds
-// within +-2 % of E_ref, the mean number of sampled local minima of the scan and
-// the mean wall time of one identification; plus the noise-free error (bias).
+// identifications at a time instead) and relative_tolerance = 1e-6. Per setting and SNR it reports
+// the mean error, the 2.5 % and 97.5 % quantiles (the 95 % band), the share of seeds within +-2 %
+// of E_ref, the mean number of sampled local minima of the scan and the mean wall time of one
+// identification; plus the noise-free error (bias).
 //
 // Usage: robustness_benchmark OUTPUT_DIR [seeds]
 //   writes OUTPUT_DIR/identifications.csv (one row per identification) and
 //   OUTPUT_DIR/settings.csv (one row per setting and SNR).
 
-#include <algorithm>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -43,6 +44,7 @@ namespace {
 struct Setting {
   std::string name;
   double w_u;
+  double w_f;
   bool prefilter;
   int scan_points;  // 0: local search from outer.initial only
 };
@@ -66,6 +68,7 @@ Outcome IdentifyOnce(const mcrewave::BarModel& model, const mcrewave::Measuremen
       mcrewave::PrefilterMeasurements(measured, prefilter, &outcome.cutoff);
   mcrewave::McreOptions mcre;
   mcre.weights.displacement_weight = setting.w_u;
+  mcre.weights.force_weight = setting.w_f;
   mcrewave::IdentificationOptions outer;
   outer.scan_points = setting.scan_points;
   outer.scan_threads = 1;
@@ -100,14 +103,17 @@ int main(int argc, char** argv) {
   const mcrewave::DataOptions truth_options;  // finite-element truth, refinement 4
   const mcrewave::BarModel model(bar);
   const double reference = bar.modulus;
-  const mcrewave::MeasurementSet truth =
-      mcrewave::SimulateTruth(bar, load, time, truth_options);
+  const mcrewave::MeasurementSet truth = mcrewave::SimulateTruth(bar, load, time, truth_options);
 
   const std::vector<Setting> settings = {
-      {"local_only_w0.01", 0.01, false, 0},
-      {"scan_w0.01", 0.01, false, 41},
-      {"scan_w0.01_prefilter", 0.01, true, 41},
-      {"scan_w0.003_prefilter", 0.003, true, 41},
+      {"local_only_w0.01", 0.01, 1.0, false, 0},
+      {"scan_w0.01", 0.01, 1.0, false, 41},
+      {"scan_w0.01_prefilter", 0.01, 1.0, true, 41},
+      {"scan121_w0.01_prefilter", 0.01, 1.0, true, 121},
+      {"scan_w0.003_prefilter", 0.003, 1.0, true, 41},
+      {"scan_w0.03_prefilter", 0.03, 1.0, true, 41},
+      {"scan_w0.01_wf0.1_prefilter", 0.01, 0.1, true, 41},
+      {"scan_w0.01_wf10_prefilter", 0.01, 10.0, true, 41},
   };
   const std::vector<double> snrs = {std::numeric_limits<double>::infinity(), 2.5, 5.0};
 
@@ -133,8 +139,7 @@ int main(int argc, char** argv) {
     for (int j = next++; j < static_cast<int>(jobs.size()); j = next++) {
       const Job& job = jobs[j];
       mcrewave::MeasurementSet measured = truth;
-      mcrewave::AddMeasurementNoise(snrs[job.snr], static_cast<std::uint64_t>(job.seed),
-                                    &measured);
+      mcrewave::AddMeasurementNoise(snrs[job.snr], static_cast<std::uint64_t>(job.seed), &measured);
       outcomes[j] = IdentifyOnce(model, measured, settings[job.setting], reference);
       std::lock_guard<std::mutex> lock(progress_mutex);
       ++done;
@@ -150,22 +155,22 @@ int main(int argc, char** argv) {
   std::fprintf(stderr, "\n");
 
   std::ostringstream rows;
-  rows << "setting,w_u,prefilter,scan_points,snr,seed,relative_error,local_minima,evaluations,"
-          "cutoff_hz,wall_time_s\n";
+  rows << "setting,w_u,w_f,prefilter,scan_points,snr,seed,relative_error,local_minima,"
+          "evaluations,cutoff_hz,wall_time_s\n";
   for (std::size_t j = 0; j < jobs.size(); ++j) {
     const Setting& setting = settings[jobs[j].setting];
     const Outcome& o = outcomes[j];
-    rows << setting.name << "," << setting.w_u << "," << (setting.prefilter ? 1 : 0) << ","
-         << setting.scan_points << "," << snrs[jobs[j].snr] << "," << jobs[j].seed << ","
-         << o.relative_error << "," << o.local_minima << "," << o.evaluations << "," << o.cutoff
-         << "," << o.wall_time_s << "\n";
+    rows << setting.name << "," << setting.w_u << "," << setting.w_f << ","
+         << (setting.prefilter ? 1 : 0) << "," << setting.scan_points << "," << snrs[jobs[j].snr]
+         << "," << jobs[j].seed << "," << o.relative_error << "," << o.local_minima << ","
+         << o.evaluations << "," << o.cutoff << "," << o.wall_time_s << "\n";
   }
   mcrewave::WriteFileAtomically(output_dir + "/identifications.csv", rows.str());
 
   std::ostringstream table;
   table << "setting,snr,seeds,noise_free_error,mean_error,q2.5_error,q97.5_error,"
            "share_within_2pct,mean_local_minima,mean_evaluations,mean_time_s,failures\n";
-  std::printf("%-24s %5s | %9s | %9s %9s %9s | %6s | %6s %6s %7s\n", "setting", "SNR", "bias",
+  std::printf("%-28s %5s | %9s | %9s %9s %9s | %6s | %6s %6s %7s\n", "setting", "SNR", "bias",
               "mean", "q2.5", "q97.5", "+-2%", "minima", "evals", "time");
   for (int s = 0; s < static_cast<int>(settings.size()); ++s) {
     double bias = std::numeric_limits<double>::quiet_NaN();
@@ -199,9 +204,10 @@ int main(int argc, char** argv) {
       table << settings[s].name << "," << snrs[k] << "," << count << "," << bias << "," << mean
             << "," << low << "," << high << "," << share << "," << minima / count << ","
             << evaluations / count << "," << seconds / count << "," << failures << "\n";
-      std::printf("%-24s %5.1f | %+8.4f%% | %+8.3f%% %+8.3f%% %+8.3f%% | %5.1f%% | %6.2f %6.1f %6.2fs\n",
-                  settings[s].name.c_str(), snrs[k], 100 * bias, 100 * mean, 100 * low,
-                  100 * high, 100 * share, minima / count, evaluations / count, seconds / count);
+      std::printf(
+          "%-28s %5.1f | %+8.4f%% | %+8.3f%% %+8.3f%% %+8.3f%% | %5.1f%% | %6.2f %6.1f %6.2fs\n",
+          settings[s].name.c_str(), snrs[k], 100 * bias, 100 * mean, 100 * low, 100 * high,
+          100 * share, minima / count, evaluations / count, seconds / count);
     }
   }
   mcrewave::WriteFileAtomically(output_dir + "/settings.csv", table.str());

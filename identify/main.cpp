@@ -207,10 +207,10 @@ int RunIdentify(const RunArguments& arguments) {
         "evaluations, {:.2f} s",
         run.identified_modulus(), config.model.modulus,
         (run.identified_modulus() - config.model.modulus) / config.model.modulus,
-        run.outer.evaluations, run.wall_time_s);
+        run.outer.scan_evaluations + run.outer.evaluations, run.wall_time_s);
   } else {
     spdlog::info("identified E = {:.9g} Pa in {} evaluations, {:.2f} s", run.identified_modulus(),
-                 run.outer.evaluations, run.wall_time_s);
+                 run.outer.scan_evaluations + run.outer.evaluations, run.wall_time_s);
   }
   spdlog::info("wrote {} files to {}", files.size(), config.output.folder);
   return 0;

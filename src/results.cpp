@@ -256,8 +256,10 @@ std::string SummaryYaml(const IdentificationRun& run) {
   yaml.Number(0, "relative_error", run.reference_known ? (identified - reference) / reference : NAN,
               "(identified - reference) / reference (null when unknown)");
   yaml.Number(0, "cost", run.cost(), "[J s] e^2 at the identified modulus");
-  yaml.Integer(0, "evaluations", outer.evaluations, "e^2 evaluations of the outer optimiser");
-  yaml.Integer(0, "sweeps", run.sweeps, "direct + retrograde sweeps of those evaluations");
+  yaml.Integer(0, "evaluations", outer.scan_evaluations + outer.evaluations,
+               "e^2 evaluations of the identification: the scan's and the refinements'");
+  yaml.Integer(0, "sweeps", outer.scan_sweeps + run.sweeps,
+               "direct + retrograde sweeps of those evaluations");
   yaml.Number(0, "wall_time_s", run.wall_time_s,
               "[s] identification, cost curve and uncertainty (not the data)");
 
@@ -294,7 +296,7 @@ std::string SummaryYaml(const IdentificationRun& run) {
   yaml.Text(1, "message", outer.message);
   yaml.Text(1, "optimizer_message", outer.optimizer_message, "the optimiser's own words");
   yaml.Number(1, "initial_modulus", outer.initial_modulus, "[Pa]");
-  yaml.Integer(1, "evaluations", outer.evaluations);
+  yaml.Integer(1, "evaluations", outer.evaluations, "of the local refinements (scan apart)");
   yaml.Integer(1, "gradient_evaluations", outer.gradient_evaluations,
                "of which with the adjoint gradient");
   yaml.Integer(1, "iterations", outer.iterations, "Ceres iterations (-1: NLopt)");
