@@ -65,4 +65,20 @@ plot $seconds_list
 unset multiplot
 GNUPLOT
 mv "$out/complexity.png.tmp" "$out/complexity.png"
+{
+  echo "## Complexity of the coupled solvers (\`complexity/\`)"
+  echo
+  echo "\`complexity.png\` (the paper's Fig. 5): multiply-accumulates and seconds of one coupled"
+  echo "solve against the degrees of freedom n for every solver, the paper's Table 1 formulas"
+  echo "dashed; rows marked 'extrapolated' were timed on fewer steps and scaled."
+  echo "\`methods.csv\`: one row per method and n; \`exponents.csv\`: fitted growth exponents;"
+  echo "\`paper_table1.csv\`: the paper's formulas; \`shooting_breakdown.csv\`: single shooting"
+  echo "as the window grows (docs/riccati_shooting.md). Written by \`scripts/complexity_study.sh\`."
+  echo
+  echo '```'
+  cat "$out/summary.txt"
+  echo '```'
+  echo
+} > "$out/summary.md.tmp"
+mv "$out/summary.md.tmp" "$out/summary.md"
 echo "wrote $out/{methods,paper_table1,exponents,shooting_breakdown}.csv, summary.txt, complexity.png"

@@ -1,16 +1,24 @@
 #!/usr/bin/env bash
-# Builds mcrewave (scripts/build.sh) and regenerates every study of issue 6 and its
-# figures into results/ with `identify study configs/studies.yaml` (include/mcrewave/study.h):
-# results/robustness/, results/relaxation/, results/cost_curves/ (CSV files, PNG figures,
-# summary.md each) and results/README.md (the summaries: what each figure shows, the
-# headline numbers). results/weights, results/complexity and results/robustness_settings
-# come from their own scripts and are left as they are.
-# Usage: scripts/studies.sh [--set key.path=value]...   e.g. --set study.kind=relaxation
-#        (the robustness study at its default 401 identifications takes most of the time)
+# Builds mcrewave (scripts/build.sh) and regenerates every study and figure of
+# results/, then results/README.md gathering their summary.md files:
+#   results/robustness_settings/  bench/robustness_benchmark, 50 seeds (docs/robustness.md)
+#   results/complexity/           scripts/complexity_study.sh (the paper's Table 1, Fig. 5)
+#   results/weights/              scripts/weights_study.sh (docs/weights.md)
+#   results/robustness/, relaxation/, cost_curves/   `identify study configs/studies.yaml`
+#                                 (include/mcrewave/study.h), which writes results/README.md
+# About 25 minutes on 2 cores. Arguments go to `identify study`, and with any of them
+# only the identify studies run, e.g.
+#   bash scripts/studies.sh --set study.kind=relaxation
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${MCREWAVE_BUILD_DIR:-$root/build}"
 
 bash "$root/scripts/build.sh" > /dev/null
 cd "$root"
+if [ "$#" -eq 0 ]; then
+  mkdir -p results/robustness_settings
+  "$build_dir/bench/robustness_benchmark" results/robustness_settings 50
+  bash "$root/scripts/complexity_study.sh"
+  bash "$root/scripts/weights_study.sh"
+fi
 "$build_dir/identify/identify" study configs/studies.yaml --output results "$@"

@@ -39,4 +39,19 @@ set grid
 plot $plot_list
 GNUPLOT
 mv "$out/cost_curves.png.tmp" "$out/cost_curves.png"
+{
+  echo "## MCRE weights (\`weights/\`)"
+  echo
+  echo "How w_u and w_f change the conditioning and the identification on the paper's case"
+  echo "(docs/weights.md): \`weights.csv\` per weight pair (a_max of A = I - G, CG and adaptive"
+  echo "sweeps at E_ref, noise-free error, errors and sampled local minima over the SNR 2.5 seeds,"
+  echo "relative curvature of e^2); \`cost_curves.png\`: e^2 / min e^2 of seed 1 at SNR 2.5."
+  echo "Written by \`scripts/weights_study.sh\`."
+  echo
+  awk -F, 'NR == 1 { printf "|"; for (i = 1; i <= NF; ++i) printf " %s |", $i; printf "\n|";
+                     for (i = 1; i <= NF; ++i) printf "---|"; printf "\n"; next }
+           { printf "|"; for (i = 1; i <= NF; ++i) printf " %s |", $i; printf "\n" }' "$out/weights.csv"
+  echo
+} > "$out/summary.md.tmp"
+mv "$out/summary.md.tmp" "$out/summary.md"
 echo "wrote $out/weights.csv, cost_curves.csv, cost_curves.png"

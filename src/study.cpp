@@ -1035,9 +1035,11 @@ std::string WriteStudiesReadme(const std::string& folder) {
   std::ostringstream md;
   md << "# Results of the studies\n\n"
      << "Written by `identify study` (`bash scripts/studies.sh` regenerates every study, figure "
-        "and this file from configs/studies.yaml); do not edit by hand. Each section below is "
-        "the `summary.md` of its folder.\n\n";
-  for (const char* study : {"robustness", "relaxation", "cost_curves"}) {
+        "and this file: the studies of configs/studies.yaml, then the robustness settings, the "
+        "complexity and the weights studies of bench/); do not edit by hand. Each section below "
+        "is the `summary.md` of its folder.\n\n";
+  for (const char* study : {"robustness", "relaxation", "cost_curves", "robustness_settings",
+                            "complexity", "weights"}) {
     const std::string summary = folder + "/" + study + "/summary.md";
     std::ifstream file(summary);
     if (!file) continue;
