@@ -100,6 +100,15 @@ TEST(GlobalSearchTest, ReturnsTheGlobalMinimumOfARuggedCostWithNloptAndCeres) {
     EXPECT_EQ(summary.scan_evaluations, options.scan_points);
     EXPECT_GT(summary.cost_gap, 0.0);
     EXPECT_GT(summary.second_modulus, 0.0);
+
+    // The case needs the global search: a local search from outer.initial alone
+    // stops in another valley.
+    options.scan_points = 0;
+    McreObjective local_objective(rugged.model, rugged.data, mcre, 0.5, CoupledSolverOptions(),
+                                  options.initial);
+    const IdentificationSummary local = Identify(options, &local_objective);
+    EXPECT_GT(std::abs(local.modulus / global - 1.0), 1e-2)
+        << OptimizerTypeToString(optimizer) << ": " << local.FullReport();
   }
 }
 
