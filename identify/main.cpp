@@ -201,6 +201,8 @@ int RunIdentify(const RunArguments& arguments) {
     const ResultsBeingWritten held;
     files = mcrewave::WriteIdentificationResults(run, config.output.folder, config.output.figures);
   }
+
+  // 5. Brief report.
   if (run.reference_known) {
     spdlog::info(
         "identified E = {:.9g} Pa (reference {:.9g} Pa, relative error {:.3e}) in {} "
@@ -247,6 +249,8 @@ int RunSimulate(const SimulateArguments& arguments) {
 }
 
 int RunStudy(const StudyArguments& arguments) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
   // 1. Read and validate the config and the output folder.
   mcrewave::Config config = mcrewave::LoadConfig(arguments.config_path, arguments.overrides);
   if (!arguments.output_folder.empty()) config.study.folder = arguments.output_folder;
@@ -281,10 +285,16 @@ int RunStudy(const StudyArguments& arguments) {
   }
 
   // 3. The README gathering the studies' summaries.
+  std::string readme;
   {
     const ResultsBeingWritten held;
-    mcrewave::StudyProgressLogger()->info("wrote {}", mcrewave::WriteStudiesReadme(folder));
+    readme = mcrewave::WriteStudiesReadme(folder);
   }
+
+  // 4. Brief report.
+  mcrewave::StudyProgressLogger()->info(
+      "study {} done in {:.1f} s; summaries in {}", mcrewave::StudyKindToString(kind),
+      std::chrono::duration<double>(Clock::now() - start).count(), readme);
   return 0;
 }
 
