@@ -3,8 +3,8 @@
 // on one bad config or bad CSV per class of mistake.
 //
 // Documented tolerance: on configs/quick.yaml the identified E is within 1 % of
-// the 200 GPa of the synthetic data (measured: +0.22 %, with an uncertainty
-// figure of 0.36 %; over 12 noise seeds the spread is 0.36 %), and NLopt and
+// the 200 GPa of the synthetic data (measured: +0.19 %, with an uncertainty
+// figure of 0.35 %; over 12 noise seeds the spread is 0.36 %), and NLopt and
 // Ceres agree to 1e-6 relative.
 #include <gtest/gtest.h>
 
