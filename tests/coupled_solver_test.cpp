@@ -319,5 +319,31 @@ TEST(AdaptiveRelaxationTest, SweepsAreStartLanczosAndTwoPerIteration) {
       << summary.FullReport();
 }
 
+// The integrator is factorised once per (E, h): by SetModulus, never by a solve.
+TEST(FactorisationCountTest, OnePerModulusWhateverTheSolvesAtThatModulus) {
+  ProblemBundle bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(0.01, 1.0));
+  McreProblem& problem = bundle.problem;
+  const int after_construction = problem.factorization_count();
+  EXPECT_EQ(after_construction, 1);  // the constructor sets the reference modulus
+
+  problem.SetModulus(0.9 * kReferenceModulus);
+  EXPECT_EQ(problem.factorization_count(), after_construction + 1);
+  const Solved cg = Solve(Options(CoupledSolverType::kConjugateGradient, 1e-10), &problem);
+  ASSERT_TRUE(cg.summary.IsSolutionUsable()) << cg.summary.FullReport();
+  const Solved adaptive = Solve(Options(CoupledSolverType::kAdaptiveRelaxation, 1e-10), &problem);
+  ASSERT_TRUE(adaptive.summary.IsSolutionUsable()) << adaptive.summary.FullReport();
+  EXPECT_GT(cg.summary.sweeps + adaptive.summary.sweeps, 100);  // many sweeps, no factorisation
+  // Setting the same modulus again does not refactorise either.
+  problem.SetModulus(0.9 * kReferenceModulus);
+  EXPECT_EQ(problem.factorization_count(), after_construction + 1);
+
+  problem.SetModulus(1.1 * kReferenceModulus);
+  EXPECT_EQ(problem.factorization_count(), after_construction + 2);
+  const Solved warm = Solve(Options(CoupledSolverType::kConjugateGradient, 1e-10), &problem,
+                            &cg.solution.retrograde);
+  ASSERT_TRUE(warm.summary.IsSolutionUsable()) << warm.summary.FullReport();
+  EXPECT_EQ(problem.factorization_count(), after_construction + 2);
+}
+
 }  // namespace
 }  // namespace mcrewave
