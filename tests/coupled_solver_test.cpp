@@ -232,5 +232,118 @@ TEST(DivergenceTest, PaperCaseWithOmegaOneIsReportedAsDivergingAndAdaptiveConver
             2.0 / (adaptive.summary.spectrum_max / options.spectrum_safety_factor));
 }
 
+// A = I - G applied to x: 2 sweeps.
+Matrix ApplyReducedOperator(McreProblem* problem, const Matrix& x) {
+  Matrix scratch, image;
+  problem->ApplyIterationMap(x, &scratch, &image);
+  return x - image;
+}
+
+// The adaptive relaxation's safeguard: when the Lanczos estimate misses a_max, the
+// residual grows, omega is re-chosen from the observed growth, and the solve still
+// converges to the all-at-once solution.
+//
+// Small spectrum_steps and a unit safety factor alone do not miss a_max here: the
+// rigid-body eigenvector of a_max dominates the start residual c (measured: 99 % of
+// ||c||_P at w_u = 1, 20 elements, 200 steps), so 2 Lanczos steps find a_max = 343
+// to 5 digits and no restart occurs. The start is therefore warm, W^(0) = W* + d with
+// W* the all-at-once solution and d = c minus its P-projection on that eigenvector:
+// the start residual -A d has no component along it, so the estimate sees only the
+// rest of the spectrum (next eigenvalue 21), omega comes out far too large and
+// the component that round-off puts back grows until the safeguard re-chooses omega
+// (measured: 1 restart, a_max re-estimated at 342.6).
+TEST(AdaptiveRelaxationTest, SafeguardRestartsAfterAnUnderestimatedSpectrumAndConverges) {
+  ProblemBundle bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(1.0, 1.0));
+  McreProblem& problem = bundle.problem;
+  problem.SetModulus(0.9 * kReferenceModulus);
+  const Solved reference = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-8), &problem);
+  ASSERT_TRUE(reference.summary.IsSolutionUsable()) << reference.summary.FullReport();
+
+  // c = T(0), and the eigenvector of a_max by power iteration from c (the next
+  // eigenvalue is 16x smaller: 12 iterations converge it to round-off).
+  Matrix displacement, rhs;
+  problem.FixedPointMap(problem.ZeroField(), &displacement, &rhs);
+  Matrix top = rhs / problem.Norm(rhs);
+  double a_max = 0.0;
+  for (int i = 0; i < 12; ++i) {
+    const Matrix image = ApplyReducedOperator(&problem, top);
+    a_max = problem.InnerProduct(top, image);
+    top = image / problem.Norm(image);
+  }
+  ASSERT_GT(a_max, 100.0);  // w_u = 1: a_max is large (3.4e2)
+  const Matrix deflated = rhs - problem.InnerProduct(rhs, top) * top;
+  const Matrix warm_start = reference.solution.retrograde + deflated;
+
+  CoupledSolverOptions options = Options(CoupledSolverType::kAdaptiveRelaxation, 1e-12);
+  options.spectrum_estimation_steps = 2;
+  options.spectrum_safety_factor = 1.0;
+  const Solved adaptive = Solve(options, &problem, &warm_start);
+  const CoupledSolverSummary& summary = adaptive.summary;
+  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+  EXPECT_GE(summary.safeguard_restarts, 1) << summary.FullReport();
+  // The final omega lies inside the convergence range 2 / a_max of the true spectrum.
+  EXPECT_LT(summary.relaxation_coefficient, 2.0 / a_max) << summary.FullReport();
+  EXPECT_GE(summary.spectrum_max, 0.9 * a_max) << summary.FullReport();
+
+  const testing::Agreement agreement = Compare(adaptive, reference);
+  EXPECT_LT(agreement.displacement, 1e-8);
+  EXPECT_LT(agreement.retrograde, 1e-8);
+  EXPECT_LT(agreement.cost, 1e-8);
+
+  // Sweeps as src/iterative_coupled_solvers.cpp spends them: 5 for a warm start
+  // (Start: T(W^(0)), c and W_u), 2 per Lanczos step, and 2 per iteration, the
+  // iterations that restart from the best iterate included (each is one
+  // FixedPointMap); the last iteration only tests convergence.
+  constexpr int kWarmStartSweeps = 5;
+  EXPECT_EQ(summary.sweeps,
+            kWarmStartSweeps + 2 * options.spectrum_estimation_steps + 2L * summary.iterations)
+      << summary.FullReport();
+  EXPECT_EQ(summary.residual_history.size(), static_cast<std::size_t>(summary.iterations) + 1);
+}
+
+// The same accounting from a cold start: 3 sweeps (Direct(0); T(0) = c and W_u
+// batched), 2 per Lanczos step, 2 per iteration.
+TEST(AdaptiveRelaxationTest, SweepsAreStartLanczosAndTwoPerIteration) {
+  ProblemBundle bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(0.01, 1.0));
+  McreProblem& problem = bundle.problem;
+  problem.SetModulus(0.9 * kReferenceModulus);
+  CoupledSolverOptions options = Options(CoupledSolverType::kAdaptiveRelaxation, 1e-10);
+  options.spectrum_estimation_steps = 5;
+  const Solved adaptive = Solve(options, &problem);
+  const CoupledSolverSummary& summary = adaptive.summary;
+  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+  EXPECT_EQ(summary.safeguard_restarts, 0);
+  constexpr int kColdStartSweeps = 3;
+  EXPECT_EQ(summary.sweeps,
+            kColdStartSweeps + 2 * options.spectrum_estimation_steps + 2L * summary.iterations)
+      << summary.FullReport();
+}
+
+// The integrator is factorised once per (E, h): by SetModulus, never by a solve.
+TEST(FactorisationCountTest, OnePerModulusWhateverTheSolvesAtThatModulus) {
+  ProblemBundle bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(0.01, 1.0));
+  McreProblem& problem = bundle.problem;
+  const int after_construction = problem.factorization_count();
+  EXPECT_EQ(after_construction, 1);  // the constructor sets the reference modulus
+
+  problem.SetModulus(0.9 * kReferenceModulus);
+  EXPECT_EQ(problem.factorization_count(), after_construction + 1);
+  const Solved cg = Solve(Options(CoupledSolverType::kConjugateGradient, 1e-10), &problem);
+  ASSERT_TRUE(cg.summary.IsSolutionUsable()) << cg.summary.FullReport();
+  const Solved adaptive = Solve(Options(CoupledSolverType::kAdaptiveRelaxation, 1e-10), &problem);
+  ASSERT_TRUE(adaptive.summary.IsSolutionUsable()) << adaptive.summary.FullReport();
+  EXPECT_GT(cg.summary.sweeps + adaptive.summary.sweeps, 100);  // many sweeps, no factorisation
+  // Setting the same modulus again does not refactorise either.
+  problem.SetModulus(0.9 * kReferenceModulus);
+  EXPECT_EQ(problem.factorization_count(), after_construction + 1);
+
+  problem.SetModulus(1.1 * kReferenceModulus);
+  EXPECT_EQ(problem.factorization_count(), after_construction + 2);
+  const Solved warm = Solve(Options(CoupledSolverType::kConjugateGradient, 1e-10), &problem,
+                            &cg.solution.retrograde);
+  ASSERT_TRUE(warm.summary.IsSolutionUsable()) << warm.summary.FullReport();
+  EXPECT_EQ(problem.factorization_count(), after_construction + 2);
+}
+
 }  // namespace
 }  // namespace mcrewave

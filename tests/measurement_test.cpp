@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -154,9 +155,47 @@ TEST_F(MeasurementTest, TimeNotIncreasing) {
 }
 
 TEST_F(MeasurementTest, NonUniformTime) {
-  ExpectReadError("t,u0,uL,f0,fL\n0,1,2,3,4\n1,1,2,3,4\n2,1,2,3,4\n3.5,1,2,3,4\n", 3,
-                  "time step 1 s differs from the file's mean step 1.16667 s by more than 1e-6 "
-                  "relative");
+  ExpectReadError("t,u0,uL,f0,fL\n0,1,2,3,4\n1,1,2,3,4\n2,1,2,3,4\n3.5,1,2,3,4\n", 5,
+                  "time step 1.5 s (from t = 2 s on the previous row), expected the file's step "
+                  "1 s (the median step) within 1e-6 relative");
+}
+
+// A file of `rows` data rows at t = 0.5 k s, the values of the rows with k in
+// `skipped` left out (so it holds rows - skipped.size() rows) and, with
+// `extra_time` >= 0, one more row at that time in its place.
+std::string UniformFile(int rows, const std::vector<int>& skipped, double extra_time = -1.0) {
+  std::string content = "t,u0,uL,f0,fL\n";
+  for (int k = 0; k < rows; ++k) {
+    const double time = 0.5 * k;  // [s]
+    if (extra_time >= 0.0 && extra_time < time && extra_time > time - 0.5) {
+      content += std::to_string(extra_time) + ",1,2,3,4\n";
+    }
+    if (std::find(skipped.begin(), skipped.end(), k) != skipped.end()) continue;
+    content += std::to_string(time) + ",1,2,3,4\n";
+  }
+  return content;
+}
+
+// One sample missing in the middle: the row after the gap (t = 19.5 s, data row 38,
+// line 40) is reported, with the step found there and the expected one.
+TEST_F(MeasurementTest, MissingSampleIsReportedWhereItsGapEnds) {
+  ExpectReadError(UniformFile(101, {38}), 40,
+                  "time step 1 s (from t = 18.5 s on the previous row), expected the file's step "
+                  "0.5 s (the median step)");
+  // The second sample missing: the first step is the bad one, reported at line 3.
+  ExpectReadError(UniformFile(101, {1}), 3, "time step 1 s (from t = 0 s on the previous row)");
+  // The last sample but one missing: the last row, line 101.
+  ExpectReadError(UniformFile(101, {99}), 101, "time step 1 s (from t = 49 s on the previous row)");
+  // A row too many at t = 30.25 s, after t = 30 s (data row 60): line 63.
+  ExpectReadError(UniformFile(101, {}, 30.25), 63,
+                  "time step 0.25 s (from t = 30 s on the previous row), expected the file's "
+                  "step 0.5 s");
+}
+
+TEST_F(MeasurementTest, UniformFileIsRead) {
+  const MeasurementSet set = ReadMeasurementCsv(WriteFile("data.csv", UniformFile(101, {})));
+  EXPECT_EQ(set.num_steps(), 100);
+  EXPECT_EQ(set.time_step, 0.5);
 }
 
 TEST_F(MeasurementTest, OnlyOneRow) {

@@ -93,6 +93,9 @@ class McreProblem {
 
   // Number of sweeps (direct + retrograde) run since construction.
   long sweep_count() const { return sweep_count_; }
+  // Number of factorisations of the integrator's iteration matrix since construction
+  // (the constructor's SetModulus included): one per change of modulus.
+  int factorization_count() const { return integrator_.factorization_count(); }
 
   // Work fields of the iterative coupled solvers, kept with the problem between
   // solves so that a solve on a problem solved before allocates no field (a fresh

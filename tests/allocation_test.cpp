@@ -1,0 +1,308 @@
+// No heap allocation in the time loops: once initialised, ThetaIntegrator's steps
+// and sweeps and McreProblem's sweeps (outputs preallocated) neither allocate nor
+// free memory.
+//
+// Allocations are counted by replacing the C allocator of this test binary (malloc,
+// calloc, realloc, free: glibc's documented way of replacing malloc) with
+// pass-throughs to glibc's own functions (__libc_malloc, ...) that count, on the
+// calling thread, while its flag is set. The C allocator rather than operator new:
+// Eigen's dense matrices and vectors allocate with std::malloc directly, and
+// libstdc++'s operator new calls malloc, so both are seen (the aligned allocation
+// functions stay glibc's: neither Eigen nor the sweeps use them). The replacement
+// applies to the whole test binary and only forwards. Under AddressSanitizer, which
+// brings its own allocator, nothing is replaced and these tests are skipped.
+#include <gtest/gtest.h>
+
+#include <cstddef>
+#include <cstdlib>
+#include <vector>
+
+#include "mcrewave/bar_model.h"
+#include "mcrewave/mcre_problem.h"
+#include "mcrewave/theta_integrator.h"
+#include "test_problems.h"
+
+#if defined(__SANITIZE_ADDRESS__)
+#define MCREWAVE_ADDRESS_SANITIZER 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define MCREWAVE_ADDRESS_SANITIZER 1
+#endif
+#endif
+
+#if defined(__GLIBC__) && !defined(MCREWAVE_ADDRESS_SANITIZER)
+#define MCREWAVE_COUNTS_ALLOCATIONS 1
+#else
+#define MCREWAVE_COUNTS_ALLOCATIONS 0
+#endif
+
+namespace {
+
+// Heap calls of this thread while counting_heap_calls is set. Constant-initialised
+// thread_local of the executable: reading them from malloc allocates nothing.
+thread_local bool counting_heap_calls = false;
+thread_local long allocation_count = 0;    // malloc, calloc, realloc
+thread_local long deallocation_count = 0;  // free of a non-null pointer
+
+}  // namespace
+
+#if MCREWAVE_COUNTS_ALLOCATIONS
+extern "C" {
+void* __libc_malloc(std::size_t size) noexcept;
+void* __libc_calloc(std::size_t count, std::size_t size) noexcept;
+void* __libc_realloc(void* pointer, std::size_t size) noexcept;
+void __libc_free(void* pointer) noexcept;
+
+void* malloc(std::size_t size) noexcept {
+  if (counting_heap_calls) ++allocation_count;
+  return __libc_malloc(size);
+}
+void* calloc(std::size_t count, std::size_t size) noexcept {
+  if (counting_heap_calls) ++allocation_count;
+  return __libc_calloc(count, size);
+}
+void* realloc(void* pointer, std::size_t size) noexcept {
+  if (counting_heap_calls) ++allocation_count;
+  return __libc_realloc(pointer, size);
+}
+void free(void* pointer) noexcept {
+  if (counting_heap_calls && pointer != nullptr) ++deallocation_count;
+  __libc_free(pointer);
+}
+}  // extern "C"
+#endif
+
+namespace mcrewave {
+namespace {
+
+using testing::MakeSmallCase;
+using testing::ProblemBundle;
+using testing::Weights;
+
+struct HeapCalls {
+  long allocations = 0;
+  long deallocations = 0;
+};
+
+// The heap calls `work` makes on this thread.
+template <typename Work>
+HeapCalls CountHeapCalls(Work&& work) {
+  allocation_count = 0;
+  deallocation_count = 0;
+  counting_heap_calls = true;
+  work();
+  counting_heap_calls = false;
+  return {allocation_count, deallocation_count};
+}
+
+// Keeps a pointer observable so that the compiler cannot elide its allocation.
+void* volatile pointer_sink = nullptr;
+
+#define SKIP_WITHOUT_ALLOCATION_COUNTING()                                                  \
+  if (!MCREWAVE_COUNTS_ALLOCATIONS) {                                                       \
+    GTEST_SKIP() << "allocation counting needs glibc's allocator (not AddressSanitizer's)"; \
+  }
+
+// The counter itself: deliberate allocations are seen, and nothing outside the
+// counted region is.
+TEST(AllocationCounterTest, CountsDeliberateAllocations) {
+  SKIP_WITHOUT_ALLOCATION_COUNTING();
+  const HeapCalls standard_vector = CountHeapCalls([] {
+    std::vector<double> values(100, 1.0);
+    pointer_sink = values.data();
+  });
+  EXPECT_EQ(standard_vector.allocations, 1);
+  EXPECT_EQ(standard_vector.deallocations, 1);
+  // Eigen's dense storage goes through std::malloc, not operator new.
+  const HeapCalls eigen_vector = CountHeapCalls([] {
+    Vector values = Vector::Constant(100, 1.0);
+    pointer_sink = values.data();
+  });
+  EXPECT_EQ(eigen_vector.allocations, 1);
+  EXPECT_EQ(eigen_vector.deallocations, 1);
+  const HeapCalls nothing = CountHeapCalls([] { pointer_sink = nullptr; });
+  EXPECT_EQ(nothing.allocations, 0);
+  EXPECT_EQ(nothing.deallocations, 0);
+}
+
+// A 20-element bar at the paper's Courant number, 200 steps.
+constexpr int kElements = 20;
+constexpr int kSteps = 200;
+constexpr double kTimeStep = 0.36e-6 * 100.0 / kElements;  // h [s]
+constexpr double kModulus = 200e9;                         // E [Pa]
+
+// The bar's K, or with `banded` a K of half bandwidth 2 (every node also coupled to
+// its second neighbour), so that the integrator leaves its tridiagonal fast path.
+SparseMatrix TestStiffness(const BarModel& model, bool banded) {
+  SparseMatrix stiffness = model.Stiffness(kModulus);
+  if (!banded) return stiffness;
+  const int n = model.num_nodes();
+  const double k = 0.1 * kModulus * model.unit_stiffness().coeff(0, 0);  // [N/m]
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int i = 0; i + 2 < n; ++i) {
+    entries.emplace_back(i, i, k);
+    entries.emplace_back(i + 2, i + 2, k);
+    entries.emplace_back(i, i + 2, -k);
+    entries.emplace_back(i + 2, i, -k);
+  }
+  SparseMatrix second_neighbours(n, n);
+  second_neighbours.setFromTriplets(entries.begin(), entries.end());
+  return stiffness + second_neighbours;
+}
+
+class IntegratorAllocationTest : public ::testing::TestWithParam<bool> {};
+
+TEST_P(IntegratorAllocationTest, StepsAndSweepsAllocateNothingAfterInit) {
+  SKIP_WITHOUT_ALLOCATION_COUNTING();
+  BarProperties bar;
+  bar.elements = kElements;
+  const BarModel model(bar);
+  ThetaIntegratorOptions options;
+  options.time_step = kTimeStep;
+  ThetaIntegrator integrator;
+  integrator.Init(model.mass(), TestStiffness(model, GetParam()), options);
+  const int n = integrator.size(), last = n - 1;
+
+  // States [m/s, m] and a unit end force [N], all preallocated.
+  Matrix velocity = Matrix::Zero(n, kSteps + 1), displacement = Matrix::Zero(n, kSteps + 1);
+  Vector force = Vector::Zero(n);
+  force[last] = 1.0;
+  const Vector shift = Vector::Constant(n, 1e-9);  // z [m]
+  const HeapCalls steps = CountHeapCalls([&] {
+    for (int k = 0; k < kSteps; ++k) {
+      integrator.Step(velocity.col(k), displacement.col(k), force, velocity.col(k + 1),
+                      displacement.col(k + 1));
+    }
+  });
+  EXPECT_EQ(steps.allocations, 0);
+  EXPECT_EQ(steps.deallocations, 0);
+  EXPECT_GT(displacement.col(kSteps).norm(), 0.0);  // the steps ran
+
+  const HeapCalls end_load_steps = CountHeapCalls([&] {
+    for (int k = 0; k < kSteps; ++k) {
+      integrator.StepWithEndLoads(velocity.col(k), displacement.col(k), shift, 1.0, -1.0,
+                                  velocity.col(k + 1), displacement.col(k + 1));
+      integrator.StepWithEndLoads(velocity.col(k), displacement.col(k), 1.0, -1.0,
+                                  velocity.col(k + 1), displacement.col(k + 1));
+    }
+  });
+  EXPECT_EQ(end_load_steps.allocations, 0);
+  EXPECT_EQ(end_load_steps.deallocations, 0);
+
+  // Three independent steps at once, from three columns into three others.
+  const HeapCalls batched_steps = CountHeapCalls([&] {
+    for (int k = 0; k + 6 <= kSteps; k += 6) {
+      const double* v_k[3] = {velocity.col(k).data(), velocity.col(k + 1).data(),
+                              velocity.col(k + 2).data()};
+      const double* u_k[3] = {displacement.col(k).data(), displacement.col(k + 1).data(),
+                              displacement.col(k + 2).data()};
+      const double* z[3] = {shift.data(), nullptr, shift.data()};
+      const double f0[3] = {1.0, 0.0, -1.0}, fL[3] = {0.0, 1.0, 2.0};
+      double* v_next[3] = {velocity.col(k + 3).data(), velocity.col(k + 4).data(),
+                           velocity.col(k + 5).data()};
+      double* u_next[3] = {displacement.col(k + 3).data(), displacement.col(k + 4).data(),
+                           displacement.col(k + 5).data()};
+      integrator.StepsWithEndLoads<3>(v_k, u_k, z, f0, fL, v_next, u_next);
+    }
+  });
+  EXPECT_EQ(batched_steps.allocations, 0);
+  EXPECT_EQ(batched_steps.deallocations, 0);
+
+  const Vector zero = Vector::Zero(n);
+  auto end_force = [last](int k, Eigen::Ref<Vector> f) {
+    f.setZero();
+    f[last] = 1.0 + 0.01 * k;  // [N]
+  };
+  int observed = 0;
+  auto record = [&](int k, const Vector& v, const Vector& u) {
+    velocity.col(k) = v;
+    displacement.col(k) = u;
+    ++observed;
+  };
+  const HeapCalls forward_sweep =
+      CountHeapCalls([&] { integrator.SweepForward(kSteps, zero, zero, end_force, record); });
+  EXPECT_EQ(forward_sweep.allocations, 0);
+  EXPECT_EQ(forward_sweep.deallocations, 0);
+  EXPECT_EQ(observed, kSteps + 1);
+  EXPECT_GT(displacement.col(kSteps).norm(), 0.0);
+
+  const Vector final_velocity = velocity.col(kSteps), final_displacement = displacement.col(kSteps);
+  observed = 0;
+  const HeapCalls backward_sweep = CountHeapCalls([&] {
+    integrator.SweepBackward(kSteps, final_velocity, final_displacement, end_force, record);
+  });
+  EXPECT_EQ(backward_sweep.allocations, 0);
+  EXPECT_EQ(backward_sweep.deallocations, 0);
+  EXPECT_EQ(observed, kSteps + 1);
+}
+
+INSTANTIATE_TEST_SUITE_P(TridiagonalAndBanded, IntegratorAllocationTest,
+                         ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& info) {
+                           return info.param ? "Banded" : "Tridiagonal";
+                         });
+
+TEST(McreProblemAllocationTest, SweepsIntoPreallocatedFieldsAllocateNothing) {
+  SKIP_WITHOUT_ALLOCATION_COUNTING();
+  ProblemBundle bundle(MakeSmallCase(kElements, kSteps, 5.0, 2), Weights(0.01, 1.0));
+  McreProblem& problem = bundle.problem;
+  problem.SetModulus(0.9 * testing::kReferenceModulus);
+  // Preallocated fields, n x (m + 1); the solvers' workspace (its zero field) too.
+  Matrix displacement = problem.ZeroField(), retrograde = problem.ZeroField();
+  Matrix displacement_2 = problem.ZeroField(), retrograde_2 = problem.ZeroField();
+  Matrix displacement_3 = problem.ZeroField(), retrograde_3 = problem.ZeroField();
+  Matrix image = problem.ZeroField();
+  problem.workspace();
+  // A non-zero retrograde field to drive the direct sweeps: W_u = Retrograde(0).
+  problem.RetrogradeSweep(problem.ZeroField(), true, &retrograde);
+  ASSERT_GT(retrograde.norm(), 0.0);
+  const long sweeps_before = problem.sweep_count();
+
+  const HeapCalls direct = CountHeapCalls([&] {
+    problem.DirectSweep(retrograde, true, &displacement);
+    problem.DirectSweep(retrograde, false, &displacement_2);
+  });
+  EXPECT_EQ(direct.allocations, 0);
+  EXPECT_EQ(direct.deallocations, 0);
+  EXPECT_GT(displacement.norm(), 0.0);
+  EXPECT_GT(displacement_2.norm(), 0.0);
+
+  const HeapCalls retrograde_sweeps = CountHeapCalls([&] {
+    problem.RetrogradeSweep(displacement, true, &retrograde_2);
+    problem.RetrogradeSweep(displacement, false, &retrograde_3);
+  });
+  EXPECT_EQ(retrograde_sweeps.allocations, 0);
+  EXPECT_EQ(retrograde_sweeps.deallocations, 0);
+  EXPECT_GT(retrograde_2.norm(), 0.0);
+  EXPECT_GT(retrograde_3.norm(), 0.0);
+
+  // The batched sweeps, with their argument lists built beforehand.
+  const std::vector<const Matrix*> retrograde_inputs{&retrograde, nullptr, &retrograde_2};
+  const std::vector<Matrix*> displacement_outputs{&displacement, &displacement_2, &displacement_3};
+  const std::vector<const Matrix*> displacement_inputs{&displacement, nullptr, &displacement_2};
+  const std::vector<Matrix*> retrograde_outputs{&retrograde_3, &image, &retrograde_2};
+  const std::vector<const Matrix*> one_retrograde{nullptr}, one_displacement{&displacement};
+  const std::vector<Matrix*> one_displacement_output{&displacement_3},
+      one_retrograde_output{&image};
+  const HeapCalls batched = CountHeapCalls([&] {
+    problem.DirectSweepsWithData(retrograde_inputs, displacement_outputs);
+    problem.RetrogradeSweepsWithData(displacement_inputs, retrograde_outputs);
+    problem.DirectSweepsWithData(one_retrograde, one_displacement_output);
+    problem.RetrogradeSweepsWithData(one_displacement, one_retrograde_output);
+  });
+  EXPECT_EQ(batched.allocations, 0);
+  EXPECT_EQ(batched.deallocations, 0);
+
+  // The compositions the solvers iterate on.
+  const HeapCalls maps = CountHeapCalls([&] {
+    problem.FixedPointMap(retrograde, &displacement, &image);
+    problem.ApplyIterationMap(retrograde, &displacement_2, &image);
+  });
+  EXPECT_EQ(maps.allocations, 0);
+  EXPECT_EQ(maps.deallocations, 0);
+  // 2 direct, 2 retrograde, 3 + 3 + 1 + 1 batched, 2 + 2 in the maps.
+  EXPECT_EQ(problem.sweep_count() - sweeps_before, 16);
+}
+
+}  // namespace
+}  // namespace mcrewave
