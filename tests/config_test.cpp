@@ -449,6 +449,40 @@ TEST_F(ConfigFileTest, TruthRefinementOutOfRange) {
                   {"data.truth_refinement must be an integer in [1, 64], got 65"});
 }
 
+TEST_F(ConfigFileTest, PrefilterCutoffAtOrAboveNyquistIsRefused) {
+  // time.step 2 us: Nyquist 250 kHz.
+  const std::string time = "time:\n  window: 1e-3\n  step: 2e-6\n";
+  ExpectLoadError(time + "prefilter:\n  cutoff_frequency: 250e3\n", 5,
+                  {"prefilter.cutoff_frequency (250000 Hz) must be below the Nyquist frequency "
+                   "0.5 / time.step = 250000 Hz (time.step = 2e-06 s)"});
+  ExpectLoadError(time + "prefilter:\n  enabled: false\n  cutoff_frequency: 1e9\n", 6,
+                  {"prefilter.cutoff_frequency (1e+09 Hz) must be below the Nyquist "
+                   "frequency"});
+  EXPECT_EQ(LoadConfig(WriteFile("below.yaml", time + "prefilter:\n  cutoff_frequency: 249999\n"))
+                .prefilter.cutoff_frequency,
+            249999.0);
+  // 0 (derived from the data) is not compared.
+  EXPECT_EQ(LoadConfig(WriteFile("zero.yaml", time + "prefilter:\n  cutoff_frequency: 0\n"))
+                .prefilter.cutoff_frequency,
+            0.0);
+}
+
+TEST_F(ConfigFileTest, PrefilterCutoffAboveNyquistIsPlacedWhereEitherKeyWasSet) {
+  // The default time.step 0.36 us: Nyquist 1388888.9 Hz; the override names itself.
+  const std::string defaults = WriteFile("defaults.yaml", "");
+  ExpectInputError([&defaults] { LoadConfig(defaults, {"prefilter.cutoff_frequency=1.5e6"}); },
+                   {"--set prefilter.cutoff_frequency=1.5e6: prefilter.cutoff_frequency "
+                    "(1.5e+06 Hz) must be below the Nyquist frequency 0.5 / time.step = "
+                    "1388888.888888889 Hz"});
+  // A cut-off valid at the file's step, made invalid by a coarser step override:
+  // placed on the cut-off's line (the key the message names first).
+  const std::string path = WriteFile("config.yaml", "prefilter:\n  cutoff_frequency: 300e3\n");
+  EXPECT_EQ(LoadConfig(path).prefilter.cutoff_frequency, 300e3);
+  ExpectInputError([&path] { LoadConfig(path, {"time.step=2e-6"}); },
+                   {path + ":2: prefilter.cutoff_frequency (300000 Hz) must be below the Nyquist "
+                           "frequency 0.5 / time.step = 250000 Hz (time.step = 2e-06 s)"});
+}
+
 TEST_F(ConfigFileTest, CsvSourceWithoutPath) {
   ExpectLoadError("data:\n  source: csv\n", 2, {"data.path must name a measurement CSV file"});
 }

@@ -29,9 +29,9 @@
 //          max_time [600 s], scan_points [41], scan_tolerance [1e-4],
 //          scan_threads [2], refine_candidates [2] (IdentificationOptions,
 //          identification.h)
-//   prefilter: enabled [true], cutoff_frequency [0 Hz: derived from the data],
-//          order [4] (PrefilterOptions, prefilter.h; applied to the measurements
-//          before the identification)
+//   prefilter: enabled [true], cutoff_frequency [0 Hz: derived from the data;
+//          else below the Nyquist frequency 0.5 / time.step], order [4] (PrefilterOptions,
+//          prefilter.h; applied to the measurements before the identification)
 //   uncertainty: samples [16], seed [1] (modulus_uncertainty.h)
 //   output: folder ["results/identify"], figures [true], curve_points [41]
 //   study: kind [all | robustness | relaxation | cost_curves], folder ["results"],
