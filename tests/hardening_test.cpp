@@ -3,8 +3,8 @@
 // paper's, meshes and files too large for memory, dead, spiked or mis-scaled
 // channels. Each either works, or stops with exit code 1 or 2 and one line saying
 // why, writing nothing.
-#include <gtest/gtest.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -80,7 +80,8 @@ pid_t StartIdentify(const std::vector<std::string>& arguments, const std::string
     ::dup2(out, 1);
     ::dup2(out, 2);
     std::vector<char*> argv = {const_cast<char*>(MCREWAVE_IDENTIFY_BINARY)};
-    for (const std::string& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));
+    for (const std::string& argument : arguments)
+      argv.push_back(const_cast<char*>(argument.c_str()));
     argv.push_back(nullptr);
     ::execv(MCREWAVE_IDENTIFY_BINARY, argv.data());
     ::_exit(127);
@@ -160,8 +161,8 @@ TEST(InterruptedWritingTest, ASignalWhileResultsAreWrittenLeavesACompleteSet) {
   int interrupted = 0;
   for (double fraction = 0.6; fraction <= 1.3; fraction += 0.1) {
     const std::string log = dir + "/run.log";
-    const pid_t pid = StartIdentify({"run", SourcePath("configs/quick.yaml"), "-q", "-o", folder},
-                                    log);
+    const pid_t pid =
+        StartIdentify({"run", SourcePath("configs/quick.yaml"), "-q", "-o", folder}, log);
     ASSERT_GT(pid, 0);
     std::this_thread::sleep_for(std::chrono::duration<double>(fraction * run_seconds));
     ::kill(pid, SIGTERM);
@@ -213,8 +214,7 @@ TEST(ExtremeInputTest, LongWindowFailsSingleShootingAndFixedOmegaRelaxationWithA
       RunIdentify("run " + SourcePath("configs/quick.yaml") + " -q -o " + dir + "/shooting" +
                   kLongWindow + " --set inner.method=single_shooting");
   EXPECT_EQ(shooting.exit_code, 1) << shooting.output;
-  EXPECT_NE(ErrorLine(shooting.output)
-                .find("is not usable: single_shooting: failure"),
+  EXPECT_NE(ErrorLine(shooting.output).find("is not usable: single_shooting: failure"),
             std::string::npos)
       << shooting.output;
   EXPECT_NE(ErrorLine(shooting.output).find("over 1200 steps"), std::string::npos);
@@ -251,8 +251,8 @@ TEST(ExtremeInputLongTest, LongWindowRiccatiAndConjugateGradientsAgree) {
 TEST(ExtremeInputTest, HundredThousandElementsAreRefusedWithTheMemoryNeeded) {
   const std::string dir = FreshDirectory("hardening_1e5_elements");
   const std::string big = " --set model.elements=100000 --set data.truth_refinement=1 -q -o ";
-  const RunResult iterative = RunIdentify("run " + SourcePath("configs/quick.yaml") + big + dir +
-                                          "/cg");
+  const RunResult iterative =
+      RunIdentify("run " + SourcePath("configs/quick.yaml") + big + dir + "/cg");
   EXPECT_EQ(iterative.exit_code, 1) << iterative.output;
   // 10 fields of 100001 x 301 doubles.
   EXPECT_NE(ErrorLine(iterative.output)
@@ -300,8 +300,9 @@ TEST(ExtremeInputTest, AMillionRowCsvIsReadInBoundedMemoryWithProgress) {
   for (const char* progress : {"read 250000 rows", "read 500000 rows", "read 1000000 rows"}) {
     EXPECT_NE(run.output.find(csv + ": " + progress), std::string::npos) << run.output;
   }
-  EXPECT_NE(ErrorLine(run.output).find(csv + ": 1000000 samples, but time.window / time.step + 1 "
-                                             "= 301"),
+  EXPECT_NE(ErrorLine(run.output)
+                .find(csv + ": 1000000 samples, but time.window / time.step + 1 "
+                            "= 301"),
             std::string::npos)
       << run.output;
   // The columns take 40 MB (80 while they are copied into the set); the peak of
@@ -321,8 +322,8 @@ class SpoiledDataTest : public ::testing::Test {
   void SetUp() override {
     dir_ = FreshDirectory(std::string("hardening_") +
                           ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    const RunResult simulated =
-        RunIdentify("simulate " + SourcePath("configs/quick.yaml") + " -q -o " + dir_ + "/clean.csv");
+    const RunResult simulated = RunIdentify("simulate " + SourcePath("configs/quick.yaml") +
+                                            " -q -o " + dir_ + "/clean.csv");
     ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
     clean_ = ReadMeasurementCsv(dir_ + "/clean.csv");
   }
@@ -331,10 +332,10 @@ class SpoiledDataTest : public ::testing::Test {
   // whenever the run fails.
   RunResult RunOn(const MeasurementSet& data) {
     WriteMeasurementCsv(data, dir_ + "/spoiled.csv");
-    const RunResult run =
-        RunIdentify("run " + SourcePath("configs/quick.yaml") + " -q -o " + dir_ +
-                    "/results --set output.figures=false --set data.source=csv --set data.path=" +
-                    dir_ + "/spoiled.csv");
+    const RunResult run = RunIdentify(
+        "run " + SourcePath("configs/quick.yaml") + " -q -o " + dir_ +
+        "/results --set output.figures=false --set data.source=csv --set data.path=" + dir_ +
+        "/spoiled.csv");
     if (run.exit_code != 0) {
       EXPECT_FALSE(fs::exists(dir_ + "/results"));
     }
@@ -395,9 +396,10 @@ TEST_F(SpoiledDataTest, DisplacementInMicrometresEndsOnABoundAndIsRefused) {
   data.uL *= 1e6;
   const RunResult run = RunOn(data);
   EXPECT_EQ(run.exit_code, 1) << run.output;
-  EXPECT_NE(ErrorLine(run.output).find("lies on outer.lower_bound (1e+11 Pa): e^2 has no minimum "
-                                       "inside the bounds; widen them, or check the units of the "
-                                       "data (SI: m and N)"),
+  EXPECT_NE(ErrorLine(run.output)
+                .find("lies on outer.lower_bound (1e+11 Pa): e^2 has no minimum "
+                      "inside the bounds; widen them, or check the units of the "
+                      "data (SI: m and N)"),
             std::string::npos)
       << run.output;
 }
@@ -416,8 +418,9 @@ TEST_F(SpoiledDataTest, TimeStepOtherThanTheConfigsIsRefused) {
   data.time_step *= 1.001;
   const RunResult run = RunOn(data);
   EXPECT_EQ(run.exit_code, 2) << run.output;
-  EXPECT_NE(ErrorLine(run.output).find("spoiled.csv: time step 1.44144e-06 s differs from "
-                                       "time.step 1.44e-06 s"),
+  EXPECT_NE(ErrorLine(run.output)
+                .find("spoiled.csv: time step 1.44144e-06 s differs from "
+                      "time.step 1.44e-06 s"),
             std::string::npos)
       << run.output;
 }
