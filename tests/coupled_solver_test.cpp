@@ -4,10 +4,14 @@
 #include "mcrewave/coupled_solver.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 #include <limits>
+#include <string>
+#include <utility>
 
 #include "test_problems.h"
 
@@ -110,7 +114,105 @@ TEST(AllAtOnceSolverTest, RefusesAboveTheSizeLimitWithAClearMessage) {
   EXPECT_NE(solved.summary.message.find("2805 unknowns"), std::string::npos)
       << solved.summary.message;
   EXPECT_NE(solved.summary.message.find("inner.max_all_at_once_unknowns"), std::string::npos);
+  EXPECT_NE(solved.summary.message.find("and would need about "), std::string::npos)
+      << solved.summary.message;
 }
+
+// The number after `prefix` in `message`, or NaN when there is none.
+double NumberAfter(const std::string& message, const std::string& prefix) {
+  const std::size_t at = message.find(prefix);
+  if (at == std::string::npos) return std::numeric_limits<double>::quiet_NaN();
+  return std::strtod(message.c_str() + at + prefix.size(), nullptr);
+}
+
+TEST(AllAtOnceSolverTest, RefusesAboveTheMemoryLimitWithTheBytesItWouldNeed) {
+  ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
+  CoupledSolverOptions options = Options(CoupledSolverType::kAllAtOnce, 1e-8);
+  options.max_all_at_once_bytes = 1000;
+  const Solved refused = Solve(options, &bundle.problem);
+  const std::string& message = refused.summary.message;
+  EXPECT_EQ(refused.summary.termination, TerminationType::kFailure);
+  EXPECT_EQ(refused.summary.sweeps, 0) << message;
+  // 21716 = the entries of the assembled matrix for n = 11 nodes, m = 50 steps
+  // (counted from its triplets when the estimate was fitted).
+  EXPECT_NE(message.find("the all-at-once solver would need about "), std::string::npos) << message;
+  EXPECT_NE(message.find("(matrix 21716 nonzeros"), std::string::npos) << message;
+  EXPECT_NE(message.find("above the limit of 1000 bytes (inner.max_all_at_once_bytes)"),
+            std::string::npos)
+      << message;
+  const double bytes = NumberAfter(message, "would need about ");
+  // 2805 unknowns: between 1 and 10 kB each.
+  EXPECT_GT(bytes, 2805.0 * 1e3) << message;
+  EXPECT_LT(bytes, 2805.0 * 1e4) << message;
+  // The limit is the estimate itself: the solve runs; one byte less, it is refused.
+  options.max_all_at_once_bytes = static_cast<long>(bytes);
+  const Solved at_limit = Solve(options, &bundle.problem);
+  EXPECT_TRUE(at_limit.summary.IsSolutionUsable()) << at_limit.summary.FullReport();
+  options.max_all_at_once_bytes = static_cast<long>(bytes) - 1;
+  EXPECT_EQ(Solve(options, &bundle.problem).summary.termination, TerminationType::kFailure);
+  // The unknown limit still applies on its own.
+  options.max_all_at_once_bytes = static_cast<long>(bytes);
+  options.max_all_at_once_unknowns = 2804;
+  EXPECT_NE(Solve(options, &bundle.problem).summary.message.find("inner.max_all_at_once_unknowns"),
+            std::string::npos);
+}
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kAddressSanitizer = true;
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+
+// Peak resident memory of this process so far [bytes].
+double PeakResidentBytes() {
+  struct rusage usage = {};
+  ::getrusage(RUSAGE_SELF, &usage);
+  return 1024.0 * usage.ru_maxrss;
+}
+
+// 21 nodes, 400 steps (42105 unknowns, about 150 MB), both mass matrices and two
+// theta (the pivots, hence the fill, depend on the values). One case per test, so
+// that under ctest each has a process, and a high-water mark, of its own.
+class AllAtOnceMemoryTest : public ::testing::TestWithParam<std::pair<MassType, double>> {};
+
+TEST_P(AllAtOnceMemoryTest, EstimateBoundsTheFactorsAndThePeak) {
+  const auto [mass, theta] = GetParam();
+  testing::SmallCase small = MakeSmallCase(20, 400, 5.0, 1);
+  small.bar.mass = mass;
+  ProblemBundle bundle(small, Weights(1.0, 1.0), theta);
+  bundle.problem.SetModulus(0.9 * kReferenceModulus);
+  CoupledSolverOptions options = Options(CoupledSolverType::kAllAtOnce, 1e-8);
+  options.max_all_at_once_bytes = 1;
+  const double estimate =
+      NumberAfter(Solve(options, &bundle.problem).summary.message, "would need about ");
+  options.max_all_at_once_bytes = CoupledSolverOptions().max_all_at_once_bytes;
+  const double peak_before = PeakResidentBytes();
+  const Solved solved = Solve(options, &bundle.problem);
+  // Growth of the high-water mark: at most what the solve held at its peak.
+  const double peak_growth = PeakResidentBytes() - peak_before;
+  ASSERT_TRUE(solved.summary.IsSolutionUsable()) << solved.summary.FullReport();
+  const std::string& message = solved.summary.message;
+  const double factors = NumberAfter(message, "unknowns, ");
+  const double estimated_factors = NumberAfter(message, "nonzeros in L and U (");
+  std::cout << MassTypeToString(mass) << ", theta " << theta << ": " << factors
+            << " nonzeros in L and U for " << estimated_factors << " estimated; peak growth "
+            << peak_growth << " bytes for " << estimate << " estimated\n";
+  EXPECT_LE(factors, estimated_factors) << message;
+  EXPECT_GE(factors, 0.9 * estimated_factors) << message;
+  if (!kAddressSanitizer) {
+    EXPECT_LE(peak_growth, estimate);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(MassAndTheta, AllAtOnceMemoryTest,
+                         ::testing::Values(std::pair{MassType::kConsistent, 0.5},
+                                           std::pair{MassType::kLumped, 1.0}));
 
 TEST(CostCurveTest, InverseCrimeDataHaveTheirMinimumAtTheReferenceModulus) {
   // Data from the model's own discretisation, noise-free.

@@ -272,7 +272,8 @@ TEST(ExtremeInputTest, HundredThousandElementsAreRefusedWithTheMemoryNeeded) {
   EXPECT_EQ(all_at_once.exit_code, 1) << all_at_once.output;
   EXPECT_NE(ErrorLine(all_at_once.output)
                 .find("the all-at-once system has 150501505 unknowns (5 n (m + 1), n = 100001 "
-                      "nodes, m = 300 steps) and would need more than"),
+                      "nodes, m = 300 steps), above the limit of 1500000 unknowns "
+                      "(inner.max_all_at_once_unknowns), and would need about "),
             std::string::npos)
       << all_at_once.output;
   EXPECT_FALSE(fs::exists(dir + "/cg"));

@@ -19,7 +19,8 @@
 //          | any other CoupledSolverType], tolerance [1e-8], max_iterations [5000],
 //          omega [0.5], spectrum_steps [12], spectrum_safety_factor [1.05],
 //          divergence_factor [1e3], max_all_at_once_unknowns [1500000],
-//          max_field_bytes [2^31], max_dense_solver_bytes [2^31],
+//          max_all_at_once_bytes [2^31], max_field_bytes [2^31],
+//          max_dense_solver_bytes [2^31],
 //          shooting_condition_limit [1e14],
 //          shooting_segment_growth [100]
 //          (CoupledSolverOptions, coupled_solver.h)
