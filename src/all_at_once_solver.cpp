@@ -10,15 +10,16 @@
 // Memory. The LU keeps this time-interleaved (natural) order: the matrix is then
 // banded (every row couples times t - 1, t, t + 1 only) and its fill is predictable,
 // so the solver can refuse before it allocates (AllAtOnceBytes). Measured with
-// Eigen 3.4 SparseLU on 2 <= n <= 321 nodes, 25 <= m <= 3200 steps, consistent and
-// lumped mass: nnz(L) + nnz(U) = 7.9 .. 10.4 n per unknown (the most at the least
-// n), at most 8.5 n + 4 (e.g.
-// n = 11, m = 800: 96.4 per unknown for 97.5 estimated; n = 81, m = 200: 674 for
-// 693; n = 321, m = 25: 2548 for 2733). COLAMD, the previous ordering, gave less
-// fill on consistent mass when n is large (n = 81, m = 200: 392 per unknown; n = 321,
-// m = 25: 246) but much more on lumped mass, growing with m (n = 41, m = 800: 1811
-// per unknown, 4.3 GB and 197 s against 345, 0.74 GB and 2.3 s in natural order),
-// and no estimate of it holds before the factorisation.
+// Eigen 3.4 SparseLU on 2 <= n <= 321 nodes, 20 <= m <= 3200 steps, consistent and
+// lumped mass, theta 0.5 to 1: nnz(L) + nnz(U) = 7.9 n .. 8.5 n + 4 per unknown
+// with w_u / w_f from 1e-8 to 1e4 (n = 11, m = 800: 96.4; n = 81, m = 200: 674;
+// n = 321, m = 25: 2548), up to 9.0 n + 4 when extreme weights (w_u / w_f = 1e12
+// .. 1e40) change the pivots (n = 81, m = 100: 725); estimated as 9.5 n + 4.
+// COLAMD, the previous ordering, gave less fill on consistent mass when n is
+// large (n = 81, m = 200: 392 per unknown; n = 321, m = 25: 246) but much more on
+// lumped mass, growing with m (n = 41, m = 800: 1811 per unknown, 4.3 GB and 197 s
+// against 345, 0.74 GB and 2.3 s in natural order), and no estimate of it holds
+// before the factorisation.
 
 #include <Eigen/SparseLU>
 #include <algorithm>
@@ -82,7 +83,7 @@ double MatrixNonZeros(int n, int m, double mass, double stiffness, double penalt
 }
 
 // Measured bound of nnz(L) + nnz(U) per unknown of the LU in natural order (above).
-double FactorNonZerosPerUnknown(int n) { return 8.5 * n + 4.0; }
+double FactorNonZerosPerUnknown(int n) { return 9.5 * n + 4.0; }
 
 // Bytes the solver would hold at its peak, the factorisation: the matrix and the
 // LU's own permuted copy of it (12 bytes per nonzero each: a double and an int
@@ -90,9 +91,10 @@ double FactorNonZerosPerUnknown(int n) { return 8.5 * n + 4.0; }
 // SparseLU's storage, which grows by 1.5x when its first guess is short), and 400
 // bytes per unknown (right-hand side, solution, SparseLU's permutations, supernode
 // tables and panel workspace). Fitted to the growth of the peak resident memory
-// during SolveCoupled on 13 of the cases above (3 <= n <= 321, both masses, theta
-// 0.5 to 1): measured / estimated = 0.69 .. 0.91. Assembly holds less (triplets at
-// 16 bytes per nonzero, then 2 x 12 while compressing), but is counted too.
+// during SolveCoupled on 15 of the cases above (3 <= n <= 161, both masses, theta
+// 0.5 to 1, extreme weights included): measured / estimated = 0.62 .. 0.88.
+// Assembly holds less (triplets at 16 bytes per nonzero, then 2 x 12 while
+// compressing), but is counted too.
 double AllAtOnceBytes(double unknowns, double matrix_nonzeros, double factor_nonzeros) {
   const double assembly = (16.0 + 12.0 + 12.0) * matrix_nonzeros + 16.0 * unknowns;
   const double factorisation =
@@ -123,7 +125,7 @@ void SolveAllAtOnce(const CoupledSolverOptions& options, McreProblem* problem,
   std::ostringstream sizes;
   sizes << "about " << static_cast<long long>(bytes) << " bytes (matrix "
         << static_cast<long long>(matrix_nonzeros) << " nonzeros x 12 bytes, twice; LU factors "
-        << "about (8.5 n + 4) nonzeros per unknown x 16 bytes; 400 bytes per unknown; n = " << n
+        << "about (9.5 n + 4) nonzeros per unknown x 16 bytes; 400 bytes per unknown; n = " << n
         << " nodes, m = " << m << " steps)";
   if (system.size() > options.max_all_at_once_unknowns) {
     std::ostringstream why;
