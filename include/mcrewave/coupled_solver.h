@@ -26,9 +26,9 @@
 //   multiple_shooting    the same on segments whose length follows the measured growth
 //                        rate of the recursion, joined by continuity (robust variant).
 //
-// The last three are direct: they report the same relative residual, computed
-// afterwards from 5 sweeps, and converge when it meets the tolerance (or the
-// round-off floor below).
+// all_at_once and the last three are direct: they report the same relative
+// residual, computed afterwards from 5 sweeps, and converge when it meets the
+// tolerance (or the round-off floor below); otherwise they fail.
 //
 // The iterative solvers stop on the relative residual ||c - A W||_P / ||c||_P
 // (the same measure for all; c = T(0)), or when ||c - A W||_P falls to the
