@@ -378,6 +378,7 @@ int Run(const std::string& output_dir, int max_dofs) {
         measurement.note = "not run: 4n-column march and 4n x 4n QR per segment beyond budget";
       } else {
         options.max_dense_solver_bytes = 8L << 30;
+        options.max_all_at_once_bytes = 8L << 30;
         measurement = Measure(method, options, paper);
       }
       if (measurement.second_steps > 0) {

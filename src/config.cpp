@@ -365,6 +365,9 @@ const std::vector<Key>& KeyTable() {
       MakeKey("inner.max_all_at_once_unknowns", &Config::inner,
               &CoupledSolverOptions::max_all_at_once_unknowns, PositiveInteger<long>(), "",
               "all_at_once refuses systems with more unknowns"),
+      MakeKey("inner.max_all_at_once_bytes", &Config::inner,
+              &CoupledSolverOptions::max_all_at_once_bytes, PositiveInteger<long>(), "bytes",
+              "all_at_once refuses when its matrix and LU factors would need more memory"),
       MakeKey("inner.max_field_bytes", &Config::inner, &CoupledSolverOptions::max_field_bytes,
               PositiveInteger<long>(), "bytes",
               "iterative methods refuse when their fields would need more memory"),
@@ -492,6 +495,30 @@ const std::vector<SectionValidator>& SectionValidators() {
       ValidatorOf(&Config::outer),       ValidatorOf(&Config::prefilter),
       ValidatorOf(&Config::uncertainty), ValidatorOf(&Config::output),
       ValidatorOf(&Config::study),
+  };
+  return validators;
+}
+
+// Checks of keys from more than one section, run once every section is valid on
+// its own. The same convention as the sections' IsValid: the message names the
+// offending key first (Locate places it where that key was set), then the keys
+// it is compared with.
+const std::vector<SectionValidator>& CrossSectionValidators() {
+  static const std::vector<SectionValidator> validators = {
+      // A cut-off at or above the Nyquist frequency is not a low-pass filter of the
+      // sampled data (the bilinear transform maps Nyquist to tan(pi/2)).
+      [](const Config& config, std::string* error) {
+        const double cutoff = config.prefilter.cutoff_frequency;
+        const double nyquist = 0.5 / config.time.step;
+        if (cutoff > 0.0 && !(cutoff < nyquist)) {
+          *error = "prefilter.cutoff_frequency (" + FormatNumber(cutoff) +
+                   " Hz) must be below the Nyquist frequency 0.5 / time.step = " +
+                   FormatNumber(nyquist) + " Hz (time.step = " + FormatNumber(config.time.step) +
+                   " s), or 0 to derive it from the data";
+          return false;
+        }
+        return true;
+      },
   };
   return validators;
 }
@@ -718,9 +745,11 @@ std::string Locate(const std::string& message, const ParsedConfig& parsed,
 }
 
 void Validate(const ParsedConfig& parsed, const std::string& name) {
-  for (const SectionValidator& is_valid : SectionValidators()) {
-    std::string error;
-    if (!is_valid(parsed.config, &error)) throw InputError(Locate(error, parsed, name));
+  for (const auto* validators : {&SectionValidators(), &CrossSectionValidators()}) {
+    for (const SectionValidator& is_valid : *validators) {
+      std::string error;
+      if (!is_valid(parsed.config, &error)) throw InputError(Locate(error, parsed, name));
+    }
   }
 }
 

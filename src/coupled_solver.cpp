@@ -62,6 +62,8 @@ bool CoupledSolverOptions::IsValid(std::string* error) const {
     why << "inner.divergence_factor must be above 1, got " << divergence_factor;
   } else if (max_all_at_once_unknowns < 1) {
     why << "inner.max_all_at_once_unknowns must be positive, got " << max_all_at_once_unknowns;
+  } else if (max_all_at_once_bytes < 1) {
+    why << "inner.max_all_at_once_bytes must be positive, got " << max_all_at_once_bytes;
   } else if (max_dense_solver_bytes < 1) {
     why << "inner.max_dense_solver_bytes must be positive, got " << max_dense_solver_bytes;
   } else if (max_field_bytes < 1) {

@@ -1,5 +1,5 @@
 // The acceptance test of the coupled solvers that compute (U, W) without iterating
-// (Riccati, single and multiple shooting): the same measure as the iterative
+// (all-at-once, Riccati, single and multiple shooting): the same measure as the iterative
 // solvers (coupled_solver.h), so that a direct solve that lost its accuracy to
 // round-off amplification is reported as a failure, never returned as numbers.
 #pragma once

@@ -2,10 +2,10 @@
 
 #include <Eigen/QR>
 #include <algorithm>
-#include <cassert>
 #include <cmath>
 #include <complex>
 #include <sstream>
+#include <stdexcept>
 #include <unsupported/Eigen/FFT>
 
 namespace mcrewave {
@@ -36,8 +36,19 @@ bool PrefilterOptions::IsValid(std::string* error) const {
 
 ZeroPhaseLowPass::ZeroPhaseLowPass(double cutoff_frequency, double sample_rate, int order)
     : cutoff_frequency_(cutoff_frequency), sample_rate_(sample_rate) {
-  assert(cutoff_frequency > 0.0 && cutoff_frequency < 0.5 * sample_rate);
-  assert(order >= 2 && order <= 12 && order % 2 == 0);
+  if (!(std::isfinite(sample_rate) && sample_rate > 0.0 && cutoff_frequency > 0.0 &&
+        cutoff_frequency < 0.5 * sample_rate)) {
+    std::ostringstream why;
+    why << "ZeroPhaseLowPass: the cut-off frequency (" << cutoff_frequency
+        << " Hz) must be positive and below the Nyquist frequency (" << 0.5 * sample_rate
+        << " Hz, half the sample rate)";
+    throw std::invalid_argument(why.str());
+  }
+  if (order < 2 || order > 12 || order % 2 != 0) {
+    throw std::invalid_argument(
+        "ZeroPhaseLowPass: the order must be an even integer in [2, 12], got " +
+        std::to_string(order));
+  }
   // Pre-warped analogue cut-off: K = tan(pi fc / fs).
   const double k = std::tan(M_PI * cutoff_frequency / sample_rate);
   for (int s = 1; s <= order / 2; ++s) {
@@ -176,8 +187,17 @@ double EstimateCutoffFrequency(const MeasurementSet& measurements) {
 
 MeasurementSet PrefilterMeasurements(const MeasurementSet& measurements,
                                      const PrefilterOptions& options, double* cutoff_used) {
-  assert(options.IsValid(nullptr));
+  std::string why;
+  if (!options.IsValid(&why)) throw std::invalid_argument(why);
   if (!options.enabled) return measurements;
+  const double nyquist = 0.5 / measurements.time_step;
+  if (!(options.cutoff_frequency < nyquist)) {
+    std::ostringstream message;
+    message << "prefilter.cutoff_frequency (" << options.cutoff_frequency
+            << " Hz) must be below the Nyquist frequency of the measurements, 0.5 / time step = "
+            << nyquist << " Hz (time step " << measurements.time_step << " s)";
+    throw std::invalid_argument(message.str());
+  }
   const double cutoff = options.cutoff_frequency > 0.0 ? options.cutoff_frequency
                                                        : EstimateCutoffFrequency(measurements);
   if (cutoff_used != nullptr) *cutoff_used = cutoff;

@@ -48,6 +48,7 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.inner.spectrum_safety_factor, actual.inner.spectrum_safety_factor);
   EXPECT_EQ(expected.inner.divergence_factor, actual.inner.divergence_factor);
   EXPECT_EQ(expected.inner.max_all_at_once_unknowns, actual.inner.max_all_at_once_unknowns);
+  EXPECT_EQ(expected.inner.max_all_at_once_bytes, actual.inner.max_all_at_once_bytes);
   EXPECT_EQ(expected.inner.max_dense_solver_bytes, actual.inner.max_dense_solver_bytes);
   EXPECT_EQ(expected.inner.max_field_bytes, actual.inner.max_field_bytes);
   EXPECT_EQ(expected.inner.shooting_condition_limit, actual.inner.shooting_condition_limit);
@@ -155,7 +156,8 @@ TEST(ConfigTest, DefaultConfigYamlParsesToTheDefaultConfig) {
   ExpectSameConfig(Config{}, ParseConfig(yaml, "default.yaml"));
   for (const char* line :
        {"model:", "load:", "time:", "data:", "mcre:", "inner:", "outer:", "uncertainty:", "output:",
-        "  length: 1", "# [m] ", "  snr: .inf", "  density: 800", "(consistent | lumped)"}) {
+        "  length: 1", "# [m] ", "  snr: .inf", "  density: 800", "(consistent | lumped)",
+        "  max_all_at_once_bytes: 2147483648"}) {
     EXPECT_NE(yaml.find(line), std::string::npos) << yaml << "\nlacks " << line;
   }
 }
@@ -184,6 +186,21 @@ TEST(ConfigTest, ScanAndPrefilterKeysAreReadAndChecked) {
       EXPECT_NE(std::string(error.what()).find(key), std::string::npos) << error.what();
     }
   }
+}
+
+TEST(ConfigTest, AllAtOnceByteLimitIsReadAndChecked) {
+  EXPECT_EQ(Config{}.inner.max_all_at_once_bytes, 1L << 31);
+  EXPECT_EQ(
+      ParseConfig("inner:\n  max_all_at_once_bytes: 1000\n", "a.yaml").inner.max_all_at_once_bytes,
+      1000);
+  ExpectInputError([] { ParseConfig("inner:\n  max_all_at_once_bytes: 0\n", "a.yaml"); },
+                   {"a.yaml:2: inner.max_all_at_once_bytes: expected a positive integer (in "
+                    "bytes), got '0'"});
+  CoupledSolverOptions options;
+  options.max_all_at_once_bytes = 0;
+  std::string why;
+  EXPECT_FALSE(options.IsValid(&why));
+  EXPECT_NE(why.find("inner.max_all_at_once_bytes must be positive"), std::string::npos) << why;
 }
 
 TEST(ConfigTest, DefaultConfigYamlCommentsEveryKey) {
@@ -231,6 +248,7 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   config.inner.spectrum_safety_factor = 1.2;
   config.inner.divergence_factor = 50.0;
   config.inner.max_all_at_once_unknowns = 3'000'000'000L;
+  config.inner.max_all_at_once_bytes = (1L << 35) + 1;
   config.inner.max_dense_solver_bytes = 1L << 33;
   config.inner.max_field_bytes = 1L << 34;
   config.inner.shooting_condition_limit = 1e12;
@@ -447,6 +465,40 @@ TEST_F(ConfigFileTest, NegativeSeed) {
 TEST_F(ConfigFileTest, TruthRefinementOutOfRange) {
   ExpectLoadError("data:\n  truth_refinement: 65\n", 2,
                   {"data.truth_refinement must be an integer in [1, 64], got 65"});
+}
+
+TEST_F(ConfigFileTest, PrefilterCutoffAtOrAboveNyquistIsRefused) {
+  // time.step 2 us: Nyquist 250 kHz.
+  const std::string time = "time:\n  window: 1e-3\n  step: 2e-6\n";
+  ExpectLoadError(time + "prefilter:\n  cutoff_frequency: 250e3\n", 5,
+                  {"prefilter.cutoff_frequency (250000 Hz) must be below the Nyquist frequency "
+                   "0.5 / time.step = 250000 Hz (time.step = 2e-06 s)"});
+  ExpectLoadError(time + "prefilter:\n  enabled: false\n  cutoff_frequency: 1e9\n", 6,
+                  {"prefilter.cutoff_frequency (1e+09 Hz) must be below the Nyquist "
+                   "frequency"});
+  EXPECT_EQ(LoadConfig(WriteFile("below.yaml", time + "prefilter:\n  cutoff_frequency: 249999\n"))
+                .prefilter.cutoff_frequency,
+            249999.0);
+  // 0 (derived from the data) is not compared.
+  EXPECT_EQ(LoadConfig(WriteFile("zero.yaml", time + "prefilter:\n  cutoff_frequency: 0\n"))
+                .prefilter.cutoff_frequency,
+            0.0);
+}
+
+TEST_F(ConfigFileTest, PrefilterCutoffAboveNyquistIsPlacedWhereEitherKeyWasSet) {
+  // The default time.step 0.36 us: Nyquist 1388888.9 Hz; the override names itself.
+  const std::string defaults = WriteFile("defaults.yaml", "");
+  ExpectInputError([&defaults] { LoadConfig(defaults, {"prefilter.cutoff_frequency=1.5e6"}); },
+                   {"--set prefilter.cutoff_frequency=1.5e6: prefilter.cutoff_frequency "
+                    "(1.5e+06 Hz) must be below the Nyquist frequency 0.5 / time.step = "
+                    "1388888.888888889 Hz"});
+  // A cut-off valid at the file's step, made invalid by a coarser step override:
+  // placed on the cut-off's line (the key the message names first).
+  const std::string path = WriteFile("config.yaml", "prefilter:\n  cutoff_frequency: 300e3\n");
+  EXPECT_EQ(LoadConfig(path).prefilter.cutoff_frequency, 300e3);
+  ExpectInputError([&path] { LoadConfig(path, {"time.step=2e-6"}); },
+                   {path + ":2: prefilter.cutoff_frequency (300000 Hz) must be below the Nyquist "
+                           "frequency 0.5 / time.step = 250000 Hz (time.step = 2e-06 s)"});
 }
 
 TEST_F(ConfigFileTest, CsvSourceWithoutPath) {

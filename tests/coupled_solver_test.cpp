@@ -4,10 +4,14 @@
 #include "mcrewave/coupled_solver.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <iostream>
 #include <limits>
+#include <string>
+#include <utility>
 
 #include "test_problems.h"
 
@@ -24,6 +28,13 @@ using testing::Solved;
 using testing::Weights;
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// The number after `prefix` in `message`, or NaN when there is none.
+double NumberAfter(const std::string& message, const std::string& prefix) {
+  const std::size_t at = message.find(prefix);
+  if (at == std::string::npos) return std::numeric_limits<double>::quiet_NaN();
+  return std::strtod(message.c_str() + at + prefix.size(), nullptr);
+}
 
 TEST(CoupledSolverOptionsTest, DefaultOptionsAreValid) {
   std::string why;
@@ -72,7 +83,11 @@ TEST_P(SolverAgreementTest, AgreesWithAllAtOnce) {
   problem.SetModulus(0.9 * kReferenceModulus);
   const Solved reference = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-8), &problem);
   ASSERT_TRUE(reference.summary.IsSolutionUsable()) << reference.summary.FullReport();
-  EXPECT_LT(reference.summary.relative_residual, 1e-12);
+  // The LU solves its space-time system to round-off; in the measure of the other
+  // solvers (sweeps of their own round-off) its W is within 1e-10.
+  EXPECT_LT(NumberAfter(reference.summary.message, "space-time residual "), 1e-12)
+      << reference.summary.message;
+  EXPECT_LT(reference.summary.relative_residual, 1e-10);
 
   CoupledSolverOptions options = Options(param.type, 1e-12);
   if (param.type == CoupledSolverType::kRelaxation) {
@@ -110,7 +125,160 @@ TEST(AllAtOnceSolverTest, RefusesAboveTheSizeLimitWithAClearMessage) {
   EXPECT_NE(solved.summary.message.find("2805 unknowns"), std::string::npos)
       << solved.summary.message;
   EXPECT_NE(solved.summary.message.find("inner.max_all_at_once_unknowns"), std::string::npos);
+  EXPECT_NE(solved.summary.message.find("and would need about "), std::string::npos)
+      << solved.summary.message;
 }
+
+TEST(AllAtOnceSolverTest, RefusesAboveTheMemoryLimitWithTheBytesItWouldNeed) {
+  ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
+  CoupledSolverOptions options = Options(CoupledSolverType::kAllAtOnce, 1e-8);
+  options.max_all_at_once_bytes = 1000;
+  const Solved refused = Solve(options, &bundle.problem);
+  const std::string& message = refused.summary.message;
+  EXPECT_EQ(refused.summary.termination, TerminationType::kFailure);
+  EXPECT_EQ(refused.summary.sweeps, 0) << message;
+  // 21716 = the entries of the assembled matrix for n = 11 nodes, m = 50 steps
+  // (counted from its triplets when the estimate was fitted).
+  EXPECT_NE(message.find("the all-at-once solver would need about "), std::string::npos) << message;
+  EXPECT_NE(message.find("(matrix 21716 nonzeros"), std::string::npos) << message;
+  EXPECT_NE(message.find("above the limit of 1000 bytes (inner.max_all_at_once_bytes)"),
+            std::string::npos)
+      << message;
+  const double bytes = NumberAfter(message, "would need about ");
+  // 2805 unknowns: between 1 and 10 kB each.
+  EXPECT_GT(bytes, 2805.0 * 1e3) << message;
+  EXPECT_LT(bytes, 2805.0 * 1e4) << message;
+  // The limit is the estimate itself: the solve runs; one byte less, it is refused.
+  options.max_all_at_once_bytes = static_cast<long>(bytes);
+  const Solved at_limit = Solve(options, &bundle.problem);
+  EXPECT_TRUE(at_limit.summary.IsSolutionUsable()) << at_limit.summary.FullReport();
+  options.max_all_at_once_bytes = static_cast<long>(bytes) - 1;
+  EXPECT_EQ(Solve(options, &bundle.problem).summary.termination, TerminationType::kFailure);
+  // The unknown limit still applies on its own.
+  options.max_all_at_once_bytes = static_cast<long>(bytes);
+  options.max_all_at_once_unknowns = 2804;
+  EXPECT_NE(Solve(options, &bundle.problem).summary.message.find("inner.max_all_at_once_unknowns"),
+            std::string::npos);
+}
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kAddressSanitizer = true;
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+
+// Peak resident memory of this process so far [bytes].
+double PeakResidentBytes() {
+  struct rusage usage = {};
+  ::getrusage(RUSAGE_SELF, &usage);
+  return 1024.0 * usage.ru_maxrss;
+}
+
+// ||T(W) - W||_P, ||T(0)||_P and the round-off floor 1e-11 ||Retrograde(0)||_P of
+// a returned W, computed here from the sweeps (coupled_solver.h).
+struct FixedPointResidual {
+  double residual, rhs, floor;
+};
+
+FixedPointResidual Residual(McreProblem* problem, const Matrix& retrograde) {
+  Matrix scratch, rhs, image, data_response;
+  problem->FixedPointMap(problem->ZeroField(), &scratch, &rhs);
+  problem->FixedPointMap(retrograde, &scratch, &image);
+  problem->RetrogradeSweep(problem->ZeroField(), true, &data_response);
+  return {problem->Norm(image - retrograde), problem->Norm(rhs),
+          1e-11 * problem->Norm(data_response)};
+}
+
+TEST(AllAtOnceSolverTest, ReportsTheResidualOfTheOtherSolversAndClaimsNoMoreThanItMeets) {
+  ProblemBundle bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(1.0, 1.0));
+  McreProblem& problem = bundle.problem;
+  problem.SetModulus(0.9 * kReferenceModulus);
+  const Solved solved = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-8), &problem);
+  ASSERT_TRUE(solved.summary.IsSolutionUsable()) << solved.summary.FullReport();
+  const FixedPointResidual check = Residual(&problem, solved.solution.retrograde);
+  const double relative = check.residual / check.rhs;
+  EXPECT_NEAR(solved.summary.relative_residual, relative, 1e-6 * relative);
+  EXPECT_LE(relative, 1e-8);
+  EXPECT_EQ(solved.summary.residual_history.size(), 1u);
+  // A tolerance below round-off: converged only if the residual is at the floor.
+  const Solved strict = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-30), &problem);
+  std::cout << "all_at_once: relative residual " << relative << ", floor "
+            << check.floor / check.rhs << " relative; at tolerance 1e-30: "
+            << TerminationTypeToString(strict.summary.termination) << "\n";
+  EXPECT_EQ(strict.summary.IsSolutionUsable(), check.residual <= check.floor)
+      << strict.summary.FullReport();
+}
+
+TEST(AllAtOnceSolverTest, FailsWhenItsSolutionMissesTheToleranceThoughTheLuResidualIsTiny) {
+  // w_u / w_f = 1e28: the space-time system is so ill-conditioned that its LU
+  // solution, with a residual at round-off, is 1e-3 from a fixed point of the
+  // sweeps (10 elements, 50 steps).
+  ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 2), Weights(1e14, 1e-14));
+  McreProblem& problem = bundle.problem;
+  problem.SetModulus(0.9 * kReferenceModulus);
+  const Solved solved = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-8), &problem);
+  const std::string& message = solved.summary.message;
+  EXPECT_FALSE(solved.summary.IsSolutionUsable()) << solved.summary.FullReport();
+  EXPECT_EQ(solved.summary.termination, TerminationType::kFailure);
+  EXPECT_LT(NumberAfter(message, "space-time residual "), 1e-12) << message;
+  EXPECT_GT(solved.summary.relative_residual, 1e-6);
+  const FixedPointResidual check = Residual(&problem, solved.solution.retrograde);
+  EXPECT_NEAR(solved.summary.relative_residual, check.residual / check.rhs,
+              1e-6 * solved.summary.relative_residual);
+  EXPECT_GT(check.residual, 1e3 * check.floor);
+  EXPECT_NE(message.find("but the solution fails its check (relative residual "), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("tolerance 1.000e-08"), std::string::npos) << message;
+  // The tolerance decides: at 0.1 the same solution is accepted.
+  const Solved loose = Solve(Options(CoupledSolverType::kAllAtOnce, 0.1), &problem);
+  EXPECT_TRUE(loose.summary.IsSolutionUsable()) << loose.summary.FullReport();
+  EXPECT_NEAR(loose.summary.relative_residual, solved.summary.relative_residual,
+              1e-6 * solved.summary.relative_residual);
+}
+
+// 21 nodes, 400 steps (42105 unknowns, about 150 MB), both mass matrices and two
+// theta (the pivots, hence the fill, depend on the values). One case per test, so
+// that under ctest each has a process, and a high-water mark, of its own.
+class AllAtOnceMemoryTest : public ::testing::TestWithParam<std::pair<MassType, double>> {};
+
+TEST_P(AllAtOnceMemoryTest, EstimateBoundsTheFactorsAndThePeak) {
+  const auto [mass, theta] = GetParam();
+  testing::SmallCase small = MakeSmallCase(20, 400, 5.0, 1);
+  small.bar.mass = mass;
+  ProblemBundle bundle(small, Weights(1.0, 1.0), theta);
+  bundle.problem.SetModulus(0.9 * kReferenceModulus);
+  CoupledSolverOptions options = Options(CoupledSolverType::kAllAtOnce, 1e-8);
+  options.max_all_at_once_bytes = 1;
+  const double estimate =
+      NumberAfter(Solve(options, &bundle.problem).summary.message, "would need about ");
+  options.max_all_at_once_bytes = CoupledSolverOptions().max_all_at_once_bytes;
+  const double peak_before = PeakResidentBytes();
+  const Solved solved = Solve(options, &bundle.problem);
+  // Growth of the high-water mark: at most what the solve held at its peak.
+  const double peak_growth = PeakResidentBytes() - peak_before;
+  ASSERT_TRUE(solved.summary.IsSolutionUsable()) << solved.summary.FullReport();
+  const std::string& message = solved.summary.message;
+  const double factors = NumberAfter(message, "unknowns, ");
+  const double estimated_factors = NumberAfter(message, "nonzeros in L and U (");
+  std::cout << MassTypeToString(mass) << ", theta " << theta << ": " << factors
+            << " nonzeros in L and U for " << estimated_factors << " estimated; peak growth "
+            << peak_growth << " bytes for " << estimate << " estimated\n";
+  EXPECT_LE(factors, estimated_factors) << message;
+  EXPECT_GE(factors, 0.8 * estimated_factors) << message;
+  if (!kAddressSanitizer) {
+    EXPECT_LE(peak_growth, estimate);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(MassAndTheta, AllAtOnceMemoryTest,
+                         ::testing::Values(std::pair{MassType::kConsistent, 0.5},
+                                           std::pair{MassType::kLumped, 1.0}));
 
 TEST(CostCurveTest, InverseCrimeDataHaveTheirMinimumAtTheReferenceModulus) {
   // Data from the model's own discretisation, noise-free.

@@ -381,6 +381,13 @@ INSTANTIATE_TEST_SUITE_P(
                  "",
                  2,
                  {"{config}:2: mcre.reference_modulus must be a finite positive"}},
+        BadInput{"prefilter_cutoff_above_nyquist",
+                 "prefilter:\n  cutoff_frequency: 2e6\n",
+                 nullptr,
+                 "",
+                 2,
+                 {"{config}:2: prefilter.cutoff_frequency (2e+06 Hz) must be below the Nyquist "
+                  "frequency 0.5 / time.step = 1388888.888888889 Hz (time.step = 3.6e-07 s)"}},
         BadInput{"boolean_expected",
                  "output:\n  figures: maybe\n",
                  nullptr,

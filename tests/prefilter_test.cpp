@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include "mcrewave/simulation.h"
 
@@ -27,6 +29,41 @@ TEST(PrefilterOptionsTest, DefaultOptionsAreValidAndBadOnesRefused) {
   options.cutoff_frequency = -1.0;
   EXPECT_FALSE(options.IsValid(&why));
   EXPECT_NE(why.find("prefilter.cutoff_frequency"), std::string::npos);
+}
+
+TEST(ZeroPhaseLowPassTest, RefusesACutoffAtOrAboveNyquistAndABadOrder) {
+  const double nyquist = 0.5 * kSampleRate;
+  EXPECT_THROW(ZeroPhaseLowPass(nyquist, kSampleRate, 4), std::invalid_argument);
+  EXPECT_THROW(ZeroPhaseLowPass(2.0 * nyquist, kSampleRate, 4), std::invalid_argument);
+  EXPECT_THROW(ZeroPhaseLowPass(0.0, kSampleRate, 4), std::invalid_argument);
+  EXPECT_THROW(ZeroPhaseLowPass(100e3, kSampleRate, 3), std::invalid_argument);
+  EXPECT_NO_THROW(ZeroPhaseLowPass(0.99 * nyquist, kSampleRate, 4));
+}
+
+TEST(PrefilterTest, RefusesACutoffAtOrAboveNyquistOfTheMeasurements) {
+  MeasurementSet data;
+  data.time_step = 2e-6;  // Nyquist 250 kHz
+  for (Vector* channel : {&data.u0, &data.uL, &data.f0, &data.fL}) *channel = Vector::Ones(100);
+  PrefilterOptions options;
+  options.cutoff_frequency = 250e3;
+  try {
+    PrefilterMeasurements(data, options);
+    ADD_FAILURE() << "a cut-off at the Nyquist frequency was accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find("prefilter.cutoff_frequency (250000 Hz) must be below "
+                        "the Nyquist frequency"),
+              std::string::npos)
+        << error.what();
+  }
+  options.cutoff_frequency = -1.0;  // invalid options: no assert, an exception
+  EXPECT_THROW(PrefilterMeasurements(data, options), std::invalid_argument);
+  options.cutoff_frequency = 200e3;
+  EXPECT_EQ(PrefilterMeasurements(data, options).fL.size(), 100);
+  // Disabled: the cut-off is not used, the data are returned as they are.
+  options.enabled = false;
+  options.cutoff_frequency = 1e9;
+  EXPECT_EQ(PrefilterMeasurements(data, options).fL, data.fL);
 }
 
 TEST(ZeroPhaseLowPassTest, GainIsOneHalfAtTheCutoffAndOneAtZero) {

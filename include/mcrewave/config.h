@@ -19,7 +19,8 @@
 //          | any other CoupledSolverType], tolerance [1e-8], max_iterations [5000],
 //          omega [0.5], spectrum_steps [12], spectrum_safety_factor [1.05],
 //          divergence_factor [1e3], max_all_at_once_unknowns [1500000],
-//          max_field_bytes [2^31], max_dense_solver_bytes [2^31],
+//          max_all_at_once_bytes [2^31], max_field_bytes [2^31],
+//          max_dense_solver_bytes [2^31],
 //          shooting_condition_limit [1e14],
 //          shooting_segment_growth [100]
 //          (CoupledSolverOptions, coupled_solver.h)
@@ -29,9 +30,9 @@
 //          max_time [600 s], scan_points [41], scan_tolerance [1e-4],
 //          scan_threads [2], refine_candidates [2] (IdentificationOptions,
 //          identification.h)
-//   prefilter: enabled [true], cutoff_frequency [0 Hz: derived from the data],
-//          order [4] (PrefilterOptions, prefilter.h; applied to the measurements
-//          before the identification)
+//   prefilter: enabled [true], cutoff_frequency [0 Hz: derived from the data;
+//          else below the Nyquist frequency 0.5 / time.step], order [4] (PrefilterOptions,
+//          prefilter.h; applied to the measurements before the identification)
 //   uncertainty: samples [16], seed [1] (modulus_uncertainty.h)
 //   output: folder ["results/identify"], figures [true], curve_points [41]
 //   study: kind [all | robustness | relaxation | cost_curves], folder ["results"],

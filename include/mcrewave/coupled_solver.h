@@ -4,7 +4,9 @@
 //
 //   all_at_once          the whole space-time system (D1, D2, R1, R2, R3) assembled
 //                        sparse and solved by sparse LU; independent of the sweeps;
-//                        the reference on small cases; refuses large problems.
+//                        the reference on small cases; refuses problems above
+//                        max_all_at_once_unknowns or whose estimated memory would
+//                        exceed max_all_at_once_bytes.
 //   relaxation           the paper's waveform relaxation (eq. 17-19) with a fixed
 //                        coefficient omega: one retrograde and one direct sweep per
 //                        iteration, the direct one driven by omega W_new + (1-omega) W.
@@ -24,9 +26,9 @@
 //   multiple_shooting    the same on segments whose length follows the measured growth
 //                        rate of the recursion, joined by continuity (robust variant).
 //
-// The last three are direct: they report the same relative residual, computed
-// afterwards from 5 sweeps, and converge when it meets the tolerance (or the
-// round-off floor below).
+// all_at_once and the last three are direct: they report the same relative
+// residual, computed afterwards from 5 sweeps, and converge when it meets the
+// tolerance (or the round-off floor below); otherwise they fail.
 //
 // The iterative solvers stop on the relative residual ||c - A W||_P / ||c||_P
 // (the same measure for all; c = T(0)), or when ||c - A W||_P falls to the
@@ -83,8 +85,11 @@ struct CoupledSolverOptions {
   double spectrum_safety_factor = 1.05;
   // A relative residual this many times above the smallest seen means divergence.
   double divergence_factor = 1e3;
-  // The all-at-once solver refuses systems with more unknowns than this.
+  // The all-at-once solver refuses systems with more unknowns than this, and when
+  // its estimated peak memory (the matrix and its sparse LU factors; see
+  // src/all_at_once_solver.cpp) would exceed max_all_at_once_bytes.
   long max_all_at_once_unknowns = 1'500'000;
+  long max_all_at_once_bytes = 2L << 30;
   // The Riccati and shooting solvers refuse when their dense storage
   // (docs/riccati_shooting.md) would exceed this many bytes.
   long max_dense_solver_bytes = 2L << 30;

@@ -38,7 +38,8 @@ struct PrefilterOptions {
 
 class ZeroPhaseLowPass {
  public:
-  // Precondition: 0 < cutoff_frequency < sample_rate / 2, order even in [2, 12].
+  // Throws std::invalid_argument unless 0 < cutoff_frequency < sample_rate / 2 (the
+  // Nyquist frequency) and order is even in [2, 12].
   ZeroPhaseLowPass(double cutoff_frequency, double sample_rate, int order);
   // The filtered signal, same length. Signals shorter than 2 samples are returned as is.
   Vector Apply(const Vector& signal) const;
@@ -65,7 +66,9 @@ double EstimateCutoffFrequency(const MeasurementSet& measurements);
 
 // The four channels filtered by the same ZeroPhaseLowPass (cut-off from options or
 // estimated). Returns the set unchanged when !options.enabled. Writes the cut-off
-// used to *cutoff_used when not null.
+// used to *cutoff_used when not null. Throws std::invalid_argument when the options
+// are not valid or a given cut-off is not below the Nyquist frequency
+// 0.5 / measurements.time_step (LoadConfig refuses both at load time).
 MeasurementSet PrefilterMeasurements(const MeasurementSet& measurements,
                                      const PrefilterOptions& options,
                                      double* cutoff_used = nullptr);
