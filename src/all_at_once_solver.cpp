@@ -93,14 +93,17 @@ double FactorNonZerosPerUnknown(int n) { return 9.5 * n + 4.0; }
 // bytes per unknown (right-hand side, solution, SparseLU's permutations, supernode
 // tables and panel workspace). Fitted to the growth of the peak resident memory
 // during SolveCoupled on 15 of the cases above (3 <= n <= 161, both masses, theta
-// 0.5 to 1, extreme weights included): measured / estimated = 0.62 .. 0.88.
-// Assembly holds less (triplets at 16 bytes per nonzero, then 2 x 12 while
-// compressing), but is counted too.
+// 0.5 to 1, extreme weights included): measured / estimated = 0.62 .. 0.88. Plus
+// 1 MiB for the allocator's granularity, which dominates tiny systems (n = 3,
+// m = 20: 0.5 MB measured for 0.3 MB of the terms above). Assembly holds less
+// (triplets at 16 bytes per nonzero, then 2 x 12 while compressing), but is
+// counted too.
 double AllAtOnceBytes(double unknowns, double matrix_nonzeros, double factor_nonzeros) {
   const double assembly = (16.0 + 12.0 + 12.0) * matrix_nonzeros + 16.0 * unknowns;
   const double factorisation =
       2.0 * 12.0 * matrix_nonzeros + 16.0 * factor_nonzeros + 400.0 * unknowns;
-  return std::max(assembly, factorisation);
+  constexpr double kAllocatorGranularity = 1 << 20;
+  return kAllocatorGranularity + std::max(assembly, factorisation);
 }
 
 }  // namespace
@@ -126,8 +129,8 @@ void SolveAllAtOnce(const CoupledSolverOptions& options, McreProblem* problem,
   std::ostringstream sizes;
   sizes << "about " << static_cast<long long>(bytes) << " bytes (matrix "
         << static_cast<long long>(matrix_nonzeros) << " nonzeros x 12 bytes, twice; LU factors "
-        << "about (9.5 n + 4) nonzeros per unknown x 16 bytes; 400 bytes per unknown; n = " << n
-        << " nodes, m = " << m << " steps)";
+        << "about (9.5 n + 4) nonzeros per unknown x 16 bytes; 400 bytes per unknown; 1 MiB; n = "
+        << n << " nodes, m = " << m << " steps)";
   if (system.size() > options.max_all_at_once_unknowns) {
     std::ostringstream why;
     why << "the all-at-once system has " << system.size() << " unknowns (5 n (m + 1), n = " << n
