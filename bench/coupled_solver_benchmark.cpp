@@ -38,6 +38,7 @@ CoupledSolverSummary Run(CoupledSolverType type, McreProblem* problem, double om
   options.relaxation_coefficient = omega;
   options.max_iterations = max_iterations;
   options.max_all_at_once_unknowns = 2'000'000;
+  options.max_all_at_once_bytes = 16L << 30;  // the paper's case needs about 14 GB
   CoupledSolution solution;
   return mcrewave::SolveCoupled(options, problem, initial, &solution);
 }
