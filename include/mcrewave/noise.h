@@ -8,7 +8,8 @@
 // The noise is Gaussian and white, drawn in the order u0, uL, f0, fL (all samples
 // of one channel, then the next) from a 64-bit Mersenne twister seeded with `seed`
 // and a Box-Muller transform written here, so the same seed gives the same numbers
-// on every platform.
+// on every platform; the same seed at two SNRs gives the same standard-normal draw,
+// scaled by each std.
 #pragma once
 
 #include <cstdint>
