@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -161,6 +162,21 @@ std::string InnerResidualCsv(const IdentificationRun& run) {
   return csv;
 }
 
+// The global scan: e^2 = scaled cost x J_rest at each scan modulus (solved at
+// outer.scan_tolerance); usable 0 where the sample's solve failed.
+std::string ScanCsv(const IdentificationRun& run) {
+  std::string csv = "modulus,cost,usable\n";
+  char row[128];
+  const IdentificationSummary& outer = run.outer;
+  for (std::size_t i = 0; i < outer.scan_moduli.size(); ++i) {
+    const bool usable = std::isfinite(outer.scan_costs[i]);
+    std::snprintf(row, sizeof(row), "%.17g,%.17g,%d\n", outer.scan_moduli[i],
+                  usable ? outer.scan_costs[i] * run.rest_cost : 0.0, usable ? 1 : 0);
+    csv += row;
+  }
+  return csv;
+}
+
 // ---------------------------------------------------------------------------
 // Figures.
 
@@ -176,18 +192,33 @@ std::string CostCurveScript(const IdentificationRun& run, const std::string& fol
       << "set xlabel 'E [GPa]'\nset ylabel 'e^2 [J s]'\nset format y '%.5g'\nset key top center\n"
       << "set arrow 1 from " << identified << ", graph 0 to " << identified
       << ", graph 1 nohead dashtype 2 lc rgb '#555555'\n";
-  // Top: everything; bottom: the window E* +- 5 % where the uncertainty's k is fitted.
+  // Top: the global scan over the bounds with the refinement (or, without a scan,
+  // everything computed); bottom: the window E* +- 5 % where the uncertainty's k
+  // is fitted.
   const double low = identified * (1.0 - kCurvatureWindow);
   const double high = identified * (1.0 + kCurvatureWindow);
+  const IdentificationSummary& outer = run.outer;
+  const bool scanned = !outer.scan_moduli.empty();
   for (int panel = 0; panel < 2; ++panel) {
-    if (panel == 0) {
+    std::string scan_plot;
+    if (panel == 0 && scanned) {
+      // Bounds over a decade or more: log E, as the scan is spaced.
+      if (outer.scan_moduli.back() >= 10.0 * outer.scan_moduli.front())
+        script << "set logscale x\n";
+      script << "set title 'global scan over the bounds (inner tolerance "
+             << run.config.outer.scan_tolerance << ") and the local refinement'\n";
+      scan_plot = GnuplotString(folder + "/scan.csv") +
+                  " skip 1 using ($1/1e9):($3 > 0 ? $2 : 1/0) with linespoints pt 5 ps 0.6 "
+                  "lc rgb '#2ca02c' title 'global scan', ";
+    } else if (panel == 0) {
       script << "set title 'over the optimiser evaluations'\n";
     } else {
-      script << "set title 'within 5 % of the identified E'\nset xrange [" << low << ":" << high
-             << "]\n";
+      script << "unset logscale x\nset title 'within 5 % of the identified E'\nset xrange [" << low
+             << ":" << high << "]\n";
     }
-    script << "plot " << curve
-           << " skip 1 using ($1/1e9):($4 > 0 ? $2 : 1/0) with linespoints pt 7 ps 0.5 lw 2 "
+    script << "plot " << scan_plot << curve
+           << " skip 1 using ($1/1e9):($4 > 0 ? $2 : 1/0) with linespoints pt 7 ps 0.5 lw 2 lc rgb "
+              "'#8b00c9' "
               "title 'e^2(E), cost curve', "
            << evaluations
            << " skip 1 using ($2/1e9):($6 > 0 ? $3 : 1/0) with points pt 6 ps 1.5 lc rgb 'red' "
@@ -226,9 +257,11 @@ std::string EndsScript(const IdentificationRun& run, const std::string& folder) 
 }
 
 std::string InnerResidualScript(const IdentificationRun& run, const std::string& folder) {
+  // The method's name with spaces for underscores (gnuplot's subscripts).
+  std::string method = CoupledSolverTypeToString(run.config.inner.type);
+  std::replace(method.begin(), method.end(), '_', ' ');
   std::ostringstream script;
-  script << GnuplotPngTerminal() << "set title 'Inner solver ("
-         << CoupledSolverTypeToString(run.config.inner.type)
+  script << GnuplotPngTerminal() << "set title 'Inner solver (" << method
          << "): relative residual ||c - A W||_P / ||c||_P from W = 0 at the identified "
             "modulus'\n"
             "set xlabel 'iteration (sweep pair)'\nset ylabel 'relative residual'\n"
@@ -388,6 +421,7 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
   write("cost_curve.csv", CostCurveCsv(run));
   write("ends.csv", EndsCsv(run));
   write("inner_residual.csv", InnerResidualCsv(run));
+  if (!run.outer.scan_moduli.empty()) write("scan.csv", ScanCsv(run));
 
   if (figures) {
     bool gnuplot_missing = false;

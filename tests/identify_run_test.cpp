@@ -107,8 +107,8 @@ TEST(IdentifyRunTest, QuickConfigIdentifiesEAndWritesEveryResult) {
   EXPECT_NE(summary.find("  cutoff_frequency: "), std::string::npos) << summary;
 
   for (const char* file :
-       {"summary.yaml", "evaluations.csv", "cost_curve.csv", "ends.csv", "inner_residual.csv",
-        "cost_curve.png", "ends.png", "inner_residual.png"}) {
+       {"summary.yaml", "evaluations.csv", "cost_curve.csv", "scan.csv", "ends.csv",
+        "inner_residual.csv", "cost_curve.png", "ends.png", "inner_residual.png"}) {
     EXPECT_TRUE(fs::exists(run.folder + "/" + file)) << file << "\n" << run.result.output;
   }
   EXPECT_EQ(TemporaryFiles(run.folder), 0);

@@ -11,13 +11,16 @@
 //                       the version
 //   evaluations.csv     the optimiser's evaluations: E, e^2, de^2/dE, inner solve
 //   cost_curve.csv      e^2(E) and de^2/dE around the identified E
+//   scan.csv            e^2 at the moduli of the global scan (when outer.scan_points
+//                       > 0), solved at outer.scan_tolerance
 //   ends.csv            measured and model end displacements and forces at the
 //                       identified E; model force F = F~ - B W / alpha
 //                       (docs/discrete_mcre.md section 2)
 //   inner_residual.csv  relative residual per inner iteration of a solve from
 //                       W = 0 at the identified E (direct solvers: their final
 //                       residual)
-//   cost_curve.png, ends.png, inner_residual.png   the same drawn by gnuplot
+//   cost_curve.png (the scan over the bounds, then E* +- 5 %), ends.png,
+//   inner_residual.png  the same drawn by gnuplot
 //                       (pngcairo), when figures are asked for (inner_residual.png
 //                       only when there is a residual to draw)
 #pragma once
