@@ -22,14 +22,6 @@
 #include "mcrewave/theta_integrator.h"
 #include "test_problems.h"
 
-#if defined(__SANITIZE_ADDRESS__)
-#define MCREWAVE_ADDRESS_SANITIZER 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define MCREWAVE_ADDRESS_SANITIZER 1
-#endif
-#endif
-
 #if defined(__GLIBC__) && !defined(MCREWAVE_ADDRESS_SANITIZER)
 #define MCREWAVE_COUNTS_ALLOCATIONS 1
 #else

@@ -18,6 +18,8 @@
 namespace mcrewave {
 namespace {
 
+using testing::kAddressSanitizer;
+
 using testing::Compare;
 using testing::kReferenceModulus;
 using testing::MakeSmallCase;
@@ -160,18 +162,6 @@ TEST(AllAtOnceSolverTest, RefusesAboveTheMemoryLimitWithTheBytesItWouldNeed) {
   EXPECT_NE(Solve(options, &bundle.problem).summary.message.find("inner.max_all_at_once_unknowns"),
             std::string::npos);
 }
-
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kAddressSanitizer = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kAddressSanitizer = true;
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
 
 // Peak resident memory of this process so far [bytes].
 double PeakResidentBytes() {

@@ -30,6 +30,7 @@
 #include "mcrewave/mcre_problem.h"
 #include "mcrewave/measurement.h"
 #include "mcrewave/simulation.h"
+#include "test_problems.h"
 
 namespace mcrewave {
 namespace {
@@ -41,18 +42,7 @@ using testing::RunResult;
 using testing::SourcePath;
 
 namespace fs = std::filesystem;
-
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kAddressSanitizer = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kAddressSanitizer = true;
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
+using testing::kAddressSanitizer;
 
 // Every file of `folder` by name, with its content.
 std::map<std::string, std::string> Snapshot(const std::string& folder) {

@@ -9,7 +9,24 @@
 #include "mcrewave/mcre_problem.h"
 #include "mcrewave/simulation.h"
 
+// MCREWAVE_ADDRESS_SANITIZER: defined when this build runs under AddressSanitizer
+// (gcc's macro or clang's feature test), whose allocator and memory overhead some
+// tests must allow for.
+#if defined(__SANITIZE_ADDRESS__)
+#define MCREWAVE_ADDRESS_SANITIZER 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define MCREWAVE_ADDRESS_SANITIZER 1
+#endif
+#endif
+
 namespace mcrewave::testing {
+
+#ifdef MCREWAVE_ADDRESS_SANITIZER
+inline constexpr bool kAddressSanitizer = true;
+#else
+inline constexpr bool kAddressSanitizer = false;
+#endif
 
 // A bar with `elements` elements and a time grid of `steps` steps of the
 // paper's Courant number c h / h_e = 0.57, the window scaled accordingly.
