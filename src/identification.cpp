@@ -434,6 +434,9 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
   // refinements left of max_evaluations and max_time.
   std::vector<IdentificationSummary> refined;
   std::string limit_message;
+  // A refinement that failed leaves its valley unknown: no result is reported
+  // over it, whatever the other refinements found.
+  std::string refinement_failure;
   int evaluations_used = points;
   // Which limit stopped the search, in the user's terms.
   auto limit_reached = [&](const std::string& when) {
@@ -470,14 +473,10 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
     if (refined.back().termination == TerminationType::kNoConvergence) {
       limit_message = limit_reached("before convergence");
     }
-  }  // A refinement that failed leaves its valley unknown: no result is reported
-  // over it, whatever the other refinements found.
-  std::string refinement_failure;
-  for (int k = 0; k < static_cast<int>(refined.size()); ++k) {
-    if (refined[k].termination == TerminationType::kFailure && refinement_failure.empty()) {
+    if (refined.back().termination == TerminationType::kFailure && refinement_failure.empty()) {
       std::ostringstream why;
-      why << "the refinement of sampled minimum " << k + 1 << " (E = " << xs[minima[k]] * scale
-          << " Pa) failed: " << refined[k].message;
+      why << "the refinement of sampled minimum " << k + 1 << " (E = " << xs[i] * scale
+          << " Pa) failed: " << refined.back().message;
       refinement_failure = why.str();
     }
   }
