@@ -33,10 +33,10 @@
 #include <string>
 #include <vector>
 
-#include "mcrewave/coupled_solver.h"
-#include "mcrewave/file_util.h"
-#include "mcrewave/operation_counts.h"
-#include "mcrewave/simulation.h"
+#include "mcrewave/core/file_util.h"
+#include "mcrewave/core/operation_counts.h"
+#include "mcrewave/mcre/coupled_solver.h"
+#include "mcrewave/model/simulation.h"
 
 namespace mcrewave {
 namespace {

@@ -20,8 +20,8 @@
 #include <limits>
 #include <vector>
 
-#include "mcrewave/coupled_solver.h"
-#include "mcrewave/simulation.h"
+#include "mcrewave/mcre/coupled_solver.h"
+#include "mcrewave/model/simulation.h"
 
 namespace {
 

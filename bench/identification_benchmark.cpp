@@ -34,11 +34,11 @@
 #include <string>
 #include <vector>
 
-#include "mcrewave/config.h"
-#include "mcrewave/identification.h"
-#include "mcrewave/identification_run.h"
-#include "mcrewave/objective.h"
-#include "mcrewave/prefilter.h"
+#include "mcrewave/app/config.h"
+#include "mcrewave/app/identification_run.h"
+#include "mcrewave/data/prefilter.h"
+#include "mcrewave/mcre/objective.h"
+#include "mcrewave/optim/identification.h"
 
 namespace {
 

@@ -31,13 +31,13 @@
 #include <thread>
 #include <vector>
 
-#include "mcrewave/file_util.h"
-#include "mcrewave/identification.h"
-#include "mcrewave/noise.h"
-#include "mcrewave/objective.h"
-#include "mcrewave/prefilter.h"
-#include "mcrewave/simulation.h"
-#include "mcrewave/study.h"
+#include "mcrewave/app/study.h"
+#include "mcrewave/core/file_util.h"
+#include "mcrewave/data/noise.h"
+#include "mcrewave/data/prefilter.h"
+#include "mcrewave/mcre/objective.h"
+#include "mcrewave/model/simulation.h"
+#include "mcrewave/optim/identification.h"
 
 namespace {
 

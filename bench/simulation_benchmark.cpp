@@ -15,9 +15,9 @@
 #include <utility>
 #include <vector>
 
-#include "mcrewave/bar_model.h"
-#include "mcrewave/simulation.h"
-#include "mcrewave/theta_integrator.h"
+#include "mcrewave/linalg/theta_integrator.h"
+#include "mcrewave/model/bar_model.h"
+#include "mcrewave/model/simulation.h"
 
 namespace mcrewave {
 namespace {

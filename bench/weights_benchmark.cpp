@@ -25,9 +25,9 @@
 #include <thread>
 #include <vector>
 
-#include "mcrewave/coupled_solver.h"
-#include "mcrewave/file_util.h"
-#include "mcrewave/simulation.h"
+#include "mcrewave/core/file_util.h"
+#include "mcrewave/mcre/coupled_solver.h"
+#include "mcrewave/model/simulation.h"
 
 namespace {
 

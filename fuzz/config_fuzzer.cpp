@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "mcrewave/config.h"
-#include "mcrewave/types.h"
+#include "mcrewave/app/config.h"
+#include "mcrewave/core/types.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string input(reinterpret_cast<const char*>(data), size);

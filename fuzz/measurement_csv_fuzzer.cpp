@@ -8,8 +8,8 @@
 #include <sstream>
 #include <string>
 
-#include "mcrewave/measurement.h"
-#include "mcrewave/types.h"
+#include "mcrewave/core/types.h"
+#include "mcrewave/data/measurement.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::istringstream text(std::string(reinterpret_cast<const char*>(data), size));
@@ -18,8 +18,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const bool usable = set.num_samples() >= 2 && set.uL.size() == set.u0.size() &&
                         set.f0.size() == set.u0.size() && set.fL.size() == set.u0.size() &&
                         std::isfinite(set.time_step) && set.time_step > 0.0 &&
-                        std::isfinite(set.start_time) && set.u0.allFinite() &&
-                        set.uL.allFinite() && set.f0.allFinite() && set.fL.allFinite();
+                        std::isfinite(set.start_time) && set.u0.allFinite() && set.uL.allFinite() &&
+                        set.f0.allFinite() && set.fL.allFinite();
     if (!usable) __builtin_trap();
   } catch (const mcrewave::InputError&) {
   }

@@ -58,14 +58,14 @@
 #include <utility>
 #include <vector>
 
-#include "mcrewave/config.h"
-#include "mcrewave/identification_run.h"
-#include "mcrewave/measurement.h"
-#include "mcrewave/noise.h"
-#include "mcrewave/results.h"
-#include "mcrewave/simulation.h"
-#include "mcrewave/study.h"
-#include "mcrewave/version.h"
+#include "mcrewave/app/config.h"
+#include "mcrewave/app/identification_run.h"
+#include "mcrewave/app/results.h"
+#include "mcrewave/app/study.h"
+#include "mcrewave/core/version.h"
+#include "mcrewave/data/measurement.h"
+#include "mcrewave/data/noise.h"
+#include "mcrewave/model/simulation.h"
 
 namespace {
 

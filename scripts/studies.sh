@@ -5,7 +5,7 @@
 #   results/complexity/           scripts/complexity_study.sh (the paper's Table 1, Fig. 5)
 #   results/weights/              scripts/weights_study.sh (docs/weights.md)
 #   results/robustness/, relaxation/, cost_curves/   `identify study configs/studies.yaml`
-#                                 (include/mcrewave/study.h), which writes results/README.md
+#                                 (include/mcrewave/app/study.h), which writes results/README.md
 # About 10 minutes on 2 cores. Arguments go to `identify study`, and with any of them
 # only the identify studies run, e.g.
 #   bash scripts/studies.sh --set study.kind=relaxation

@@ -17,9 +17,9 @@
 #include <cstdlib>
 #include <vector>
 
-#include "mcrewave/bar_model.h"
-#include "mcrewave/mcre_problem.h"
-#include "mcrewave/theta_integrator.h"
+#include "mcrewave/linalg/theta_integrator.h"
+#include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/model/bar_model.h"
 #include "test_problems.h"
 
 #if defined(__GLIBC__) && !defined(MCREWAVE_ADDRESS_SANITIZER)

@@ -1,5 +1,5 @@
 // SymmetricBandMatrix products and BandLdlt solves against Eigen's dense ones.
-#include "mcrewave/band_matrix.h"
+#include "mcrewave/linalg/band_matrix.h"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <random>
 #include <vector>
 
-#include "mcrewave/bar_model.h"
+#include "mcrewave/model/bar_model.h"
 
 namespace mcrewave {
 namespace {
@@ -170,8 +170,8 @@ TEST(TwistedTridiagonalLdltTest, BatchedSolvesMatchSingleSolvesExactly) {
     factor.SolveInPlace<3>({x0.data(), x1.data(), x2.data()});
     Vector y0 = b0, y1 = b1;
     factor.SolveInPlace<2>({y0.data(), y1.data()});
-    for (const auto& [batched, rhs] : {std::pair<Vector, Vector>{x0, b0}, {x1, b1}, {x2, b2},
-                                       {y0, b0}, {y1, b1}}) {
+    for (const auto& [batched, rhs] :
+         {std::pair<Vector, Vector>{x0, b0}, {x1, b1}, {x2, b2}, {y0, b0}, {y1, b1}}) {
       Vector single = rhs;
       factor.SolveInPlace(single);
       EXPECT_EQ((batched - single).cwiseAbs().maxCoeff(), 0.0) << "n = " << n;

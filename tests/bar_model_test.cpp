@@ -1,6 +1,6 @@
 // BarModel: the assembled M, K1, K = E K1 and B against their closed forms for
 // linear elements, on a bar whose dimensions are all different from the defaults.
-#include "mcrewave/bar_model.h"
+#include "mcrewave/model/bar_model.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "mcrewave/config.h"
+#include "mcrewave/app/config.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "mcrewave/types.h"
+#include "mcrewave/core/types.h"
 
 namespace mcrewave {
 namespace {

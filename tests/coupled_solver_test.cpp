@@ -1,7 +1,7 @@
 // Tests of the coupled direct / retrograde solvers: every sweep-based solver
 // against the independent all-at-once solver, the inverse-crime cost curve, the
 // adjoint gradient against finite differences, and divergence reporting.
-#include "mcrewave/coupled_solver.h"
+#include "mcrewave/mcre/coupled_solver.h"
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>

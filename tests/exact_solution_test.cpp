@@ -2,7 +2,7 @@
 // which is computed by d'Alembert's sum of reflected pulses: a modal series written
 // here with closed-form Duhamel integrals, boundary conditions, the momentum
 // balance of the whole bar, the quasi-static limit and the wave arrival time.
-#include "mcrewave/exact_solution.h"
+#include "mcrewave/model/exact_solution.h"
 
 #include <gtest/gtest.h>
 

@@ -9,11 +9,11 @@
 #include <cmath>
 #include <vector>
 
-#include "mcrewave/bar_model.h"
-#include "mcrewave/identification.h"
-#include "mcrewave/objective.h"
-#include "mcrewave/prefilter.h"
-#include "mcrewave/simulation.h"
+#include "mcrewave/data/prefilter.h"
+#include "mcrewave/mcre/objective.h"
+#include "mcrewave/model/bar_model.h"
+#include "mcrewave/model/simulation.h"
+#include "mcrewave/optim/identification.h"
 #include "test_problems.h"
 
 namespace mcrewave {
@@ -142,8 +142,7 @@ double NoiseFreeError(bool prefilter_enabled, double* cutoff) {
   const MeasurementSet data = PrefilterMeasurements(
       MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data), prefilter, cutoff);
   const IdentificationOptions options;
-  McreObjective objective(model, data, McreOptions(), 0.5, CoupledSolverOptions(),
-                          options.initial);
+  McreObjective objective(model, data, McreOptions(), 0.5, CoupledSolverOptions(), options.initial);
   const IdentificationSummary summary = Identify(options, &objective);
   EXPECT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
   EXPECT_EQ(summary.local_minima, 1) << summary.FullReport();

@@ -24,12 +24,12 @@
 #include <vector>
 
 #include "identify_binary.h"
-#include "mcrewave/bar_model.h"
-#include "mcrewave/config.h"
-#include "mcrewave/coupled_solver.h"
-#include "mcrewave/mcre_problem.h"
-#include "mcrewave/measurement.h"
-#include "mcrewave/simulation.h"
+#include "mcrewave/app/config.h"
+#include "mcrewave/data/measurement.h"
+#include "mcrewave/mcre/coupled_solver.h"
+#include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/model/bar_model.h"
+#include "mcrewave/model/simulation.h"
 #include "test_problems.h"
 
 namespace mcrewave {

@@ -3,7 +3,7 @@
 // of NLopt are guarded (an exception in the objective is reported with its
 // message, the best point seen is the one reported, limits are honoured); and
 // the options name their keys when invalid.
-#include "mcrewave/identification.h"
+#include "mcrewave/optim/identification.h"
 
 #include <gtest/gtest.h>
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "identify_binary.h"
-#include "mcrewave/measurement.h"
+#include "mcrewave/data/measurement.h"
 
 namespace mcrewave {
 namespace {

@@ -1,6 +1,6 @@
 // Tests of the discrete MCRE problem: weights, the adjoint structure of the two
 // sweeps, and the cost at consistent data.
-#include "mcrewave/mcre_problem.h"
+#include "mcrewave/mcre/mcre_problem.h"
 
 #include <gtest/gtest.h>
 

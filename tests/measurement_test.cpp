@@ -1,4 +1,4 @@
-#include "mcrewave/measurement.h"
+#include "mcrewave/data/measurement.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "mcrewave/types.h"
+#include "mcrewave/core/types.h"
 
 namespace mcrewave {
 namespace {

@@ -1,7 +1,7 @@
 // Tests of the uncertainty figure's pieces: the noise levels estimated from the
 // data, the slope of de^2/dE, and the first-order standard deviation (linear in
 // the noise level, unavailable without curvature or noise).
-#include "mcrewave/modulus_uncertainty.h"
+#include "mcrewave/mcre/modulus_uncertainty.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <limits>
 #include <vector>
 
-#include "mcrewave/noise.h"
+#include "mcrewave/data/noise.h"
 #include "test_problems.h"
 
 namespace mcrewave {

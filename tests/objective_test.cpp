@@ -1,7 +1,7 @@
 // Tests of the outer loop's objective: McreObjective evaluates e^2(E) scaled,
 // with or without the adjoint gradient, warm-starts, records every evaluation,
 // keeps the best, and reports an unusable inner solve as false with a message.
-#include "mcrewave/objective.h"
+#include "mcrewave/mcre/objective.h"
 
 #include <gtest/gtest.h>
 

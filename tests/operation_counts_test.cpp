@@ -1,11 +1,11 @@
 // Tests of the multiply-accumulate counts: the kernel formulas against their
 // closed forms, and the Riccati solver's count against its loop structure
 // (exactly affine in the number of steps, about 6.3 n^3 per step).
-#include "mcrewave/operation_counts.h"
+#include "mcrewave/core/operation_counts.h"
 
 #include <gtest/gtest.h>
 
-#include "mcrewave/coupled_solver.h"
+#include "mcrewave/mcre/coupled_solver.h"
 #include "test_problems.h"
 
 namespace mcrewave {

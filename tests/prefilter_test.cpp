@@ -1,5 +1,5 @@
 // Tests of the zero-phase low-pass pre-filter.
-#include "mcrewave/prefilter.h"
+#include "mcrewave/data/prefilter.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "mcrewave/simulation.h"
+#include "mcrewave/model/simulation.h"
 
 namespace mcrewave {
 namespace {

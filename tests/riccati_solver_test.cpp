@@ -6,7 +6,7 @@
 #include <cmath>
 #include <iostream>
 
-#include "mcrewave/coupled_solver.h"
+#include "mcrewave/mcre/coupled_solver.h"
 #include "test_problems.h"
 
 namespace mcrewave {

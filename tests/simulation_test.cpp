@@ -1,7 +1,7 @@
 // The direct simulation of the reference experiment: convergence of the FE + theta
 // model to the exact solution, consistency of the clamp reaction, the refined truth
 // and the measurement noise.
-#include "mcrewave/simulation.h"
+#include "mcrewave/model/simulation.h"
 
 #include <gtest/gtest.h>
 
@@ -15,9 +15,9 @@
 #include <utility>
 #include <vector>
 
-#include "mcrewave/exact_solution.h"
-#include "mcrewave/noise.h"
-#include "mcrewave/theta_integrator.h"
+#include "mcrewave/data/noise.h"
+#include "mcrewave/linalg/theta_integrator.h"
+#include "mcrewave/model/exact_solution.h"
 
 namespace mcrewave {
 namespace {

@@ -1,7 +1,7 @@
 // The studies of study.h on a tiny case (12 elements, 150 steps, a 15-point
 // scan): each study's numbers against what must hold, thread-count
 // independence, the files written, and the `study:` config checks.
-#include "mcrewave/study.h"
+#include "mcrewave/app/study.h"
 
 #include <gtest/gtest.h>
 
@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "mcrewave/config.h"
-#include "mcrewave/types.h"
+#include "mcrewave/app/config.h"
+#include "mcrewave/core/types.h"
 
 namespace mcrewave {
 namespace {

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <memory>
 
-#include "mcrewave/bar_model.h"
-#include "mcrewave/coupled_solver.h"
-#include "mcrewave/mcre_problem.h"
-#include "mcrewave/simulation.h"
+#include "mcrewave/mcre/coupled_solver.h"
+#include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/model/bar_model.h"
+#include "mcrewave/model/simulation.h"
 
 // MCREWAVE_ADDRESS_SANITIZER: defined when this build runs under AddressSanitizer
 // (gcc's macro or clang's feature test), whose allocator and memory overhead some

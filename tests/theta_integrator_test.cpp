@@ -1,6 +1,6 @@
 // ThetaIntegrator: options, convergence order, agreement with a plain first-order
 // theta integrator on the full state, time reversal and factorisation count.
-#include "mcrewave/theta_integrator.h"
+#include "mcrewave/linalg/theta_integrator.h"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +14,7 @@
 #include <utility>
 #include <vector>
 
-#include "mcrewave/bar_model.h"
+#include "mcrewave/model/bar_model.h"
 
 namespace mcrewave {
 namespace {

@@ -1,0 +1,111 @@
+// The YAML configuration of an mcrewave run.
+//
+// Every key is declared once, in a table in src/config.cpp, with its type, its
+// default, its unit and a one-line description; loading, validation, the
+// `--set key.path=value` overrides and the commented default config
+// (DefaultConfigYaml) all come from that table. Values are SI units. Enums are
+// written by name (see types.h).
+//
+// Sections and keys (defaults in brackets):
+//   model: length [1 m], section [1e-4 m^2], density [800 kg/m^3],
+//          modulus [200e9 Pa], elements [100], mass [consistent | lumped]
+//   load:  kind [half_sine], amplitude [1000 N], duration [1e-4 s]
+//   time:  window [0.63e-3 s], step [0.36e-6 s], theta [0.5]
+//   data:  source [synthetic | csv], path [""], truth [finite_element | exact],
+//          truth_refinement [4], snr [.inf], seed [1]
+//   mcre:  w_u [0.01], w_f [1], reference_modulus [200e9 Pa] (E0 of the weights;
+//          objective.h)
+//   inner: method [conjugate_gradient | all_at_once | relaxation | adaptive_relaxation
+//          | any other CoupledSolverType], tolerance [1e-8], max_iterations [5000],
+//          omega [0.5], spectrum_steps [12], spectrum_safety_factor [1.05],
+//          divergence_factor [1e3], max_all_at_once_unknowns [1500000],
+//          max_all_at_once_bytes [2^31], max_field_bytes [2^31],
+//          max_dense_solver_bytes [2^31],
+//          shooting_condition_limit [1e14],
+//          shooting_segment_growth [100]
+//          (CoupledSolverOptions, coupled_solver.h)
+//   outer: optimizer [nlopt | ceres], algorithm [default | bobyqa | cobyla | sbplx |
+//          mma | lbfgs | bfgs | brent], lower_bound [100e9 Pa], upper_bound [400e9 Pa],
+//          initial [160e9 Pa], relative_tolerance [1e-7], max_evaluations [150],
+//          max_time [600 s], scan_points [41], scan_tolerance [1e-4],
+//          scan_threads [2], refine_candidates [2] (IdentificationOptions,
+//          identification.h)
+//   prefilter: enabled [true], cutoff_frequency [0 Hz: derived from the data;
+//          else below the Nyquist frequency 0.5 / time.step], order [4] (PrefilterOptions,
+//          prefilter.h; applied to the measurements before the identification)
+//   uncertainty: samples [16], seed [1] (modulus_uncertainty.h)
+//   output: folder ["results/identify"], figures [true], curve_points [41]
+//   study: kind [all | robustness | relaxation | cost_curves], folder ["results"],
+//          threads [0: every core], figures [true], robustness_snr
+//          [[.inf, 20, 10, 5, 2.5]], robustness_seeds [100], relaxation_snr
+//          [[.inf, 10, 2.5]], relaxation_moduli [[0.8, 1, 1.2]], omega_min [0.005],
+//          omega_max [0.1], omega_points [20], relaxation_tolerance [1e-4],
+//          cost_curve_snr [[.inf, 10, 2.5]], cost_curve_seeds [3],
+//          cost_curve_points [41], cost_curve_low [0.8], cost_curve_high [1.2]
+//          (StudyOptions, study.h; used by `identify study` only)
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mcrewave/app/study.h"
+#include "mcrewave/data/prefilter.h"
+#include "mcrewave/mcre/coupled_solver.h"
+#include "mcrewave/mcre/modulus_uncertainty.h"
+#include "mcrewave/mcre/objective.h"
+#include "mcrewave/model/bar_model.h"
+#include "mcrewave/model/experiment.h"
+#include "mcrewave/optim/identification.h"
+
+namespace mcrewave {
+
+// The `output:` section: where `identify run` writes its results and what.
+struct OutputOptions {
+  // Results folder; a relative path is taken from the working directory (not
+  // from the config's folder); `identify run --output` replaces it.
+  std::string folder = "results/identify";
+  // Write the PNG figures (gnuplot) beside the CSV files.
+  bool figures = true;
+  // Points of the cost curve e^2(E) computed around the identified modulus.
+  int curve_points = 41;
+
+  // Valid when folder is not empty and curve_points is in [5, 1000].
+  bool IsValid(std::string* error) const;
+};
+
+struct Config {
+  std::string source_path;  // the file the config was read from ("" for defaults)
+  BarProperties model;
+  LoadOptions load;
+  TimeOptions time;
+  DataOptions data;
+  McreOptions mcre;
+  CoupledSolverOptions inner;
+  IdentificationOptions outer;
+  PrefilterOptions prefilter;
+  UncertaintyOptions uncertainty;
+  OutputOptions output;
+  StudyOptions study;
+};
+
+// Reads a config file, applies the overrides ("key.path=value", each parsed as a
+// YAML scalar and validated exactly as the same key in the file), and validates
+// everything before any computation. A relative data.path is resolved against
+// the config file's folder. Throws InputError with one message naming the file,
+// the line (for keys from the file) or the override, the key, and what was
+// expected: unknown keys (with the nearest valid key suggested), wrong types,
+// out-of-range values, a missing or unreadable file, malformed YAML.
+Config LoadConfig(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// The same from YAML text; `name` stands for the file name in messages.
+Config ParseConfig(const std::string& yaml_text, const std::string& name,
+                   const std::vector<std::string>& overrides = {});
+
+// A complete config with every key at its default, each commented with its unit
+// and meaning; ParseConfig(DefaultConfigYaml(), ...) gives the default Config.
+std::string DefaultConfigYaml();
+
+// The config as resolved (every key, current values) in YAML, for summaries.
+std::string ConfigToYaml(const Config& config);
+
+}  // namespace mcrewave

@@ -1,0 +1,107 @@
+// One identification as `identify run` performs it, from a validated Config to
+// everything the results show, before anything is written (results.h writes).
+//
+//   1. LoadMeasurements: synthetic data (data.source: synthetic) or the CSV file,
+//      checked against the model's time grid.
+//   2. The pre-filter (prefilter.h) of the measurements when prefilter.enabled.
+//   3. Identify (identification.h) on an McreObjective (objective.h) with
+//      x = E / outer.initial: the global scan and local refinements.
+//   4. At the identified E*: the cost curve e^2(E) on output.curve_points points
+//      around E*, warm-started point to point, and the uncertainty figure
+//      (modulus_uncertainty.h).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mcrewave/app/config.h"
+#include "mcrewave/data/measurement.h"
+#include "mcrewave/mcre/modulus_uncertainty.h"
+#include "mcrewave/mcre/objective.h"
+#include "mcrewave/optim/identification.h"
+
+namespace mcrewave {
+
+// The measurements of config.data: MakeSyntheticMeasurements, or the CSV file
+// data.path. Throws InputError naming the file when a CSV is malformed (see
+// ReadMeasurementCsv) or does not match the model's time grid: its time step must
+// equal time.step and its sample count time.window / time.step + 1 (both to
+// 1e-6 relative).
+MeasurementSet LoadMeasurements(const Config& config);
+
+// Everything one identification computed.
+struct IdentificationRun {
+  Config config;
+  // The measurements the MCRE compared with: pre-filtered when prefilter.enabled.
+  MeasurementSet data;
+  // The pre-filter's cut-off frequency [Hz] (given or derived); 0 when off.
+  double prefilter_cutoff = 0.0;
+  // Synthetic data: they were made with E = config.model.modulus, the reference
+  // the identified modulus is compared with. False for CSV data.
+  bool reference_known = false;
+  // The noise levels the uncertainty draws, and where they come from:
+  // "synthetic_snr" (the levels the synthetic noise was drawn with) or
+  // "data_differences" (DifferenceNoiseLevels: CSV data, or no synthetic noise).
+  NoiseLevels noise;
+  std::string noise_source;
+  // DifferenceNoiseLevels of the measurements as given (before the pre-filter).
+  // The uncertainty draws white noise of `noise` on the channels, unfiltered:
+  // with the pre-filter on, it overstates the spread (conservative).
+  NoiseLevels estimated_noise;
+  NoiseLevels misfit;  // RMS misfits at the optimum (MisfitLevels)
+
+  IdentificationSummary outer;
+  // The optimiser's evaluations, in order; evaluations[best_index] is the one
+  // at the identified E, and `solution` its coupled solution.
+  std::vector<ObjectiveEvaluation> evaluations;
+  int best_index = -1;
+  CoupledSolution solution;
+  double alpha = 0.0;      // force weight used [m/N]
+  double beta = 0.0;       // displacement weight used [N/m]
+  double rest_cost = 0.0;  // J_rest, the cost scale [J s]
+  long sweeps = 0;         // sweeps of the optimiser's evaluations
+
+  std::vector<CostCurvePoint> cost_curve;  // ascending E
+  long cost_curve_sweeps = 0;
+  // A coupled solve at the identified E from W = 0, for the inner solver's
+  // convergence history (the optimiser's solves are warm-started: the one at E*
+  // takes few iterations, often none).
+  CoupledSolverSummary cold_solve;
+  ModulusUncertainty uncertainty;
+  double wall_time_s = -1.0;  // the whole of RunIdentification
+
+  // The outer loop converged; only then are the fields after `outer` filled.
+  bool IsUsable() const { return outer.IsSolutionUsable(); }
+  double identified_modulus() const { return outer.modulus; }
+  // e^2 at the identified E [J s].
+  double cost() const { return best_index >= 0 ? evaluations[best_index].cost : -1.0; }
+};
+
+// Runs steps 2 and 3 on measurements made by LoadMeasurements(config): the
+// fields up to `solution` (and wall_time_s); no cost curve, no uncertainty.
+// Precondition: config valid. Never throws for a failed identification.
+IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& data);
+
+// Why `modulus` [Pa] cannot be reported as identified: it lies on a bound of
+// the search (within kOnBoundTolerance relative), where e^2 has no minimum but
+// only its least value inside the bounds; "" when it lies inside.
+constexpr double kOnBoundTolerance = 1e-6;
+std::string ModulusOnBoundMessage(double modulus, const IdentificationOptions& outer);
+
+// Why the identified E cannot be reported: at E* the model misses the measured
+// displacements (or forces) by an RMS misfit (run.misfit) above
+// kImplausibleMisfitFactor times the RMS of those measurements (run.data, both
+// ends), i.e. it explains nothing of them, as data in wrong units or from
+// another structure give, whatever the bounds; "" otherwise. Measured: correct
+// data at SNR 2.5 to inf give misfits below their RMS; a channel scaled by 1e6
+// gives 1e4 to 1e6 times it. Precondition: run.IsUsable() and RunIdentification
+// ran (run.misfit is set).
+constexpr double kImplausibleMisfitFactor = 10.0;
+std::string ImplausibleMisfitMessage(const IdentificationRun& run);
+
+// Runs steps 2 to 4 on measurements made by LoadMeasurements(config).
+// Precondition: config valid (as LoadConfig returns it). Never throws for a
+// failed identification: see IsUsable() and outer.message.
+IdentificationRun RunIdentification(const Config& config, const MeasurementSet& data);
+
+}  // namespace mcrewave

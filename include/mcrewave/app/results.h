@@ -1,0 +1,46 @@
+// The results of `identify run` in its output folder. Every file is written
+// atomically (file_util.h; gnuplot draws to a temporary name that is then
+// renamed), and only once everything is computed, so a reader never sees a
+// half-written file and a failed run leaves none behind.
+//
+//   summary.yaml        identified_modulus [Pa], reference_modulus and
+//                       relative_error (null for CSV data), cost e^2 [J s],
+//                       evaluations, sweeps, wall_time_s, the uncertainty figure
+//                       and its meaning, optimiser and inner-solver totals, the
+//                       weights, the cost curve's extent, the resolved config and
+//                       the version
+//   evaluations.csv     the optimiser's evaluations: E, e^2, de^2/dE, inner solve
+//   cost_curve.csv      e^2(E) and de^2/dE around the identified E
+//   scan.csv            e^2 at the moduli of the global scan (when outer.scan_points
+//                       > 0), solved at outer.scan_tolerance
+//   ends.csv            measured and model end displacements and forces at the
+//                       identified E; model force F = F~ - B W / alpha
+//                       (docs/discrete_mcre.md section 2)
+//   inner_residual.csv  relative residual per inner iteration of a solve from
+//                       W = 0 at the identified E (direct solvers: their final
+//                       residual)
+//   cost_curve.png (the scan over the bounds, then E* +- 5 %), ends.png,
+//   inner_residual.png  the same drawn by gnuplot
+//                       (pngcairo), when figures are asked for (inner_residual.png
+//                       only when there is a residual to draw)
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mcrewave/app/identification_run.h"
+
+namespace mcrewave {
+
+// The text of summary.yaml. Precondition: run.IsUsable().
+std::string SummaryYaml(const IdentificationRun& run);
+
+// Writes the files above into `folder` (created if needed) and returns their
+// paths. Without gnuplot on the PATH, or when gnuplot fails, the figures are
+// skipped with a warning; the CSV files and the summary are still written.
+// Throws std::runtime_error naming the file that cannot be written.
+// Precondition: run.IsUsable().
+std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run,
+                                                    const std::string& folder, bool figures);
+
+}  // namespace mcrewave

@@ -1,0 +1,268 @@
+// Studies of the identification, run by `identify study CONFIG` from the
+// `study:` section of a config (config.h), each into a folder of its own:
+//
+//   robustness   For every SNR of robustness_snr and noise seeds 1..robustness_seeds
+//                (one run at SNR inf: without noise every seed gives the same data),
+//                the identification of `identify run` (pre-filter, global scan,
+//                local refinement; identification_run.h) on data from the finer
+//                truth of `data:` (no inverse crime). The noise-free truth is
+//                simulated once; only the noise differs from run to run. Per SNR:
+//                mean, standard deviation and 2.5 / 97.5 % quantiles of the
+//                relative error of E, the share of runs that converged, mean outer
+//                evaluations and inner sweeps (the paper identifies E down to
+//                SNR 2.5).
+//   relaxation   For every SNR of relaxation_snr (noise seed data.seed) and E =
+//                f E_ref, f in relaxation_moduli: the sweeps the fixed-omega
+//                relaxation needs to reach relaxation_tolerance on a grid of omega
+//                (the paper's Fig. 3), beside what the spectrum of A = I - G
+//                predicts (Lanczos estimate of the adaptive relaxation): the
+//                convergence limit omega < 2 / a_max, the optimal omega
+//                2 / (a_min + a_max), the adaptive rule's omega and the iterations
+//                ln(tol) / ln(rho(omega)), rho = max |1 - omega a|; and the residual
+//                against iteration of the fixed omega (the grid's fastest), the
+//                adaptive relaxation and conjugate gradients (Fig. 4 extended),
+//                each to inner.tolerance.
+//   cost_curves  For every SNR of cost_curve_snr and seeds 1..cost_curve_seeds (one
+//                at SNR inf): e^2(E) on cost_curve_points moduli evenly spaced over
+//                [cost_curve_low, cost_curve_high] E_ref, and the modulus the
+//                identification finds on the same data (the paper's Fig. 6).
+//
+// E_ref is model.modulus, the modulus of the synthetic data. Every study uses
+// the config's model, load, time grid, data truth, weights, inner solver,
+// pre-filter and outer loop; the measurements of one (SNR, seed) are the truth
+// plus AddMeasurementNoise(snr, seed) (noise.h), then the pre-filter.
+//
+// Runs are spread over `threads` threads (0: every core), each run on one thread
+// (the identifications' scans with outer.scan_threads = 1), and stored by index:
+// the numbers do not depend on the number of threads. Progress lines with an
+// estimate of the time left go to StudyProgressLogger() as runs complete.
+#pragma once
+
+#include <spdlog/logger.h>
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mcrewave/mcre/coupled_solver.h"
+
+namespace mcrewave {
+
+struct Config;
+
+enum class StudyKind {
+  kRobustness,
+  kRelaxation,
+  kCostCurves,
+  kAll,  // the three above
+};
+const char* StudyKindToString(StudyKind kind);
+bool StringToStudyKind(const std::string& name, StudyKind* kind);
+
+// The `study:` section of the config.
+struct StudyOptions {
+  StudyKind kind = StudyKind::kAll;
+  // Results folder of `identify study` (one subfolder per study and a
+  // README.md); relative to the working directory; --output replaces it.
+  std::string folder = "results";
+  // Threads running the studies' runs; 0: std::thread::hardware_concurrency().
+  int threads = 0;
+  // Figures (gnuplot) beside the CSV files.
+  bool figures = true;
+
+  // Robustness: signal-to-noise ratios (.inf: no noise) and seeds per finite SNR.
+  std::vector<double> robustness_snr = {std::numeric_limits<double>::infinity(), 20.0, 10.0, 5.0,
+                                        2.5};
+  int robustness_seeds = 100;
+
+  // Relaxation: SNRs, moduli as factors of E_ref, the omega grid (evenly
+  // spaced, ends included) and the relative residual the grid's solves reach
+  // (the paper used 1e-4).
+  std::vector<double> relaxation_snr = {std::numeric_limits<double>::infinity(), 10.0, 2.5};
+  std::vector<double> relaxation_moduli = {0.8, 1.0, 1.2};
+  double omega_min = 0.005;
+  double omega_max = 0.1;
+  int omega_points = 20;
+  double relaxation_tolerance = 1e-4;
+
+  // Cost curves: SNRs, seeds per finite SNR, and the grid of E as factors of E_ref.
+  std::vector<double> cost_curve_snr = {std::numeric_limits<double>::infinity(), 10.0, 2.5};
+  int cost_curve_seeds = 3;
+  int cost_curve_points = 41;
+  double cost_curve_low = 0.8;
+  double cost_curve_high = 1.2;
+
+  // Valid when folder is not empty, threads in [0, 256], every SNR > 0 (.inf
+  // allowed), lists not empty (at most 100 values), seeds in [1, 100000],
+  // relaxation_moduli in (0, 10], 0 < omega_min < omega_max < 2, omega_points
+  // in [2, 1000], relaxation_tolerance in (0, 1), cost_curve_points in
+  // [3, 10000], 0 < cost_curve_low < cost_curve_high. Messages name the
+  // study.* keys.
+  bool IsValid(std::string* error) const;
+};
+
+// Whether `kind` runs the study `part` (kAll runs every one).
+bool StudySelected(StudyKind kind, StudyKind part);
+
+// ---------------------------------------------------------------------------
+// Robustness.
+
+struct RobustnessRun {
+  double snr = 0.0;
+  int snr_index = 0;       // position of snr in robustness_snr
+  std::uint64_t seed = 0;  // noise seed (0 at SNR inf: no noise drawn)
+  // The outer loop converged and E* lies strictly inside the bounds.
+  bool converged = false;
+  std::string message;  // why not, when not converged
+  double identified_modulus = std::numeric_limits<double>::quiet_NaN();  // [Pa]
+  double relative_error = std::numeric_limits<double>::quiet_NaN();      // (E* - E_ref) / E_ref
+  int evaluations = 0;       // outer evaluations, scan included
+  int scan_evaluations = 0;  // of which in the global scan
+  long sweeps = 0;           // inner sweeps of the scan and the local refinements
+  int local_minima = 0;      // sampled local minima of the scan
+};
+
+struct RobustnessStatistics {
+  double snr = 0.0;
+  int runs = 0;
+  int converged = 0;
+  double converged_share = 0.0;
+  // Over the converged runs (NaN when none): relative error of E.
+  double mean_error = std::numeric_limits<double>::quiet_NaN();
+  double std_error = std::numeric_limits<double>::quiet_NaN();  // sample std (0 for one run)
+  double quantile_025 = std::numeric_limits<double>::quiet_NaN();
+  double quantile_975 = std::numeric_limits<double>::quiet_NaN();
+  double mean_evaluations = 0.0;  // over all runs
+  double mean_sweeps = 0.0;       // over all runs
+};
+
+struct RobustnessStudy {
+  double reference_modulus = 0.0;                // E_ref [Pa]
+  std::vector<RobustnessRun> runs;               // SNR by SNR, seeds ascending
+  std::vector<RobustnessStatistics> statistics;  // one per SNR, in robustness_snr order
+  int threads = 0;
+  double wall_time_s = 0.0;
+};
+
+// Precondition: config valid (as LoadConfig returns it), synthetic data.
+RobustnessStudy RunRobustnessStudy(const Config& config);
+
+// ---------------------------------------------------------------------------
+// Relaxation coefficient.
+
+// One (SNR, E) case: the spectrum estimate and the reference solves.
+struct RelaxationCase {
+  double snr = 0.0;
+  double modulus_factor = 0.0;  // E / E_ref
+  double modulus = 0.0;         // [Pa]
+  // Lanczos estimate of the extreme eigenvalues of A = I - G (inner.spectrum_steps
+  // steps from c, no safety factor).
+  double spectrum_min = 0.0;
+  double spectrum_max = 0.0;
+  double omega_limit = 0.0;    // 2 / a_max: the fixed relaxation diverges above
+  double omega_optimal = 0.0;  // 2 / (a_min + a_max): least contraction factor
+  // The adaptive relaxation's final omega (with inner.spectrum_safety_factor)
+  // and the sweeps of each reference solve to inner.tolerance.
+  double omega_adaptive = 0.0;
+  long adaptive_sweeps = 0;
+  long conjugate_gradient_sweeps = 0;
+  double omega_fastest = 0.0;  // the grid's omega of fewest sweeps (NaN: none converged)
+  long fixed_sweeps = 0;       // its solve to inner.tolerance
+};
+
+// One solve of the omega grid.
+struct RelaxationPoint {
+  int case_index = 0;
+  double omega = 0.0;
+  TerminationType termination = TerminationType::kFailure;
+  int iterations = 0;
+  long sweeps = 0;
+  double relative_residual = 0.0;
+  // ln(tol) / ln(rho), rho = max(|1 - omega a_min|, |1 - omega a_max|), rounded
+  // up; -1 when rho >= 1 (divergence predicted).
+  int predicted_iterations = -1;
+};
+
+// Relative residual per iteration of one reference solve.
+struct ResidualHistory {
+  int case_index = 0;
+  CoupledSolverType method = CoupledSolverType::kConjugateGradient;
+  double omega = std::numeric_limits<double>::quiet_NaN();  // NaN for CG
+  std::vector<double> residuals;
+};
+
+struct RelaxationStudy {
+  double tolerance = 0.0;                  // of the grid's solves
+  std::vector<RelaxationCase> cases;       // SNR by SNR, moduli in the config's order
+  std::vector<RelaxationPoint> points;     // case by case, omega ascending
+  std::vector<ResidualHistory> histories;  // case by case: fixed, adaptive, CG
+  int threads = 0;
+  double wall_time_s = 0.0;
+};
+
+// Precondition: config valid, synthetic data.
+RelaxationStudy RunRelaxationStudy(const Config& config);
+
+// ---------------------------------------------------------------------------
+// Cost curves.
+
+struct CostCurveRun {
+  double snr = 0.0;
+  std::uint64_t seed = 0;      // 0 at SNR inf
+  std::vector<double> moduli;  // [Pa], ascending
+  std::vector<double> costs;   // e^2 [J s] (NaN where the coupled solve is not usable)
+  bool converged = false;      // of the identification on the same data
+  double identified_modulus = std::numeric_limits<double>::quiet_NaN();  // [Pa]
+  double identified_cost = std::numeric_limits<double>::quiet_NaN();     // e^2 there [J s]
+  double relative_error = std::numeric_limits<double>::quiet_NaN();
+};
+
+struct CostCurveStudy {
+  double reference_modulus = 0.0;
+  std::vector<CostCurveRun> curves;  // SNR by SNR, seeds ascending
+  int threads = 0;
+  double wall_time_s = 0.0;
+};
+
+// Precondition: config valid, synthetic data.
+CostCurveStudy RunCostCurveStudy(const Config& config);
+
+// ---------------------------------------------------------------------------
+// Results. Each Write* creates `folder` if needed and writes, each file
+// atomically (file_util.h), the CSV files, the PNG figures when `figures` (and
+// gnuplot is there; otherwise a warning) and summary.md (what each figure shows
+// and the headline numbers); returns the paths written. Throws
+// std::runtime_error naming a file that cannot be written.
+//
+//   robustness/   runs.csv (one row per identification), statistics.csv (one
+//                 per SNR), robustness.png (mean and 95 % band of the error per
+//                 SNR, every run as a point)
+//   relaxation/   cases.csv (spectrum, omegas, reference sweeps per case),
+//                 sweeps.csv (the omega grid), residuals.csv (the histories),
+//                 sweeps_vs_omega.png, residuals.png
+//   cost_curves/  curves.csv (e^2 on the grid), minima.csv (identified E per
+//                 curve), cost_curves.png
+std::vector<std::string> WriteRobustnessResults(const RobustnessStudy& study,
+                                                const std::string& folder, bool figures);
+std::vector<std::string> WriteRelaxationResults(const RelaxationStudy& study,
+                                                const std::string& folder, bool figures);
+std::vector<std::string> WriteCostCurveResults(const CostCurveStudy& study,
+                                               const std::string& folder, bool figures);
+
+// Writes folder/README.md: the summary.md of each study subfolder present
+// (robustness, relaxation, cost_curves), in that order, under a short header.
+// Returns its path.
+std::string WriteStudiesReadme(const std::string& folder);
+
+// The logger of the studies' progress lines: the default logger's sinks under
+// the name "study", not registered, so that its level is set apart from the
+// default logger's (which the identifications inside a study log to).
+std::shared_ptr<spdlog::logger> StudyProgressLogger();
+
+// The q-quantile of values (linear interpolation between order statistics).
+// Precondition: values not empty, q in [0, 1].
+double Quantile(std::vector<double> values, double q);
+
+}  // namespace mcrewave

@@ -1,0 +1,59 @@
+// A measurement set: the four channels of the experiment sampled on a uniform
+// time grid, and its CSV form.
+//
+// CSV format: a header line exactly `t,u0,uL,f0,fL`, then one row per sample
+// t_k = t_0 + k h with h uniform, SI units (s, m, m, N, N):
+//   t   time [s]
+//   u0  displacement at x = 0 [m]
+//   uL  displacement at x = L [m]
+//   f0  force applied ON the bar at x = 0, positive along +x [N] (the clamp reaction)
+//   fL  force applied ON the bar at x = L, positive along +x [N] (the shock load)
+#pragma once
+
+#include <istream>
+#include <string>
+
+#include "mcrewave/core/types.h"
+
+namespace mcrewave {
+
+struct MeasurementSet {
+  double start_time = 0.0;  // t_0 [s]
+  double time_step = 0.0;   // h [s]
+  Vector u0, uL;            // [m], one entry per sample
+  Vector f0, fL;            // [N], one entry per sample
+
+  int num_samples() const { return static_cast<int>(u0.size()); }
+  int num_steps() const { return num_samples() - 1; }
+  double Time(int k) const { return start_time + k * time_step; }
+};
+
+// Reads a measurement CSV. Validates the header, the column count, every number
+// (finite, no NaN/Inf), at least two rows, and a strictly increasing uniform time
+// column (relative spread of the steps at most 1e-6). Throws InputError naming the
+// file and the line on any failure. Logs a progress line every 250000 rows;
+// memory is the five columns of doubles (at most about 100 bytes per row while
+// they grow), never the whole text.
+MeasurementSet ReadMeasurementCsv(const std::string& path);
+
+// The same from a stream; `name` stands for the file name in messages.
+MeasurementSet ParseMeasurementCsv(std::istream& text, const std::string& name);
+
+// Refuses measurements that read well but cannot be identified from, with an
+// InputError naming `name`, the line of the sample (as in the CSV file: sample k
+// on line k + 2) and the column:
+//   - a dead channel: uL, f0 or fL zero on every sample (u0 may be: the clamped end);
+//   - an outlier: the sample of largest second difference x[k-1] - 2 x[k] + x[k+1],
+//     when that is above both kOutlierNoiseFactor times the channel's robust noise level
+//     (1.4826 median |second difference|) and half the channel's peak |x|.
+// A channel in wrong units (scaled by 1e6) passes here; the identification then
+// ends on a bound of outer:, which `identify run` refuses.
+void CheckMeasurementChannels(const MeasurementSet& measurements, const std::string& name);
+constexpr double kOutlierNoiseFactor = 50.0;
+
+// Writes the set as CSV with full precision (17 significant digits), atomically
+// (temporary file then rename). Throws std::runtime_error if the file cannot be
+// written.
+void WriteMeasurementCsv(const MeasurementSet& measurements, const std::string& path);
+
+}  // namespace mcrewave

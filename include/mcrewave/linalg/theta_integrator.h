@@ -1,0 +1,198 @@
+// The theta-method time integrator of the structural system
+//
+//     M u'' + K u = f(t),
+//
+// written in first-order form x = (v, u), v = u' (second source document,
+// formulation.md section 5):
+//
+//     [M 0] x' = [0 -K] x + [f]        i.e.  Mx x' = A x + b + r.
+//     [0 I]      [I  0]     [0]
+//
+// Scheme, with f_theta the theta-weighted force of the step (the caller's input):
+//
+//     (Mx - h theta A) x_{k+1} = (Mx + h (1 - theta) A) x_k + h (f_theta, 0).
+//
+// The iteration matrix W = Mx - h theta A = [M, h theta K; -h theta I, I] is
+// factorised once in Init through its Schur complement
+//
+//     S = M + h^2 theta^2 K           (symmetric positive definite, banded),
+//
+// so a step is, with the free state formed first and the input added after,
+//
+//     rhs_free = R v_k - h K u_k,  R = M - h^2 theta (1 - theta) K    (free state)
+//     S v_{k+1} = rhs_free + h f_theta                               (input)
+//     u_{k+1}   = u_k + h (1 - theta) v_k + h theta v_{k+1}.
+//
+// (Substituting u_{k+1} from the second block row into the first gives
+// rhs_free = M v_k - h K (u_k + h theta (1 - theta) v_k).)
+//
+// By linearity v_{k+1} = S^-1 rhs_free + S^-1 h f_theta: the input's effect is
+// added to the free state's right-hand side and both go through one solve.
+//
+// Tridiagonal M and K (linear elements, the bar's case) take a fast path: the
+// right-hand side in one branch-free pass over the bands, S solved by the twisted
+// factorisation of band_matrix.h (two independent recurrences of n/2 steps), u
+// updated in one more pass. Other bandwidths use SymmetricBandMatrix and BandLdlt.
+// Both solve the same system; they differ by round-off.
+//
+// StepWithEndLoads takes a force of the form the MCRE sweeps need without forming
+// it: f_theta = -K z + f0 e_0 + fL e_{n-1} (z optional), so that
+//   rhs = R v_k - h K (u_k + z) + h (f0 e_0 + fL e_{n-1})
+// is one pass.
+// theta = 1/2 is the trapezoidal rule (second order, energy conserving); theta = 1
+// is backward Euler (first order).
+//
+// The same integrator runs the retrograde problem in reversed time
+// tau = T - t: SweepBackward starts from a final state and steps from index m down
+// to 0; the "velocity" it carries is then du/dtau = -du/dt. The integrator knows
+// nothing of MCRE: the caller forms f_theta for each step.
+#pragma once
+
+#include <utility>
+
+#include "mcrewave/core/types.h"
+#include "mcrewave/linalg/band_matrix.h"
+
+namespace mcrewave {
+
+struct ThetaIntegratorOptions {
+  double time_step = 0.36e-6;  // h [s]
+  double theta = 0.5;          // implicitness, in [0, 1]; 1/2 = trapezoidal
+
+  bool IsValid(std::string* error) const;
+};
+
+class ThetaIntegrator {
+ public:
+  // Builds and factorises S = M + h^2 theta^2 K and allocates every scratch vector.
+  // M must be SPD and K symmetric positive semi-definite, both banded. Call again
+  // (re-initialise) whenever K (the modulus), h or theta changes. Throws
+  // std::runtime_error if S is not positive definite.
+  void Init(const SparseMatrix& mass, const SparseMatrix& stiffness,
+            const ThetaIntegratorOptions& options);
+
+  // One step from (v_k, u_k) with the theta-weighted force f_theta of the step.
+  // Writes (v_next, u_next); they must not alias the inputs. No allocation.
+  void Step(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref<const Vector>& u_k,
+            const Eigen::Ref<const Vector>& force_theta, Eigen::Ref<Vector> v_next,
+            Eigen::Ref<Vector> u_next);
+
+  // One step with the force f_theta = -K z + f0 e_0 + fL e_{n-1} [N] (z [m], same
+  // size as u_k) or, without z, f_theta = f0 e_0 + fL e_{n-1}. Same contract as
+  // Step otherwise.
+  void StepWithEndLoads(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref<const Vector>& u_k,
+                        const Eigen::Ref<const Vector>& z, double f0, double fL,
+                        Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next);
+  void StepWithEndLoads(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref<const Vector>& u_k,
+                        double f0, double fL, Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next);
+
+  // B independent steps at once (B = 2 or 3), step b as StepWithEndLoads from
+  // (v_k[b], u_k[b]) with z[b] (null: none), f0[b], fL[b]; all arrays of size()
+  // contiguous doubles, outputs distinct from every input. The tridiagonal solves
+  // run interleaved (about the latency of one); the results are those of B single
+  // steps, bit for bit.
+  static constexpr int kMaxBatch = 3;
+  template <int B>
+  void StepsWithEndLoads(const double* const (&v_k)[B], const double* const (&u_k)[B],
+                         const double* const (&z)[B], const double (&f0)[B], const double (&fL)[B],
+                         double* const (&v_next)[B], double* const (&u_next)[B]);
+
+  // Runs num_steps steps forward in time from (v0, u0).
+  //   forcing(k, f): writes into f (an Eigen::Ref<Vector> of size n) the force
+  //                  f_theta of the step t_k -> t_{k+1};
+  //   observer(k, v, u): called for k = 0, ..., num_steps with the state at t_k.
+  template <typename Forcing, typename Observer>
+  void SweepForward(int num_steps, const Eigen::Ref<const Vector>& v0,
+                    const Eigen::Ref<const Vector>& u0, Forcing&& forcing, Observer&& observer);
+
+  // Runs num_steps steps backward in time from the final state (v_T, u_T) at
+  // t_m = T, with v = du/dtau = -du/dt.
+  //   forcing(k, f): the force f_theta of the step t_{k+1} -> t_k (k = m-1 .. 0);
+  //   observer(k, v, u): called for k = num_steps, ..., 0.
+  template <typename Forcing, typename Observer>
+  void SweepBackward(int num_steps, const Eigen::Ref<const Vector>& v_final,
+                     const Eigen::Ref<const Vector>& u_final, Forcing&& forcing,
+                     Observer&& observer);
+
+  int size() const { return static_cast<int>(mass_.size()); }
+  const ThetaIntegratorOptions& options() const { return options_; }
+  const SymmetricBandMatrix& mass() const { return mass_; }
+  const SymmetricBandMatrix& stiffness() const { return stiffness_; }
+  // Number of factorisations of the iteration matrix since construction.
+  int factorization_count() const { return factorization_count_; }
+
+ private:
+  template <typename Forcing, typename Observer>
+  void Sweep(int num_steps, int first, int direction, const Eigen::Ref<const Vector>& v_start,
+             const Eigen::Ref<const Vector>& u_start, Forcing&& forcing, Observer&& observer);
+
+  // The tridiagonal fast path: rhs = R v_k - h K s + h f (f: the full force when
+  // kForceVector, else only f0 e_0 + fL e_{n-1}), solve, u update. s = u_k + z when
+  // z is not null, else u_k.
+  template <bool kForceVector>
+  void TridiagonalStep(const double* v_k, const double* u_k, const double* z, const double* force,
+                       double f0, double fL, double* v_next, double* u_next);
+  // The parts of TridiagonalStep: rhs into v_next (shifted: scratch for u_k + z),
+  // and u_next = u_k + h (1 - theta) v_k + h theta v_next.
+  template <bool kForceVector>
+  void TridiagonalRightHandSide(const double* v_k, const double* u_k, const double* z,
+                                const double* force, double f0, double fL, double* shifted,
+                                double* v_next) const;
+  void UpdateDisplacement(const double* u_k, const double* v_k, const double* v_next,
+                          double* u_next) const;
+
+  ThetaIntegratorOptions options_;
+  SymmetricBandMatrix mass_;               // M
+  SymmetricBandMatrix stiffness_;          // K
+  SymmetricBandMatrix free_state_matrix_;  // R = M - h^2 theta (1 - theta) K
+  BandLdlt iteration_matrix_;              // LDL^T of S = M + h^2 theta^2 K (bandwidth > 1)
+  // The tridiagonal fast path (half bandwidth <= 1).
+  bool tridiagonal_ = false;
+  TwistedTridiagonalLdlt tridiagonal_factor_;  // S
+  // The bands of R and -h K: diagonal [i] = row i, sub-diagonal [i] = (i, i-1)
+  // ([0] unused).
+  Vector free_diagonal_, free_sub_;            // R
+  Vector stiffness_diagonal_, stiffness_sub_;  // -h K
+  Vector shifted_;                             // scratch: s = u_k + z
+  Matrix shifted_batch_;                       // the same for StepsWithEndLoads, n x kMaxBatch
+  int factorization_count_ = 0;
+  // Scratch, allocated in Init.
+  Vector force_;        // f_theta handed to forcing()
+  Vector v_[2], u_[2];  // double buffer of the state
+};
+
+template <typename Forcing, typename Observer>
+void ThetaIntegrator::Sweep(int num_steps, int first, int direction,
+                            const Eigen::Ref<const Vector>& v_start,
+                            const Eigen::Ref<const Vector>& u_start, Forcing&& forcing,
+                            Observer&& observer) {
+  v_[0] = v_start;
+  u_[0] = u_start;
+  int k = first;
+  observer(k, static_cast<const Vector&>(v_[0]), static_cast<const Vector&>(u_[0]));
+  for (int s = 0; s < num_steps; ++s) {
+    const int cur = s & 1, nxt = cur ^ 1;
+    // Forward: step k -> k+1 has index k. Backward: step k -> k-1 has index k-1.
+    forcing(direction > 0 ? k : k - 1, Eigen::Ref<Vector>(force_));
+    Step(v_[cur], u_[cur], force_, v_[nxt], u_[nxt]);
+    k += direction;
+    observer(k, static_cast<const Vector&>(v_[nxt]), static_cast<const Vector&>(u_[nxt]));
+  }
+}
+
+template <typename Forcing, typename Observer>
+void ThetaIntegrator::SweepForward(int num_steps, const Eigen::Ref<const Vector>& v0,
+                                   const Eigen::Ref<const Vector>& u0, Forcing&& forcing,
+                                   Observer&& observer) {
+  Sweep(num_steps, 0, +1, v0, u0, std::forward<Forcing>(forcing), std::forward<Observer>(observer));
+}
+
+template <typename Forcing, typename Observer>
+void ThetaIntegrator::SweepBackward(int num_steps, const Eigen::Ref<const Vector>& v_final,
+                                    const Eigen::Ref<const Vector>& u_final, Forcing&& forcing,
+                                    Observer&& observer) {
+  Sweep(num_steps, num_steps, -1, v_final, u_final, std::forward<Forcing>(forcing),
+        std::forward<Observer>(observer));
+}
+
+}  // namespace mcrewave

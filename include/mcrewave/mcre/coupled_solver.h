@@ -1,0 +1,152 @@
+// Solvers of the coupled direct / retrograde MCRE system for one trial modulus
+// (docs/discrete_mcre.md). All return the same (U, W) for the same discrete
+// problem, to their tolerance:
+//
+//   all_at_once          the whole space-time system (D1, D2, R1, R2, R3) assembled
+//                        sparse and solved by sparse LU; independent of the sweeps;
+//                        the reference on small cases; refuses problems above
+//                        max_all_at_once_unknowns or whose estimated memory would
+//                        exceed max_all_at_once_bytes.
+//   relaxation           the paper's waveform relaxation (eq. 17-19) with a fixed
+//                        coefficient omega: one retrograde and one direct sweep per
+//                        iteration, the direct one driven by omega W_new + (1-omega) W.
+//   adaptive_relaxation  the same, omega = 2 / (a_min + a_max) from a Lanczos
+//                        estimate of the extreme eigenvalues a of A = I - G, with a
+//                        safeguard that re-estimates a_max from observed growth.
+//   conjugate_gradient   CG on A W = c in the inner product <.,.>_P where A is
+//                        self-adjoint positive definite: one retrograde and one
+//                        direct sweep per iteration, no coefficient to tune.
+//   riccati              the discrete Riccati sweep Z_k = P_k Y_k + q_k (dense 2n x 2n
+//                        P_k) backward from the final condition, then the state
+//                        forward (docs/riccati_shooting.md); refuses when its storage
+//                        would exceed max_dense_solver_bytes.
+//   single_shooting      the initial retrograde state Z_0 from the fundamental matrix
+//                        of the coupled recursion; fails (never returns garbage) when
+//                        the shooting matrix is too ill-conditioned.
+//   multiple_shooting    the same on segments whose length follows the measured growth
+//                        rate of the recursion, joined by continuity (robust variant).
+//
+// all_at_once and the last three are direct: they report the same relative
+// residual, computed afterwards from 5 sweeps, and converge when it meets the
+// tolerance (or the round-off floor below); otherwise they fail.
+//
+// The iterative solvers stop on the relative residual ||c - A W||_P / ||c||_P
+// (the same measure for all; c = T(0)), or when ||c - A W||_P falls to the
+// round-off floor 1e-11 ||W_u||_P, W_u the retrograde response to the displacement
+// data alone (c is a difference of two such responses, which cancel for data
+// consistent with the model). Non-convergence and divergence are
+// reported in the summary, never returned as numbers: the solution is usable only
+// when summary.IsSolutionUsable().
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mcrewave/mcre/mcre_problem.h"
+
+namespace mcrewave {
+
+enum class CoupledSolverType {
+  kAllAtOnce,
+  kRelaxation,
+  kAdaptiveRelaxation,
+  kConjugateGradient,
+  kRiccati,
+  kSingleShooting,
+  kMultipleShooting,
+};
+const char* CoupledSolverTypeToString(CoupledSolverType type);
+bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type);
+
+// Fields of n x (m + 1) doubles an iterative solve holds at once: its iterates U
+// and W, residual, search direction, image and scratch, the start's right-hand
+// side and data response, and the caller's warm start and zero field.
+constexpr int kIterativeSolverFields = 10;
+
+enum class TerminationType {
+  kConvergence,    // the residual reached the tolerance
+  kNoConvergence,  // the iteration limit was reached first
+  kDivergence,     // the residual grew (or became non-finite): the iteration diverges
+  kFailure,        // refused or broke down (problem too large, singular system...)
+};
+const char* TerminationTypeToString(TerminationType type);
+
+struct CoupledSolverOptions {
+  CoupledSolverType type = CoupledSolverType::kConjugateGradient;
+  // Stopping test on ||c - A W||_P / ||c||_P (the paper used 1e-4).
+  double tolerance = 1e-8;
+  // Iterations (sweep pairs) allowed to the iterative solvers.
+  int max_iterations = 5000;
+  // omega of the fixed-coefficient relaxation, in (0, 2).
+  double relaxation_coefficient = 0.5;
+  // Lanczos steps of the adaptive relaxation's spectrum estimate (2 sweeps each).
+  int spectrum_estimation_steps = 12;
+  // The Lanczos estimate of a_max is multiplied by this factor before omega is chosen.
+  double spectrum_safety_factor = 1.05;
+  // A relative residual this many times above the smallest seen means divergence.
+  double divergence_factor = 1e3;
+  // The all-at-once solver refuses systems with more unknowns than this, and when
+  // its estimated peak memory (the matrix and its sparse LU factors; see
+  // src/all_at_once_solver.cpp) would exceed max_all_at_once_bytes.
+  long max_all_at_once_unknowns = 1'500'000;
+  long max_all_at_once_bytes = 2L << 30;
+  // The Riccati and shooting solvers refuse when their dense storage
+  // (docs/riccati_shooting.md) would exceed this many bytes.
+  long max_dense_solver_bytes = 2L << 30;
+  // The iterative solvers (relaxation, adaptive_relaxation, conjugate_gradient)
+  // refuse when the fields they hold at once (kIterativeSolverFields fields of
+  // n x (m + 1) doubles) would exceed this many bytes.
+  long max_field_bytes = 2L << 30;
+  // Shooting fails when the 2-norm condition number of its (equilibrated) shooting
+  // matrix exceeds this, or is not finite.
+  double shooting_condition_limit = 1e14;
+  // Multiple shooting ends a segment when the largest of its fundamental solutions
+  // (started from unit states in energy coordinates) has grown by this factor.
+  double shooting_segment_growth = 100.0;
+
+  bool IsValid(std::string* error) const;
+};
+
+struct CoupledSolverSummary {
+  CoupledSolverType type = CoupledSolverType::kConjugateGradient;
+  TerminationType termination = TerminationType::kFailure;
+  std::string message = "not run";
+  int iterations = -1;                   // sweep pairs of the main iteration
+  long sweeps = -1;                      // every direct or retrograde sweep, estimation included
+  double relative_residual = -1.0;       // final ||c - A W||_P / ||c||_P
+  std::vector<double> residual_history;  // relative residual per iteration
+  double relaxation_coefficient = -1.0;  // omega used by the relaxation solvers
+  double spectrum_min = -1.0;            // estimated a_min of A = I - G (adaptive only)
+  double spectrum_max = -1.0;            // estimated a_max of A = I - G (adaptive only)
+  int safeguard_restarts = 0;            // adaptive only: omega re-chosen after growth
+  double wall_time_s = -1.0;
+  // Riccati and shooting only: multiply-accumulates of the method itself (the
+  // residual check excluded), counted as include/mcrewave/operation_counts.h says.
+  double multiply_accumulates = -1.0;
+  // Single shooting: 2-norm condition number of the equilibrated shooting matrix.
+  // Multiple shooting: max |r_ii| / min |r_ii| of the QR factor of the global
+  // system, a lower bound of its condition number.
+  double shooting_condition_number = -1.0;
+  int shooting_segments = -1;  // shooting only: number of segments
+
+  bool IsSolutionUsable() const { return termination == TerminationType::kConvergence; }
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+struct CoupledSolution {
+  Matrix displacement;         // U, n x (m + 1) [m]
+  Matrix retrograde;           // W, n x (m + 1) [m]
+  double cost = -1.0;          // e^2(E) [J s]
+  double cost_gradient = 0.0;  // de^2/dE [J s / Pa]
+};
+
+// Solves the coupled problem at the problem's current modulus. initial_retrograde
+// (nullable) is the initial guess W^(0) of the iterative solvers (warm start, e.g.
+// the previous E's solution); it must have the problem's shape. Precondition:
+// options.IsValid(). The solution's fields are meaningful only when the summary
+// says so.
+CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, McreProblem* problem,
+                                  const Matrix* initial_retrograde, CoupledSolution* solution);
+
+}  // namespace mcrewave

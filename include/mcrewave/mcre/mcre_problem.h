@@ -1,0 +1,134 @@
+// The time-discrete coupled direct / retrograde MCRE problem for one trial
+// modulus (docs/discrete_mcre.md; formulation.md sections 2 and 3).
+//
+// Fields are stored as n x (m + 1) matrices, column j = time t_j = j h:
+// U (displacement), W (retrograde field, the constitutive gap). The problem owns
+// one ThetaIntegrator, factorised once per modulus (SetModulus), and offers the
+// two sweeps that every coupled solver is built from:
+//
+//   DirectSweep:      W -> U,  (D1, D2) forward with the force F~ - (K + B/alpha) W
+//   RetrogradeSweep:  U -> W,  (R1, R2) backward with the force c_j beta (B U_j - U~_j),
+//                              then W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j
+//
+// and the inner product <x, y>_P in which the reduced operator A = I - G is
+// self-adjoint, the cost e^2 and its derivative de^2/dE.
+#pragma once
+
+#include <vector>
+
+#include "mcrewave/data/measurement.h"
+#include "mcrewave/linalg/theta_integrator.h"
+#include "mcrewave/model/bar_model.h"
+
+namespace mcrewave {
+
+// Dimensionless weights of the data terms (formulation.md section 2):
+//   beta = w_u S E0 / L [N/m],  alpha = w_f L / (S E0) [m/N],
+// so that every term of J is an energy [J] and e^2 is in [J s].
+//
+// Defaults w_u = 0.01, w_f = 1: the extreme eigenvalue of the iteration map, due to
+// the rigid-body mode of the unclamped model, scales with w_u / w_f (about -35 at
+// these defaults on the paper's case against -3.4e3 at w_u = 1), so relaxation and
+// CG converge in tens to hundreds of sweeps instead of thousands; the evidence for
+// the identification itself is in docs/weights.md.
+struct McreWeights {
+  double displacement_weight = 0.01;  // w_u
+  double force_weight = 1.0;          // w_f
+  bool IsValid(std::string* error) const;
+};
+
+class McreProblem {
+ public:
+  // Keeps references to model and data: both must outlive the problem.
+  // reference_modulus is E0 of the weights [Pa]; theta of the time scheme.
+  // Precondition: data.num_steps() >= 1, weights valid, theta in [0, 1].
+  McreProblem(const BarModel& model, const MeasurementSet& data, const McreWeights& weights,
+              double reference_modulus, double theta);
+
+  // Sets the trial modulus E [Pa] and refactorises the integrator (once per E).
+  void SetModulus(double modulus);
+  double modulus() const { return modulus_; }
+
+  int num_nodes() const { return model_.num_nodes(); }
+  int num_steps() const { return data_.num_steps(); }
+  double time_step() const { return data_.time_step; }
+  double theta() const { return theta_; }
+  double alpha() const { return alpha_; }  // force weight [m/N]
+  double beta() const { return beta_; }    // displacement weight [N/m]
+  const BarModel& model() const { return model_; }
+  const MeasurementSet& data() const { return data_; }
+  // A zero field of the problem's shape, n x (m + 1).
+  Matrix ZeroField() const { return Matrix::Zero(num_nodes(), num_steps() + 1); }
+  // Quadrature weight c_j (1/2 at both ends, 1 inside).
+  double QuadratureWeight(int j) const { return (j == 0 || j == num_steps()) ? 0.5 : 1.0; }
+
+  // W -> U. With include_data the force data F~ enter; without, the sweep is the
+  // linear part only. U is resized if needed (outside the time loop).
+  void DirectSweep(const Matrix& retrograde, bool include_data, Matrix* displacement);
+  // U -> W. With include_data the displacement data U~ enter.
+  void RetrogradeSweep(const Matrix& displacement, bool include_data, Matrix* retrograde);
+  // Up to ThetaIntegrator::kMaxBatch sweeps with the data at once, sweep b from
+  // inputs[b] (null: the zero field) into outputs[b] (resized); the time steps of the
+  // sweeps run interleaved, for the cost of fewer than that many sweeps, and give
+  // the results of the single sweeps bit for bit. Counted as that many sweeps.
+  // Outputs distinct from every input.
+  void DirectSweepsWithData(const std::vector<const Matrix*>& retrograde,
+                            const std::vector<Matrix*>& displacement);
+  void RetrogradeSweepsWithData(const std::vector<const Matrix*>& displacement,
+                                const std::vector<Matrix*>& retrograde);
+  // The affine map T(W) = RetrogradeSweep(DirectSweep(W)) with the data: two sweeps.
+  // displacement receives DirectSweep(W).
+  void FixedPointMap(const Matrix& retrograde, Matrix* displacement, Matrix* image);
+  // The linear part: G W = T(W) - T(0); two sweeps. scratch_displacement is work space.
+  void ApplyIterationMap(const Matrix& retrograde, Matrix* scratch_displacement, Matrix* image);
+
+  // <x, y>_P = sum_j c_j h x_j^T (K + B/alpha) y_j.
+  double InnerProduct(const Matrix& x, const Matrix& y);
+  double Norm(const Matrix& x) { return std::sqrt(std::max(0.0, InnerProduct(x, x))); }
+
+  // e^2 = sum_j c_j h [1/2 W^T K W + W^T B W / (2 alpha) + beta/2 |B U - U~|^2]  [J s].
+  double Cost(const Matrix& displacement, const Matrix& retrograde);
+  // de^2/dE = -(1/(2E)) sum_j c_j h W_j^T K (W_j + 2 U_j)  [J s / Pa].
+  double CostGradient(const Matrix& displacement, const Matrix& retrograde);
+
+  // Number of sweeps (direct + retrograde) run since construction.
+  long sweep_count() const { return sweep_count_; }
+  // Number of factorisations of the integrator's iteration matrix since construction
+  // (the constructor's SetModulus included): one per change of modulus.
+  int factorization_count() const { return integrator_.factorization_count(); }
+
+  // Work fields of the iterative coupled solvers, kept with the problem between
+  // solves so that a solve on a problem solved before allocates no field (a fresh
+  // n x (m + 1) field costs its page faults, measured at about 15 % of an
+  // identification's CPU time). Each is resized by its user; `zero` is the zero
+  // field, never written.
+  struct SolverWorkspace {
+    Matrix residual, direction, image, scratch, rhs, data_response;
+    Matrix zero;
+  };
+  SolverWorkspace& workspace();
+
+ private:
+  template <int B>
+  void DirectSweeps(const Matrix* const (&retrograde)[B], Matrix* const (&displacement)[B]);
+  template <int B>
+  void RetrogradeSweeps(const Matrix* const (&displacement)[B], Matrix* const (&retrograde)[B]);
+
+  const BarModel& model_;
+  const MeasurementSet& data_;
+  double theta_;
+  double alpha_;
+  double beta_;
+  double modulus_ = 0.0;
+  ThetaIntegrator integrator_;
+  SymmetricBandMatrix unit_stiffness_;  // K1
+  long sweep_count_ = 0;
+  SolverWorkspace workspace_;
+  // Scratch, allocated in the constructor.
+  Vector velocity_[2], omega_[2];  // double buffers of the sweeps' velocity and omega
+  Vector shift_;                   // W_theta of the direct sweep's step
+  // The same for the batched sweeps: columns [2 b, 2 b + 1] of sweep b's double buffers.
+  Matrix batch_velocity_, batch_state_, batch_shift_;
+};
+
+}  // namespace mcrewave

@@ -1,0 +1,105 @@
+// An uncertainty figure for the identified modulus: the first-order standard
+// deviation of E* under white measurement noise.
+//
+// E* is where g(E) = de^2/dE vanishes. The coupled solution s = (U, W) is linear
+// in the data d (zero data give the bar at rest), and g is a quadratic form
+// Q(s) of it, so fresh noise n added to the data changes g at E* by
+//   dg = 2 Q(s_d, s_n) + Q(s_n, s_n),
+// and, to first order in n, moves the minimum by dE = -dg_1 / k with
+//   dg_1 = 2 Q(s_d, s_n) = (Q(s_d + s_n) - Q(s_d - s_n)) / 2   (polarisation),
+//   k    = d^2 e^2 / dE^2, the slope of g around E*.
+// s_n is one coupled solve with the noise alone as data, at E*. The standard
+// deviation of dE is estimated over `samples` seeded noise draws:
+//   std(E*) = sqrt(mean_i dE_i^2)   (dE is linear in n, so its mean is zero).
+//
+// k is the least-squares slope of g over the cost-curve points within
+// +- kCurvatureWindow E* of E*, not the local second derivative: at low SNR the
+// cost has noise-made ripples a few per cent of E apart whose local curvature
+// says nothing about how far the minimum moves. The figure is first order: it
+// is trustworthy when it is small compared with that window, indicative
+// otherwise.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "mcrewave/data/measurement.h"
+#include "mcrewave/mcre/coupled_solver.h"
+#include "mcrewave/mcre/objective.h"
+#include "mcrewave/model/bar_model.h"
+
+namespace mcrewave {
+
+// The `uncertainty:` section of the config.
+struct UncertaintyOptions {
+  int samples = 16;        // noise draws, in [2, 1000]
+  std::uint64_t seed = 1;  // seed of the draws (independent of data.seed's noise)
+
+  bool IsValid(std::string* error) const;
+};
+
+// Standard deviations of white noise on the two displacement and the two force
+// channels.
+struct NoiseLevels {
+  double displacement_std = 0.0;  // [m]
+  double force_std = 0.0;         // [N]
+};
+
+// Noise levels estimated from the data alone, channel by channel, from second
+// differences d2_j = x_{j+1} - 2 x_j + x_{j-1}: for white noise of std s they have
+// std sqrt(6) s, while a signal smooth on the sampling scale adds little, and
+// the median absolute deviation ignores the few samples at wave fronts:
+//   s = 1.4826 median_j |d2_j - median d2| / sqrt(6),
+// then s^2 averaged over the two channels of each type. For measured data,
+// whose noise is not known.
+NoiseLevels DifferenceNoiseLevels(const MeasurementSet& data);
+
+// RMS misfits of the coupled solution at the optimum: displacement
+// sqrt(mean_{ends, j} (U_end,j - u~_end,j)^2) and force
+// sqrt(mean_{ends, j} (W_end,j / alpha)^2) (F - F~ = -B W / alpha).
+NoiseLevels MisfitLevels(const MeasurementSet& data, const CoupledSolution& solution, double alpha);
+
+// A point of the cost curve e^2(E).
+struct CostCurvePoint {
+  double modulus = 0.0;        // E [Pa]
+  double cost = -1.0;          // e^2 [J s]
+  double cost_gradient = 0.0;  // de^2/dE [J s / Pa]
+  bool usable = false;
+};
+
+// Half-width of the window of the curvature fit, as a fraction of E*.
+inline constexpr double kCurvatureWindow = 0.05;
+
+// Least-squares slope k of de^2/dE against E over the usable points with
+// |E - center| <= window * center [J s / Pa^2]; all usable points when fewer
+// than 3 lie in the window. *points_used receives the count. Returns 0 when
+// fewer than 2 points are usable.
+double CostGradientSlope(const std::vector<CostCurvePoint>& curve, double center, double window,
+                         int* points_used);
+
+struct ModulusUncertainty {
+  bool available = false;
+  std::string message = "not computed";  // why not available, or "ok"
+  double std_dev = -1.0;                 // std(E*) [Pa]
+  double relative_std_dev = -1.0;        // std(E*) / E*
+  double curvature = -1.0;               // k [J s / Pa^2]
+  int curvature_points = 0;              // cost-curve points of the fit
+  int samples = 0;                       // noise draws used
+  NoiseLevels noise;                     // the levels drawn
+  long sweeps = 0;                       // of the noise solves
+};
+
+// The figure at the identified modulus (see the top of this file). `solution`
+// is the coupled solution of `data` at `modulus`; noise the levels to draw.
+// Not available (with a message) when curvature <= 0, both noise levels are 0,
+// or a noise solve is not usable. Precondition: options.IsValid().
+ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
+                                              const BarModel& model, const MeasurementSet& data,
+                                              const McreOptions& mcre, double theta,
+                                              const CoupledSolverOptions& inner, double modulus,
+                                              const CoupledSolution& solution,
+                                              const NoiseLevels& noise, double curvature,
+                                              int curvature_points);
+
+}  // namespace mcrewave

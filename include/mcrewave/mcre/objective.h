@@ -1,0 +1,156 @@
+// The objective of the outer loop: the MCRE cost e^2 as a function of the
+// trial modulus E, seen by every optimiser through one interface.
+//
+// ModulusObjective is that interface (shaped like ceres::FirstOrderFunction):
+// one scaled parameter x = E / modulus_scale(), a scaled cost, an optional
+// gradient, and false (never a made-up number) when the value cannot be had.
+// McreObjective implements it with an McreProblem and the coupled solver of
+// coupled_solver.h: each evaluation sets E, solves the coupled problem
+// warm-started from the previous usable solutions and records what it did.
+//
+// Warm start: with the last two usable solutions W(E1) (last) and W(E0) at
+// E0 != E1, the next solve at E starts from the linear extrapolation
+//   W^(0) = W(E1) + t (W(E1) - W(E0)),  t = (E - E1) / (E1 - E0),
+// when |t| <= kMaxExtrapolation (W depends smoothly on E between resonances; a
+// scan step or a local optimiser's step is then much closer to the line through the
+// last two solutions than to the last one); otherwise from W(E1) alone.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mcrewave/data/measurement.h"
+#include "mcrewave/mcre/coupled_solver.h"
+#include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/model/bar_model.h"
+
+namespace mcrewave {
+
+// A scalar objective of one parameter x = E / modulus_scale() (x of order 1).
+class ModulusObjective {
+ public:
+  virtual ~ModulusObjective() = default;
+
+  // E [Pa] per unit of the parameter x.
+  virtual double modulus_scale() const = 0;
+
+  // Writes the cost at x = parameters[0] to *cost and, when gradient is not
+  // null, d cost / d x to gradient[0]. Returns false when the value could not be
+  // computed (error_message() then says why); *cost and *gradient are then
+  // meaningless. May throw: the optimisers of identification.h catch.
+  virtual bool Evaluate(const double* parameters, double* cost, double* gradient) = 0;
+
+  // Why the last failed Evaluate failed ("" when none failed).
+  virtual std::string error_message() const = 0;
+
+  // An independent objective of the same cost (same scale, same cost scaling),
+  // its inner solves run to the relative tolerance inner_tolerance, usable on
+  // another thread while this one is not evaluated; null when the objective
+  // cannot be copied (the default).
+  virtual std::unique_ptr<ModulusObjective> CloneForScan(double inner_tolerance) const {
+    (void)inner_tolerance;
+    return nullptr;
+  }
+
+  // Inner sweeps (direct + retrograde) of every evaluation so far; 0 when the
+  // objective has no inner solver (the default).
+  virtual long sweeps() const { return 0; }
+};
+
+// The `mcre:` section of the config: the weights of the data terms and the
+// modulus E0 they are built with (mcre_problem.h):
+//   beta = w_u S E0 / L,  alpha = w_f L / (S E0).
+// E0 is a fixed nominal modulus, not the unknown: the same functional is then
+// minimised whatever the start or the bounds of the outer loop.
+struct McreOptions {
+  McreWeights weights;
+  double reference_modulus = 200e9;  // E0 [Pa]
+
+  bool IsValid(std::string* error) const;
+};
+
+// One evaluation of e^2(E) by McreObjective.
+struct ObjectiveEvaluation {
+  double modulus = -1.0;            // E [Pa]
+  double cost = -1.0;               // e^2(E) [J s]; meaningful only when usable
+  double cost_gradient = 0.0;       // de^2/dE [J s / Pa], the adjoint gradient
+  bool gradient_requested = false;  // whether the caller asked for the gradient
+  bool usable = false;              // inner.IsSolutionUsable()
+  CoupledSolverSummary inner;       // the coupled solve
+};
+
+class McreObjective : public ModulusObjective {
+ public:
+  // Keeps references to model and data: both must outlive the objective.
+  // modulus_scale [Pa] is E per unit of x. Preconditions: mcre.IsValid(),
+  // inner.IsValid(), theta in [0, 1], modulus_scale > 0, data.num_steps() >= 1.
+  McreObjective(const BarModel& model, const MeasurementSet& data, const McreOptions& mcre,
+                double theta, const CoupledSolverOptions& inner, double modulus_scale);
+
+  double modulus_scale() const override { return modulus_scale_; }
+
+  // cost = e^2(E) / cost_scale() and gradient = (de^2/dE) modulus_scale / cost_scale()
+  // at E = x modulus_scale. False when x is not a positive finite number or the
+  // coupled solve is not usable (the solver's message is kept).
+  bool Evaluate(const double* parameters, double* cost, double* gradient) override;
+  std::string error_message() const override { return error_message_; }
+  // A new McreObjective on the same model, data and weights with
+  // inner.tolerance = inner_tolerance (its evaluations are its own).
+  std::unique_ptr<ModulusObjective> CloneForScan(double inner_tolerance) const override;
+
+  // Evaluates e^2 and de^2/dE at modulus E [Pa] (> 0) and records it; returns the
+  // record. Evaluate calls this.
+  const ObjectiveEvaluation& EvaluateModulus(double modulus, bool gradient_requested = true);
+
+  // J_rest = sum_j c_j h [alpha/2 |F~_j|^2 + beta/2 |U~_j|^2] [J s]: the functional
+  // for the bar left at rest (U = W = 0, zero end forces), which satisfies the
+  // state equation for every E, so 0 <= e^2(E) <= J_rest.
+  double rest_cost() const { return rest_cost_; }
+  // The cost scale [J s]: J_rest, or 1 when the data are all zero (J_rest = 0).
+  double cost_scale() const { return rest_cost_ > 0.0 ? rest_cost_ : 1.0; }
+
+  // Every evaluation, in order.
+  const std::vector<ObjectiveEvaluation>& evaluations() const { return evaluations_; }
+  // Index in evaluations() of the usable evaluation of least cost (the first
+  // one on ties), or -1 when none was usable.
+  int best_index() const { return best_index_; }
+  // The coupled solution of evaluations()[best_index()] (empty when none).
+  const CoupledSolution& best_solution() const { return best_solution_; }
+  // The coupled solution of the last evaluation (valid when it was usable).
+  const CoupledSolution& last_solution() const { return solution_; }
+  // Sweeps (direct + retrograde) of every evaluation.
+  long sweeps() const override { return problem_.sweep_count(); }
+
+  // The next evaluation starts its inner iteration from this retrograde field
+  // (shape of problem().ZeroField()) instead of the last usable solutions; later
+  // evaluations extrapolate from it once they have a second solution.
+  void SetWarmStart(const Matrix& retrograde);
+
+  // Largest |t| of the extrapolated warm start (above: the last solution alone).
+  static constexpr double kMaxExtrapolation = 2.0;
+
+  McreProblem& problem() { return problem_; }
+
+ private:
+  const BarModel& model_;
+  const MeasurementSet& data_;
+  McreOptions mcre_;
+  double theta_;
+  McreProblem problem_;
+  CoupledSolverOptions inner_;
+  double modulus_scale_;
+  double rest_cost_ = 0.0;
+  std::vector<ObjectiveEvaluation> evaluations_;
+  int best_index_ = -1;
+  CoupledSolution best_solution_;
+  CoupledSolution solution_;             // of the last evaluation
+  Matrix warm_start_;                    // W(E1), the last usable solution; empty: start from zero
+  double warm_start_modulus_ = 0.0;      // E1 [Pa]; 0 when W(E1) was set by SetWarmStart
+  Matrix previous_start_;                // W(E0), the one before; empty: none
+  double previous_start_modulus_ = 0.0;  // E0 [Pa]
+  Matrix initial_;                       // the extrapolated W^(0)
+  std::string error_message_;
+};
+
+}  // namespace mcrewave

@@ -1,0 +1,52 @@
+// The reference experiment (formulation.md section 1): the shock load, the time
+// grid and where the measurements come from.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+
+#include "mcrewave/core/types.h"
+
+namespace mcrewave {
+
+// The load applied on the bar at x = L, positive along +x.
+struct LoadOptions {
+  LoadKind kind = LoadKind::kHalfSine;
+  double amplitude = 1000.0;  // F0 [N]
+  double duration = 1e-4;     // t_load [s]
+
+  bool IsValid(std::string* error) const;
+  // F(t) [N] at time t [s].
+  double Value(double time) const;
+};
+
+// The observation window and the time discretisation of the model.
+struct TimeOptions {
+  double window = 0.63e-3;  // T [s]
+  double step = 0.36e-6;    // h [s]
+  double theta = 0.5;       // theta-method parameter, in [0, 1]
+
+  // Valid when window and step are positive, theta is in [0, 1] and the window
+  // holds a whole number of steps (to 1e-9 relative).
+  bool IsValid(std::string* error) const;
+  // m = T / h, the number of steps; samples are t_k = k h, k = 0..m.
+  int NumSteps() const;
+};
+
+// Where the measurements come from. Synthetic data are computed on a "truth"
+// (a finer FE discretisation, or the exact solution: never the identifying
+// model's own grid unless truth_refinement = 1), sampled at t_k = k h, then
+// Gaussian white noise is added at the given SNR (see noise.h for the definition).
+struct DataOptions {
+  DataSource source = DataSource::kSynthetic;
+  std::string path;                                      // CSV file when source = csv
+  TruthModel truth = TruthModel::kFiniteElement;         // synthetic only
+  int truth_refinement = 4;                              // mesh and step refined by this factor
+  double snr = std::numeric_limits<double>::infinity();  // inf = no noise
+  std::uint64_t seed = 1;                                // noise seed
+
+  bool IsValid(std::string* error) const;
+};
+
+}  // namespace mcrewave

@@ -1,0 +1,884 @@
+#include "mcrewave/app/config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "mcrewave/core/types.h"
+
+namespace mcrewave {
+namespace {
+
+// ---------------------------------------------------------------------------
+// Value types: how one YAML scalar becomes a C++ value and back.
+
+// A value type of the config. `read` returns false (leaving *value as it was)
+// when the node is not a valid T; `write` gives YAML text that `read` turns back
+// into the same value.
+template <typename T>
+struct ValueType {
+  std::string expected;  // what a valid value looks like, for messages: "a number"
+  std::string choices;   // "a | b" for enums, "" otherwise (for the commented config)
+  std::function<bool(const YAML::Node& node, T* value)> read;
+  std::function<std::string(const T& value)> write;
+};
+
+// The shortest decimal text that reads back as exactly `value`, in fixed notation
+// below 1e6 (800, not 8e+02); ".inf"/"-.inf" for infinities (YAML spelling).
+std::string FormatNumber(double value) {
+  if (std::isinf(value)) return value > 0 ? ".inf" : "-.inf";
+  int precision = 1;
+  char text[64];
+  while (precision < 17) {
+    std::snprintf(text, sizeof(text), "%.*g", precision, value);
+    if (std::strtod(text, nullptr) == value) break;
+    ++precision;
+  }
+  const double magnitude = std::abs(value);
+  if (magnitude >= 1.0 && magnitude < 1e6) {
+    // %g switches to exponents once the exponent reaches the precision.
+    precision = std::max(precision, 1 + static_cast<int>(std::floor(std::log10(magnitude))));
+  }
+  std::snprintf(text, sizeof(text), "%.*g", precision, value);
+  return text;
+}
+
+// Any number except NaN; .inf and -.inf are numbers (ranges are checked by the
+// sections' IsValid).
+ValueType<double> Number() {
+  ValueType<double> type;
+  type.expected = "a number";
+  type.read = [](const YAML::Node& node, double* value) {
+    if (!node.IsScalar()) return false;
+    double parsed;
+    if (!YAML::convert<double>::decode(node, parsed) || std::isnan(parsed)) return false;
+    *value = parsed;
+    return true;
+  };
+  type.write = FormatNumber;
+  return type;
+}
+
+// A decimal integer >= 1 that fits Int; "1.5" and "1e3" are not integers.
+template <typename Int>
+ValueType<Int> PositiveInteger() {
+  ValueType<Int> type;
+  type.expected = "a positive integer";
+  type.read = [](const YAML::Node& node, Int* value) {
+    if (!node.IsScalar() || node.Scalar().empty()) return false;
+    const std::string& text = node.Scalar();
+    errno = 0;
+    char* end = nullptr;
+    const long long parsed = std::strtoll(text.c_str(), &end, 10);
+    if (errno != 0 || *end != '\0' || std::isspace(static_cast<unsigned char>(text[0])) ||
+        parsed < 1 || parsed > std::numeric_limits<Int>::max()) {
+      return false;
+    }
+    *value = static_cast<Int>(parsed);
+    return true;
+  };
+  type.write = [](const Int& value) { return std::to_string(value); };
+  return type;
+}
+
+// A decimal integer >= 0 that fits int (0 often means "off").
+ValueType<int> NonNegativeInteger() {
+  ValueType<int> type = PositiveInteger<int>();
+  type.expected = "an integer >= 0";
+  type.read = [](const YAML::Node& node, int* value) {
+    if (node.IsScalar() && node.Scalar() == "0") {
+      *value = 0;
+      return true;
+    }
+    return PositiveInteger<int>().read(node, value);
+  };
+  return type;
+}
+
+// A decimal integer in [0, 2^64 - 1].
+ValueType<std::uint64_t> UnsignedInteger() {
+  ValueType<std::uint64_t> type;
+  type.expected = "an integer in [0, 18446744073709551615]";
+  type.read = [](const YAML::Node& node, std::uint64_t* value) {
+    if (!node.IsScalar() || node.Scalar().empty()) return false;
+    const std::string& text = node.Scalar();
+    // strtoull accepts (and wraps) a minus sign and skips leading spaces: refuse both.
+    if (!std::isdigit(static_cast<unsigned char>(text[0])) && text[0] != '+') return false;
+    errno = 0;
+    char* end = nullptr;
+    const unsigned long long parsed = std::strtoull(text.c_str(), &end, 10);
+    if (errno != 0 || *end != '\0') return false;
+    *value = static_cast<std::uint64_t>(parsed);
+    return true;
+  };
+  type.write = [](const std::uint64_t& value) { return std::to_string(value); };
+  return type;
+}
+
+// Any scalar, taken as text; an empty value (YAML null) is the empty string.
+ValueType<std::string> Text() {
+  ValueType<std::string> type;
+  type.expected = "a string";
+  type.read = [](const YAML::Node& node, std::string* value) {
+    if (node.IsNull()) {
+      value->clear();
+      return true;
+    }
+    if (!node.IsScalar()) return false;
+    *value = node.Scalar();
+    return true;
+  };
+  type.write = [](const std::string& value) {
+    YAML::Emitter emitter;
+    emitter << YAML::DoubleQuoted << value;
+    return std::string(emitter.c_str());
+  };
+  return type;
+}
+
+// true or false (YAML also accepts yes/no, on/off).
+ValueType<bool> Boolean() {
+  ValueType<bool> type;
+  type.expected = "true or false";
+  type.read = [](const YAML::Node& node, bool* value) {
+    if (!node.IsScalar()) return false;
+    bool parsed;
+    if (!YAML::convert<bool>::decode(node, parsed)) return false;
+    *value = parsed;
+    return true;
+  };
+  type.write = [](const bool& value) { return std::string(value ? "true" : "false"); };
+  return type;
+}
+
+// A YAML list of numbers ([.inf, 20, 2.5]); a single number is a list of one.
+// NaN is refused; ranges are checked by the sections' IsValid.
+ValueType<std::vector<double>> NumberList() {
+  ValueType<std::vector<double>> type;
+  type.expected = "a list of numbers, e.g. [.inf, 20, 2.5]";
+  type.read = [](const YAML::Node& node, std::vector<double>* value) {
+    const ValueType<double> number = Number();
+    std::vector<double> parsed;
+    if (node.IsScalar()) {
+      double single;
+      if (!number.read(node, &single)) return false;
+      parsed.push_back(single);
+    } else if (node.IsSequence()) {
+      for (const YAML::Node& element : node) {
+        double element_value;
+        if (!number.read(element, &element_value)) return false;
+        parsed.push_back(element_value);
+      }
+    } else {
+      return false;
+    }
+    *value = parsed;
+    return true;
+  };
+  type.write = [](const std::vector<double>& value) {
+    std::string text = "[";
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      text += (i == 0 ? "" : ", ") + FormatNumber(value[i]);
+    }
+    return text + "]";
+  };
+  return type;
+}
+
+// An enum written by name, with the to/from-string pair of types.h; `values`
+// lists every value (for the messages and the commented config).
+template <typename Enum>
+ValueType<Enum> EnumByName(std::vector<Enum> values, const char* (*to_string)(Enum),
+                           bool (*from_string)(const std::string&, Enum*)) {
+  ValueType<Enum> type;
+  type.expected = "one of ";
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    type.expected += std::string(i == 0 ? "" : ", ") + "'" + to_string(values[i]) + "'";
+    type.choices += std::string(i == 0 ? "" : " | ") + to_string(values[i]);
+  }
+  type.read = [from_string](const YAML::Node& node, Enum* value) {
+    return node.IsScalar() && from_string(node.Scalar(), value);
+  };
+  type.write = [to_string](const Enum& value) { return std::string(to_string(value)); };
+  return type;
+}
+
+// ---------------------------------------------------------------------------
+// The key table.
+
+// One key of the config: its dotted path, documentation, and how its value is
+// read from YAML into a Config and written back.
+struct Key {
+  std::string path;         // "section.name"
+  std::string unit;         // SI unit, "" for dimensionless values
+  std::string description;  // one line, for the commented default config
+  std::string choices;      // "a | b" for enums, "" otherwise
+  std::string expected;     // for messages: "a number (in m)"
+  std::function<bool(const YAML::Node& node, Config* config)> read;
+  std::function<std::string(const Config& config)> write;
+
+  std::string section() const { return path.substr(0, path.find('.')); }
+  std::string name() const { return path.substr(path.find('.') + 1); }
+};
+
+// The row of key `path` stored in config.*section.*field.
+template <typename Section, typename T>
+Key MakeKey(const char* path, Section Config::*section, T Section::*field, const ValueType<T>& type,
+            const char* unit, const char* description) {
+  Key key;
+  key.path = path;
+  key.unit = unit;
+  key.description = description;
+  key.choices = type.choices;
+  key.expected = type.expected + (key.unit.empty() ? "" : " (in " + key.unit + ")");
+  key.read = [section, field, read = type.read](const YAML::Node& node, Config* config) {
+    return read(node, &((config->*section).*field));
+  };
+  key.write = [section, field, write = type.write](const Config& config) {
+    return write((config.*section).*field);
+  };
+  return key;
+}
+
+// The row of key `path` stored in config.*section.*part.*field (a struct inside
+// a section, e.g. mcre.weights.displacement_weight).
+template <typename Section, typename Part, typename T>
+Key MakeKey(const char* path, Section Config::*section, Part Section::*part, T Part::*field,
+            const ValueType<T>& type, const char* unit, const char* description) {
+  Key key;
+  key.path = path;
+  key.unit = unit;
+  key.description = description;
+  key.choices = type.choices;
+  key.expected = type.expected + (key.unit.empty() ? "" : " (in " + key.unit + ")");
+  key.read = [section, part, field, read = type.read](const YAML::Node& node, Config* config) {
+    return read(node, &((config->*section).*part.*field));
+  };
+  key.write = [section, part, field, write = type.write](const Config& config) {
+    return write((config.*section).*part.*field);
+  };
+  return key;
+}
+
+// Every CoupledSolverType, in the order of the enum: the values whose name is
+// known to CoupledSolverTypeToString, from the first (the enum is contiguous
+// from 0), so that a solver added to coupled_solver.h is accepted here as well.
+std::vector<CoupledSolverType> AllCoupledSolverTypes() {
+  std::vector<CoupledSolverType> types;
+  for (int value = 0;; ++value) {
+    const auto type = static_cast<CoupledSolverType>(value);
+    if (std::string(CoupledSolverTypeToString(type)) == "unknown") break;
+    types.push_back(type);
+  }
+  return types;
+}
+
+// Every key of the config, in the order of the written config. Defaults are those
+// of a default-constructed Config. To add a key, add a row (and the field to its
+// section struct); to add a section, also add its struct to Config and its
+// IsValid to SectionValidators().
+const std::vector<Key>& KeyTable() {
+  static const std::vector<Key> table = {
+      MakeKey("model.length", &Config::model, &BarProperties::length, Number(), "m",
+              "length L of the bar"),
+      MakeKey("model.section", &Config::model, &BarProperties::section, Number(), "m^2",
+              "cross-section area S"),
+      MakeKey("model.density", &Config::model, &BarProperties::density, Number(), "kg/m^3",
+              "density rho"),
+      MakeKey("model.modulus", &Config::model, &BarProperties::modulus, Number(), "Pa",
+              "Young's modulus E of the reference (or initial) model"),
+      MakeKey("model.elements", &Config::model, &BarProperties::elements, PositiveInteger<int>(),
+              "", "number N of linear finite elements"),
+      MakeKey("model.mass", &Config::model, &BarProperties::mass,
+              EnumByName<MassType>({MassType::kConsistent, MassType::kLumped}, MassTypeToString,
+                                   StringToMassType),
+              "", "element mass matrix"),
+      MakeKey("load.kind", &Config::load, &LoadOptions::kind,
+              EnumByName<LoadKind>({LoadKind::kHalfSine}, LoadKindToString, StringToLoadKind), "",
+              "shape of the shock load applied at x = L"),
+      MakeKey("load.amplitude", &Config::load, &LoadOptions::amplitude, Number(), "N",
+              "peak force F0"),
+      MakeKey("load.duration", &Config::load, &LoadOptions::duration, Number(), "s",
+              "duration t_load of the load"),
+      MakeKey("time.window", &Config::time, &TimeOptions::window, Number(), "s",
+              "observation window T"),
+      MakeKey("time.step", &Config::time, &TimeOptions::step, Number(), "s",
+              "time step h; T / h must be a whole number"),
+      MakeKey("time.theta", &Config::time, &TimeOptions::theta, Number(), "",
+              "theta-method parameter in [0, 1] (0.5: trapezoidal rule)"),
+      MakeKey("data.source", &Config::data, &DataOptions::source,
+              EnumByName<DataSource>({DataSource::kSynthetic, DataSource::kCsv}, DataSourceToString,
+                                     StringToDataSource),
+              "", "where the measurements come from"),
+      MakeKey("data.path", &Config::data, &DataOptions::path, Text(), "",
+              "measurement CSV (t,u0,uL,f0,fL) if source is csv; relative to this file"),
+      MakeKey("data.truth", &Config::data, &DataOptions::truth,
+              EnumByName<TruthModel>({TruthModel::kFiniteElement, TruthModel::kExact},
+                                     TruthModelToString, StringToTruthModel),
+              "", "truth sampled by the synthetic data"),
+      MakeKey("data.truth_refinement", &Config::data, &DataOptions::truth_refinement,
+              PositiveInteger<int>(), "",
+              "mesh and step refinement of the finite_element truth, in [1, 64]"),
+      MakeKey("data.snr", &Config::data, &DataOptions::snr, Number(), "",
+              "signal-to-noise ratio of the synthetic noise (.inf: no noise)"),
+      MakeKey("data.seed", &Config::data, &DataOptions::seed, UnsignedInteger(), "",
+              "seed of the noise generator"),
+      MakeKey("mcre.w_u", &Config::mcre, &McreOptions::weights, &McreWeights::displacement_weight,
+              Number(), "", "displacement weight: beta = w_u S E0 / L"),
+      MakeKey("mcre.w_f", &Config::mcre, &McreOptions::weights, &McreWeights::force_weight,
+              Number(), "", "force weight: alpha = w_f L / (S E0)"),
+      MakeKey("mcre.reference_modulus", &Config::mcre, &McreOptions::reference_modulus, Number(),
+              "Pa", "E0 of the weights: a fixed nominal modulus, not the unknown"),
+      MakeKey("inner.method", &Config::inner, &CoupledSolverOptions::type,
+              EnumByName<CoupledSolverType>(AllCoupledSolverTypes(), CoupledSolverTypeToString,
+                                            StringToCoupledSolverType),
+              "", "solver of the coupled direct/retrograde problem for one E"),
+      MakeKey("inner.tolerance", &Config::inner, &CoupledSolverOptions::tolerance, Number(), "",
+              "stop when ||c - A W||_P / ||c||_P falls below this, in (0, 1)"),
+      MakeKey("inner.max_iterations", &Config::inner, &CoupledSolverOptions::max_iterations,
+              PositiveInteger<int>(), "", "sweep pairs allowed to one iterative solve"),
+      MakeKey("inner.omega", &Config::inner, &CoupledSolverOptions::relaxation_coefficient,
+              Number(), "", "relaxation coefficient of method relaxation, in (0, 2)"),
+      MakeKey("inner.spectrum_steps", &Config::inner,
+              &CoupledSolverOptions::spectrum_estimation_steps, PositiveInteger<int>(), "",
+              "Lanczos steps of adaptive_relaxation's spectrum estimate, at least 2"),
+      MakeKey("inner.spectrum_safety_factor", &Config::inner,
+              &CoupledSolverOptions::spectrum_safety_factor, Number(), "",
+              "adaptive_relaxation: factor (>= 1) on the estimated largest eigenvalue"),
+      MakeKey("inner.divergence_factor", &Config::inner, &CoupledSolverOptions::divergence_factor,
+              Number(), "", "a residual this many times above the least seen is divergence"),
+      MakeKey("inner.max_all_at_once_unknowns", &Config::inner,
+              &CoupledSolverOptions::max_all_at_once_unknowns, PositiveInteger<long>(), "",
+              "all_at_once refuses systems with more unknowns"),
+      MakeKey("inner.max_all_at_once_bytes", &Config::inner,
+              &CoupledSolverOptions::max_all_at_once_bytes, PositiveInteger<long>(), "bytes",
+              "all_at_once refuses when its matrix and LU factors would need more memory"),
+      MakeKey("inner.max_field_bytes", &Config::inner, &CoupledSolverOptions::max_field_bytes,
+              PositiveInteger<long>(), "bytes",
+              "iterative methods refuse when their fields would need more memory"),
+      MakeKey("inner.max_dense_solver_bytes", &Config::inner,
+              &CoupledSolverOptions::max_dense_solver_bytes, PositiveInteger<long>(), "bytes",
+              "riccati and multiple_shooting refuse to store more"),
+      MakeKey("inner.shooting_condition_limit", &Config::inner,
+              &CoupledSolverOptions::shooting_condition_limit, Number(), "",
+              "shooting fails above this condition number of its matrix (> 1)"),
+      MakeKey("inner.shooting_segment_growth", &Config::inner,
+              &CoupledSolverOptions::shooting_segment_growth, Number(), "",
+              "multiple_shooting: growth (> 1) of the fastest solution per segment"),
+      MakeKey("outer.optimizer", &Config::outer, &IdentificationOptions::optimizer,
+              EnumByName<OptimizerType>({OptimizerType::kNlopt, OptimizerType::kCeres},
+                                        OptimizerTypeToString, StringToOptimizerType),
+              "", "outer optimiser of e^2(E)"),
+      MakeKey("outer.algorithm", &Config::outer, &IdentificationOptions::algorithm,
+              EnumByName<OuterAlgorithm>(
+                  {OuterAlgorithm::kDefault, OuterAlgorithm::kBobyqa, OuterAlgorithm::kCobyla,
+                   OuterAlgorithm::kSbplx, OuterAlgorithm::kMma, OuterAlgorithm::kLbfgs,
+                   OuterAlgorithm::kBfgs, OuterAlgorithm::kBrent},
+                  OuterAlgorithmToString, StringToOuterAlgorithm),
+              "",
+              "default: bobyqa (nlopt) or lbfgs (ceres); nlopt: bobyqa, cobyla, sbplx, mma, "
+              "lbfgs, brent (bounded 1-D, derivative-free); ceres: lbfgs, bfgs"),
+      MakeKey("outer.lower_bound", &Config::outer, &IdentificationOptions::lower_bound, Number(),
+              "Pa", "least modulus searched, > 0"),
+      MakeKey("outer.upper_bound", &Config::outer, &IdentificationOptions::upper_bound, Number(),
+              "Pa", "largest modulus searched"),
+      MakeKey("outer.initial", &Config::outer, &IdentificationOptions::initial, Number(), "Pa",
+              "start of the search, strictly inside the bounds; also the scale of E"),
+      MakeKey("outer.relative_tolerance", &Config::outer,
+              &IdentificationOptions::relative_tolerance, Number(), "",
+              "stop when a step changes E by less than this fraction of E"),
+      MakeKey("outer.max_evaluations", &Config::outer, &IdentificationOptions::max_evaluations,
+              PositiveInteger<int>(), "",
+              "e^2 evaluations allowed to the identification, the scan's included"),
+      MakeKey("outer.max_time", &Config::outer, &IdentificationOptions::max_time, Number(), "s",
+              "wall time allowed to the identification, scan included"),
+      MakeKey("outer.scan_points", &Config::outer, &IdentificationOptions::scan_points,
+              NonNegativeInteger(), "",
+              "moduli of the global scan over the bounds before the local search; 0: none"),
+      MakeKey("outer.scan_tolerance", &Config::outer, &IdentificationOptions::scan_tolerance,
+              Number(), "", "relative residual of the scan's inner solves, in (0, 1)"),
+      MakeKey("outer.scan_threads", &Config::outer, &IdentificationOptions::scan_threads,
+              PositiveInteger<int>(), "", "threads of the scan, in [1, 64]"),
+      MakeKey("outer.refine_candidates", &Config::outer, &IdentificationOptions::refine_candidates,
+              PositiveInteger<int>(), "",
+              "lowest sampled minima of the scan refined by the local optimiser"),
+      MakeKey("prefilter.enabled", &Config::prefilter, &PrefilterOptions::enabled, Boolean(), "",
+              "zero-phase Butterworth low-pass of the four measured channels"),
+      MakeKey("prefilter.cutoff_frequency", &Config::prefilter, &PrefilterOptions::cutoff_frequency,
+              Number(), "Hz", "cut-off of the pre-filter; 0: derived from the measured load"),
+      MakeKey("prefilter.order", &Config::prefilter, &PrefilterOptions::order,
+              PositiveInteger<int>(), "", "Butterworth order of one pass, even, in [2, 12]"),
+      MakeKey("uncertainty.samples", &Config::uncertainty, &UncertaintyOptions::samples,
+              PositiveInteger<int>(), "", "noise draws of the first-order std of E, in [2, 1000]"),
+      MakeKey("uncertainty.seed", &Config::uncertainty, &UncertaintyOptions::seed,
+              UnsignedInteger(), "", "seed of those noise draws"),
+      MakeKey("output.folder", &Config::output, &OutputOptions::folder, Text(), "",
+              "results folder of identify run, relative to the working directory"),
+      MakeKey("output.figures", &Config::output, &OutputOptions::figures, Boolean(), "",
+              "also draw the PNG figures with gnuplot"),
+      MakeKey("output.curve_points", &Config::output, &OutputOptions::curve_points,
+              PositiveInteger<int>(), "", "points of the cost curve e^2(E), in [5, 1000]"),
+      MakeKey("study.kind", &Config::study, &StudyOptions::kind,
+              EnumByName<StudyKind>({StudyKind::kRobustness, StudyKind::kRelaxation,
+                                     StudyKind::kCostCurves, StudyKind::kAll},
+                                    StudyKindToString, StringToStudyKind),
+              "", "which study `identify study` runs (study.h)"),
+      MakeKey("study.folder", &Config::study, &StudyOptions::folder, Text(), "",
+              "results folder of identify study (a subfolder per study), relative to the "
+              "working directory"),
+      MakeKey("study.threads", &Config::study, &StudyOptions::threads, NonNegativeInteger(), "",
+              "threads running the studies' runs, in [0, 256]; 0: every core"),
+      MakeKey("study.figures", &Config::study, &StudyOptions::figures, Boolean(), "",
+              "also draw the studies' PNG figures with gnuplot"),
+      MakeKey("study.robustness_snr", &Config::study, &StudyOptions::robustness_snr, NumberList(),
+              "", "robustness: SNRs of the noise (.inf: none), each > 0"),
+      MakeKey("study.robustness_seeds", &Config::study, &StudyOptions::robustness_seeds,
+              PositiveInteger<int>(), "", "robustness: noise seeds 1..N per finite SNR"),
+      MakeKey("study.relaxation_snr", &Config::study, &StudyOptions::relaxation_snr, NumberList(),
+              "", "relaxation: SNRs of the data (noise seed data.seed)"),
+      MakeKey("study.relaxation_moduli", &Config::study, &StudyOptions::relaxation_moduli,
+              NumberList(), "", "relaxation: trial moduli E / model.modulus, in (0, 10]"),
+      MakeKey("study.omega_min", &Config::study, &StudyOptions::omega_min, Number(), "",
+              "relaxation: least omega of the grid, > 0"),
+      MakeKey("study.omega_max", &Config::study, &StudyOptions::omega_max, Number(), "",
+              "relaxation: largest omega of the grid, < 2"),
+      MakeKey("study.omega_points", &Config::study, &StudyOptions::omega_points,
+              PositiveInteger<int>(), "", "relaxation: omegas of the grid, in [2, 1000]"),
+      MakeKey("study.relaxation_tolerance", &Config::study, &StudyOptions::relaxation_tolerance,
+              Number(), "", "relaxation: relative residual the grid's solves reach, in (0, 1)"),
+      MakeKey("study.cost_curve_snr", &Config::study, &StudyOptions::cost_curve_snr, NumberList(),
+              "", "cost curves: SNRs of the data"),
+      MakeKey("study.cost_curve_seeds", &Config::study, &StudyOptions::cost_curve_seeds,
+              PositiveInteger<int>(), "", "cost curves: noise seeds 1..N per finite SNR"),
+      MakeKey("study.cost_curve_points", &Config::study, &StudyOptions::cost_curve_points,
+              PositiveInteger<int>(), "", "cost curves: moduli of each curve, in [3, 10000]"),
+      MakeKey("study.cost_curve_low", &Config::study, &StudyOptions::cost_curve_low, Number(), "",
+              "cost curves: least E / model.modulus, > 0"),
+      MakeKey("study.cost_curve_high", &Config::study, &StudyOptions::cost_curve_high, Number(), "",
+              "cost curves: largest E / model.modulus"),
+  };
+  return table;
+}
+
+// Checks the values of one section; on failure writes a message that names the
+// offending key by its dotted path (e.g. "model.length must be ...").
+using SectionValidator = std::function<bool(const Config& config, std::string* error)>;
+
+template <typename Section>
+SectionValidator ValidatorOf(Section Config::*section) {
+  return [section](const Config& config, std::string* error) {
+    return (config.*section).IsValid(error);
+  };
+}
+
+// One entry per section of Config, in the order of the checks.
+const std::vector<SectionValidator>& SectionValidators() {
+  static const std::vector<SectionValidator> validators = {
+      ValidatorOf(&Config::model),       ValidatorOf(&Config::load),
+      ValidatorOf(&Config::time),        ValidatorOf(&Config::data),
+      ValidatorOf(&Config::mcre),        ValidatorOf(&Config::inner),
+      ValidatorOf(&Config::outer),       ValidatorOf(&Config::prefilter),
+      ValidatorOf(&Config::uncertainty), ValidatorOf(&Config::output),
+      ValidatorOf(&Config::study),
+  };
+  return validators;
+}
+
+// Checks of keys from more than one section, run once every section is valid on
+// its own. The same convention as the sections' IsValid: the message names the
+// offending key first (Locate places it where that key was set), then the keys
+// it is compared with.
+const std::vector<SectionValidator>& CrossSectionValidators() {
+  static const std::vector<SectionValidator> validators = {
+      // A cut-off at or above the Nyquist frequency is not a low-pass filter of the
+      // sampled data (the bilinear transform maps Nyquist to tan(pi/2)).
+      [](const Config& config, std::string* error) {
+        const double cutoff = config.prefilter.cutoff_frequency;
+        const double nyquist = 0.5 / config.time.step;
+        if (cutoff > 0.0 && !(cutoff < nyquist)) {
+          *error = "prefilter.cutoff_frequency (" + FormatNumber(cutoff) +
+                   " Hz) must be below the Nyquist frequency 0.5 / time.step = " +
+                   FormatNumber(nyquist) + " Hz (time.step = " + FormatNumber(config.time.step) +
+                   " s), or 0 to derive it from the data";
+          return false;
+        }
+        return true;
+      },
+  };
+  return validators;
+}
+
+// The section names in table order, each once.
+std::vector<std::string> SectionNames() {
+  std::vector<std::string> sections;
+  for (const Key& key : KeyTable()) {
+    if (std::find(sections.begin(), sections.end(), key.section()) == sections.end()) {
+      sections.push_back(key.section());
+    }
+  }
+  return sections;
+}
+
+const Key* FindKey(const std::string& path) {
+  for (const Key& key : KeyTable()) {
+    if (key.path == path) return &key;
+  }
+  return nullptr;
+}
+
+// ---------------------------------------------------------------------------
+// Messages.
+
+// Levenshtein distance (insertions, deletions, substitutions).
+std::size_t EditDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> previous(b.size() + 1), current(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) previous[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    current[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t substitution = previous[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1);
+      current[j] = std::min({previous[j] + 1, current[j - 1] + 1, substitution});
+    }
+    std::swap(previous, current);
+  }
+  return previous[b.size()];
+}
+
+// "; did you mean '<nearest candidate>'?", or "" when there are no candidates.
+std::string Suggestion(const std::string& word, const std::vector<std::string>& candidates) {
+  const std::string* nearest = nullptr;
+  std::size_t best = std::numeric_limits<std::size_t>::max();
+  for (const std::string& candidate : candidates) {
+    const std::size_t distance = EditDistance(word, candidate);
+    if (distance < best) {
+      best = distance;
+      nearest = &candidate;
+    }
+  }
+  return nearest == nullptr ? "" : "; did you mean '" + *nearest + "'?";
+}
+
+std::string UnknownKeyMessage(const std::string& path) {
+  std::vector<std::string> paths;
+  for (const Key& key : KeyTable()) paths.push_back(key.path);
+  return "unknown key '" + path + "'" + Suggestion(path, paths);
+}
+
+// How a node is shown after "got": its text when a scalar, else its kind.
+std::string Describe(const YAML::Node& node) {
+  switch (node.Type()) {
+    case YAML::NodeType::Scalar:
+      return "'" + node.Scalar() + "'";
+    case YAML::NodeType::Sequence:
+      return "a list";
+    case YAML::NodeType::Map:
+      return "a map";
+    default:
+      return "nothing";
+  }
+}
+
+std::string Join(const std::vector<std::string>& words, const char* separator) {
+  std::string joined;
+  for (std::size_t i = 0; i < words.size(); ++i) joined += (i == 0 ? "" : separator) + words[i];
+  return joined;
+}
+
+// "<name>:<line>" with the 1-based line of a node, or "<name>" when the node has
+// no position.
+std::string Where(const std::string& name, const YAML::Mark& mark) {
+  return mark.is_null() ? name : name + ":" + std::to_string(mark.line + 1);
+}
+
+// ---------------------------------------------------------------------------
+// Parsing.
+
+// A parsed config and, for every key that was set, where it was set: "<file>:<line>"
+// or "--set <override>". Used to place the messages of later checks.
+struct ParsedConfig {
+  Config config;
+  std::map<std::string, std::string> origins;
+};
+
+// Reads the keys of one section map into parsed->config.
+void ReadSection(const std::string& section, const YAML::Node& keys, const std::string& name,
+                 ParsedConfig* parsed) {
+  std::map<std::string, int> first_lines;
+  for (const auto& entry : keys) {
+    const YAML::Node& key_node = entry.first;
+    const std::string where = Where(name, key_node.Mark());
+    if (!key_node.IsScalar()) {
+      throw InputError(where + ": " + section + ": expected a key name, got " + Describe(key_node));
+    }
+    const std::string path = section + "." + key_node.Scalar();
+    const Key* key = FindKey(path);
+    if (key == nullptr) throw InputError(where + ": " + UnknownKeyMessage(path));
+    const int line = key_node.Mark().line + 1;
+    if (!first_lines.emplace(path, line).second) {
+      throw InputError(where + ": duplicate key '" + path + "' (first given on line " +
+                       std::to_string(first_lines[path]) + ")");
+    }
+    if (!key->read(entry.second, &parsed->config)) {
+      throw InputError(where + ": " + path + ": expected " + key->expected + ", got " +
+                       Describe(entry.second));
+    }
+    parsed->origins[path] = where;
+  }
+}
+
+// Reads the YAML document (a map of sections) into parsed->config.
+void ReadDocument(const YAML::Node& root, const std::string& name, ParsedConfig* parsed) {
+  const std::vector<std::string> sections = SectionNames();
+  if (root.IsNull()) return;  // an empty file: every key at its default
+  if (!root.IsMap()) {
+    throw InputError(Where(name, root.Mark()) + ": expected a map of sections (" +
+                     Join(sections, ", ") + ") at the top level, got " + Describe(root));
+  }
+  std::map<std::string, int> first_lines;
+  for (const auto& entry : root) {
+    const YAML::Node& section_node = entry.first;
+    const std::string where = Where(name, section_node.Mark());
+    if (!section_node.IsScalar()) {
+      throw InputError(where + ": expected a section name, got " + Describe(section_node));
+    }
+    const std::string& section = section_node.Scalar();
+    if (std::find(sections.begin(), sections.end(), section) == sections.end()) {
+      throw InputError(where + ": unknown section '" + section + "'" +
+                       Suggestion(section, sections));
+    }
+    const int line = section_node.Mark().line + 1;
+    if (!first_lines.emplace(section, line).second) {
+      throw InputError(where + ": duplicate section '" + section + "' (first given on line " +
+                       std::to_string(first_lines[section]) + ")");
+    }
+    const YAML::Node& keys = entry.second;
+    if (keys.IsNull()) continue;  // "section:" alone: every key of it at its default
+    if (!keys.IsMap()) {
+      std::vector<std::string> names;
+      for (const Key& key : KeyTable()) {
+        if (key.section() == section) names.push_back(key.name());
+      }
+      throw InputError(where + ": " + section + ": expected a map of keys (" + Join(names, ", ") +
+                       "), got " + Describe(keys));
+    }
+    ReadSection(section, keys, name, parsed);
+  }
+}
+
+// `text` without leading and trailing spaces and tabs.
+std::string Trim(const std::string& text) {
+  const std::size_t first = text.find_first_not_of(" \t");
+  if (first == std::string::npos) return "";
+  return text.substr(first, text.find_last_not_of(" \t") - first + 1);
+}
+
+// Applies one "key.path=value" override.
+void ApplyOverride(const std::string& override_text, ParsedConfig* parsed) {
+  const std::string where = "--set " + override_text;
+  const std::size_t equals = override_text.find('=');
+  if (equals == std::string::npos) {
+    throw InputError(where + ": expected key.path=value, e.g. model.elements=200");
+  }
+  const std::string path = Trim(override_text.substr(0, equals));
+  const Key* key = FindKey(path);
+  if (key == nullptr) throw InputError(where + ": " + UnknownKeyMessage(path));
+  YAML::Node value;
+  try {
+    value = YAML::Load(override_text.substr(equals + 1));
+  } catch (const YAML::Exception& error) {
+    throw InputError(where + ": expected " + key->expected + ", got malformed YAML (" + error.msg +
+                     ")");
+  }
+  if (!key->read(value, &parsed->config)) {
+    throw InputError(where + ": expected " + key->expected + ", got " + Describe(value));
+  }
+  parsed->origins[path] = where;
+}
+
+// True when `text` mentions `path` as a whole word ("data.path" but not "data.paths").
+bool Mentions(const std::string& text, const std::string& path, std::size_t* position) {
+  for (std::size_t at = text.find(path); at != std::string::npos; at = text.find(path, at + 1)) {
+    const std::size_t after = at + path.size();
+    const bool word_ends =
+        after == text.size() ||
+        !(std::isalnum(static_cast<unsigned char>(text[after])) || text[after] == '_');
+    const bool word_starts = at == 0 || !(std::isalnum(static_cast<unsigned char>(text[at - 1])) ||
+                                          text[at - 1] == '_' || text[at - 1] == '.');
+    if (word_ends && word_starts) {
+      *position = at;
+      return true;
+    }
+  }
+  return false;
+}
+
+// Prefixes a validation message with where the key it names was set: of the keys
+// the message mentions, the first one (in the message) that was set in the file or
+// by an override; the bare file name when none was.
+std::string Locate(const std::string& message, const ParsedConfig& parsed,
+                   const std::string& name) {
+  std::size_t best_position = std::string::npos;
+  std::string where = name;
+  for (const auto& [path, origin] : parsed.origins) {
+    std::size_t position;
+    if (Mentions(message, path, &position) && position < best_position) {
+      best_position = position;
+      where = origin;
+    }
+  }
+  return where + ": " + message;
+}
+
+void Validate(const ParsedConfig& parsed, const std::string& name) {
+  for (const auto* validators : {&SectionValidators(), &CrossSectionValidators()}) {
+    for (const SectionValidator& is_valid : *validators) {
+      std::string error;
+      if (!is_valid(parsed.config, &error)) throw InputError(Locate(error, parsed, name));
+    }
+  }
+}
+
+ParsedConfig Parse(const std::string& yaml_text, const std::string& name,
+                   const std::vector<std::string>& overrides) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& error) {
+    throw InputError(Where(name, error.mark) + ": malformed YAML: " + error.msg);
+  }
+  ParsedConfig parsed;
+  ReadDocument(root, name, &parsed);
+  for (const std::string& override_text : overrides) ApplyOverride(override_text, &parsed);
+  Validate(parsed, name);
+  return parsed;
+}
+
+// The whole file, or InputError("cannot read config file ...").
+std::string ReadConfigFile(const std::string& path) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) {
+    throw InputError("cannot read config file " + path + ": " + std::strerror(errno));
+  }
+  std::string content;
+  char buffer[4096];
+  std::size_t count;
+  while ((count = std::fread(buffer, 1, sizeof(buffer), file)) > 0) content.append(buffer, count);
+  const bool failed = std::ferror(file) != 0;
+  const int read_errno = errno;
+  std::fclose(file);
+  if (failed) {
+    throw InputError("cannot read config file " + path + ": " + std::strerror(read_errno));
+  }
+  return content;
+}
+
+// Empty when `path` is a readable regular file, else why not.
+std::string WhyUnreadable(const std::string& path) {
+  std::error_code status_error;
+  if (std::filesystem::is_directory(path, status_error)) return "it is a directory";
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) return std::strerror(errno);
+  std::fclose(file);
+  return "";
+}
+
+// ---------------------------------------------------------------------------
+// Writing.
+
+// The config as YAML, one section per table section; with comments, each key
+// line ends with "# [unit] description (choices)".
+std::string WriteYaml(const Config& config, bool with_comments) {
+  std::vector<std::pair<std::string, std::string>> lines;  // text, comment
+  std::string section;
+  for (const Key& key : KeyTable()) {
+    if (key.section() != section) {
+      section = key.section();
+      lines.emplace_back(section + ":", "");
+    }
+    std::string comment = key.unit.empty() ? "" : "[" + key.unit + "] ";
+    comment += key.description;
+    if (!key.choices.empty()) comment += " (" + key.choices + ")";
+    lines.emplace_back("  " + key.name() + ": " + key.write(config), comment);
+  }
+  std::size_t width = 0;
+  for (const auto& [text, comment] : lines) width = std::max(width, text.size());
+
+  std::ostringstream yaml;
+  for (const auto& [text, comment] : lines) {
+    yaml << text;
+    if (with_comments && !comment.empty()) {
+      yaml << std::string(width - text.size() + 2, ' ') << "# " << comment;
+    }
+    yaml << "\n";
+  }
+  return yaml.str();
+}
+
+}  // namespace
+
+bool OutputOptions::IsValid(std::string* error) const {
+  std::string why;
+  if (folder.empty()) {
+    why = "output.folder must name a folder";
+  } else if (curve_points < 5 || curve_points > 1000) {
+    why =
+        "output.curve_points must be an integer in [5, 1000], got " + std::to_string(curve_points);
+  } else {
+    return true;
+  }
+  if (error != nullptr) *error = why;
+  return false;
+}
+
+Config ParseConfig(const std::string& yaml_text, const std::string& name,
+                   const std::vector<std::string>& overrides) {
+  return Parse(yaml_text, name, overrides).config;
+}
+
+Config LoadConfig(const std::string& path, const std::vector<std::string>& overrides) {
+  ParsedConfig parsed = Parse(ReadConfigFile(path), path, overrides);
+  Config& config = parsed.config;
+  config.source_path = path;
+
+  const std::filesystem::path data_path(config.data.path);
+  if (!config.data.path.empty() && data_path.is_relative()) {
+    config.data.path = (std::filesystem::path(path).parent_path() / data_path).string();
+  }
+  if (config.data.source == DataSource::kCsv) {
+    const std::string why = WhyUnreadable(config.data.path);
+    if (!why.empty()) {
+      const auto origin = parsed.origins.find("data.path");
+      const std::string where = origin == parsed.origins.end() ? path : origin->second;
+      throw InputError(where + ": data.path: cannot read measurement file '" + config.data.path +
+                       "': " + why);
+    }
+  }
+  return config;
+}
+
+std::string DefaultConfigYaml() {
+  return "# mcrewave configuration: every key at its default value (SI units).\n"
+         "# Override any key on the command line with --set section.key=value.\n" +
+         WriteYaml(Config{}, /*with_comments=*/true);
+}
+
+std::string ConfigToYaml(const Config& config) {
+  return WriteYaml(config, /*with_comments=*/false);
+}
+
+}  // namespace mcrewave

@@ -1,0 +1,258 @@
+#include "mcrewave/app/identification_run.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <utility>
+
+#include "mcrewave/data/noise.h"
+#include "mcrewave/data/prefilter.h"
+#include "mcrewave/model/simulation.h"
+
+namespace mcrewave {
+namespace {
+
+// Relative agreement asked of a CSV's time grid with the config's.
+constexpr double kGridTolerance = 1e-6;
+
+// The moduli of the cost curve, ascending: `points` moduli evenly spaced over
+// the window E* +- kCurvatureWindow E*; when the optimiser's evaluations reach
+// farther, half of them over the span of the evaluations instead and the other
+// half over the window, so the curve shows both the optimiser's path and the
+// neighbourhood of E*. Clipped to the bounds.
+std::vector<double> CostCurveModuli(const Config& config, const IdentificationRun& run) {
+  const double center = run.identified_modulus();
+  const double lower = config.outer.lower_bound;
+  const double upper = config.outer.upper_bound;
+  const double window_low = std::max(lower, center * (1.0 - kCurvatureWindow));
+  const double window_high = std::min(upper, center * (1.0 + kCurvatureWindow));
+  double span_low = window_low;
+  double span_high = window_high;
+  for (const ObjectiveEvaluation& evaluation : run.evaluations) {
+    span_low = std::min(span_low, evaluation.modulus);
+    span_high = std::max(span_high, evaluation.modulus);
+  }
+  const int points = config.output.curve_points;
+  const bool wider = span_low < window_low || span_high > window_high;
+  const int span_points = wider ? points / 2 : 0;
+  std::vector<double> moduli;
+  for (int i = 0; i < span_points; ++i) {
+    moduli.push_back(span_low + (span_high - span_low) * i / (span_points - 1.0));
+  }
+  const int window_points = points - span_points;
+  for (int i = 0; i < window_points; ++i) {
+    moduli.push_back(window_low + (window_high - window_low) * i / (window_points - 1.0));
+  }
+  std::sort(moduli.begin(), moduli.end());
+  return moduli;
+}
+
+// The cost curve at CostCurveModuli, each solve warm-started from the previous
+// point's (the first from the solution at E*).
+std::vector<CostCurvePoint> ComputeCostCurve(const Config& config, const BarModel& model,
+                                             const MeasurementSet& data,
+                                             const IdentificationRun& run, long* sweeps) {
+  const double center = run.identified_modulus();
+  const std::vector<double> moduli = CostCurveModuli(config, run);
+  spdlog::info("cost curve: {} points over [{:.6g}, {:.6g}] Pa", moduli.size(), moduli.front(),
+               moduli.back());
+
+  McreObjective objective(model, data, config.mcre, config.time.theta, config.inner, center);
+  objective.SetWarmStart(run.solution.retrograde);
+  std::vector<CostCurvePoint> curve;
+  for (const double modulus : moduli) {
+    const ObjectiveEvaluation& evaluation = objective.EvaluateModulus(modulus);
+    CostCurvePoint point;
+    point.modulus = modulus;
+    point.usable = evaluation.usable;
+    point.cost = evaluation.cost;
+    point.cost_gradient = evaluation.cost_gradient;
+    if (!point.usable) {
+      spdlog::warn("cost curve: the coupled solve at E = {:.6g} Pa is not usable ({})", modulus,
+                   evaluation.inner.BriefReport());
+    }
+    curve.push_back(point);
+  }
+  *sweeps = objective.sweeps();
+  return curve;
+}
+
+std::string Number(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+}  // namespace
+
+MeasurementSet LoadMeasurements(const Config& config) {
+  if (config.data.source == DataSource::kSynthetic) {
+    return MakeSyntheticMeasurements(config.model, config.load, config.time, config.data);
+  }
+  const std::string& path = config.data.path;
+  MeasurementSet data = ReadMeasurementCsv(path);
+  const std::string config_name = config.source_path.empty() ? "the config" : config.source_path;
+  if (std::abs(data.time_step - config.time.step) > kGridTolerance * config.time.step) {
+    throw InputError(path + ": time step " + Number(data.time_step) + " s differs from time.step " +
+                     Number(config.time.step) + " s of " + config_name +
+                     "; the model runs on the data's time grid");
+  }
+  const int expected_samples = config.time.NumSteps() + 1;
+  if (data.num_samples() != expected_samples) {
+    throw InputError(
+        path + ": " + std::to_string(data.num_samples()) +
+        " samples, but time.window / time.step + 1 = " + std::to_string(expected_samples) + " in " +
+        config_name + " (time.window " + Number(config.time.window) + " s)");
+  }
+  return data;
+}
+
+IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& data) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  IdentificationRun run;
+  run.config = config;
+  run.reference_known = config.data.source == DataSource::kSynthetic;
+  run.data = PrefilterMeasurements(data, config.prefilter, &run.prefilter_cutoff);
+  if (config.prefilter.enabled) {
+    spdlog::info("pre-filter: zero-phase Butterworth of order {} (x2), cut-off {:.6g} Hz{}",
+                 config.prefilter.order, run.prefilter_cutoff,
+                 config.prefilter.cutoff_frequency > 0.0 ? "" : " (derived from the load)");
+  }
+
+  const BarModel model(config.model);
+  McreObjective objective(model, run.data, config.mcre, config.time.theta, config.inner,
+                          config.outer.initial);
+  run.alpha = objective.problem().alpha();
+  run.beta = objective.problem().beta();
+  run.rest_cost = objective.rest_cost();
+  spdlog::info(
+      "identifying E with {}/{} from {:.6g} Pa in [{:.6g}, {:.6g}] Pa; inner {}",
+      OptimizerTypeToString(config.outer.optimizer),
+      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
+      config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
+      CoupledSolverTypeToString(config.inner.type));
+  run.outer = Identify(config.outer, &objective);
+  run.evaluations = objective.evaluations();
+  run.sweeps = objective.sweeps();
+  spdlog::info("{}", run.outer.BriefReport());
+  if (run.IsUsable()) {
+    // Every field reported belongs to the identified E: the objective's best
+    // evaluation is at E* unless another evaluation went lower; then E* is
+    // solved once more (warm-started).
+    run.best_index = objective.best_index();
+    run.solution = objective.best_solution();
+    if (run.evaluations[run.best_index].modulus != run.identified_modulus()) {
+      const ObjectiveEvaluation& at_optimum = objective.EvaluateModulus(run.identified_modulus());
+      if (!at_optimum.usable) {
+        run.outer.termination = TerminationType::kFailure;
+        run.outer.message =
+            "the coupled solve at the identified E is not usable: " + at_optimum.inner.message;
+      }
+      run.evaluations = objective.evaluations();
+      run.sweeps = objective.sweeps();
+      run.best_index = static_cast<int>(run.evaluations.size()) - 1;
+      run.solution = objective.last_solution();
+    }
+  }
+  run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return run;
+}
+
+IdentificationRun RunIdentification(const Config& config, const MeasurementSet& data) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  IdentificationRun run = IdentifyModulus(config, data);
+  if (!run.IsUsable()) return run;
+  const BarModel model(config.model);
+
+  // The cost curve around E*.
+  run.cost_curve = ComputeCostCurve(config, model, run.data, run, &run.cost_curve_sweeps);
+
+  // The inner solver's convergence at E* from W = 0.
+  McreObjective cold(model, run.data, config.mcre, config.time.theta, config.inner,
+                     run.identified_modulus());
+  run.cold_solve = cold.EvaluateModulus(run.identified_modulus()).inner;
+
+  // The uncertainty figure: noise levels known for synthetic data with noise,
+  // estimated from the data's second differences otherwise.
+  run.misfit = MisfitLevels(run.data, run.solution, run.alpha);
+  run.estimated_noise = DifferenceNoiseLevels(data);
+  if (run.reference_known && std::isfinite(config.data.snr)) {
+    const MeasurementSet truth = SimulateTruth(config.model, config.load, config.time, config.data);
+    // std = RMS(signal) / SNR (noise.h)
+    run.noise.displacement_std = RootMeanSquare(truth.uL) / config.data.snr;
+    run.noise.force_std = RootMeanSquare(truth.fL) / config.data.snr;
+    run.noise_source = "synthetic_snr";
+  } else {
+    run.noise = run.estimated_noise;
+    run.noise_source = "data_differences";
+  }
+  int curvature_points = 0;
+  const double curvature = CostGradientSlope(run.cost_curve, run.identified_modulus(),
+                                             kCurvatureWindow, &curvature_points);
+  run.uncertainty = EstimateModulusUncertainty(
+      config.uncertainty, model, run.data, config.mcre, config.time.theta, config.inner,
+      run.identified_modulus(), run.solution, run.noise, curvature, curvature_points);
+  if (run.uncertainty.available) {
+    spdlog::info("uncertainty: std(E) = {:.4g} Pa ({:.3g} %) over {} noise draws",
+                 run.uncertainty.std_dev, 100.0 * run.uncertainty.relative_std_dev,
+                 run.uncertainty.samples);
+  } else {
+    spdlog::warn("uncertainty not available: {}", run.uncertainty.message);
+  }
+  run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return run;
+}
+
+std::string ModulusOnBoundMessage(double modulus, const IdentificationOptions& outer) {
+  const std::pair<double, const char*> bounds[] = {{outer.lower_bound, "outer.lower_bound"},
+                                                   {outer.upper_bound, "outer.upper_bound"}};
+  for (const auto& [bound, key] : bounds) {
+    if (std::abs(modulus - bound) <= kOnBoundTolerance * bound) {
+      char message[512];
+      std::snprintf(message, sizeof(message),
+                    "E = %.6g Pa lies on %s (%.6g Pa): e^2 has no minimum inside the bounds; "
+                    "widen them, or check the units of the data (SI: m and N)",
+                    modulus, key, bound);
+      return message;
+    }
+  }
+  return "";
+}
+
+std::string ImplausibleMisfitMessage(const IdentificationRun& run) {
+  const MeasurementSet& data = run.data;
+  // RMS over both ends: sqrt((|a|^2 + |b|^2) / (2 samples)).
+  auto both_ends_rms = [&](const Vector& a, const Vector& b) {
+    return std::sqrt((a.squaredNorm() + b.squaredNorm()) / (2.0 * data.num_samples()));
+  };
+  struct QuantityType {
+    const char* name;
+    const char* unit;
+    double misfit;
+    double measured;
+  };
+  const QuantityType types[] = {
+      {"displacements", "m", run.misfit.displacement_std, both_ends_rms(data.u0, data.uL)},
+      {"forces", "N", run.misfit.force_std, both_ends_rms(data.f0, data.fL)}};
+  for (const QuantityType& type : types) {
+    if (!(type.misfit <= kImplausibleMisfitFactor * type.measured)) {
+      char message[512];
+      std::snprintf(message, sizeof(message),
+                    "at E = %.6g Pa the model misses the measured end %s by an RMS of %.4g %s, "
+                    "%.3g times their own RMS (%.4g %s): it explains nothing of them; check the "
+                    "units of the data (SI: m and N) and the model's geometry and density",
+                    run.identified_modulus(), type.name, type.misfit, type.unit,
+                    type.misfit / type.measured, type.measured, type.unit);
+      return message;
+    }
+  }
+  return "";
+}
+
+}  // namespace mcrewave

@@ -1,0 +1,453 @@
+#include "mcrewave/app/results.h"
+
+#include <spdlog/spdlog.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "mcrewave/core/file_util.h"
+#include "mcrewave/core/version.h"
+
+namespace mcrewave {
+namespace {
+
+// The meaning of the uncertainty figure, written beside it.
+constexpr const char* kUncertaintyMeaning =
+    "first-order standard deviation of the identified E under fresh white measurement noise of "
+    "the levels below: std over the noise draws of -dg/k, dg the change of de^2/dE at E caused "
+    "by one draw, k the slope of de^2/dE over E +- 5 %; indicative only when it is not small "
+    "against that 5 %";
+
+// The shortest decimal text that reads back as exactly `value` ("null" for NaN,
+// ".inf" for infinities, YAML spelling).
+std::string Format(double value) {
+  if (std::isnan(value)) return "null";
+  if (std::isinf(value)) return value > 0 ? ".inf" : "-.inf";
+  char text[64];
+  for (int precision = 1; precision <= 17; ++precision) {
+    std::snprintf(text, sizeof(text), "%.*g", precision, value);
+    if (std::strtod(text, nullptr) == value) break;
+  }
+  return text;
+}
+
+std::string Quoted(const std::string& text) {
+  YAML::Emitter emitter;
+  emitter << YAML::DoubleQuoted << text;
+  return emitter.c_str();
+}
+
+// YAML lines "key: value  # comment", the comments aligned per block.
+class YamlWriter {
+ public:
+  void Line(int indent, const std::string& key, const std::string& value,
+            const std::string& comment = "") {
+    lines_.push_back(
+        {std::string(2 * indent, ' ') + key + ":" + (value.empty() ? "" : " " + value), comment});
+  }
+  void Number(int indent, const std::string& key, double value, const std::string& comment = "") {
+    Line(indent, key, Format(value), comment);
+  }
+  void Integer(int indent, const std::string& key, long value, const std::string& comment = "") {
+    Line(indent, key, std::to_string(value), comment);
+  }
+  void Text(int indent, const std::string& key, const std::string& value,
+            const std::string& comment = "") {
+    Line(indent, key, Quoted(value), comment);
+  }
+  void Raw(const std::string& text) { lines_.push_back({text, ""}); }
+
+  std::string str() const {
+    // Comments aligned after the longest commented line of at most kAlignLimit
+    // characters; longer lines keep theirs two spaces after the text.
+    constexpr std::size_t kAlignLimit = 60;
+    std::size_t width = 0;
+    for (const auto& [text, comment] : lines_) {
+      if (!comment.empty() && text.size() <= kAlignLimit) width = std::max(width, text.size());
+    }
+    std::string out;
+    for (const auto& [text, comment] : lines_) {
+      out += text;
+      if (!comment.empty()) {
+        out += std::string(text.size() < width ? width - text.size() + 2 : 2, ' ') + "# " + comment;
+      }
+      out += "\n";
+    }
+    return out;
+  }
+
+ private:
+  std::vector<std::pair<std::string, std::string>> lines_;
+};
+
+// ---------------------------------------------------------------------------
+// CSV files.
+
+std::string EvaluationsCsv(const IdentificationRun& run) {
+  std::string csv =
+      "evaluation,modulus,cost,cost_gradient,gradient_requested,usable,inner_iterations,sweeps,"
+      "relative_residual\n";
+  char row[512];
+  for (std::size_t i = 0; i < run.evaluations.size(); ++i) {
+    const ObjectiveEvaluation& e = run.evaluations[i];
+    std::snprintf(row, sizeof(row), "%zu,%.17g,%.17g,%.17g,%d,%d,%d,%ld,%.6g\n", i + 1, e.modulus,
+                  e.usable ? e.cost : NAN, e.usable ? e.cost_gradient : NAN,
+                  e.gradient_requested ? 1 : 0, e.usable ? 1 : 0, e.inner.iterations,
+                  e.inner.sweeps, e.inner.relative_residual);
+    csv += row;
+  }
+  return csv;
+}
+
+std::string CostCurveCsv(const IdentificationRun& run) {
+  std::string csv = "modulus,cost,cost_gradient,usable\n";
+  char row[256];
+  for (const CostCurvePoint& point : run.cost_curve) {
+    std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%d\n", point.modulus,
+                  point.usable ? point.cost : NAN, point.usable ? point.cost_gradient : NAN,
+                  point.usable ? 1 : 0);
+    csv += row;
+  }
+  return csv;
+}
+
+// Measured and model channels at both ends; the model force at the ends is
+// F = F~ - B W / alpha.
+std::string EndsCsv(const IdentificationRun& run) {
+  const MeasurementSet& data = run.data;
+  const Matrix& displacement = run.solution.displacement;
+  const Matrix& retrograde = run.solution.retrograde;
+  const int last = static_cast<int>(displacement.rows()) - 1;
+  std::string csv =
+      "t,u0_measured,u0_model,uL_measured,uL_model,f0_measured,f0_model,fL_measured,fL_model\n";
+  char row[512];
+  for (int j = 0; j < data.num_samples(); ++j) {
+    // f_model = f~ - w_end / alpha
+    const double f0_model = data.f0[j] - retrograde(0, j) / run.alpha;
+    const double fL_model = data.fL[j] - retrograde(last, j) / run.alpha;
+    std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+                  data.Time(j), data.u0[j], displacement(0, j), data.uL[j], displacement(last, j),
+                  data.f0[j], f0_model, data.fL[j], fL_model);
+    csv += row;
+  }
+  return csv;
+}
+
+// The relative residual per iteration of the solve from W = 0 at the identified
+// E; for the direct solvers (no iteration history) their one final residual.
+std::vector<double> InnerResidualHistory(const IdentificationRun& run) {
+  const CoupledSolverSummary& inner = run.cold_solve;
+  if (!inner.residual_history.empty()) return inner.residual_history;
+  if (inner.relative_residual >= 0.0) return {inner.relative_residual};
+  return {};
+}
+
+std::string InnerResidualCsv(const IdentificationRun& run) {
+  std::string csv = "iteration,relative_residual\n";
+  char row[128];
+  const std::vector<double> history = InnerResidualHistory(run);
+  for (std::size_t i = 0; i < history.size(); ++i) {
+    std::snprintf(row, sizeof(row), "%zu,%.17g\n", i + 1, history[i]);
+    csv += row;
+  }
+  return csv;
+}
+
+// The global scan: e^2 = scaled cost x J_rest at each scan modulus (solved at
+// outer.scan_tolerance); usable 0 where the sample's solve failed.
+std::string ScanCsv(const IdentificationRun& run) {
+  std::string csv = "modulus,cost,usable\n";
+  char row[128];
+  const IdentificationSummary& outer = run.outer;
+  for (std::size_t i = 0; i < outer.scan_moduli.size(); ++i) {
+    const bool usable = std::isfinite(outer.scan_costs[i]);
+    std::snprintf(row, sizeof(row), "%.17g,%.17g,%d\n", outer.scan_moduli[i],
+                  usable ? outer.scan_costs[i] * run.rest_cost : 0.0, usable ? 1 : 0);
+    csv += row;
+  }
+  return csv;
+}
+
+// ---------------------------------------------------------------------------
+// Figures.
+
+std::string CostCurveScript(const IdentificationRun& run, const std::string& folder) {
+  const double identified = run.identified_modulus() / 1e9;
+  const std::string curve = GnuplotString(folder + "/cost_curve.csv");
+  const std::string evaluations = GnuplotString(folder + "/evaluations.csv");
+  std::ostringstream script;
+  script
+      << GnuplotPngTerminal() << "set terminal pngcairo size 1000,1000\n"
+      << "set multiplot layout 2,1 title 'MCRE cost curve e^2(E); identified E = " << identified
+      << " GPa (dashed)'\n"
+      << "set xlabel 'E [GPa]'\nset ylabel 'e^2 [J s]'\nset format y '%.5g'\nset key top center\n"
+      << "set arrow 1 from " << identified << ", graph 0 to " << identified
+      << ", graph 1 nohead dashtype 2 lc rgb '#555555'\n";
+  // Top: the global scan over the bounds with the refinement (or, without a scan,
+  // everything computed); bottom: the window E* +- 5 % where the uncertainty's k
+  // is fitted.
+  const double low = identified * (1.0 - kCurvatureWindow);
+  const double high = identified * (1.0 + kCurvatureWindow);
+  const IdentificationSummary& outer = run.outer;
+  const bool scanned = !outer.scan_moduli.empty();
+  for (int panel = 0; panel < 2; ++panel) {
+    std::string scan_plot;
+    if (panel == 0 && scanned) {
+      // Bounds over a decade or more: log E, as the scan is spaced.
+      if (outer.scan_moduli.back() >= 10.0 * outer.scan_moduli.front())
+        script << "set logscale x\n";
+      script << "set title 'global scan over the bounds (inner tolerance "
+             << run.config.outer.scan_tolerance << ") and the local refinement'\n";
+      scan_plot = GnuplotString(folder + "/scan.csv") +
+                  " skip 1 using ($1/1e9):($3 > 0 ? $2 : 1/0) with linespoints pt 5 ps 0.6 "
+                  "lc rgb '#2ca02c' title 'global scan', ";
+    } else if (panel == 0) {
+      script << "set title 'over the optimiser evaluations'\n";
+    } else {
+      script << "unset logscale x\nset title 'within 5 % of the identified E'\nset xrange [" << low
+             << ":" << high << "]\n";
+    }
+    script << "plot " << scan_plot << curve
+           << " skip 1 using ($1/1e9):($4 > 0 ? $2 : 1/0) with linespoints pt 7 ps 0.5 lw 2 lc rgb "
+              "'#8b00c9' "
+              "title 'e^2(E), cost curve', "
+           << evaluations
+           << " skip 1 using ($2/1e9):($6 > 0 ? $3 : 1/0) with points pt 6 ps 1.5 lc rgb 'red' "
+              "title 'optimiser evaluations'\n";
+  }
+  script << "unset multiplot\n";
+  return script.str();
+}
+
+std::string EndsScript(const IdentificationRun& run, const std::string& folder) {
+  const std::string csv = GnuplotString(folder + "/ends.csv");
+  std::ostringstream script;
+  script << GnuplotPngTerminal() << "set terminal pngcairo size 1200,900\nset multiplot layout 2,2 "
+         << "title 'Measured and model end quantities at the identified modulus'\n"
+         << "set xlabel 't [ms]'\n";
+  struct Panel {
+    const char* title;
+    const char* unit;
+    int measured;  // column of the measured value
+    double scale;
+  };
+  const Panel panels[] = {{"u_0 (x = 0)", "u [um]", 2, 1e6},
+                          {"u_L (x = L)", "u [um]", 4, 1e6},
+                          {"f_0 (x = 0, clamp reaction)", "f [N]", 6, 1.0},
+                          {"f_L (x = L, load)", "f [N]", 8, 1.0}};
+  for (const Panel& panel : panels) {
+    script << "set title '" << panel.title << "'\nset ylabel '" << panel.unit << "'\n"
+           << "plot " << csv << " skip 1 using ($1*1e3):($" << panel.measured << "*" << panel.scale
+           << ") with lines lc rgb '#aaaaaa' title '"
+           << (run.config.prefilter.enabled ? "measured, pre-filtered" : "measured") << "', " << csv
+           << " skip 1 using ($1*1e3):($" << panel.measured + 1 << "*" << panel.scale
+           << ") with lines lw 2 lc rgb '#1f4e9c' title 'model'\n";
+  }
+  script << "unset multiplot\n";
+  return script.str();
+}
+
+std::string InnerResidualScript(const IdentificationRun& run, const std::string& folder) {
+  // The method's name with spaces for underscores (gnuplot's subscripts).
+  std::string method = CoupledSolverTypeToString(run.config.inner.type);
+  std::replace(method.begin(), method.end(), '_', ' ');
+  std::ostringstream script;
+  script << GnuplotPngTerminal() << "set title 'Inner solver (" << method
+         << "): relative residual ||c - A W||_P / ||c||_P from W = 0 at the identified "
+            "modulus'\n"
+            "set xlabel 'iteration (sweep pair)'\nset ylabel 'relative residual'\n"
+            "set logscale y\nset format y '10^{%T}'\n"
+         << "plot " << GnuplotString(folder + "/inner_residual.csv")
+         << " skip 1 using 1:2 with linespoints pt 7 ps 0.6 lw 2 title 'relative residual', "
+         << run.config.inner.tolerance << " with lines dashtype 2 lc rgb '#555555' "
+         << "title 'inner.tolerance'\n";
+  return script.str();
+}
+
+}  // namespace
+
+std::string SummaryYaml(const IdentificationRun& run) {
+  const IdentificationSummary& outer = run.outer;
+  const double identified = run.identified_modulus();
+  const double reference = run.reference_known ? run.config.model.modulus : NAN;
+  YamlWriter yaml;
+  yaml.Raw("# mcrewave identify run: the modulus E identified by minimising the MCRE cost e^2(E)");
+  if (!run.config.source_path.empty()) yaml.Raw("# config: " + run.config.source_path);
+  yaml.Text(0, "version", kVersion, "mcrewave version");
+  yaml.Number(0, "identified_modulus", identified, "[Pa] E minimising e^2");
+  yaml.Number(0, "reference_modulus", reference,
+              "[Pa] E the synthetic data were made with (null: unknown, CSV data)");
+  yaml.Number(0, "relative_error", run.reference_known ? (identified - reference) / reference : NAN,
+              "(identified - reference) / reference (null when unknown)");
+  yaml.Number(0, "cost", run.cost(), "[J s] e^2 at the identified modulus");
+  yaml.Integer(0, "evaluations", outer.scan_evaluations + outer.evaluations,
+               "e^2 evaluations of the identification: the scan's and the refinements'");
+  yaml.Integer(0, "sweeps", outer.scan_sweeps + run.sweeps,
+               "direct + retrograde sweeps of those evaluations");
+  yaml.Number(0, "wall_time_s", run.wall_time_s,
+              "[s] identification, cost curve and uncertainty (not the data)");
+
+  const ModulusUncertainty& uncertainty = run.uncertainty;
+  yaml.Line(0, "uncertainty", "");
+  yaml.Number(1, "modulus_std_dev", uncertainty.available ? uncertainty.std_dev : NAN,
+              "[Pa] null when not available (see message)");
+  yaml.Number(1, "relative_std_dev", uncertainty.available ? uncertainty.relative_std_dev : NAN,
+              "modulus_std_dev / identified_modulus");
+  yaml.Text(1, "meaning", kUncertaintyMeaning);
+  yaml.Text(1, "message", uncertainty.message);
+  yaml.Number(1, "curvature", uncertainty.curvature,
+              "[J s/Pa^2] k, least-squares slope of de^2/dE over E +- 5 %");
+  yaml.Integer(1, "curvature_points", uncertainty.curvature_points, "cost-curve points of k");
+  yaml.Integer(1, "samples", uncertainty.samples, "noise draws");
+  yaml.Number(1, "noise_std_displacement", run.noise.displacement_std, "[m] drawn on u0 and uL");
+  yaml.Number(1, "noise_std_force", run.noise.force_std, "[N] drawn on f0 and fL");
+  yaml.Text(1, "noise_source", run.noise_source,
+            "synthetic_snr: the data's own noise; data_differences: estimated from the data");
+  yaml.Number(1, "estimated_noise_std_displacement", run.estimated_noise.displacement_std,
+              "[m] from the second differences of the data (MAD)");
+  yaml.Number(1, "estimated_noise_std_force", run.estimated_noise.force_std,
+              "[N] from the second differences of the data (MAD)");
+  yaml.Number(1, "misfit_rms_displacement", run.misfit.displacement_std,
+              "[m] RMS of U - u~ at both ends, at the optimum");
+  yaml.Number(1, "misfit_rms_force", run.misfit.force_std,
+              "[N] RMS of F - f~ = -W / alpha at both ends, at the optimum");
+  yaml.Integer(1, "sweeps", uncertainty.sweeps, "of the noise solves");
+
+  yaml.Line(0, "optimizer", "");
+  yaml.Text(1, "name", OptimizerTypeToString(outer.optimizer));
+  yaml.Text(1, "algorithm", OuterAlgorithmToString(outer.algorithm));
+  yaml.Text(1, "termination", TerminationTypeToString(outer.termination));
+  yaml.Text(1, "message", outer.message);
+  yaml.Text(1, "optimizer_message", outer.optimizer_message, "the optimiser's own words");
+  yaml.Number(1, "initial_modulus", outer.initial_modulus, "[Pa]");
+  yaml.Integer(1, "evaluations", outer.evaluations, "of the local refinements (scan apart)");
+  yaml.Integer(1, "gradient_evaluations", outer.gradient_evaluations,
+               "of which with the adjoint gradient");
+  yaml.Integer(1, "iterations", outer.iterations, "Ceres iterations (-1: NLopt)");
+  yaml.Number(1, "scaled_cost", outer.cost, "e^2 / cost_scale at the identified modulus");
+  yaml.Number(1, "cost_scale", run.rest_cost,
+              "[J s] J_rest, the functional of the bar left at rest (>= e^2 for every E)");
+  yaml.Number(1, "wall_time_s", outer.wall_time_s, "[s] scan and refinements");
+
+  yaml.Line(0, "scan", "", "global scan of e^2 over the bounds (outer.scan_points)");
+  yaml.Integer(1, "points", static_cast<long>(outer.scan_moduli.size()), "0: no scan");
+  yaml.Integer(1, "local_minima", outer.local_minima, "sampled local minima of e^2 seen");
+  yaml.Integer(1, "failed_points", outer.scan_failures, "samples without a usable cost");
+  yaml.Number(1, "second_modulus", outer.second_modulus > 0.0 ? outer.second_modulus : NAN,
+              "[Pa] the second-lowest minimum (null: fewer than two)");
+  yaml.Number(1, "scaled_cost_gap", outer.cost_gap,
+              "e^2 / cost_scale of the second-lowest minimum minus the lowest");
+  yaml.Number(1, "cost_gap", outer.cost_gap * run.rest_cost, "[J s] the same gap of e^2");
+  yaml.Integer(1, "refinements", outer.refinements, "local searches from the lowest minima");
+  yaml.Integer(1, "sweeps", outer.scan_sweeps, "direct + retrograde sweeps of the scan");
+  yaml.Number(1, "wall_time_s", outer.scan_wall_time_s, "[s] of the scan");
+
+  yaml.Line(0, "prefilter", "", "zero-phase low-pass of the measurements (prefilter.*)");
+  yaml.Line(1, "enabled", run.config.prefilter.enabled ? "true" : "false");
+  yaml.Number(1, "cutoff_frequency", run.config.prefilter.enabled ? run.prefilter_cutoff : NAN,
+              "[Hz] cut-off used (null: off)");
+  yaml.Text(1, "cutoff_source",
+            !run.config.prefilter.enabled                 ? "off"
+            : run.config.prefilter.cutoff_frequency > 0.0 ? "config"
+                                                          : "derived_from_load",
+            "config: prefilter.cutoff_frequency; derived_from_load: EstimateCutoffFrequency");
+
+  long inner_iterations = 0;
+  int max_inner_iterations = 0;
+  double inner_time = 0.0;
+  for (const ObjectiveEvaluation& evaluation : run.evaluations) {
+    inner_iterations += std::max(0, evaluation.inner.iterations);
+    max_inner_iterations = std::max(max_inner_iterations, evaluation.inner.iterations);
+    inner_time += std::max(0.0, evaluation.inner.wall_time_s);
+  }
+  const CoupledSolverSummary& best_inner = run.evaluations[run.best_index].inner;
+  yaml.Line(0, "inner", "");
+  yaml.Text(1, "method", CoupledSolverTypeToString(run.config.inner.type));
+  yaml.Integer(1, "solves", static_cast<long>(run.evaluations.size()),
+               "coupled solves of the optimiser");
+  yaml.Integer(1, "iterations", inner_iterations, "sweep pairs over those solves");
+  yaml.Integer(1, "max_iterations_one_solve", max_inner_iterations);
+  yaml.Integer(1, "sweeps", run.sweeps);
+  yaml.Number(1, "wall_time_s", inner_time, "[s] in those solves");
+  yaml.Integer(1, "iterations_at_optimum", best_inner.iterations,
+               "of the solve at the identified modulus");
+  yaml.Number(1, "relative_residual_at_optimum", best_inner.relative_residual);
+  yaml.Integer(1, "iterations_from_zero_at_optimum", run.cold_solve.iterations,
+               "of a solve from W = 0 at the identified modulus (inner_residual.csv)");
+
+  yaml.Line(0, "weights", "");
+  yaml.Number(1, "alpha", run.alpha, "[m/N] force weight w_f L / (S E0)");
+  yaml.Number(1, "beta", run.beta, "[N/m] displacement weight w_u S E0 / L");
+
+  yaml.Line(0, "cost_curve", "");
+  yaml.Integer(1, "points", static_cast<long>(run.cost_curve.size()));
+  yaml.Number(1, "lowest_modulus", run.cost_curve.empty() ? NAN : run.cost_curve.front().modulus,
+              "[Pa]");
+  yaml.Number(1, "highest_modulus", run.cost_curve.empty() ? NAN : run.cost_curve.back().modulus,
+              "[Pa]");
+  yaml.Integer(1, "sweeps", run.cost_curve_sweeps);
+  yaml.Integer(0, "total_sweeps",
+               run.outer.scan_sweeps + run.sweeps + run.cost_curve_sweeps + uncertainty.sweeps,
+               "scan, optimiser, cost curve and uncertainty");
+
+  yaml.Line(0, "config", "", "as resolved (every key)");
+  std::istringstream config(ConfigToYaml(run.config));
+  for (std::string line; std::getline(config, line);) yaml.Raw("  " + line);
+  return yaml.str();
+}
+
+std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run,
+                                                    const std::string& folder, bool figures) {
+  std::error_code error;
+  std::filesystem::create_directories(folder, error);
+  if (error) throw std::runtime_error("cannot create folder " + folder + ": " + error.message());
+
+  std::vector<std::string> written;
+  auto write = [&](const std::string& name, const std::string& content) {
+    const std::string path = folder + "/" + name;
+    WriteFileAtomically(path, content);
+    written.push_back(path);
+  };
+  write("evaluations.csv", EvaluationsCsv(run));
+  write("cost_curve.csv", CostCurveCsv(run));
+  write("ends.csv", EndsCsv(run));
+  write("inner_residual.csv", InnerResidualCsv(run));
+  if (!run.outer.scan_moduli.empty()) write("scan.csv", ScanCsv(run));
+
+  if (figures) {
+    bool gnuplot_missing = false;
+    std::vector<std::pair<std::string, std::string>> drawings = {
+        {"cost_curve", CostCurveScript(run, folder)},
+        {"ends", EndsScript(run, folder)},
+    };
+    if (!InnerResidualHistory(run).empty()) {
+      drawings.emplace_back("inner_residual", InnerResidualScript(run, folder));
+    }
+    for (const auto& [name, script] : drawings) {
+      const std::string why = DrawGnuplotFigure(folder, name, script, &gnuplot_missing);
+      if (gnuplot_missing) {
+        spdlog::warn("gnuplot not found on the PATH: figures skipped (the CSV files are written)");
+        break;
+      }
+      if (!why.empty()) {
+        spdlog::warn("figure {}.png skipped: {}", name, why);
+        continue;
+      }
+      written.push_back(folder + "/" + name + ".png");
+    }
+  }
+  // The summary last: its presence says the folder is complete.
+  write("summary.yaml", SummaryYaml(run));
+  return written;
+}
+
+}  // namespace mcrewave

@@ -1,0 +1,1055 @@
+#include "mcrewave/app/study.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+#include <utility>
+
+#include "mcrewave/app/config.h"
+#include "mcrewave/app/identification_run.h"
+#include "mcrewave/core/file_util.h"
+#include "mcrewave/data/noise.h"
+#include "mcrewave/data/prefilter.h"
+#include "mcrewave/mcre/objective.h"
+#include "mcrewave/model/simulation.h"
+
+namespace mcrewave {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+int ResolveThreads(int threads) {
+  if (threads > 0) return threads;
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+// "1 min 05 s" or "42 s".
+std::string Duration(double seconds) {
+  char text[64];
+  const long whole = std::lround(seconds);
+  if (whole >= 60) {
+    std::snprintf(text, sizeof(text), "%ld min %02ld s", whole / 60, whole % 60);
+  } else {
+    std::snprintf(text, sizeof(text), "%ld s", whole);
+  }
+  return text;
+}
+
+// Counts completed runs and logs one progress line per run with the time left,
+// extrapolated from the mean time per completed run so far.
+class Progress {
+ public:
+  Progress(std::string what, int total) : what_(std::move(what)), total_(total) {}
+
+  void RunDone() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++done_;
+    const double elapsed = SecondsSince(start_);
+    // left = elapsed / done * (total - done)
+    const double left = elapsed / done_ * (total_ - done_);
+    StudyProgressLogger()->info("{}: {} / {} runs, {} elapsed, about {} left", what_, done_, total_,
+                                Duration(elapsed), Duration(left));
+  }
+
+ private:
+  std::string what_;
+  int total_;
+  int done_ = 0;
+  std::mutex mutex_;
+  Clock::time_point start_ = Clock::now();
+};
+
+// Calls task(i) for every i in [0, count) on `threads` threads, each taking the
+// next index not yet taken, and progress->RunDone() after each. The tasks must
+// write only their own results (by index). The first exception a task throws is
+// rethrown once every thread has stopped (the others stop taking new indices).
+void ParallelFor(int count, int threads, const std::function<void(int)>& task, Progress* progress) {
+  std::atomic<int> next{0};
+  std::atomic<bool> failed{false};
+  std::exception_ptr first_error;
+  std::mutex error_mutex;
+  auto worker = [&]() {
+    for (int i = next++; i < count && !failed; i = next++) {
+      try {
+        task(i);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!first_error) first_error = std::current_exception();
+        failed = true;
+        return;
+      }
+      progress->RunDone();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < std::min(threads, count); ++t) pool.emplace_back(worker);
+  worker();
+  for (std::thread& thread : pool) thread.join();
+  if (first_error) std::rethrow_exception(first_error);
+}
+
+// The measurements of one (SNR, seed): the noise-free truth plus white noise
+// (noise.h); the truth itself at SNR inf.
+MeasurementSet NoisyMeasurements(const MeasurementSet& truth, double snr, std::uint64_t seed) {
+  MeasurementSet measured = truth;
+  AddMeasurementNoise(snr, seed, &measured);
+  return measured;
+}
+
+MeasurementSet SimulateStudyTruth(const Config& config) {
+  return SimulateTruth(config.model, config.load, config.time, config.data);
+}
+
+// The identification of one run as `identify run` does it, with the scan on
+// the run's own thread; *converged when the outer loop converged inside the bounds.
+IdentificationRun IdentifyOnOneThread(const Config& config, const MeasurementSet& measured,
+                                      double snr, std::uint64_t seed, bool* converged,
+                                      std::string* message) {
+  Config run_config = config;
+  run_config.outer.scan_threads = 1;
+  run_config.data.snr = snr;
+  run_config.data.seed = seed;
+  IdentificationRun run = IdentifyModulus(run_config, measured);
+  *converged = run.IsUsable();
+  *message = run.IsUsable() ? "" : run.outer.message;
+  if (run.IsUsable()) {
+    *message = ModulusOnBoundMessage(run.identified_modulus(), config.outer);
+    *converged = message->empty();
+  }
+  return run;
+}
+
+// Noise seeds of one SNR: 1..seeds, or the single seed 0 (no noise drawn) at SNR inf.
+std::vector<std::uint64_t> SeedsOf(double snr, int seeds) {
+  if (std::isinf(snr)) return {0};
+  std::vector<std::uint64_t> list;
+  for (int seed = 1; seed <= seeds; ++seed) list.push_back(static_cast<std::uint64_t>(seed));
+  return list;
+}
+
+// ---------------------------------------------------------------------------
+// Text.
+
+// Number as CSV text: 10 significant digits, "nan", "inf".
+std::string Csv(double value) {
+  if (std::isnan(value)) return "nan";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.10g", value);
+  return text;
+}
+
+// Number for tables: `digits` significant digits.
+std::string Brief(double value, int digits = 4) {
+  if (std::isnan(value)) return "-";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.*g", digits, value);
+  return text;
+}
+
+// A ratio as a signed percentage with 3 decimals ("+0.012 %").
+std::string Percent(double ratio) {
+  if (std::isnan(ratio)) return "-";
+  char text[64];
+  std::snprintf(text, sizeof(text), "%+.3f %%", 100.0 * ratio);
+  return text;
+}
+
+std::string SnrText(double snr) { return std::isinf(snr) ? "inf" : Brief(snr); }
+
+// Writes `files` (name, content) into folder, then draws `figures` (name,
+// script) when asked; returns the paths written.
+std::vector<std::string> WriteStudyFolder(
+    const std::string& folder, const std::vector<std::pair<std::string, std::string>>& files,
+    const std::vector<std::pair<std::string, std::string>>& figures, bool draw,
+    const std::string& summary) {
+  std::error_code error;
+  std::filesystem::create_directories(folder, error);
+  if (error) throw std::runtime_error("cannot create folder " + folder + ": " + error.message());
+  std::vector<std::string> written;
+  for (const auto& [name, content] : files) {
+    WriteFileAtomically(folder + "/" + name, content);
+    written.push_back(folder + "/" + name);
+  }
+  if (draw) {
+    for (const auto& [name, script] : figures) {
+      bool gnuplot_missing = false;
+      const std::string why = DrawGnuplotFigure(folder, name, script, &gnuplot_missing);
+      if (gnuplot_missing) {
+        spdlog::warn("gnuplot not found on the PATH: figures skipped (the CSV files are written)");
+        break;
+      }
+      if (!why.empty()) {
+        spdlog::warn("figure {}/{}.png skipped: {}", folder, name, why);
+        continue;
+      }
+      written.push_back(folder + "/" + name + ".png");
+    }
+  }
+  WriteFileAtomically(folder + "/summary.md", summary);
+  written.push_back(folder + "/summary.md");
+  return written;
+}
+
+// Sampled local minima of a curve (interior points lower than both neighbours;
+// NaN points break the comparison).
+int LocalMinima(const std::vector<double>& values) {
+  int minima = 0;
+  for (std::size_t i = 1; i + 1 < values.size(); ++i) {
+    if (values[i] < values[i - 1] && values[i] < values[i + 1]) ++minima;
+  }
+  return minima;
+}
+
+// "plot a, b, c\n": one gnuplot plot command of the given plot elements.
+std::string PlotCommand(const std::vector<std::string>& plots) {
+  std::string command = "plot ";
+  for (std::size_t i = 0; i < plots.size(); ++i) command += (i == 0 ? "" : ", ") + plots[i];
+  return command + "\n";
+}
+
+// Gnuplot colours of the curves, by index.
+std::string Colour(int index) {
+  static const char* const colours[] = {"#1f4e9c", "#d62728", "#2ca02c", "#ff7f0e",
+                                        "#9467bd", "#8c564b", "#17becf", "#7f7f7f"};
+  return colours[index % 8];
+}
+
+}  // namespace
+
+const char* StudyKindToString(StudyKind kind) {
+  switch (kind) {
+    case StudyKind::kRobustness:
+      return "robustness";
+    case StudyKind::kRelaxation:
+      return "relaxation";
+    case StudyKind::kCostCurves:
+      return "cost_curves";
+    case StudyKind::kAll:
+      return "all";
+  }
+  return "unknown";
+}
+
+bool StringToStudyKind(const std::string& name, StudyKind* kind) {
+  for (StudyKind candidate :
+       {StudyKind::kRobustness, StudyKind::kRelaxation, StudyKind::kCostCurves, StudyKind::kAll}) {
+    if (name == StudyKindToString(candidate)) {
+      *kind = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
+bool StudySelected(StudyKind kind, StudyKind part) {
+  return kind == StudyKind::kAll || kind == part;
+}
+
+bool StudyOptions::IsValid(std::string* error) const {
+  std::ostringstream why;
+  auto check_snr = [&](const std::vector<double>& list, const char* key) {
+    if (list.empty() || list.size() > 100) {
+      why << key << " must hold 1 to 100 SNRs, got " << list.size();
+      return false;
+    }
+    for (const double snr : list) {
+      if (!(snr > 0.0)) {
+        why << key << " must hold SNRs > 0 (.inf: no noise), got " << snr;
+        return false;
+      }
+    }
+    return true;
+  };
+  if (folder.empty()) {
+    why << "study.folder must name a folder";
+  } else if (!(threads >= 0 && threads <= 256)) {
+    why << "study.threads must lie in [0, 256] (0: every core), got " << threads;
+  } else if (!check_snr(robustness_snr, "study.robustness_snr")) {
+  } else if (!(robustness_seeds >= 1 && robustness_seeds <= 100000)) {
+    why << "study.robustness_seeds must lie in [1, 100000], got " << robustness_seeds;
+  } else if (!check_snr(relaxation_snr, "study.relaxation_snr")) {
+  } else if (relaxation_moduli.empty() || relaxation_moduli.size() > 100 ||
+             std::any_of(relaxation_moduli.begin(), relaxation_moduli.end(),
+                         [](double f) { return !(f > 0.0 && f <= 10.0); })) {
+    why << "study.relaxation_moduli must hold 1 to 100 factors of model.modulus in (0, 10]";
+  } else if (!(omega_min > 0.0 && omega_min < omega_max && omega_max < 2.0)) {
+    why << "study.omega_min and study.omega_max must satisfy 0 < omega_min < omega_max < 2, got "
+        << omega_min << " and " << omega_max;
+  } else if (!(omega_points >= 2 && omega_points <= 1000)) {
+    why << "study.omega_points must lie in [2, 1000], got " << omega_points;
+  } else if (!(relaxation_tolerance > 0.0 && relaxation_tolerance < 1.0)) {
+    why << "study.relaxation_tolerance must lie in (0, 1), got " << relaxation_tolerance;
+  } else if (!check_snr(cost_curve_snr, "study.cost_curve_snr")) {
+  } else if (!(cost_curve_seeds >= 1 && cost_curve_seeds <= 100000)) {
+    why << "study.cost_curve_seeds must lie in [1, 100000], got " << cost_curve_seeds;
+  } else if (!(cost_curve_points >= 3 && cost_curve_points <= 10000)) {
+    why << "study.cost_curve_points must lie in [3, 10000], got " << cost_curve_points;
+  } else if (!(cost_curve_low > 0.0 && cost_curve_low < cost_curve_high &&
+               std::isfinite(cost_curve_high))) {
+    why << "study.cost_curve_low and study.cost_curve_high must satisfy 0 < cost_curve_low < "
+           "cost_curve_high (finite), got "
+        << cost_curve_low << " and " << cost_curve_high;
+  } else {
+    return true;
+  }
+  if (error != nullptr) *error = why.str();
+  return false;
+}
+
+std::shared_ptr<spdlog::logger> StudyProgressLogger() {
+  static const std::shared_ptr<spdlog::logger> logger = [] {
+    std::shared_ptr<spdlog::logger> clone = spdlog::default_logger()->clone("study");
+    clone->set_level(spdlog::level::info);
+    return clone;
+  }();
+  return logger;
+}
+
+double Quantile(std::vector<double> values, double q) {
+  std::sort(values.begin(), values.end());
+  const double position = q * (values.size() - 1.0);
+  const std::size_t below = static_cast<std::size_t>(std::floor(position));
+  const std::size_t above = std::min(below + 1, values.size() - 1);
+  // linear interpolation between the order statistics around q (n - 1)
+  return values[below] + (position - below) * (values[above] - values[below]);
+}
+
+// ---------------------------------------------------------------------------
+// Robustness.
+
+RobustnessStudy RunRobustnessStudy(const Config& config) {
+  const auto start = Clock::now();
+  const StudyOptions& options = config.study;
+  RobustnessStudy study;
+  study.reference_modulus = config.model.modulus;
+  study.threads = ResolveThreads(options.threads);
+  for (int k = 0; k < static_cast<int>(options.robustness_snr.size()); ++k) {
+    const double snr = options.robustness_snr[k];
+    for (const std::uint64_t seed : SeedsOf(snr, options.robustness_seeds)) {
+      RobustnessRun run;
+      run.snr = snr;
+      run.snr_index = k;
+      run.seed = seed;
+      study.runs.push_back(run);
+    }
+  }
+  // The noise-free truth once; each run adds its own noise.
+  const MeasurementSet truth = SimulateStudyTruth(config);
+  StudyProgressLogger()->info(
+      "robustness: {} identifications ({} SNRs, {} seeds per finite SNR) on {} threads",
+      study.runs.size(), options.robustness_snr.size(), options.robustness_seeds, study.threads);
+  Progress progress("robustness", static_cast<int>(study.runs.size()));
+  ParallelFor(
+      static_cast<int>(study.runs.size()), study.threads,
+      [&](int i) {
+        RobustnessRun& run = study.runs[i];
+        const MeasurementSet measured = NoisyMeasurements(truth, run.snr, run.seed);
+        const IdentificationRun identification =
+            IdentifyOnOneThread(config, measured, run.snr, run.seed, &run.converged, &run.message);
+        const IdentificationSummary& outer = identification.outer;
+        run.evaluations = outer.evaluations + outer.scan_evaluations;
+        run.scan_evaluations = outer.scan_evaluations;
+        run.sweeps = identification.sweeps + outer.scan_sweeps;
+        run.local_minima = outer.local_minima;
+        if (run.converged) {
+          run.identified_modulus = identification.identified_modulus();
+          // relative error = (E* - E_ref) / E_ref
+          run.relative_error =
+              (run.identified_modulus - study.reference_modulus) / study.reference_modulus;
+        }
+      },
+      &progress);
+
+  for (int k = 0; k < static_cast<int>(options.robustness_snr.size()); ++k) {
+    RobustnessStatistics statistics;
+    statistics.snr = options.robustness_snr[k];
+    std::vector<double> errors;
+    for (const RobustnessRun& run : study.runs) {
+      if (run.snr_index != k) continue;
+      ++statistics.runs;
+      statistics.mean_evaluations += run.evaluations;
+      statistics.mean_sweeps += static_cast<double>(run.sweeps);
+      if (run.converged) errors.push_back(run.relative_error);
+    }
+    statistics.converged = static_cast<int>(errors.size());
+    statistics.converged_share = static_cast<double>(errors.size()) / statistics.runs;
+    statistics.mean_evaluations /= statistics.runs;
+    statistics.mean_sweeps /= statistics.runs;
+    if (!errors.empty()) {
+      double sum = 0.0;
+      for (const double e : errors) sum += e;
+      statistics.mean_error = sum / errors.size();
+      // sample standard deviation: sqrt(sum (e - mean)^2 / (n - 1)); 0 for one run
+      double squares = 0.0;
+      for (const double e : errors)
+        squares += (e - statistics.mean_error) * (e - statistics.mean_error);
+      statistics.std_error = errors.size() > 1 ? std::sqrt(squares / (errors.size() - 1.0)) : 0.0;
+      statistics.quantile_025 = Quantile(errors, 0.025);
+      statistics.quantile_975 = Quantile(errors, 0.975);
+    }
+    study.statistics.push_back(statistics);
+  }
+  study.wall_time_s = SecondsSince(start);
+  return study;
+}
+
+namespace {
+
+std::string RobustnessRunsCsv(const RobustnessStudy& study) {
+  std::ostringstream csv;
+  csv << "snr,snr_index,seed,converged,identified_modulus,relative_error,evaluations,"
+         "scan_evaluations,sweeps,local_minima\n";
+  for (const RobustnessRun& run : study.runs) {
+    csv << Csv(run.snr) << "," << run.snr_index << "," << run.seed << "," << (run.converged ? 1 : 0)
+        << "," << Csv(run.identified_modulus) << "," << Csv(run.relative_error) << ","
+        << run.evaluations << "," << run.scan_evaluations << "," << run.sweeps << ","
+        << run.local_minima << "\n";
+  }
+  return csv.str();
+}
+
+std::string RobustnessStatisticsCsv(const RobustnessStudy& study) {
+  std::ostringstream csv;
+  csv << "snr,snr_index,runs,converged_share,mean_error,std_error,q2.5_error,q97.5_error,"
+         "mean_evaluations,mean_sweeps\n";
+  for (std::size_t k = 0; k < study.statistics.size(); ++k) {
+    const RobustnessStatistics& s = study.statistics[k];
+    csv << Csv(s.snr) << "," << k << "," << s.runs << "," << Csv(s.converged_share) << ","
+        << Csv(s.mean_error) << "," << Csv(s.std_error) << "," << Csv(s.quantile_025) << ","
+        << Csv(s.quantile_975) << "," << Csv(s.mean_evaluations) << "," << Csv(s.mean_sweeps)
+        << "\n";
+  }
+  return csv.str();
+}
+
+std::string RobustnessScript(const RobustnessStudy& study, const std::string& folder) {
+  const std::string runs = GnuplotString(folder + "/runs.csv");
+  const std::string statistics = GnuplotString(folder + "/statistics.csv");
+  std::ostringstream script;
+  script << GnuplotPngTerminal()
+         << "set title 'Relative error of the identified E against SNR (data from the finer "
+            "truth)'\n"
+         << "set xlabel 'SNR'\nset ylabel '(E^* - E_{ref}) / E_{ref} [%]'\n"
+         << "set xrange [-0.5:" << study.statistics.size() - 0.5 << "]\n"
+         << "set key top left\n"
+         // every run, spread sideways by its seed (golden-ratio jitter in [-0.2, 0.2])
+         << "jitter(s) = 0.4 * (s * 0.6180339887 - floor(s * 0.6180339887) - 0.5)\n"
+         << "plot " << runs
+         << " skip 1 using ($2 + jitter($3)):($4 > 0 ? 100 * $6 : 1/0) with points pt 7 ps 0.6 "
+            "lc rgb '#7f9fcf' title 'each run', "
+         << statistics
+         << " skip 1 using 2:(100 * $5):(100 * $7):(100 * $8):xtic(1) with yerrorbars pt 5 ps 1.2 "
+            "lw 2 lc rgb '#d62728' title 'mean and 2.5-97.5 % quantiles'\n";
+  return script.str();
+}
+
+std::string RobustnessSummary(const RobustnessStudy& study) {
+  std::ostringstream md;
+  md << "## Robustness (`robustness/`)\n\n"
+     << "`robustness.png`: the relative error (E* - E_ref) / E_ref of the identified modulus "
+        "against the SNR, every run as a point and, per SNR, the mean with the 2.5-97.5 % "
+        "quantile band of the converged runs. Each run is the identification of `identify run` "
+        "(pre-filter, global scan, local refinement) on data from the finer truth plus white "
+        "noise of one seed; at SNR inf there is one run (no noise), whose error is the "
+        "discretisation bias only (model against the finer truth). `runs.csv`: one row per "
+        "identification; `statistics.csv`: one row per SNR. E_ref = "
+     << Brief(study.reference_modulus / 1e9, 6) << " GPa.\n\n"
+     << "| SNR | runs | converged | mean error | std | 2.5 % | 97.5 % | evaluations | sweeps |\n"
+     << "|---|---|---|---|---|---|---|---|---|\n";
+  for (const RobustnessStatistics& s : study.statistics) {
+    md << "| " << SnrText(s.snr) << " | " << s.runs << " | " << Brief(100.0 * s.converged_share, 4)
+       << " % | " << Percent(s.mean_error) << " | " << Brief(100.0 * s.std_error, 3) << " % | "
+       << Percent(s.quantile_025) << " | " << Percent(s.quantile_975) << " | "
+       << Brief(s.mean_evaluations, 4) << " | " << Brief(s.mean_sweeps, 5) << " |\n";
+  }
+  md << "\nEvaluations: outer evaluations of e^2 (the scan's included), means over all runs; "
+        "sweeps: inner sweeps of the scan and the local refinements.\n\n";
+  for (const RobustnessStatistics& s : study.statistics) {
+    if (std::isinf(s.snr)) {
+      md << "- SNR inf: error " << Percent(s.mean_error)
+         << ", the discretisation bias (no noise).\n";
+    }
+  }
+  // The lowest finite SNR: the paper's claim.
+  const RobustnessStatistics* lowest = nullptr;
+  for (const RobustnessStatistics& s : study.statistics) {
+    if (std::isfinite(s.snr) && (lowest == nullptr || s.snr < lowest->snr)) lowest = &s;
+  }
+  if (lowest != nullptr) {
+    md << "- SNR " << SnrText(lowest->snr) << ": " << lowest->converged << " of " << lowest->runs
+       << " runs converged; mean error " << Percent(lowest->mean_error) << ", 95 % of the runs "
+       << "within [" << Percent(lowest->quantile_025) << ", " << Percent(lowest->quantile_975)
+       << "].\n";
+  }
+  md << "- " << study.runs.size() << " identifications in " << Duration(study.wall_time_s) << " on "
+     << study.threads << " threads.\n\n";
+  return md.str();
+}
+
+}  // namespace
+
+std::vector<std::string> WriteRobustnessResults(const RobustnessStudy& study,
+                                                const std::string& folder, bool figures) {
+  return WriteStudyFolder(
+      folder,
+      {{"runs.csv", RobustnessRunsCsv(study)}, {"statistics.csv", RobustnessStatisticsCsv(study)}},
+      {{"robustness", RobustnessScript(study, folder)}}, figures, RobustnessSummary(study));
+}
+
+// ---------------------------------------------------------------------------
+// Relaxation coefficient.
+
+namespace {
+
+// The extreme eigenvalues of A = I - G at the problem's modulus: the Lanczos
+// estimate of the adaptive relaxation (coupled_solver.h) without its safety
+// factor, read from the summary of an adaptive solve stopped after its first
+// iteration (the estimate precedes the iteration).
+std::pair<double, double> EstimateSpectrum(const CoupledSolverOptions& inner,
+                                           McreProblem* problem) {
+  CoupledSolverOptions options = inner;
+  options.type = CoupledSolverType::kAdaptiveRelaxation;
+  options.spectrum_safety_factor = 1.0;
+  options.max_iterations = 1;
+  CoupledSolution solution;
+  const CoupledSolverSummary summary = SolveCoupled(options, problem, nullptr, &solution);
+  return {summary.spectrum_min, summary.spectrum_max};
+}
+
+// Iterations of the fixed relaxation to reduce the residual by `tolerance`:
+// ln(tol) / ln(rho), rho = max(|1 - omega a_min|, |1 - omega a_max|) the
+// contraction factor in <.,.>_P (iterations_ = ceil); -1 when rho >= 1.
+int PredictedIterations(double omega, double a_min, double a_max, double tolerance) {
+  const double rho = std::max(std::abs(1.0 - omega * a_min), std::abs(1.0 - omega * a_max));
+  if (!(rho < 1.0)) return -1;
+  if (rho == 0.0) return 1;
+  return static_cast<int>(std::ceil(std::log(tolerance) / std::log(rho)));
+}
+
+}  // namespace
+
+RelaxationStudy RunRelaxationStudy(const Config& config) {
+  const auto start = Clock::now();
+  const StudyOptions& options = config.study;
+  RelaxationStudy study;
+  study.tolerance = options.relaxation_tolerance;
+  study.threads = ResolveThreads(options.threads);
+  for (const double snr : options.relaxation_snr) {
+    for (const double factor : options.relaxation_moduli) {
+      RelaxationCase relaxation_case;
+      relaxation_case.snr = snr;
+      relaxation_case.modulus_factor = factor;
+      relaxation_case.modulus = factor * config.model.modulus;
+      study.cases.push_back(relaxation_case);
+    }
+  }
+  std::vector<double> omegas;
+  for (int i = 0; i < options.omega_points; ++i) {
+    omegas.push_back(options.omega_min +
+                     (options.omega_max - options.omega_min) * i / (options.omega_points - 1.0));
+  }
+  const int cases = static_cast<int>(study.cases.size());
+  std::vector<std::vector<RelaxationPoint>> points(cases);
+  std::vector<std::vector<ResidualHistory>> histories(cases);
+
+  const MeasurementSet truth = SimulateStudyTruth(config);
+  const BarModel model(config.model);
+  StudyProgressLogger()->info(
+      "relaxation: {} cases ({} SNRs x {} moduli), {} omegas each, on {} threads", cases,
+      options.relaxation_snr.size(), options.relaxation_moduli.size(), omegas.size(),
+      study.threads);
+  Progress progress("relaxation", cases);
+  ParallelFor(
+      cases, study.threads,
+      [&](int c) {
+        RelaxationCase& relaxation_case = study.cases[c];
+        const MeasurementSet data = PrefilterMeasurements(
+            NoisyMeasurements(truth, relaxation_case.snr, config.data.seed), config.prefilter);
+        McreProblem problem(model, data, config.mcre.weights, config.mcre.reference_modulus,
+                            config.time.theta);
+        problem.SetModulus(relaxation_case.modulus);
+        const auto [a_min, a_max] = EstimateSpectrum(config.inner, &problem);
+        relaxation_case.spectrum_min = a_min;
+        relaxation_case.spectrum_max = a_max;
+        // the fixed relaxation contracts every component iff |1 - omega a| < 1: omega < 2 / a_max
+        relaxation_case.omega_limit = 2.0 / a_max;
+        // least max |1 - omega a| over [a_min, a_max]
+        relaxation_case.omega_optimal = 2.0 / (a_min + a_max);
+
+        auto solve = [&](CoupledSolverType type, double omega, double tolerance) {
+          CoupledSolverOptions solver = config.inner;
+          solver.type = type;
+          if (type == CoupledSolverType::kRelaxation) solver.relaxation_coefficient = omega;
+          solver.tolerance = tolerance;
+          CoupledSolution solution;
+          return SolveCoupled(solver, &problem, nullptr, &solution);
+        };
+        long fewest_sweeps = -1;
+        relaxation_case.omega_fastest = std::numeric_limits<double>::quiet_NaN();
+        for (const double omega : omegas) {
+          const CoupledSolverSummary summary =
+              solve(CoupledSolverType::kRelaxation, omega, options.relaxation_tolerance);
+          RelaxationPoint point;
+          point.case_index = c;
+          point.omega = omega;
+          point.termination = summary.termination;
+          point.iterations = summary.iterations;
+          point.sweeps = summary.sweeps;
+          point.relative_residual = summary.relative_residual;
+          point.predicted_iterations =
+              PredictedIterations(omega, a_min, a_max, options.relaxation_tolerance);
+          points[c].push_back(point);
+          if (summary.IsSolutionUsable() && (fewest_sweeps < 0 || summary.sweeps < fewest_sweeps)) {
+            fewest_sweeps = summary.sweeps;
+            relaxation_case.omega_fastest = omega;
+          }
+        }
+
+        // The reference solves to inner.tolerance, with their residual histories.
+        auto record = [&](CoupledSolverType type, double omega,
+                          const CoupledSolverSummary& summary) {
+          ResidualHistory history;
+          history.case_index = c;
+          history.method = type;
+          history.omega = omega;
+          history.residuals = summary.residual_history;
+          histories[c].push_back(history);
+        };
+        if (!std::isnan(relaxation_case.omega_fastest)) {
+          const CoupledSolverSummary fixed =
+              solve(CoupledSolverType::kRelaxation, relaxation_case.omega_fastest,
+                    config.inner.tolerance);
+          relaxation_case.fixed_sweeps = fixed.sweeps;
+          record(CoupledSolverType::kRelaxation, relaxation_case.omega_fastest, fixed);
+        }
+        const double unused_omega = std::numeric_limits<double>::quiet_NaN();
+        const CoupledSolverSummary adaptive =
+            solve(CoupledSolverType::kAdaptiveRelaxation, unused_omega, config.inner.tolerance);
+        relaxation_case.omega_adaptive = adaptive.relaxation_coefficient;
+        relaxation_case.adaptive_sweeps = adaptive.sweeps;
+        record(CoupledSolverType::kAdaptiveRelaxation, adaptive.relaxation_coefficient, adaptive);
+        const CoupledSolverSummary krylov =
+            solve(CoupledSolverType::kConjugateGradient, unused_omega, config.inner.tolerance);
+        relaxation_case.conjugate_gradient_sweeps = krylov.sweeps;
+        record(CoupledSolverType::kConjugateGradient, std::numeric_limits<double>::quiet_NaN(),
+               krylov);
+      },
+      &progress);
+  for (int c = 0; c < cases; ++c) {
+    study.points.insert(study.points.end(), points[c].begin(), points[c].end());
+    study.histories.insert(study.histories.end(), histories[c].begin(), histories[c].end());
+  }
+  study.wall_time_s = SecondsSince(start);
+  return study;
+}
+
+namespace {
+
+std::string RelaxationCasesCsv(const RelaxationStudy& study) {
+  std::ostringstream csv;
+  csv << "case,snr,modulus_factor,modulus,spectrum_min,spectrum_max,omega_limit,omega_optimal,"
+         "omega_adaptive,omega_fastest,fixed_sweeps,adaptive_sweeps,conjugate_gradient_sweeps\n";
+  for (std::size_t c = 0; c < study.cases.size(); ++c) {
+    const RelaxationCase& r = study.cases[c];
+    csv << c << "," << Csv(r.snr) << "," << Csv(r.modulus_factor) << "," << Csv(r.modulus) << ","
+        << Csv(r.spectrum_min) << "," << Csv(r.spectrum_max) << "," << Csv(r.omega_limit) << ","
+        << Csv(r.omega_optimal) << "," << Csv(r.omega_adaptive) << "," << Csv(r.omega_fastest)
+        << "," << r.fixed_sweeps << "," << r.adaptive_sweeps << "," << r.conjugate_gradient_sweeps
+        << "\n";
+  }
+  return csv.str();
+}
+
+std::string RelaxationSweepsCsv(const RelaxationStudy& study) {
+  std::ostringstream csv;
+  csv << "case,snr,modulus_factor,omega,termination,converged,iterations,sweeps,"
+         "relative_residual,predicted_iterations\n";
+  for (const RelaxationPoint& p : study.points) {
+    const RelaxationCase& r = study.cases[p.case_index];
+    csv << p.case_index << "," << Csv(r.snr) << "," << Csv(r.modulus_factor) << "," << Csv(p.omega)
+        << "," << TerminationTypeToString(p.termination) << ","
+        << (p.termination == TerminationType::kConvergence ? 1 : 0) << "," << p.iterations << ","
+        << p.sweeps << "," << Csv(p.relative_residual) << "," << p.predicted_iterations << "\n";
+  }
+  return csv.str();
+}
+
+std::string ResidualsCsv(const RelaxationStudy& study) {
+  std::ostringstream csv;
+  csv << "history,case,snr,modulus_factor,method,omega,iteration,relative_residual\n";
+  for (std::size_t h = 0; h < study.histories.size(); ++h) {
+    const ResidualHistory& history = study.histories[h];
+    const RelaxationCase& r = study.cases[history.case_index];
+    for (std::size_t i = 0; i < history.residuals.size(); ++i) {
+      csv << h << "," << history.case_index << "," << Csv(r.snr) << "," << Csv(r.modulus_factor)
+          << "," << CoupledSolverTypeToString(history.method) << "," << Csv(history.omega) << ","
+          << i << "," << Csv(history.residuals[i]) << "\n";
+    }
+  }
+  return csv.str();
+}
+
+// The distinct values of `field` over the cases, in first-seen order.
+std::vector<double> Distinct(const RelaxationStudy& study, double RelaxationCase::*field) {
+  std::vector<double> values;
+  for (const RelaxationCase& r : study.cases) {
+    if (std::find(values.begin(), values.end(), r.*field) == values.end())
+      values.push_back(r.*field);
+  }
+  return values;
+}
+
+std::string SweepsScript(const RelaxationStudy& study, const std::string& folder) {
+  const std::string csv = GnuplotString(folder + "/sweeps.csv");
+  const std::vector<double> factors = Distinct(study, &RelaxationCase::modulus_factor);
+  const std::vector<double> snrs = Distinct(study, &RelaxationCase::snr);
+  std::ostringstream script;
+  script << GnuplotPngTerminal() << "set terminal pngcairo size " << 560 * factors.size()
+         << ",620 enhanced font 'sans,10'\n"
+         << "set multiplot layout 1," << factors.size()
+         << " title 'Sweeps of the fixed-omega relaxation to a relative residual of "
+         << Brief(study.tolerance)
+         << " (lines: measured, dashed: predicted from the spectrum; "
+            "arrows: 2/a_{max} solid, adaptive omega dotted)'\n"
+         << "set xlabel '{/Symbol w}'\nset ylabel 'sweeps'\nset logscale y\nset key top right\n";
+  // The omega axis holds the grid and every marked omega.
+  double omega_high = 0.0;
+  for (const RelaxationPoint& p : study.points) omega_high = std::max(omega_high, p.omega);
+  for (const RelaxationCase& r : study.cases) {
+    omega_high = std::max({omega_high, r.omega_limit, r.omega_adaptive});
+  }
+  script << "set xrange [0:" << 1.05 * omega_high << "]\n";
+  for (const double factor : factors) {
+    script << "unset arrow\nset title 'E = " << Brief(factor) << " E_{ref}'\n";
+    std::vector<std::string> plots;
+    for (std::size_t c = 0; c < study.cases.size(); ++c) {
+      const RelaxationCase& r = study.cases[c];
+      if (r.modulus_factor != factor) continue;
+      const int colour_index =
+          static_cast<int>(std::find(snrs.begin(), snrs.end(), r.snr) - snrs.begin());
+      const std::string colour = Colour(colour_index);
+      script << "set arrow from " << r.omega_limit << ", graph 0 to " << r.omega_limit
+             << ", graph 1 nohead lw 1.5 lc rgb '" << colour << "'\n"
+             << "set arrow from " << r.omega_adaptive << ", graph 0 to " << r.omega_adaptive
+             << ", graph 1 nohead dashtype 3 lw 1.5 lc rgb '" << colour << "'\n";
+      std::ostringstream measured, predicted;
+      measured << csv << " skip 1 using ($1 == " << c << " && $6 == 1 ? $4 : 1/0):8 "
+               << "with linespoints pt 7 ps 0.7 lw 2 lc rgb '" << colour << "' title 'SNR "
+               << SnrText(r.snr) << "'";
+      // predicted sweeps: 3 to start, 2 per iteration (coupled_solver.h)
+      predicted << csv << " skip 1 using ($1 == " << c << " && $10 > 0 ? $4 : 1/0):(3 + 2 * $10) "
+                << "with lines dashtype 2 lc rgb '" << colour << "' notitle";
+      plots.push_back(measured.str());
+      plots.push_back(predicted.str());
+    }
+    script << PlotCommand(plots);
+  }
+  script << "unset multiplot\n";
+  return script.str();
+}
+
+// The case of each SNR whose modulus factor is nearest 1.
+std::vector<int> CasesNearestReference(const RelaxationStudy& study) {
+  std::vector<int> chosen;
+  for (const double snr : Distinct(study, &RelaxationCase::snr)) {
+    int best = -1;
+    for (std::size_t c = 0; c < study.cases.size(); ++c) {
+      if (study.cases[c].snr != snr) continue;
+      if (best < 0 || std::abs(study.cases[c].modulus_factor - 1.0) <
+                          std::abs(study.cases[best].modulus_factor - 1.0)) {
+        best = static_cast<int>(c);
+      }
+    }
+    chosen.push_back(best);
+  }
+  return chosen;
+}
+
+std::string ResidualsScript(const RelaxationStudy& study, const std::string& folder) {
+  const std::string csv = GnuplotString(folder + "/residuals.csv");
+  const std::vector<int> chosen = CasesNearestReference(study);
+  std::ostringstream script;
+  script << GnuplotPngTerminal() << "set terminal pngcairo size " << 560 * chosen.size()
+         << ",620 enhanced font 'sans,10'\n"
+         << "set multiplot layout 1," << chosen.size()
+         << " title 'Relative residual ||c - A W||_P / ||c||_P against iteration'\n"
+         << "set xlabel 'iteration (sweep pair)'\nset ylabel 'relative residual'\n"
+         << "set logscale y\nset format y '10^{%T}'\nset key top right\n";
+  for (const int c : chosen) {
+    const RelaxationCase& r = study.cases[c];
+    script << "set title 'SNR " << SnrText(r.snr) << ", E = " << Brief(r.modulus_factor)
+           << " E_{ref}'\n";
+    std::vector<std::string> plots;
+    int colour_index = 0;
+    for (std::size_t h = 0; h < study.histories.size(); ++h) {
+      const ResidualHistory& history = study.histories[h];
+      if (history.case_index != c) continue;
+      std::string title;
+      if (history.method == CoupledSolverType::kRelaxation) {
+        title = "fixed {/Symbol w} = " + Brief(history.omega, 3) + " (fastest of the grid)";
+      } else if (history.method == CoupledSolverType::kAdaptiveRelaxation) {
+        title = "adaptive {/Symbol w} = " + Brief(history.omega, 3);
+      } else {
+        title = "conjugate gradients (Krylov)";
+      }
+      std::ostringstream plot;
+      plot << csv << " skip 1 using ($1 == " << h << " ? $7 : 1/0):8 with lines lw 2 lc rgb '"
+           << Colour(colour_index++) << "' title '" << title << "'";
+      plots.push_back(plot.str());
+    }
+    script << PlotCommand(plots);
+  }
+  script << "unset multiplot\n";
+  return script.str();
+}
+
+std::string RelaxationSummary(const RelaxationStudy& study) {
+  std::ostringstream md;
+  md << "## Relaxation coefficient (`relaxation/`)\n\n"
+     << "`sweeps_vs_omega.png` (the paper's Fig. 3): sweeps of the fixed-omega waveform "
+        "relaxation from W = 0 to a relative residual of "
+     << Brief(study.tolerance)
+     << " against omega, one panel per trial E and one line per SNR, beside the sweeps the "
+        "Lanczos estimate [a_min, a_max] of the spectrum of A = I - G predicts (dashed: 3 + 2 "
+        "ln(tol) / ln(max |1 - omega a|)), the predicted convergence limit omega = 2 / a_max "
+        "(solid vertical) and the adaptive relaxation's omega (dotted vertical). "
+        "`residuals.png` (Fig. 4 extended): relative residual against iteration at the E "
+        "nearest E_ref, per SNR, for the grid's fastest fixed omega, the adaptive relaxation "
+        "and conjugate gradients, each to inner.tolerance. `cases.csv`: spectrum, omegas and "
+        "reference sweeps per case; `sweeps.csv`: the grid; `residuals.csv`: the histories.\n\n"
+     << "| SNR | E / E_ref | a_min | a_max | 2 / a_max | largest converged omega | 2 / (a_min + "
+        "a_max) | fastest omega | adaptive omega | sweeps: fixed / adaptive / CG |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|\n";
+  for (std::size_t c = 0; c < study.cases.size(); ++c) {
+    const RelaxationCase& r = study.cases[c];
+    double largest_converged = std::numeric_limits<double>::quiet_NaN();
+    for (const RelaxationPoint& p : study.points) {
+      if (p.case_index == static_cast<int>(c) && p.termination == TerminationType::kConvergence) {
+        largest_converged =
+            std::isnan(largest_converged) ? p.omega : std::max(largest_converged, p.omega);
+      }
+    }
+    md << "| " << SnrText(r.snr) << " | " << Brief(r.modulus_factor) << " | "
+       << Brief(r.spectrum_min) << " | " << Brief(r.spectrum_max) << " | " << Brief(r.omega_limit)
+       << " | " << Brief(largest_converged) << " | " << Brief(r.omega_optimal) << " | "
+       << Brief(r.omega_fastest) << " | " << Brief(r.omega_adaptive) << " | " << r.fixed_sweeps
+       << " / " << r.adaptive_sweeps << " / " << r.conjugate_gradient_sweeps << " |\n";
+  }
+  md << "\nSweeps of the last column to inner.tolerance, each from W = 0 (the adaptive "
+        "relaxation's include its spectrum estimate). "
+     << study.cases.size() << " cases in " << Duration(study.wall_time_s) << " on " << study.threads
+     << " threads.\n\n";
+  return md.str();
+}
+
+}  // namespace
+
+std::vector<std::string> WriteRelaxationResults(const RelaxationStudy& study,
+                                                const std::string& folder, bool figures) {
+  return WriteStudyFolder(folder,
+                          {{"cases.csv", RelaxationCasesCsv(study)},
+                           {"sweeps.csv", RelaxationSweepsCsv(study)},
+                           {"residuals.csv", ResidualsCsv(study)}},
+                          {{"sweeps_vs_omega", SweepsScript(study, folder)},
+                           {"residuals", ResidualsScript(study, folder)}},
+                          figures, RelaxationSummary(study));
+}
+
+// ---------------------------------------------------------------------------
+// Cost curves.
+
+CostCurveStudy RunCostCurveStudy(const Config& config) {
+  const auto start = Clock::now();
+  const StudyOptions& options = config.study;
+  CostCurveStudy study;
+  study.reference_modulus = config.model.modulus;
+  study.threads = ResolveThreads(options.threads);
+  for (const double snr : options.cost_curve_snr) {
+    for (const std::uint64_t seed : SeedsOf(snr, options.cost_curve_seeds)) {
+      CostCurveRun curve;
+      curve.snr = snr;
+      curve.seed = seed;
+      study.curves.push_back(curve);
+    }
+  }
+  const MeasurementSet truth = SimulateStudyTruth(config);
+  const BarModel model(config.model);
+  StudyProgressLogger()->info(
+      "cost curves: {} curves of {} points, each with an identification, "
+      "on {} threads",
+      study.curves.size(), options.cost_curve_points, study.threads);
+  Progress progress("cost curves", static_cast<int>(study.curves.size()));
+  ParallelFor(
+      static_cast<int>(study.curves.size()), study.threads,
+      [&](int i) {
+        CostCurveRun& curve = study.curves[i];
+        const MeasurementSet measured = NoisyMeasurements(truth, curve.snr, curve.seed);
+        std::string message;
+        const IdentificationRun identification = IdentifyOnOneThread(
+            config, measured, curve.snr, curve.seed, &curve.converged, &message);
+        if (curve.converged) {
+          curve.identified_modulus = identification.identified_modulus();
+          curve.identified_cost = identification.cost();
+          curve.relative_error =
+              (curve.identified_modulus - study.reference_modulus) / study.reference_modulus;
+        }
+        // e^2 on the grid, on the pre-filtered data the identification saw,
+        // warm-started point to point.
+        McreObjective objective(model, identification.data, config.mcre, config.time.theta,
+                                config.inner, study.reference_modulus);
+        for (int k = 0; k < options.cost_curve_points; ++k) {
+          const double factor =
+              options.cost_curve_low + (options.cost_curve_high - options.cost_curve_low) * k /
+                                           (options.cost_curve_points - 1.0);
+          const ObjectiveEvaluation& evaluation =
+              objective.EvaluateModulus(factor * study.reference_modulus, false);
+          curve.moduli.push_back(factor * study.reference_modulus);
+          curve.costs.push_back(evaluation.usable ? evaluation.cost
+                                                  : std::numeric_limits<double>::quiet_NaN());
+        }
+      },
+      &progress);
+  study.wall_time_s = SecondsSince(start);
+  return study;
+}
+
+namespace {
+
+std::string CurvesCsv(const CostCurveStudy& study) {
+  std::ostringstream csv;
+  csv << "curve,snr,seed,modulus,modulus_factor,cost\n";
+  for (std::size_t i = 0; i < study.curves.size(); ++i) {
+    const CostCurveRun& curve = study.curves[i];
+    for (std::size_t k = 0; k < curve.moduli.size(); ++k) {
+      csv << i << "," << Csv(curve.snr) << "," << curve.seed << "," << Csv(curve.moduli[k]) << ","
+          << Csv(curve.moduli[k] / study.reference_modulus) << "," << Csv(curve.costs[k]) << "\n";
+    }
+  }
+  return csv.str();
+}
+
+std::string MinimaCsv(const CostCurveStudy& study) {
+  std::ostringstream csv;
+  csv << "curve,snr,seed,converged,identified_modulus,modulus_factor,relative_error,cost,"
+         "grid_local_minima\n";
+  for (std::size_t i = 0; i < study.curves.size(); ++i) {
+    const CostCurveRun& curve = study.curves[i];
+    csv << i << "," << Csv(curve.snr) << "," << curve.seed << "," << (curve.converged ? 1 : 0)
+        << "," << Csv(curve.identified_modulus) << ","
+        << Csv(curve.identified_modulus / study.reference_modulus) << ","
+        << Csv(curve.relative_error) << "," << Csv(curve.identified_cost) << ","
+        << LocalMinima(curve.costs) << "\n";
+  }
+  return csv.str();
+}
+
+std::string CostCurvesScript(const CostCurveStudy& study, const std::string& folder) {
+  const std::string curves = GnuplotString(folder + "/curves.csv");
+  const std::string minima = GnuplotString(folder + "/minima.csv");
+  std::vector<double> snrs;
+  for (const CostCurveRun& curve : study.curves) {
+    if (std::find(snrs.begin(), snrs.end(), curve.snr) == snrs.end()) snrs.push_back(curve.snr);
+  }
+  std::ostringstream script;
+  script << GnuplotPngTerminal() << "set terminal pngcairo size " << 560 * snrs.size()
+         << ",620 enhanced font 'sans,10'\n"
+         << "set multiplot layout 1," << snrs.size()
+         << " title 'MCRE cost e^2(E), one curve per noise seed; circles: the identified E'\n"
+         << "set xlabel 'E / E_{ref}'\nset ylabel 'e^2 [J s]'\nset format y '%.3g'\n"
+         << "set key top center\n"
+         << "set arrow 1 from 1, graph 0 to 1, graph 1 nohead dashtype 2 lc rgb '#555555'\n";
+  for (const double snr : snrs) {
+    script << "set title 'SNR " << SnrText(snr) << "'\n";
+    std::vector<std::string> plots;
+    int colour_index = 0;
+    for (std::size_t i = 0; i < study.curves.size(); ++i) {
+      const CostCurveRun& curve = study.curves[i];
+      if (curve.snr != snr) continue;
+      const std::string colour = Colour(colour_index++);
+      std::ostringstream line, point;
+      line << curves << " skip 1 using ($1 == " << i << " ? $5 : 1/0):6 with lines lw 2 lc rgb '"
+           << colour << "' title '"
+           << (std::isinf(snr) ? std::string("no noise") : "seed " + std::to_string(curve.seed))
+           << "'";
+      point << minima << " skip 1 using ($1 == " << i << " && $4 == 1 ? $6 : 1/0):8 with points "
+            << "pt 6 ps 2 lw 2 lc rgb '" << colour << "' notitle";
+      plots.push_back(line.str());
+      plots.push_back(point.str());
+    }
+    script << PlotCommand(plots);
+  }
+  script << "unset multiplot\n";
+  return script.str();
+}
+
+std::string CostCurvesSummary(const CostCurveStudy& study) {
+  std::ostringstream md;
+  md << "## Cost curves (`cost_curves/`)\n\n"
+     << "`cost_curves.png` (the paper's Fig. 6): the MCRE cost e^2(E) on a grid of E, one panel "
+        "per SNR and one curve per noise seed, on the pre-filtered data the identification sees; "
+        "circles mark the modulus the identification (global scan and local refinement) finds "
+        "on the same data. `curves.csv`: the grids; `minima.csv`: the identified E and the "
+        "sampled local minima of each curve.\n\n"
+     << "| SNR | seed | identified E / E_ref | relative error | local minima on the grid |\n"
+     << "|---|---|---|---|---|\n";
+  for (const CostCurveRun& curve : study.curves) {
+    md << "| " << SnrText(curve.snr) << " | " << curve.seed << " | "
+       << (curve.converged ? Brief(curve.identified_modulus / study.reference_modulus, 6)
+                           : std::string("not converged"))
+       << " | " << Percent(curve.relative_error) << " | " << LocalMinima(curve.costs) << " |\n";
+  }
+  md << "\n"
+     << study.curves.size() << " curves in " << Duration(study.wall_time_s) << " on "
+     << study.threads << " threads.\n\n";
+  return md.str();
+}
+
+}  // namespace
+
+std::vector<std::string> WriteCostCurveResults(const CostCurveStudy& study,
+                                               const std::string& folder, bool figures) {
+  return WriteStudyFolder(
+      folder, {{"curves.csv", CurvesCsv(study)}, {"minima.csv", MinimaCsv(study)}},
+      {{"cost_curves", CostCurvesScript(study, folder)}}, figures, CostCurvesSummary(study));
+}
+
+std::string WriteStudiesReadme(const std::string& folder) {
+  std::ostringstream md;
+  md << "# Results of the studies\n\n"
+     << "Written by `identify study` (`bash scripts/studies.sh` regenerates every study, figure "
+        "and this file: the studies of configs/studies.yaml, then the robustness settings, the "
+        "complexity and the weights studies of bench/); do not edit by hand. Each section below "
+        "is the `summary.md` of its folder.\n\n";
+  for (const char* study : {"robustness", "relaxation", "cost_curves", "robustness_settings",
+                            "complexity", "weights"}) {
+    const std::string summary = folder + "/" + study + "/summary.md";
+    std::ifstream file(summary);
+    if (!file) continue;
+    std::ostringstream text;
+    text << file.rdbuf();
+    md << text.str();
+  }
+  const std::string path = folder + "/README.md";
+  WriteFileAtomically(path, md.str());
+  return path;
+}
+
+}  // namespace mcrewave

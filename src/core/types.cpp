@@ -1,0 +1,44 @@
+#include "mcrewave/core/types.h"
+
+#include <array>
+#include <utility>
+
+#include "core/enum_names.h"
+
+namespace mcrewave {
+namespace {
+
+using internal::FromName;
+using internal::ToName;
+
+// One table per enum: the only place where a name is tied to a value.
+
+constexpr std::array<std::pair<MassType, const char*>, 2> kMassTypes{
+    {{MassType::kConsistent, "consistent"}, {MassType::kLumped, "lumped"}}};
+constexpr std::array<std::pair<LoadKind, const char*>, 1> kLoadKinds{
+    {{LoadKind::kHalfSine, "half_sine"}}};
+constexpr std::array<std::pair<DataSource, const char*>, 2> kDataSources{
+    {{DataSource::kSynthetic, "synthetic"}, {DataSource::kCsv, "csv"}}};
+constexpr std::array<std::pair<TruthModel, const char*>, 2> kTruthModels{
+    {{TruthModel::kFiniteElement, "finite_element"}, {TruthModel::kExact, "exact"}}};
+
+}  // namespace
+
+const char* MassTypeToString(MassType type) { return ToName(kMassTypes, type); }
+bool StringToMassType(const std::string& name, MassType* type) {
+  return FromName(kMassTypes, name, type);
+}
+const char* LoadKindToString(LoadKind kind) { return ToName(kLoadKinds, kind); }
+bool StringToLoadKind(const std::string& name, LoadKind* kind) {
+  return FromName(kLoadKinds, name, kind);
+}
+const char* DataSourceToString(DataSource source) { return ToName(kDataSources, source); }
+bool StringToDataSource(const std::string& name, DataSource* source) {
+  return FromName(kDataSources, name, source);
+}
+const char* TruthModelToString(TruthModel model) { return ToName(kTruthModels, model); }
+bool StringToTruthModel(const std::string& name, TruthModel* model) {
+  return FromName(kTruthModels, name, model);
+}
+
+}  // namespace mcrewave

@@ -1,0 +1,250 @@
+#include "mcrewave/data/measurement.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <array>
+#include <cassert>
+#include <cerrno>
+#include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "mcrewave/core/file_util.h"
+
+namespace mcrewave {
+namespace {
+
+constexpr int kNumColumns = 5;
+constexpr std::array<const char*, kNumColumns> kColumnNames = {"t", "u0", "uL", "f0", "fL"};
+constexpr char kHeader[] = "t,u0,uL,f0,fL";
+// Largest accepted |step - reference step| / reference step, the reference being
+// the median of the file's steps.
+constexpr double kStepTolerance = 1e-6;
+// A progress line every this many rows (large files).
+constexpr std::size_t kProgressRows = 250000;
+
+// `line` without trailing spaces, tabs and carriage returns (Windows line ends).
+std::string StripLineEnd(const std::string& line) {
+  const std::size_t last = line.find_last_not_of(" \t\r");
+  return last == std::string::npos ? "" : line.substr(0, last + 1);
+}
+
+// Parses a whole field (surrounding spaces allowed) as a number with strtod;
+// false when anything else is left over or the field is empty.
+bool ParseNumber(const std::string& field, double* value) {
+  const char* begin = field.c_str();
+  char* end = nullptr;
+  *value = std::strtod(begin, &end);
+  if (end == begin) return false;
+  while (*end == ' ' || *end == '\t') ++end;
+  return *end == '\0';
+}
+
+// Formats "%g" with the default 6 significant digits, for messages.
+std::string Short(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", value);
+  return text;
+}
+
+// The step of t_0 + k h that reproduces every time of the file exactly, searched
+// among the doubles within a few ulps of the mean step; the mean step itself when
+// none does. This makes a file written by WriteMeasurementCsv read back bit for bit.
+double ExactStep(const std::vector<double>& times, double mean_step) {
+  double candidate = mean_step;
+  for (int ulp = 0; ulp < 4; ++ulp) candidate = std::nextafter(candidate, 0.0);
+  for (int trial = 0; trial < 9; ++trial, candidate = std::nextafter(candidate, HUGE_VAL)) {
+    bool reproduces_all = true;
+    for (std::size_t k = 0; k < times.size() && reproduces_all; ++k) {
+      reproduces_all = times[0] + static_cast<double>(k) * candidate == times[k];
+    }
+    if (reproduces_all) return candidate;
+  }
+  return mean_step;
+}
+
+}  // namespace
+
+MeasurementSet ReadMeasurementCsv(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) {
+    throw InputError("cannot read measurement file " + path + ": " + std::strerror(errno));
+  }
+  return ParseMeasurementCsv(file, path);
+}
+
+MeasurementSet ParseMeasurementCsv(std::istream& file, const std::string& path) {
+  auto fail = [&path](long line_number, const std::string& what) {
+    throw InputError(path + ":" + std::to_string(line_number) + ": " + what);
+  };
+
+  std::array<std::vector<double>, kNumColumns> columns;
+  std::string line;
+  std::vector<std::string> fields;  // the fields of the current row
+  long line_number = 0;
+  long first_blank_line = 0;  // first empty line seen so far, 0 if none
+  while (std::getline(file, line)) {
+    ++line_number;
+    line = StripLineEnd(line);
+    if (line_number == 1) {
+      if (line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // UTF-8 byte order mark
+      if (line != kHeader) {
+        fail(1, std::string("expected the header '") + kHeader + "', got '" + line + "'");
+      }
+      continue;
+    }
+    if (line.empty()) {
+      if (first_blank_line == 0) first_blank_line = line_number;
+      continue;
+    }
+    if (first_blank_line != 0) fail(first_blank_line, "empty line between data rows");
+
+    fields.clear();
+    for (std::size_t field_start = 0;;) {
+      const std::size_t comma = line.find(',', field_start);
+      fields.push_back(line.substr(field_start, comma - field_start));
+      if (comma == std::string::npos) break;
+      field_start = comma + 1;
+    }
+    if (fields.size() != kNumColumns) {
+      fail(line_number, "expected " + std::to_string(kNumColumns) + " columns, got " +
+                            std::to_string(fields.size()));
+    }
+    std::array<double, kNumColumns> row;
+    for (int column = 0; column < kNumColumns; ++column) {
+      if (!ParseNumber(fields[column], &row[column])) {
+        fail(line_number, std::string("column '") + kColumnNames[column] + "': '" + fields[column] +
+                              "' is not a number");
+      }
+      if (!std::isfinite(row[column])) {
+        fail(line_number, std::string("column '") + kColumnNames[column] + "': '" + fields[column] +
+                              "' is not a finite number");
+      }
+    }
+    if (!columns[0].empty() && !(row[0] > columns[0].back())) {
+      fail(line_number, "time is not strictly increasing (t = " + Short(row[0]) + " s after " +
+                            Short(columns[0].back()) + " s)");
+    }
+    for (int c = 0; c < kNumColumns; ++c) columns[c].push_back(row[c]);
+    if (columns[0].size() % kProgressRows == 0) {
+      spdlog::info("{}: read {} rows", path, columns[0].size());
+    }
+  }
+  if (file.bad()) {
+    throw InputError("cannot read measurement file " + path + ": " + std::strerror(errno));
+  }
+  if (line_number == 0) {
+    fail(1, std::string("expected the header '") + kHeader + "', got an empty file");
+  }
+
+  const std::vector<double>& times = columns[0];
+  const std::size_t rows = times.size();
+  if (rows < 2) {
+    fail(line_number, "expected at least 2 data rows, got " + std::to_string(rows));
+  }
+  const double mean_step = (times.back() - times.front()) / static_cast<double>(rows - 1);
+  if (!std::isfinite(mean_step)) {
+    fail(line_number, "time span " + Short(times.front()) + " s to " + Short(times.back()) +
+                          " s is too wide for a double");
+  }
+  // Each step against the median step: a sample missing (or one too many) anywhere
+  // changes only the steps next to it, and the row where the first bad step ends (the
+  // first row whose t is off) is reported. (The mean step is off by about 1/rows for
+  // a single missing sample, so every step differed from it and line 3 was blamed.)
+  double reference_step = 0.0;
+  {
+    std::vector<double> steps(rows - 1);
+    for (std::size_t k = 1; k < rows; ++k) steps[k - 1] = times[k] - times[k - 1];
+    const auto median = steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2);
+    std::nth_element(steps.begin(), median, steps.end());
+    reference_step = *median;
+  }
+  for (std::size_t k = 1; k < rows; ++k) {
+    const double step = times[k] - times[k - 1];
+    if (std::abs(step - reference_step) > kStepTolerance * reference_step) {
+      // Data row k is on line k + 2: the header is line 1 and an empty line between
+      // data rows is refused above.
+      fail(static_cast<long>(k) + 2,
+           "time step " + Short(step) + " s (from t = " + Short(times[k - 1]) +
+               " s on the previous row), expected the file's step " + Short(reference_step) +
+               " s (the median step) within 1e-6 relative");
+    }
+  }
+
+  MeasurementSet measurements;
+  measurements.start_time = times.front();
+  measurements.time_step = ExactStep(times, mean_step);
+  auto to_vector = [](const std::vector<double>& values) {
+    return Vector(
+        Eigen::Map<const Vector>(values.data(), static_cast<Eigen::Index>(values.size())));
+  };
+  // Each column is freed once copied: at most one column is held twice.
+  measurements.u0 = to_vector(columns[1]);
+  columns[1] = {};
+  measurements.uL = to_vector(columns[2]);
+  columns[2] = {};
+  measurements.f0 = to_vector(columns[3]);
+  columns[3] = {};
+  measurements.fL = to_vector(columns[4]);
+  return measurements;
+}
+
+void CheckMeasurementChannels(const MeasurementSet& measurements, const std::string& name) {
+  const Vector* channels[] = {&measurements.u0, &measurements.uL, &measurements.f0,
+                              &measurements.fL};
+  for (int c = 0; c < 4; ++c) {
+    const Vector& x = *channels[c];
+    const std::string column = std::string("column '") + kColumnNames[c + 1] + "'";
+    const double peak = x.size() > 0 ? x.cwiseAbs().maxCoeff() : 0.0;
+    if (peak == 0.0 && c > 0) {
+      throw InputError(name + ":2: " + column +
+                       " is zero on every row: a dead channel (only u0, at the clamped end, "
+                       "may be zero)");
+    }
+    const Eigen::Index samples = x.size();
+    if (samples < 3) continue;
+    const Vector second_differences =
+        x.head(samples - 2) - 2.0 * x.segment(1, samples - 2) + x.tail(samples - 2);
+    std::vector<double> magnitudes(second_differences.data(),
+                                   second_differences.data() + second_differences.size());
+    for (double& magnitude : magnitudes) magnitude = std::abs(magnitude);
+    std::nth_element(magnitudes.begin(), magnitudes.begin() + magnitudes.size() / 2,
+                     magnitudes.end());
+    const double noise_level = 1.4826 * magnitudes[magnitudes.size() / 2];
+    const double threshold = std::max(kOutlierNoiseFactor * noise_level, 0.5 * peak);
+    Eigen::Index worst = 0;  // the sample k + 1 of the largest |second difference|
+    const double largest = second_differences.cwiseAbs().maxCoeff(&worst);
+    if (largest > threshold) {
+      throw InputError(name + ":" + std::to_string(worst + 3) + ": " + column + ": " +
+                       Short(x[worst + 1]) + " is an outlier: its second difference " +
+                       Short(second_differences[worst]) + " is above " +
+                       Short(kOutlierNoiseFactor) + " times the channel's noise level " +
+                       Short(noise_level) + " and half its peak " + Short(peak) +
+                       "; repair or remove the file's outliers");
+    }
+  }
+}
+
+void WriteMeasurementCsv(const MeasurementSet& measurements, const std::string& path) {
+  const int samples = measurements.num_samples();
+  assert(measurements.uL.size() == samples && measurements.f0.size() == samples &&
+         measurements.fL.size() == samples);
+  std::string content = std::string(kHeader) + "\n";
+  content.reserve(content.size() + static_cast<std::size_t>(samples) * 5 * 25);
+  char row[5 * 32];
+  for (int k = 0; k < samples; ++k) {
+    const int length = std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g,%.17g\n",
+                                     measurements.Time(k), measurements.u0[k], measurements.uL[k],
+                                     measurements.f0[k], measurements.fL[k]);
+    content.append(row, static_cast<std::size_t>(length));
+  }
+  WriteFileAtomically(path, content);
+}
+
+}  // namespace mcrewave

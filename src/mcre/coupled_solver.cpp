@@ -1,0 +1,174 @@
+#include "mcrewave/mcre/coupled_solver.h"
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+#include "core/enum_names.h"
+#include "mcre/coupled_solver_internal.h"
+
+namespace mcrewave {
+namespace {
+
+constexpr std::array<std::pair<CoupledSolverType, const char*>, 7> kSolverTypes{{
+    {CoupledSolverType::kAllAtOnce, "all_at_once"},
+    {CoupledSolverType::kRelaxation, "relaxation"},
+    {CoupledSolverType::kAdaptiveRelaxation, "adaptive_relaxation"},
+    {CoupledSolverType::kConjugateGradient, "conjugate_gradient"},
+    {CoupledSolverType::kRiccati, "riccati"},
+    {CoupledSolverType::kSingleShooting, "single_shooting"},
+    {CoupledSolverType::kMultipleShooting, "multiple_shooting"},
+}};
+
+}  // namespace
+
+const char* CoupledSolverTypeToString(CoupledSolverType type) {
+  return internal::ToName(kSolverTypes, type);
+}
+
+bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type) {
+  return internal::FromName(kSolverTypes, name, type);
+}
+
+const char* TerminationTypeToString(TerminationType type) {
+  switch (type) {
+    case TerminationType::kConvergence:
+      return "convergence";
+    case TerminationType::kNoConvergence:
+      return "no_convergence";
+    case TerminationType::kDivergence:
+      return "divergence";
+    case TerminationType::kFailure:
+      return "failure";
+  }
+  return "unknown";
+}
+
+bool CoupledSolverOptions::IsValid(std::string* error) const {
+  std::ostringstream why;
+  if (!(tolerance > 0.0 && tolerance < 1.0)) {
+    why << "inner.tolerance must lie in (0, 1), got " << tolerance;
+  } else if (max_iterations < 1) {
+    why << "inner.max_iterations must be at least 1, got " << max_iterations;
+  } else if (!(relaxation_coefficient > 0.0 && relaxation_coefficient < 2.0)) {
+    why << "inner.omega must lie in (0, 2), got " << relaxation_coefficient;
+  } else if (spectrum_estimation_steps < 2) {
+    why << "inner.spectrum_steps must be at least 2, got " << spectrum_estimation_steps;
+  } else if (!(spectrum_safety_factor >= 1.0 && std::isfinite(spectrum_safety_factor))) {
+    why << "inner.spectrum_safety_factor must be at least 1, got " << spectrum_safety_factor;
+  } else if (!(divergence_factor > 1.0)) {
+    why << "inner.divergence_factor must be above 1, got " << divergence_factor;
+  } else if (max_all_at_once_unknowns < 1) {
+    why << "inner.max_all_at_once_unknowns must be positive, got " << max_all_at_once_unknowns;
+  } else if (max_all_at_once_bytes < 1) {
+    why << "inner.max_all_at_once_bytes must be positive, got " << max_all_at_once_bytes;
+  } else if (max_dense_solver_bytes < 1) {
+    why << "inner.max_dense_solver_bytes must be positive, got " << max_dense_solver_bytes;
+  } else if (max_field_bytes < 1) {
+    why << "inner.max_field_bytes must be positive, got " << max_field_bytes;
+  } else if (!(shooting_condition_limit > 1.0)) {
+    why << "inner.shooting_condition_limit must be above 1, got " << shooting_condition_limit;
+  } else if (!(shooting_segment_growth > 1.0 && std::isfinite(shooting_segment_growth))) {
+    why << "inner.shooting_segment_growth must be a finite number above 1, got "
+        << shooting_segment_growth;
+  } else {
+    return true;
+  }
+  if (error != nullptr) *error = why.str();
+  return false;
+}
+
+std::string CoupledSolverSummary::BriefReport() const {
+  std::ostringstream out;
+  out << CoupledSolverTypeToString(type) << ": " << TerminationTypeToString(termination) << ", "
+      << iterations << " iterations, " << sweeps << " sweeps, relative residual "
+      << relative_residual << ", " << wall_time_s << " s";
+  return out.str();
+}
+
+std::string CoupledSolverSummary::FullReport() const {
+  std::ostringstream out;
+  out << "Coupled direct/retrograde solve\n"
+      << "  method                 " << CoupledSolverTypeToString(type) << "\n"
+      << "  termination            " << TerminationTypeToString(termination) << "\n"
+      << "  message                " << message << "\n"
+      << "  iterations             " << iterations << "\n"
+      << "  sweeps                 " << sweeps << "\n"
+      << "  relative residual      " << relative_residual << "\n";
+  if (relaxation_coefficient > 0.0) {
+    out << "  relaxation coefficient " << relaxation_coefficient << "\n";
+  }
+  if (spectrum_max > 0.0) {
+    out << "  spectrum of I - G      [" << spectrum_min << ", " << spectrum_max << "]\n"
+        << "  safeguard restarts     " << safeguard_restarts << "\n";
+  }
+  if (shooting_segments > 0) {
+    out << "  shooting segments      " << shooting_segments << "\n"
+        << "  shooting condition     " << shooting_condition_number << "\n";
+  }
+  if (multiply_accumulates >= 0.0) {
+    out << "  multiply-accumulates   " << multiply_accumulates << "\n";
+  }
+  out << "  wall time              " << wall_time_s << " s\n";
+  return out.str();
+}
+
+CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, McreProblem* problem,
+                                  const Matrix* initial_retrograde, CoupledSolution* solution) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  const long sweeps_before = problem->sweep_count();
+  CoupledSolverSummary summary;
+  summary.type = options.type;
+  std::string why;
+  if (!options.IsValid(&why)) {
+    summary.message = "invalid options: " + why;
+    return summary;
+  }
+  const bool iterative = options.type == CoupledSolverType::kRelaxation ||
+                         options.type == CoupledSolverType::kAdaptiveRelaxation ||
+                         options.type == CoupledSolverType::kConjugateGradient;
+  const double field_bytes = static_cast<double>(kIterativeSolverFields) * sizeof(double) *
+                             problem->num_nodes() * (problem->num_steps() + 1.0);
+  if (iterative && field_bytes > static_cast<double>(options.max_field_bytes)) {
+    std::ostringstream refusal;
+    refusal << CoupledSolverTypeToString(options.type) << " needs "
+            << static_cast<long long>(field_bytes) << " bytes (" << kIterativeSolverFields
+            << " fields of n x (m + 1) doubles, n = " << problem->num_nodes()
+            << " nodes, m = " << problem->num_steps() << " steps), above the limit of "
+            << options.max_field_bytes
+            << " bytes (inner.max_field_bytes); use fewer elements or a shorter window";
+    summary.message = refusal.str();
+    return summary;
+  }
+  switch (options.type) {
+    case CoupledSolverType::kAllAtOnce:
+      internal::SolveAllAtOnce(options, problem, solution, &summary);
+      break;
+    case CoupledSolverType::kRelaxation:
+    case CoupledSolverType::kAdaptiveRelaxation:
+      internal::SolveByRelaxation(options, problem, initial_retrograde, solution, &summary);
+      break;
+    case CoupledSolverType::kConjugateGradient:
+      internal::SolveByConjugateGradient(options, problem, initial_retrograde, solution, &summary);
+      break;
+    case CoupledSolverType::kRiccati:
+      internal::SolveByRiccati(options, problem, solution, &summary);
+      break;
+    case CoupledSolverType::kSingleShooting:
+    case CoupledSolverType::kMultipleShooting:
+      internal::SolveByShooting(options, problem, solution, &summary);
+      break;
+  }
+  if (summary.IsSolutionUsable()) {
+    solution->cost = problem->Cost(solution->displacement, solution->retrograde);
+    solution->cost_gradient = problem->CostGradient(solution->displacement, solution->retrograde);
+  }
+  summary.sweeps = problem->sweep_count() - sweeps_before;
+  summary.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace mcrewave

@@ -1,0 +1,25 @@
+// Internal entry points of the coupled solvers (one per method), called by
+// SolveCoupled once options are checked and the clock is started. Each fills the
+// solution's fields (U and W) and the summary's termination, message, iterations,
+// residuals and method-specific figures; SolveCoupled adds cost, gradient,
+// sweeps and time.
+#pragma once
+
+#include "mcrewave/mcre/coupled_solver.h"
+
+namespace mcrewave::internal {
+
+void SolveAllAtOnce(const CoupledSolverOptions& options, McreProblem* problem,
+                    CoupledSolution* solution, CoupledSolverSummary* summary);
+void SolveByRelaxation(const CoupledSolverOptions& options, McreProblem* problem,
+                       const Matrix* initial_retrograde, CoupledSolution* solution,
+                       CoupledSolverSummary* summary);
+void SolveByConjugateGradient(const CoupledSolverOptions& options, McreProblem* problem,
+                              const Matrix* initial_retrograde, CoupledSolution* solution,
+                              CoupledSolverSummary* summary);
+void SolveByRiccati(const CoupledSolverOptions& options, McreProblem* problem,
+                    CoupledSolution* solution, CoupledSolverSummary* summary);
+void SolveByShooting(const CoupledSolverOptions& options, McreProblem* problem,
+                     CoupledSolution* solution, CoupledSolverSummary* summary);
+
+}  // namespace mcrewave::internal

@@ -1,0 +1,172 @@
+#include "mcrewave/mcre/modulus_uncertainty.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include "mcrewave/mcre/mcre_problem.h"
+
+namespace mcrewave {
+
+bool UncertaintyOptions::IsValid(std::string* error) const {
+  if (samples >= 2 && samples <= 1000) return true;
+  if (error != nullptr) {
+    *error = "uncertainty.samples must be an integer in [2, 1000], got " + std::to_string(samples);
+  }
+  return false;
+}
+
+namespace {
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const std::size_t middle = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + middle, values.end());
+  return values[middle];
+}
+
+// s = 1.4826 MAD(d2) / sqrt(6) of one channel (0 with fewer than 3 samples).
+double DifferenceNoiseStd(const Vector& channel) {
+  std::vector<double> second_differences;
+  for (Eigen::Index j = 1; j + 1 < channel.size(); ++j) {
+    second_differences.push_back(channel[j + 1] - 2.0 * channel[j] + channel[j - 1]);
+  }
+  const double median = Median(second_differences);
+  for (double& value : second_differences) value = std::abs(value - median);
+  return 1.4826 * Median(second_differences) / std::sqrt(6.0);
+}
+
+}  // namespace
+
+NoiseLevels DifferenceNoiseLevels(const MeasurementSet& data) {
+  NoiseLevels levels;
+  // s^2 averaged over the two ends
+  levels.displacement_std = std::sqrt(
+      0.5 * (std::pow(DifferenceNoiseStd(data.u0), 2) + std::pow(DifferenceNoiseStd(data.uL), 2)));
+  levels.force_std = std::sqrt(
+      0.5 * (std::pow(DifferenceNoiseStd(data.f0), 2) + std::pow(DifferenceNoiseStd(data.fL), 2)));
+  return levels;
+}
+
+NoiseLevels MisfitLevels(const MeasurementSet& data, const CoupledSolution& solution,
+                         double alpha) {
+  const Matrix& displacement = solution.displacement;
+  const Matrix& retrograde = solution.retrograde;
+  const int last = static_cast<int>(displacement.rows()) - 1;
+  double displacement_sum = 0.0;
+  double force_sum = 0.0;
+  for (int j = 0; j < data.num_samples(); ++j) {
+    displacement_sum += std::pow(displacement(0, j) - data.u0[j], 2) +
+                        std::pow(displacement(last, j) - data.uL[j], 2);
+    // F - F~ = -B W / alpha at the two ends
+    force_sum += std::pow(retrograde(0, j) / alpha, 2) + std::pow(retrograde(last, j) / alpha, 2);
+  }
+  const double count = 2.0 * data.num_samples();
+  NoiseLevels levels;
+  levels.displacement_std = std::sqrt(displacement_sum / count);
+  levels.force_std = std::sqrt(force_sum / count);
+  return levels;
+}
+
+double CostGradientSlope(const std::vector<CostCurvePoint>& curve, double center, double window,
+                         int* points_used) {
+  std::vector<const CostCurvePoint*> chosen;
+  for (const CostCurvePoint& point : curve) {
+    if (point.usable && std::abs(point.modulus - center) <= window * center) {
+      chosen.push_back(&point);
+    }
+  }
+  if (chosen.size() < 3) {
+    chosen.clear();
+    for (const CostCurvePoint& point : curve) {
+      if (point.usable) chosen.push_back(&point);
+    }
+  }
+  *points_used = static_cast<int>(chosen.size());
+  if (chosen.size() < 2) return 0.0;
+  double mean_modulus = 0.0;
+  double mean_gradient = 0.0;
+  for (const CostCurvePoint* point : chosen) {
+    mean_modulus += point->modulus;
+    mean_gradient += point->cost_gradient;
+  }
+  mean_modulus /= chosen.size();
+  mean_gradient /= chosen.size();
+  // k = sum (E_i - mean E)(g_i - mean g) / sum (E_i - mean E)^2
+  double covariance = 0.0;
+  double variance = 0.0;
+  for (const CostCurvePoint* point : chosen) {
+    covariance += (point->modulus - mean_modulus) * (point->cost_gradient - mean_gradient);
+    variance += (point->modulus - mean_modulus) * (point->modulus - mean_modulus);
+  }
+  return variance > 0.0 ? covariance / variance : 0.0;
+}
+
+ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
+                                              const BarModel& model, const MeasurementSet& data,
+                                              const McreOptions& mcre, double theta,
+                                              const CoupledSolverOptions& inner, double modulus,
+                                              const CoupledSolution& solution,
+                                              const NoiseLevels& noise, double curvature,
+                                              int curvature_points) {
+  assert(options.IsValid(nullptr));
+  ModulusUncertainty result;
+  result.noise = noise;
+  result.curvature = curvature;
+  result.curvature_points = curvature_points;
+  if (!(curvature > 0.0)) {
+    result.message = "the cost curve is not convex around the optimum (slope of de^2/dE <= 0)";
+    return result;
+  }
+  if (!(noise.displacement_std > 0.0 || noise.force_std > 0.0)) {
+    result.message = "no noise to propagate (both noise levels are 0)";
+    return result;
+  }
+  MeasurementSet noise_data = data;
+  std::mt19937_64 engine(options.seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Matrix plus_displacement, plus_retrograde, minus_displacement, minus_retrograde;
+  double sum_of_squares = 0.0;
+  for (int sample = 0; sample < options.samples; ++sample) {
+    for (Vector* channel : {&noise_data.u0, &noise_data.uL}) {
+      for (double& value : *channel) value = noise.displacement_std * normal(engine);
+    }
+    for (Vector* channel : {&noise_data.f0, &noise_data.fL}) {
+      for (double& value : *channel) value = noise.force_std * normal(engine);
+    }
+    McreProblem problem(model, noise_data, mcre.weights, mcre.reference_modulus, theta);
+    problem.SetModulus(modulus);
+    CoupledSolution noise_solution;
+    const CoupledSolverSummary summary = SolveCoupled(inner, &problem, nullptr, &noise_solution);
+    result.sweeps += summary.sweeps;
+    if (!summary.IsSolutionUsable()) {
+      result.message = "a noise solve is not usable: " + summary.BriefReport();
+      return result;
+    }
+    plus_displacement = solution.displacement + noise_solution.displacement;
+    plus_retrograde = solution.retrograde + noise_solution.retrograde;
+    minus_displacement = solution.displacement - noise_solution.displacement;
+    minus_retrograde = solution.retrograde - noise_solution.retrograde;
+    // dg_1 = (g(s_d + s_n) - g(s_d - s_n)) / 2, g the quadratic de^2/dE at E*
+    const double gradient_change =
+        0.5 * (problem.CostGradient(plus_displacement, plus_retrograde) -
+               problem.CostGradient(minus_displacement, minus_retrograde));
+    // dE = -dg_1 / k
+    const double modulus_change = -gradient_change / curvature;
+    sum_of_squares += modulus_change * modulus_change;
+    spdlog::debug("uncertainty sample {}: dE = {:.4g} Pa", sample + 1, modulus_change);
+  }
+  result.samples = options.samples;
+  // std(E*) = sqrt(mean dE_i^2)
+  result.std_dev = std::sqrt(sum_of_squares / options.samples);
+  result.relative_std_dev = result.std_dev / modulus;
+  result.available = true;
+  result.message = "ok";
+  return result;
+}
+
+}  // namespace mcrewave

@@ -1,0 +1,134 @@
+#include "mcrewave/mcre/objective.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cassert>
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <utility>
+
+namespace mcrewave {
+
+bool McreOptions::IsValid(std::string* error) const {
+  if (!weights.IsValid(error)) return false;
+  if (!(std::isfinite(reference_modulus) && reference_modulus > 0.0)) {
+    std::ostringstream why;
+    why << "mcre.reference_modulus must be a finite positive number of Pa, got "
+        << reference_modulus;
+    if (error != nullptr) *error = why.str();
+    return false;
+  }
+  return true;
+}
+
+McreObjective::McreObjective(const BarModel& model, const MeasurementSet& data,
+                             const McreOptions& mcre, double theta,
+                             const CoupledSolverOptions& inner, double modulus_scale)
+    : model_(model),
+      data_(data),
+      mcre_(mcre),
+      theta_(theta),
+      problem_(model, data, mcre.weights, mcre.reference_modulus, theta),
+      inner_(inner),
+      modulus_scale_(modulus_scale) {
+  assert(mcre.IsValid(nullptr) && inner.IsValid(nullptr) && modulus_scale > 0.0);
+  // The displacement part beta/2 |B U - U~|^2 of J at U = W = 0 is Cost(0, 0);
+  // the force part is alpha/2 |F - F~|^2 with F = 0.
+  const Matrix zero = problem_.ZeroField();
+  double force_part = 0.0;
+  for (int j = 0; j <= data.num_steps(); ++j) {
+    // c_j h alpha/2 (f~0_j^2 + f~L_j^2)
+    force_part += problem_.QuadratureWeight(j) * data.time_step * 0.5 * problem_.alpha() *
+                  (data.f0[j] * data.f0[j] + data.fL[j] * data.fL[j]);
+  }
+  rest_cost_ = problem_.Cost(zero, zero) + force_part;
+}
+
+std::unique_ptr<ModulusObjective> McreObjective::CloneForScan(double inner_tolerance) const {
+  CoupledSolverOptions inner = inner_;
+  inner.tolerance = inner_tolerance;
+  return std::make_unique<McreObjective>(model_, data_, mcre_, theta_, inner, modulus_scale_);
+}
+
+void McreObjective::SetWarmStart(const Matrix& retrograde) {
+  assert(retrograde.rows() == problem_.num_nodes() &&
+         retrograde.cols() == problem_.num_steps() + 1);
+  warm_start_ = retrograde;
+  warm_start_modulus_ = 0.0;
+  previous_start_.resize(0, 0);
+  previous_start_modulus_ = 0.0;
+}
+
+const ObjectiveEvaluation& McreObjective::EvaluateModulus(double modulus, bool gradient_requested) {
+  assert(modulus > 0.0 && std::isfinite(modulus));
+  problem_.SetModulus(modulus);
+  ObjectiveEvaluation record;
+  record.modulus = modulus;
+  record.gradient_requested = gradient_requested;
+  const Matrix* initial = warm_start_.size() > 0 ? &warm_start_ : nullptr;
+  if (initial != nullptr && previous_start_.size() > 0 &&
+      previous_start_modulus_ != warm_start_modulus_) {
+    // t = (E - E1) / (E1 - E0);  W^(0) = W(E1) + t (W(E1) - W(E0)).
+    const double t =
+        (modulus - warm_start_modulus_) / (warm_start_modulus_ - previous_start_modulus_);
+    if (std::abs(t) <= kMaxExtrapolation) {
+      initial_ = warm_start_ + t * (warm_start_ - previous_start_);
+      initial = &initial_;
+    }
+  }
+  record.inner = SolveCoupled(inner_, &problem_, initial, &solution_);
+  record.usable = record.inner.IsSolutionUsable();
+  if (record.usable) {
+    record.cost = solution_.cost;
+    record.cost_gradient = solution_.cost_gradient;
+    // The last two usable solutions; one set by SetWarmStart (modulus unknown) is
+    // not extrapolated from.
+    if (warm_start_.size() > 0 && warm_start_modulus_ > 0.0) {
+      previous_start_.swap(warm_start_);
+      previous_start_modulus_ = warm_start_modulus_;
+    } else {
+      previous_start_.resize(0, 0);
+    }
+    warm_start_ = solution_.retrograde;
+    warm_start_modulus_ = modulus;
+    if (best_index_ < 0 || record.cost < evaluations_[best_index_].cost) {
+      best_index_ = static_cast<int>(evaluations_.size());
+      best_solution_ = solution_;
+    }
+  }
+  spdlog::debug(
+      "e^2({:.9g} Pa) = {:.9g} J s, de^2/dE = {:.6g} J s/Pa; inner {} (from {:.3g})", modulus,
+      record.cost, record.cost_gradient, record.inner.BriefReport(),
+      record.inner.residual_history.empty() ? -1.0 : record.inner.residual_history.front());
+  evaluations_.push_back(std::move(record));
+  return evaluations_.back();
+}
+
+bool McreObjective::Evaluate(const double* parameters, double* cost, double* gradient) {
+  const double modulus = parameters[0] * modulus_scale_;
+  if (!(std::isfinite(modulus) && modulus > 0.0)) {
+    std::ostringstream why;
+    why << "trial modulus " << modulus << " Pa is not a positive finite number";
+    error_message_ = why.str();
+    return false;
+  }
+  const ObjectiveEvaluation& record = EvaluateModulus(modulus, gradient != nullptr);
+  if (!record.usable) {
+    std::ostringstream why;
+    why << "the coupled solve at E = " << modulus
+        << " Pa is not usable: " << record.inner.BriefReport() << " (" << record.inner.message
+        << ")";
+    error_message_ = why.str();
+    return false;
+  }
+  // cost = e^2 / J_rest
+  *cost = record.cost / cost_scale();
+  if (gradient != nullptr) {
+    // d cost / dx = (de^2/dE) (dE/dx) / J_rest, dE/dx = modulus_scale
+    gradient[0] = record.cost_gradient * modulus_scale_ / cost_scale();
+  }
+  return true;
+}
+
+}  // namespace mcrewave

@@ -1,0 +1,112 @@
+#include "mcrewave/model/simulation.h"
+
+#include <cassert>
+#include <stdexcept>
+#include <vector>
+
+#include "mcrewave/data/noise.h"
+#include "mcrewave/linalg/band_matrix.h"
+#include "mcrewave/linalg/theta_integrator.h"
+#include "mcrewave/model/exact_solution.h"
+
+namespace mcrewave {
+namespace {
+
+// The rows and columns of the free nodes 1..N (node 0 is clamped).
+SparseMatrix FreeBlock(const SparseMatrix& full) {
+  const int n = static_cast<int>(full.rows());
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int j = 1; j < n; ++j) {
+    for (SparseMatrix::InnerIterator it(full, j); it; ++it) {
+      if (it.row() >= 1) entries.emplace_back(it.row() - 1, j - 1, it.value());
+    }
+  }
+  SparseMatrix block(n - 1, n - 1);
+  block.setFromTriplets(entries.begin(), entries.end());
+  return block;
+}
+
+// Clamped simulation on `bar` with `steps_per_sample` steps of `time.step /
+// steps_per_sample` between two samples of the output grid t_k = k time.step.
+MeasurementSet SimulateClamped(const BarProperties& bar, const LoadOptions& load,
+                               const TimeOptions& time, int steps_per_sample) {
+  const BarModel model(bar);
+  const SparseMatrix stiffness = model.Stiffness(bar.modulus);
+  const SparseMatrix free_mass = FreeBlock(model.mass());
+  const SparseMatrix free_stiffness = FreeBlock(stiffness);
+  const int num_free = model.num_nodes() - 1;
+  const int loaded = num_free - 1;  // node N in the free numbering
+
+  ThetaIntegratorOptions integrator_options;
+  integrator_options.time_step = time.step / steps_per_sample;
+  integrator_options.theta = time.theta;
+  ThetaIntegrator integrator;
+  integrator.Init(free_mass, free_stiffness, integrator_options);
+  BandLdlt mass_factor;
+  if (!mass_factor.Compute(SymmetricBandMatrix(free_mass))) {
+    throw std::runtime_error("clamped simulation: the mass matrix is not positive definite");
+  }
+
+  // Coupling of node 0 to node 1 in row 0 of M and K (linear elements).
+  const double mass_01 = model.mass().coeff(0, 1);
+  const double stiffness_01 = stiffness.coeff(0, 1);
+
+  const int num_samples = time.NumSteps() + 1;
+  const int num_steps = time.NumSteps() * steps_per_sample;
+  const double h = integrator_options.time_step;
+  const double theta = time.theta;
+  MeasurementSet out;
+  out.time_step = time.step;
+  out.u0 = Vector::Zero(num_samples);
+  out.uL = Vector::Zero(num_samples);
+  out.f0 = Vector::Zero(num_samples);
+  out.fL = Vector::Zero(num_samples);
+
+  Vector acceleration = Vector::Zero(num_free);
+  const Vector zero = Vector::Zero(num_free);
+  integrator.SweepForward(
+      num_steps, zero, zero,
+      [&](int k, Eigen::Ref<Vector> force) {
+        // f_theta = theta F(t_{k+1}) + (1 - theta) F(t_k) on the loaded node.
+        force.setZero();
+        force[loaded] = theta * load.Value((k + 1) * h) + (1.0 - theta) * load.Value(k * h);
+      },
+      [&](int k, const Vector& /*velocity*/, const Vector& displacement) {
+        if (k % steps_per_sample != 0) return;
+        const int sample = k / steps_per_sample;
+        const double applied = load.Value(k * h);
+        // M_r a_k = f_k - K_r u_k, then f0_k = M_01 a_1 + K_01 u_1.
+        integrator.stiffness().Multiply(displacement, acceleration);
+        acceleration = -acceleration;
+        acceleration[loaded] += applied;
+        mass_factor.SolveInPlace(acceleration);
+        out.uL[sample] = displacement[loaded];
+        out.f0[sample] = mass_01 * acceleration[0] + stiffness_01 * displacement[0];
+        out.fL[sample] = applied;
+      });
+  return out;
+}
+
+}  // namespace
+
+MeasurementSet SimulateClampedBar(const BarProperties& bar, const LoadOptions& load,
+                                  const TimeOptions& time) {
+  return SimulateClamped(bar, load, time, 1);
+}
+
+MeasurementSet SimulateTruth(const BarProperties& bar, const LoadOptions& load,
+                             const TimeOptions& time, const DataOptions& data) {
+  if (data.truth == TruthModel::kExact) return ExactBarSolution(bar, load).Sample(time);
+  BarProperties fine = bar;
+  fine.elements = bar.elements * data.truth_refinement;
+  return SimulateClamped(fine, load, time, data.truth_refinement);
+}
+
+MeasurementSet MakeSyntheticMeasurements(const BarProperties& bar, const LoadOptions& load,
+                                         const TimeOptions& time, const DataOptions& data) {
+  MeasurementSet measurements = SimulateTruth(bar, load, time, data);
+  AddMeasurementNoise(data.snr, data.seed, &measurements);
+  return measurements;
+}
+
+}  // namespace mcrewave
