@@ -22,8 +22,22 @@ constexpr std::array<std::pair<DataSource, const char*>, 2> kDataSources{
 constexpr std::array<std::pair<TruthModel, const char*>, 2> kTruthModels{
     {{TruthModel::kFiniteElement, "finite_element"}, {TruthModel::kExact, "exact"}}};
 
+constexpr std::array<std::pair<SensorKind, const char*>, 2> kSensorKinds{
+    {{SensorKind::kDisplacement, "displacement"}, {SensorKind::kStrain, "strain"}}};
+constexpr std::array<std::pair<Zoning, const char*>, 3> kZonings{{{Zoning::kEqual, "equal"},
+                                                                  {Zoning::kPerElement, "per_element"},
+                                                                  {Zoning::kBoundaries, "boundaries"}}};
+
 }  // namespace
 
+const char* SensorKindToString(SensorKind kind) { return ToName(kSensorKinds, kind); }
+bool StringToSensorKind(const std::string& name, SensorKind* kind) {
+  return FromName(kSensorKinds, name, kind);
+}
+const char* ZoningToString(Zoning zoning) { return ToName(kZonings, zoning); }
+bool StringToZoning(const std::string& name, Zoning* zoning) {
+  return FromName(kZonings, name, zoning);
+}
 const char* MassTypeToString(MassType type) { return ToName(kMassTypes, type); }
 bool StringToMassType(const std::string& name, MassType* type) {
   return FromName(kMassTypes, name, type);

@@ -1,5 +1,6 @@
 #include "mcrewave/model/bar_model.h"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <sstream>
@@ -26,8 +27,139 @@ bool BarProperties::IsValid(std::string* error) const {
   return ok;
 }
 
-BarModel::BarModel(const BarProperties& properties) : properties_(properties) {
+std::string ValidateModulusZones(const BarProperties& bar, const std::vector<ModulusZone>& zones,
+                                 const std::string& key) {
+  for (std::size_t i = 0; i < zones.size(); ++i) {
+    const ModulusZone& zone = zones[i];
+    std::ostringstream why;
+    why << key << "[" << i << "]";
+    if (!(std::isfinite(zone.start) && std::isfinite(zone.end) && zone.start >= 0.0 &&
+          zone.end <= bar.length && zone.start < zone.end)) {
+      why << " must satisfy 0 <= start < end <= L = " << bar.length << " m, got [" << zone.start
+          << ", " << zone.end << "] m";
+      return why.str();
+    }
+    if (!(std::isfinite(zone.modulus) && zone.modulus > 0.0)) {
+      why << ".modulus must be a finite positive number [Pa], got " << zone.modulus;
+      return why.str();
+    }
+  }
+  return "";
+}
+
+Vector ElementModuli(const BarProperties& bar, const std::vector<ModulusZone>& zones) {
+  assert(ValidateModulusZones(bar, zones, "zones").empty());
+  const int n = bar.elements;
+  const double he = bar.length / n;
+  Vector moduli(n);
+  for (int e = 0; e < n; ++e) {
+    const double a = e * he, b = (e + 1) * he;
+    // Pieces of [a, b] in series: 1 / E_e = sum (length / h_e) / E_piece. Paint the
+    // zones in order over the background, as breakpoints of the element.
+    std::vector<double> cuts{a, b};
+    for (const ModulusZone& zone : zones) {
+      if (zone.start > a && zone.start < b) cuts.push_back(zone.start);
+      if (zone.end > a && zone.end < b) cuts.push_back(zone.end);
+    }
+    std::sort(cuts.begin(), cuts.end());
+    double compliance = 0.0;  // sum (length / h_e) / E_piece [1/Pa]
+    for (std::size_t c = 0; c + 1 < cuts.size(); ++c) {
+      const double length = cuts[c + 1] - cuts[c];
+      if (length <= 0.0) continue;
+      const double middle = 0.5 * (cuts[c] + cuts[c + 1]);
+      double modulus = bar.modulus;
+      for (const ModulusZone& zone : zones) {
+        if (middle >= zone.start && middle <= zone.end) modulus = zone.modulus;
+      }
+      compliance += (length / he) / modulus;
+    }
+    moduli[e] = 1.0 / compliance;
+  }
+  return moduli;
+}
+
+std::string ZoneLayout::Validate(const BarProperties& bar) const {
+  std::ostringstream why;
+  switch (zoning) {
+    case Zoning::kEqual:
+      if (zone_count < 1 || zone_count > bar.elements) {
+        why << "model.zone_count must be between 1 and model.elements = " << bar.elements
+            << " (every zone needs an element), got " << zone_count;
+      }
+      break;
+    case Zoning::kPerElement:
+      break;
+    case Zoning::kBoundaries: {
+      if (zone_boundaries.empty()) {
+        why << "model.zone_boundaries must list at least one interior boundary [m] with "
+               "model.zoning: boundaries";
+        break;
+      }
+      double previous = 0.0;
+      for (std::size_t i = 0; i < zone_boundaries.size(); ++i) {
+        const double b = zone_boundaries[i];
+        if (!(std::isfinite(b) && b > previous && b < bar.length)) {
+          why << "model.zone_boundaries[" << i << "] = " << b
+              << " m: boundaries must increase strictly inside (0, L = " << bar.length << " m)";
+          break;
+        }
+        previous = b;
+      }
+      if (!why.str().empty()) break;
+      // Every zone must hold an element midpoint.
+      const std::vector<int> zones = ElementZones(bar);
+      std::vector<int> count(zone_boundaries.size() + 1, 0);
+      for (int z : zones) ++count[z];
+      for (std::size_t z = 0; z < count.size(); ++z) {
+        if (count[z] == 0) {
+          const double a = z == 0 ? 0.0 : zone_boundaries[z - 1];
+          const double b = z == zone_boundaries.size() ? bar.length : zone_boundaries[z];
+          why << "model.zone_boundaries: zone " << z << " [" << a << ", " << b
+              << "] m holds no element midpoint (elements of " << bar.length / bar.elements
+              << " m): widen it or refine model.elements";
+          break;
+        }
+      }
+      break;
+    }
+  }
+  return why.str();
+}
+
+std::vector<int> ZoneLayout::ElementZones(const BarProperties& bar) const {
+  const int n = bar.elements;
+  const double he = bar.length / n;
+  std::vector<int> zones(n, 0);
+  for (int e = 0; e < n; ++e) {
+    const double middle = (e + 0.5) * he;
+    switch (zoning) {
+      case Zoning::kEqual:
+        // Zone z holds [z L / Z, (z + 1) L / Z): floor(Z x / L), clamped to Z - 1.
+        zones[e] = std::min(zone_count - 1,
+                            static_cast<int>(std::floor(zone_count * middle / bar.length)));
+        break;
+      case Zoning::kPerElement:
+        zones[e] = e;
+        break;
+      case Zoning::kBoundaries:
+        zones[e] = static_cast<int>(
+            std::upper_bound(zone_boundaries.begin(), zone_boundaries.end(), middle) -
+            zone_boundaries.begin());
+        break;
+    }
+  }
+  return zones;
+}
+
+BarModel::BarModel(const BarProperties& properties)
+    : BarModel(properties, std::vector<int>(properties.elements, 0)) {}
+
+BarModel::BarModel(const BarProperties& properties, const std::vector<int>& element_zones)
+    : properties_(properties), element_zones_(element_zones) {
   assert(properties.IsValid(nullptr));
+  assert(static_cast<int>(element_zones.size()) == properties.elements);
+  num_zones_ =
+      element_zones.empty() ? 1 : *std::max_element(element_zones.begin(), element_zones.end()) + 1;
   const int n = num_nodes();
   const double he = element_length();
   const double rho_s = properties.density * properties.section;
@@ -62,6 +194,61 @@ BarModel::BarModel(const BarProperties& properties) : properties_(properties) {
   boundary_selector_.resize(n, n);
   std::vector<Eigen::Triplet<double>> b_entries{{0, 0, 1.0}, {n - 1, n - 1, 1.0}};
   boundary_selector_.setFromTriplets(b_entries.begin(), b_entries.end());
+}
+
+SparseMatrix BarModel::StiffnessOfElements(const Vector& element_moduli) const {
+  assert(element_moduli.size() == num_elements());
+  const int n = num_nodes();
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(4 * num_elements());
+  for (int e = 0; e < num_elements(); ++e) {
+    // E_e K1_e = E_e k1_e [1 -1; -1 1] on nodes (e, e + 1).
+    const double k = element_moduli[e] * element_unit_stiffness(e);
+    entries.emplace_back(e, e, k);
+    entries.emplace_back(e + 1, e + 1, k);
+    entries.emplace_back(e, e + 1, -k);
+    entries.emplace_back(e + 1, e, -k);
+  }
+  SparseMatrix stiffness(n, n);
+  stiffness.setFromTriplets(entries.begin(), entries.end());
+  return stiffness;
+}
+
+SparseMatrix BarModel::Stiffness(const Vector& zone_moduli) const {
+  assert(zone_moduli.size() == num_zones());
+  if (num_zones_ == 1) return Stiffness(zone_moduli[0]);
+  Vector element_moduli(num_elements());
+  for (int e = 0; e < num_elements(); ++e) element_moduli[e] = zone_moduli[element_zones_[e]];
+  return StiffnessOfElements(element_moduli);
+}
+
+int BarModel::ElementAt(double position) const {
+  assert(position >= 0.0 && position <= properties_.length);
+  const int e = static_cast<int>(std::floor(position / element_length()));
+  return std::clamp(e, 0, num_elements() - 1);
+}
+
+ObservationRow BarModel::DisplacementRow(double position) const {
+  const int e = ElementAt(position);
+  // xi = (x - x_e) / h_e in [0, 1]; h = (1 - xi) e_e + xi e_{e+1}.
+  const double xi = std::clamp(position / element_length() - e, 0.0, 1.0);
+  ObservationRow row;
+  row.nodes[0] = e;
+  row.nodes[1] = e + 1;
+  row.coefficients[0] = 1.0 - xi;
+  row.coefficients[1] = xi;
+  return row;
+}
+
+ObservationRow BarModel::StrainRow(double position) const {
+  const int e = ElementAt(position);
+  // h = (e_{e+1} - e_e) / h_e.
+  ObservationRow row;
+  row.nodes[0] = e;
+  row.nodes[1] = e + 1;
+  row.coefficients[0] = -1.0 / element_length();
+  row.coefficients[1] = 1.0 / element_length();
+  return row;
 }
 
 double BarModel::WaveSpeed(double modulus) const {

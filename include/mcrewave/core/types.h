@@ -54,4 +54,22 @@ enum class TruthModel {
 const char* TruthModelToString(TruthModel model);
 bool StringToTruthModel(const std::string& name, TruthModel* model);
 
+// Kind of an interior sensor channel of the bar (CSV header `u@X`, `e@X`).
+enum class SensorKind {
+  kDisplacement,  // u@X: axial displacement [m] at X m from the clamped end
+  kStrain,        // e@X: axial strain [-] of the element holding X (compression negative)
+};
+const char* SensorKindToString(SensorKind kind);
+bool StringToSensorKind(const std::string& name, SensorKind* kind);
+
+// How the identification's zones of constant modulus are laid over the bar's elements
+// (model/bar_model.h, ZoneLayout).
+enum class Zoning {
+  kEqual,       // model.zone_count zones of equal length
+  kPerElement,  // one zone per element
+  kBoundaries,  // zones between the interior boundaries model.zone_boundaries [m]
+};
+const char* ZoningToString(Zoning zoning);
+bool StringToZoning(const std::string& name, Zoning* zoning);
+
 }  // namespace mcrewave

@@ -1,12 +1,25 @@
-// The finite-element model of the elastic bar (formulation.md sections 1 and 3).
+// The finite-element model of the elastic bar (docs/discrete_mcre.md; zones and
+// sensors: docs/zones_and_sensors.md).
 //
 // A bar x in [0, L] of section S and density rho, meshed with N linear elements
-// of length h_e = L / N and N + 1 nodes numbered from x = 0. All nodes are kept:
-// the clamp of the reference experiment is a boundary condition of the direct
-// simulation only (ClampedBarSimulation); the MCRE model knows the ends only
-// through the measured data. The stiffness is K = E K1 so that a new trial
-// modulus costs no re-assembly.
+// of length h_e = L / N and N + 1 nodes numbered from x = 0; element e joins nodes
+// e and e + 1. All nodes are kept: the clamp of the reference experiment is a
+// boundary condition of the direct simulation only (ClampedBarSimulation); the
+// MCRE model knows the ends only through the measured data.
+//
+// Zones. The modulus is piecewise constant over Z zones, each a set of elements:
+//   K(E_1..E_Z) = sum_z E_z K1_z,   K1_z = sum_{e in z} K1_e,
+// so that a new trial modulus costs no re-assembly of the element matrices. An
+// element belongs to the zone that holds its midpoint (ZoneLayout). One zone (the
+// default) is the paper's uniform bar, K = E K1.
+//
+// Sensors. An observation row h (H's row) reads a channel off the nodal
+// displacements U: displacement at x in element e (local coordinate xi in [0, 1]):
+// h = (1 - xi) e_e + xi e_{e+1}; axial strain of element e: h = (e_{e+1} - e_e) / h_e.
 #pragma once
+
+#include <string>
+#include <vector>
 
 #include "mcrewave/core/types.h"
 
@@ -24,10 +37,61 @@ struct BarProperties {
   bool IsValid(std::string* error) const;
 };
 
+// A stretch [start, end] of the bar [m] with its own modulus [Pa]: the truth's
+// heterogeneities of synthetic data (data.truth_zones), over the modulus of
+// BarProperties elsewhere.
+struct ModulusZone {
+  double start = 0.0;    // [m]
+  double end = 0.0;      // [m]
+  double modulus = 0.0;  // [Pa]
+};
+
+// The moduli of the N elements of `bar` [Pa] under the zones (in order, a later zone
+// over an earlier one where they overlap). An element partly covered gets the
+// modulus of its pieces in series, 1 / E_e = sum_pieces (length / h_e) / E_piece,
+// which keeps the element's static axial stiffness exact. Precondition: the zones
+// are valid for the bar (ValidateModulusZones).
+Vector ElementModuli(const BarProperties& bar, const std::vector<ModulusZone>& zones);
+// Empty when every zone lies in [0, L] with start < end and a finite positive
+// modulus; otherwise the reason, naming zone i as `key`[i].
+std::string ValidateModulusZones(const BarProperties& bar, const std::vector<ModulusZone>& zones,
+                                 const std::string& key);
+
+// The identification's zones: which zone each element belongs to.
+struct ZoneLayout {
+  Zoning zoning = Zoning::kEqual;
+  int zone_count = 1;                   // kEqual: Z zones of equal length
+  std::vector<double> zone_boundaries;  // kBoundaries: interior boundaries [m], increasing
+
+  // Empty when the layout is usable on `bar` (every zone holds at least one element,
+  // boundaries strictly inside (0, L) and increasing); otherwise the reason, naming
+  // the keys model.zoning, model.zone_count, model.zone_boundaries.
+  std::string Validate(const BarProperties& bar) const;
+  // The zone of each element, by its midpoint: zone z holds the elements whose
+  // midpoint lies in [b_z, b_{z+1}) (the last zone up to L inclusive), b_0 = 0,
+  // b_Z = L; kEqual: b_z = z L / Z; kPerElement: zone e = element e.
+  // Precondition: Validate(bar) is empty.
+  std::vector<int> ElementZones(const BarProperties& bar) const;
+};
+
+// One row of the observation operator H: a channel is
+// coefficients[0] U[nodes[0]] + coefficients[1] U[nodes[1]].
+struct ObservationRow {
+  int nodes[2] = {0, 0};
+  double coefficients[2] = {0.0, 0.0};
+  double Apply(const double* displacement) const {
+    return coefficients[0] * displacement[nodes[0]] + coefficients[1] * displacement[nodes[1]];
+  }
+};
+
 class BarModel {
  public:
-  // Assembles M and K1. Precondition: properties.IsValid().
+  // Assembles M and the K1_z of one zone (the whole bar). Precondition:
+  // properties.IsValid().
   explicit BarModel(const BarProperties& properties);
+  // Assembles M and K1_z for the zones of `element_zones` (one entry per element,
+  // zones numbered 0..Z-1, each holding at least one element).
+  BarModel(const BarProperties& properties, const std::vector<int>& element_zones);
 
   const BarProperties& properties() const { return properties_; }
   int num_elements() const { return properties_.elements; }
@@ -41,8 +105,33 @@ class BarModel {
   // Stiffness per unit modulus K1 [m] (K = E K1 [N/m]), symmetric, tridiagonal,
   // kernel = rigid translations.
   const SparseMatrix& unit_stiffness() const { return unit_stiffness_; }
-  // K = modulus * K1 [N/m].
+  // K = modulus * K1 [N/m], every zone at the same modulus.
   SparseMatrix Stiffness(double modulus) const { return modulus * unit_stiffness_; }
+  // K = sum_z E_z K1_z [N/m]; zone_moduli has num_zones() entries [Pa].
+  SparseMatrix Stiffness(const Vector& zone_moduli) const;
+  // K = sum_e E_e K1_e [N/m] from a modulus per element [Pa] (num_elements() entries).
+  SparseMatrix StiffnessOfElements(const Vector& element_moduli) const;
+
+  int num_zones() const { return num_zones_; }
+  // Zone of element e, in [0, num_zones()).
+  int element_zone(int element) const { return element_zones_[element]; }
+  const std::vector<int>& element_zones() const { return element_zones_; }
+  // The axial stiffness per unit modulus of element e, k1_e = S / h_e [m]:
+  // K1_e = k1_e [1 -1; -1 1] on nodes (e, e + 1).
+  double element_unit_stiffness(int element) const {
+    return properties_.section / element_length();
+  }
+  // x of the midpoint of element e [m].
+  double element_midpoint(int element) const { return (element + 0.5) * element_length(); }
+  // x of node i [m].
+  double node_position(int node) const { return node * element_length(); }
+
+  // The element that holds x in [0, L]: floor(x / h_e), the last element for x = L
+  // (a node shared by two elements belongs to the one on its right).
+  int ElementAt(double position) const;
+  // Observation rows (see the file comment). Precondition: 0 <= x <= L.
+  ObservationRow DisplacementRow(double position) const;
+  ObservationRow StrainRow(double position) const;
   // B = e_0 e_0^T + e_N e_N^T, the selector of the two measured end nodes.
   const SparseMatrix& boundary_selector() const { return boundary_selector_; }
 
@@ -51,6 +140,8 @@ class BarModel {
 
  private:
   BarProperties properties_;
+  int num_zones_ = 1;
+  std::vector<int> element_zones_;
   SparseMatrix mass_;
   SparseMatrix unit_stiffness_;
   SparseMatrix boundary_selector_;
