@@ -12,16 +12,28 @@
 
 #include <istream>
 #include <string>
+#include <vector>
 
 #include "mcrewave/core/types.h"
 
 namespace mcrewave {
 
+// An interior sensor channel: CSV column `u@X` (displacement [m] at X m from the
+// clamped end) or `e@X` (axial strain [-] of the element holding X, compression
+// negative).
+struct SensorChannel {
+  std::string name;  // the CSV header, e.g. "u@0.25"
+  SensorKind kind = SensorKind::kDisplacement;
+  double position = 0.0;  // X [m]
+  Vector values;          // one entry per sample [m] or [-]
+};
+
 struct MeasurementSet {
-  double start_time = 0.0;  // t_0 [s]
-  double time_step = 0.0;   // h [s]
-  Vector u0, uL;            // [m], one entry per sample
-  Vector f0, fL;            // [N], one entry per sample
+  double start_time = 0.0;             // t_0 [s]
+  double time_step = 0.0;              // h [s]
+  Vector u0, uL;                       // [m], one entry per sample
+  Vector f0, fL;                       // [N], one entry per sample
+  std::vector<SensorChannel> sensors;  // interior channels, in the file's column order
 
   int num_samples() const { return static_cast<int>(u0.size()); }
   int num_steps() const { return num_samples() - 1; }

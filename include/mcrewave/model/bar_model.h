@@ -118,7 +118,8 @@ class BarModel {
   const std::vector<int>& element_zones() const { return element_zones_; }
   // The axial stiffness per unit modulus of element e, k1_e = S / h_e [m]:
   // K1_e = k1_e [1 -1; -1 1] on nodes (e, e + 1).
-  double element_unit_stiffness(int element) const {
+  // (The mesh is uniform: the same for every element.)
+  double element_unit_stiffness([[maybe_unused]] int element) const {
     return properties_.section / element_length();
   }
   // x of the midpoint of element e [m].
