@@ -12,6 +12,8 @@ bool McreWeights::IsValid(std::string* error) const {
     why << "mcre.w_u must be a finite positive number, got " << displacement_weight;
   } else if (!(std::isfinite(force_weight) && force_weight > 0.0)) {
     why << "mcre.w_f must be a finite positive number, got " << force_weight;
+  } else if (!(std::isfinite(strain_weight) && strain_weight > 0.0)) {
+    why << "mcre.w_e must be a finite positive number, got " << strain_weight;
   } else {
     return true;
   }

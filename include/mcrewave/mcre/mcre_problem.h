@@ -31,9 +31,14 @@ namespace mcrewave {
 // these defaults on the paper's case against -3.4e3 at w_u = 1), so relaxation and
 // CG converge in tens to hundreds of sweeps instead of thousands; the evidence for
 // the identification itself is in docs/weights.md.
+//
+// Strain gauges (docs/zones_and_sensors.md): beta_e = w_e S E0 L [N m]; a uniform
+// strain e over the bar moves its end by e L, so w_e = w_u weighs a gauge like an end
+// displacement sensor of the same information; the default follows w_u.
 struct McreWeights {
   double displacement_weight = 0.01;  // w_u
   double force_weight = 1.0;          // w_f
+  double strain_weight = 0.01;        // w_e
   bool IsValid(std::string* error) const;
 };
 
