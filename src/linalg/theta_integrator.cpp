@@ -69,7 +69,8 @@ void ThetaIntegrator::Init(const SparseMatrix& mass, const SparseMatrix& stiffne
 template <bool kForceVector>
 void ThetaIntegrator::TridiagonalRightHandSide(const double* v_k, const double* u_k,
                                                const double* z, const double* force, double f0,
-                                               double fL, double* shifted, double* v_next) const {
+                                               double fL, double* shifted, double* v_next,
+                                               const PointLoads* point_loads) const {
   const int n = size();
   const double h = options_.time_step;
   const double* s = u_k;
@@ -100,6 +101,12 @@ void ThetaIntegrator::TridiagonalRightHandSide(const double* v_k, const double* 
   if constexpr (kForceVector) first_row += h * force[0];
   v_next[0] = first_row + h * f0;
   if (n == 1) v_next[0] += h * fL;
+  // + h p_i e_{node_i}.
+  if (point_loads != nullptr) {
+    for (int i = 0; i < point_loads->count; ++i) {
+      v_next[point_loads->nodes[i]] += h * point_loads->values[i];
+    }
+  }
 }
 
 void ThetaIntegrator::UpdateDisplacement(const double* u_k, const double* v_k, const double* v_next,
@@ -114,8 +121,9 @@ void ThetaIntegrator::UpdateDisplacement(const double* u_k, const double* v_k, c
 template <bool kForceVector>
 void ThetaIntegrator::TridiagonalStep(const double* v_k, const double* u_k, const double* z,
                                       const double* force, double f0, double fL, double* v_next,
-                                      double* u_next) {
-  TridiagonalRightHandSide<kForceVector>(v_k, u_k, z, force, f0, fL, shifted_.data(), v_next);
+                                      double* u_next, const PointLoads* point_loads) {
+  TridiagonalRightHandSide<kForceVector>(v_k, u_k, z, force, f0, fL, shifted_.data(), v_next,
+                                         point_loads);
   // S v_{k+1} = rhs.
   tridiagonal_factor_.SolveInPlace(v_next);
   UpdateDisplacement(u_k, v_k, v_next, u_next);
@@ -125,25 +133,29 @@ template <int B>
 void ThetaIntegrator::StepsWithEndLoads(const double* const (&v_k)[B],
                                         const double* const (&u_k)[B], const double* const (&z)[B],
                                         const double (&f0)[B], const double (&fL)[B],
-                                        double* const (&v_next)[B], double* const (&u_next)[B]) {
+                                        double* const (&v_next)[B], double* const (&u_next)[B],
+                                        const PointLoads* const* point_loads) {
   static_assert(B >= 2 && B <= kMaxBatch, "2 or 3 steps at once");
   const int n = size();
   if (!tridiagonal_) {
     for (int b = 0; b < B; ++b) {
       using ConstMap = Eigen::Map<const Vector>;
       Eigen::Map<Vector> v_out(v_next[b], n), u_out(u_next[b], n);
+      const PointLoads* loads = point_loads != nullptr ? point_loads[b] : nullptr;
       if (z[b] != nullptr) {
         StepWithEndLoads(ConstMap(v_k[b], n), ConstMap(u_k[b], n), ConstMap(z[b], n), f0[b], fL[b],
-                         v_out, u_out);
+                         v_out, u_out, loads);
       } else {
-        StepWithEndLoads(ConstMap(v_k[b], n), ConstMap(u_k[b], n), f0[b], fL[b], v_out, u_out);
+        StepWithEndLoads(ConstMap(v_k[b], n), ConstMap(u_k[b], n), f0[b], fL[b], v_out, u_out,
+                         loads);
       }
     }
     return;
   }
   for (int b = 0; b < B; ++b) {
     TridiagonalRightHandSide<false>(v_k[b], u_k[b], z[b], nullptr, f0[b], fL[b],
-                                    shifted_batch_.col(b).data(), v_next[b]);
+                                    shifted_batch_.col(b).data(), v_next[b],
+                                    point_loads != nullptr ? point_loads[b] : nullptr);
   }
   tridiagonal_factor_.SolveInPlace<B>(v_next);
   for (int b = 0; b < B; ++b) UpdateDisplacement(u_k[b], v_k[b], v_next[b], u_next[b]);
@@ -153,12 +165,12 @@ template void ThetaIntegrator::StepsWithEndLoads<2>(const double* const (&)[2],
                                                     const double* const (&)[2],
                                                     const double* const (&)[2], const double (&)[2],
                                                     const double (&)[2], double* const (&)[2],
-                                                    double* const (&)[2]);
+                                                    double* const (&)[2], const PointLoads* const*);
 template void ThetaIntegrator::StepsWithEndLoads<3>(const double* const (&)[3],
                                                     const double* const (&)[3],
                                                     const double* const (&)[3], const double (&)[3],
                                                     const double (&)[3], double* const (&)[3],
-                                                    double* const (&)[3]);
+                                                    double* const (&)[3], const PointLoads* const*);
 
 void ThetaIntegrator::Step(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref<const Vector>& u_k,
                            const Eigen::Ref<const Vector>& force_theta, Eigen::Ref<Vector> v_next,
@@ -182,33 +194,42 @@ void ThetaIntegrator::Step(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref
 void ThetaIntegrator::StepWithEndLoads(const Eigen::Ref<const Vector>& v_k,
                                        const Eigen::Ref<const Vector>& u_k,
                                        const Eigen::Ref<const Vector>& z, double f0, double fL,
-                                       Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next) {
+                                       Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next,
+                                       const PointLoads* point_loads) {
   assert(z.size() == u_k.size());
   if (tridiagonal_) {
     TridiagonalStep<false>(v_k.data(), u_k.data(), z.data(), nullptr, f0, fL, v_next.data(),
-                           u_next.data());
+                           u_next.data(), point_loads);
     return;
   }
-  // f_theta = -K z + f0 e_0 + fL e_{n-1}, formed in force_.
+  // f_theta = -K z + f0 e_0 + fL e_{n-1} + sum_i p_i e_{node_i}, formed in force_.
   stiffness_.Multiply(z, force_);
   force_ = -force_;
-  force_[0] += f0;
-  force_[size() - 1] += fL;
+  AddEndAndPointLoads(f0, fL, point_loads);
   Step(v_k, u_k, force_, v_next, u_next);
 }
 
 void ThetaIntegrator::StepWithEndLoads(const Eigen::Ref<const Vector>& v_k,
                                        const Eigen::Ref<const Vector>& u_k, double f0, double fL,
-                                       Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next) {
+                                       Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next,
+                                       const PointLoads* point_loads) {
   if (tridiagonal_) {
     TridiagonalStep<false>(v_k.data(), u_k.data(), nullptr, nullptr, f0, fL, v_next.data(),
-                           u_next.data());
+                           u_next.data(), point_loads);
     return;
   }
   force_.setZero();
+  AddEndAndPointLoads(f0, fL, point_loads);
+  Step(v_k, u_k, force_, v_next, u_next);
+}
+
+void ThetaIntegrator::AddEndAndPointLoads(double f0, double fL, const PointLoads* point_loads) {
   force_[0] += f0;
   force_[size() - 1] += fL;
-  Step(v_k, u_k, force_, v_next, u_next);
+  if (point_loads == nullptr) return;
+  for (int i = 0; i < point_loads->count; ++i) {
+    force_[point_loads->nodes[i]] += point_loads->values[i];
+  }
 }
 
 }  // namespace mcrewave

@@ -116,14 +116,16 @@ void SolveAllAtOnce(const CoupledSolverOptions& options, McreProblem* problem,
   const BarModel& model = problem->model();
   const MeasurementSet& data = problem->data();
   const double h = problem->time_step(), theta = problem->theta();
-  const double alpha = problem->alpha(), beta = problem->beta();
+  const double alpha = problem->alpha();
   const SparseMatrix& mass = model.mass();
-  const SparseMatrix stiffness = model.Stiffness(problem->modulus());
+  const SparseMatrix stiffness = model.Stiffness(problem->moduli());
   const SparseMatrix& selector = model.boundary_selector();
   const SparseMatrix penalty = stiffness + selector / alpha;  // P = K + B / alpha
+  // H^T diag(beta_k) H (the paper's case: beta B).
+  const SparseMatrix observation = problem->WeightedObservation();
   const double num_unknowns = static_cast<double>(system.size());
   const double matrix_nonzeros = MatrixNonZeros(n, m, mass.nonZeros(), stiffness.nonZeros(),
-                                                penalty.nonZeros(), selector.nonZeros());
+                                                penalty.nonZeros(), observation.nonZeros());
   const double factor_nonzeros = FactorNonZerosPerUnknown(n) * num_unknowns;
   const double bytes = AllAtOnceBytes(num_unknowns, matrix_nonzeros, factor_nonzeros);
   std::ostringstream sizes;
@@ -192,16 +194,15 @@ void SolveAllAtOnce(const CoupledSolverOptions& options, McreProblem* problem,
     system.AddIdentity(kOmega, j - 1, kOmega, j, -1.0);
     system.AddIdentity(kOmega, j - 1, kY, j, -h * (1.0 - theta));
     // (R2) in the rows of Y_{j-1}:
-    // M Y_{j-1} + h theta K Omega_{j-1} - M Y_j + h (1-theta) K Omega_j - h c_j beta B U_j
-    //   = -h c_j beta U~_j.
+    // M Y_{j-1} + h theta K Omega_{j-1} - M Y_j + h (1-theta) K Omega_j
+    //   - h c_j H^T diag(beta) H U_j = -h c_j H^T diag(beta) d~_j.
     system.Add(kY, j - 1, kY, j - 1, mass, 1.0);
     system.Add(kY, j - 1, kOmega, j - 1, stiffness, h * theta);
     system.Add(kY, j - 1, kY, j, mass, -1.0);
     system.Add(kY, j - 1, kOmega, j, stiffness, h * (1.0 - theta));
-    system.Add(kY, j - 1, kU, j, selector, -h * c_j * beta);
-    const int row = system.Index(kY, j - 1);
-    rhs[row] = -h * c_j * beta * data.u0[j];
-    rhs[row + last] = -h * c_j * beta * data.uL[j];
+    system.Add(kY, j - 1, kU, j, observation, -h * c_j);
+    problem->WeightedData(j, rhs.segment(system.Index(kY, j - 1), n));
+    rhs.segment(system.Index(kY, j - 1), n) *= -h * c_j;
   }
   for (int j = 0; j <= m; ++j) {
     // (R3) in the rows of W_j: c_j W_j - theta Omega_{j-1} - (1-theta) Omega_j = 0.

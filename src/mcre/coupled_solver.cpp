@@ -143,6 +143,17 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, McreProbl
     summary.message = refusal.str();
     return summary;
   }
+  const bool comparator = options.type == CoupledSolverType::kRiccati ||
+                          options.type == CoupledSolverType::kSingleShooting ||
+                          options.type == CoupledSolverType::kMultipleShooting;
+  if (comparator && !problem->observes_ends_only()) {
+    // Their transfer operators are written for H = B (the two end displacements).
+    summary.message = std::string(CoupledSolverTypeToString(options.type)) +
+                      " handles the paper's end sensors only (u0 and uL, no interior sensor); "
+                      "with interior sensors or an end channel left out use inner.solver: "
+                      "conjugate_gradient, adaptive_relaxation, relaxation or all_at_once";
+    return summary;
+  }
   switch (options.type) {
     case CoupledSolverType::kAllAtOnce:
       internal::SolveAllAtOnce(options, problem, solution, &summary);
@@ -164,7 +175,9 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, McreProbl
   }
   if (summary.IsSolutionUsable()) {
     solution->cost = problem->Cost(solution->displacement, solution->retrograde);
-    solution->cost_gradient = problem->CostGradient(solution->displacement, solution->retrograde);
+    problem->CostGradients(solution->displacement, solution->retrograde, &solution->cost_gradients);
+    // One zone: de^2/dE; several: the derivative along a common change of every zone.
+    solution->cost_gradient = solution->cost_gradients.sum();
   }
   summary.sweeps = problem->sweep_count() - sweeps_before;
   summary.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();

@@ -63,7 +63,7 @@ DiscreteMcreOperators::DiscreteMcreOperators(const McreProblem& problem)
       inverse_alpha_(1.0 / problem.alpha()) {
   const BarModel& model = problem.model();
   const SymmetricBandMatrix mass(model.mass());
-  stiffness_ = SymmetricBandMatrix(model.Stiffness(problem.modulus()));
+  stiffness_ = SymmetricBandMatrix(model.Stiffness(problem.moduli()));
   bandwidth_ = std::max(mass.half_bandwidth(), stiffness_.half_bandwidth());
   const double h = time_step_, theta = theta_;
   // R = M - h^2 theta (1 - theta) K.

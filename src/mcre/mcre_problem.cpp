@@ -3,6 +3,7 @@
 #include <cassert>
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 namespace mcrewave {
 
@@ -22,13 +23,42 @@ bool McreWeights::IsValid(std::string* error) const {
 }
 
 McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
-                         const McreWeights& weights, double reference_modulus, double theta)
-    : model_(model), data_(data), theta_(theta), unit_stiffness_(model.unit_stiffness()) {
+                         const McreWeights& weights, double reference_modulus, double theta,
+                         EndDisplacementChannels ends)
+    : model_(model),
+      data_(data),
+      theta_(theta),
+      ends_(ends),
+      unit_stiffness_(model.unit_stiffness()) {
   assert(weights.IsValid(nullptr) && data.num_steps() >= 1 && reference_modulus > 0.0);
   const BarProperties& bar = model.properties();
-  // beta = w_u S E0 / L, alpha = w_f L / (S E0)  (formulation.md section 2).
+  // beta = w_u S E0 / L, alpha = w_f L / (S E0)  (docs/discrete_mcre.md);
+  // beta_e = w_e S E0 L  (docs/zones_and_sensors.md).
   beta_ = weights.displacement_weight * bar.section * reference_modulus / bar.length;
   alpha_ = weights.force_weight * bar.length / (bar.section * reference_modulus);
+  strain_beta_ = weights.strain_weight * bar.section * reference_modulus * bar.length;
+  beta_u0_ = ends.u0 ? beta_ : 0.0;
+  beta_uL_ = ends.uL ? beta_ : 0.0;
+  const int num_sensors = static_cast<int>(data.sensors.size());
+  sensor_weights_.resize(num_sensors);
+  for (int k = 0; k < num_sensors; ++k) {
+    const SensorChannel& sensor = data.sensors[k];
+    assert(sensor.position >= 0.0 && sensor.position <= bar.length &&
+           sensor.values.size() == data.num_samples());
+    const bool strain = sensor.kind == SensorKind::kStrain;
+    sensor_rows_.push_back(strain ? model.StrainRow(sensor.position)
+                                  : model.DisplacementRow(sensor.position));
+    sensor_weights_[k] = strain ? strain_beta_ : beta_;
+    sensor_data_.push_back(&sensor.values);
+    load_nodes_.push_back(sensor_rows_.back().nodes[0]);
+    load_nodes_.push_back(sensor_rows_.back().nodes[1]);
+  }
+  load_values_ = Matrix::Zero(2 * num_sensors, ThetaIntegrator::kMaxBatch);
+  for (int b = 0; b < ThetaIntegrator::kMaxBatch; ++b) {
+    point_loads_[b].count = 2 * num_sensors;
+    point_loads_[b].nodes = load_nodes_.data();
+    point_loads_[b].values = load_values_.col(b).data();
+  }
   const int n = model.num_nodes();
   for (int b = 0; b < 2; ++b) {
     velocity_[b] = Vector::Zero(n);
@@ -43,12 +73,31 @@ McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
 
 void McreProblem::SetModulus(double modulus) {
   assert(modulus > 0.0);
-  if (modulus == modulus_) return;
-  modulus_ = modulus;
+  SetModuli(Vector::Constant(model_.num_zones(), modulus));
+}
+
+void McreProblem::SetModuli(const Vector& zone_moduli) {
+  assert(zone_moduli.size() == model_.num_zones() && zone_moduli.minCoeff() > 0.0);
+  if (moduli_.size() == zone_moduli.size() && moduli_ == zone_moduli) return;
+  moduli_ = zone_moduli;
   ThetaIntegratorOptions options;
   options.time_step = data_.time_step;
   options.theta = theta_;
-  integrator_.Init(model_.mass(), model_.Stiffness(modulus), options);
+  // K = sum_z E_z K1_z (one zone: E K1).
+  integrator_.Init(model_.mass(), model_.Stiffness(moduli_), options);
+}
+
+void McreProblem::SensorLoads(int j, const double* displacement_j, bool include_data,
+                              double* values) const {
+  const double quadrature = QuadratureWeight(j);
+  for (int k = 0; k < num_interior_sensors(); ++k) {
+    // r_k = c_j beta_k (h_k . U_j - d~_kj), applied as r_k h_k.
+    double misfit = displacement_j != nullptr ? sensor_rows_[k].Apply(displacement_j) : 0.0;
+    if (include_data) misfit -= (*sensor_data_[k])[j];
+    const double load = quadrature * sensor_weights_[k] * misfit;
+    values[2 * k] = load * sensor_rows_[k].coefficients[0];
+    values[2 * k + 1] = load * sensor_rows_[k].coefficients[1];
+  }
 }
 
 void McreProblem::DirectSweep(const Matrix& retrograde, bool include_data, Matrix* displacement) {
@@ -88,16 +137,23 @@ void McreProblem::RetrogradeSweep(const Matrix& displacement, bool include_data,
   omega_[0].setZero();
   for (int j = m, s = 0; j > 0; --j, ++s) {
     const int current = s & 1, next = current ^ 1;
-    // Step t_j -> t_{j-1} carries the force c_j beta (B U_j - U~_j) (R2).
-    const double weight = QuadratureWeight(j) * beta_;
-    double f0 = weight * displacement(0, j);
-    double fL = weight * displacement(last, j);
+    // Step t_j -> t_{j-1} carries the force c_j H^T diag(beta_k) (H U_j - d~_j) (R2):
+    // the end displacement rows as end loads, the interior sensors as point loads.
+    const double weight0 = QuadratureWeight(j) * beta_u0_;
+    const double weightL = QuadratureWeight(j) * beta_uL_;
+    double f0 = weight0 * displacement(0, j);
+    double fL = weightL * displacement(last, j);
     if (include_data) {
-      f0 -= weight * data_.u0[j];
-      fL -= weight * data_.uL[j];
+      f0 -= weight0 * data_.u0[j];
+      fL -= weightL * data_.uL[j];
+    }
+    const PointLoads* loads = nullptr;
+    if (num_interior_sensors() > 0) {
+      SensorLoads(j, displacement.col(j).data(), include_data, load_values_.col(0).data());
+      loads = &point_loads_[0];
     }
     integrator_.StepWithEndLoads(velocity_[current], omega_[current], f0, fL, velocity_[next],
-                                 omega_[next]);
+                                 omega_[next], loads);
     // W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j  (R3), omega_m = 0; times
     // 1/c_j in {1, 2}, exact, instead of a division per entry.
     retrograde->col(j) =
@@ -169,6 +225,7 @@ void McreProblem::RetrogradeSweeps(const Matrix* const (&displacement)[B],
     batch_state_.col(2 * b).setZero();
   }
   const double* no_shift[B] = {};
+  const PointLoads* loads[B] = {};
   for (int j = m, step = 0; j > 0; --j, ++step) {
     const int current = step & 1, next = current ^ 1;
     const double* v_k[B];
@@ -176,19 +233,27 @@ void McreProblem::RetrogradeSweeps(const Matrix* const (&displacement)[B],
     double f0[B], fL[B];
     double* v_next[B];
     double* omega_next[B];
-    // As RetrogradeSweep: the force c_j beta (B U_j - U~_j) on step t_j -> t_{j-1}.
-    const double weight = QuadratureWeight(j) * beta_;
+    // As RetrogradeSweep: the force c_j H^T diag(beta_k) (H U_j - d~_j) on step
+    // t_j -> t_{j-1}.
+    const double weight0 = QuadratureWeight(j) * beta_u0_;
+    const double weightL = QuadratureWeight(j) * beta_uL_;
     for (int b = 0; b < B; ++b) {
-      f0[b] = displacement[b] != nullptr ? weight * (*displacement[b])(0, j) : 0.0;
-      fL[b] = displacement[b] != nullptr ? weight * (*displacement[b])(last, j) : 0.0;
-      f0[b] -= weight * data_.u0[j];
-      fL[b] -= weight * data_.uL[j];
+      f0[b] = displacement[b] != nullptr ? weight0 * (*displacement[b])(0, j) : 0.0;
+      fL[b] = displacement[b] != nullptr ? weightL * (*displacement[b])(last, j) : 0.0;
+      f0[b] -= weight0 * data_.u0[j];
+      fL[b] -= weightL * data_.uL[j];
+      if (num_interior_sensors() > 0) {
+        SensorLoads(j, displacement[b] != nullptr ? displacement[b]->col(j).data() : nullptr, true,
+                    load_values_.col(b).data());
+        loads[b] = &point_loads_[b];
+      }
       v_k[b] = batch_velocity_.col(2 * b + current).data();
       v_next[b] = batch_velocity_.col(2 * b + next).data();
       omega_k[b] = batch_state_.col(2 * b + current).data();
       omega_next[b] = batch_state_.col(2 * b + next).data();
     }
-    integrator_.StepsWithEndLoads<B>(v_k, omega_k, no_shift, f0, fL, v_next, omega_next);
+    integrator_.StepsWithEndLoads<B>(v_k, omega_k, no_shift, f0, fL, v_next, omega_next,
+                                     num_interior_sensors() > 0 ? loads : nullptr);
     for (int b = 0; b < B; ++b) {
       retrograde[b]->col(j) = (theta_ * batch_state_.col(2 * b + next) +
                                (1.0 - theta_) * batch_state_.col(2 * b + current)) *
@@ -280,8 +345,16 @@ double McreProblem::Cost(const Matrix& displacement, const Matrix& retrograde) {
         (2.0 * alpha_);
     const double u0_misfit = displacement(0, j) - data_.u0[j];
     const double uL_misfit = displacement(last, j) - data_.uL[j];
-    const double displacement_misfit =
-        0.5 * beta_ * (u0_misfit * u0_misfit + uL_misfit * uL_misfit);
+    double displacement_misfit =
+        observes_ends_only()
+            ? 0.5 * beta_ * (u0_misfit * u0_misfit + uL_misfit * uL_misfit)
+            : 0.5 * (beta_u0_ * u0_misfit * u0_misfit + beta_uL_ * uL_misfit * uL_misfit);
+    // + 1/2 beta_k (h_k . U_j - d~_kj)^2 over the interior sensors.
+    for (int k = 0; k < num_interior_sensors(); ++k) {
+      const double misfit =
+          sensor_rows_[k].Apply(displacement.col(j).data()) - (*sensor_data_[k])[j];
+      displacement_misfit += 0.5 * sensor_weights_[k] * misfit * misfit;
+    }
     sum += QuadratureWeight(j) * h * (gap + force_misfit + displacement_misfit);
   }
   return sum;
@@ -299,6 +372,81 @@ double McreProblem::CostGradient(const Matrix& displacement, const Matrix& retro
            (unit_stiffness_.BilinearForm(w, w) + 2.0 * unit_stiffness_.BilinearForm(w, u));
   }
   return -0.5 * sum;
+}
+
+void McreProblem::CostGradients(const Matrix& displacement, const Matrix& retrograde,
+                                Vector* gradient) {
+  const int zones = num_zones();
+  if (zones == 1) {
+    gradient->setConstant(1, CostGradient(displacement, retrograde));
+    return;
+  }
+  const int m = num_steps(), elements = model_.num_elements();
+  const double h = time_step();
+  gradient->setZero(zones);
+  for (int j = 0; j <= m; ++j) {
+    const double* w = retrograde.col(j).data();
+    const double* u = displacement.col(j).data();
+    const double weight = -0.5 * QuadratureWeight(j) * h;
+    for (int e = 0; e < elements; ++e) {
+      // W_j^T K1_e (W_j + 2 U_j) = k1_e dW (dW + 2 dU), dX = X_{e+1} - X_e; summed by zone.
+      const double dw = w[e + 1] - w[e];
+      const double du = u[e + 1] - u[e];
+      (*gradient)[model_.element_zone(e)] +=
+          weight * model_.element_unit_stiffness(e) * dw * (dw + 2.0 * du);
+    }
+  }
+}
+
+SparseMatrix McreProblem::WeightedObservation() const {
+  const int n = num_nodes();
+  std::vector<Eigen::Triplet<double>> entries{{0, 0, beta_u0_}, {n - 1, n - 1, beta_uL_}};
+  for (int k = 0; k < num_interior_sensors(); ++k) {
+    // beta_k h_k h_k^T.
+    const ObservationRow& row = sensor_rows_[k];
+    for (int a = 0; a < 2; ++a) {
+      for (int b = 0; b < 2; ++b) {
+        entries.emplace_back(row.nodes[a], row.nodes[b],
+                             sensor_weights_[k] * row.coefficients[a] * row.coefficients[b]);
+      }
+    }
+  }
+  SparseMatrix weighted(n, n);
+  weighted.setFromTriplets(entries.begin(), entries.end());
+  weighted.prune(0.0);
+  return weighted;
+}
+
+void McreProblem::WeightedData(int j, Eigen::Ref<Vector> load) const {
+  load.setZero();
+  load[0] += beta_u0_ * data_.u0[j];
+  load[num_nodes() - 1] += beta_uL_ * data_.uL[j];
+  for (int k = 0; k < num_interior_sensors(); ++k) {
+    // beta_k h_k d~_kj.
+    const ObservationRow& row = sensor_rows_[k];
+    const double weighted = sensor_weights_[k] * (*sensor_data_[k])[j];
+    load[row.nodes[0]] += weighted * row.coefficients[0];
+    load[row.nodes[1]] += weighted * row.coefficients[1];
+  }
+}
+
+Vector McreProblem::ErrorMap(const Matrix& retrograde) const {
+  const int m = num_steps(), elements = model_.num_elements();
+  const double h = time_step();
+  Vector map = Vector::Zero(elements);
+  for (int j = 0; j <= m; ++j) {
+    const double* w = retrograde.col(j).data();
+    const double weight = 0.5 * QuadratureWeight(j) * h;
+    for (int e = 0; e < elements; ++e) {
+      // 1/2 W_j^T K_el W_j = 1/2 E_e k1_e (W_{e+1} - W_e)^2.
+      const double dw = w[e + 1] - w[e];
+      map[e] += weight * dw * dw;
+    }
+  }
+  for (int e = 0; e < elements; ++e) {
+    map[e] *= moduli_[model_.element_zone(e)] * model_.element_unit_stiffness(e);
+  }
+  return map;
 }
 
 }  // namespace mcrewave

@@ -24,12 +24,14 @@ bool McreOptions::IsValid(std::string* error) const {
 
 McreObjective::McreObjective(const BarModel& model, const MeasurementSet& data,
                              const McreOptions& mcre, double theta,
-                             const CoupledSolverOptions& inner, double modulus_scale)
+                             const CoupledSolverOptions& inner, double modulus_scale,
+                             EndDisplacementChannels ends)
     : model_(model),
       data_(data),
       mcre_(mcre),
       theta_(theta),
-      problem_(model, data, mcre.weights, mcre.reference_modulus, theta),
+      ends_(ends),
+      problem_(model, data, mcre.weights, mcre.reference_modulus, theta, ends),
       inner_(inner),
       modulus_scale_(modulus_scale) {
   assert(mcre.IsValid(nullptr) && inner.IsValid(nullptr) && modulus_scale > 0.0);
@@ -48,7 +50,8 @@ McreObjective::McreObjective(const BarModel& model, const MeasurementSet& data,
 std::unique_ptr<ModulusObjective> McreObjective::CloneForScan(double inner_tolerance) const {
   CoupledSolverOptions inner = inner_;
   inner.tolerance = inner_tolerance;
-  return std::make_unique<McreObjective>(model_, data_, mcre_, theta_, inner, modulus_scale_);
+  return std::make_unique<McreObjective>(model_, data_, mcre_, theta_, inner, modulus_scale_,
+                                         ends_);
 }
 
 void McreObjective::SetWarmStart(const Matrix& retrograde) {
@@ -63,9 +66,6 @@ void McreObjective::SetWarmStart(const Matrix& retrograde) {
 const ObjectiveEvaluation& McreObjective::EvaluateModulus(double modulus, bool gradient_requested) {
   assert(modulus > 0.0 && std::isfinite(modulus));
   problem_.SetModulus(modulus);
-  ObjectiveEvaluation record;
-  record.modulus = modulus;
-  record.gradient_requested = gradient_requested;
   const Matrix* initial = warm_start_.size() > 0 ? &warm_start_ : nullptr;
   if (initial != nullptr && previous_start_.size() > 0 &&
       previous_start_modulus_ != warm_start_modulus_) {
@@ -77,29 +77,51 @@ const ObjectiveEvaluation& McreObjective::EvaluateModulus(double modulus, bool g
       initial = &initial_;
     }
   }
+  return Solve(modulus, gradient_requested, initial);
+}
+
+const ObjectiveEvaluation& McreObjective::EvaluateModuli(const Vector& zone_moduli,
+                                                         bool gradient_requested) {
+  assert(zone_moduli.size() == problem_.num_zones() && zone_moduli.allFinite() &&
+         zone_moduli.minCoeff() > 0.0);
+  if (zone_moduli.minCoeff() == zone_moduli.maxCoeff()) {
+    return EvaluateModulus(zone_moduli[0], gradient_requested);
+  }
+  problem_.SetModuli(zone_moduli);
+  // From the last usable solution: no line to extrapolate along in several dimensions.
+  return Solve(-1.0, gradient_requested, warm_start_.size() > 0 ? &warm_start_ : nullptr);
+}
+
+const ObjectiveEvaluation& McreObjective::Solve(double modulus, bool gradient_requested,
+                                                const Matrix* initial) {
+  ObjectiveEvaluation record;
+  record.modulus = modulus;
+  record.moduli = problem_.moduli();
+  record.gradient_requested = gradient_requested;
   record.inner = SolveCoupled(inner_, &problem_, initial, &solution_);
   record.usable = record.inner.IsSolutionUsable();
   if (record.usable) {
     record.cost = solution_.cost;
     record.cost_gradient = solution_.cost_gradient;
-    // The last two usable solutions; one set by SetWarmStart (modulus unknown) is
-    // not extrapolated from.
-    if (warm_start_.size() > 0 && warm_start_modulus_ > 0.0) {
+    record.cost_gradients = solution_.cost_gradients;
+    // The last two usable solutions; one set by SetWarmStart or at unequal zone moduli
+    // (modulus unknown: 0) is not extrapolated from.
+    if (warm_start_.size() > 0 && warm_start_modulus_ > 0.0 && modulus > 0.0) {
       previous_start_.swap(warm_start_);
       previous_start_modulus_ = warm_start_modulus_;
     } else {
       previous_start_.resize(0, 0);
     }
     warm_start_ = solution_.retrograde;
-    warm_start_modulus_ = modulus;
+    warm_start_modulus_ = modulus > 0.0 ? modulus : 0.0;
     if (best_index_ < 0 || record.cost < evaluations_[best_index_].cost) {
       best_index_ = static_cast<int>(evaluations_.size());
       best_solution_ = solution_;
     }
   }
   spdlog::debug(
-      "e^2({:.9g} Pa) = {:.9g} J s, de^2/dE = {:.6g} J s/Pa; inner {} (from {:.3g})", modulus,
-      record.cost, record.cost_gradient, record.inner.BriefReport(),
+      "e^2({:.9g} Pa) = {:.9g} J s, de^2/dE = {:.6g} J s/Pa; inner {} (from {:.3g})",
+      record.moduli.mean(), record.cost, record.cost_gradient, record.inner.BriefReport(),
       record.inner.residual_history.empty() ? -1.0 : record.inner.residual_history.front());
   evaluations_.push_back(std::move(record));
   return evaluations_.back();

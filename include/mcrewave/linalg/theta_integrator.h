@@ -38,7 +38,8 @@
 // StepWithEndLoads takes a force of the form the MCRE sweeps need without forming
 // it: f_theta = -K z + f0 e_0 + fL e_{n-1} (z optional), so that
 //   rhs = R v_k - h K (u_k + z) + h (f0 e_0 + fL e_{n-1})
-// is one pass.
+// is one pass. Optional point loads (PointLoads) add sum_i p_i e_{node_i} to f_theta
+// in the same pass: the interior sensors' loads of the retrograde sweep.
 // theta = 1/2 is the trapezoidal rule (second order, energy conserving); theta = 1
 // is backward Euler (first order).
 //
@@ -54,6 +55,14 @@
 #include "mcrewave/linalg/band_matrix.h"
 
 namespace mcrewave {
+
+// Point loads p_i [N] at nodes node_i, a few per step (sensor loads); the arrays
+// belong to the caller and must hold `count` entries each.
+struct PointLoads {
+  int count = 0;
+  const int* nodes = nullptr;
+  const double* values = nullptr;  // [N]
+};
 
 struct ThetaIntegratorOptions {
   double time_step = 0.36e-6;  // h [s]
@@ -80,22 +89,27 @@ class ThetaIntegrator {
   // One step with the force f_theta = -K z + f0 e_0 + fL e_{n-1} [N] (z [m], same
   // size as u_k) or, without z, f_theta = f0 e_0 + fL e_{n-1}. Same contract as
   // Step otherwise.
+  // point_loads (nullable) adds its loads to f_theta.
   void StepWithEndLoads(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref<const Vector>& u_k,
                         const Eigen::Ref<const Vector>& z, double f0, double fL,
-                        Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next);
+                        Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next,
+                        const PointLoads* point_loads = nullptr);
   void StepWithEndLoads(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref<const Vector>& u_k,
-                        double f0, double fL, Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next);
+                        double f0, double fL, Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next,
+                        const PointLoads* point_loads = nullptr);
 
   // B independent steps at once (B = 2 or 3), step b as StepWithEndLoads from
   // (v_k[b], u_k[b]) with z[b] (null: none), f0[b], fL[b]; all arrays of size()
-  // contiguous doubles, outputs distinct from every input. The tridiagonal solves
+  // contiguous doubles, outputs distinct from every input; point_loads[b] (nullable,
+  // or the whole array null) as in StepWithEndLoads. The tridiagonal solves
   // run interleaved (about the latency of one); the results are those of B single
   // steps, bit for bit.
   static constexpr int kMaxBatch = 3;
   template <int B>
   void StepsWithEndLoads(const double* const (&v_k)[B], const double* const (&u_k)[B],
                          const double* const (&z)[B], const double (&f0)[B], const double (&fL)[B],
-                         double* const (&v_next)[B], double* const (&u_next)[B]);
+                         double* const (&v_next)[B], double* const (&u_next)[B],
+                         const PointLoads* const* point_loads = nullptr);
 
   // Runs num_steps steps forward in time from (v0, u0).
   //   forcing(k, f): writes into f (an Eigen::Ref<Vector> of size n) the force
@@ -131,13 +145,16 @@ class ThetaIntegrator {
   // z is not null, else u_k.
   template <bool kForceVector>
   void TridiagonalStep(const double* v_k, const double* u_k, const double* z, const double* force,
-                       double f0, double fL, double* v_next, double* u_next);
+                       double f0, double fL, double* v_next, double* u_next,
+                       const PointLoads* point_loads = nullptr);
   // The parts of TridiagonalStep: rhs into v_next (shifted: scratch for u_k + z),
   // and u_next = u_k + h (1 - theta) v_k + h theta v_next.
   template <bool kForceVector>
   void TridiagonalRightHandSide(const double* v_k, const double* u_k, const double* z,
                                 const double* force, double f0, double fL, double* shifted,
-                                double* v_next) const;
+                                double* v_next, const PointLoads* point_loads) const;
+  // f_theta's end and point loads added into force_ (the banded path).
+  void AddEndAndPointLoads(double f0, double fL, const PointLoads* point_loads);
   void UpdateDisplacement(const double* u_k, const double* v_k, const double* v_next,
                           double* u_next) const;
 

@@ -138,7 +138,8 @@ struct CoupledSolution {
   Matrix displacement;         // U, n x (m + 1) [m]
   Matrix retrograde;           // W, n x (m + 1) [m]
   double cost = -1.0;          // e^2(E) [J s]
-  double cost_gradient = 0.0;  // de^2/dE [J s / Pa]
+  double cost_gradient = 0.0;  // de^2/dE [J s / Pa] (several zones: sum_z de^2/dE_z)
+  Vector cost_gradients;       // de^2/dE_z [J s / Pa], one per zone
 };
 
 // Solves the coupled problem at the problem's current modulus. initial_retrograde

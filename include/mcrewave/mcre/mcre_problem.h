@@ -1,17 +1,25 @@
-// The time-discrete coupled direct / retrograde MCRE problem for one trial
-// modulus (docs/discrete_mcre.md; formulation.md sections 2 and 3).
+// The time-discrete coupled direct / retrograde MCRE problem for one set of trial
+// zone moduli (docs/discrete_mcre.md; zones and sensors: docs/zones_and_sensors.md).
 //
 // Fields are stored as n x (m + 1) matrices, column j = time t_j = j h:
 // U (displacement), W (retrograde field, the constitutive gap). The problem owns
-// one ThetaIntegrator, factorised once per modulus (SetModulus), and offers the
+// one ThetaIntegrator, factorised once per set of moduli (SetModuli), and offers the
 // two sweeps that every coupled solver is built from:
 //
 //   DirectSweep:      W -> U,  (D1, D2) forward with the force F~ - (K + B/alpha) W
-//   RetrogradeSweep:  U -> W,  (R1, R2) backward with the force c_j beta (B U_j - U~_j),
+//   RetrogradeSweep:  U -> W,  (R1, R2) backward with the force
+//                              c_j H^T diag(beta_k) (H U_j - d~_j),
 //                              then W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j
 //
 // and the inner product <x, y>_P in which the reduced operator A = I - G is
-// self-adjoint, the cost e^2 and its derivative de^2/dE.
+// self-adjoint, the cost e^2, its derivatives de^2/dE_z and the error map.
+//
+// The observation H stacks the end displacement rows e_0^T, e_N^T (each unless left
+// out of data.channels) and one row per interior sensor of the data (u@X, e@X; rows of
+// BarModel::DisplacementRow / StrainRow), with weights beta_u = w_u S E0 / L for
+// displacements and beta_e = w_e S E0 L for strains. With the two end rows only, it is
+// the paper's B = e_0 e_0^T + e_N e_N^T and every number is the one of the paper's case.
+// The measured end forces f0, fL are the model's loads and keep their alpha term.
 #pragma once
 
 #include <vector>
@@ -42,24 +50,45 @@ struct McreWeights {
   bool IsValid(std::string* error) const;
 };
 
+// Which end displacement channels enter the data term (config data.channels); the
+// interior sensors are those of the data set.
+struct EndDisplacementChannels {
+  bool u0 = true;
+  bool uL = true;
+};
+
 class McreProblem {
  public:
   // Keeps references to model and data: both must outlive the problem.
-  // reference_modulus is E0 of the weights [Pa]; theta of the time scheme.
-  // Precondition: data.num_steps() >= 1, weights valid, theta in [0, 1].
+  // reference_modulus is E0 of the weights [Pa]; theta of the time scheme. The zones
+  // are the model's; every zone starts at the model's properties().modulus.
+  // Precondition: data.num_steps() >= 1, weights valid, theta in [0, 1], every sensor
+  // position in [0, L].
   McreProblem(const BarModel& model, const MeasurementSet& data, const McreWeights& weights,
-              double reference_modulus, double theta);
+              double reference_modulus, double theta, EndDisplacementChannels ends = {});
 
-  // Sets the trial modulus E [Pa] and refactorises the integrator (once per E).
+  // Sets every zone's modulus to E [Pa] and refactorises the integrator (once per change).
   void SetModulus(double modulus);
-  double modulus() const { return modulus_; }
+  // Sets the zone moduli E_z [Pa] (model().num_zones() entries) and refactorises the
+  // integrator when they changed: K = sum_z E_z K1_z.
+  void SetModuli(const Vector& zone_moduli);
+  // The modulus of a one-zone model, else the first zone's [Pa].
+  double modulus() const { return moduli_.size() > 0 ? moduli_[0] : 0.0; }
+  const Vector& moduli() const { return moduli_; }
+  int num_zones() const { return model_.num_zones(); }
 
   int num_nodes() const { return model_.num_nodes(); }
   int num_steps() const { return data_.num_steps(); }
   double time_step() const { return data_.time_step; }
   double theta() const { return theta_; }
-  double alpha() const { return alpha_; }  // force weight [m/N]
-  double beta() const { return beta_; }    // displacement weight [N/m]
+  double alpha() const { return alpha_; }              // force weight [m/N]
+  double beta() const { return beta_; }                // displacement weight beta_u [N/m]
+  double strain_beta() const { return strain_beta_; }  // strain weight beta_e [N m]
+  const EndDisplacementChannels& end_channels() const { return ends_; }
+  // Number of interior sensor rows of H (u@X, e@X); 0 in the paper's case.
+  int num_interior_sensors() const { return static_cast<int>(sensor_rows_.size()); }
+  // True when H is the paper's B: both end displacements and no interior sensor.
+  bool observes_ends_only() const { return ends_.u0 && ends_.uL && num_interior_sensors() == 0; }
   const BarModel& model() const { return model_; }
   const MeasurementSet& data() const { return data_; }
   // A zero field of the problem's shape, n x (m + 1).
@@ -91,10 +120,27 @@ class McreProblem {
   double InnerProduct(const Matrix& x, const Matrix& y);
   double Norm(const Matrix& x) { return std::sqrt(std::max(0.0, InnerProduct(x, x))); }
 
-  // e^2 = sum_j c_j h [1/2 W^T K W + W^T B W / (2 alpha) + beta/2 |B U - U~|^2]  [J s].
+  // e^2 = sum_j c_j h [1/2 W^T K W + W^T B W / (2 alpha)
+  //                    + 1/2 (H U - d~)^T diag(beta_k) (H U - d~)]  [J s].
   double Cost(const Matrix& displacement, const Matrix& retrograde);
-  // de^2/dE = -(1/(2E)) sum_j c_j h W_j^T K (W_j + 2 U_j)  [J s / Pa].
+  // de^2/dE = -(1/(2E)) sum_j c_j h W_j^T K (W_j + 2 U_j)  [J s / Pa], the derivative
+  // along a common change of every zone's modulus (one zone: the modulus).
+  // Precondition: every zone at the same modulus.
   double CostGradient(const Matrix& displacement, const Matrix& retrograde);
+  // de^2/dE_z = -(1/(2 E_z)) sum_j c_j h W_j^T K_z (W_j + 2 U_j) = -(1/2) sum_j c_j h
+  // W_j^T K1_z (W_j + 2 U_j) [J s / Pa], every zone from the one pair of fields;
+  // gradient is resized to num_zones(). One zone: CostGradient.
+  void CostGradients(const Matrix& displacement, const Matrix& retrograde, Vector* gradient);
+  // The error map: the share of each element in the constitutive part of e^2,
+  //   e_el^2 = sum_j c_j h 1/2 W_j^T K_el W_j  [J s],
+  // one entry per element; their sum is sum_j c_j h 1/2 W_j^T K W_j.
+  Vector ErrorMap(const Matrix& retrograde) const;
+
+  // H^T diag(beta_k) H [N/m], n x n: the data term's operator on U (the paper's
+  // case: beta B). For the assembled reference solvers.
+  SparseMatrix WeightedObservation() const;
+  // H^T diag(beta_k) d~_j [N] at sample j into load (size n).
+  void WeightedData(int j, Eigen::Ref<Vector> load) const;
 
   // Number of sweeps (direct + retrograde) run since construction.
   long sweep_count() const { return sweep_count_; }
@@ -119,14 +165,31 @@ class McreProblem {
   template <int B>
   void RetrogradeSweeps(const Matrix* const (&displacement)[B], Matrix* const (&retrograde)[B]);
 
+  // The retrograde force of step t_j -> t_{j-1} at the interior sensors,
+  // c_j H_s^T diag(beta_s) (H_s U_j - d~_j) (without the data when include_data is
+  // false), into loads' values (two nodes per sensor). U_j may be null (zero).
+  void SensorLoads(int j, const double* displacement_j, bool include_data, double* values) const;
+
   const BarModel& model_;
   const MeasurementSet& data_;
   double theta_;
   double alpha_;
   double beta_;
-  double modulus_ = 0.0;
+  double strain_beta_;
+  EndDisplacementChannels ends_;
+  double beta_u0_, beta_uL_;  // beta_u for an end displacement channel in use, else 0
+  Vector moduli_;             // E_z [Pa]
+  // Interior sensors: H's rows, their weights beta_k and data d~_k (one per sample).
+  std::vector<ObservationRow> sensor_rows_;
+  Vector sensor_weights_;
+  std::vector<const Vector*> sensor_data_;
+  // Point loads of the retrograde sweeps at the sensors' nodes, values per sweep
+  // of a batch (column b), allocated in the constructor.
+  std::vector<int> load_nodes_;
+  Matrix load_values_;
+  PointLoads point_loads_[ThetaIntegrator::kMaxBatch];
   ThetaIntegrator integrator_;
-  SymmetricBandMatrix unit_stiffness_;  // K1
+  SymmetricBandMatrix unit_stiffness_;  // K1 = sum_z K1_z
   long sweep_count_ = 0;
   SolverWorkspace workspace_;
   // Scratch, allocated in the constructor.

@@ -72,9 +72,11 @@ struct McreOptions {
 
 // One evaluation of e^2(E) by McreObjective.
 struct ObjectiveEvaluation {
-  double modulus = -1.0;            // E [Pa]
+  double modulus = -1.0;            // E [Pa] when every zone has it; -1 when they differ
+  Vector moduli;                    // E_z [Pa], one per zone
   double cost = -1.0;               // e^2(E) [J s]; meaningful only when usable
-  double cost_gradient = 0.0;       // de^2/dE [J s / Pa], the adjoint gradient
+  double cost_gradient = 0.0;       // de^2/dE [J s / Pa], the adjoint gradient (sum over zones)
+  Vector cost_gradients;            // de^2/dE_z [J s / Pa], one per zone
   bool gradient_requested = false;  // whether the caller asked for the gradient
   bool usable = false;              // inner.IsSolutionUsable()
   CoupledSolverSummary inner;       // the coupled solve
@@ -85,8 +87,11 @@ class McreObjective : public ModulusObjective {
   // Keeps references to model and data: both must outlive the objective.
   // modulus_scale [Pa] is E per unit of x. Preconditions: mcre.IsValid(),
   // inner.IsValid(), theta in [0, 1], modulus_scale > 0, data.num_steps() >= 1.
+  // ends: the end displacement channels in use (data.channels); the interior sensors
+  // are those of data.
   McreObjective(const BarModel& model, const MeasurementSet& data, const McreOptions& mcre,
-                double theta, const CoupledSolverOptions& inner, double modulus_scale);
+                double theta, const CoupledSolverOptions& inner, double modulus_scale,
+                EndDisplacementChannels ends = {});
 
   double modulus_scale() const override { return modulus_scale_; }
 
@@ -102,6 +107,11 @@ class McreObjective : public ModulusObjective {
   // Evaluates e^2 and de^2/dE at modulus E [Pa] (> 0) and records it; returns the
   // record. Evaluate calls this.
   const ObjectiveEvaluation& EvaluateModulus(double modulus, bool gradient_requested = true);
+  // Evaluates e^2 and every de^2/dE_z at the zone moduli E_z [Pa] (> 0, one per zone
+  // of the model) and records it. Equal moduli: EvaluateModulus. Unequal: the solve
+  // starts from the last usable solution.
+  const ObjectiveEvaluation& EvaluateModuli(const Vector& zone_moduli,
+                                            bool gradient_requested = true);
 
   // J_rest = sum_j c_j h [alpha/2 |F~_j|^2 + beta/2 |U~_j|^2] [J s]: the functional
   // for the bar left at rest (U = W = 0, zero end forces), which satisfies the
@@ -133,10 +143,15 @@ class McreObjective : public ModulusObjective {
   McreProblem& problem() { return problem_; }
 
  private:
+  // Solves at the problem's moduli from `initial` (nullable) and records the evaluation;
+  // modulus is the common modulus, or -1 when the zones differ.
+  const ObjectiveEvaluation& Solve(double modulus, bool gradient_requested, const Matrix* initial);
+
   const BarModel& model_;
   const MeasurementSet& data_;
   McreOptions mcre_;
   double theta_;
+  EndDisplacementChannels ends_;
   McreProblem problem_;
   CoupledSolverOptions inner_;
   double modulus_scale_;
