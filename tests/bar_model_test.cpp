@@ -193,3 +193,92 @@ TEST(BarPropertiesTest, InvalidPropertiesAreRefusedWithTheKey) {
 
 }  // namespace
 }  // namespace mcrewave
+
+namespace mcrewave {
+namespace {
+
+BarProperties TenElementBar() {
+  BarProperties bar;
+  bar.elements = 10;  // h_e = 0.1 m
+  return bar;
+}
+
+TEST(BarZonesTest, ElementsBelongToTheZoneOfTheirMidpoint) {
+  const BarProperties bar = TenElementBar();
+  ZoneLayout layout;
+  layout.zone_count = 3;  // boundaries 1/3, 2/3: midpoints 0.05 .. 0.95
+  EXPECT_EQ(layout.Validate(bar), "");
+  EXPECT_EQ(layout.ElementZones(bar), (std::vector<int>{0, 0, 0, 1, 1, 1, 1, 2, 2, 2}));
+  layout.zoning = Zoning::kBoundaries;
+  layout.zone_boundaries = {0.6, 0.7};
+  EXPECT_EQ(layout.Validate(bar), "");
+  EXPECT_EQ(layout.ElementZones(bar), (std::vector<int>{0, 0, 0, 0, 0, 0, 1, 2, 2, 2}));
+  layout.zoning = Zoning::kPerElement;
+  EXPECT_EQ(layout.ElementZones(bar), (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7, 8, 9}));
+}
+
+TEST(BarZonesTest, LayoutsWithoutAnElementInAZoneAreRefusedNamingTheKey) {
+  const BarProperties bar = TenElementBar();
+  ZoneLayout layout;
+  layout.zone_count = 11;
+  EXPECT_NE(layout.Validate(bar).find("model.zone_count"), std::string::npos);
+  layout.zoning = Zoning::kBoundaries;
+  layout.zone_boundaries = {0.61, 0.64};  // no midpoint in [0.61, 0.64)
+  EXPECT_NE(layout.Validate(bar).find("holds no element"), std::string::npos);
+  layout.zone_boundaries = {0.7, 0.6};
+  EXPECT_NE(layout.Validate(bar).find("model.zone_boundaries[1]"), std::string::npos);
+  layout.zone_boundaries = {1.2};
+  EXPECT_NE(layout.Validate(bar).find("model.zone_boundaries[0]"), std::string::npos);
+}
+
+TEST(BarZonesTest, ZoneStiffnessIsTheSumOfScaledZoneMatrices) {
+  const BarProperties bar = TenElementBar();
+  ZoneLayout layout;
+  layout.zone_count = 2;
+  const BarModel model(bar, layout.ElementZones(bar));
+  ASSERT_EQ(model.num_zones(), 2);
+  Vector moduli(2);
+  moduli << 100e9, 300e9;
+  const Matrix k = Matrix(model.Stiffness(moduli));
+  // Node 5 joins element 4 (zone 0) and element 5 (zone 1): (E_0 + E_1) S / h_e.
+  EXPECT_DOUBLE_EQ(k(5, 5), (100e9 + 300e9) * bar.section / 0.1);
+  EXPECT_DOUBLE_EQ(k(2, 3), -100e9 * bar.section / 0.1);
+  EXPECT_DOUBLE_EQ(k(7, 8), -300e9 * bar.section / 0.1);
+  // Equal moduli: E K1.
+  EXPECT_LT(
+      (Matrix(model.Stiffness(Vector::Constant(2, 2e11))) - Matrix(model.Stiffness(2e11))).norm(),
+      1e-6 * k.norm());
+}
+
+TEST(BarZonesTest, TruthModuliPutPartlyCoveredElementsInSeries) {
+  const BarProperties bar = TenElementBar();
+  // A zone of 100 GPa over [0.6, 0.75]: element 6 fully, element 7 half covered.
+  const Vector moduli = ElementModuli(bar, {{0.6, 0.75, 100e9}});
+  EXPECT_DOUBLE_EQ(moduli[5], bar.modulus);
+  EXPECT_DOUBLE_EQ(moduli[6], 100e9);
+  // 1 / E = 0.5 / 100 GPa + 0.5 / 200 GPa.
+  // Measured 7e-16 relative (the pieces' lengths carry the round-off of 0.75 - 0.7).
+  EXPECT_NEAR(moduli[7], 1.0 / (0.5 / 100e9 + 0.5 / 200e9), 1e-14 * moduli[7]);
+  EXPECT_DOUBLE_EQ(moduli[8], bar.modulus);
+  EXPECT_NE(
+      ValidateModulusZones(bar, {{0.5, 1.5, 1e9}}, "data.truth_zones").find("data.truth_zones[0]"),
+      std::string::npos);
+}
+
+TEST(BarSensorsTest, RowsInterpolateDisplacementAndDifferentiateForStrain) {
+  const BarModel model(TenElementBar());
+  // A linear field u = 2 x + 1: u(0.25) = 1.5, strain 2 everywhere.
+  Vector u(11);
+  for (int i = 0; i <= 10; ++i) u[i] = 2.0 * model.node_position(i) + 1.0;
+  EXPECT_NEAR(model.DisplacementRow(0.25).Apply(u.data()), 1.5, 1e-15);
+  EXPECT_NEAR(model.DisplacementRow(1.0).Apply(u.data()), 3.0, 1e-15);
+  EXPECT_NEAR(model.StrainRow(0.65).Apply(u.data()), 2.0, 1e-13);
+  EXPECT_NEAR(model.StrainRow(0.0).Apply(u.data()), 2.0, 1e-13);
+  // A node belongs to the element on its right; x = L to the last element.
+  EXPECT_EQ(model.ElementAt(0.3), 3);
+  EXPECT_EQ(model.ElementAt(1.0), 9);
+  EXPECT_EQ(model.StrainRow(0.35).nodes[0], 3);
+}
+
+}  // namespace
+}  // namespace mcrewave

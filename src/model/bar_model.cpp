@@ -56,12 +56,24 @@ Vector ElementModuli(const BarProperties& bar, const std::vector<ModulusZone>& z
     const double a = e * he, b = (e + 1) * he;
     // Pieces of [a, b] in series: 1 / E_e = sum (length / h_e) / E_piece. Paint the
     // zones in order over the background, as breakpoints of the element.
+    // Zone ends within 1e-9 h_e of a node are at the node (0.6 vs 6 x 0.1).
+    const double tolerance = 1e-9 * he;
     std::vector<double> cuts{a, b};
     for (const ModulusZone& zone : zones) {
-      if (zone.start > a && zone.start < b) cuts.push_back(zone.start);
-      if (zone.end > a && zone.end < b) cuts.push_back(zone.end);
+      for (double cut : {zone.start, zone.end}) {
+        if (cut > a + tolerance && cut < b - tolerance) cuts.push_back(cut);
+      }
     }
     std::sort(cuts.begin(), cuts.end());
+    if (cuts.size() == 2) {
+      // One piece: the element's modulus as it is (no round-off of a harmonic mean).
+      double modulus = bar.modulus;
+      for (const ModulusZone& zone : zones) {
+        if (0.5 * (a + b) >= zone.start && 0.5 * (a + b) <= zone.end) modulus = zone.modulus;
+      }
+      moduli[e] = modulus;
+      continue;
+    }
     double compliance = 0.0;  // sum (length / h_e) / E_piece [1/Pa]
     for (std::size_t c = 0; c + 1 < cuts.size(); ++c) {
       const double length = cuts[c + 1] - cuts[c];
@@ -224,7 +236,8 @@ SparseMatrix BarModel::Stiffness(const Vector& zone_moduli) const {
 
 int BarModel::ElementAt(double position) const {
   assert(position >= 0.0 && position <= properties_.length);
-  const int e = static_cast<int>(std::floor(position / element_length()));
+  // x / h_e within 1e-9 below a node counts as the node (0.3 / 0.1 = 2.9999999999999996).
+  const int e = static_cast<int>(std::floor(position / element_length() + 1e-9));
   return std::clamp(e, 0, num_elements() - 1);
 }
 

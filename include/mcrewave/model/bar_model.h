@@ -128,7 +128,8 @@ class BarModel {
   double node_position(int node) const { return node * element_length(); }
 
   // The element that holds x in [0, L]: floor(x / h_e), the last element for x = L
-  // (a node shared by two elements belongs to the one on its right).
+  // (a node shared by two elements belongs to the one on its right; x within 1e-9 h_e
+  // below a node counts as the node).
   int ElementAt(double position) const;
   // Observation rows (see the file comment). Precondition: 0 <= x <= L.
   ObservationRow DisplacementRow(double position) const;
