@@ -173,6 +173,13 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
   // The cost curve around E*.
   run.cost_curve = ComputeCostCurve(config, model, run.data, run, &run.cost_curve_sweeps);
 
+  // The error map of the constitutive gap at the homogeneous E* (error_map.h).
+  run.error_map = ComputeErrorMap(model, Vector::Constant(1, run.identified_modulus()),
+                                  run.solution.retrograde, config.time.step);
+  const int peak = run.error_map.PeakElement();
+  spdlog::info("error map: largest share {:.3g} of the constitutive gap at x = {:.4g} m",
+               run.error_map.Fractions()[peak], run.error_map.position[peak]);
+
   // The inner solver's convergence at E* from W = 0.
   McreObjective cold(model, run.data, config.mcre, config.time.theta, config.inner,
                      run.identified_modulus());

@@ -275,6 +275,52 @@ std::string InnerResidualScript(const IdentificationRun& run, const std::string&
 
 }  // namespace
 
+std::string ErrorMapCsv(const IdentificationRun& run) {
+  const ErrorMap& map = run.error_map;
+  const Vector fractions = map.Fractions();
+  std::string csv = "element,x,share,fraction\n";
+  for (Eigen::Index e = 0; e < map.share.size(); ++e) {
+    csv += std::to_string(e) + "," + Format(map.position[e]) + "," + Format(map.share[e]) + "," +
+           Format(fractions[e]) + "\n";
+  }
+  return csv;
+}
+
+// gnuplot's nonuniform matrix: first row the count and the x of each element, then
+// one row per time: t, then the densities.
+std::string ErrorMapSpaceTimeData(const IdentificationRun& run) {
+  const ErrorMap& map = run.error_map;
+  std::string text = std::to_string(map.position.size());
+  for (Eigen::Index e = 0; e < map.position.size(); ++e) text += " " + Format(map.position[e]);
+  text += "\n";
+  for (Eigen::Index i = 0; i < map.times.size(); ++i) {
+    text += Format(map.times[i]);
+    for (Eigen::Index e = 0; e < map.density.cols(); ++e) text += " " + Format(map.density(i, e));
+    text += "\n";
+  }
+  return text;
+}
+
+std::string ErrorMapScript(const IdentificationRun& run, const std::string& folder) {
+  std::ostringstream script;
+  script << GnuplotPngTerminal() << "set terminal pngcairo size 1100,900\n"
+         << "set multiplot layout 2,1 title 'MCRE error map at the identified E = "
+         << run.identified_modulus() / 1e9 << " GPa'\n"
+         << "set xlabel 'x [m]'\nset ylabel 'share of the constitutive gap'\nset grid\n"
+         << "set xrange [0:" << run.config.model.length << "]\n"
+         << "set title 'e_{el}^2 / sum e_{el}^2 per element'\n"
+         << "plot " << GnuplotString(folder + "/error_map.csv")
+         << " skip 1 using 2:4 with boxes fill solid 0.6 lc rgb '#1f4e9c' notitle\n"
+         << "set title 'gap energy density 1/2 W^T K_{el} W / h_e [J/m] over x and t'\n"
+         << "set ylabel 't [ms]'\nunset grid\nset palette rgb 21,22,23\n"
+         << "set cblabel 'J/m'\nset yrange [0:" << run.config.time.window * 1e3 << "]\n"
+         << "set datafile separator whitespace\n"
+         << "plot " << GnuplotString(folder + "/error_map_spacetime.dat")
+         << " matrix nonuniform using 1:($2*1e3):3 with image notitle\n"
+         << "unset multiplot\n";
+  return script.str();
+}
+
 std::string SummaryYaml(const IdentificationRun& run) {
   const IdentificationSummary& outer = run.outer;
   const double identified = run.identified_modulus();
@@ -295,6 +341,15 @@ std::string SummaryYaml(const IdentificationRun& run) {
                "direct + retrograde sweeps of those evaluations");
   yaml.Number(0, "wall_time_s", run.wall_time_s,
               "[s] identification, cost curve and uncertainty (not the data)");
+
+  if (run.error_map.share.size() > 0) {
+    const int peak = run.error_map.PeakElement();
+    yaml.Line(0, "error_map", "", "the constitutive gap by element at the identified E");
+    yaml.Integer(1, "peak_element", peak, "element of the largest share");
+    yaml.Number(1, "peak_position", run.error_map.position[peak], "[m] its midpoint");
+    yaml.Number(1, "peak_fraction", run.error_map.Fractions()[peak],
+                "its share of the constitutive gap");
+  }
 
   const ModulusUncertainty& uncertainty = run.uncertainty;
   yaml.Line(0, "uncertainty", "");
@@ -422,6 +477,10 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
   write("ends.csv", EndsCsv(run));
   write("inner_residual.csv", InnerResidualCsv(run));
   if (!run.outer.scan_moduli.empty()) write("scan.csv", ScanCsv(run));
+  if (run.error_map.share.size() > 0) {
+    write("error_map.csv", ErrorMapCsv(run));
+    write("error_map_spacetime.dat", ErrorMapSpaceTimeData(run));
+  }
 
   if (figures) {
     bool gnuplot_missing = false;
@@ -429,6 +488,8 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
         {"cost_curve", CostCurveScript(run, folder)},
         {"ends", EndsScript(run, folder)},
     };
+    if (run.error_map.share.size() > 0)
+      drawings.emplace_back("error_map", ErrorMapScript(run, folder));
     if (!InnerResidualHistory(run).empty()) {
       drawings.emplace_back("inner_residual", InnerResidualScript(run, folder));
     }

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <vector>
 
+#include "mcrewave/mcre/error_map.h"
+
 namespace mcrewave {
 
 bool McreWeights::IsValid(std::string* error) const {
@@ -431,22 +433,7 @@ void McreProblem::WeightedData(int j, Eigen::Ref<Vector> load) const {
 }
 
 Vector McreProblem::ErrorMap(const Matrix& retrograde) const {
-  const int m = num_steps(), elements = model_.num_elements();
-  const double h = time_step();
-  Vector map = Vector::Zero(elements);
-  for (int j = 0; j <= m; ++j) {
-    const double* w = retrograde.col(j).data();
-    const double weight = 0.5 * QuadratureWeight(j) * h;
-    for (int e = 0; e < elements; ++e) {
-      // 1/2 W_j^T K_el W_j = 1/2 E_e k1_e (W_{e+1} - W_e)^2.
-      const double dw = w[e + 1] - w[e];
-      map[e] += weight * dw * dw;
-    }
-  }
-  for (int e = 0; e < elements; ++e) {
-    map[e] *= moduli_[model_.element_zone(e)] * model_.element_unit_stiffness(e);
-  }
-  return map;
+  return ElementGapShares(model_, moduli_, retrograde, time_step());
 }
 
 }  // namespace mcrewave

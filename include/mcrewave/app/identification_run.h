@@ -7,8 +7,8 @@
 //   3. Identify (identification.h) on an McreObjective (objective.h) with
 //      x = E / outer.initial: the global scan and local refinements.
 //   4. At the identified E*: the cost curve e^2(E) on output.curve_points points
-//      around E*, warm-started point to point, and the uncertainty figure
-//      (modulus_uncertainty.h).
+//      around E*, warm-started point to point, the error map of the constitutive
+//      gap (error_map.h) and the uncertainty figure (modulus_uncertainty.h).
 #pragma once
 
 #include <string>
@@ -16,6 +16,7 @@
 
 #include "mcrewave/app/config.h"
 #include "mcrewave/data/measurement.h"
+#include "mcrewave/mcre/error_map.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/mcre/objective.h"
 #include "mcrewave/optim/identification.h"
@@ -68,6 +69,8 @@ struct IdentificationRun {
   // takes few iterations, often none).
   CoupledSolverSummary cold_solve;
   ModulusUncertainty uncertainty;
+  // The error map at the identified (homogeneous) E, from `solution`.
+  ErrorMap error_map;
   double wall_time_s = -1.0;  // the whole of RunIdentification
 
   // The outer loop converged; only then are the fields after `outer` filled.

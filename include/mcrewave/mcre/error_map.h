@@ -1,0 +1,44 @@
+// The MCRE error map: where along the structure the constitutive relation is
+// violated (docs/zones_and_sensors.md, "The error map").
+//
+// At a modulus field E_z and its coupled solution (U, W), the constitutive part of
+// e^2 splits by element,
+//
+//   e^2_constitutive = sum_el e_el^2,   e_el^2 = sum_j c_j h 1/2 W_j^T K_el W_j  [J s],
+//
+// with K_el = E_el K1_el the element's stiffness. The elements whose modulus is wrong
+// carry most of it: the map localises a stiffness change before any zone modulus is
+// identified. The space-time picture is the gap's energy density per element and
+// sample, 1/2 W_j^T K_el W_j / h_e [J/m], on at most max_time_columns samples.
+#pragma once
+
+#include "mcrewave/core/types.h"
+#include "mcrewave/model/bar_model.h"
+
+namespace mcrewave {
+
+struct ErrorMap {
+  Vector position;  // element midpoints [m]
+  Vector share;     // e_el^2 [J s], one per element
+  // The space-time picture: density(i, el) = 1/2 W_ji^T K_el W_ji / h_e [J/m] at the
+  // sample j_i of times(i) (every stride-th sample of the window).
+  Vector times;    // [s]
+  Matrix density;  // times.size() x elements
+
+  // Index of the element with the largest share (-1 when empty).
+  int PeakElement() const;
+  // share / sum(share): the fraction of the constitutive gap in each element.
+  Vector Fractions() const;
+};
+
+// e_el^2 for every element (ErrorMap.share) of `model` at the zone moduli (one per
+// zone) from the retrograde field W (n x (m + 1)) on steps of time_step [s].
+Vector ElementGapShares(const BarModel& model, const Vector& zone_moduli, const Matrix& retrograde,
+                        double time_step);
+
+// The whole map, with the space-time picture on at most max_time_columns samples.
+// Precondition: max_time_columns >= 2.
+ErrorMap ComputeErrorMap(const BarModel& model, const Vector& zone_moduli, const Matrix& retrograde,
+                         double time_step, int max_time_columns = 160);
+
+}  // namespace mcrewave
