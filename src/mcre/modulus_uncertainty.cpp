@@ -49,6 +49,25 @@ NoiseLevels DifferenceNoiseLevels(const MeasurementSet& data) {
       0.5 * (std::pow(DifferenceNoiseStd(data.u0), 2) + std::pow(DifferenceNoiseStd(data.uL), 2)));
   levels.force_std = std::sqrt(
       0.5 * (std::pow(DifferenceNoiseStd(data.f0), 2) + std::pow(DifferenceNoiseStd(data.fL), 2)));
+  if (data.sensors.empty()) return levels;
+  // With interior sensors: s^2 averaged over every channel of the kind.
+  double displacement_sum =
+      std::pow(DifferenceNoiseStd(data.u0), 2) + std::pow(DifferenceNoiseStd(data.uL), 2);
+  int displacement_count = 2;
+  double strain_sum = 0.0;
+  int strain_count = 0;
+  for (const SensorChannel& sensor : data.sensors) {
+    const double variance = std::pow(DifferenceNoiseStd(sensor.values), 2);
+    if (sensor.kind == SensorKind::kStrain) {
+      strain_sum += variance;
+      ++strain_count;
+    } else {
+      displacement_sum += variance;
+      ++displacement_count;
+    }
+  }
+  levels.displacement_std = std::sqrt(displacement_sum / displacement_count);
+  if (strain_count > 0) levels.strain_std = std::sqrt(strain_sum / strain_count);
   return levels;
 }
 
@@ -112,7 +131,7 @@ ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
                                               const CoupledSolverOptions& inner, double modulus,
                                               const CoupledSolution& solution,
                                               const NoiseLevels& noise, double curvature,
-                                              int curvature_points) {
+                                              int curvature_points, EndDisplacementChannels ends) {
   assert(options.IsValid(nullptr));
   ModulusUncertainty result;
   result.noise = noise;
@@ -138,7 +157,12 @@ ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
     for (Vector* channel : {&noise_data.f0, &noise_data.fL}) {
       for (double& value : *channel) value = noise.force_std * normal(engine);
     }
-    McreProblem problem(model, noise_data, mcre.weights, mcre.reference_modulus, theta);
+    for (SensorChannel& sensor : noise_data.sensors) {
+      const double level =
+          sensor.kind == SensorKind::kStrain ? noise.strain_std : noise.displacement_std;
+      for (double& value : sensor.values) value = level * normal(engine);
+    }
+    McreProblem problem(model, noise_data, mcre.weights, mcre.reference_modulus, theta, ends);
     problem.SetModulus(modulus);
     CoupledSolution noise_solution;
     const CoupledSolverSummary summary = SolveCoupled(inner, &problem, nullptr, &noise_solution);

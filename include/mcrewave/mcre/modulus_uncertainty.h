@@ -42,8 +42,9 @@ struct UncertaintyOptions {
 // Standard deviations of white noise on the two displacement and the two force
 // channels.
 struct NoiseLevels {
-  double displacement_std = 0.0;  // [m]
+  double displacement_std = 0.0;  // [m], every displacement channel (u0, uL, u@X)
   double force_std = 0.0;         // [N]
+  double strain_std = 0.0;        // [-], every strain channel (e@X); 0 without any
 };
 
 // Noise levels estimated from the data alone, channel by channel, from second
@@ -51,8 +52,9 @@ struct NoiseLevels {
 // std sqrt(6) s, while a signal smooth on the sampling scale adds little, and
 // the median absolute deviation ignores the few samples at wave fronts:
 //   s = 1.4826 median_j |d2_j - median d2| / sqrt(6),
-// then s^2 averaged over the two channels of each type. For measured data,
-// whose noise is not known.
+// then s^2 averaged over the channels of each type (displacements: the two ends and
+// every u@X; forces: the two ends; strains: every e@X). For measured data, whose noise
+// is not known.
 NoiseLevels DifferenceNoiseLevels(const MeasurementSet& data);
 
 // RMS misfits of the coupled solution at the optimum: displacement
@@ -92,6 +94,9 @@ struct ModulusUncertainty {
 
 // The figure at the identified modulus (see the top of this file). `solution`
 // is the coupled solution of `data` at `modulus`; noise the levels to draw.
+// The noise drawn: displacement_std on u0, uL and every u@X, force_std on f0 and fL,
+// strain_std on every e@X (after the end channels, so that the paper's case keeps its
+// draws); `ends` as in McreProblem.
 // Not available (with a message) when curvature <= 0, both noise levels are 0,
 // or a noise solve is not usable. Precondition: options.IsValid().
 ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
@@ -100,6 +105,7 @@ ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
                                               const CoupledSolverOptions& inner, double modulus,
                                               const CoupledSolution& solution,
                                               const NoiseLevels& noise, double curvature,
-                                              int curvature_points);
+                                              int curvature_points,
+                                              EndDisplacementChannels ends = {});
 
 }  // namespace mcrewave
