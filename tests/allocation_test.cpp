@@ -296,5 +296,30 @@ TEST(McreProblemAllocationTest, SweepsIntoPreallocatedFieldsAllocateNothing) {
   EXPECT_EQ(problem.sweep_count() - sweeps_before, 16);
 }
 
+TEST(McreProblemAllocationTest, RetrogradeSweepsWithInteriorSensorsAllocateNothing) {
+  SKIP_WITHOUT_ALLOCATION_COUNTING();
+  ProblemBundle bundle(MakeSmallCase(kElements, kSteps, 5.0, 2), Weights(0.01, 1.0));
+  // A displacement and a strain sensor inside the bar, read off the data's own model.
+  MeasurementSet data = bundle.data;
+  data.sensors.push_back({"u@0.4", SensorKind::kDisplacement, 0.4, 1e-6 * data.uL});
+  data.sensors.push_back({"e@0.7", SensorKind::kStrain, 0.7, 1e-3 * data.uL});
+  McreProblem problem(bundle.model, data, Weights(0.01, 1.0), testing::kReferenceModulus, 0.5);
+  problem.SetModulus(0.9 * testing::kReferenceModulus);
+  Matrix displacement = problem.ZeroField(), retrograde = problem.ZeroField();
+  Matrix retrograde_2 = problem.ZeroField(), retrograde_3 = problem.ZeroField();
+  problem.workspace();
+  problem.DirectSweep(problem.ZeroField(), true, &displacement);
+  const std::vector<const Matrix*> inputs{&displacement, nullptr};
+  const std::vector<Matrix*> outputs{&retrograde_2, &retrograde_3};
+  const HeapCalls calls = CountHeapCalls([&] {
+    problem.RetrogradeSweep(displacement, true, &retrograde);
+    problem.RetrogradeSweep(displacement, false, &retrograde_2);
+    problem.RetrogradeSweepsWithData(inputs, outputs);
+  });
+  EXPECT_EQ(calls.allocations, 0);
+  EXPECT_EQ(calls.deallocations, 0);
+  EXPECT_GT(retrograde.norm(), 0.0);
+}
+
 }  // namespace
 }  // namespace mcrewave
