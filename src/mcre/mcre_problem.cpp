@@ -334,32 +334,53 @@ double McreProblem::InnerProduct(const Matrix& x, const Matrix& y) {
   return sum;
 }
 
+double McreProblem::SampleCost(int j, const double* displacement, const double* retrograde) const {
+  const int last = num_nodes() - 1;
+  const double gap = 0.5 * integrator_.stiffness().BilinearForm(retrograde, retrograde);
+  const double force_misfit =
+      (retrograde[0] * retrograde[0] + retrograde[last] * retrograde[last]) / (2.0 * alpha_);
+  const double u0_misfit = displacement[0] - data_.u0[j];
+  const double uL_misfit = displacement[last] - data_.uL[j];
+  double displacement_misfit =
+      observes_ends_only()
+          ? 0.5 * beta_ * (u0_misfit * u0_misfit + uL_misfit * uL_misfit)
+          : 0.5 * (beta_u0_ * u0_misfit * u0_misfit + beta_uL_ * uL_misfit * uL_misfit);
+  // + 1/2 beta_k (h_k . U_j - d~_kj)^2 over the interior sensors.
+  for (int k = 0; k < num_interior_sensors(); ++k) {
+    const double misfit = sensor_rows_[k].Apply(displacement) - (*sensor_data_[k])[j];
+    displacement_misfit += 0.5 * sensor_weights_[k] * misfit * misfit;
+  }
+  return gap + force_misfit + displacement_misfit;
+}
+
 double McreProblem::Cost(const Matrix& displacement, const Matrix& retrograde) {
-  const int n = num_nodes(), m = num_steps(), last = n - 1;
+  const int m = num_steps();
   const double h = time_step();
-  const SymmetricBandMatrix& stiffness = integrator_.stiffness();
   double sum = 0.0;
   for (int j = 0; j <= m; ++j) {
-    const double* w = retrograde.col(j).data();
-    const double gap = 0.5 * stiffness.BilinearForm(w, w);
-    const double force_misfit =
-        (retrograde(0, j) * retrograde(0, j) + retrograde(last, j) * retrograde(last, j)) /
-        (2.0 * alpha_);
-    const double u0_misfit = displacement(0, j) - data_.u0[j];
-    const double uL_misfit = displacement(last, j) - data_.uL[j];
-    double displacement_misfit =
-        observes_ends_only()
-            ? 0.5 * beta_ * (u0_misfit * u0_misfit + uL_misfit * uL_misfit)
-            : 0.5 * (beta_u0_ * u0_misfit * u0_misfit + beta_uL_ * uL_misfit * uL_misfit);
-    // + 1/2 beta_k (h_k . U_j - d~_kj)^2 over the interior sensors.
-    for (int k = 0; k < num_interior_sensors(); ++k) {
-      const double misfit =
-          sensor_rows_[k].Apply(displacement.col(j).data()) - (*sensor_data_[k])[j];
-      displacement_misfit += 0.5 * sensor_weights_[k] * misfit * misfit;
-    }
-    sum += QuadratureWeight(j) * h * (gap + force_misfit + displacement_misfit);
+    // c_j h [1/2 W^T K W + W^T B W / (2 alpha) + 1/2 (H U - d~)^T diag(beta) (H U - d~)].
+    sum += QuadratureWeight(j) * h *
+           SampleCost(j, displacement.col(j).data(), retrograde.col(j).data());
   }
   return sum;
+}
+
+double McreProblem::SampleGradient(const double* displacement, const double* retrograde) const {
+  // W_j^T K1 (W_j + 2 U_j), with K = E K1 so that -(1/(2E)) W^T K (.) = -(1/2) W^T K1 (.).
+  return unit_stiffness_.BilinearForm(retrograde, retrograde) +
+         2.0 * unit_stiffness_.BilinearForm(retrograde, displacement);
+}
+
+void McreProblem::AddSampleZoneGradients(double weight, const double* displacement,
+                                         const double* retrograde, Vector* gradient) const {
+  for (int e = 0; e < model_.num_elements(); ++e) {
+    // weight W_j^T K1_e (W_j + 2 U_j) = weight k1_e dW (dW + 2 dU), dX = X_{e+1} - X_e,
+    // summed by zone.
+    const double dw = retrograde[e + 1] - retrograde[e];
+    const double du = displacement[e + 1] - displacement[e];
+    (*gradient)[model_.element_zone(e)] +=
+        weight * model_.element_unit_stiffness(e) * dw * (dw + 2.0 * du);
+  }
 }
 
 double McreProblem::CostGradient(const Matrix& displacement, const Matrix& retrograde) {
@@ -367,11 +388,8 @@ double McreProblem::CostGradient(const Matrix& displacement, const Matrix& retro
   const double h = time_step();
   double sum = 0.0;
   for (int j = 0; j <= m; ++j) {
-    // W_j^T K1 (W_j + 2 U_j), with K = E K1 so that -(1/(2E)) W^T K (.) = -(1/2) W^T K1 (.).
-    const double* w = retrograde.col(j).data();
-    const double* u = displacement.col(j).data();
     sum += QuadratureWeight(j) * h *
-           (unit_stiffness_.BilinearForm(w, w) + 2.0 * unit_stiffness_.BilinearForm(w, u));
+           SampleGradient(displacement.col(j).data(), retrograde.col(j).data());
   }
   return -0.5 * sum;
 }
@@ -383,20 +401,12 @@ void McreProblem::CostGradients(const Matrix& displacement, const Matrix& retrog
     gradient->setConstant(1, CostGradient(displacement, retrograde));
     return;
   }
-  const int m = num_steps(), elements = model_.num_elements();
+  const int m = num_steps();
   const double h = time_step();
   gradient->setZero(zones);
   for (int j = 0; j <= m; ++j) {
-    const double* w = retrograde.col(j).data();
-    const double* u = displacement.col(j).data();
-    const double weight = -0.5 * QuadratureWeight(j) * h;
-    for (int e = 0; e < elements; ++e) {
-      // W_j^T K1_e (W_j + 2 U_j) = k1_e dW (dW + 2 dU), dX = X_{e+1} - X_e; summed by zone.
-      const double dw = w[e + 1] - w[e];
-      const double du = u[e + 1] - u[e];
-      (*gradient)[model_.element_zone(e)] +=
-          weight * model_.element_unit_stiffness(e) * dw * (dw + 2.0 * du);
-    }
+    AddSampleZoneGradients(-0.5 * QuadratureWeight(j) * h, displacement.col(j).data(),
+                           retrograde.col(j).data(), gradient);
   }
 }
 

@@ -165,6 +165,15 @@ class McreProblem {
   template <int B>
   void RetrogradeSweeps(const Matrix* const (&displacement)[B], Matrix* const (&retrograde)[B]);
 
+  // The integrand of e^2 at sample j without c_j h:
+  // 1/2 W^T K W + W^T B W / (2 alpha) + 1/2 (H U - d~_j)^T diag(beta) (H U - d~_j).
+  double SampleCost(int j, const double* displacement, const double* retrograde) const;
+  // W_j^T K1 (W_j + 2 U_j) (one zone's gradient integrand, without -(1/2) c_j h).
+  double SampleGradient(const double* displacement, const double* retrograde) const;
+  // gradient[z] += weight W_j^T K1_z (W_j + 2 U_j) for every zone.
+  void AddSampleZoneGradients(double weight, const double* displacement, const double* retrograde,
+                              Vector* gradient) const;
+
   // The retrograde force of step t_j -> t_{j-1} at the interior sensors,
   // c_j H_s^T diag(beta_s) (H_s U_j - d~_j) (without the data when include_data is
   // false), into loads' values (two nodes per sensor). U_j may be null (zero).
