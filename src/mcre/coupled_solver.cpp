@@ -12,7 +12,7 @@
 namespace mcrewave {
 namespace {
 
-constexpr std::array<std::pair<CoupledSolverType, const char*>, 7> kSolverTypes{{
+constexpr std::array<std::pair<CoupledSolverType, const char*>, 8> kSolverTypes{{
     {CoupledSolverType::kAllAtOnce, "all_at_once"},
     {CoupledSolverType::kRelaxation, "relaxation"},
     {CoupledSolverType::kAdaptiveRelaxation, "adaptive_relaxation"},
@@ -20,6 +20,7 @@ constexpr std::array<std::pair<CoupledSolverType, const char*>, 7> kSolverTypes{
     {CoupledSolverType::kRiccati, "riccati"},
     {CoupledSolverType::kSingleShooting, "single_shooting"},
     {CoupledSolverType::kMultipleShooting, "multiple_shooting"},
+    {CoupledSolverType::kStreamingConjugateGradient, "streaming_conjugate_gradient"},
 }};
 
 }  // namespace
@@ -172,8 +173,13 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, McreProbl
     case CoupledSolverType::kMultipleShooting:
       internal::SolveByShooting(options, problem, solution, &summary);
       break;
+    case CoupledSolverType::kStreamingConjugateGradient:
+      // Fills the cost and the gradients itself, from its final streaming pass.
+      internal::SolveByStreamingConjugateGradient(options, problem, solution, &summary);
+      break;
   }
-  if (summary.IsSolutionUsable()) {
+  if (summary.IsSolutionUsable() &&
+      options.type != CoupledSolverType::kStreamingConjugateGradient) {
     solution->cost = problem->Cost(solution->displacement, solution->retrograde);
     problem->CostGradients(solution->displacement, solution->retrograde, &solution->cost_gradients);
     // One zone: de^2/dE; several: the derivative along a common change of every zone.

@@ -21,5 +21,9 @@ void SolveByRiccati(const CoupledSolverOptions& options, McreProblem* problem,
                     CoupledSolution* solution, CoupledSolverSummary* summary);
 void SolveByShooting(const CoupledSolverOptions& options, McreProblem* problem,
                      CoupledSolution* solution, CoupledSolverSummary* summary);
+// Also fills the solution's cost, gradients, traces, end retrograde values and
+// error map (its fields U and W stay empty).
+void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, McreProblem* problem,
+                                       CoupledSolution* solution, CoupledSolverSummary* summary);
 
 }  // namespace mcrewave::internal

@@ -28,16 +28,25 @@ Vector ErrorMap::Fractions() const {
   return total > 0.0 ? Vector(share / total) : Vector(Vector::Zero(share.size()));
 }
 
+void AddSampleGapShares(const BarModel& model, const Vector& zone_moduli, const double* retrograde,
+                        double weight, Vector* shares) {
+  for (int e = 0; e < model.num_elements(); ++e) {
+    // 1/2 W_j^T K_el W_j = 1/2 E_el k1_el (W_{el+1} - W_el)^2.
+    const double jump = retrograde[e + 1] - retrograde[e];
+    (*shares)[e] += weight * 0.5 * zone_moduli[model.element_zone(e)] *
+                    model.element_unit_stiffness(e) * jump * jump;
+  }
+}
+
 Vector ElementGapShares(const BarModel& model, const Vector& zone_moduli, const Matrix& retrograde,
                         double time_step) {
   assert(zone_moduli.size() == model.num_zones() && retrograde.rows() == model.num_nodes());
-  const int m = static_cast<int>(retrograde.cols()) - 1, elements = model.num_elements();
-  Vector shares = Vector::Zero(elements);
+  const int m = static_cast<int>(retrograde.cols()) - 1;
+  Vector shares = Vector::Zero(model.num_elements());
   for (int j = 0; j <= m; ++j) {
     // c_j h, c_j = 1/2 at both ends of the window.
     const double weight = (j == 0 || j == m ? 0.5 : 1.0) * time_step;
-    for (int e = 0; e < elements; ++e)
-      shares[e] += weight * ElementGap(model, zone_moduli, retrograde, e, j);
+    AddSampleGapShares(model, zone_moduli, retrograde.col(j).data(), weight, &shares);
   }
   return shares;
 }

@@ -67,6 +67,14 @@ McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
     omega_[b] = Vector::Zero(n);
   }
   shift_ = Vector::Zero(n);
+  for (int b = 0; b < 2; ++b) {
+    for (Vector* v : {&stream_velocity_[b], &stream_omega_[b], &stream_rebuilt_velocity_[b],
+                      &stream_rebuilt_omega_[b], &stream_direct_velocity_[b],
+                      &stream_displacement_[b], &stream_retrograde_[b]}) {
+      *v = Vector::Zero(n);
+    }
+  }
+  stream_shift_ = Vector::Zero(n);
   batch_velocity_ = Matrix::Zero(n, 2 * ThetaIntegrator::kMaxBatch);
   batch_state_ = Matrix::Zero(n, 2 * ThetaIntegrator::kMaxBatch);
   batch_shift_ = Matrix::Zero(n, ThetaIntegrator::kMaxBatch);

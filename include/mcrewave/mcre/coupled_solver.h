@@ -54,6 +54,9 @@ enum class CoupledSolverType {
   kRiccati,
   kSingleShooting,
   kMultipleShooting,
+  // Conjugate gradients on the sensor traces with O(n) memory (docs/streaming.md):
+  // no space-time field is stored; theta = 1/2 only.
+  kStreamingConjugateGradient,
 };
 const char* CoupledSolverTypeToString(CoupledSolverType type);
 bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type);
@@ -135,8 +138,14 @@ struct CoupledSolverSummary {
 };
 
 struct CoupledSolution {
+  // U and W, n x (m + 1) [m]; empty (0 x 0) after a streaming solve, which stores
+  // neither: its fields are summed as they pass (cost, gradients, error map) and
+  // its traces and end retrograde values are kept.
   Matrix displacement;         // U, n x (m + 1) [m]
   Matrix retrograde;           // W, n x (m + 1) [m]
+  Matrix traces;               // H U (streaming only), McreProblem::num_traces() x (m + 1)
+  Matrix end_retrograde;       // W at nodes 0 and N (streaming only), 2 x (m + 1) [m]
+  Vector error_map;            // e_el^2 per element (streaming only) [J s]
   double cost = -1.0;          // e^2(E) [J s]
   double cost_gradient = 0.0;  // de^2/dE [J s / Pa] (several zones: sum_z de^2/dE_z)
   Vector cost_gradients;       // de^2/dE_z [J s / Pa], one per zone

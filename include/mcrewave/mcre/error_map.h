@@ -31,6 +31,10 @@ struct ErrorMap {
   Vector Fractions() const;
 };
 
+// shares[el] += weight 1/2 W_j^T K_el W_j for every element, from W_j (n entries).
+void AddSampleGapShares(const BarModel& model, const Vector& zone_moduli, const double* retrograde,
+                        double weight, Vector* shares);
+
 // e_el^2 for every element (ErrorMap.share) of `model` at the zone moduli (one per
 // zone) from the retrograde field W (n x (m + 1)) on steps of time_step [s].
 Vector ElementGapShares(const BarModel& model, const Vector& zone_moduli, const Matrix& retrograde,

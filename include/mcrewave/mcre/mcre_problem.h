@@ -142,6 +142,40 @@ class McreProblem {
   // H^T diag(beta_k) d~_j [N] at sample j into load (size n).
   void WeightedData(int j, Eigen::Ref<Vector> load) const;
 
+  // --- Streaming: the coupled problem on the sensor traces (docs/streaming.md) ---
+  // A trace field y holds one row per channel of H, in the order u0, uL, then the
+  // interior sensors (a row whose channel is left out has weight 0), and one column
+  // per sample: num_traces() x (m + 1). The retrograde field depends on U only
+  // through y = H U, so the coupled problem is a fixed point y = Phi(y) with
+  //   Phi(y) = H Direct(Retrograde(y)),
+  // where Retrograde(y) takes its load c_j H^T diag(beta) (y_j - d~_j) from y. Phi is
+  // applied with O(n) memory: the retrograde sweep runs backward keeping only its
+  // state, then a forward pass rebuilds W_j by stepping the trapezoidal recursion the
+  // other way (exactly invertible for theta = 1/2 and no damping) and runs the direct
+  // sweep beside it. Three sweeps per application.
+  int num_traces() const { return 2 + num_interior_sensors(); }
+  Matrix ZeroTraces() const { return Matrix::Zero(num_traces(), num_steps() + 1); }
+  // <a, b>_beta = sum_j c_j h sum_k beta_k a_kj b_kj, in which I - (Phi - Phi(0)) is
+  // self-adjoint and positive definite on the weighted rows.
+  double TraceInnerProduct(const Matrix& a, const Matrix& b) const;
+  // What a streaming application gathers at each sample when asked (the cost,
+  // gradient and error map of the fields it passes through, never stored).
+  struct StreamingTotals {
+    double cost = 0.0;      // e^2 [J s]
+    Vector cost_gradients;  // de^2/dE_z [J s / Pa]
+    Vector error_map;       // e_el^2 [J s] per element
+    Matrix end_retrograde;  // W at nodes 0 and N, 2 x (m + 1) [m]
+    // ||omega_m|| / max_j ||omega_j|| of the rebuilt retrograde state: 0 in exact
+    // arithmetic (the sweep started from omega_m = 0), the rebuild's round-off.
+    double rebuild_error = 0.0;
+  };
+  // image = Phi(traces) with the data (include_data), or its linear part without.
+  // With totals (not null), the sums of the fields of that application are gathered.
+  // Precondition: theta = 1/2. traces and image of shape ZeroTraces(), distinct. No
+  // allocation but image's and totals' (resized once).
+  void StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
+                    StreamingTotals* totals = nullptr);
+
   // Number of sweeps (direct + retrograde) run since construction.
   long sweep_count() const { return sweep_count_; }
   // Number of factorisations of the integrator's iteration matrix since construction
@@ -174,6 +208,10 @@ class McreProblem {
   void AddSampleZoneGradients(double weight, const double* displacement, const double* retrograde,
                               Vector* gradient) const;
 
+  // The retrograde loads of step t_j -> t_{j-1} from traces y_j (end loads f0, fL
+  // and the sensors' point loads into stream_loads_).
+  void TraceLoads(int j, const Matrix& traces, bool include_data, double* f0, double* fL);
+
   // The retrograde force of step t_j -> t_{j-1} at the interior sensors,
   // c_j H_s^T diag(beta_s) (H_s U_j - d~_j) (without the data when include_data is
   // false), into loads' values (two nodes per sensor). U_j may be null (zero).
@@ -201,6 +239,11 @@ class McreProblem {
   SymmetricBandMatrix unit_stiffness_;  // K1 = sum_z K1_z
   long sweep_count_ = 0;
   SolverWorkspace workspace_;
+  // Streaming scratch (double buffers of the three sweeps' states, W_{j-1}, W_j, the
+  // direct step's shift), allocated in the constructor: O(n).
+  Vector stream_velocity_[2], stream_omega_[2], stream_rebuilt_velocity_[2],
+      stream_rebuilt_omega_[2], stream_direct_velocity_[2], stream_displacement_[2],
+      stream_retrograde_[2], stream_shift_;
   // Scratch, allocated in the constructor.
   Vector velocity_[2], omega_[2];  // double buffers of the sweeps' velocity and omega
   Vector shift_;                   // W_theta of the direct sweep's step

@@ -1,0 +1,138 @@
+// The streaming application of the coupled map on sensor traces (mcre_problem.h,
+// docs/streaming.md): the retrograde sweep backward keeping only its state, then one
+// forward pass that rebuilds W_j by the reversed trapezoidal recursion and runs the
+// direct sweep beside it.
+#include <cassert>
+#include <cmath>
+
+#include "mcrewave/mcre/error_map.h"
+#include "mcrewave/mcre/mcre_problem.h"
+
+namespace mcrewave {
+
+double McreProblem::TraceInnerProduct(const Matrix& a, const Matrix& b) const {
+  const int m = num_steps();
+  double sum = 0.0;
+  for (int j = 0; j <= m; ++j) {
+    // c_j h sum_k beta_k a_kj b_kj.
+    double term = beta_u0_ * a(0, j) * b(0, j) + beta_uL_ * a(1, j) * b(1, j);
+    for (int k = 0; k < num_interior_sensors(); ++k) {
+      term += sensor_weights_[k] * a(2 + k, j) * b(2 + k, j);
+    }
+    sum += QuadratureWeight(j) * time_step() * term;
+  }
+  return sum;
+}
+
+void McreProblem::TraceLoads(int j, const Matrix& traces, bool include_data, double* f0,
+                             double* fL) {
+  const double quadrature = QuadratureWeight(j);
+  // c_j beta (y_j - d~_j) at the ends; the sensors' c_j beta_k (y_kj - d~_kj) h_k.
+  *f0 = quadrature * beta_u0_ * (traces(0, j) - (include_data ? data_.u0[j] : 0.0));
+  *fL = quadrature * beta_uL_ * (traces(1, j) - (include_data ? data_.uL[j] : 0.0));
+  double* values = load_values_.col(0).data();
+  for (int k = 0; k < num_interior_sensors(); ++k) {
+    const double misfit = traces(2 + k, j) - (include_data ? (*sensor_data_[k])[j] : 0.0);
+    const double load = quadrature * sensor_weights_[k] * misfit;
+    values[2 * k] = load * sensor_rows_[k].coefficients[0];
+    values[2 * k + 1] = load * sensor_rows_[k].coefficients[1];
+  }
+}
+
+void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
+                               StreamingTotals* totals) {
+  assert(theta_ == 0.5);
+  assert(traces.rows() == num_traces() && traces.cols() == num_steps() + 1 && image != &traces);
+  const int m = num_steps(), last = num_nodes() - 1;
+  const double h = time_step();
+  image->resize(num_traces(), m + 1);
+  const PointLoads* loads = num_interior_sensors() > 0 ? &point_loads_[0] : nullptr;
+  double f0 = 0.0, fL = 0.0;
+
+  // 1. The retrograde sweep from rest at T, its state only: (v_j, omega_j), j = m..0.
+  stream_velocity_[0].setZero();
+  stream_omega_[0].setZero();
+  for (int j = m, s = 0; j > 0; --j, ++s) {
+    const int current = s & 1, next = current ^ 1;
+    TraceLoads(j, traces, include_data, &f0, &fL);
+    integrator_.StepWithEndLoads(stream_velocity_[current], stream_omega_[current], f0, fL,
+                                 stream_velocity_[next], stream_omega_[next], loads);
+  }
+  const int final_state = m & 1;
+
+  // 2. Forward: the rebuilt retrograde state and the direct sweep side by side. For
+  // theta = 1/2 the step (a_{j-1}, omega_{j-1}) -> (a_j, omega_j) with a = -v and the
+  // load of the backward step j -> j-1 inverts that step exactly (docs/streaming.md).
+  stream_rebuilt_velocity_[0] = -stream_velocity_[final_state];
+  stream_rebuilt_omega_[0] = stream_omega_[final_state];
+  // W_0 = (1 - theta) omega_0 / c_0.
+  stream_retrograde_[0] = ((1.0 - theta_) / QuadratureWeight(0)) * stream_rebuilt_omega_[0];
+  stream_direct_velocity_[0].setZero();
+  stream_displacement_[0].setZero();
+  double largest_omega = stream_rebuilt_omega_[0].norm();
+  if (totals != nullptr) {
+    totals->cost = 0.0;
+    totals->cost_gradients.setZero(num_zones());
+    totals->error_map.setZero(model_.num_elements());
+    totals->end_retrograde.resize(2, m + 1);
+  }
+  auto observe = [&](int j, const Vector& displacement, const Vector& retrograde) {
+    // y_j = H U_j.
+    double* column = image->col(j).data();
+    column[0] = displacement[0];
+    column[1] = displacement[last];
+    for (int k = 0; k < num_interior_sensors(); ++k) {
+      column[2 + k] = sensor_rows_[k].Apply(displacement.data());
+    }
+    if (totals == nullptr) return;
+    const double weight = QuadratureWeight(j) * h;
+    totals->cost += weight * SampleCost(j, displacement.data(), retrograde.data());
+    if (num_zones() == 1) {
+      totals->cost_gradients[0] +=
+          -0.5 * weight * SampleGradient(displacement.data(), retrograde.data());
+    } else {
+      AddSampleZoneGradients(-0.5 * weight, displacement.data(), retrograde.data(),
+                             &totals->cost_gradients);
+    }
+    AddSampleGapShares(model_, moduli_, retrograde.data(), weight, &totals->error_map);
+    totals->end_retrograde(0, j) = retrograde[0];
+    totals->end_retrograde(1, j) = retrograde[last];
+  };
+  observe(0, stream_displacement_[0], stream_retrograde_[0]);
+  const double inverse_alpha = 1.0 / alpha_;
+  for (int j = 1; j <= m; ++j) {
+    const int current = (j - 1) & 1, next = current ^ 1;
+    TraceLoads(j, traces, include_data, &f0, &fL);
+    integrator_.StepWithEndLoads(stream_rebuilt_velocity_[current], stream_rebuilt_omega_[current],
+                                 f0, fL, stream_rebuilt_velocity_[next],
+                                 stream_rebuilt_omega_[next], loads);
+    // W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j, with omega_m = 0 exactly
+    // (the rebuilt omega_m is its round-off).
+    const double omega_weight = j == m ? 0.0 : 1.0 - theta_;
+    stream_retrograde_[next] =
+        (theta_ * stream_rebuilt_omega_[current] + omega_weight * stream_rebuilt_omega_[next]) *
+        (1.0 / QuadratureWeight(j));
+    if (j < m) largest_omega = std::max(largest_omega, stream_rebuilt_omega_[next].norm());
+    // The direct step t_{j-1} -> t_j with f_theta = -K W_theta + (F~_theta - B W_theta /
+    // alpha), W_theta = theta W_j + (1 - theta) W_{j-1} (as DirectSweep).
+    stream_shift_ =
+        theta_ * stream_retrograde_[next] + (1.0 - theta_) * stream_retrograde_[current];
+    double direct_f0 = -inverse_alpha * stream_shift_[0];
+    double direct_fL = -inverse_alpha * stream_shift_[last];
+    if (include_data) {
+      direct_f0 += theta_ * data_.f0[j] + (1.0 - theta_) * data_.f0[j - 1];
+      direct_fL += theta_ * data_.fL[j] + (1.0 - theta_) * data_.fL[j - 1];
+    }
+    integrator_.StepWithEndLoads(stream_direct_velocity_[current], stream_displacement_[current],
+                                 stream_shift_, direct_f0, direct_fL, stream_direct_velocity_[next],
+                                 stream_displacement_[next]);
+    observe(j, stream_displacement_[next], stream_retrograde_[next]);
+  }
+  if (totals != nullptr) {
+    totals->rebuild_error =
+        largest_omega > 0.0 ? stream_rebuilt_omega_[m & 1].norm() / largest_omega : 0.0;
+  }
+  sweep_count_ += 3;
+}
+
+}  // namespace mcrewave
