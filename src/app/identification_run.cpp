@@ -62,7 +62,7 @@ std::vector<CostCurvePoint> ComputeCostCurve(const Config& config, const BarMode
                moduli.back());
 
   McreObjective objective(model, data, config.mcre, config.time.theta, config.inner, center);
-  objective.SetWarmStart(run.solution.retrograde);
+  if (run.solution.has_fields()) objective.SetWarmStart(run.solution.retrograde);
   std::vector<CostCurvePoint> curve;
   for (const double modulus : moduli) {
     const ObjectiveEvaluation& evaluation = objective.EvaluateModulus(modulus);
@@ -174,8 +174,17 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
   run.cost_curve = ComputeCostCurve(config, model, run.data, run, &run.cost_curve_sweeps);
 
   // The error map of the constitutive gap at the homogeneous E* (error_map.h).
-  run.error_map = ComputeErrorMap(model, Vector::Constant(1, run.identified_modulus()),
-                                  run.solution.retrograde, config.time.step);
+  if (run.solution.has_fields()) {
+    run.error_map = ComputeErrorMap(model, Vector::Constant(1, run.identified_modulus()),
+                                    run.solution.retrograde, config.time.step);
+  } else {
+    // The streaming solver summed the shares as W passed; no space-time picture.
+    run.error_map.share = run.solution.error_map;
+    run.error_map.position.resize(model.num_elements());
+    for (int e = 0; e < model.num_elements(); ++e) {
+      run.error_map.position[e] = model.element_midpoint(e);
+    }
+  }
   const int peak = run.error_map.PeakElement();
   spdlog::info("error map: largest share {:.3g} of the constitutive gap at x = {:.4g} m",
                run.error_map.Fractions()[peak], run.error_map.position[peak]);

@@ -124,19 +124,17 @@ std::string CostCurveCsv(const IdentificationRun& run) {
 // F = F~ - B W / alpha.
 std::string EndsCsv(const IdentificationRun& run) {
   const MeasurementSet& data = run.data;
-  const Matrix& displacement = run.solution.displacement;
-  const Matrix& retrograde = run.solution.retrograde;
-  const int last = static_cast<int>(displacement.rows()) - 1;
+  const CoupledSolution& solution = run.solution;
   std::string csv =
       "t,u0_measured,u0_model,uL_measured,uL_model,f0_measured,f0_model,fL_measured,fL_model\n";
   char row[512];
   for (int j = 0; j < data.num_samples(); ++j) {
     // f_model = f~ - w_end / alpha
-    const double f0_model = data.f0[j] - retrograde(0, j) / run.alpha;
-    const double fL_model = data.fL[j] - retrograde(last, j) / run.alpha;
+    const double f0_model = data.f0[j] - solution.EndRetrograde(0, j) / run.alpha;
+    const double fL_model = data.fL[j] - solution.EndRetrograde(1, j) / run.alpha;
     std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
-                  data.Time(j), data.u0[j], displacement(0, j), data.uL[j], displacement(last, j),
-                  data.f0[j], f0_model, data.fL[j], fL_model);
+                  data.Time(j), data.u0[j], solution.EndDisplacement(0, j), data.uL[j],
+                  solution.EndDisplacement(1, j), data.f0[j], f0_model, data.fL[j], fL_model);
     csv += row;
   }
   return csv;
@@ -302,16 +300,23 @@ std::string ErrorMapSpaceTimeData(const IdentificationRun& run) {
 }
 
 std::string ErrorMapScript(const IdentificationRun& run, const std::string& folder) {
+  // The space-time panel only when the density was kept (not after a streaming solve).
+  const bool space_time = run.error_map.density.size() > 0;
   std::ostringstream script;
-  script << GnuplotPngTerminal() << "set terminal pngcairo size 1100,900\n"
-         << "set multiplot layout 2,1 title 'MCRE error map at the identified E = "
-         << run.identified_modulus() / 1e9 << " GPa'\n"
+  script << GnuplotPngTerminal() << "set terminal pngcairo size 1100," << (space_time ? 900 : 450)
+         << "\nset multiplot layout " << (space_time ? 2 : 1)
+         << ",1 title 'MCRE error map at the identified E = " << run.identified_modulus() / 1e9
+         << " GPa'\n"
          << "set xlabel 'x [m]'\nset ylabel 'share of the constitutive gap'\nset grid\n"
          << "set xrange [0:" << run.config.model.length << "]\n"
          << "set title 'e_{el}^2 / sum e_{el}^2 per element'\n"
          << "plot " << GnuplotString(folder + "/error_map.csv")
-         << " skip 1 using 2:4 with boxes fill solid 0.6 lc rgb '#1f4e9c' notitle\n"
-         << "set title 'gap energy density 1/2 W^T K_{el} W / h_e [J/m] over x and t'\n"
+         << " skip 1 using 2:4 with boxes fill solid 0.6 lc rgb '#1f4e9c' notitle\n";
+  if (!space_time) {
+    script << "unset multiplot\n";
+    return script.str();
+  }
+  script << "set title 'gap energy density 1/2 W^T K_{el} W / h_e [J/m] over x and t'\n"
          << "set ylabel 't [ms]'\nunset grid\nset palette rgb 21,22,23\n"
          << "set cblabel 'J/m'\nset yrange [0:" << run.config.time.window * 1e3 << "]\n"
          << "set datafile separator whitespace\n"
@@ -479,7 +484,9 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
   if (!run.outer.scan_moduli.empty()) write("scan.csv", ScanCsv(run));
   if (run.error_map.share.size() > 0) {
     write("error_map.csv", ErrorMapCsv(run));
-    write("error_map_spacetime.dat", ErrorMapSpaceTimeData(run));
+    if (run.error_map.density.size() > 0) {
+      write("error_map_spacetime.dat", ErrorMapSpaceTimeData(run));
+    }
   }
 
   if (figures) {

@@ -73,16 +73,14 @@ NoiseLevels DifferenceNoiseLevels(const MeasurementSet& data) {
 
 NoiseLevels MisfitLevels(const MeasurementSet& data, const CoupledSolution& solution,
                          double alpha) {
-  const Matrix& displacement = solution.displacement;
-  const Matrix& retrograde = solution.retrograde;
-  const int last = static_cast<int>(displacement.rows()) - 1;
   double displacement_sum = 0.0;
   double force_sum = 0.0;
   for (int j = 0; j < data.num_samples(); ++j) {
-    displacement_sum += std::pow(displacement(0, j) - data.u0[j], 2) +
-                        std::pow(displacement(last, j) - data.uL[j], 2);
+    displacement_sum += std::pow(solution.EndDisplacement(0, j) - data.u0[j], 2) +
+                        std::pow(solution.EndDisplacement(1, j) - data.uL[j], 2);
     // F - F~ = -B W / alpha at the two ends
-    force_sum += std::pow(retrograde(0, j) / alpha, 2) + std::pow(retrograde(last, j) / alpha, 2);
+    force_sum += std::pow(solution.EndRetrograde(0, j) / alpha, 2) +
+                 std::pow(solution.EndRetrograde(1, j) / alpha, 2);
   }
   const double count = 2.0 * data.num_samples();
   NoiseLevels levels;
@@ -137,6 +135,12 @@ ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
   result.noise = noise;
   result.curvature = curvature;
   result.curvature_points = curvature_points;
+  if (!solution.has_fields()) {
+    result.message =
+        "the first-order figure needs the stored fields U and W, which the streaming solver "
+        "does not keep (inner.method: conjugate_gradient gives it)";
+    return result;
+  }
   if (!(curvature > 0.0)) {
     result.message = "the cost curve is not convex around the optimum (slope of de^2/dE <= 0)";
     return result;

@@ -141,11 +141,23 @@ struct CoupledSolution {
   // U and W, n x (m + 1) [m]; empty (0 x 0) after a streaming solve, which stores
   // neither: its fields are summed as they pass (cost, gradients, error map) and
   // its traces and end retrograde values are kept.
-  Matrix displacement;         // U, n x (m + 1) [m]
-  Matrix retrograde;           // W, n x (m + 1) [m]
-  Matrix traces;               // H U (streaming only), McreProblem::num_traces() x (m + 1)
-  Matrix end_retrograde;       // W at nodes 0 and N (streaming only), 2 x (m + 1) [m]
-  Vector error_map;            // e_el^2 per element (streaming only) [J s]
+  Matrix displacement;    // U, n x (m + 1) [m]
+  Matrix retrograde;      // W, n x (m + 1) [m]
+  Matrix traces;          // H U (streaming only), McreProblem::num_traces() x (m + 1)
+  Matrix end_retrograde;  // W at nodes 0 and N (streaming only), 2 x (m + 1) [m]
+  Vector error_map;       // e_el^2 per element (streaming only) [J s]
+
+  // Whether U and W are stored (every solver but the streaming one).
+  bool has_fields() const { return displacement.size() > 0; }
+  // U and W at node 0 (end 0) or node N (end 1) at sample j [m], from the fields or,
+  // after a streaming solve, from its traces and end values.
+  double EndDisplacement(int end, int j) const {
+    return has_fields() ? displacement(end == 0 ? 0 : displacement.rows() - 1, j) : traces(end, j);
+  }
+  double EndRetrograde(int end, int j) const {
+    return has_fields() ? retrograde(end == 0 ? 0 : retrograde.rows() - 1, j)
+                        : end_retrograde(end, j);
+  }
   double cost = -1.0;          // e^2(E) [J s]
   double cost_gradient = 0.0;  // de^2/dE [J s / Pa] (several zones: sum_z de^2/dE_z)
   Vector cost_gradients;       // de^2/dE_z [J s / Pa], one per zone
