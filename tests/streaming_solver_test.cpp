@@ -9,6 +9,7 @@
 #include <random>
 #include <string>
 
+#include "identify_binary.h"
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/error_map.h"
 #include "mcrewave/mcre/mcre_problem.h"
@@ -123,6 +124,46 @@ INSTANTIATE_TEST_SUITE_P(Cases, StreamingAgreementTest,
                          [](const ::testing::TestParamInfo<StreamingCase>& info) {
                            return std::string(info.param.name);
                          });
+
+TEST(StreamingSolverTest, AgreesWithStoredFieldsOnThePapersGrid) {
+  // The paper's bar and grid (100 elements, 1750 steps), data from the 4x finer truth
+  // at SNR 2.5, E = 0.9 E_ref: e^2 and de^2/dE of both solvers at the tolerance 1e-10.
+  // Measured 0 (e^2, the same bits) and 6.1e-10 (gradient); 12 iterations each.
+  testing::SmallCase paper = MakeSmallCase(100, 1750, 2.5, 4);
+  ProblemBundle bundle(paper, Weights(0.01, 1.0));
+  bundle.problem.SetModulus(0.9 * 200e9);
+  const Solved stored =
+      Solve(Options(CoupledSolverType::kConjugateGradient, 1e-10), &bundle.problem);
+  const Solved streamed =
+      Solve(Options(CoupledSolverType::kStreamingConjugateGradient, 1e-10), &bundle.problem);
+  ASSERT_TRUE(stored.summary.IsSolutionUsable() && streamed.summary.IsSolutionUsable());
+  EXPECT_NEAR(streamed.solution.cost, stored.solution.cost, 1e-14 * stored.solution.cost);
+  EXPECT_NEAR(streamed.solution.cost_gradient, stored.solution.cost_gradient,
+              6e-9 * std::abs(stored.solution.cost_gradient));
+}
+
+TEST(StreamingSolverTest, IdentifiesTheSameModulusAsStoredFields) {
+  // identify run on configs/quick.yaml with either solver, inner tolerance 1e-10:
+  // measured 2.3e-9 apart (the issue asks for 1e-8).
+  const std::string config = testing::SourcePath("configs/quick.yaml");
+  const std::string common = " --set inner.tolerance=1e-10 --set output.figures=false -q";
+  const std::string stored_folder = testing::FreshDirectory("streaming_stored") + "/r";
+  const std::string streamed_folder = testing::FreshDirectory("streaming_streamed") + "/r";
+  const testing::RunResult stored =
+      testing::RunIdentify("run " + config + " --output " + stored_folder + common);
+  const testing::RunResult streamed =
+      testing::RunIdentify("run " + config + " --output " + streamed_folder + common +
+                           " --set inner.method=streaming_conjugate_gradient");
+  ASSERT_EQ(stored.exit_code, 0) << stored.output;
+  ASSERT_EQ(streamed.exit_code, 0) << streamed.output;
+  auto identified = [](const std::string& folder) {
+    const std::string summary = testing::ReadText(folder + "/summary.yaml");
+    const std::size_t at = summary.find("identified_modulus: ");
+    return std::stod(summary.substr(at + 20, 30));
+  };
+  const double e_stored = identified(stored_folder), e_streamed = identified(streamed_folder);
+  EXPECT_NEAR(e_streamed, e_stored, 1e-8 * e_stored);
+}
 
 TEST(StreamingSolverTest, RefusesThetaOtherThanOneHalfNamingTheSolverThatCan) {
   ProblemBundle bundle(MakeSmallCase(10, 40, 5.0, 2), Weights(0.01, 1.0), 1.0);
