@@ -7,7 +7,8 @@
 // and I - L is self-adjoint positive definite in <.,.>_beta on the weighted rows
 // (L = -H D P D* H^T diag(beta)), with the same nonzero spectrum as A = I - G of the
 // stored-field solvers: CG takes as many iterations, at three sweeps each instead of
-// two, and holds a handful of trace fields (channels x (m + 1)) and O(n) states.
+// two (four for theta != 1/2, from checkpoints), and holds a handful of trace fields
+// (channels x (m + 1)) and O(n) states (O(n sqrt(m)) with checkpoints).
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -33,13 +34,6 @@ constexpr double kMaxRebuildError = 1e-8;
 
 void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, McreProblem* problem,
                                        CoupledSolution* solution, CoupledSolverSummary* summary) {
-  if (problem->theta() != 0.5) {
-    summary->message =
-        "streaming_conjugate_gradient rebuilds the retrograde field by running the "
-        "trapezoidal recursion backwards, which needs time.theta = 0.5 (got " +
-        std::to_string(problem->theta()) + "); use conjugate_gradient";
-    return;
-  }
   solution->displacement.resize(0, 0);
   solution->retrograde.resize(0, 0);
   // y = 0: r = b = Phi(0).
