@@ -1,6 +1,6 @@
 // The YAML configuration of an mcrewave run.
 //
-// Every key is declared once, in a table in src/config.cpp, with its type, its
+// Every key is declared once, in a table in src/app/config.cpp, with its type, its
 // default, its unit and a one-line description; loading, validation, the
 // `--set key.path=value` overrides and the commented default config
 // (DefaultConfigYaml) all come from that table. Values are SI units. Enums are
