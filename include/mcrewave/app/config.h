@@ -76,6 +76,7 @@ struct OutputOptions {
 struct Config {
   std::string source_path;  // the file the config was read from ("" for defaults)
   BarProperties model;
+  ZoneLayout zones;  // the identification's zones (keys model.zoning, zone_count, zone_boundaries)
   LoadOptions load;
   TimeOptions time;
   DataOptions data;
