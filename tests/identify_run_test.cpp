@@ -281,7 +281,7 @@ TEST_P(BadInputTest, IsRefusedWithOneClearLineAndNothingWritten) {
   const std::string csv = dir + "/data.csv";
   const std::string folder = dir + "/results";
   if (bad.csv != nullptr) {
-    std::ofstream(csv) << (std::string(bad.csv) == "uniform:301:2e-6" ? UniformCsv(301, 2e-6)
+    std::ofstream(csv) << (std::string(bad.csv) == "uniform:150:2e-6" ? UniformCsv(150, 2e-6)
                            : std::string(bad.csv) == "uniform:101"    ? UniformCsv(101, 1.44e-6)
                                                                       : std::string(bad.csv));
   }
@@ -437,13 +437,14 @@ INSTANTIATE_TEST_SUITE_P(
                  2,
                  {"{config}:3: data.path: cannot read measurement file", "absent.csv",
                   "No such file or directory"}},
-        BadInput{"csv_time_step_differs",
+        BadInput{"csv_other_step_short_of_the_window",
                  "time:\n  window: 0.432e-3\n  step: 1.44e-6\n"
                  "data:\n  source: csv\n  path: {csv}\n",
-                 "uniform:301:2e-6",
+                 "uniform:150:2e-6",
                  "",
                  2,
-                 {"{csv}: time step 2e-06 s differs from time.step 1.44e-06 s of {config}"}},
+                 {"{csv}: the data span [0, 0.000298] s does not cover the model's window "
+                  "[0, 0.000432] s"}},
         BadInput{"csv_sample_count_differs",
                  "time:\n  window: 0.432e-3\n  step: 1.44e-6\n"
                  "data:\n  source: csv\n  path: {csv}\n",

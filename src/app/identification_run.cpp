@@ -11,6 +11,7 @@
 
 #include "mcrewave/data/noise.h"
 #include "mcrewave/data/prefilter.h"
+#include "mcrewave/data/resample.h"
 #include "mcrewave/model/simulation.h"
 
 namespace mcrewave {
@@ -61,7 +62,8 @@ std::vector<CostCurvePoint> ComputeCostCurve(const Config& config, const BarMode
   spdlog::info("cost curve: {} points over [{:.6g}, {:.6g}] Pa", moduli.size(), moduli.front(),
                moduli.back());
 
-  McreObjective objective(model, data, config.mcre, config.time.theta, config.inner, center);
+  McreObjective objective(model, data, config.mcre, config.time.theta, config.inner, center,
+                          run.ends);
   if (run.solution.has_fields()) objective.SetWarmStart(run.solution.retrograde);
   std::vector<CostCurvePoint> curve;
   for (const double modulus : moduli) {
@@ -90,18 +92,33 @@ std::string Number(double value) {
 }  // namespace
 
 MeasurementSet LoadMeasurements(const Config& config) {
+  bool use_u0 = true, use_uL = true;
   if (config.data.source == DataSource::kSynthetic) {
-    return MakeSyntheticMeasurements(config.model, config.load, config.time, config.data);
+    MeasurementSet data =
+        MakeSyntheticMeasurements(config.model, config.load, config.time, config.data);
+    SelectChannels(data, config.data.channels, "data.channels", "the synthetic data (data.sensors)",
+                   &use_u0, &use_uL);
+    return data;
   }
   const std::string& path = config.data.path;
   MeasurementSet data = ReadMeasurementCsv(path);
   const std::string config_name = config.source_path.empty() ? "the config" : config.source_path;
-  if (std::abs(data.time_step - config.time.step) > kGridTolerance * config.time.step) {
-    throw InputError(path + ": time step " + Number(data.time_step) + " s differs from time.step " +
-                     Number(config.time.step) + " s of " + config_name +
-                     "; the model runs on the data's time grid");
-  }
   const int expected_samples = config.time.NumSteps() + 1;
+  if (std::abs(data.time_step - config.time.step) > kGridTolerance * config.time.step ||
+      std::abs(data.start_time) > kGridTolerance * config.time.step) {
+    // Another rate or origin: band-limited resampling onto the model's grid (resample.h).
+    spdlog::info("{}: resampling {} samples of {:.6g} s onto {} samples of time.step {:.6g} s",
+                 path, data.num_samples(), data.time_step, expected_samples, config.time.step);
+    data = ResampleMeasurements(data, config.time.step, expected_samples, path);
+  }
+  SelectChannels(data, config.data.channels, "data.channels", path, &use_u0, &use_uL);
+  for (std::size_t k = 0; k < data.sensors.size(); ++k) {
+    if (data.sensors[k].position > config.model.length) {
+      throw InputError(path + ":1: column '" + data.sensors[k].name +
+                       "': the sensor lies outside the bar [0, " + Number(config.model.length) +
+                       "] m (model.length of " + config_name + ")");
+    }
+  }
   if (data.num_samples() != expected_samples) {
     throw InputError(
         path + ": " + std::to_string(data.num_samples()) +
@@ -117,7 +134,11 @@ IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& da
   IdentificationRun run;
   run.config = config;
   run.reference_known = config.data.source == DataSource::kSynthetic;
-  run.data = PrefilterMeasurements(data, config.prefilter, &run.prefilter_cutoff);
+  // The channels of data.channels (LoadMeasurements checked they exist), then the
+  // pre-filter.
+  run.data = PrefilterMeasurements(SelectChannels(data, config.data.channels, "data.channels",
+                                                  "the data", &run.ends.u0, &run.ends.uL),
+                                   config.prefilter, &run.prefilter_cutoff);
   if (config.prefilter.enabled) {
     spdlog::info("pre-filter: zero-phase Butterworth of order {} (x2), cut-off {:.6g} Hz{}",
                  config.prefilter.order, run.prefilter_cutoff,
@@ -126,7 +147,7 @@ IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& da
 
   const BarModel model(config.model);
   McreObjective objective(model, run.data, config.mcre, config.time.theta, config.inner,
-                          config.outer.initial);
+                          config.outer.initial, run.ends);
   run.alpha = objective.problem().alpha();
   run.beta = objective.problem().beta();
   run.rest_cost = objective.rest_cost();
@@ -191,7 +212,7 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
 
   // The inner solver's convergence at E* from W = 0.
   McreObjective cold(model, run.data, config.mcre, config.time.theta, config.inner,
-                     run.identified_modulus());
+                     run.identified_modulus(), run.ends);
   run.cold_solve = cold.EvaluateModulus(run.identified_modulus()).inner;
 
   // The uncertainty figure: noise levels known for synthetic data with noise,
@@ -203,6 +224,18 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
     // std = RMS(signal) / SNR (noise.h)
     run.noise.displacement_std = RootMeanSquare(truth.uL) / config.data.snr;
     run.noise.force_std = RootMeanSquare(truth.fL) / config.data.snr;
+    // Strains: RMS over every strain channel / SNR (noise.h).
+    double strain_squares = 0.0;
+    Eigen::Index strain_samples = 0;
+    for (const SensorChannel& sensor : truth.sensors) {
+      if (sensor.kind != SensorKind::kStrain) continue;
+      strain_squares += sensor.values.squaredNorm();
+      strain_samples += sensor.values.size();
+    }
+    if (strain_samples > 0) {
+      run.noise.strain_std =
+          std::sqrt(strain_squares / static_cast<double>(strain_samples)) / config.data.snr;
+    }
     run.noise_source = "synthetic_snr";
   } else {
     run.noise = run.estimated_noise;
@@ -213,7 +246,7 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
                                              kCurvatureWindow, &curvature_points);
   run.uncertainty = EstimateModulusUncertainty(
       config.uncertainty, model, run.data, config.mcre, config.time.theta, config.inner,
-      run.identified_modulus(), run.solution, run.noise, curvature, curvature_points);
+      run.identified_modulus(), run.solution, run.noise, curvature, curvature_points, run.ends);
   if (run.uncertainty.available) {
     spdlog::info("uncertainty: std(E) = {:.4g} Pa ({:.3g} %) over {} noise draws",
                  run.uncertainty.std_dev, 100.0 * run.uncertainty.relative_std_dev,

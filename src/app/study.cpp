@@ -914,7 +914,7 @@ CostCurveStudy RunCostCurveStudy(const Config& config) {
         // e^2 on the grid, on the pre-filtered data the identification saw,
         // warm-started point to point.
         McreObjective objective(model, identification.data, config.mcre, config.time.theta,
-                                config.inner, study.reference_modulus);
+                                config.inner, study.reference_modulus, identification.ends);
         for (int k = 0; k < options.cost_curve_points; ++k) {
           const double factor =
               options.cost_curve_low + (options.cost_curve_high - options.cost_curve_low) * k /

@@ -317,6 +317,40 @@ void CheckMeasurementChannels(const MeasurementSet& measurements, const std::str
   }
 }
 
+MeasurementSet SelectChannels(const MeasurementSet& measurements,
+                              const std::vector<std::string>& channels, const std::string& key,
+                              const std::string& source, bool* use_u0, bool* use_uL) {
+  *use_u0 = true;
+  *use_uL = true;
+  if (channels.empty()) return measurements;
+  MeasurementSet selected = measurements;
+  selected.sensors.clear();
+  *use_u0 = std::find(channels.begin(), channels.end(), "u0") != channels.end();
+  *use_uL = std::find(channels.begin(), channels.end(), "uL") != channels.end();
+  for (std::size_t i = 0; i < channels.size(); ++i) {
+    ChannelName wanted;
+    std::string why;
+    if (!ParseChannelName(channels[i], &wanted, &why)) {
+      throw InputError(key + "[" + std::to_string(i) + "] = '" + channels[i] + "': " + why);
+    }
+    if (wanted.kind != ChannelName::Kind::kSensor) continue;
+    auto found = std::find_if(measurements.sensors.begin(), measurements.sensors.end(),
+                              [&wanted](const SensorChannel& sensor) {
+                                return sensor.kind == wanted.sensor_kind &&
+                                       sensor.position == wanted.position;
+                              });
+    if (found == measurements.sensors.end()) {
+      std::string available;
+      for (const SensorChannel& sensor : measurements.sensors) available += " " + sensor.name;
+      throw InputError(
+          key + "[" + std::to_string(i) + "] = '" + channels[i] + "': no such channel in " +
+          source + " (its interior channels:" + (available.empty() ? " none" : available) + ")");
+    }
+    selected.sensors.push_back(*found);
+  }
+  return selected;
+}
+
 void WriteMeasurementCsv(const MeasurementSet& measurements, const std::string& path) {
   const int samples = measurements.num_samples();
   assert(measurements.uL.size() == samples && measurements.f0.size() == samples &&

@@ -33,8 +33,11 @@ MeasurementSet LoadMeasurements(const Config& config);
 // Everything one identification computed.
 struct IdentificationRun {
   Config config;
-  // The measurements the MCRE compared with: pre-filtered when prefilter.enabled.
+  // The measurements the MCRE compared with: the channels of data.channels,
+  // pre-filtered when prefilter.enabled.
   MeasurementSet data;
+  // The end displacement channels among them (data.channels).
+  EndDisplacementChannels ends;
   // The pre-filter's cut-off frequency [Hz] (given or derived); 0 when off.
   double prefilter_cutoff = 0.0;
   // Synthetic data: they were made with E = config.model.modulus, the reference

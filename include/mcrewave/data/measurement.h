@@ -81,6 +81,15 @@ MeasurementSet ParseMeasurementCsv(std::istream& text, const std::string& name);
 void CheckMeasurementChannels(const MeasurementSet& measurements, const std::string& name);
 constexpr double kOutlierNoiseFactor = 50.0;
 
+// The channels an identification uses (config data.channels): the set with only the
+// interior sensors named in `channels` (all when `channels` is empty) and, in *use_u0
+// and *use_uL, whether the end displacements are among them (f0 and fL always are:
+// the model's loads). Throws InputError naming `key`, the channel and `source` when a
+// channel is not in the set.
+MeasurementSet SelectChannels(const MeasurementSet& measurements,
+                              const std::vector<std::string>& channels, const std::string& key,
+                              const std::string& source, bool* use_u0, bool* use_uL);
+
 // Writes the set as CSV (t,u0,uL,f0,fL, then the sensors by name) with full precision
 // (17 significant digits), atomically
 // (temporary file then rename). Throws std::runtime_error if the file cannot be
