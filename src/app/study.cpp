@@ -17,6 +17,7 @@
 #include <thread>
 #include <utility>
 
+#include "app/study_internal.h"
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/core/file_util.h"
@@ -26,9 +27,7 @@
 #include "mcrewave/model/simulation.h"
 
 namespace mcrewave {
-namespace {
-
-using Clock = std::chrono::steady_clock;
+namespace internal {
 
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -39,7 +38,6 @@ int ResolveThreads(int threads) {
   return std::max(1u, std::thread::hardware_concurrency());
 }
 
-// "1 min 05 s" or "42 s".
 std::string Duration(double seconds) {
   char text[64];
   const long whole = std::lround(seconds);
@@ -51,34 +49,16 @@ std::string Duration(double seconds) {
   return text;
 }
 
-// Counts completed runs and logs one progress line per run with the time left,
-// extrapolated from the mean time per completed run so far.
-class Progress {
- public:
-  Progress(std::string what, int total) : what_(std::move(what)), total_(total) {}
+void Progress::RunDone() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++done_;
+  const double elapsed = SecondsSince(start_);
+  // left = elapsed / done * (total - done)
+  const double left = elapsed / done_ * (total_ - done_);
+  StudyProgressLogger()->info("{}: {} / {} runs, {} elapsed, about {} left", what_, done_, total_,
+                              Duration(elapsed), Duration(left));
+}
 
-  void RunDone() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    ++done_;
-    const double elapsed = SecondsSince(start_);
-    // left = elapsed / done * (total - done)
-    const double left = elapsed / done_ * (total_ - done_);
-    StudyProgressLogger()->info("{}: {} / {} runs, {} elapsed, about {} left", what_, done_, total_,
-                                Duration(elapsed), Duration(left));
-  }
-
- private:
-  std::string what_;
-  int total_;
-  int done_ = 0;
-  std::mutex mutex_;
-  Clock::time_point start_ = Clock::now();
-};
-
-// Calls task(i) for every i in [0, count) on `threads` threads, each taking the
-// next index not yet taken, and progress->RunDone() after each. The tasks must
-// write only their own results (by index). The first exception a task throws is
-// rethrown once every thread has stopped (the others stop taking new indices).
 void ParallelFor(int count, int threads, const std::function<void(int)>& task, Progress* progress) {
   std::atomic<int> next{0};
   std::atomic<bool> failed{false};
@@ -146,7 +126,6 @@ std::vector<std::uint64_t> SeedsOf(double snr, int seeds) {
 // ---------------------------------------------------------------------------
 // Text.
 
-// Number as CSV text: 10 significant digits, "nan", "inf".
 std::string Csv(double value) {
   if (std::isnan(value)) return "nan";
   if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
@@ -155,8 +134,7 @@ std::string Csv(double value) {
   return text;
 }
 
-// Number for tables: `digits` significant digits.
-std::string Brief(double value, int digits = 4) {
+std::string Brief(double value, int digits) {
   if (std::isnan(value)) return "-";
   if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
   char text[64];
@@ -164,7 +142,6 @@ std::string Brief(double value, int digits = 4) {
   return text;
 }
 
-// A ratio as a signed percentage with 3 decimals ("+0.012 %").
 std::string Percent(double ratio) {
   if (std::isnan(ratio)) return "-";
   char text[64];
@@ -174,8 +151,6 @@ std::string Percent(double ratio) {
 
 std::string SnrText(double snr) { return std::isinf(snr) ? "inf" : Brief(snr); }
 
-// Writes `files` (name, content) into folder, then draws `figures` (name,
-// script) when asked; returns the paths written.
 std::vector<std::string> WriteStudyFolder(
     const std::string& folder, const std::vector<std::pair<std::string, std::string>>& files,
     const std::vector<std::pair<std::string, std::string>>& figures, bool draw,
@@ -225,14 +200,15 @@ std::string PlotCommand(const std::vector<std::string>& plots) {
   return command + "\n";
 }
 
-// Gnuplot colours of the curves, by index.
 std::string Colour(int index) {
   static const char* const colours[] = {"#1f4e9c", "#d62728", "#2ca02c", "#ff7f0e",
                                         "#9467bd", "#8c564b", "#17becf", "#7f7f7f"};
   return colours[index % 8];
 }
 
-}  // namespace
+}  // namespace internal
+
+using namespace internal;
 
 const char* StudyKindToString(StudyKind kind) {
   switch (kind) {
