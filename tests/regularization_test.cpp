@@ -89,7 +89,8 @@ TEST(DiscrepancyPrincipleTest, ChoosesTheWeightOfTheClosedForm) {
   // b = A p_true + noise of std 0.05 over 40 rows, p_true piecewise constant; the target
   // is the expected misfit of the truth, 1/2 m sigma^2. The weight whose Tikhonov misfit
   // equals the target, lambda*, by bisection of the closed form; the discrepancy
-  // principle's weight lies within its final bracket, [lambda* / 10^(1/16), lambda*].
+  // principle's weight lies within its final bracket,
+  // [lambda* / grid_factor^(1/2^bisection_steps), lambda*].
   const int m = 40, n = 10;
   std::mt19937_64 engine(3);
   std::normal_distribution<double> normal;
@@ -122,7 +123,10 @@ TEST(DiscrepancyPrincipleTest, ChoosesTheWeightOfTheClosedForm) {
     options.step_tolerance = 1e-10;
     options.function_tolerance = 0.0;
     RegularizationOptions regularization;
-    regularization.max_weight = 1e2;
+    // Absolute weights 1e2 down to 1e-10: the options are relative to the start's cost.
+    const double start_cost = 0.5 * b.squaredNorm();
+    regularization.max_weight = 1e2 / start_cost;
+    regularization.min_weight = 1e-10 / start_cost;
     const RegularizedMinimization result =
         MinimizeRegularized(options, regularization, &data, std::vector<double>(n, -5.0),
                             std::vector<double>(n, 5.0), std::vector<double>(n, 0.0), target);
@@ -132,7 +136,10 @@ TEST(DiscrepancyPrincipleTest, ChoosesTheWeightOfTheClosedForm) {
     // Measured: lambda = 1.3335 against 1.4763 (ratio 0.903, the bracket's lower end is
     // 0.866) with both minimisers, 7 minimisations (3 of the grid, 4 bisections).
     EXPECT_LE(result.weight, expected * 1.001);
-    EXPECT_GE(result.weight, expected / std::pow(10.0, 1.0 / 16.0) / 1.001);
+    EXPECT_GE(result.weight, expected /
+                                 std::pow(regularization.grid_factor,
+                                          std::pow(0.5, regularization.bisection_steps)) /
+                                 1.001);
     // The misfit at the result is the closed form's at that weight.
     EXPECT_NEAR(result.misfit, data.Misfit(result.weight), 1e-6 * target);
   }
@@ -145,13 +152,15 @@ TEST(DiscrepancyPrincipleTest, AnUnreachableTargetKeepsTheSmallestWeightAndSaysS
   LeastSquares data(a, b);
   BoundedMinimizerOptions options;
   RegularizationOptions regularization;
-  regularization.min_weight = 1e-3;
+  // Absolute weights 1 down to 1e-3: relative to the start's cost 1/2 |b|^2 = 45.5.
+  regularization.max_weight = 1.0 / 45.5;
+  regularization.min_weight = 1e-3 / 45.5;
   const RegularizedMinimization result =
       MinimizeRegularized(options, regularization, &data, std::vector<double>(3, -10.0),
                           std::vector<double>(3, 10.0), std::vector<double>(3, 0.0), 1.0);
   EXPECT_EQ(result.weight_choice, "discrepancy_not_reached");
-  EXPECT_NEAR(result.weight, 1e-3, 1e-12);
-  EXPECT_EQ(result.path.size(), 4u);  // 1, 0.1, 0.01, 0.001
+  EXPECT_NEAR(result.weight, 1e-2, 1e-12);
+  EXPECT_EQ(result.path.size(), 2u);  // 1, 0.01 (the grid stops above 0.001)
 }
 
 TEST(RegularizationOptionsTest, NamesAndMessages) {

@@ -93,6 +93,8 @@ class Guard {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   }
   StopReason stop() const { return stop_; }
+  // A point of lower cost than the first evaluation's was found.
+  bool improved() const { return !best_.empty() && best_cost_ < initial_cost_; }
 
   // The termination the stop calls for: limits kNoConvergence, failures kFailure.
   void ReportStop(BoundedMinimizerSummary* summary) const {
@@ -231,8 +233,19 @@ void RunNlopt(const BoundedMinimizerOptions& options, const std::vector<double>&
     summary->message = "NLopt ran out of memory";
   } catch (const std::exception& error) {
     summary->optimizer_message = error.what();
-    summary->termination = TerminationType::kFailure;
-    summary->message = std::string("NLopt failed: ") + error.what();
+    if (guard->stop() == StopReason::kNone && guard->improved() &&
+        UsesGradient(options.algorithm) && std::string(error.what()) == "nlopt failure") {
+      // NLOPT_FAILURE of a gradient-based algorithm that made progress: its line
+      // search found no decrease along a descent direction, i.e. the cost is flat to
+      // the objective's precision there (the inner solves' tolerance), as
+      // roundoff_limited says for the scalar loop.
+      summary->termination = TerminationType::kConvergence;
+      summary->message =
+          "converged to the objective's precision (NLopt: line search without decrease)";
+    } else {
+      summary->termination = TerminationType::kFailure;
+      summary->message = std::string("NLopt failed: ") + error.what();
+    }
   }
   if (guard->stop() != StopReason::kNone) guard->ReportStop(summary);
 }

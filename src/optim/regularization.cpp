@@ -154,6 +154,12 @@ RegularizedMinimization MinimizeRegularized(
   // that meets the target.
   result.target_misfit = target_misfit;
   std::vector<double> start = initial;
+  // c0, the data cost at the start: the grid's unit.
+  double start_cost = 0.0;
+  if (!data->Evaluate(initial.data(), &start_cost, nullptr) || !(start_cost > 0.0)) {
+    start_cost = 1.0;  // a failure shows in the first minimisation
+  }
+  ++result.evaluations;
   double missed = -1.0;  // the last weight that missed the target
   BoundedMinimizerSummary hit;
   double hit_weight = -1.0;
@@ -161,8 +167,9 @@ RegularizedMinimization MinimizeRegularized(
   BoundedMinimizerSummary last;
   double last_weight = -1.0;
   double last_misfit = -1.0;
-  for (double weight = regularization.max_weight;
-       weight >= regularization.min_weight * (1.0 - 1e-12); weight /= regularization.grid_factor) {
+  for (double weight = regularization.max_weight * start_cost;
+       weight >= regularization.min_weight * start_cost * (1.0 - 1e-12);
+       weight /= regularization.grid_factor) {
     BoundedMinimizerSummary summary = MinimizeAt(options, regularization, data, lower, upper, start,
                                                  weight, target_misfit, &result, &point);
     if (!summary.IsSolutionUsable()) {

@@ -28,7 +28,10 @@
 // or a false return of the objective is caught in the adapter, its message kept and
 // the optimiser stopped (NLopt force-stopped: its C++ wrapper would report a bare
 // "nlopt failure"); a non-finite cost is a failure. The best point seen is reported,
-// not the optimiser's last.
+// not the optimiser's last. NLopt's generic failure of a gradient-based algorithm
+// after progress (its line search found no decrease: the cost is flat to the
+// objective's precision, measured on the paper's bar with inner solves at 1e-8) counts
+// as convergence, as roundoff_limited does.
 //
 // Scaling: the cost is evaluated once at the start before the optimiser runs, and the
 // optimiser sees cost / |cost(start)| (and the gradient likewise): its internal tests
@@ -79,7 +82,7 @@ struct BoundedMinimizerOptions {
   double step_tolerance = 1e-8;
   // Stop when a step changes the cost by at most this fraction (NLopt ftol_rel;
   // Ceres function_tolerance); 0: no such test.
-  double function_tolerance = 1e-12;
+  double function_tolerance = 1e-10;
   // Evaluations allowed; reaching the limit is not convergence.
   int max_evaluations = 2000;
   // Wall time allowed [s]; reaching it is not convergence.
