@@ -152,7 +152,7 @@ TEST_P(BoundedMinimizerTest, TheEvaluationLimitIsNotConvergence) {
       MinimizeWithinBounds(options, &objective, {-2.0, -1.0}, {2.0, 3.0}, {-1.2, 1.0});
   EXPECT_EQ(summary.termination, TerminationType::kNoConvergence) << summary.FullReport();
   EXPECT_LE(summary.evaluations, 7);
-  EXPECT_NE(summary.message.find("outer.zones.max_evaluations"), std::string::npos);
+  EXPECT_NE(summary.message.find("zone_identification.max_evaluations"), std::string::npos);
 }
 
 INSTANTIATE_TEST_SUITE_P(Algorithms, BoundedMinimizerTest,
@@ -183,11 +183,11 @@ TEST(BoundedMinimizerOptionsTest, MessagesNameTheKeys) {
   EXPECT_TRUE(options.IsValid(&error));
   options.step_tolerance = 0.0;
   EXPECT_FALSE(options.IsValid(&error));
-  EXPECT_NE(error.find("outer.zones.step_tolerance"), std::string::npos);
+  EXPECT_NE(error.find("zone_identification.step_tolerance"), std::string::npos);
   options = BoundedMinimizerOptions();
   options.max_evaluations = 1;
   EXPECT_FALSE(options.IsValid(&error));
-  EXPECT_NE(error.find("outer.zones.max_evaluations"), std::string::npos);
+  EXPECT_NE(error.find("zone_identification.max_evaluations"), std::string::npos);
 }
 
 }  // namespace

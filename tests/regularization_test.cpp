@@ -174,7 +174,7 @@ TEST(RegularizationOptionsTest, NamesAndMessages) {
   EXPECT_TRUE(options.IsValid(&error));
   options.grid_factor = 1.0;
   EXPECT_FALSE(options.IsValid(&error));
-  EXPECT_NE(error.find("outer.zones.grid_factor"), std::string::npos);
+  EXPECT_NE(error.find("zone_identification.grid_factor"), std::string::npos);
 }
 
 }  // namespace

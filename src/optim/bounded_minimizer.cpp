@@ -39,13 +39,13 @@ class Guard {
   bool Evaluate(const double* x, double* cost, double* gradient) {
     if (stop_ != StopReason::kNone) return false;
     if (evaluations_ >= options_.max_evaluations) {
-      Stop(StopReason::kEvaluationLimit, "outer.zones.max_evaluations (" +
+      Stop(StopReason::kEvaluationLimit, "zone_identification.max_evaluations (" +
                                              std::to_string(options_.max_evaluations) +
                                              ") reached before convergence");
       return false;
     }
     if (ElapsedSeconds() > options_.max_time) {
-      Stop(StopReason::kTimeLimit, "outer.zones.max_time reached before convergence");
+      Stop(StopReason::kTimeLimit, "zone_identification.max_time reached before convergence");
       return false;
     }
     ++evaluations_;
@@ -390,13 +390,13 @@ bool UsesGradient(BoundedAlgorithm algorithm) {
 bool BoundedMinimizerOptions::IsValid(std::string* error) const {
   std::ostringstream why;
   if (!(step_tolerance > 0.0 && step_tolerance < 0.1)) {
-    why << "outer.zones.step_tolerance must lie in (0, 0.1), got " << step_tolerance;
+    why << "zone_identification.step_tolerance must lie in (0, 0.1), got " << step_tolerance;
   } else if (!(function_tolerance >= 0.0 && function_tolerance < 0.1)) {
-    why << "outer.zones.function_tolerance must lie in [0, 0.1), got " << function_tolerance;
+    why << "zone_identification.function_tolerance must lie in [0, 0.1), got " << function_tolerance;
   } else if (max_evaluations < 2) {
-    why << "outer.zones.max_evaluations must be at least 2, got " << max_evaluations;
+    why << "zone_identification.max_evaluations must be at least 2, got " << max_evaluations;
   } else if (!(max_time > 0.0 && std::isfinite(max_time))) {
-    why << "outer.zones.max_time must be a positive number of seconds, got " << max_time;
+    why << "zone_identification.max_time must be a positive number of seconds, got " << max_time;
   } else {
     return true;
   }

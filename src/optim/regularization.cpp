@@ -68,20 +68,20 @@ bool StringToRegularizationKind(const std::string& name, RegularizationKind* kin
 bool RegularizationOptions::IsValid(std::string* error) const {
   std::ostringstream why;
   if (!std::isfinite(weight)) {
-    why << "outer.zones.regularization_weight must be a finite number (< 0: automatic), got "
+    why << "zone_identification.regularization_weight must be a finite number (< 0: automatic), got "
         << weight;
   } else if (!(tv_smoothing > 0.0 && tv_smoothing < 1.0)) {
-    why << "outer.zones.tv_smoothing must lie in (0, 1), got " << tv_smoothing;
+    why << "zone_identification.tv_smoothing must lie in (0, 1), got " << tv_smoothing;
   } else if (!(min_weight > 0.0 && max_weight > min_weight && std::isfinite(max_weight))) {
-    why << "outer.zones.min_weight and outer.zones.max_weight must satisfy 0 < min_weight < "
+    why << "zone_identification.min_weight and zone_identification.max_weight must satisfy 0 < min_weight < "
            "max_weight, got "
         << min_weight << " and " << max_weight;
   } else if (!(grid_factor > 1.0 && grid_factor <= 1e6)) {
-    why << "outer.zones.grid_factor must lie in (1, 1e6], got " << grid_factor;
+    why << "zone_identification.grid_factor must lie in (1, 1e6], got " << grid_factor;
   } else if (bisection_steps < 0 || bisection_steps > 30) {
-    why << "outer.zones.bisection_steps must lie in [0, 30], got " << bisection_steps;
+    why << "zone_identification.bisection_steps must lie in [0, 30], got " << bisection_steps;
   } else if (!(discrepancy_factor > 0.0 && std::isfinite(discrepancy_factor))) {
-    why << "outer.zones.discrepancy_factor must be a positive number, got " << discrepancy_factor;
+    why << "zone_identification.discrepancy_factor must be a positive number, got " << discrepancy_factor;
   } else {
     return true;
   }

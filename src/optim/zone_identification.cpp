@@ -59,7 +59,7 @@ bool ZoneIdentificationOptions::IsValid(std::string* error) const {
   if (!minimizer.IsValid(error) || !regularization.IsValid(error)) return false;
   if (noise_samples < 1 || noise_samples > 1000) {
     if (error != nullptr) {
-      *error = "outer.zones.noise_samples must be an integer in [1, 1000], got " +
+      *error = "zone_identification.noise_samples must be an integer in [1, 1000], got " +
                std::to_string(noise_samples);
     }
     return false;

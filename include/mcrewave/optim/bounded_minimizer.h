@@ -73,7 +73,7 @@ const char* BoundedAlgorithmToString(BoundedAlgorithm algorithm);
 bool StringToBoundedAlgorithm(const std::string& name, BoundedAlgorithm* algorithm);
 bool UsesGradient(BoundedAlgorithm algorithm);
 
-// The `outer.zones:` options of the minimiser.
+// The `zone_identification:` options of the minimiser.
 struct BoundedMinimizerOptions {
   BoundedAlgorithm algorithm = BoundedAlgorithm::kNloptLbfgs;
   // Stop when a step changes every parameter by at most this much (absolute: on
@@ -89,7 +89,7 @@ struct BoundedMinimizerOptions {
   double max_time = 600.0;
 
   // Valid when step_tolerance in (0, 0.1), function_tolerance in [0, 0.1),
-  // max_evaluations >= 2, max_time > 0. Messages name the outer.zones.* keys.
+  // max_evaluations >= 2, max_time > 0. Messages name the zone_identification.* keys.
   bool IsValid(std::string* error) const;
 };
 

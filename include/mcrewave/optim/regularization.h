@@ -39,7 +39,7 @@ enum class RegularizationKind {
 const char* RegularizationKindToString(RegularizationKind kind);
 bool StringToRegularizationKind(const std::string& name, RegularizationKind* kind);
 
-// The `outer.zones.regularization*` options.
+// The `zone_identification.*` options.
 struct RegularizationOptions {
   RegularizationKind kind = RegularizationKind::kTikhonov;
   // lambda; < 0: chosen by the discrepancy principle.
@@ -58,7 +58,7 @@ struct RegularizationOptions {
   // tau of the target misfit tau * (expected e^2 of the noise).
   double discrepancy_factor = 1.0;
 
-  // Messages name the outer.zones.regularization* keys.
+  // Messages name the zone_identification.* keys.
   bool IsValid(std::string* error) const;
 };
 

@@ -56,7 +56,7 @@ class ZoneMcreObjective : public MultiParameterObjective {
   std::string error_message_;
 };
 
-// The `outer.zones:` section.
+// The `zone_identification:` section.
 struct ZoneIdentificationOptions {
   BoundedMinimizerOptions minimizer;
   RegularizationOptions regularization;
@@ -64,7 +64,7 @@ struct ZoneIdentificationOptions {
   int noise_samples = 4;
   std::uint64_t noise_seed = 1;
 
-  // Messages name the outer.zones.* keys.
+  // Messages name the zone_identification.* keys.
   bool IsValid(std::string* error) const;
 };
 
