@@ -8,7 +8,8 @@
 // run only where its ten fields fit in --max-stored-bytes (default 4 GB).
 // Prints one row per case and the fitted log-log slopes of time and memory.
 //
-// Usage: streaming_benchmark [--max-elements N] [--max-steps M] [--max-stored-bytes B]
+// Usage: streaming_benchmark [--min-elements N] [--max-elements N] [--min-steps M]
+//                            [--max-steps M] [--max-stored-bytes B] [--tolerance T]
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -56,10 +57,13 @@ struct Measured {
   double cost = NAN;
 };
 
+double tolerance = 1e-8;
+
 Measured SolveOnce(McreProblem* problem, CoupledSolverType type) {
   CoupledSolverOptions options;
   options.type = type;
-  options.tolerance = 1e-8;
+  options.tolerance = tolerance;
+  options.max_iterations = 100000;
   options.max_field_bytes = 1L << 40;
   ResetPeak();
   const long before = ResidentBytes();
@@ -72,6 +76,9 @@ Measured SolveOnce(McreProblem* problem, CoupledSolverType type) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     measured.iterations = summary.iterations;
     measured.cost = summary.IsSolutionUsable() ? solution.cost : NAN;
+    if (!summary.IsSolutionUsable()) {
+      std::fprintf(stderr, "%s: %s\n", CoupledSolverTypeToString(type), summary.message.c_str());
+    }
     measured.peak_bytes = static_cast<double>(PeakResidentBytes() - before);
   }
   problem->workspace() = McreProblem::SolverWorkspace();  // release the stored fields
@@ -155,23 +162,27 @@ int main(int argc, char** argv) {
   int max_elements = 100000;
   int max_steps = 100000;
   double max_stored_bytes = 4e9;
+  int min_elements = 100, min_steps = 1000;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (std::strcmp(argv[i], "--max-elements") == 0) max_elements = std::atoi(argv[i + 1]);
     if (std::strcmp(argv[i], "--max-steps") == 0) max_steps = std::atoi(argv[i + 1]);
     if (std::strcmp(argv[i], "--max-stored-bytes") == 0) max_stored_bytes = std::atof(argv[i + 1]);
+    if (std::strcmp(argv[i], "--min-elements") == 0) min_elements = std::atoi(argv[i + 1]);
+    if (std::strcmp(argv[i], "--min-steps") == 0) min_steps = std::atoi(argv[i + 1]);
+    if (std::strcmp(argv[i], "--tolerance") == 0) tolerance = std::atof(argv[i + 1]);
   }
   spdlog::set_level(spdlog::level::warn);
   std::printf("%9s %7s | %-29s | %-29s | %10s\n", "", "", "stored-field CG", "streaming CG", "");
   std::printf("%9s %7s | %9s %5s %11s | %9s %5s %11s | %10s\n", "nodes", "steps", "time [s]",
               "iter", "peak [MB]", "time [s]", "iter", "peak [MB]", "d e^2 / e^2");
   std::vector<Row> by_nodes;
-  for (int elements = 100; elements <= max_elements; elements *= 10) {
+  for (int elements = min_elements; elements <= max_elements; elements *= 10) {
     by_nodes.push_back(Case(elements, 1750, max_stored_bytes));
     Print(by_nodes.back());
   }
   Table(by_nodes, true);
   std::vector<Row> by_steps;
-  for (int steps = 1000; steps <= max_steps; steps *= 10) {
+  for (int steps = min_steps; steps <= max_steps; steps *= 10) {
     by_steps.push_back(Case(100, steps, max_stored_bytes));
     Print(by_steps.back());
   }

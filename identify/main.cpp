@@ -8,6 +8,7 @@
 //   identify run configs/paper_bar.yaml --output results/main
 //   identify run configs/quick.yaml --set outer.optimizer=ceres --output /tmp/quick -v
 //   identify run configs/measured_csv.yaml -q
+//   identify run configs/paper_bar.yaml --set inner.method=streaming_conjugate_gradient -o /tmp/s
 //   identify simulate configs/paper_bar.yaml --output measurements.csv
 //   identify simulate configs/paper_bar.yaml --set data.snr=.inf --output clean.csv
 //   identify simulate configs/paper_bar.yaml --set model.elements=400 --output fine.csv
@@ -20,21 +21,21 @@
 //   of data.path, which must be on the config's time grid), identifies E by
 //   minimising the MCRE cost e^2(E) with the outer optimiser of `outer:` (NLopt
 //   or Ceres) over coupled direct/retrograde solves by the method of `inner:`,
-//   then computes the cost curve around the identified E and an uncertainty
-//   figure, and writes summary.yaml, CSV files and PNG figures into the output
-//   folder (include/mcrewave/results.h), each file atomically and only at the
+//   then computes the cost curve around the identified E, the error map of the
+//   constitutive gap and an uncertainty figure, and writes summary.yaml, CSV files and PNG figures into the output
+//   folder (include/mcrewave/app/results.h), each file atomically and only at the
 //   end. One progress line per outer evaluation at the default level. SIGINT,
 //   SIGTERM or SIGHUP stop a run at once, but not while it writes its results:
 //   an interrupted run leaves the earlier results of its folder as they were.
 //
-//   `simulate` reads a YAML config (see include/mcrewave/config.h or
+//   `simulate` reads a YAML config (see include/mcrewave/app/config.h or
 //   --print-default-config), simulates the bar clamped at x = 0 and hit by a
 //   half-sine load at x = L on the truth discretisation of `data:`, samples the
 //   four channels (u0, uL, f0, fL) on the model's time grid, adds white noise at
 //   the configured SNR and writes the measurement CSV (t,u0,uL,f0,fL).
 //
 //   `study` reads a YAML config and runs the studies of its `study:` section
-//   (include/mcrewave/study.h): robustness over SNR and noise seeds, the
+//   (include/mcrewave/app/study.h): robustness over SNR and noise seeds, the
 //   relaxation coefficient, cost curves; each into a subfolder of the output
 //   folder (CSV files, PNG figures, summary.md), then a README.md gathering the
 //   summaries. Runs spread over study.threads threads; one progress line per

@@ -321,5 +321,27 @@ TEST(McreProblemAllocationTest, RetrogradeSweepsWithInteriorSensorsAllocateNothi
   EXPECT_GT(retrograde.norm(), 0.0);
 }
 
+TEST(McreProblemAllocationTest, StreamingMapAllocatesNothingAfterItsFirstCall) {
+  SKIP_WITHOUT_ALLOCATION_COUNTING();
+  ProblemBundle bundle(MakeSmallCase(kElements, kSteps, 5.0, 2), Weights(0.01, 1.0));
+  MeasurementSet data = bundle.data;
+  data.sensors.push_back({"e@0.7", SensorKind::kStrain, 0.7, 1e-3 * data.uL});
+  McreProblem problem(bundle.model, data, Weights(0.01, 1.0), testing::kReferenceModulus, 0.5);
+  problem.SetModulus(0.9 * testing::kReferenceModulus);
+  const Matrix traces = Matrix::Constant(problem.num_traces(), problem.num_steps() + 1, 1e-7);
+  Matrix image;
+  McreProblem::StreamingTotals totals;
+  // The first calls size the image and the totals.
+  problem.StreamingMap(traces, true, &image, &totals);
+  const HeapCalls calls = CountHeapCalls([&] {
+    problem.StreamingMap(traces, true, &image);
+    problem.StreamingMap(traces, false, &image);
+    problem.StreamingMap(traces, true, &image, &totals);
+  });
+  EXPECT_EQ(calls.allocations, 0);
+  EXPECT_EQ(calls.deallocations, 0);
+  EXPECT_GT(totals.cost, 0.0);
+}
+
 }  // namespace
 }  // namespace mcrewave

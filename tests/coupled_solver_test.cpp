@@ -448,7 +448,7 @@ TEST(AdaptiveRelaxationTest, SafeguardRestartsAfterAnUnderestimatedSpectrumAndCo
   EXPECT_LT(agreement.retrograde, 1e-8);
   EXPECT_LT(agreement.cost, 1e-8);
 
-  // Sweeps as src/iterative_coupled_solvers.cpp spends them: 5 for a warm start
+  // Sweeps as src/mcre/iterative_coupled_solvers.cpp spends them: 5 for a warm start
   // (Start: T(W^(0)), c and W_u), 2 per Lanczos step, and 2 per iteration, the
   // iterations that restart from the best iterate included (each is one
   // FixedPointMap); the last iteration only tests convergence.

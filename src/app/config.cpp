@@ -200,6 +200,76 @@ ValueType<std::vector<double>> NumberList() {
   return type;
 }
 
+// A YAML list of strings ([u@0.25, e@0.65]); a single string is a list of one, an
+// empty value the empty list.
+ValueType<std::vector<std::string>> TextList() {
+  ValueType<std::vector<std::string>> type;
+  type.expected = "a list of channel names, e.g. [u@0.25, e@0.65]";
+  type.read = [](const YAML::Node& node, std::vector<std::string>* value) {
+    std::vector<std::string> parsed;
+    if (node.IsNull()) {
+      value->clear();
+      return true;
+    }
+    if (node.IsScalar()) {
+      parsed.push_back(node.Scalar());
+    } else if (node.IsSequence()) {
+      for (const YAML::Node& element : node) {
+        if (!element.IsScalar()) return false;
+        parsed.push_back(element.Scalar());
+      }
+    } else {
+      return false;
+    }
+    *value = parsed;
+    return true;
+  };
+  type.write = [](const std::vector<std::string>& value) {
+    std::string text = "[";
+    for (std::size_t i = 0; i < value.size(); ++i) text += (i == 0 ? "" : ", ") + value[i];
+    return text + "]";
+  };
+  return type;
+}
+
+// A YAML list of zones, each a map {start: m, end: m, modulus: Pa} (flow or block
+// style); ranges are checked against the bar by ValidateDataAgainstBar.
+ValueType<std::vector<ModulusZone>> ZoneList() {
+  ValueType<std::vector<ModulusZone>> type;
+  type.expected = "a list of zones {start: m, end: m, modulus: Pa}";
+  type.read = [](const YAML::Node& node, std::vector<ModulusZone>* value) {
+    std::vector<ModulusZone> parsed;
+    if (node.IsNull()) {
+      value->clear();
+      return true;
+    }
+    if (!node.IsSequence()) return false;
+    const ValueType<double> number = Number();
+    for (const YAML::Node& element : node) {
+      if (!element.IsMap() || element.size() != 3) return false;
+      ModulusZone zone;
+      if (!element["start"] || !element["end"] || !element["modulus"] ||
+          !number.read(element["start"], &zone.start) || !number.read(element["end"], &zone.end) ||
+          !number.read(element["modulus"], &zone.modulus)) {
+        return false;
+      }
+      parsed.push_back(zone);
+    }
+    *value = parsed;
+    return true;
+  };
+  type.write = [](const std::vector<ModulusZone>& value) {
+    std::string text = "[";
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      text += std::string(i == 0 ? "" : ", ") + "{start: " + FormatNumber(value[i].start) +
+              ", end: " + FormatNumber(value[i].end) +
+              ", modulus: " + FormatNumber(value[i].modulus) + "}";
+    }
+    return text + "]";
+  };
+  return type;
+}
+
 // An enum written by name, with the to/from-string pair of types.h; `values`
 // lists every value (for the messages and the commented config).
 template <typename Enum>
@@ -308,6 +378,14 @@ const std::vector<Key>& KeyTable() {
               EnumByName<MassType>({MassType::kConsistent, MassType::kLumped}, MassTypeToString,
                                    StringToMassType),
               "", "element mass matrix"),
+      MakeKey("model.zoning", &Config::zones, &ZoneLayout::zoning,
+              EnumByName<Zoning>({Zoning::kEqual, Zoning::kPerElement, Zoning::kBoundaries},
+                                 ZoningToString, StringToZoning),
+              "", "zones of constant modulus the identification finds (docs/zones_and_sensors.md)"),
+      MakeKey("model.zone_count", &Config::zones, &ZoneLayout::zone_count, PositiveInteger<int>(),
+              "", "zones of equal length (model.zoning: equal; 1 = the uniform bar)"),
+      MakeKey("model.zone_boundaries", &Config::zones, &ZoneLayout::zone_boundaries, NumberList(),
+              "m", "interior zone boundaries (model.zoning: boundaries)"),
       MakeKey("load.kind", &Config::load, &LoadOptions::kind,
               EnumByName<LoadKind>({LoadKind::kHalfSine}, LoadKindToString, StringToLoadKind), "",
               "shape of the shock load applied at x = L"),
@@ -338,10 +416,20 @@ const std::vector<Key>& KeyTable() {
               "signal-to-noise ratio of the synthetic noise (.inf: no noise)"),
       MakeKey("data.seed", &Config::data, &DataOptions::seed, UnsignedInteger(), "",
               "seed of the noise generator"),
+      MakeKey("data.sensors", &Config::data, &DataOptions::sensors, TextList(), "",
+              "interior channels of synthetic data beside u0, uL, f0, fL: u@X (displacement "
+              "at X m), e@X (strain at X m)"),
+      MakeKey("data.channels", &Config::data, &DataOptions::channels, TextList(), "",
+              "channels the identification uses ([] = every channel of the data; f0 and fL "
+              "always)"),
+      MakeKey("data.truth_zones", &Config::data, &DataOptions::truth_zones, ZoneList(), "",
+              "synthetic truth: stretches of another modulus, [{start: m, end: m, modulus: Pa}]"),
       MakeKey("mcre.w_u", &Config::mcre, &McreOptions::weights, &McreWeights::displacement_weight,
               Number(), "", "displacement weight: beta = w_u S E0 / L"),
       MakeKey("mcre.w_f", &Config::mcre, &McreOptions::weights, &McreWeights::force_weight,
               Number(), "", "force weight: alpha = w_f L / (S E0)"),
+      MakeKey("mcre.w_e", &Config::mcre, &McreOptions::weights, &McreWeights::strain_weight,
+              Number(), "", "strain weight: beta_e = w_e S E0 L"),
       MakeKey("mcre.reference_modulus", &Config::mcre, &McreOptions::reference_modulus, Number(),
               "Pa", "E0 of the weights: a fixed nominal modulus, not the unknown"),
       MakeKey("inner.method", &Config::inner, &CoupledSolverOptions::type,
@@ -560,6 +648,16 @@ const std::vector<SectionValidator>& SectionValidators() {
 // it is compared with.
 const std::vector<SectionValidator>& CrossSectionValidators() {
   static const std::vector<SectionValidator> validators = {
+      // The identification's zones on the bar (each holds an element).
+      [](const Config& config, std::string* error) {
+        *error = config.zones.Validate(config.model);
+        return error->empty();
+      },
+      // Sensors on the bar, truth zones inside it and apart, a truth that can give them.
+      [](const Config& config, std::string* error) {
+        *error = ValidateDataAgainstBar(config.data, config.model);
+        return error->empty();
+      },
       // A cut-off at or above the Nyquist frequency is not a low-pass filter of the
       // sampled data (the bilinear transform maps Nyquist to tan(pi/2)).
       [](const Config& config, std::string* error) {

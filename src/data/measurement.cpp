@@ -20,8 +20,9 @@
 namespace mcrewave {
 namespace {
 
-constexpr int kNumColumns = 5;
-constexpr std::array<const char*, kNumColumns> kColumnNames = {"t", "u0", "uL", "f0", "fL"};
+// The required columns, in the order they are written: time and the four end channels.
+constexpr int kEndColumns = 5;
+constexpr std::array<const char*, kEndColumns> kColumnNames = {"t", "u0", "uL", "f0", "fL"};
 constexpr char kHeader[] = "t,u0,uL,f0,fL";
 // Largest accepted |step - reference step| / reference step, the reference being
 // the median of the file's steps.
@@ -71,6 +72,39 @@ double ExactStep(const std::vector<double>& times, double mean_step) {
 
 }  // namespace
 
+bool ParseChannelName(const std::string& text, ChannelName* channel, std::string* why) {
+  static const std::array<std::pair<const char*, ChannelName::Kind>, 5> kEnds{{
+      {"t", ChannelName::Kind::kTime},
+      {"u0", ChannelName::Kind::kU0},
+      {"uL", ChannelName::Kind::kUL},
+      {"f0", ChannelName::Kind::kF0},
+      {"fL", ChannelName::Kind::kFL},
+  }};
+  for (const auto& [name, kind] : kEnds) {
+    if (text == name) {
+      *channel = ChannelName();
+      channel->kind = kind;
+      return true;
+    }
+  }
+  const bool displacement = text.rfind("u@", 0) == 0, strain = text.rfind("e@", 0) == 0;
+  if (!displacement && !strain) {
+    *why = "not a channel name (t, u0, uL, f0, fL, u@X or e@X with X in m)";
+    return false;
+  }
+  const std::string number = text.substr(2);
+  double position = 0.0;
+  if (number.empty() || number.find_first_of(" \t") != std::string::npos ||
+      !ParseNumber(number, &position) || !std::isfinite(position) || position < 0.0) {
+    *why = "the position X of '" + text + "' must be a finite number >= 0 (in m)";
+    return false;
+  }
+  channel->kind = ChannelName::Kind::kSensor;
+  channel->sensor_kind = strain ? SensorKind::kStrain : SensorKind::kDisplacement;
+  channel->position = position;
+  return true;
+}
+
 MeasurementSet ReadMeasurementCsv(const std::string& path) {
   std::ifstream file(path, std::ios::binary);
   if (!file) {
@@ -84,19 +118,73 @@ MeasurementSet ParseMeasurementCsv(std::istream& file, const std::string& path) 
     throw InputError(path + ":" + std::to_string(line_number) + ": " + what);
   };
 
-  std::array<std::vector<double>, kNumColumns> columns;
+  // The header: column c holds channel names[c]; destination[c] is 0 for t, 1..4 for
+  // u0, uL, f0, fL, and 5 + k for interior sensor k.
+  std::vector<std::string> names;
+  std::vector<int> destination;
+  std::vector<SensorChannel> sensors;
+  std::vector<std::vector<double>> columns;
   std::string line;
   std::vector<std::string> fields;  // the fields of the current row
   long line_number = 0;
   long first_blank_line = 0;  // first empty line seen so far, 0 if none
+  auto split = [&fields](const std::string& text) {
+    fields.clear();
+    for (std::size_t field_start = 0;;) {
+      const std::size_t comma = text.find(',', field_start);
+      fields.push_back(text.substr(field_start, comma - field_start));
+      if (comma == std::string::npos) break;
+      field_start = comma + 1;
+    }
+  };
+  const std::string expected_header =
+      std::string("a header naming the columns: ") + kHeader +
+      " in any order, then any interior channels u@X (displacement at X m) and e@X (strain "
+      "at X m)";
   while (std::getline(file, line)) {
     ++line_number;
     line = StripLineEnd(line);
     if (line_number == 1) {
       if (line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // UTF-8 byte order mark
-      if (line != kHeader) {
-        fail(1, std::string("expected the header '") + kHeader + "', got '" + line + "'");
+      split(line);
+      std::array<int, kEndColumns> found{};
+      for (std::string field : fields) {
+        const std::size_t first = field.find_first_not_of(" \t");
+        const std::size_t last = field.find_last_not_of(" \t");
+        field = first == std::string::npos ? "" : field.substr(first, last - first + 1);
+        ChannelName channel;
+        std::string why;
+        if (!ParseChannelName(field, &channel, &why)) {
+          fail(1, "column " + std::to_string(names.size() + 1) + " '" + field + "': " + why +
+                      "; expected " + expected_header);
+        }
+        for (std::size_t c = 0; c < names.size(); ++c) {
+          const bool same_sensor =
+              channel.kind == ChannelName::Kind::kSensor && destination[c] >= kEndColumns &&
+              sensors[destination[c] - kEndColumns].kind == channel.sensor_kind &&
+              sensors[destination[c] - kEndColumns].position == channel.position;
+          if (names[c] == field || same_sensor) {
+            fail(1, "column " + std::to_string(names.size() + 1) + " '" + field +
+                        "' repeats column " + std::to_string(c + 1) + " '" + names[c] + "'");
+          }
+        }
+        names.push_back(field);
+        if (channel.kind == ChannelName::Kind::kSensor) {
+          destination.push_back(kEndColumns + static_cast<int>(sensors.size()));
+          sensors.push_back({field, channel.sensor_kind, channel.position, Vector()});
+        } else {
+          const int end = static_cast<int>(channel.kind);  // t, u0, uL, f0, fL = 0..4
+          destination.push_back(end);
+          found[end] = 1;
+        }
       }
+      for (int c = 0; c < kEndColumns; ++c) {
+        if (found[c] == 0) {
+          fail(1, std::string("the header '") + line + "' lacks the column '" + kColumnNames[c] +
+                      "'; expected " + expected_header);
+        }
+      }
+      columns.resize(kEndColumns + sensors.size());
       continue;
     }
     if (line.empty()) {
@@ -105,33 +193,25 @@ MeasurementSet ParseMeasurementCsv(std::istream& file, const std::string& path) 
     }
     if (first_blank_line != 0) fail(first_blank_line, "empty line between data rows");
 
-    fields.clear();
-    for (std::size_t field_start = 0;;) {
-      const std::size_t comma = line.find(',', field_start);
-      fields.push_back(line.substr(field_start, comma - field_start));
-      if (comma == std::string::npos) break;
-      field_start = comma + 1;
-    }
-    if (fields.size() != kNumColumns) {
-      fail(line_number, "expected " + std::to_string(kNumColumns) + " columns, got " +
+    split(line);
+    if (fields.size() != names.size()) {
+      fail(line_number, "expected " + std::to_string(names.size()) + " columns, got " +
                             std::to_string(fields.size()));
     }
-    std::array<double, kNumColumns> row;
-    for (int column = 0; column < kNumColumns; ++column) {
-      if (!ParseNumber(fields[column], &row[column])) {
-        fail(line_number, std::string("column '") + kColumnNames[column] + "': '" + fields[column] +
-                              "' is not a number");
+    for (std::size_t c = 0; c < names.size(); ++c) {
+      double value = 0.0;
+      if (!ParseNumber(fields[c], &value)) {
+        fail(line_number, "column '" + names[c] + "': '" + fields[c] + "' is not a number");
       }
-      if (!std::isfinite(row[column])) {
-        fail(line_number, std::string("column '") + kColumnNames[column] + "': '" + fields[column] +
-                              "' is not a finite number");
+      if (!std::isfinite(value)) {
+        fail(line_number, "column '" + names[c] + "': '" + fields[c] + "' is not a finite number");
       }
+      if (destination[c] == 0 && !columns[0].empty() && !(value > columns[0].back())) {
+        fail(line_number, "time is not strictly increasing (t = " + Short(value) + " s after " +
+                              Short(columns[0].back()) + " s)");
+      }
+      columns[destination[c]].push_back(value);
     }
-    if (!columns[0].empty() && !(row[0] > columns[0].back())) {
-      fail(line_number, "time is not strictly increasing (t = " + Short(row[0]) + " s after " +
-                            Short(columns[0].back()) + " s)");
-    }
-    for (int c = 0; c < kNumColumns; ++c) columns[c].push_back(row[c]);
     if (columns[0].size() % kProgressRows == 0) {
       spdlog::info("{}: read {} rows", path, columns[0].size());
     }
@@ -140,7 +220,7 @@ MeasurementSet ParseMeasurementCsv(std::istream& file, const std::string& path) 
     throw InputError("cannot read measurement file " + path + ": " + std::strerror(errno));
   }
   if (line_number == 0) {
-    fail(1, std::string("expected the header '") + kHeader + "', got an empty file");
+    fail(1, "expected " + expected_header + ", got an empty file");
   }
 
   const std::vector<double>& times = columns[0];
@@ -192,6 +272,12 @@ MeasurementSet ParseMeasurementCsv(std::istream& file, const std::string& path) 
   measurements.f0 = to_vector(columns[3]);
   columns[3] = {};
   measurements.fL = to_vector(columns[4]);
+  columns[4] = {};
+  for (std::size_t k = 0; k < sensors.size(); ++k) {
+    sensors[k].values = to_vector(columns[kEndColumns + k]);
+    columns[kEndColumns + k] = {};
+  }
+  measurements.sensors = std::move(sensors);
   return measurements;
 }
 
@@ -235,14 +321,25 @@ void WriteMeasurementCsv(const MeasurementSet& measurements, const std::string& 
   const int samples = measurements.num_samples();
   assert(measurements.uL.size() == samples && measurements.f0.size() == samples &&
          measurements.fL.size() == samples);
-  std::string content = std::string(kHeader) + "\n";
-  content.reserve(content.size() + static_cast<std::size_t>(samples) * 5 * 25);
+  std::string content = kHeader;
+  for (const SensorChannel& sensor : measurements.sensors) {
+    assert(sensor.values.size() == samples);
+    content += "," + sensor.name;
+  }
+  content += "\n";
+  content.reserve(content.size() +
+                  static_cast<std::size_t>(samples) * (5 + measurements.sensors.size()) * 25);
   char row[5 * 32];
   for (int k = 0; k < samples; ++k) {
-    const int length = std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g,%.17g\n",
-                                     measurements.Time(k), measurements.u0[k], measurements.uL[k],
-                                     measurements.f0[k], measurements.fL[k]);
+    int length = std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g,%.17g",
+                               measurements.Time(k), measurements.u0[k], measurements.uL[k],
+                               measurements.f0[k], measurements.fL[k]);
     content.append(row, static_cast<std::size_t>(length));
+    for (const SensorChannel& sensor : measurements.sensors) {
+      length = std::snprintf(row, sizeof(row), ",%.17g", sensor.values[k]);
+      content.append(row, static_cast<std::size_t>(length));
+    }
+    content += '\n';
   }
   WriteFileAtomically(path, content);
 }

@@ -51,6 +51,22 @@ void AddMeasurementNoise(double snr, std::uint64_t seed, MeasurementSet* measure
   for (Vector* channel : {&measurements->f0, &measurements->fL}) {
     for (double& value : *channel) value += std_f * normal();
   }
+  // Interior sensors after the end channels (the end channels keep their draws):
+  // displacements at std_u, strains at RMS(every strain channel) / SNR.
+  double strain_squares = 0.0;
+  Eigen::Index strain_samples = 0;
+  for (const SensorChannel& sensor : measurements->sensors) {
+    if (sensor.kind != SensorKind::kStrain) continue;
+    strain_squares += sensor.values.squaredNorm();
+    strain_samples += sensor.values.size();
+  }
+  const double std_e =
+      strain_samples > 0 ? std::sqrt(strain_squares / static_cast<double>(strain_samples)) / snr
+                         : 0.0;
+  for (SensorChannel& sensor : measurements->sensors) {
+    const double level = sensor.kind == SensorKind::kStrain ? std_e : std_u;
+    for (double& value : sensor.values) value += level * normal();
+  }
 }
 
 }  // namespace mcrewave

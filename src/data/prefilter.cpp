@@ -207,6 +207,7 @@ MeasurementSet PrefilterMeasurements(const MeasurementSet& measurements,
   filtered.uL = filter.Apply(measurements.uL);
   filtered.f0 = filter.Apply(measurements.f0);
   filtered.fL = filter.Apply(measurements.fL);
+  for (SensorChannel& sensor : filtered.sensors) sensor.values = filter.Apply(sensor.values);
   return filtered;
 }
 

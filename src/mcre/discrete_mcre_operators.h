@@ -1,7 +1,7 @@
 // The banded operators of the discrete MCRE system (docs/discrete_mcre.md) for the
 // solvers that do not go through McreProblem's sweeps (Riccati, shooting): they
 // apply single theta steps and band products to the columns of dense blocks, and
-// count every multiply-accumulate they perform (include/mcrewave/operation_counts.h).
+// count every multiply-accumulate they perform (include/mcrewave/core/operation_counts.h).
 //
 // Notation (docs/riccati_shooting.md): n nodes, M mass, K = E K1 stiffness,
 // B = e_0 e_0^T + e_N e_N^T, Kp = K + B / alpha, and for the theta method with step h

@@ -1,5 +1,6 @@
 #include "mcrewave/mcre/mcre_problem.h"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <sstream>
@@ -75,6 +76,12 @@ McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
     }
   }
   stream_shift_ = Vector::Zero(n);
+  if (theta != 0.5) {
+    const int m = data.num_steps();
+    checkpoint_stride_ = std::max(1, static_cast<int>(std::ceil(std::sqrt(2.0 * m))));
+    checkpoints_ = Matrix::Zero(2 * n, m / checkpoint_stride_ + 1);
+    segment_ = Matrix::Zero(n, checkpoint_stride_ + 1);
+  }
   batch_velocity_ = Matrix::Zero(n, 2 * ThetaIntegrator::kMaxBatch);
   batch_state_ = Matrix::Zero(n, 2 * ThetaIntegrator::kMaxBatch);
   batch_shift_ = Matrix::Zero(n, ThetaIntegrator::kMaxBatch);

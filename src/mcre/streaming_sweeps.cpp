@@ -41,43 +41,21 @@ void McreProblem::TraceLoads(int j, const Matrix& traces, bool include_data, dou
 
 void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
                                StreamingTotals* totals) {
-  assert(theta_ == 0.5);
   assert(traces.rows() == num_traces() && traces.cols() == num_steps() + 1 && image != &traces);
   const int m = num_steps(), last = num_nodes() - 1;
   const double h = time_step();
   image->resize(num_traces(), m + 1);
   const PointLoads* loads = num_interior_sensors() > 0 ? &point_loads_[0] : nullptr;
   double f0 = 0.0, fL = 0.0;
-
-  // 1. The retrograde sweep from rest at T, its state only: (v_j, omega_j), j = m..0.
-  stream_velocity_[0].setZero();
-  stream_omega_[0].setZero();
-  for (int j = m, s = 0; j > 0; --j, ++s) {
-    const int current = s & 1, next = current ^ 1;
-    TraceLoads(j, traces, include_data, &f0, &fL);
-    integrator_.StepWithEndLoads(stream_velocity_[current], stream_omega_[current], f0, fL,
-                                 stream_velocity_[next], stream_omega_[next], loads);
-  }
-  const int final_state = m & 1;
-
-  // 2. Forward: the rebuilt retrograde state and the direct sweep side by side. For
-  // theta = 1/2 the step (a_{j-1}, omega_{j-1}) -> (a_j, omega_j) with a = -v and the
-  // load of the backward step j -> j-1 inverts that step exactly (docs/streaming.md).
-  stream_rebuilt_velocity_[0] = -stream_velocity_[final_state];
-  stream_rebuilt_omega_[0] = stream_omega_[final_state];
-  // W_0 = (1 - theta) omega_0 / c_0.
-  stream_retrograde_[0] = ((1.0 - theta_) / QuadratureWeight(0)) * stream_rebuilt_omega_[0];
-  stream_direct_velocity_[0].setZero();
-  stream_displacement_[0].setZero();
-  double largest_omega = stream_rebuilt_omega_[0].norm();
   if (totals != nullptr) {
     totals->cost = 0.0;
     totals->cost_gradients.setZero(num_zones());
     totals->error_map.setZero(model_.num_elements());
     totals->end_retrograde.resize(2, m + 1);
+    totals->rebuild_error = 0.0;
   }
+  // y_j = H U_j into the image, and the totals of sample j.
   auto observe = [&](int j, const Vector& displacement, const Vector& retrograde) {
-    // y_j = H U_j.
     double* column = image->col(j).data();
     column[0] = displacement[0];
     column[1] = displacement[last];
@@ -98,8 +76,53 @@ void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* 
     totals->end_retrograde(0, j) = retrograde[0];
     totals->end_retrograde(1, j) = retrograde[last];
   };
-  observe(0, stream_displacement_[0], stream_retrograde_[0]);
+  // The direct step t_{j-1} -> t_j from (V, U)[current] into [next], given W_{j-1} and
+  // W_j, with f_theta = -K W_theta + (F~_theta - B W_theta / alpha),
+  // W_theta = theta W_j + (1 - theta) W_{j-1} (as DirectSweep); then observe(j).
   const double inverse_alpha = 1.0 / alpha_;
+  auto direct_step = [&](int j, const Vector& previous_retrograde, const Vector& retrograde) {
+    const int current = (j - 1) & 1, next = current ^ 1;
+    stream_shift_ = theta_ * retrograde + (1.0 - theta_) * previous_retrograde;
+    double direct_f0 = -inverse_alpha * stream_shift_[0];
+    double direct_fL = -inverse_alpha * stream_shift_[last];
+    if (include_data) {
+      direct_f0 += theta_ * data_.f0[j] + (1.0 - theta_) * data_.f0[j - 1];
+      direct_fL += theta_ * data_.fL[j] + (1.0 - theta_) * data_.fL[j - 1];
+    }
+    integrator_.StepWithEndLoads(stream_direct_velocity_[current], stream_displacement_[current],
+                                 stream_shift_, direct_f0, direct_fL, stream_direct_velocity_[next],
+                                 stream_displacement_[next]);
+    observe(j, stream_displacement_[next], retrograde);
+  };
+  stream_direct_velocity_[0].setZero();
+  stream_displacement_[0].setZero();
+
+  if (theta_ != 0.5) {
+    CheckpointedStreamingMap(traces, include_data, observe, direct_step);
+    sweep_count_ += 4;
+    return;
+  }
+
+  // 1. The retrograde sweep from rest at T, its state only: (v_j, omega_j), j = m..0.
+  stream_velocity_[0].setZero();
+  stream_omega_[0].setZero();
+  for (int j = m, s = 0; j > 0; --j, ++s) {
+    const int current = s & 1, next = current ^ 1;
+    TraceLoads(j, traces, include_data, &f0, &fL);
+    integrator_.StepWithEndLoads(stream_velocity_[current], stream_omega_[current], f0, fL,
+                                 stream_velocity_[next], stream_omega_[next], loads);
+  }
+  const int final_state = m & 1;
+
+  // 2. Forward: the rebuilt retrograde state and the direct sweep side by side. For
+  // theta = 1/2 the step (a_{j-1}, omega_{j-1}) -> (a_j, omega_j) with a = -v and the
+  // load of the backward step j -> j-1 inverts that step exactly (docs/streaming.md).
+  stream_rebuilt_velocity_[0] = -stream_velocity_[final_state];
+  stream_rebuilt_omega_[0] = stream_omega_[final_state];
+  // W_0 = (1 - theta) omega_0 / c_0.
+  stream_retrograde_[0] = ((1.0 - theta_) / QuadratureWeight(0)) * stream_rebuilt_omega_[0];
+  double largest_omega = stream_rebuilt_omega_[0].norm();
+  observe(0, stream_displacement_[0], stream_retrograde_[0]);
   for (int j = 1; j <= m; ++j) {
     const int current = (j - 1) & 1, next = current ^ 1;
     TraceLoads(j, traces, include_data, &f0, &fL);
@@ -113,26 +136,74 @@ void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* 
         (theta_ * stream_rebuilt_omega_[current] + omega_weight * stream_rebuilt_omega_[next]) *
         (1.0 / QuadratureWeight(j));
     if (j < m) largest_omega = std::max(largest_omega, stream_rebuilt_omega_[next].norm());
-    // The direct step t_{j-1} -> t_j with f_theta = -K W_theta + (F~_theta - B W_theta /
-    // alpha), W_theta = theta W_j + (1 - theta) W_{j-1} (as DirectSweep).
-    stream_shift_ =
-        theta_ * stream_retrograde_[next] + (1.0 - theta_) * stream_retrograde_[current];
-    double direct_f0 = -inverse_alpha * stream_shift_[0];
-    double direct_fL = -inverse_alpha * stream_shift_[last];
-    if (include_data) {
-      direct_f0 += theta_ * data_.f0[j] + (1.0 - theta_) * data_.f0[j - 1];
-      direct_fL += theta_ * data_.fL[j] + (1.0 - theta_) * data_.fL[j - 1];
-    }
-    integrator_.StepWithEndLoads(stream_direct_velocity_[current], stream_displacement_[current],
-                                 stream_shift_, direct_f0, direct_fL, stream_direct_velocity_[next],
-                                 stream_displacement_[next]);
-    observe(j, stream_displacement_[next], stream_retrograde_[next]);
+    direct_step(j, stream_retrograde_[current], stream_retrograde_[next]);
   }
   if (totals != nullptr) {
     totals->rebuild_error =
         largest_omega > 0.0 ? stream_rebuilt_omega_[m & 1].norm() / largest_omega : 0.0;
   }
   sweep_count_ += 3;
+}
+
+template <typename Observe, typename DirectStep>
+void McreProblem::CheckpointedStreamingMap(const Matrix& traces, bool include_data,
+                                           Observe& observe, DirectStep& direct_step) {
+  const int m = num_steps(), stride = checkpoint_stride_;
+  const PointLoads* loads = num_interior_sensors() > 0 ? &point_loads_[0] : nullptr;
+  double f0 = 0.0, fL = 0.0;
+  const int n = num_nodes();
+  // 1. The retrograde sweep from rest at T keeping its state (v_j, omega_j) at the
+  // checkpoints j = m - i stride (column i of checkpoints_: v over omega).
+  stream_velocity_[0].setZero();
+  stream_omega_[0].setZero();
+  checkpoints_.col(0).setZero();
+  for (int j = m, s = 0; j > 0; --j, ++s) {
+    const int current = s & 1, next = current ^ 1;
+    TraceLoads(j, traces, include_data, &f0, &fL);
+    integrator_.StepWithEndLoads(stream_velocity_[current], stream_omega_[current], f0, fL,
+                                 stream_velocity_[next], stream_omega_[next], loads);
+    if ((m - (j - 1)) % stride == 0) {
+      const int column = (m - (j - 1)) / stride;
+      checkpoints_.col(column).head(n) = stream_velocity_[next];
+      checkpoints_.col(column).tail(n) = stream_omega_[next];
+    }
+  }
+  // 2. Forward over the segments [a, b] between checkpoints, earliest first: from the
+  // checkpoint at b the retrograde steps b -> a again (the same steps, so the same
+  // bits as the first pass) with omega_j kept for j in [a, b] (column j - a of
+  // segment_), then W_j in forward order and the direct steps.
+  const int lowest_checkpoint = m % stride;  // j of the last checkpoint
+  int a = 0;
+  int b = lowest_checkpoint > 0 ? lowest_checkpoint : std::min(stride, m);
+  while (a < m) {
+    const int column = (m - b) / stride;
+    stream_velocity_[0] = checkpoints_.col(column).head(n);
+    stream_omega_[0] = checkpoints_.col(column).tail(n);
+    segment_.col(b - a) = stream_omega_[0];
+    for (int j = b, s = 0; j > a; --j, ++s) {
+      const int current = s & 1, next = current ^ 1;
+      TraceLoads(j, traces, include_data, &f0, &fL);
+      integrator_.StepWithEndLoads(stream_velocity_[current], stream_omega_[current], f0, fL,
+                                   stream_velocity_[next], stream_omega_[next], loads);
+      segment_.col(j - 1 - a) = stream_omega_[next];
+    }
+    if (a == 0) {
+      // W_0 = (1 - theta) omega_0 / c_0.
+      stream_retrograde_[0] = ((1.0 - theta_) / QuadratureWeight(0)) * segment_.col(0);
+      observe(0, stream_displacement_[0], stream_retrograde_[0]);
+    }
+    for (int j = a + 1; j <= b; ++j) {
+      const int current = (j - 1) & 1, next = current ^ 1;
+      // W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j (omega_m = 0: the
+      // checkpoint at m is the rest state).
+      stream_retrograde_[next] =
+          (theta_ * segment_.col(j - 1 - a) + (1.0 - theta_) * segment_.col(j - a)) *
+          (1.0 / QuadratureWeight(j));
+      direct_step(j, stream_retrograde_[current], stream_retrograde_[next]);
+    }
+    a = b;
+    b = std::min(b + stride, m);
+  }
 }
 
 }  // namespace mcrewave

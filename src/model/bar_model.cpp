@@ -43,6 +43,13 @@ std::string ValidateModulusZones(const BarProperties& bar, const std::vector<Mod
       why << ".modulus must be a finite positive number [Pa], got " << zone.modulus;
       return why.str();
     }
+    for (std::size_t k = 0; k < i; ++k) {
+      if (zone.start < zones[k].end && zones[k].start < zone.end) {
+        why << " [" << zone.start << ", " << zone.end << "] m overlaps " << key << "[" << k << "] ["
+            << zones[k].start << ", " << zones[k].end << "] m";
+        return why.str();
+      }
+    }
   }
   return "";
 }

@@ -1,7 +1,10 @@
 #include "mcrewave/model/experiment.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
+
+#include "mcrewave/data/measurement.h"
 
 namespace mcrewave {
 namespace {
@@ -76,7 +79,79 @@ bool DataOptions::IsValid(std::string* error) const {
     why << "data.snr must be positive (.inf for no noise), got " << snr;
     return Fail(error, why.str());
   }
+  // Channel names: well formed, interior sensors only in data.sensors, none twice.
+  const std::pair<const char*, const std::vector<std::string>*> lists[] = {
+      {"data.sensors", &sensors}, {"data.channels", &channels}};
+  for (const auto& [key, list] : lists) {
+    for (std::size_t i = 0; i < list->size(); ++i) {
+      ChannelName channel;
+      std::string reason;
+      const std::string& name = (*list)[i];
+      if (!ParseChannelName(name, &channel, &reason) || channel.kind == ChannelName::Kind::kTime) {
+        why << key << "[" << i << "] = '" << name
+            << "': " << (reason.empty() ? "not a measured channel" : reason);
+        return Fail(error, why.str());
+      }
+      if (list == &sensors && channel.kind != ChannelName::Kind::kSensor) {
+        why << key << "[" << i << "] = '" << name
+            << "': the end channels u0, uL, f0, fL are always simulated; list only interior "
+               "sensors u@X or e@X here";
+        return Fail(error, why.str());
+      }
+      for (std::size_t k = 0; k < i; ++k) {
+        ChannelName other;
+        std::string ignored;
+        ParseChannelName((*list)[k], &other, &ignored);
+        const bool same =
+            (*list)[k] == name ||
+            (channel.kind == ChannelName::Kind::kSensor && other.kind == channel.kind &&
+             other.sensor_kind == channel.sensor_kind && other.position == channel.position);
+        if (same) {
+          why << key << "[" << i << "] = '" << name << "' repeats " << key << "[" << k << "] = '"
+              << (*list)[k] << "'";
+          return Fail(error, why.str());
+        }
+      }
+    }
+  }
+  if (!channels.empty()) {
+    for (const char* load : {"f0", "fL"}) {
+      if (std::find(channels.begin(), channels.end(), load) == channels.end()) {
+        why << "data.channels must include " << load
+            << ": the measured end forces are the model's loads (leave data.channels empty "
+               "to use every channel)";
+        return Fail(error, why.str());
+      }
+    }
+  }
   return true;
+}
+
+std::string ValidateDataAgainstBar(const DataOptions& data, const BarProperties& bar) {
+  std::ostringstream why;
+  const std::pair<const char*, const std::vector<std::string>*> lists[] = {
+      {"data.sensors", &data.sensors}, {"data.channels", &data.channels}};
+  for (const auto& [key, list] : lists) {
+    for (std::size_t i = 0; i < list->size(); ++i) {
+      ChannelName channel;
+      std::string ignored;
+      if (ParseChannelName((*list)[i], &channel, &ignored) &&
+          channel.kind == ChannelName::Kind::kSensor && channel.position > bar.length) {
+        why << key << "[" << i << "] = '" << (*list)[i] << "': the sensor lies outside the bar [0, "
+            << bar.length << "] m (model.length)";
+        return why.str();
+      }
+    }
+  }
+  std::string reason = ValidateModulusZones(bar, data.truth_zones, "data.truth_zones");
+  if (!reason.empty()) return reason;
+  if (data.source == DataSource::kSynthetic && data.truth == TruthModel::kExact &&
+      (!data.truth_zones.empty() || !data.sensors.empty())) {
+    return std::string("data.") + (data.truth_zones.empty() ? "sensors" : "truth_zones") +
+           ": the exact truth (data.truth: exact) is the uniform bar observed at its ends; use "
+           "data.truth: finite_element for zones and interior sensors";
+  }
+  return "";
 }
 
 }  // namespace mcrewave

@@ -2,6 +2,7 @@
 
 #include <cassert>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "mcrewave/data/noise.h"
@@ -29,9 +30,15 @@ SparseMatrix FreeBlock(const SparseMatrix& full) {
 // Clamped simulation on `bar` with `steps_per_sample` steps of `time.step /
 // steps_per_sample` between two samples of the output grid t_k = k time.step.
 MeasurementSet SimulateClamped(const BarProperties& bar, const LoadOptions& load,
-                               const TimeOptions& time, int steps_per_sample) {
+                               const TimeOptions& time, int steps_per_sample,
+                               const std::vector<ModulusZone>& zones,
+                               const std::vector<std::string>& sensors) {
   const BarModel model(bar);
-  const SparseMatrix stiffness = model.Stiffness(bar.modulus);
+  // K = sum_e E_e K1_e with the truth's element moduli (in series where a zone ends
+  // inside an element); without zones, E K1 as the paper's bar.
+  const SparseMatrix stiffness = zones.empty()
+                                     ? model.Stiffness(bar.modulus)
+                                     : model.StiffnessOfElements(ElementModuli(bar, zones));
   const SparseMatrix free_mass = FreeBlock(model.mass());
   const SparseMatrix free_stiffness = FreeBlock(stiffness);
   const int num_free = model.num_nodes() - 1;
@@ -61,6 +68,20 @@ MeasurementSet SimulateClamped(const BarProperties& bar, const LoadOptions& load
   out.uL = Vector::Zero(num_samples);
   out.f0 = Vector::Zero(num_samples);
   out.fL = Vector::Zero(num_samples);
+  // The interior sensors' rows on this mesh (node 0 is clamped: u_0 = 0).
+  std::vector<ObservationRow> rows;
+  for (const std::string& name : sensors) {
+    ChannelName channel;
+    std::string why;
+    const bool parsed = ParseChannelName(name, &channel, &why);
+    assert(parsed && channel.kind == ChannelName::Kind::kSensor);
+    (void)parsed;
+    rows.push_back(channel.sensor_kind == SensorKind::kStrain
+                       ? model.StrainRow(channel.position)
+                       : model.DisplacementRow(channel.position));
+    out.sensors.push_back({name, channel.sensor_kind, channel.position, Vector::Zero(num_samples)});
+  }
+  Vector nodal = Vector::Zero(model.num_nodes());  // all nodes, u_0 = 0
 
   Vector acceleration = Vector::Zero(num_free);
   const Vector zero = Vector::Zero(num_free);
@@ -81,6 +102,12 @@ MeasurementSet SimulateClamped(const BarProperties& bar, const LoadOptions& load
         acceleration[loaded] += applied;
         mass_factor.SolveInPlace(acceleration);
         out.uL[sample] = displacement[loaded];
+        if (!rows.empty()) {
+          nodal.tail(num_free) = displacement;
+          for (std::size_t r = 0; r < rows.size(); ++r) {
+            out.sensors[r].values[sample] = rows[r].Apply(nodal.data());
+          }
+        }
         out.f0[sample] = mass_01 * acceleration[0] + stiffness_01 * displacement[0];
         out.fL[sample] = applied;
       });
@@ -90,16 +117,20 @@ MeasurementSet SimulateClamped(const BarProperties& bar, const LoadOptions& load
 }  // namespace
 
 MeasurementSet SimulateClampedBar(const BarProperties& bar, const LoadOptions& load,
-                                  const TimeOptions& time) {
-  return SimulateClamped(bar, load, time, 1);
+                                  const TimeOptions& time, const std::vector<ModulusZone>& zones,
+                                  const std::vector<std::string>& sensors) {
+  return SimulateClamped(bar, load, time, 1, zones, sensors);
 }
 
 MeasurementSet SimulateTruth(const BarProperties& bar, const LoadOptions& load,
                              const TimeOptions& time, const DataOptions& data) {
-  if (data.truth == TruthModel::kExact) return ExactBarSolution(bar, load).Sample(time);
+  if (data.truth == TruthModel::kExact) {
+    assert(data.truth_zones.empty() && data.sensors.empty());
+    return ExactBarSolution(bar, load).Sample(time);
+  }
   BarProperties fine = bar;
   fine.elements = bar.elements * data.truth_refinement;
-  return SimulateClamped(fine, load, time, data.truth_refinement);
+  return SimulateClamped(fine, load, time, data.truth_refinement, data.truth_zones, data.sensors);
 }
 
 MeasurementSet MakeSyntheticMeasurements(const BarProperties& bar, const LoadOptions& load,

@@ -1,6 +1,6 @@
 // The YAML configuration of an mcrewave run.
 //
-// Every key is declared once, in a table in src/config.cpp, with its type, its
+// Every key is declared once, in a table in src/app/config.cpp, with its type, its
 // default, its unit and a one-line description; loading, validation, the
 // `--set key.path=value` overrides and the commented default config
 // (DefaultConfigYaml) all come from that table. Values are SI units. Enums are
@@ -77,6 +77,7 @@ struct OutputOptions {
 struct Config {
   std::string source_path;  // the file the config was read from ("" for defaults)
   BarProperties model;
+  ZoneLayout zones;  // the identification's zones (keys model.zoning, zone_count, zone_boundaries)
   LoadOptions load;
   TimeOptions time;
   DataOptions data;

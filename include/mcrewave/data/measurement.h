@@ -1,13 +1,18 @@
-// A measurement set: the four channels of the experiment sampled on a uniform
-// time grid, and its CSV form.
+// A measurement set: named channels sampled on a uniform time grid, and its CSV form.
 //
-// CSV format: a header line exactly `t,u0,uL,f0,fL`, then one row per sample
-// t_k = t_0 + k h with h uniform, SI units (s, m, m, N, N):
-//   t   time [s]
-//   u0  displacement at x = 0 [m]
-//   uL  displacement at x = L [m]
-//   f0  force applied ON the bar at x = 0, positive along +x [N] (the clamp reaction)
-//   fL  force applied ON the bar at x = L, positive along +x [N] (the shock load)
+// CSV format: a header line naming the columns, then one row per sample
+// t_k = t_0 + k h with h uniform, SI units. The columns, in any order:
+//   t    time [s]                                                     (required)
+//   u0   displacement at x = 0 [m]                                    (required)
+//   uL   displacement at x = L [m]                                    (required)
+//   f0   force applied ON the bar at x = 0, positive along +x [N]     (required;
+//        the clamp reaction)
+//   fL   force applied ON the bar at x = L, positive along +x [N]     (required;
+//        the shock load)
+//   u@X  displacement [m] at X m from the clamped end                 (any number)
+//   e@X  axial strain [-] of the element holding X, compression negative (any number)
+// e.g. `t,u0,uL,f0,fL,u@0.25,u@0.5,e@0.2,e@0.65`. The paper's file `t,u0,uL,f0,fL`
+// keeps its meaning.
 #pragma once
 
 #include <istream>
@@ -28,6 +33,17 @@ struct SensorChannel {
   Vector values;          // one entry per sample [m] or [-]
 };
 
+// A column name of the CSV header, parsed.
+struct ChannelName {
+  enum class Kind { kTime, kU0, kUL, kF0, kFL, kSensor };  // t, u0, uL, f0, fL, u@X / e@X
+  Kind kind = Kind::kTime;
+  SensorKind sensor_kind = SensorKind::kDisplacement;  // kSensor only
+  double position = 0.0;                               // X [m], kSensor only
+};
+// Parses a channel name; false with the reason in *why for anything else (e.g. `x@1`,
+// `u@`, `u@abc`, a negative or non-finite X).
+bool ParseChannelName(const std::string& text, ChannelName* channel, std::string* why);
+
 struct MeasurementSet {
   double start_time = 0.0;             // t_0 [s]
   double time_step = 0.0;              // h [s]
@@ -40,7 +56,9 @@ struct MeasurementSet {
   double Time(int k) const { return start_time + k * time_step; }
 };
 
-// Reads a measurement CSV. Validates the header, the column count, every number
+// Reads a measurement CSV. Validates the header (every name a channel, the required
+// ones present, none twice: the same name, or the same sensor kind and position), the
+// column count, every number
 // (finite, no NaN/Inf), at least two rows, and a strictly increasing uniform time
 // column (relative spread of the steps at most 1e-6). Throws InputError naming the
 // file and the line on any failure. Logs a progress line every 250000 rows;
@@ -63,7 +81,8 @@ MeasurementSet ParseMeasurementCsv(std::istream& text, const std::string& name);
 void CheckMeasurementChannels(const MeasurementSet& measurements, const std::string& name);
 constexpr double kOutlierNoiseFactor = 50.0;
 
-// Writes the set as CSV with full precision (17 significant digits), atomically
+// Writes the set as CSV (t,u0,uL,f0,fL, then the sensors by name) with full precision
+// (17 significant digits), atomically
 // (temporary file then rename). Throws std::runtime_error if the file cannot be
 // written.
 void WriteMeasurementCsv(const MeasurementSet& measurements, const std::string& path);

@@ -1,15 +1,16 @@
 // Measurement noise.
 //
-// SNR definition (the paper gives none; formulation.md section 1): per quantity
-// type, SNR = RMS(signal) / std(noise). The RMS is taken on uL for displacements
-// and on fL for forces; the same noise standard deviation is applied to both ends
-// of that type:
-//   std_u = RMS(uL) / snr  on u0 and uL,     std_f = RMS(fL) / snr  on f0 and fL.
-// The noise is Gaussian and white, drawn in the order u0, uL, f0, fL (all samples
-// of one channel, then the next) from a 64-bit Mersenne twister seeded with `seed`
-// and a Box-Muller transform written here, so the same seed gives the same numbers
-// on every platform; the same seed at two SNRs gives the same standard-normal draw,
-// scaled by each std.
+// SNR definition (the paper gives none): per quantity type, SNR = RMS(signal) /
+// std(noise), the same noise standard deviation applied to every channel of that type:
+//   displacements (u0, uL and every u@X):  std_u = RMS(uL) / snr,
+//   strains (every e@X):                   std_e = RMS over all strain channels / snr,
+//   forces (f0, fL):                       std_f = RMS(fL) / snr.
+// The noise is Gaussian and white, drawn in the order u0, uL, f0, fL, then the
+// interior sensors in their order (all samples of one channel, then the next) from a
+// 64-bit Mersenne twister seeded with `seed` and a Box-Muller transform written here,
+// so the same seed gives the same numbers on every platform and the end channels the
+// same draws with or without sensors; the same seed at two SNRs gives the same
+// standard-normal draw, scaled by each std.
 #pragma once
 
 #include <cstdint>

@@ -64,11 +64,11 @@ class ZeroPhaseLowPass {
 // [2 / T, 0.45 x sample rate].
 double EstimateCutoffFrequency(const MeasurementSet& measurements);
 
-// The four channels filtered by the same ZeroPhaseLowPass (cut-off from options or
-// estimated). Returns the set unchanged when !options.enabled. Writes the cut-off
-// used to *cutoff_used when not null. Throws std::invalid_argument when the options
-// are not valid or a given cut-off is not below the Nyquist frequency
-// 0.5 / measurements.time_step (LoadConfig refuses both at load time).
+// Every channel (the four end channels and the interior sensors) filtered by the same
+// ZeroPhaseLowPass (cut-off from options or estimated). Returns the set unchanged when
+// !options.enabled. Writes the cut-off used to *cutoff_used when not null. Throws
+// std::invalid_argument when the options are not valid or a given cut-off is not below the Nyquist
+// frequency 0.5 / measurements.time_step (LoadConfig refuses both at load time).
 MeasurementSet PrefilterMeasurements(const MeasurementSet& measurements,
                                      const PrefilterOptions& options,
                                      double* cutoff_used = nullptr);

@@ -90,7 +90,7 @@ struct CoupledSolverOptions {
   double divergence_factor = 1e3;
   // The all-at-once solver refuses systems with more unknowns than this, and when
   // its estimated peak memory (the matrix and its sparse LU factors; see
-  // src/all_at_once_solver.cpp) would exceed max_all_at_once_bytes.
+  // src/mcre/all_at_once_solver.cpp) would exceed max_all_at_once_bytes.
   long max_all_at_once_unknowns = 1'500'000;
   long max_all_at_once_bytes = 2L << 30;
   // The Riccati and shooting solvers refuse when their dense storage

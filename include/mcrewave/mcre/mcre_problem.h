@@ -152,7 +152,9 @@ class McreProblem {
   // applied with O(n) memory: the retrograde sweep runs backward keeping only its
   // state, then a forward pass rebuilds W_j by stepping the trapezoidal recursion the
   // other way (exactly invertible for theta = 1/2 and no damping) and runs the direct
-  // sweep beside it. Three sweeps per application.
+  // sweep beside it. Three sweeps per application. For theta != 1/2 the retrograde
+  // field comes from checkpoints instead (CheckpointedStreamingMap: four sweeps, memory
+  // O(n sqrt(m))).
   int num_traces() const { return 2 + num_interior_sensors(); }
   Matrix ZeroTraces() const { return Matrix::Zero(num_traces(), num_steps() + 1); }
   // <a, b>_beta = sum_j c_j h sum_k beta_k a_kj b_kj, in which I - (Phi - Phi(0)) is
@@ -171,7 +173,7 @@ class McreProblem {
   };
   // image = Phi(traces) with the data (include_data), or its linear part without.
   // With totals (not null), the sums of the fields of that application are gathered.
-  // Precondition: theta = 1/2. traces and image of shape ZeroTraces(), distinct. No
+  // traces and image of shape ZeroTraces(), distinct. No
   // allocation but image's and totals' (resized once).
   void StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
                     StreamingTotals* totals = nullptr);
@@ -207,6 +209,14 @@ class McreProblem {
   // gradient[z] += weight W_j^T K1_z (W_j + 2 U_j) for every zone.
   void AddSampleZoneGradients(double weight, const double* displacement, const double* retrograde,
                               Vector* gradient) const;
+
+  // StreamingMap for theta != 1/2, where the step is not its own inverse: the
+  // retrograde sweep keeps its state every checkpoint_stride_ steps, then each segment
+  // between checkpoints is swept again, its omega kept, and consumed in forward order
+  // (four sweeps; memory 2 n m / stride + n stride, stride = ceil(sqrt(2 m))).
+  template <typename Observe, typename DirectStep>
+  void CheckpointedStreamingMap(const Matrix& traces, bool include_data, Observe& observe,
+                                DirectStep& direct_step);
 
   // The retrograde loads of step t_j -> t_{j-1} from traces y_j (end loads f0, fL
   // and the sensors' point loads into stream_loads_).
@@ -244,6 +254,10 @@ class McreProblem {
   Vector stream_velocity_[2], stream_omega_[2], stream_rebuilt_velocity_[2],
       stream_rebuilt_omega_[2], stream_direct_velocity_[2], stream_displacement_[2],
       stream_retrograde_[2], stream_shift_;
+  // theta != 1/2 only: the checkpoints (2n x (m / stride + 1)) and one segment's omega
+  // (n x (stride + 1)), allocated in the constructor.
+  int checkpoint_stride_ = 1;
+  Matrix checkpoints_, segment_;
   // Scratch, allocated in the constructor.
   Vector velocity_[2], omega_[2];  // double buffers of the sweeps' velocity and omega
   Vector shift_;                   // W_theta of the direct sweep's step

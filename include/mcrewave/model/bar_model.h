@@ -46,14 +46,14 @@ struct ModulusZone {
   double modulus = 0.0;  // [Pa]
 };
 
-// The moduli of the N elements of `bar` [Pa] under the zones (in order, a later zone
-// over an earlier one where they overlap). An element partly covered gets the
+// The moduli of the N elements of `bar` [Pa] under the zones (which do not overlap).
+// An element partly covered gets the
 // modulus of its pieces in series, 1 / E_e = sum_pieces (length / h_e) / E_piece,
 // which keeps the element's static axial stiffness exact. Precondition: the zones
 // are valid for the bar (ValidateModulusZones).
 Vector ElementModuli(const BarProperties& bar, const std::vector<ModulusZone>& zones);
 // Empty when every zone lies in [0, L] with start < end and a finite positive
-// modulus; otherwise the reason, naming zone i as `key`[i].
+// modulus, and no two zones overlap; otherwise the reason, naming zone i as `key`[i].
 std::string ValidateModulusZones(const BarProperties& bar, const std::vector<ModulusZone>& zones,
                                  const std::string& key);
 

@@ -5,8 +5,10 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "mcrewave/core/types.h"
+#include "mcrewave/model/bar_model.h"
 
 namespace mcrewave {
 
@@ -45,8 +47,25 @@ struct DataOptions {
   int truth_refinement = 4;                              // mesh and step refined by this factor
   double snr = std::numeric_limits<double>::infinity();  // inf = no noise
   std::uint64_t seed = 1;                                // noise seed
+  // Interior sensor channels of synthetic data (`u@X`, `e@X`; data/measurement.h),
+  // beside u0, uL, f0, fL.
+  std::vector<std::string> sensors;
+  // The channels the identification uses (names as in the CSV header); empty: every
+  // channel of the data. f0 and fL, the model's loads, must be among them.
+  std::vector<std::string> channels;
+  // The truth's stretches of another modulus (synthetic only; `model.modulus`
+  // elsewhere), each [start, end] m at `modulus` Pa, not overlapping.
+  std::vector<ModulusZone> truth_zones;
 
+  // Checks what needs no other section: channel names well formed and not repeated
+  // (data.sensors, data.channels), f0 and fL among data.channels. Positions against
+  // the bar and the truth zones are checked with the model (ValidateDataAgainstBar).
   bool IsValid(std::string* error) const;
 };
+
+// Empty when data's sensors lie on the bar [0, L], its truth zones are valid for it
+// (ValidateModulusZones, not overlapping) and the exact truth is not asked for zones
+// or sensors it cannot give; otherwise the reason, naming the key.
+std::string ValidateDataAgainstBar(const DataOptions& data, const BarProperties& bar);
 
 }  // namespace mcrewave

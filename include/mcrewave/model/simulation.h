@@ -1,6 +1,9 @@
 // Direct simulation of the reference experiment and synthetic measurements.
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include "mcrewave/data/measurement.h"
 #include "mcrewave/model/bar_model.h"
 #include "mcrewave/model/experiment.h"
@@ -9,7 +12,10 @@ namespace mcrewave {
 
 // Simulates the bar clamped at x = 0, at rest at t = 0, loaded at x = L by
 // load.Value(t), with the FE model of `bar` and the theta method of `time`, and
-// returns the four channels at t_k = k h (k = 0..m).
+// returns the four channels at t_k = k h (k = 0..m), and the interior sensors named
+// in `sensors` (u@X, e@X: the observation rows of this mesh, model/bar_model.h). With
+// `zones`, the modulus is bar.modulus but over the zones (ElementModuli: an element
+// partly covered has its pieces in series).
 //
 // The clamp reaction is the force the free bar needs at node 0 to reproduce the
 // clamped motion: f0_k = row_0(M a_k + K u_k), with the accelerations a_k of the
@@ -17,11 +23,15 @@ namespace mcrewave {
 // driven by (f0, fL) with the same scheme, reproduce the clamped trajectory to
 // round-off (v_{k+1} - v_k = h (theta a_{k+1} + (1 - theta) a_k) holds exactly).
 MeasurementSet SimulateClampedBar(const BarProperties& bar, const LoadOptions& load,
-                                  const TimeOptions& time);
+                                  const TimeOptions& time,
+                                  const std::vector<ModulusZone>& zones = {},
+                                  const std::vector<std::string>& sensors = {});
 
 // The noise-free "truth" sampled on the model's grid t_k = k h: the clamped
 // simulation on a mesh and step refined by data.truth_refinement (every r-th step
-// kept), or the exact solution (exact_solution.h).
+// kept) with data.truth_zones and data.sensors, or the exact solution
+// (exact_solution.h; uniform bar, end channels only: ValidateDataAgainstBar refuses
+// the rest).
 MeasurementSet SimulateTruth(const BarProperties& bar, const LoadOptions& load,
                              const TimeOptions& time, const DataOptions& data);
 
