@@ -51,14 +51,11 @@ std::string ModuliScript(const ZoneIdentificationRun& run, const std::string& fo
 
 }  // namespace
 
-ZoneLayout IdentificationZoneLayout(const Config& config) {
-  (void)config;
-  return ZoneLayout();  // one zone until Config::zones lands (see the header)
-}
+ZoneLayout IdentificationZoneLayout(const Config& config) { return config.zones; }
 
 std::vector<ModulusZone> TruthZones(const Config& config) {
-  (void)config;
-  return {};  // data.truth_zones: not on this branch yet (see the header)
+  if (config.data.source != DataSource::kSynthetic) return {};
+  return config.data.truth_zones;
 }
 
 ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayout& layout,

@@ -26,13 +26,11 @@ struct ZoneIdentificationRun {
   Vector truth_element_moduli;
 };
 
-// The zone layout of the identification. The data helper's keys model.zoning,
-// model.zone_count and model.zone_boundaries (Config::zones) are not on this branch
-// yet: until they are, one zone (no zone identification). Replace the body with
-// `return config.zones;` when they land.
+// The zone layout of the identification: Config::zones (model.zoning, model.zone_count,
+// model.zone_boundaries). More than one zone runs the zone identification.
 ZoneLayout IdentificationZoneLayout(const Config& config);
-// The truth zones of synthetic data over model.modulus (data.truth_zones, the data
-// helper's key; empty until it lands or for CSV data).
+// The truth zones of synthetic data over model.modulus (data.truth_zones); empty for
+// CSV data.
 std::vector<ModulusZone> TruthZones(const Config& config);
 
 // Runs the zone identification when the layout has more than one zone on
