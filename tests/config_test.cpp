@@ -531,7 +531,7 @@ TEST_F(ConfigFileTest, SectionThatIsNotAMap) {
 TEST_F(ConfigFileTest, TopLevelThatIsNotAMap) {
   ExpectLoadError("- model\n- load\n", 1,
                   {"expected a map of sections (model, load, time, data, mcre, inner, outer, "
-                   "prefilter, uncertainty, output, study)",
+                   "prefilter, uncertainty, output, study, zone_identification)",
                    "got a list"});
 }
 

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <utility>
 
+#include "mcrewave/app/zone_identification_run.h"
 #include "mcrewave/data/noise.h"
 #include "mcrewave/data/prefilter.h"
 #include "mcrewave/data/resample.h"
@@ -254,6 +255,10 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
   } else {
     spdlog::warn("uncertainty not available: {}", run.uncertainty.message);
   }
+  // Every zone's modulus from E* when the identification has zones
+  // (zone_identification_run.h).
+  run.zones =
+      RunZoneIdentification(config, IdentificationZoneLayout(config), run, TruthZones(config));
   run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return run;
 }

@@ -459,6 +459,10 @@ std::string SummaryYaml(const IdentificationRun& run) {
                run.outer.scan_sweeps + run.sweeps + run.cost_curve_sweeps + uncertainty.sweeps,
                "scan, optimiser, cost curve and uncertainty");
 
+  if (run.zones.ran) {
+    for (const std::string& line : ZonesYamlLines(run.zones)) yaml.Raw(line);
+  }
+
   yaml.Line(0, "config", "", "as resolved (every key)");
   std::istringstream config(ConfigToYaml(run.config));
   for (std::string line; std::getline(config, line);) yaml.Raw("  " + line);
@@ -512,6 +516,9 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
       }
       written.push_back(folder + "/" + name + ".png");
     }
+  }
+  for (const std::string& path : WriteZoneResults(run.zones, run.config.model, folder, figures)) {
+    written.push_back(path);
   }
   // The summary last: its presence says the folder is complete.
   write("summary.yaml", SummaryYaml(run));

@@ -56,6 +56,7 @@
 #include "mcrewave/model/bar_model.h"
 #include "mcrewave/model/experiment.h"
 #include "mcrewave/optim/identification.h"
+#include "mcrewave/optim/zone_identification.h"
 
 namespace mcrewave {
 
@@ -87,6 +88,8 @@ struct Config {
   UncertaintyOptions uncertainty;
   OutputOptions output;
   StudyOptions study;
+  // The identification of zone moduli after the scalar one (optim/zone_identification.h).
+  ZoneIdentificationOptions zone_identification;
 };
 
 // Reads a config file, applies the overrides ("key.path=value", each parsed as a

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mcrewave/app/config.h"
+#include "mcrewave/app/zone_identification_run.h"
 #include "mcrewave/data/measurement.h"
 #include "mcrewave/mcre/error_map.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
@@ -74,6 +75,8 @@ struct IdentificationRun {
   ModulusUncertainty uncertainty;
   // The error map at the identified (homogeneous) E, from `solution`.
   ErrorMap error_map;
+  // The zone moduli from E* (ran = false with one zone).
+  ZoneIdentificationRun zones;
   double wall_time_s = -1.0;  // the whole of RunIdentification
 
   // The outer loop converged; only then are the fields after `outer` filled.

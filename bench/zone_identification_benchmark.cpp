@@ -1,0 +1,152 @@
+// Wall time of the identification of zone moduli (optim/zone_identification.h) on the
+// paper's case (configs/paper_bar.yaml, or the config given), after the scalar
+// identification that gives the homogeneous start E*.
+//
+// Data: the end forces of the paper's experiment drive a per-element truth of the
+// model's own mesh with a soft zone of 0.7 E over [0.6, 0.7] L (direct sweep at W = 0);
+// its end displacements are the measured ones (noise-free unless --snr is given, then
+// seeded white noise at that SNR on both kinds, as noise.h defines it). For Z = 10 equal
+// zones and one zone per element it reports the scalar E*, the zone identification's
+// time, evaluations, weight, the worst zone error and the mean over [0.6, 0.7] L.
+// Goals (issue 13): 10 zones under 5 s, 100 zones under 20 s on one core.
+//
+// Usage: zone_identification_benchmark [--snr S] [--algorithm NAME] [--zones Z] [--verbose]
+//        [CONFIG.yaml]
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "mcrewave/app/config.h"
+#include "mcrewave/app/identification_run.h"
+#include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/optim/zone_identification.h"
+
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+double Rms(const mcrewave::Vector& v) { return std::sqrt(v.squaredNorm() / v.size()); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace mcrewave;
+  std::string path = "configs/paper_bar.yaml";
+  double snr = std::numeric_limits<double>::infinity();
+  BoundedAlgorithm algorithm = BoundedAlgorithm::kNloptLbfgs;
+  bool verbose = false;
+  int only_zones = 0;  // 0: both
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--snr") == 0 && i + 1 < argc) {
+      snr = std::atof(argv[++i]);
+    } else if (std::strcmp(argv[i], "--verbose") == 0) {
+      verbose = true;
+    } else if (std::strcmp(argv[i], "--zones") == 0 && i + 1 < argc) {
+      only_zones = std::atoi(argv[++i]);
+    } else if (std::strcmp(argv[i], "--algorithm") == 0 && i + 1 < argc) {
+      if (!StringToBoundedAlgorithm(argv[++i], &algorithm)) {
+        std::fprintf(stderr, "unknown algorithm %s\n", argv[i]);
+        return 2;
+      }
+    } else {
+      path = argv[i];
+    }
+  }
+  spdlog::set_level(verbose ? spdlog::level::info : spdlog::level::warn);
+  try {
+    Config config = LoadConfig(path, {"data.snr=.inf"});
+    MeasurementSet data = LoadMeasurements(config);
+    // The truth: a soft zone of 0.7 E over [0.6, 0.7] L, one modulus per element.
+    ZoneLayout per_element;
+    per_element.zoning = Zoning::kPerElement;
+    const BarModel truth_model(config.model, per_element.ElementZones(config.model));
+    Vector truth(config.model.elements);
+    for (int e = 0; e < config.model.elements; ++e) {
+      const double x = truth_model.element_midpoint(e) / config.model.length;
+      truth[e] = (x > 0.6 && x < 0.7 ? 0.7 : 1.0) * config.model.modulus;
+    }
+    McreProblem truth_problem(truth_model, data, config.mcre.weights, config.mcre.reference_modulus,
+                              config.time.theta);
+    truth_problem.SetModuli(truth);
+    Matrix displacement;
+    truth_problem.DirectSweep(truth_problem.ZeroField(), true, &displacement);
+    data.u0 = displacement.row(0).transpose();
+    data.uL = displacement.row(truth_model.num_nodes() - 1).transpose();
+    if (std::isfinite(snr)) {
+      std::mt19937_64 engine(1);
+      std::normal_distribution<double> normal;
+      const double u_std = Rms(data.uL) / snr;
+      const double f_std = Rms(data.fL) / snr;
+      for (Vector* v : {&data.u0, &data.uL}) {
+        for (double& value : *v) value += u_std * normal(engine);
+      }
+      for (Vector* v : {&data.f0, &data.fL}) {
+        for (double& value : *v) value += f_std * normal(engine);
+      }
+    }
+    const NoiseLevels noise = DifferenceNoiseLevels(data);
+    const auto scalar_start = std::chrono::steady_clock::now();
+    const IdentificationRun scalar = IdentifyModulus(config, data);
+    const double scalar_s = Seconds(scalar_start);
+    if (!scalar.IsUsable()) {
+      std::fprintf(stderr, "scalar identification failed: %s\n", scalar.outer.message.c_str());
+      return 1;
+    }
+    std::printf("%s: %d elements, %d steps, SNR %g, %s; scalar E* = %.6g GPa in %.2f s\n",
+                path.c_str(), config.model.elements, data.num_steps(), snr,
+                BoundedAlgorithmToString(algorithm), scalar.identified_modulus() * 1e-9, scalar_s);
+    std::printf("%6s %8s %12s %10s %12s %14s %14s %s\n", "zones", "time [s]", "evaluations",
+                "sweeps", "weight", "worst error", "soft mean/0.7E", "choice");
+    PrefilterOptions prefilter = config.prefilter;
+    prefilter.cutoff_frequency = scalar.prefilter_cutoff;
+    for (int zones : {10, config.model.elements}) {
+      if (only_zones > 0 && zones != only_zones) continue;
+      ZoneLayout layout;
+      layout.zone_count = zones;
+      if (zones == config.model.elements) layout.zoning = Zoning::kPerElement;
+      const BarModel model(config.model, layout.ElementZones(config.model));
+      ZoneIdentificationOptions options;
+      options.minimizer.algorithm = algorithm;
+      const auto start = std::chrono::steady_clock::now();
+      const ZoneIdentificationSummary summary = IdentifyZoneModuli(
+          options, model, scalar.data, config.mcre, config.time.theta, config.inner, {},
+          scalar.identified_modulus(), config.outer.lower_bound, config.outer.upper_bound, noise,
+          prefilter, &scalar.solution.retrograde);
+      const double seconds = Seconds(start);
+      if (summary.moduli.size() == 0) {
+        std::fprintf(stderr, "%d zones: %s\n", zones, summary.message.c_str());
+        continue;
+      }
+      double worst = 0.0, soft_sum = 0.0;
+      int soft_count = 0;
+      for (int e = 0; e < config.model.elements; ++e) {
+        const double identified = summary.moduli[model.element_zone(e)];
+        worst = std::max(worst, std::abs(identified / truth[e] - 1.0));
+        const double x = model.element_midpoint(e) / config.model.length;
+        if (x > 0.6 && x < 0.7) {
+          soft_sum += identified;
+          ++soft_count;
+        }
+      }
+      std::printf("%6d %8.2f %12d %10ld %12.3g %13.3g%% %14.4f %s (%s)\n", zones, seconds,
+                  summary.evaluations, summary.sweeps, summary.regularized.weight, 100.0 * worst,
+                  soft_sum / soft_count / (0.7 * config.model.modulus),
+                  summary.regularized.weight_choice.c_str(),
+                  TerminationTypeToString(summary.termination));
+      if (!summary.IsSolutionUsable()) std::printf("  %s\n", summary.message.c_str());
+    }
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "error: %s\n", error.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,118 @@
+// Identification of every zone modulus at once (docs/zones_and_sensors.md,
+// "Identification of zone moduli"; formulation: the project's MCRE problem with zones,
+// K = sum_z E_z K1_z, and the gradient of every zone from the one coupled solve,
+//   de^2/dE_z = -(1/(2 E_z)) sum_j c_j h W_j^T K_z (W_j + 2 U_j)
+// (McreProblem::CostGradients; docs/zones_and_sensors.md).
+//
+// Started from the homogeneous E* of the scalar identification (identification.h).
+// Parameters p_z = log(E_z / E*): positivity for free, a step in p is a relative step in
+// E, and the regularisation penalises jumps of log E (regularization.h). Chain rule:
+//   d cost / d p_z = (d cost / d E_z) E_z.
+// The cost is the scaled e^2 / J_rest of McreObjective. Bounds: outer.lower_bound and
+// outer.upper_bound on every zone, i.e. log(lower / E*) <= p_z <= log(upper / E*).
+//
+// The regularisation weight by the discrepancy principle needs the misfit the noise
+// alone explains: ExpectedNoiseCost, the mean scaled e^2 of data made of noise alone
+// (white, at the noise levels estimated from the measurements by their second
+// differences, DifferenceNoiseLevels, passed through the same pre-filter as the data)
+// at the homogeneous E*. Why that level: the coupled solution is affine in the data
+// and e^2 a quadratic form of its residuals; data of the model at the true moduli give
+// a zero residual, so at the truth e^2(truth + noise) = e^2(noise) exactly (inverse
+// crime) and its mean over noise draws is the misfit the truth itself would show.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "mcrewave/data/prefilter.h"
+#include "mcrewave/mcre/modulus_uncertainty.h"
+#include "mcrewave/mcre/objective.h"
+#include "mcrewave/optim/bounded_minimizer.h"
+#include "mcrewave/optim/regularization.h"
+
+namespace mcrewave {
+
+// McreObjective::EvaluateModuli seen as a function of p_z = log(E_z / modulus_scale).
+// Logs one line per evaluation.
+class ZoneMcreObjective : public MultiParameterObjective {
+ public:
+  // objective must outlive this adapter; its model has the identification's zones.
+  ZoneMcreObjective(McreObjective* objective, double modulus_scale);
+
+  int num_parameters() const override { return num_zones_; }
+  bool Evaluate(const double* p, double* cost, double* gradient) override;
+  std::string error_message() const override { return error_message_; }
+
+  // E_z = modulus_scale exp(p_z) [Pa].
+  Vector Moduli(const double* p) const;
+  int evaluations() const { return evaluations_; }
+
+ private:
+  McreObjective* objective_;
+  double modulus_scale_;
+  int num_zones_;
+  int evaluations_ = 0;
+  std::string error_message_;
+};
+
+// The `zone_identification:` section.
+struct ZoneIdentificationOptions {
+  BoundedMinimizerOptions minimizer;
+  RegularizationOptions regularization;
+  // Noise draws of the discrepancy target (ExpectedNoiseCost).
+  int noise_samples = 4;
+  std::uint64_t noise_seed = 1;
+
+  // Messages name the zone_identification.* keys.
+  bool IsValid(std::string* error) const;
+};
+
+struct ZoneIdentificationSummary {
+  TerminationType termination = TerminationType::kFailure;
+  std::string message = "not run";
+  double homogeneous_modulus = -1.0;    // E*, the start and the scale [Pa]
+  Vector moduli;                        // E_z [Pa], one per zone (empty: none usable)
+  std::vector<double> zone_start;       // [m], per zone: the first element's left node
+  std::vector<double> zone_end;         // [m], per zone: the last element's right node
+  double cost = -1.0;                   // e^2 at moduli [J s]
+  double homogeneous_cost = -1.0;       // e^2 at E* in every zone [J s]
+  double cost_scale = -1.0;             // J_rest [J s]
+  NoiseLevels noise;                    // levels of the discrepancy target's draws
+  double noise_cost = -1.0;             // ExpectedNoiseCost (scaled); -1: not computed
+  RegularizedMinimization regularized;  // weight, its choice, the path, the minimiser
+  std::vector<int> zones_on_bounds;     // zones whose modulus lies on a bound
+  int evaluations = 0;                  // coupled solves of the zone identification
+  long sweeps = 0;
+  double wall_time_s = -1.0;
+
+  bool IsSolutionUsable() const { return termination == TerminationType::kConvergence; }
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+// Mean over `samples` draws of e^2(noise alone) / cost_scale at the zone moduli,
+// the noise white at `noise`'s levels on every channel the data have, then pre-filtered
+// as `prefilter` says (enabled with its cutoff; disabled: as drawn). -1 when a solve is
+// not usable.
+double ExpectedNoiseCost(const BarModel& model, const MeasurementSet& data, const McreOptions& mcre,
+                         double theta, const CoupledSolverOptions& inner,
+                         EndDisplacementChannels ends, const Vector& moduli,
+                         const NoiseLevels& noise, const PrefilterOptions& prefilter, int samples,
+                         std::uint64_t seed, double cost_scale);
+
+// Identifies the zone moduli of `model` (its zones) from `data` (as the objective sees
+// them: pre-filtered when the pre-filter is on), from the homogeneous E* within
+// [lower_bound, upper_bound] on every zone. noise: the estimated noise levels of the
+// measurements (for the discrepancy target); prefilter: the pre-filter the data went
+// through, its cutoff_frequency the one used. warm_start: the retrograde field of the
+// scalar identification at E* (nullable). Never throws for a failed identification.
+// Preconditions: options valid, 0 < lower_bound < E* < upper_bound.
+ZoneIdentificationSummary IdentifyZoneModuli(
+    const ZoneIdentificationOptions& options, const BarModel& model, const MeasurementSet& data,
+    const McreOptions& mcre, double theta, const CoupledSolverOptions& inner,
+    EndDisplacementChannels ends, double homogeneous_modulus, double lower_bound,
+    double upper_bound, const NoiseLevels& noise, const PrefilterOptions& prefilter,
+    const Matrix* warm_start = nullptr);
+
+}  // namespace mcrewave

@@ -1,0 +1,171 @@
+#include "mcrewave/app/zone_identification_run.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "mcrewave/app/identification_run.h"
+#include "mcrewave/core/file_util.h"
+
+namespace mcrewave {
+namespace {
+
+std::string Number(double value) {
+  if (std::isnan(value)) return "null";
+  char text[64];
+  std::snprintf(text, sizeof(text), "%.10g", value);
+  return text;
+}
+
+// Per element: x_start, x_end, identified E, truth E (empty when unknown).
+std::string ElementModuliCsv(const ZoneIdentificationRun& run, const BarModel& model) {
+  std::ostringstream csv;
+  csv << "element,x_start_m,x_end_m,identified_pa,truth_pa\n";
+  for (int e = 0; e < model.num_elements(); ++e) {
+    csv << e << "," << Number(model.node_position(e)) << "," << Number(model.node_position(e + 1))
+        << "," << Number(run.summary.moduli[model.element_zone(e)]) << ","
+        << (run.truth_element_moduli.size() > 0 ? Number(run.truth_element_moduli[e]) : "") << "\n";
+  }
+  return csv.str();
+}
+
+std::string ModuliScript(const ZoneIdentificationRun& run, const std::string& folder) {
+  const std::string csv = GnuplotString(folder + "/moduli.csv");
+  std::ostringstream script;
+  script << GnuplotPngTerminal() << "set title 'Identified E(x), " << run.summary.moduli.size()
+         << " zones'\nset xlabel 'x [m]'\nset ylabel 'E [GPa]'\n"
+         << "plot " << csv
+         << " using 2:($4*1e-9):($3-$2):(0) with vectors nohead lw 3 lc rgb '#d62728' "
+            "title 'identified'";
+  if (run.truth_element_moduli.size() > 0) {
+    script << ", \\\n     " << csv
+           << " using 2:($5*1e-9):($3-$2):(0) with vectors nohead lw 1.5 dt 2 lc rgb '#000000' "
+              "title 'truth'";
+  }
+  script << ", \\\n     " << Number(run.summary.homogeneous_modulus * 1e-9)
+         << " with lines dt 3 lc rgb '#1f77b4' title 'homogeneous E*'\n";
+  return script.str();
+}
+
+}  // namespace
+
+ZoneLayout IdentificationZoneLayout(const Config& config) { return config.zones; }
+
+std::vector<ModulusZone> TruthZones(const Config& config) {
+  if (config.data.source != DataSource::kSynthetic) return {};
+  return config.data.truth_zones;
+}
+
+ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayout& layout,
+                                            const IdentificationRun& scalar,
+                                            const std::vector<ModulusZone>& truth_zones) {
+  ZoneIdentificationRun run;
+  run.layout = layout;
+  const BarModel model(config.model, layout.ElementZones(config.model));
+  if (model.num_zones() <= 1) return run;
+  run.ran = true;
+  if (scalar.reference_known) run.truth_element_moduli = ElementModuli(config.model, truth_zones);
+  PrefilterOptions prefilter = config.prefilter;
+  prefilter.cutoff_frequency = scalar.prefilter_cutoff;
+  spdlog::info("zones: identifying {} zone moduli from E* = {:.9g} Pa", model.num_zones(),
+               scalar.identified_modulus());
+  run.summary = IdentifyZoneModuli(
+      config.zone_identification, model, scalar.data, config.mcre, config.time.theta, config.inner,
+      {}, scalar.identified_modulus(), config.outer.lower_bound, config.outer.upper_bound,
+      scalar.estimated_noise, prefilter,
+      scalar.solution.has_fields() ? &scalar.solution.retrograde : nullptr);
+  spdlog::info("zones: {}", run.summary.BriefReport());
+  return run;
+}
+
+std::vector<std::string> ZonesYamlLines(const ZoneIdentificationRun& run) {
+  const ZoneIdentificationSummary& s = run.summary;
+  std::vector<std::string> lines;
+  auto line = [&](int indent, const std::string& key, const std::string& value,
+                  const std::string& comment = "") {
+    lines.push_back(std::string(2 * indent, ' ') + key + ":" + (value.empty() ? "" : " " + value) +
+                    (comment.empty() ? "" : "  # " + comment));
+  };
+  line(0, "zones", "", "identification of every zone modulus from the homogeneous E*");
+  line(1, "count", std::to_string(s.moduli.size()));
+  line(1, "termination", TerminationTypeToString(s.termination));
+  line(1, "message", "\"" + s.message + "\"");
+  line(1, "homogeneous_modulus", Number(s.homogeneous_modulus), "[Pa] E*, the start");
+  line(1, "cost", Number(s.cost), "[J s] e^2 at the zone moduli");
+  line(1, "homogeneous_cost", Number(s.homogeneous_cost), "[J s] e^2 at E* in every zone");
+  line(1, "algorithm", BoundedAlgorithmToString(s.regularized.minimizer.algorithm));
+  line(1, "regularization_weight", Number(s.regularized.weight),
+       "lambda of the jump penalty on log E");
+  line(1, "weight_choice", s.regularized.weight_choice);
+  line(1, "target_misfit", Number(s.regularized.target_misfit),
+       "e^2 / J_rest the noise explains (discrepancy principle; -1: not used)");
+  line(1, "misfit", Number(s.regularized.misfit), "e^2 / J_rest at the zone moduli");
+  line(1, "weights_tried", std::to_string(s.regularized.path.size()));
+  line(1, "evaluations", std::to_string(s.evaluations));
+  line(1, "sweeps", std::to_string(s.sweeps));
+  line(1, "wall_time_s", Number(s.wall_time_s));
+  std::string on_bounds = "[";
+  for (std::size_t i = 0; i < s.zones_on_bounds.size(); ++i) {
+    on_bounds += (i == 0 ? "" : ", ") + std::to_string(s.zones_on_bounds[i]);
+  }
+  line(1, "zones_on_bounds", on_bounds + "]");
+  line(1, "moduli", "", "per zone: index, start and end [m], modulus [Pa], modulus / E*");
+  for (Eigen::Index z = 0; z < s.moduli.size(); ++z) {
+    lines.push_back("    - {index: " + std::to_string(z) + ", start: " + Number(s.zone_start[z]) +
+                    ", end: " + Number(s.zone_end[z]) + ", modulus: " + Number(s.moduli[z]) +
+                    ", relative: " + Number(s.moduli[z] / s.homogeneous_modulus) + "}");
+  }
+  return lines;
+}
+
+std::string ZonesCsv(const ZoneIdentificationRun& run, const BarProperties& bar) {
+  const BarModel model(bar, run.layout.ElementZones(bar));
+  const ZoneIdentificationSummary& s = run.summary;
+  std::ostringstream csv;
+  csv << "zone,start_m,end_m,modulus_pa,relative_to_homogeneous,truth_modulus_pa\n";
+  for (Eigen::Index z = 0; z < s.moduli.size(); ++z) {
+    std::string truth;
+    if (run.truth_element_moduli.size() > 0) {
+      double sum = 0.0;
+      int count = 0;
+      for (int e = 0; e < model.num_elements(); ++e) {
+        if (model.element_zone(e) == z) {
+          sum += run.truth_element_moduli[e];
+          ++count;
+        }
+      }
+      truth = Number(sum / count);
+    }
+    csv << z << "," << Number(s.zone_start[z]) << "," << Number(s.zone_end[z]) << ","
+        << Number(s.moduli[z]) << "," << Number(s.moduli[z] / s.homogeneous_modulus) << "," << truth
+        << "\n";
+  }
+  return csv.str();
+}
+
+std::vector<std::string> WriteZoneResults(const ZoneIdentificationRun& run,
+                                          const BarProperties& bar, const std::string& folder,
+                                          bool figures) {
+  std::vector<std::string> written;
+  if (!run.ran || run.summary.moduli.size() == 0) return written;
+  const BarModel model(bar, run.layout.ElementZones(bar));
+  WriteFileAtomically(folder + "/zones.csv", ZonesCsv(run, bar));
+  written.push_back(folder + "/zones.csv");
+  WriteFileAtomically(folder + "/moduli.csv", ElementModuliCsv(run, model));
+  written.push_back(folder + "/moduli.csv");
+  if (figures) {
+    bool gnuplot_missing = false;
+    const std::string why =
+        DrawGnuplotFigure(folder, "moduli", ModuliScript(run, folder), &gnuplot_missing);
+    if (why.empty()) {
+      written.push_back(folder + "/moduli.png");
+    } else if (!gnuplot_missing) {
+      spdlog::warn("figure moduli.png skipped: {}", why);
+    }
+  }
+  return written;
+}
+
+}  // namespace mcrewave

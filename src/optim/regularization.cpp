@@ -1,0 +1,231 @@
+#include "mcrewave/optim/regularization.h"
+
+#include <spdlog/spdlog.h>
+
+#include <array>
+#include <cmath>
+#include <sstream>
+#include <utility>
+
+#include "core/enum_names.h"
+
+namespace mcrewave {
+namespace {
+
+constexpr std::array<std::pair<RegularizationKind, const char*>, 3> kRegularizationKinds{{
+    {RegularizationKind::kNone, "none"},
+    {RegularizationKind::kTikhonov, "tikhonov"},
+    {RegularizationKind::kTotalVariation, "total_variation"},
+}};
+
+// One minimisation at `weight` from `start`, recorded in *result.
+BoundedMinimizerSummary MinimizeAt(const BoundedMinimizerOptions& options,
+                                   const RegularizationOptions& regularization,
+                                   MultiParameterObjective* data, const std::vector<double>& lower,
+                                   const std::vector<double>& upper,
+                                   const std::vector<double>& start, double weight,
+                                   double target_misfit, RegularizedMinimization* result,
+                                   RegularizedPoint* point) {
+  RegularizedObjective objective(data, regularization.kind, weight, regularization.tv_smoothing);
+  BoundedMinimizerSummary summary = MinimizeWithinBounds(options, &objective, lower, upper, start);
+  result->evaluations += summary.evaluations;
+  point->weight = weight;
+  point->evaluations = summary.evaluations;
+  point->termination = summary.termination;
+  if (!summary.x.empty()) {
+    // The parts at the best point: evaluate once more without the gradient (the
+    // objective's last evaluation need not be the best one).
+    double cost = 0.0;
+    RegularizedObjective parts(data, regularization.kind, weight, regularization.tv_smoothing);
+    if (parts.Evaluate(summary.x.data(), &cost, nullptr)) {
+      point->misfit = parts.last_data_cost();
+      point->roughness = JumpPenalty(regularization.kind, 1.0, regularization.tv_smoothing,
+                                     summary.x.data(), static_cast<int>(summary.x.size()), nullptr);
+      ++result->evaluations;
+    } else {
+      summary.termination = TerminationType::kFailure;
+      summary.message = "the data cost at the minimiser failed: " + data->error_message();
+      point->termination = summary.termination;
+    }
+  }
+  point->meets_target =
+      target_misfit >= 0.0 && summary.IsSolutionUsable() && point->misfit <= target_misfit;
+  spdlog::info("regularisation weight {:.3g}: misfit {:.6g} (target {:.6g}), roughness {:.6g}; {}",
+               weight, point->misfit, target_misfit, point->roughness, summary.BriefReport());
+  result->path.push_back(*point);
+  return summary;
+}
+
+}  // namespace
+
+const char* RegularizationKindToString(RegularizationKind kind) {
+  return internal::ToName(kRegularizationKinds, kind);
+}
+bool StringToRegularizationKind(const std::string& name, RegularizationKind* kind) {
+  return internal::FromName(kRegularizationKinds, name, kind);
+}
+
+bool RegularizationOptions::IsValid(std::string* error) const {
+  std::ostringstream why;
+  if (!std::isfinite(weight)) {
+    why << "zone_identification.regularization_weight must be a finite number (< 0: automatic), got "
+        << weight;
+  } else if (!(tv_smoothing > 0.0 && tv_smoothing < 1.0)) {
+    why << "zone_identification.tv_smoothing must lie in (0, 1), got " << tv_smoothing;
+  } else if (!(min_weight > 0.0 && max_weight > min_weight && std::isfinite(max_weight))) {
+    why << "zone_identification.min_weight and zone_identification.max_weight must satisfy 0 < min_weight < "
+           "max_weight, got "
+        << min_weight << " and " << max_weight;
+  } else if (!(grid_factor > 1.0 && grid_factor <= 1e6)) {
+    why << "zone_identification.grid_factor must lie in (1, 1e6], got " << grid_factor;
+  } else if (bisection_steps < 0 || bisection_steps > 30) {
+    why << "zone_identification.bisection_steps must lie in [0, 30], got " << bisection_steps;
+  } else if (!(discrepancy_factor > 0.0 && std::isfinite(discrepancy_factor))) {
+    why << "zone_identification.discrepancy_factor must be a positive number, got " << discrepancy_factor;
+  } else {
+    return true;
+  }
+  if (error != nullptr) *error = why.str();
+  return false;
+}
+
+double JumpPenalty(RegularizationKind kind, double weight, double tv_smoothing, const double* p,
+                   int n, double* gradient) {
+  if (kind == RegularizationKind::kNone || weight == 0.0) return 0.0;
+  double penalty = 0.0;
+  for (int z = 0; z + 1 < n; ++z) {
+    const double d = p[z + 1] - p[z];
+    double phi = 0.0;
+    double dphi = 0.0;  // phi'(d)
+    if (kind == RegularizationKind::kTikhonov) {
+      phi = d * d;
+      dphi = 2.0 * d;
+    } else {
+      const double root = std::sqrt(d * d + tv_smoothing * tv_smoothing);
+      phi = root - tv_smoothing;
+      dphi = d / root;
+    }
+    penalty += phi;
+    if (gradient != nullptr) {
+      // d phi(p_{z+1} - p_z) / d p_{z+1} = phi',  / d p_z = -phi'
+      gradient[z + 1] += weight * dphi;
+      gradient[z] -= weight * dphi;
+    }
+  }
+  return weight * penalty;
+}
+
+RegularizedObjective::RegularizedObjective(MultiParameterObjective* data, RegularizationKind kind,
+                                           double weight, double tv_smoothing)
+    : data_(data), kind_(kind), weight_(weight), tv_smoothing_(tv_smoothing) {}
+
+bool RegularizedObjective::Evaluate(const double* x, double* cost, double* gradient) {
+  double data_cost = 0.0;
+  if (!data_->Evaluate(x, &data_cost, gradient)) return false;
+  const double penalty = JumpPenalty(kind_, weight_, tv_smoothing_, x, num_parameters(), gradient);
+  last_data_cost_ = data_cost;
+  last_penalty_ = penalty;
+  *cost = data_cost + penalty;
+  return true;
+}
+
+RegularizedMinimization MinimizeRegularized(
+    const BoundedMinimizerOptions& options, const RegularizationOptions& regularization,
+    MultiParameterObjective* data, const std::vector<double>& lower,
+    const std::vector<double>& upper, const std::vector<double>& initial, double target_misfit) {
+  RegularizedMinimization result;
+  RegularizedPoint point;
+  const bool automatic =
+      regularization.kind != RegularizationKind::kNone && regularization.weight < 0.0;
+  if (!automatic) {
+    const double weight =
+        regularization.kind == RegularizationKind::kNone ? 0.0 : regularization.weight;
+    result.weight_choice = regularization.kind == RegularizationKind::kNone ? "none" : "fixed";
+    result.minimizer = MinimizeAt(options, regularization, data, lower, upper, initial, weight,
+                                  target_misfit, &result, &point);
+    result.weight = weight;
+    result.target_misfit = target_misfit;
+    result.x = result.minimizer.x;
+    result.misfit = point.misfit;
+    return result;
+  }
+
+  // The discrepancy principle: descend the grid, warm-started, to the first weight
+  // that meets the target.
+  result.target_misfit = target_misfit;
+  std::vector<double> start = initial;
+  // c0, the data cost at the start: the grid's unit.
+  double start_cost = 0.0;
+  if (!data->Evaluate(initial.data(), &start_cost, nullptr) || !(start_cost > 0.0)) {
+    start_cost = 1.0;  // a failure shows in the first minimisation
+  }
+  ++result.evaluations;
+  double missed = -1.0;  // the last weight that missed the target
+  BoundedMinimizerSummary hit;
+  double hit_weight = -1.0;
+  double hit_misfit = -1.0;
+  BoundedMinimizerSummary last;
+  double last_weight = -1.0;
+  double last_misfit = -1.0;
+  for (double weight = regularization.max_weight * start_cost;
+       weight >= regularization.min_weight * start_cost * (1.0 - 1e-12);
+       weight /= regularization.grid_factor) {
+    BoundedMinimizerSummary summary = MinimizeAt(options, regularization, data, lower, upper, start,
+                                                 weight, target_misfit, &result, &point);
+    if (!summary.IsSolutionUsable()) {
+      result.minimizer = std::move(summary);
+      result.weight = weight;
+      result.weight_choice = "discrepancy";
+      result.x = result.minimizer.x;
+      result.misfit = point.misfit;
+      return result;  // a failed minimisation ends the search: its message says why
+    }
+    start = summary.x;
+    last = summary;
+    last_weight = weight;
+    last_misfit = point.misfit;
+    if (point.meets_target) {
+      hit = std::move(summary);
+      hit_weight = weight;
+      hit_misfit = point.misfit;
+      break;
+    }
+    missed = weight;
+  }
+  if (hit_weight < 0.0) {
+    result.minimizer = std::move(last);
+    result.weight = last_weight;
+    result.weight_choice = "discrepancy_not_reached";
+    result.x = result.minimizer.x;
+    result.misfit = last_misfit;
+    spdlog::warn(
+        "no regularisation weight down to {:.3g} brings the misfit {:.6g} to the noise's level "
+        "{:.6g}: the smallest weight kept",
+        last_weight, last_misfit, target_misfit);
+    return result;
+  }
+  // Bisection in log lambda between the weight that missed (larger) and the hit.
+  if (missed > 0.0) {
+    for (int step = 0; step < regularization.bisection_steps; ++step) {
+      const double weight = std::sqrt(missed * hit_weight);
+      BoundedMinimizerSummary summary = MinimizeAt(options, regularization, data, lower, upper,
+                                                   hit.x, weight, target_misfit, &result, &point);
+      if (!summary.IsSolutionUsable()) break;  // keep the hit
+      if (point.meets_target) {
+        hit = std::move(summary);
+        hit_weight = weight;
+        hit_misfit = point.misfit;
+      } else {
+        missed = weight;
+      }
+    }
+  }
+  result.minimizer = std::move(hit);
+  result.weight = hit_weight;
+  result.weight_choice = "discrepancy";
+  result.x = result.minimizer.x;
+  result.misfit = hit_misfit;
+  return result;
+}
+
+}  // namespace mcrewave

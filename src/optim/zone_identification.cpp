@@ -1,0 +1,212 @@
+#include "mcrewave/optim/zone_identification.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <random>
+#include <sstream>
+
+namespace mcrewave {
+
+ZoneMcreObjective::ZoneMcreObjective(McreObjective* objective, double modulus_scale)
+    : objective_(objective),
+      modulus_scale_(modulus_scale),
+      num_zones_(objective->problem().num_zones()) {}
+
+Vector ZoneMcreObjective::Moduli(const double* p) const {
+  Vector moduli(num_zones_);
+  for (int z = 0; z < num_zones_; ++z) moduli[z] = modulus_scale_ * std::exp(p[z]);
+  return moduli;
+}
+
+bool ZoneMcreObjective::Evaluate(const double* p, double* cost, double* gradient) {
+  ++evaluations_;
+  const Vector moduli = Moduli(p);
+  if (!(moduli.allFinite() && moduli.minCoeff() > 0.0)) {
+    error_message_ = "a trial zone modulus is not a positive finite number";
+    return false;
+  }
+  const ObjectiveEvaluation& record = objective_->EvaluateModuli(moduli, gradient != nullptr);
+  if (!record.usable) {
+    error_message_ =
+        "the coupled solve at the zone moduli of evaluation " + std::to_string(evaluations_) +
+        " is not usable: " + record.inner.BriefReport() + " (" + record.inner.message + ")";
+    return false;
+  }
+  const double scale = objective_->cost_scale();
+  // cost = e^2 / J_rest
+  *cost = record.cost / scale;
+  double gradient_norm = 0.0;
+  if (gradient != nullptr) {
+    for (int z = 0; z < num_zones_; ++z) {
+      // d cost / d p_z = (de^2/dE_z) (dE_z/dp_z) / J_rest,  dE_z/dp_z = E_z
+      gradient[z] = record.cost_gradients[z] * moduli[z] / scale;
+      gradient_norm = std::max(gradient_norm, std::abs(gradient[z]));
+    }
+  }
+  spdlog::info(
+      "zones evaluation {}: e^2 / J_rest = {:.10g}, |grad|_inf = {:.3g}, E in [{:.6g}, "
+      "{:.6g}] GPa; inner {}",
+      evaluations_, *cost, gradient_norm, moduli.minCoeff() * 1e-9, moduli.maxCoeff() * 1e-9,
+      record.inner.BriefReport());
+  return true;
+}
+
+bool ZoneIdentificationOptions::IsValid(std::string* error) const {
+  if (!minimizer.IsValid(error) || !regularization.IsValid(error)) return false;
+  if (noise_samples < 1 || noise_samples > 1000) {
+    if (error != nullptr) {
+      *error = "zone_identification.noise_samples must be an integer in [1, 1000], got " +
+               std::to_string(noise_samples);
+    }
+    return false;
+  }
+  return true;
+}
+
+std::string ZoneIdentificationSummary::BriefReport() const {
+  std::ostringstream out;
+  out << TerminationTypeToString(termination) << ": " << moduli.size() << " zones, e^2 " << cost
+      << " J s (homogeneous " << homogeneous_cost << "), weight " << regularized.weight << " ("
+      << regularized.weight_choice << "), " << evaluations << " evaluations, " << wall_time_s
+      << " s";
+  return out.str();
+}
+
+std::string ZoneIdentificationSummary::FullReport() const {
+  std::ostringstream out;
+  out << "Zone identification\n"
+      << "  termination:        " << TerminationTypeToString(termination) << "\n"
+      << "  message:            " << message << "\n"
+      << "  homogeneous E*:     " << homogeneous_modulus << " Pa\n"
+      << "  e^2:                " << cost << " J s (at E*: " << homogeneous_cost << ")\n"
+      << "  weight:             " << regularized.weight << " (" << regularized.weight_choice
+      << ", target misfit " << regularized.target_misfit << ", noise e^2 / J_rest " << noise_cost
+      << ")\n"
+      << "  evaluations:        " << evaluations << ", sweeps " << sweeps << "\n"
+      << "  wall time:          " << wall_time_s << " s\n";
+  for (Eigen::Index z = 0; z < moduli.size(); ++z) {
+    out << "  zone " << z << " [" << zone_start[z] << ", " << zone_end[z] << "] m: " << moduli[z]
+        << " Pa (" << moduli[z] / homogeneous_modulus << " E*)\n";
+  }
+  out << regularized.minimizer.FullReport();
+  return out.str();
+}
+
+double ExpectedNoiseCost(const BarModel& model, const MeasurementSet& data, const McreOptions& mcre,
+                         double theta, const CoupledSolverOptions& inner,
+                         EndDisplacementChannels ends, const Vector& moduli,
+                         const NoiseLevels& noise, const PrefilterOptions& prefilter, int samples,
+                         std::uint64_t seed, double cost_scale) {
+  std::mt19937_64 engine(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  MeasurementSet drawn = data;
+  double sum = 0.0;
+  for (int sample = 0; sample < samples; ++sample) {
+    for (Vector* channel : {&drawn.u0, &drawn.uL}) {
+      for (double& value : *channel) value = noise.displacement_std * normal(engine);
+    }
+    for (Vector* channel : {&drawn.f0, &drawn.fL}) {
+      for (double& value : *channel) value = noise.force_std * normal(engine);
+    }
+    for (SensorChannel& sensor : drawn.sensors) {
+      const double level =
+          sensor.kind == SensorKind::kStrain ? noise.strain_std : noise.displacement_std;
+      for (double& value : sensor.values) value = level * normal(engine);
+    }
+    const MeasurementSet noise_data =
+        prefilter.enabled ? PrefilterMeasurements(drawn, prefilter) : drawn;
+    McreObjective objective(model, noise_data, mcre, theta, inner, moduli[0], ends);
+    const ObjectiveEvaluation& record = objective.EvaluateModuli(moduli, false);
+    if (!record.usable) return -1.0;
+    sum += record.cost;
+  }
+  return sum / samples / cost_scale;
+}
+
+ZoneIdentificationSummary IdentifyZoneModuli(
+    const ZoneIdentificationOptions& options, const BarModel& model, const MeasurementSet& data,
+    const McreOptions& mcre, double theta, const CoupledSolverOptions& inner,
+    EndDisplacementChannels ends, double homogeneous_modulus, double lower_bound,
+    double upper_bound, const NoiseLevels& noise, const PrefilterOptions& prefilter,
+    const Matrix* warm_start) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  ZoneIdentificationSummary summary;
+  summary.homogeneous_modulus = homogeneous_modulus;
+  summary.noise = noise;
+  const int zones = model.num_zones();
+  // Zone extents from the elements each holds.
+  summary.zone_start.assign(zones, model.properties().length);
+  summary.zone_end.assign(zones, 0.0);
+  for (int e = 0; e < model.num_elements(); ++e) {
+    const int z = model.element_zone(e);
+    summary.zone_start[z] = std::min(summary.zone_start[z], model.node_position(e));
+    summary.zone_end[z] = std::max(summary.zone_end[z], model.node_position(e + 1));
+  }
+  try {
+    McreObjective objective(model, data, mcre, theta, inner, homogeneous_modulus, ends);
+    if (warm_start != nullptr && warm_start->rows() == objective.problem().num_nodes() &&
+        warm_start->cols() == objective.problem().num_steps() + 1) {
+      objective.SetWarmStart(*warm_start);
+    }
+    summary.cost_scale = objective.cost_scale();
+    ZoneMcreObjective zone_objective(&objective, homogeneous_modulus);
+    const std::vector<double> lower(zones, std::log(lower_bound / homogeneous_modulus));
+    const std::vector<double> upper(zones, std::log(upper_bound / homogeneous_modulus));
+    const std::vector<double> initial(zones, 0.0);
+
+    double target = -1.0;
+    const bool automatic = options.regularization.kind != RegularizationKind::kNone &&
+                           options.regularization.weight < 0.0;
+    if (automatic) {
+      summary.noise_cost = ExpectedNoiseCost(
+          model, data, mcre, theta, inner, ends, Vector::Constant(zones, homogeneous_modulus),
+          noise, prefilter, options.noise_samples, options.noise_seed, summary.cost_scale);
+      if (summary.noise_cost < 0.0) {
+        summary.termination = TerminationType::kFailure;
+        summary.message = "a noise solve of the discrepancy target is not usable";
+        summary.wall_time_s = elapsed();
+        return summary;
+      }
+      target = options.regularization.discrepancy_factor * summary.noise_cost;
+      spdlog::info("zones: discrepancy target e^2 / J_rest = {:.6g} (noise alone, {} draws)",
+                   target, options.noise_samples);
+    }
+    summary.regularized = MinimizeRegularized(options.minimizer, options.regularization,
+                                              &zone_objective, lower, upper, initial, target);
+    summary.evaluations = zone_objective.evaluations();
+    summary.sweeps = objective.sweeps();
+    if (!objective.evaluations().empty() && objective.evaluations().front().usable) {
+      summary.homogeneous_cost = objective.evaluations().front().cost;
+    }
+    const RegularizedMinimization& result = summary.regularized;
+    summary.termination = result.minimizer.termination;
+    summary.message = result.minimizer.message;
+    if (!result.x.empty()) {
+      summary.moduli = zone_objective.Moduli(result.x.data());
+      summary.cost = result.misfit * summary.cost_scale;
+      for (int z = 0; z < zones; ++z) {
+        if (std::abs(result.x[z] - lower[z]) < 1e-6 || std::abs(result.x[z] - upper[z]) < 1e-6) {
+          summary.zones_on_bounds.push_back(z);
+        }
+      }
+      if (!summary.zones_on_bounds.empty()) {
+        spdlog::warn("zones: {} zone(s) on a bound of [outer.lower_bound, outer.upper_bound]",
+                     summary.zones_on_bounds.size());
+      }
+    }
+  } catch (const std::exception& error) {
+    summary.termination = TerminationType::kFailure;
+    summary.message = std::string("the zone identification failed: ") + error.what();
+  }
+  summary.wall_time_s = elapsed();
+  return summary;
+}
+
+}  // namespace mcrewave

@@ -1,0 +1,181 @@
+// The jump penalty of optim/regularization.h (its gradient against central differences)
+// and the discrepancy principle's weight on a linear least-squares problem whose answer
+// is known in closed form.
+#include "mcrewave/optim/regularization.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "mcrewave/core/types.h"
+
+namespace mcrewave {
+namespace {
+
+TEST(JumpPenaltyTest, GradientMatchesCentralDifferences) {
+  const std::vector<double> p{0.1, -0.2, 0.35, 0.35, 0.0004, -0.7, 0.2};
+  const int n = static_cast<int>(p.size());
+  for (RegularizationKind kind :
+       {RegularizationKind::kTikhonov, RegularizationKind::kTotalVariation}) {
+    std::vector<double> gradient(n, 0.0);
+    JumpPenalty(kind, 0.7, 1e-3, p.data(), n, gradient.data());
+    double worst = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const double step = 1e-6;
+      std::vector<double> plus = p, minus = p;
+      plus[i] += step;
+      minus[i] -= step;
+      const double difference = (JumpPenalty(kind, 0.7, 1e-3, plus.data(), n, nullptr) -
+                                 JumpPenalty(kind, 0.7, 1e-3, minus.data(), n, nullptr)) /
+                                (2.0 * step);
+      worst = std::max(worst, std::abs(difference - gradient[i]));
+    }
+    // Measured: 4e-10 (Tikhonov: exact quadratic, round-off only) and 1.7e-7 (TV: the
+    // jump of 4e-4 lies within eps = 1e-3, curvature 1 / eps).
+    EXPECT_LT(worst, kind == RegularizationKind::kTikhonov ? 1e-8 : 2e-6)
+        << RegularizationKindToString(kind);
+  }
+  // The penalty adds to the gradient it is given.
+  std::vector<double> gradient(n, 1.0);
+  JumpPenalty(RegularizationKind::kNone, 0.7, 1e-3, p.data(), n, gradient.data());
+  for (double g : gradient) EXPECT_EQ(g, 1.0);
+}
+
+TEST(JumpPenaltyTest, ValuesOfBothKinds) {
+  const std::vector<double> p{0.0, 0.3, 0.3, -0.1};
+  EXPECT_NEAR(JumpPenalty(RegularizationKind::kTikhonov, 2.0, 1e-3, p.data(), 4, nullptr),
+              2.0 * (0.09 + 0.0 + 0.16), 1e-15);
+  const double eps = 1e-3;
+  const double tv = (std::sqrt(0.09 + eps * eps) - eps) + 0.0 + (std::sqrt(0.16 + eps * eps) - eps);
+  EXPECT_NEAR(JumpPenalty(RegularizationKind::kTotalVariation, 2.0, eps, p.data(), 4, nullptr),
+              2.0 * tv, 1e-15);
+}
+
+// 1/2 |A p - b|^2 over 10 parameters.
+class LeastSquares : public MultiParameterObjective {
+ public:
+  LeastSquares(Eigen::MatrixXd a, Eigen::VectorXd b) : a_(std::move(a)), b_(std::move(b)) {}
+  int num_parameters() const override { return static_cast<int>(a_.cols()); }
+  bool Evaluate(const double* x, double* cost, double* gradient) override {
+    const Eigen::Map<const Eigen::VectorXd> p(x, a_.cols());
+    const Eigen::VectorXd r = a_ * p - b_;
+    *cost = 0.5 * r.squaredNorm();
+    if (gradient != nullptr) Eigen::Map<Eigen::VectorXd>(gradient, a_.cols()) = a_.transpose() * r;
+    return true;
+  }
+  // The Tikhonov minimiser of 1/2 |A p - b|^2 + lambda |L p|^2 and its misfit:
+  // (A^T A + 2 lambda L^T L) p = A^T b.
+  double Misfit(double lambda) const {
+    const int n = static_cast<int>(a_.cols());
+    Eigen::MatrixXd l = Eigen::MatrixXd::Zero(n - 1, n);
+    for (int z = 0; z + 1 < n; ++z) {
+      l(z, z) = -1.0;
+      l(z, z + 1) = 1.0;
+    }
+    const Eigen::MatrixXd normal = a_.transpose() * a_ + 2.0 * lambda * l.transpose() * l;
+    const Eigen::VectorXd p = normal.ldlt().solve(a_.transpose() * b_);
+    return 0.5 * (a_ * p - b_).squaredNorm();
+  }
+
+ private:
+  Eigen::MatrixXd a_;
+  Eigen::VectorXd b_;
+};
+
+TEST(DiscrepancyPrincipleTest, ChoosesTheWeightOfTheClosedForm) {
+  // b = A p_true + noise of std 0.05 over 40 rows, p_true piecewise constant; the target
+  // is the expected misfit of the truth, 1/2 m sigma^2. The weight whose Tikhonov misfit
+  // equals the target, lambda*, by bisection of the closed form; the discrepancy
+  // principle's weight lies within its final bracket,
+  // [lambda* / grid_factor^(1/2^bisection_steps), lambda*].
+  const int m = 40, n = 10;
+  std::mt19937_64 engine(3);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd a(m, n);
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j < n; ++j) a(i, j) = std::exp(-0.5 * std::pow((i / 4.0 - j) / 1.5, 2));
+  }
+  Eigen::VectorXd truth = Eigen::VectorXd::Zero(n);
+  truth.segment(6, 1).setConstant(-0.35);
+  const double sigma = 0.05;
+  Eigen::VectorXd b = a * truth;
+  for (int i = 0; i < m; ++i) b[i] += sigma * normal(engine);
+  LeastSquares data(a, b);
+  const double target = 0.5 * m * sigma * sigma;
+
+  // lambda*: misfit(lambda) increases; bisection in log lambda.
+  double low = 1e-10, high = 1e2;
+  ASSERT_LT(data.Misfit(low), target);
+  ASSERT_GT(data.Misfit(high), target);
+  for (int i = 0; i < 200; ++i) {
+    const double middle = std::sqrt(low * high);
+    (data.Misfit(middle) > target ? high : low) = middle;
+  }
+  const double expected = low;
+
+  for (BoundedAlgorithm algorithm :
+       {BoundedAlgorithm::kNloptLbfgs, BoundedAlgorithm::kCeresLbfgs}) {
+    BoundedMinimizerOptions options;
+    options.algorithm = algorithm;
+    options.step_tolerance = 1e-10;
+    options.function_tolerance = 0.0;
+    RegularizationOptions regularization;
+    // Absolute weights 1e2 down to 1e-10: the options are relative to the start's cost.
+    const double start_cost = 0.5 * b.squaredNorm();
+    regularization.max_weight = 1e2 / start_cost;
+    regularization.min_weight = 1e-10 / start_cost;
+    const RegularizedMinimization result =
+        MinimizeRegularized(options, regularization, &data, std::vector<double>(n, -5.0),
+                            std::vector<double>(n, 5.0), std::vector<double>(n, 0.0), target);
+    ASSERT_TRUE(result.IsSolutionUsable()) << result.minimizer.FullReport();
+    EXPECT_EQ(result.weight_choice, "discrepancy");
+    EXPECT_LE(result.misfit, target);
+    // Measured: lambda = 1.3335 against 1.4763 (ratio 0.903, the bracket's lower end is
+    // 0.866) with both minimisers, 7 minimisations (3 of the grid, 4 bisections).
+    EXPECT_LE(result.weight, expected * 1.001);
+    EXPECT_GE(result.weight, expected /
+                                 std::pow(regularization.grid_factor,
+                                          std::pow(0.5, regularization.bisection_steps)) /
+                                 1.001);
+    // The misfit at the result is the closed form's at that weight.
+    EXPECT_NEAR(result.misfit, data.Misfit(result.weight), 1e-6 * target);
+  }
+}
+
+TEST(DiscrepancyPrincipleTest, AnUnreachableTargetKeepsTheSmallestWeightAndSaysSo) {
+  Eigen::MatrixXd a = Eigen::MatrixXd::Identity(6, 3);
+  Eigen::VectorXd b(6);
+  b << 1, 2, 3, 4, 5, 6;  // rows 3..5 cannot be fitted: misfit >= 1/2 (16 + 25 + 36)
+  LeastSquares data(a, b);
+  BoundedMinimizerOptions options;
+  RegularizationOptions regularization;
+  // Absolute weights 1 down to 1e-3: relative to the start's cost 1/2 |b|^2 = 45.5.
+  regularization.max_weight = 1.0 / 45.5;
+  regularization.min_weight = 1e-3 / 45.5;
+  const RegularizedMinimization result =
+      MinimizeRegularized(options, regularization, &data, std::vector<double>(3, -10.0),
+                          std::vector<double>(3, 10.0), std::vector<double>(3, 0.0), 1.0);
+  EXPECT_EQ(result.weight_choice, "discrepancy_not_reached");
+  EXPECT_NEAR(result.weight, 1e-2, 1e-12);
+  EXPECT_EQ(result.path.size(), 2u);  // 1, 0.01 (the grid stops above 0.001)
+}
+
+TEST(RegularizationOptionsTest, NamesAndMessages) {
+  RegularizationKind kind = RegularizationKind::kNone;
+  ASSERT_TRUE(StringToRegularizationKind("total_variation", &kind));
+  EXPECT_EQ(kind, RegularizationKind::kTotalVariation);
+  EXPECT_STREQ(RegularizationKindToString(RegularizationKind::kTikhonov), "tikhonov");
+  EXPECT_FALSE(StringToRegularizationKind("tv", &kind));
+  RegularizationOptions options;
+  std::string error;
+  EXPECT_TRUE(options.IsValid(&error));
+  options.grid_factor = 1.0;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("zone_identification.grid_factor"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace mcrewave

@@ -1,0 +1,164 @@
+// IdentifyZoneModuli (optim/zone_identification.h): the adapter's gradient in
+// p = log(E / E*) against central differences, and the inverse crime: 10 zones from
+// noise-free data of the model itself, every zone recovered.
+#include "mcrewave/optim/zone_identification.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "mcrewave/mcre/objective.h"
+#include "mcrewave/model/bar_model.h"
+#include "mcrewave/model/simulation.h"
+#include "test_problems.h"
+
+namespace mcrewave {
+namespace {
+
+using testing::MakeSmallCase;
+using testing::Options;
+
+ZoneLayout EqualZones(int count) {
+  ZoneLayout layout;
+  layout.zone_count = count;
+  return layout;
+}
+
+// A soft zone over [0.6, 0.7] L (zone 6 of 10 equal zones) at 0.7 E.
+Vector SoftZoneModuli(int zones) {
+  Vector moduli = Vector::Constant(zones, 200e9);
+  for (int z = 0; z < zones; ++z) {
+    const double middle = (z + 0.5) / zones;
+    if (middle > 0.6 && middle < 0.7) moduli[z] = 140e9;
+  }
+  return moduli;
+}
+
+// A zoned bar and noise-free data of the model itself at the truth's zone moduli: the
+// end forces of the paper's experiment drive the zoned model (direct sweep at W = 0),
+// its end displacements are the measured ones (the inverse crime).
+struct InverseCrime {
+  InverseCrime(int elements, int steps, int zones, const Vector& truth)
+      : small(MakeSmallCase(elements, steps, std::numeric_limits<double>::infinity(), 1)),
+        model(small.bar, EqualZones(zones).ElementZones(small.bar)),
+        data(MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data)) {
+    McreProblem problem(model, data, testing::Weights(0.01, 1.0), 200e9, 0.5);
+    problem.SetModuli(truth);
+    Matrix displacement;
+    problem.DirectSweep(problem.ZeroField(), true, &displacement);
+    data.u0 = displacement.row(0).transpose();
+    data.uL = displacement.row(model.num_nodes() - 1).transpose();
+  }
+  testing::SmallCase small;
+  BarModel model;
+  MeasurementSet data;
+};
+
+McreOptions Mcre() {
+  McreOptions mcre;
+  mcre.weights = testing::Weights(0.01, 1.0);
+  return mcre;
+}
+
+TEST(ZoneMcreObjectiveTest, GradientInLogModuliMatchesCentralDifferences) {
+  InverseCrime crime(40, 120, 10, SoftZoneModuli(10));
+  McreObjective objective(crime.model, crime.data, Mcre(), 0.5,
+                          Options(CoupledSolverType::kConjugateGradient, 1e-13), 190e9);
+  ZoneMcreObjective zones(&objective, 190e9);
+  ASSERT_EQ(zones.num_parameters(), 10);
+  std::vector<double> p(10);
+  for (int z = 0; z < 10; ++z) p[z] = 0.1 * std::sin(1.0 + 2.0 * z);
+  double cost = 0.0;
+  std::vector<double> gradient(10);
+  ASSERT_TRUE(zones.Evaluate(p.data(), &cost, gradient.data()));
+  double largest = 0.0;
+  for (double g : gradient) largest = std::max(largest, std::abs(g));
+  double worst = 0.0;
+  for (int z = 0; z < 10; ++z) {
+    const double step = 1e-5;
+    std::vector<double> plus = p, minus = p;
+    plus[z] += step;
+    minus[z] -= step;
+    double cost_plus = 0.0, cost_minus = 0.0;
+    ASSERT_TRUE(zones.Evaluate(plus.data(), &cost_plus, nullptr));
+    ASSERT_TRUE(zones.Evaluate(minus.data(), &cost_minus, nullptr));
+    worst =
+        std::max(worst, std::abs((cost_plus - cost_minus) / (2.0 * step) - gradient[z]) / largest);
+  }
+  // Measured: 1.0e-9 relative to the largest component.
+  EXPECT_LT(worst, 1e-8);
+  const Vector moduli = zones.Moduli(p.data());
+  EXPECT_NEAR(moduli[3], 190e9 * std::exp(p[3]), 1e-6);
+}
+
+class ZoneInverseCrimeTest : public ::testing::TestWithParam<BoundedAlgorithm> {};
+
+TEST_P(ZoneInverseCrimeTest, RecoversEveryZone) {
+  // 10 zones on 40 elements, a soft zone at 0.7 E aligned with zone 6, noise-free data
+  // of the model itself; started from the homogeneous 190 GPa, no regularisation.
+  const Vector truth = SoftZoneModuli(10);
+  InverseCrime crime(40, 120, 10, truth);
+  ZoneIdentificationOptions options;
+  options.minimizer.algorithm = GetParam();
+  options.minimizer.step_tolerance = 1e-10;
+  options.minimizer.function_tolerance = 0.0;
+  options.regularization.kind = RegularizationKind::kNone;
+  PrefilterOptions prefilter;
+  prefilter.enabled = false;
+  const ZoneIdentificationSummary summary =
+      IdentifyZoneModuli(options, crime.model, crime.data, Mcre(), 0.5,
+                         Options(CoupledSolverType::kConjugateGradient, 1e-12), {}, 190e9, 100e9,
+                         400e9, NoiseLevels{}, prefilter);
+  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+  ASSERT_EQ(summary.moduli.size(), 10);
+  double worst = 0.0;
+  for (int z = 0; z < 10; ++z)
+    worst = std::max(worst, std::abs(summary.moduli[z] / truth[z] - 1.0));
+  // Measured worst relative errors (evaluations, seconds on the 2-core machine):
+  // nlopt_lbfgs 1.4e-10 (27, 0.01 s), nlopt_slsqp 5.1e-12 (48, 0.02 s), nlopt_mma 6.3e-10
+  // (524, 0.25 s), nlopt_bobyqa 2.7e-11 (436, 0.22 s), ceres_lbfgs 1.7e-11 (28, 0.02 s).
+  EXPECT_LT(worst, 1e-8) << summary.FullReport();
+  EXPECT_NEAR(summary.zone_start[6], 0.6, 1e-12);
+  EXPECT_NEAR(summary.zone_end[6], 0.7, 1e-12);
+  EXPECT_EQ(summary.regularized.weight_choice, "none");
+  EXPECT_TRUE(summary.zones_on_bounds.empty());
+}
+
+INSTANTIATE_TEST_SUITE_P(Minimizers, ZoneInverseCrimeTest,
+                         ::testing::Values(BoundedAlgorithm::kNloptLbfgs,
+                                           BoundedAlgorithm::kNloptSlsqp,
+                                           BoundedAlgorithm::kNloptMma,
+                                           BoundedAlgorithm::kNloptBobyqa,
+                                           BoundedAlgorithm::kCeresLbfgs),
+                         [](const ::testing::TestParamInfo<BoundedAlgorithm>& info) {
+                           return std::string(BoundedAlgorithmToString(info.param));
+                         });
+
+TEST(ZoneDiscrepancyTest, NoiseFreeDataNeedNoRegularisationToSpeakOf) {
+  // The automatic weight on the noise-free inverse crime: the noise levels estimated
+  // from the data's second differences are those of the signal's own curvature, small;
+  // the weight found must leave every zone within 1 %.
+  const Vector truth = SoftZoneModuli(10);
+  InverseCrime crime(40, 120, 10, truth);
+  ZoneIdentificationOptions options;
+  PrefilterOptions prefilter;
+  prefilter.enabled = false;
+  const ZoneIdentificationSummary summary =
+      IdentifyZoneModuli(options, crime.model, crime.data, Mcre(), 0.5,
+                         Options(CoupledSolverType::kConjugateGradient, 1e-12), {}, 190e9, 100e9,
+                         400e9, DifferenceNoiseLevels(crime.data), prefilter);
+  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+  double worst = 0.0;
+  for (int z = 0; z < 10; ++z)
+    worst = std::max(worst, std::abs(summary.moduli[z] / truth[z] - 1.0));
+  // Measured: target 8.5e-10 (e^2 / J_rest of noise drawn at the estimated levels),
+  // weight 1.15e-7 by the discrepancy principle (8 grid weights from 1, 4 bisections),
+  // worst zone 0.50 % off, 286 evaluations.
+  EXPECT_EQ(summary.regularized.weight_choice, "discrepancy");
+  EXPECT_LT(worst, 0.01) << summary.FullReport();
+}
+
+}  // namespace
+}  // namespace mcrewave
