@@ -197,9 +197,11 @@ ParsedFile ParseFile(std::istream& text, const std::string& name) {
                   " is not a non-negative integer");
     }
   }
-  constexpr long long kMaxDimension = 2000000000LL;  // indices are ints
+  // At most 1e8 rows and columns: beyond any structure mcrewave can integrate, and a
+  // bound on what a mistyped size line makes the reader allocate.
+  constexpr long long kMaxDimension = 100000000LL;
   if (sizes[0] < 1 || sizes[1] < 1 || sizes[0] > kMaxDimension || sizes[1] > kMaxDimension) {
-    reader.Fail("size line: rows and columns must lie in [1, 2e9], got " +
+    reader.Fail("size line: rows and columns must lie in [1, 1e8], got " +
                 std::to_string(sizes[0]) + " x " + std::to_string(sizes[1]));
   }
   file.rows = static_cast<long>(sizes[0]);
@@ -214,7 +216,7 @@ ParsedFile ParseFile(std::istream& text, const std::string& name) {
     if (count > 500000000LL) {
       reader.Fail("array of " + std::to_string(count) + " values: too large for a dense file");
     }
-    file.dense.reserve(static_cast<std::size_t>(count));
+    file.dense.reserve(static_cast<std::size_t>(std::min<long long>(count, 1LL << 20)));
     while (reader.NextData(&line)) {
       if (static_cast<long long>(file.dense.size()) == count) {
         reader.Fail("value beyond the " + std::to_string(count) + " (" + std::to_string(file.rows) +

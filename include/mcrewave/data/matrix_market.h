@@ -23,7 +23,9 @@
 // matrix. MatrixMarketReadOptions::sum_duplicates sums them instead (the convention
 // of scipy's coo_matrix.tocsr, for unassembled element contributions).
 //
-// Every error is an InputError "FILE:LINE: what was found, what was expected" (no
+// Rows and columns are limited to 1e8 (a bound on what a mistyped size line makes the
+// reader allocate). Every error is an InputError "FILE:LINE: what was found, what was
+// expected" (no
 // line for a file that cannot be opened or ends early: "FILE: ...").
 #pragma once
 
