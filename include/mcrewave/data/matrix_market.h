@@ -25,8 +25,7 @@
 //
 // Rows and columns are limited to 1e8 (a bound on what a mistyped size line makes the
 // reader allocate). Every error is an InputError "FILE:LINE: what was found, what was
-// expected" (no
-// line for a file that cannot be opened or ends early: "FILE: ...").
+// expected" (no line for a file that cannot be opened or ends early: "FILE: ...").
 #pragma once
 
 #include <istream>
