@@ -173,6 +173,12 @@ TEST(MatrixExportTest, BadModelsGiveOneClearError) {
     WriteText(folder, "model.yaml", "mass: M.mtx\nzone: []\n");
   });
   EXPECT_TRUE(Contains(why, "model.yaml:2: unknown key 'zone'")) << why;
+  why = SpoiledError("spoil_entry_key", [](const std::string& folder) {
+    WriteText(folder, "model.yaml",
+              "mass: M.mtx\nzones:\n  - name: a\n    stiffness: K_zone0.mtx\n"
+              "    nominal_modulus: 1\n    modulus: 2\n");
+  });
+  EXPECT_TRUE(Contains(why, "model.yaml:6: unknown key 'modulus'")) << why;
 }
 
 }  // namespace

@@ -49,6 +49,20 @@ std::string RequiredString(const std::string& name, const YAML::Node& entry,
   return value.Scalar();
 }
 
+// Refuses a list entry that is not a map or has a key outside `keys`.
+void CheckEntryKeys(const std::string& name, const YAML::Node& entry,
+                    const std::set<std::string>& keys, const std::string& expected) {
+  if (!entry.IsMap()) {
+    throw InputError(Where(name, entry) + ": expected a map {" + expected + "}");
+  }
+  for (const auto& key : entry) {
+    if (keys.count(key.first.Scalar()) == 0) {
+      throw InputError(Where(name, key.first) + ": unknown key '" + key.first.Scalar() +
+                       "' (expected " + expected + ")");
+    }
+  }
+}
+
 void Refuse(const std::string& why) {
   if (!why.empty()) throw InputError(why);
 }
@@ -180,6 +194,8 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
   };
   std::set<std::string> names;
   for (const YAML::Node& entry : sequence("zones")) {
+    CheckEntryKeys(manifest_path, entry, {"name", "stiffness", "nominal_modulus"},
+                   "name, stiffness, nominal_modulus");
     MatrixModelZone zone;
     zone.name = RequiredString(manifest_path, entry, "name");
     if (!names.insert(zone.name).second) {
@@ -201,6 +217,7 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
   }
   std::set<std::string> channels;
   for (const YAML::Node& entry : sequence("loads")) {
+    CheckEntryKeys(manifest_path, entry, {"channel", "vector"}, "channel, vector");
     MatrixModelLoad load;
     load.channel = RequiredString(manifest_path, entry, "channel");
     if (!channels.insert(load.channel).second) {
@@ -213,6 +230,7 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
     data.loads.push_back(std::move(load));
   }
   for (const YAML::Node& entry : sequence("sensors")) {
+    CheckEntryKeys(manifest_path, entry, {"channel", "row"}, "channel, row");
     MatrixModelSensor sensor;
     sensor.channel = RequiredString(manifest_path, entry, "channel");
     if (!channels.insert(sensor.channel).second) {
