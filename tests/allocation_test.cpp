@@ -234,6 +234,86 @@ INSTANTIATE_TEST_SUITE_P(TridiagonalAndBanded, IntegratorAllocationTest,
                            return info.param ? "Banded" : "Tridiagonal";
                          });
 
+// The sparse path (linalg/sparse_theta_step.h) on a 2-D lattice: its steps, shifted
+// steps, batched steps and sweeps neither allocate nor free after Init.
+TEST(SparseIntegratorAllocationTest, StepsAndSweepsAllocateNothingAfterInit) {
+  SKIP_WITHOUT_ALLOCATION_COUNTING();
+  constexpr int kSide = 12, n = kSide * kSide;
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int j = 0; j < kSide; ++j) {
+    for (int i = 0; i < kSide; ++i) {
+      const int a = j * kSide + i;
+      entries.emplace_back(a, a, i == 0 ? 1.0 : 0.0);  // springs to the ground at i = 0
+      for (const int b : {i + 1 < kSide ? a + 1 : -1, j + 1 < kSide ? a + kSide : -1}) {
+        if (b < 0) continue;
+        entries.emplace_back(a, a, 1.0);
+        entries.emplace_back(b, b, 1.0);
+        entries.emplace_back(a, b, -1.0);
+        entries.emplace_back(b, a, -1.0);
+      }
+    }
+  }
+  SparseMatrix stiffness(n, n), mass(n, n);
+  stiffness.setFromTriplets(entries.begin(), entries.end());
+  mass.setIdentity();
+  ThetaIntegratorOptions options;
+  options.time_step = 0.1;
+  options.factorization = Factorization::kSparse;
+  ThetaIntegrator integrator;
+  integrator.Init(mass, stiffness, options);
+  ASSERT_EQ(integrator.factorization(), Factorization::kSparse);
+  Matrix velocity = Matrix::Zero(n, kSteps + 1), displacement = Matrix::Zero(n, kSteps + 1);
+  Vector force = Vector::Zero(n);
+  force[n - 1] = 1.0;
+  const Vector shift = Vector::Constant(n, 1e-3);
+  const int nodes[2] = {3, 70};
+  const double values[2] = {1.0, -2.0};
+  const PointLoads point_loads{2, nodes, values};
+  const HeapCalls steps = CountHeapCalls([&] {
+    for (int k = 0; k < kSteps; ++k) {
+      integrator.Step(velocity.col(k), displacement.col(k), force, velocity.col(k + 1),
+                      displacement.col(k + 1));
+      integrator.StepShifted(velocity.col(k), displacement.col(k), shift, force,
+                             velocity.col(k + 1), displacement.col(k + 1));
+      integrator.StepWithEndLoads(velocity.col(k), displacement.col(k), shift, 1.0, -1.0,
+                                  velocity.col(k + 1), displacement.col(k + 1), &point_loads);
+      integrator.StepWithEndLoads(velocity.col(k), displacement.col(k), 1.0, -1.0,
+                                  velocity.col(k + 1), displacement.col(k + 1), &point_loads);
+    }
+  });
+  EXPECT_EQ(steps.allocations, 0);
+  EXPECT_EQ(steps.deallocations, 0);
+  EXPECT_GT(displacement.col(kSteps).norm(), 0.0);
+  const HeapCalls batched_steps = CountHeapCalls([&] {
+    for (int k = 0; k + 4 <= kSteps; k += 4) {
+      const double* v_k[2] = {velocity.col(k).data(), velocity.col(k + 1).data()};
+      const double* u_k[2] = {displacement.col(k).data(), displacement.col(k + 1).data()};
+      const double* z[2] = {shift.data(), nullptr};
+      const double f0[2] = {1.0, 0.0}, fL[2] = {0.0, 1.0};
+      double* v_next[2] = {velocity.col(k + 2).data(), velocity.col(k + 3).data()};
+      double* u_next[2] = {displacement.col(k + 2).data(), displacement.col(k + 3).data()};
+      integrator.StepsWithEndLoads<2>(v_k, u_k, z, f0, fL, v_next, u_next);
+    }
+  });
+  EXPECT_EQ(batched_steps.allocations, 0);
+  EXPECT_EQ(batched_steps.deallocations, 0);
+  const Vector zero = Vector::Zero(n);
+  auto end_force = [n](int k, Eigen::Ref<Vector> f) {
+    f.setZero();
+    f[n - 1] = 1.0 + 0.01 * k;
+  };
+  auto record = [&](int k, const Vector& v, const Vector& u) {
+    velocity.col(k) = v;
+    displacement.col(k) = u;
+  };
+  const HeapCalls sweeps = CountHeapCalls([&] {
+    integrator.SweepForward(kSteps, zero, zero, end_force, record);
+    integrator.SweepBackward(kSteps, zero, zero, end_force, record);
+  });
+  EXPECT_EQ(sweeps.allocations, 0);
+  EXPECT_EQ(sweeps.deallocations, 0);
+}
+
 TEST(McreProblemAllocationTest, SweepsIntoPreallocatedFieldsAllocateNothing) {
   SKIP_WITHOUT_ALLOCATION_COUNTING();
   ProblemBundle bundle(MakeSmallCase(kElements, kSteps, 5.0, 2), Weights(0.01, 1.0));

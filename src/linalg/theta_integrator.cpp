@@ -1,11 +1,51 @@
 #include "mcrewave/linalg/theta_integrator.h"
 
+#include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
+
+#include "core/enum_names.h"
 
 namespace mcrewave {
+namespace {
+
+constexpr std::array<std::pair<Factorization, const char*>, 3> kFactorizationNames = {{
+    {Factorization::kAutomatic, "automatic"},
+    {Factorization::kBand, "band"},
+    {Factorization::kSparse, "sparse"},
+}};
+
+}  // namespace
+
+const char* FactorizationToString(Factorization factorization) {
+  return internal::ToName(kFactorizationNames, factorization);
+}
+
+bool StringToFactorization(const std::string& name, Factorization* factorization) {
+  return internal::FromName(kFactorizationNames, name, factorization);
+}
+
+int HalfBandwidth(const SparseMatrix& matrix) {
+  int bandwidth = 0;
+  for (int j = 0; j < matrix.outerSize(); ++j) {
+    for (SparseMatrix::InnerIterator it(matrix, j); it; ++it) {
+      bandwidth = std::max(bandwidth, static_cast<int>(std::abs(it.row() - it.col())));
+    }
+  }
+  return bandwidth;
+}
+
+Factorization ChooseFactorization(Factorization requested, const SparseMatrix& mass,
+                                  const SparseMatrix& stiffness) {
+  if (requested != Factorization::kAutomatic) return requested;
+  const int bandwidth = std::max(HalfBandwidth(mass), HalfBandwidth(stiffness));
+  return bandwidth <= kMaxAutomaticBandwidth ? Factorization::kBand : Factorization::kSparse;
+}
 
 bool ThetaIntegratorOptions::IsValid(std::string* error) const {
   std::ostringstream why;
@@ -25,6 +65,28 @@ void ThetaIntegrator::Init(const SparseMatrix& mass, const SparseMatrix& stiffne
   assert(options.IsValid(nullptr));
   assert(mass.rows() == stiffness.rows());
   options_ = options;
+  sparse_path_ =
+      ChooseFactorization(options.factorization, mass, stiffness) == Factorization::kSparse;
+  if (sparse_path_) {
+    // The sparse path (sparse_theta_step.h); the band members are released.
+    mass_ = SymmetricBandMatrix();
+    stiffness_ = SymmetricBandMatrix();
+    free_state_matrix_ = SymmetricBandMatrix();
+    iteration_matrix_ = BandLdlt();
+    tridiagonal_ = false;
+    ++factorization_count_;
+    if (!sparse_.Compute(mass, stiffness, options.time_step, options.theta)) {
+      throw std::runtime_error(
+          "theta integrator: the iteration matrix M + h^2 theta^2 K is not positive definite");
+    }
+    const int n = size();
+    force_ = Vector::Zero(n);
+    for (int b = 0; b < 2; ++b) {
+      v_[b] = Vector::Zero(n);
+      u_[b] = Vector::Zero(n);
+    }
+    return;
+  }
   mass_ = SymmetricBandMatrix(mass);
   stiffness_ = SymmetricBandMatrix(stiffness);
   const double h = options.time_step, theta = options.theta;
@@ -180,6 +242,11 @@ void ThetaIntegrator::Step(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref
                           v_next.data(), u_next.data());
     return;
   }
+  if (sparse_path_) {
+    sparse_.Step(v_k.data(), u_k.data(), nullptr, force_theta.data(), 0.0, 0.0, nullptr,
+                 v_next.data(), u_next.data());
+    return;
+  }
   const double h = options_.time_step;
   const double theta = options_.theta;
   // Free state and input: rhs = R v_k - h K u_k + h f_theta.
@@ -202,6 +269,11 @@ void ThetaIntegrator::StepWithEndLoads(const Eigen::Ref<const Vector>& v_k,
                            u_next.data(), point_loads);
     return;
   }
+  if (sparse_path_) {
+    sparse_.Step(v_k.data(), u_k.data(), z.data(), nullptr, f0, fL, point_loads, v_next.data(),
+                 u_next.data());
+    return;
+  }
   // f_theta = -K z + f0 e_0 + fL e_{n-1} + sum_i p_i e_{node_i}, formed in force_.
   stiffness_.Multiply(z, force_);
   force_ = -force_;
@@ -218,8 +290,30 @@ void ThetaIntegrator::StepWithEndLoads(const Eigen::Ref<const Vector>& v_k,
                            u_next.data(), point_loads);
     return;
   }
+  if (sparse_path_) {
+    sparse_.Step(v_k.data(), u_k.data(), nullptr, nullptr, f0, fL, point_loads, v_next.data(),
+                 u_next.data());
+    return;
+  }
   force_.setZero();
   AddEndAndPointLoads(f0, fL, point_loads);
+  Step(v_k, u_k, force_, v_next, u_next);
+}
+
+void ThetaIntegrator::StepShifted(const Eigen::Ref<const Vector>& v_k,
+                                  const Eigen::Ref<const Vector>& u_k,
+                                  const Eigen::Ref<const Vector>& z,
+                                  const Eigen::Ref<const Vector>& force, Eigen::Ref<Vector> v_next,
+                                  Eigen::Ref<Vector> u_next) {
+  assert(z.size() == u_k.size() && force.size() == u_k.size());
+  if (sparse_path_) {
+    sparse_.Step(v_k.data(), u_k.data(), z.data(), force.data(), 0.0, 0.0, nullptr, v_next.data(),
+                 u_next.data());
+    return;
+  }
+  // Band paths: f_theta = force - K z formed in force_.
+  stiffness_.Multiply(z, force_);
+  force_ = force - force_;
   Step(v_k, u_k, force_, v_next, u_next);
 }
 

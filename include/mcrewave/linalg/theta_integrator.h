@@ -40,6 +40,13 @@
 //   rhs = R v_k - h K (u_k + z) + h (f0 e_0 + fL e_{n-1})
 // is one pass. Optional point loads (PointLoads) add sum_i p_i e_{node_i} to f_theta
 // in the same pass: the interior sensors' loads of the retrograde sweep.
+// General sparse M and K (a structure from another finite-element code, whose
+// bandwidth the band path would fill in) take the sparse path of sparse_theta_step.h:
+// S factorised by a sparse LDL^T with a fill-reducing ordering, the right-hand side
+// in one pass over the union pattern of M and K. ThetaIntegratorOptions::factorization
+// chooses (kAutomatic: by the bandwidth, see ChooseFactorization); the bar's banded
+// paths are unchanged.
+//
 // theta = 1/2 is the trapezoidal rule (second order, energy conserving); theta = 1
 // is backward Euler (first order).
 //
@@ -53,6 +60,7 @@
 
 #include "mcrewave/core/types.h"
 #include "mcrewave/linalg/band_matrix.h"
+#include "mcrewave/linalg/sparse_theta_step.h"
 
 namespace mcrewave {
 
@@ -64,9 +72,29 @@ struct PointLoads {
   const double* values = nullptr;  // [N]
 };
 
+// How the iteration matrix S = M + h^2 theta^2 K is factorised.
+enum class Factorization {
+  kAutomatic,  // kBand when the band of S is narrow (ChooseFactorization), else kSparse
+  kBand,       // band LDL^T (tridiagonal: the twisted factorisation), band_matrix.h
+  kSparse,     // sparse LDL^T with AMD ordering, sparse_theta_step.h
+};
+const char* FactorizationToString(Factorization factorization);
+bool StringToFactorization(const std::string& name, Factorization* factorization);
+
+// kAutomatic's choice for M and K: kBand when the half bandwidth p of their union
+// is at most kMaxAutomaticBandwidth (the bar: p = 1; a band LDL^T of p <= 32 is dense
+// contiguous work of a few times the sparse factor's), else kSparse. Other values are
+// returned as they are.
+constexpr int kMaxAutomaticBandwidth = 32;
+Factorization ChooseFactorization(Factorization requested, const SparseMatrix& mass,
+                                  const SparseMatrix& stiffness);
+// The largest |i - j| of a stored entry.
+int HalfBandwidth(const SparseMatrix& matrix);
+
 struct ThetaIntegratorOptions {
   double time_step = 0.36e-6;  // h [s]
   double theta = 0.5;          // implicitness, in [0, 1]; 1/2 = trapezoidal
+  Factorization factorization = Factorization::kAutomatic;
 
   bool IsValid(std::string* error) const;
 };
@@ -98,6 +126,13 @@ class ThetaIntegrator {
                         double f0, double fL, Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next,
                         const PointLoads* point_loads = nullptr);
 
+  // One step with the force f_theta = -K z + force [N] (z [m]): the direct sweep of
+  // a general model, whose loads are vectors rather than end forces. Same contract as
+  // Step. No allocation.
+  void StepShifted(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref<const Vector>& u_k,
+                   const Eigen::Ref<const Vector>& z, const Eigen::Ref<const Vector>& force,
+                   Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next);
+
   // B independent steps at once (B = 2 or 3), step b as StepWithEndLoads from
   // (v_k[b], u_k[b]) with z[b] (null: none), f0[b], fL[b]; all arrays of size()
   // contiguous doubles, outputs distinct from every input; point_loads[b] (nullable,
@@ -128,10 +163,17 @@ class ThetaIntegrator {
                      const Eigen::Ref<const Vector>& u_final, Forcing&& forcing,
                      Observer&& observer);
 
-  int size() const { return static_cast<int>(mass_.size()); }
+  int size() const { return sparse_path_ ? sparse_.size() : static_cast<int>(mass_.size()); }
   const ThetaIntegratorOptions& options() const { return options_; }
+  // The path Init took: kBand or kSparse.
+  Factorization factorization() const {
+    return sparse_path_ ? Factorization::kSparse : Factorization::kBand;
+  }
+  // M and K as band matrices: the band path only (empty on the sparse path).
   const SymmetricBandMatrix& mass() const { return mass_; }
   const SymmetricBandMatrix& stiffness() const { return stiffness_; }
+  // The sparse path's M, K, factor and products (sparse path only).
+  const SparseThetaStepper& sparse() const { return sparse_; }
   // Number of factorisations of the iteration matrix since construction.
   int factorization_count() const { return factorization_count_; }
 
@@ -159,6 +201,8 @@ class ThetaIntegrator {
                           double* u_next) const;
 
   ThetaIntegratorOptions options_;
+  bool sparse_path_ = false;
+  SparseThetaStepper sparse_;              // the sparse path
   SymmetricBandMatrix mass_;               // M
   SymmetricBandMatrix stiffness_;          // K
   SymmetricBandMatrix free_state_matrix_;  // R = M - h^2 theta (1 - theta) K

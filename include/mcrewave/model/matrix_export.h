@@ -1,0 +1,85 @@
+// A structure given by matrices (docs/matrix_models.md), in memory and as files:
+// the mass M, one stiffness K_z per zone assembled at a nominal modulus E_z,nominal
+// (K = sum_z (E_z / E_z,nominal) K_z), one spatial vector per load channel and one
+// sparse observation row per sensor channel, each named by its CSV column.
+//
+// On disk: one Matrix Market file per matrix, vector and row, and a manifest
+// `model.yaml` that names them:
+//
+//   mass: M.mtx
+//   zones:
+//     - {name: zone0, stiffness: K_zone0.mtx, nominal_modulus: 2.0e+11}
+//   loads:
+//     - {channel: fL, vector: load_fL.mtx}
+//   sensors:
+//     - {channel: uL, row: sensor_uL.mtx}
+//
+// (file names relative to the manifest's folder). WriteBarMatrixModel exports the
+// built-in bar this way, so that the general path can be tested against it.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mcrewave/core/types.h"
+#include "mcrewave/model/bar_model.h"
+
+namespace mcrewave {
+
+struct MatrixModelZone {
+  std::string name;
+  SparseMatrix stiffness;        // K_z [N/m] at nominal_modulus
+  double nominal_modulus = 1.0;  // E_z,nominal [Pa]
+};
+
+struct MatrixModelLoad {
+  std::string channel;  // the CSV column of its time history [N]
+  Vector vector;        // spatial distribution [-]: the load is f(t) vector
+};
+
+struct MatrixModelSensor {
+  std::string channel;  // the CSV column it is compared with
+  SparseMatrix row;     // 1 x n observation row: channel = row U
+};
+
+struct MatrixModelData {
+  SparseMatrix mass;  // M [kg], n x n
+  std::vector<MatrixModelZone> zones;
+  std::vector<MatrixModelLoad> loads;
+  std::vector<MatrixModelSensor> sensors;
+
+  int dofs() const { return static_cast<int>(mass.rows()); }
+  // K = sum_z (E_z / E_z,nominal) K_z; zone_moduli has zones.size() entries [Pa].
+  SparseMatrix Stiffness(const Vector& zone_moduli) const;
+};
+
+// The observation row of a channel as a 1 x n sparse matrix.
+SparseMatrix ObservationRowMatrix(const ObservationRow& row, int dofs);
+
+// A sensor of the bar to export: `u@X` (kDisplacement) or `e@X` (kStrain).
+struct BarSensor {
+  SensorKind kind = SensorKind::kDisplacement;
+  double position = 0.0;  // X [m]
+};
+
+// The bar as matrices: M, K1_z times nominal_modulus per zone (zone z named "zone<z>"),
+// the end loads (channels f0: e_0, fL: e_N), the end displacement rows (u0, uL) and
+// the rows of `sensors` (channels u@X / e@X, as the measurement CSV names them).
+MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
+                               const std::vector<BarSensor>& sensors = {});
+
+// Writes `data` into `folder` (which must exist): M.mtx, K_<zone>.mtx,
+// load_<channel>.mtx, sensor_<channel>.mtx ('@' of a channel becomes '_at_') and the
+// manifest model.yaml, each atomically, matrices in symmetric storage, 17 digits.
+// Returns the manifest's path. Throws std::runtime_error when a file cannot be
+// written.
+std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& data);
+
+// Reads a manifest and its files, and checks them (model/matrix_model_check.h): M
+// square, symmetric, positive definite; every K_z symmetric and of M's size; the
+// load vectors of M's size; the sensor rows within M's dofs; zone names and channels
+// distinct; nominal moduli finite and positive. Throws InputError naming the file
+// (and line, for the manifest and the Matrix Market files) on the first problem.
+MatrixModelData ReadMatrixModel(const std::string& manifest_path);
+
+}  // namespace mcrewave

@@ -1,0 +1,250 @@
+#include "mcrewave/model/matrix_export.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "mcrewave/core/file_util.h"
+#include "mcrewave/data/matrix_market.h"
+#include "mcrewave/model/matrix_model_check.h"
+
+namespace mcrewave {
+namespace {
+
+// A channel name as a file name part: '@' -> "_at_", '/' and spaces -> '_'.
+std::string FileSafe(const std::string& name) {
+  std::string safe;
+  for (const char c : name) {
+    if (c == '@') {
+      safe += "_at_";
+    } else if (c == '/' || c == ' ' || c == '\\') {
+      safe += '_';
+    } else {
+      safe += c;
+    }
+  }
+  return safe;
+}
+
+std::string Folder(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
+}
+
+std::string Where(const std::string& name, const YAML::Node& node) {
+  return name + ":" + std::to_string(node.Mark().line + 1);
+}
+
+// The string of key `key` of a map entry.
+std::string RequiredString(const std::string& name, const YAML::Node& entry,
+                           const std::string& key) {
+  const YAML::Node value = entry[key];
+  if (!value || !value.IsScalar() || value.Scalar().empty()) {
+    throw InputError(Where(name, entry) + ": expected key '" + key + "' (a name)");
+  }
+  return value.Scalar();
+}
+
+// Refuses a list entry that is not a map or has a key outside `keys`.
+void CheckEntryKeys(const std::string& name, const YAML::Node& entry,
+                    const std::set<std::string>& keys, const std::string& expected) {
+  if (!entry.IsMap()) {
+    throw InputError(Where(name, entry) + ": expected a map {" + expected + "}");
+  }
+  for (const auto& key : entry) {
+    if (keys.count(key.first.Scalar()) == 0) {
+      throw InputError(Where(name, key.first) + ": unknown key '" + key.first.Scalar() +
+                       "' (expected " + expected + ")");
+    }
+  }
+}
+
+void Refuse(const std::string& why) {
+  if (!why.empty()) throw InputError(why);
+}
+
+}  // namespace
+
+SparseMatrix MatrixModelData::Stiffness(const Vector& zone_moduli) const {
+  SparseMatrix stiffness(dofs(), dofs());
+  for (std::size_t z = 0; z < zones.size(); ++z) {
+    stiffness +=
+        (zone_moduli[static_cast<Eigen::Index>(z)] / zones[z].nominal_modulus) * zones[z].stiffness;
+  }
+  return stiffness;
+}
+
+SparseMatrix ObservationRowMatrix(const ObservationRow& row, int dofs) {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int i = 0; i < 2; ++i) {
+    if (row.coefficients[i] != 0.0) entries.emplace_back(0, row.nodes[i], row.coefficients[i]);
+  }
+  SparseMatrix matrix(1, dofs);
+  matrix.setFromTriplets(entries.begin(), entries.end());  // a repeated node sums
+  return matrix;
+}
+
+MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
+                               const std::vector<BarSensor>& sensors) {
+  MatrixModelData data;
+  const int n = model.num_nodes();
+  data.mass = model.mass();
+  for (int z = 0; z < model.num_zones(); ++z) {
+    MatrixModelZone zone;
+    zone.name = "zone" + std::to_string(z);
+    zone.nominal_modulus = nominal_modulus;
+    zone.stiffness = model.Stiffness(Vector::Unit(model.num_zones(), z) * nominal_modulus);
+    data.zones.push_back(std::move(zone));
+  }
+  data.loads.push_back({"f0", Vector::Unit(n, model.left_node())});
+  data.loads.push_back({"fL", Vector::Unit(n, model.right_node())});
+  ObservationRow end;
+  end.coefficients[0] = 1.0;
+  end.nodes[0] = end.nodes[1] = model.left_node();
+  data.sensors.push_back({"u0", ObservationRowMatrix(end, n)});
+  end.nodes[0] = end.nodes[1] = model.right_node();
+  data.sensors.push_back({"uL", ObservationRowMatrix(end, n)});
+  for (const BarSensor& sensor : sensors) {
+    const ObservationRow row = sensor.kind == SensorKind::kDisplacement
+                                   ? model.DisplacementRow(sensor.position)
+                                   : model.StrainRow(sensor.position);
+    std::ostringstream name;
+    name << (sensor.kind == SensorKind::kDisplacement ? "u@" : "e@") << sensor.position;
+    data.sensors.push_back({name.str(), ObservationRowMatrix(row, n)});
+  }
+  return data;
+}
+
+std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& data) {
+  YAML::Emitter manifest;
+  manifest.SetDoublePrecision(17);
+  manifest << YAML::BeginMap;
+  manifest << YAML::Key << "mass" << YAML::Value << "M.mtx";
+  WriteMatrixMarketMatrix(folder + "/M.mtx", data.mass, MatrixMarketStorage::kSymmetric,
+                          "mass matrix M [kg]");
+  manifest << YAML::Key << "zones" << YAML::Value << YAML::BeginSeq;
+  for (const MatrixModelZone& zone : data.zones) {
+    const std::string file = "K_" + FileSafe(zone.name) + ".mtx";
+    WriteMatrixMarketMatrix(folder + "/" + file, zone.stiffness, MatrixMarketStorage::kSymmetric,
+                            "stiffness of zone " + zone.name + " [N/m] at its nominal modulus");
+    manifest << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << zone.name
+             << YAML::Key << "stiffness" << YAML::Value << file << YAML::Key << "nominal_modulus"
+             << YAML::Value << zone.nominal_modulus << YAML::EndMap;
+  }
+  manifest << YAML::EndSeq;
+  manifest << YAML::Key << "loads" << YAML::Value << YAML::BeginSeq;
+  for (const MatrixModelLoad& load : data.loads) {
+    const std::string file = "load_" + FileSafe(load.channel) + ".mtx";
+    WriteMatrixMarketVector(folder + "/" + file, load.vector,
+                            "spatial vector of load channel " + load.channel);
+    manifest << YAML::Flow << YAML::BeginMap << YAML::Key << "channel" << YAML::Value
+             << load.channel << YAML::Key << "vector" << YAML::Value << file << YAML::EndMap;
+  }
+  manifest << YAML::EndSeq;
+  manifest << YAML::Key << "sensors" << YAML::Value << YAML::BeginSeq;
+  for (const MatrixModelSensor& sensor : data.sensors) {
+    const std::string file = "sensor_" + FileSafe(sensor.channel) + ".mtx";
+    WriteMatrixMarketMatrix(folder + "/" + file, sensor.row, MatrixMarketStorage::kGeneral,
+                            "observation row of sensor channel " + sensor.channel);
+    manifest << YAML::Flow << YAML::BeginMap << YAML::Key << "channel" << YAML::Value
+             << sensor.channel << YAML::Key << "row" << YAML::Value << file << YAML::EndMap;
+  }
+  manifest << YAML::EndSeq << YAML::EndMap;
+  const std::string path = folder + "/model.yaml";
+  WriteFileAtomically(path, std::string("# mcrewave matrix model (docs/matrix_models.md)\n") +
+                                manifest.c_str() + "\n");
+  return path;
+}
+
+MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(manifest_path);
+  } catch (const YAML::BadFile&) {
+    throw InputError("cannot read matrix model manifest " + manifest_path);
+  } catch (const YAML::Exception& error) {
+    throw InputError(manifest_path + ":" + std::to_string(error.mark.line + 1) + ": " + error.msg);
+  }
+  if (!root.IsMap()) throw InputError(manifest_path + ":1: expected a map (mass, zones, ...)");
+  for (const auto& key : root) {
+    const std::string name = key.first.Scalar();
+    if (name != "mass" && name != "zones" && name != "loads" && name != "sensors") {
+      throw InputError(Where(manifest_path, key.first) + ": unknown key '" + name +
+                       "' (expected mass, zones, loads, sensors)");
+    }
+  }
+  const std::string folder = Folder(manifest_path) + "/";
+  MatrixModelData data;
+  const std::string mass_file = folder + RequiredString(manifest_path, root, "mass");
+  data.mass = ReadMatrixMarketMatrix(mass_file);
+  Refuse(CheckSquare(data.mass, mass_file));
+  Refuse(CheckSymmetric(data.mass, mass_file));
+  Refuse(CheckPositiveDefinite(data.mass, mass_file));
+  const int n = data.dofs();
+  auto sequence = [&](const char* key) {
+    const YAML::Node node = root[key];
+    if (!node || !node.IsSequence() || node.size() == 0) {
+      throw InputError(manifest_path + ": expected '" + key + "', a non-empty list");
+    }
+    return node;
+  };
+  std::set<std::string> names;
+  for (const YAML::Node& entry : sequence("zones")) {
+    CheckEntryKeys(manifest_path, entry, {"name", "stiffness", "nominal_modulus"},
+                   "name, stiffness, nominal_modulus");
+    MatrixModelZone zone;
+    zone.name = RequiredString(manifest_path, entry, "name");
+    if (!names.insert(zone.name).second) {
+      throw InputError(Where(manifest_path, entry) + ": zone '" + zone.name + "' given twice");
+    }
+    const std::string file = folder + RequiredString(manifest_path, entry, "stiffness");
+    double modulus = 0.0;
+    if (!entry["nominal_modulus"] ||
+        !YAML::convert<double>::decode(entry["nominal_modulus"], modulus) ||
+        !std::isfinite(modulus) || modulus <= 0.0) {
+      throw InputError(Where(manifest_path, entry) +
+                       ": expected nominal_modulus, a finite positive modulus [Pa]");
+    }
+    zone.nominal_modulus = modulus;
+    zone.stiffness = ReadMatrixMarketMatrix(file);
+    Refuse(CheckSameSize(zone.stiffness, file, n, mass_file));
+    Refuse(CheckSymmetric(zone.stiffness, file));
+    data.zones.push_back(std::move(zone));
+  }
+  std::set<std::string> channels;
+  for (const YAML::Node& entry : sequence("loads")) {
+    CheckEntryKeys(manifest_path, entry, {"channel", "vector"}, "channel, vector");
+    MatrixModelLoad load;
+    load.channel = RequiredString(manifest_path, entry, "channel");
+    if (!channels.insert(load.channel).second) {
+      throw InputError(Where(manifest_path, entry) + ": channel '" + load.channel +
+                       "' given twice");
+    }
+    const std::string file = folder + RequiredString(manifest_path, entry, "vector");
+    load.vector = ReadMatrixMarketVector(file);
+    Refuse(CheckVectorSize(load.vector, file, n, mass_file));
+    data.loads.push_back(std::move(load));
+  }
+  for (const YAML::Node& entry : sequence("sensors")) {
+    CheckEntryKeys(manifest_path, entry, {"channel", "row"}, "channel, row");
+    MatrixModelSensor sensor;
+    sensor.channel = RequiredString(manifest_path, entry, "channel");
+    if (!channels.insert(sensor.channel).second) {
+      throw InputError(Where(manifest_path, entry) + ": channel '" + sensor.channel +
+                       "' given twice");
+    }
+    const std::string file = folder + RequiredString(manifest_path, entry, "row");
+    SparseMatrix row = ReadMatrixMarketMatrix(file);
+    Refuse(CheckSensorRow(row, sensor.channel, file, n, mass_file));
+    if (row.rows() != 1) row = SparseMatrix(row.transpose());
+    sensor.row = std::move(row);
+    data.sensors.push_back(std::move(sensor));
+  }
+  return data;
+}
+
+}  // namespace mcrewave
