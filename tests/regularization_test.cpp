@@ -145,7 +145,7 @@ TEST(DiscrepancyPrincipleTest, ChoosesTheWeightOfTheClosedForm) {
   }
 }
 
-TEST(DiscrepancyPrincipleTest, AnUnreachableTargetKeepsTheSmallestWeightAndSaysSo) {
+TEST(DiscrepancyPrincipleTest, AnUnreachableTargetFallsBackToTheMisfitFloor) {
   Eigen::MatrixXd a = Eigen::MatrixXd::Identity(6, 3);
   Eigen::VectorXd b(6);
   b << 1, 2, 3, 4, 5, 6;  // rows 3..5 cannot be fitted: misfit >= 1/2 (16 + 25 + 36)
@@ -158,9 +158,13 @@ TEST(DiscrepancyPrincipleTest, AnUnreachableTargetKeepsTheSmallestWeightAndSaysS
   const RegularizedMinimization result =
       MinimizeRegularized(options, regularization, &data, std::vector<double>(3, -10.0),
                           std::vector<double>(3, 10.0), std::vector<double>(3, 0.0), 1.0);
-  EXPECT_EQ(result.weight_choice, "discrepancy_not_reached");
-  EXPECT_NEAR(result.weight, 1e-2, 1e-12);
-  EXPECT_EQ(result.path.size(), 2u);  // 1, 0.01 (the grid stops above 0.001)
+  // The grid 1, 0.01 misses; its floor (0.01's misfit) + 10 % is met at once by weight 1
+  // (misfit 38.94 against 38.5 * 1.1): kept, no bisection (nothing missed above it).
+  EXPECT_EQ(result.weight_choice, "misfit_floor");
+  EXPECT_NEAR(result.weight, 1.0, 1e-12);
+  EXPECT_EQ(result.path.size(), 2u);
+  EXPECT_GT(result.misfit_floor, 38.5);
+  EXPECT_LT(result.misfit, 1.1 * result.misfit_floor);
 }
 
 TEST(RegularizationOptionsTest, NamesAndMessages) {

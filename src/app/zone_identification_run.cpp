@@ -35,7 +35,8 @@ std::string ModuliScript(const ZoneIdentificationRun& run, const std::string& fo
   const std::string csv = GnuplotString(folder + "/moduli.csv");
   std::ostringstream script;
   script << GnuplotPngTerminal() << "set title 'Identified E(x), " << run.summary.moduli.size()
-         << " zones'\nset xlabel 'x [m]'\nset ylabel 'E [GPa]'\n"
+         << " zones'\nset xlabel 'x [m]'\nset ylabel 'E [GPa]'\nset offsets 0, 0, graph 0.05, "
+            "graph 0.05\n"
          << "plot " << csv
          << " using 2:($4*1e-9):($3-$2):(0) with vectors nohead lw 3 lc rgb '#d62728' "
             "title 'identified'";
@@ -102,6 +103,8 @@ std::vector<std::string> ZonesYamlLines(const ZoneIdentificationRun& run) {
   line(1, "target_misfit", Number(s.regularized.target_misfit),
        "e^2 / J_rest the noise explains (discrepancy principle; -1: not used)");
   line(1, "misfit", Number(s.regularized.misfit), "e^2 / J_rest at the zone moduli");
+  line(1, "misfit_floor", Number(s.regularized.misfit_floor),
+       "least e^2 / J_rest of the weight grid when the target was missed (-1: met)");
   line(1, "weights_tried", std::to_string(s.regularized.path.size()));
   line(1, "evaluations", std::to_string(s.evaluations));
   line(1, "sweeps", std::to_string(s.sweeps));

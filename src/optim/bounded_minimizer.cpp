@@ -392,7 +392,8 @@ bool BoundedMinimizerOptions::IsValid(std::string* error) const {
   if (!(step_tolerance > 0.0 && step_tolerance < 0.1)) {
     why << "zone_identification.step_tolerance must lie in (0, 0.1), got " << step_tolerance;
   } else if (!(function_tolerance >= 0.0 && function_tolerance < 0.1)) {
-    why << "zone_identification.function_tolerance must lie in [0, 0.1), got " << function_tolerance;
+    why << "zone_identification.function_tolerance must lie in [0, 0.1), got "
+        << function_tolerance;
   } else if (max_evaluations < 2) {
     why << "zone_identification.max_evaluations must be at least 2, got " << max_evaluations;
   } else if (!(max_time > 0.0 && std::isfinite(max_time))) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 #include <utility>
+#include <vector>
 
 #include "core/enum_names.h"
 
@@ -68,12 +69,14 @@ bool StringToRegularizationKind(const std::string& name, RegularizationKind* kin
 bool RegularizationOptions::IsValid(std::string* error) const {
   std::ostringstream why;
   if (!std::isfinite(weight)) {
-    why << "zone_identification.regularization_weight must be a finite number (< 0: automatic), got "
+    why << "zone_identification.regularization_weight must be a finite number (< 0: automatic), "
+           "got "
         << weight;
   } else if (!(tv_smoothing > 0.0 && tv_smoothing < 1.0)) {
     why << "zone_identification.tv_smoothing must lie in (0, 1), got " << tv_smoothing;
   } else if (!(min_weight > 0.0 && max_weight > min_weight && std::isfinite(max_weight))) {
-    why << "zone_identification.min_weight and zone_identification.max_weight must satisfy 0 < min_weight < "
+    why << "zone_identification.min_weight and zone_identification.max_weight must satisfy 0 < "
+           "min_weight < "
            "max_weight, got "
         << min_weight << " and " << max_weight;
   } else if (!(grid_factor > 1.0 && grid_factor <= 1e6)) {
@@ -81,7 +84,8 @@ bool RegularizationOptions::IsValid(std::string* error) const {
   } else if (bisection_steps < 0 || bisection_steps > 30) {
     why << "zone_identification.bisection_steps must lie in [0, 30], got " << bisection_steps;
   } else if (!(discrepancy_factor > 0.0 && std::isfinite(discrepancy_factor))) {
-    why << "zone_identification.discrepancy_factor must be a positive number, got " << discrepancy_factor;
+    why << "zone_identification.discrepancy_factor must be a positive number, got "
+        << discrepancy_factor;
   } else {
     return true;
   }
@@ -167,6 +171,9 @@ RegularizedMinimization MinimizeRegularized(
   BoundedMinimizerSummary last;
   double last_weight = -1.0;
   double last_misfit = -1.0;
+  // The grid's minimisations, for the misfit-floor fallback.
+  std::vector<BoundedMinimizerSummary> grid;
+  std::vector<double> grid_weights, grid_misfits;
   for (double weight = regularization.max_weight * start_cost;
        weight >= regularization.min_weight * start_cost * (1.0 - 1e-12);
        weight /= regularization.grid_factor) {
@@ -184,6 +191,9 @@ RegularizedMinimization MinimizeRegularized(
     last = summary;
     last_weight = weight;
     last_misfit = point.misfit;
+    grid.push_back(summary);
+    grid_weights.push_back(weight);
+    grid_misfits.push_back(point.misfit);
     if (point.meets_target) {
       hit = std::move(summary);
       hit_weight = weight;
@@ -192,24 +202,35 @@ RegularizedMinimization MinimizeRegularized(
     }
     missed = weight;
   }
+  double target = target_misfit;
+  result.weight_choice = "discrepancy";
   if (hit_weight < 0.0) {
-    result.minimizer = std::move(last);
-    result.weight = last_weight;
-    result.weight_choice = "discrepancy_not_reached";
-    result.x = result.minimizer.x;
-    result.misfit = last_misfit;
+    // The misfit floor: no weight reaches the noise's level (model error, or the noise
+    // underestimated). The smallest weight would fit the noise as well as it can; the
+    // principle is applied instead to the floor itself, raised by kMisfitFloorMargin.
+    result.misfit_floor = last_misfit;
+    target = (1.0 + kMisfitFloorMargin) * last_misfit;
     spdlog::warn(
         "no regularisation weight down to {:.3g} brings the misfit {:.6g} to the noise's level "
-        "{:.6g}: the smallest weight kept",
-        last_weight, last_misfit, target_misfit);
-    return result;
+        "{:.6g}: the target becomes the floor + {:.0f} %, {:.6g}",
+        last_weight, last_misfit, target_misfit, 100.0 * kMisfitFloorMargin, target);
+    result.weight_choice = "misfit_floor";
+    for (std::size_t k = 0; k < grid.size(); ++k) {
+      if (grid_misfits[k] <= target) {
+        hit = grid[k];
+        hit_weight = grid_weights[k];
+        hit_misfit = grid_misfits[k];
+        missed = k > 0 ? grid_weights[k - 1] : -1.0;
+        break;
+      }
+    }
   }
   // Bisection in log lambda between the weight that missed (larger) and the hit.
   if (missed > 0.0) {
     for (int step = 0; step < regularization.bisection_steps; ++step) {
       const double weight = std::sqrt(missed * hit_weight);
       BoundedMinimizerSummary summary = MinimizeAt(options, regularization, data, lower, upper,
-                                                   hit.x, weight, target_misfit, &result, &point);
+                                                   hit.x, weight, target, &result, &point);
       if (!summary.IsSolutionUsable()) break;  // keep the hit
       if (point.meets_target) {
         hit = std::move(summary);
@@ -222,7 +243,6 @@ RegularizedMinimization MinimizeRegularized(
   }
   result.minimizer = std::move(hit);
   result.weight = hit_weight;
-  result.weight_choice = "discrepancy";
   result.x = result.minimizer.x;
   result.misfit = hit_misfit;
   return result;
