@@ -22,8 +22,8 @@
 //   minimising the MCRE cost e^2(E) with the outer optimiser of `outer:` (NLopt
 //   or Ceres) over coupled direct/retrograde solves by the method of `inner:`,
 //   then computes the cost curve around the identified E, the error map of the
-//   constitutive gap and an uncertainty figure, and writes summary.yaml, CSV files and PNG figures into the output
-//   folder (include/mcrewave/app/results.h), each file atomically and only at the
+//   constitutive gap and an uncertainty figure, and writes summary.yaml, CSV files and PNG figures
+//   into the output folder (include/mcrewave/app/results.h), each file atomically and only at the
 //   end. One progress line per outer evaluation at the default level. SIGINT,
 //   SIGTERM or SIGHUP stop a run at once, but not while it writes its results:
 //   an interrupted run leaves the earlier results of its folder as they were.
@@ -60,6 +60,7 @@
 #include <vector>
 
 #include "mcrewave/app/config.h"
+#include "mcrewave/app/damage_study.h"
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/app/results.h"
 #include "mcrewave/app/study.h"
@@ -283,6 +284,12 @@ int RunStudy(const StudyArguments& arguments) {
     const mcrewave::CostCurveStudy study = mcrewave::RunCostCurveStudy(config);
     const ResultsBeingWritten held;
     mcrewave::WriteCostCurveResults(study, folder + "/cost_curves", figures);
+  }
+
+  if (mcrewave::StudySelected(kind, mcrewave::StudyKind::kDamage)) {
+    const mcrewave::DamageStudy study = mcrewave::RunDamageStudy(config);
+    const ResultsBeingWritten held;
+    mcrewave::WriteDamageResults(study, folder + "/damage", figures);
   }
 
   // 3. The README gathering the studies' summaries.

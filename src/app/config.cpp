@@ -523,7 +523,7 @@ const std::vector<Key>& KeyTable() {
               PositiveInteger<int>(), "", "points of the cost curve e^2(E), in [5, 1000]"),
       MakeKey("study.kind", &Config::study, &StudyOptions::kind,
               EnumByName<StudyKind>({StudyKind::kRobustness, StudyKind::kRelaxation,
-                                     StudyKind::kCostCurves, StudyKind::kAll},
+                                     StudyKind::kCostCurves, StudyKind::kAll, StudyKind::kDamage},
                                     StudyKindToString, StringToStudyKind),
               "", "which study `identify study` runs (study.h)"),
       MakeKey("study.folder", &Config::study, &StudyOptions::folder, Text(), "",
@@ -559,6 +559,12 @@ const std::vector<Key>& KeyTable() {
               "cost curves: least E / model.modulus, > 0"),
       MakeKey("study.cost_curve_high", &Config::study, &StudyOptions::cost_curve_high, Number(), "",
               "cost curves: largest E / model.modulus"),
+      MakeKey("study.damage_snr", &Config::study, &StudyOptions::damage_snr, NumberList(), "",
+              "damage localisation: SNRs of the grid (.inf: no noise)"),
+      MakeKey("study.damage_seeds", &Config::study, &StudyOptions::damage_seeds,
+              PositiveInteger<int>(), "",
+              "damage localisation: noise seeds of the soft zone at SNR 10 (interior sensors, "
+              "10 zones)"),
       MakeKey("zone_identification.algorithm", &Config::zone_identification,
               &ZoneIdentificationOptions::minimizer, &BoundedMinimizerOptions::algorithm,
               EnumByName<BoundedAlgorithm>(

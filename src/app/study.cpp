@@ -220,13 +220,15 @@ const char* StudyKindToString(StudyKind kind) {
       return "cost_curves";
     case StudyKind::kAll:
       return "all";
+    case StudyKind::kDamage:
+      return "damage";
   }
   return "unknown";
 }
 
 bool StringToStudyKind(const std::string& name, StudyKind* kind) {
-  for (StudyKind candidate :
-       {StudyKind::kRobustness, StudyKind::kRelaxation, StudyKind::kCostCurves, StudyKind::kAll}) {
+  for (StudyKind candidate : {StudyKind::kRobustness, StudyKind::kRelaxation,
+                              StudyKind::kCostCurves, StudyKind::kAll, StudyKind::kDamage}) {
     if (name == StudyKindToString(candidate)) {
       *kind = candidate;
       return true;
@@ -236,7 +238,7 @@ bool StringToStudyKind(const std::string& name, StudyKind* kind) {
 }
 
 bool StudySelected(StudyKind kind, StudyKind part) {
-  return kind == StudyKind::kAll || kind == part;
+  return (kind == StudyKind::kAll && part != StudyKind::kDamage) || kind == part;
 }
 
 bool StudyOptions::IsValid(std::string* error) const {
@@ -283,6 +285,9 @@ bool StudyOptions::IsValid(std::string* error) const {
     why << "study.cost_curve_low and study.cost_curve_high must satisfy 0 < cost_curve_low < "
            "cost_curve_high (finite), got "
         << cost_curve_low << " and " << cost_curve_high;
+  } else if (!check_snr(damage_snr, "study.damage_snr")) {
+  } else if (!(damage_seeds >= 1 && damage_seeds <= 1000)) {
+    why << "study.damage_seeds must lie in [1, 1000], got " << damage_seeds;
   } else {
     return true;
   }
@@ -1014,8 +1019,8 @@ std::string WriteStudiesReadme(const std::string& folder) {
         "and this file: the studies of configs/studies.yaml, then the robustness settings, the "
         "complexity and the weights studies of bench/); do not edit by hand. Each section below "
         "is the `summary.md` of its folder.\n\n";
-  for (const char* study : {"robustness", "relaxation", "cost_curves", "robustness_settings",
-                            "complexity", "weights"}) {
+  for (const char* study : {"robustness", "relaxation", "cost_curves", "damage",
+                            "robustness_settings", "complexity", "weights"}) {
     const std::string summary = folder + "/" + study + "/summary.md";
     std::ifstream file(summary);
     if (!file) continue;

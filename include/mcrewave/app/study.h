@@ -56,7 +56,8 @@ enum class StudyKind {
   kRobustness,
   kRelaxation,
   kCostCurves,
-  kAll,  // the three above
+  kAll,     // the three above
+  kDamage,  // damage localisation with zones and sensors (damage_study.h); not in kAll
 };
 const char* StudyKindToString(StudyKind kind);
 bool StringToStudyKind(const std::string& name, StudyKind* kind);
@@ -93,6 +94,10 @@ struct StudyOptions {
   int cost_curve_points = 41;
   double cost_curve_low = 0.8;
   double cost_curve_high = 1.2;
+
+  // Damage localisation (damage_study.h): SNRs of the grid and seeds of the SNR-10 runs.
+  std::vector<double> damage_snr = {std::numeric_limits<double>::infinity(), 20.0, 10.0, 5.0};
+  int damage_seeds = 20;
 
   // Valid when folder is not empty, threads in [0, 256], every SNR > 0 (.inf
   // allowed), lists not empty (at most 100 values), seeds in [1, 100000],

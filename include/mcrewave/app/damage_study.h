@@ -1,0 +1,75 @@
+// The damage-localisation study (docs/zones_and_sensors.md, "Damage localisation"),
+// run by `identify study` with study.kind: damage (or all):
+//
+// On the config's bar (the paper's: 100 elements, 1750 steps, truth 4x finer) with
+// three truths:
+//   soft          0.7 E_ref over [0.6, 0.7] m (on the identification's zone boundaries),
+//   non_aligned   0.75 E_ref over [0.63, 0.71] m (no model zone matches it),
+//   two_zones     0.8 E_ref over [0.15, 0.25] m and 1.15 E_ref over [0.55, 0.65] m;
+// two sensor sets: the ends only (u0, uL, f0, fL), and the ends with u@0.25, 0.5,
+// 0.75 and e@0.2, 0.45, 0.65, 0.9; every SNR of study.damage_snr (noise seed 1, none at
+// SNR inf); two zonings of the identification: 10 equal zones and one zone per
+// element. Then study.damage_seeds seeds of the soft truth with the interior sensors at
+// SNR 10 and 10 zones. Each run: the scalar identification (E*), the error map at E*
+// (its peak), the zone identification from E* (every zone's modulus), against the
+// truth's modulus of each zone (its elements in series).
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "mcrewave/model/bar_model.h"
+
+namespace mcrewave {
+
+struct Config;
+
+struct DamageTruth {
+  std::string name;
+  std::vector<ModulusZone> zones;  // moduli as factors of E_ref
+};
+// The three truths of the study, moduli as factors of E_ref.
+const std::vector<DamageTruth>& DamageTruths();
+// The interior sensors of the study.
+const std::vector<std::string>& DamageInteriorSensors();
+
+struct DamageRun {
+  int truth = 0;  // index in DamageTruths()
+  bool interior_sensors = false;
+  double snr = 0.0;
+  std::uint64_t seed = 0;    // 0 at SNR inf
+  bool per_element = false;  // one zone per element; else 10 equal zones
+  bool converged = false;    // the scalar and the zone identification both converged
+  std::string message;       // why not, when not converged
+  double homogeneous_modulus = std::numeric_limits<double>::quiet_NaN();  // E* [Pa]
+  double error_map_peak = std::numeric_limits<double>::quiet_NaN();  // x of its largest element [m]
+  std::vector<double> zone_start, zone_end;                          // [m]
+  std::vector<double> moduli;                                        // identified E_z [Pa]
+  std::vector<double> truth_moduli;  // the truth's E over each zone, in series [Pa]
+  int weakest_zone = -1;             // index of the smallest identified E_z
+  double max_zone_error = std::numeric_limits<double>::quiet_NaN();  // max |E_z / truth_z - 1|
+  double regularization_weight = std::numeric_limits<double>::quiet_NaN();
+  int evaluations = 0;  // coupled solves, scalar and zones
+  double wall_time_s = std::numeric_limits<double>::quiet_NaN();
+};
+
+struct DamageStudy {
+  double reference_modulus = 0.0;  // E_ref [Pa]
+  double length = 0.0;             // L [m]
+  std::vector<DamageRun> runs;     // the grid (truth, sensors, SNR, zoning), then the seeds
+  int threads = 0;
+  double wall_time_s = 0.0;
+};
+
+// Precondition: config valid (as LoadConfig returns it), synthetic finite-element truth.
+DamageStudy RunDamageStudy(const Config& config);
+
+// damage/: runs.csv (one row per run), zones.csv (one row per run and zone),
+// profiles.png (identified E(x) against the truth, per truth), error_map_peaks.png
+// and summary.md (the goals of the study against the measured figures).
+std::vector<std::string> WriteDamageResults(const DamageStudy& study, const std::string& folder,
+                                            bool figures);
+
+}  // namespace mcrewave

@@ -1,0 +1,416 @@
+#include "mcrewave/app/damage_study.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "app/study_internal.h"
+#include "mcrewave/app/config.h"
+#include "mcrewave/app/identification_run.h"
+#include "mcrewave/app/zone_identification_run.h"
+#include "mcrewave/core/file_util.h"
+#include "mcrewave/mcre/error_map.h"
+#include "mcrewave/mcre/modulus_uncertainty.h"
+#include "mcrewave/model/simulation.h"
+
+namespace mcrewave {
+namespace {
+
+using internal::Brief;
+using internal::Csv;
+using internal::Percent;
+using internal::SnrText;
+
+constexpr int kEqualZones = 10;
+
+struct DamageCase {
+  int truth;
+  bool interior_sensors;
+  double snr;
+  std::uint64_t seed;
+  bool per_element;
+};
+
+// The grid (truth, sensors, SNR, zoning), then the seeds 2..damage_seeds of the soft
+// truth with the interior sensors at SNR 10 and 10 zones (seed 1 is in the grid when
+// 10 is one of the SNRs).
+std::vector<DamageCase> Cases(const StudyOptions& options) {
+  std::vector<DamageCase> cases;
+  for (int truth = 0; truth < static_cast<int>(DamageTruths().size()); ++truth) {
+    for (bool interior : {false, true}) {
+      for (double snr : options.damage_snr) {
+        for (bool per_element : {false, true}) {
+          cases.push_back({truth, interior, snr, std::isinf(snr) ? 0u : 1u, per_element});
+        }
+      }
+    }
+  }
+  for (int seed = 2; seed <= options.damage_seeds; ++seed) {
+    cases.push_back({0, true, 10.0, static_cast<std::uint64_t>(seed), false});
+  }
+  return cases;
+}
+
+std::vector<ModulusZone> ScaledTruth(const DamageTruth& truth, double reference) {
+  std::vector<ModulusZone> zones = truth.zones;
+  for (ModulusZone& zone : zones) zone.modulus *= reference;
+  return zones;
+}
+
+// The truth's modulus of each zone of `model`: its elements in series,
+// 1 / E_z = mean over the zone's elements of 1 / E_e (equal lengths).
+std::vector<double> TruthPerZone(const BarModel& model, const Vector& element_moduli) {
+  std::vector<double> compliance(model.num_zones(), 0.0);
+  std::vector<int> count(model.num_zones(), 0);
+  for (int e = 0; e < model.num_elements(); ++e) {
+    compliance[model.element_zone(e)] += 1.0 / element_moduli[e];
+    ++count[model.element_zone(e)];
+  }
+  std::vector<double> moduli(model.num_zones());
+  for (int z = 0; z < model.num_zones(); ++z) moduli[z] = count[z] / compliance[z];
+  return moduli;
+}
+
+void RunOne(const Config& config, const DamageCase& damage, DamageRun* run) {
+  const auto start = std::chrono::steady_clock::now();
+  const double reference = config.model.modulus;
+  run->truth = damage.truth;
+  run->interior_sensors = damage.interior_sensors;
+  run->snr = damage.snr;
+  run->seed = damage.seed;
+  run->per_element = damage.per_element;
+
+  Config run_config = config;
+  run_config.outer.scan_threads = 1;
+  run_config.data.truth_zones = ScaledTruth(DamageTruths()[damage.truth], reference);
+  run_config.data.sensors =
+      damage.interior_sensors ? DamageInteriorSensors() : std::vector<std::string>{};
+  run_config.data.channels.clear();
+  run_config.data.snr = damage.snr;
+  run_config.data.seed = damage.seed;
+  run_config.zones = ZoneLayout();
+  run_config.zones.zoning = damage.per_element ? Zoning::kPerElement : Zoning::kEqual;
+  run_config.zones.zone_count = kEqualZones;
+
+  const MeasurementSet measured = MakeSyntheticMeasurements(run_config.model, run_config.load,
+                                                            run_config.time, run_config.data);
+  IdentificationRun scalar = IdentifyModulus(run_config, measured);
+  run->evaluations = static_cast<int>(scalar.evaluations.size());
+  if (!scalar.IsUsable()) {
+    run->message = "scalar identification: " + scalar.outer.message;
+    return;
+  }
+  run->homogeneous_modulus = scalar.identified_modulus();
+  // The error map at E* (error_map.h).
+  const BarModel uniform(run_config.model);
+  const Vector shares =
+      scalar.solution.has_fields()
+          ? ElementGapShares(uniform, Vector::Constant(1, run->homogeneous_modulus),
+                             scalar.solution.retrograde, run_config.time.step)
+          : scalar.solution.error_map;
+  Eigen::Index peak = 0;
+  shares.maxCoeff(&peak);
+  run->error_map_peak = uniform.element_midpoint(static_cast<int>(peak));
+
+  scalar.estimated_noise = DifferenceNoiseLevels(measured);
+  const ZoneIdentificationRun zones =
+      RunZoneIdentification(run_config, run_config.zones, scalar, run_config.data.truth_zones);
+  const ZoneIdentificationSummary& summary = zones.summary;
+  run->evaluations += summary.evaluations;
+  run->regularization_weight = summary.regularized.weight;
+  if (!summary.IsSolutionUsable() || summary.moduli.size() == 0) {
+    run->message = "zone identification: " + summary.message;
+    return;
+  }
+  const BarModel zoned(run_config.model, run_config.zones.ElementZones(run_config.model));
+  run->zone_start = summary.zone_start;
+  run->zone_end = summary.zone_end;
+  run->moduli.assign(summary.moduli.data(), summary.moduli.data() + summary.moduli.size());
+  run->truth_moduli =
+      TruthPerZone(zoned, ElementModuli(run_config.model, run_config.data.truth_zones));
+  run->weakest_zone = static_cast<int>(std::min_element(run->moduli.begin(), run->moduli.end()) -
+                                       run->moduli.begin());
+  run->max_zone_error = 0.0;
+  for (std::size_t z = 0; z < run->moduli.size(); ++z) {
+    run->max_zone_error =
+        std::max(run->max_zone_error, std::abs(run->moduli[z] / run->truth_moduli[z] - 1.0));
+  }
+  run->converged = true;
+  run->wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::string SensorsText(bool interior) { return interior ? "interior" : "ends"; }
+std::string ZoningText(bool per_element) { return per_element ? "per_element" : "10_equal"; }
+
+std::string RunsCsv(const DamageStudy& study) {
+  std::ostringstream csv;
+  csv << "run,truth,sensors,snr,seed,zoning,converged,homogeneous_modulus_pa,error_map_peak_m,"
+         "weakest_zone_start_m,weakest_zone_end_m,weakest_ratio,max_zone_error,"
+         "regularization_weight,evaluations,wall_time_s,message\n";
+  for (std::size_t i = 0; i < study.runs.size(); ++i) {
+    const DamageRun& run = study.runs[i];
+    const bool zones = run.converged && run.weakest_zone >= 0;
+    csv << i << "," << DamageTruths()[run.truth].name << "," << SensorsText(run.interior_sensors)
+        << "," << SnrText(run.snr) << "," << run.seed << "," << ZoningText(run.per_element) << ","
+        << (run.converged ? 1 : 0) << "," << Csv(run.homogeneous_modulus) << ","
+        << Csv(run.error_map_peak) << "," << (zones ? Csv(run.zone_start[run.weakest_zone]) : "")
+        << "," << (zones ? Csv(run.zone_end[run.weakest_zone]) : "") << ","
+        << (zones ? Csv(run.moduli[run.weakest_zone] / study.reference_modulus) : "") << ","
+        << Csv(run.max_zone_error) << "," << Csv(run.regularization_weight) << ","
+        << run.evaluations << "," << Csv(run.wall_time_s) << ",\"" << run.message << "\"\n";
+  }
+  return csv.str();
+}
+
+std::string ZonesCsvOf(const DamageStudy& study) {
+  std::ostringstream csv;
+  csv << "run,zone,start_m,end_m,modulus_pa,truth_pa,ratio_to_reference,truth_ratio\n";
+  for (std::size_t i = 0; i < study.runs.size(); ++i) {
+    const DamageRun& run = study.runs[i];
+    for (std::size_t z = 0; z < run.moduli.size(); ++z) {
+      csv << i << "," << z << "," << Csv(run.zone_start[z]) << "," << Csv(run.zone_end[z]) << ","
+          << Csv(run.moduli[z]) << "," << Csv(run.truth_moduli[z]) << ","
+          << Csv(run.moduli[z] / study.reference_modulus) << ","
+          << Csv(run.truth_moduli[z] / study.reference_modulus) << "\n";
+    }
+  }
+  return csv.str();
+}
+
+// The run of the grid with these settings (seed 1, or 0 at SNR inf), or -1.
+int FindRun(const DamageStudy& study, int truth, bool interior, double snr, bool per_element) {
+  for (std::size_t i = 0; i < study.runs.size(); ++i) {
+    const DamageRun& run = study.runs[i];
+    if (run.truth == truth && run.interior_sensors == interior && run.per_element == per_element &&
+        (run.snr == snr || (std::isinf(run.snr) && std::isinf(snr))) && run.seed <= 1) {
+      return static_cast<int>(i);
+    }
+  }
+  return -1;
+}
+
+// profile_<truth>.csv: x and E(x) / E_ref of the truth and of three runs (NaN when
+// absent), sampled at 1000 points.
+std::string ProfileCsv(const DamageStudy& study, int truth, const std::vector<int>& runs,
+                       double length) {
+  std::ostringstream csv;
+  csv << "x_m,truth";
+  for (std::size_t r = 0; r < runs.size(); ++r) csv << ",run" << r;
+  csv << "\n";
+  const std::vector<ModulusZone> zones = DamageTruths()[truth].zones;
+  for (int i = 0; i <= 1000; ++i) {
+    const double x = length * i / 1000.0;
+    double truth_value = 1.0;
+    for (const ModulusZone& zone : zones) {
+      if (x >= zone.start && x <= zone.end) truth_value = zone.modulus;
+    }
+    csv << Csv(x) << "," << Csv(truth_value);
+    for (int index : runs) {
+      double value = std::nan("");
+      if (index >= 0 && study.runs[index].converged) {
+        const DamageRun& run = study.runs[index];
+        for (std::size_t z = 0; z < run.moduli.size(); ++z) {
+          if (x >= run.zone_start[z] && x <= run.zone_end[z]) {
+            value = run.moduli[z] / study.reference_modulus;
+          }
+        }
+      }
+      csv << "," << Csv(value);
+    }
+    csv << "\n";
+  }
+  return csv.str();
+}
+
+std::string ProfilesScript(const std::string& folder, const std::vector<std::string>& labels) {
+  std::ostringstream script;
+  script << GnuplotPngTerminal() << "set terminal pngcairo size 1100,1200\n"
+         << "set multiplot layout 3,1 title 'Identified E(x) / E_{ref} against the truth (interior "
+            "sensors)'\nset xlabel 'x [m]'\nset ylabel 'E / E_{ref}'\nset grid\n"
+         << "set key outside right\nset datafile separator comma\n";
+  for (std::size_t t = 0; t < DamageTruths().size(); ++t) {
+    const std::string csv = GnuplotString(folder + "/profile_" + DamageTruths()[t].name + ".csv");
+    script << "set title '" << DamageTruths()[t].name << "'\nplot " << csv
+           << " skip 1 using 1:2 with lines lw 3 lc rgb '#000000' title 'truth'";
+    for (std::size_t r = 0; r < labels.size(); ++r) {
+      script << ", " << csv << " skip 1 using 1:" << r + 3 << " with lines lw 2 lc rgb '"
+             << internal::Colour(static_cast<int>(r)) << "' title '" << labels[r] << "'";
+    }
+    script << "\n";
+  }
+  script << "unset multiplot\n";
+  return script.str();
+}
+
+std::string Summary(const DamageStudy& study) {
+  std::ostringstream md;
+  const double reference = study.reference_modulus;
+  md << "# Damage localisation (zones and sensors)\n\n"
+     << study.runs.size() << " runs on " << study.threads << " threads in "
+     << internal::Duration(study.wall_time_s)
+     << ". Each run: the scalar identification (E*), the error map at E*, then every zone "
+        "modulus from E* (docs/zones_and_sensors.md). Truths: `soft` 0.7 E over [0.6, 0.7] m, "
+        "`non_aligned` 0.75 E over [0.63, 0.71] m, `two_zones` 0.8 E over [0.15, 0.25] m and "
+        "1.15 E over [0.55, 0.65] m. Sensors: `ends` (u0, uL, f0, fL) or `interior` (the ends "
+        "with u@0.25, 0.5, 0.75 and e@0.2, 0.45, 0.65, 0.9). Zone errors against the truth's "
+        "modulus of each zone (its elements in series).\n\n";
+  // Goal 1: noise-free, 10 zones, every zone within 1 %.
+  md << "## Noise-free, 10 zones: every zone within 1 %\n\n"
+     << "| truth | sensors | max zone error | weakest zone | E_weakest / E_ref | error map peak "
+        "[m] | "
+        "goal |\n|---|---|---|---|---|---|---|\n";
+  for (int t = 0; t < static_cast<int>(DamageTruths().size()); ++t) {
+    for (bool interior : {false, true}) {
+      const int i = FindRun(study, t, interior, std::numeric_limits<double>::infinity(), false);
+      if (i < 0) continue;
+      const DamageRun& run = study.runs[i];
+      md << "| " << DamageTruths()[t].name << " | " << SensorsText(interior) << " | ";
+      if (!run.converged) {
+        md << "failed: " << run.message << " | | | | no |\n";
+        continue;
+      }
+      md << Percent(run.max_zone_error) << " | [" << Brief(run.zone_start[run.weakest_zone]) << ", "
+         << Brief(run.zone_end[run.weakest_zone]) << "] | "
+         << Brief(run.moduli[run.weakest_zone] / reference) << " | " << Brief(run.error_map_peak)
+         << " | " << (run.max_zone_error <= 0.01 ? "met" : "missed") << " |\n";
+    }
+  }
+  // Goal 2: the seeds at SNR 10.
+  int seeds = 0, weakest = 0, soft_within = 0, others_within = 0;
+  double worst_soft = 0.0, worst_other = 0.0;
+  for (const DamageRun& run : study.runs) {
+    if (!(run.truth == 0 && run.interior_sensors && run.snr == 10.0 && !run.per_element)) continue;
+    ++seeds;
+    if (!run.converged) continue;
+    int soft = -1;  // the zone of the smallest truth
+    for (std::size_t z = 0; z < run.truth_moduli.size(); ++z) {
+      if (soft < 0 || run.truth_moduli[z] < run.truth_moduli[soft]) soft = static_cast<int>(z);
+    }
+    if (run.weakest_zone == soft) ++weakest;
+    double other = 0.0;
+    for (std::size_t z = 0; z < run.moduli.size(); ++z) {
+      const double error = std::abs(run.moduli[z] / run.truth_moduli[z] - 1.0);
+      if (static_cast<int>(z) == soft) {
+        worst_soft = std::max(worst_soft, error);
+        if (error <= 0.05) ++soft_within;
+      } else {
+        other = std::max(other, error);
+      }
+    }
+    worst_other = std::max(worst_other, other);
+    if (other <= 0.05) ++others_within;
+  }
+  md << "\n## SNR 10, interior sensors, 10 zones, " << seeds << " seeds (soft truth)\n\n"
+     << "| soft zone the weakest | soft zone within 5 % | every other zone within 5 % | worst "
+        "soft-zone error | worst other-zone error |\n|---|---|---|---|---|\n"
+     << "| " << weakest << " / " << seeds << " | " << soft_within << " / " << seeds << " | "
+     << others_within << " / " << seeds << " | " << Percent(worst_soft) << " | "
+     << Percent(worst_other) << " |\n\nGoal: the soft zone the weakest in at least 19 of 20, "
+     << "its modulus and every other zone within 5 %.\n";
+  // Goal 3: one zone per element at SNR 20.
+  const int per_element = FindRun(study, 0, true, 20.0, true);
+  if (per_element >= 0 && study.runs[per_element].converged) {
+    const DamageRun& run = study.runs[per_element];
+    double inside = 0.0, outside = 0.0;
+    int inside_count = 0, outside_count = 0;
+    for (std::size_t z = 0; z < run.moduli.size(); ++z) {
+      const double middle = 0.5 * (run.zone_start[z] + run.zone_end[z]);
+      if (middle > 0.6 && middle < 0.7) {
+        inside += run.moduli[z] / reference;
+        ++inside_count;
+      } else {
+        outside += run.moduli[z] / reference;
+        ++outside_count;
+      }
+    }
+    inside /= std::max(inside_count, 1);
+    outside /= std::max(outside_count, 1);
+    md << "\n## One zone per element, SNR 20, interior sensors (soft truth)\n\n"
+       << "Mean identified E / E_ref over [0.6, 0.7] m: " << Brief(inside)
+       << " (goal: within 10 % of 0.7: " << (std::abs(inside / 0.7 - 1.0) <= 0.1 ? "met" : "missed")
+       << "); elsewhere: " << Brief(outside)
+       << " (goal: within 10 % of 1: " << (std::abs(outside - 1.0) <= 0.1 ? "met" : "missed")
+       << "); regularisation weight " << Brief(run.regularization_weight) << ", " << run.evaluations
+       << " evaluations, " << internal::Duration(run.wall_time_s) << ".\n";
+  }
+  // The grid: every run.
+  md << "\n## Every run of the grid\n\n| truth | sensors | SNR | zoning | E* / E_ref | error map "
+        "peak [m] | weakest zone | E_weakest / E_ref | max zone error | evaluations | time |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const DamageRun& run : study.runs) {
+    if (run.seed > 1) continue;
+    md << "| " << DamageTruths()[run.truth].name << " | " << SensorsText(run.interior_sensors)
+       << " | " << SnrText(run.snr) << " | " << ZoningText(run.per_element) << " | ";
+    if (!run.converged) {
+      md << Brief(run.homogeneous_modulus / reference) << " | " << Brief(run.error_map_peak)
+         << " | failed | | | " << run.evaluations << " | |\n";
+      continue;
+    }
+    md << Brief(run.homogeneous_modulus / reference) << " | " << Brief(run.error_map_peak) << " | ["
+       << Brief(run.zone_start[run.weakest_zone]) << ", " << Brief(run.zone_end[run.weakest_zone])
+       << "] | " << Brief(run.moduli[run.weakest_zone] / reference) << " | "
+       << Percent(run.max_zone_error) << " | " << run.evaluations << " | "
+       << internal::Duration(run.wall_time_s) << " |\n";
+  }
+  md << "\nFigures: profiles.png (identified E(x) against the truth with the interior sensors: "
+        "10 zones noise-free and at SNR 10, one zone per element at SNR 20).\n";
+  return md.str();
+}
+
+}  // namespace
+
+const std::vector<DamageTruth>& DamageTruths() {
+  static const std::vector<DamageTruth> truths = {
+      {"soft", {{0.6, 0.7, 0.7}}},
+      {"non_aligned", {{0.63, 0.71, 0.75}}},
+      {"two_zones", {{0.15, 0.25, 0.8}, {0.55, 0.65, 1.15}}},
+  };
+  return truths;
+}
+
+const std::vector<std::string>& DamageInteriorSensors() {
+  static const std::vector<std::string> sensors = {"u@0.25", "u@0.5",  "u@0.75", "e@0.2",
+                                                   "e@0.45", "e@0.65", "e@0.9"};
+  return sensors;
+}
+
+DamageStudy RunDamageStudy(const Config& config) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<DamageCase> cases = Cases(config.study);
+  DamageStudy study;
+  study.reference_modulus = config.model.modulus;
+  study.length = config.model.length;
+  study.runs.resize(cases.size());
+  study.threads = internal::ResolveThreads(config.study.threads);
+  internal::Progress progress("damage", static_cast<int>(cases.size()));
+  internal::ParallelFor(
+      static_cast<int>(cases.size()), study.threads,
+      [&](int i) { RunOne(config, cases[i], &study.runs[i]); }, &progress);
+  study.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return study;
+}
+
+std::vector<std::string> WriteDamageResults(const DamageStudy& study, const std::string& folder,
+                                            bool figures) {
+  std::vector<std::pair<std::string, std::string>> files = {{"runs.csv", RunsCsv(study)},
+                                                            {"zones.csv", ZonesCsvOf(study)}};
+  for (int t = 0; t < static_cast<int>(DamageTruths().size()); ++t) {
+    const std::vector<int> runs = {
+        FindRun(study, t, true, std::numeric_limits<double>::infinity(), false),
+        FindRun(study, t, true, 10.0, false), FindRun(study, t, true, 20.0, true)};
+    files.emplace_back("profile_" + DamageTruths()[t].name + ".csv",
+                       ProfileCsv(study, t, runs, study.length));
+  }
+  const std::vector<std::pair<std::string, std::string>> drawings = {
+      {"profiles",
+       ProfilesScript(folder, {"10 zones, SNR inf", "10 zones, SNR 10", "per element, SNR 20"})}};
+  return internal::WriteStudyFolder(folder, files, drawings, figures, Summary(study));
+}
+
+}  // namespace mcrewave
