@@ -5,6 +5,7 @@
 #   results/complexity/           scripts/complexity_study.sh (the paper's Table 1, Fig. 5)
 #   results/weights/              scripts/weights_study.sh (docs/weights.md)
 #   results/robustness/, relaxation/, cost_curves/   `identify study configs/studies.yaml`
+#   results/damage/               `identify study configs/studies.yaml --set study.kind=damage`
 #                                 (include/mcrewave/app/study.h), which writes results/README.md
 # About 10 minutes on 2 cores. Arguments go to `identify study`, and with any of them
 # only the identify studies run, e.g.
@@ -22,3 +23,10 @@ if [ "$#" -eq 0 ]; then
   bash "$root/scripts/weights_study.sh"
 fi
 "$build_dir/identify/identify" study configs/studies.yaml --output results "$@"
+if [ "$#" -eq 0 ]; then
+  # The damage-localisation study (results/damage; zones and interior sensors): hours
+  # on 2 cores at the paper's resolution, dominated by the SNR-10 seeds with strain
+  # gauges (about 1300 inner sweeps per solve at mcre.w_e = 0.01).
+  "$build_dir/identify/identify" study configs/studies.yaml --output results \
+    --set study.kind=damage
+fi

@@ -74,7 +74,7 @@ ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayo
                scalar.identified_modulus());
   run.summary = IdentifyZoneModuli(
       config.zone_identification, model, scalar.data, config.mcre, config.time.theta, config.inner,
-      {}, scalar.identified_modulus(), config.outer.lower_bound, config.outer.upper_bound,
+      scalar.ends, scalar.identified_modulus(), config.outer.lower_bound, config.outer.upper_bound,
       scalar.estimated_noise, prefilter,
       scalar.solution.has_fields() ? &scalar.solution.retrograde : nullptr);
   spdlog::info("zones: {}", run.summary.BriefReport());
