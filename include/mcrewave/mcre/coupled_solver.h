@@ -55,7 +55,8 @@ enum class CoupledSolverType {
   kSingleShooting,
   kMultipleShooting,
   // Conjugate gradients on the sensor traces with O(n) memory (docs/streaming.md):
-  // no space-time field is stored; theta = 1/2 only.
+  // no space-time field is stored (theta = 1/2: O(n) memory; other theta: checkpoints,
+  // O(n sqrt(m))).
   kStreamingConjugateGradient,
 };
 const char* CoupledSolverTypeToString(CoupledSolverType type);
