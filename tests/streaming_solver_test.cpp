@@ -1,7 +1,7 @@
 // Tests of the streaming coupled solver (docs/streaming.md): the trace operator's
 // symmetry, agreement with the stored-field conjugate gradients (cost, every zone's
 // gradient, error map, traces) with and without interior sensors, the round-off of
-// the rebuilt retrograde field over long windows, and its refusal for theta != 1/2.
+// the rebuilt retrograde field over long windows, checkpoints for theta != 1/2, memory.
 #include <gtest/gtest.h>
 
 #include <cmath>
