@@ -320,48 +320,60 @@ double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// The scaled costs at xs: block b of scan_threads contiguous blocks evaluated in
-// order by copy b of the objective on its own thread (or all on `objective`
-// when it offers no copy). Samples not reached within options.max_time of
-// `start` stay NaN. *first_failure: why the lowest failed sample failed;
-// *sweeps: the inner sweeps the scan ran.
+// Scan points are split into this many contiguous chunks (fewer when there are
+// fewer points), whatever the thread count, so that every cost is the same bits
+// on 1 or 64 threads.
+constexpr int kScanChunks = 8;
+
+// The scaled costs at xs. The points form min(kScanChunks, P) contiguous chunks,
+// chunk c = [c P / C, (c + 1) P / C); each chunk is evaluated in order by a fresh
+// copy of the objective (CloneForScan), warm-started point to point from its own
+// first point only, so a cost depends on its chunk and never on which thread ran
+// it. Chunk c runs on thread c mod scan_threads. Without copies (CloneForScan
+// gives none) every point is evaluated in order on `objective`. Samples not
+// reached within options.max_time of `start` stay NaN. *first_failure: why the
+// lowest failed sample failed; *sweeps: the inner sweeps the scan ran.
 std::vector<double> ScanCosts(const IdentificationOptions& options, ModulusObjective* objective,
                               const std::vector<double>& xs, Clock::time_point start,
                               std::string* first_failure, long* sweeps) {
   const int points = static_cast<int>(xs.size());
   std::vector<double> costs(xs.size(), std::numeric_limits<double>::quiet_NaN());
-  auto scan_cost = [&](ModulusObjective* evaluated, int i, std::string* failure) {
-    if (SecondsSince(start) >= options.max_time) {
-      *failure = "outer.max_time reached during the scan";
-      return std::numeric_limits<double>::quiet_NaN();
-    }
-    return ScanCost(evaluated, xs[i], failure);
-  };
-  std::vector<std::unique_ptr<ModulusObjective>> copies;
-  const int blocks = std::min(options.scan_threads, points);
-  for (int b = 0; b < blocks; ++b) {
-    std::unique_ptr<ModulusObjective> copy = objective->CloneForScan(options.scan_tolerance);
-    if (copy == nullptr) break;
-    copies.push_back(std::move(copy));
-  }
   std::vector<std::string> failures(xs.size());
-  if (static_cast<int>(copies.size()) < blocks) {
-    const long sweeps_before = objective->sweeps();
-    for (int i = 0; i < points; ++i) costs[i] = scan_cost(objective, i, &failures[i]);
-    *sweeps = objective->sweeps() - sweeps_before;
-  } else {
-    // Block b holds the points [b P / B, (b + 1) P / B).
-    auto run_block = [&](int b) {
-      for (int i = b * points / blocks; i < (b + 1) * points / blocks; ++i) {
-        costs[i] = scan_cost(copies[b].get(), i, &failures[i]);
+  auto scan_cost = [&](ModulusObjective* evaluated, int i) {
+    if (SecondsSince(start) >= options.max_time) {
+      failures[i] = "outer.max_time reached during the scan";
+      return;
+    }
+    costs[i] = ScanCost(evaluated, xs[i], &failures[i]);
+  };
+  const int chunks = std::min(kScanChunks, points);
+  const int threads = std::min(options.scan_threads, chunks);
+  std::vector<long> thread_sweeps(threads, 0);
+  std::vector<char> cloned(threads, 1);
+  auto run_chunks = [&](int thread) {
+    for (int c = thread; c < chunks; c += threads) {
+      std::unique_ptr<ModulusObjective> copy = objective->CloneForScan(options.scan_tolerance);
+      if (copy == nullptr) {
+        cloned[thread] = 0;
+        return;
       }
-    };
-    std::vector<std::thread> threads;
-    for (int b = 1; b < blocks; ++b) threads.emplace_back(run_block, b);
-    run_block(0);
-    for (std::thread& thread : threads) thread.join();
-    *sweeps = 0;
-    for (const std::unique_ptr<ModulusObjective>& copy : copies) *sweeps += copy->sweeps();
+      for (int i = c * points / chunks; i < (c + 1) * points / chunks; ++i) {
+        scan_cost(copy.get(), i);
+      }
+      thread_sweeps[thread] += copy->sweeps();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(run_chunks, t);
+  run_chunks(0);
+  for (std::thread& thread : pool) thread.join();
+  *sweeps = 0;
+  for (const long count : thread_sweeps) *sweeps += count;
+  if (std::find(cloned.begin(), cloned.end(), 0) != cloned.end()) {
+    // CloneForScan gives no copy (it gives one always or never): every point on `objective`.
+    const long sweeps_before = objective->sweeps();
+    for (int i = 0; i < points; ++i) scan_cost(objective, i);
+    *sweeps = objective->sweeps() - sweeps_before;
   }
   for (const std::string& failure : failures) {
     if (!failure.empty()) {

@@ -23,10 +23,10 @@
 // changes, docs/robustness.md), so a local optimiser started anywhere stops in
 // the nearest valley. Identify first evaluates the cost on scan_points moduli
 // evenly spaced in log E over [lower_bound, upper_bound] (copies of the objective at the
-// loose inner tolerance scan_tolerance, on scan_threads threads, each thread a
-// fixed contiguous block warm-started point to point: the result depends on the
-// options, never on timing), counts the local minima of those samples, and then
-// refines the refine_candidates lowest of them with the local optimiser, each
+// loose inner tolerance scan_tolerance, in 8 fixed contiguous chunks, each a
+// fresh copy warm-started point to point, spread over scan_threads threads: every
+// cost is the same bits whatever the thread count or timing), counts the local minima of those
+// samples, and then refines the refine_candidates lowest of them with the local optimiser, each
 // bracketed by its two neighbouring scan points (a sampled minimum c_i < c_{i-1},
 // c_{i+1} of a continuous cost holds a local minimum strictly between them). The
 // refined minimum of least cost is the result. scan_points = 0 keeps the local
