@@ -95,6 +95,43 @@ TEST(IdentifyStudyTest, OneKindRunsThatStudyOnly) {
   EXPECT_FALSE(fs::exists(folder + "/relaxation"));
 }
 
+// The text of a study's file without the lines that give its wall time and
+// thread count ("... in 0 s on 4 threads.").
+std::string WithoutTimingLines(const std::string& text) {
+  std::istringstream lines(text);
+  std::string kept;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find(" threads.") == std::string::npos) kept += line + "\n";
+  }
+  return kept;
+}
+
+TEST(IdentifyStudyTest, EveryStudyWritesTheSameBitsOnOneTwoOrFourThreads) {
+  const std::string directory = FreshDirectory("identify_study_threads");
+  const std::string config = WriteConfig(directory, kTinyStudyConfig);
+  std::vector<std::string> folders;
+  for (const int threads : {1, 2, 4}) {
+    folders.push_back(directory + "/results_" + std::to_string(threads));
+    const RunResult result =
+        RunIdentify("study " + config + " --set study.figures=false -q --set study.threads=" +
+                    std::to_string(threads) + " --output " + folders.back());
+    ASSERT_EQ(result.exit_code, 0) << result.output;
+  }
+  int files = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(folders[0])) {
+    if (!entry.is_regular_file()) continue;
+    const std::string relative = fs::relative(entry.path(), folders[0]).string();
+    const std::string one = WithoutTimingLines(ReadText(entry.path().string()));
+    for (std::size_t k = 1; k < folders.size(); ++k) {
+      EXPECT_EQ(one, WithoutTimingLines(ReadText(folders[k] + "/" + relative)))
+          << relative << " differs between 1 and " << (k == 1 ? 2 : 4) << " threads";
+    }
+    ++files;
+  }
+  // runs, statistics, cases, sweeps, residuals, curves, minima, 3 summaries, README.
+  EXPECT_EQ(files, 11);
+}
+
 TEST(IdentifyStudyTest, BadStudyValuesStopBeforeAnyComputation) {
   const std::string directory = FreshDirectory("identify_study_bad");
   std::string text = kTinyStudyConfig;
