@@ -8,6 +8,8 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <map>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -90,6 +92,37 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.study.cost_curve_points, actual.study.cost_curve_points);
   EXPECT_EQ(expected.study.cost_curve_low, actual.study.cost_curve_low);
   EXPECT_EQ(expected.study.cost_curve_high, actual.study.cost_curve_high);
+  EXPECT_EQ(expected.study.damage_snr, actual.study.damage_snr);
+  EXPECT_EQ(expected.study.damage_seeds, actual.study.damage_seeds);
+  EXPECT_EQ(expected.zones.zoning, actual.zones.zoning);
+  EXPECT_EQ(expected.zones.zone_count, actual.zones.zone_count);
+  EXPECT_EQ(expected.zones.zone_boundaries, actual.zones.zone_boundaries);
+  EXPECT_EQ(expected.data.sensors, actual.data.sensors);
+  EXPECT_EQ(expected.data.channels, actual.data.channels);
+  ASSERT_EQ(expected.data.truth_zones.size(), actual.data.truth_zones.size());
+  for (std::size_t i = 0; i < expected.data.truth_zones.size(); ++i) {
+    EXPECT_EQ(expected.data.truth_zones[i].start, actual.data.truth_zones[i].start);
+    EXPECT_EQ(expected.data.truth_zones[i].end, actual.data.truth_zones[i].end);
+    EXPECT_EQ(expected.data.truth_zones[i].modulus, actual.data.truth_zones[i].modulus);
+  }
+  EXPECT_EQ(expected.mcre.weights.strain_weight, actual.mcre.weights.strain_weight);
+  const ZoneIdentificationOptions& zones = expected.zone_identification;
+  const ZoneIdentificationOptions& zones_again = actual.zone_identification;
+  EXPECT_EQ(zones.minimizer.algorithm, zones_again.minimizer.algorithm);
+  EXPECT_EQ(zones.minimizer.step_tolerance, zones_again.minimizer.step_tolerance);
+  EXPECT_EQ(zones.minimizer.function_tolerance, zones_again.minimizer.function_tolerance);
+  EXPECT_EQ(zones.minimizer.max_evaluations, zones_again.minimizer.max_evaluations);
+  EXPECT_EQ(zones.minimizer.max_time, zones_again.minimizer.max_time);
+  EXPECT_EQ(zones.regularization.kind, zones_again.regularization.kind);
+  EXPECT_EQ(zones.regularization.weight, zones_again.regularization.weight);
+  EXPECT_EQ(zones.regularization.tv_smoothing, zones_again.regularization.tv_smoothing);
+  EXPECT_EQ(zones.regularization.max_weight, zones_again.regularization.max_weight);
+  EXPECT_EQ(zones.regularization.min_weight, zones_again.regularization.min_weight);
+  EXPECT_EQ(zones.regularization.grid_factor, zones_again.regularization.grid_factor);
+  EXPECT_EQ(zones.regularization.bisection_steps, zones_again.regularization.bisection_steps);
+  EXPECT_EQ(zones.regularization.discrepancy_factor, zones_again.regularization.discrepancy_factor);
+  EXPECT_EQ(zones.noise_samples, zones_again.noise_samples);
+  EXPECT_EQ(zones.noise_seed, zones_again.noise_seed);
 }
 
 // Runs `action`, which must throw InputError whose message contains every one of
@@ -285,6 +318,173 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   const std::string infinite_snr = ConfigToYaml(config);
   EXPECT_NE(infinite_snr.find("snr: .inf"), std::string::npos) << infinite_snr;
   ExpectSameConfig(config, ParseConfig(infinite_snr, "resolved.yaml"));
+}
+
+// Every key of a config YAML text as "section.key" -> its value as written
+// (comments and comment lines dropped; a '#' inside a quoted value kept).
+std::map<std::string, std::string> FlatKeys(const std::string& yaml) {
+  std::map<std::string, std::string> keys;
+  std::istringstream lines(yaml);
+  std::string section;
+  for (std::string line; std::getline(lines, line);) {
+    const std::size_t first = line.find_first_not_of(' ');
+    if (first == std::string::npos || line[first] == '#') continue;
+    bool quoted = false;
+    std::size_t end = line.size();
+    for (std::size_t i = first; i < line.size(); ++i) {
+      if (line[i] == '"' && (i == 0 || line[i - 1] != '\\')) quoted = !quoted;
+      if (line[i] == '#' && !quoted) {
+        end = i;
+        break;
+      }
+    }
+    std::string text = line.substr(0, end);
+    text.erase(text.find_last_not_of(' ') + 1);
+    const std::size_t colon = text.find(':');
+    if (colon == std::string::npos) continue;
+    if (first == 0) {
+      section = text.substr(0, colon);
+      continue;
+    }
+    std::string value = text.substr(colon + 1);
+    value.erase(0, value.find_first_not_of(' '));
+    keys[section + "." + text.substr(first, colon - first)] = value;
+  }
+  return keys;
+}
+
+// Every key of the table set to a value other than its default (valid
+// together: csv data with a path, explicit zone boundaries, ceres with bfgs, ...).
+constexpr const char* kEveryKeyNotAtItsDefault = R"(model:
+  length: 0.30000000000000004
+  section: 3.3333333333333335e-05
+  density: 7850.000000000001
+  modulus: 2.1e11
+  elements: 437
+  mass: lumped
+  zoning: boundaries
+  zone_count: 3
+  zone_boundaries: [0.1, 0.2]
+load:
+  kind: half_sine
+  amplitude: -12.5
+  duration: 6.666666666666667e-05
+time:
+  window: 1e-3
+  step: 1e-6
+  theta: 0.6
+data:
+  source: csv
+  path: "dir with spaces/quote\"s and \\ back: # x.csv"
+  truth: exact
+  truth_refinement: 64
+  snr: 2.5
+  seed: 18446744073709551615
+  sensors: [u@0.1, e@0.25]
+  channels: [fL, f0, uL, u@0.1, e@0.25]
+  truth_zones: [{start: 0.1, end: 0.15, modulus: 1.4e11}]
+mcre:
+  w_u: 0.3
+  w_f: 0.14285714285714285
+  w_e: 0.7
+  reference_modulus: 70e9
+inner:
+  method: adaptive_relaxation
+  tolerance: 1e-11
+  max_iterations: 123
+  omega: 0.7
+  spectrum_steps: 9
+  spectrum_safety_factor: 1.2
+  divergence_factor: 50
+  max_all_at_once_unknowns: 3000000000
+  max_all_at_once_bytes: 34359738369
+  max_field_bytes: 17179869184
+  max_dense_solver_bytes: 8589934592
+  shooting_condition_limit: 1e12
+  shooting_segment_growth: 1e3
+outer:
+  optimizer: ceres
+  algorithm: bfgs
+  lower_bound: 1e9
+  upper_bound: 1e12
+  initial: 33333333333.333332
+  relative_tolerance: 1e-9
+  max_evaluations: 167
+  max_time: 0.5
+  scan_points: 17
+  scan_tolerance: 3e-3
+  scan_threads: 3
+  refine_candidates: 4
+prefilter:
+  enabled: false
+  cutoff_frequency: 12345.5
+  order: 6
+uncertainty:
+  samples: 3
+  seed: 99
+output:
+  folder: "out dir/run #1"
+  figures: false
+  curve_points: 7
+study:
+  kind: cost_curves
+  folder: "studies/x"
+  threads: 3
+  figures: false
+  robustness_snr: [.inf, 0.3333333333333333, 2.5]
+  robustness_seeds: 7
+  relaxation_snr: [5]
+  relaxation_moduli: [0.30000000000000004]
+  omega_min: 0.01
+  omega_max: 0.2
+  omega_points: 5
+  relaxation_tolerance: 1e-6
+  cost_curve_snr: [20]
+  cost_curve_seeds: 2
+  cost_curve_points: 9
+  cost_curve_low: 0.7
+  cost_curve_high: 1.1428571428571428
+  damage_snr: [.inf, 15]
+  damage_seeds: 3
+zone_identification:
+  algorithm: ceres_lbfgs
+  step_tolerance: 1e-9
+  function_tolerance: 1e-11
+  max_evaluations: 321
+  max_time: 12.5
+  regularization: total_variation
+  regularization_weight: 0.25
+  tv_smoothing: 0.002
+  max_weight: 2
+  min_weight: 1e-7
+  grid_factor: 10
+  bisection_steps: 5
+  discrepancy_factor: 1.5
+  noise_samples: 6
+  noise_seed: 7
+)";
+
+TEST(ConfigTest, EveryKeyAtANonDefaultValueRoundTripsExactly) {
+  const Config config = ParseConfig(kEveryKeyNotAtItsDefault, "every_key.yaml");
+  const std::string yaml = ConfigToYaml(config);
+  const std::map<std::string, std::string> keys = FlatKeys(yaml);
+  const std::map<std::string, std::string> defaults = FlatKeys(ConfigToYaml(Config()));
+  // The resolved YAML holds every key of the commented default config, and every
+  // one of them differs from its default here: a key added to the table but
+  // left out of kEveryKeyNotAtItsDefault fails this test.
+  const std::map<std::string, std::string> documented = FlatKeys(DefaultConfigYaml());
+  ASSERT_EQ(documented.size(), defaults.size());
+  for (const auto& [key, value] : documented) {
+    ASSERT_EQ(keys.count(key), 1u) << key << " is not written by ConfigToYaml";
+    // load.kind has one value only (half_sine).
+    if (key == "load.kind") continue;
+    EXPECT_NE(keys.at(key), defaults.at(key)) << key << " is at its default";
+  }
+  EXPECT_EQ(keys.size(), documented.size());
+  // Read back: the same config, field by field and as text.
+  const Config again = ParseConfig(yaml, "resolved.yaml");
+  ExpectSameConfig(config, again);
+  EXPECT_EQ(ConfigToYaml(again), yaml);
 }
 
 TEST(ConfigTest, PaperBarConfigLoads) {

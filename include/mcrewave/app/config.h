@@ -8,13 +8,16 @@
 //
 // Sections and keys (defaults in brackets):
 //   model: length [1 m], section [1e-4 m^2], density [800 kg/m^3],
-//          modulus [200e9 Pa], elements [100], mass [consistent | lumped]
+//          modulus [200e9 Pa], elements [100], mass [consistent | lumped],
+//          zoning [equal | per_element | boundaries], zone_count [1],
+//          zone_boundaries [[] m] (ZoneLayout, bar_model.h)
 //   load:  kind [half_sine], amplitude [1000 N], duration [1e-4 s]
 //   time:  window [0.63e-3 s], step [0.36e-6 s], theta [0.5]
 //   data:  source [synthetic | csv], path [""], truth [finite_element | exact],
-//          truth_refinement [4], snr [.inf], seed [1]
-//   mcre:  w_u [0.01], w_f [1], reference_modulus [200e9 Pa] (E0 of the weights;
-//          objective.h)
+//          truth_refinement [4], snr [.inf], seed [1], sensors [[]: u@X, e@X],
+//          channels [[]: every channel], truth_zones [[]: {start, end, modulus}]
+//   mcre:  w_u [0.01], w_f [1], w_e [0.01], reference_modulus [200e9 Pa] (E0 of
+//          the weights; objective.h)
 //   inner: method [conjugate_gradient | all_at_once | relaxation | adaptive_relaxation
 //          | any other CoupledSolverType], tolerance [1e-8], max_iterations [5000],
 //          omega [0.5], spectrum_steps [12], spectrum_safety_factor [1.05],
@@ -35,14 +38,22 @@
 //          prefilter.h; applied to the measurements before the identification)
 //   uncertainty: samples [16], seed [1] (modulus_uncertainty.h)
 //   output: folder ["results/identify"], figures [true], curve_points [41]
-//   study: kind [all | robustness | relaxation | cost_curves], folder ["results"],
+//   study: kind [all | robustness | relaxation | cost_curves | damage], folder ["results"],
 //          threads [0: every core], figures [true], robustness_snr
 //          [[.inf, 20, 10, 5, 2.5]], robustness_seeds [100], relaxation_snr
 //          [[.inf, 10, 2.5]], relaxation_moduli [[0.8, 1, 1.2]], omega_min [0.005],
 //          omega_max [0.1], omega_points [20], relaxation_tolerance [1e-4],
 //          cost_curve_snr [[.inf, 10, 2.5]], cost_curve_seeds [3],
-//          cost_curve_points [41], cost_curve_low [0.8], cost_curve_high [1.2]
+//          cost_curve_points [41], cost_curve_low [0.8], cost_curve_high [1.2],
+//          damage_snr [[.inf, 20, 10, 5]], damage_seeds [20]
 //          (StudyOptions, study.h; used by `identify study` only)
+//   zone_identification: algorithm [nlopt_lbfgs], step_tolerance [1e-8],
+//          function_tolerance [1e-10], max_evaluations [2000], max_time [600 s],
+//          regularization [tikhonov | total_variation | none],
+//          regularization_weight [-1: discrepancy principle], tv_smoothing [1e-3],
+//          max_weight [1], min_weight [1e-8], grid_factor [100], bisection_steps [3],
+//          discrepancy_factor [1], noise_samples [4], noise_seed [1]
+//          (ZoneIdentificationOptions, zone_identification.h)
 #pragma once
 
 #include <string>
