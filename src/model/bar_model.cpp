@@ -275,4 +275,17 @@ double BarModel::WaveSpeed(double modulus) const {
   return std::sqrt(modulus / properties_.density);
 }
 
+SparseMatrix BarModel::ClampedBlock(const SparseMatrix& full) {
+  const int n = static_cast<int>(full.rows());
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int j = 1; j < n; ++j) {
+    for (SparseMatrix::InnerIterator it(full, j); it; ++it) {
+      if (it.row() >= 1) entries.emplace_back(it.row() - 1, j - 1, it.value());
+    }
+  }
+  SparseMatrix block(n - 1, n - 1);
+  block.setFromTriplets(entries.begin(), entries.end());
+  return block;
+}
+
 }  // namespace mcrewave

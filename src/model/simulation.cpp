@@ -13,20 +13,6 @@
 namespace mcrewave {
 namespace {
 
-// The rows and columns of the free nodes 1..N (node 0 is clamped).
-SparseMatrix FreeBlock(const SparseMatrix& full) {
-  const int n = static_cast<int>(full.rows());
-  std::vector<Eigen::Triplet<double>> entries;
-  for (int j = 1; j < n; ++j) {
-    for (SparseMatrix::InnerIterator it(full, j); it; ++it) {
-      if (it.row() >= 1) entries.emplace_back(it.row() - 1, j - 1, it.value());
-    }
-  }
-  SparseMatrix block(n - 1, n - 1);
-  block.setFromTriplets(entries.begin(), entries.end());
-  return block;
-}
-
 // Clamped simulation on `bar` with `steps_per_sample` steps of `time.step /
 // steps_per_sample` between two samples of the output grid t_k = k time.step.
 MeasurementSet SimulateClamped(const BarProperties& bar, const LoadOptions& load,
@@ -39,8 +25,8 @@ MeasurementSet SimulateClamped(const BarProperties& bar, const LoadOptions& load
   const SparseMatrix stiffness = zones.empty()
                                      ? model.Stiffness(bar.modulus)
                                      : model.StiffnessOfElements(ElementModuli(bar, zones));
-  const SparseMatrix free_mass = FreeBlock(model.mass());
-  const SparseMatrix free_stiffness = FreeBlock(stiffness);
+  const SparseMatrix free_mass = BarModel::ClampedBlock(model.mass());
+  const SparseMatrix free_stiffness = BarModel::ClampedBlock(stiffness);
   const int num_free = model.num_nodes() - 1;
   const int loaded = num_free - 1;  // node N in the free numbering
 

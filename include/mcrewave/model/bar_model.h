@@ -140,6 +140,10 @@ class BarModel {
   // Wave speed c = sqrt(E / rho) [m/s] for a given modulus.
   double WaveSpeed(double modulus) const;
 
+  // The rows and columns of the free nodes 1..N of a matrix over every node: the
+  // bar clamped at x = 0 (node 0 removed).
+  static SparseMatrix ClampedBlock(const SparseMatrix& full);
+
  private:
   BarProperties properties_;
   int num_zones_ = 1;

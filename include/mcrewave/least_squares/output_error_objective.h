@@ -1,0 +1,110 @@
+// Output-error least squares (finite-element model updating, FEMU): the comparator
+// practitioners use instead of the MCRE. The bar is clamped at x = 0 (the clamp
+// taken as rigid, u_0 = 0), driven at x = L by the measured force fL~, and its
+// predicted outputs are compared with the other measured channels:
+//
+//   J(E) = 1/2 sum_k c_k h [ sum_{u channels} (u_k - u~_k)^2 / s_u^2
+//                           + (f0_k - f0~_k)^2 / s_f^2
+//                           + sum_{e channels} (e_k - e~_k)^2 / s_e^2 ]      [s]
+//
+// (c_k the trapezoidal weights, 1/2 at both ends; s_u, s_f, s_e the noise levels
+// of each kind: the misfit normalised by the noise). The u channels are uL and the
+// interior displacement sensors u@X in use (u0 is zero in the model whatever E:
+// it does not enter); the e channels the strain gauges e@X; f0 the clamp reaction,
+// f0_k = row_0(M a_k + K u_k) with the accelerations of the free nodes from
+// M_r a_k = fL~_k e_N - K_r u_k (as model/simulation.h makes the synthetic f0).
+//
+// The model is the theta scheme of linalg/theta_integrator.h on the free nodes,
+//   M_r (v_{k+1} - v_k) = -h K_r (theta u_{k+1} + (1 - theta) u_k) + h f_theta,k,
+//   f_theta,k = (theta fL~_{k+1} + (1 - theta) fL~_k) e_N.
+// With K = E K1 (one modulus), its exact derivative s_k = du_k/dE obeys the same
+// scheme with the input -K1 (theta u_{k+1} + (1 - theta) u_k) = -K (...) / E:
+// one more sweep, run beside the first (forward sensitivity), gives
+//   dJ/dE = sum_k c_k h [ sum (u_k - u~_k) s_k / s_u^2 + (f0_k - f0~_k) df0_k / s_f^2 + ... ],
+//   df0_k = row_0(M da_k + K s_k + K u_k / E),  M_r da_k = -K_r s_k - K_r u_k / E.
+// Two sweeps per evaluation with the gradient, one without; no inner iteration.
+//
+// The cost seen by the optimisers is J / J_rest with J_rest = J of the bar at rest
+// (every prediction 0), and the gradient dJ/dx / J_rest with x = E / modulus_scale.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mcrewave/core/types.h"
+#include "mcrewave/data/measurement.h"
+#include "mcrewave/linalg/band_matrix.h"
+#include "mcrewave/linalg/theta_integrator.h"
+#include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/mcre/modulus_uncertainty.h"
+#include "mcrewave/mcre/objective.h"
+#include "mcrewave/model/bar_model.h"
+
+namespace mcrewave {
+
+// The outputs of the clamped model at one modulus, on the data's samples.
+struct OutputErrorPrediction {
+  double modulus = -1.0;        // E [Pa]
+  double cost = -1.0;           // J(E) [s] (misfits normalised by the noise levels)
+  double cost_gradient = 0.0;   // dJ/dE [s / Pa] (0 when not asked for)
+  Vector uL;                    // [m], one per sample
+  Vector f0;                    // [N], the clamp reaction
+  std::vector<Vector> sensors;  // per interior sensor of the data [m] or [-]
+};
+
+class OutputErrorObjective : public ModulusObjective {
+ public:
+  // Keeps references to model and data: both must outlive the objective. The
+  // model must have one zone. noise: the levels s_u, s_f, s_e of the misfit's
+  // normalisation (> 0 for every kind the data hold). ends: whether uL enters
+  // (ends.uL; u0 never does). theta in [0, 1], modulus_scale > 0 [Pa].
+  OutputErrorObjective(const BarModel& model, const MeasurementSet& data, const NoiseLevels& noise,
+                       double theta, double modulus_scale, EndDisplacementChannels ends = {});
+
+  double modulus_scale() const override { return modulus_scale_; }
+  // cost = J(E) / cost_scale(), gradient = dJ/dE modulus_scale / cost_scale() at
+  // E = x modulus_scale. False when x is not a positive finite number or J is not
+  // finite (the reason in error_message()).
+  bool Evaluate(const double* parameters, double* cost, double* gradient) override;
+  std::string error_message() const override { return error_message_; }
+  std::unique_ptr<ModulusObjective> CloneForScan(double inner_tolerance) const override;
+  long sweeps() const override { return sweeps_; }
+
+  // Simulates the clamped model at E [Pa] (> 0): predictions and J, and dJ/dE when
+  // gradient_requested. Re-initialises the integrator (E changes K).
+  const OutputErrorPrediction& Predict(double modulus, bool gradient_requested);
+
+  // J_rest [s]: J with every prediction 0; the cost scale (1 when J_rest = 0).
+  double rest_cost() const { return rest_cost_; }
+  double cost_scale() const { return rest_cost_ > 0.0 ? rest_cost_ : 1.0; }
+
+ private:
+  const BarModel& model_;
+  const MeasurementSet& data_;
+  NoiseLevels noise_;
+  double theta_;
+  double modulus_scale_;
+  EndDisplacementChannels ends_;
+
+  SparseMatrix free_mass_;
+  SparseMatrix free_stiffness_one_;          // K1 on the free nodes (K_r = E K1_r)
+  double mass_01_ = 0.0;                     // M(0, 1)
+  double stiffness_one_01_ = 0.0;            // K1(0, 1)
+  BandLdlt mass_factor_;                     // of M_r
+  std::vector<ObservationRow> sensor_rows_;  // the data's interior sensors on this mesh
+  std::vector<double> sensor_weights_;       // 1 / s^2 of each sensor's kind
+  ThetaIntegrator integrator_;
+
+  // Scratch of Predict, sized in the constructor.
+  Vector velocity_, displacement_, next_velocity_, next_displacement_;
+  Vector sensitivity_velocity_, sensitivity_, next_sensitivity_velocity_, next_sensitivity_;
+  Vector shift_, acceleration_, acceleration_sensitivity_, nodal_;
+
+  OutputErrorPrediction prediction_;
+  double rest_cost_ = 0.0;
+  long sweeps_ = 0;
+  std::string error_message_;
+};
+
+}  // namespace mcrewave

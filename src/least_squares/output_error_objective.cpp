@@ -1,0 +1,175 @@
+#include "mcrewave/least_squares/output_error_objective.h"
+
+#include <cassert>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace mcrewave {
+
+OutputErrorObjective::OutputErrorObjective(const BarModel& model, const MeasurementSet& data,
+                                           const NoiseLevels& noise, double theta,
+                                           double modulus_scale, EndDisplacementChannels ends)
+    : model_(model),
+      data_(data),
+      noise_(noise),
+      theta_(theta),
+      modulus_scale_(modulus_scale),
+      ends_(ends),
+      free_mass_(BarModel::ClampedBlock(model.mass())),
+      free_stiffness_one_(BarModel::ClampedBlock(model.unit_stiffness())),
+      mass_01_(model.mass().coeff(0, 1)),
+      stiffness_one_01_(model.unit_stiffness().coeff(0, 1)) {
+  assert(model.num_zones() == 1 && theta >= 0.0 && theta <= 1.0 && modulus_scale > 0.0);
+  assert(data.num_steps() >= 1 && noise.displacement_std > 0.0 && noise.force_std > 0.0);
+  if (!mass_factor_.Compute(SymmetricBandMatrix(free_mass_))) {
+    throw std::runtime_error("output-error model: the mass matrix is not positive definite");
+  }
+  for (const SensorChannel& sensor : data.sensors) {
+    const bool strain = sensor.kind == SensorKind::kStrain;
+    assert(!strain || noise.strain_std > 0.0);
+    sensor_rows_.push_back(strain ? model.StrainRow(sensor.position)
+                                  : model.DisplacementRow(sensor.position));
+    const double level = strain ? noise.strain_std : noise.displacement_std;
+    sensor_weights_.push_back(1.0 / (level * level));
+  }
+  const int free = model.num_nodes() - 1;
+  for (Vector* scratch :
+       {&velocity_, &displacement_, &next_velocity_, &next_displacement_, &sensitivity_velocity_,
+        &sensitivity_, &next_sensitivity_velocity_, &next_sensitivity_, &shift_, &acceleration_,
+        &acceleration_sensitivity_}) {
+    scratch->setZero(free);
+  }
+  nodal_.setZero(model.num_nodes());
+  const int samples = data.num_samples();
+  prediction_.uL.setZero(samples);
+  prediction_.f0.setZero(samples);
+  prediction_.sensors.assign(data.sensors.size(), Vector::Zero(samples));
+
+  // J_rest: every prediction 0.
+  const double h = data.time_step;
+  const double weight_u = 1.0 / (noise.displacement_std * noise.displacement_std);
+  const double weight_f = 1.0 / (noise.force_std * noise.force_std);
+  for (int k = 0; k < samples; ++k) {
+    // c_k h / 2 [uL~^2 / s_u^2 + f0~^2 / s_f^2 + sum sensors]
+    const double c = (k == 0 || k == samples - 1) ? 0.5 : 1.0;
+    double sum = weight_f * data.f0[k] * data.f0[k];
+    if (ends_.uL) sum += weight_u * data.uL[k] * data.uL[k];
+    for (std::size_t i = 0; i < data.sensors.size(); ++i) {
+      sum += sensor_weights_[i] * data.sensors[i].values[k] * data.sensors[i].values[k];
+    }
+    rest_cost_ += 0.5 * c * h * sum;
+  }
+}
+
+std::unique_ptr<ModulusObjective> OutputErrorObjective::CloneForScan(double) const {
+  return std::make_unique<OutputErrorObjective>(model_, data_, noise_, theta_, modulus_scale_,
+                                                ends_);
+}
+
+const OutputErrorPrediction& OutputErrorObjective::Predict(double modulus,
+                                                           bool gradient_requested) {
+  assert(modulus > 0.0 && std::isfinite(modulus));
+  ThetaIntegratorOptions options;
+  options.time_step = data_.time_step;
+  options.theta = theta_;
+  const SparseMatrix free_stiffness = modulus * free_stiffness_one_;
+  integrator_.Init(free_mass_, free_stiffness, options);
+
+  const int samples = data_.num_samples();
+  const int loaded = static_cast<int>(velocity_.size()) - 1;  // node N, free numbering
+  const double h = data_.time_step;
+  const double stiffness_01 = modulus * stiffness_one_01_;
+  const double weight_u = 1.0 / (noise_.displacement_std * noise_.displacement_std);
+  const double weight_f = 1.0 / (noise_.force_std * noise_.force_std);
+  velocity_.setZero();
+  displacement_.setZero();
+  sensitivity_velocity_.setZero();
+  sensitivity_.setZero();
+  double cost = 0.0, gradient = 0.0;
+  for (int k = 0; k < samples; ++k) {
+    if (k > 0) {
+      // f_theta = (theta fL~_k + (1 - theta) fL~_{k-1}) e_N on the step t_{k-1} -> t_k.
+      const double load = theta_ * data_.fL[k] + (1.0 - theta_) * data_.fL[k - 1];
+      integrator_.StepWithEndLoads(velocity_, displacement_, 0.0, load, next_velocity_,
+                                   next_displacement_);
+      if (gradient_requested) {
+        // ds: the same scheme with f_theta = -K z, z = (theta u_k + (1 - theta) u_{k-1}) / E.
+        shift_ = (theta_ * next_displacement_ + (1.0 - theta_) * displacement_) / modulus;
+        integrator_.StepWithEndLoads(sensitivity_velocity_, sensitivity_, shift_, 0.0, 0.0,
+                                     next_sensitivity_velocity_, next_sensitivity_);
+        sensitivity_velocity_.swap(next_sensitivity_velocity_);
+        sensitivity_.swap(next_sensitivity_);
+      }
+      velocity_.swap(next_velocity_);
+      displacement_.swap(next_displacement_);
+    }
+    // M_r a_k = fL~_k e_N - K_r u_k;  f0_k = M_01 a_1 + K_01 u_1 (free node 1 is index 0).
+    integrator_.stiffness().Multiply(displacement_, acceleration_);
+    acceleration_ = -acceleration_;
+    acceleration_[loaded] += data_.fL[k];
+    mass_factor_.SolveInPlace(acceleration_);
+    const double f0 = mass_01_ * acceleration_[0] + stiffness_01 * displacement_[0];
+    prediction_.uL[k] = displacement_[loaded];
+    prediction_.f0[k] = f0;
+    const double c = (k == 0 || k == samples - 1) ? 0.5 : 1.0;
+    const double residual_f = f0 - data_.f0[k];
+    const double residual_u = displacement_[loaded] - data_.uL[k];
+    // c_k h / 2 [(uL - uL~)^2 / s_u^2 + (f0 - f0~)^2 / s_f^2 + sensors]
+    double sum = weight_f * residual_f * residual_f;
+    if (ends_.uL) sum += weight_u * residual_u * residual_u;
+    if (!sensor_rows_.empty()) nodal_.tail(nodal_.size() - 1) = displacement_;
+    for (std::size_t i = 0; i < sensor_rows_.size(); ++i) {
+      const double predicted = sensor_rows_[i].Apply(nodal_.data());
+      prediction_.sensors[i][k] = predicted;
+      const double residual = predicted - data_.sensors[i].values[k];
+      sum += sensor_weights_[i] * residual * residual;
+    }
+    cost += 0.5 * c * h * sum;
+    if (gradient_requested) {
+      // M_r da_k = -K_r (s_k + u_k / E);  df0_k = M_01 da_1 + K_01 s_1 + K_01 u_1 / E.
+      shift_ = sensitivity_ + displacement_ / modulus;
+      integrator_.stiffness().Multiply(shift_, acceleration_sensitivity_);
+      acceleration_sensitivity_ = -acceleration_sensitivity_;
+      mass_factor_.SolveInPlace(acceleration_sensitivity_);
+      const double df0 = mass_01_ * acceleration_sensitivity_[0] + stiffness_01 * shift_[0];
+      // d/dE of the bracket above, times c_k h / 2.
+      double dsum = 2.0 * weight_f * residual_f * df0;
+      if (ends_.uL) dsum += 2.0 * weight_u * residual_u * sensitivity_[loaded];
+      if (!sensor_rows_.empty()) nodal_.tail(nodal_.size() - 1) = sensitivity_;
+      for (std::size_t i = 0; i < sensor_rows_.size(); ++i) {
+        const double residual = prediction_.sensors[i][k] - data_.sensors[i].values[k];
+        dsum += 2.0 * sensor_weights_[i] * residual * sensor_rows_[i].Apply(nodal_.data());
+      }
+      gradient += 0.5 * c * h * dsum;
+    }
+  }
+  sweeps_ += gradient_requested ? 2 : 1;
+  prediction_.modulus = modulus;
+  prediction_.cost = cost;
+  prediction_.cost_gradient = gradient_requested ? gradient : 0.0;
+  return prediction_;
+}
+
+bool OutputErrorObjective::Evaluate(const double* parameters, double* cost, double* gradient) {
+  const double modulus = parameters[0] * modulus_scale_;
+  if (!(std::isfinite(modulus) && modulus > 0.0)) {
+    std::ostringstream why;
+    why << "trial modulus " << modulus << " Pa is not a positive finite number";
+    error_message_ = why.str();
+    return false;
+  }
+  const OutputErrorPrediction& prediction = Predict(modulus, gradient != nullptr);
+  if (!std::isfinite(prediction.cost) || !std::isfinite(prediction.cost_gradient)) {
+    std::ostringstream why;
+    why << "the output-error misfit at E = " << modulus << " Pa is not finite";
+    error_message_ = why.str();
+    return false;
+  }
+  *cost = prediction.cost / cost_scale();
+  if (gradient != nullptr) gradient[0] = prediction.cost_gradient * modulus_scale_ / cost_scale();
+  error_message_.clear();
+  return true;
+}
+
+}  // namespace mcrewave
