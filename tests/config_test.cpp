@@ -70,6 +70,7 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.prefilter.enabled, actual.prefilter.enabled);
   EXPECT_EQ(expected.prefilter.cutoff_frequency, actual.prefilter.cutoff_frequency);
   EXPECT_EQ(expected.prefilter.order, actual.prefilter.order);
+  EXPECT_EQ(expected.prefilter.at_rest_before_start, actual.prefilter.at_rest_before_start);
   EXPECT_EQ(expected.uncertainty.samples, actual.uncertainty.samples);
   EXPECT_EQ(expected.uncertainty.seed, actual.uncertainty.seed);
   EXPECT_EQ(expected.output.folder, actual.output.folder);
@@ -419,6 +420,7 @@ prefilter:
   enabled: false
   cutoff_frequency: 12345.5
   order: 6
+  at_rest_before_start: false
 uncertainty:
   samples: 3
   seed: 99

@@ -128,7 +128,7 @@ void ExtendEdge(const double* x, int stride, int pad, int fit_count, double* ext
 
 }  // namespace
 
-Vector ZeroPhaseLowPass::Apply(const Vector& signal) const {
+Vector ZeroPhaseLowPass::Apply(const Vector& signal, bool at_rest_before_start) const {
   const int n = static_cast<int>(signal.size());
   if (n < 2) return signal;
   const int pad = std::min(pad_, n - 1);
@@ -137,7 +137,12 @@ Vector ZeroPhaseLowPass::Apply(const Vector& signal) const {
       std::clamp(static_cast<int>(std::ceil(sample_rate_ / cutoff_frequency_)), 4, n);
   std::vector<double> extended(n + 2 * pad);
   std::vector<double> edge(pad);
-  ExtendEdge(signal.data(), +1, pad, fit_count, edge.data());
+  if (at_rest_before_start) {
+    // x(-k) = 0: the rest state before t_0 (the sections then start at rest).
+    std::fill(edge.begin(), edge.end(), 0.0);
+  } else {
+    ExtendEdge(signal.data(), +1, pad, fit_count, edge.data());
+  }
   for (int k = 1; k <= pad; ++k) extended[pad - k] = edge[k - 1];
   for (int i = 0; i < n; ++i) extended[pad + i] = signal[i];
   ExtendEdge(signal.data() + n - 1, -1, pad, fit_count, edge.data());
@@ -203,11 +208,14 @@ MeasurementSet PrefilterMeasurements(const MeasurementSet& measurements,
   if (cutoff_used != nullptr) *cutoff_used = cutoff;
   const ZeroPhaseLowPass filter(cutoff, 1.0 / measurements.time_step, options.order);
   MeasurementSet filtered = measurements;
-  filtered.u0 = filter.Apply(measurements.u0);
-  filtered.uL = filter.Apply(measurements.uL);
-  filtered.f0 = filter.Apply(measurements.f0);
-  filtered.fL = filter.Apply(measurements.fL);
-  for (SensorChannel& sensor : filtered.sensors) sensor.values = filter.Apply(sensor.values);
+  const bool rest = options.at_rest_before_start;
+  filtered.u0 = filter.Apply(measurements.u0, rest);
+  filtered.uL = filter.Apply(measurements.uL, rest);
+  filtered.f0 = filter.Apply(measurements.f0, rest);
+  filtered.fL = filter.Apply(measurements.fL, rest);
+  for (SensorChannel& sensor : filtered.sensors) {
+    sensor.values = filter.Apply(sensor.values, rest);
+  }
   return filtered;
 }
 

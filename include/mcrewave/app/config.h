@@ -34,7 +34,8 @@
 //          scan_threads [2], refine_candidates [2] (IdentificationOptions,
 //          identification.h)
 //   prefilter: enabled [true], cutoff_frequency [0 Hz: derived from the data;
-//          else below the Nyquist frequency 0.5 / time.step], order [4] (PrefilterOptions,
+//          else below the Nyquist frequency 0.5 / time.step], order [4],
+//          at_rest_before_start [true] (PrefilterOptions,
 //          prefilter.h; applied to the measurements before the identification)
 //   uncertainty: samples [16], seed [1] (modulus_uncertainty.h)
 //   output: folder ["results/identify"], figures [true], curve_points [41]

@@ -14,7 +14,11 @@
 // period (plain odd reflection, as scipy's filtfilt, flips the curvature at the
 // junction and leaves a transient of 4e-3 of an 8 kHz sine at a 100 kHz cut-off;
 // with the cubic, 7e-4), and each section starts in its steady state for the first
-// padded sample.
+// padded sample. A record of a structure at rest before its first sample (the
+// shock load's experiment: every channel is 0 for t < t_0) is instead extended at
+// its start by those zeros, the filter starting at rest: the first samples' noise
+// is then averaged like any other sample's, where the reflection keeps it (it pins
+// the extension to x_0).
 #pragma once
 
 #include <string>
@@ -32,6 +36,9 @@ struct PrefilterOptions {
   // Cut-off frequency [Hz]; 0 derives it from the data (EstimateCutoffFrequency).
   double cutoff_frequency = 0.0;
   int order = 4;  // Butterworth order of one pass, even, 2..12
+  // Every channel is 0 before the first sample (the bar at rest until the load
+  // starts): the filter's start uses it (ZeroPhaseLowPass::Apply).
+  bool at_rest_before_start = true;
 
   bool IsValid(std::string* error) const;
 };
@@ -41,8 +48,10 @@ class ZeroPhaseLowPass {
   // Throws std::invalid_argument unless 0 < cutoff_frequency < sample_rate / 2 (the
   // Nyquist frequency) and order is even in [2, 12].
   ZeroPhaseLowPass(double cutoff_frequency, double sample_rate, int order);
-  // The filtered signal, same length. Signals shorter than 2 samples are returned as is.
-  Vector Apply(const Vector& signal) const;
+  // The filtered signal, same length. Signals shorter than 2 samples are returned as
+  // is. at_rest_before_start: the signal is 0 before its first sample (the start is
+  // extended by zeros, not by reflection).
+  Vector Apply(const Vector& signal, bool at_rest_before_start = false) const;
   // Magnitude of the zero-phase response |H(f)|^2 at frequency f [Hz].
   double Gain(double frequency) const;
 
