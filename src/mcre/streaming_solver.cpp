@@ -33,6 +33,12 @@ std::string Scientific(double value) {
 // O(delta): 1e-6 keeps them well inside what the identification resolves.
 constexpr double kMaxRebuildError = 1e-6;
 
+// When the true residual of the final pass misses the tolerance, CG restarts from
+// it at most this many times; after that, a true residual within
+// kRoundOffFloorFactor times the rebuild error is accepted (and said so).
+constexpr int kMaxRestarts = 2;
+constexpr double kRoundOffFloorFactor = 10.0;
+
 }  // namespace
 
 void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, McreProblem* problem,
@@ -46,28 +52,16 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
   const double rhs_norm = std::sqrt(std::max(problem->TraceInnerProduct(residual, residual), 0.0));
   summary->iterations = 0;
   McreProblem::StreamingTotals totals;
-  auto finish = [&](const std::string& message) {
-    // The final pass at y: the true residual Phi(y) - y and the sums of the fields.
+  // The final pass at y: the true residual Phi(y) - y = b - (I - L) y into `image`,
+  // its norm relative to ||b|| returned, and the sums of the fields in `totals`.
+  auto final_pass = [&]() {
     problem->StreamingMap(traces, true, &image, &totals);
     image -= traces;
-    const double relative =
-        rhs_norm > 0.0
-            ? std::sqrt(std::max(problem->TraceInnerProduct(image, image), 0.0)) / rhs_norm
-            : 0.0;
-    summary->relative_residual = relative;
-    if (!(totals.rebuild_error <= kMaxRebuildError)) {
-      summary->termination = TerminationType::kFailure;
-      summary->message = "the rebuilt retrograde field drifted: relative error " +
-                         Scientific(totals.rebuild_error) + " of omega at T (limit " +
-                         Scientific(kMaxRebuildError) + ")";
-      return;
-    }
-    if (!(relative <= std::max(options.tolerance, 1e-12))) {
-      summary->termination = TerminationType::kNoConvergence;
-      summary->message = "the true trace residual " + Scientific(relative) +
-                         " misses the tolerance " + Scientific(options.tolerance);
-      return;
-    }
+    return rhs_norm > 0.0
+               ? std::sqrt(std::max(problem->TraceInnerProduct(image, image), 0.0)) / rhs_norm
+               : 0.0;
+  };
+  auto accept = [&](const std::string& message) {
     summary->termination = TerminationType::kConvergence;
     summary->message = message + "; rebuild error " + Scientific(totals.rebuild_error);
     solution->cost = totals.cost;
@@ -78,11 +72,13 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
     solution->error_map = totals.error_map;
   };
   if (rhs_norm == 0.0) {
-    finish("the data are matched exactly: b = Phi(0) = 0");
+    final_pass();
+    accept("the data are matched exactly: b = Phi(0) = 0");
     return;
   }
   direction = residual;
   double rho = problem->TraceInnerProduct(residual, residual);
+  int restarts = 0;
   for (int iteration = 0;; ++iteration) {
     const double relative = std::sqrt(std::max(rho, 0.0)) / rhs_norm;
     if (!std::isfinite(relative)) {
@@ -97,9 +93,43 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
     summary->relative_residual = relative;
     summary->iterations = iteration;
     if (relative <= options.tolerance) {
-      finish("relative trace residual " + Scientific(relative) + " <= tolerance " +
-             Scientific(options.tolerance));
-      return;
+      const double true_relative = final_pass();
+      summary->relative_residual = true_relative;
+      if (!(totals.rebuild_error <= kMaxRebuildError)) {
+        summary->termination = TerminationType::kFailure;
+        summary->message = "the rebuilt retrograde field drifted: relative error " +
+                           Scientific(totals.rebuild_error) + " of omega at T (limit " +
+                           Scientific(kMaxRebuildError) + ")";
+        return;
+      }
+      // The rebuild's round-off is a floor under the true residual: Phi itself is
+      // known to about rebuild_error (1.1e-8 measured on 1e5 elements at Courant
+      // number 570, where a tolerance of 1e-8 cannot be met).
+      const double floor = kRoundOffFloorFactor * totals.rebuild_error;
+      if (true_relative <= options.tolerance) {
+        accept("relative trace residual " + Scientific(true_relative) + " <= tolerance " +
+               Scientific(options.tolerance));
+        return;
+      }
+      if (restarts == kMaxRestarts && true_relative <= floor) {
+        accept("relative trace residual " + Scientific(true_relative) + " at the round-off floor " +
+               Scientific(floor) + " of the rebuilt field (tolerance " +
+               Scientific(options.tolerance) + ")");
+        return;
+      }
+      if (restarts == kMaxRestarts) {
+        summary->termination = TerminationType::kNoConvergence;
+        summary->message = "the true trace residual " + Scientific(true_relative) +
+                           " misses the tolerance " + Scientific(options.tolerance) + " after " +
+                           std::to_string(restarts) + " restarts";
+        return;
+      }
+      // Restart from the true residual: the recursive one drifted from it.
+      ++restarts;
+      residual = image;
+      direction = residual;
+      rho = problem->TraceInnerProduct(residual, residual);
+      continue;
     }
     if (iteration == options.max_iterations) {
       summary->termination = TerminationType::kNoConvergence;
