@@ -296,7 +296,7 @@ TEST(CostCurveTest, InverseCrimeDataHaveTheirMinimumAtTheReferenceModulus) {
   EXPECT_EQ(best, 20) << "minimum of the 41-point curve at E = " << 0.5 + best * 0.025 << " E_ref";
 }
 
-TEST(CostCurveTest, ExactSolutionDataIdentifyTheModulusWithinOnePercent) {
+TEST(CostCurveTest, ExactSolutionDataIdentifyTheModulusToItsDiscretisationBias) {
   // The paper's case at 100 elements, noise-free data from the exact
   // solution: the minimiser of e^2, found by golden-section search, is the
   // discretisation bias only.
@@ -315,7 +315,7 @@ TEST(CostCurveTest, ExactSolutionDataIdentifyTheModulusWithinOnePercent) {
   double a = 0.9, b = 1.1;
   double x1 = b - golden * (b - a), x2 = a + golden * (b - a);
   double f1 = cost(x1), f2 = cost(x2);
-  while (b - a > 1e-4) {
+  while (b - a > 1e-6) {
     if (f1 < f2) {
       b = x2, x2 = x1, f2 = f1, x1 = b - golden * (b - a), f1 = cost(x1);
     } else {
@@ -324,8 +324,8 @@ TEST(CostCurveTest, ExactSolutionDataIdentifyTheModulusWithinOnePercent) {
   }
   const double identified = 0.5 * (a + b);
   RecordProperty("identified_over_reference", std::to_string(identified));
-  std::cout << "exact-solution data, paper's case: E / E_ref = " << identified << "\n";
-  EXPECT_NEAR(identified, 1.0, 0.01);
+  // Measured E / E_ref - 1 = -5.70e-6 (the search resolves 5e-7).
+  EXPECT_NEAR(identified, 1.0, 3e-5);
 }
 
 class GradientTest : public ::testing::TestWithParam<double> {};

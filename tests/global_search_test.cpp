@@ -165,6 +165,7 @@ double NoiseFreeError(bool prefilter_enabled, double* cutoff) {
 }
 
 TEST(GlobalSearchTest, NoiseFreeDataFromTheFinerTruthGiveEWithinATenthOfAPercent) {
+  // The discretisation bias of 30 elements against the 4x finer truth: measured -2.51e-4.
   double cutoff = 0.0;
   EXPECT_LE(std::abs(NoiseFreeError(false, &cutoff)), 1e-3);
 }
@@ -174,8 +175,10 @@ TEST(GlobalSearchTest, PrefilterDoesNotBiasNoiseFreeIdentification) {
   const double filtered = NoiseFreeError(true, &cutoff);
   EXPECT_GT(cutoff, 0.0);
   EXPECT_LE(std::abs(filtered), 1e-3);
+  // The pre-filter's own bias: measured 5.1e-8 (filtered -2.50965e-4, unfiltered
+  // -2.51016e-4).
   double unused = 0.0;
-  EXPECT_LE(std::abs(filtered - NoiseFreeError(false, &unused)), 1e-3);
+  EXPECT_LE(std::abs(filtered - NoiseFreeError(false, &unused)), 5e-7);
 }
 
 }  // namespace
