@@ -119,21 +119,5 @@ TEST(McreProblemTest, ConsistentDataGiveZeroCostAtZeroRetrogradeField) {
   EXPECT_EQ(problem.sweep_count(), 2);
 }
 
-TEST(McreProblemTest, CostGradientFormulaMatchesModulusDerivativeOfLagrangianTerms) {
-  // de^2/dE = -(1/2) sum_j c_j h W_j^T K1 (W_j + 2 U_j): check it against a direct
-  // evaluation with dense matrices for random fields.
-  ProblemBundle bundle(MakeSmallCase(6, 10, 5.0, 1), Weights(1.0, 1.0));
-  McreProblem& problem = bundle.problem;
-  const Matrix u = RandomField(problem, 3), w = RandomField(problem, 4);
-  const Eigen::MatrixXd k1 = Eigen::MatrixXd(bundle.model.unit_stiffness());
-  double expected = 0.0;
-  for (int j = 0; j <= problem.num_steps(); ++j) {
-    expected += problem.QuadratureWeight(j) * problem.time_step() *
-                w.col(j).dot(k1 * (w.col(j) + 2.0 * u.col(j)));
-  }
-  expected *= -0.5;
-  EXPECT_NEAR(problem.CostGradient(u, w), expected, 1e-12 * std::abs(expected));
-}
-
 }  // namespace
 }  // namespace mcrewave
