@@ -1,9 +1,16 @@
 // Tests of the multiply-accumulate counts: the kernel formulas against their
-// closed forms, and the Riccati solver's count against its loop structure
-// (exactly affine in the number of steps, about 6.3 n^3 per step).
+// closed forms and against reference kernels that count what they execute, and
+// the Riccati solver's count against its loop structure (exactly affine in the
+// number of steps, about 6.3 n^3 per step).
 #include "mcrewave/core/operation_counts.h"
 
 #include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <vector>
 
 #include "mcrewave/mcre/coupled_solver.h"
 #include "test_problems.h"
@@ -51,6 +58,172 @@ TEST(OperationCountsTest, RiccatiCountIsAffineInTheStepsWithSixAndAThirdNCubedPe
   // 6.33 n^3 of dense work and O(n^2) band work on the columns (about 112 n^2).
   EXPECT_GT(per_step, 6.33 * cube);
   EXPECT_LT(per_step, 6.34 * cube + 130.0 * n * n);
+}
+
+}  // namespace
+}  // namespace mcrewave
+
+namespace mcrewave {
+namespace {
+
+// Reference kernels written out loop by loop with a counter: each multiplication
+// or division is one MAC, as in operation_counts.h. They compute real results
+// (checked against Eigen) and their counts must equal the closed forms for every
+// size: a wrong formula fails here.
+struct Counter {
+  long macs = 0;
+  double Multiply(double a, double b) {
+    ++macs;
+    return a * b;
+  }
+  double Divide(double a, double b) {
+    ++macs;
+    return a / b;
+  }
+};
+
+// A random symmetric positive definite n x n matrix of half bandwidth p.
+Eigen::MatrixXd RandomBand(int n, int p, unsigned seed) {
+  std::srand(seed);
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 1; j <= std::min(n - 1, i + p); ++j) {
+      a(i, j) = a(j, i) = std::rand() / (2.0 * RAND_MAX) - 0.25;
+    }
+    a(i, i) = 2.0 * p + 1.0;
+  }
+  return a;
+}
+
+Eigen::VectorXd CountedBandProduct(const Eigen::MatrixXd& a, int p, const Eigen::VectorXd& x,
+                                   Counter* counter) {
+  const int n = static_cast<int>(a.rows());
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(n);
+  for (int i = 0; i < n; ++i) {
+    for (int j = std::max(0, i - p); j <= std::min(n - 1, i + p); ++j) {
+      y[i] += counter->Multiply(a(i, j), x[j]);
+    }
+  }
+  return y;
+}
+
+// x = A^-1 b with A = L D L^T (L unit lower of half bandwidth p): forward, scaling,
+// backward; only the solve is counted.
+Eigen::VectorXd CountedBandSolve(const Eigen::MatrixXd& a, int p, const Eigen::VectorXd& b,
+                                 Counter* counter) {
+  const int n = static_cast<int>(a.rows());
+  Eigen::MatrixXd lower = Eigen::MatrixXd::Identity(n, n);
+  Eigen::VectorXd diagonal(n);
+  for (int j = 0; j < n; ++j) {
+    double d = a(j, j);
+    for (int k = std::max(0, j - p); k < j; ++k) d -= lower(j, k) * lower(j, k) * diagonal[k];
+    diagonal[j] = d;
+    for (int i = j + 1; i <= std::min(n - 1, j + p); ++i) {
+      double s = a(i, j);
+      for (int k = std::max(0, i - p); k < j; ++k) s -= lower(i, k) * lower(j, k) * diagonal[k];
+      lower(i, j) = s / d;
+    }
+  }
+  Eigen::VectorXd x = b;
+  for (int i = 0; i < n; ++i) {
+    for (int k = std::max(0, i - p); k < i; ++k) x[i] -= counter->Multiply(lower(i, k), x[k]);
+  }
+  for (int i = 0; i < n; ++i) x[i] = counter->Divide(x[i], diagonal[i]);
+  for (int i = n - 1; i >= 0; --i) {
+    for (int k = i + 1; k <= std::min(n - 1, i + p); ++k) {
+      x[i] -= counter->Multiply(lower(k, i), x[k]);
+    }
+  }
+  return x;
+}
+
+TEST(OperationCountsTest, BandKernelsCountedOnRealProductsAndSolves) {
+  for (const int n : {1, 2, 5, 9}) {
+    for (const int p : {1, 2, 3}) {
+      if (p >= n && n > 1) continue;
+      const Eigen::MatrixXd a = RandomBand(n, p, 10 * n + p);
+      const Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(n, 1.0, 2.0);
+      Counter product;
+      EXPECT_LT((CountedBandProduct(a, p, x, &product) - a * x).norm(), 1e-13 * (a * x).norm());
+      EXPECT_EQ(product.macs, counts::BandProduct(n, std::min(p, n - 1))) << n << ", " << p;
+      Counter solve;
+      const Eigen::VectorXd solved = CountedBandSolve(a, p, x, &solve);
+      EXPECT_LT((a * solved - x).norm(), 1e-13 * x.norm());
+      EXPECT_EQ(solve.macs, counts::BandSolve(n, std::min(p, n - 1))) << n << ", " << p;
+    }
+  }
+}
+
+TEST(OperationCountsTest, DenseKernelsCountedOnRealFactorisations) {
+  for (const int size : {1, 2, 3, 6, 11}) {
+    const Eigen::MatrixXd a =
+        Eigen::MatrixXd::Random(size, size) + size * Eigen::MatrixXd::Identity(size, size);
+    // LU with partial pivoting (Doolittle, in place): the multipliers and the
+    // rank-one updates.
+    Counter factorisation;
+    Eigen::MatrixXd lu = a;
+    std::vector<int> pivots(size);
+    for (int k = 0; k < size; ++k) {
+      int pivot = k;
+      for (int i = k + 1; i < size; ++i) {
+        if (std::abs(lu(i, k)) > std::abs(lu(pivot, k))) pivot = i;
+      }
+      lu.row(k).swap(lu.row(pivot));
+      pivots[k] = pivot;
+      for (int i = k + 1; i < size; ++i) {
+        lu(i, k) = factorisation.Divide(lu(i, k), lu(k, k));
+        for (int j = k + 1; j < size; ++j) lu(i, j) -= factorisation.Multiply(lu(i, k), lu(k, j));
+      }
+    }
+    EXPECT_EQ(factorisation.macs, counts::LuFactorization(size)) << size;
+    // One right-hand side: forward with the unit lower factor, backward with U.
+    Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(size, -1.0, 1.0), x = b;
+    for (int k = 0; k < size; ++k) std::swap(x[k], x[pivots[k]]);
+    Counter substitution;
+    for (int i = 0; i < size; ++i) {
+      for (int j = 0; j < i; ++j) x[i] -= substitution.Multiply(lu(i, j), x[j]);
+    }
+    const long forward = substitution.macs;
+    for (int i = size - 1; i >= 0; --i) {
+      for (int j = i + 1; j < size; ++j) x[i] -= substitution.Multiply(lu(i, j), x[j]);
+      x[i] = substitution.Divide(x[i], lu(i, i));
+    }
+    EXPECT_LT((a * x - b).norm(), 1e-12 * b.norm());
+    EXPECT_EQ(substitution.macs, counts::LuSolve(size, 1)) << size;
+    EXPECT_EQ(substitution.macs - forward, counts::TriangularSolve(size, 1)) << size;
+
+    // Householder QR of a (size + 3) x size matrix, R only: per reflector the norm of
+    // its column, then a dot product and an update per column to its right.
+    const int rows = size + 3;
+    Eigen::MatrixXd r = Eigen::MatrixXd::Random(rows, size);
+    const Eigen::MatrixXd original = r;
+    Counter qr;
+    for (int k = 0; k < size; ++k) {
+      double norm2 = 0.0;
+      for (int i = k; i < rows; ++i) norm2 += qr.Multiply(r(i, k), r(i, k));
+      Eigen::VectorXd v = r.col(k).tail(rows - k);
+      v[0] += (v[0] >= 0.0 ? 1.0 : -1.0) * std::sqrt(norm2);
+      // |v|^2 = 2 (|x|^2 + |x_0| |x|): O(1), not counted (as the closed form).
+      const double vv = 2.0 * (norm2 + std::abs(r(k, k)) * std::sqrt(norm2));
+      for (int j = k; j < size; ++j) {
+        if (j == k) {
+          r(k, k) = -(r(k, k) >= 0.0 ? 1.0 : -1.0) * std::sqrt(norm2);
+          r.col(k).tail(rows - k - 1).setZero();
+          continue;
+        }
+        double dot = 0.0;
+        for (int i = k; i < rows; ++i) dot += qr.Multiply(v[i - k], r(i, j));
+        const double factor = 2.0 * dot / vv;
+        for (int i = k; i < rows; ++i) r(i, j) -= qr.Multiply(factor, v[i - k]);
+      }
+    }
+    EXPECT_EQ(qr.macs, counts::HouseholderQr(rows, size)) << size;
+    // R^T R = A^T A.
+    const Eigen::MatrixXd upper = r.topRows(size).triangularView<Eigen::Upper>();
+    EXPECT_LT((upper.transpose() * upper - original.transpose() * original).norm(),
+              1e-12 * (original.transpose() * original).norm())
+        << size;
+  }
 }
 
 }  // namespace
