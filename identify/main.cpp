@@ -14,7 +14,8 @@
 //   identify simulate configs/paper_bar.yaml --set model.elements=400 --output fine.csv
 //   identify study configs/studies.yaml --output results
 //   identify study configs/studies.yaml --set study.kind=robustness --set study.robustness_seeds=10
-//   identify --print-default-config > my_config.yaml
+//   identify study configs/paper_bar.yaml --set study.kind=comparator --set
+//   study.comparator_seeds=30 identify --print-default-config > my_config.yaml
 //
 // Description:
 //   `run` reads a YAML config, gets the measurements (synthetic, or the CSV file
@@ -59,6 +60,7 @@
 #include <utility>
 #include <vector>
 
+#include "mcrewave/app/comparator_study.h"
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/damage_study.h"
 #include "mcrewave/app/identification_run.h"
@@ -290,6 +292,11 @@ int RunStudy(const StudyArguments& arguments) {
     const mcrewave::DamageStudy study = mcrewave::RunDamageStudy(config);
     const ResultsBeingWritten held;
     mcrewave::WriteDamageResults(study, folder + "/damage", figures);
+  }
+  if (mcrewave::StudySelected(kind, mcrewave::StudyKind::kComparator)) {
+    const mcrewave::ComparatorStudy study = mcrewave::RunComparatorStudy(config);
+    const ResultsBeingWritten held;
+    mcrewave::WriteComparatorResults(study, folder + "/comparator", figures);
   }
 
   // 3. The README gathering the studies' summaries.

@@ -95,6 +95,9 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.study.cost_curve_high, actual.study.cost_curve_high);
   EXPECT_EQ(expected.study.damage_snr, actual.study.damage_snr);
   EXPECT_EQ(expected.study.damage_seeds, actual.study.damage_seeds);
+  EXPECT_EQ(expected.study.comparator_snr, actual.study.comparator_snr);
+  EXPECT_EQ(expected.study.comparator_seeds, actual.study.comparator_seeds);
+  EXPECT_EQ(expected.study.comparator_errors, actual.study.comparator_errors);
   EXPECT_EQ(expected.zones.zoning, actual.zones.zoning);
   EXPECT_EQ(expected.zones.zone_count, actual.zones.zone_count);
   EXPECT_EQ(expected.zones.zone_boundaries, actual.zones.zone_boundaries);
@@ -448,6 +451,9 @@ study:
   cost_curve_high: 1.1428571428571428
   damage_snr: [.inf, 15]
   damage_seeds: 3
+  comparator_snr: [.inf, 7]
+  comparator_seeds: 4
+  comparator_errors: [density, soft_zone]
 zone_identification:
   algorithm: ceres_lbfgs
   step_tolerance: 1e-9

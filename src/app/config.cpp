@@ -525,9 +525,10 @@ const std::vector<Key>& KeyTable() {
       MakeKey("output.curve_points", &Config::output, &OutputOptions::curve_points,
               PositiveInteger<int>(), "", "points of the cost curve e^2(E), in [5, 1000]"),
       MakeKey("study.kind", &Config::study, &StudyOptions::kind,
-              EnumByName<StudyKind>({StudyKind::kRobustness, StudyKind::kRelaxation,
-                                     StudyKind::kCostCurves, StudyKind::kAll, StudyKind::kDamage},
-                                    StudyKindToString, StringToStudyKind),
+              EnumByName<StudyKind>(
+                  {StudyKind::kRobustness, StudyKind::kRelaxation, StudyKind::kCostCurves,
+                   StudyKind::kAll, StudyKind::kDamage, StudyKind::kComparator},
+                  StudyKindToString, StringToStudyKind),
               "", "which study `identify study` runs (study.h)"),
       MakeKey("study.folder", &Config::study, &StudyOptions::folder, Text(), "",
               "results folder of identify study (a subfolder per study), relative to the "
@@ -568,6 +569,14 @@ const std::vector<Key>& KeyTable() {
               PositiveInteger<int>(), "",
               "damage localisation: noise seeds of the soft zone at SNR 10 (interior sensors, "
               "10 zones)"),
+      MakeKey("study.comparator_snr", &Config::study, &StudyOptions::comparator_snr, NumberList(),
+              "", "MCRE against least squares: SNRs (.inf: no noise)"),
+      MakeKey("study.comparator_seeds", &Config::study, &StudyOptions::comparator_seeds,
+              PositiveInteger<int>(), "", "MCRE against least squares: noise seeds per SNR"),
+      MakeKey("study.comparator_errors", &Config::study, &StudyOptions::comparator_errors,
+              TextList(), "",
+              "MCRE against least squares: model errors (none, density, force_gain, "
+              "displacement_gain, soft_zone)"),
       MakeKey("zone_identification.algorithm", &Config::zone_identification,
               &ZoneIdentificationOptions::minimizer, &BoundedMinimizerOptions::algorithm,
               EnumByName<BoundedAlgorithm>(

@@ -18,6 +18,7 @@
 #include <utility>
 
 #include "app/study_internal.h"
+#include "mcrewave/app/comparator_study.h"
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/core/file_util.h"
@@ -222,13 +223,16 @@ const char* StudyKindToString(StudyKind kind) {
       return "all";
     case StudyKind::kDamage:
       return "damage";
+    case StudyKind::kComparator:
+      return "comparator";
   }
   return "unknown";
 }
 
 bool StringToStudyKind(const std::string& name, StudyKind* kind) {
-  for (StudyKind candidate : {StudyKind::kRobustness, StudyKind::kRelaxation,
-                              StudyKind::kCostCurves, StudyKind::kAll, StudyKind::kDamage}) {
+  for (StudyKind candidate :
+       {StudyKind::kRobustness, StudyKind::kRelaxation, StudyKind::kCostCurves, StudyKind::kAll,
+        StudyKind::kDamage, StudyKind::kComparator}) {
     if (name == StudyKindToString(candidate)) {
       *kind = candidate;
       return true;
@@ -238,7 +242,9 @@ bool StringToStudyKind(const std::string& name, StudyKind* kind) {
 }
 
 bool StudySelected(StudyKind kind, StudyKind part) {
-  return (kind == StudyKind::kAll && part != StudyKind::kDamage) || kind == part;
+  return (kind == StudyKind::kAll && part != StudyKind::kDamage &&
+          part != StudyKind::kComparator) ||
+         kind == part;
 }
 
 bool StudyOptions::IsValid(std::string* error) const {
@@ -288,6 +294,17 @@ bool StudyOptions::IsValid(std::string* error) const {
   } else if (!check_snr(damage_snr, "study.damage_snr")) {
   } else if (!(damage_seeds >= 1 && damage_seeds <= 1000)) {
     why << "study.damage_seeds must lie in [1, 1000], got " << damage_seeds;
+  } else if (!check_snr(comparator_snr, "study.comparator_snr")) {
+  } else if (!(comparator_seeds >= 1 && comparator_seeds <= 100000)) {
+    why << "study.comparator_seeds must lie in [1, 100000], got " << comparator_seeds;
+  } else if (comparator_errors.empty() ||
+             std::any_of(comparator_errors.begin(), comparator_errors.end(),
+                         [](const std::string& name) {
+                           const std::vector<std::string>& known = ComparatorModelErrors();
+                           return std::find(known.begin(), known.end(), name) == known.end();
+                         })) {
+    why << "study.comparator_errors must hold model errors among none, density, force_gain, "
+           "displacement_gain, soft_zone";
   } else {
     return true;
   }
@@ -1019,7 +1036,7 @@ std::string WriteStudiesReadme(const std::string& folder) {
         "and this file: the studies of configs/studies.yaml, then the robustness settings, the "
         "complexity and the weights studies of bench/); do not edit by hand. Each section below "
         "is the `summary.md` of its folder.\n\n";
-  for (const char* study : {"robustness", "relaxation", "cost_curves", "damage",
+  for (const char* study : {"robustness", "relaxation", "cost_curves", "damage", "comparator",
                             "robustness_settings", "complexity", "weights"}) {
     const std::string summary = folder + "/" + study + "/summary.md";
     std::ifstream file(summary);

@@ -39,14 +39,17 @@
 //          prefilter.h; applied to the measurements before the identification)
 //   uncertainty: samples [16], seed [1] (modulus_uncertainty.h)
 //   output: folder ["results/identify"], figures [true], curve_points [41]
-//   study: kind [all | robustness | relaxation | cost_curves | damage], folder ["results"],
+//   study: kind [all | robustness | relaxation | cost_curves | damage | comparator],
+//          folder ["results"],
 //          threads [0: every core], figures [true], robustness_snr
 //          [[.inf, 20, 10, 5, 2.5]], robustness_seeds [100], relaxation_snr
 //          [[.inf, 10, 2.5]], relaxation_moduli [[0.8, 1, 1.2]], omega_min [0.005],
 //          omega_max [0.1], omega_points [20], relaxation_tolerance [1e-4],
 //          cost_curve_snr [[.inf, 10, 2.5]], cost_curve_seeds [3],
 //          cost_curve_points [41], cost_curve_low [0.8], cost_curve_high [1.2],
-//          damage_snr [[.inf, 20, 10, 5]], damage_seeds [20]
+//          damage_snr [[.inf, 20, 10, 5]], damage_seeds [20], comparator_snr
+//          [[20, 10, 5, 2.5]], comparator_seeds [100], comparator_errors [[none,
+//          density, force_gain, displacement_gain, soft_zone]]
 //          (StudyOptions, study.h; used by `identify study` only)
 //   zone_identification: algorithm [nlopt_lbfgs], step_tolerance [1e-8],
 //          function_tolerance [1e-10], max_evaluations [2000], max_time [600 s],

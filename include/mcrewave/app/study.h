@@ -56,8 +56,9 @@ enum class StudyKind {
   kRobustness,
   kRelaxation,
   kCostCurves,
-  kAll,     // the three above
-  kDamage,  // damage localisation with zones and sensors (damage_study.h); not in kAll
+  kAll,         // the three above
+  kDamage,      // damage localisation with zones and sensors (damage_study.h); not in kAll
+  kComparator,  // MCRE against output-error least squares (comparator_study.h); not in kAll
 };
 const char* StudyKindToString(StudyKind kind);
 bool StringToStudyKind(const std::string& name, StudyKind* kind);
@@ -98,6 +99,13 @@ struct StudyOptions {
   // Damage localisation (damage_study.h): SNRs of the grid and seeds of the SNR-10 runs.
   std::vector<double> damage_snr = {std::numeric_limits<double>::infinity(), 20.0, 10.0, 5.0};
   int damage_seeds = 20;
+
+  // MCRE against least squares (comparator_study.h): SNRs, seeds per finite SNR and
+  // the model errors (ComparatorModelErrors()).
+  std::vector<double> comparator_snr = {20.0, 10.0, 5.0, 2.5};
+  int comparator_seeds = 100;
+  std::vector<std::string> comparator_errors = {"none", "density", "force_gain",
+                                                "displacement_gain", "soft_zone"};
 
   // Valid when folder is not empty, threads in [0, 256], every SNR > 0 (.inf
   // allowed), lists not empty (at most 100 values), seeds in [1, 100000],

@@ -1,0 +1,87 @@
+// The comparator study (`identify study --set study.kind=comparator`): the MCRE and
+// output-error least squares (least_squares/output_error_objective.h) identify E from
+// the same data, with the same global scan, optimiser and bounds (outer:), with and
+// without the pre-filter, over noise seeds, on the config's case as it is ("none")
+// and with the model errors real tests have:
+//
+//   density            the identification's model 3 % denser than the bar measured
+//   force_gain         the measured load fL 5 % too high (a force sensor's gain)
+//   displacement_gain  the measured uL 3 % too high (a displacement sensor's gain)
+//   soft_zone          the bar 10 % softer over [0, 0.1 L] (by the clamp), the model
+//                      uniform
+//
+// Least squares weighs each channel by 1 / s^2 with s = RMS(measured channel) / SNR
+// (at SNR inf the RMS alone: only the ratio of the weights matters). Every run
+// is seeded, its scans on one thread: the study's numbers do not depend on
+// study.threads.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace mcrewave {
+
+struct Config;
+
+// The names of the model errors above, in this order.
+const std::vector<std::string>& ComparatorModelErrors();
+
+struct ComparatorRun {
+  std::string model_error;  // one of ComparatorModelErrors()
+  double snr = 0.0;
+  std::uint64_t seed = 0;  // 0 at SNR inf
+  bool prefilter = false;
+  bool least_squares = false;  // else MCRE
+  bool converged = false;
+  std::string message;  // the outer loop's, when not converged
+  double modulus = std::numeric_limits<double>::quiet_NaN();  // identified E [Pa]
+  double error = std::numeric_limits<double>::quiet_NaN();    // E / E_ref - 1
+  int local_minima = 0;                                       // of the global scan
+  int evaluations = 0;                                        // scan and refinement
+  double wall_time_s = std::numeric_limits<double>::quiet_NaN();
+};
+
+// Over the converged runs of one (model error, functional, pre-filter, SNR).
+struct ComparatorStatistics {
+  std::string model_error;
+  bool least_squares = false;
+  bool prefilter = false;
+  double snr = 0.0;
+  int runs = 0;
+  double converged_share = 0.0;
+  double mean_error = std::numeric_limits<double>::quiet_NaN();  // the bias
+  double std_error = std::numeric_limits<double>::quiet_NaN();
+  double rms_error = std::numeric_limits<double>::quiet_NaN();
+  double quantile_025 = std::numeric_limits<double>::quiet_NaN();
+  double quantile_975 = std::numeric_limits<double>::quiet_NaN();
+  double within_2_percent = std::numeric_limits<double>::quiet_NaN();  // share of the runs
+  double one_valley = std::numeric_limits<double>::quiet_NaN();        // share with 1 minimum
+  double mean_local_minima = std::numeric_limits<double>::quiet_NaN();
+  double mean_evaluations = std::numeric_limits<double>::quiet_NaN();
+  double mean_wall_time_s = std::numeric_limits<double>::quiet_NaN();
+};
+
+struct ComparatorStudy {
+  double reference_modulus = 0.0;         // E_ref [Pa]
+  std::vector<std::string> model_errors;  // study.comparator_errors
+  std::vector<double> snrs;               // study.comparator_snr
+  std::vector<ComparatorRun> runs;
+  std::vector<ComparatorStatistics> statistics;
+  int threads = 0;
+  double wall_time_s = 0.0;
+};
+
+// Runs study.comparator_errors x study.comparator_snr x seeds (1..comparator_seeds
+// per finite SNR, one run at SNR inf) x {no pre-filter, pre-filter} x {MCRE, least
+// squares} on the config's case, on study.threads threads, with a progress line per
+// data set. Precondition: config valid.
+ComparatorStudy RunComparatorStudy(const Config& config);
+
+// Writes runs.csv, statistics.csv, comparator.png (rms error of E against the SNR,
+// one panel per model error) and summary.md into `folder`; returns the paths.
+std::vector<std::string> WriteComparatorResults(const ComparatorStudy& study,
+                                                const std::string& folder, bool figures);
+
+}  // namespace mcrewave

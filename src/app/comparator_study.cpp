@@ -1,0 +1,353 @@
+#include "mcrewave/app/comparator_study.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "app/study_internal.h"
+#include "mcrewave/app/config.h"
+#include "mcrewave/app/study.h"
+#include "mcrewave/core/file_util.h"
+#include "mcrewave/data/prefilter.h"
+#include "mcrewave/least_squares/output_error_objective.h"
+#include "mcrewave/mcre/objective.h"
+#include "mcrewave/model/simulation.h"
+#include "mcrewave/optim/identification.h"
+
+namespace mcrewave {
+namespace {
+
+using internal::Brief;
+using internal::Csv;
+using internal::Percent;
+using internal::SnrText;
+
+constexpr double kDensityError = 1.03;      // the model's density / the bar's
+constexpr double kForceGain = 1.05;         // measured fL / true fL
+constexpr double kDisplacementGain = 1.03;  // measured uL / true uL
+constexpr double kSoftZoneFactor = 0.9;     // E over the soft zone / E
+constexpr double kSoftZoneLength = 0.1;     // its length / L, from the clamp
+constexpr int kRunsPerDataSet = 4;          // {MCRE, least squares} x {raw, pre-filtered}
+
+struct DataSet {
+  std::string model_error;
+  double snr;
+  std::uint64_t seed;
+};
+
+std::vector<DataSet> DataSets(const StudyOptions& options) {
+  std::vector<DataSet> sets;
+  for (const std::string& error : options.comparator_errors) {
+    for (const double snr : options.comparator_snr) {
+      const int seeds = std::isinf(snr) ? 1 : options.comparator_seeds;
+      for (int seed = 1; seed <= seeds; ++seed) {
+        sets.push_back({error, snr, std::isinf(snr) ? 0u : static_cast<std::uint64_t>(seed)});
+      }
+    }
+  }
+  return sets;
+}
+
+double RootMeanSquare(const Vector& values) {
+  return values.size() > 0 ? values.norm() / std::sqrt(static_cast<double>(values.size())) : 0.0;
+}
+
+// One identification of `functional` on `data` with the model `model`.
+void Identify(const Config& config, const BarModel& model, const MeasurementSet& data,
+              bool least_squares, ComparatorRun* run) {
+  const auto start = std::chrono::steady_clock::now();
+  IdentificationOptions outer = config.outer;
+  outer.scan_threads = 1;
+  IdentificationSummary summary;
+  if (least_squares) {
+    // s = RMS(measured) / SNR; at SNR inf the RMS alone (the weights' ratio).
+    const double snr = std::isinf(run->snr) ? 1.0 : run->snr;
+    NoiseLevels noise;
+    noise.displacement_std = RootMeanSquare(data.uL) / snr;
+    noise.force_std = RootMeanSquare(data.f0) / snr;
+    OutputErrorObjective objective(model, data, noise, config.time.theta, outer.initial);
+    summary = mcrewave::Identify(outer, &objective);
+  } else {
+    McreObjective objective(model, data, config.mcre, config.time.theta, config.inner,
+                            outer.initial);
+    summary = mcrewave::Identify(outer, &objective);
+  }
+  run->converged = summary.IsSolutionUsable();
+  if (!run->converged) run->message = summary.message;
+  run->modulus = summary.modulus;
+  run->error = summary.modulus / config.model.modulus - 1.0;
+  run->local_minima = summary.local_minima;
+  run->evaluations = summary.scan_evaluations + summary.evaluations;
+  run->wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The four runs of one data set: runs[0..3] = MCRE raw, MCRE pre-filtered, least
+// squares raw, least squares pre-filtered.
+void RunDataSet(const Config& config, const DataSet& set, ComparatorRun* runs) {
+  Config truth = config;
+  truth.data.snr = set.snr;
+  truth.data.seed = set.seed;
+  if (set.model_error == "soft_zone") {
+    truth.data.truth_zones = {
+        {0.0, kSoftZoneLength * config.model.length, kSoftZoneFactor * config.model.modulus}};
+  }
+  MeasurementSet measured =
+      MakeSyntheticMeasurements(truth.model, truth.load, truth.time, truth.data);
+  if (set.model_error == "force_gain") measured.fL *= kForceGain;
+  if (set.model_error == "displacement_gain") measured.uL *= kDisplacementGain;
+  BarProperties identified = config.model;
+  if (set.model_error == "density") identified.density *= kDensityError;
+  const BarModel model(identified);
+  for (int k = 0; k < kRunsPerDataSet; ++k) {
+    ComparatorRun& run = runs[k];
+    run.model_error = set.model_error;
+    run.snr = set.snr;
+    run.seed = set.seed;
+    run.least_squares = k >= 2;
+    run.prefilter = k % 2 == 1;
+    PrefilterOptions prefilter = config.prefilter;
+    prefilter.enabled = run.prefilter;
+    const MeasurementSet data = PrefilterMeasurements(measured, prefilter, nullptr);
+    Identify(config, model, data, run.least_squares, &run);
+  }
+}
+
+std::vector<ComparatorStatistics> Statistics(const ComparatorStudy& study) {
+  std::vector<ComparatorStatistics> table;
+  for (const std::string& error : study.model_errors) {
+    for (const bool least_squares : {false, true}) {
+      for (const bool prefilter : {false, true}) {
+        for (const double snr : study.snrs) {
+          ComparatorStatistics row;
+          row.model_error = error;
+          row.least_squares = least_squares;
+          row.prefilter = prefilter;
+          row.snr = snr;
+          std::vector<double> errors;
+          double minima = 0.0, one_valley = 0.0, evaluations = 0.0, time = 0.0, within = 0.0;
+          for (const ComparatorRun& run : study.runs) {
+            if (run.model_error != error || run.least_squares != least_squares ||
+                run.prefilter != prefilter ||
+                !(run.snr == snr || (std::isinf(run.snr) && std::isinf(snr)))) {
+              continue;
+            }
+            ++row.runs;
+            if (!run.converged) continue;
+            errors.push_back(run.error);
+            minima += run.local_minima;
+            one_valley += run.local_minima == 1 ? 1.0 : 0.0;
+            evaluations += run.evaluations;
+            time += run.wall_time_s;
+            within += std::abs(run.error) <= 0.02 ? 1.0 : 0.0;
+          }
+          const double n = static_cast<double>(errors.size());
+          row.converged_share = row.runs > 0 ? n / row.runs : 0.0;
+          if (n > 0) {
+            double mean = 0.0, squares = 0.0;
+            for (const double e : errors) mean += e / n;
+            for (const double e : errors) squares += e * e / n;
+            double variance = 0.0;
+            for (const double e : errors) variance += (e - mean) * (e - mean);
+            row.mean_error = mean;
+            row.std_error = n > 1 ? std::sqrt(variance / (n - 1.0)) : 0.0;
+            row.rms_error = std::sqrt(squares);
+            row.quantile_025 = Quantile(errors, 0.025);
+            row.quantile_975 = Quantile(errors, 0.975);
+            // Shares over every run: a run that did not converge is not within 2 %.
+            row.within_2_percent = within / row.runs;
+            row.one_valley = one_valley / n;
+            row.mean_local_minima = minima / n;
+            row.mean_evaluations = evaluations / n;
+            row.mean_wall_time_s = time / n;
+          }
+          table.push_back(row);
+        }
+      }
+    }
+  }
+  return table;
+}
+
+std::string FunctionalText(bool least_squares) { return least_squares ? "least_squares" : "mcre"; }
+std::string FilterText(bool prefilter) { return prefilter ? "prefilter" : "raw"; }
+
+std::string RunsCsv(const ComparatorStudy& study) {
+  std::ostringstream csv;
+  csv << "model_error,snr,seed,functional,data,converged,modulus_pa,relative_error,local_minima,"
+         "evaluations,wall_time_s,message\n";
+  for (const ComparatorRun& run : study.runs) {
+    csv << run.model_error << "," << SnrText(run.snr) << "," << run.seed << ","
+        << FunctionalText(run.least_squares) << "," << FilterText(run.prefilter) << ","
+        << (run.converged ? 1 : 0) << "," << Csv(run.modulus) << "," << Csv(run.error) << ","
+        << run.local_minima << "," << run.evaluations << "," << Csv(run.wall_time_s) << ",\""
+        << run.message << "\"\n";
+  }
+  return csv.str();
+}
+
+std::string StatisticsCsv(const ComparatorStudy& study) {
+  std::ostringstream csv;
+  csv << "model_error,functional,data,snr,runs,converged_share,mean_error,std_error,rms_error,"
+         "q2.5_error,q97.5_error,within_2_percent,one_valley,mean_local_minima,"
+         "mean_evaluations,mean_wall_time_s\n";
+  for (const ComparatorStatistics& row : study.statistics) {
+    csv << row.model_error << "," << FunctionalText(row.least_squares) << ","
+        << FilterText(row.prefilter) << "," << SnrText(row.snr) << "," << row.runs << ","
+        << Csv(row.converged_share) << "," << Csv(row.mean_error) << "," << Csv(row.std_error)
+        << "," << Csv(row.rms_error) << "," << Csv(row.quantile_025) << "," << Csv(row.quantile_975)
+        << "," << Csv(row.within_2_percent) << "," << Csv(row.one_valley) << ","
+        << Csv(row.mean_local_minima) << "," << Csv(row.mean_evaluations) << ","
+        << Csv(row.mean_wall_time_s) << "\n";
+  }
+  return csv.str();
+}
+
+// curves.csv: one row per (model error, SNR) with the rms error of the four
+// (functional, data) combinations, for the figure (finite SNRs only: log axis).
+std::string CurvesCsv(const ComparatorStudy& study) {
+  std::ostringstream csv;
+  csv << "model_error_index,snr,mcre_raw,mcre_prefilter,least_squares_raw,least_squares_"
+         "prefilter\n";
+  for (std::size_t e = 0; e < study.model_errors.size(); ++e) {
+    for (const double snr : study.snrs) {
+      if (std::isinf(snr)) continue;
+      csv << e << "," << Csv(snr);
+      for (const bool least_squares : {false, true}) {
+        for (const bool prefilter : {false, true}) {
+          for (const ComparatorStatistics& row : study.statistics) {
+            if (row.model_error == study.model_errors[e] && row.least_squares == least_squares &&
+                row.prefilter == prefilter && row.snr == snr) {
+              csv << "," << Csv(100.0 * row.rms_error);
+            }
+          }
+        }
+      }
+      csv << "\n";
+    }
+  }
+  return csv.str();
+}
+
+std::string CurvesScript(const std::string& folder, const ComparatorStudy& study) {
+  const int panels = static_cast<int>(study.model_errors.size());
+  const int columns = std::min(panels, 3);
+  const int rows = (panels + columns - 1) / columns;
+  const std::string csv = GnuplotString(folder + "/curves.csv");
+  std::ostringstream script;
+  script << GnuplotPngTerminal() << "set terminal pngcairo size " << 520 * columns << ","
+         << 420 * rows << "\nset datafile separator comma\nset logscale xy\nset grid\n"
+         << "set xlabel 'SNR'\nset ylabel 'rms error of E [%]'\nset key top right\n"
+         << "set multiplot layout " << rows << "," << columns
+         << " title 'MCRE against output-error least squares'\n";
+  const char* titles[] = {"MCRE, raw", "MCRE, pre-filtered", "least squares, raw",
+                          "least squares, pre-filtered"};
+  for (int e = 0; e < panels; ++e) {
+    std::string title = study.model_errors[e];
+    std::replace(title.begin(), title.end(), '_', ' ');
+    script << "set title '" << title << "'\nplot ";
+    for (int c = 0; c < 4; ++c) {
+      script << (c > 0 ? ", " : "") << csv << " skip 1 using ($1 == " << e
+             << " ? $2 : NaN):" << c + 3 << " with linespoints lw 2 pt 7 lc rgb '"
+             << internal::Colour(c) << "' title '" << titles[c] << "'";
+    }
+    script << "\n";
+  }
+  script << "unset multiplot\n";
+  return script.str();
+}
+
+std::string Summary(const ComparatorStudy& study) {
+  std::ostringstream md;
+  md << "# MCRE against output-error least squares\n\n"
+     << study.runs.size() << " identifications on " << study.threads << " threads in "
+     << internal::Duration(study.wall_time_s)
+     << ". The same data for both functionals, the same scan, optimiser and bounds; "
+        "least squares: the clamped model driven by the measured fL, misfit of uL and f0 "
+        "normalised by RMS(channel) / SNR. Model errors: `density` the model 3 % denser, "
+        "`force_gain` fL measured 5 % high, `displacement_gain` uL measured 3 % high, "
+        "`soft_zone` the bar 10 % softer over the 10 % of its length by the clamp. Errors "
+        "of E relative to the bar's modulus; `within 2 %` and `one valley` as shares of "
+        "the runs.\n\n"
+     << "| model error | functional | data | SNR | runs | mean | std | rms | 95 % band | "
+        "within 2 % | one valley | valleys | evaluations | time [s] |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const ComparatorStatistics& row : study.statistics) {
+    md << "| " << row.model_error << " | " << FunctionalText(row.least_squares) << " | "
+       << FilterText(row.prefilter) << " | " << SnrText(row.snr) << " | " << row.runs << " | "
+       << Percent(row.mean_error) << " | " << Percent(row.std_error) << " | "
+       << Percent(row.rms_error) << " | [" << Percent(row.quantile_025) << ", "
+       << Percent(row.quantile_975) << "] | " << Brief(100.0 * row.within_2_percent, 3) << " % | "
+       << Brief(100.0 * row.one_valley, 3) << " % | " << Brief(row.mean_local_minima, 3) << " | "
+       << Brief(row.mean_evaluations, 3) << " | " << Brief(row.mean_wall_time_s, 3) << " |\n";
+  }
+  md << "\nRatio of the rms errors, MCRE / least squares (1 or less: MCRE as accurate):\n\n"
+     << "| model error | data |";
+  for (const double snr : study.snrs) md << " SNR " << SnrText(snr) << " |";
+  md << "\n|---|---|";
+  for (std::size_t i = 0; i < study.snrs.size(); ++i) md << "---|";
+  md << "\n";
+  auto rms = [&](const std::string& error, bool least_squares, bool prefilter, double snr) {
+    for (const ComparatorStatistics& row : study.statistics) {
+      if (row.model_error == error && row.least_squares == least_squares &&
+          row.prefilter == prefilter &&
+          (row.snr == snr || (std::isinf(row.snr) && std::isinf(snr)))) {
+        return row.rms_error;
+      }
+    }
+    return std::nan("");
+  };
+  for (const std::string& error : study.model_errors) {
+    for (const bool prefilter : {false, true}) {
+      md << "| " << error << " | " << FilterText(prefilter) << " |";
+      for (const double snr : study.snrs) {
+        md << " " << Brief(rms(error, false, prefilter, snr) / rms(error, true, prefilter, snr), 3)
+           << " |";
+      }
+      md << "\n";
+    }
+  }
+  md << "\nFigure: comparator.png (rms error of E against the SNR, one panel per model error).\n";
+  return md.str();
+}
+
+}  // namespace
+
+const std::vector<std::string>& ComparatorModelErrors() {
+  static const std::vector<std::string> errors = {"none", "density", "force_gain",
+                                                  "displacement_gain", "soft_zone"};
+  return errors;
+}
+
+ComparatorStudy RunComparatorStudy(const Config& config) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<DataSet> sets = DataSets(config.study);
+  ComparatorStudy study;
+  study.reference_modulus = config.model.modulus;
+  study.model_errors = config.study.comparator_errors;
+  study.snrs = config.study.comparator_snr;
+  study.runs.resize(kRunsPerDataSet * sets.size());
+  study.threads = internal::ResolveThreads(config.study.threads);
+  internal::Progress progress("comparator", static_cast<int>(sets.size()));
+  internal::ParallelFor(
+      static_cast<int>(sets.size()), study.threads,
+      [&](int i) { RunDataSet(config, sets[i], &study.runs[kRunsPerDataSet * i]); }, &progress);
+  study.statistics = Statistics(study);
+  study.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return study;
+}
+
+std::vector<std::string> WriteComparatorResults(const ComparatorStudy& study,
+                                                const std::string& folder, bool figures) {
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"runs.csv", RunsCsv(study)},
+      {"statistics.csv", StatisticsCsv(study)},
+      {"curves.csv", CurvesCsv(study)}};
+  const std::vector<std::pair<std::string, std::string>> drawings = {
+      {"comparator", CurvesScript(folder, study)}};
+  return internal::WriteStudyFolder(folder, files, drawings, figures, Summary(study));
+}
+
+}  // namespace mcrewave
