@@ -152,13 +152,8 @@ const OutputErrorPrediction& OutputErrorObjective::Predict(double modulus,
 }
 
 bool OutputErrorObjective::Evaluate(const double* parameters, double* cost, double* gradient) {
-  const double modulus = parameters[0] * modulus_scale_;
-  if (!(std::isfinite(modulus) && modulus > 0.0)) {
-    std::ostringstream why;
-    why << "trial modulus " << modulus << " Pa is not a positive finite number";
-    error_message_ = why.str();
-    return false;
-  }
+  double modulus = 0.0;
+  if (!TrialModulus(parameters[0], modulus_scale_, &modulus, &error_message_)) return false;
   const OutputErrorPrediction& prediction = Predict(modulus, gradient != nullptr);
   if (!std::isfinite(prediction.cost) || !std::isfinite(prediction.cost_gradient)) {
     std::ostringstream why;

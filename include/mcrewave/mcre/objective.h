@@ -58,6 +58,10 @@ class ModulusObjective {
   virtual long sweeps() const { return 0; }
 };
 
+// E = parameter x modulus_scale [Pa], the trial modulus of an optimiser's parameter;
+// false, with the reason in *why, when it is not a positive finite number.
+bool TrialModulus(double parameter, double modulus_scale, double* modulus, std::string* why);
+
 // The `mcre:` section of the config: the weights of the data terms and the
 // modulus E0 they are built with (mcre_problem.h):
 //   beta = w_u S E0 / L,  alpha = w_f L / (S E0).
