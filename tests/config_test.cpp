@@ -65,6 +65,9 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.outer.max_time, actual.outer.max_time);
   EXPECT_EQ(expected.outer.scan_points, actual.outer.scan_points);
   EXPECT_EQ(expected.outer.scan_tolerance, actual.outer.scan_tolerance);
+  EXPECT_EQ(expected.outer.scan_samples_per_valley, actual.outer.scan_samples_per_valley);
+  EXPECT_EQ(expected.outer.scan_max_points, actual.outer.scan_max_points);
+  EXPECT_EQ(expected.outer.refine_margin, actual.outer.refine_margin);
   EXPECT_EQ(expected.outer.scan_threads, actual.outer.scan_threads);
   EXPECT_EQ(expected.outer.refine_candidates, actual.outer.refine_candidates);
   EXPECT_EQ(expected.prefilter.enabled, actual.prefilter.enabled);
@@ -416,8 +419,11 @@ outer:
   max_evaluations: 167
   max_time: 0.5
   scan_points: 17
+  scan_samples_per_valley: 2.5
+  scan_max_points: 333
   scan_tolerance: 3e-3
   scan_threads: 3
+  refine_margin: 0.25
   refine_candidates: 4
 prefilter:
   enabled: false

@@ -229,17 +229,20 @@ TEST(IdentificationTest, TimeLimitIsHonoured) {
 
 TEST(IdentificationTest, EvaluationLimitCountsTheScanAndCoversEveryRefinement) {
   for (const OptimizerType optimizer : {OptimizerType::kNlopt, OptimizerType::kCeres}) {
-    ScriptedObjective objective = Parabola();
+    // A quartic, so that the scan's cubic Hermite estimate is not its minimum.
+    ScriptedObjective objective(
+        [](double x) { return std::pow(x - 1.3, 2) + std::pow(x - 1.3, 4); },
+        [](double x) { return 2.0 * (x - 1.3) + 4.0 * std::pow(x - 1.3, 3); });
     IdentificationOptions options = Options(optimizer, OuterAlgorithm::kDefault);
     options.scan_points = 11;
-    options.max_evaluations = 14;  // 3 left to the refinement: not enough to 1e-8
+    options.max_evaluations = 13;  // 2 left to the refinement: not enough to 1e-8
     const IdentificationSummary summary = Identify(options, &objective);
     EXPECT_EQ(summary.termination, TerminationType::kNoConvergence) << summary.FullReport();
-    EXPECT_NE(summary.message.find("outer.max_evaluations (14, the scan's 11 included) reached"),
+    EXPECT_NE(summary.message.find("outer.max_evaluations (13, the scan's 11 included) reached"),
               std::string::npos)
         << summary.message;
-    EXPECT_EQ(objective.evaluated.size(), 14u);
-    EXPECT_EQ(summary.scan_evaluations + summary.evaluations, 14);
+    EXPECT_EQ(objective.evaluated.size(), 13u);
+    EXPECT_EQ(summary.scan_evaluations + summary.evaluations, 13);
   }
 }
 
@@ -278,21 +281,42 @@ TEST(IdentificationTest, AFailedScanSampleIsNoEvidenceOfAMinimum) {
   EXPECT_NEAR(summary.modulus, 1.3e9, 1e-5 * 1.3e9);
 }
 
+TEST(IdentificationTest, AValleyHiddenBetweenTwoSamplesOfOneSlopeIsSeen) {
+  // p(x) = -(x - 1.03)^3 + 0.0027 (x - 1.03) falls everywhere but on (1.0, 1.06),
+  // between the samples 0.951 and 1.117, where both gradients are negative: the
+  // costs alone show no minimum there; the Hermite interpolant of costs and
+  // gradients (here the cubic itself) has its minimum at 1.0. The cost keeps
+  // falling to the upper bound, a valley at the bound and the global minimum.
+  ScriptedObjective objective([](double x) { return -std::pow(x - 1.03, 3) + 0.0027 * (x - 1.03); },
+                              [](double x) { return -3.0 * std::pow(x - 1.03, 2) + 0.0027; });
+  const IdentificationSummary summary = Identify(ScanOptions(OptimizerType::kNlopt), &objective);
+  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+  ASSERT_EQ(summary.local_minima, 2) << summary.FullReport();
+  EXPECT_NEAR(summary.modulus, 2.5e9, 1e-7 * 2.5e9);
+  // Lowest first: the bound, then the hidden valley at x = 1.03 - 0.03.
+  EXPECT_NEAR(summary.valleys[1].estimated_modulus, 1.0e9, 1e-9 * 1e9);
+  EXPECT_NEAR(summary.valleys[1].lower_modulus, 0.951e9, 1e-3 * 1e9);
+  EXPECT_FALSE(summary.valleys[1].refined);  // far above the bound's cost
+}
+
 TEST(IdentificationTest, AFailedRefinementOfAnyValleyFailsTheIdentification) {
   for (const OptimizerType optimizer : {OptimizerType::kNlopt, OptimizerType::kCeres}) {
-    // Two valleys: the deeper at x = 2, the other at x = 0.8, refined second;
-    // every evaluation below x = 1 after the scan fails.
+    // Two valleys: the deeper at x = 2 (cost 1), the other at x = 0.8 (cost 1.1,
+    // within refine_margin 0.2 of it), refined second; every evaluation below x = 1
+    // after the scan fails.
     ScriptedObjective objective(
-        [](double x) { return std::min((x - 0.8) * (x - 0.8) + 0.1, (x - 2.0) * (x - 2.0)); },
+        [](double x) { return 1.0 + std::min((x - 0.8) * (x - 0.8) + 0.1, (x - 2.0) * (x - 2.0)); },
         [](double x) {
           return (x - 0.8) * (x - 0.8) + 0.1 < (x - 2.0) * (x - 2.0) ? 2.0 * (x - 0.8)
                                                                      : 2.0 * (x - 2.0);
         });
     objective.fails = [](int count, double x) { return count > 11 && x < 1.0; };
-    const IdentificationSummary summary = Identify(ScanOptions(optimizer), &objective);
+    IdentificationOptions options = ScanOptions(optimizer);
+    options.refine_margin = 0.2;
+    const IdentificationSummary summary = Identify(options, &objective);
     EXPECT_EQ(summary.local_minima, 2);
     EXPECT_EQ(summary.termination, TerminationType::kFailure) << summary.FullReport();
-    EXPECT_NE(summary.message.find("the refinement of sampled minimum 2"), std::string::npos)
+    EXPECT_NE(summary.message.find("the refinement of valley 2"), std::string::npos)
         << summary.message;
     EXPECT_NE(summary.message.find("scripted"), std::string::npos) << summary.message;
   }

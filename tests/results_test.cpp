@@ -115,14 +115,17 @@ TEST_F(ResultFilesTest, EvaluationsCsvHoldsEveryEvaluationInOrder) {
 
 TEST_F(ResultFilesTest, ScanCsvHoldsTheScanCostsInJouleSeconds) {
   const Csv csv = ReadCsv(File("scan.csv"));
-  EXPECT_EQ(csv.header, "modulus,cost,usable");
+  EXPECT_EQ(csv.header, "modulus,cost,cost_gradient,usable");
   ASSERT_EQ(csv.rows.size(), run_->outer.scan_moduli.size());
   ASSERT_EQ(csv.rows.size(), 41u);
   for (std::size_t i = 0; i < csv.rows.size(); ++i) {
     EXPECT_EQ(csv.rows[i][0], run_->outer.scan_moduli[i]);
     // e^2 = scaled cost x J_rest
     EXPECT_EQ(csv.rows[i][1], run_->outer.scan_costs[i] * run_->rest_cost);
-    EXPECT_EQ(csv.rows[i][2], 1.0);
+    // de^2/dE = (d cost / dx) J_rest / E_scale
+    EXPECT_EQ(csv.rows[i][2],
+              run_->outer.scan_gradients[i] * (run_->rest_cost / run_->config.outer.initial));
+    EXPECT_EQ(csv.rows[i][3], 1.0);
   }
   // Evenly spaced in log E over the bounds [100, 400] GPa.
   EXPECT_EQ(csv.rows.front()[0], 100e9);

@@ -160,16 +160,43 @@ std::string InnerResidualCsv(const IdentificationRun& run) {
   return csv;
 }
 
-// The global scan: e^2 = scaled cost x J_rest at each scan modulus (solved at
-// outer.scan_tolerance); usable 0 where the sample's solve failed.
+// The global scan: e^2 = scaled cost x J_rest and de^2/dE at each scan modulus
+// (solved at outer.scan_tolerance); usable 0 where the sample's solve failed.
 std::string ScanCsv(const IdentificationRun& run) {
-  std::string csv = "modulus,cost,usable\n";
-  char row[128];
+  std::string csv = "modulus,cost,cost_gradient,usable\n";
+  char row[160];
   const IdentificationSummary& outer = run.outer;
+  // de^2/dE = (d cost/dx) J_rest / E_scale, E_scale = outer.initial.
+  const double gradient_scale = run.rest_cost / run.config.outer.initial;
   for (std::size_t i = 0; i < outer.scan_moduli.size(); ++i) {
     const bool usable = std::isfinite(outer.scan_costs[i]);
-    std::snprintf(row, sizeof(row), "%.17g,%.17g,%d\n", outer.scan_moduli[i],
-                  usable ? outer.scan_costs[i] * run.rest_cost : 0.0, usable ? 1 : 0);
+    std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%d\n", outer.scan_moduli[i],
+                  usable ? outer.scan_costs[i] * run.rest_cost : 0.0,
+                  usable ? outer.scan_gradients[i] * gradient_scale : 0.0, usable ? 1 : 0);
+    csv += row;
+  }
+  return csv;
+}
+
+// Every valley of the scan: its bracket, the estimate, and the refined minimum
+// (e^2 in J s; refined 0 and modulus/cost empty when it was not refined).
+std::string ValleysCsv(const IdentificationRun& run) {
+  std::string csv =
+      "valley,lower_modulus,upper_modulus,estimated_modulus,estimated_cost,refined,modulus,cost,"
+      "evaluations\n";
+  char row[320];
+  int index = 0;
+  for (const ScanValley& valley : run.outer.valleys) {
+    std::snprintf(row, sizeof(row), "%d,%.17g,%.17g,%.17g,%.17g,%d,", ++index, valley.lower_modulus,
+                  valley.upper_modulus, valley.estimated_modulus,
+                  valley.estimated_cost * run.rest_cost, valley.refined ? 1 : 0);
+    csv += row;
+    if (valley.refined) {
+      std::snprintf(row, sizeof(row), "%.17g,%.17g,%d\n", valley.modulus,
+                    valley.cost * run.rest_cost, valley.evaluations);
+    } else {
+      std::snprintf(row, sizeof(row), ",,0\n");
+    }
     csv += row;
   }
   return csv;
@@ -197,17 +224,26 @@ std::string CostCurveScript(const IdentificationRun& run, const std::string& fol
   const double high = identified * (1.0 + kCurvatureWindow);
   const IdentificationSummary& outer = run.outer;
   const bool scanned = !outer.scan_moduli.empty();
+  // The scan's samples and the valleys it saw (estimates; refined minima), on both
+  // panels: the bottom one shows the valleys near E* that the top one's scale hides.
+  const std::string scan_plot =
+      !scanned ? std::string()
+               : GnuplotString(folder + "/scan.csv") +
+                     " skip 1 using ($1/1e9):($4 > 0 ? $2 : 1/0) with linespoints pt 5 ps 0.6 "
+                     "lc rgb '#2ca02c' title 'global scan', " +
+                     GnuplotString(folder + "/valleys.csv") +
+                     " skip 1 using ($4/1e9):5 with points pt 9 ps 1.6 lc rgb '#ff7f0e' "
+                     "title 'valleys seen (estimate)', " +
+                     GnuplotString(folder + "/valleys.csv") +
+                     " skip 1 using ($6 > 0 ? $7/1e9 : 1/0):8 with points pt 4 ps 2 lw 2 "
+                     "lc rgb '#1f77b4' title 'valleys refined', ";
   for (int panel = 0; panel < 2; ++panel) {
-    std::string scan_plot;
     if (panel == 0 && scanned) {
       // Bounds over a decade or more: log E, as the scan is spaced.
       if (outer.scan_moduli.back() >= 10.0 * outer.scan_moduli.front())
         script << "set logscale x\n";
       script << "set title 'global scan over the bounds (inner tolerance "
-             << run.config.outer.scan_tolerance << ") and the local refinement'\n";
-      scan_plot = GnuplotString(folder + "/scan.csv") +
-                  " skip 1 using ($1/1e9):($3 > 0 ? $2 : 1/0) with linespoints pt 5 ps 0.6 "
-                  "lc rgb '#2ca02c' title 'global scan', ";
+             << run.config.outer.scan_tolerance << "), its valleys and the local refinements'\n";
     } else if (panel == 0) {
       script << "set title 'over the optimiser evaluations'\n";
     } else {
@@ -398,16 +434,29 @@ std::string SummaryYaml(const IdentificationRun& run) {
               "[J s] J_rest, the functional of the bar left at rest (>= e^2 for every E)");
   yaml.Number(1, "wall_time_s", outer.wall_time_s, "[s] scan and refinements");
 
-  yaml.Line(0, "scan", "", "global scan of e^2 over the bounds (outer.scan_points)");
+  yaml.Line(0, "scan", "", "global scan of e^2 and de^2/dE over the bounds (outer.scan_*)");
   yaml.Integer(1, "points", static_cast<long>(outer.scan_moduli.size()), "0: no scan");
-  yaml.Integer(1, "local_minima", outer.local_minima, "sampled local minima of e^2 seen");
+  yaml.Number(1, "predicted_valley_spacing", outer.predicted_valley_spacing,
+              "mean spacing of the valleys of e^2 in ln E (0: not predicted)");
+  yaml.Line(1, "resolution_limited", outer.scan_resolution_limited ? "true" : "false",
+            "true: more samples wanted than outer.scan_max_points");
+  yaml.Integer(1, "local_minima", outer.local_minima, "valleys of e^2 seen (valleys.csv)");
   yaml.Integer(1, "failed_points", outer.scan_failures, "samples without a usable cost");
   yaml.Number(1, "second_modulus", outer.second_modulus > 0.0 ? outer.second_modulus : NAN,
-              "[Pa] the second-lowest minimum (null: fewer than two)");
+              "[Pa] the second-lowest valley (null: fewer than two)");
   yaml.Number(1, "scaled_cost_gap", outer.cost_gap,
-              "e^2 / cost_scale of the second-lowest minimum minus the lowest");
+              "e^2 / cost_scale of the second-lowest valley minus the lowest");
   yaml.Number(1, "cost_gap", outer.cost_gap * run.rest_cost, "[J s] the same gap of e^2");
-  yaml.Integer(1, "refinements", outer.refinements, "local searches from the lowest minima");
+  yaml.Integer(1, "refinements", outer.refinements,
+               "valleys refined (within outer.refine_margin of the lowest)");
+  yaml.Line(1, "valleys", "",
+            "every valley: estimate [Pa], refined minimiser [Pa] or null, e^2 [J s]");
+  for (const ScanValley& valley : outer.valleys) {
+    yaml.Raw("    - {estimate: " + Format(valley.estimated_modulus) +
+             ", modulus: " + Format(valley.refined ? valley.modulus : NAN) + ", cost: " +
+             Format((valley.refined ? valley.cost : valley.estimated_cost) * run.rest_cost) +
+             ", refined: " + (valley.refined ? "true" : "false") + "}");
+  }
   yaml.Integer(1, "sweeps", outer.scan_sweeps, "direct + retrograde sweeps of the scan");
   yaml.Number(1, "wall_time_s", outer.scan_wall_time_s, "[s] of the scan");
 
@@ -485,7 +534,10 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
   write("cost_curve.csv", CostCurveCsv(run));
   write("ends.csv", EndsCsv(run));
   write("inner_residual.csv", InnerResidualCsv(run));
-  if (!run.outer.scan_moduli.empty()) write("scan.csv", ScanCsv(run));
+  if (!run.outer.scan_moduli.empty()) {
+    write("scan.csv", ScanCsv(run));
+    write("valleys.csv", ValleysCsv(run));
+  }
   if (run.error_map.share.size() > 0) {
     write("error_map.csv", ErrorMapCsv(run));
     if (run.error_map.density.size() > 0) {

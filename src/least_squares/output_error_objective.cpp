@@ -5,6 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "mcrewave/optim/valley_spacing.h"
+
 namespace mcrewave {
 
 OutputErrorObjective::OutputErrorObjective(const BarModel& model, const MeasurementSet& data,
@@ -65,6 +67,22 @@ OutputErrorObjective::OutputErrorObjective(const BarModel& model, const Measurem
 std::unique_ptr<ModulusObjective> OutputErrorObjective::CloneForScan(double) const {
   return std::make_unique<OutputErrorObjective>(model_, data_, noise_, theta_, modulus_scale_,
                                                 ends_);
+}
+
+double OutputErrorObjective::ValleySpacing() {
+  const OutputErrorPrediction& prediction = Predict(modulus_scale_, false);
+  const int channels = 2 + static_cast<int>(prediction.sensors.size());
+  Matrix traces(channels, prediction.f0.size());
+  Vector weights(channels);
+  traces.row(0) = prediction.uL.transpose();
+  weights[0] = ends_.uL ? 1.0 / (noise_.displacement_std * noise_.displacement_std) : 0.0;
+  traces.row(1) = prediction.f0.transpose();
+  weights[1] = 1.0 / (noise_.force_std * noise_.force_std);
+  for (int i = 0; i + 2 < channels; ++i) {
+    traces.row(2 + i) = prediction.sensors[i].transpose();
+    weights[2 + i] = sensor_weights_[i];
+  }
+  return PredictedValleySpacing(traces, weights, data_.time_step);
 }
 
 const OutputErrorPrediction& OutputErrorObjective::Predict(double modulus,

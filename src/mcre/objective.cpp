@@ -8,6 +8,8 @@
 #include <sstream>
 #include <utility>
 
+#include "mcrewave/optim/valley_spacing.h"
+
 namespace mcrewave {
 
 bool McreOptions::IsValid(std::string* error) const {
@@ -52,6 +54,12 @@ std::unique_ptr<ModulusObjective> McreObjective::CloneForScan(double inner_toler
   inner.tolerance = inner_tolerance;
   return std::make_unique<McreObjective>(model_, data_, mcre_, theta_, inner, modulus_scale_,
                                          ends_);
+}
+
+double McreObjective::ValleySpacing() {
+  Matrix traces;
+  problem_.DataResponseTraces(&traces);
+  return PredictedValleySpacing(traces, problem_.TraceWeights(), problem_.time_step());
 }
 
 void McreObjective::SetWarmStart(const Matrix& retrograde) {

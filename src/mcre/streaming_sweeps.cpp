@@ -24,6 +24,40 @@ double McreProblem::TraceInnerProduct(const Matrix& a, const Matrix& b) const {
   return sum;
 }
 
+Vector McreProblem::TraceWeights() const {
+  Vector weights(num_traces());
+  weights[0] = beta_u0_;
+  weights[1] = beta_uL_;
+  for (int k = 0; k < num_interior_sensors(); ++k) weights[2 + k] = sensor_weights_[k];
+  return weights;
+}
+
+void McreProblem::DataResponseTraces(Matrix* traces) {
+  const int m = num_steps(), last = num_nodes() - 1;
+  traces->resize(num_traces(), m + 1);
+  // From rest: U_0 = V_0 = 0; the force of step t_k -> t_{k+1} is F~_theta alone (W = 0).
+  stream_velocity_[0].setZero();
+  stream_displacement_[0].setZero();
+  auto observe = [&](int j, const Vector& displacement) {
+    (*traces)(0, j) = displacement[0];
+    (*traces)(1, j) = displacement[last];
+    for (int k = 0; k < num_interior_sensors(); ++k) {
+      (*traces)(2 + k, j) = sensor_rows_[k].Apply(displacement.data());
+    }
+  };
+  observe(0, stream_displacement_[0]);
+  for (int k = 0; k < m; ++k) {
+    const int current = k & 1, next = current ^ 1;
+    // f_theta = theta F~_{k+1} + (1 - theta) F~_k at both ends.
+    const double f0 = theta_ * data_.f0[k + 1] + (1.0 - theta_) * data_.f0[k];
+    const double fL = theta_ * data_.fL[k + 1] + (1.0 - theta_) * data_.fL[k];
+    integrator_.StepWithEndLoads(stream_velocity_[current], stream_displacement_[current], f0, fL,
+                                 stream_velocity_[next], stream_displacement_[next]);
+    observe(k + 1, stream_displacement_[next]);
+  }
+  ++sweep_count_;
+}
+
 void McreProblem::TraceLoads(int j, const Matrix& traces, bool include_data, double* f0,
                              double* fL) {
   const double quadrature = QuadratureWeight(j);

@@ -10,27 +10,32 @@ namespace mcrewave::internal {
 namespace {
 
 // The bounded map between Ceres' free parameter z and x = E / E_scale:
-//   x(z) = x_lo + (x_hi - x_lo) s(z),  s(z) = 1 / (1 + exp(-z)),
-//   dx/dz = (x_hi - x_lo) s (1 - s),
-// smooth, increasing, and inside [x_lo, x_hi] for every z.
+//   x(z) = x_lo + (x_hi - x_lo) s(sigma z),  s(y) = 1 / (1 + exp(-y)),
+//   dx/dz = sigma (x_hi - x_lo) s (1 - s),
+// smooth, increasing, and inside [x_lo, x_hi] for every z. The scale sigma sets
+// the curvature of the cost in z: Ceres' first line-search step is
+// -g min(1, 1 / |g|) in z, the Newton step -g / c'' when c'' = d^2 cost / dz^2 = 1,
+// so sigma = 1 / (sqrt(k) dx/dz|_{sigma=1}) with k the curvature in x at the start
+// makes the first step follow the curvature of e^2 instead of a unit step in z.
 struct BoundedMap {
   double x_lower;
   double x_upper;
+  double sigma = 1.0;
 
-  double X(double z) const { return x_lower + (x_upper - x_lower) * Logistic(z); }
+  double X(double z) const { return x_lower + (x_upper - x_lower) * Logistic(sigma * z); }
   double DxDz(double z) const {
-    const double s = Logistic(z);
-    return (x_upper - x_lower) * s * (1.0 - s);
+    const double s = Logistic(sigma * z);
+    return sigma * (x_upper - x_lower) * s * (1.0 - s);
   }
-  // z(x) = log(s / (1 - s)), s = (x - x_lo) / (x_hi - x_lo); x strictly inside.
+  // z(x) = log(s / (1 - s)) / sigma, s = (x - x_lo) / (x_hi - x_lo); x strictly inside.
   double Z(double x) const {
     const double s = (x - x_lower) / (x_upper - x_lower);
-    return std::log(s / (1.0 - s));
+    return std::log(s / (1.0 - s)) / sigma;
   }
-  // 1 / (1 + exp(-z)), written so that exp never overflows.
-  static double Logistic(double z) {
-    if (z >= 0.0) return 1.0 / (1.0 + std::exp(-z));
-    const double e = std::exp(z);
+  // 1 / (1 + exp(-y)), written so that exp never overflows.
+  static double Logistic(double y) {
+    if (y >= 0.0) return 1.0 / (1.0 + std::exp(-y));
+    const double e = std::exp(y);
     return e / (1.0 + e);
   }
 };
@@ -91,9 +96,13 @@ class StoppingCallback : public ceres::IterationCallback {
 }  // namespace
 
 void MinimizeWithCeres(const IdentificationOptions& options, GuardedObjective* objective,
-                       IdentificationSummary* summary) {
+                       double curvature, IdentificationSummary* summary) {
   const double scale = objective->modulus_scale();
-  const BoundedMap map{options.lower_bound / scale, options.upper_bound / scale};
+  BoundedMap map{options.lower_bound / scale, options.upper_bound / scale};
+  if (curvature > 0.0 && std::isfinite(curvature)) {
+    // d^2 cost / dz^2 = k (dx/dz)^2 = 1 at the start (the term g d^2x/dz^2 left out).
+    map.sigma = 1.0 / (std::sqrt(curvature) * map.DxDz(map.Z(options.initial / scale)));
+  }
   double z = map.Z(options.initial / scale);
 
   ceres::GradientProblemSolver::Options solver_options;

@@ -119,10 +119,19 @@ bool IdentificationOptions::IsValid(std::string* error) const {
     why << "outer.max_time must be a positive number of seconds, got " << max_time;
   } else if (!(scan_points == 0 || (scan_points >= 3 && scan_points <= 100000))) {
     why << "outer.scan_points must be 0 (no scan) or in [3, 100000], got " << scan_points;
+  } else if (!(scan_samples_per_valley == 0.0 ||
+               (scan_samples_per_valley >= 1.0 && scan_samples_per_valley <= 100.0))) {
+    why << "outer.scan_samples_per_valley must be 0 (the scan_points grid alone) or in [1, 100], "
+        << "got " << scan_samples_per_valley;
+  } else if (!(scan_max_points >= std::max(scan_points, 3) && scan_max_points <= 100000)) {
+    why << "outer.scan_max_points must lie in [outer.scan_points (" << scan_points
+        << "), 100000], got " << scan_max_points;
   } else if (!(scan_tolerance > 0.0 && scan_tolerance < 1.0)) {
     why << "outer.scan_tolerance must lie in (0, 1), got " << scan_tolerance;
   } else if (!(scan_threads >= 1 && scan_threads <= 64)) {
     why << "outer.scan_threads must lie in [1, 64], got " << scan_threads;
+  } else if (!(refine_margin >= 0.0 && refine_margin <= 10.0)) {
+    why << "outer.refine_margin must lie in [0, 10], got " << refine_margin;
   } else if (!(refine_candidates >= 1 && refine_candidates <= 100)) {
     why << "outer.refine_candidates must lie in [1, 100], got " << refine_candidates;
   } else if (!IsAlgorithmAvailable(optimizer, algorithm)) {
@@ -142,8 +151,8 @@ std::string IdentificationSummary::BriefReport() const {
       << TerminationTypeToString(termination) << ", E = " << modulus << " Pa after " << evaluations
       << " evaluations (" << gradient_evaluations << " with gradient), " << wall_time_s << " s";
   if (!scan_moduli.empty()) {
-    out << "; scan of " << scan_moduli.size() << " points saw " << local_minima
-        << " local minima, scaled cost gap " << cost_gap;
+    out << "; scan of " << scan_moduli.size() << " points saw " << local_minima << " valleys ("
+        << refinements << " refined), scaled cost gap " << cost_gap;
   }
   return out.str();
 }
@@ -164,12 +173,24 @@ std::string IdentificationSummary::FullReport() const {
   if (!scan_moduli.empty()) {
     out << "  scan points            " << scan_moduli.size() << " over [" << scan_moduli.front()
         << ", " << scan_moduli.back() << "] Pa\n"
-        << "  scan local minima      " << local_minima << "\n"
+        << "  predicted valley step  " << predicted_valley_spacing << " in ln E\n"
+        << "  resolution limited     " << (scan_resolution_limited ? "yes" : "no") << "\n"
+        << "  valleys                " << local_minima << "\n"
         << "  second minimum         " << second_modulus << " Pa\n"
         << "  scaled cost gap        " << cost_gap << "\n"
         << "  refinements            " << refinements << "\n"
         << "  scan sweeps            " << scan_sweeps << "\n"
         << "  scan wall time         " << scan_wall_time_s << " s\n";
+  }
+  for (const ScanValley& valley : valleys) {
+    out << "    valley in [" << valley.lower_modulus << ", " << valley.upper_modulus
+        << "] Pa: estimate " << valley.estimated_modulus << " Pa, cost " << valley.estimated_cost;
+    if (valley.refined) {
+      out << "; refined " << valley.modulus << " Pa, cost " << valley.cost << " ("
+          << TerminationTypeToString(valley.termination) << ", " << valley.evaluations
+          << " evaluations)";
+    }
+    out << "\n";
   }
   if (iterations >= 0) out << "  iterations             " << iterations << "\n";
   out << "  wall time              " << wall_time_s << " s\n";
@@ -269,9 +290,11 @@ void GuardedObjective::FillSummary(IdentificationSummary* summary) const {
 
 namespace {
 
-// One local search from options.initial within options' bounds.
+// One local search from options.initial within options' bounds. curvature: an
+// estimate of d^2 cost / dx^2 near the start (0: unknown), for the step scale of
+// Ceres and of NLopt's gradient methods.
 IdentificationSummary MinimizeLocally(const IdentificationOptions& options,
-                                      ModulusObjective* objective) {
+                                      ModulusObjective* objective, double curvature = 0.0) {
   IdentificationSummary summary;
   summary.optimizer = options.optimizer;
   summary.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm);
@@ -280,9 +303,9 @@ IdentificationSummary MinimizeLocally(const IdentificationOptions& options,
   if (summary.algorithm == OuterAlgorithm::kBrent) {
     internal::MinimizeWithBrent(options, &guarded, &summary);
   } else if (options.optimizer == OptimizerType::kNlopt) {
-    internal::MinimizeWithNlopt(options, &guarded, &summary);
+    internal::MinimizeWithNlopt(options, &guarded, curvature, &summary);
   } else {
-    internal::MinimizeWithCeres(options, &guarded, &summary);
+    internal::MinimizeWithCeres(options, &guarded, curvature, &summary);
   }
   guarded.FillSummary(&summary);
   if (!guarded.has_best() && summary.termination == TerminationType::kConvergence) {
@@ -292,26 +315,28 @@ IdentificationSummary MinimizeLocally(const IdentificationOptions& options,
   return summary;
 }
 
-// Scaled cost at x, NaN when the evaluation fails or throws (why written to
-// *failure).
-double ScanCost(ModulusObjective* objective, double x, std::string* failure) {
-  double cost = std::numeric_limits<double>::quiet_NaN();
+// Scaled cost and gradient at x into *cost, *gradient; both NaN when the
+// evaluation fails, throws or gives a non-finite value (why written to *failure).
+void ScanSample(ModulusObjective* objective, double x, double* cost, double* gradient,
+                std::string* failure) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  *cost = kNaN;
+  *gradient = kNaN;
   try {
-    if (!objective->Evaluate(&x, &cost, nullptr)) {
+    if (!objective->Evaluate(&x, cost, gradient)) {
       *failure = objective->error_message();
-      cost = std::numeric_limits<double>::quiet_NaN();
-    } else if (!std::isfinite(cost)) {
-      *failure = "the objective returned a non-finite cost";
-      cost = std::numeric_limits<double>::quiet_NaN();
+    } else if (!std::isfinite(*cost) || !std::isfinite(*gradient)) {
+      *failure = "the objective returned a non-finite cost or gradient";
+    } else {
+      return;
     }
   } catch (const std::exception& error) {
     *failure = std::string("the objective threw: ") + error.what();
-    cost = std::numeric_limits<double>::quiet_NaN();
   } catch (...) {
     *failure = "the objective threw an exception that is not a std::exception";
-    cost = std::numeric_limits<double>::quiet_NaN();
   }
-  return cost;
+  *cost = kNaN;
+  *gradient = kNaN;
 }
 
 using Clock = std::chrono::steady_clock;
@@ -321,30 +346,32 @@ double SecondsSince(Clock::time_point start) {
 }
 
 // Scan points are split into this many contiguous chunks (fewer when there are
-// fewer points), whatever the thread count, so that every cost is the same bits
+// fewer points), whatever the thread count, so that every sample is the same bits
 // on 1 or 64 threads.
 constexpr int kScanChunks = 8;
 
-// The scaled costs at xs. The points form min(kScanChunks, P) contiguous chunks,
-// chunk c = [c P / C, (c + 1) P / C); each chunk is evaluated in order by a fresh
-// copy of the objective (CloneForScan), warm-started point to point from its own
-// first point only, so a cost depends on its chunk and never on which thread ran
-// it. Chunk c runs on thread c mod scan_threads. Without copies (CloneForScan
-// gives none) every point is evaluated in order on `objective`. Samples not
-// reached within options.max_time of `start` stay NaN. *first_failure: why the
-// lowest failed sample failed; *sweeps: the inner sweeps the scan ran.
-std::vector<double> ScanCosts(const IdentificationOptions& options, ModulusObjective* objective,
-                              const std::vector<double>& xs, Clock::time_point start,
-                              std::string* first_failure, long* sweeps) {
+// The scaled costs and gradients at xs. The points form min(kScanChunks, P)
+// contiguous chunks, chunk c = [c P / C, (c + 1) P / C); each chunk is evaluated in
+// order by a fresh copy of the objective (CloneForScan), warm-started point to
+// point from its own first point only, so a sample depends on its chunk and never
+// on which thread ran it. Chunk c runs on thread c mod scan_threads. Without copies
+// (CloneForScan gives none) every point is evaluated in order on `objective`.
+// Samples not reached within options.max_time of `start` stay NaN.
+// *first_failure: why the lowest failed sample failed; *sweeps: the inner sweeps
+// the scan ran.
+void ScanSamples(const IdentificationOptions& options, ModulusObjective* objective,
+                 const std::vector<double>& xs, Clock::time_point start, std::vector<double>* costs,
+                 std::vector<double>* gradients, std::string* first_failure, long* sweeps) {
   const int points = static_cast<int>(xs.size());
-  std::vector<double> costs(xs.size(), std::numeric_limits<double>::quiet_NaN());
+  costs->assign(xs.size(), std::numeric_limits<double>::quiet_NaN());
+  gradients->assign(xs.size(), std::numeric_limits<double>::quiet_NaN());
   std::vector<std::string> failures(xs.size());
-  auto scan_cost = [&](ModulusObjective* evaluated, int i) {
+  auto sample = [&](ModulusObjective* evaluated, int i) {
     if (SecondsSince(start) >= options.max_time) {
       failures[i] = "outer.max_time reached during the scan";
       return;
     }
-    costs[i] = ScanCost(evaluated, xs[i], &failures[i]);
+    ScanSample(evaluated, xs[i], &(*costs)[i], &(*gradients)[i], &failures[i]);
   };
   const int chunks = std::min(kScanChunks, points);
   const int threads = std::min(options.scan_threads, chunks);
@@ -358,7 +385,7 @@ std::vector<double> ScanCosts(const IdentificationOptions& options, ModulusObjec
         return;
       }
       for (int i = c * points / chunks; i < (c + 1) * points / chunks; ++i) {
-        scan_cost(copy.get(), i);
+        sample(copy.get(), i);
       }
       thread_sweeps[thread] += copy->sweeps();
     }
@@ -372,7 +399,7 @@ std::vector<double> ScanCosts(const IdentificationOptions& options, ModulusObjec
   if (std::find(cloned.begin(), cloned.end(), 0) != cloned.end()) {
     // CloneForScan gives no copy (it gives one always or never): every point on `objective`.
     const long sweeps_before = objective->sweeps();
-    for (int i = 0; i < points; ++i) scan_cost(objective, i);
+    for (int i = 0; i < points; ++i) sample(objective, i);
     *sweeps = objective->sweeps() - sweeps_before;
   }
   for (const std::string& failure : failures) {
@@ -381,24 +408,124 @@ std::vector<double> ScanCosts(const IdentificationOptions& options, ModulusObjec
       break;
     }
   }
-  return costs;
 }
 
-// Indices of the sampled local minima of costs, lowest cost first: usable
-// samples below each neighbour (an end needs only its one neighbour). A failed
-// (NaN) neighbour is no evidence of a minimum: a sample beside one is not listed.
-std::vector<int> SampledMinima(const std::vector<double>& costs) {
-  const int n = static_cast<int>(costs.size());
-  std::vector<int> minima;
-  for (int i = 0; i < n; ++i) {
-    if (!std::isfinite(costs[i])) continue;
-    // Comparisons with NaN are false: a failed neighbour fails the test.
-    const bool below_left = i == 0 || costs[i] < costs[i - 1];
-    const bool below_right = i == n - 1 || costs[i] <= costs[i + 1];
-    if (below_left && below_right) minima.push_back(i);
+// A valley of the scan: bracket [xs[left], xs[left + 1]], the estimate of its
+// minimum (x, scaled cost) and the curvature d^2 cost / dx^2 there.
+struct ValleyEstimate {
+  int left = 0;
+  double x = 0.0;
+  double cost = 0.0;
+  double curvature = 0.0;
+};
+
+// The local minimum inside (0, 1) of the cubic Hermite interpolant on [x0, x1] of
+// costs c0, c1 and gradients g0, g1 (d cost / dx), if it has one. With w = x1 - x0,
+// d0 = w g0, d1 = w g1 and t in [0, 1]:
+//   p(t) = a t^3 + b t^2 + d0 t + c0,  a = 2 (c0 - c1) + d0 + d1,
+//   b = 3 (c1 - c0) - 2 d0 - d1,  p'(t) = 3 a t^2 + 2 b t + d0,
+// and a minimum is a root of p' with p''(t) = 6 a t + 2 b > 0.
+bool HermiteMinimum(double x0, double x1, double c0, double c1, double g0, double g1,
+                    ValleyEstimate* valley) {
+  const double w = x1 - x0;
+  const double d0 = w * g0, d1 = w * g1;
+  const double a = 2.0 * (c0 - c1) + d0 + d1;
+  const double b = 3.0 * (c1 - c0) - 2.0 * d0 - d1;
+  // Roots of 3 a t^2 + 2 b t + d0, written without cancellation.
+  double roots[2];
+  int count = 0;
+  const double qa = 3.0 * a, qb = 2.0 * b;
+  if (std::abs(qa) <= 1e-14 * (std::abs(qb) + std::abs(d0))) {
+    if (qb != 0.0) roots[count++] = -d0 / qb;
+  } else {
+    const double discriminant = qb * qb - 4.0 * qa * d0;
+    if (discriminant >= 0.0) {
+      const double q = -0.5 * (qb + std::copysign(std::sqrt(discriminant), qb));
+      if (q != 0.0) roots[count++] = q / qa;
+      roots[count++] = q != 0.0 ? d0 / q : -qb / (2.0 * qa);
+    }
   }
-  std::stable_sort(minima.begin(), minima.end(), [&](int a, int b) { return costs[a] < costs[b]; });
-  return minima;
+  for (int r = 0; r < count; ++r) {
+    const double t = roots[r];
+    const double second = 6.0 * a * t + 2.0 * b;
+    if (t > 0.0 && t < 1.0 && second > 0.0) {
+      valley->x = x0 + t * w;
+      valley->cost = ((a * t + b) * t + d0) * t + c0;
+      valley->curvature = second / (w * w);
+      return true;
+    }
+  }
+  // A sign change with the root on an end: the minimum is that end.
+  if (g0 < 0.0 && g1 >= 0.0) {
+    const bool at_right = std::abs(c1) <= std::abs(c0);
+    valley->x = at_right ? x1 : x0;
+    valley->cost = at_right ? c1 : c0;
+    valley->curvature = (g1 - g0) / w;
+    return true;
+  }
+  return false;
+}
+
+// The valleys of the scan (xs ascending, costs and gradients NaN where failed),
+// lowest estimated cost first: the interior minima of the Hermite interpolant of
+// every interval between usable samples, and a bound whose gradient points
+// outward.
+std::vector<ValleyEstimate> FindValleys(const std::vector<double>& xs,
+                                        const std::vector<double>& costs,
+                                        const std::vector<double>& gradients) {
+  const int n = static_cast<int>(xs.size());
+  std::vector<ValleyEstimate> valleys;
+  auto usable = [&](int i) { return std::isfinite(costs[i]) && std::isfinite(gradients[i]); };
+  if (n >= 2 && usable(0) && gradients[0] >= 0.0 && usable(1)) {
+    // Rising from the lower bound: a valley at the bound.
+    valleys.push_back({0, xs[0], costs[0], (gradients[1] - gradients[0]) / (xs[1] - xs[0])});
+  }
+  for (int i = 0; i + 1 < n; ++i) {
+    if (!usable(i) || !usable(i + 1)) continue;
+    ValleyEstimate valley;
+    valley.left = i;
+    if (HermiteMinimum(xs[i], xs[i + 1], costs[i], costs[i + 1], gradients[i], gradients[i + 1],
+                       &valley)) {
+      valleys.push_back(valley);
+    }
+  }
+  if (n >= 2 && usable(n - 1) && gradients[n - 1] <= 0.0 && usable(n - 2)) {
+    // Falling to the upper bound: a valley at the bound.
+    valleys.push_back({n - 2, xs[n - 1], costs[n - 1],
+                       (gradients[n - 1] - gradients[n - 2]) / (xs[n - 1] - xs[n - 2])});
+  }
+  std::stable_sort(
+      valleys.begin(), valleys.end(),
+      [](const ValleyEstimate& a, const ValleyEstimate& b) { return a.cost < b.cost; });
+  return valleys;
+}
+
+// The scan's moduli (scaled), evenly spaced in log E over [x_lower, x_upper]:
+// max(scan_points, scan_samples_per_valley per predicted spacing), at most
+// scan_max_points (*limited then true).
+std::vector<double> ScanGrid(const IdentificationOptions& options, double x_lower, double x_upper,
+                             double valley_spacing, bool* limited) {
+  const double log_range = std::log(x_upper / x_lower);
+  int points = options.scan_points;
+  *limited = false;
+  if (options.scan_samples_per_valley > 0.0 && valley_spacing > 0.0) {
+    // Samples per valley spacing over the log range, both ends included.
+    const double wanted =
+        std::ceil(log_range / valley_spacing * options.scan_samples_per_valley) + 1;
+    if (wanted > options.scan_max_points) {
+      *limited = true;
+      points = options.scan_max_points;
+    } else {
+      points = std::max(points, static_cast<int>(wanted));
+    }
+  }
+  std::vector<double> xs(points);
+  for (int i = 0; i < points; ++i) {
+    // x_i = x_lo (x_hi / x_lo)^(i / (P - 1)): evenly spaced in log E, so that
+    // bounds over decades still get samples near every modulus.
+    xs[i] = x_lower * std::pow(x_upper / x_lower, i / (points - 1.0));
+  }
+  return xs;
 }
 
 }  // namespace
@@ -419,18 +546,29 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
   const double scale = objective->modulus_scale();
   const double x_lower = options.lower_bound / scale;
   const double x_upper = options.upper_bound / scale;
-  const int points = options.scan_points;
-  std::vector<double> xs(points);
-  for (int i = 0; i < points; ++i) {
-    // x_i = x_lo (x_hi / x_lo)^(i / (P - 1)): evenly spaced in log E, so that
-    // bounds over decades still get samples near every modulus.
-    xs[i] = x_lower * std::pow(x_upper / x_lower, i / (points - 1.0));
+  double valley_spacing = 0.0;
+  if (options.scan_samples_per_valley > 0.0) {
+    try {
+      valley_spacing = objective->ValleySpacing();
+    } catch (const std::exception& error) {
+      spdlog::warn("scan: no predicted valley spacing ({}): scan_points alone", error.what());
+    }
+  }
+  bool limited = false;
+  const std::vector<double> xs = ScanGrid(options, x_lower, x_upper, valley_spacing, &limited);
+  const int points = static_cast<int>(xs.size());
+  if (limited) {
+    spdlog::warn(
+        "scan: the predicted valley spacing {:.3g} in ln E asks for more than "
+        "outer.scan_max_points "
+        "({}) samples: valleys narrower than the scan's step may be missed",
+        valley_spacing, options.scan_max_points);
   }
   std::string scan_failure;
   long scan_sweeps = 0;
-  const std::vector<double> costs =
-      ScanCosts(options, objective, xs, start, &scan_failure, &scan_sweeps);
-  const std::vector<int> minima = SampledMinima(costs);
+  std::vector<double> costs, gradients;
+  ScanSamples(options, objective, xs, start, &costs, &gradients, &scan_failure, &scan_sweeps);
+  const std::vector<ValleyEstimate> valleys = FindValleys(xs, costs, gradients);
   const double scan_wall_time_s = SecondsSince(start);
   const int scan_failures = static_cast<int>(
       std::count_if(costs.begin(), costs.end(), [](double cost) { return !std::isfinite(cost); }));
@@ -438,13 +576,17 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
     spdlog::warn("scan: {} of {} samples have no usable cost (first: {})", scan_failures, points,
                  scan_failure);
   }
-  spdlog::info("scan of {} moduli over [{:.6g}, {:.6g}] Pa: {} sampled local minima, {:.3g} s",
-               points, options.lower_bound, options.upper_bound, minima.size(), scan_wall_time_s);
+  spdlog::info(
+      "scan of {} moduli over [{:.6g}, {:.6g}] Pa (predicted valley spacing {:.3g} in ln E): {} "
+      "valleys, {:.3g} s",
+      points, options.lower_bound, options.upper_bound, valley_spacing, valleys.size(),
+      scan_wall_time_s);
 
-  // Local refinements of the lowest sampled minima, each within the bracket of
-  // its neighbouring scan points and with what the scan and the earlier
-  // refinements left of max_evaluations and max_time.
+  // Local refinements of the valleys within refine_margin of the lowest estimate,
+  // each within its bracket and with what the scan and the earlier refinements
+  // left of max_evaluations and max_time.
   std::vector<IdentificationSummary> refined;
+  std::vector<ScanValley> reported(valleys.size());
   std::string limit_message;
   // A refinement that failed leaves its valley unknown: no result is reported
   // over it, whatever the other refinements found.
@@ -461,36 +603,67 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
     }
     return why.str();
   };
-  const int candidates = std::min<int>(options.refine_candidates, static_cast<int>(minima.size()));
-  for (int k = 0; k < candidates && limit_message.empty(); ++k) {
-    const int i = minima[k];
+  // A refinement of valley k within the samples [first, last].
+  auto refine = [&](int k, int first, int last) {
+    const ValleyEstimate& valley = valleys[k];
     IdentificationOptions local = options;
     local.max_evaluations = options.max_evaluations - evaluations_used;
     local.max_time = options.max_time - SecondsSince(start);
-    if (local.max_evaluations < 2 || !(local.max_time > 0.0)) {
-      limit_message =
-          limit_reached("before sampled minimum " + std::to_string(k + 1) + " was refined");
-      break;
-    }
-    local.lower_bound = xs[std::max(i - 1, 0)] * scale;
-    local.upper_bound = xs[std::min(i + 1, points - 1)] * scale;
-    // Start at the sample, moved strictly inside the bracket at an end of the scan.
+    local.lower_bound = xs[first] * scale;
+    local.upper_bound = xs[last] * scale;
+    // Start at the estimate, moved strictly inside the bracket.
     const double width = local.upper_bound - local.lower_bound;
-    local.initial = std::clamp(xs[i] * scale, local.lower_bound + 1e-3 * width,
+    local.initial = std::clamp(valley.x * scale, local.lower_bound + 1e-3 * width,
                                local.upper_bound - 1e-3 * width);
-    spdlog::info("refining sampled minimum {} at E = {:.6g} Pa within [{:.6g}, {:.6g}] Pa", k + 1,
-                 xs[i] * scale, local.lower_bound, local.upper_bound);
-    refined.push_back(MinimizeLocally(local, objective));
-    evaluations_used += refined.back().evaluations;
-    if (refined.back().termination == TerminationType::kNoConvergence) {
+    spdlog::info("refining valley {} (estimate E = {:.9g} Pa) within [{:.6g}, {:.6g}] Pa", k + 1,
+                 valley.x * scale, local.lower_bound, local.upper_bound);
+    IdentificationSummary result = MinimizeLocally(local, objective, valley.curvature);
+    evaluations_used += result.evaluations;
+    return result;
+  };
+  const double lowest = valleys.empty() ? 0.0 : valleys.front().cost;
+  const double threshold = lowest + options.refine_margin * std::abs(lowest);
+  for (int k = 0; k < static_cast<int>(valleys.size()); ++k) {
+    const ValleyEstimate& valley = valleys[k];
+    ScanValley& report = reported[k];
+    report.lower_modulus = xs[valley.left] * scale;
+    report.upper_modulus = xs[valley.left + 1] * scale;
+    report.estimated_modulus = valley.x * scale;
+    report.estimated_cost = valley.cost;
+    const bool wanted = k == 0 || (valley.cost <= threshold && k < options.refine_candidates);
+    if (!wanted || !limit_message.empty()) continue;
+    if (options.max_evaluations - evaluations_used < 2 || SecondsSince(start) >= options.max_time) {
+      limit_message = limit_reached("before valley " + std::to_string(k + 1) + " was refined");
+      continue;
+    }
+    IdentificationSummary result = refine(k, valley.left, valley.left + 1);
+    // Ended on an inner edge of its bracket (the scan's gradient, at its loose
+    // tolerance, misplaced the sign change): once more over the neighbouring intervals.
+    const double tolerance = 4.0 * options.relative_tolerance * result.modulus;
+    const bool on_left = valley.left > 0 && result.modulus - report.lower_modulus <= tolerance;
+    const bool on_right =
+        valley.left + 2 < points && report.upper_modulus - result.modulus <= tolerance;
+    if (result.IsSolutionUsable() && (on_left || on_right) &&
+        options.max_evaluations - evaluations_used >= 2) {
+      const int evaluations_before = result.evaluations;
+      result = refine(k, std::max(valley.left - 1, 0), std::min(valley.left + 2, points - 1));
+      result.evaluations += evaluations_before;
+    }
+    report.refined = true;
+    report.termination = result.termination;
+    report.modulus = result.modulus;
+    report.cost = result.cost;
+    report.evaluations = result.evaluations;
+    if (result.termination == TerminationType::kNoConvergence) {
       limit_message = limit_reached("before convergence");
     }
-    if (refined.back().termination == TerminationType::kFailure && refinement_failure.empty()) {
+    if (result.termination == TerminationType::kFailure && refinement_failure.empty()) {
       std::ostringstream why;
-      why << "the refinement of sampled minimum " << k + 1 << " (E = " << xs[i] * scale
-          << " Pa) failed: " << refined.back().message;
+      why << "the refinement of valley " << k + 1 << " (E = " << report.estimated_modulus
+          << " Pa) failed: " << result.message;
       refinement_failure = why.str();
     }
+    refined.push_back(std::move(result));
   }
 
   // The usable refinement of least cost; the first refinement's failure if none is.
@@ -535,25 +708,28 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
   summary.refinements = static_cast<int>(refined.size());
   for (const double x : xs) summary.scan_moduli.push_back(x * scale);
   summary.scan_costs = costs;
+  summary.scan_gradients = gradients;
   summary.scan_evaluations = points;
   summary.scan_sweeps = scan_sweeps;
   summary.scan_failures = scan_failures;
-  summary.local_minima = static_cast<int>(minima.size());
-  // The second valley: its refined cost when refined, else its sampled cost.
-  if (minima.size() >= 2 && best >= 0) {
+  summary.predicted_valley_spacing = valley_spacing;
+  summary.scan_resolution_limited = limited;
+  summary.local_minima = static_cast<int>(valleys.size());
+  // The second valley: its refined cost when refined, else its estimated cost.
+  if (best >= 0) {
     double second_cost = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < static_cast<int>(minima.size()); ++k) {
-      const bool was_refined = k < static_cast<int>(refined.size());
-      if (k == best || (was_refined && !refined[k].IsSolutionUsable())) continue;
-      const double cost = was_refined ? refined[k].cost : costs[minima[k]];
-      const double modulus = was_refined ? refined[k].modulus : xs[minima[k]] * scale;
+    for (const ScanValley& valley : reported) {
+      if (valley.refined && valley.modulus == summary.modulus) continue;
+      if (valley.refined && valley.termination != TerminationType::kConvergence) continue;
+      const double cost = valley.refined ? valley.cost : valley.estimated_cost;
       if (cost < second_cost) {
         second_cost = cost;
-        summary.second_modulus = modulus;
+        summary.second_modulus = valley.refined ? valley.modulus : valley.estimated_modulus;
       }
     }
     if (std::isfinite(second_cost)) summary.cost_gap = second_cost - summary.cost;
   }
+  summary.valleys = std::move(reported);
   summary.scan_wall_time_s = scan_wall_time_s;
   summary.wall_time_s = SecondsSince(start);
   return summary;

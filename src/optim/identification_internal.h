@@ -58,10 +58,14 @@ class GuardedObjective {
 // The back ends. Each runs its optimiser on the guarded objective and sets the
 // summary's termination, message, optimizer_message and (Ceres) iterations;
 // Identify then calls FillSummary.
+// curvature as for Ceres: the gradient methods see the cost in units of its change
+// over the bounds (curvature x width^2).
 void MinimizeWithNlopt(const IdentificationOptions& options, GuardedObjective* objective,
-                       IdentificationSummary* summary);
+                       double curvature, IdentificationSummary* summary);
+// curvature: an estimate of d^2 cost / dx^2 at options.initial (0: unknown), which
+// scales Ceres' parameter so that its first step is the Newton step.
 void MinimizeWithCeres(const IdentificationOptions& options, GuardedObjective* objective,
-                       IdentificationSummary* summary);
+                       double curvature, IdentificationSummary* summary);
 void MinimizeWithBrent(const IdentificationOptions& options, GuardedObjective* objective,
                        IdentificationSummary* summary);
 

@@ -31,6 +31,7 @@ nlopt::algorithm NloptAlgorithm(OuterAlgorithm algorithm) {
 struct CallbackData {
   GuardedObjective* objective;
   nlopt::opt* optimizer;
+  double cost_unit;  // NLopt sees cost / cost_unit and gradient / cost_unit
 };
 
 // The NLopt objective. Never throws (GuardedObjective catches): on a failed or
@@ -45,7 +46,8 @@ double NloptObjective(const std::vector<double>& x, std::vector<double>& gradien
     if (gradient_out != nullptr) gradient_out[0] = 0.0;
     return HUGE_VAL;
   }
-  return cost;
+  if (gradient_out != nullptr) gradient_out[0] /= callback->cost_unit;
+  return cost / callback->cost_unit;
 }
 
 std::string ResultName(nlopt::result result) {
@@ -70,10 +72,19 @@ std::string ResultName(nlopt::result result) {
 }  // namespace
 
 void MinimizeWithNlopt(const IdentificationOptions& options, GuardedObjective* objective,
-                       IdentificationSummary* summary) {
+                       double curvature, IdentificationSummary* summary) {
   const double scale = objective->modulus_scale();
   nlopt::opt optimizer(NloptAlgorithm(summary->algorithm), 1);
-  CallbackData data{objective, &optimizer};
+  // The gradient methods (MMA's convexity term, L-BFGS' first step) assume cost
+  // changes of order one across the bounds; a flat e^2 stops MMA at its start. Their
+  // cost unit is the change the curvature k predicts over the bounds' width w: k w^2.
+  double cost_unit = 1.0;
+  const double width = (options.upper_bound - options.lower_bound) / scale;
+  if (UsesGradient(options.optimizer, summary->algorithm) && curvature > 0.0 &&
+      std::isfinite(curvature * width * width) && curvature * width * width > 0.0) {
+    cost_unit = curvature * width * width;
+  }
+  CallbackData data{objective, &optimizer, cost_unit};
   optimizer.set_min_objective(NloptObjective, &data);
   optimizer.set_lower_bounds(options.lower_bound / scale);
   optimizer.set_upper_bounds(options.upper_bound / scale);

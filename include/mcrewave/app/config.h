@@ -29,9 +29,10 @@
 //          (CoupledSolverOptions, coupled_solver.h)
 //   outer: optimizer [nlopt | ceres], algorithm [default | bobyqa | cobyla | sbplx |
 //          mma | lbfgs | bfgs | brent], lower_bound [100e9 Pa], upper_bound [400e9 Pa],
-//          initial [160e9 Pa], relative_tolerance [1e-7], max_evaluations [150],
-//          max_time [600 s], scan_points [41], scan_tolerance [1e-4],
-//          scan_threads [2], refine_candidates [2] (IdentificationOptions,
+//          initial [160e9 Pa], relative_tolerance [1e-7], max_evaluations [1000],
+//          max_time [600 s], scan_points [41], scan_samples_per_valley [4],
+//          scan_max_points [2000], scan_tolerance [1e-4], scan_threads [2],
+//          refine_margin [0.05], refine_candidates [10] (IdentificationOptions,
 //          identification.h)
 //   prefilter: enabled [true], cutoff_frequency [0 Hz: derived from the data;
 //          else below the Nyquist frequency 0.5 / time.step], order [4],

@@ -70,6 +70,9 @@ class OutputErrorObjective : public ModulusObjective {
   std::string error_message() const override { return error_message_; }
   std::unique_ptr<ModulusObjective> CloneForScan(double inner_tolerance) const override;
   long sweeps() const override { return sweeps_; }
+  // From the predicted outputs (uL, f0, the sensors) at E = modulus_scale, weighted
+  // by 1 / s^2 of their kind: one sweep.
+  double ValleySpacing() override;
 
   // Simulates the clamped model at E [Pa] (> 0): predictions and J, and dJ/dE when
   // gradient_requested. Re-initialises the integrator (E changes K).

@@ -178,6 +178,14 @@ class McreProblem {
   void StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
                     StreamingTotals* totals = nullptr);
 
+  // The weight beta_k [N/m or N m] of each trace row (0 for an end channel left out).
+  Vector TraceWeights() const;
+  // traces = H U of the direct sweep with W = 0 and the measured forces (the model
+  // driven by the data alone, at the current moduli), num_traces() x (m + 1): the
+  // predicted outputs whose valleys the global scan must resolve (valley_spacing.h).
+  // One direct sweep, O(n) memory (no field stored); resizes traces.
+  void DataResponseTraces(Matrix* traces);
+
   // Number of sweeps (direct + retrograde) run since construction.
   long sweep_count() const { return sweep_count_; }
   // Number of factorisations of the integrator's iteration matrix since construction

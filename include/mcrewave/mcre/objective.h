@@ -56,6 +56,12 @@ class ModulusObjective {
   // Inner sweeps (direct + retrograde) of every evaluation so far; 0 when the
   // objective has no inner solver (the default).
   virtual long sweeps() const { return 0; }
+
+  // The predicted mean spacing, in ln E, of the valleys of the cost
+  // (PredictedValleySpacing of optim/valley_spacing.h on the model's response to
+  // the measured loads); 0 when the objective cannot tell (the default). Runs the
+  // model once (counted in sweeps()).
+  virtual double ValleySpacing() { return 0.0; }
 };
 
 // E = parameter x modulus_scale [Pa], the trial modulus of an optimiser's parameter;
@@ -135,6 +141,9 @@ class McreObjective : public ModulusObjective {
   const CoupledSolution& last_solution() const { return solution_; }
   // Sweeps (direct + retrograde) of every evaluation.
   long sweeps() const override { return problem_.sweep_count(); }
+  // From the traces of the model driven by the measured forces at the problem's
+  // current moduli (McreProblem::DataResponseTraces), weighted by beta_k: one sweep.
+  double ValleySpacing() override;
 
   // The next evaluation starts its inner iteration from this retrograde field
   // (shape of problem().ZeroField()) instead of the last usable solutions; later

@@ -18,19 +18,34 @@
 // Both see the same objective: x = E / E_scale of order 1 (E_scale =
 // objective->modulus_scale()) and the cost scaled by the objective.
 //
-// Global search (scan_points > 0, the default): e^2(E) of noisy data is rugged
-// (the noise shifts the model's resonances in and out of phase with it as E
-// changes, docs/robustness.md), so a local optimiser started anywhere stops in
-// the nearest valley. Identify first evaluates the cost on scan_points moduli
-// evenly spaced in log E over [lower_bound, upper_bound] (copies of the objective at the
-// loose inner tolerance scan_tolerance, in 8 fixed contiguous chunks, each a
+// Global search (scan_points > 0, the default; docs/global_search.md): e^2(E) of
+// noisy data is rugged (the noise shifts the model's resonances in and out of
+// phase with it as E changes), so a local optimiser started anywhere stops in the
+// nearest valley, and different optimisers in different valleys. Identify first
+// samples the cost AND its gradient over [lower_bound, upper_bound], evenly in
+// log E, finely enough to see every valley: the objective predicts the mean
+// spacing of the valleys in ln E from the model's response to the measured loads
+// (ModulusObjective::ValleySpacing, valley_spacing.h), and the scan takes
+// scan_samples_per_valley samples per spacing (never fewer than scan_points, never
+// more than scan_max_points). The samples run at the loose inner tolerance
+// scan_tolerance, on copies of the objective in 8 fixed contiguous chunks, each a
 // fresh copy warm-started point to point, spread over scan_threads threads: every
-// cost is the same bits whatever the thread count or timing), counts the local minima of those
-// samples, and then refines the refine_candidates lowest of them with the local optimiser, each
-// bracketed by its two neighbouring scan points (a sampled minimum c_i < c_{i-1},
-// c_{i+1} of a continuous cost holds a local minimum strictly between them). The
-// refined minimum of least cost is the result. scan_points = 0 keeps the local
-// search from `initial` alone.
+// sample is the same bits whatever the thread count or timing.
+//
+// Valleys. Between neighbouring samples x_i < x_{i+1} with costs c and
+// gradients g, the cubic Hermite interpolant p of (c_i, g_i, c_{i+1}, g_{i+1})
+// locates a valley when it has a local minimum inside: always when g_i < 0 <=
+// g_{i+1} (a sign change of de^2/dE brackets a minimum), and also when two
+// extrema hide between samples of one sign. A positive gradient at the lower
+// bound (negative at the upper) is a valley at that bound. Each valley gets its
+// estimate x* (p's minimum), p(x*) and the curvature p''(x*). Every valley whose
+// estimated cost lies within refine_margin (relative) of the lowest estimate is
+// refined (at most refine_candidates, lowest first) by the local optimiser inside
+// its bracket [x_i, x_{i+1}], started at x* with the curvature (Ceres' parameter is
+// scaled so that its first step is the Newton step of p); a refinement that ends on
+// an inner edge of its bracket is run again over the two neighbouring intervals.
+// The refined valley of least cost is the result; every valley is reported.
+// scan_points = 0 keeps the local search from `initial` alone.
 #pragma once
 
 #include <limits>
@@ -81,32 +96,59 @@ struct IdentificationOptions {
   double relative_tolerance = 1e-7;
   // e^2 evaluations allowed to the whole identification, the scan's included;
   // reaching the limit is not convergence.
-  int max_evaluations = 150;
+  int max_evaluations = 1000;
   // Wall time allowed to the whole identification (scan and refinements) [s];
   // reaching it is not convergence.
   double max_time = 600.0;
-  // Moduli of the global scan, evenly spaced in log E over the bounds (ends
-  // included); 0: no scan, local search from `initial` only. 41 over the default
-  // bounds is a step of 3.5 % in E, under a third of the spacing of the valleys
-  // measured at SNR 2.5 (docs/robustness.md).
+  // Fewest moduli of the global scan, evenly spaced in log E over the bounds
+  // (ends included); 0: no scan, local search from `initial` only. 41 over the
+  // default bounds is a step of 3.5 % in E.
   int scan_points = 41;
+  // Samples per predicted valley spacing (ModulusObjective::ValleySpacing); the
+  // scan takes max(scan_points, this many per spacing over the bounds). With the
+  // gradient at every sample, a valley is missed only when a maximum and a minimum
+  // fall between two samples; at 4 per mean spacing, the scans of the paper's case
+  // saw every valley a 0.06 % grid sees (docs/global_search.md). 0: scan_points alone.
+  double scan_samples_per_valley = 4.0;
+  // Most samples of the scan; a scan that would need more is cut to this and
+  // reported (summary.scan_resolution_limited, a warning).
+  int scan_max_points = 2000;
   // Relative residual asked of the inner solves of the scan (the refinement uses
-  // the objective's own, inner.tolerance): the scan only ranks valleys. 1e-4 picks
-  // the same brackets as 1e-5 on paper_bar.yaml over seeds 1..10 (identical refined
-  // E) for 14 % fewer scan sweeps (docs/performance.md).
+  // the objective's own, inner.tolerance): the scan only ranks and brackets
+  // valleys.
   double scan_tolerance = 1e-4;
   // Threads of the scan (each its own copy of the objective).
   int scan_threads = 2;
-  // Lowest sampled minima refined by the local optimiser.
-  int refine_candidates = 2;
+  // Every valley whose estimated scaled cost is within refine_margin x the lowest
+  // estimate (relative) is refined: at its minimum, e^2 of noisy data is mostly the
+  // noise's energy, whose relative spread between noise draws is sqrt(2 / N) for N
+  // independent samples (1.7 % for the unfiltered record of the paper's case, 9 %
+  // filtered), so valleys closer than that cannot be told apart by their cost.
+  double refine_margin = 0.05;
+  // Most valleys refined.
+  int refine_candidates = 10;
 
   // Valid when 0 < lower_bound < initial < upper_bound (finite),
   // relative_tolerance in (0, 0.1), max_evaluations >= 2 (and >= scan_points + 2
-  // with a scan), max_time > 0, the
-  // algorithm exists for the optimiser, scan_points is 0 or in [3, 100000],
-  // scan_tolerance in (0, 1), scan_threads in [1, 64] and refine_candidates in
+  // with a scan), max_time > 0, the algorithm exists for the optimiser,
+  // scan_points is 0 or in [3, 100000], scan_samples_per_valley 0 or in [1, 100],
+  // scan_max_points in [scan_points, 100000], scan_tolerance in (0, 1),
+  // scan_threads in [1, 64], refine_margin in [0, 10] and refine_candidates in
   // [1, 100]. Messages name the outer.* keys.
   bool IsValid(std::string* error) const;
+};
+
+// A valley of the cost seen by the global scan.
+struct ScanValley {
+  double lower_modulus = -1.0;      // [Pa] its bracket, two neighbouring samples
+  double upper_modulus = -1.0;      // [Pa]
+  double estimated_modulus = -1.0;  // [Pa] minimum of the Hermite interpolant
+  double estimated_cost = 0.0;      // scaled cost there (the interpolant's)
+  bool refined = false;
+  TerminationType termination = TerminationType::kFailure;  // of its refinement
+  double modulus = -1.0;  // [Pa] refined minimiser (-1: not refined)
+  double cost = 0.0;      // scaled cost there
+  int evaluations = 0;    // of its refinement
 };
 
 struct IdentificationSummary {
@@ -125,17 +167,24 @@ struct IdentificationSummary {
   double wall_time_s = -1.0;
 
   // The global scan (empty / zero when scan_points = 0).
-  std::vector<double> scan_moduli;  // [Pa], ascending
-  std::vector<double> scan_costs;   // scaled cost at scan_moduli (NaN: not usable)
-  int scan_evaluations = 0;         // scan evaluations, not counted in `evaluations`
-  long scan_sweeps = 0;             // inner sweeps of the scan (its copies' or the objective's)
-  int scan_failures = 0;            // scan samples without a usable cost (NaN in scan_costs)
-  int local_minima = 0;             // sampled local minima of scan_costs (ends included)
-  // Scaled cost of the second-lowest minimum minus the lowest, both refined
-  // when refined (NaN with fewer than two minima): a small gap says a second
-  // valley nearly as deep, i.e. a fragile identification.
+  std::vector<double> scan_moduli;     // [Pa], ascending
+  std::vector<double> scan_costs;      // scaled cost at scan_moduli (NaN: not usable)
+  std::vector<double> scan_gradients;  // d cost / dx there (NaN: not usable)
+  int scan_evaluations = 0;            // scan evaluations, not counted in `evaluations`
+  long scan_sweeps = 0;                // inner sweeps of the scan (its copies' or the objective's)
+  int scan_failures = 0;               // scan samples without a usable cost (NaN in scan_costs)
+  // Predicted mean spacing of the valleys in ln E (0: the objective cannot tell).
+  double predicted_valley_spacing = 0.0;
+  // The scan wanted more than outer.scan_max_points samples: valleys may be missed.
+  bool scan_resolution_limited = false;
+  // Every valley the scan saw, lowest estimated cost first.
+  std::vector<ScanValley> valleys;
+  int local_minima = 0;  // valleys.size()
+  // Scaled cost of the second-lowest valley minus the lowest, both refined when
+  // refined (NaN with fewer than two valleys): a small gap says a second valley
+  // nearly as deep, i.e. a fragile identification.
   double cost_gap = std::numeric_limits<double>::quiet_NaN();
-  double second_modulus = -1.0;  // [Pa] the second-lowest minimum (-1: none)
+  double second_modulus = -1.0;  // [Pa] the second-lowest valley (-1: none)
   int refinements = 0;           // local refinements run
   double scan_wall_time_s = 0.0;
 
