@@ -171,8 +171,9 @@ TEST(IdentifyRunTest, OneTwoOrFourThreadsWriteTheSameBits) {
   for (std::size_t k = 1; k < runs.size(); ++k) {
     EXPECT_EQ(WithoutRunLines(ReadText(runs[0].folder + "/summary.yaml")),
               WithoutRunLines(ReadText(runs[k].folder + "/summary.yaml")));
-    for (const char* file : {"evaluations.csv", "cost_curve.csv", "scan.csv", "ends.csv",
-                             "inner_residual.csv", "error_map.csv"}) {
+    for (const char* file :
+         {"evaluations.csv", "cost_curve.csv", "scan.csv", "valleys.csv", "ends.csv",
+          "inner_residual.csv", "error_map.csv", "error_map_spacetime.dat"}) {
       EXPECT_EQ(ReadText(runs[0].folder + "/" + file), ReadText(runs[k].folder + "/" + file))
           << file << " differs between 1 and " << (k == 1 ? 2 : 4) << " threads";
     }
