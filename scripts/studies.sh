@@ -5,9 +5,12 @@
 #   results/complexity/           scripts/complexity_study.sh (the paper's Table 1, Fig. 5)
 #   results/weights/              scripts/weights_study.sh (docs/weights.md)
 #   results/robustness/, relaxation/, cost_curves/   `identify study configs/studies.yaml`
+#   results/comparator/           `identify study configs/studies.yaml --set study.kind=comparator`
+#                                 (MCRE against least squares, 100 seeds x 4 SNRs x 5 model
+#                                 errors; about 1.5 hours on 2 cores)
 #   results/damage/               `identify study configs/studies.yaml --set study.kind=damage`
 #                                 (include/mcrewave/app/study.h), which writes results/README.md
-# About 10 minutes on 2 cores. Arguments go to `identify study`, and with any of them
+# The first four parts take about 10 minutes on 2 cores. Arguments go to `identify study`, and with any of them
 # only the identify studies run, e.g.
 #   bash scripts/studies.sh --set study.kind=relaxation
 set -euo pipefail
@@ -24,6 +27,8 @@ if [ "$#" -eq 0 ]; then
 fi
 "$build_dir/identify/identify" study configs/studies.yaml --output results "$@"
 if [ "$#" -eq 0 ]; then
+  "$build_dir/identify/identify" study configs/studies.yaml --output results \
+    --set study.kind=comparator
   # The damage-localisation study (results/damage; zones and interior sensors): hours
   # on 2 cores at the paper's resolution, dominated by the SNR-10 seeds with strain
   # gauges (about 1300 inner sweeps per solve at mcre.w_e = 0.01).

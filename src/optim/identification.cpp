@@ -564,6 +564,12 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
         "({}) samples: valleys narrower than the scan's step may be missed",
         valley_spacing, options.scan_max_points);
   }
+  if (points + 2 > options.max_evaluations) {
+    spdlog::warn(
+        "scan: {} samples leave fewer than 2 of outer.max_evaluations ({}) to the refinements: "
+        "raise outer.max_evaluations",
+        points, options.max_evaluations);
+  }
   std::string scan_failure;
   long scan_sweeps = 0;
   std::vector<double> costs, gradients;
