@@ -217,6 +217,11 @@ TEST(ConfigTest, ScanAndPrefilterKeysAreReadAndChecked) {
            {"outer.scan_points=2", "outer.scan_points"},
            {"outer.scan_points=-1", "outer.scan_points"},
            {"outer.scan_tolerance=1.5", "outer.scan_tolerance"},
+           {"outer.scan_samples_per_valley=0.5", "outer.scan_samples_per_valley"},
+           {"outer.scan_samples_per_valley=-1", "outer.scan_samples_per_valley"},
+           {"outer.scan_max_points=20", "outer.scan_max_points"},
+           {"outer.refine_margin=-0.1", "outer.refine_margin"},
+           {"outer.refine_margin=.nan", "outer.refine_margin"},
            {"prefilter.order=3", "prefilter.order"},
            {"prefilter.cutoff_frequency=-1", "prefilter.cutoff_frequency"}}) {
     try {
