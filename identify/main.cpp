@@ -14,8 +14,9 @@
 //   identify simulate configs/paper_bar.yaml --set model.elements=400 --output fine.csv
 //   identify study configs/studies.yaml --output results
 //   identify study configs/studies.yaml --set study.kind=robustness --set study.robustness_seeds=10
-//   identify study configs/paper_bar.yaml --set study.kind=comparator --set
-//   study.comparator_seeds=30 identify --print-default-config > my_config.yaml
+//   identify study configs/paper_bar.yaml --set study.kind=comparator
+//   identify run configs/paper_bar.yaml --set outer.functional=least_squares -o /tmp/ls
+//   identify --print-default-config > my_config.yaml
 //
 // Description:
 //   `run` reads a YAML config, gets the measurements (synthetic, or the CSV file
@@ -165,12 +166,42 @@ void CheckOutputFolder(const std::string& folder) {
   }
 }
 
+// Steps 3 to 5 of RunIdentify with outer.functional: least_squares: the
+// comparator's estimate of E, its fit and cost curve.
+int IdentifyByLeastSquares(const mcrewave::Config& config, const mcrewave::MeasurementSet& data) {
+  const mcrewave::LeastSquaresRun run = mcrewave::RunLeastSquares(config, data);
+  const std::string on_bound =
+      run.IsUsable() ? mcrewave::ModulusOnBoundMessage(run.identified_modulus(), config.outer)
+                     : run.outer.message;
+  if (!on_bound.empty()) {
+    std::fprintf(stderr, "error: identification failed: %s\n", on_bound.c_str());
+    return 1;
+  }
+  std::vector<std::string> files;
+  {
+    const ResultsBeingWritten held;
+    files = mcrewave::WriteLeastSquaresResults(run, config.output.folder, config.output.figures);
+  }
+  spdlog::info("identified E = {:.9g} Pa by least squares in {} evaluations, {:.2f} s",
+               run.identified_modulus(), run.outer.scan_evaluations + run.outer.evaluations,
+               run.wall_time_s);
+  spdlog::info("wrote {} files to {}", files.size(), config.output.folder);
+  return 0;
+}
+
 int RunIdentify(const RunArguments& arguments) {
   // 1. Read and validate the config and the output folder (nothing is computed
   //    or written if either is invalid).
   mcrewave::Config config = mcrewave::LoadConfig(arguments.config_path, arguments.overrides);
   if (!arguments.output_folder.empty()) config.output.folder = arguments.output_folder;
   CheckOutputFolder(config.output.folder);
+  if (config.outer.functional == mcrewave::OuterFunctional::kLeastSquares &&
+      config.zones.ElementZones(config.model).back() > 0) {
+    throw mcrewave::InputError(arguments.config_path +
+                               ": outer.functional 'least_squares' identifies one modulus; the "
+                               "zones of model.zoning / model.zone_count are identified by the "
+                               "MCRE only (outer.functional 'mcre')");
+  }
 
   // 2. The measurements, checked against the model's time grid.
   const mcrewave::MeasurementSet data = mcrewave::LoadMeasurements(config);
@@ -184,7 +215,11 @@ int RunIdentify(const RunArguments& arguments) {
                                                                 : std::string("synthetic"),
                data.num_samples());
 
-  // 3. Identify E, then the cost curve and the uncertainty figure.
+  // 3. Identify E, then the cost curve and the uncertainty figure (by output-error
+  //    least squares instead of the MCRE with outer.functional: least_squares).
+  if (config.outer.functional == mcrewave::OuterFunctional::kLeastSquares) {
+    return IdentifyByLeastSquares(config, data);
+  }
   const mcrewave::IdentificationRun run = mcrewave::RunIdentification(config, data);
   if (!run.IsUsable()) {
     std::fprintf(stderr, "error: identification failed: %s\n", run.outer.message.c_str());

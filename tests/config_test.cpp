@@ -64,6 +64,7 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.outer.max_evaluations, actual.outer.max_evaluations);
   EXPECT_EQ(expected.outer.max_time, actual.outer.max_time);
   EXPECT_EQ(expected.outer.scan_points, actual.outer.scan_points);
+  EXPECT_EQ(expected.outer.functional, actual.outer.functional);
   EXPECT_EQ(expected.outer.scan_tolerance, actual.outer.scan_tolerance);
   EXPECT_EQ(expected.outer.scan_samples_per_valley, actual.outer.scan_samples_per_valley);
   EXPECT_EQ(expected.outer.scan_max_points, actual.outer.scan_max_points);
@@ -415,6 +416,7 @@ inner:
   shooting_condition_limit: 1e12
   shooting_segment_growth: 1e3
 outer:
+  functional: least_squares
   optimizer: ceres
   algorithm: bfgs
   lower_bound: 1e9

@@ -104,5 +104,34 @@ TEST(OutputErrorObjectiveTest, NloptAndCeresFindTheModulusOfNoiseFreeData) {
   }
 }
 
+TEST(OutputErrorObjectiveTest, FisherInformationIsTheGaussNewtonSumOfCentralDifferences) {
+  // I = sum_k c_k sum (dy_k/dE)^2 / s^2 from the forward sensitivity against the same
+  // sum of central differences of the predicted outputs (step 1e-6 E): measured
+  // 5.9e-10 relative.
+  const InverseCrime crime({"u@0.3", "e@0.55"}, 20.0);
+  OutputErrorObjective objective(crime.model, crime.data, crime.noise, 0.5, kModulus);
+  const double modulus = 1.03 * kModulus;
+  const double information = objective.Predict(modulus, true).fisher_information;
+  const double step = 1e-6 * modulus;
+  const OutputErrorPrediction plus = objective.Predict(modulus + step, false);
+  const OutputErrorPrediction minus = objective.Predict(modulus - step, false);
+  double sum = 0.0;
+  const int samples = crime.data.num_samples();
+  for (int k = 0; k < samples; ++k) {
+    const double c = (k == 0 || k == samples - 1) ? 0.5 : 1.0;
+    auto term = [&](double up, double down, double level) {
+      const double derivative = (up - down) / (2.0 * step);
+      return derivative * derivative / (level * level);
+    };
+    double channels = term(plus.uL[k], minus.uL[k], crime.noise.displacement_std) +
+                      term(plus.f0[k], minus.f0[k], crime.noise.force_std);
+    channels += term(plus.sensors[0][k], minus.sensors[0][k], crime.noise.displacement_std);
+    channels += term(plus.sensors[1][k], minus.sensors[1][k], crime.noise.strain_std);
+    sum += c * channels;
+  }
+  EXPECT_GT(information, 0.0);
+  EXPECT_NEAR(information / sum, 1.0, 5e-9) << information << " against " << sum;
+}
+
 }  // namespace
 }  // namespace mcrewave

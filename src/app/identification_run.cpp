@@ -18,6 +18,18 @@
 namespace mcrewave {
 namespace {
 
+// RMS over every strain channel (e@X) of the set; 0 without any.
+double StrainRms(const MeasurementSet& set) {
+  double squares = 0.0;
+  Eigen::Index samples = 0;
+  for (const SensorChannel& sensor : set.sensors) {
+    if (sensor.kind != SensorKind::kStrain) continue;
+    squares += sensor.values.squaredNorm();
+    samples += sensor.values.size();
+  }
+  return samples > 0 ? std::sqrt(squares / static_cast<double>(samples)) : 0.0;
+}
+
 // Relative agreement asked of a CSV's time grid with the config's.
 constexpr double kGridTolerance = 1e-6;
 
@@ -220,28 +232,7 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
   // estimated from the data's second differences otherwise.
   run.misfit = MisfitLevels(run.data, run.solution, run.alpha);
   run.estimated_noise = DifferenceNoiseLevels(data);
-  if (run.reference_known && std::isfinite(config.data.snr)) {
-    const MeasurementSet truth = SimulateTruth(config.model, config.load, config.time, config.data);
-    // std = RMS(signal) / SNR (noise.h)
-    run.noise.displacement_std = RootMeanSquare(truth.uL) / config.data.snr;
-    run.noise.force_std = RootMeanSquare(truth.fL) / config.data.snr;
-    // Strains: RMS over every strain channel / SNR (noise.h).
-    double strain_squares = 0.0;
-    Eigen::Index strain_samples = 0;
-    for (const SensorChannel& sensor : truth.sensors) {
-      if (sensor.kind != SensorKind::kStrain) continue;
-      strain_squares += sensor.values.squaredNorm();
-      strain_samples += sensor.values.size();
-    }
-    if (strain_samples > 0) {
-      run.noise.strain_std =
-          std::sqrt(strain_squares / static_cast<double>(strain_samples)) / config.data.snr;
-    }
-    run.noise_source = "synthetic_snr";
-  } else {
-    run.noise = run.estimated_noise;
-    run.noise_source = "data_differences";
-  }
+  run.noise = MeasurementNoiseLevels(config, data, &run.noise_source);
   int curvature_points = 0;
   const double curvature = CostGradientSlope(run.cost_curve, run.identified_modulus(),
                                              kCurvatureWindow, &curvature_points);
@@ -259,6 +250,86 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
   // (zone_identification_run.h).
   run.zones =
       RunZoneIdentification(config, IdentificationZoneLayout(config), run, TruthZones(config));
+  run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return run;
+}
+
+NoiseLevels MeasurementNoiseLevels(const Config& config, const MeasurementSet& data,
+                                   std::string* source) {
+  if (!(config.data.source == DataSource::kSynthetic && std::isfinite(config.data.snr))) {
+    *source = "data_differences";
+    return DifferenceNoiseLevels(data);
+  }
+  NoiseLevels noise;
+  const MeasurementSet truth = SimulateTruth(config.model, config.load, config.time, config.data);
+  // std = RMS(signal) / SNR (noise.h)
+  noise.displacement_std = RootMeanSquare(truth.uL) / config.data.snr;
+  noise.force_std = RootMeanSquare(truth.fL) / config.data.snr;
+  // Strains: RMS over every strain channel / SNR (noise.h).
+  noise.strain_std = StrainRms(truth) / config.data.snr;
+  *source = "synthetic_snr";
+  return noise;
+}
+
+LeastSquaresRun RunLeastSquares(const Config& config, const MeasurementSet& data) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  LeastSquaresRun run;
+  run.config = config;
+  run.reference_known = config.data.source == DataSource::kSynthetic;
+  run.data = PrefilterMeasurements(SelectChannels(data, config.data.channels, "data.channels",
+                                                  "the data", &run.ends.u0, &run.ends.uL),
+                                   config.prefilter, &run.prefilter_cutoff);
+  run.noise = MeasurementNoiseLevels(config, data, &run.noise_source);
+  // Noise-free data have no level to normalise by: the RMS of the channels instead
+  // (only the ratio of the weights matters then, as in the comparator study).
+  for (auto [level, rms] :
+       {std::pair<double*, double>{&run.noise.displacement_std, RootMeanSquare(run.data.uL)},
+        {&run.noise.force_std, RootMeanSquare(run.data.fL)},
+        {&run.noise.strain_std, StrainRms(run.data)}}) {
+    if (!(*level > 0.0) && rms > 0.0) {
+      *level = rms;
+      run.noise_source = "channel_rms";
+    }
+  }
+  const BarModel model(config.model);
+  OutputErrorObjective objective(model, run.data, run.noise, config.time.theta,
+                                 config.outer.initial, run.ends);
+  run.rest_cost = objective.rest_cost();
+  spdlog::info(
+      "identifying E by output-error least squares with {}/{} from {:.6g} Pa in [{:.6g}, "
+      "{:.6g}] Pa; noise levels {:.4g} m, {:.4g} N ({})",
+      OptimizerTypeToString(config.outer.optimizer),
+      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
+      config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
+      run.noise.displacement_std, run.noise.force_std, run.noise_source);
+  run.outer = Identify(config.outer, &objective);
+  spdlog::info("{}", run.outer.BriefReport());
+  if (run.IsUsable()) {
+    const double identified = run.identified_modulus();
+    run.fit = objective.Predict(identified, true);
+    // J(E) on output.curve_points moduli evenly spaced over E* +- 5 %.
+    const int points = std::max(config.output.curve_points, 3);
+    for (int i = 0; i < points; ++i) {
+      const double modulus =
+          identified * (1.0 - kCurvatureWindow + 2.0 * kCurvatureWindow * i / (points - 1.0));
+      const OutputErrorPrediction& prediction = objective.Predict(modulus, true);
+      CostCurvePoint point;
+      point.modulus = modulus;
+      point.cost = prediction.cost;
+      point.cost_gradient = prediction.cost_gradient;
+      point.usable = std::isfinite(prediction.cost) && std::isfinite(prediction.cost_gradient);
+      run.cost_curve.push_back(point);
+    }
+    int curvature_points = 0;
+    run.curvature =
+        CostGradientSlope(run.cost_curve, identified, kCurvatureWindow, &curvature_points);
+    // The Cramer-Rao bound 1 / sqrt(I), I the Fisher information at E* (OutputErrorPrediction).
+    if (run.fit.fisher_information > 0.0) {
+      run.modulus_std_bound = 1.0 / std::sqrt(run.fit.fisher_information);
+    }
+  }
+  run.sweeps = objective.sweeps() + run.outer.scan_sweeps;
   run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return run;
 }

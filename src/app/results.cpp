@@ -108,10 +108,10 @@ std::string EvaluationsCsv(const IdentificationRun& run) {
   return csv;
 }
 
-std::string CostCurveCsv(const IdentificationRun& run) {
+std::string CostCurveCsv(const std::vector<CostCurvePoint>& curve) {
   std::string csv = "modulus,cost,cost_gradient,usable\n";
   char row[256];
-  for (const CostCurvePoint& point : run.cost_curve) {
+  for (const CostCurvePoint& point : curve) {
     std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%d\n", point.modulus,
                   point.usable ? point.cost : NAN, point.usable ? point.cost_gradient : NAN,
                   point.usable ? 1 : 0);
@@ -162,16 +162,16 @@ std::string InnerResidualCsv(const IdentificationRun& run) {
 
 // The global scan: e^2 = scaled cost x J_rest and de^2/dE at each scan modulus
 // (solved at outer.scan_tolerance); usable 0 where the sample's solve failed.
-std::string ScanCsv(const IdentificationRun& run) {
+// cost_scale: J_rest of the objective; modulus_scale: its E_scale (outer.initial).
+std::string ScanCsv(const IdentificationSummary& outer, double cost_scale, double modulus_scale) {
   std::string csv = "modulus,cost,cost_gradient,usable\n";
   char row[160];
-  const IdentificationSummary& outer = run.outer;
-  // de^2/dE = (d cost/dx) J_rest / E_scale, E_scale = outer.initial.
-  const double gradient_scale = run.rest_cost / run.config.outer.initial;
+  // de^2/dE = (d cost/dx) J_rest / E_scale.
+  const double gradient_scale = cost_scale / modulus_scale;
   for (std::size_t i = 0; i < outer.scan_moduli.size(); ++i) {
     const bool usable = std::isfinite(outer.scan_costs[i]);
     std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%d\n", outer.scan_moduli[i],
-                  usable ? outer.scan_costs[i] * run.rest_cost : 0.0,
+                  usable ? outer.scan_costs[i] * cost_scale : 0.0,
                   usable ? outer.scan_gradients[i] * gradient_scale : 0.0, usable ? 1 : 0);
     csv += row;
   }
@@ -180,20 +180,20 @@ std::string ScanCsv(const IdentificationRun& run) {
 
 // Every valley of the scan: its bracket, the estimate, and the refined minimum
 // (e^2 in J s; refined 0 and modulus/cost empty when it was not refined).
-std::string ValleysCsv(const IdentificationRun& run) {
+std::string ValleysCsv(const IdentificationSummary& outer, double cost_scale) {
   std::string csv =
       "valley,lower_modulus,upper_modulus,estimated_modulus,estimated_cost,refined,modulus,cost,"
       "evaluations\n";
   char row[320];
   int index = 0;
-  for (const ScanValley& valley : run.outer.valleys) {
+  for (const ScanValley& valley : outer.valleys) {
     std::snprintf(row, sizeof(row), "%d,%.17g,%.17g,%.17g,%.17g,%d,", ++index, valley.lower_modulus,
                   valley.upper_modulus, valley.estimated_modulus,
-                  valley.estimated_cost * run.rest_cost, valley.refined ? 1 : 0);
+                  valley.estimated_cost * cost_scale, valley.refined ? 1 : 0);
     csv += row;
     if (valley.refined) {
-      std::snprintf(row, sizeof(row), "%.17g,%.17g,%d\n", valley.modulus,
-                    valley.cost * run.rest_cost, valley.evaluations);
+      std::snprintf(row, sizeof(row), "%.17g,%.17g,%d\n", valley.modulus, valley.cost * cost_scale,
+                    valley.evaluations);
     } else {
       std::snprintf(row, sizeof(row), ",,0\n");
     }
@@ -204,6 +204,19 @@ std::string ValleysCsv(const IdentificationRun& run) {
 
 // ---------------------------------------------------------------------------
 // Figures.
+
+// The gnuplot plot items of scan.csv and valleys.csv (E in GPa), each ending in ", ".
+std::string ScanPlots(const std::string& folder) {
+  return GnuplotString(folder + "/scan.csv") +
+         " skip 1 using ($1/1e9):($4 > 0 ? $2 : 1/0) with linespoints pt 5 ps 0.6 "
+         "lc rgb '#2ca02c' title 'global scan', " +
+         GnuplotString(folder + "/valleys.csv") +
+         " skip 1 using ($4/1e9):5 with points pt 9 ps 1.6 lc rgb '#ff7f0e' "
+         "title 'valleys seen (estimate)', " +
+         GnuplotString(folder + "/valleys.csv") +
+         " skip 1 using ($6 > 0 ? $7/1e9 : 1/0):8 with points pt 4 ps 2 lw 2 "
+         "lc rgb '#1f77b4' title 'valleys refined', ";
+}
 
 std::string CostCurveScript(const IdentificationRun& run, const std::string& folder) {
   const double identified = run.identified_modulus() / 1e9;
@@ -226,17 +239,7 @@ std::string CostCurveScript(const IdentificationRun& run, const std::string& fol
   const bool scanned = !outer.scan_moduli.empty();
   // The scan's samples and the valleys it saw (estimates; refined minima), on both
   // panels: the bottom one shows the valleys near E* that the top one's scale hides.
-  const std::string scan_plot =
-      !scanned ? std::string()
-               : GnuplotString(folder + "/scan.csv") +
-                     " skip 1 using ($1/1e9):($4 > 0 ? $2 : 1/0) with linespoints pt 5 ps 0.6 "
-                     "lc rgb '#2ca02c' title 'global scan', " +
-                     GnuplotString(folder + "/valleys.csv") +
-                     " skip 1 using ($4/1e9):5 with points pt 9 ps 1.6 lc rgb '#ff7f0e' "
-                     "title 'valleys seen (estimate)', " +
-                     GnuplotString(folder + "/valleys.csv") +
-                     " skip 1 using ($6 > 0 ? $7/1e9 : 1/0):8 with points pt 4 ps 2 lw 2 "
-                     "lc rgb '#1f77b4' title 'valleys refined', ";
+  const std::string scan_plot = scanned ? ScanPlots(folder) : std::string();
   for (int panel = 0; panel < 2; ++panel) {
     if (panel == 0 && scanned) {
       // Bounds over a decade or more: log E, as the scan is spaced.
@@ -362,6 +365,69 @@ std::string ErrorMapScript(const IdentificationRun& run, const std::string& fold
   return script.str();
 }
 
+// The optimizer:, scan: and prefilter: blocks of a summary, for a cost named
+// `cost` (e^2 or J) in `unit` (J s or s) whose scale is cost_scale.
+void OptimizerScanAndPrefilterYaml(const IdentificationSummary& outer, double cost_scale,
+                                   const Config& config, double prefilter_cutoff,
+                                   const std::string& cost, const std::string& unit,
+                                   YamlWriter* yaml) {
+  yaml->Line(0, "optimizer", "");
+  yaml->Text(1, "name", OptimizerTypeToString(outer.optimizer));
+  yaml->Text(1, "algorithm", OuterAlgorithmToString(outer.algorithm));
+  yaml->Text(1, "termination", TerminationTypeToString(outer.termination));
+  yaml->Text(1, "message", outer.message);
+  yaml->Text(1, "optimizer_message", outer.optimizer_message, "the optimiser's own words");
+  yaml->Number(1, "initial_modulus", outer.initial_modulus, "[Pa]");
+  yaml->Integer(1, "evaluations", outer.evaluations, "of the local refinements (scan apart)");
+  yaml->Integer(1, "gradient_evaluations", outer.gradient_evaluations,
+                "of which with the gradient");
+  yaml->Integer(1, "iterations", outer.iterations, "Ceres iterations (-1: NLopt)");
+  yaml->Number(1, "scaled_cost", outer.cost, cost + " / cost_scale at the identified modulus");
+  yaml->Number(1, "cost_scale", cost_scale,
+               "[" + unit + "] " + cost + " of the bar left at rest, the scale of the cost");
+  yaml->Number(1, "wall_time_s", outer.wall_time_s, "[s] scan and refinements");
+
+  yaml->Line(0, "scan", "",
+             "global scan of " + cost + " and d" + cost + "/dE over the bounds (outer.scan_*)");
+  yaml->Integer(1, "points", static_cast<long>(outer.scan_moduli.size()), "0: no scan");
+  yaml->Number(1, "predicted_valley_spacing", outer.predicted_valley_spacing,
+               "mean spacing of the valleys of " + cost + " in ln E (0: not predicted)");
+  yaml->Line(1, "resolution_limited", outer.scan_resolution_limited ? "true" : "false",
+             "true: more samples wanted than outer.scan_max_points");
+  yaml->Integer(1, "local_minima", outer.local_minima,
+                "valleys of " + cost + " seen (valleys.csv)");
+  yaml->Integer(1, "failed_points", outer.scan_failures, "samples without a usable cost");
+  yaml->Number(1, "second_modulus", outer.second_modulus > 0.0 ? outer.second_modulus : NAN,
+               "[Pa] the second-lowest valley (null: fewer than two)");
+  yaml->Number(1, "scaled_cost_gap", outer.cost_gap,
+               cost + " / cost_scale of the second-lowest valley minus the lowest");
+  yaml->Number(1, "cost_gap", outer.cost_gap * cost_scale,
+               "[" + unit + "] the same gap of " + cost);
+  yaml->Integer(1, "refinements", outer.refinements,
+                "valleys refined (within outer.refine_margin of the lowest)");
+  yaml->Line(
+      1, "valleys", "",
+      "every valley: estimate [Pa], refined minimiser [Pa] or null, " + cost + " [" + unit + "]");
+  for (const ScanValley& valley : outer.valleys) {
+    yaml->Raw("    - {estimate: " + Format(valley.estimated_modulus) +
+              ", modulus: " + Format(valley.refined ? valley.modulus : NAN) + ", cost: " +
+              Format((valley.refined ? valley.cost : valley.estimated_cost) * cost_scale) +
+              ", refined: " + (valley.refined ? "true" : "false") + "}");
+  }
+  yaml->Integer(1, "sweeps", outer.scan_sweeps, "sweeps of the scan");
+  yaml->Number(1, "wall_time_s", outer.scan_wall_time_s, "[s] of the scan");
+
+  yaml->Line(0, "prefilter", "", "zero-phase low-pass of the measurements (prefilter.*)");
+  yaml->Line(1, "enabled", config.prefilter.enabled ? "true" : "false");
+  yaml->Number(1, "cutoff_frequency", config.prefilter.enabled ? prefilter_cutoff : NAN,
+               "[Hz] cut-off used (null: off)");
+  yaml->Text(1, "cutoff_source",
+             !config.prefilter.enabled                 ? "off"
+             : config.prefilter.cutoff_frequency > 0.0 ? "config"
+                                                       : "derived_from_load",
+             "config: prefilter.cutoff_frequency; derived_from_load: EstimateCutoffFrequency");
+}
+
 std::string SummaryYaml(const IdentificationRun& run) {
   const IdentificationSummary& outer = run.outer;
   const double identified = run.identified_modulus();
@@ -418,57 +484,8 @@ std::string SummaryYaml(const IdentificationRun& run) {
               "[N] RMS of F - f~ = -W / alpha at both ends, at the optimum");
   yaml.Integer(1, "sweeps", uncertainty.sweeps, "of the noise solves");
 
-  yaml.Line(0, "optimizer", "");
-  yaml.Text(1, "name", OptimizerTypeToString(outer.optimizer));
-  yaml.Text(1, "algorithm", OuterAlgorithmToString(outer.algorithm));
-  yaml.Text(1, "termination", TerminationTypeToString(outer.termination));
-  yaml.Text(1, "message", outer.message);
-  yaml.Text(1, "optimizer_message", outer.optimizer_message, "the optimiser's own words");
-  yaml.Number(1, "initial_modulus", outer.initial_modulus, "[Pa]");
-  yaml.Integer(1, "evaluations", outer.evaluations, "of the local refinements (scan apart)");
-  yaml.Integer(1, "gradient_evaluations", outer.gradient_evaluations,
-               "of which with the adjoint gradient");
-  yaml.Integer(1, "iterations", outer.iterations, "Ceres iterations (-1: NLopt)");
-  yaml.Number(1, "scaled_cost", outer.cost, "e^2 / cost_scale at the identified modulus");
-  yaml.Number(1, "cost_scale", run.rest_cost,
-              "[J s] J_rest, the functional of the bar left at rest (>= e^2 for every E)");
-  yaml.Number(1, "wall_time_s", outer.wall_time_s, "[s] scan and refinements");
-
-  yaml.Line(0, "scan", "", "global scan of e^2 and de^2/dE over the bounds (outer.scan_*)");
-  yaml.Integer(1, "points", static_cast<long>(outer.scan_moduli.size()), "0: no scan");
-  yaml.Number(1, "predicted_valley_spacing", outer.predicted_valley_spacing,
-              "mean spacing of the valleys of e^2 in ln E (0: not predicted)");
-  yaml.Line(1, "resolution_limited", outer.scan_resolution_limited ? "true" : "false",
-            "true: more samples wanted than outer.scan_max_points");
-  yaml.Integer(1, "local_minima", outer.local_minima, "valleys of e^2 seen (valleys.csv)");
-  yaml.Integer(1, "failed_points", outer.scan_failures, "samples without a usable cost");
-  yaml.Number(1, "second_modulus", outer.second_modulus > 0.0 ? outer.second_modulus : NAN,
-              "[Pa] the second-lowest valley (null: fewer than two)");
-  yaml.Number(1, "scaled_cost_gap", outer.cost_gap,
-              "e^2 / cost_scale of the second-lowest valley minus the lowest");
-  yaml.Number(1, "cost_gap", outer.cost_gap * run.rest_cost, "[J s] the same gap of e^2");
-  yaml.Integer(1, "refinements", outer.refinements,
-               "valleys refined (within outer.refine_margin of the lowest)");
-  yaml.Line(1, "valleys", "",
-            "every valley: estimate [Pa], refined minimiser [Pa] or null, e^2 [J s]");
-  for (const ScanValley& valley : outer.valleys) {
-    yaml.Raw("    - {estimate: " + Format(valley.estimated_modulus) +
-             ", modulus: " + Format(valley.refined ? valley.modulus : NAN) + ", cost: " +
-             Format((valley.refined ? valley.cost : valley.estimated_cost) * run.rest_cost) +
-             ", refined: " + (valley.refined ? "true" : "false") + "}");
-  }
-  yaml.Integer(1, "sweeps", outer.scan_sweeps, "direct + retrograde sweeps of the scan");
-  yaml.Number(1, "wall_time_s", outer.scan_wall_time_s, "[s] of the scan");
-
-  yaml.Line(0, "prefilter", "", "zero-phase low-pass of the measurements (prefilter.*)");
-  yaml.Line(1, "enabled", run.config.prefilter.enabled ? "true" : "false");
-  yaml.Number(1, "cutoff_frequency", run.config.prefilter.enabled ? run.prefilter_cutoff : NAN,
-              "[Hz] cut-off used (null: off)");
-  yaml.Text(1, "cutoff_source",
-            !run.config.prefilter.enabled                 ? "off"
-            : run.config.prefilter.cutoff_frequency > 0.0 ? "config"
-                                                          : "derived_from_load",
-            "config: prefilter.cutoff_frequency; derived_from_load: EstimateCutoffFrequency");
+  OptimizerScanAndPrefilterYaml(outer, run.rest_cost, run.config, run.prefilter_cutoff, "e^2",
+                                "J s", &yaml);
 
   long inner_iterations = 0;
   int max_inner_iterations = 0;
@@ -531,12 +548,12 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
     written.push_back(path);
   };
   write("evaluations.csv", EvaluationsCsv(run));
-  write("cost_curve.csv", CostCurveCsv(run));
+  write("cost_curve.csv", CostCurveCsv(run.cost_curve));
   write("ends.csv", EndsCsv(run));
   write("inner_residual.csv", InnerResidualCsv(run));
   if (!run.outer.scan_moduli.empty()) {
-    write("scan.csv", ScanCsv(run));
-    write("valleys.csv", ValleysCsv(run));
+    write("scan.csv", ScanCsv(run.outer, run.rest_cost, run.config.outer.initial));
+    write("valleys.csv", ValleysCsv(run.outer, run.rest_cost));
   }
   if (run.error_map.share.size() > 0) {
     write("error_map.csv", ErrorMapCsv(run));
@@ -574,6 +591,173 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
   }
   // The summary last: its presence says the folder is complete.
   write("summary.yaml", SummaryYaml(run));
+  return written;
+}
+
+namespace {
+
+// Measured and predicted channels of the least-squares fit at the identified E:
+// uL (x = L) and f0 (the clamp reaction), then each interior sensor.
+std::string FitCsv(const LeastSquaresRun& run) {
+  const MeasurementSet& data = run.data;
+  const OutputErrorPrediction& fit = run.fit;
+  std::string csv = "t,uL_measured,uL_model,f0_measured,f0_model";
+  for (const SensorChannel& sensor : data.sensors) {
+    csv += "," + sensor.name + "_measured," + sensor.name + "_model";
+  }
+  csv += "\n";
+  char row[128];
+  for (int j = 0; j < data.num_samples(); ++j) {
+    std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g,%.17g", data.Time(j), data.uL[j],
+                  fit.uL[j], data.f0[j], fit.f0[j]);
+    csv += row;
+    for (std::size_t k = 0; k < data.sensors.size(); ++k) {
+      std::snprintf(row, sizeof(row), ",%.17g,%.17g", data.sensors[k].values[j], fit.sensors[k][j]);
+      csv += row;
+    }
+    csv += "\n";
+  }
+  return csv;
+}
+
+std::string LeastSquaresCostCurveScript(const LeastSquaresRun& run, const std::string& folder) {
+  const double identified = run.identified_modulus() / 1e9;
+  const bool scanned = !run.outer.scan_moduli.empty();
+  std::ostringstream script;
+  script << GnuplotPngTerminal() << "set terminal pngcairo size 1000,1000\n"
+         << "set multiplot layout 2,1 title 'Output-error least squares J(E); identified E = "
+         << identified << " GPa (dashed)'\n"
+         << "set xlabel 'E [GPa]'\nset ylabel 'J [s]'\nset format y '%.5g'\nset key top center\n"
+         << "set arrow 1 from " << identified << ", graph 0 to " << identified
+         << ", graph 1 nohead dashtype 2 lc rgb '#555555'\n";
+  const std::string curve = GnuplotString(folder + "/cost_curve.csv") +
+                            " skip 1 using ($1/1e9):($4 > 0 ? $2 : 1/0) with linespoints pt 7 "
+                            "ps 0.5 lw 2 lc rgb '#8b00c9' title 'J(E), cost curve'";
+  if (scanned) {
+    if (run.outer.scan_moduli.back() >= 10.0 * run.outer.scan_moduli.front())
+      script << "set logscale x\n";
+    script << "set title 'global scan over the bounds, its valleys and the local refinements'\n"
+           << "plot " << ScanPlots(folder) << curve << "\nunset logscale x\n";
+  }
+  script << "set title 'within 5 % of the identified E'\nset xrange ["
+         << identified * (1.0 - kCurvatureWindow) << ":" << identified * (1.0 + kCurvatureWindow)
+         << "]\nplot " << (scanned ? ScanPlots(folder) : std::string()) << curve
+         << "\nunset multiplot\n";
+  return script.str();
+}
+
+std::string FitScript(const LeastSquaresRun& run, const std::string& folder) {
+  const std::string csv = GnuplotString(folder + "/fit.csv");
+  const char* measured = run.config.prefilter.enabled ? "measured, pre-filtered" : "measured";
+  std::ostringstream script;
+  script << GnuplotPngTerminal() << "set terminal pngcairo size 1200,500\nset multiplot layout 1,2 "
+         << "title 'Least-squares fit at the identified modulus: the clamped model driven by the "
+            "measured f_L'\n"
+         << "set xlabel 't [ms]'\n"
+         << "set title 'u_L (x = L)'\nset ylabel 'u [um]'\nplot " << csv
+         << " skip 1 using ($1*1e3):($2*1e6) with lines lc rgb '#aaaaaa' title '" << measured
+         << "', " << csv
+         << " skip 1 using ($1*1e3):($3*1e6) with lines lw 2 lc rgb '#1f4e9c' title 'model'\n"
+         << "set title 'f_0 (x = 0, clamp reaction)'\nset ylabel 'f [N]'\nplot " << csv
+         << " skip 1 using ($1*1e3):4 with lines lc rgb '#aaaaaa' title '" << measured << "', "
+         << csv << " skip 1 using ($1*1e3):5 with lines lw 2 lc rgb '#1f4e9c' title 'model'\n"
+         << "unset multiplot\n";
+  return script.str();
+}
+
+}  // namespace
+
+std::string LeastSquaresSummaryYaml(const LeastSquaresRun& run) {
+  const IdentificationSummary& outer = run.outer;
+  const double identified = run.identified_modulus();
+  const double reference = run.reference_known ? run.config.model.modulus : NAN;
+  YamlWriter yaml;
+  yaml.Raw("# mcrewave identify run: the modulus E identified by output-error least squares J(E)");
+  if (!run.config.source_path.empty()) yaml.Raw("# config: " + run.config.source_path);
+  yaml.Text(0, "version", kVersion, "mcrewave version");
+  yaml.Text(0, "functional", OuterFunctionalToString(run.config.outer.functional),
+            "outer.functional");
+  yaml.Number(0, "identified_modulus", identified, "[Pa] E minimising J");
+  yaml.Number(0, "reference_modulus", reference,
+              "[Pa] E the synthetic data were made with (null: unknown, CSV data)");
+  yaml.Number(0, "relative_error", run.reference_known ? (identified - reference) / reference : NAN,
+              "(identified - reference) / reference (null when unknown)");
+  yaml.Number(0, "cost", run.fit.cost,
+              "[s] J = 1/2 sum_k c_k h (misfit / noise level)^2 at the identified modulus");
+  yaml.Integer(0, "evaluations", outer.scan_evaluations + outer.evaluations,
+               "J evaluations of the identification: the scan's and the refinements'");
+  yaml.Integer(0, "sweeps", run.sweeps, "simulations and sensitivity sweeps, curve included");
+  yaml.Number(0, "wall_time_s", run.wall_time_s, "[s] identification and cost curve");
+
+  yaml.Line(0, "uncertainty", "");
+  yaml.Number(1, "modulus_std_bound", run.modulus_std_bound,
+              "[Pa] 1 / sqrt(I): Cramer-Rao bound with the measured load taken as exact");
+  yaml.Number(1, "relative_std_bound", run.modulus_std_bound / identified,
+              "modulus_std_bound / identified_modulus; the load's noise is not counted");
+  yaml.Number(1, "fisher_information", run.fit.fisher_information,
+              "[1/Pa^2] sum_k c_k sum (dy/dE)^2 / s^2 at the identified modulus");
+  yaml.Number(1, "curvature", run.curvature,
+              "[s/Pa^2] d^2J/dE^2 observed, least-squares slope of dJ/dE over E +- 5 %");
+  yaml.Number(1, "noise_std_displacement", run.noise.displacement_std,
+              "[m] s_u, the normalisation of the displacement misfit");
+  yaml.Number(1, "noise_std_force", run.noise.force_std, "[N] s_f, of the force misfit");
+  yaml.Number(1, "noise_std_strain", run.noise.strain_std, "[-] s_e, of the strain misfit");
+  yaml.Text(1, "noise_source", run.noise_source,
+            "synthetic_snr: the data's own noise; data_differences: estimated from the data; "
+            "channel_rms: noise-free data, the channels' RMS");
+
+  OptimizerScanAndPrefilterYaml(outer, run.rest_cost, run.config, run.prefilter_cutoff, "J", "s",
+                                &yaml);
+
+  yaml.Line(0, "cost_curve", "");
+  yaml.Integer(1, "points", static_cast<long>(run.cost_curve.size()));
+  yaml.Number(1, "lowest_modulus", run.cost_curve.empty() ? NAN : run.cost_curve.front().modulus,
+              "[Pa]");
+  yaml.Number(1, "highest_modulus", run.cost_curve.empty() ? NAN : run.cost_curve.back().modulus,
+              "[Pa]");
+
+  yaml.Line(0, "config", "", "as resolved (every key)");
+  std::istringstream config(ConfigToYaml(run.config));
+  for (std::string line; std::getline(config, line);) yaml.Raw("  " + line);
+  return yaml.str();
+}
+
+std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
+                                                  const std::string& folder, bool figures) {
+  std::error_code error;
+  std::filesystem::create_directories(folder, error);
+  if (error) throw std::runtime_error("cannot create folder " + folder + ": " + error.message());
+  std::vector<std::string> written;
+  auto write = [&](const std::string& name, const std::string& content) {
+    const std::string path = folder + "/" + name;
+    WriteFileAtomically(path, content);
+    written.push_back(path);
+  };
+  write("cost_curve.csv", CostCurveCsv(run.cost_curve));
+  write("fit.csv", FitCsv(run));
+  if (!run.outer.scan_moduli.empty()) {
+    write("scan.csv", ScanCsv(run.outer, run.rest_cost, run.config.outer.initial));
+    write("valleys.csv", ValleysCsv(run.outer, run.rest_cost));
+  }
+  if (figures) {
+    bool gnuplot_missing = false;
+    for (const auto& [name, script] : std::vector<std::pair<std::string, std::string>>{
+             {"cost_curve", LeastSquaresCostCurveScript(run, folder)},
+             {"fit", FitScript(run, folder)}}) {
+      const std::string why = DrawGnuplotFigure(folder, name, script, &gnuplot_missing);
+      if (gnuplot_missing) {
+        spdlog::warn("gnuplot not found on the PATH: figures skipped (the CSV files are written)");
+        break;
+      }
+      if (!why.empty()) {
+        spdlog::warn("figure {}.png skipped: {}", name, why);
+        continue;
+      }
+      written.push_back(folder + "/" + name + ".png");
+    }
+  }
+  // The summary last: its presence says the folder is complete.
+  write("summary.yaml", LeastSquaresSummaryYaml(run));
   return written;
 }
 

@@ -104,7 +104,7 @@ const OutputErrorPrediction& OutputErrorObjective::Predict(double modulus,
   displacement_.setZero();
   sensitivity_velocity_.setZero();
   sensitivity_.setZero();
-  double cost = 0.0, gradient = 0.0;
+  double cost = 0.0, gradient = 0.0, information = 0.0;
   for (int k = 0; k < samples; ++k) {
     if (k > 0) {
       // f_theta = (theta fL~_k + (1 - theta) fL~_{k-1}) e_N on the step t_{k-1} -> t_k.
@@ -153,19 +153,28 @@ const OutputErrorPrediction& OutputErrorObjective::Predict(double modulus,
       const double df0 = mass_01_ * acceleration_sensitivity_[0] + stiffness_01 * shift_[0];
       // d/dE of the bracket above, times c_k h / 2.
       double dsum = 2.0 * weight_f * residual_f * df0;
-      if (ends_.uL) dsum += 2.0 * weight_u * residual_u * sensitivity_[loaded];
+      // c_k sum (dy/dE)^2 / s^2, the Fisher information's terms.
+      double isum = weight_f * df0 * df0;
+      if (ends_.uL) {
+        dsum += 2.0 * weight_u * residual_u * sensitivity_[loaded];
+        isum += weight_u * sensitivity_[loaded] * sensitivity_[loaded];
+      }
       if (!sensor_rows_.empty()) nodal_.tail(nodal_.size() - 1) = sensitivity_;
       for (std::size_t i = 0; i < sensor_rows_.size(); ++i) {
         const double residual = prediction_.sensors[i][k] - data_.sensors[i].values[k];
-        dsum += 2.0 * sensor_weights_[i] * residual * sensor_rows_[i].Apply(nodal_.data());
+        const double derivative = sensor_rows_[i].Apply(nodal_.data());
+        dsum += 2.0 * sensor_weights_[i] * residual * derivative;
+        isum += sensor_weights_[i] * derivative * derivative;
       }
       gradient += 0.5 * c * h * dsum;
+      information += c * isum;
     }
   }
   sweeps_ += gradient_requested ? 2 : 1;
   prediction_.modulus = modulus;
   prediction_.cost = cost;
   prediction_.cost_gradient = gradient_requested ? gradient : 0.0;
+  prediction_.fisher_information = gradient_requested ? information : 0.0;
   return prediction_;
 }
 

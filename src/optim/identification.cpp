@@ -23,6 +23,11 @@ namespace {
 using internal::FromName;
 using internal::ToName;
 
+constexpr std::array<std::pair<OuterFunctional, const char*>, 2> kOuterFunctionals{{
+    {OuterFunctional::kMcre, "mcre"},
+    {OuterFunctional::kLeastSquares, "least_squares"},
+}};
+
 constexpr std::array<std::pair<OptimizerType, const char*>, 2> kOptimizerTypes{{
     {OptimizerType::kNlopt, "nlopt"},
     {OptimizerType::kCeres, "ceres"},
@@ -53,6 +58,13 @@ std::string AvailableAlgorithms(OptimizerType optimizer) {
 }
 
 }  // namespace
+
+const char* OuterFunctionalToString(OuterFunctional functional) {
+  return ToName(kOuterFunctionals, functional);
+}
+bool StringToOuterFunctional(const std::string& name, OuterFunctional* functional) {
+  return FromName(kOuterFunctionals, name, functional);
+}
 
 const char* OptimizerTypeToString(OptimizerType type) { return ToName(kOptimizerTypes, type); }
 bool StringToOptimizerType(const std::string& name, OptimizerType* type) {

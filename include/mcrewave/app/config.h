@@ -27,7 +27,8 @@
 //          shooting_condition_limit [1e14],
 //          shooting_segment_growth [100]
 //          (CoupledSolverOptions, coupled_solver.h)
-//   outer: optimizer [nlopt | ceres], algorithm [default | bobyqa | cobyla | sbplx |
+//   outer: functional [mcre | least_squares], optimizer [nlopt | ceres], algorithm [default |
+//   bobyqa | cobyla | sbplx |
 //          mma | lbfgs | bfgs | brent], lower_bound [100e9 Pa], upper_bound [400e9 Pa],
 //          initial [160e9 Pa], relative_tolerance [1e-7], max_evaluations [1000],
 //          max_time [600 s], scan_points [41], scan_samples_per_valley [4],

@@ -11,12 +11,14 @@
 //      gap (error_map.h) and the uncertainty figure (modulus_uncertainty.h).
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/zone_identification_run.h"
 #include "mcrewave/data/measurement.h"
+#include "mcrewave/least_squares/output_error_objective.h"
 #include "mcrewave/mcre/error_map.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/mcre/objective.h"
@@ -112,5 +114,51 @@ std::string ImplausibleMisfitMessage(const IdentificationRun& run);
 // Precondition: config valid (as LoadConfig returns it). Never throws for a
 // failed identification: see IsUsable() and outer.message.
 IdentificationRun RunIdentification(const Config& config, const MeasurementSet& data);
+
+// The noise levels of the measurements `data` (as LoadMeasurements made them):
+// for synthetic data with noise, those the noise was drawn with (RMS of the
+// truth's channel / SNR, noise.h; *source = "synthetic_snr"); otherwise estimated
+// from the data's second differences (DifferenceNoiseLevels; "data_differences").
+NoiseLevels MeasurementNoiseLevels(const Config& config, const MeasurementSet& data,
+                                   std::string* source);
+
+// One identification by output-error least squares (outer.functional:
+// least_squares; least_squares/output_error_objective.h): the same data path,
+// pre-filter, global scan and optimiser as the MCRE's, on J(E), the misfit of
+// the clamped model driven by the measured fL, normalised by the noise levels.
+struct LeastSquaresRun {
+  Config config;
+  MeasurementSet data;  // the channels in use, pre-filtered as for the MCRE
+  EndDisplacementChannels ends;
+  double prefilter_cutoff = 0.0;  // [Hz]; 0 when off
+  bool reference_known = false;   // synthetic data: E_ref = config.model.modulus
+  NoiseLevels noise;              // s_u, s_f, s_e of the misfit's normalisation
+  std::string noise_source;       // as MeasurementNoiseLevels says
+  IdentificationSummary outer;
+  double rest_cost = 0.0;     // J_rest [s], the cost scale
+  OutputErrorPrediction fit;  // the model's outputs and J at the identified E
+  // J(E) and dJ/dE on output.curve_points moduli evenly spaced over E* +- 5 %.
+  std::vector<CostCurvePoint> cost_curve;
+  // d^2J/dE^2 at E* [s / Pa^2], the slope of dJ/dE over the curve (the observed
+  // curvature, ripple included).
+  double curvature = 0.0;
+  // 1 / sqrt(fit.fisher_information) [Pa]: the Cramer-Rao bound of E under white
+  // noise of the levels `noise` on the outputs with the measured load taken as
+  // exact. The noise of the load that drives the model is not counted, so the
+  // spread of E over noise draws is larger (measured: results/comparator). NaN
+  // when the information is not positive.
+  double modulus_std_bound = std::numeric_limits<double>::quiet_NaN();
+  long sweeps = 0;  // of every simulation (scan, refinement, fit, curve)
+  double wall_time_s = -1.0;
+
+  bool IsUsable() const { return outer.IsSolutionUsable(); }
+  double identified_modulus() const { return outer.modulus; }
+};
+
+// Runs the least-squares identification on measurements made by
+// LoadMeasurements(config), then its fit and cost curve at E*. Precondition:
+// config valid with outer.functional = least_squares. Never throws for a failed
+// identification: see IsUsable() and outer.message.
+LeastSquaresRun RunLeastSquares(const Config& config, const MeasurementSet& data);
 
 }  // namespace mcrewave

@@ -45,4 +45,18 @@ std::string SummaryYaml(const IdentificationRun& run);
 std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run,
                                                     const std::string& folder, bool figures);
 
+// The results of `identify run` with outer.functional: least_squares:
+//   summary.yaml     identified_modulus, reference and relative error, J [s], the
+//                    uncertainty 1 / sqrt(d^2J/dE^2) and the noise levels, the
+//                    optimizer, scan and prefilter blocks as above, the config
+//   scan.csv, valleys.csv   as above, of J
+//   cost_curve.csv   J(E) and dJ/dE over E* +- 5 %
+//   fit.csv          measured and predicted uL, f0 and interior sensors at E*
+//   cost_curve.png, fit.png
+// written as WriteIdentificationResults writes (atomically, summary last).
+// Precondition: run.IsUsable().
+std::string LeastSquaresSummaryYaml(const LeastSquaresRun& run);
+std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
+                                                  const std::string& folder, bool figures);
+
 }  // namespace mcrewave

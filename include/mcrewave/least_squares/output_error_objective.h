@@ -45,9 +45,14 @@ namespace mcrewave {
 
 // The outputs of the clamped model at one modulus, on the data's samples.
 struct OutputErrorPrediction {
-  double modulus = -1.0;        // E [Pa]
-  double cost = -1.0;           // J(E) [s] (misfits normalised by the noise levels)
-  double cost_gradient = 0.0;   // dJ/dE [s / Pa] (0 when not asked for)
+  double modulus = -1.0;       // E [Pa]
+  double cost = -1.0;          // J(E) [s] (misfits normalised by the noise levels)
+  double cost_gradient = 0.0;  // dJ/dE [s / Pa] (0 when not asked for)
+  // The Fisher information of E under white noise of the normalisation's levels,
+  //   I = sum_k c_k sum_channels (dy_k/dE)^2 / s^2  [1/Pa^2]
+  // (Gauss-Newton: the expected curvature of chi^2 / 2, free of the residuals'
+  // ripple), with the gradient (0 when not asked for); std(E) >= 1 / sqrt(I).
+  double fisher_information = 0.0;
   Vector uL;                    // [m], one per sample
   Vector f0;                    // [N], the clamp reaction
   std::vector<Vector> sensors;  // per interior sensor of the data [m] or [-]

@@ -57,6 +57,16 @@
 
 namespace mcrewave {
 
+// The functional the outer loop minimises over E. Identify minimises whatever
+// ModulusObjective it is given; identify run (app/identification_run.h) builds it
+// from this choice.
+enum class OuterFunctional {
+  kMcre,          // the MCRE cost e^2(E) (McreObjective)
+  kLeastSquares,  // output-error least squares J(E) (OutputErrorObjective), the comparator
+};
+const char* OuterFunctionalToString(OuterFunctional functional);
+bool StringToOuterFunctional(const std::string& name, OuterFunctional* functional);
+
 enum class OptimizerType {
   kNlopt,
   kCeres,
@@ -86,6 +96,8 @@ bool UsesGradient(OptimizerType optimizer, OuterAlgorithm algorithm);
 
 // The `outer:` section of the config.
 struct IdentificationOptions {
+  // Read by the caller that builds the objective, not by Identify.
+  OuterFunctional functional = OuterFunctional::kMcre;
   OptimizerType optimizer = OptimizerType::kNlopt;
   OuterAlgorithm algorithm = OuterAlgorithm::kDefault;
   double lower_bound = 100e9;  // [Pa]
