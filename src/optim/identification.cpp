@@ -469,7 +469,7 @@ bool HermiteMinimum(double x0, double x1, double c0, double c1, double g0, doubl
   }
   // A sign change with the root on an end: the minimum is that end.
   if (g0 < 0.0 && g1 >= 0.0) {
-    const bool at_right = std::abs(c1) <= std::abs(c0);
+    const bool at_right = c1 <= c0;
     valley->x = at_right ? x1 : x0;
     valley->cost = at_right ? c1 : c0;
     valley->curvature = (g1 - g0) / w;
@@ -572,8 +572,8 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
   if (limited) {
     spdlog::warn(
         "scan: the predicted valley spacing {:.3g} in ln E asks for more than "
-        "outer.scan_max_points "
-        "({}) samples: valleys narrower than the scan's step may be missed",
+        "outer.scan_max_points ({}) samples: valleys narrower than the scan's step may be "
+        "missed",
         valley_spacing, options.scan_max_points);
   }
   if (points + 2 > options.max_evaluations) {
