@@ -9,6 +9,7 @@
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/study.h"
 #include "mcrewave/core/file_util.h"
+#include "mcrewave/data/noise.h"
 #include "mcrewave/data/prefilter.h"
 #include "mcrewave/least_squares/output_error_objective.h"
 #include "mcrewave/mcre/objective.h"
@@ -47,10 +48,6 @@ std::vector<DataSet> DataSets(const StudyOptions& options) {
     }
   }
   return sets;
-}
-
-double RootMeanSquare(const Vector& values) {
-  return values.size() > 0 ? values.norm() / std::sqrt(static_cast<double>(values.size())) : 0.0;
 }
 
 // One identification of `functional` on `data` with the model `model`.

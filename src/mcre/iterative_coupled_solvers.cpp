@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "mcre/coupled_solver_internal.h"
+#include "mcre/direct_solution_check.h"
 
 namespace mcrewave::internal {
 namespace {
@@ -80,13 +81,6 @@ bool Converged(const StartingPoint& start, double relative, double tolerance) {
   return relative <= tolerance || relative * start.rhs_norm <= start.residual_floor;
 }
 
-std::string Scientific(double value) {
-  std::ostringstream out;
-  out.precision(3);
-  out << std::scientific << value;
-  return out.str();
-}
-
 // Extreme eigenvalues of A = I - G by `steps` Lanczos steps in <.,.>_P from
 // `start`; 2 sweeps per step. Returns {a_min, a_max} of the Ritz values.
 std::pair<double, double> EstimateSpectrum(McreProblem* problem, const Matrix& start, int steps) {
@@ -120,10 +114,10 @@ std::pair<double, double> EstimateSpectrum(McreProblem* problem, const Matrix& s
 // The message of a converged solve.
 std::string ConvergenceMessage(const StartingPoint& start, double relative, double tolerance) {
   if (relative <= tolerance) {
-    return "relative residual " + Scientific(relative) + " <= tolerance " + Scientific(tolerance);
+    return "relative residual " + ScientificString(relative) + " <= tolerance " + ScientificString(tolerance);
   }
-  return "residual " + Scientific(relative * start.rhs_norm) + " at the round-off floor " +
-         Scientific(start.residual_floor) +
+  return "residual " + ScientificString(relative * start.rhs_norm) + " at the round-off floor " +
+         ScientificString(start.residual_floor) +
          " (c = T(0) nearly cancels: the data are close to consistent with the model)";
 }
 
@@ -169,7 +163,7 @@ void SolveByRelaxation(const CoupledSolverOptions& options, McreProblem* problem
     if (!std::isfinite(relative)) {
       summary->termination = TerminationType::kDivergence;
       summary->message = "the relaxation diverged: the residual is not finite at iteration " +
-                         std::to_string(iteration) + " (omega = " + Scientific(omega) + ")";
+                         std::to_string(iteration) + " (omega = " + ScientificString(omega) + ")";
       return;
     }
     if (Converged(start, relative, options.tolerance)) {
@@ -211,9 +205,9 @@ void SolveByRelaxation(const CoupledSolverOptions& options, McreProblem* problem
     if (relative > options.divergence_factor * best_residual) {
       summary->termination = TerminationType::kDivergence;
       summary->message = "the relaxation diverges: the relative residual grew from " +
-                         Scientific(best_residual) + " to " + Scientific(relative) +
+                         ScientificString(best_residual) + " to " + ScientificString(relative) +
                          " by iteration " + std::to_string(iteration) +
-                         "; omega = " + Scientific(omega) +
+                         "; omega = " + ScientificString(omega) +
                          " is above the convergence limit 2 / (1 - lambda_min(G)): use a "
                          "smaller omega, adaptive_relaxation or conjugate_gradient";
       return;
@@ -221,8 +215,8 @@ void SolveByRelaxation(const CoupledSolverOptions& options, McreProblem* problem
     if (iteration == options.max_iterations) {
       summary->termination = TerminationType::kNoConvergence;
       summary->message = "no convergence in " + std::to_string(iteration) +
-                         " iterations: relative residual " + Scientific(relative) +
-                         " > tolerance " + Scientific(options.tolerance);
+                         " iterations: relative residual " + ScientificString(relative) +
+                         " > tolerance " + ScientificString(options.tolerance);
       return;
     }
     // W <- omega T(W) + (1 - omega) W = W + omega r; then U = Direct(W), r = T(W) - W.
@@ -279,7 +273,7 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, McreProblem* 
       }
       if (++restarts > kMaxVerifiedRestarts) {
         summary->termination = TerminationType::kNoConvergence;
-        summary->message = "the true residual " + Scientific(relative) +
+        summary->message = "the true residual " + ScientificString(relative) +
                            " stays above the tolerance (round-off limit reached)";
         return;
       }
@@ -291,8 +285,8 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, McreProblem* 
     if (iteration == options.max_iterations) {
       summary->termination = TerminationType::kNoConvergence;
       summary->message = "no convergence in " + std::to_string(iteration) +
-                         " iterations: relative residual " + Scientific(relative) +
-                         " > tolerance " + Scientific(options.tolerance);
+                         " iterations: relative residual " + ScientificString(relative) +
+                         " > tolerance " + ScientificString(options.tolerance);
       return;
     }
     // q = A p = p - G p.
@@ -301,7 +295,7 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, McreProblem* 
     const double curvature = problem->InnerProduct(direction, image);
     if (!(curvature > 0.0)) {
       summary->termination = TerminationType::kFailure;
-      summary->message = "conjugate gradients broke down: <p, A p>_P = " + Scientific(curvature) +
+      summary->message = "conjugate gradients broke down: <p, A p>_P = " + ScientificString(curvature) +
                          " is not positive at iteration " + std::to_string(iteration);
       return;
     }

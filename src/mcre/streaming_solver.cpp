@@ -14,16 +14,10 @@
 #include <sstream>
 
 #include "mcre/coupled_solver_internal.h"
+#include "mcre/direct_solution_check.h"
 
 namespace mcrewave::internal {
 namespace {
-
-std::string Scientific(double value) {
-  std::ostringstream out;
-  out.precision(3);
-  out << std::scientific << value;
-  return out.str();
-}
 
 // Largest relative rebuild error of the retrograde state accepted in the final pass.
 // Measured 1e-15 to 1e-14 over 200 steps and 4.8e-12 over 1e4 steps of a 20-element
@@ -63,7 +57,7 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
   };
   auto accept = [&](const std::string& message) {
     summary->termination = TerminationType::kConvergence;
-    summary->message = message + "; rebuild error " + Scientific(totals.rebuild_error);
+    summary->message = message + "; rebuild error " + ScientificString(totals.rebuild_error);
     solution->cost = totals.cost;
     solution->cost_gradients = totals.cost_gradients;
     solution->cost_gradient = totals.cost_gradients.sum();
@@ -98,8 +92,8 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
       if (!(totals.rebuild_error <= kMaxRebuildError)) {
         summary->termination = TerminationType::kFailure;
         summary->message = "the rebuilt retrograde field drifted: relative error " +
-                           Scientific(totals.rebuild_error) + " of omega at T (limit " +
-                           Scientific(kMaxRebuildError) + ")";
+                           ScientificString(totals.rebuild_error) + " of omega at T (limit " +
+                           ScientificString(kMaxRebuildError) + ")";
         return;
       }
       // The rebuild's round-off is a floor under the true residual: Phi itself is
@@ -107,20 +101,20 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
       // number 570, where a tolerance of 1e-8 cannot be met).
       const double floor = kRoundOffFloorFactor * totals.rebuild_error;
       if (true_relative <= options.tolerance) {
-        accept("relative trace residual " + Scientific(true_relative) + " <= tolerance " +
-               Scientific(options.tolerance));
+        accept("relative trace residual " + ScientificString(true_relative) + " <= tolerance " +
+               ScientificString(options.tolerance));
         return;
       }
       if (restarts == kMaxRestarts && true_relative <= floor) {
-        accept("relative trace residual " + Scientific(true_relative) + " at the round-off floor " +
-               Scientific(floor) + " of the rebuilt field (tolerance " +
-               Scientific(options.tolerance) + ")");
+        accept("relative trace residual " + ScientificString(true_relative) + " at the round-off floor " +
+               ScientificString(floor) + " of the rebuilt field (tolerance " +
+               ScientificString(options.tolerance) + ")");
         return;
       }
       if (restarts == kMaxRestarts) {
         summary->termination = TerminationType::kNoConvergence;
-        summary->message = "the true trace residual " + Scientific(true_relative) +
-                           " misses the tolerance " + Scientific(options.tolerance) + " after " +
+        summary->message = "the true trace residual " + ScientificString(true_relative) +
+                           " misses the tolerance " + ScientificString(options.tolerance) + " after " +
                            std::to_string(restarts) + " restarts";
         return;
       }
@@ -134,7 +128,7 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
     if (iteration == options.max_iterations) {
       summary->termination = TerminationType::kNoConvergence;
       summary->message = "no convergence in " + std::to_string(iteration) +
-                         " iterations: relative trace residual " + Scientific(relative);
+                         " iterations: relative trace residual " + ScientificString(relative);
       return;
     }
     // q = (I - L) p.
@@ -144,7 +138,7 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
     if (!(curvature > 0.0)) {
       summary->termination = TerminationType::kFailure;
       summary->message =
-          "streaming conjugate gradients broke down: <p, (I - L) p> = " + Scientific(curvature) +
+          "streaming conjugate gradients broke down: <p, (I - L) p> = " + ScientificString(curvature) +
           " at iteration " + std::to_string(iteration);
       return;
     }
