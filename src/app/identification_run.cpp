@@ -18,6 +18,22 @@
 namespace mcrewave {
 namespace {
 
+// The measurements an identification compares with: the channels of
+// data.channels (LoadMeasurements checked they exist), then the pre-filter
+// (its cut-off into *cutoff, 0 when off); *ends: the end displacements in use.
+MeasurementSet IdentificationData(const Config& config, const MeasurementSet& data,
+                                  EndDisplacementChannels* ends, double* cutoff) {
+  MeasurementSet selected = PrefilterMeasurements(
+      SelectChannels(data, config.data.channels, "data.channels", "the data", &ends->u0, &ends->uL),
+      config.prefilter, cutoff);
+  if (config.prefilter.enabled) {
+    spdlog::info("pre-filter: zero-phase Butterworth of order {} (x2), cut-off {:.6g} Hz{}",
+                 config.prefilter.order, *cutoff,
+                 config.prefilter.cutoff_frequency > 0.0 ? "" : " (derived from the load)");
+  }
+  return selected;
+}
+
 // RMS over every strain channel (e@X) of the set; 0 without any.
 double StrainRms(const MeasurementSet& set) {
   double squares = 0.0;
@@ -147,16 +163,7 @@ IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& da
   IdentificationRun run;
   run.config = config;
   run.reference_known = config.data.source == DataSource::kSynthetic;
-  // The channels of data.channels (LoadMeasurements checked they exist), then the
-  // pre-filter.
-  run.data = PrefilterMeasurements(SelectChannels(data, config.data.channels, "data.channels",
-                                                  "the data", &run.ends.u0, &run.ends.uL),
-                                   config.prefilter, &run.prefilter_cutoff);
-  if (config.prefilter.enabled) {
-    spdlog::info("pre-filter: zero-phase Butterworth of order {} (x2), cut-off {:.6g} Hz{}",
-                 config.prefilter.order, run.prefilter_cutoff,
-                 config.prefilter.cutoff_frequency > 0.0 ? "" : " (derived from the load)");
-  }
+  run.data = IdentificationData(config, data, &run.ends, &run.prefilter_cutoff);
 
   const BarModel model(config.model);
   McreObjective objective(model, run.data, config.mcre, config.time.theta, config.inner,
@@ -277,9 +284,7 @@ LeastSquaresRun RunLeastSquares(const Config& config, const MeasurementSet& data
   LeastSquaresRun run;
   run.config = config;
   run.reference_known = config.data.source == DataSource::kSynthetic;
-  run.data = PrefilterMeasurements(SelectChannels(data, config.data.channels, "data.channels",
-                                                  "the data", &run.ends.u0, &run.ends.uL),
-                                   config.prefilter, &run.prefilter_cutoff);
+  run.data = IdentificationData(config, data, &run.ends, &run.prefilter_cutoff);
   run.noise = MeasurementNoiseLevels(config, data, &run.noise_source);
   // Noise-free data have no level to normalise by: the RMS of the channels instead
   // (only the ratio of the weights matters then, as in the comparator study).

@@ -365,6 +365,54 @@ std::string ErrorMapScript(const IdentificationRun& run, const std::string& fold
   return script.str();
 }
 
+// A results folder being filled: every file written atomically, its path kept.
+class ResultsFolder {
+ public:
+  // Creates the folder; throws std::runtime_error when it cannot.
+  explicit ResultsFolder(const std::string& folder) : folder_(folder) {
+    std::error_code error;
+    std::filesystem::create_directories(folder, error);
+    if (error) throw std::runtime_error("cannot create folder " + folder + ": " + error.message());
+  }
+  void Write(const std::string& name, const std::string& content) {
+    const std::string path = folder_ + "/" + name;
+    WriteFileAtomically(path, content);
+    written_.push_back(path);
+  }
+  // Draws each (name, gnuplot script) into name.png; without gnuplot, or when a
+  // figure fails, warns and goes on without it.
+  void Draw(const std::vector<std::pair<std::string, std::string>>& drawings) {
+    bool gnuplot_missing = false;
+    for (const auto& [name, script] : drawings) {
+      const std::string why = DrawGnuplotFigure(folder_, name, script, &gnuplot_missing);
+      if (gnuplot_missing) {
+        spdlog::warn("gnuplot not found on the PATH: figures skipped (the CSV files are written)");
+        return;
+      }
+      if (!why.empty()) {
+        spdlog::warn("figure {}.png skipped: {}", name, why);
+        continue;
+      }
+      written_.push_back(folder_ + "/" + name + ".png");
+    }
+  }
+  void Add(const std::vector<std::string>& paths) {
+    written_.insert(written_.end(), paths.begin(), paths.end());
+  }
+  const std::vector<std::string>& written() const { return written_; }
+
+ private:
+  std::string folder_;
+  std::vector<std::string> written_;
+};
+
+// The closing config: block of a summary, every key as resolved.
+void ConfigYaml(const Config& config, YamlWriter* yaml) {
+  yaml->Line(0, "config", "", "as resolved (every key)");
+  std::istringstream text(ConfigToYaml(config));
+  for (std::string line; std::getline(text, line);) yaml->Raw("  " + line);
+}
+
 // The optimizer:, scan: and prefilter: blocks of a summary, for a cost named
 // `cost` (e^2 or J) in `unit` (J s or s) whose scale is cost_scale.
 void OptimizerScanAndPrefilterYaml(const IdentificationSummary& outer, double cost_scale,
@@ -528,42 +576,28 @@ std::string SummaryYaml(const IdentificationRun& run) {
   if (run.zones.ran) {
     for (const std::string& line : ZonesYamlLines(run.zones)) yaml.Raw(line);
   }
-
-  yaml.Line(0, "config", "", "as resolved (every key)");
-  std::istringstream config(ConfigToYaml(run.config));
-  for (std::string line; std::getline(config, line);) yaml.Raw("  " + line);
+  ConfigYaml(run.config, &yaml);
   return yaml.str();
 }
 
 std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run,
                                                     const std::string& folder, bool figures) {
-  std::error_code error;
-  std::filesystem::create_directories(folder, error);
-  if (error) throw std::runtime_error("cannot create folder " + folder + ": " + error.message());
-
-  std::vector<std::string> written;
-  auto write = [&](const std::string& name, const std::string& content) {
-    const std::string path = folder + "/" + name;
-    WriteFileAtomically(path, content);
-    written.push_back(path);
-  };
-  write("evaluations.csv", EvaluationsCsv(run));
-  write("cost_curve.csv", CostCurveCsv(run.cost_curve));
-  write("ends.csv", EndsCsv(run));
-  write("inner_residual.csv", InnerResidualCsv(run));
+  ResultsFolder results(folder);
+  results.Write("evaluations.csv", EvaluationsCsv(run));
+  results.Write("cost_curve.csv", CostCurveCsv(run.cost_curve));
+  results.Write("ends.csv", EndsCsv(run));
+  results.Write("inner_residual.csv", InnerResidualCsv(run));
   if (!run.outer.scan_moduli.empty()) {
-    write("scan.csv", ScanCsv(run.outer, run.rest_cost, run.config.outer.initial));
-    write("valleys.csv", ValleysCsv(run.outer, run.rest_cost));
+    results.Write("scan.csv", ScanCsv(run.outer, run.rest_cost, run.config.outer.initial));
+    results.Write("valleys.csv", ValleysCsv(run.outer, run.rest_cost));
   }
   if (run.error_map.share.size() > 0) {
-    write("error_map.csv", ErrorMapCsv(run));
+    results.Write("error_map.csv", ErrorMapCsv(run));
     if (run.error_map.density.size() > 0) {
-      write("error_map_spacetime.dat", ErrorMapSpaceTimeData(run));
+      results.Write("error_map_spacetime.dat", ErrorMapSpaceTimeData(run));
     }
   }
-
   if (figures) {
-    bool gnuplot_missing = false;
     std::vector<std::pair<std::string, std::string>> drawings = {
         {"cost_curve", CostCurveScript(run, folder)},
         {"ends", EndsScript(run, folder)},
@@ -573,25 +607,12 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
     if (!InnerResidualHistory(run).empty()) {
       drawings.emplace_back("inner_residual", InnerResidualScript(run, folder));
     }
-    for (const auto& [name, script] : drawings) {
-      const std::string why = DrawGnuplotFigure(folder, name, script, &gnuplot_missing);
-      if (gnuplot_missing) {
-        spdlog::warn("gnuplot not found on the PATH: figures skipped (the CSV files are written)");
-        break;
-      }
-      if (!why.empty()) {
-        spdlog::warn("figure {}.png skipped: {}", name, why);
-        continue;
-      }
-      written.push_back(folder + "/" + name + ".png");
-    }
+    results.Draw(drawings);
   }
-  for (const std::string& path : WriteZoneResults(run.zones, run.config.model, folder, figures)) {
-    written.push_back(path);
-  }
+  results.Add(WriteZoneResults(run.zones, run.config.model, folder, figures));
   // The summary last: its presence says the folder is complete.
-  write("summary.yaml", SummaryYaml(run));
-  return written;
+  results.Write("summary.yaml", SummaryYaml(run));
+  return results.written();
 }
 
 namespace {
@@ -715,50 +736,26 @@ std::string LeastSquaresSummaryYaml(const LeastSquaresRun& run) {
               "[Pa]");
   yaml.Number(1, "highest_modulus", run.cost_curve.empty() ? NAN : run.cost_curve.back().modulus,
               "[Pa]");
-
-  yaml.Line(0, "config", "", "as resolved (every key)");
-  std::istringstream config(ConfigToYaml(run.config));
-  for (std::string line; std::getline(config, line);) yaml.Raw("  " + line);
+  ConfigYaml(run.config, &yaml);
   return yaml.str();
 }
 
 std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
                                                   const std::string& folder, bool figures) {
-  std::error_code error;
-  std::filesystem::create_directories(folder, error);
-  if (error) throw std::runtime_error("cannot create folder " + folder + ": " + error.message());
-  std::vector<std::string> written;
-  auto write = [&](const std::string& name, const std::string& content) {
-    const std::string path = folder + "/" + name;
-    WriteFileAtomically(path, content);
-    written.push_back(path);
-  };
-  write("cost_curve.csv", CostCurveCsv(run.cost_curve));
-  write("fit.csv", FitCsv(run));
+  ResultsFolder results(folder);
+  results.Write("cost_curve.csv", CostCurveCsv(run.cost_curve));
+  results.Write("fit.csv", FitCsv(run));
   if (!run.outer.scan_moduli.empty()) {
-    write("scan.csv", ScanCsv(run.outer, run.rest_cost, run.config.outer.initial));
-    write("valleys.csv", ValleysCsv(run.outer, run.rest_cost));
+    results.Write("scan.csv", ScanCsv(run.outer, run.rest_cost, run.config.outer.initial));
+    results.Write("valleys.csv", ValleysCsv(run.outer, run.rest_cost));
   }
   if (figures) {
-    bool gnuplot_missing = false;
-    for (const auto& [name, script] : std::vector<std::pair<std::string, std::string>>{
-             {"cost_curve", LeastSquaresCostCurveScript(run, folder)},
-             {"fit", FitScript(run, folder)}}) {
-      const std::string why = DrawGnuplotFigure(folder, name, script, &gnuplot_missing);
-      if (gnuplot_missing) {
-        spdlog::warn("gnuplot not found on the PATH: figures skipped (the CSV files are written)");
-        break;
-      }
-      if (!why.empty()) {
-        spdlog::warn("figure {}.png skipped: {}", name, why);
-        continue;
-      }
-      written.push_back(folder + "/" + name + ".png");
-    }
+    results.Draw({{"cost_curve", LeastSquaresCostCurveScript(run, folder)},
+                  {"fit", FitScript(run, folder)}});
   }
   // The summary last: its presence says the folder is complete.
-  write("summary.yaml", LeastSquaresSummaryYaml(run));
-  return written;
+  results.Write("summary.yaml", LeastSquaresSummaryYaml(run));
+  return results.written();
 }
 
 }  // namespace mcrewave
