@@ -106,6 +106,36 @@ Vector SoftZoneModuli(int zones) {
   return moduli;
 }
 
+TEST(McreZonesTest, DataResponseTracesAreTheDirectSweepAtZeroObservedByH) {
+  // The streaming traces of the model driven by the data alone (one sweep, no field)
+  // against H applied to the stored direct sweep at W = 0: measured the same bits.
+  const ZonedCase zoned(20, 120, EqualZones(2), SoftZoneModuli(2), 0.01);
+  McreProblem& problem = *zoned.problem;
+  Matrix traces, displacement;
+  problem.DataResponseTraces(&traces);
+  problem.DirectSweep(problem.ZeroField(), true, &displacement);
+  ASSERT_EQ(traces.rows(), 2 + static_cast<int>(zoned.data.sensors.size()));
+  ASSERT_EQ(traces.cols(), displacement.cols());
+  const int last = problem.num_nodes() - 1;
+  for (Eigen::Index j = 0; j < traces.cols(); ++j) {
+    EXPECT_EQ(traces(0, j), displacement(0, j)) << j;
+    EXPECT_EQ(traces(1, j), displacement(last, j)) << j;
+    for (std::size_t k = 0; k < zoned.data.sensors.size(); ++k) {
+      const SensorChannel& sensor = zoned.data.sensors[k];
+      const ObservationRow row = sensor.kind == SensorKind::kStrain
+                                     ? zoned.model.StrainRow(sensor.position)
+                                     : zoned.model.DisplacementRow(sensor.position);
+      EXPECT_EQ(traces(2 + k, j), row.Apply(displacement.col(j).data()))
+          << sensor.name << ", " << j;
+    }
+  }
+  // The weights of the rows: beta_u at both ends, beta_u or beta_e per sensor.
+  const Vector weights = problem.TraceWeights();
+  EXPECT_EQ(weights[0], problem.beta());
+  EXPECT_EQ(weights[1], problem.beta());
+  EXPECT_EQ(weights[4], problem.strain_beta());
+}
+
 TEST(McreZonesTest, EqualZoneModuliGiveTheOneZoneProblem) {
   // The same data on a one-zone and a 10-zone model at equal moduli: e^2 and the
   // gradient agree; measured 0 (e^2: the same K bit for bit) and 3.5e-16 to 2.1e-15 (the
