@@ -33,19 +33,12 @@ Vector McreProblem::TraceWeights() const {
 }
 
 void McreProblem::DataResponseTraces(Matrix* traces) {
-  const int m = num_steps(), last = num_nodes() - 1;
+  const int m = num_steps();
   traces->resize(num_traces(), m + 1);
   // From rest: U_0 = V_0 = 0; the force of step t_k -> t_{k+1} is F~_theta alone (W = 0).
   stream_velocity_[0].setZero();
   stream_displacement_[0].setZero();
-  auto observe = [&](int j, const Vector& displacement) {
-    (*traces)(0, j) = displacement[0];
-    (*traces)(1, j) = displacement[last];
-    for (int k = 0; k < num_interior_sensors(); ++k) {
-      (*traces)(2 + k, j) = sensor_rows_[k].Apply(displacement.data());
-    }
-  };
-  observe(0, stream_displacement_[0]);
+  ObserveTraces(stream_displacement_[0], traces->col(0).data());
   for (int k = 0; k < m; ++k) {
     const int current = k & 1, next = current ^ 1;
     // f_theta = theta F~_{k+1} + (1 - theta) F~_k at both ends.
@@ -53,9 +46,17 @@ void McreProblem::DataResponseTraces(Matrix* traces) {
     const double fL = theta_ * data_.fL[k + 1] + (1.0 - theta_) * data_.fL[k];
     integrator_.StepWithEndLoads(stream_velocity_[current], stream_displacement_[current], f0, fL,
                                  stream_velocity_[next], stream_displacement_[next]);
-    observe(k + 1, stream_displacement_[next]);
+    ObserveTraces(stream_displacement_[next], traces->col(k + 1).data());
   }
   ++sweep_count_;
+}
+
+void McreProblem::ObserveTraces(const Vector& displacement, double* column) const {
+  column[0] = displacement[0];
+  column[1] = displacement[num_nodes() - 1];
+  for (int k = 0; k < num_interior_sensors(); ++k) {
+    column[2 + k] = sensor_rows_[k].Apply(displacement.data());
+  }
 }
 
 void McreProblem::TraceLoads(int j, const Matrix& traces, bool include_data, double* f0,
@@ -90,12 +91,7 @@ void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* 
   }
   // y_j = H U_j into the image, and the totals of sample j.
   auto observe = [&](int j, const Vector& displacement, const Vector& retrograde) {
-    double* column = image->col(j).data();
-    column[0] = displacement[0];
-    column[1] = displacement[last];
-    for (int k = 0; k < num_interior_sensors(); ++k) {
-      column[2 + k] = sensor_rows_[k].Apply(displacement.data());
-    }
+    ObserveTraces(displacement, image->col(j).data());
     if (totals == nullptr) return;
     const double weight = QuadratureWeight(j) * h;
     totals->cost += weight * SampleCost(j, displacement.data(), retrograde.data());

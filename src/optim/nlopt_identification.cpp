@@ -78,12 +78,12 @@ void MinimizeWithNlopt(const IdentificationOptions& options, GuardedObjective* o
   // The gradient methods (MMA's convexity term, L-BFGS' first step) assume cost
   // changes of order one across the bounds; a flat e^2 stops MMA at its start. Their
   // cost unit is the change the curvature k predicts over the bounds' width w: k w^2.
-  double cost_unit = 1.0;
   const double width = (options.upper_bound - options.lower_bound) / scale;
-  if (UsesGradient(options.optimizer, summary->algorithm) && curvature > 0.0 &&
-      std::isfinite(curvature * width * width) && curvature * width * width > 0.0) {
-    cost_unit = curvature * width * width;
-  }
+  const double predicted_change = curvature * width * width;
+  const double cost_unit = UsesGradient(options.optimizer, summary->algorithm) &&
+                                   predicted_change > 0.0 && std::isfinite(predicted_change)
+                               ? predicted_change
+                               : 1.0;
   CallbackData data{objective, &optimizer, cost_unit};
   optimizer.set_min_objective(NloptObjective, &data);
   optimizer.set_lower_bounds(options.lower_bound / scale);

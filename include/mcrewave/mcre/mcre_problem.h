@@ -226,6 +226,9 @@ class McreProblem {
   void CheckpointedStreamingMap(const Matrix& traces, bool include_data, Observe& observe,
                                 DirectStep& direct_step);
 
+  // column[0 .. num_traces()) = H U_j of the displacement U_j (the trace rows' order).
+  void ObserveTraces(const Vector& displacement, double* column) const;
+
   // The retrograde loads of step t_j -> t_{j-1} from traces y_j (end loads f0, fL
   // and the sensors' point loads into stream_loads_).
   void TraceLoads(int j, const Matrix& traces, bool include_data, double* f0, double* fL);
