@@ -208,13 +208,16 @@ def write_mesh(folder, refine):
         f.write(f"# Cantilever plate {LENGTH} x {HEIGHT} x {THICKNESS} m, Q4 plane stress "
                 f"{mesh.nx} x {mesh.ny} elements, {n} dofs\n")
         f.write("# (scripts/make_plate_example.py; docs/matrix_models.md)\n")
-        f.write("mass: M.mtx\nzones:\n")
+        # The scales of the MCRE weights (docs/matrix_models.md section 3): the plate's
+        # thickness (in-plane stiffness ~ E t) and its length.
+        f.write(f"mass: M.mtx\nstiffness_length: {THICKNESS}\nlength: {LENGTH}\nzones:\n")
         for zone in ("matrix", "inclusion"):
             f.write(f"  - {{name: {zone}, stiffness: K_{zone}.mtx, "
                     f"nominal_modulus: {NOMINAL_MODULUS:.17g}}}\n")
         f.write("loads:\n  - {channel: F, vector: load_F.mtx}\nsensors:\n")
         for sensor in SENSORS:
-            f.write(f"  - {{channel: {sensor[0]}, row: sensor_{sensor[0]}.mtx}}\n")
+            kind = ", kind: strain" if sensor[1] == "exx" else ""
+            f.write(f"  - {{channel: {sensor[0]}, row: sensor_{sensor[0]}.mtx{kind}}}\n")
     with open(os.path.join(folder, "nodes.csv"), "w") as f:
         f.write("node,x,y,dof_x,dof_y\n")
         for j in range(mesh.ny + 1):

@@ -47,6 +47,11 @@ TEST(MatrixExportTest, TheBarReadsBackExactly) {
   const std::string manifest = WriteMatrixModel(MakeFolder("bar_export"), data);
   const MatrixModelData back = ReadMatrixModel(manifest);
   EXPECT_EQ(MaxDifference(back.mass, data.mass), 0.0);
+  // The weights' scales a* = S / L and l* = L (written with 17 digits: the same bits).
+  EXPECT_EQ(back.stiffness_length, model.properties().section / model.properties().length);
+  EXPECT_EQ(back.length, model.properties().length);
+  EXPECT_EQ(back.sensors[2].kind, SensorKind::kDisplacement);
+  EXPECT_EQ(back.sensors[3].kind, SensorKind::kStrain);
   for (std::size_t z = 0; z < 3; ++z) {
     EXPECT_EQ(back.zones[z].name, data.zones[z].name);
     EXPECT_EQ(back.zones[z].nominal_modulus, 200e9);
@@ -164,21 +169,39 @@ TEST(MatrixExportTest, BadModelsGiveOneClearError) {
   EXPECT_TRUE(Contains(why, "load_fL.mtx: ends after 1 of the 2 values")) << why;
   why = SpoiledError("spoil_manifest", [](const std::string& folder) {
     WriteText(folder, "model.yaml",
-              "mass: M.mtx\nzones:\n  - {name: a, stiffness: K_zone0.mtx, nominal_modulus: 1}\n"
+              "mass: M.mtx\nstiffness_length: 1\nlength: 1\n"
+              "zones:\n  - {name: a, stiffness: K_zone0.mtx, nominal_modulus: 1}\n"
               "loads:\n  - {channel: fL, vector: load_fL.mtx}\nsensors:\n"
               "  - {channel: fL, row: sensor_uL.mtx}\n");
   });
-  EXPECT_TRUE(Contains(why, "model.yaml:7: channel 'fL' given twice")) << why;
+  EXPECT_TRUE(Contains(why, "model.yaml:9: channel 'fL' given twice")) << why;
   why = SpoiledError("spoil_key", [](const std::string& folder) {
     WriteText(folder, "model.yaml", "mass: M.mtx\nzone: []\n");
   });
   EXPECT_TRUE(Contains(why, "model.yaml:2: unknown key 'zone'")) << why;
   why = SpoiledError("spoil_entry_key", [](const std::string& folder) {
     WriteText(folder, "model.yaml",
-              "mass: M.mtx\nzones:\n  - name: a\n    stiffness: K_zone0.mtx\n"
+              "mass: M.mtx\nstiffness_length: 1\nlength: 1\nzones:\n  - name: a\n"
+              "    stiffness: K_zone0.mtx\n"
               "    nominal_modulus: 1\n    modulus: 2\n");
   });
-  EXPECT_TRUE(Contains(why, "model.yaml:6: unknown key 'modulus'")) << why;
+  EXPECT_TRUE(Contains(why, "model.yaml:8: unknown key 'modulus'")) << why;
+  why = SpoiledError("spoil_scale", [](const std::string& folder) {
+    WriteText(folder, "model.yaml", "mass: M.mtx\nstiffness_length: -1\nlength: 1\n");
+  });
+  EXPECT_TRUE(Contains(why,
+                       "model.yaml:2: expected key 'stiffness_length', a finite positive "
+                       "length [m]"))
+      << why;
+  why = SpoiledError("spoil_kind", [](const std::string& folder) {
+    WriteText(folder, "model.yaml",
+              "mass: M.mtx\nstiffness_length: 1\nlength: 1\n"
+              "zones:\n  - {name: a, stiffness: K_zone0.mtx, nominal_modulus: 1}\n"
+              "loads:\n  - {channel: fL, vector: load_fL.mtx}\nsensors:\n"
+              "  - {channel: uL, row: sensor_uL.mtx, kind: force}\n");
+  });
+  EXPECT_TRUE(Contains(why, "model.yaml:9: kind must be displacement or strain, got 'force'"))
+      << why;
 }
 
 }  // namespace

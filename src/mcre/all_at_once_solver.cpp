@@ -108,19 +108,16 @@ double AllAtOnceBytes(double unknowns, double matrix_nonzeros, double factor_non
 
 }  // namespace
 
-void SolveAllAtOnce(const CoupledSolverOptions& options, McreProblem* problem,
+void SolveAllAtOnce(const CoupledSolverOptions& options, CoupledProblem* problem,
                     CoupledSolution* solution, CoupledSolverSummary* summary) {
-  const int n = problem->num_nodes(), m = problem->num_steps(), last = n - 1;
+  const int n = problem->num_nodes(), m = problem->num_steps();
   SpaceTimeAssembler system(n, m);
   summary->iterations = 0;
-  const BarModel& model = problem->model();
-  const MeasurementSet& data = problem->data();
   const double h = problem->time_step(), theta = problem->theta();
-  const double alpha = problem->alpha();
-  const SparseMatrix& mass = model.mass();
-  const SparseMatrix stiffness = model.Stiffness(problem->moduli());
-  const SparseMatrix& selector = model.boundary_selector();
-  const SparseMatrix penalty = stiffness + selector / alpha;  // P = K + B / alpha
+  const SparseMatrix mass = problem->MassMatrix();
+  const SparseMatrix stiffness = problem->StiffnessMatrix();
+  // P = K + G diag(1/alpha) G^T (the bar: K + B / alpha).
+  const SparseMatrix penalty = problem->PenaltyMatrix();
   // H^T diag(beta_k) H (the paper's case: beta B).
   const SparseMatrix observation = problem->WeightedObservation();
   const double num_unknowns = static_cast<double>(system.size());
@@ -160,6 +157,9 @@ void SolveAllAtOnce(const CoupledSolverOptions& options, McreProblem* problem,
     return;
   }
   Vector rhs = Vector::Zero(system.size());
+  // The measured forces G F~_k and G F~_{k+1} of the step being assembled.
+  Vector force_now(n), force_next(n);
+  problem->MeasuredForce(0, force_next);
 
   // Rest and final conditions: U_0 = V_0 = 0, Omega_m = Y_m = 0.
   system.AddIdentity(kU, 0, kU, 0, 1.0);
@@ -176,9 +176,9 @@ void SolveAllAtOnce(const CoupledSolverOptions& options, McreProblem* problem,
     system.Add(kV, k + 1, kU, k, stiffness, h * (1.0 - theta));
     system.Add(kV, k + 1, kW, k + 1, penalty, h * theta);
     system.Add(kV, k + 1, kW, k, penalty, h * (1.0 - theta));
-    const int row = system.Index(kV, k + 1);
-    rhs[row] = h * (theta * data.f0[k + 1] + (1.0 - theta) * data.f0[k]);
-    rhs[row + last] = h * (theta * data.fL[k + 1] + (1.0 - theta) * data.fL[k]);
+    force_now.swap(force_next);
+    problem->MeasuredForce(k + 1, force_next);
+    rhs.segment(system.Index(kV, k + 1), n) = h * (theta * force_next + (1.0 - theta) * force_now);
     // (D2) in the rows of U_{k+1}: U_{k+1} - U_k - h theta V_{k+1} - h (1-theta) V_k = 0.
     system.AddIdentity(kU, k + 1, kU, k + 1, 1.0);
     system.AddIdentity(kU, k + 1, kU, k, -1.0);

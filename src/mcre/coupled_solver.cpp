@@ -116,7 +116,7 @@ std::string CoupledSolverSummary::FullReport() const {
   return out.str();
 }
 
-CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, McreProblem* problem,
+CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledProblem* problem,
                                   const Matrix* initial_retrograde, CoupledSolution* solution) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
@@ -147,7 +147,17 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, McreProbl
   const bool comparator = options.type == CoupledSolverType::kRiccati ||
                           options.type == CoupledSolverType::kSingleShooting ||
                           options.type == CoupledSolverType::kMultipleShooting;
-  if (comparator && !problem->observes_ends_only()) {
+  // Riccati, shooting and the streaming solver are written for the built-in bar.
+  McreProblem* bar = dynamic_cast<McreProblem*>(problem);
+  if ((comparator || options.type == CoupledSolverType::kStreamingConjugateGradient) &&
+      bar == nullptr) {
+    summary.message = std::string(CoupledSolverTypeToString(options.type)) +
+                      " handles the built-in bar only; for a structure given by matrices use "
+                      "inner.solver: conjugate_gradient, adaptive_relaxation, relaxation or "
+                      "all_at_once";
+    return summary;
+  }
+  if (comparator && !bar->observes_ends_only()) {
     // Their transfer operators are written for H = B (the two end displacements).
     summary.message = std::string(CoupledSolverTypeToString(options.type)) +
                       " handles the paper's end sensors only (u0 and uL, no interior sensor); "
@@ -167,15 +177,15 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, McreProbl
       internal::SolveByConjugateGradient(options, problem, initial_retrograde, solution, &summary);
       break;
     case CoupledSolverType::kRiccati:
-      internal::SolveByRiccati(options, problem, solution, &summary);
+      internal::SolveByRiccati(options, bar, solution, &summary);
       break;
     case CoupledSolverType::kSingleShooting:
     case CoupledSolverType::kMultipleShooting:
-      internal::SolveByShooting(options, problem, solution, &summary);
+      internal::SolveByShooting(options, bar, solution, &summary);
       break;
     case CoupledSolverType::kStreamingConjugateGradient:
       // Fills the cost and the gradients itself, from its final streaming pass.
-      internal::SolveByStreamingConjugateGradient(options, problem, solution, &summary);
+      internal::SolveByStreamingConjugateGradient(options, bar, solution, &summary);
       break;
   }
   if (summary.IsSolutionUsable() &&

@@ -9,12 +9,12 @@
 
 namespace mcrewave::internal {
 
-void SolveAllAtOnce(const CoupledSolverOptions& options, McreProblem* problem,
+void SolveAllAtOnce(const CoupledSolverOptions& options, CoupledProblem* problem,
                     CoupledSolution* solution, CoupledSolverSummary* summary);
-void SolveByRelaxation(const CoupledSolverOptions& options, McreProblem* problem,
+void SolveByRelaxation(const CoupledSolverOptions& options, CoupledProblem* problem,
                        const Matrix* initial_retrograde, CoupledSolution* solution,
                        CoupledSolverSummary* summary);
-void SolveByConjugateGradient(const CoupledSolverOptions& options, McreProblem* problem,
+void SolveByConjugateGradient(const CoupledSolverOptions& options, CoupledProblem* problem,
                               const Matrix* initial_retrograde, CoupledSolution* solution,
                               CoupledSolverSummary* summary);
 void SolveByRiccati(const CoupledSolverOptions& options, McreProblem* problem,

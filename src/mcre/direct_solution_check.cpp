@@ -14,7 +14,7 @@ std::string ScientificString(double value) {
 }
 
 void CheckDirectSolution(const CoupledSolverOptions& options, const std::string& method_description,
-                         McreProblem* problem, const CoupledSolution& solution,
+                         CoupledProblem* problem, const CoupledSolution& solution,
                          CoupledSolverSummary* summary) {
   const Matrix& displacement = solution.displacement;
   const Matrix& retrograde = solution.retrograde;

@@ -19,7 +19,7 @@ namespace mcrewave::internal {
 // summary->termination, relative_residual and message (method_description, then the
 // figures).
 void CheckDirectSolution(const CoupledSolverOptions& options, const std::string& method_description,
-                         McreProblem* problem, const CoupledSolution& solution,
+                         CoupledProblem* problem, const CoupledSolution& solution,
                          CoupledSolverSummary* summary);
 
 // "1.234e-05": three significant digits, for messages.

@@ -36,11 +36,11 @@ struct StartingPoint {
 // floor only acts on data consistent with the model to about 1e-3 or better.
 constexpr double kRoundOffFloor = 1e-11;
 
-StartingPoint Start(McreProblem* problem, const Matrix* initial_retrograde,
+StartingPoint Start(CoupledProblem* problem, const Matrix* initial_retrograde,
                     CoupledSolution* solution, Matrix* residual, CoupledSolverSummary* summary) {
   StartingPoint start;
   Matrix& retrograde = solution->retrograde;
-  McreProblem::SolverWorkspace& work = problem->workspace();
+  CoupledProblem::SolverWorkspace& work = problem->workspace();
   const bool zero_start =
       initial_retrograde == nullptr || initial_retrograde->cwiseAbs().maxCoeff() == 0.0;
   // T(W^(0)) = Retrograde(U), U = Direct(W^(0)); c = T(0); W_u = Retrograde(0): the
@@ -83,7 +83,8 @@ bool Converged(const StartingPoint& start, double relative, double tolerance) {
 
 // Extreme eigenvalues of A = I - G by `steps` Lanczos steps in <.,.>_P from
 // `start`; 2 sweeps per step. Returns {a_min, a_max} of the Ritz values.
-std::pair<double, double> EstimateSpectrum(McreProblem* problem, const Matrix& start, int steps) {
+std::pair<double, double> EstimateSpectrum(CoupledProblem* problem, const Matrix& start,
+                                           int steps) {
   Matrix q = start / problem->Norm(start);
   Matrix q_previous = problem->ZeroField();
   Matrix w, scratch;
@@ -123,7 +124,7 @@ std::string ConvergenceMessage(const StartingPoint& start, double relative, doub
 
 }  // namespace
 
-void SolveByRelaxation(const CoupledSolverOptions& options, McreProblem* problem,
+void SolveByRelaxation(const CoupledSolverOptions& options, CoupledProblem* problem,
                        const Matrix* initial_retrograde, CoupledSolution* solution,
                        CoupledSolverSummary* summary) {
   const bool adaptive = options.type == CoupledSolverType::kAdaptiveRelaxation;
@@ -226,12 +227,12 @@ void SolveByRelaxation(const CoupledSolverOptions& options, McreProblem* problem
   }
 }
 
-void SolveByConjugateGradient(const CoupledSolverOptions& options, McreProblem* problem,
+void SolveByConjugateGradient(const CoupledSolverOptions& options, CoupledProblem* problem,
                               const Matrix* initial_retrograde, CoupledSolution* solution,
                               CoupledSolverSummary* summary) {
   Matrix& retrograde = solution->retrograde;
   Matrix& displacement = solution->displacement;
-  McreProblem::SolverWorkspace& work = problem->workspace();
+  CoupledProblem::SolverWorkspace& work = problem->workspace();
   Matrix& residual = work.residual;
   const StartingPoint start = Start(problem, initial_retrograde, solution, &residual, summary);
   if (start.solved) return;

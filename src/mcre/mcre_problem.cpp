@@ -10,6 +10,9 @@
 
 namespace mcrewave {
 
+static_assert(CoupledProblem::kMaxSweepBatch == ThetaIntegrator::kMaxBatch,
+              "the batched sweeps interleave the integrator's batch");
+
 bool McreWeights::IsValid(std::string* error) const {
   std::ostringstream why;
   if (!(std::isfinite(displacement_weight) && displacement_weight > 0.0)) {
@@ -181,13 +184,6 @@ void McreProblem::RetrogradeSweep(const Matrix& displacement, bool include_data,
   ++sweep_count_;
 }
 
-McreProblem::SolverWorkspace& McreProblem::workspace() {
-  if (workspace_.zero.rows() != num_nodes() || workspace_.zero.cols() != num_steps() + 1) {
-    workspace_.zero = ZeroField();
-  }
-  return workspace_;
-}
-
 template <int B>
 void McreProblem::DirectSweeps(const Matrix* const (&retrograde)[B],
                                Matrix* const (&displacement)[B]) {
@@ -324,17 +320,6 @@ void McreProblem::RetrogradeSweepsWithData(const std::vector<const Matrix*>& dis
   }
 }
 
-void McreProblem::FixedPointMap(const Matrix& retrograde, Matrix* displacement, Matrix* image) {
-  DirectSweep(retrograde, true, displacement);
-  RetrogradeSweep(*displacement, true, image);
-}
-
-void McreProblem::ApplyIterationMap(const Matrix& retrograde, Matrix* scratch_displacement,
-                                    Matrix* image) {
-  DirectSweep(retrograde, false, scratch_displacement);
-  RetrogradeSweep(*scratch_displacement, false, image);
-}
-
 double McreProblem::InnerProduct(const Matrix& x, const Matrix& y) {
   const int n = num_nodes(), m = num_steps(), last = n - 1;
   const double h = time_step();
@@ -423,6 +408,17 @@ void McreProblem::CostGradients(const Matrix& displacement, const Matrix& retrog
     AddSampleZoneGradients(-0.5 * QuadratureWeight(j) * h, displacement.col(j).data(),
                            retrograde.col(j).data(), gradient);
   }
+}
+
+SparseMatrix McreProblem::PenaltyMatrix() const {
+  // P = K + B / alpha, B = e_0 e_0^T + e_N e_N^T.
+  return model_.Stiffness(moduli_) + model_.boundary_selector() / alpha_;
+}
+
+void McreProblem::MeasuredForce(int j, Eigen::Ref<Vector> load) const {
+  load.setZero();
+  load[0] = data_.f0[j];
+  load[num_nodes() - 1] = data_.fL[j];
 }
 
 SparseMatrix McreProblem::WeightedObservation() const {

@@ -63,6 +63,18 @@ void CheckEntryKeys(const std::string& name, const YAML::Node& entry,
   }
 }
 
+// The value of top-level key `key`: a finite positive length [m].
+double RequiredLength(const std::string& name, const YAML::Node& root, const std::string& key) {
+  const YAML::Node value = root[key];
+  double length = 0.0;
+  if (!value || !YAML::convert<double>::decode(value, length) || !std::isfinite(length) ||
+      length <= 0.0) {
+    throw InputError((value ? Where(name, value) : name) + ": expected key '" + key +
+                     "', a finite positive length [m] (docs/matrix_models.md section 3)");
+  }
+  return length;
+}
+
 void Refuse(const std::string& why) {
   if (!why.empty()) throw InputError(why);
 }
@@ -93,6 +105,8 @@ MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
   MatrixModelData data;
   const int n = model.num_nodes();
   data.mass = model.mass();
+  data.stiffness_length = model.properties().section / model.properties().length;
+  data.length = model.properties().length;
   for (int z = 0; z < model.num_zones(); ++z) {
     MatrixModelZone zone;
     zone.name = "zone" + std::to_string(z);
@@ -114,7 +128,7 @@ MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
                                    : model.StrainRow(sensor.position);
     std::ostringstream name;
     name << (sensor.kind == SensorKind::kDisplacement ? "u@" : "e@") << sensor.position;
-    data.sensors.push_back({name.str(), ObservationRowMatrix(row, n)});
+    data.sensors.push_back({name.str(), ObservationRowMatrix(row, n), sensor.kind});
   }
   return data;
 }
@@ -124,6 +138,8 @@ std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& d
   manifest.SetDoublePrecision(17);
   manifest << YAML::BeginMap;
   manifest << YAML::Key << "mass" << YAML::Value << "M.mtx";
+  manifest << YAML::Key << "stiffness_length" << YAML::Value << data.stiffness_length;
+  manifest << YAML::Key << "length" << YAML::Value << data.length;
   WriteMatrixMarketMatrix(folder + "/M.mtx", data.mass, MatrixMarketStorage::kSymmetric,
                           "mass matrix M [kg]");
   manifest << YAML::Key << "zones" << YAML::Value << YAML::BeginSeq;
@@ -151,7 +167,11 @@ std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& d
     WriteMatrixMarketMatrix(folder + "/" + file, sensor.row, MatrixMarketStorage::kGeneral,
                             "observation row of sensor channel " + sensor.channel);
     manifest << YAML::Flow << YAML::BeginMap << YAML::Key << "channel" << YAML::Value
-             << sensor.channel << YAML::Key << "row" << YAML::Value << file << YAML::EndMap;
+             << sensor.channel << YAML::Key << "row" << YAML::Value << file;
+    if (sensor.kind == SensorKind::kStrain) {
+      manifest << YAML::Key << "kind" << YAML::Value << "strain";
+    }
+    manifest << YAML::EndMap;
   }
   manifest << YAML::EndSeq << YAML::EndMap;
   const std::string path = folder + "/model.yaml";
@@ -172,13 +192,16 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
   if (!root.IsMap()) throw InputError(manifest_path + ":1: expected a map (mass, zones, ...)");
   for (const auto& key : root) {
     const std::string name = key.first.Scalar();
-    if (name != "mass" && name != "zones" && name != "loads" && name != "sensors") {
+    if (name != "mass" && name != "stiffness_length" && name != "length" && name != "zones" &&
+        name != "loads" && name != "sensors") {
       throw InputError(Where(manifest_path, key.first) + ": unknown key '" + name +
-                       "' (expected mass, zones, loads, sensors)");
+                       "' (expected mass, stiffness_length, length, zones, loads, sensors)");
     }
   }
   const std::string folder = Folder(manifest_path) + "/";
   MatrixModelData data;
+  data.stiffness_length = RequiredLength(manifest_path, root, "stiffness_length");
+  data.length = RequiredLength(manifest_path, root, "length");
   const std::string mass_file = folder + RequiredString(manifest_path, root, "mass");
   data.mass = ReadMatrixMarketMatrix(mass_file);
   Refuse(CheckSquare(data.mass, mass_file));
@@ -230,9 +253,20 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
     data.loads.push_back(std::move(load));
   }
   for (const YAML::Node& entry : sequence("sensors")) {
-    CheckEntryKeys(manifest_path, entry, {"channel", "row"}, "channel, row");
+    CheckEntryKeys(manifest_path, entry, {"channel", "row", "kind"}, "channel, row, kind");
     MatrixModelSensor sensor;
     sensor.channel = RequiredString(manifest_path, entry, "channel");
+    if (entry["kind"]) {
+      const std::string kind = RequiredString(manifest_path, entry, "kind");
+      if (kind == "strain") {
+        sensor.kind = SensorKind::kStrain;
+      } else if (kind != "displacement") {
+        throw InputError(Where(manifest_path, entry["kind"]) +
+                         ": kind must be displacement or "
+                         "strain, got '" +
+                         kind + "'");
+      }
+    }
     if (!channels.insert(sensor.channel).second) {
       throw InputError(Where(manifest_path, entry) + ": channel '" + sensor.channel +
                        "' given twice");

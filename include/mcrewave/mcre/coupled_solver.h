@@ -164,12 +164,14 @@ struct CoupledSolution {
   Vector cost_gradients;       // de^2/dE_z [J s / Pa], one per zone
 };
 
-// Solves the coupled problem at the problem's current modulus. initial_retrograde
-// (nullable) is the initial guess W^(0) of the iterative solvers (warm start, e.g.
-// the previous E's solution); it must have the problem's shape. Precondition:
-// options.IsValid(). The solution's fields are meaningful only when the summary
-// says so.
-CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, McreProblem* problem,
+// Solves the coupled problem at the problem's current moduli: the bar (McreProblem)
+// with every solver, a structure given by matrices (MatrixMcreProblem) with the
+// iterative solvers and all_at_once (the others refuse it in the summary).
+// initial_retrograde (nullable) is the initial guess W^(0) of the iterative solvers
+// (warm start, e.g. the previous E's solution); it must have the problem's shape.
+// Precondition: options.IsValid(). The solution's fields are meaningful only when
+// the summary says so.
+CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledProblem* problem,
                                   const Matrix* initial_retrograde, CoupledSolution* solution);
 
 }  // namespace mcrewave

@@ -1,5 +1,7 @@
-// The time-discrete coupled direct / retrograde MCRE problem for one set of trial
-// zone moduli (docs/discrete_mcre.md; zones and sensors: docs/zones_and_sensors.md).
+// The time-discrete coupled direct / retrograde MCRE problem of the built-in bar for
+// one set of trial zone moduli (docs/discrete_mcre.md; zones and sensors:
+// docs/zones_and_sensors.md); a CoupledProblem (coupled_problem.h), as is the
+// problem of a structure given by matrices (matrix_mcre_problem.h).
 //
 // Fields are stored as n x (m + 1) matrices, column j = time t_j = j h:
 // U (displacement), W (retrograde field, the constitutive gap). The problem owns
@@ -26,6 +28,7 @@
 
 #include "mcrewave/data/measurement.h"
 #include "mcrewave/linalg/theta_integrator.h"
+#include "mcrewave/mcre/coupled_problem.h"
 #include "mcrewave/model/bar_model.h"
 
 namespace mcrewave {
@@ -57,7 +60,7 @@ struct EndDisplacementChannels {
   bool uL = true;
 };
 
-class McreProblem {
+class McreProblem : public CoupledProblem {
  public:
   // Keeps references to model and data: both must outlive the problem.
   // reference_modulus is E0 of the weights [Pa]; theta of the time scheme. The zones
@@ -71,16 +74,15 @@ class McreProblem {
   void SetModulus(double modulus);
   // Sets the zone moduli E_z [Pa] (model().num_zones() entries) and refactorises the
   // integrator when they changed: K = sum_z E_z K1_z.
-  void SetModuli(const Vector& zone_moduli);
+  void SetModuli(const Vector& zone_moduli) override;
   // The modulus of a one-zone model, else the first zone's [Pa].
   double modulus() const { return moduli_.size() > 0 ? moduli_[0] : 0.0; }
-  const Vector& moduli() const { return moduli_; }
-  int num_zones() const { return model_.num_zones(); }
+  const Vector& moduli() const override { return moduli_; }
 
-  int num_nodes() const { return model_.num_nodes(); }
-  int num_steps() const { return data_.num_steps(); }
-  double time_step() const { return data_.time_step; }
-  double theta() const { return theta_; }
+  int num_nodes() const override { return model_.num_nodes(); }
+  int num_steps() const override { return data_.num_steps(); }
+  double time_step() const override { return data_.time_step; }
+  double theta() const override { return theta_; }
   double alpha() const { return alpha_; }              // force weight [m/N]
   double beta() const { return beta_; }                // displacement weight beta_u [N/m]
   double strain_beta() const { return strain_beta_; }  // strain weight beta_e [N m]
@@ -91,38 +93,25 @@ class McreProblem {
   bool observes_ends_only() const { return ends_.u0 && ends_.uL && num_interior_sensors() == 0; }
   const BarModel& model() const { return model_; }
   const MeasurementSet& data() const { return data_; }
-  // A zero field of the problem's shape, n x (m + 1).
-  Matrix ZeroField() const { return Matrix::Zero(num_nodes(), num_steps() + 1); }
-  // Quadrature weight c_j (1/2 at both ends, 1 inside).
-  double QuadratureWeight(int j) const { return (j == 0 || j == num_steps()) ? 0.5 : 1.0; }
-
   // W -> U. With include_data the force data F~ enter; without, the sweep is the
   // linear part only. U is resized if needed (outside the time loop).
-  void DirectSweep(const Matrix& retrograde, bool include_data, Matrix* displacement);
+  void DirectSweep(const Matrix& retrograde, bool include_data, Matrix* displacement) override;
   // U -> W. With include_data the displacement data U~ enter.
-  void RetrogradeSweep(const Matrix& displacement, bool include_data, Matrix* retrograde);
-  // Up to ThetaIntegrator::kMaxBatch sweeps with the data at once, sweep b from
-  // inputs[b] (null: the zero field) into outputs[b] (resized); the time steps of the
-  // sweeps run interleaved, for the cost of fewer than that many sweeps, and give
-  // the results of the single sweeps bit for bit. Counted as that many sweeps.
-  // Outputs distinct from every input.
+  void RetrogradeSweep(const Matrix& displacement, bool include_data, Matrix* retrograde) override;
+  // The batched sweeps of CoupledProblem: the time steps of the sweeps run
+  // interleaved (ThetaIntegrator::StepsWithEndLoads), for the cost of fewer than that
+  // many sweeps, and give the results of the single sweeps bit for bit.
   void DirectSweepsWithData(const std::vector<const Matrix*>& retrograde,
-                            const std::vector<Matrix*>& displacement);
+                            const std::vector<Matrix*>& displacement) override;
   void RetrogradeSweepsWithData(const std::vector<const Matrix*>& displacement,
-                                const std::vector<Matrix*>& retrograde);
-  // The affine map T(W) = RetrogradeSweep(DirectSweep(W)) with the data: two sweeps.
-  // displacement receives DirectSweep(W).
-  void FixedPointMap(const Matrix& retrograde, Matrix* displacement, Matrix* image);
-  // The linear part: G W = T(W) - T(0); two sweeps. scratch_displacement is work space.
-  void ApplyIterationMap(const Matrix& retrograde, Matrix* scratch_displacement, Matrix* image);
+                                const std::vector<Matrix*>& retrograde) override;
 
   // <x, y>_P = sum_j c_j h x_j^T (K + B/alpha) y_j.
-  double InnerProduct(const Matrix& x, const Matrix& y);
-  double Norm(const Matrix& x) { return std::sqrt(std::max(0.0, InnerProduct(x, x))); }
+  double InnerProduct(const Matrix& x, const Matrix& y) override;
 
   // e^2 = sum_j c_j h [1/2 W^T K W + W^T B W / (2 alpha)
   //                    + 1/2 (H U - d~)^T diag(beta_k) (H U - d~)]  [J s].
-  double Cost(const Matrix& displacement, const Matrix& retrograde);
+  double Cost(const Matrix& displacement, const Matrix& retrograde) override;
   // de^2/dE = -(1/(2E)) sum_j c_j h W_j^T K (W_j + 2 U_j)  [J s / Pa], the derivative
   // along a common change of every zone's modulus (one zone: the modulus).
   // Precondition: every zone at the same modulus.
@@ -130,17 +119,22 @@ class McreProblem {
   // de^2/dE_z = -(1/(2 E_z)) sum_j c_j h W_j^T K_z (W_j + 2 U_j) = -(1/2) sum_j c_j h
   // W_j^T K1_z (W_j + 2 U_j) [J s / Pa], every zone from the one pair of fields;
   // gradient is resized to num_zones(). One zone: CostGradient.
-  void CostGradients(const Matrix& displacement, const Matrix& retrograde, Vector* gradient);
+  void CostGradients(const Matrix& displacement, const Matrix& retrograde,
+                     Vector* gradient) override;
   // The error map: the share of each element in the constitutive part of e^2,
   //   e_el^2 = sum_j c_j h 1/2 W_j^T K_el W_j  [J s],
   // one entry per element; their sum is sum_j c_j h 1/2 W_j^T K W_j.
   Vector ErrorMap(const Matrix& retrograde) const;
 
-  // H^T diag(beta_k) H [N/m], n x n: the data term's operator on U (the paper's
-  // case: beta B). For the assembled reference solvers.
-  SparseMatrix WeightedObservation() const;
-  // H^T diag(beta_k) d~_j [N] at sample j into load (size n).
-  void WeightedData(int j, Eigen::Ref<Vector> load) const;
+  // The operators of the space-time system: M, K = sum_z E_z K1_z, P = K + B/alpha,
+  // H^T diag(beta_k) H (the paper's case: beta B), H^T diag(beta_k) d~_j and the
+  // measured end forces f0~_j e_0 + fL~_j e_N.
+  SparseMatrix MassMatrix() const override { return model_.mass(); }
+  SparseMatrix StiffnessMatrix() const override { return model_.Stiffness(moduli_); }
+  SparseMatrix PenaltyMatrix() const override;
+  SparseMatrix WeightedObservation() const override;
+  void WeightedData(int j, Eigen::Ref<Vector> load) const override;
+  void MeasuredForce(int j, Eigen::Ref<Vector> load) const override;
 
   // --- Streaming: the coupled problem on the sensor traces (docs/streaming.md) ---
   // A trace field y holds one row per channel of H, in the order u0, uL, then the
@@ -186,22 +180,9 @@ class McreProblem {
   // One direct sweep, O(n) memory (no field stored); resizes traces.
   void DataResponseTraces(Matrix* traces);
 
-  // Number of sweeps (direct + retrograde) run since construction.
-  long sweep_count() const { return sweep_count_; }
   // Number of factorisations of the integrator's iteration matrix since construction
   // (the constructor's SetModulus included): one per change of modulus.
   int factorization_count() const { return integrator_.factorization_count(); }
-
-  // Work fields of the iterative coupled solvers, kept with the problem between
-  // solves so that a solve on a problem solved before allocates no field (a fresh
-  // n x (m + 1) field costs its page faults, measured at about 15 % of an
-  // identification's CPU time). Each is resized by its user; `zero` is the zero
-  // field, never written.
-  struct SolverWorkspace {
-    Matrix residual, direction, image, scratch, rhs, data_response;
-    Matrix zero;
-  };
-  SolverWorkspace& workspace();
 
  private:
   template <int B>
@@ -258,8 +239,6 @@ class McreProblem {
   PointLoads point_loads_[ThetaIntegrator::kMaxBatch];
   ThetaIntegrator integrator_;
   SymmetricBandMatrix unit_stiffness_;  // K1 = sum_z K1_z
-  long sweep_count_ = 0;
-  SolverWorkspace workspace_;
   // Streaming scratch (double buffers of the three sweeps' states, W_{j-1}, W_j, the
   // direct step's shift), allocated in the constructor: O(n).
   Vector stream_velocity_[2], stream_omega_[2], stream_rebuilt_velocity_[2],

@@ -7,12 +7,15 @@
 // `model.yaml` that names them:
 //
 //   mass: M.mtx
+//   stiffness_length: 1.0e-4   # a* [m]: k* = E0 a* is the structure's stiffness scale
+//   length: 1.0                # l* [m]: the span that turns a strain into a displacement
 //   zones:
 //     - {name: zone0, stiffness: K_zone0.mtx, nominal_modulus: 2.0e+11}
 //   loads:
 //     - {channel: fL, vector: load_fL.mtx}
 //   sensors:
 //     - {channel: uL, row: sensor_uL.mtx}
+//     - {channel: e@0.5, row: sensor_e_at_0.5.mtx, kind: strain}
 //
 // (file names relative to the manifest's folder). WriteBarMatrixModel exports the
 // built-in bar this way, so that the general path can be tested against it.
@@ -40,10 +43,18 @@ struct MatrixModelLoad {
 struct MatrixModelSensor {
   std::string channel;  // the CSV column it is compared with
   SparseMatrix row;     // 1 x n observation row: channel = row U
+  // What the row measures: a displacement [m] or a strain [-] (manifest key `kind`,
+  // default displacement); it chooses the weight of the channel's data term.
+  SensorKind kind = SensorKind::kDisplacement;
 };
 
 struct MatrixModelData {
   SparseMatrix mass;  // M [kg], n x n
+  // The structure's own scales that make the MCRE weights dimensionless
+  // (docs/matrix_models.md section 3): k* = E0 stiffness_length [N/m] and l* = length.
+  // The bar: S / L and L; a plate in plane stress: its thickness and its length.
+  double stiffness_length = 0.0;  // a* [m]
+  double length = 0.0;            // l* [m]
   std::vector<MatrixModelZone> zones;
   std::vector<MatrixModelLoad> loads;
   std::vector<MatrixModelSensor> sensors;
@@ -62,9 +73,9 @@ struct BarSensor {
   double position = 0.0;  // X [m]
 };
 
-// The bar as matrices: M, K1_z times nominal_modulus per zone (zone z named "zone<z>"),
-// the end loads (channels f0: e_0, fL: e_N), the end displacement rows (u0, uL) and
-// the rows of `sensors` (channels u@X / e@X, as the measurement CSV names them).
+// The bar as matrices (scales a* = S / L, l* = L): M, K1_z times nominal_modulus per zone (zone z
+// named "zone<z>"), the end loads (channels f0: e_0, fL: e_N), the end displacement rows (u0, uL)
+// and the rows of `sensors` (channels u@X / e@X, as the measurement CSV names them).
 MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
                                const std::vector<BarSensor>& sensors = {});
 
@@ -78,7 +89,8 @@ std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& d
 // Reads a manifest and its files, and checks them (model/matrix_model_check.h): M
 // square, symmetric, positive definite; every K_z symmetric and of M's size; the
 // load vectors of M's size; the sensor rows within M's dofs; zone names and channels
-// distinct; nominal moduli finite and positive. Throws InputError naming the file
+// distinct; nominal moduli and the scales stiffness_length and length finite and
+// positive; a sensor's kind displacement or strain. Throws InputError naming the file
 // (and line, for the manifest and the Matrix Market files) on the first problem.
 MatrixModelData ReadMatrixModel(const std::string& manifest_path);
 

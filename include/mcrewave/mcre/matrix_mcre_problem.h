@@ -1,0 +1,114 @@
+// The coupled direct / retrograde MCRE problem of a structure given by matrices
+// (docs/matrix_models.md section 2): mass M, zone stiffnesses K_z assembled at their
+// nominal moduli, load vectors G = [g_1 ... g_C] whose histories F~ are measured, and
+// observation rows H (one per sensor channel) whose histories d~ are measured.
+//
+// Scheme (the theta method of M U'' + K (U + W) = G f, K = sum_z (E_z / E_z,nom) K_z):
+//
+//   DirectSweep:      W -> U, from rest, step t_k -> t_{k+1} with
+//                       f_theta = -K W_theta + G (F~_theta - diag(1/alpha) G^T W_theta),
+//                       X_theta = theta X_{k+1} + (1 - theta) X_k
+//                     (ThetaIntegrator::StepShifted: z = W_theta, force = G (...));
+//   RetrogradeSweep:  U -> W, from rest at T in reversed time, step t_j -> t_{j-1}
+//                     with the force c_j H^T diag(beta) (H U_j - d~_j), then
+//                       W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j,
+//
+// the bar's sweeps (mcre_problem.h) with its end loads and rows replaced by G and H.
+// Weights from the structure's scales (section 3): k* = E0 a*,
+//   beta_k = w_u k* (displacement row), w_e k* l*^2 (strain row),  alpha_c = w_f / k*,
+// so that the bar exported with a* = S / L and l* = L has the bar's weights.
+//
+// The integrator is factorised once per set of moduli (SetModuli), by the sparse
+// LDL^T or the band path (ThetaIntegratorOptions::factorization). The sweeps allocate
+// nothing: every scratch vector is sized in the constructor.
+#pragma once
+
+#include <vector>
+
+#include "mcrewave/linalg/theta_integrator.h"
+#include "mcrewave/mcre/coupled_problem.h"
+#include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/model/matrix_export.h"
+
+namespace mcrewave {
+
+// The measured histories of a matrix model's channels, sampled at t_j = j h,
+// j = 0..m: one row per load channel and one per sensor channel, in the model's order
+// (MatrixModelData::loads, ::sensors).
+struct ChannelHistories {
+  double time_step = 0.0;  // h [s]
+  Matrix loads;            // F~ [N], C x (m + 1)
+  Matrix outputs;          // d~ [m] or [-], S x (m + 1)
+  int num_steps() const { return static_cast<int>(loads.cols()) - 1; }
+};
+
+class MatrixMcreProblem : public CoupledProblem {
+ public:
+  // Keeps references to model and data: both must outlive the problem.
+  // reference_modulus is E0 of the weights [Pa]; every zone starts at its nominal
+  // modulus. Preconditions: data has the model's channels (rows) and m >= 1 steps,
+  // the model's scales positive, weights valid, theta in [0, 1].
+  MatrixMcreProblem(const MatrixModelData& model, const ChannelHistories& data,
+                    const McreWeights& weights, double reference_modulus, double theta,
+                    Factorization factorization = Factorization::kAutomatic);
+
+  int num_nodes() const override { return model_.dofs(); }
+  int num_steps() const override { return data_.num_steps(); }
+  double time_step() const override { return data_.time_step; }
+  double theta() const override { return theta_; }
+  const Vector& moduli() const override { return moduli_; }
+  // K = sum_z (E_z / E_z,nom) K_z, refactorised when the moduli changed.
+  void SetModuli(const Vector& zone_moduli) override;
+
+  void DirectSweep(const Matrix& retrograde, bool include_data, Matrix* displacement) override;
+  void RetrogradeSweep(const Matrix& displacement, bool include_data, Matrix* retrograde) override;
+  double InnerProduct(const Matrix& x, const Matrix& y) override;
+  double Cost(const Matrix& displacement, const Matrix& retrograde) override;
+  // de^2/dE_z = -(1/(2 E_z,nom)) sum_j c_j h W_j^T K_z (W_j + 2 U_j) [J s / Pa].
+  void CostGradients(const Matrix& displacement, const Matrix& retrograde,
+                     Vector* gradient) override;
+  // Each zone's share of the constitutive part of e^2,
+  //   e_z^2 = (E_z / E_z,nom) sum_j c_j h 1/2 W_j^T K_z W_j  [J s];
+  // from matrices alone a zone is the finest unit (docs/matrix_models.md section 2).
+  Vector ZoneErrorMap(const Matrix& retrograde);
+  // The same energy split by dof, e_i^2 = sum_j c_j h 1/2 W_ij (K W_j)_i [J s]: it sums
+  // to the constitutive part and shows where in a zone the gap sits (a nodal
+  // density for a figure over the mesh; an entry can be slightly negative).
+  Vector DofErrorMap(const Matrix& retrograde);
+
+  SparseMatrix MassMatrix() const override { return model_.mass; }
+  SparseMatrix StiffnessMatrix() const override { return stiffness_; }
+  SparseMatrix PenaltyMatrix() const override;
+  SparseMatrix WeightedObservation() const override;
+  void WeightedData(int j, Eigen::Ref<Vector> load) const override;
+  void MeasuredForce(int j, Eigen::Ref<Vector> load) const override;
+
+  // H U of DirectSweep(0) with the data: the model's outputs driven by the measured
+  // loads alone, S x (m + 1) (synthetic data of this model: ChannelHistories::outputs).
+  Matrix ModelOutputs();
+
+  const Vector& alphas() const { return alphas_; }  // alpha_c [m/N], per load channel
+  const Vector& betas() const { return betas_; }    // beta_k [N/m or N m], per sensor
+  int factorization_count() const { return integrator_.factorization_count(); }
+  const ThetaIntegrator& integrator() const { return integrator_; }
+
+ private:
+  const MatrixModelData& model_;
+  const ChannelHistories& data_;
+  double theta_;
+  Factorization factorization_;
+  Vector moduli_;                        // E_z [Pa]
+  Vector alphas_, betas_;                // alpha_c [m/N], beta_k
+  SparseMatrix loads_;                   // G, n x C
+  SparseMatrix loads_transposed_;        // G^T, C x n
+  SparseMatrix observation_;             // H, S x n
+  SparseMatrix observation_transposed_;  // H^T, n x S
+  SparseMatrix stiffness_;               // K at moduli_
+  ThetaIntegrator integrator_;
+  // Scratch, allocated in the constructor: double buffers of the sweeps' velocity and
+  // state, W_theta, the step's force, a product K x, two vectors per load channel and
+  // one per sensor channel.
+  Vector velocity_[2], state_[2], shift_, force_, product_, channel_, other_channel_, trace_;
+};
+
+}  // namespace mcrewave

@@ -1,0 +1,299 @@
+// Tests of the MCRE problem of a structure given by matrices
+// (mcre/matrix_mcre_problem.h, docs/matrix_models.md): the bar exported to Matrix
+// Market gives the built-in bar's sweeps, e^2 and zone gradients; the assembled
+// all-at-once solver and conjugate gradients agree on a general sparse structure;
+// every zone's gradient of the plate matches a central difference; the zone map
+// sums to the constitutive part.
+#include "mcrewave/mcre/matrix_mcre_problem.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "identify_binary.h"
+#include "mcrewave/mcre/coupled_solver.h"
+#include "test_problems.h"
+
+namespace mcrewave {
+namespace {
+
+using testing::MakeSmallCase;
+using testing::RelativeDifference;
+using testing::SmallCase;
+using testing::Weights;
+
+const std::string kPlate = std::string(MCREWAVE_SOURCE_DIR) + "/configs/plate/";
+
+// The bar's measurements as the channel histories of BarMatrixModel's channels:
+// loads f0, fL; sensors u0, uL, then the interior sensors in the data's order.
+ChannelHistories BarHistories(const MeasurementSet& data) {
+  ChannelHistories histories;
+  histories.time_step = data.time_step;
+  const int samples = data.num_samples();
+  histories.loads.resize(2, samples);
+  histories.loads.row(0) = data.f0.transpose();
+  histories.loads.row(1) = data.fL.transpose();
+  histories.outputs.resize(2 + static_cast<int>(data.sensors.size()), samples);
+  histories.outputs.row(0) = data.u0.transpose();
+  histories.outputs.row(1) = data.uL.transpose();
+  for (std::size_t k = 0; k < data.sensors.size(); ++k) {
+    histories.outputs.row(2 + static_cast<int>(k)) = data.sensors[k].values.transpose();
+  }
+  return histories;
+}
+
+CoupledSolverOptions Tight(CoupledSolverType type) {
+  CoupledSolverOptions options;
+  options.type = type;
+  options.tolerance = 1e-12;
+  return options;
+}
+
+// The bar of 30 elements in 3 zones with an interior displacement sensor and a strain
+// gauge, SNR 20, built in and through Matrix Market files.
+class BarThroughMatricesTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    SmallCase c = MakeSmallCase(30, 240, 20.0, 2);
+    c.data.sensors = {"u@0.25", "e@0.65"};
+    std::vector<int> zones(30);
+    for (int e = 0; e < 30; ++e) zones[e] = e / 10;
+    model_ = std::make_unique<BarModel>(c.bar, zones);
+    data_ = MakeSyntheticMeasurements(c.bar, c.load, c.time, c.data);
+    const std::vector<BarSensor> sensors = {{SensorKind::kDisplacement, 0.25},
+                                            {SensorKind::kStrain, 0.65}};
+    const std::string folder = testing::FreshDirectory("bar_through_matrices");
+    matrices_ = ReadMatrixModel(WriteMatrixModel(folder, BarMatrixModel(*model_, 200e9, sensors)));
+    histories_ = BarHistories(data_);
+    weights_ = Weights(0.01, 1.0);
+    weights_.strain_weight = 0.003;
+  }
+  std::unique_ptr<BarModel> model_;
+  MeasurementSet data_;
+  MatrixModelData matrices_;
+  ChannelHistories histories_;
+  McreWeights weights_;
+};
+
+TEST_F(BarThroughMatricesTest, SweepsWeightsCostAndZoneGradientsAreTheBuiltInBars) {
+  McreProblem bar(*model_, data_, weights_, 200e9, 0.5);
+  MatrixMcreProblem general(matrices_, histories_, weights_, 200e9, 0.5);
+  // The weights from a* = S / L and l* = L are the bar's (the same formulas).
+  EXPECT_DOUBLE_EQ(general.alphas()[0], bar.alpha());
+  EXPECT_DOUBLE_EQ(general.betas()[0], bar.beta());
+  EXPECT_DOUBLE_EQ(general.betas()[3], bar.strain_beta());
+  const Vector moduli = (Vector(3) << 180e9, 200e9, 230e9).finished();
+  bar.SetModuli(moduli);
+  general.SetModuli(moduli);
+  // The bar exported is tridiagonal: the general problem takes the same band path.
+  EXPECT_EQ(general.integrator().factorization(), Factorization::kBand);
+
+  // One sweep of each kind from the same input: the general force vectors against the
+  // bar's end and point loads. Measured 1.1e-14 (direct) and 1.6e-15 (retrograde).
+  Matrix w = bar.ZeroField(), u_bar, u_general, w_bar, w_general;
+  bar.RetrogradeSweep(bar.ZeroField(), true, &w);
+  bar.DirectSweep(w, true, &u_bar);
+  general.DirectSweep(w, true, &u_general);
+  EXPECT_LT(RelativeDifference(u_general, u_bar), 1e-13);
+  bar.RetrogradeSweep(u_bar, true, &w_bar);
+  general.RetrogradeSweep(u_bar, true, &w_general);
+  EXPECT_LT(RelativeDifference(w_general, w_bar), 1e-14);
+  // The inner products and the cost on the same fields: measured 1.3e-15 and 1.1e-15.
+  EXPECT_NEAR(general.InnerProduct(w_bar, w), bar.InnerProduct(w_bar, w),
+              1e-14 * std::abs(bar.InnerProduct(w_bar, w)));
+  EXPECT_NEAR(general.Cost(u_bar, w_bar), bar.Cost(u_bar, w_bar), 1e-14 * bar.Cost(u_bar, w_bar));
+
+  // Solved by CG to 1e-12: e^2 and the zone gradients, measured 4.7e-15 and 6.6e-13
+  // apart (relative to the gradient's norm; the issue asks for 1e-12).
+  CoupledSolution bar_solution, general_solution;
+  ASSERT_TRUE(
+      SolveCoupled(Tight(CoupledSolverType::kConjugateGradient), &bar, nullptr, &bar_solution)
+          .IsSolutionUsable());
+  ASSERT_TRUE(SolveCoupled(Tight(CoupledSolverType::kConjugateGradient), &general, nullptr,
+                           &general_solution)
+                  .IsSolutionUsable());
+  EXPECT_NEAR(general_solution.cost, bar_solution.cost, 1e-12 * bar_solution.cost);
+  for (int z = 0; z < 3; ++z) {
+    EXPECT_NEAR(general_solution.cost_gradients[z], bar_solution.cost_gradients[z],
+                2e-12 * bar_solution.cost_gradients.norm())
+        << "zone " << z;
+  }
+  // The zone map against the bar's element map summed by zone.
+  const Vector elements = bar.ErrorMap(bar_solution.retrograde);
+  const Vector zones = general.ZoneErrorMap(general_solution.retrograde);
+  for (int z = 0; z < 3; ++z) {
+    EXPECT_NEAR(zones[z], elements.segment(10 * z, 10).sum(), 1e-12 * elements.sum());
+  }
+}
+
+TEST_F(BarThroughMatricesTest, TheSparsePathGivesTheSameSolution) {
+  MatrixMcreProblem band(matrices_, histories_, weights_, 200e9, 0.5, Factorization::kBand);
+  MatrixMcreProblem sparse(matrices_, histories_, weights_, 200e9, 0.5, Factorization::kSparse);
+  EXPECT_EQ(sparse.integrator().factorization(), Factorization::kSparse);
+  CoupledSolution a, b;
+  ASSERT_TRUE(SolveCoupled(Tight(CoupledSolverType::kConjugateGradient), &band, nullptr, &a)
+                  .IsSolutionUsable());
+  ASSERT_TRUE(SolveCoupled(Tight(CoupledSolverType::kConjugateGradient), &sparse, nullptr, &b)
+                  .IsSolutionUsable());
+  // Measured 1.7e-14 in e^2, 9.2e-14 in W.
+  EXPECT_NEAR(b.cost, a.cost, 1e-13 * a.cost);
+  EXPECT_LT(RelativeDifference(b.retrograde, a.retrograde), 1e-12);
+}
+
+// A general sparse structure: a 2-D lattice of 7 x 4 free nodes (one dof each, a
+// membrane), springs to the 4 neighbours and the diagonals, the column x = 0
+// clamped, two zones (x < 4 and x >= 4), a load spread over the last column, a
+// displacement sensor and a difference ("strain") row. Numbered column by column so
+// that its band is 4 to 5 wide and the sparse path is taken when asked.
+MatrixModelData Lattice() {
+  constexpr int kColumns = 7, kRows = 4, kDofs = kColumns * kRows;
+  auto dof = [](int column, int row) { return (column - 1) * kRows + row; };  // column >= 1
+  std::vector<Eigen::Triplet<double>> mass, stiffness[2];
+  for (int i = 0; i < kDofs; ++i) {
+    mass.emplace_back(i, i, 2.0);
+  }
+  auto spring = [&](int c0, int r0, int c1, int r1, double k) {
+    const int zone = std::max(c0, c1) < 4 ? 0 : 1;
+    const int a = c0 >= 1 ? dof(c0, r0) : -1, b = c1 >= 1 ? dof(c1, r1) : -1;
+    if (a >= 0) stiffness[zone].emplace_back(a, a, k);
+    if (b >= 0) stiffness[zone].emplace_back(b, b, k);
+    if (a >= 0 && b >= 0) {
+      stiffness[zone].emplace_back(a, b, -k);
+      stiffness[zone].emplace_back(b, a, -k);
+      mass.emplace_back(a, b, 0.25);
+      mass.emplace_back(b, a, 0.25);
+    }
+  };
+  for (int c = 0; c <= kColumns; ++c) {
+    for (int r = 0; r < kRows; ++r) {
+      if (c < kColumns) spring(c, r, c + 1, r, 3e3);
+      if (r + 1 < kRows && c >= 1) spring(c, r, c, r + 1, 1e3);
+      if (r + 1 < kRows && c < kColumns) spring(c, r, c + 1, r + 1, 5e2);
+    }
+  }
+  MatrixModelData model;
+  model.stiffness_length = 1e-8;  // k* = E0 a* = 2e3 N/m at E0 = 2e11 Pa
+  model.length = 0.1;
+  model.mass.resize(kDofs, kDofs);
+  model.mass.setFromTriplets(mass.begin(), mass.end());
+  for (int z = 0; z < 2; ++z) {
+    MatrixModelZone zone;
+    zone.name = "zone" + std::to_string(z);
+    zone.nominal_modulus = 2e11;
+    zone.stiffness.resize(kDofs, kDofs);
+    zone.stiffness.setFromTriplets(stiffness[z].begin(), stiffness[z].end());
+    model.zones.push_back(zone);
+  }
+  Vector load = Vector::Zero(kDofs);
+  for (int r = 0; r < kRows; ++r) load[dof(kColumns, r)] = 0.25;
+  model.loads.push_back({"F", load});
+  SparseMatrix tip(1, kDofs), gauge(1, kDofs);
+  tip.insert(0, dof(kColumns, 3)) = 1.0;
+  gauge.insert(0, dof(3, 0)) = -10.0;
+  gauge.insert(0, dof(4, 0)) = 10.0;
+  model.sensors.push_back({"u_tip", tip, SensorKind::kDisplacement});
+  model.sensors.push_back({"e_mid", gauge, SensorKind::kStrain});
+  return model;
+}
+
+// Histories on m steps of h: a half-sine load of `duration` and outputs of `truth`'s
+// model at `truth_moduli` (its own mesh: model outputs) plus a deterministic wiggle of
+// relative size `spoil` (so that the data are not the model's).
+ChannelHistories Histories(const MatrixModelData& truth, const Vector& truth_moduli, int steps,
+                           double time_step, double duration, double spoil) {
+  ChannelHistories histories;
+  histories.time_step = time_step;
+  histories.loads = Matrix::Zero(1, steps + 1);
+  for (int j = 0; j <= steps; ++j) {
+    const double t = j * time_step;
+    if (t < duration) histories.loads(0, j) = 1e3 * std::sin(M_PI * t / duration);
+  }
+  histories.outputs = Matrix::Zero(static_cast<int>(truth.sensors.size()), steps + 1);
+  MatrixMcreProblem simulation(truth, histories, Weights(0.01, 1.0), 2e11, 0.5);
+  simulation.SetModuli(truth_moduli);
+  histories.outputs = simulation.ModelOutputs();
+  for (int k = 0; k < histories.outputs.rows(); ++k) {
+    const double scale = histories.outputs.row(k).cwiseAbs().maxCoeff();
+    for (int j = 0; j <= steps; ++j) {
+      histories.outputs(k, j) += spoil * scale * std::sin(0.37 * j + k);
+    }
+  }
+  return histories;
+}
+
+TEST(MatrixMcreProblemTest, AllAtOnceAndIterativeSolversAgreeOnASparseLattice) {
+  const MatrixModelData lattice = Lattice();
+  const Vector truth = (Vector(2) << 2e11, 1.6e11).finished();
+  const ChannelHistories data = Histories(lattice, truth, 120, 2e-3, 0.05, 0.05);
+  MatrixMcreProblem problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5, Factorization::kSparse);
+  problem.SetModuli((Vector(2) << 1.8e11, 2.1e11).finished());
+  CoupledSolution reference;
+  const CoupledSolverSummary direct =
+      SolveCoupled(Tight(CoupledSolverType::kAllAtOnce), &problem, nullptr, &reference);
+  ASSERT_TRUE(direct.IsSolutionUsable()) << direct.FullReport();
+  for (const CoupledSolverType type :
+       {CoupledSolverType::kConjugateGradient, CoupledSolverType::kAdaptiveRelaxation}) {
+    CoupledSolution solution;
+    const CoupledSolverSummary summary = SolveCoupled(Tight(type), &problem, nullptr, &solution);
+    ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+    // Measured: W 1.7e-11 (CG) and 1.0e-11 (adaptive relaxation) apart, U 4.2e-14 and
+    // 2.1e-14, e^2 4.7e-15 and 3.6e-15, the gradients 3.1e-12 and 8.6e-12.
+    EXPECT_LT(RelativeDifference(solution.retrograde, reference.retrograde), 1e-10)
+        << CoupledSolverTypeToString(type);
+    EXPECT_LT(RelativeDifference(solution.displacement, reference.displacement), 1e-12);
+    EXPECT_NEAR(solution.cost, reference.cost, 3e-14 * reference.cost);
+    EXPECT_LT((solution.cost_gradients - reference.cost_gradients).norm(),
+              5e-11 * reference.cost_gradients.norm());
+  }
+  // The zone map sums to the constitutive part 1/2 sum_j c_j h W^T K W, and the dof
+  // map to the same.
+  const Vector zones = problem.ZoneErrorMap(reference.retrograde);
+  const Vector dofs = problem.DofErrorMap(reference.retrograde);
+  EXPECT_NEAR(dofs.sum(), zones.sum(), 1e-13 * zones.sum());
+  EXPECT_GT(zones.minCoeff(), 0.0);
+  // The solvers written for the bar refuse a matrix model, naming the ones that work.
+  CoupledSolution refused;
+  const CoupledSolverSummary riccati =
+      SolveCoupled(Tight(CoupledSolverType::kRiccati), &problem, nullptr, &refused);
+  EXPECT_EQ(riccati.termination, TerminationType::kFailure);
+  EXPECT_NE(riccati.message.find("handles the built-in bar only"), std::string::npos);
+}
+
+TEST(MatrixMcreProblemTest, EveryZoneGradientOfThePlateMatchesACentralDifference) {
+  const MatrixModelData coarse = ReadMatrixModel(kPlate + "coarse/model.yaml");
+  const MatrixModelData fine = ReadMatrixModel(kPlate + "fine/model.yaml");
+  // Data from the fine mesh (inclusion 25 % softer), 150 steps of 1 us.
+  const ChannelHistories data =
+      Histories(fine, (Vector(2) << 2e11, 1.5e11).finished(), 150, 1e-6, 2e-5, 0.0);
+  MatrixMcreProblem problem(coarse, data, Weights(0.01, 1.0), 2e11, 0.5);
+  const Vector moduli = (Vector(2) << 1.9e11, 1.7e11).finished();
+  // CG to 1e-9 (e^2 is then exact to about 1e-18 relative: its error is quadratic in
+  // the residual), warm-started from the solution at the centre.
+  CoupledSolverOptions options = Tight(CoupledSolverType::kConjugateGradient);
+  options.tolerance = 1e-9;
+  Matrix centre;
+  auto solve = [&](const Vector& at) {
+    problem.SetModuli(at);
+    CoupledSolution solution;
+    EXPECT_TRUE(SolveCoupled(options, &problem, centre.size() > 0 ? &centre : nullptr, &solution)
+                    .IsSolutionUsable());
+    return solution;
+  };
+  const CoupledSolution at = solve(moduli);
+  centre = at.retrograde;
+  for (int z = 0; z < 2; ++z) {
+    // Central difference of step 1e-4 E_z.
+    const double step = 1e-4 * moduli[z];
+    Vector plus = moduli, minus = moduli;
+    plus[z] += step;
+    minus[z] -= step;
+    const double difference = (solve(plus).cost - solve(minus).cost) / (2.0 * step);
+    // Measured 1.7e-7 (matrix) and 1.7e-8 (inclusion) relative; the issue asks 1e-6.
+    EXPECT_NEAR(at.cost_gradients[z], difference, 1e-6 * std::abs(difference)) << "zone " << z;
+  }
+}
+
+}  // namespace
+}  // namespace mcrewave
