@@ -13,11 +13,14 @@
 // brings its own allocator, nothing is replaced and these tests are skipped.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstddef>
 #include <cstdlib>
+#include <string>
 #include <vector>
 
 #include "mcrewave/linalg/theta_integrator.h"
+#include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/mcre/mcre_problem.h"
 #include "mcrewave/model/bar_model.h"
 #include "test_problems.h"
@@ -399,6 +402,42 @@ TEST(McreProblemAllocationTest, RetrogradeSweepsWithInteriorSensorsAllocateNothi
   EXPECT_EQ(calls.allocations, 0);
   EXPECT_EQ(calls.deallocations, 0);
   EXPECT_GT(retrograde.norm(), 0.0);
+}
+
+// The problem of a structure given by matrices (the coarse plate, sparse path): its
+// sweeps, the solvers' maps and the sums over the fields allocate nothing.
+TEST(MatrixMcreProblemAllocationTest, SweepsAndSumsAllocateNothing) {
+  SKIP_WITHOUT_ALLOCATION_COUNTING();
+  const MatrixModelData plate =
+      ReadMatrixModel(std::string(MCREWAVE_SOURCE_DIR) + "/configs/plate/coarse/model.yaml");
+  ChannelHistories data;
+  data.time_step = 1e-6;
+  data.loads = Matrix::Zero(1, 21);
+  data.loads(0, 3) = 1e3;
+  data.outputs = Matrix::Constant(static_cast<int>(plate.sensors.size()), 21, 1e-7);
+  MatrixMcreProblem problem(plate, data, Weights(0.01, 1.0), 2e11, 0.5);
+  ASSERT_EQ(problem.integrator().factorization(), Factorization::kSparse);
+  Matrix displacement = problem.ZeroField(), retrograde = problem.ZeroField();
+  Matrix image = problem.ZeroField();
+  Vector gradient = Vector::Zero(2);
+  problem.workspace();
+  problem.RetrogradeSweep(problem.ZeroField(), true, &retrograde);
+  const std::vector<const Matrix*> inputs{&retrograde, nullptr};
+  const std::vector<Matrix*> outputs{&displacement, &image};
+  double sums = 0.0;
+  const HeapCalls calls = CountHeapCalls([&] {
+    problem.DirectSweep(retrograde, true, &displacement);
+    problem.RetrogradeSweep(displacement, false, &image);
+    problem.FixedPointMap(retrograde, &displacement, &image);
+    problem.DirectSweepsWithData(inputs, outputs);
+    sums = problem.InnerProduct(retrograde, image) + problem.Cost(displacement, retrograde);
+    problem.CostGradients(displacement, retrograde, &gradient);
+  });
+  EXPECT_EQ(calls.allocations, 0);
+  EXPECT_EQ(calls.deallocations, 0);
+  EXPECT_TRUE(std::isfinite(sums));
+  EXPECT_GT(displacement.norm(), 0.0);
+  EXPECT_NE(gradient[0], 0.0);
 }
 
 TEST(McreProblemAllocationTest, StreamingMapAllocatesNothingAfterItsFirstCall) {
