@@ -56,11 +56,7 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
   channel_ = Vector::Zero(num_loads);
   other_channel_ = Vector::Zero(num_loads);
   trace_ = Vector::Zero(num_sensors);
-  Vector nominal(model.zones.size());
-  for (std::size_t z = 0; z < model.zones.size(); ++z) {
-    nominal[static_cast<Eigen::Index>(z)] = model.zones[z].nominal_modulus;
-  }
-  SetModuli(nominal);
+  SetModuli(NominalModuli());
 }
 
 void MatrixMcreProblem::SetModuli(const Vector& zone_moduli) {
@@ -222,6 +218,25 @@ void MatrixMcreProblem::WeightedData(int j, Eigen::Ref<Vector> load) const {
 void MatrixMcreProblem::MeasuredForce(int j, Eigen::Ref<Vector> load) const {
   // G F~_j.
   load.noalias() = loads_ * data_.loads.col(j);
+}
+
+double MatrixMcreProblem::RestCost() const {
+  double sum = 0.0;
+  for (int j = 0; j <= num_steps(); ++j) {
+    // c_j h [1/2 F~^T diag(alpha) F~ + 1/2 d~^T diag(beta) d~].
+    sum += QuadratureWeight(j) * time_step() * 0.5 *
+           (alphas_.dot(data_.loads.col(j).cwiseAbs2()) +
+            betas_.dot(data_.outputs.col(j).cwiseAbs2()));
+  }
+  return sum;
+}
+
+Vector MatrixMcreProblem::NominalModuli() const {
+  Vector nominal(model_.zones.size());
+  for (std::size_t z = 0; z < model_.zones.size(); ++z) {
+    nominal[static_cast<Eigen::Index>(z)] = model_.zones[z].nominal_modulus;
+  }
+  return nominal;
 }
 
 Matrix MatrixMcreProblem::ModelOutputs() {

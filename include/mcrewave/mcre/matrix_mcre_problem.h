@@ -87,6 +87,13 @@ class MatrixMcreProblem : public CoupledProblem {
   // loads alone, S x (m + 1) (synthetic data of this model: ChannelHistories::outputs).
   Matrix ModelOutputs();
 
+  // J_rest = sum_j c_j h [1/2 F~_j^T diag(alpha) F~_j + 1/2 d~_j^T diag(beta) d~_j]
+  // [J s]: the functional of the structure left at rest (U = W = 0, zero loads), which
+  // satisfies the state equation at any moduli, so 0 <= e^2 <= J_rest.
+  double RestCost() const;
+  // E_z,nom of every zone [Pa].
+  Vector NominalModuli() const;
+
   const Vector& alphas() const { return alphas_; }  // alpha_c [m/N], per load channel
   const Vector& betas() const { return betas_; }    // beta_k [N/m or N m], per sensor
   int factorization_count() const { return integrator_.factorization_count(); }
