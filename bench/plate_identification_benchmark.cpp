@@ -100,8 +100,8 @@ void AddNoise(const MatrixModelData& model, double snr, std::uint64_t seed,
   };
   for (int j = 0; j < data->loads.cols(); ++j) data->loads(0, j) += std_f * normal();
   for (int k = 0; k < data->outputs.rows(); ++k) {
-    const double std = model.sensors[k].kind == SensorKind::kStrain ? std_e : std_u;
-    for (int j = 0; j < data->outputs.cols(); ++j) data->outputs(k, j) += std * normal();
+    const double deviation = model.sensors[k].kind == SensorKind::kStrain ? std_e : std_u;
+    for (int j = 0; j < data->outputs.cols(); ++j) data->outputs(k, j) += deviation * normal();
   }
 }
 
