@@ -153,7 +153,7 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
       bar == nullptr) {
     summary.message = std::string(CoupledSolverTypeToString(options.type)) +
                       " handles the built-in bar only; for a structure given by matrices use "
-                      "inner.solver: conjugate_gradient, adaptive_relaxation, relaxation or "
+                      "inner.method: conjugate_gradient, adaptive_relaxation, relaxation or "
                       "all_at_once";
     return summary;
   }
@@ -161,7 +161,7 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
     // Their transfer operators are written for H = B (the two end displacements).
     summary.message = std::string(CoupledSolverTypeToString(options.type)) +
                       " handles the paper's end sensors only (u0 and uL, no interior sensor); "
-                      "with interior sensors or an end channel left out use inner.solver: "
+                      "with interior sensors or an end channel left out use inner.method: "
                       "conjugate_gradient, adaptive_relaxation, relaxation or all_at_once";
     return summary;
   }
