@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mcrewave/core/types.h"
@@ -317,6 +318,58 @@ TEST_F(MeasurementTest, MissingFile) {
   } catch (const InputError& error) {
     EXPECT_EQ(std::string(error.what()),
               "cannot read measurement file " + path + ": No such file or directory");
+  }
+}
+
+// A CSV of any channels (a structure given by matrices): t anywhere, the other
+// columns by name in the file's order, written back bit for bit.
+TEST_F(MeasurementTest, AChannelTableReadsAnyNamedColumnsAndWritesThemBack) {
+  const std::string path =
+      WriteFile("table.csv", "F,t, uy tip ,exx\n1,0,0.5,-1e-6\n2,1e-6,0.25,3e-7\n4,2e-6,0,1e-300\n");
+  const ChannelTable table = ReadChannelTable(path);
+  EXPECT_EQ(table.names, (std::vector<std::string>{"F", "uy tip", "exx"}));
+  ASSERT_EQ(table.samples, 3);
+  EXPECT_EQ(table.start_time, 0.0);
+  EXPECT_EQ(table.time_step, 1e-6);
+  EXPECT_EQ(table.columns[0], (Vector(3) << 1, 2, 4).finished());
+  EXPECT_EQ(table.columns[2][2], 1e-300);
+  EXPECT_EQ(table.Find("uy tip"), 1);
+  EXPECT_EQ(table.Find("t"), -1);
+  WriteChannelTable(table, PathOf("again.csv"));
+  const ChannelTable again = ReadChannelTable(PathOf("again.csv"));
+  EXPECT_EQ(again.names, table.names);
+  EXPECT_EQ(again.time_step, table.time_step);
+  for (std::size_t c = 0; c < table.columns.size(); ++c) EXPECT_EQ(again.columns[c], table.columns[c]);
+}
+
+TEST_F(MeasurementTest, AChannelTableRefusesABadHeaderNamingTheLine) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"F,uy\n1,2\n3,4\n", "lacks the time column 't'"},
+      {"t,F,F\n0,1,2\n1,1,2\n", "column 3 'F' repeats column 2 'F'"},
+      {"t,,F\n0,1,2\n1,1,2\n", "column 2 has no name"},
+      {"t,F\n0,1\n1,x\n", "column 'F': 'x' is not a number"},
+  };
+  for (const auto& [content, what] : cases) {
+    const std::string path = WriteFile("table.csv", content);
+    try {
+      ReadChannelTable(path);
+      ADD_FAILURE() << "accepted:\n" << content;
+    } catch (const InputError& error) {
+      EXPECT_EQ(std::string(error.what()).rfind(path + ":", 0), 0u) << error.what();
+      EXPECT_NE(std::string(error.what()).find(what), std::string::npos) << error.what();
+    }
+  }
+  // The caller's own check runs on the header before any row.
+  const HeaderCheck needs_uy = [](const std::vector<std::string>& names, const std::string&) {
+    return std::find(names.begin(), names.end(), "uy") == names.end() ? std::string("no uy")
+                                                                       : std::string();
+  };
+  const std::string path = WriteFile("table.csv", "t,F\n0,1\n1,bad\n");
+  try {
+    ReadChannelTable(path, needs_uy);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()), path + ":1: no uy");
   }
 }
 

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 namespace mcrewave {
 namespace {
@@ -85,6 +86,29 @@ TEST(ResampleTest, DataThatDoNotCoverTheWindowAreRefused) {
               std::string::npos)
         << error.what();
   }
+}
+
+// The table of any channels is resampled as the bar's set is: the same bits per
+// channel, up and down (the down-sampling's low-pass included).
+TEST(ResampleTest, AChannelTableIsResampledAsTheBarsSet) {
+  const MeasurementSet data = Sines(1e-6, 400, 2e4);
+  ChannelTable table;
+  table.time_step = data.time_step;
+  table.samples = data.num_samples();
+  table.names = {"fL", "tip", "gauge"};
+  table.columns = {data.fL, data.uL, data.sensors[0].values};
+  for (const auto& [step, samples] : {std::pair<double, int>{0.4e-6, 900},
+                                      std::pair<double, int>{2.5e-6, 150}}) {
+    const MeasurementSet set = ResampleMeasurements(data, step, samples, "data.csv");
+    const ChannelTable resampled = ResampleChannelTable(table, step, samples, "data.csv");
+    ASSERT_EQ(resampled.samples, samples);
+    EXPECT_EQ(resampled.time_step, step);
+    EXPECT_EQ(resampled.names, table.names);
+    EXPECT_EQ(resampled.columns[0], set.fL) << step;
+    EXPECT_EQ(resampled.columns[1], set.uL) << step;
+    EXPECT_EQ(resampled.columns[2], set.sensors[0].values) << step;
+  }
+  EXPECT_THROW(ResampleChannelTable(table, 1e-6, 500, "data.csv"), InputError);
 }
 
 }  // namespace

@@ -113,16 +113,28 @@ MeasurementSet ReadMeasurementCsv(const std::string& path) {
   return ParseMeasurementCsv(file, path);
 }
 
-MeasurementSet ParseMeasurementCsv(std::istream& file, const std::string& path) {
+int ChannelTable::Find(const std::string& name) const {
+  const auto found = std::find(names.begin(), names.end(), name);
+  return found == names.end() ? -1 : static_cast<int>(found - names.begin());
+}
+
+ChannelTable ReadChannelTable(const std::string& path, const HeaderCheck& check_header) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) {
+    throw InputError("cannot read measurement file " + path + ": " + std::strerror(errno));
+  }
+  return ParseChannelTable(file, path, check_header);
+}
+
+ChannelTable ParseChannelTable(std::istream& file, const std::string& path,
+                               const HeaderCheck& check_header) {
   auto fail = [&path](long line_number, const std::string& what) {
     throw InputError(path + ":" + std::to_string(line_number) + ": " + what);
   };
 
-  // The header: column c holds channel names[c]; destination[c] is 0 for t, 1..4 for
-  // u0, uL, f0, fL, and 5 + k for interior sensor k.
+  // The header: column c holds names[c]; time_column is the column of t.
   std::vector<std::string> names;
-  std::vector<int> destination;
-  std::vector<SensorChannel> sensors;
+  std::size_t time_column = 0;
   std::vector<std::vector<double>> columns;
   std::string line;
   std::vector<std::string> fields;  // the fields of the current row
@@ -137,54 +149,36 @@ MeasurementSet ParseMeasurementCsv(std::istream& file, const std::string& path) 
       field_start = comma + 1;
     }
   };
-  const std::string expected_header =
-      std::string("a header naming the columns: ") + kHeader +
-      " in any order, then any interior channels u@X (displacement at X m) and e@X (strain "
-      "at X m)";
   while (std::getline(file, line)) {
     ++line_number;
     line = StripLineEnd(line);
     if (line_number == 1) {
       if (line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // UTF-8 byte order mark
       split(line);
-      std::array<int, kEndColumns> found{};
       for (std::string field : fields) {
         const std::size_t first = field.find_first_not_of(" \t");
         const std::size_t last = field.find_last_not_of(" \t");
-        field = first == std::string::npos ? "" : field.substr(first, last - first + 1);
-        ChannelName channel;
-        std::string why;
-        if (!ParseChannelName(field, &channel, &why)) {
-          fail(1, "column " + std::to_string(names.size() + 1) + " '" + field + "': " + why +
-                      "; expected " + expected_header);
-        }
-        for (std::size_t c = 0; c < names.size(); ++c) {
-          const bool same_sensor =
-              channel.kind == ChannelName::Kind::kSensor && destination[c] >= kEndColumns &&
-              sensors[destination[c] - kEndColumns].kind == channel.sensor_kind &&
-              sensors[destination[c] - kEndColumns].position == channel.position;
-          if (names[c] == field || same_sensor) {
-            fail(1, "column " + std::to_string(names.size() + 1) + " '" + field +
-                        "' repeats column " + std::to_string(c + 1) + " '" + names[c] + "'");
+        names.push_back(first == std::string::npos ? "" : field.substr(first, last - first + 1));
+      }
+      if (check_header) {
+        const std::string why = check_header(names, line);
+        if (!why.empty()) fail(1, why);
+      }
+      for (std::size_t c = 0; c < names.size(); ++c) {
+        if (names[c].empty()) fail(1, "column " + std::to_string(c + 1) + " has no name");
+        for (std::size_t other = 0; other < c; ++other) {
+          if (names[other] == names[c]) {
+            fail(1, "column " + std::to_string(c + 1) + " '" + names[c] + "' repeats column " +
+                        std::to_string(other + 1) + " '" + names[other] + "'");
           }
         }
-        names.push_back(field);
-        if (channel.kind == ChannelName::Kind::kSensor) {
-          destination.push_back(kEndColumns + static_cast<int>(sensors.size()));
-          sensors.push_back({field, channel.sensor_kind, channel.position, Vector()});
-        } else {
-          const int end = static_cast<int>(channel.kind);  // t, u0, uL, f0, fL = 0..4
-          destination.push_back(end);
-          found[end] = 1;
-        }
       }
-      for (int c = 0; c < kEndColumns; ++c) {
-        if (found[c] == 0) {
-          fail(1, std::string("the header '") + line + "' lacks the column '" + kColumnNames[c] +
-                      "'; expected " + expected_header);
-        }
+      const auto time = std::find(names.begin(), names.end(), "t");
+      if (time == names.end()) {
+        fail(1, "the header '" + line + "' lacks the time column 't' [s]");
       }
-      columns.resize(kEndColumns + sensors.size());
+      time_column = static_cast<std::size_t>(time - names.begin());
+      columns.resize(names.size());
       continue;
     }
     if (line.empty()) {
@@ -206,24 +200,28 @@ MeasurementSet ParseMeasurementCsv(std::istream& file, const std::string& path) 
       if (!std::isfinite(value)) {
         fail(line_number, "column '" + names[c] + "': '" + fields[c] + "' is not a finite number");
       }
-      if (destination[c] == 0 && !columns[0].empty() && !(value > columns[0].back())) {
+      if (c == time_column && !columns[c].empty() && !(value > columns[c].back())) {
         fail(line_number, "time is not strictly increasing (t = " + Short(value) + " s after " +
-                              Short(columns[0].back()) + " s)");
+                              Short(columns[c].back()) + " s)");
       }
-      columns[destination[c]].push_back(value);
+      columns[c].push_back(value);
     }
-    if (columns[0].size() % kProgressRows == 0) {
-      spdlog::info("{}: read {} rows", path, columns[0].size());
+    if (columns[time_column].size() % kProgressRows == 0) {
+      spdlog::info("{}: read {} rows", path, columns[time_column].size());
     }
   }
   if (file.bad()) {
     throw InputError("cannot read measurement file " + path + ": " + std::strerror(errno));
   }
   if (line_number == 0) {
-    fail(1, "expected " + expected_header + ", got an empty file");
+    const std::string expected = check_header ? check_header({}, "") : "";
+    fail(1, "expected " +
+                (expected.empty() ? std::string("a header naming the columns, t among them")
+                                  : expected) +
+                ", got an empty file");
   }
 
-  const std::vector<double>& times = columns[0];
+  const std::vector<double>& times = columns[time_column];
   const std::size_t rows = times.size();
   if (rows < 2) {
     fail(line_number, "expected at least 2 data rows, got " + std::to_string(rows));
@@ -257,27 +255,101 @@ MeasurementSet ParseMeasurementCsv(std::istream& file, const std::string& path) 
     }
   }
 
-  MeasurementSet measurements;
-  measurements.start_time = times.front();
-  measurements.time_step = ExactStep(times, mean_step);
-  auto to_vector = [](const std::vector<double>& values) {
-    return Vector(
-        Eigen::Map<const Vector>(values.data(), static_cast<Eigen::Index>(values.size())));
-  };
+  ChannelTable table;
+  table.start_time = times.front();
+  table.time_step = ExactStep(times, mean_step);
+  table.samples = static_cast<int>(rows);
   // Each column is freed once copied: at most one column is held twice.
-  measurements.u0 = to_vector(columns[1]);
-  columns[1] = {};
-  measurements.uL = to_vector(columns[2]);
-  columns[2] = {};
-  measurements.f0 = to_vector(columns[3]);
-  columns[3] = {};
-  measurements.fL = to_vector(columns[4]);
-  columns[4] = {};
-  for (std::size_t k = 0; k < sensors.size(); ++k) {
-    sensors[k].values = to_vector(columns[kEndColumns + k]);
-    columns[kEndColumns + k] = {};
+  for (std::size_t c = 0; c < names.size(); ++c) {
+    if (c == time_column) continue;
+    table.names.push_back(names[c]);
+    table.columns.emplace_back(Eigen::Map<const Vector>(
+        columns[c].data(), static_cast<Eigen::Index>(columns[c].size())));
+    columns[c] = {};
   }
-  measurements.sensors = std::move(sensors);
+  return table;
+}
+
+void WriteChannelTable(const ChannelTable& table, const std::string& path) {
+  std::string content = "t";
+  for (std::size_t c = 0; c < table.names.size(); ++c) {
+    assert(table.columns[c].size() == table.samples);
+    content += "," + table.names[c];
+  }
+  content += "\n";
+  content.reserve(content.size() +
+                  static_cast<std::size_t>(table.samples) * (1 + table.names.size()) * 25);
+  char field[32];
+  for (int k = 0; k < table.samples; ++k) {
+    int length = std::snprintf(field, sizeof(field), "%.17g", table.Time(k));
+    content.append(field, static_cast<std::size_t>(length));
+    for (const Vector& column : table.columns) {
+      length = std::snprintf(field, sizeof(field), ",%.17g", column[k]);
+      content.append(field, static_cast<std::size_t>(length));
+    }
+    content += '\n';
+  }
+  WriteFileAtomically(path, content);
+}
+
+MeasurementSet ParseMeasurementCsv(std::istream& file, const std::string& path) {
+  const std::string expected_header =
+      std::string("a header naming the columns: ") + kHeader +
+      " in any order, then any interior channels u@X (displacement at X m) and e@X (strain "
+      "at X m)";
+  // The bar's header: every name a channel of data/measurement.h, no sensor twice, the
+  // five end columns present ("" when so; an empty header asks what is expected).
+  auto check_header = [&expected_header](const std::vector<std::string>& names,
+                                         const std::string& line) -> std::string {
+    if (names.empty()) return expected_header;
+    std::array<int, kEndColumns> found{};
+    std::vector<ChannelName> channels;
+    for (std::size_t c = 0; c < names.size(); ++c) {
+      ChannelName channel;
+      std::string why;
+      if (!ParseChannelName(names[c], &channel, &why)) {
+        return "column " + std::to_string(c + 1) + " '" + names[c] + "': " + why + "; expected " +
+               expected_header;
+      }
+      for (std::size_t other = 0; other < c; ++other) {
+        const bool same_sensor = channel.kind == ChannelName::Kind::kSensor &&
+                                 channels[other].kind == ChannelName::Kind::kSensor &&
+                                 channels[other].sensor_kind == channel.sensor_kind &&
+                                 channels[other].position == channel.position;
+        if (names[other] == names[c] || same_sensor) {
+          return "column " + std::to_string(c + 1) + " '" + names[c] + "' repeats column " +
+                 std::to_string(other + 1) + " '" + names[other] + "'";
+        }
+      }
+      if (channel.kind != ChannelName::Kind::kSensor) found[static_cast<int>(channel.kind)] = 1;
+      channels.push_back(channel);
+    }
+    for (int c = 0; c < kEndColumns; ++c) {
+      if (found[c] == 0) {
+        return std::string("the header '") + line + "' lacks the column '" + kColumnNames[c] +
+               "'; expected " + expected_header;
+      }
+    }
+    return "";
+  };
+  ChannelTable table = ParseChannelTable(file, path, check_header);
+
+  MeasurementSet measurements;
+  measurements.start_time = table.start_time;
+  measurements.time_step = table.time_step;
+  Vector* ends[] = {nullptr, &measurements.u0, &measurements.uL, &measurements.f0,
+                    &measurements.fL};
+  for (std::size_t c = 0; c < table.names.size(); ++c) {
+    ChannelName channel;
+    std::string why;
+    ParseChannelName(table.names[c], &channel, &why);  // checked with the header
+    if (channel.kind == ChannelName::Kind::kSensor) {
+      measurements.sensors.push_back(
+          {table.names[c], channel.sensor_kind, channel.position, std::move(table.columns[c])});
+    } else {
+      *ends[static_cast<int>(channel.kind)] = std::move(table.columns[c]);
+    }
+  }
   return measurements;
 }
 

@@ -156,14 +156,18 @@ Vector ZeroPhaseLowPass::Apply(const Vector& signal, bool at_rest_before_start) 
 }
 
 double EstimateCutoffFrequency(const MeasurementSet& measurements) {
-  const int n = measurements.num_samples();
-  const double sample_rate = 1.0 / measurements.time_step;
-  const double lowest = 2.0 / (measurements.time_step * std::max(n - 1, 1));
+  return EstimateCutoffFrequency(measurements.fL, measurements.time_step);
+}
+
+double EstimateCutoffFrequency(const Vector& load, double time_step) {
+  const auto n = static_cast<int>(load.size());
+  const double sample_rate = 1.0 / time_step;
+  const double lowest = 2.0 / (time_step * std::max(n - 1, 1));
   const double highest = 0.45 * sample_rate;
   if (n < 64) return highest;
-  // Periodogram of fL.
+  // Periodogram of the load.
   Eigen::FFT<double> fft;
-  std::vector<double> samples(measurements.fL.data(), measurements.fL.data() + n);
+  std::vector<double> samples(load.data(), load.data() + n);
   std::vector<std::complex<double>> spectrum;
   fft.fwd(spectrum, samples);
   const int bins = n / 2 + 1;

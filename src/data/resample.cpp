@@ -82,4 +82,37 @@ MeasurementSet ResampleMeasurements(const MeasurementSet& data, double step, int
   return out;
 }
 
+ChannelTable ResampleChannelTable(const ChannelTable& data, double step, int samples,
+                                  const std::string& name) {
+  assert(step > 0.0 && samples >= 2);
+  const double h = data.time_step;
+  const double tolerance = 1e-6 * h;
+  const double end = data.Time(data.samples - 1);
+  const double window = (samples - 1) * step;
+  if (data.start_time > tolerance || end < window - tolerance) {
+    throw InputError(name + ": the data span [" + Short(data.start_time) + ", " + Short(end) +
+                     "] s does not cover the model's window [0, " + Short(window) +
+                     "] s (time.window)");
+  }
+  ChannelTable out;
+  out.start_time = 0.0;
+  out.time_step = step;
+  out.samples = samples;
+  out.names = data.names;
+  if (step > h) {
+    // Down-sampling: low-pass below the new Nyquist frequency first, from rest (the
+    // filter of ResampleMeasurements).
+    const ZeroPhaseLowPass filter(0.4 / step, 1.0 / h, 8);
+    for (const Vector& column : data.columns) {
+      out.columns.push_back(Interpolate(filter.Apply(column, /*at_rest_before_start=*/true),
+                                        data.start_time, h, step, samples));
+    }
+  } else {
+    for (const Vector& column : data.columns) {
+      out.columns.push_back(Interpolate(column, data.start_time, h, step, samples));
+    }
+  }
+  return out;
+}
+
 }  // namespace mcrewave

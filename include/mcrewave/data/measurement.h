@@ -15,6 +15,7 @@
 // keeps its meaning.
 #pragma once
 
+#include <functional>
 #include <istream>
 #include <string>
 #include <vector>
@@ -68,6 +69,41 @@ MeasurementSet ReadMeasurementCsv(const std::string& path);
 
 // The same from a stream; `name` stands for the file name in messages.
 MeasurementSet ParseMeasurementCsv(std::istream& text, const std::string& name);
+
+// A table of named channels on a uniform time grid: the CSV form of the measurements
+// of any structure (a column `t` [s], then any columns, each a channel named by its
+// header; a structure given by matrices maps them to its loads and sensors).
+struct ChannelTable {
+  double start_time = 0.0;         // t_0 [s]
+  double time_step = 0.0;          // h [s]
+  int samples = 0;                 // rows
+  std::vector<std::string> names;  // every column but t, in the file's order
+  std::vector<Vector> columns;     // one per name, `samples` entries each
+
+  double Time(int k) const { return start_time + k * time_step; }
+  // The index of the column named `name`, or -1.
+  int Find(const std::string& name) const;
+};
+
+// A check of a header before any row is read: the column names (t included, trimmed)
+// and the header line as read; returns "" when they are acceptable, else the reason
+// (reported on line 1). Called with no names to ask what a header should be, for the
+// message of an empty file.
+using HeaderCheck =
+    std::function<std::string(const std::vector<std::string>& names, const std::string& line)>;
+
+// Reads a channel CSV: a header (every column named, no name twice, a column `t`,
+// then check_header's own conditions), at least two rows of finite numbers, one per
+// column, and a strictly increasing uniform time column (relative spread of the steps
+// at most 1e-6, against their median). Throws InputError naming the file and the line
+// on any failure. Memory: the columns of doubles (one column held twice at the end).
+ChannelTable ReadChannelTable(const std::string& path, const HeaderCheck& check_header = {});
+ChannelTable ParseChannelTable(std::istream& text, const std::string& name,
+                               const HeaderCheck& check_header = {});
+
+// Writes the table as CSV (t, then the columns by name), 17 significant digits,
+// atomically. Throws std::runtime_error if the file cannot be written.
+void WriteChannelTable(const ChannelTable& table, const std::string& path);
 
 // Refuses measurements that read well but cannot be identified from, with an
 // InputError naming `name`, the line of the sample (as in the CSV file: sample k

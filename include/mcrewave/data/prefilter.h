@@ -72,6 +72,8 @@ class ZeroPhaseLowPass {
 // level (estimated from the upper half of the band) and 1e-5 x its peak, clamped to
 // [2 / T, 0.45 x sample rate].
 double EstimateCutoffFrequency(const MeasurementSet& measurements);
+// The same from any measured load history sampled at time_step [s].
+double EstimateCutoffFrequency(const Vector& load, double time_step);
 
 // Every channel (the four end channels and the interior sensors) filtered by the same
 // ZeroPhaseLowPass (cut-off from options or estimated). Returns the set unchanged when

@@ -29,4 +29,8 @@ namespace mcrewave {
 MeasurementSet ResampleMeasurements(const MeasurementSet& data, double step, int samples,
                                     const std::string& name);
 
+// The same for a table of any channels (a structure given by matrices).
+ChannelTable ResampleChannelTable(const ChannelTable& data, double step, int samples,
+                                  const std::string& name);
+
 }  // namespace mcrewave
