@@ -16,6 +16,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -270,6 +271,36 @@ ValueType<std::vector<ModulusZone>> ZoneList() {
   return type;
 }
 
+// A YAML map of names to names ({F: force_N, uy_tip: tip_y}); an empty value the
+// empty map. The order of the pairs is kept.
+ValueType<std::vector<std::pair<std::string, std::string>>> NameMap() {
+  using Pairs = std::vector<std::pair<std::string, std::string>>;
+  ValueType<Pairs> type;
+  type.expected = "a map of channel names to CSV columns, e.g. {F: force, uy_tip: tip_y}";
+  type.read = [](const YAML::Node& node, Pairs* value) {
+    if (node.IsNull()) {
+      value->clear();
+      return true;
+    }
+    if (!node.IsMap()) return false;
+    Pairs parsed;
+    for (const auto& pair : node) {
+      if (!pair.first.IsScalar() || !pair.second.IsScalar()) return false;
+      parsed.emplace_back(pair.first.Scalar(), pair.second.Scalar());
+    }
+    *value = parsed;
+    return true;
+  };
+  type.write = [](const Pairs& value) {
+    std::string text = "{";
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      text += (i == 0 ? "" : ", ") + value[i].first + ": " + value[i].second;
+    }
+    return text + "}";
+  };
+  return type;
+}
+
 // An enum written by name, with the to/from-string pair of types.h; `values`
 // lists every value (for the messages and the commented config).
 template <typename Enum>
@@ -364,6 +395,14 @@ std::vector<CoupledSolverType> AllCoupledSolverTypes() {
 // IsValid to SectionValidators().
 const std::vector<Key>& KeyTable() {
   static const std::vector<Key> table = {
+      MakeKey("model.kind", &Config::structure, &StructureOptions::kind,
+              EnumByName<ModelKind>({ModelKind::kBar, ModelKind::kMatrix}, ModelKindToString,
+                                    StringToModelKind),
+              "", "the structure: the built-in bar, or matrices named by model.manifest"),
+      MakeKey("model.manifest", &Config::structure, &StructureOptions::manifest, Text(), "",
+              "model.kind matrix: the manifest model.yaml of the matrices; relative to this file"),
+      MakeKey("model.channel_map", &Config::structure, &StructureOptions::channel_map, NameMap(),
+              "", "model.kind matrix: {manifest channel: CSV column} where the names differ"),
       MakeKey("model.length", &Config::model, &BarProperties::length, Number(), "m",
               "length L of the bar"),
       MakeKey("model.section", &Config::model, &BarProperties::section, Number(), "m^2",
@@ -424,6 +463,11 @@ const std::vector<Key>& KeyTable() {
               "always)"),
       MakeKey("data.truth_zones", &Config::data, &DataOptions::truth_zones, ZoneList(), "",
               "synthetic truth: stretches of another modulus, [{start: m, end: m, modulus: Pa}]"),
+      MakeKey("data.truth_manifest", &Config::data, &DataOptions::truth_manifest, Text(), "",
+              "model.kind matrix, synthetic: the truth's manifest (\"\": the model's own); "
+              "relative to this file"),
+      MakeKey("data.truth_moduli", &Config::data, &DataOptions::truth_moduli, NumberList(), "Pa",
+              "model.kind matrix, synthetic: the truth's zone moduli ([]: their nominal moduli)"),
       MakeKey("mcre.w_u", &Config::mcre, &McreOptions::weights, &McreWeights::displacement_weight,
               Number(), "", "displacement weight: beta = w_u S E0 / L"),
       MakeKey("mcre.w_f", &Config::mcre, &McreOptions::weights, &McreWeights::force_weight,
@@ -664,7 +708,8 @@ SectionValidator ValidatorOf(Section Config::*section) {
 // One entry per section of Config, in the order of the checks.
 const std::vector<SectionValidator>& SectionValidators() {
   static const std::vector<SectionValidator> validators = {
-      ValidatorOf(&Config::model),       ValidatorOf(&Config::load),
+      ValidatorOf(&Config::structure),   ValidatorOf(&Config::model),
+      ValidatorOf(&Config::load),
       ValidatorOf(&Config::time),        ValidatorOf(&Config::data),
       ValidatorOf(&Config::mcre),        ValidatorOf(&Config::inner),
       ValidatorOf(&Config::outer),       ValidatorOf(&Config::prefilter),
@@ -672,6 +717,53 @@ const std::vector<SectionValidator>& SectionValidators() {
       ValidatorOf(&Config::study),       ValidatorOf(&Config::zone_identification),
   };
   return validators;
+}
+
+// "" when the keys that apply to one kind of structure only are at their defaults
+// with the other kind; else the message, naming the key first.
+std::string StructureKeysProblem(const Config& config) {
+  const Config defaults;
+  const std::string kind = ModelKindToString(config.structure.kind);
+  if (config.structure.kind == ModelKind::kBar) {
+    const std::pair<const char*, bool> matrix_keys[] = {
+        {"model.manifest", !config.structure.manifest.empty()},
+        {"model.channel_map", !config.structure.channel_map.empty()},
+        {"data.truth_manifest", !config.data.truth_manifest.empty()},
+        {"data.truth_moduli", !config.data.truth_moduli.empty()},
+    };
+    for (const auto& [key, set] : matrix_keys) {
+      if (set) return std::string(key) + " applies to model.kind 'matrix' only (model.kind is 'bar')";
+    }
+    return "";
+  }
+  const std::pair<const char*, bool> bar_keys[] = {
+      {"model.zoning", config.zones.zoning != defaults.zones.zoning},
+      {"model.zone_count", config.zones.zone_count != defaults.zones.zone_count},
+      {"model.zone_boundaries", !config.zones.zone_boundaries.empty()},
+      {"data.sensors", !config.data.sensors.empty()},
+      {"data.channels", !config.data.channels.empty()},
+      {"data.truth_zones", !config.data.truth_zones.empty()},
+  };
+  for (const auto& [key, set] : bar_keys) {
+    if (set) {
+      return std::string(key) + " applies to the bar only; with model.kind '" + kind +
+             "' the zones, loads and sensors are those of the manifest (model.manifest)";
+    }
+  }
+  if (config.outer.functional != OuterFunctional::kMcre) {
+    return "outer.functional must be 'mcre' with model.kind '" + kind +
+           "' (least squares is the bar's comparator)";
+  }
+  const CoupledSolverType method = config.inner.type;
+  if (method != CoupledSolverType::kConjugateGradient &&
+      method != CoupledSolverType::kRelaxation &&
+      method != CoupledSolverType::kAdaptiveRelaxation &&
+      method != CoupledSolverType::kAllAtOnce) {
+    return std::string("inner.method '") + CoupledSolverTypeToString(method) +
+           "' solves the bar only; with model.kind '" + kind +
+           "' use conjugate_gradient, relaxation, adaptive_relaxation or all_at_once";
+  }
+  return "";
 }
 
 // Checks of keys from more than one section, run once every section is valid on
@@ -688,6 +780,11 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
       // Sensors on the bar, truth zones inside it and apart, a truth that can give them.
       [](const Config& config, std::string* error) {
         *error = ValidateDataAgainstBar(config.data, config.model);
+        return error->empty();
+      },
+      // The keys of one kind of structure are left at their defaults with the other.
+      [](const Config& config, std::string* error) {
+        *error = StructureKeysProblem(config);
         return error->empty();
       },
       // A cut-off at or above the Nyquist frequency is not a low-pass filter of the
@@ -1016,6 +1113,41 @@ std::string WriteYaml(const Config& config, bool with_comments) {
 
 }  // namespace
 
+bool StructureOptions::IsValid(std::string* error) const {
+  std::string why;
+  if (kind == ModelKind::kMatrix && manifest.empty()) {
+    why = "model.manifest must name the manifest (model.yaml) of the matrices when model.kind "
+          "is matrix";
+  }
+  for (std::size_t i = 0; i < channel_map.size() && why.empty(); ++i) {
+    const auto& [channel, column] = channel_map[i];
+    if (channel.empty() || column.empty()) {
+      why = "model.channel_map: pair " + std::to_string(i + 1) +
+            " must name a channel and a CSV column";
+    } else if (column == "t") {
+      why = "model.channel_map: channel '" + channel + "' cannot map to the time column 't'";
+    }
+    for (std::size_t other = 0; other < i && why.empty(); ++other) {
+      if (channel_map[other].first == channel) {
+        why = "model.channel_map: channel '" + channel + "' is mapped twice";
+      } else if (channel_map[other].second == column) {
+        why = "model.channel_map: column '" + column + "' is mapped to both '" +
+              channel_map[other].first + "' and '" + channel + "'";
+      }
+    }
+  }
+  if (why.empty()) return true;
+  if (error != nullptr) *error = why;
+  return false;
+}
+
+std::string StructureOptions::Column(const std::string& channel) const {
+  for (const auto& [mapped, column] : channel_map) {
+    if (mapped == channel) return column;
+  }
+  return channel;
+}
+
 bool OutputOptions::IsValid(std::string* error) const {
   std::string why;
   if (folder.empty()) {
@@ -1040,17 +1172,26 @@ Config LoadConfig(const std::string& path, const std::vector<std::string>& overr
   Config& config = parsed.config;
   config.source_path = path;
 
-  const std::filesystem::path data_path(config.data.path);
-  if (!config.data.path.empty() && data_path.is_relative()) {
-    config.data.path = (std::filesystem::path(path).parent_path() / data_path).string();
-  }
-  if (config.data.source == DataSource::kCsv) {
-    const std::string why = WhyUnreadable(config.data.path);
+  // The files the config names: relative to its folder, readable when they are used.
+  const bool matrix = config.structure.kind == ModelKind::kMatrix;
+  const std::tuple<const char*, std::string*, bool, const char*> files[] = {
+      {"data.path", &config.data.path, config.data.source == DataSource::kCsv,
+       "measurement file"},
+      {"model.manifest", &config.structure.manifest, matrix, "manifest"},
+      {"data.truth_manifest", &config.data.truth_manifest,
+       matrix && config.data.source == DataSource::kSynthetic, "manifest"},
+  };
+  for (const auto& [key, file, used, what] : files) {
+    const std::filesystem::path file_path(*file);
+    if (!file->empty() && file_path.is_relative()) {
+      *file = (std::filesystem::path(path).parent_path() / file_path).string();
+    }
+    if (!used || file->empty()) continue;
+    const std::string why = WhyUnreadable(*file);
     if (!why.empty()) {
-      const auto origin = parsed.origins.find("data.path");
+      const auto origin = parsed.origins.find(key);
       const std::string where = origin == parsed.origins.end() ? path : origin->second;
-      throw InputError(where + ": data.path: cannot read measurement file '" + config.data.path +
-                       "': " + why);
+      throw InputError(where + ": " + key + ": cannot read " + what + " '" + *file + "': " + why);
     }
   }
   return config;

@@ -24,6 +24,8 @@ constexpr std::array<std::pair<TruthModel, const char*>, 2> kTruthModels{
 
 constexpr std::array<std::pair<SensorKind, const char*>, 2> kSensorKinds{
     {{SensorKind::kDisplacement, "displacement"}, {SensorKind::kStrain, "strain"}}};
+constexpr std::array<std::pair<ModelKind, const char*>, 2> kModelKinds{
+    {{ModelKind::kBar, "bar"}, {ModelKind::kMatrix, "matrix"}}};
 constexpr std::array<std::pair<Zoning, const char*>, 3> kZonings{{{Zoning::kEqual, "equal"},
                                                                   {Zoning::kPerElement, "per_element"},
                                                                   {Zoning::kBoundaries, "boundaries"}}};
@@ -53,6 +55,11 @@ bool StringToDataSource(const std::string& name, DataSource* source) {
 const char* TruthModelToString(TruthModel model) { return ToName(kTruthModels, model); }
 bool StringToTruthModel(const std::string& name, TruthModel* model) {
   return FromName(kTruthModels, name, model);
+}
+
+const char* ModelKindToString(ModelKind kind) { return ToName(kModelKinds, kind); }
+bool StringToModelKind(const std::string& name, ModelKind* kind) {
+  return FromName(kModelKinds, name, kind);
 }
 
 }  // namespace mcrewave

@@ -79,6 +79,13 @@ bool DataOptions::IsValid(std::string* error) const {
     why << "data.snr must be positive (.inf for no noise), got " << snr;
     return Fail(error, why.str());
   }
+  for (std::size_t z = 0; z < truth_moduli.size(); ++z) {
+    if (!(truth_moduli[z] > 0.0) || !std::isfinite(truth_moduli[z])) {
+      why << "data.truth_moduli must hold finite positive moduli (Pa), got " << truth_moduli[z]
+          << " at index " << z;
+      return Fail(error, why.str());
+    }
+  }
   // Channel names: well formed, interior sensors only in data.sensors, none twice.
   const std::pair<const char*, const std::vector<std::string>*> lists[] = {
       {"data.sensors", &sensors}, {"data.channels", &channels}};

@@ -7,7 +7,8 @@
 // written by name (see types.h).
 //
 // Sections and keys (defaults in brackets):
-//   model: length [1 m], section [1e-4 m^2], density [800 kg/m^3],
+//   model: kind [bar | matrix], manifest [""], channel_map [{}] (StructureOptions),
+//          length [1 m], section [1e-4 m^2], density [800 kg/m^3],
 //          modulus [200e9 Pa], elements [100], mass [consistent | lumped],
 //          zoning [equal | per_element | boundaries], zone_count [1],
 //          zone_boundaries [[] m] (ZoneLayout, bar_model.h)
@@ -15,7 +16,8 @@
 //   time:  window [0.63e-3 s], step [0.36e-6 s], theta [0.5]
 //   data:  source [synthetic | csv], path [""], truth [finite_element | exact],
 //          truth_refinement [4], snr [.inf], seed [1], sensors [[]: u@X, e@X],
-//          channels [[]: every channel], truth_zones [[]: {start, end, modulus}]
+//          channels [[]: every channel], truth_zones [[]: {start, end, modulus}],
+//          truth_manifest [""], truth_moduli [[]]
 //   mcre:  w_u [0.01], w_f [1], w_e [0.01], reference_modulus [200e9 Pa] (E0 of
 //          the weights; objective.h)
 //   inner: method [conjugate_gradient | all_at_once | relaxation | adaptive_relaxation
@@ -63,6 +65,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mcrewave/app/study.h"
@@ -91,8 +94,27 @@ struct OutputOptions {
   bool IsValid(std::string* error) const;
 };
 
+// The `model:` keys that choose the structure (docs/matrix_models.md section 9):
+// the built-in bar (the other model: keys) or a structure given by matrices.
+struct StructureOptions {
+  ModelKind kind = ModelKind::kBar;
+  // model.yaml of the matrices (model/matrix_export.h) when kind is matrix; a
+  // relative path is taken from the config file's folder.
+  std::string manifest;
+  // Pairs (channel of the manifest, CSV column) for the channels whose column has
+  // another name; a channel not listed is read from the column of its own name.
+  std::vector<std::pair<std::string, std::string>> channel_map;
+
+  // Valid when a matrix model names its manifest and the map pairs are named, none
+  // is `t`, and no channel or column appears twice.
+  bool IsValid(std::string* error) const;
+  // The CSV column of a manifest channel.
+  std::string Column(const std::string& channel) const;
+};
+
 struct Config {
   std::string source_path;  // the file the config was read from ("" for defaults)
+  StructureOptions structure;  // keys model.kind, model.manifest, model.channel_map
   BarProperties model;
   ZoneLayout zones;  // the identification's zones (keys model.zoning, zone_count, zone_boundaries)
   LoadOptions load;

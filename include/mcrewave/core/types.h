@@ -72,4 +72,13 @@ enum class Zoning {
 const char* ZoningToString(Zoning zoning);
 bool StringToZoning(const std::string& name, Zoning* zoning);
 
+// The structure a run identifies (config key model.kind).
+enum class ModelKind {
+  kBar,     // the built-in bar of the model: section (model/bar_model.h)
+  kMatrix,  // matrices from another finite-element code, named by model.manifest
+            // (model/matrix_export.h, docs/matrix_models.md)
+};
+const char* ModelKindToString(ModelKind kind);
+bool StringToModelKind(const std::string& name, ModelKind* kind);
+
 }  // namespace mcrewave

@@ -56,6 +56,11 @@ struct DataOptions {
   // The truth's stretches of another modulus (synthetic only; `model.modulus`
   // elsewhere), each [start, end] m at `modulus` Pa, not overlapping.
   std::vector<ModulusZone> truth_zones;
+  // Synthetic data of a structure given by matrices (model.kind: matrix): the truth's
+  // manifest ("" = the model's own; relative to the config file) and its zone moduli
+  // [Pa] (one per zone of the truth's manifest; [] = their nominal moduli).
+  std::string truth_manifest;
+  std::vector<double> truth_moduli;
 
   // Checks what needs no other section: channel names well formed and not repeated
   // (data.sensors, data.channels), f0 and fL among data.channels. Positions against
