@@ -1,8 +1,9 @@
 //                         mcrewave identify
 //
-// Identifies the Young's modulus of an elastic bar from noisy transient
-// measurements with the modified constitutive relation error (MCRE), and
-// simulates the reference experiment that produces such measurements.
+// Identifies the Young's modulus of an elastic bar, or the zone moduli of any
+// linear structure given by matrices from another finite-element code, from noisy
+// transient measurements with the modified constitutive relation error (MCRE), and
+// simulates the experiment that produces such measurements.
 //
 // Sample runs:
 //   identify run configs/paper_bar.yaml --output results/main
@@ -16,6 +17,9 @@
 //   identify study configs/studies.yaml --set study.kind=robustness --set study.robustness_seeds=10
 //   identify study configs/paper_bar.yaml --set study.kind=comparator
 //   identify run configs/paper_bar.yaml --set outer.functional=least_squares -o /tmp/ls
+//   identify run configs/plate.yaml --output /tmp/plate
+//   identify simulate configs/plate.yaml --output plate.csv
+//   identify run configs/plate.yaml --set data.source=csv --set data.path=$PWD/plate.csv -o /tmp/p
 //   identify --print-default-config > my_config.yaml
 //
 // Description:
@@ -29,6 +33,12 @@
 //   end. One progress line per outer evaluation at the default level. SIGINT,
 //   SIGTERM or SIGHUP stop a run at once, but not while it writes its results:
 //   an interrupted run leaves the earlier results of its folder as they were.
+//
+//   With model.kind: matrix, `run` reads the matrices of model.manifest and identifies
+//   every zone modulus at once (include/mcrewave/app/matrix_identification_run.h),
+//   writing summary.yaml, zones.csv, fit.csv, the error maps and their figures; the
+//   CSV's columns are the manifest's channels (model.channel_map renames them), and
+//   `simulate` writes such a CSV from the truth of data.truth_manifest.
 //
 //   `simulate` reads a YAML config (see include/mcrewave/app/config.h or
 //   --print-default-config), simulates the bar clamped at x = 0 and hit by a
@@ -65,6 +75,7 @@
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/damage_study.h"
 #include "mcrewave/app/identification_run.h"
+#include "mcrewave/app/matrix_identification_run.h"
 #include "mcrewave/app/results.h"
 #include "mcrewave/app/study.h"
 #include "mcrewave/core/version.h"
@@ -189,12 +200,46 @@ int IdentifyByLeastSquares(const mcrewave::Config& config, const mcrewave::Measu
   return 0;
 }
 
+// Steps 2 to 5 of RunIdentify with model.kind: matrix: every zone modulus of a
+// structure given by matrices (app/matrix_identification_run.h).
+int IdentifyMatrixModel(const mcrewave::Config& config) {
+  const mcrewave::MatrixModelData model = mcrewave::LoadMatrixModel(config);
+  const mcrewave::MatrixMeasurements data = mcrewave::LoadMatrixMeasurements(config, model);
+  const mcrewave::MatrixIdentificationRun run =
+      mcrewave::RunMatrixIdentification(config, model, data);
+  if (!run.IsUsable()) {
+    std::fprintf(stderr, "error: identification failed: %s\n", run.failure.c_str());
+    return 1;
+  }
+  std::vector<std::string> files;
+  {
+    const ResultsBeingWritten held;
+    files = mcrewave::WriteMatrixIdentificationResults(run, config, model, config.output.folder,
+                                                       config.output.figures);
+  }
+  for (std::size_t z = 0; z < run.zone_names.size(); ++z) {
+    const auto index = static_cast<Eigen::Index>(z);
+    if (run.truth_moduli.size() > 0) {
+      spdlog::info("zone {}: E = {:.9g} Pa (truth {:.9g} Pa, relative error {:.3e})",
+                   run.zone_names[z], run.identified_moduli[index], run.truth_moduli[index],
+                   run.identified_moduli[index] / run.truth_moduli[index] - 1.0);
+    } else {
+      spdlog::info("zone {}: E = {:.9g} Pa", run.zone_names[z], run.identified_moduli[index]);
+    }
+  }
+  spdlog::info("identified {} zone moduli in {} evaluations, {:.2f} s", run.zone_names.size(),
+               run.outer.evaluations, run.wall_time_s);
+  spdlog::info("wrote {} files to {}", files.size(), config.output.folder);
+  return 0;
+}
+
 int RunIdentify(const RunArguments& arguments) {
   // 1. Read and validate the config and the output folder (nothing is computed
   //    or written if either is invalid).
   mcrewave::Config config = mcrewave::LoadConfig(arguments.config_path, arguments.overrides);
   if (!arguments.output_folder.empty()) config.output.folder = arguments.output_folder;
   CheckOutputFolder(config.output.folder);
+  if (config.structure.kind == mcrewave::ModelKind::kMatrix) return IdentifyMatrixModel(config);
   if (config.outer.functional == mcrewave::OuterFunctional::kLeastSquares &&
       config.zones.ElementZones(config.model).back() > 0) {
     throw mcrewave::InputError(arguments.config_path +
@@ -263,6 +308,22 @@ int RunSimulate(const SimulateArguments& arguments) {
 
   // 1. Read and validate the config (nothing is computed if it is invalid).
   const mcrewave::Config config = mcrewave::LoadConfig(arguments.config_path, arguments.overrides);
+  if (config.structure.kind == mcrewave::ModelKind::kMatrix) {
+    // A structure given by matrices: its truth's outputs and loads, under the columns
+    // identify run reads (model.channel_map).
+    const mcrewave::MatrixModelData model = mcrewave::LoadMatrixModel(config);
+    const mcrewave::MatrixMeasurements data = mcrewave::LoadMatrixMeasurements(config, model);
+    {
+      const ResultsBeingWritten held;
+      mcrewave::WriteChannelTable(
+          mcrewave::MatrixMeasurementTable(config, model, data.histories), arguments.output_path);
+    }
+    spdlog::info("wrote {} samples of {} channels to {} in {:.3f} s",
+                 data.histories.num_steps() + 1, model.loads.size() + model.sensors.size(),
+                 arguments.output_path,
+                 std::chrono::duration<double>(Clock::now() - start).count());
+    return 0;
+  }
   spdlog::info("config {}: {} elements, {} steps of {:.4g} s, truth {} (refinement {}), SNR {}",
                arguments.config_path, config.model.elements, config.time.NumSteps(),
                config.time.step, mcrewave::TruthModelToString(config.data.truth),
@@ -296,6 +357,11 @@ int RunStudy(const StudyArguments& arguments) {
   if (config.data.source != mcrewave::DataSource::kSynthetic) {
     throw mcrewave::InputError(arguments.config_path +
                                ": data.source: the studies need synthetic data, got 'csv'");
+  }
+  if (config.structure.kind != mcrewave::ModelKind::kBar) {
+    throw mcrewave::InputError(arguments.config_path +
+                               ": model.kind: the studies run on the bar, got 'matrix' (the "
+                               "plate's study: scripts/plate_study.sh)");
   }
   CheckOutputFolder(config.study.folder);
   const std::string& folder = config.study.folder;

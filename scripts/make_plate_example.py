@@ -13,9 +13,10 @@ meshes of the same plate are written:
                            follows the finer elements)
 
 Each folder holds M.mtx, one K_<zone>.mtx per zone at the nominal modulus, the load
-vector load_F.mtx (a unit transverse traction resultant on the free edge x = L; its
-time history is the CSV channel F), one sensor_<channel>.mtx row per sensor, the
-manifest model.yaml read by mcrewave (model/matrix_export.h) and the mesh
+vectors load_F.mtx and load_Fx.mtx (a unit transverse or axial traction resultant on
+the free edge x = L; its time history is the CSV channel F), one sensor_<channel>.mtx
+row per sensor, the manifests model.yaml (transverse impact) and model_axial.yaml
+(axial impact) read by mcrewave (model/matrix_export.h) and the mesh
 (nodes.csv, elements.csv) for drawing the error map. The clamped dofs are eliminated.
 
 Usage: python3 scripts/make_plate_example.py [--output configs/plate] [--nx 24 --ny 6]
@@ -188,6 +189,13 @@ def write_mesh(folder, refine):
             load[mesh.dof[nj, mesh.nx] + 1] -= 0.5 / mesh.ny
     write_vector(os.path.join(folder, "load_F.mtx"), load,
                  "unit -y traction resultant on the edge x = L; history: channel F [N]")
+    # The axial impact: a unit +x traction resultant on the same edge (model_axial.yaml).
+    axial = np.zeros(n)
+    for j in range(mesh.ny):
+        for nj in (j, j + 1):
+            axial[mesh.dof[nj, mesh.nx]] += 0.5 / mesh.ny
+    write_vector(os.path.join(folder, "load_Fx.mtx"), axial,
+                 "unit +x traction resultant on the edge x = L; history: channel F [N]")
     for sensor in SENSORS:
         channel, kind = sensor[0], sensor[1]
         if kind in ("ux", "uy"):
@@ -204,20 +212,24 @@ def write_mesh(folder, refine):
                 row[mesh.dof[ja, ia]] = -1.0 / gauge
         write_row(os.path.join(folder, f"sensor_{channel}.mtx"), n, row,
                   f"sensor {channel} ({kind})")
-    with open(os.path.join(folder, "model.yaml"), "w") as f:
-        f.write(f"# Cantilever plate {LENGTH} x {HEIGHT} x {THICKNESS} m, Q4 plane stress "
-                f"{mesh.nx} x {mesh.ny} elements, {n} dofs\n")
-        f.write("# (scripts/make_plate_example.py; docs/matrix_models.md)\n")
-        # The scales of the MCRE weights (docs/matrix_models.md section 3): the plate's
-        # thickness (in-plane stiffness ~ E t) and its length.
-        f.write(f"mass: M.mtx\nstiffness_length: {THICKNESS}\nlength: {LENGTH}\nzones:\n")
-        for zone in ("matrix", "inclusion"):
-            f.write(f"  - {{name: {zone}, stiffness: K_{zone}.mtx, "
-                    f"nominal_modulus: {NOMINAL_MODULUS:.17g}}}\n")
-        f.write("loads:\n  - {channel: F, vector: load_F.mtx}\nsensors:\n")
-        for sensor in SENSORS:
-            kind = ", kind: strain" if sensor[1] == "exx" else ""
-            f.write(f"  - {{channel: {sensor[0]}, row: sensor_{sensor[0]}.mtx{kind}}}\n")
+    # Two manifests of the same matrices: the transverse impact (model.yaml) and the
+    # axial one (model_axial.yaml), both measured as channel F.
+    for manifest, vector, impact in (("model.yaml", "load_F.mtx", "transverse"),
+                                     ("model_axial.yaml", "load_Fx.mtx", "axial")):
+        with open(os.path.join(folder, manifest), "w") as f:
+            f.write(f"# Cantilever plate {LENGTH} x {HEIGHT} x {THICKNESS} m, Q4 plane stress "
+                    f"{mesh.nx} x {mesh.ny} elements, {n} dofs, {impact} impact\n")
+            f.write("# (scripts/make_plate_example.py; docs/matrix_models.md)\n")
+            # The scales of the MCRE weights (docs/matrix_models.md section 3): the plate's
+            # thickness (in-plane stiffness ~ E t) and its length.
+            f.write(f"mass: M.mtx\nstiffness_length: {THICKNESS}\nlength: {LENGTH}\nzones:\n")
+            for zone in ("matrix", "inclusion"):
+                f.write(f"  - {{name: {zone}, stiffness: K_{zone}.mtx, "
+                        f"nominal_modulus: {NOMINAL_MODULUS:.17g}}}\n")
+            f.write(f"loads:\n  - {{channel: F, vector: {vector}}}\nsensors:\n")
+            for sensor in SENSORS:
+                kind = ", kind: strain" if sensor[1] == "exx" else ""
+                f.write(f"  - {{channel: {sensor[0]}, row: sensor_{sensor[0]}.mtx{kind}}}\n")
     with open(os.path.join(folder, "nodes.csv"), "w") as f:
         f.write("node,x,y,dof_x,dof_y\n")
         for j in range(mesh.ny + 1):

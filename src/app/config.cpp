@@ -443,7 +443,8 @@ const std::vector<Key>& KeyTable() {
                                      StringToDataSource),
               "", "where the measurements come from"),
       MakeKey("data.path", &Config::data, &DataOptions::path, Text(), "",
-              "measurement CSV (t,u0,uL,f0,fL) if source is csv; relative to this file"),
+              "measurement CSV if source is csv (t,u0,uL,f0,fL; matrices: t and the manifest's "
+              "channels); relative to this file"),
       MakeKey("data.truth", &Config::data, &DataOptions::truth,
               EnumByName<TruthModel>({TruthModel::kFiniteElement, TruthModel::kExact},
                                      TruthModelToString, StringToTruthModel),

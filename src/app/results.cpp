@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -755,6 +756,199 @@ std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
   }
   // The summary last: its presence says the folder is complete.
   results.Write("summary.yaml", LeastSquaresSummaryYaml(run));
+  return results.written();
+}
+
+namespace {
+
+// Each zone's share of the constitutive gap (0 when the gap is 0).
+Vector Shares(const Vector& map) {
+  const double total = map.sum();
+  return total != 0.0 ? Vector(map / total) : Vector(Vector::Zero(map.size()));
+}
+
+std::string MatrixZonesCsv(const MatrixIdentificationRun& run) {
+  std::string csv =
+      "zone,name,nominal_modulus_pa,identified_modulus_pa,relative_to_nominal,truth_modulus_pa,"
+      "relative_error,error_share_nominal,error_share_identified,relative_gap_nominal,"
+      "relative_gap_identified\n";
+  const Vector nominal_share = Shares(run.nominal_zone_map), share = Shares(run.zone_map);
+  for (int z = 0; z < run.nominal_moduli.size(); ++z) {
+    const double identified = run.identified_moduli[z];
+    const bool truth = run.truth_moduli.size() > 0;
+    csv += std::to_string(z) + "," + run.zone_names[static_cast<std::size_t>(z)] + "," +
+           Format(run.nominal_moduli[z]) + "," + Format(identified) + "," +
+           Format(identified / run.nominal_moduli[z]) + "," +
+           (truth ? Format(run.truth_moduli[z]) : "") + "," +
+           (truth ? Format(identified / run.truth_moduli[z] - 1.0) : "") + "," +
+           Format(nominal_share[z]) + "," + Format(share[z]) + "," +
+           Format(run.nominal_zone_gap[z]) + "," + Format(run.zone_gap[z]) + "\n";
+  }
+  return csv;
+}
+
+// t, each load as used, each sensor as used and as the identified model gives it.
+std::string MatrixFitCsv(const MatrixIdentificationRun& run) {
+  std::string csv = "t";
+  for (const std::string& load : run.load_names) csv += "," + load;
+  for (const std::string& sensor : run.sensor_names) {
+    csv += "," + sensor + "_measured," + sensor + "_model";
+  }
+  csv += "\n";
+  for (int j = 0; j <= run.steps; ++j) {
+    csv += Format(j * run.time_step);
+    for (int c = 0; c < run.data.loads.rows(); ++c) csv += "," + Format(run.data.loads(c, j));
+    for (int k = 0; k < run.data.outputs.rows(); ++k) {
+      csv += "," + Format(run.data.outputs(k, j)) + "," + Format(run.model_outputs(k, j));
+    }
+    csv += "\n";
+  }
+  return csv;
+}
+
+std::string MatrixDofMapCsv(const MatrixIdentificationRun& run) {
+  std::string csv = "dof,nominal_j_s,identified_j_s\n";
+  for (int i = 0; i < run.dofs; ++i) {
+    csv += std::to_string(i) + "," + Format(run.nominal_dof_map[i]) + "," +
+           Format(run.dof_map[i]) + "\n";
+  }
+  return csv;
+}
+
+std::string MatrixEvaluationsCsv(const MatrixIdentificationRun& run) {
+  std::string csv = "evaluation";
+  for (const std::string& zone : run.zone_names) csv += "," + zone + "_pa";
+  csv += ",scaled_cost,usable,gradient_norm\n";
+  for (std::size_t i = 0; i < run.evaluations.size(); ++i) {
+    const MatrixEvaluation& e = run.evaluations[i];
+    csv += std::to_string(i + 1);
+    for (int z = 0; z < e.moduli.size(); ++z) csv += "," + Format(e.moduli[z]);
+    csv += "," + Format(e.cost) + "," + (e.usable ? "1" : "0") + "," + Format(e.gradient_norm) +
+           "\n";
+  }
+  return csv;
+}
+
+std::string MatrixZonesScript(const MatrixIdentificationRun& run, const std::string& folder) {
+  const std::string csv = GnuplotString(folder + "/zones.csv");
+  std::ostringstream script;
+  script << GnuplotPngTerminal() << "set terminal pngcairo size 1200,500\n"
+         << "set termoption noenhanced\nset datafile separator ','\n"
+            "set multiplot layout 1,2 title "
+         << GnuplotString("Zones of " + run.manifest) << "\n"
+         << "set style data histograms\nset style histogram clustered gap 1\n"
+            "set style fill solid 0.8 border -1\nset xtics rotate by -30\n"
+            "set key top right\nset yrange [0:*]\nset offsets 0, 0, graph 0.25, 0\n"
+            "set title 'Zone moduli'\nset ylabel 'E [GPa]'\nplot "
+         << csv << " skip 1 using ($3*1e-9):xtic(2) title 'nominal' lc rgb '#aaaaaa', '' skip 1 "
+         << "using ($4*1e-9) title 'identified' lc rgb '#d62728'";
+  if (run.truth_moduli.size() > 0) {
+    script << ", '' skip 1 using ($6*1e-9) title 'truth' lc rgb '#000000'";
+  }
+  script << "\nset title 'MCRE error map: constitutive gap / strain energy of the zone'\n"
+            "set ylabel 'relative gap'\nplot "
+         << csv << " skip 1 using 10:xtic(2) title 'at the nominal moduli' lc rgb '#fdae61', '' "
+         << "skip 1 using 11 title 'at the identified moduli' lc rgb '#2c7bb6'\n"
+            "unset multiplot\n";
+  return script.str();
+}
+
+// The first sensors (at most 6 panels), measured and model, in um or microstrain.
+std::string MatrixFitScript(const MatrixIdentificationRun& run, const std::string& folder,
+                            bool prefiltered, const std::vector<SensorKind>& kinds) {
+  const std::string csv = GnuplotString(folder + "/fit.csv");
+  const int panels = std::min<int>(6, static_cast<int>(run.sensor_names.size()));
+  const int loads = static_cast<int>(run.load_names.size());
+  std::ostringstream script;
+  script << GnuplotPngTerminal() << "set terminal pngcairo size 1000," << 220 * std::max(panels, 1)
+         << "\nset termoption noenhanced\nset datafile separator ','\nset multiplot layout " << std::max(panels, 1)
+         << ",1 title 'Sensors: " << (prefiltered ? "measured, pre-filtered" : "measured")
+         << " (grey) and the identified model driven by the measured loads (blue)'\n"
+            "set xlabel 't [ms]'\n";
+  for (int k = 0; k < panels; ++k) {
+    const bool strain = kinds[static_cast<std::size_t>(k)] == SensorKind::kStrain;
+    const int column = 2 + loads + 2 * k;
+    script << "set title " << GnuplotString(run.sensor_names[static_cast<std::size_t>(k)])
+           << "\nset ylabel '" << (strain ? "strain [1e-6]" : "u [um]") << "'\nplot " << csv
+           << " skip 1 using ($1*1e3):($" << column << "*1e6) with lines lc rgb '#aaaaaa' notitle, "
+           << csv << " skip 1 using ($1*1e3):($" << column + 1
+           << "*1e6) with lines lw 2 lc rgb '#1f4e9c' notitle\n";
+  }
+  script << "unset multiplot\n";
+  return script.str();
+}
+
+}  // namespace
+
+std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& config) {
+  YamlWriter yaml;
+  yaml.Raw("# mcrewave identify run: the zone moduli of a structure given by matrices, by the MCRE");
+  if (!config.source_path.empty()) yaml.Raw("# config: " + config.source_path);
+  yaml.Text(0, "version", kVersion, "mcrewave version");
+  yaml.Line(0, "model", "");
+  yaml.Text(1, "kind", ModelKindToString(config.structure.kind));
+  yaml.Text(1, "manifest", run.manifest);
+  yaml.Integer(1, "dofs", run.dofs);
+  yaml.Integer(1, "zones", static_cast<long>(run.zone_names.size()));
+  yaml.Integer(1, "loads", static_cast<long>(run.load_names.size()));
+  yaml.Integer(1, "sensors", static_cast<long>(run.sensor_names.size()));
+  yaml.Line(0, "data", "");
+  yaml.Text(1, "source", run.data_source);
+  yaml.Integer(1, "steps", run.steps);
+  yaml.Number(1, "time_step", run.time_step, "[s]");
+  yaml.Line(0, "zones", "", "identified modulus per zone (zones.csv)");
+  const Vector nominal_share = Shares(run.nominal_zone_map), share = Shares(run.zone_map);
+  for (int z = 0; z < run.nominal_moduli.size(); ++z) {
+    const bool truth = run.truth_moduli.size() > 0;
+    yaml.Raw("  - {name: " + Quoted(run.zone_names[static_cast<std::size_t>(z)]) +
+             ", nominal: " + Format(run.nominal_moduli[z]) +
+             ", modulus: " + Format(run.identified_moduli[z]) +
+             ", truth: " + Format(truth ? run.truth_moduli[z] : NAN) + ", relative_error: " +
+             Format(truth ? run.identified_moduli[z] / run.truth_moduli[z] - 1.0 : NAN) +
+             ", error_share_nominal: " + Format(nominal_share[z]) +
+             ", error_share_identified: " + Format(share[z]) +
+             ", relative_gap_nominal: " + Format(run.nominal_zone_gap[z]) +
+             ", relative_gap_identified: " + Format(run.zone_gap[z]) + "}");
+  }
+  yaml.Number(0, "cost", run.cost, "[J s] e^2 at the identified moduli");
+  yaml.Number(0, "nominal_cost", run.nominal_cost, "[J s] e^2 at the nominal moduli");
+  yaml.Number(0, "cost_scale", run.rest_cost,
+              "[J s] J_rest, e^2 of the structure left at rest (0 <= e^2 <= J_rest)");
+  yaml.Line(0, "optimizer", "", "zone_identification: (the zone moduli in log E)");
+  yaml.Text(1, "algorithm", BoundedAlgorithmToString(run.outer.algorithm));
+  yaml.Text(1, "termination", TerminationTypeToString(run.outer.termination));
+  yaml.Text(1, "message", run.outer.message);
+  yaml.Text(1, "optimizer_message", run.outer.optimizer_message, "the optimiser's own words");
+  yaml.Integer(1, "evaluations", run.outer.evaluations);
+  yaml.Integer(1, "gradient_evaluations", run.outer.gradient_evaluations);
+  yaml.Number(1, "scaled_cost", run.outer.cost, "e^2 / cost_scale at the identified moduli");
+  yaml.Line(0, "prefilter", "");
+  yaml.Line(1, "enabled", config.prefilter.enabled ? "true" : "false");
+  yaml.Number(1, "cutoff_frequency", run.prefilter_cutoff, "[Hz] the cut-off used (0: off)");
+  yaml.Number(0, "wall_time_s", run.wall_time_s, "[s] identification and error maps");
+  ConfigYaml(config, &yaml);
+  return yaml.str();
+}
+
+std::vector<std::string> WriteMatrixIdentificationResults(const MatrixIdentificationRun& run,
+                                                          const Config& config,
+                                                          const MatrixModelData& model,
+                                                          const std::string& folder,
+                                                          bool figures) {
+  assert(run.IsUsable());
+  ResultsFolder results(folder);
+  results.Write("zones.csv", MatrixZonesCsv(run));
+  results.Write("evaluations.csv", MatrixEvaluationsCsv(run));
+  results.Write("fit.csv", MatrixFitCsv(run));
+  results.Write("error_map_dofs.csv", MatrixDofMapCsv(run));
+  if (figures) {
+    std::vector<SensorKind> kinds;
+    for (const MatrixModelSensor& sensor : model.sensors) kinds.push_back(sensor.kind);
+    results.Draw({{"zones", MatrixZonesScript(run, folder)},
+                  {"fit", MatrixFitScript(run, folder, config.prefilter.enabled, kinds)}});
+  }
+  // The summary last: its presence says the folder is complete.
+  results.Write("summary.yaml", MatrixSummaryYaml(run, config));
   return results.written();
 }
 

@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "mcrewave/app/identification_run.h"
+#include "mcrewave/app/matrix_identification_run.h"
 
 namespace mcrewave {
 
@@ -58,5 +59,28 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
 std::string LeastSquaresSummaryYaml(const LeastSquaresRun& run);
 std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
                                                   const std::string& folder, bool figures);
+
+// The results of `identify run` with model.kind: matrix (app/matrix_identification_run.h):
+//   summary.yaml        the model (manifest, dofs, zones, channels), the data, every
+//                       zone's nominal, identified and (synthetic data) truth modulus
+//                       and its share of the constitutive gap at the nominal and the
+//                       identified moduli, e^2 and J_rest [J s], the optimiser, the
+//                       pre-filter, the resolved config
+//   zones.csv           the same per zone
+//   evaluations.csv     every evaluation: the zone moduli [Pa], e^2 / J_rest, usable,
+//                       |gradient|
+//   fit.csv             t, the loads and the sensors as used (pre-filtered), and each
+//                       sensor as the identified model driven by the loads gives it
+//   error_map_dofs.csv  the constitutive gap per dof [J s] at the nominal and the
+//                       identified moduli (MatrixMcreProblem::DofErrorMap)
+//   zones.png, fit.png  moduli and error shares per zone; the first six sensors
+// written as WriteIdentificationResults writes (atomically, summary last).
+// Precondition: run.IsUsable().
+std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& config);
+std::vector<std::string> WriteMatrixIdentificationResults(const MatrixIdentificationRun& run,
+                                                          const Config& config,
+                                                          const MatrixModelData& model,
+                                                          const std::string& folder,
+                                                          bool figures);
 
 }  // namespace mcrewave

@@ -1,0 +1,125 @@
+// `identify run` and `identify simulate` on a structure given by matrices
+// (model.kind: matrix; docs/matrix_models.md section 9):
+//
+//   1. LoadMatrixModel: the manifest of model.manifest (model/matrix_export.h), each
+//      channel read from the CSV column model.channel_map gives it (its own name
+//      otherwise);
+//   2. LoadMatrixMeasurements: the CSV of data.path, its columns picked by that map and
+//      resampled onto the config's grid t_j = j time.step, j = 0..time.window /
+//      time.step (data/resample.h); or synthetic data: the truth's manifest
+//      (data.truth_manifest, default the model's own) at data.truth_moduli (default
+//      its nominal moduli), every load channel driven by the load: history, on the
+//      same grid and theta, white noise per quantity at data.snr (AddMatrixModelNoise);
+//   3. RunMatrixIdentification: the pre-filter of prefilter: on every channel, then
+//      every zone modulus at once, p_z = log(E_z / E_z,nom) (MatrixZoneObjective), by
+//      the optimiser of zone_identification: from the nominal moduli within
+//      [outer.lower_bound, outer.upper_bound] Pa in every zone, inner solves by
+//      inner:; no jump penalty (matrices do not say which zones are neighbours).
+//      Then the error maps (zone and dof) at the nominal and the identified moduli
+//      and the model's outputs at the identified moduli.
+//
+// Results: WriteMatrixIdentificationResults (app/results.h).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "mcrewave/app/config.h"
+#include "mcrewave/data/measurement.h"
+#include "mcrewave/mcre/matrix_mcre_problem.h"
+#include "mcrewave/optim/bounded_minimizer.h"
+
+namespace mcrewave {
+
+// The measurements of a matrix model on the config's time grid.
+struct MatrixMeasurements {
+  ChannelHistories histories;  // rows in the model's channel order (loads, sensors)
+  std::string source;          // the CSV's path, or "synthetic"
+  // Synthetic data: the truth's modulus of each of the model's zones [Pa], matched by
+  // zone name; empty for CSV data or when a zone of the model is not one of the truth's.
+  Vector truth_moduli;
+};
+
+// Reads the manifest of config.structure.manifest. Throws InputError naming the file
+// and line (ReadMatrixModel), or the config and the key: a model.channel_map channel
+// that is not one of the manifest's; a zone's nominal modulus outside
+// [outer.lower_bound, outer.upper_bound] (the search starts there).
+// Precondition: config.structure.kind is kMatrix.
+MatrixModelData LoadMatrixModel(const Config& config);
+
+// The measurements of `model` per config.data (step 2 above). Throws InputError naming
+// the CSV file and the column of a channel it lacks (or the key model.channel_map when
+// the map renamed it), the file when the data do not cover the time window, the truth's
+// manifest when it lacks one of the model's channels or data.truth_moduli does not
+// have one modulus per truth zone.
+MatrixMeasurements LoadMatrixMeasurements(const Config& config, const MatrixModelData& model);
+
+// The outputs H U of `truth` at zone_moduli [Pa] from rest, driven by `loads` (one row
+// per load channel [N], sampled at t_j = j time_step) with the theta method: the
+// noise-free data of that structure (sensor rows, model order).
+Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_moduli,
+                           const Matrix& loads, double time_step, double theta);
+
+// Adds white Gaussian noise to every channel: standard deviation RMS / snr of the
+// channels of the same quantity (the displacement sensors together, the strain
+// sensors together, the loads together), drawn by a 64-bit Mersenne twister seeded
+// with `seed` (Box-Muller), the loads first, then the sensors in order, sample by
+// sample. Nothing when snr is infinite.
+void AddMatrixModelNoise(const MatrixModelData& model, double snr, std::uint64_t seed,
+                         ChannelHistories* data);
+
+// The measurements as the CSV identify run reads back: t, then every channel under
+// its column (model.channel_map).
+ChannelTable MatrixMeasurementTable(const Config& config, const MatrixModelData& model,
+                                    const ChannelHistories& histories);
+
+// One evaluation of the identification's cost.
+struct MatrixEvaluation {
+  Vector moduli;                      // E_z [Pa]
+  double cost = 0.0;                  // e^2 / J_rest
+  bool usable = false;                // the inner solve was usable
+  double gradient_norm = -1.0;        // |d cost / d p|; -1 without gradient
+};
+
+struct MatrixIdentificationRun {
+  std::string manifest;  // the model's manifest path
+  int dofs = 0;
+  int steps = 0;
+  double time_step = 0.0;                // h [s]
+  std::string data_source;               // CSV path or "synthetic"
+  double prefilter_cutoff = 0.0;         // [Hz]; 0: no pre-filter
+  std::vector<std::string> zone_names;
+  Vector nominal_moduli;                 // E_z,nom [Pa], the start
+  Vector identified_moduli;              // [Pa]; empty when no usable point
+  Vector truth_moduli;                   // [Pa]; empty when unknown
+  BoundedMinimizerSummary outer;
+  std::vector<MatrixEvaluation> evaluations;
+  double rest_cost = 0.0;                // J_rest [J s]
+  double nominal_cost = 0.0;             // e^2 at the nominal moduli [J s]
+  double cost = 0.0;                     // e^2 at the identified moduli [J s]
+  // Constitutive part of e^2 per zone and per dof [J s], at the nominal moduli (where
+  // the model is wrong) and at the identified ones.
+  Vector nominal_zone_map, zone_map, nominal_dof_map, dof_map;
+  // Each zone's gap relative to its strain energy over the window [-]: e_z^2 over the
+  // same sum of U, (E_z / E_z,nom) sum_j c_j h 1/2 U_j^T K_z U_j. Independent of the
+  // zone's size, it is the map that points at a wrong zone.
+  Vector nominal_zone_gap, zone_gap;
+  // Channels and names, as used (pre-filtered), and the model's outputs H U at the
+  // identified moduli.
+  ChannelHistories data;
+  std::vector<std::string> load_names, sensor_names;
+  Matrix model_outputs;
+  std::string failure;                   // why the run is not usable ("" when it is)
+  double wall_time_s = 0.0;
+
+  bool IsUsable() const { return failure.empty(); }
+};
+
+// Step 3 above. Never throws for the optimiser or the inner solver: their failures
+// are in run.failure (and run.outer). Progress: one info line per evaluation.
+MatrixIdentificationRun RunMatrixIdentification(const Config& config,
+                                                const MatrixModelData& model,
+                                                const MatrixMeasurements& measurements);
+
+}  // namespace mcrewave

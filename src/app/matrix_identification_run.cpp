@@ -1,0 +1,408 @@
+#include "mcrewave/app/matrix_identification_run.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cassert>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <utility>
+
+#include "mcrewave/data/prefilter.h"
+#include "mcrewave/data/resample.h"
+#include "mcrewave/optim/matrix_zone_objective.h"
+
+namespace mcrewave {
+namespace {
+
+// Every channel of the model, loads then sensors, with its CSV column.
+std::vector<std::pair<std::string, std::string>> ChannelColumns(const Config& config,
+                                                                const MatrixModelData& model) {
+  std::vector<std::pair<std::string, std::string>> channels;
+  for (const MatrixModelLoad& load : model.loads) {
+    channels.emplace_back(load.channel, config.structure.Column(load.channel));
+  }
+  for (const MatrixModelSensor& sensor : model.sensors) {
+    channels.emplace_back(sensor.channel, config.structure.Column(sensor.channel));
+  }
+  return channels;
+}
+
+// Where a config key was set, for messages: the config file.
+std::string ConfigName(const Config& config) {
+  return config.source_path.empty() ? std::string("config") : config.source_path;
+}
+
+// The CSV of data.path on the config's grid, rows in the model's channel order.
+ChannelHistories ReadMatrixMeasurementCsv(const Config& config, const MatrixModelData& model) {
+  const std::string& path = config.data.path;
+  const auto channels = ChannelColumns(config, model);
+  // Every channel's column must be in the header (checked before any row is read).
+  const HeaderCheck check_header = [&](const std::vector<std::string>& names,
+                                       const std::string&) -> std::string {
+    if (names.empty()) return "a header naming the columns: t and the model's channels";
+    for (const auto& [channel, column] : channels) {
+      if (std::find(names.begin(), names.end(), column) != names.end()) continue;
+      return "the header lacks the column '" + column + "' of the model's channel '" + channel +
+             "'" +
+             (column == channel ? std::string(" (model.channel_map can name another column)")
+                                : " (model.channel_map of " + ConfigName(config) + ")");
+    }
+    return "";
+  };
+  ChannelTable table = ReadChannelTable(path, check_header);
+  const int samples = config.time.NumSteps() + 1;
+  if (table.time_step != config.time.step || table.start_time != 0.0 ||
+      table.samples != samples) {
+    spdlog::info("{}: resampling {} samples of {:.4g} s onto {} samples of {:.4g} s", path,
+                 table.samples, table.time_step, samples, config.time.step);
+    table = ResampleChannelTable(table, config.time.step, samples, path);
+  }
+  ChannelHistories histories;
+  histories.time_step = config.time.step;
+  const auto loads = static_cast<int>(model.loads.size());
+  histories.loads.resize(loads, samples);
+  histories.outputs.resize(static_cast<int>(model.sensors.size()), samples);
+  for (std::size_t c = 0; c < channels.size(); ++c) {
+    const Vector& column = table.columns[static_cast<std::size_t>(table.Find(channels[c].second))];
+    const auto row = static_cast<int>(c);
+    if (row < loads) {
+      histories.loads.row(row) = column.transpose();
+    } else {
+      histories.outputs.row(row - loads) = column.transpose();
+    }
+  }
+  return histories;
+}
+
+// Synthetic data: the truth's outputs at its moduli, with noise; the truth's moduli of
+// the model's zones in *truth_moduli (empty when a zone name is not the truth's).
+ChannelHistories SyntheticMatrixMeasurements(const Config& config, const MatrixModelData& model,
+                                             Vector* truth_moduli) {
+  const std::string manifest = config.data.truth_manifest.empty() ? config.structure.manifest
+                                                                  : config.data.truth_manifest;
+  const MatrixModelData truth =
+      manifest == config.structure.manifest ? model : ReadMatrixModel(manifest);
+  const auto zones = static_cast<int>(truth.zones.size());
+  Vector moduli(zones);
+  if (!config.data.truth_moduli.empty()) {
+    if (static_cast<int>(config.data.truth_moduli.size()) != zones) {
+      throw InputError(ConfigName(config) + ": data.truth_moduli has " +
+                       std::to_string(config.data.truth_moduli.size()) +
+                       " moduli; the truth's manifest " + manifest + " has " +
+                       std::to_string(zones) + " zones");
+    }
+    for (int z = 0; z < zones; ++z) moduli[z] = config.data.truth_moduli[z];
+  } else {
+    for (int z = 0; z < zones; ++z) moduli[z] = truth.zones[z].nominal_modulus;
+  }
+  // The truth's channels in the model's order.
+  std::vector<int> load_rows, sensor_rows;
+  auto find = [&](const auto& list, const std::string& channel) {
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      if (list[i].channel == channel) return static_cast<int>(i);
+    }
+    throw InputError(manifest + ": the truth has no channel '" + channel +
+                     "' of the model's manifest " + config.structure.manifest);
+  };
+  for (const MatrixModelLoad& load : model.loads) load_rows.push_back(find(truth.loads, load.channel));
+  for (const MatrixModelSensor& sensor : model.sensors) {
+    sensor_rows.push_back(find(truth.sensors, sensor.channel));
+  }
+  const int steps = config.time.NumSteps();
+  // F_c(t_j) = F(t_j) of load:, on every load channel of the truth.
+  Matrix truth_loads(static_cast<int>(truth.loads.size()), steps + 1);
+  for (int j = 0; j <= steps; ++j) {
+    truth_loads.col(j).setConstant(config.load.Value(j * config.time.step));
+  }
+  const Matrix outputs =
+      SimulateMatrixModel(truth, moduli, truth_loads, config.time.step, config.time.theta);
+  ChannelHistories histories;
+  histories.time_step = config.time.step;
+  histories.loads.resize(static_cast<int>(load_rows.size()), steps + 1);
+  histories.outputs.resize(static_cast<int>(sensor_rows.size()), steps + 1);
+  for (std::size_t c = 0; c < load_rows.size(); ++c) {
+    histories.loads.row(static_cast<int>(c)) = truth_loads.row(load_rows[c]);
+  }
+  for (std::size_t k = 0; k < sensor_rows.size(); ++k) {
+    histories.outputs.row(static_cast<int>(k)) = outputs.row(sensor_rows[k]);
+  }
+  AddMatrixModelNoise(model, config.data.snr, config.data.seed, &histories);
+
+  truth_moduli->resize(static_cast<int>(model.zones.size()));
+  for (std::size_t z = 0; z < model.zones.size(); ++z) {
+    int found = -1;
+    for (int t = 0; t < zones; ++t) {
+      if (truth.zones[t].name == model.zones[z].name) found = t;
+    }
+    if (found < 0) {
+      *truth_moduli = Vector();
+      break;
+    }
+    (*truth_moduli)[static_cast<int>(z)] = moduli[found];
+  }
+  return histories;
+}
+
+double RootMeanSquareOfRows(const Matrix& rows) {
+  return rows.size() > 0 ? std::sqrt(rows.squaredNorm() / static_cast<double>(rows.size())) : 0.0;
+}
+
+// Records every evaluation of the zone objective and logs a progress line.
+class RecordingObjective : public MultiParameterObjective {
+ public:
+  RecordingObjective(MatrixZoneObjective* objective, std::vector<MatrixEvaluation>* records)
+      : objective_(objective), records_(records) {}
+  int num_parameters() const override { return objective_->num_parameters(); }
+  bool Evaluate(const double* p, double* cost, double* gradient) override {
+    MatrixEvaluation record;
+    record.moduli = objective_->Moduli(p);
+    record.usable = objective_->Evaluate(p, cost, gradient);
+    record.cost = record.usable ? *cost : std::nan("");
+    if (record.usable && gradient != nullptr) {
+      record.gradient_norm = Eigen::Map<const Vector>(gradient, num_parameters()).norm();
+    }
+    records_->push_back(record);
+    std::string moduli;
+    for (int z = 0; z < record.moduli.size(); ++z) {
+      moduli += (z == 0 ? "" : ", ") + fmt::format("{:.6g}", record.moduli[z] * 1e-9);
+    }
+    spdlog::info("evaluation {}: E = [{}] GPa, e^2 / J_rest = {:.9e}{}", records_->size(), moduli,
+                 record.cost, record.usable ? "" : " (" + objective_->error_message() + ")");
+    return record.usable;
+  }
+  std::string error_message() const override { return objective_->error_message(); }
+
+ private:
+  MatrixZoneObjective* objective_;
+  std::vector<MatrixEvaluation>* records_;
+};
+
+// The coupled solve at `moduli`: e^2 and the zone and dof maps; false with the
+// reason in *failure when it is not usable.
+bool SolveAt(const Vector& moduli, const CoupledSolverOptions& inner, MatrixMcreProblem* problem,
+             double* cost, Vector* zone_map, Vector* zone_gap, Vector* dof_map,
+             std::string* failure) {
+  problem->SetModuli(moduli);
+  CoupledSolution solution;
+  const CoupledSolverSummary summary = SolveCoupled(inner, problem, nullptr, &solution);
+  if (!summary.IsSolutionUsable() || !std::isfinite(solution.cost)) {
+    *failure = "the coupled solve is not usable: " + summary.BriefReport();
+    return false;
+  }
+  *cost = solution.cost;
+  *zone_map = problem->ZoneErrorMap(solution.retrograde);
+  // The gap relative to the zone's own strain energy: the same sum over U,
+  //   e_z^2 / ((E_z / E_z,nom) sum_j c_j h 1/2 U_j^T K_z U_j).
+  const Vector energy = problem->ZoneErrorMap(solution.displacement);
+  *zone_gap = zone_map->cwiseQuotient(energy.cwiseMax(std::numeric_limits<double>::min()));
+  *dof_map = problem->DofErrorMap(solution.retrograde);
+  return true;
+}
+
+}  // namespace
+
+MatrixModelData LoadMatrixModel(const Config& config) {
+  assert(config.structure.kind == ModelKind::kMatrix);
+  MatrixModelData model = ReadMatrixModel(config.structure.manifest);
+  for (const auto& [channel, column] : config.structure.channel_map) {
+    const bool known =
+        std::any_of(model.loads.begin(), model.loads.end(),
+                    [&](const MatrixModelLoad& load) { return load.channel == channel; }) ||
+        std::any_of(model.sensors.begin(), model.sensors.end(),
+                    [&](const MatrixModelSensor& sensor) { return sensor.channel == channel; });
+    if (!known) {
+      throw InputError(ConfigName(config) + ": model.channel_map: '" + channel +
+                       "' is not a channel of the manifest " + config.structure.manifest);
+    }
+  }
+  for (const MatrixModelZone& zone : model.zones) {
+    if (!(zone.nominal_modulus > config.outer.lower_bound &&
+          zone.nominal_modulus < config.outer.upper_bound)) {
+      throw InputError(ConfigName(config) + ": outer.lower_bound and outer.upper_bound [" +
+                       fmt::format("{:g}, {:g}", config.outer.lower_bound,
+                                   config.outer.upper_bound) +
+                       "] Pa must hold the nominal modulus " +
+                       fmt::format("{:g}", zone.nominal_modulus) + " Pa of zone '" + zone.name +
+                       "' of " + config.structure.manifest + " (the search starts there)");
+    }
+  }
+  return model;
+}
+
+MatrixMeasurements LoadMatrixMeasurements(const Config& config, const MatrixModelData& model) {
+  MatrixMeasurements measurements;
+  if (config.data.source == DataSource::kCsv) {
+    measurements.histories = ReadMatrixMeasurementCsv(config, model);
+    measurements.source = config.data.path;
+  } else {
+    measurements.histories =
+        SyntheticMatrixMeasurements(config, model, &measurements.truth_moduli);
+    measurements.source = "synthetic";
+  }
+  return measurements;
+}
+
+Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_moduli,
+                           const Matrix& loads, double time_step, double theta) {
+  ChannelHistories data;
+  data.time_step = time_step;
+  data.loads = loads;
+  data.outputs = Matrix::Zero(static_cast<int>(truth.sensors.size()), loads.cols());
+  // The weights and their reference modulus do not enter the direct sweep from W = 0.
+  MatrixMcreProblem simulation(truth, data, McreWeights(), truth.zones[0].nominal_modulus, theta);
+  simulation.SetModuli(zone_moduli);
+  return simulation.ModelOutputs();
+}
+
+void AddMatrixModelNoise(const MatrixModelData& model, double snr, std::uint64_t seed,
+                         ChannelHistories* data) {
+  if (std::isinf(snr)) return;
+  // The sensor rows of each quantity, gathered for their RMS.
+  const auto samples = data->outputs.cols();
+  int strain_count = 0;
+  for (const MatrixModelSensor& sensor : model.sensors) {
+    strain_count += sensor.kind == SensorKind::kStrain ? 1 : 0;
+  }
+  Matrix displacements(data->outputs.rows() - strain_count, samples), strains(strain_count, samples);
+  for (int k = 0, u = 0, e = 0; k < data->outputs.rows(); ++k) {
+    if (model.sensors[k].kind == SensorKind::kStrain) {
+      strains.row(e++) = data->outputs.row(k);
+    } else {
+      displacements.row(u++) = data->outputs.row(k);
+    }
+  }
+  const double std_u = RootMeanSquareOfRows(displacements) / snr;
+  const double std_e = RootMeanSquareOfRows(strains) / snr;
+  const double std_f = RootMeanSquareOfRows(data->loads) / snr;
+  std::mt19937_64 generator(seed);
+  // Uniform in (0, 1) from 53 random bits; a standard normal draw by Box-Muller.
+  auto uniform = [&] { return (static_cast<double>(generator() >> 11) + 0.5) * 0x1.0p-53; };
+  auto normal = [&] {
+    return std::sqrt(-2.0 * std::log(uniform())) * std::cos(2.0 * M_PI * uniform());
+  };
+  for (int c = 0; c < data->loads.rows(); ++c) {
+    for (int j = 0; j < data->loads.cols(); ++j) data->loads(c, j) += std_f * normal();
+  }
+  for (int k = 0; k < data->outputs.rows(); ++k) {
+    const double deviation = model.sensors[k].kind == SensorKind::kStrain ? std_e : std_u;
+    for (int j = 0; j < samples; ++j) data->outputs(k, j) += deviation * normal();
+  }
+}
+
+ChannelTable MatrixMeasurementTable(const Config& config, const MatrixModelData& model,
+                                    const ChannelHistories& histories) {
+  ChannelTable table;
+  table.time_step = histories.time_step;
+  table.samples = static_cast<int>(histories.loads.cols());
+  const auto loads = static_cast<int>(model.loads.size());
+  for (const auto& [channel, column] : ChannelColumns(config, model)) {
+    const auto row = static_cast<int>(table.names.size());
+    table.names.push_back(column);
+    table.columns.emplace_back(row < loads ? histories.loads.row(row).transpose()
+                                           : histories.outputs.row(row - loads).transpose());
+  }
+  return table;
+}
+
+MatrixIdentificationRun RunMatrixIdentification(const Config& config,
+                                                const MatrixModelData& model,
+                                                const MatrixMeasurements& measurements) {
+  const auto start = std::chrono::steady_clock::now();
+  MatrixIdentificationRun run;
+  run.manifest = config.structure.manifest;
+  run.dofs = model.dofs();
+  run.steps = measurements.histories.num_steps();
+  run.time_step = measurements.histories.time_step;
+  run.data_source = measurements.source;
+  run.truth_moduli = measurements.truth_moduli;
+  for (const MatrixModelZone& zone : model.zones) run.zone_names.push_back(zone.name);
+  for (const MatrixModelLoad& load : model.loads) run.load_names.push_back(load.channel);
+  for (const MatrixModelSensor& sensor : model.sensors) run.sensor_names.push_back(sensor.channel);
+  run.data = measurements.histories;
+
+  // 1. The pre-filter, the same on every channel (the structure is linear and
+  //    time-invariant: the model driven by the filtered loads answers with the filtered
+  //    outputs); the cut-off from the loads' spectra unless given.
+  if (config.prefilter.enabled) {
+    double cutoff = config.prefilter.cutoff_frequency;
+    if (cutoff <= 0.0) {
+      const Matrix& source = run.data.loads.rows() > 0 ? run.data.loads : run.data.outputs;
+      for (int c = 0; c < source.rows(); ++c) {
+        cutoff = std::max(cutoff, EstimateCutoffFrequency(source.row(c).transpose(), run.time_step));
+      }
+    }
+    const ZeroPhaseLowPass filter(cutoff, 1.0 / run.time_step, config.prefilter.order);
+    for (Matrix* rows : {&run.data.loads, &run.data.outputs}) {
+      for (int r = 0; r < rows->rows(); ++r) {
+        rows->row(r) =
+            filter.Apply(rows->row(r).transpose(), config.prefilter.at_rest_before_start)
+                .transpose();
+      }
+    }
+    run.prefilter_cutoff = cutoff;
+    spdlog::info("pre-filter: zero-phase Butterworth, cut-off {:.6g} Hz", cutoff);
+  }
+
+  // 2. Every zone modulus at once, p_z = log(E_z / E_z,nom), from p = 0.
+  MatrixMcreProblem problem(model, run.data, config.mcre.weights, config.mcre.reference_modulus,
+                            config.time.theta);
+  run.nominal_moduli = problem.NominalModuli();
+  run.rest_cost = problem.RestCost();
+  MatrixZoneObjective objective(&problem, config.inner);
+  RecordingObjective recorder(&objective, &run.evaluations);
+  const auto zones = static_cast<std::size_t>(model.zones.size());
+  std::vector<double> lower(zones), upper(zones);
+  for (std::size_t z = 0; z < zones; ++z) {
+    lower[z] = std::log(config.outer.lower_bound / run.nominal_moduli[static_cast<int>(z)]);
+    upper[z] = std::log(config.outer.upper_bound / run.nominal_moduli[static_cast<int>(z)]);
+  }
+  spdlog::info("matrix model {}: {} dofs, {} zones, {} loads, {} sensors, {} steps of {:.4g} s",
+               run.manifest, run.dofs, zones, model.loads.size(), model.sensors.size(), run.steps,
+               run.time_step);
+  run.outer = MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper,
+                                   std::vector<double>(zones, 0.0));
+  spdlog::info("zones: {}", run.outer.BriefReport());
+  if (run.outer.x.empty()) {
+    run.failure = "no usable evaluation: " + run.outer.message;
+  } else {
+    run.identified_moduli = objective.Moduli(run.outer.x.data());
+    if (!run.outer.IsSolutionUsable()) {
+      run.failure = "the optimiser stopped before a tolerance was met: " + run.outer.message;
+    }
+    for (std::size_t z = 0; z < zones && run.failure.empty(); ++z) {
+      // A modulus on a bound is where the search stopped, not where the data point.
+      const double p = run.outer.x[z];
+      if (std::abs(p - lower[z]) < 1e-6 || std::abs(p - upper[z]) < 1e-6) {
+        run.failure = fmt::format(
+            "zone '{}' ends on a bound of outer.lower_bound / outer.upper_bound ({:.6g} Pa): "
+            "widen the bounds or check the data's units",
+            run.zone_names[z], run.identified_moduli[static_cast<int>(z)]);
+      }
+    }
+  }
+
+  // 3. The error maps at the nominal and at the identified moduli, the model's outputs.
+  std::string why;
+  if (!SolveAt(run.nominal_moduli, config.inner, &problem, &run.nominal_cost,
+               &run.nominal_zone_map, &run.nominal_zone_gap, &run.nominal_dof_map, &why) &&
+      run.failure.empty()) {
+    run.failure = "at the nominal moduli, " + why;
+  }
+  if (run.identified_moduli.size() > 0) {
+    if (!SolveAt(run.identified_moduli, config.inner, &problem, &run.cost, &run.zone_map,
+                 &run.zone_gap, &run.dof_map, &why) &&
+        run.failure.empty()) {
+      run.failure = "at the identified moduli, " + why;
+    }
+    problem.SetModuli(run.identified_moduli);
+    run.model_outputs = problem.ModelOutputs();
+  }
+  run.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return run;
+}
+
+}  // namespace mcrewave
