@@ -127,8 +127,8 @@ TEST_P(EveryOptimizerTest, ReturnsTheGlobalMinimiserOfARuggedCost) {
                              OuterAlgorithmToString(tried.algorithm);
     ASSERT_TRUE(summary.IsSolutionUsable()) << name << ": " << summary.FullReport();
     // Measured: at most 5.4e-8 from the dense minimiser (Ceres, filtered; NLopt BOBYQA
-    // 5e-10, L-BFGS 1.4e-9, Brent 1.5e-8); the goal is 1e-6.
-    EXPECT_NEAR(summary.modulus / global, 1.0, 1e-6) << name << ": " << summary.FullReport();
+    // 5e-10, L-BFGS 1.4e-9, Brent 1.5e-8); the goal was 1e-6.
+    EXPECT_NEAR(summary.modulus / global, 1.0, 5e-7) << name << ": " << summary.FullReport();
     // The scan sees every valley the dense grid sees (and no fewer).
     EXPECT_GE(summary.local_minima, dense_valleys) << name << ": " << summary.FullReport();
     EXPECT_GT(summary.predicted_valley_spacing, 0.0);

@@ -290,8 +290,9 @@ TEST(MatrixMcreProblemTest, EveryZoneGradientOfThePlateMatchesACentralDifference
     plus[z] += step;
     minus[z] -= step;
     const double difference = (solve(plus).cost - solve(minus).cost) / (2.0 * step);
-    // Measured 1.7e-7 (matrix) and 1.7e-8 (inclusion) relative; the issue asks 1e-6.
-    EXPECT_NEAR(at.cost_gradients[z], difference, 1e-6 * std::abs(difference)) << "zone " << z;
+    // Measured 1.65e-7 (matrix) and 1.8e-8 (inclusion) relative; the issue asks 1e-6.
+    EXPECT_NEAR(at.cost_gradients[z], difference, (z == 0 ? 1e-6 : 1.5e-7) * std::abs(difference))
+        << "zone " << z;
   }
 }
 
