@@ -9,10 +9,10 @@
 // (+x, built from nodes.csv), 200 steps of 1 us (about 2.5 transits of the plate's
 // length by the longitudinal wave), trapezoidal rule; the truth: matrix 200 GPa,
 // inclusion 140 GPa (30 % softer). The five sensors of the example (uy_tip, uy_mid,
-// ux_tip and the gauges exx_root, exx_mid). Noise as data/noise.h defines it for the
-// bar, per quantity type: std = RMS over the displacement channels / SNR, over the
-// strain channels / SNR, and RMS(F) / SNR for the load; Gaussian draws (Box-Muller on a
-// 64-bit Mersenne twister seeded with the seed) in the order F, then the sensors.
+// ux_tip and the gauges exx_root, exx_mid). Noise of identify's synthetic data
+// (AddMatrixModelNoise, app/matrix_identification_run.h), per quantity type: std = RMS
+// over the displacement channels / SNR, over the strain channels / SNR, and RMS(F) /
+// SNR for the load.
 //
 // Identification: MatrixZoneObjective (p_z = log(E_z / 200 GPa)) minimised by NLopt
 // L-BFGS within [100, 400] GPa from the nominal 200 GPa in both zones, CG inner solves
@@ -36,12 +36,12 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
-#include <random>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "mcrewave/app/matrix_identification_run.h"
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/optim/matrix_zone_objective.h"
@@ -69,40 +69,8 @@ ChannelHistories FineTruth(const MatrixModelData& fine) {
     if (t < kImpactDuration)
       data.loads(0, j) = kImpactAmplitude * std::sin(M_PI * t / kImpactDuration);
   }
-  data.outputs = Matrix::Zero(static_cast<int>(fine.sensors.size()), kSteps + 1);
-  MatrixMcreProblem simulation(fine, data, McreWeights(), kNominal, 0.5);
-  simulation.SetModuli(TruthModuli());
-  data.outputs = simulation.ModelOutputs();
+  data.outputs = SimulateMatrixModel(fine, TruthModuli(), data.loads, kTimeStep, 0.5);
   return data;
-}
-
-double RootMeanSquare(const Matrix& rows) {
-  return rows.size() > 0 ? std::sqrt(rows.squaredNorm() / static_cast<double>(rows.size())) : 0.0;
-}
-
-// White Gaussian noise of the header's definition added to `data`.
-void AddNoise(const MatrixModelData& model, double snr, std::uint64_t seed,
-              ChannelHistories* data) {
-  if (std::isinf(snr)) return;
-  Matrix displacements(0, data->outputs.cols()), strains(0, data->outputs.cols());
-  for (int k = 0; k < data->outputs.rows(); ++k) {
-    Matrix& kind = model.sensors[k].kind == SensorKind::kStrain ? strains : displacements;
-    kind.conservativeResize(kind.rows() + 1, Eigen::NoChange);
-    kind.row(kind.rows() - 1) = data->outputs.row(k);
-  }
-  const double std_u = RootMeanSquare(displacements) / snr;
-  const double std_e = RootMeanSquare(strains) / snr;
-  const double std_f = RootMeanSquare(data->loads) / snr;
-  std::mt19937_64 generator(seed);
-  auto uniform = [&] { return (static_cast<double>(generator() >> 11) + 0.5) * 0x1.0p-53; };
-  auto normal = [&] {
-    return std::sqrt(-2.0 * std::log(uniform())) * std::cos(2.0 * M_PI * uniform());
-  };
-  for (int j = 0; j < data->loads.cols(); ++j) data->loads(0, j) += std_f * normal();
-  for (int k = 0; k < data->outputs.rows(); ++k) {
-    const double deviation = model.sensors[k].kind == SensorKind::kStrain ? std_e : std_u;
-    for (int j = 0; j < data->outputs.cols(); ++j) data->outputs(k, j) += deviation * normal();
-  }
 }
 
 struct Run {
@@ -118,7 +86,7 @@ struct Run {
 void Identify(const MatrixModelData& coarse, const ChannelHistories& truth, Run* run) {
   const auto start = std::chrono::steady_clock::now();
   ChannelHistories data = truth;
-  AddNoise(coarse, run->snr, run->seed, &data);
+  AddMatrixModelNoise(coarse, run->snr, run->seed, &data);
   MatrixMcreProblem problem(coarse, data, McreWeights(), kNominal, 0.5);
   CoupledSolverOptions inner;
   inner.tolerance = 1e-8;
