@@ -11,15 +11,26 @@
 // step from below), their ratio, and nnz(L + D). Prints the rows and the fitted
 // log-log slope of the step time against nnz(L + D).
 //
+// Then the MCRE sweeps of the same grid as a structure given by matrices
+// (mcre/matrix_mcre_problem.h: one zone, a load on the last dof, three displacement
+// sensors, kSweepSteps steps): the time per step of a direct and of a retrograde sweep
+// (each forms its force from G, H and the other field, then steps) against the
+// integrator's step; the bytes of the space-time fields an iterative coupled solve of
+// kFieldSteps steps would hold, and whether SolveCoupled refuses them under the
+// default inner.max_field_bytes (its message, with the bytes, for the largest grid).
+//
 //   build/bench/sparse_step_benchmark [--max-dofs 250000]
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "mcrewave/linalg/theta_integrator.h"
+#include "mcrewave/mcre/coupled_solver.h"
+#include "mcrewave/mcre/matrix_mcre_problem.h"
 
 namespace mcrewave {
 namespace {
@@ -61,6 +72,67 @@ void MakeGrid(int side, SparseMatrix* mass, SparseMatrix* stiffness) {
   stiffness->setFromTriplets(k.begin(), k.end());
 }
 
+constexpr int kSweepSteps = 20;    // steps of the measured sweeps
+constexpr int kFieldSteps = 1000;  // steps of the field-memory figure (m ~ 1000 in the MCRE)
+
+// The grid as a one-zone matrix model: K at the nominal modulus 1, a unit load on the
+// last dof (channel F), displacement sensors at the first, middle and last dofs.
+MatrixModelData GridModel(const SparseMatrix& mass, const SparseMatrix& stiffness) {
+  const auto n = static_cast<int>(mass.rows());
+  MatrixModelData model;
+  model.mass = mass;
+  model.stiffness_length = 1.0;
+  model.length = 1.0;
+  model.zones.push_back({"grid", stiffness, 1.0});
+  Vector load = Vector::Zero(n);
+  load[n - 1] = 1.0;
+  model.loads.push_back({"F", load});
+  for (const int dof : {0, n / 2, n - 1}) {
+    SparseMatrix row(1, n);
+    row.insert(0, dof) = 1.0;
+    model.sensors.push_back({"u" + std::to_string(dof), row, SensorKind::kDisplacement});
+  }
+  return model;
+}
+
+// Seconds per step of a direct and of a retrograde sweep of the grid's MCRE problem,
+// and the refusal (or "") of a CG solve over kFieldSteps steps under the default
+// inner.max_field_bytes.
+void MeasureSweeps(const SparseMatrix& mass, const SparseMatrix& stiffness, double* direct,
+                   double* retrograde, std::string* refusal) {
+  const MatrixModelData model = GridModel(mass, stiffness);
+  const auto n = static_cast<int>(mass.rows());
+  ChannelHistories data;
+  data.time_step = 0.5;
+  data.loads = Matrix::Zero(1, kSweepSteps + 1);
+  for (int j = 0; j <= kSweepSteps; ++j) data.loads(0, j) = std::sin(0.3 * j);
+  data.outputs = Matrix::Zero(3, kSweepSteps + 1);
+  MatrixMcreProblem problem(model, data, McreWeights(), 1.0, 0.5, Factorization::kSparse);
+  problem.SetModuli(Vector::Ones(1));
+  Matrix displacement(n, kSweepSteps + 1), field(n, kSweepSteps + 1);
+  Matrix zero = Matrix::Zero(n, kSweepSteps + 1);
+  Clock::time_point start = Clock::now();
+  problem.DirectSweep(zero, true, &displacement);
+  *direct = Seconds(start) / kSweepSteps;
+  start = Clock::now();
+  problem.RetrogradeSweep(displacement, true, &field);
+  *retrograde = Seconds(start) / kSweepSteps;
+
+  ChannelHistories long_data;
+  long_data.time_step = 0.5;
+  long_data.loads = Matrix::Zero(1, kFieldSteps + 1);
+  long_data.outputs = Matrix::Zero(3, kFieldSteps + 1);
+  MatrixMcreProblem long_problem(model, long_data, McreWeights(), 1.0, 0.5,
+                                 Factorization::kSparse);
+  CoupledSolverOptions options;  // conjugate gradients, the default max_field_bytes
+  CoupledSolution solution;
+  const double field_bytes = static_cast<double>(kIterativeSolverFields) * sizeof(double) * n *
+                             (kFieldSteps + 1.0);
+  *refusal = field_bytes > static_cast<double>(options.max_field_bytes)
+                 ? SolveCoupled(options, &long_problem, nullptr, &solution).message
+                 : "";
+}
+
 // Least-squares slope of log y against log x.
 double Slope(const std::vector<double>& x, const std::vector<double>& y) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
@@ -79,9 +151,11 @@ void Run(long max_dofs) {
   std::printf("%9s %12s %10s %12s %12s %8s %10s\n", "dofs", "nnz(L+D)", "init_s", "step_us",
               "solve_us", "ratio", "ns/nnz");
   std::vector<double> nonzeros, step_times;
+  std::vector<int> sides;
   for (const int side : {32, 71, 100, 224, 316, 500, 708, 1000}) {
     const long n = static_cast<long>(side) * side;
     if (n > max_dofs) break;
+    sides.push_back(side);
     SparseMatrix mass, stiffness;
     MakeGrid(side, &mass, &stiffness);
     ThetaIntegratorOptions options;
@@ -117,6 +191,28 @@ void Run(long max_dofs) {
   }
   std::printf("fitted slope of the step time against nnz(L+D): %.3f\n",
               Slope(nonzeros, step_times));
+
+  std::printf("\nMCRE sweeps of the grid as a matrix model (%d steps; fields of %d steps)\n",
+              kSweepSteps, kFieldSteps);
+  std::printf("%9s %12s %12s %12s %12s %14s %9s\n", "dofs", "step_us", "direct_us",
+              "retro_us", "direct/step", "field_bytes", "refused");
+  std::string last_refusal;
+  for (std::size_t c = 0; c < sides.size(); ++c) {
+    SparseMatrix mass, stiffness;
+    MakeGrid(sides[c], &mass, &stiffness);
+    double direct = 0.0, retrograde = 0.0;
+    std::string refusal;
+    MeasureSweeps(mass, stiffness, &direct, &retrograde, &refusal);
+    const long n = static_cast<long>(sides[c]) * sides[c];
+    const double field_bytes =
+        static_cast<double>(kIterativeSolverFields) * sizeof(double) * n * (kFieldSteps + 1.0);
+    std::printf("%9ld %12.1f %12.1f %12.1f %12.2f %14.4g %9s\n", n, 1e6 * step_times[c],
+                1e6 * direct, 1e6 * retrograde, direct / step_times[c], field_bytes,
+                refusal.empty() ? "no" : "yes");
+    std::fflush(stdout);
+    if (!refusal.empty()) last_refusal = refusal;
+  }
+  if (!last_refusal.empty()) std::printf("refusal of the largest: %s\n", last_refusal.c_str());
 }
 
 }  // namespace
