@@ -207,7 +207,8 @@ bool SolveAt(const Vector& moduli, const CoupledSolverOptions& inner, MatrixMcre
 MatrixModelData LoadMatrixModel(const Config& config) {
   assert(config.structure.kind == ModelKind::kMatrix);
   MatrixModelData model = ReadMatrixModel(config.structure.manifest);
-  for (const auto& [channel, column] : config.structure.channel_map) {
+  for (const auto& entry : config.structure.channel_map) {
+    const std::string& channel = entry.first;
     const bool known =
         std::any_of(model.loads.begin(), model.loads.end(),
                     [&](const MatrixModelLoad& load) { return load.channel == channel; }) ||
