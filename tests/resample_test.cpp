@@ -88,8 +88,9 @@ TEST(ResampleTest, DataThatDoNotCoverTheWindowAreRefused) {
   }
 }
 
-// The table of any channels is resampled as the bar's set is: the same bits per
-// channel, up and down (the down-sampling's low-pass included).
+// The bar's set is resampled as a table of its channels: each channel of
+// ResampleMeasurements is the same bits as its column of ResampleChannelTable, up and
+// down (the down-sampling's low-pass included), sensors after the four end channels.
 TEST(ResampleTest, AChannelTableIsResampledAsTheBarsSet) {
   const MeasurementSet data = Sines(1e-6, 400, 2e4);
   ChannelTable table;

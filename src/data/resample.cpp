@@ -3,6 +3,8 @@
 #include <cassert>
 #include <cmath>
 #include <cstdio>
+#include <utility>
+#include <vector>
 
 #include "mcrewave/data/prefilter.h"
 
@@ -49,35 +51,26 @@ std::string Short(double value) {
 
 MeasurementSet ResampleMeasurements(const MeasurementSet& data, double step, int samples,
                                     const std::string& name) {
-  assert(step > 0.0 && samples >= 2);
-  const double h = data.time_step;
-  const double tolerance = 1e-6 * h;
-  const double end = data.Time(data.num_samples() - 1);
-  const double window = (samples - 1) * step;
-  if (data.start_time > tolerance || end < window - tolerance) {
-    throw InputError(name + ": the data span [" + Short(data.start_time) + ", " + Short(end) +
-                     "] s does not cover the model's window [0, " + Short(window) +
-                     "] s (time.window)");
-  }
-  MeasurementSet filtered = data;
-  if (step > h) {
-    // Down-sampling: low-pass below the new Nyquist frequency first.
-    PrefilterOptions options;
-    options.enabled = true;
-    options.cutoff_frequency = 0.4 / step;
-    options.order = 8;
-    filtered = PrefilterMeasurements(data, options, nullptr);
-  }
+  // The set as a table (u0, uL, f0, fL, then the sensors), resampled channel by channel.
+  ChannelTable table;
+  table.start_time = data.start_time;
+  table.time_step = data.time_step;
+  table.samples = data.num_samples();
+  table.columns = {data.u0, data.uL, data.f0, data.fL};
+  for (const SensorChannel& sensor : data.sensors) table.columns.push_back(sensor.values);
+  table.names.resize(table.columns.size());
+  ChannelTable resampled = ResampleChannelTable(table, step, samples, name);
   MeasurementSet out;
   out.start_time = 0.0;
   out.time_step = step;
-  out.u0 = Interpolate(filtered.u0, data.start_time, h, step, samples);
-  out.uL = Interpolate(filtered.uL, data.start_time, h, step, samples);
-  out.f0 = Interpolate(filtered.f0, data.start_time, h, step, samples);
-  out.fL = Interpolate(filtered.fL, data.start_time, h, step, samples);
-  for (const SensorChannel& sensor : filtered.sensors) {
-    out.sensors.push_back({sensor.name, sensor.kind, sensor.position,
-                           Interpolate(sensor.values, data.start_time, h, step, samples)});
+  out.u0 = std::move(resampled.columns[0]);
+  out.uL = std::move(resampled.columns[1]);
+  out.f0 = std::move(resampled.columns[2]);
+  out.fL = std::move(resampled.columns[3]);
+  for (std::size_t k = 0; k < data.sensors.size(); ++k) {
+    const SensorChannel& sensor = data.sensors[k];
+    out.sensors.push_back(
+        {sensor.name, sensor.kind, sensor.position, std::move(resampled.columns[4 + k])});
   }
   return out;
 }
@@ -100,8 +93,8 @@ ChannelTable ResampleChannelTable(const ChannelTable& data, double step, int sam
   out.samples = samples;
   out.names = data.names;
   if (step > h) {
-    // Down-sampling: low-pass below the new Nyquist frequency first, from rest (the
-    // filter of ResampleMeasurements).
+    // Down-sampling: low-pass below the new Nyquist frequency first (order 8, from
+    // rest: the record is at rest before its first sample).
     const ZeroPhaseLowPass filter(0.4 / step, 1.0 / h, 8);
     for (const Vector& column : data.columns) {
       out.columns.push_back(Interpolate(filter.Apply(column, /*at_rest_before_start=*/true),
