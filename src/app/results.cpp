@@ -761,18 +761,12 @@ std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
 
 namespace {
 
-// Each zone's share of the constitutive gap (0 when the gap is 0).
-Vector Shares(const Vector& map) {
-  const double total = map.sum();
-  return total != 0.0 ? Vector(map / total) : Vector(Vector::Zero(map.size()));
-}
-
 std::string MatrixZonesCsv(const MatrixIdentificationRun& run) {
   std::string csv =
       "zone,name,nominal_modulus_pa,identified_modulus_pa,relative_to_nominal,truth_modulus_pa,"
       "relative_error,error_share_nominal,error_share_identified,relative_gap_nominal,"
       "relative_gap_identified\n";
-  const Vector nominal_share = Shares(run.nominal_zone_map), share = Shares(run.zone_map);
+  const Vector nominal_share = GapFractions(run.nominal_zone_map), share = GapFractions(run.zone_map);
   for (int z = 0; z < run.nominal_moduli.size(); ++z) {
     const double identified = run.identified_moduli[z];
     const bool truth = run.truth_moduli.size() > 0;
@@ -897,7 +891,7 @@ std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& 
   yaml.Integer(1, "steps", run.steps);
   yaml.Number(1, "time_step", run.time_step, "[s]");
   yaml.Line(0, "zones", "", "identified modulus per zone (zones.csv)");
-  const Vector nominal_share = Shares(run.nominal_zone_map), share = Shares(run.zone_map);
+  const Vector nominal_share = GapFractions(run.nominal_zone_map), share = GapFractions(run.zone_map);
   for (int z = 0; z < run.nominal_moduli.size(); ++z) {
     const bool truth = run.truth_moduli.size() > 0;
     yaml.Raw("  - {name: " + Quoted(run.zone_names[static_cast<std::size_t>(z)]) +

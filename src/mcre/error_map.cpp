@@ -23,10 +23,12 @@ int ErrorMap::PeakElement() const {
   return static_cast<int>(peak);
 }
 
-Vector ErrorMap::Fractions() const {
-  const double total = share.sum();
-  return total > 0.0 ? Vector(share / total) : Vector(Vector::Zero(share.size()));
+Vector GapFractions(const Vector& shares) {
+  const double total = shares.sum();
+  return total > 0.0 ? Vector(shares / total) : Vector(Vector::Zero(shares.size()));
 }
+
+Vector ErrorMap::Fractions() const { return GapFractions(share); }
 
 void AddSampleGapShares(const BarModel& model, const Vector& zone_moduli, const double* retrograde,
                         double weight, Vector* shares) {

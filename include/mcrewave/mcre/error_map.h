@@ -31,6 +31,10 @@ struct ErrorMap {
   Vector Fractions() const;
 };
 
+// shares / sum(shares), zeros when the sum is not positive: the fraction of a
+// constitutive gap in each part (element, zone, dof).
+Vector GapFractions(const Vector& shares);
+
 // shares[el] += weight 1/2 W_j^T K_el W_j for every element, from W_j (n entries).
 void AddSampleGapShares(const BarModel& model, const Vector& zone_moduli, const double* retrograde,
                         double weight, Vector* shares);
