@@ -180,8 +180,20 @@ class RecordingObjective : public MultiParameterObjective {
   std::vector<MatrixEvaluation>* records_;
 };
 
-// The coupled solve at `moduli`: e^2 and the zone and dof maps; false with the
-// reason in *failure when it is not usable.
+// e^2 and the zone and dof maps of a usable coupled solution at the problem's moduli.
+void CostAndMaps(MatrixMcreProblem* problem, const CoupledSolution& solution, double* cost,
+                 Vector* zone_map, Vector* zone_gap, Vector* dof_map) {
+  *cost = solution.cost;
+  *zone_map = problem->ZoneErrorMap(solution.retrograde);
+  // The gap relative to the zone's own strain energy: the same sum over U,
+  //   e_z^2 / ((E_z / E_z,nom) sum_j c_j h 1/2 U_j^T K_z U_j).
+  const Vector energy = problem->ZoneErrorMap(solution.displacement);
+  *zone_gap = zone_map->cwiseQuotient(energy.cwiseMax(std::numeric_limits<double>::min()));
+  *dof_map = problem->DofErrorMap(solution.retrograde);
+}
+
+// The coupled solve at `moduli`, then CostAndMaps; false with the reason in *failure
+// when it is not usable.
 bool SolveAt(const Vector& moduli, const CoupledSolverOptions& inner, MatrixMcreProblem* problem,
              double* cost, Vector* zone_map, Vector* zone_gap, Vector* dof_map,
              std::string* failure) {
@@ -192,13 +204,7 @@ bool SolveAt(const Vector& moduli, const CoupledSolverOptions& inner, MatrixMcre
     *failure = "the coupled solve is not usable: " + summary.BriefReport();
     return false;
   }
-  *cost = solution.cost;
-  *zone_map = problem->ZoneErrorMap(solution.retrograde);
-  // The gap relative to the zone's own strain energy: the same sum over U,
-  //   e_z^2 / ((E_z / E_z,nom) sum_j c_j h 1/2 U_j^T K_z U_j).
-  const Vector energy = problem->ZoneErrorMap(solution.displacement);
-  *zone_gap = zone_map->cwiseQuotient(energy.cwiseMax(std::numeric_limits<double>::min()));
-  *dof_map = problem->DofErrorMap(solution.retrograde);
+  CostAndMaps(problem, solution, cost, zone_map, zone_gap, dof_map);
   return true;
 }
 
@@ -385,21 +391,26 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config,
     }
   }
 
-  // 3. The error maps at the nominal and at the identified moduli, the model's outputs.
+  // 3. The error maps and the model's outputs at the identified moduli (from the last
+  //    evaluation's solve when it was there, as it usually is), then the maps at the
+  //    nominal moduli.
   std::string why;
+  if (run.identified_moduli.size() > 0) {
+    const MatrixEvaluation& last = run.evaluations.back();
+    if (last.usable && last.moduli == run.identified_moduli) {
+      CostAndMaps(&problem, objective.last_solution(), &run.cost, &run.zone_map, &run.zone_gap,
+                  &run.dof_map);
+    } else if (!SolveAt(run.identified_moduli, config.inner, &problem, &run.cost, &run.zone_map,
+                        &run.zone_gap, &run.dof_map, &why) &&
+               run.failure.empty()) {
+      run.failure = "at the identified moduli, " + why;
+    }
+    run.model_outputs = problem.ModelOutputs();
+  }
   if (!SolveAt(run.nominal_moduli, config.inner, &problem, &run.nominal_cost,
                &run.nominal_zone_map, &run.nominal_zone_gap, &run.nominal_dof_map, &why) &&
       run.failure.empty()) {
     run.failure = "at the nominal moduli, " + why;
-  }
-  if (run.identified_moduli.size() > 0) {
-    if (!SolveAt(run.identified_moduli, config.inner, &problem, &run.cost, &run.zone_map,
-                 &run.zone_gap, &run.dof_map, &why) &&
-        run.failure.empty()) {
-      run.failure = "at the identified moduli, " + why;
-    }
-    problem.SetModuli(run.identified_moduli);
-    run.model_outputs = problem.ModelOutputs();
   }
   run.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
