@@ -114,6 +114,9 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
     EXPECT_EQ(expected.data.truth_zones[i].modulus, actual.data.truth_zones[i].modulus);
   }
   EXPECT_EQ(expected.mcre.weights.strain_weight, actual.mcre.weights.strain_weight);
+  EXPECT_EQ(expected.mcre.weights.reaction_weight, actual.mcre.weights.reaction_weight);
+  EXPECT_EQ(expected.mcre.clamp, actual.mcre.clamp);
+  EXPECT_EQ(expected.study.comparator_data, actual.study.comparator_data);
   EXPECT_EQ(expected.structure.kind, actual.structure.kind);
   EXPECT_EQ(expected.structure.manifest, actual.structure.manifest);
   EXPECT_EQ(expected.structure.channel_map, actual.structure.channel_map);
@@ -405,7 +408,9 @@ mcre:
   w_u: 0.3
   w_f: 0.14285714285714285
   w_e: 0.7
+  w_r: 0.03
   reference_modulus: 70e9
+  clamp: trusted
 inner:
   method: adaptive_relaxation
   tolerance: 1e-11
@@ -472,6 +477,7 @@ study:
   comparator_snr: [.inf, 7]
   comparator_seeds: 4
   comparator_errors: [density, soft_zone]
+  comparator_data: [prefilter]
 zone_identification:
   algorithm: ceres_lbfgs
   step_tolerance: 1e-9
@@ -538,6 +544,8 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
        "model.zone_count applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\ndata:\n  sensors: [u@0.5]\n",
        "data.sensors applies to the bar only"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\nmcre:\n  clamp: trusted\n",
+       "mcre.clamp applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\nouter:\n  functional: least_squares\n",
        "outer.functional must be 'mcre'"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\ninner:\n  method: riccati\n",
@@ -730,6 +738,14 @@ TEST_F(ConfigFileTest, NanLength) {
 TEST_F(ConfigFileTest, UnknownEnumNameListsTheNames) {
   ExpectLoadError("model:\n  mass: diagonal\n", 2,
                   {"model.mass: expected one of 'consistent', 'lumped', got 'diagonal'"});
+}
+
+TEST_F(ConfigFileTest, UnknownClampModelAndComparatorDataAreRefused) {
+  ExpectLoadError("mcre:\n  clamp: rigid\n", 2,
+                  {"mcre.clamp: expected one of 'measured', 'trusted', got 'rigid'"});
+  ExpectLoadError("mcre:\n  w_r: 0\n", 2, {"mcre.w_r must be a finite positive number"});
+  ExpectLoadError("study:\n  comparator_data: [raw, raw]\n", 2,
+                  {"study.comparator_data must hold raw, prefilter or both, once each"});
 }
 
 TEST_F(ConfigFileTest, NegativeSeed) {

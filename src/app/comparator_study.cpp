@@ -29,7 +29,6 @@ constexpr double kForceGain = 1.05;         // measured fL / true fL
 constexpr double kDisplacementGain = 1.03;  // measured uL / true uL
 constexpr double kSoftZoneFactor = 0.9;     // E over the soft zone / E
 constexpr double kSoftZoneLength = 0.1;     // its length / L, from the clamp
-constexpr int kRunsPerDataSet = 4;          // {MCRE, least squares} x {raw, pre-filtered}
 
 struct DataSet {
   std::string model_error;
@@ -80,9 +79,10 @@ void Identify(const Config& config, const BarModel& model, const MeasurementSet&
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The four runs of one data set: runs[0..3] = MCRE raw, MCRE pre-filtered, least
-// squares raw, least squares pre-filtered.
-void RunDataSet(const Config& config, const DataSet& set, ComparatorRun* runs) {
+// The runs of one data set, {MCRE, least squares} x `prefilters` in that order (all
+// four: MCRE raw, MCRE pre-filtered, least squares raw, least squares pre-filtered).
+void RunDataSet(const Config& config, const DataSet& set, const std::vector<bool>& prefilters,
+                ComparatorRun* runs) {
   Config truth = config;
   truth.data.snr = set.snr;
   truth.data.seed = set.seed;
@@ -97,13 +97,14 @@ void RunDataSet(const Config& config, const DataSet& set, ComparatorRun* runs) {
   BarProperties identified = config.model;
   if (set.model_error == "density") identified.density *= kDensityError;
   const BarModel model(identified);
-  for (int k = 0; k < kRunsPerDataSet; ++k) {
+  const int filters = static_cast<int>(prefilters.size());
+  for (int k = 0; k < 2 * filters; ++k) {
     ComparatorRun& run = runs[k];
     run.model_error = set.model_error;
     run.snr = set.snr;
     run.seed = set.seed;
-    run.least_squares = k >= 2;
-    run.prefilter = k % 2 == 1;
+    run.least_squares = k >= filters;
+    run.prefilter = prefilters[k % filters];
     PrefilterOptions prefilter = config.prefilter;
     prefilter.enabled = run.prefilter;
     const MeasurementSet data = PrefilterMeasurements(measured, prefilter, nullptr);
@@ -115,7 +116,7 @@ std::vector<ComparatorStatistics> Statistics(const ComparatorStudy& study) {
   std::vector<ComparatorStatistics> table;
   for (const std::string& error : study.model_errors) {
     for (const bool least_squares : {false, true}) {
-      for (const bool prefilter : {false, true}) {
+      for (const bool prefilter : study.prefilters) {
         for (const double snr : study.snrs) {
           ComparatorStatistics row;
           row.model_error = error;
@@ -201,18 +202,23 @@ std::string StatisticsCsv(const ComparatorStudy& study) {
   return csv.str();
 }
 
-// curves.csv: one row per (model error, SNR) with the rms error of the four
-// (functional, data) combinations, for the figure (finite SNRs only: log axis).
+// curves.csv: one row per (model error, SNR) with the rms error of each (functional,
+// data) combination, for the figure (finite SNRs only: log axis).
 std::string CurvesCsv(const ComparatorStudy& study) {
   std::ostringstream csv;
-  csv << "model_error_index,snr,mcre_raw,mcre_prefilter,least_squares_raw,least_squares_"
-         "prefilter\n";
+  csv << "model_error_index,snr";
+  for (const bool least_squares : {false, true}) {
+    for (const bool prefilter : study.prefilters) {
+      csv << "," << FunctionalText(least_squares) << "_" << FilterText(prefilter);
+    }
+  }
+  csv << "\n";
   for (std::size_t e = 0; e < study.model_errors.size(); ++e) {
     for (const double snr : study.snrs) {
       if (std::isinf(snr)) continue;
       csv << e << "," << Csv(snr);
       for (const bool least_squares : {false, true}) {
-        for (const bool prefilter : {false, true}) {
+        for (const bool prefilter : study.prefilters) {
           for (const ComparatorStatistics& row : study.statistics) {
             if (row.model_error == study.model_errors[e] && row.least_squares == least_squares &&
                 row.prefilter == prefilter && row.snr == snr) {
@@ -238,16 +244,24 @@ std::string CurvesScript(const std::string& folder, const ComparatorStudy& study
          << "set xlabel 'SNR'\nset ylabel 'rms error of E [%]'\nset key top right\n"
          << "set multiplot layout " << rows << "," << columns
          << " title 'MCRE against output-error least squares'\n";
-  const char* titles[] = {"MCRE, raw", "MCRE, pre-filtered", "least squares, raw",
-                          "least squares, pre-filtered"};
+  std::vector<std::string> titles;  // the columns of curves.csv after model_error_index, snr
+  for (const bool least_squares : {false, true}) {
+    for (const bool prefilter : study.prefilters) {
+      titles.push_back(std::string(least_squares ? "least squares" : "MCRE") +
+                       (prefilter ? ", pre-filtered" : ", raw"));
+    }
+  }
   for (int e = 0; e < panels; ++e) {
     std::string title = study.model_errors[e];
     std::replace(title.begin(), title.end(), '_', ' ');
     script << "set title '" << title << "'\nplot ";
-    for (int c = 0; c < 4; ++c) {
+    for (int c = 0; c < static_cast<int>(titles.size()); ++c) {
+      // The colours of the four combinations stay the same whichever are drawn.
+      const int colour = 2 * (c / static_cast<int>(study.prefilters.size())) +
+                         (study.prefilters[c % study.prefilters.size()] ? 1 : 0);
       script << (c > 0 ? ", " : "") << csv << " skip 1 using ($1 == " << e
              << " ? $2 : NaN):" << c + 3 << " with linespoints lw 2 pt 7 lc rgb '"
-             << internal::Colour(c) << "' title '" << titles[c] << "'";
+             << internal::Colour(colour) << "' title '" << titles[c] << "'";
     }
     script << "\n";
   }
@@ -296,7 +310,7 @@ std::string Summary(const ComparatorStudy& study) {
     return std::nan("");
   };
   for (const std::string& error : study.model_errors) {
-    for (const bool prefilter : {false, true}) {
+    for (const bool prefilter : study.prefilters) {
       md << "| " << error << " | " << FilterText(prefilter) << " |";
       for (const double snr : study.snrs) {
         md << " " << Brief(rms(error, false, prefilter, snr) / rms(error, true, prefilter, snr), 3)
@@ -324,12 +338,17 @@ ComparatorStudy RunComparatorStudy(const Config& config) {
   study.reference_modulus = config.model.modulus;
   study.model_errors = config.study.comparator_errors;
   study.snrs = config.study.comparator_snr;
-  study.runs.resize(kRunsPerDataSet * sets.size());
+  for (const std::string& data : config.study.comparator_data) {
+    study.prefilters.push_back(data == "prefilter");
+  }
+  const int runs_per_set = 2 * static_cast<int>(study.prefilters.size());
+  study.runs.resize(runs_per_set * sets.size());
   study.threads = internal::ResolveThreads(config.study.threads);
   internal::Progress progress("comparator", static_cast<int>(sets.size()));
   internal::ParallelFor(
       static_cast<int>(sets.size()), study.threads,
-      [&](int i) { RunDataSet(config, sets[i], &study.runs[kRunsPerDataSet * i]); }, &progress);
+      [&](int i) { RunDataSet(config, sets[i], study.prefilters, &study.runs[runs_per_set * i]); },
+      &progress);
   study.statistics = Statistics(study);
   study.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -475,8 +475,15 @@ const std::vector<Key>& KeyTable() {
               Number(), "", "force weight: alpha = w_f L / (S E0)"),
       MakeKey("mcre.w_e", &Config::mcre, &McreOptions::weights, &McreWeights::strain_weight,
               Number(), "", "strain weight: beta_e = w_e S E0 L"),
+      MakeKey("mcre.w_r", &Config::mcre, &McreOptions::weights, &McreWeights::reaction_weight,
+              Number(), "", "clamp reaction weight (mcre.clamp trusted): alpha_r = w_r L / (S E0)"),
       MakeKey("mcre.reference_modulus", &Config::mcre, &McreOptions::reference_modulus, Number(),
               "Pa", "E0 of the weights: a fixed nominal modulus, not the unknown"),
+      MakeKey("mcre.clamp", &Config::mcre, &McreOptions::clamp,
+              EnumByName<ClampModel>({ClampModel::kMeasured, ClampModel::kTrusted},
+                                     ClampModelToString, StringToClampModel),
+              "", "the clamp at x = 0: measured (free-free model, f0 a load, u0 an output) "
+              "or trusted (u(0) = 0 imposed, f0 a measured output)"),
       MakeKey("inner.method", &Config::inner, &CoupledSolverOptions::type,
               EnumByName<CoupledSolverType>(AllCoupledSolverTypes(), CoupledSolverTypeToString,
                                             StringToCoupledSolverType),
@@ -636,6 +643,9 @@ const std::vector<Key>& KeyTable() {
               TextList(), "",
               "MCRE against least squares: model errors (none, density, force_gain, "
               "displacement_gain, soft_zone)"),
+      MakeKey("study.comparator_data", &Config::study, &StudyOptions::comparator_data,
+              TextList(), "",
+              "MCRE against least squares: the data identified from (raw, prefilter)"),
       MakeKey("zone_identification.algorithm", &Config::zone_identification,
               &ZoneIdentificationOptions::minimizer, &BoundedMinimizerOptions::algorithm,
               EnumByName<BoundedAlgorithm>(
@@ -744,6 +754,8 @@ std::string StructureKeysProblem(const Config& config) {
       {"data.sensors", !config.data.sensors.empty()},
       {"data.channels", !config.data.channels.empty()},
       {"data.truth_zones", !config.data.truth_zones.empty()},
+      {"mcre.clamp", config.mcre.clamp != defaults.mcre.clamp},
+      {"mcre.w_r", config.mcre.weights.reaction_weight != defaults.mcre.weights.reaction_weight},
   };
   for (const auto& [key, set] : bar_keys) {
     if (set) {

@@ -305,6 +305,13 @@ bool StudyOptions::IsValid(std::string* error) const {
                          })) {
     why << "study.comparator_errors must hold model errors among none, density, force_gain, "
            "displacement_gain, soft_zone";
+  } else if (comparator_data.empty() || comparator_data.size() > 2 ||
+             std::any_of(comparator_data.begin(), comparator_data.end(),
+                         [](const std::string& name) {
+                           return name != "raw" && name != "prefilter";
+                         }) ||
+             (comparator_data.size() == 2 && comparator_data[0] == comparator_data[1])) {
+    why << "study.comparator_data must hold raw, prefilter or both, once each";
   } else {
     return true;
   }

@@ -26,6 +26,8 @@ constexpr std::array<std::pair<SensorKind, const char*>, 2> kSensorKinds{
     {{SensorKind::kDisplacement, "displacement"}, {SensorKind::kStrain, "strain"}}};
 constexpr std::array<std::pair<ModelKind, const char*>, 2> kModelKinds{
     {{ModelKind::kBar, "bar"}, {ModelKind::kMatrix, "matrix"}}};
+constexpr std::array<std::pair<ClampModel, const char*>, 2> kClampModels{
+    {{ClampModel::kMeasured, "measured"}, {ClampModel::kTrusted, "trusted"}}};
 constexpr std::array<std::pair<Zoning, const char*>, 3> kZonings{{{Zoning::kEqual, "equal"},
                                                                   {Zoning::kPerElement, "per_element"},
                                                                   {Zoning::kBoundaries, "boundaries"}}};
@@ -60,6 +62,11 @@ bool StringToTruthModel(const std::string& name, TruthModel* model) {
 const char* ModelKindToString(ModelKind kind) { return ToName(kModelKinds, kind); }
 bool StringToModelKind(const std::string& name, ModelKind* kind) {
   return FromName(kModelKinds, name, kind);
+}
+
+const char* ClampModelToString(ClampModel model) { return ToName(kClampModels, model); }
+bool StringToClampModel(const std::string& name, ClampModel* model) {
+  return FromName(kClampModels, name, model);
 }
 
 }  // namespace mcrewave

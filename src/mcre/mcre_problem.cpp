@@ -21,6 +21,8 @@ bool McreWeights::IsValid(std::string* error) const {
     why << "mcre.w_f must be a finite positive number, got " << force_weight;
   } else if (!(std::isfinite(strain_weight) && strain_weight > 0.0)) {
     why << "mcre.w_e must be a finite positive number, got " << strain_weight;
+  } else if (!(std::isfinite(reaction_weight) && reaction_weight > 0.0)) {
+    why << "mcre.w_r must be a finite positive number, got " << reaction_weight;
   } else {
     return true;
   }
@@ -30,11 +32,12 @@ bool McreWeights::IsValid(std::string* error) const {
 
 McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
                          const McreWeights& weights, double reference_modulus, double theta,
-                         EndDisplacementChannels ends)
+                         EndDisplacementChannels ends, ClampModel clamp)
     : model_(model),
       data_(data),
       theta_(theta),
       ends_(ends),
+      clamp_(clamp),
       unit_stiffness_(model.unit_stiffness()) {
   assert(weights.IsValid(nullptr) && data.num_steps() >= 1 && reference_modulus > 0.0);
   const BarProperties& bar = model.properties();
@@ -43,21 +46,43 @@ McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
   beta_ = weights.displacement_weight * bar.section * reference_modulus / bar.length;
   alpha_ = weights.force_weight * bar.length / (bar.section * reference_modulus);
   strain_beta_ = weights.strain_weight * bar.section * reference_modulus * bar.length;
-  beta_u0_ = ends.u0 ? beta_ : 0.0;
-  beta_uL_ = ends.uL ? beta_ : 0.0;
-  const int num_sensors = static_cast<int>(data.sensors.size());
-  sensor_weights_.resize(num_sensors);
-  for (int k = 0; k < num_sensors; ++k) {
-    const SensorChannel& sensor = data.sensors[k];
+  const bool trusted = clamp == ClampModel::kTrusted;
+  if (trusted) ends_.u0 = false;
+  beta_u0_ = ends_.u0 ? beta_ : 0.0;
+  beta_uL_ = ends_.uL ? beta_ : 0.0;
+  inverse_alpha0_ = trusted ? 0.0 : 1.0 / alpha_;
+  force0_gain_ = trusted ? 0.0 : 1.0;
+  std::vector<double> weights_of_rows;
+  for (const SensorChannel& sensor : data.sensors) {
     assert(sensor.position >= 0.0 && sensor.position <= bar.length &&
            sensor.values.size() == data.num_samples());
     const bool strain = sensor.kind == SensorKind::kStrain;
     sensor_rows_.push_back(strain ? model.StrainRow(sensor.position)
                                   : model.DisplacementRow(sensor.position));
-    sensor_weights_[k] = strain ? strain_beta_ : beta_;
+    // U_0 = 0 under a trusted clamp: the row's node-0 part observes nothing and
+    // would load the held node.
+    if (trusted && sensor_rows_.back().nodes[0] == 0) sensor_rows_.back().coefficients[0] = 0.0;
+    weights_of_rows.push_back(strain ? strain_beta_ : beta_);
     sensor_data_.push_back(&sensor.values);
-    load_nodes_.push_back(sensor_rows_.back().nodes[0]);
-    load_nodes_.push_back(sensor_rows_.back().nodes[1]);
+  }
+  if (trusted) {
+    // The clamp reaction r(U) = K_01(E) U_1, weight alpha, data f0~; its coefficient
+    // is set with the moduli (SetModuli).
+    reaction_row_ = static_cast<int>(sensor_rows_.size());
+    ObservationRow reaction;
+    reaction.nodes[0] = 0;
+    reaction.nodes[1] = 1;
+    sensor_rows_.push_back(reaction);
+    // alpha_r = w_r L / (S E0).
+    weights_of_rows.push_back(weights.reaction_weight * bar.length /
+                              (bar.section * reference_modulus));
+    sensor_data_.push_back(&data.f0);
+  }
+  const int num_sensors = static_cast<int>(sensor_rows_.size());
+  sensor_weights_ = Eigen::Map<const Vector>(weights_of_rows.data(), num_sensors);
+  for (const ObservationRow& row : sensor_rows_) {
+    load_nodes_.push_back(row.nodes[0]);
+    load_nodes_.push_back(row.nodes[1]);
   }
   load_values_ = Matrix::Zero(2 * num_sensors, ThetaIntegrator::kMaxBatch);
   for (int b = 0; b < ThetaIntegrator::kMaxBatch; ++b) {
@@ -103,8 +128,38 @@ void McreProblem::SetModuli(const Vector& zone_moduli) {
   ThetaIntegratorOptions options;
   options.time_step = data_.time_step;
   options.theta = theta_;
-  // K = sum_z E_z K1_z (one zone: E K1).
-  integrator_.Init(model_.mass(), model_.Stiffness(moduli_), options);
+  if (reaction_row_ >= 0) {
+    // r(U) = K_01 U_1 = -(E_1 S / l_1) U_1.
+    sensor_rows_[reaction_row_].coefficients[1] =
+        moduli_[model_.element_zone(0)] * model_.unit_stiffness().coeff(0, 1);
+  }
+  // K = sum_z E_z K1_z (one zone: E K1); node 0 decoupled under a trusted clamp.
+  integrator_.Init(MassMatrix(), StiffnessMatrix(), options);
+}
+
+namespace {
+
+// The matrix with row and column 0 decoupled from the others (diagonal kept): the
+// node held at rest when its load is zero.
+SparseMatrix WithFirstNodeHeld(SparseMatrix matrix) {
+  for (int column = 0; column < matrix.outerSize(); ++column) {
+    for (SparseMatrix::InnerIterator entry(matrix, column); entry; ++entry) {
+      if ((entry.row() == 0) != (entry.col() == 0)) entry.valueRef() = 0.0;
+    }
+  }
+  matrix.prune(0.0);
+  return matrix;
+}
+
+}  // namespace
+
+SparseMatrix McreProblem::MassMatrix() const {
+  return clamp_ == ClampModel::kTrusted ? WithFirstNodeHeld(model_.mass()) : model_.mass();
+}
+
+SparseMatrix McreProblem::StiffnessMatrix() const {
+  SparseMatrix stiffness = model_.Stiffness(moduli_);
+  return clamp_ == ClampModel::kTrusted ? WithFirstNodeHeld(std::move(stiffness)) : stiffness;
 }
 
 void McreProblem::SensorLoads(int j, const double* displacement_j, bool include_data,
@@ -135,10 +190,10 @@ void McreProblem::DirectSweep(const Matrix& retrograde, bool include_data, Matri
     //   f_theta = -K W_theta + (F~_theta - B W_theta / alpha),
     //   W_theta = theta W_{k+1} + (1 - theta) W_k.
     shift_ = theta_ * retrograde.col(k + 1) + (1.0 - theta_) * retrograde.col(k);
-    double f0 = -inverse_alpha * shift_[0];
+    double f0 = -inverse_alpha0_ * shift_[0];
     double fL = -inverse_alpha * shift_[last];
     if (include_data) {
-      f0 += theta_ * data_.f0[k + 1] + (1.0 - theta_) * data_.f0[k];
+      f0 += force0_gain_ * (theta_ * data_.f0[k + 1] + (1.0 - theta_) * data_.f0[k]);
       fL += theta_ * data_.fL[k + 1] + (1.0 - theta_) * data_.fL[k];
     }
     integrator_.StepWithEndLoads(velocity_[current], displacement->col(k), shift_, f0, fL,
@@ -206,13 +261,13 @@ void McreProblem::DirectSweeps(const Matrix* const (&retrograde)[B],
     double* u_next[B];
     for (int b = 0; b < B; ++b) {
       // As DirectSweep: f_theta = -K W_theta + (F~_theta - B W_theta / alpha).
-      f0[b] = theta_ * data_.f0[k + 1] + (1.0 - theta_) * data_.f0[k];
+      f0[b] = force0_gain_ * (theta_ * data_.f0[k + 1] + (1.0 - theta_) * data_.f0[k]);
       fL[b] = theta_ * data_.fL[k + 1] + (1.0 - theta_) * data_.fL[k];
       z[b] = nullptr;
       if (retrograde[b] != nullptr) {
         batch_shift_.col(b) =
             theta_ * retrograde[b]->col(k + 1) + (1.0 - theta_) * retrograde[b]->col(k);
-        f0[b] = -inverse_alpha * batch_shift_(0, b) + f0[b];
+        f0[b] = -inverse_alpha0_ * batch_shift_(0, b) + f0[b];
         fL[b] = -inverse_alpha * batch_shift_(last, b) + fL[b];
         z[b] = batch_shift_.col(b).data();
       }
@@ -328,7 +383,7 @@ double McreProblem::InnerProduct(const Matrix& x, const Matrix& y) {
   for (int j = 0; j <= m; ++j) {
     // x_j^T (K + B/alpha) y_j.
     double term = stiffness.BilinearForm(x.col(j).data(), y.col(j).data());
-    term += (x(0, j) * y(0, j) + x(last, j) * y(last, j)) / alpha_;
+    term += (force0_gain_ * x(0, j) * y(0, j) + x(last, j) * y(last, j)) / alpha_;
     sum += QuadratureWeight(j) * h * term;
   }
   return sum;
@@ -338,7 +393,8 @@ double McreProblem::SampleCost(int j, const double* displacement, const double* 
   const int last = num_nodes() - 1;
   const double gap = 0.5 * integrator_.stiffness().BilinearForm(retrograde, retrograde);
   const double force_misfit =
-      (retrograde[0] * retrograde[0] + retrograde[last] * retrograde[last]) / (2.0 * alpha_);
+      (force0_gain_ * retrograde[0] * retrograde[0] + retrograde[last] * retrograde[last]) /
+      (2.0 * alpha_);
   const double u0_misfit = displacement[0] - data_.u0[j];
   const double uL_misfit = displacement[last] - data_.uL[j];
   double displacement_misfit =
@@ -383,15 +439,27 @@ void McreProblem::AddSampleZoneGradients(double weight, const double* displaceme
   }
 }
 
+double McreProblem::ReactionGradient(int j, const double* displacement) const {
+  if (reaction_row_ < 0) return 0.0;
+  // alpha_r (r(U_j) / E_1) (r(U_j) - f0~_j): d/dE_1 of alpha_r/2 (r(U_j) - f0~_j)^2 with
+  // r = E_1 K1_01 U_1.
+  const double reaction = sensor_rows_[reaction_row_].Apply(displacement);
+  return sensor_weights_[reaction_row_] * (reaction / moduli_[model_.element_zone(0)]) *
+         (reaction - data_.f0[j]);
+}
+
 double McreProblem::CostGradient(const Matrix& displacement, const Matrix& retrograde) {
   const int m = num_steps();
   const double h = time_step();
-  double sum = 0.0;
+  double sum = 0.0, reaction_sum = 0.0;
   for (int j = 0; j <= m; ++j) {
     sum += QuadratureWeight(j) * h *
            SampleGradient(displacement.col(j).data(), retrograde.col(j).data());
+    if (reaction_row_ >= 0) {
+      reaction_sum += QuadratureWeight(j) * h * ReactionGradient(j, displacement.col(j).data());
+    }
   }
-  return -0.5 * sum;
+  return reaction_row_ >= 0 ? -0.5 * sum + reaction_sum : -0.5 * sum;
 }
 
 void McreProblem::CostGradients(const Matrix& displacement, const Matrix& retrograde,
@@ -407,17 +475,26 @@ void McreProblem::CostGradients(const Matrix& displacement, const Matrix& retrog
   for (int j = 0; j <= m; ++j) {
     AddSampleZoneGradients(-0.5 * QuadratureWeight(j) * h, displacement.col(j).data(),
                            retrograde.col(j).data(), gradient);
+    if (reaction_row_ >= 0) {
+      (*gradient)[model_.element_zone(0)] +=
+          QuadratureWeight(j) * h * ReactionGradient(j, displacement.col(j).data());
+    }
   }
 }
 
 SparseMatrix McreProblem::PenaltyMatrix() const {
-  // P = K + B / alpha, B = e_0 e_0^T + e_N e_N^T.
+  // P = K + B / alpha, B = e_0 e_0^T + e_N e_N^T (trusted clamp: e_N e_N^T).
+  if (clamp_ == ClampModel::kTrusted) {
+    SparseMatrix penalty = StiffnessMatrix();
+    penalty.coeffRef(num_nodes() - 1, num_nodes() - 1) += 1.0 / alpha_;
+    return penalty;
+  }
   return model_.Stiffness(moduli_) + model_.boundary_selector() / alpha_;
 }
 
 void McreProblem::MeasuredForce(int j, Eigen::Ref<Vector> load) const {
   load.setZero();
-  load[0] = data_.f0[j];
+  load[0] = force0_gain_ * data_.f0[j];
   load[num_nodes() - 1] = data_.fL[j];
 }
 

@@ -166,7 +166,8 @@ ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
           sensor.kind == SensorKind::kStrain ? noise.strain_std : noise.displacement_std;
       for (double& value : sensor.values) value = level * normal(engine);
     }
-    McreProblem problem(model, noise_data, mcre.weights, mcre.reference_modulus, theta, ends);
+    McreProblem problem(model, noise_data, mcre.weights, mcre.reference_modulus, theta, ends,
+                        mcre.clamp);
     problem.SetModulus(modulus);
     CoupledSolution noise_solution;
     const CoupledSolverSummary summary = SolveCoupled(inner, &problem, nullptr, &noise_solution);
@@ -180,9 +181,20 @@ ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
     minus_displacement = solution.displacement - noise_solution.displacement;
     minus_retrograde = solution.retrograde - noise_solution.retrograde;
     // dg_1 = (g(s_d + s_n) - g(s_d - s_n)) / 2, g the quadratic de^2/dE at E*
-    const double gradient_change =
+    double gradient_change =
         0.5 * (problem.CostGradient(plus_displacement, plus_retrograde) -
                problem.CostGradient(minus_displacement, minus_retrograde));
+    if (mcre.clamp == ClampModel::kTrusted) {
+      // The reaction's explicit term alpha_r (r / E) (r - f0~) holds the data f0~
+      // itself, which the problem above has as the noise f0_n only: the difference
+      // leaves out -sum_j c_j h alpha_r r(U_n,j) f0~_d,j / E (linear in the noise).
+      for (int j = 0; j <= problem.num_steps(); ++j) {
+        gradient_change -= problem.QuadratureWeight(j) * problem.time_step() *
+                           problem.reaction_weight() *
+                           problem.ClampReaction(noise_solution.displacement.col(j).data()) *
+                           data.f0[j] / modulus;
+      }
+    }
     // dE = -dg_1 / k
     const double modulus_change = -gradient_change / curvature;
     sum_of_squares += modulus_change * modulus_change;

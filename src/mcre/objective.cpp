@@ -33,18 +33,20 @@ McreObjective::McreObjective(const BarModel& model, const MeasurementSet& data,
       mcre_(mcre),
       theta_(theta),
       ends_(ends),
-      problem_(model, data, mcre.weights, mcre.reference_modulus, theta, ends),
+      problem_(model, data, mcre.weights, mcre.reference_modulus, theta, ends, mcre.clamp),
       inner_(inner),
       modulus_scale_(modulus_scale) {
   assert(mcre.IsValid(nullptr) && inner.IsValid(nullptr) && modulus_scale > 0.0);
-  // The displacement part beta/2 |B U - U~|^2 of J at U = W = 0 is Cost(0, 0);
-  // the force part is alpha/2 |F - F~|^2 with F = 0.
+  // The output part 1/2 (H U - d~)^T diag(beta_k) (H U - d~) of J at U = W = 0 is
+  // Cost(0, 0); the load part is alpha/2 |F - F~|^2 with F = 0 (a trusted clamp's f0
+  // is an output, in Cost(0, 0)).
   const Matrix zero = problem_.ZeroField();
+  const double f0_gain = mcre.clamp == ClampModel::kTrusted ? 0.0 : 1.0;
   double force_part = 0.0;
   for (int j = 0; j <= data.num_steps(); ++j) {
     // c_j h alpha/2 (f~0_j^2 + f~L_j^2)
     force_part += problem_.QuadratureWeight(j) * data.time_step * 0.5 * problem_.alpha() *
-                  (data.f0[j] * data.f0[j] + data.fL[j] * data.fL[j]);
+                  (f0_gain * data.f0[j] * data.f0[j] + data.fL[j] * data.fL[j]);
   }
   rest_cost_ = problem_.Cost(zero, zero) + force_part;
 }

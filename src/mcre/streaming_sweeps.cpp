@@ -42,7 +42,7 @@ void McreProblem::DataResponseTraces(Matrix* traces) {
   for (int k = 0; k < m; ++k) {
     const int current = k & 1, next = current ^ 1;
     // f_theta = theta F~_{k+1} + (1 - theta) F~_k at both ends.
-    const double f0 = theta_ * data_.f0[k + 1] + (1.0 - theta_) * data_.f0[k];
+    const double f0 = force0_gain_ * (theta_ * data_.f0[k + 1] + (1.0 - theta_) * data_.f0[k]);
     const double fL = theta_ * data_.fL[k + 1] + (1.0 - theta_) * data_.fL[k];
     integrator_.StepWithEndLoads(stream_velocity_[current], stream_displacement_[current], f0, fL,
                                  stream_velocity_[next], stream_displacement_[next]);
@@ -102,6 +102,10 @@ void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* 
       AddSampleZoneGradients(-0.5 * weight, displacement.data(), retrograde.data(),
                              &totals->cost_gradients);
     }
+    if (reaction_row_ >= 0) {
+      totals->cost_gradients[model_.element_zone(0)] +=
+          weight * ReactionGradient(j, displacement.data());
+    }
     AddSampleGapShares(model_, moduli_, retrograde.data(), weight, &totals->error_map);
     totals->end_retrograde(0, j) = retrograde[0];
     totals->end_retrograde(1, j) = retrograde[last];
@@ -113,10 +117,10 @@ void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* 
   auto direct_step = [&](int j, const Vector& previous_retrograde, const Vector& retrograde) {
     const int current = (j - 1) & 1, next = current ^ 1;
     stream_shift_ = theta_ * retrograde + (1.0 - theta_) * previous_retrograde;
-    double direct_f0 = -inverse_alpha * stream_shift_[0];
+    double direct_f0 = -inverse_alpha0_ * stream_shift_[0];
     double direct_fL = -inverse_alpha * stream_shift_[last];
     if (include_data) {
-      direct_f0 += theta_ * data_.f0[j] + (1.0 - theta_) * data_.f0[j - 1];
+      direct_f0 += force0_gain_ * (theta_ * data_.f0[j] + (1.0 - theta_) * data_.f0[j - 1]);
       direct_fL += theta_ * data_.fL[j] + (1.0 - theta_) * data_.fL[j - 1];
     }
     integrator_.StepWithEndLoads(stream_direct_velocity_[current], stream_displacement_[current],

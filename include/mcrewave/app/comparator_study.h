@@ -67,6 +67,7 @@ struct ComparatorStudy {
   double reference_modulus = 0.0;         // E_ref [Pa]
   std::vector<std::string> model_errors;  // study.comparator_errors
   std::vector<double> snrs;               // study.comparator_snr
+  std::vector<bool> prefilters;           // study.comparator_data: false raw, true prefilter
   std::vector<ComparatorRun> runs;
   std::vector<ComparatorStatistics> statistics;
   int threads = 0;
@@ -74,8 +75,8 @@ struct ComparatorStudy {
 };
 
 // Runs study.comparator_errors x study.comparator_snr x seeds (1..comparator_seeds
-// per finite SNR, one run at SNR inf) x {no pre-filter, pre-filter} x {MCRE, least
-// squares} on the config's case, on study.threads threads, with a progress line per
+// per finite SNR, one run at SNR inf) x study.comparator_data (raw, pre-filtered) x
+// {MCRE, least squares} on the config's case, on study.threads threads, with a progress line per
 // data set. Precondition: config valid.
 ComparatorStudy RunComparatorStudy(const Config& config);
 

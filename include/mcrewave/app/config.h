@@ -53,7 +53,8 @@
 //          cost_curve_points [41], cost_curve_low [0.8], cost_curve_high [1.2],
 //          damage_snr [[.inf, 20, 10, 5]], damage_seeds [20], comparator_snr
 //          [[20, 10, 5, 2.5]], comparator_seeds [100], comparator_errors [[none,
-//          density, force_gain, displacement_gain, soft_zone]]
+//          density, force_gain, displacement_gain, soft_zone]], comparator_data
+//          [[raw, prefilter]]
 //          (StudyOptions, study.h; used by `identify study` only)
 //   zone_identification: algorithm [nlopt_lbfgs], step_tolerance [1e-8],
 //          function_tolerance [1e-10], max_evaluations [2000], max_time [600 s],

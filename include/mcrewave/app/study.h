@@ -106,6 +106,8 @@ struct StudyOptions {
   int comparator_seeds = 100;
   std::vector<std::string> comparator_errors = {"none", "density", "force_gain",
                                                 "displacement_gain", "soft_zone"};
+  // The data each functional identifies from: raw and/or prefilter (pre-filtered).
+  std::vector<std::string> comparator_data = {"raw", "prefilter"};
 
   // Valid when folder is not empty, threads in [0, 256], every SNR > 0 (.inf
   // allowed), lists not empty (at most 100 values), seeds in [1, 100000],

@@ -81,4 +81,15 @@ enum class ModelKind {
 const char* ModelKindToString(ModelKind kind);
 bool StringToModelKind(const std::string& name, ModelKind* kind);
 
+// How the MCRE treats the bar's clamp at x = 0 (config key mcre.clamp;
+// docs/trusted_clamp.md).
+enum class ClampModel {
+  kMeasured,  // the paper's: known only through the measured u0 and f0; free-free
+              // model, f0 a load with its alpha term, u0 an output with its beta term
+  kTrusted,   // u(0) = 0 imposed exactly (the least-squares comparator's assumption);
+              // f0 compared with the model's clamp reaction as a measured output
+};
+const char* ClampModelToString(ClampModel model);
+bool StringToClampModel(const std::string& name, ClampModel* model);
+
 }  // namespace mcrewave

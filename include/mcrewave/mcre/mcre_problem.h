@@ -22,6 +22,19 @@
 // displacements and beta_e = w_e S E0 L for strains. With the two end rows only, it is
 // the paper's B = e_0 e_0^T + e_N e_N^T and every number is the one of the paper's case.
 // The measured end forces f0, fL are the model's loads and keep their alpha term.
+//
+// Trusted clamp (ClampModel::kTrusted, docs/trusted_clamp.md): u(0) = 0 is imposed
+// exactly instead of being a measured output. Row and column 0 of M and K are
+// decoupled (their diagonals kept), so that U_0 = W_0 = 0 through every sweep: the
+// fields keep their n = N + 1 rows and the bar's clamped dofs are those of the
+// comparator. Then fL is the only load (P = K + e_N e_N^T / alpha), u0 is not an
+// output, and f0 becomes one: the last row of the sensors is the clamp reaction of
+// the kinematic field,
+//   r(U) = K_01(E) U_1 = -(E_1 S / l_1) U_1,   weight alpha_r = w_r L / (S E0), data f0~,
+// the stress of the first element, which equals -S sigma(0) to O(l^2) because
+// sigma_x(0) = rho u_tt(0) = 0 at a fixed end. The row depends on the modulus E_1 of
+// the first element's zone, so that de^2/dE_z gains the explicit term
+//   sum_j c_j h alpha_r (r(U_j) / E_1) (r(U_j) - f0~_j)   (the zone of element 1).
 #pragma once
 
 #include <vector>
@@ -50,6 +63,8 @@ struct McreWeights {
   double displacement_weight = 0.01;  // w_u
   double force_weight = 1.0;          // w_f
   double strain_weight = 0.01;        // w_e
+  // w_r: the trusted clamp's reaction output, alpha_r = w_r L / (S E0) [m/N].
+  double reaction_weight = 1e-3;
   bool IsValid(std::string* error) const;
 };
 
@@ -67,8 +82,10 @@ class McreProblem : public CoupledProblem {
   // are the model's; every zone starts at the model's properties().modulus.
   // Precondition: data.num_steps() >= 1, weights valid, theta in [0, 1], every sensor
   // position in [0, L].
+  // clamp: kTrusted imposes u(0) = 0 (ends.u0 is then ignored) and observes f0.
   McreProblem(const BarModel& model, const MeasurementSet& data, const McreWeights& weights,
-              double reference_modulus, double theta, EndDisplacementChannels ends = {});
+              double reference_modulus, double theta, EndDisplacementChannels ends = {},
+              ClampModel clamp = ClampModel::kMeasured);
 
   // Sets every zone's modulus to E [Pa] and refactorises the integrator (once per change).
   void SetModulus(double modulus);
@@ -87,7 +104,19 @@ class McreProblem : public CoupledProblem {
   double beta() const { return beta_; }                // displacement weight beta_u [N/m]
   double strain_beta() const { return strain_beta_; }  // strain weight beta_e [N m]
   const EndDisplacementChannels& end_channels() const { return ends_; }
-  // Number of interior sensor rows of H (u@X, e@X); 0 in the paper's case.
+  ClampModel clamp() const { return clamp_; }
+  // alpha_r [m/N], the weight of a trusted clamp's reaction; 0 when the clamp is measured.
+  double reaction_weight() const {
+    return reaction_row_ >= 0 ? sensor_weights_[reaction_row_] : 0.0;
+  }
+  // Trusted clamp: the reaction r(U_j) = K_01(E) U_1 [N] of the displacement column
+  // U_j (n entries); 0 when the clamp is measured.
+  double ClampReaction(const double* displacement) const {
+    return reaction_row_ >= 0 ? sensor_rows_[reaction_row_].Apply(displacement) : 0.0;
+  }
+  // Number of sensor rows of H besides the end displacements: the interior sensors of
+  // the data (u@X, e@X), then the clamp reaction when the clamp is trusted; 0 in the
+  // paper's case.
   int num_interior_sensors() const { return static_cast<int>(sensor_rows_.size()); }
   // True when H is the paper's B: both end displacements and no interior sensor.
   bool observes_ends_only() const { return ends_.u0 && ends_.uL && num_interior_sensors() == 0; }
@@ -128,9 +157,10 @@ class McreProblem : public CoupledProblem {
 
   // The operators of the space-time system: M, K = sum_z E_z K1_z, P = K + B/alpha,
   // H^T diag(beta_k) H (the paper's case: beta B), H^T diag(beta_k) d~_j and the
-  // measured end forces f0~_j e_0 + fL~_j e_N.
-  SparseMatrix MassMatrix() const override { return model_.mass(); }
-  SparseMatrix StiffnessMatrix() const override { return model_.Stiffness(moduli_); }
+  // measured end forces f0~_j e_0 + fL~_j e_N. Trusted clamp: M and K with row and
+  // column 0 decoupled, B = e_N e_N^T, the load fL~_j e_N alone.
+  SparseMatrix MassMatrix() const override;
+  SparseMatrix StiffnessMatrix() const override;
   SparseMatrix PenaltyMatrix() const override;
   SparseMatrix WeightedObservation() const override;
   void WeightedData(int j, Eigen::Ref<Vector> load) const override;
@@ -195,6 +225,9 @@ class McreProblem : public CoupledProblem {
   double SampleCost(int j, const double* displacement, const double* retrograde) const;
   // W_j^T K1 (W_j + 2 U_j) (one zone's gradient integrand, without -(1/2) c_j h).
   double SampleGradient(const double* displacement, const double* retrograde) const;
+  // The explicit term of a trusted clamp's reaction row at sample j, without c_j h:
+  // alpha_r (r(U_j) / E_1) (r(U_j) - f0~_j), for the zone of element 1 (0 without it).
+  double ReactionGradient(int j, const double* displacement) const;
   // gradient[z] += weight W_j^T K1_z (W_j + 2 U_j) for every zone.
   void AddSampleZoneGradients(double weight, const double* displacement, const double* retrograde,
                               Vector* gradient) const;
@@ -226,7 +259,13 @@ class McreProblem : public CoupledProblem {
   double beta_;
   double strain_beta_;
   EndDisplacementChannels ends_;
+  ClampModel clamp_;
   double beta_u0_, beta_uL_;  // beta_u for an end displacement channel in use, else 0
+  // The node-0 terms of the direct sweep: 1/alpha and the gain of f0~ (1), or 0 and 0
+  // when the clamp is trusted.
+  double inverse_alpha0_, force0_gain_;
+  // Trusted clamp: the index of the reaction row in sensor_rows_, else -1.
+  int reaction_row_ = -1;
   Vector moduli_;             // E_z [Pa]
   // Interior sensors: H's rows, their weights beta_k and data d~_k (one per sample).
   std::vector<ObservationRow> sensor_rows_;

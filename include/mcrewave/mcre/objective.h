@@ -76,6 +76,9 @@ bool TrialModulus(double parameter, double modulus_scale, double* modulus, std::
 struct McreOptions {
   McreWeights weights;
   double reference_modulus = 200e9;  // E0 [Pa]
+  // The clamp at x = 0: measured (the paper's free-free model) or trusted (u(0) = 0,
+  // f0 a measured output); mcre_problem.h.
+  ClampModel clamp = ClampModel::kMeasured;
 
   bool IsValid(std::string* error) const;
 };
