@@ -186,13 +186,18 @@ ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
                problem.CostGradient(minus_displacement, minus_retrograde));
     if (mcre.clamp == ClampModel::kTrusted) {
       // The reaction's explicit term alpha_r (r / E) (r - f0~) holds the data f0~
-      // itself, which the problem above has as the noise f0_n only: the difference
-      // leaves out -sum_j c_j h alpha_r r(U_n,j) f0~_d,j / E (linear in the noise).
+      // itself, which the problem above has as the noise f_n only. With r_d, r_n the
+      // reactions of s_d, s_n and f_d the data's f0~, its part linear in the noise is
+      //   alpha_r / E [r_n (r_d - f_d) + r_d (r_n - f_n)],
+      // while the difference above gave alpha_r / E [2 r_d r_n - f_n r_n]: add
+      //   alpha_r / E [r_n (f_n - f_d) - r_d f_n]  at every sample.
       for (int j = 0; j <= problem.num_steps(); ++j) {
-        gradient_change -= problem.QuadratureWeight(j) * problem.time_step() *
-                           problem.reaction_weight() *
-                           problem.ClampReaction(noise_solution.displacement.col(j).data()) *
-                           data.f0[j] / modulus;
+        const double r_d = problem.ClampReaction(solution.displacement.col(j).data());
+        const double r_n = problem.ClampReaction(noise_solution.displacement.col(j).data());
+        const double f_n = noise_data.f0[j], f_d = data.f0[j];
+        gradient_change += problem.QuadratureWeight(j) * problem.time_step() *
+                           problem.reaction_weight() / modulus *
+                           (r_n * (f_n - f_d) - r_d * f_n);
       }
     }
     // dE = -dg_1 / k
