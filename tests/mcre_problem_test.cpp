@@ -30,6 +30,22 @@ Matrix RandomField(const McreProblem& problem, unsigned seed) {
   return field;
 }
 
+// <x, G y> = <G x, y> to `tolerance` of ||x||_P ||G y||_P, and <x, G x>, <y, G y> < 0;
+// returns G x.
+Matrix ExpectSelfAdjointAndNegative(McreProblem& problem, const Matrix& x, const Matrix& y,
+                                    double tolerance) {
+  Matrix gx, gy, scratch;
+  problem.ApplyIterationMap(x, &scratch, &gx);
+  problem.ApplyIterationMap(y, &scratch, &gy);
+  const double xgy = problem.InnerProduct(x, gy);
+  const double gxy = problem.InnerProduct(gx, y);
+  const double scale = problem.Norm(x) * problem.Norm(gy);
+  EXPECT_LT(std::abs(xgy - gxy), tolerance * scale) << "<x,Gy> = " << xgy << ", <Gx,y> = " << gxy;
+  EXPECT_LT(problem.InnerProduct(x, gx), 0.0);
+  EXPECT_LT(problem.InnerProduct(y, gy), 0.0);
+  return gx;
+}
+
 TEST(McreWeightsTest, DefaultWeightsAreValid) {
   std::string why;
   EXPECT_TRUE(McreWeights().IsValid(&why)) << why;
@@ -55,16 +71,7 @@ TEST_P(IterationMapTest, IsSelfAdjointAndNegativeInPInnerProduct) {
   ProblemBundle bundle(MakeSmallCase(12, 60, 5.0, 2), Weights(1.0, 1.0), theta);
   McreProblem& problem = bundle.problem;
   problem.SetModulus(0.9 * 200e9);
-  const Matrix x = RandomField(problem, 1), y = RandomField(problem, 2);
-  Matrix gx, gy, scratch;
-  problem.ApplyIterationMap(x, &scratch, &gx);
-  problem.ApplyIterationMap(y, &scratch, &gy);
-  const double xgy = problem.InnerProduct(x, gy);
-  const double gxy = problem.InnerProduct(gx, y);
-  const double scale = problem.Norm(x) * problem.Norm(gy);
-  EXPECT_LT(std::abs(xgy - gxy), 1e-11 * scale) << "<x,Gy> = " << xgy << ", <Gx,y> = " << gxy;
-  EXPECT_LT(problem.InnerProduct(x, gx), 0.0);
-  EXPECT_LT(problem.InnerProduct(y, gy), 0.0);
+  ExpectSelfAdjointAndNegative(problem, RandomField(problem, 1), RandomField(problem, 2), 1e-11);
 }
 
 INSTANTIATE_TEST_SUITE_P(Theta, IterationMapTest, ::testing::Values(0.5, 0.75, 1.0));
@@ -181,17 +188,9 @@ TEST_P(TrustedClampMapTest, IsSelfAdjointAndNegativeInPInnerProduct) {
   // Fields of the clamped problem: W_0 = 0.
   x.row(0).setZero();
   y.row(0).setZero();
-  Matrix gx, gy, scratch;
-  problem.ApplyIterationMap(x, &scratch, &gx);
-  problem.ApplyIterationMap(y, &scratch, &gy);
-  EXPECT_EQ(gx.row(0).cwiseAbs().maxCoeff(), 0.0);
-  const double xgy = problem.InnerProduct(x, gy);
-  const double gxy = problem.InnerProduct(gx, y);
-  const double scale = problem.Norm(x) * problem.Norm(gy);
   // Measured 8.7e-17 (theta 1/2) and 1.1e-17 (theta 1) of the scale.
-  EXPECT_LT(std::abs(xgy - gxy), 1e-15 * scale) << "<x,Gy> = " << xgy << ", <Gx,y> = " << gxy;
-  EXPECT_LT(problem.InnerProduct(x, gx), 0.0);
-  EXPECT_LT(problem.InnerProduct(y, gy), 0.0);
+  const Matrix gx = ExpectSelfAdjointAndNegative(problem, x, y, 1e-15);
+  EXPECT_EQ(gx.row(0).cwiseAbs().maxCoeff(), 0.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Theta, TrustedClampMapTest, ::testing::Values(0.5, 1.0));
