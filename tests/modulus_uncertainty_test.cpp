@@ -189,6 +189,16 @@ TEST_F(ModulusUncertaintyTest, MisfitLevelsAreTheRmsEndMisfits) {
   EXPECT_NEAR(misfit.displacement_std, std::sqrt(sum / (2.0 * data_.num_samples())),
               1e-12 * misfit.displacement_std);
   EXPECT_GT(misfit.force_std, 0.0);
+  // A trusted clamp's misfit at x = 0 is r(U) - f0~: a reaction 3 N above the data.
+  const Vector reaction = data_.f0.array() + 3.0;
+  const NoiseLevels trusted = MisfitLevels(data_, solution_, problem_.alpha(), &reaction);
+  double force_sum = 0.0;
+  for (int j = 0; j < data_.num_samples(); ++j) {
+    force_sum += 9.0 + std::pow(solution_.retrograde(last, j) / problem_.alpha(), 2);
+  }
+  EXPECT_NEAR(trusted.force_std, std::sqrt(force_sum / (2.0 * data_.num_samples())),
+              1e-12 * trusted.force_std);
+  EXPECT_EQ(trusted.displacement_std, misfit.displacement_std);
 }
 
 }  // namespace

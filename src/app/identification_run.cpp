@@ -237,7 +237,20 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
 
   // The uncertainty figure: noise levels known for synthetic data with noise,
   // estimated from the data's second differences otherwise.
-  run.misfit = MisfitLevels(run.data, run.solution, run.alpha);
+  Vector clamp_reaction;
+  if (config.mcre.clamp == ClampModel::kTrusted) {
+    // r(U_j) at E*: the reaction row of the stored fields, or the last trace row of a
+    // streaming solve.
+    const McreProblem& problem = cold.problem();
+    clamp_reaction.resize(run.data.num_samples());
+    for (int j = 0; j < run.data.num_samples(); ++j) {
+      clamp_reaction[j] = run.solution.has_fields()
+                              ? problem.ClampReaction(run.solution.displacement.col(j).data())
+                              : run.solution.traces(problem.num_traces() - 1, j);
+    }
+  }
+  run.misfit = MisfitLevels(run.data, run.solution, run.alpha,
+                            clamp_reaction.size() > 0 ? &clamp_reaction : nullptr);
   run.estimated_noise = DifferenceNoiseLevels(data);
   run.noise = MeasurementNoiseLevels(config, data, &run.noise_source);
   int curvature_points = 0;

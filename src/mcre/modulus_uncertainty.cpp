@@ -72,15 +72,17 @@ NoiseLevels DifferenceNoiseLevels(const MeasurementSet& data) {
 }
 
 NoiseLevels MisfitLevels(const MeasurementSet& data, const CoupledSolution& solution,
-                         double alpha) {
+                         double alpha, const Vector* clamp_reaction) {
+  assert(clamp_reaction == nullptr || clamp_reaction->size() == data.num_samples());
   double displacement_sum = 0.0;
   double force_sum = 0.0;
   for (int j = 0; j < data.num_samples(); ++j) {
     displacement_sum += std::pow(solution.EndDisplacement(0, j) - data.u0[j], 2) +
                         std::pow(solution.EndDisplacement(1, j) - data.uL[j], 2);
-    // F - F~ = -B W / alpha at the two ends
-    force_sum += std::pow(solution.EndRetrograde(0, j) / alpha, 2) +
-                 std::pow(solution.EndRetrograde(1, j) / alpha, 2);
+    // F - F~ = -B W / alpha at the two ends; r(U) - f0~ at a trusted clamp.
+    const double f0_misfit = clamp_reaction != nullptr ? (*clamp_reaction)[j] - data.f0[j]
+                                                       : solution.EndRetrograde(0, j) / alpha;
+    force_sum += std::pow(f0_misfit, 2) + std::pow(solution.EndRetrograde(1, j) / alpha, 2);
   }
   const double count = 2.0 * data.num_samples();
   NoiseLevels levels;

@@ -59,8 +59,11 @@ NoiseLevels DifferenceNoiseLevels(const MeasurementSet& data);
 
 // RMS misfits of the coupled solution at the optimum: displacement
 // sqrt(mean_{ends, j} (U_end,j - u~_end,j)^2) and force
-// sqrt(mean_{ends, j} (W_end,j / alpha)^2) (F - F~ = -B W / alpha).
-NoiseLevels MisfitLevels(const MeasurementSet& data, const CoupledSolution& solution, double alpha);
+// sqrt(mean_{ends, j} (W_end,j / alpha)^2) (F - F~ = -B W / alpha). With a trusted
+// clamp, clamp_reaction holds the model's reaction r(U_j) [N], j = 0..m, and the
+// misfit at x = 0 is r(U_j) - f0~_j instead (f0 is an output; mcre_problem.h).
+NoiseLevels MisfitLevels(const MeasurementSet& data, const CoupledSolution& solution, double alpha,
+                         const Vector* clamp_reaction = nullptr);
 
 // A point of the cost curve e^2(E).
 struct CostCurvePoint {
