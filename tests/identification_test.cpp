@@ -116,6 +116,21 @@ INSTANTIATE_TEST_SUITE_P(NloptAndCeres, EveryAlgorithmTest,
                                   "_" + OuterAlgorithmToString(std::get<1>(info.param));
                          });
 
+TEST(IdentificationSummaryTest, ReportsSayNoSecondValleyInsteadOfANan) {
+  IdentificationSummary summary;
+  summary.scan_moduli = {1e11, 2e11, 3e11};
+  summary.local_minima = 1;
+  for (const std::string& report : {summary.BriefReport(), summary.FullReport()}) {
+    EXPECT_EQ(report.find("nan"), std::string::npos) << report;
+    EXPECT_NE(report.find("second valley"), std::string::npos) << report;
+  }
+  summary.local_minima = 2;
+  summary.second_modulus = 2.5e11;
+  summary.cost_gap = 0.125;
+  EXPECT_NE(summary.BriefReport().find("scaled cost gap to the second 0.125"), std::string::npos);
+  EXPECT_NE(summary.FullReport().find("second minimum         2.5e+11 Pa"), std::string::npos);
+}
+
 TEST(IdentificationTest, CeresNeedsFewerEvaluationsThanBobyqaOnASmoothMinimum) {
   ScriptedObjective for_nlopt = Parabola();
   ScriptedObjective for_ceres = Parabola();

@@ -164,7 +164,12 @@ std::string IdentificationSummary::BriefReport() const {
       << " evaluations (" << gradient_evaluations << " with gradient), " << wall_time_s << " s";
   if (!scan_moduli.empty()) {
     out << "; scan of " << scan_moduli.size() << " points saw " << local_minima << " valleys ("
-        << refinements << " refined), scaled cost gap " << cost_gap;
+        << refinements << " refined)";
+    if (std::isnan(cost_gap)) {
+      out << ", no second valley";
+    } else {
+      out << ", scaled cost gap to the second " << cost_gap;
+    }
   }
   return out.str();
 }
@@ -187,10 +192,14 @@ std::string IdentificationSummary::FullReport() const {
         << ", " << scan_moduli.back() << "] Pa\n"
         << "  predicted valley step  " << predicted_valley_spacing << " in ln E\n"
         << "  resolution limited     " << (scan_resolution_limited ? "yes" : "no") << "\n"
-        << "  valleys                " << local_minima << "\n"
-        << "  second minimum         " << second_modulus << " Pa\n"
-        << "  scaled cost gap        " << cost_gap << "\n"
-        << "  refinements            " << refinements << "\n"
+        << "  valleys                " << local_minima << "\n";
+    if (std::isnan(cost_gap)) {
+      out << "  second minimum         none (no second valley)\n";
+    } else {
+      out << "  second minimum         " << second_modulus << " Pa\n"
+          << "  scaled cost gap        " << cost_gap << "\n";
+    }
+    out << "  refinements            " << refinements << "\n"
         << "  scan sweeps            " << scan_sweeps << "\n"
         << "  scan wall time         " << scan_wall_time_s << " s\n";
   }
