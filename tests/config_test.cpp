@@ -580,6 +580,16 @@ TEST(ConfigTest, PaperBarConfigLoads) {
   EXPECT_EQ(config.time.NumSteps(), 1750);
 }
 
+TEST(ConfigTest, PaperBarWithATrustedClampDiffersInItsMcreSectionOnly) {
+  Config expected = LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar.yaml");
+  expected.mcre.clamp = ClampModel::kTrusted;
+  expected.mcre.weights.displacement_weight = 1e-5;
+  expected.mcre.weights.reaction_weight = 1e-4;
+  expected.output.folder = "results/paper_bar_trusted_clamp";
+  ExpectSameConfig(expected, LoadConfig(std::string(MCREWAVE_SOURCE_DIR) +
+                                        "/configs/paper_bar_trusted_clamp.yaml"));
+}
+
 TEST(ConfigTest, QuickAndMeasuredCsvConfigsLoad) {
   const Config quick = LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/quick.yaml");
   EXPECT_EQ(quick.model.elements, 25);
