@@ -66,7 +66,7 @@ McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
     sensor_data_.push_back(&sensor.values);
   }
   if (trusted) {
-    // The clamp reaction r(U) = K_01(E) U_1, weight alpha, data f0~; its coefficient
+    // The clamp reaction r(U) = K_01(E) U_1, weight alpha_r, data f0~; its coefficient
     // is set with the moduli (SetModuli).
     reaction_row_ = static_cast<int>(sensor_rows_.size());
     ObservationRow reaction;
