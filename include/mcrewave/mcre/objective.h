@@ -126,9 +126,10 @@ class McreObjective : public ModulusObjective {
   const ObjectiveEvaluation& EvaluateModuli(const Vector& zone_moduli,
                                             bool gradient_requested = true);
 
-  // J_rest = sum_j c_j h [alpha/2 |F~_j|^2 + beta/2 |U~_j|^2] [J s]: the functional
-  // for the bar left at rest (U = W = 0, zero end forces), which satisfies the
-  // state equation for every E, so 0 <= e^2(E) <= J_rest.
+  // J_rest = sum_j c_j h [alpha/2 |F~_j|^2 + beta/2 |U~_j|^2] [J s] (a trusted
+  // clamp: alpha/2 fL~_j^2 + alpha_r/2 f0~_j^2 + beta/2 uL~_j^2, with the sensors'
+  // terms as ever): the functional for the bar left at rest (U = W = 0, zero end
+  // forces), which satisfies the state equation for every E, so 0 <= e^2(E) <= J_rest.
   double rest_cost() const { return rest_cost_; }
   // The cost scale [J s]: J_rest, or 1 when the data are all zero (J_rest = 0).
   double cost_scale() const { return rest_cost_ > 0.0 ? rest_cost_ : 1.0; }
