@@ -443,7 +443,7 @@ double McreProblem::ReactionGradient(int j, const double* displacement) const {
   if (reaction_row_ < 0) return 0.0;
   // alpha_r (r(U_j) / E_1) (r(U_j) - f0~_j): d/dE_1 of alpha_r/2 (r(U_j) - f0~_j)^2 with
   // r = E_1 K1_01 U_1.
-  const double reaction = sensor_rows_[reaction_row_].Apply(displacement);
+  const double reaction = ClampReaction(displacement);
   return sensor_weights_[reaction_row_] * (reaction / moduli_[model_.element_zone(0)]) *
          (reaction - data_.f0[j]);
 }
@@ -455,11 +455,10 @@ double McreProblem::CostGradient(const Matrix& displacement, const Matrix& retro
   for (int j = 0; j <= m; ++j) {
     sum += QuadratureWeight(j) * h *
            SampleGradient(displacement.col(j).data(), retrograde.col(j).data());
-    if (reaction_row_ >= 0) {
-      reaction_sum += QuadratureWeight(j) * h * ReactionGradient(j, displacement.col(j).data());
-    }
+    reaction_sum += QuadratureWeight(j) * h * ReactionGradient(j, displacement.col(j).data());
   }
-  return reaction_row_ >= 0 ? -0.5 * sum + reaction_sum : -0.5 * sum;
+  // The reaction's explicit term is 0 without a trusted clamp.
+  return -0.5 * sum + reaction_sum;
 }
 
 void McreProblem::CostGradients(const Matrix& displacement, const Matrix& retrograde,
