@@ -32,6 +32,14 @@ Vector McreProblem::TraceWeights() const {
   return weights;
 }
 
+Matrix McreProblem::DataTraces() const {
+  Matrix traces(num_traces(), num_steps() + 1);
+  traces.row(0) = data_.u0.transpose();
+  traces.row(1) = data_.uL.transpose();
+  for (int k = 0; k < num_interior_sensors(); ++k) traces.row(2 + k) = sensor_data_[k]->transpose();
+  return traces;
+}
+
 void McreProblem::DataResponseTraces(Matrix* traces) {
   const int m = num_steps();
   traces->resize(num_traces(), m + 1);

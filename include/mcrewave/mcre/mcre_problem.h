@@ -183,6 +183,9 @@ class McreProblem : public CoupledProblem {
   // O(n sqrt(m))).
   int num_traces() const { return 2 + num_interior_sensors(); }
   Matrix ZeroTraces() const { return Matrix::Zero(num_traces(), num_steps() + 1); }
+  // The data d~ in the trace rows' order (u0, uL, the sensors; f0 in the reaction
+  // row): the traces at which the retrograde field vanishes (W = 0).
+  Matrix DataTraces() const;
   // <a, b>_beta = sum_j c_j h sum_k beta_k a_kj b_kj, in which I - (Phi - Phi(0)) is
   // self-adjoint and positive definite on the weighted rows.
   double TraceInnerProduct(const Matrix& a, const Matrix& b) const;
