@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -58,6 +59,46 @@ TEST(ErrorMapTest, SharesAreTheElementEnergiesOfTheGapSummedOverTheWindow) {
   const double jump = w[3] - w[2];
   EXPECT_NEAR(map.density(2, 2), 0.5 * 150e9 * bar.section / (1.0 / 6) * jump * jump / (1.0 / 6),
               1e-14 * map.density(2, 2));
+}
+
+TEST(ErrorMapTest, FineMeshesAverageTheirElementsIntoAtMost2000Columns) {
+  // 4001 elements: groups of ceil(4001 / 2000) = 3, so 1334 columns, the last one of
+  // 2 elements; each column the mean of its elements' densities from a 4001-column
+  // picture computed element by element here.
+  BarProperties bar;
+  bar.elements = 4001;
+  const BarModel model(bar);
+  ASSERT_EQ(SpaceTimeGroupSize(4001), 3);
+  ASSERT_EQ(SpaceTimeGroupSize(2000), 1);
+  const Vector positions = SpaceTimeColumnPositions(model);
+  ASSERT_EQ(positions.size(), 1334);
+  const double length = 1.0 / 4001;
+  // Column 0 holds elements 0..2 (centre: element 1's midpoint); the last, 3999..4000.
+  EXPECT_NEAR(positions[0], 1.5 * length, 1e-15);
+  EXPECT_NEAR(positions[1333], 4000.0 * length, 1e-15);
+  std::mt19937 engine(5);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Matrix retrograde(model.num_nodes(), 3);
+  for (Eigen::Index i = 0; i < retrograde.size(); ++i)
+    retrograde.data()[i] = 1e-6 * uniform(engine);
+  const Vector moduli = Vector::Constant(1, 200e9);
+  const ErrorMap map = ComputeErrorMap(model, moduli, retrograde, 1e-6, 3);
+  ASSERT_EQ(map.density.rows(), 3);
+  ASSERT_EQ(map.density.cols(), 1334);
+  double worst = 0.0;
+  for (int c = 0; c < 1334; ++c) {
+    const int first = 3 * c, end = std::min(4001, first + 3);
+    double sum = 0.0;
+    for (int e = first; e < end; ++e) {
+      const double jump = retrograde(e + 1, 1) - retrograde(e, 1);
+      // 1/2 E (S / l) jump^2 / l.
+      sum += 0.5 * 200e9 * bar.section / length * jump * jump / length;
+    }
+    const double expected = sum / (end - first);
+    worst = std::max(worst, std::abs(map.density(1, c) - expected) / expected);
+  }
+  // Measured 0: the same products in the same order.
+  EXPECT_LT(worst, 1e-15);
 }
 
 TEST(ErrorMapFilesTest, IdentifyRunWritesTheMapItsPeakAndTheFigure) {

@@ -103,20 +103,29 @@ TEST_P(StreamingAgreementTest, MatchesStoredFieldConjugateGradients) {
       stored.solution.cost_gradients.norm();
   const Vector map = problem.ErrorMap(stored.solution.retrograde);
   const double error_map = (streamed.solution.error_map - map).norm() / map.norm();
+  const Matrix picture = ComputeErrorMap(model, moduli, stored.solution.retrograde,
+                                         small.time.step)
+                             .density;
+  ASSERT_EQ(streamed.solution.gap_density.rows(), picture.rows());
+  ASSERT_EQ(streamed.solution.gap_density.cols(), picture.cols());
+  const double space_time = (streamed.solution.gap_density - picture).norm() / picture.norm();
   const double end_displacement =
       (streamed.solution.traces.row(1) - stored.solution.displacement.row(problem.num_nodes() - 1))
           .norm() /
       stored.solution.displacement.row(problem.num_nodes() - 1).norm();
-  // Measured at most 1.6e-15 (cost), 1.5e-12 (gradients), 3.1e-12 (error map) and
-  // 6.4e-13 (uL), both solvers at the tolerance 1e-12.
+  // Measured at most 1.6e-15 (cost), 1.4e-12 (gradients), 3.1e-12 (error map),
+  // 1.5e-11 (its space-time picture) and 4.7e-13 (uL), both solvers at the tolerance
+  // 1e-12.
   EXPECT_LT(cost, 1.5e-14) << param.name;
   EXPECT_LT(gradient, 1e-11) << param.name;
   EXPECT_LT(error_map, 3e-11) << param.name;
   EXPECT_LT(end_displacement, 3e-12) << param.name;
-  // The same nonzero spectrum: as many iterations as the stored-field CG (measured
-  // 11 / 10, 111 / 107, 110 / 108; the trusted clamp's stiffer spectrum 112 / 104).
-  const int slack = stored.summary.iterations / (param.clamp == ClampModel::kTrusted ? 10 : 20);
-  EXPECT_LE(std::abs(streamed.summary.iterations - stored.summary.iterations), 2 + slack)
+  EXPECT_LT(space_time, 3e-11) << param.name;
+  // The same nonzero spectrum and the same stopping test, but CG minimises another
+  // norm on the traces than on W: a few more iterations (measured 11 / 10,
+  // 115 / 107, 117 / 108; the trusted clamp's stiffer spectrum 120 / 104).
+  EXPECT_GE(streamed.summary.iterations, stored.summary.iterations - 2);
+  EXPECT_LE(streamed.summary.iterations, 1.25 * stored.summary.iterations + 2)
       << streamed.summary.iterations << " vs " << stored.summary.iterations;
 }
 
@@ -149,7 +158,7 @@ TEST(StreamingSolverTest, AgreesWithStoredFieldsOnThePapersGrid) {
 
 TEST(StreamingSolverTest, IdentifiesTheSameModulusAsStoredFields) {
   // identify run on configs/quick.yaml with either solver, inner tolerance 1e-10:
-  // measured 2.0e-9 apart (the issue asks for 1e-8).
+  // measured 3.7e-9 apart (the issue asks for 1e-8).
   const std::string config = testing::SourcePath("configs/quick.yaml");
   const std::string common = " --set inner.tolerance=1e-10 --set output.figures=false -q";
   const std::string stored_folder = testing::FreshDirectory("streaming_stored") + "/r";
@@ -185,8 +194,10 @@ TEST(StreamingSolverTest, CheckpointsGiveTheStoredFieldSolutionForOtherTheta) {
         Solve(Options(CoupledSolverType::kStreamingConjugateGradient, 1e-12), &bundle.problem);
     ASSERT_TRUE(stored.summary.IsSolutionUsable()) << stored.summary.message;
     ASSERT_TRUE(streamed.summary.IsSolutionUsable()) << streamed.summary.message;
-    // Four sweeps per application: the start, the iterations and the final pass.
-    EXPECT_EQ(bundle.problem.sweep_count() - sweeps, 4L * (streamed.summary.iterations + 2));
+    // Four sweeps per application (the start, one per iteration, the one whose q_k
+    // showed r_k met the tolerance, and the final pass) and one backward sweep for the
+    // norm of each of the two true residuals.
+    EXPECT_EQ(bundle.problem.sweep_count() - sweeps, 4L * (streamed.summary.iterations + 3) + 2);
     const double cost =
         std::abs(streamed.solution.cost - stored.solution.cost) / stored.solution.cost;
     const double gradient =
@@ -265,16 +276,19 @@ TEST(StreamingSolverTest, ATolerancePastRoundOffRestartsThenStopsAtTheFloorAndSa
   options.tolerance = 1e-16;
   CoupledSolution solution;
   const CoupledSolverSummary summary = SolveCoupled(options, &bundle.problem, nullptr, &solution);
-  // Measured: 22 iterations, the recursive residual rising twice at the restarts
-  // (to 1.3e-14 and 2.5e-14), a final true residual of 1.2e-14 against a floor of
-  // 1.2e-12 (10 times the rebuild error 4.2e-14, times ||y|| / ||r_0||).
+  // Measured: 19 iterations, the residual rising from below the tolerance at the two
+  // restarts (to 3.2e-14 and 8.8e-15), a final true residual of 1.5e-14 against a
+  // floor of 1.6e-13 (10 times the rebuild error 1.9e-14, times ||y||_W / ||r_0||_W).
   ASSERT_EQ(summary.termination, TerminationType::kConvergence) << summary.message;
   EXPECT_NE(summary.message.find("at the round-off floor"), std::string::npos) << summary.message;
   int rises = 0;
   for (std::size_t i = 1; i < summary.residual_history.size(); ++i) {
-    if (summary.residual_history[i] > summary.residual_history[i - 1]) ++rises;
+    if (summary.residual_history[i - 1] <= options.tolerance &&
+        summary.residual_history[i] > summary.residual_history[i - 1]) {
+      ++rises;
+    }
   }
-  EXPECT_GE(rises, 2);
+  EXPECT_EQ(rises, 2);
   EXPECT_GT(summary.relative_residual, options.tolerance);
   EXPECT_LT(summary.relative_residual, 4e-14);
 }

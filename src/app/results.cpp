@@ -324,12 +324,14 @@ std::string ErrorMapCsv(const IdentificationRun& run) {
   return csv;
 }
 
-// gnuplot's nonuniform matrix: first row the count and the x of each element, then
+// gnuplot's nonuniform matrix: first row the count and the x of each column, then
 // one row per time: t, then the densities.
 std::string ErrorMapSpaceTimeData(const IdentificationRun& run) {
   const ErrorMap& map = run.error_map;
-  std::string text = std::to_string(map.position.size());
-  for (Eigen::Index e = 0; e < map.position.size(); ++e) text += " " + Format(map.position[e]);
+  std::string text = std::to_string(map.density_position.size());
+  for (Eigen::Index c = 0; c < map.density_position.size(); ++c) {
+    text += " " + Format(map.density_position[c]);
+  }
   text += "\n";
   for (Eigen::Index i = 0; i < map.times.size(); ++i) {
     text += Format(map.times[i]);
@@ -340,7 +342,7 @@ std::string ErrorMapSpaceTimeData(const IdentificationRun& run) {
 }
 
 std::string ErrorMapScript(const IdentificationRun& run, const std::string& folder) {
-  // The space-time panel only when the density was kept (not after a streaming solve).
+  // The space-time panel when the map has one.
   const bool space_time = run.error_map.density.size() > 0;
   std::ostringstream script;
   script << GnuplotPngTerminal() << "set terminal pngcairo size 1100," << (space_time ? 900 : 450)

@@ -4,17 +4,6 @@
 #include <cassert>
 
 namespace mcrewave {
-namespace {
-
-// 1/2 W_j^T K_el W_j = 1/2 E_el k1_el (W_{el+1} - W_el)^2 [J], for element el at sample j.
-double ElementGap(const BarModel& model, const Vector& zone_moduli, const Matrix& retrograde,
-                  int element, int j) {
-  const double jump = retrograde(element + 1, j) - retrograde(element, j);
-  return 0.5 * zone_moduli[model.element_zone(element)] * model.element_unit_stiffness(element) *
-         jump * jump;
-}
-
-}  // namespace
 
 int ErrorMap::PeakElement() const {
   if (share.size() == 0) return -1;
@@ -53,26 +42,64 @@ Vector ElementGapShares(const BarModel& model, const Vector& zone_moduli, const 
   return shares;
 }
 
+int SpaceTimeStride(int num_steps, int max_time_columns) {
+  assert(max_time_columns >= 2 && num_steps >= 0);
+  // stride = ceil(m / (max_time_columns - 1)), at least 1.
+  return std::max(1, (num_steps + max_time_columns - 2) / (max_time_columns - 1));
+}
+
+int SpaceTimeGroupSize(int num_elements) {
+  // ceil(elements / kMaxSpaceTimeColumns).
+  return (num_elements + kMaxSpaceTimeColumns - 1) / kMaxSpaceTimeColumns;
+}
+
+Vector SpaceTimeColumnPositions(const BarModel& model) {
+  const int elements = model.num_elements(), group = SpaceTimeGroupSize(elements);
+  const int columns = (elements + group - 1) / group;
+  Vector positions(columns);
+  for (int c = 0; c < columns; ++c) {
+    // Midway between the first and the last element's midpoints.
+    const int last = std::min(elements, (c + 1) * group) - 1;
+    positions[c] = 0.5 * (model.element_midpoint(c * group) + model.element_midpoint(last));
+  }
+  return positions;
+}
+
+void SampleGapDensity(const BarModel& model, const Vector& zone_moduli, const double* retrograde,
+                      double* row) {
+  const int elements = model.num_elements(), group = SpaceTimeGroupSize(elements);
+  for (int first = 0, c = 0; first < elements; first += group, ++c) {
+    const int end = std::min(elements, first + group);
+    double sum = 0.0;
+    for (int e = first; e < end; ++e) {
+      // 1/2 W_j^T K_el W_j / h_e = 1/2 E_el k1_el (W_{el+1} - W_el)^2 / h_e [J/m].
+      const double jump = retrograde[e + 1] - retrograde[e];
+      sum += 0.5 * zone_moduli[model.element_zone(e)] * model.element_unit_stiffness(e) * jump *
+             jump / model.element_length();
+    }
+    row[c] = end - first == 1 ? sum : sum / (end - first);
+  }
+}
+
 ErrorMap ComputeErrorMap(const BarModel& model, const Vector& zone_moduli, const Matrix& retrograde,
                          double time_step, int max_time_columns) {
-  assert(max_time_columns >= 2);
-  ErrorMap map;
   const int elements = model.num_elements();
+  ErrorMap map;
   map.position.resize(elements);
   for (int e = 0; e < elements; ++e) map.position[e] = model.element_midpoint(e);
   map.share = ElementGapShares(model, zone_moduli, retrograde, time_step);
   const int m = static_cast<int>(retrograde.cols()) - 1;
-  // Every stride-th sample, stride = ceil(m / (max_time_columns - 1)).
-  const int stride = std::max(1, (m + max_time_columns - 2) / (max_time_columns - 1));
+  const int stride = SpaceTimeStride(m, max_time_columns);
   const int rows = m / stride + 1;
+  map.density_position = SpaceTimeColumnPositions(model);
   map.times.resize(rows);
-  map.density.resize(rows, elements);
+  map.density.resize(rows, map.density_position.size());
+  Vector row(map.density_position.size());
   for (int i = 0; i < rows; ++i) {
     const int j = i * stride;
     map.times[i] = j * time_step;
-    for (int e = 0; e < elements; ++e) {
-      map.density(i, e) = ElementGap(model, zone_moduli, retrograde, e, j) / model.element_length();
-    }
+    SampleGapDensity(model, zone_moduli, retrograde.col(j).data(), row.data());
+    map.density.row(i) = row.transpose();
   }
   return map;
 }

@@ -104,6 +104,7 @@ McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
     }
   }
   stream_shift_ = Vector::Zero(n);
+  stream_density_row_ = Vector::Zero(SpaceTimeColumnPositions(model).size());
   if (theta != 0.5) {
     const int m = data.num_steps();
     checkpoint_stride_ = std::max(1, static_cast<int>(std::ceil(std::sqrt(2.0 * m))));
@@ -375,16 +376,20 @@ void McreProblem::RetrogradeSweepsWithData(const std::vector<const Matrix*>& dis
   }
 }
 
+double McreProblem::PenaltyForm(const double* x, const double* y) const {
+  const int last = num_nodes() - 1;
+  // x^T K y + (x_0 y_0 + x_N y_N) / alpha (trusted clamp: x_N y_N / alpha).
+  return integrator_.stiffness().BilinearForm(x, y) +
+         (force0_gain_ * x[0] * y[0] + x[last] * y[last]) / alpha_;
+}
+
 double McreProblem::InnerProduct(const Matrix& x, const Matrix& y) {
-  const int n = num_nodes(), m = num_steps(), last = n - 1;
+  const int m = num_steps();
   const double h = time_step();
-  const SymmetricBandMatrix& stiffness = integrator_.stiffness();
   double sum = 0.0;
   for (int j = 0; j <= m; ++j) {
-    // x_j^T (K + B/alpha) y_j.
-    double term = stiffness.BilinearForm(x.col(j).data(), y.col(j).data());
-    term += (force0_gain_ * x(0, j) * y(0, j) + x(last, j) * y(last, j)) / alpha_;
-    sum += QuadratureWeight(j) * h * term;
+    // c_j h x_j^T (K + B/alpha) y_j.
+    sum += QuadratureWeight(j) * h * PenaltyForm(x.col(j).data(), y.col(j).data());
   }
   return sum;
 }

@@ -24,6 +24,35 @@ double McreProblem::TraceInnerProduct(const Matrix& a, const Matrix& b) const {
   return sum;
 }
 
+double McreProblem::RetrogradeEnergy(const Matrix& traces) {
+  assert(traces.rows() == num_traces() && traces.cols() == num_steps() + 1);
+  const int m = num_steps();
+  const double h = time_step();
+  const PointLoads* loads = num_interior_sensors() > 0 ? &point_loads_[0] : nullptr;
+  double f0 = 0.0, fL = 0.0, energy = 0.0;
+  // The retrograde sweep from rest at T driven by the traces alone, W_j formed as the
+  // state passes: W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j, omega_m = 0.
+  stream_velocity_[0].setZero();
+  stream_omega_[0].setZero();
+  for (int j = m, s = 0; j > 0; --j, ++s) {
+    const int current = s & 1, next = current ^ 1;
+    TraceLoads(j, traces, false, &f0, &fL);
+    integrator_.StepWithEndLoads(stream_velocity_[current], stream_omega_[current], f0, fL,
+                                 stream_velocity_[next], stream_omega_[next], loads);
+    stream_retrograde_[0] = (theta_ * stream_omega_[next] + (1.0 - theta_) * stream_omega_[current]) *
+                            (1.0 / QuadratureWeight(j));
+    // + c_j h W_j^T (K + B/alpha) W_j.
+    energy += QuadratureWeight(j) * h *
+              PenaltyForm(stream_retrograde_[0].data(), stream_retrograde_[0].data());
+  }
+  // W_0 = (1 - theta) omega_0 / c_0.
+  stream_retrograde_[0] = ((1.0 - theta_) / QuadratureWeight(0)) * stream_omega_[m & 1];
+  energy += QuadratureWeight(0) * h *
+            PenaltyForm(stream_retrograde_[0].data(), stream_retrograde_[0].data());
+  ++sweep_count_;
+  return energy;
+}
+
 Vector McreProblem::TraceWeights() const {
   Vector weights(num_traces());
   weights[0] = beta_u0_;
@@ -94,6 +123,7 @@ void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* 
     totals->cost = 0.0;
     totals->cost_gradients.setZero(num_zones());
     totals->error_map.setZero(model_.num_elements());
+    totals->gap_density.resize(m / SpaceTimeStride(m) + 1, stream_density_row_.size());
     totals->end_retrograde.resize(2, m + 1);
     totals->rebuild_error = 0.0;
   }
@@ -115,6 +145,10 @@ void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* 
           weight * ReactionGradient(j, displacement.data());
     }
     AddSampleGapShares(model_, moduli_, retrograde.data(), weight, &totals->error_map);
+    if (j % SpaceTimeStride(m) == 0) {
+      SampleGapDensity(model_, moduli_, retrograde.data(), stream_density_row_.data());
+      totals->gap_density.row(j / SpaceTimeStride(m)) = stream_density_row_.transpose();
+    }
     totals->end_retrograde(0, j) = retrograde[0];
     totals->end_retrograde(1, j) = retrograde[last];
   };

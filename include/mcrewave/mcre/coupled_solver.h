@@ -147,6 +147,7 @@ struct CoupledSolution {
   Matrix traces;          // H U (streaming only), McreProblem::num_traces() x (m + 1)
   Matrix end_retrograde;  // W at nodes 0 and N (streaming only), 2 x (m + 1) [m]
   Vector error_map;       // e_el^2 per element (streaming only) [J s]
+  Matrix gap_density;     // the error map's space-time picture (streaming only) [J/m]
 
   // Whether U and W are stored (every solver but the streaming one).
   bool has_fields() const { return displacement.size() > 0; }

@@ -9,7 +9,9 @@
 // with K_el = E_el K1_el the element's stiffness. The elements whose modulus is wrong
 // carry most of it: the map localises a stiffness change before any zone modulus is
 // identified. The space-time picture is the gap's energy density per element and
-// sample, 1/2 W_j^T K_el W_j / h_e [J/m], on at most max_time_columns samples.
+// sample, 1/2 W_j^T K_el W_j / h_e [J/m], on at most max_time_columns samples and, on
+// meshes of more than kMaxSpaceTimeColumns elements, averaged over groups of
+// consecutive elements (SpaceTimeGroupSize).
 #pragma once
 
 #include "mcrewave/core/types.h"
@@ -17,13 +19,19 @@
 
 namespace mcrewave {
 
+// Most samples and columns of the space-time picture.
+constexpr int kSpaceTimeSamples = 160;
+constexpr int kMaxSpaceTimeColumns = 2000;
+
 struct ErrorMap {
   Vector position;  // element midpoints [m]
   Vector share;     // e_el^2 [J s], one per element
-  // The space-time picture: density(i, el) = 1/2 W_ji^T K_el W_ji / h_e [J/m] at the
-  // sample j_i of times(i) (every stride-th sample of the window).
-  Vector times;    // [s]
-  Matrix density;  // times.size() x elements
+  // The space-time picture: density(i, c) = 1/2 W_ji^T K_el W_ji / h_e [J/m] at the
+  // sample j_i of times(i) (every stride-th sample of the window), averaged over the
+  // elements el of column c (one element per column up to kMaxSpaceTimeColumns).
+  Vector times;             // [s]
+  Vector density_position;  // column centres [m]
+  Matrix density;           // times.size() x density_position.size()
 
   // Index of the element with the largest share (-1 when empty).
   int PeakElement() const;
@@ -44,9 +52,22 @@ void AddSampleGapShares(const BarModel& model, const Vector& zone_moduli, const 
 Vector ElementGapShares(const BarModel& model, const Vector& zone_moduli, const Matrix& retrograde,
                         double time_step);
 
+// The space-time picture's layout: every SpaceTimeStride-th of the m + 1 samples
+// (at most max_time_columns >= 2 of them), and columns of SpaceTimeGroupSize
+// consecutive elements (the last column may hold fewer), centred at
+// SpaceTimeColumnPositions.
+int SpaceTimeStride(int num_steps, int max_time_columns = kSpaceTimeSamples);
+int SpaceTimeGroupSize(int num_elements);
+Vector SpaceTimeColumnPositions(const BarModel& model);
+
+// row[c] = the mean over column c's elements of 1/2 W_j^T K_el W_j / h_e [J/m], from
+// W_j (n entries); row holds SpaceTimeColumnPositions(model).size() entries.
+void SampleGapDensity(const BarModel& model, const Vector& zone_moduli, const double* retrograde,
+                      double* row);
+
 // The whole map, with the space-time picture on at most max_time_columns samples.
 // Precondition: max_time_columns >= 2.
 ErrorMap ComputeErrorMap(const BarModel& model, const Vector& zone_moduli, const Matrix& retrograde,
-                         double time_step, int max_time_columns = 160);
+                         double time_step, int max_time_columns = kSpaceTimeSamples);
 
 }  // namespace mcrewave

@@ -189,12 +189,21 @@ class McreProblem : public CoupledProblem {
   // <a, b>_beta = sum_j c_j h sum_k beta_k a_kj b_kj, in which I - (Phi - Phi(0)) is
   // self-adjoint and positive definite on the weighted rows.
   double TraceInnerProduct(const Matrix& a, const Matrix& b) const;
+  // ||R r||_P^2 = sum_j c_j h W_j^T (K + B/alpha) W_j for W = R r, the retrograde field
+  // driven by the traces r without data; in trace terms <r, -L r>_beta with
+  // L = Phi - Phi(0). For a trace residual r = Phi(y) - y it is the squared P-norm of the
+  // stored-field solvers' residual at W = Retrograde(y), whose tolerance is relative
+  // to it. One backward sweep, its state only (O(n) memory, no allocation).
+  double RetrogradeEnergy(const Matrix& traces);
   // What a streaming application gathers at each sample when asked (the cost,
   // gradient and error map of the fields it passes through, never stored).
   struct StreamingTotals {
     double cost = 0.0;      // e^2 [J s]
     Vector cost_gradients;  // de^2/dE_z [J s / Pa]
     Vector error_map;       // e_el^2 [J s] per element
+    // The error map's space-time picture (error_map.h): the gap energy density [J/m]
+    // at every SpaceTimeStride(m)-th sample (rows) on SpaceTimeColumnPositions (columns).
+    Matrix gap_density;
     Matrix end_retrograde;  // W at nodes 0 and N, 2 x (m + 1) [m]
     // ||omega_m|| / max_j ||omega_j|| of the rebuilt retrograde state: 0 in exact
     // arithmetic (the sweep started from omega_m = 0), the rebuild's round-off.
@@ -228,6 +237,8 @@ class McreProblem : public CoupledProblem {
   // The integrand of e^2 at sample j without c_j h:
   // 1/2 W^T K W + W^T B W / (2 alpha) + 1/2 (H U - d~_j)^T diag(beta) (H U - d~_j).
   double SampleCost(int j, const double* displacement, const double* retrograde) const;
+  // x^T (K + B/alpha) y of two nodal vectors (n entries each).
+  double PenaltyForm(const double* x, const double* y) const;
   // W_j^T K1 (W_j + 2 U_j) (one zone's gradient integrand, without -(1/2) c_j h).
   double SampleGradient(const double* displacement, const double* retrograde) const;
   // The explicit term of a trusted clamp's reaction row at sample j, without c_j h:
@@ -288,6 +299,8 @@ class McreProblem : public CoupledProblem {
   Vector stream_velocity_[2], stream_omega_[2], stream_rebuilt_velocity_[2],
       stream_rebuilt_omega_[2], stream_direct_velocity_[2], stream_displacement_[2],
       stream_retrograde_[2], stream_shift_;
+  // One row of the space-time picture's gap density (SpaceTimeColumnPositions entries).
+  Vector stream_density_row_;
   // theta != 1/2 only: the checkpoints (2n x (m / stride + 1)) and one segment's omega
   // (n x (stride + 1)), allocated in the constructor.
   int checkpoint_stride_ = 1;
