@@ -265,6 +265,29 @@ TEST(StreamingMemoryTest, PeakResidentMemoryStaysFarBelowOneSpaceTimeField) {
 namespace mcrewave {
 namespace {
 
+TEST(StreamingSolverTest, ADriftingRebuildSwitchesToCheckpointsAndSaysSo) {
+  // A rebuild-error limit below the round-off (measured 1.9e-14 here; 1.1e-6 on the
+  // paper's bar with 1e6 elements, Courant number 5700): the first final pass finds
+  // the drift, the problem switches to checkpoints for good, and the solve ends on the
+  // stored-field CG's solution. Measured 6.7e-16 (e^2) and 8.4e-13 (gradient) apart.
+  ProblemBundle bundle(testing::MakeSmallCase(20, 200, 5.0, 2), McreWeights());
+  bundle.problem.SetModulus(0.9 * 200e9);
+  const Solved stored =
+      Solve(Options(CoupledSolverType::kConjugateGradient, 1e-12), &bundle.problem);
+  ASSERT_FALSE(bundle.problem.uses_checkpoints());
+  CoupledSolverOptions options = Options(CoupledSolverType::kStreamingConjugateGradient, 1e-12);
+  options.max_rebuild_error = 1e-20;
+  const Solved streamed = Solve(options, &bundle.problem);
+  ASSERT_TRUE(streamed.summary.IsSolutionUsable()) << streamed.summary.message;
+  EXPECT_TRUE(bundle.problem.uses_checkpoints());
+  EXPECT_NE(streamed.summary.message.find("W from checkpoints after the rebuilt field drifted"),
+            std::string::npos)
+      << streamed.summary.message;
+  EXPECT_NEAR(streamed.solution.cost, stored.solution.cost, 5e-15 * stored.solution.cost);
+  EXPECT_NEAR(streamed.solution.cost_gradient, stored.solution.cost_gradient,
+              8e-12 * std::abs(stored.solution.cost_gradient));
+}
+
 TEST(StreamingSolverTest, ATolerancePastRoundOffRestartsThenStopsAtTheFloorAndSaysSo) {
   // Tolerance 1e-16 on a 20-element bar: the true residual of the final pass cannot
   // meet it (the rebuilt field is known to about 1e-15). CG restarts twice from the

@@ -67,6 +67,8 @@ bool CoupledSolverOptions::IsValid(std::string* error) const {
     why << "inner.max_all_at_once_bytes must be positive, got " << max_all_at_once_bytes;
   } else if (max_dense_solver_bytes < 1) {
     why << "inner.max_dense_solver_bytes must be positive, got " << max_dense_solver_bytes;
+  } else if (!(max_rebuild_error > 0.0 && max_rebuild_error < 1.0)) {
+    why << "max_rebuild_error must lie in (0, 1), got " << max_rebuild_error;
   } else if (max_field_bytes < 1) {
     why << "inner.max_field_bytes must be positive, got " << max_field_bytes;
   } else if (!(shooting_condition_limit > 1.0)) {

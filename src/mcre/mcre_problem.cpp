@@ -105,12 +105,7 @@ McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
   }
   stream_shift_ = Vector::Zero(n);
   stream_density_row_ = Vector::Zero(SpaceTimeColumnPositions(model).size());
-  if (theta != 0.5) {
-    const int m = data.num_steps();
-    checkpoint_stride_ = std::max(1, static_cast<int>(std::ceil(std::sqrt(2.0 * m))));
-    checkpoints_ = Matrix::Zero(2 * n, m / checkpoint_stride_ + 1);
-    segment_ = Matrix::Zero(n, checkpoint_stride_ + 1);
-  }
+  if (theta != 0.5) UseCheckpoints();
   batch_velocity_ = Matrix::Zero(n, 2 * ThetaIntegrator::kMaxBatch);
   batch_state_ = Matrix::Zero(n, 2 * ThetaIntegrator::kMaxBatch);
   batch_shift_ = Matrix::Zero(n, ThetaIntegrator::kMaxBatch);

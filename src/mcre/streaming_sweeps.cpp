@@ -2,6 +2,7 @@
 // docs/streaming.md): the retrograde sweep backward keeping only its state, then one
 // forward pass that rebuilds W_j by the reversed trapezoidal recursion and runs the
 // direct sweep beside it.
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 
@@ -59,6 +60,15 @@ Vector McreProblem::TraceWeights() const {
   weights[1] = beta_uL_;
   for (int k = 0; k < num_interior_sensors(); ++k) weights[2 + k] = sensor_weights_[k];
   return weights;
+}
+
+void McreProblem::UseCheckpoints() {
+  if (uses_checkpoints()) return;
+  const int n = num_nodes(), m = num_steps();
+  // stride = ceil(sqrt(2 m)): memory 2 n m / stride + n stride, about 2 n sqrt(2 m).
+  checkpoint_stride_ = std::max(1, static_cast<int>(std::ceil(std::sqrt(2.0 * m))));
+  checkpoints_ = Matrix::Zero(2 * n, m / checkpoint_stride_ + 1);
+  segment_ = Matrix::Zero(n, checkpoint_stride_ + 1);
 }
 
 Matrix McreProblem::DataTraces() const {
@@ -173,7 +183,7 @@ void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* 
   stream_direct_velocity_[0].setZero();
   stream_displacement_[0].setZero();
 
-  if (theta_ != 0.5) {
+  if (uses_checkpoints()) {
     CheckpointedStreamingMap(traces, include_data, observe, direct_step);
     sweep_count_ += 4;
     return;
