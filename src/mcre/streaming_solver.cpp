@@ -8,8 +8,9 @@
 // (L = -H D P D* H^T diag(beta)), with the same nonzero spectrum as A = I - G of the
 // stored-field solvers: CG takes as many iterations or more (1.0 to 1.7 times,
 // measured: it minimises another norm of the error), at three sweeps each instead of
-// two (four for theta != 1/2, from checkpoints), and holds a handful of trace fields
-// (channels x (m + 1)) and O(n) states (O(n sqrt(m)) with checkpoints).
+// two (four from checkpoints: theta != 1/2, or after the rebuild drifted), and holds
+// a handful of trace fields (channels x (m + 1)) and O(n) states (O(n sqrt(m)) with
+// checkpoints).
 //
 // CG starts from the data, y_0 = d~, where the retrograde field vanishes: the
 // stored-field solvers' start W = 0. Its stopping test is theirs: the residual

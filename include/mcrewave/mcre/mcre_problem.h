@@ -309,8 +309,8 @@ class McreProblem : public CoupledProblem {
       stream_retrograde_[2], stream_shift_;
   // One row of the space-time picture's gap density (SpaceTimeColumnPositions entries).
   Vector stream_density_row_;
-  // theta != 1/2 only: the checkpoints (2n x (m / stride + 1)) and one segment's omega
-  // (n x (stride + 1)), allocated in the constructor.
+  // theta != 1/2 or after UseCheckpoints: the checkpoints (2n x (m / stride + 1)) and
+  // one segment's omega (n x (stride + 1)), allocated by UseCheckpoints.
   int checkpoint_stride_ = 1;
   Matrix checkpoints_, segment_;
   // Scratch, allocated in the constructor.
