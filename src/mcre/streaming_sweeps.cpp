@@ -29,17 +29,15 @@ double McreProblem::RetrogradeEnergy(const Matrix& traces) {
   assert(traces.rows() == num_traces() && traces.cols() == num_steps() + 1);
   const int m = num_steps();
   const double h = time_step();
-  const PointLoads* loads = num_interior_sensors() > 0 ? &point_loads_[0] : nullptr;
-  double f0 = 0.0, fL = 0.0, energy = 0.0;
+  double energy = 0.0;
   // The retrograde sweep from rest at T driven by the traces alone, W_j formed as the
   // state passes: W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j, omega_m = 0.
   stream_velocity_[0].setZero();
   stream_omega_[0].setZero();
   for (int j = m, s = 0; j > 0; --j, ++s) {
     const int current = s & 1, next = current ^ 1;
-    TraceLoads(j, traces, false, &f0, &fL);
-    integrator_.StepWithEndLoads(stream_velocity_[current], stream_omega_[current], f0, fL,
-                                 stream_velocity_[next], stream_omega_[next], loads);
+    RetrogradeTraceStep(j, traces, false, stream_velocity_[current], stream_omega_[current],
+                        stream_velocity_[next], stream_omega_[next]);
     stream_retrograde_[0] = (theta_ * stream_omega_[next] + (1.0 - theta_) * stream_omega_[current]) *
                             (1.0 / QuadratureWeight(j));
     // + c_j h W_j^T (K + B/alpha) W_j.
@@ -121,19 +119,28 @@ void McreProblem::TraceLoads(int j, const Matrix& traces, bool include_data, dou
   }
 }
 
+void McreProblem::RetrogradeTraceStep(int j, const Matrix& traces, bool include_data,
+                                      const Vector& velocity, const Vector& state,
+                                      Vector& velocity_next, Vector& state_next) {
+  double f0 = 0.0, fL = 0.0;
+  TraceLoads(j, traces, include_data, &f0, &fL);
+  integrator_.StepWithEndLoads(velocity, state, f0, fL, velocity_next, state_next,
+                               num_interior_sensors() > 0 ? &point_loads_[0] : nullptr);
+}
+
 void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
                                StreamingTotals* totals) {
   assert(traces.rows() == num_traces() && traces.cols() == num_steps() + 1 && image != &traces);
   const int m = num_steps(), last = num_nodes() - 1;
   const double h = time_step();
   image->resize(num_traces(), m + 1);
-  const PointLoads* loads = num_interior_sensors() > 0 ? &point_loads_[0] : nullptr;
-  double f0 = 0.0, fL = 0.0;
+  // Every picture_stride-th sample goes into the error map's space-time picture.
+  const int picture_stride = SpaceTimeStride(m);
   if (totals != nullptr) {
     totals->cost = 0.0;
     totals->cost_gradients.setZero(num_zones());
     totals->error_map.setZero(model_.num_elements());
-    totals->gap_density.resize(m / SpaceTimeStride(m) + 1, stream_density_row_.size());
+    totals->gap_density.resize(m / picture_stride + 1, stream_density_row_.size());
     totals->end_retrograde.resize(2, m + 1);
     totals->rebuild_error = 0.0;
   }
@@ -155,9 +162,9 @@ void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* 
           weight * ReactionGradient(j, displacement.data());
     }
     AddSampleGapShares(model_, moduli_, retrograde.data(), weight, &totals->error_map);
-    if (j % SpaceTimeStride(m) == 0) {
+    if (j % picture_stride == 0) {
       SampleGapDensity(model_, moduli_, retrograde.data(), stream_density_row_.data());
-      totals->gap_density.row(j / SpaceTimeStride(m)) = stream_density_row_.transpose();
+      totals->gap_density.row(j / picture_stride) = stream_density_row_.transpose();
     }
     totals->end_retrograde(0, j) = retrograde[0];
     totals->end_retrograde(1, j) = retrograde[last];
@@ -194,9 +201,8 @@ void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* 
   stream_omega_[0].setZero();
   for (int j = m, s = 0; j > 0; --j, ++s) {
     const int current = s & 1, next = current ^ 1;
-    TraceLoads(j, traces, include_data, &f0, &fL);
-    integrator_.StepWithEndLoads(stream_velocity_[current], stream_omega_[current], f0, fL,
-                                 stream_velocity_[next], stream_omega_[next], loads);
+    RetrogradeTraceStep(j, traces, include_data, stream_velocity_[current], stream_omega_[current],
+                        stream_velocity_[next], stream_omega_[next]);
   }
   const int final_state = m & 1;
 
@@ -211,10 +217,9 @@ void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* 
   observe(0, stream_displacement_[0], stream_retrograde_[0]);
   for (int j = 1; j <= m; ++j) {
     const int current = (j - 1) & 1, next = current ^ 1;
-    TraceLoads(j, traces, include_data, &f0, &fL);
-    integrator_.StepWithEndLoads(stream_rebuilt_velocity_[current], stream_rebuilt_omega_[current],
-                                 f0, fL, stream_rebuilt_velocity_[next],
-                                 stream_rebuilt_omega_[next], loads);
+    RetrogradeTraceStep(j, traces, include_data, stream_rebuilt_velocity_[current],
+                        stream_rebuilt_omega_[current], stream_rebuilt_velocity_[next],
+                        stream_rebuilt_omega_[next]);
     // W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j, with omega_m = 0 exactly
     // (the rebuilt omega_m is its round-off).
     const double omega_weight = j == m ? 0.0 : 1.0 - theta_;
@@ -235,8 +240,6 @@ template <typename Observe, typename DirectStep>
 void McreProblem::CheckpointedStreamingMap(const Matrix& traces, bool include_data,
                                            Observe& observe, DirectStep& direct_step) {
   const int m = num_steps(), stride = checkpoint_stride_;
-  const PointLoads* loads = num_interior_sensors() > 0 ? &point_loads_[0] : nullptr;
-  double f0 = 0.0, fL = 0.0;
   const int n = num_nodes();
   // 1. The retrograde sweep from rest at T keeping its state (v_j, omega_j) at the
   // checkpoints j = m - i stride (column i of checkpoints_: v over omega).
@@ -245,9 +248,8 @@ void McreProblem::CheckpointedStreamingMap(const Matrix& traces, bool include_da
   checkpoints_.col(0).setZero();
   for (int j = m, s = 0; j > 0; --j, ++s) {
     const int current = s & 1, next = current ^ 1;
-    TraceLoads(j, traces, include_data, &f0, &fL);
-    integrator_.StepWithEndLoads(stream_velocity_[current], stream_omega_[current], f0, fL,
-                                 stream_velocity_[next], stream_omega_[next], loads);
+    RetrogradeTraceStep(j, traces, include_data, stream_velocity_[current], stream_omega_[current],
+                        stream_velocity_[next], stream_omega_[next]);
     if ((m - (j - 1)) % stride == 0) {
       const int column = (m - (j - 1)) / stride;
       checkpoints_.col(column).head(n) = stream_velocity_[next];
@@ -268,9 +270,8 @@ void McreProblem::CheckpointedStreamingMap(const Matrix& traces, bool include_da
     segment_.col(b - a) = stream_omega_[0];
     for (int j = b, s = 0; j > a; --j, ++s) {
       const int current = s & 1, next = current ^ 1;
-      TraceLoads(j, traces, include_data, &f0, &fL);
-      integrator_.StepWithEndLoads(stream_velocity_[current], stream_omega_[current], f0, fL,
-                                   stream_velocity_[next], stream_omega_[next], loads);
+      RetrogradeTraceStep(j, traces, include_data, stream_velocity_[current],
+                          stream_omega_[current], stream_velocity_[next], stream_omega_[next]);
       segment_.col(j - 1 - a) = stream_omega_[next];
     }
     if (a == 0) {

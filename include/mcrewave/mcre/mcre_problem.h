@@ -270,6 +270,11 @@ class McreProblem : public CoupledProblem {
   // The retrograde loads of step t_j -> t_{j-1} from traces y_j (end loads f0, fL
   // and the sensors' point loads into stream_loads_).
   void TraceLoads(int j, const Matrix& traces, bool include_data, double* f0, double* fL);
+  // The retrograde step t_j -> t_{j-1} with the loads of TraceLoads: from (v, omega)
+  // into (v_next, omega_next) (the rebuild runs the same step the other way). No
+  // allocation.
+  void RetrogradeTraceStep(int j, const Matrix& traces, bool include_data, const Vector& velocity,
+                           const Vector& state, Vector& velocity_next, Vector& state_next);
 
   // The retrograde force of step t_j -> t_{j-1} at the interior sensors,
   // c_j H_s^T diag(beta_s) (H_s U_j - d~_j) (without the data when include_data is
