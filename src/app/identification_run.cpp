@@ -220,18 +220,8 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
                                     run.solution.retrograde, config.time.step);
   } else {
     // The streaming solver summed the shares and sampled the picture as W passed.
-    run.error_map.share = run.solution.error_map;
-    run.error_map.position.resize(model.num_elements());
-    for (int e = 0; e < model.num_elements(); ++e) {
-      run.error_map.position[e] = model.element_midpoint(e);
-    }
-    const int stride = SpaceTimeStride(run.data.num_steps());
-    run.error_map.density = run.solution.gap_density;
-    run.error_map.density_position = SpaceTimeColumnPositions(model);
-    run.error_map.times.resize(run.error_map.density.rows());
-    for (int i = 0; i < run.error_map.times.size(); ++i) {
-      run.error_map.times[i] = i * stride * config.time.step;
-    }
+    run.error_map = AssembleErrorMap(model, run.solution.error_map, run.solution.gap_density,
+                                     SpaceTimeStride(run.data.num_steps()), config.time.step);
   }
   const int peak = run.error_map.PeakElement();
   spdlog::info("error map: largest share {:.3g} of the constitutive gap at x = {:.4g} m",

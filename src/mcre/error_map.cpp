@@ -77,31 +77,36 @@ void SampleGapDensity(const BarModel& model, const Vector& zone_moduli, const do
       sum += 0.5 * zone_moduli[model.element_zone(e)] * model.element_unit_stiffness(e) * jump *
              jump / model.element_length();
     }
-    row[c] = end - first == 1 ? sum : sum / (end - first);
+    row[c] = sum / (end - first);
   }
+}
+
+ErrorMap AssembleErrorMap(const BarModel& model, const Vector& shares, const Matrix& density,
+                          int stride, double time_step) {
+  assert(shares.size() == model.num_elements() && stride >= 1);
+  ErrorMap map;
+  map.position.resize(model.num_elements());
+  for (int e = 0; e < model.num_elements(); ++e) map.position[e] = model.element_midpoint(e);
+  map.share = shares;
+  map.density_position = SpaceTimeColumnPositions(model);
+  map.density = density;
+  map.times.resize(density.rows());
+  for (int i = 0; i < density.rows(); ++i) map.times[i] = (i * stride) * time_step;
+  return map;
 }
 
 ErrorMap ComputeErrorMap(const BarModel& model, const Vector& zone_moduli, const Matrix& retrograde,
                          double time_step, int max_time_columns) {
-  const int elements = model.num_elements();
-  ErrorMap map;
-  map.position.resize(elements);
-  for (int e = 0; e < elements; ++e) map.position[e] = model.element_midpoint(e);
-  map.share = ElementGapShares(model, zone_moduli, retrograde, time_step);
   const int m = static_cast<int>(retrograde.cols()) - 1;
   const int stride = SpaceTimeStride(m, max_time_columns);
-  const int rows = m / stride + 1;
-  map.density_position = SpaceTimeColumnPositions(model);
-  map.times.resize(rows);
-  map.density.resize(rows, map.density_position.size());
-  Vector row(map.density_position.size());
-  for (int i = 0; i < rows; ++i) {
-    const int j = i * stride;
-    map.times[i] = j * time_step;
-    SampleGapDensity(model, zone_moduli, retrograde.col(j).data(), row.data());
-    map.density.row(i) = row.transpose();
+  Matrix density(m / stride + 1, SpaceTimeColumnPositions(model).size());
+  Vector row(density.cols());
+  for (int i = 0; i < density.rows(); ++i) {
+    SampleGapDensity(model, zone_moduli, retrograde.col(i * stride).data(), row.data());
+    density.row(i) = row.transpose();
   }
-  return map;
+  return AssembleErrorMap(model, ElementGapShares(model, zone_moduli, retrograde, time_step),
+                          density, stride, time_step);
 }
 
 }  // namespace mcrewave

@@ -65,6 +65,12 @@ Vector SpaceTimeColumnPositions(const BarModel& model);
 void SampleGapDensity(const BarModel& model, const Vector& zone_moduli, const double* retrograde,
                       double* row);
 
+// The map from its sums: the shares e_el^2 (one per element) and the picture's
+// density (rows at every stride-th sample of steps time_step [s], columns on
+// SpaceTimeColumnPositions), as a streaming solve gathers them.
+ErrorMap AssembleErrorMap(const BarModel& model, const Vector& shares, const Matrix& density,
+                          int stride, double time_step);
+
 // The whole map, with the space-time picture on at most max_time_columns samples.
 // Precondition: max_time_columns >= 2.
 ErrorMap ComputeErrorMap(const BarModel& model, const Vector& zone_moduli, const Matrix& retrograde,
