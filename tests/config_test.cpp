@@ -410,7 +410,7 @@ mcre:
   w_e: 0.7
   w_r: 0.03
   reference_modulus: 70e9
-  clamp: trusted
+  clamp: measured
 inner:
   method: adaptive_relaxation
   tolerance: 1e-11
@@ -544,7 +544,7 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
        "model.zone_count applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\ndata:\n  sensors: [u@0.5]\n",
        "data.sensors applies to the bar only"},
-      {"model:\n  kind: matrix\n  manifest: m.yaml\nmcre:\n  clamp: trusted\n",
+      {"model:\n  kind: matrix\n  manifest: m.yaml\nmcre:\n  clamp: measured\n",
        "mcre.clamp applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\nouter:\n  functional: least_squares\n",
        "outer.functional must be 'mcre'"},
@@ -580,14 +580,13 @@ TEST(ConfigTest, PaperBarConfigLoads) {
   EXPECT_EQ(config.time.NumSteps(), 1750);
 }
 
-TEST(ConfigTest, PaperBarWithATrustedClampDiffersInItsMcreSectionOnly) {
+TEST(ConfigTest, PaperBarFreeFreeDiffersInItsMcreSectionOnly) {
   Config expected = LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar.yaml");
-  expected.mcre.clamp = ClampModel::kTrusted;
-  expected.mcre.weights.displacement_weight = 1e-5;
-  expected.mcre.weights.reaction_weight = 1e-4;
-  expected.output.folder = "results/paper_bar_trusted_clamp";
-  ExpectSameConfig(expected, LoadConfig(std::string(MCREWAVE_SOURCE_DIR) +
-                                        "/configs/paper_bar_trusted_clamp.yaml"));
+  expected.mcre.clamp = ClampModel::kMeasured;
+  expected.mcre.weights.displacement_weight = 0.01;
+  expected.output.folder = "results/paper_bar_free_free";
+  ExpectSameConfig(
+      expected, LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar_free_free.yaml"));
 }
 
 TEST(ConfigTest, QuickAndMeasuredCsvConfigsLoad) {
@@ -824,8 +823,9 @@ TEST_F(ConfigFileTest, MalformedYaml) {
 }
 
 TEST_F(ConfigFileTest, SectionThatIsNotAMap) {
-  ExpectLoadError("data:\n  seed: 3\nmodel: 3\n", 3,
-                  {"model: expected a map of keys (kind, manifest, channel_map, length, section", "got '3'"});
+  ExpectLoadError(
+      "data:\n  seed: 3\nmodel: 3\n", 3,
+      {"model: expected a map of keys (kind, manifest, channel_map, length, section", "got '3'"});
 }
 
 TEST_F(ConfigFileTest, TopLevelThatIsNotAMap) {

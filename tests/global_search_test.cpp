@@ -29,9 +29,11 @@ using testing::SmallCase;
 
 constexpr double kReference = 200e9;  // E of the data [Pa]
 
+// The paper's free-free formulation at w_u, whose valleys these tests measure.
 McreOptions WeightsOf(double w_u) {
   McreOptions mcre;
   mcre.weights.displacement_weight = w_u;
+  mcre.clamp = ClampModel::kMeasured;
   return mcre;
 }
 
@@ -250,19 +252,22 @@ double NoiseFreeError(bool prefilter_enabled, double* cutoff) {
   return (summary.modulus - kReference) / kReference;
 }
 
-TEST(GlobalSearchTest, NoiseFreeDataFromTheFinerTruthGiveEWithinATenthOfAPercent) {
-  // The discretisation bias of 30 elements against the 4x finer truth: measured -2.51e-4.
+TEST(GlobalSearchTest, NoiseFreeDataFromTheFinerTruthGiveEWithinTwoTenthsOfAPercent) {
+  // The discretisation bias of 30 elements against the 4x finer truth, at the
+  // default trusted clamp: measured 1.53e-3 in size (the paper's free-free
+  // formulation: -2.51e-4), mostly the kinematic clamp reaction's O(l^2) error
+  // (docs/trusted_clamp.md section 1).
   double cutoff = 0.0;
-  EXPECT_LE(std::abs(NoiseFreeError(false, &cutoff)), 1e-3);
+  EXPECT_LE(std::abs(NoiseFreeError(false, &cutoff)), 2e-3);
 }
 
 TEST(GlobalSearchTest, PrefilterDoesNotBiasNoiseFreeIdentification) {
   double cutoff = 0.0;
   const double filtered = NoiseFreeError(true, &cutoff);
   EXPECT_GT(cutoff, 0.0);
-  EXPECT_LE(std::abs(filtered), 1e-3);
-  // The pre-filter's own bias: measured 5.1e-8 (filtered -2.50965e-4, unfiltered
-  // -2.51016e-4).
+  EXPECT_LE(std::abs(filtered), 2e-3);
+  // The pre-filter's own bias: measured 3.4e-7 (filtered 1.53268e-3, unfiltered
+  // 1.53234e-3, in size).
   double unused = 0.0;
   EXPECT_LE(std::abs(filtered - NoiseFreeError(false, &unused)), 5e-7);
 }

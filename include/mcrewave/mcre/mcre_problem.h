@@ -50,11 +50,13 @@ namespace mcrewave {
 //   beta = w_u S E0 / L [N/m],  alpha = w_f L / (S E0) [m/N],
 // so that every term of J is an energy [J] and e^2 is in [J s].
 //
-// Defaults w_u = 0.01, w_f = 1: the extreme eigenvalue of the iteration map, due to
-// the rigid-body mode of the unclamped model, scales with w_u / w_f (about -35 at
-// these defaults on the paper's case against -3.4e3 at w_u = 1), so relaxation and
-// CG converge in tens to hundreds of sweeps instead of thousands; the evidence for
-// the identification itself is in docs/weights.md.
+// Defaults w_u = 0.01, w_f = 1, the weights of the paper's free-free formulation
+// (the config's defaults are TrustedClampWeights() of objective.h): the extreme
+// eigenvalue of the iteration map, due to the rigid-body mode of the unclamped model,
+// scales with w_u / w_f (about -35 at these defaults on the paper's case against
+// -3.4e3 at w_u = 1), so relaxation and CG converge in tens to hundreds of sweeps
+// instead of thousands; the evidence for the identification itself is in
+// docs/weights.md.
 //
 // Strain gauges (docs/zones_and_sensors.md): beta_e = w_e S E0 L [N m]; a uniform
 // strain e over the bar moves its end by e L, so w_e = w_u weighs a gauge like an end

@@ -68,17 +68,30 @@ class ModulusObjective {
 // false, with the reason in *why, when it is not a positive finite number.
 bool TrialModulus(double parameter, double modulus_scale, double* modulus, std::string* why);
 
+// The config's default weights, chosen with the clamp trusted on the comparator
+// study (docs/trusted_clamp.md section 7): w_u = w_e = 1e-7, w_f = 1, w_r = 1e-6.
+// Data weights this small put the coupled problem near its least-squares limit,
+// where it is mildly conditioned (a few CG iterations), and w_r / w_u = 10 weighs uL
+// and the clamp reaction about as their noise does on the paper's case.
+inline McreWeights TrustedClampWeights() {
+  McreWeights weights;
+  weights.displacement_weight = 1e-7;
+  weights.strain_weight = 1e-7;
+  weights.reaction_weight = 1e-6;
+  return weights;
+}
+
 // The `mcre:` section of the config: the weights of the data terms and the
 // modulus E0 they are built with (mcre_problem.h):
 //   beta = w_u S E0 / L,  alpha = w_f L / (S E0).
 // E0 is a fixed nominal modulus, not the unknown: the same functional is then
 // minimised whatever the start or the bounds of the outer loop.
 struct McreOptions {
-  McreWeights weights;
+  McreWeights weights = TrustedClampWeights();
   double reference_modulus = 200e9;  // E0 [Pa]
-  // The clamp at x = 0: measured (the paper's free-free model) or trusted (u(0) = 0,
-  // f0 a measured output); mcre_problem.h.
-  ClampModel clamp = ClampModel::kMeasured;
+  // The clamp at x = 0: trusted (u(0) = 0, f0 a measured output) or measured (the
+  // paper's free-free model); mcre_problem.h.
+  ClampModel clamp = ClampModel::kTrusted;
 
   bool IsValid(std::string* error) const;
 };
