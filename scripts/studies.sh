@@ -11,7 +11,7 @@
 #                                 omega below 2 converges)
 #   results/comparator/           `identify study configs/studies.yaml --set study.kind=comparator`
 #                                 (MCRE against least squares, 100 seeds x 4 SNRs x 5 model
-#                                 errors; about 1.5 hours on 2 cores)
+#                                 errors on pre-filtered data; about 20 minutes on 2 cores)
 #   results/damage/               `identify study configs/studies.yaml --set study.kind=damage`
 #                                 (include/mcrewave/app/study.h), which writes results/README.md
 # The first four parts take about 10 minutes on 2 cores. Arguments go to `identify study`, and with any of them

@@ -584,6 +584,7 @@ TEST(ConfigTest, PaperBarFreeFreeDiffersInItsMcreSectionOnly) {
   Config expected = LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar.yaml");
   expected.mcre.clamp = ClampModel::kMeasured;
   expected.mcre.weights.displacement_weight = 0.01;
+  expected.mcre.weights.strain_weight = 0.01;
   expected.output.folder = "results/paper_bar_free_free";
   ExpectSameConfig(
       expected, LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar_free_free.yaml"));
