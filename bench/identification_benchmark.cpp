@@ -94,7 +94,7 @@ SweepStepTimes SweepStepSeconds(const mcrewave::Config& config,
                                 const mcrewave::MeasurementSet& data) {
   const mcrewave::BarModel model(config.model);
   mcrewave::McreProblem problem(model, data, config.mcre.weights, config.mcre.reference_modulus,
-                                config.time.theta);
+                                config.time.theta, {}, config.mcre.clamp);
   problem.SetModulus(config.model.modulus);
   mcrewave::Matrix retrograde = problem.ZeroField(), displacement;
   problem.DirectSweep(retrograde, true, &displacement);

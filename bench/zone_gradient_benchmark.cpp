@@ -48,7 +48,7 @@ Figures Measure(const mcrewave::Config& config, const mcrewave::MeasurementSet& 
   layout.zone_count = zones;
   const BarModel model(config.model, layout.ElementZones(config.model));
   McreProblem problem(model, data, config.mcre.weights, config.mcre.reference_modulus,
-                      config.time.theta);
+                      config.time.theta, {}, config.mcre.clamp);
   Vector moduli(zones);
   for (int z = 0; z < zones; ++z) moduli[z] = config.model.modulus * (1.0 + 1e-3 * (z % 3));
   problem.SetModuli(moduli);

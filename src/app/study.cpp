@@ -589,7 +589,7 @@ RelaxationStudy RunRelaxationStudy(const Config& config) {
         const MeasurementSet data = PrefilterMeasurements(
             NoisyMeasurements(truth, relaxation_case.snr, config.data.seed), config.prefilter);
         McreProblem problem(model, data, config.mcre.weights, config.mcre.reference_modulus,
-                            config.time.theta);
+                            config.time.theta, {}, config.mcre.clamp);
         problem.SetModulus(relaxation_case.modulus);
         const auto [a_min, a_max] = EstimateSpectrum(config.inner, &problem);
         relaxation_case.spectrum_min = a_min;
