@@ -71,7 +71,7 @@ double MaxError(const std::vector<double>& x, const std::vector<double>& expecte
   return error;
 }
 
-class BoundedMinimizerTest : public testing::TestWithParam<BoundedAlgorithm> {};
+class BoundedMinimizerTest : public ::testing::TestWithParam<BoundedAlgorithm> {};
 
 TEST_P(BoundedMinimizerTest, InteriorQuadratic) {
   const std::vector<double> a{1.0, 2.0, 0.5, 4.0, 1.5};
@@ -156,11 +156,11 @@ TEST_P(BoundedMinimizerTest, TheEvaluationLimitIsNotConvergence) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Algorithms, BoundedMinimizerTest,
-                         testing::Values(BoundedAlgorithm::kNloptLbfgs, BoundedAlgorithm::kNloptMma,
+                         ::testing::Values(BoundedAlgorithm::kNloptLbfgs, BoundedAlgorithm::kNloptMma,
                                          BoundedAlgorithm::kNloptSlsqp,
                                          BoundedAlgorithm::kNloptBobyqa,
                                          BoundedAlgorithm::kCeresLbfgs),
-                         [](const testing::TestParamInfo<BoundedAlgorithm>& info) {
+                         [](const ::testing::TestParamInfo<BoundedAlgorithm>& info) {
                            return std::string(BoundedAlgorithmToString(info.param));
                          });
 

@@ -40,6 +40,7 @@ using testing::ReadText;
 using testing::RunIdentify;
 using testing::RunResult;
 using testing::SourcePath;
+using testing::WithoutRunLines;
 
 namespace fs = std::filesystem;
 using testing::kAddressSanitizer;
@@ -142,20 +143,6 @@ TEST_P(InterruptedRunTest, LeavesTheEarlierResultsIntactAndNoTemporaryFile) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Signals, InterruptedRunTest, ::testing::Values(SIGINT, SIGTERM, SIGHUP));
-
-// A summary.yaml without the lines that differ between two runs of one config
-// into two folders: wall times and the folder.
-std::string WithoutRunLines(const std::string& yaml) {
-  std::istringstream lines(yaml);
-  std::string kept;
-  for (std::string line; std::getline(lines, line);) {
-    if (line.find("wall_time_s:") == std::string::npos &&
-        line.find("folder:") == std::string::npos) {
-      kept += line + "\n";
-    }
-  }
-  return kept;
-}
 
 // A folder holds exactly the set `expected` (file names and bytes, the
 // summary's run lines apart).
@@ -371,9 +358,9 @@ TEST(ExtremeInputLongTest, LongWindowRiccatiAndConjugateGradientsAgree) {
     ASSERT_EQ(run.exit_code, 0) << method << ": " << run.output;
     identified[i++] = SummaryNumber(ReadText(folder + "/summary.yaml"), "identified_modulus");
   }
-  // Measured: 200.433156 GPa by Riccati, the two 8.3e-7 apart: outer.relative_tolerance is 1e-4 here, and the round-off
-  // difference of the two inner solvers' costs moves where Ceres' line search stops
-  // inside it. The first to 1e-6 of the figure (the run is seeded).
+  // Measured: 200.433156 GPa by Riccati, the two 8.3e-7 apart: outer.relative_tolerance is 1e-4
+  // here, and the round-off difference of the two inner solvers' costs moves where Ceres' line
+  // search stops inside it. The first to 1e-6 of the figure (the run is seeded).
   EXPECT_NEAR(identified[0] / 200.433156e9, 1.0, 1e-6);
   EXPECT_NEAR(identified[1] / identified[0], 1.0, 8e-6);
 }

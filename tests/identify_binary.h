@@ -52,4 +52,25 @@ inline std::string ReadText(const std::string& path) {
   return text.str();
 }
 
+// Whether `text` holds `part`.
+inline bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+// A summary.yaml without the lines that differ between two runs of one config into
+// two folders: wall times, the scan's thread count and the folder.
+inline std::string WithoutRunLines(const std::string& yaml) {
+  std::istringstream lines(yaml);
+  std::string kept;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("wall_time_s:") != std::string::npos ||
+        line.find("scan_threads:") != std::string::npos ||
+        line.find("folder:") != std::string::npos) {
+      continue;
+    }
+    kept += line + "\n";
+  }
+  return kept;
+}
+
 }  // namespace mcrewave::testing

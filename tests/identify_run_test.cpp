@@ -28,6 +28,7 @@ using testing::ReadText;
 using testing::RunIdentify;
 using testing::RunResult;
 using testing::SourcePath;
+using testing::WithoutRunLines;
 
 namespace fs = std::filesystem;
 
@@ -210,20 +211,6 @@ TEST(IdentifyRunTest, LeastSquaresWithZonesIsRefusedNamingTheKey) {
             std::string::npos)
       << run.result.output;
   EXPECT_FALSE(fs::exists(run.folder));
-}
-
-std::string WithoutRunLines(const std::string& yaml) {
-  std::istringstream lines(yaml);
-  std::string kept;
-  for (std::string line; std::getline(lines, line);) {
-    if (line.find("wall_time_s:") != std::string::npos ||
-        line.find("scan_threads:") != std::string::npos ||
-        line.find("folder:") != std::string::npos) {
-      continue;
-    }
-    kept += line + "\n";
-  }
-  return kept;
 }
 
 // The MCRE run, the least-squares run and the zoned run (its zone step starts from the

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "identify_binary.h"
 #include "mcrewave/data/matrix_market.h"
 #include "mcrewave/linalg/theta_integrator.h"
 
@@ -129,9 +130,7 @@ std::string SpoiledError(const std::string& name, Spoil&& spoil) {
   return "";
 }
 
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
+using testing::Contains;
 
 TEST(MatrixExportTest, BadModelsGiveOneClearError) {
   std::string why = SpoiledError("spoil_size", [](const std::string& folder) {

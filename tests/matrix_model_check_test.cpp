@@ -5,14 +5,13 @@
 #include <string>
 #include <vector>
 
+#include "identify_binary.h"
 #include "mcrewave/model/bar_model.h"
 
 namespace mcrewave {
 namespace {
 
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
+using testing::Contains;
 
 TEST(MatrixModelCheckTest, TheBarsMatricesPass) {
   BarProperties bar;
