@@ -1,6 +1,8 @@
 // Wall time of the identification of zone moduli (optim/zone_identification.h) on the
-// paper's case (configs/paper_bar.yaml, or the config given), after the scalar
-// identification that gives the homogeneous start E*.
+// paper's case (configs/paper_bar_free_free.yaml, or the config given), after the
+// scalar identification that gives the homogeneous start E*. The data below are those
+// of the free-free model (driven by both measured end forces), hence its config: the
+// trusted clamp's model does not reproduce them.
 //
 // Data: the end forces of the paper's experiment drive a per-element truth of the
 // model's own mesh with a soft zone of 0.7 E over [0.6, 0.7] L (direct sweep at W = 0);
@@ -40,7 +42,7 @@ double Rms(const mcrewave::Vector& v) { return std::sqrt(v.squaredNorm() / v.siz
 
 int main(int argc, char** argv) {
   using namespace mcrewave;
-  std::string path = "configs/paper_bar.yaml";
+  std::string path = "configs/paper_bar_free_free.yaml";
   double snr = std::numeric_limits<double>::infinity();
   BoundedAlgorithm algorithm = BoundedAlgorithm::kNloptLbfgs;
   bool verbose = false;
