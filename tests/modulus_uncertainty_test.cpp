@@ -61,14 +61,6 @@ TEST(CostGradientSlopeTest, FitsTheSlopeWithinTheWindow) {
   EXPECT_EQ(CostGradientSlope(one, 2e11, 0.05, &points), 0.0);
 }
 
-// The paper's free-free formulation at w_u = 0.01, which these figures were measured with.
-McreOptions PaperMcre() {
-  McreOptions mcre;
-  mcre.weights = testing::Weights(0.01, 1.0);
-  mcre.clamp = ClampModel::kMeasured;
-  return mcre;
-}
-
 // At the minimum of e^2 for a small noisy case.
 class ModulusUncertaintyTest : public ::testing::Test {
  protected:
@@ -76,8 +68,8 @@ class ModulusUncertaintyTest : public ::testing::Test {
       : case_(MakeSmallCase(20, 120, 20.0, 2)),
         model_(case_.bar),
         data_(MakeSyntheticMeasurements(case_.bar, case_.load, case_.time, case_.data)),
-        problem_(model_, data_, PaperMcre().weights, PaperMcre().reference_modulus,
-                 case_.time.theta, {}, PaperMcre().clamp) {
+        problem_(model_, data_, mcre_.weights, mcre_.reference_modulus, case_.time.theta, {},
+                 mcre_.clamp) {
     problem_.SetModulus(kModulus);
     SolveCoupled(CoupledSolverOptions(), &problem_, nullptr, &solution_);
   }
@@ -85,12 +77,14 @@ class ModulusUncertaintyTest : public ::testing::Test {
   ModulusUncertainty Estimate(const NoiseLevels& noise, double curvature) {
     UncertaintyOptions options;
     options.samples = 4;
-    return EstimateModulusUncertainty(options, model_, data_, PaperMcre(), case_.time.theta,
+    return EstimateModulusUncertainty(options, model_, data_, mcre_, case_.time.theta,
                                       CoupledSolverOptions(), kModulus, solution_, noise, curvature,
                                       5);
   }
 
   static constexpr double kModulus = 200e9;
+  // The free-free formulation, which these figures were measured in.
+  const McreOptions mcre_ = testing::FreeFreeMcre();
   testing::SmallCase case_;
   BarModel model_;
   MeasurementSet data_;

@@ -6,6 +6,7 @@
 
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/mcre/objective.h"
 #include "mcrewave/model/bar_model.h"
 #include "mcrewave/model/simulation.h"
 
@@ -72,6 +73,15 @@ inline McreWeights Weights(double w_u, double w_f) {
   weights.displacement_weight = w_u;
   weights.force_weight = w_f;
   return weights;
+}
+
+// The paper's free-free formulation (mcre.clamp: measured) at w_u, w_f = 1, in which
+// the figures of many tests were measured (the config's defaults trust the clamp).
+inline McreOptions FreeFreeMcre(double w_u = 0.01) {
+  McreOptions mcre;
+  mcre.weights = Weights(w_u, 1.0);
+  mcre.clamp = ClampModel::kMeasured;
+  return mcre;
 }
 
 // ||a - b|| / ||b|| (Frobenius).

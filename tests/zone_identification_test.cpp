@@ -59,12 +59,7 @@ struct InverseCrime {
 // The paper's free-free formulation: the inverse crime's data are the model's own
 // outputs, and its f0 is the finite-element reaction, which the trusted clamp's
 // kinematic reaction does not reproduce exactly (docs/trusted_clamp.md section 1).
-McreOptions Mcre() {
-  McreOptions mcre;
-  mcre.weights = testing::Weights(0.01, 1.0);
-  mcre.clamp = ClampModel::kMeasured;
-  return mcre;
-}
+McreOptions Mcre() { return testing::FreeFreeMcre(); }
 
 TEST(ZoneMcreObjectiveTest, GradientInLogModuliMatchesCentralDifferences) {
   InverseCrime crime(40, 120, 10, SoftZoneModuli(10));
