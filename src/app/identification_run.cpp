@@ -93,7 +93,7 @@ std::vector<CostCurvePoint> ComputeCostCurve(const Config& config, const BarMode
 
   McreObjective objective(model, data, config.mcre, config.time.theta, config.inner, center,
                           run.ends);
-  if (run.solution.has_fields()) objective.SetWarmStart(run.solution.retrograde);
+  if (run.solution.WarmStart().size() > 0) objective.SetWarmStart(run.solution.WarmStart());
   std::vector<CostCurvePoint> curve;
   for (const double modulus : moduli) {
     const ObjectiveEvaluation& evaluation = objective.EvaluateModulus(modulus);

@@ -76,7 +76,7 @@ ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayo
       config.zone_identification, model, scalar.data, config.mcre, config.time.theta, config.inner,
       scalar.ends, scalar.identified_modulus(), config.outer.lower_bound, config.outer.upper_bound,
       scalar.estimated_noise, prefilter,
-      scalar.solution.has_fields() ? &scalar.solution.retrograde : nullptr);
+      scalar.solution.WarmStart().size() > 0 ? &scalar.solution.WarmStart() : nullptr);
   spdlog::info("zones: {}", run.summary.BriefReport());
   return run;
 }

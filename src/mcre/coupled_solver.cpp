@@ -119,7 +119,7 @@ std::string CoupledSolverSummary::FullReport() const {
 }
 
 CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledProblem* problem,
-                                  const Matrix* initial_retrograde, CoupledSolution* solution) {
+                                  const Matrix* initial_guess, CoupledSolution* solution) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   const long sweeps_before = problem->sweep_count();
@@ -173,10 +173,10 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
       break;
     case CoupledSolverType::kRelaxation:
     case CoupledSolverType::kAdaptiveRelaxation:
-      internal::SolveByRelaxation(options, problem, initial_retrograde, solution, &summary);
+      internal::SolveByRelaxation(options, problem, initial_guess, solution, &summary);
       break;
     case CoupledSolverType::kConjugateGradient:
-      internal::SolveByConjugateGradient(options, problem, initial_retrograde, solution, &summary);
+      internal::SolveByConjugateGradient(options, problem, initial_guess, solution, &summary);
       break;
     case CoupledSolverType::kRiccati:
       internal::SolveByRiccati(options, bar, solution, &summary);
@@ -187,7 +187,7 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
       break;
     case CoupledSolverType::kStreamingConjugateGradient:
       // Fills the cost and the gradients itself, from its final streaming pass.
-      internal::SolveByStreamingConjugateGradient(options, bar, solution, &summary);
+      internal::SolveByStreamingConjugateGradient(options, bar, initial_guess, solution, &summary);
       break;
   }
   if (summary.IsSolutionUsable() &&

@@ -22,8 +22,10 @@ void SolveByRiccati(const CoupledSolverOptions& options, McreProblem* problem,
 void SolveByShooting(const CoupledSolverOptions& options, McreProblem* problem,
                      CoupledSolution* solution, CoupledSolverSummary* summary);
 // Also fills the solution's cost, gradients, traces, end retrograde values and
-// error map (its fields U and W stay empty).
+// error map (its fields U and W stay empty). initial_traces (nullable): a warm start
+// y^(0) of the problem's ZeroTraces() shape.
 void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, McreProblem* problem,
-                                       CoupledSolution* solution, CoupledSolverSummary* summary);
+                                       const Matrix* initial_traces, CoupledSolution* solution,
+                                       CoupledSolverSummary* summary);
 
 }  // namespace mcrewave::internal

@@ -64,10 +64,10 @@ double McreObjective::ValleySpacing() {
   return PredictedValleySpacing(traces, problem_.TraceWeights(), problem_.time_step());
 }
 
-void McreObjective::SetWarmStart(const Matrix& retrograde) {
-  assert(retrograde.rows() == problem_.num_nodes() &&
-         retrograde.cols() == problem_.num_steps() + 1);
-  warm_start_ = retrograde;
+void McreObjective::SetWarmStart(const Matrix& start) {
+  assert((start.rows() == problem_.num_nodes() || start.rows() == problem_.num_traces()) &&
+         start.cols() == problem_.num_steps() + 1);
+  warm_start_ = start;
   warm_start_modulus_ = 0.0;
   previous_start_.resize(0, 0);
   previous_start_modulus_ = 0.0;
@@ -122,7 +122,7 @@ const ObjectiveEvaluation& McreObjective::Solve(double modulus, bool gradient_re
     } else {
       previous_start_.resize(0, 0);
     }
-    warm_start_ = solution_.retrograde;
+    warm_start_ = solution_.WarmStart();
     warm_start_modulus_ = modulus > 0.0 ? modulus : 0.0;
     if (best_index_ < 0 || record.cost < evaluations_[best_index_].cost) {
       best_index_ = static_cast<int>(evaluations_.size());

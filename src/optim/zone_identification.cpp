@@ -151,8 +151,9 @@ ZoneIdentificationSummary IdentifyZoneModuli(
   }
   try {
     McreObjective objective(model, data, mcre, theta, inner, homogeneous_modulus, ends);
-    if (warm_start != nullptr && warm_start->rows() == objective.problem().num_nodes() &&
-        warm_start->cols() == objective.problem().num_steps() + 1) {
+    const McreProblem& problem = objective.problem();
+    if (warm_start != nullptr && warm_start->cols() == problem.num_steps() + 1 &&
+        (warm_start->rows() == problem.num_nodes() || warm_start->rows() == problem.num_traces())) {
       objective.SetWarmStart(*warm_start);
     }
     summary.cost_scale = objective.cost_scale();

@@ -158,6 +158,9 @@ struct CoupledSolution {
 
   // Whether U and W are stored (every solver but the streaming one).
   bool has_fields() const { return displacement.size() > 0; }
+  // The unknown of the iterative solver that produced this solution, as SolveCoupled's
+  // initial_guess: W, or the traces after a streaming solve (empty when there is none).
+  const Matrix& WarmStart() const { return has_fields() ? retrograde : traces; }
   // U and W at node 0 (end 0) or node N (end 1) at sample j [m], from the fields or,
   // after a streaming solve, from its traces and end values.
   double EndDisplacement(int end, int j) const {
@@ -175,11 +178,14 @@ struct CoupledSolution {
 // Solves the coupled problem at the problem's current moduli: the bar (McreProblem)
 // with every solver, a structure given by matrices (MatrixMcreProblem) with the
 // iterative solvers and all_at_once (the others refuse it in the summary).
-// initial_retrograde (nullable) is the initial guess W^(0) of the iterative solvers
-// (warm start, e.g. the previous E's solution); it must have the problem's shape.
-// Precondition: options.IsValid(). The solution's fields are meaningful only when
+// initial_guess (nullable) is the iterative solver's unknown at the start (warm start,
+// e.g. the previous E's solution): W^(0), the problem's ZeroField() shape, for
+// relaxation and conjugate_gradient; the traces y^(0), McreProblem::ZeroTraces()
+// shape (a solution's `traces`), for streaming_conjugate_gradient, which starts from
+// the data instead when they are farther from the solution. The direct solvers ignore
+// it. Precondition: options.IsValid(). The solution's fields are meaningful only when
 // the summary says so.
 CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledProblem* problem,
-                                  const Matrix* initial_retrograde, CoupledSolution* solution);
+                                  const Matrix* initial_guess, CoupledSolution* solution);
 
 }  // namespace mcrewave

@@ -13,7 +13,9 @@
 //   W^(0) = W(E1) + t (W(E1) - W(E0)),  t = (E - E1) / (E1 - E0),
 // when |t| <= kMaxExtrapolation (W depends smoothly on E between resonances; a
 // scan step or a local optimiser's step is then much closer to the line through the
-// last two solutions than to the last one); otherwise from W(E1) alone.
+// last two solutions than to the last one); otherwise from W(E1) alone. The
+// streaming solver's unknown is the traces H U instead of W (CoupledSolution::
+// WarmStart()), extrapolated the same way.
 #pragma once
 
 #include <memory>
@@ -162,10 +164,11 @@ class McreObjective : public ModulusObjective {
   // current moduli (McreProblem::DataResponseTraces), weighted by beta_k: one sweep.
   double ValleySpacing() override;
 
-  // The next evaluation starts its inner iteration from this retrograde field
-  // (shape of problem().ZeroField()) instead of the last usable solutions; later
-  // evaluations extrapolate from it once they have a second solution.
-  void SetWarmStart(const Matrix& retrograde);
+  // The next evaluation starts its inner iteration from `start` (a solution's
+  // WarmStart(): a retrograde field of problem().ZeroField()'s shape, or the traces of
+  // problem().ZeroTraces()'s for the streaming solver) instead of the last usable
+  // solutions; later evaluations extrapolate from it once they have a second solution.
+  void SetWarmStart(const Matrix& start);
 
   // Largest |t| of the extrapolated warm start (above: the last solution alone).
   static constexpr double kMaxExtrapolation = 2.0;
@@ -190,7 +193,7 @@ class McreObjective : public ModulusObjective {
   int best_index_ = -1;
   CoupledSolution best_solution_;
   CoupledSolution solution_;             // of the last evaluation
-  Matrix warm_start_;                    // W(E1), the last usable solution; empty: start from zero
+  Matrix warm_start_;                    // W(E1) (or its traces), the last usable solution; empty: none
   double warm_start_modulus_ = 0.0;      // E1 [Pa]; 0 when W(E1) was set by SetWarmStart
   Matrix previous_start_;                // W(E0), the one before; empty: none
   double previous_start_modulus_ = 0.0;  // E0 [Pa]
