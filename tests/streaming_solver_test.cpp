@@ -178,6 +178,13 @@ TEST(StreamingSolverTest, AWarmStartFromANearbyModulusGivesTheSameSolutionInFewe
   EXPECT_LT(warm.summary.iterations, cold.summary.iterations);
   EXPECT_NE(warm.summary.message.find("from the warm start"), std::string::npos)
       << warm.summary.message;
+  // From its own solution the start is the final pass: no iteration, 8 sweeps (the
+  // data's residual and its norm, the start's and its norm) against 629 cold.
+  const Solved again = Solve(options, &problem, &cold.solution.WarmStart());
+  ASSERT_TRUE(again.summary.IsSolutionUsable()) << again.summary.message;
+  EXPECT_EQ(again.summary.iterations, 0);
+  EXPECT_EQ(again.summary.sweeps, 8);
+  EXPECT_NEAR(again.solution.cost, cold.solution.cost, 2e-15 * cold.solution.cost);
   const Matrix away = -problem.DataTraces();
   const Solved refused = Solve(options, &problem, &away);
   ASSERT_TRUE(refused.summary.IsSolutionUsable());

@@ -15,7 +15,8 @@
 // CG starts from the data, y_0 = d~, where the retrograde field vanishes: the
 // stored-field solvers' start W = 0, or from a warm start y^(0) (the previous
 // modulus's traces) when its residual is smaller in the W-norm below (three sweeps
-// for that residual and one for its norm, against three per iteration saved). Its
+// for that residual and one for its norm, against three per iteration saved; a start
+// within the tolerance is accepted from that pass, with no iteration). Its
 // stopping test is the stored-field solvers' whatever the start: the residual
 // r = Phi(y) - y maps to their residual c - A W = R r at W = Retrograde(y) (R the
 // retrograde sweep driven by r without data), whose P-norm is
@@ -108,8 +109,9 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
   // true one after a restart, then from the CG recursion (after q_k is formed).
   double relative = 1.0;
   if (initial_traces != nullptr) {
-    // r^(0) = Phi(y^(0)) - y^(0), into `image` until it is kept.
-    problem->StreamingMap(*initial_traces, true, &image);
+    // r^(0) = Phi(y^(0)) - y^(0), into `image` until it is kept; the pass sums the
+    // fields too, so that a start already within the tolerance is the final pass.
+    problem->StreamingMap(*initial_traces, true, &image, &totals);
     image -= *initial_traces;
     const double warm_relative =
         std::sqrt(std::max(problem->RetrogradeEnergy(image), 0.0)) / rhs_norm;
@@ -118,6 +120,13 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
       residual.swap(image);
       relative = warm_relative;
       start_note = "; from the warm start (relative residual " + ScientificString(warm_relative) + ")";
+      if (relative <= options.tolerance && totals.rebuild_error <= options.max_rebuild_error) {
+        summary->residual_history.push_back(relative);
+        summary->relative_residual = relative;
+        accept("relative residual " + ScientificString(relative) + " <= tolerance " +
+               ScientificString(options.tolerance) + " at the start");
+        return;
+      }
     }
   }
   direction = residual;
