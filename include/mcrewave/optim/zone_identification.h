@@ -106,7 +106,8 @@ double ExpectedNoiseCost(const BarModel& model, const MeasurementSet& data, cons
 // [lower_bound, upper_bound] on every zone. noise: the estimated noise levels of the
 // measurements (for the discrepancy target); prefilter: the pre-filter the data went
 // through, its cutoff_frequency the one used. warm_start: the scalar identification's
-// solution at E* (CoupledSolution::WarmStart(), nullable). Never throws for a failed identification.
+// solution at E* (CoupledSolution::WarmStart(), nullable). Never throws for a failed
+// identification.
 // Preconditions: options valid, 0 < lower_bound < E* < upper_bound.
 ZoneIdentificationSummary IdentifyZoneModuli(
     const ZoneIdentificationOptions& options, const BarModel& model, const MeasurementSet& data,
