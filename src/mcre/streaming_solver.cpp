@@ -79,9 +79,9 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
   McreProblem::StreamingTotals totals;
   // The final pass at y: the true residual Phi(y) - y = b - (I - L) y into `image`,
   // its W-norm relative to ||r_0||_W returned, and the sums of the fields in `totals`.
-  auto final_pass = [&]() {
-    problem->StreamingMap(traces, true, &image, &totals);
-    image -= traces;
+  auto final_pass = [&](const Matrix& y) {
+    problem->StreamingMap(y, true, &image, &totals);
+    image -= y;
     return rhs_norm > 0.0 ? std::sqrt(std::max(problem->RetrogradeEnergy(image), 0.0)) / rhs_norm
                           : 0.0;
   };
@@ -90,8 +90,8 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
   std::string start_note, switch_note;
   auto accept = [&](const std::string& message) {
     summary->termination = TerminationType::kConvergence;
-    summary->message =
-        message + "; rebuild error " + ScientificString(totals.rebuild_error) + start_note + switch_note;
+    summary->message = message + "; rebuild error " + ScientificString(totals.rebuild_error) +
+                       start_note + switch_note;
     solution->cost = totals.cost;
     solution->cost_gradients = totals.cost_gradients;
     solution->cost_gradient = totals.cost_gradients.sum();
@@ -101,7 +101,7 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
     solution->gap_density = totals.gap_density;
   };
   if (rhs_norm == 0.0) {
-    final_pass();
+    final_pass(traces);
     accept("the data are matched exactly: Phi(d~) = d~");
     return;
   }
@@ -109,17 +109,15 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
   // true one after a restart, then from the CG recursion (after q_k is formed).
   double relative = 1.0;
   if (initial_traces != nullptr) {
-    // r^(0) = Phi(y^(0)) - y^(0), into `image` until it is kept; the pass sums the
-    // fields too, so that a start already within the tolerance is the final pass.
-    problem->StreamingMap(*initial_traces, true, &image, &totals);
-    image -= *initial_traces;
-    const double warm_relative =
-        std::sqrt(std::max(problem->RetrogradeEnergy(image), 0.0)) / rhs_norm;
+    // r^(0) = Phi(y^(0)) - y^(0), into `image` until it is kept; a final pass, so
+    // that a start already within the tolerance needs no other.
+    const double warm_relative = final_pass(*initial_traces);
     if (warm_relative < relative) {
       traces = *initial_traces;
       residual.swap(image);
       relative = warm_relative;
-      start_note = "; from the warm start (relative residual " + ScientificString(warm_relative) + ")";
+      start_note =
+          "; from the warm start (relative residual " + ScientificString(warm_relative) + ")";
       if (relative <= options.tolerance && totals.rebuild_error <= options.max_rebuild_error) {
         summary->residual_history.push_back(relative);
         summary->relative_residual = relative;
@@ -153,15 +151,15 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
     const double curvature = problem->TraceInnerProduct(direction, image);
     if (!(curvature > 0.0)) {
       summary->termination = TerminationType::kFailure;
-      summary->message =
-          "streaming conjugate gradients broke down: <p, (I - L) p> = " + ScientificString(curvature) +
-          " at iteration " + std::to_string(iteration);
+      summary->message = "streaming conjugate gradients broke down: <p, (I - L) p> = " +
+                         ScientificString(curvature) + " at iteration " + std::to_string(iteration);
       return;
     }
     if (since_restart > 0) {
       // ||r_k||_W^2 = <p_k, -L p_k> + 2 beta_k <p_k, p_{k-1}> + beta_k^2 <p_{k-1}, -L p_{k-1}>.
-      const double energy = direction_energy + 2.0 * direction_coefficient * consecutive_directions +
-                            direction_coefficient * direction_coefficient * previous_direction_energy;
+      const double energy =
+          direction_energy + 2.0 * direction_coefficient * consecutive_directions +
+          direction_coefficient * direction_coefficient * previous_direction_energy;
       relative = std::sqrt(std::max(energy, 0.0)) / rhs_norm;
       if (!std::isfinite(relative)) {
         summary->termination = TerminationType::kFailure;
@@ -181,8 +179,9 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
       const double rho_next = problem->TraceInnerProduct(residual, residual);
       direction_coefficient = rho_next / rho;
       // <p_{k+1}, p_k> = <r_{k+1}, p_k> + beta_{k+1} <p_k, p_k>.
-      consecutive_directions = problem->TraceInnerProduct(residual, direction) +
-                               direction_coefficient * problem->TraceInnerProduct(direction, direction);
+      consecutive_directions =
+          problem->TraceInnerProduct(residual, direction) +
+          direction_coefficient * problem->TraceInnerProduct(direction, direction);
       direction = residual + direction_coefficient * direction;
       previous_direction_energy = direction_energy;
       rho = rho_next;
@@ -191,7 +190,7 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
     // r_k met the tolerance: the final pass checks the true residual of y_k. (Not
     // y_{k+1}: ||r_k||_W is not monotone, CG minimising another norm, and r_{k+1}
     // measured up to 1e4 times r_k.)
-    double true_relative = final_pass();
+    double true_relative = final_pass(traces);
     if (!(totals.rebuild_error <= options.max_rebuild_error)) {
       // The reversed recursion drifted (the stiff modes' round-off at a high Courant
       // number): W from checkpoints from now on, exact, and y's true residual measured
@@ -200,7 +199,7 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
                     ScientificString(totals.rebuild_error) + " (limit " +
                     ScientificString(options.max_rebuild_error) + ")";
       problem->UseCheckpoints();
-      true_relative = final_pass();
+      true_relative = final_pass(traces);
       ++max_restarts;
     }
     summary->relative_residual = true_relative;
@@ -231,8 +230,8 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, Mcre
       }
       summary->termination = TerminationType::kNoConvergence;
       summary->message = "the true residual " + ScientificString(true_relative) +
-                         " misses the tolerance " + ScientificString(options.tolerance) + " after " +
-                         std::to_string(restarts) + " restarts";
+                         " misses the tolerance " + ScientificString(options.tolerance) +
+                         " after " + std::to_string(restarts) + " restarts";
       return;
     }
     // Restart from the true residual: the recursive one drifted from it.
