@@ -135,7 +135,9 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(zones.regularization.max_weight, zones_again.regularization.max_weight);
   EXPECT_EQ(zones.regularization.min_weight, zones_again.regularization.min_weight);
   EXPECT_EQ(zones.regularization.grid_factor, zones_again.regularization.grid_factor);
-  EXPECT_EQ(zones.regularization.bisection_steps, zones_again.regularization.bisection_steps);
+  EXPECT_EQ(zones.regularization.refinement_steps, zones_again.regularization.refinement_steps);
+  EXPECT_EQ(zones.regularization.discrepancy_tolerance,
+            zones_again.regularization.discrepancy_tolerance);
   EXPECT_EQ(zones.regularization.discrepancy_factor, zones_again.regularization.discrepancy_factor);
   EXPECT_EQ(zones.noise_samples, zones_again.noise_samples);
   EXPECT_EQ(zones.noise_seed, zones_again.noise_seed);
@@ -490,7 +492,8 @@ zone_identification:
   max_weight: 2
   min_weight: 1e-7
   grid_factor: 10
-  bisection_steps: 5
+  refinement_steps: 5
+  discrepancy_tolerance: 0.5
   discrepancy_factor: 1.5
   noise_samples: 6
   noise_seed: 7

@@ -87,10 +87,10 @@ class LeastSquares : public MultiParameterObjective {
 
 TEST(DiscrepancyPrincipleTest, ChoosesTheWeightOfTheClosedForm) {
   // b = A p_true + noise of std 0.05 over 40 rows, p_true piecewise constant; the target
-  // is the expected misfit of the truth, 1/2 m sigma^2. The weight whose Tikhonov misfit
-  // equals the target, lambda*, by bisection of the closed form; the discrepancy
-  // principle's weight lies within its final bracket,
-  // [lambda* / grid_factor^(1/2^bisection_steps), lambda*].
+  // is the expected misfit of the truth, 1/2 m sigma^2. The weights whose Tikhonov
+  // misfit equals the target, lambda*, and target / (1 + discrepancy_tolerance),
+  // lambda_low, by bisection of the closed form; the discrepancy principle's weight
+  // lies between them.
   const int m = 40, n = 10;
   std::mt19937_64 engine(3);
   std::normal_distribution<double> normal;
@@ -105,43 +105,54 @@ TEST(DiscrepancyPrincipleTest, ChoosesTheWeightOfTheClosedForm) {
   for (int i = 0; i < m; ++i) b[i] += sigma * normal(engine);
   LeastSquares data(a, b);
   const double target = 0.5 * m * sigma * sigma;
+  // The weight whose misfit is `level`: misfit(lambda) increases; bisection in log lambda.
+  const auto weight_of_misfit = [&](double level) {
+    double low = 1e-10, high = 1e2;
+    EXPECT_LT(data.Misfit(low), level);
+    EXPECT_GT(data.Misfit(high), level);
+    for (int i = 0; i < 200; ++i) {
+      const double middle = std::sqrt(low * high);
+      (data.Misfit(middle) > level ? high : low) = middle;
+    }
+    return low;
+  };
+  const double expected = weight_of_misfit(target);
 
-  // lambda*: misfit(lambda) increases; bisection in log lambda.
-  double low = 1e-10, high = 1e2;
-  ASSERT_LT(data.Misfit(low), target);
-  ASSERT_GT(data.Misfit(high), target);
-  for (int i = 0; i < 200; ++i) {
-    const double middle = std::sqrt(low * high);
-    (data.Misfit(middle) > target ? high : low) = middle;
-  }
-  const double expected = low;
-
-  for (BoundedAlgorithm algorithm :
-       {BoundedAlgorithm::kNloptLbfgs, BoundedAlgorithm::kCeresLbfgs}) {
-    BoundedMinimizerOptions options;
-    options.algorithm = algorithm;
-    options.step_tolerance = 1e-10;
-    options.function_tolerance = 0.0;
-    RegularizationOptions regularization;
-    // Absolute weights 1e2 down to 1e-10: the options are relative to the start's cost.
-    const double start_cost = 0.5 * b.squaredNorm();
-    regularization.max_weight = 1e2 / start_cost;
-    regularization.min_weight = 1e-10 / start_cost;
-    const RegularizedMinimization result =
-        MinimizeRegularized(options, regularization, &data, std::vector<double>(n, -5.0),
-                            std::vector<double>(n, 5.0), std::vector<double>(n, 0.0), target);
-    ASSERT_TRUE(result.IsSolutionUsable()) << result.minimizer.FullReport();
-    EXPECT_EQ(result.weight_choice, "discrepancy");
-    EXPECT_LE(result.misfit, target);
-    // Measured: lambda = 1.3335 against 1.4763 (ratio 0.903, the bracket's lower end is
-    // 0.866) with both minimisers, 7 minimisations (3 of the grid, 4 bisections).
-    EXPECT_LE(result.weight, expected * 1.001);
-    EXPECT_GE(result.weight, expected /
-                                 std::pow(regularization.grid_factor,
-                                          std::pow(0.5, regularization.bisection_steps)) /
-                                 1.001);
-    // The misfit at the result is the closed form's at that weight.
-    EXPECT_NEAR(result.misfit, data.Misfit(result.weight), 1e-6 * target);
+  // The default tolerance, met by the grid's weight 1 (no refinement), and a tight one
+  // that the regula falsi must reach.
+  for (double tolerance : {RegularizationOptions().discrepancy_tolerance, 1e-3}) {
+    const double lowest = weight_of_misfit(target / (1.0 + tolerance));
+    for (BoundedAlgorithm algorithm :
+         {BoundedAlgorithm::kNloptLbfgs, BoundedAlgorithm::kCeresLbfgs}) {
+      BoundedMinimizerOptions options;
+      options.algorithm = algorithm;
+      options.step_tolerance = 1e-10;
+      options.function_tolerance = 0.0;
+      RegularizationOptions regularization;
+      regularization.discrepancy_tolerance = tolerance;
+      regularization.refinement_steps = 10;
+      // Absolute weights 1e2 down to 1e-10: the options are relative to the start's cost.
+      const double start_cost = 0.5 * b.squaredNorm();
+      regularization.max_weight = 1e2 / start_cost;
+      regularization.min_weight = 1e-10 / start_cost;
+      const RegularizedMinimization result =
+          MinimizeRegularized(options, regularization, &data, std::vector<double>(n, -5.0),
+                              std::vector<double>(n, 5.0), std::vector<double>(n, 0.0), target);
+      ASSERT_TRUE(result.IsSolutionUsable()) << result.minimizer.FullReport();
+      EXPECT_EQ(result.weight_choice, "discrepancy");
+      EXPECT_LE(result.misfit, target);
+      EXPECT_GE(result.misfit * (1.0 + tolerance), target);
+      EXPECT_LE(result.weight, expected * 1.001);
+      EXPECT_GE(result.weight, lowest / 1.001);
+      // Measured with both minimisers: tolerance 0.25, lambda = 1 against lambda* =
+      // 1.4763 (lambda_low 0.4029), 2 minimisations (the grid's 1e2 and 1; the 4
+      // bisections of log lambda it replaced made 7 for 1.3335); tolerance 1e-3,
+      // lambda = 1.4763 (lambda_low 1.4715), 6 minimisations (4 of regula falsi, where
+      // bisection would need 11 to bracket lambda* within that factor 1.0033).
+      EXPECT_LE(result.path.size(), tolerance > 0.1 ? 2u : 6u);
+      // The misfit at the result is the closed form's at that weight.
+      EXPECT_NEAR(result.misfit, data.Misfit(result.weight), 1e-6 * target);
+    }
   }
 }
 
@@ -159,7 +170,7 @@ TEST(DiscrepancyPrincipleTest, AnUnreachableTargetFallsBackToTheMisfitFloor) {
       MinimizeRegularized(options, regularization, &data, std::vector<double>(3, -10.0),
                           std::vector<double>(3, 10.0), std::vector<double>(3, 0.0), 1.0);
   // The grid 1, 0.01 misses; its floor (0.01's misfit) + 10 % is met at once by weight 1
-  // (misfit 38.94 against 38.5 * 1.1): kept, no bisection (nothing missed above it).
+  // (misfit 38.94 against 38.5 * 1.1): kept, no refinement (nothing missed above it).
   EXPECT_EQ(result.weight_choice, "misfit_floor");
   EXPECT_NEAR(result.weight, 1.0, 1e-12);
   EXPECT_EQ(result.path.size(), 2u);

@@ -81,8 +81,11 @@ bool RegularizationOptions::IsValid(std::string* error) const {
         << min_weight << " and " << max_weight;
   } else if (!(grid_factor > 1.0 && grid_factor <= 1e6)) {
     why << "zone_identification.grid_factor must lie in (1, 1e6], got " << grid_factor;
-  } else if (bisection_steps < 0 || bisection_steps > 30) {
-    why << "zone_identification.bisection_steps must lie in [0, 30], got " << bisection_steps;
+  } else if (refinement_steps < 0 || refinement_steps > 30) {
+    why << "zone_identification.refinement_steps must lie in [0, 30], got " << refinement_steps;
+  } else if (!(discrepancy_tolerance > 0.0 && discrepancy_tolerance <= 10.0)) {
+    why << "zone_identification.discrepancy_tolerance must lie in (0, 10], got "
+        << discrepancy_tolerance;
   } else if (!(discrepancy_factor > 0.0 && std::isfinite(discrepancy_factor))) {
     why << "zone_identification.discrepancy_factor must be a positive number, got "
         << discrepancy_factor;
@@ -165,6 +168,7 @@ RegularizedMinimization MinimizeRegularized(
   }
   ++result.evaluations;
   double missed = -1.0;  // the last weight that missed the target
+  double missed_misfit = -1.0;
   BoundedMinimizerSummary hit;
   double hit_weight = -1.0;
   double hit_misfit = -1.0;
@@ -201,6 +205,7 @@ RegularizedMinimization MinimizeRegularized(
       break;
     }
     missed = weight;
+    missed_misfit = point.misfit;
   }
   double target = target_misfit;
   result.weight_choice = "discrepancy";
@@ -221,23 +226,50 @@ RegularizedMinimization MinimizeRegularized(
         hit_weight = grid_weights[k];
         hit_misfit = grid_misfits[k];
         missed = k > 0 ? grid_weights[k - 1] : -1.0;
+        missed_misfit = k > 0 ? grid_misfits[k - 1] : -1.0;
         break;
       }
     }
   }
-  // Bisection in log lambda between the weight that missed (larger) and the hit.
+  // Regula falsi (Illinois) between the weight that missed (larger) and the hit on
+  // f(s) = ln(misfit / target), s = ln lambda, which misfit's near power law in lambda
+  // makes nearly linear: stops once the hit's misfit lies within
+  // [target / (1 + discrepancy_tolerance), target], or after refinement_steps.
   if (missed > 0.0) {
-    for (int step = 0; step < regularization.bisection_steps; ++step) {
-      const double weight = std::sqrt(missed * hit_weight);
+    const auto log_ratio = [&](double misfit) { return std::log(misfit / target); };
+    double hit_log = std::log(hit_weight), missed_log = std::log(missed);
+    double hit_f = target > 0.0 && hit_misfit > 0.0 ? log_ratio(hit_misfit) : 0.0;
+    double missed_f = target > 0.0 ? log_ratio(missed_misfit) : 0.0;
+    int last_side = 0;  // +1: the last step replaced the missed end, -1: the hit
+    for (int step = 0; step < regularization.refinement_steps; ++step) {
+      if (hit_misfit * (1.0 + regularization.discrepancy_tolerance) >= target) break;
+      // The root of the chord; the midpoint when the chord is not usable (a zero
+      // misfit at the hit, or a misfit that did not grow with lambda).
+      double s = 0.5 * (hit_log + missed_log);
+      if (target > 0.0 && hit_misfit > 0.0 && missed_f > hit_f) {
+        s = hit_log - hit_f * (missed_log - hit_log) / (missed_f - hit_f);
+      }
+      const double weight = std::exp(s);
+      if (!(weight > hit_weight && weight < missed)) break;
       BoundedMinimizerSummary summary = MinimizeAt(options, regularization, data, lower, upper,
                                                    hit.x, weight, target, &result, &point);
-      if (!summary.IsSolutionUsable()) break;  // keep the hit
+      if (!summary.IsSolutionUsable() || !(point.misfit > 0.0)) break;  // keep the hit
+      const double f = log_ratio(point.misfit);
       if (point.meets_target) {
         hit = std::move(summary);
         hit_weight = weight;
         hit_misfit = point.misfit;
+        hit_log = s;
+        hit_f = f;
+        // Illinois: an end kept twice has its value halved, so that the chord moves it.
+        if (last_side == -1) missed_f *= 0.5;
+        last_side = -1;
       } else {
         missed = weight;
+        missed_log = s;
+        missed_f = f;
+        if (last_side == +1) hit_f *= 0.5;
+        last_side = +1;
       }
     }
   }
