@@ -337,6 +337,10 @@ void RunCeres(const BoundedMinimizerOptions& options, const std::vector<double>&
   ceres::GradientProblemSolver::Options solver_options;
   solver_options.line_search_direction_type = ceres::LBFGS;
   solver_options.line_search_type = ceres::WOLFE;
+  // Ceres' default rank 20 starves the many weakly determined parameters of one zone
+  // per element: 677 evaluations for the last weight of the 100-zone paper bar
+  // (noise-free) against 66 with a rank of 100; the rank does not matter for 10 zones.
+  solver_options.max_lbfgs_rank = 100;
   solver_options.max_num_iterations = options.max_evaluations;
   solver_options.max_solver_time_in_seconds = options.max_time;
   solver_options.parameter_tolerance = 1e-15;
