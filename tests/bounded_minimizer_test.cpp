@@ -82,8 +82,8 @@ TEST_P(BoundedMinimizerTest, InteriorQuadratic) {
       MinimizeWithinBounds(OptionsFor(GetParam()), &objective, lower, upper, initial);
   ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
   const double error = MaxError(summary.x, c);
-  // Measured max errors (evaluations): nlopt_lbfgs 1.3e-9 (14), nlopt_mma 9.9e-11 (45),
-  // nlopt_slsqp 9.9e-15 (19), nlopt_bobyqa 4.8e-13 (74), ceres_lbfgs 9.6e-12 (23).
+  // Measured max errors (evaluations): nlopt_lbfgs 2.9e-9 (14), nlopt_mma 1.5e-11 (48),
+  // nlopt_slsqp 1.6e-13 (26), nlopt_bobyqa 4.8e-13 (75), ceres_lbfgs 7.8e-13 (20).
   EXPECT_LT(error, 1.5e-8) << summary.FullReport();
 }
 
@@ -103,8 +103,8 @@ TEST_P(BoundedMinimizerTest, OptimumOnBounds) {
       MinimizeWithinBounds(OptionsFor(GetParam()), &objective, lower, upper, initial);
   ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
   const double error = MaxError(summary.x, expected);
-  // Measured max errors (evaluations): nlopt_lbfgs 3.0e-10 (9), nlopt_mma 8.3e-10 (84),
-  // nlopt_slsqp 5.6e-17 (20), nlopt_bobyqa 5.1e-10 (65), ceres_lbfgs 1.4e-9 (15; the
+  // Measured max errors (evaluations): nlopt_lbfgs 8.7e-11 (11), nlopt_mma 2.8e-9 (50),
+  // nlopt_slsqp 1.2e-15 (28), nlopt_bobyqa 5.3e-10 (71), ceres_lbfgs 4.0e-10 (17; the
   // sine transform reaches the bounds at a finite y).
   EXPECT_LT(error, 1.5e-8) << summary.FullReport();
   for (std::size_t i = 0; i < summary.x.size(); ++i) {
@@ -125,8 +125,8 @@ TEST_P(BoundedMinimizerTest, Rosenbrock) {
       MinimizeWithinBounds(OptionsFor(GetParam()), &objective, lower, upper, initial);
   ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
   const double error = MaxError(summary.x, {1.0, 1.0});
-  // Measured max errors (evaluations): nlopt_lbfgs 1.1e-13 (51), nlopt_slsqp 1.1e-16 (67),
-  // nlopt_bobyqa 4.1e-12 (200), ceres_lbfgs 0 (50).
+  // Measured max errors (evaluations): nlopt_lbfgs 1.1e-13 (52), nlopt_slsqp 7.5e-15 (56),
+  // nlopt_bobyqa 1.7e-11 (201), ceres_lbfgs 1.4e-12 (43).
   EXPECT_LT(error, 5e-11) << summary.FullReport();
 }
 

@@ -136,8 +136,8 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(zones.regularization.min_weight, zones_again.regularization.min_weight);
   EXPECT_EQ(zones.regularization.grid_factor, zones_again.regularization.grid_factor);
   EXPECT_EQ(zones.regularization.refinement_steps, zones_again.regularization.refinement_steps);
-  EXPECT_EQ(zones.regularization.discrepancy_tolerance,
-            zones_again.regularization.discrepancy_tolerance);
+  EXPECT_EQ(zones.regularization.weight_tolerance,
+            zones_again.regularization.weight_tolerance);
   EXPECT_EQ(zones.regularization.discrepancy_factor, zones_again.regularization.discrepancy_factor);
   EXPECT_EQ(zones.noise_samples, zones_again.noise_samples);
   EXPECT_EQ(zones.noise_seed, zones_again.noise_seed);
@@ -481,7 +481,7 @@ study:
   comparator_errors: [density, soft_zone]
   comparator_data: [prefilter]
 zone_identification:
-  algorithm: ceres_lbfgs
+  algorithm: nlopt_slsqp
   step_tolerance: 1e-9
   function_tolerance: 1e-11
   max_evaluations: 321
@@ -493,7 +493,7 @@ zone_identification:
   min_weight: 1e-7
   grid_factor: 10
   refinement_steps: 5
-  discrepancy_tolerance: 0.5
+  weight_tolerance: 0.5
   discrepancy_factor: 1.5
   noise_samples: 6
   noise_seed: 7

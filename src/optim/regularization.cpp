@@ -83,9 +83,8 @@ bool RegularizationOptions::IsValid(std::string* error) const {
     why << "zone_identification.grid_factor must lie in (1, 1e6], got " << grid_factor;
   } else if (refinement_steps < 0 || refinement_steps > 30) {
     why << "zone_identification.refinement_steps must lie in [0, 30], got " << refinement_steps;
-  } else if (!(discrepancy_tolerance > 0.0 && discrepancy_tolerance <= 10.0)) {
-    why << "zone_identification.discrepancy_tolerance must lie in (0, 10], got "
-        << discrepancy_tolerance;
+  } else if (!(weight_tolerance > 0.0 && weight_tolerance <= 100.0)) {
+    why << "zone_identification.weight_tolerance must lie in (0, 100], got " << weight_tolerance;
   } else if (!(discrepancy_factor > 0.0 && std::isfinite(discrepancy_factor))) {
     why << "zone_identification.discrepancy_factor must be a positive number, got "
         << discrepancy_factor;
@@ -233,8 +232,10 @@ RegularizedMinimization MinimizeRegularized(
   }
   // Regula falsi (Illinois) between the weight that missed (larger) and the hit on
   // f(s) = ln(misfit / target), s = ln lambda, which misfit's near power law in lambda
-  // makes nearly linear: stops once the hit's misfit lies within
-  // [target / (1 + discrepancy_tolerance), target], or after refinement_steps.
+  // makes nearly linear: stops once the chord's root lies within a factor
+  // 1 + weight_tolerance of the hit (the weight, not the misfit: near the noise's level
+  // the misfit can vary by 10 % over 4 decades of lambda, where the zones change the
+  // most), or after refinement_steps.
   if (missed > 0.0) {
     const auto log_ratio = [&](double misfit) { return std::log(misfit / target); };
     double hit_log = std::log(hit_weight), missed_log = std::log(missed);
@@ -242,15 +243,15 @@ RegularizedMinimization MinimizeRegularized(
     double missed_f = target > 0.0 ? log_ratio(missed_misfit) : 0.0;
     int last_side = 0;  // +1: the last step replaced the missed end, -1: the hit
     for (int step = 0; step < regularization.refinement_steps; ++step) {
-      if (hit_misfit * (1.0 + regularization.discrepancy_tolerance) >= target) break;
       // The root of the chord; the midpoint when the chord is not usable (a zero
       // misfit at the hit, or a misfit that did not grow with lambda).
       double s = 0.5 * (hit_log + missed_log);
       if (target > 0.0 && hit_misfit > 0.0 && missed_f > hit_f) {
         s = hit_log - hit_f * (missed_log - hit_log) / (missed_f - hit_f);
       }
+      if (s - hit_log <= std::log1p(regularization.weight_tolerance)) break;
       const double weight = std::exp(s);
-      if (!(weight > hit_weight && weight < missed)) break;
+      if (!(weight < missed)) break;
       BoundedMinimizerSummary summary = MinimizeAt(options, regularization, data, lower, upper,
                                                    hit.x, weight, target, &result, &point);
       if (!summary.IsSolutionUsable() || !(point.misfit > 0.0)) break;  // keep the hit

@@ -56,12 +56,12 @@
 //          density, force_gain, displacement_gain, soft_zone]], comparator_data
 //          [[raw, prefilter]]
 //          (StudyOptions, study.h; used by `identify study` only)
-//   zone_identification: algorithm [nlopt_lbfgs], step_tolerance [1e-8],
+//   zone_identification: algorithm [ceres_lbfgs], step_tolerance [1e-8],
 //          function_tolerance [1e-10], max_evaluations [2000], max_time [600 s],
 //          regularization [tikhonov | total_variation | none],
 //          regularization_weight [-1: discrepancy principle], tv_smoothing [1e-3],
-//          max_weight [1], min_weight [1e-8], grid_factor [100], refinement_steps [3],
-//          discrepancy_tolerance [0.25], discrepancy_factor [1], noise_samples [4],
+//          max_weight [1], min_weight [1e-8], grid_factor [100], refinement_steps [4],
+//          weight_tolerance [0.25], discrepancy_factor [1], noise_samples [4],
 //          noise_seed [1]
 //          (ZoneIdentificationOptions, zone_identification.h)
 #pragma once

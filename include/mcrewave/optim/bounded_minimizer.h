@@ -75,7 +75,9 @@ bool UsesGradient(BoundedAlgorithm algorithm);
 
 // The `zone_identification:` options of the minimiser.
 struct BoundedMinimizerOptions {
-  BoundedAlgorithm algorithm = BoundedAlgorithm::kNloptLbfgs;
+  // Ceres' L-BFGS: the paper's bar, noise-free, 10 zones in 133 evaluations and 100 in
+  // 189, against 264 and 373 for NLopt's (docs/zones_and_sensors.md).
+  BoundedAlgorithm algorithm = BoundedAlgorithm::kCeresLbfgs;
   // Stop when a step changes every parameter by at most this much (absolute: on
   // p = log(E / E_scale) it is a relative change of E). NLopt xtol_abs; Ceres: the
   // same test on x in an iteration callback.

@@ -20,8 +20,8 @@
 // is 1e-6 or less, where a weight of 1 would freeze every zone), is descended, each minimisation
 // warm-started from the previous one, down to the first lambda that meets the
 // target; then regula falsi (Illinois) on ln(misfit / target) against ln lambda
-// between it and the last lambda that missed, until the misfit lies within
-// [target / (1 + discrepancy_tolerance), target] or refinement_steps are spent. When no lambda down to min_weight meets the target (model
+// between it and the last lambda that missed, until the chord's root lies within a
+// factor 1 + weight_tolerance of the lambda kept or refinement_steps are spent. When no lambda down to min_weight meets the target (model
 // error, or a noise level underestimated) the smallest would fit the noise as well as
 // the zones can (measured: zones between 0.59 and 1.84 E* on the paper's bar at SNR 20,
 // 10 zones, target 1.82e-6 against a floor of 1.86e-6); the principle is then applied
@@ -59,12 +59,12 @@ struct RegularizationOptions {
   // the target (a factor 10 and 4 bisections took 403 evaluations and 11 s on 10 zones
   // of the paper's bar, noise-free).
   double grid_factor = 100.0;
-  // The refinement after the grid: at most refinement_steps regula falsi steps, stopped
-  // once the misfit lies within [target / (1 + discrepancy_tolerance), target]. The
-  // misfit follows nearly a power of lambda, so one or two steps suffice where 3
-  // bisections took 3 and left the weight within a factor 100^(1/8) = 1.78.
-  int refinement_steps = 3;
-  double discrepancy_tolerance = 0.25;
+  // The refinement after the grid: at most refinement_steps regula falsi steps,
+  // stopped once the chord's root lies within a factor 1 + weight_tolerance of the
+  // lambda kept. The misfit follows nearly a power of lambda, so the chord lands
+  // close where 3 bisections left the weight within a factor 100^(1/8) = 1.78.
+  int refinement_steps = 4;
+  double weight_tolerance = 0.25;
   // tau of the target misfit tau * (expected e^2 of the noise).
   double discrepancy_factor = 1.0;
 
