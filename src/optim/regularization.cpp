@@ -231,8 +231,8 @@ RegularizedMinimization MinimizeRegularized(
     }
   }
   // Regula falsi (Illinois) between the weight that missed (larger) and the hit on
-  // f(s) = ln(misfit / target), s = ln lambda, which misfit's near power law in lambda
-  // makes nearly linear: stops once the chord's root lies within a factor
+  // f(s) = ln(misfit / target), s = ln lambda, nearly linear where the misfit follows
+  // a power of lambda: stops once the chord's root lies within a factor
   // 1 + weight_tolerance of the hit (the weight, not the misfit: near the noise's level
   // the misfit can vary by 10 % over 4 decades of lambda, where the zones change the
   // most), or after refinement_steps.

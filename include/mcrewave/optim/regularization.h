@@ -21,7 +21,8 @@
 // warm-started from the previous one, down to the first lambda that meets the
 // target; then regula falsi (Illinois) on ln(misfit / target) against ln lambda
 // between it and the last lambda that missed, until the chord's root lies within a
-// factor 1 + weight_tolerance of the lambda kept or refinement_steps are spent. When no lambda down to min_weight meets the target (model
+// factor 1 + weight_tolerance of the lambda kept or refinement_steps are spent. When
+// no lambda down to min_weight meets the target (model
 // error, or a noise level underestimated) the smallest would fit the noise as well as
 // the zones can (measured: zones between 0.59 and 1.84 E* on the paper's bar at SNR 20,
 // 10 zones, target 1.82e-6 against a floor of 1.86e-6); the principle is then applied
