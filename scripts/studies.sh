@@ -43,9 +43,11 @@ else
   # The damage-localisation study (results/damage; zones and interior sensors), in the
   # free-free formulation its quick-case test checks: with the clamp trusted the
   # reaction's misfit puts the error map's peak at the clamp (0.02 m on the quick
-  # case). The gauges' weight w_e = 1e-4: noise-free, 10 zones, every zone within
-  # 1.0 % in 72 s a run, against 2.2 % in 203 s at 1e-3 and about 1300 inner sweeps a
-  # solve at 0.01 (docs/zones_and_sensors.md, "Damage localisation").
+  # case). The gauges' weight w_e = 1e-4, the lightest at which the error map points
+  # at the soft zone: noise-free, 10 zones, every zone within 1.0 % in 72 s a run,
+  # against 2.0 % in 203 s at 1e-3 and about 1300 inner sweeps a solve at 0.01
+  # (docs/zones_and_sensors.md, "The gauges' weight w_e"). Hours on 2 cores: the runs
+  # with interior sensors and one zone per element take over 8 min each.
   "$build_dir/identify/identify" study configs/studies.yaml --output results \
     --set study.kind=damage --set mcre.clamp=measured --set mcre.w_u=0.01 --set mcre.w_e=1e-4
 fi
