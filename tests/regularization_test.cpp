@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <utility>
 #include <random>
 #include <vector>
 
@@ -68,7 +69,9 @@ class LeastSquares : public MultiParameterObjective {
   }
   // The Tikhonov minimiser of 1/2 |A p - b|^2 + lambda |L p|^2 and its misfit:
   // (A^T A + 2 lambda L^T L) p = A^T b.
-  double Misfit(double lambda) const {
+  double Misfit(double lambda) const { return MisfitAndRoughness(lambda).first; }
+  // The misfit and the roughness |L p|^2 there.
+  std::pair<double, double> MisfitAndRoughness(double lambda) const {
     const int n = static_cast<int>(a_.cols());
     Eigen::MatrixXd l = Eigen::MatrixXd::Zero(n - 1, n);
     for (int z = 0; z + 1 < n; ++z) {
@@ -77,7 +80,7 @@ class LeastSquares : public MultiParameterObjective {
     }
     const Eigen::MatrixXd normal = a_.transpose() * a_ + 2.0 * lambda * l.transpose() * l;
     const Eigen::VectorXd p = normal.ldlt().solve(a_.transpose() * b_);
-    return 0.5 * (a_ * p - b_).squaredNorm();
+    return {0.5 * (a_ * p - b_).squaredNorm(), (l * p).squaredNorm()};
   }
 
  private:
@@ -171,6 +174,68 @@ TEST(DiscrepancyPrincipleTest, AnUnreachableTargetFallsBackToTheMisfitFloor) {
   EXPECT_EQ(result.path.size(), 2u);
   EXPECT_GT(result.misfit_floor, 38.5);
   EXPECT_LT(result.misfit, 1.1 * result.misfit_floor);
+}
+
+TEST(LCurveCornerTest, FindsTheBendOfAnLAndNoneOfALine) {
+  // ln misfit 2, 1, 0, 0, 0 against ln roughness 0, 0, 0, 1, 2: a right angle at
+  // index 2, 0.707 below the chord (indices 1 and 3: 0.354).
+  const std::vector<double> misfits{std::exp(2.0), std::exp(1.0), 1.0, 1.0, 1.0};
+  const std::vector<double> roughness{1.0, 1.0, 1.0, std::exp(1.0), std::exp(2.0)};
+  EXPECT_EQ(LCurveCorner(misfits, roughness), 2);
+  // A straight line bends nowhere; fewer than 3 points or a zero value give none.
+  EXPECT_EQ(LCurveCorner({4.0, 2.0, 1.0}, {1.0, 2.0, 4.0}), -1);
+  EXPECT_EQ(LCurveCorner({4.0, 1.0}, {1.0, 4.0}), -1);
+  EXPECT_EQ(LCurveCorner({4.0, 1.0, 1.0}, {1.0, 0.0, 4.0}), -1);
+}
+
+TEST(DiscrepancyPrincipleTest, AnUnreachableTargetTakesTheCornerOfTheClosedFormsLCurve) {
+  // The closed-form test's problem with rows 40..45 that no p fits (b = 1 there, A = 0):
+  // its misfit floor exceeds the target. The weight is the grid's L-curve corner,
+  // found here from the closed form's misfits and roughness at the grid's weights.
+  const int m = 40, n = 10;
+  std::mt19937_64 engine(3);
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(m + 6, n);
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j < n; ++j) a(i, j) = std::exp(-0.5 * std::pow((i / 4.0 - j) / 1.5, 2));
+  }
+  Eigen::VectorXd truth = Eigen::VectorXd::Zero(n);
+  truth.segment(6, 1).setConstant(-0.35);
+  Eigen::VectorXd b = Eigen::VectorXd::Ones(m + 6);
+  b.head(m) = a.topRows(m) * truth;
+  for (int i = 0; i < m; ++i) b[i] += 0.05 * normal(engine);
+  LeastSquares data(a, b);
+  const double target = 0.5 * m * 0.05 * 0.05;  // under the floor 3 + (noise's part)
+  RegularizationOptions regularization;
+  const double start_cost = 0.5 * b.squaredNorm();
+  regularization.max_weight = 1e2 / start_cost;
+  regularization.min_weight = 1e-10 / start_cost;
+  std::vector<double> weights, misfits, roughness;
+  for (double weight = 1e2; weight >= 1e-10 * (1.0 - 1e-12);
+       weight /= regularization.grid_factor) {
+    const auto [misfit, rough] = data.MisfitAndRoughness(weight);
+    weights.push_back(weight);
+    misfits.push_back(misfit);
+    roughness.push_back(rough);
+  }
+  const int corner = LCurveCorner(misfits, roughness);
+  ASSERT_GT(corner, 0);
+  for (BoundedAlgorithm algorithm :
+       {BoundedAlgorithm::kNloptLbfgs, BoundedAlgorithm::kCeresLbfgs}) {
+    BoundedMinimizerOptions options;
+    options.algorithm = algorithm;
+    options.step_tolerance = 1e-10;
+    options.function_tolerance = 0.0;
+    const RegularizedMinimization result =
+        MinimizeRegularized(options, regularization, &data, std::vector<double>(n, -5.0),
+                            std::vector<double>(n, 5.0), std::vector<double>(n, 0.0), target);
+    ASSERT_TRUE(result.IsSolutionUsable()) << result.minimizer.FullReport();
+    EXPECT_EQ(result.weight_choice, "l_curve");
+    // Measured with both minimisers: the corner at lambda = 1 (index 1 of the grid
+    // 1e2 .. 1e-10, 7 minimisations), the closed form's to 1e-12.
+    EXPECT_NEAR(result.weight, weights[corner], 1e-12 * weights[corner]);
+    EXPECT_NEAR(result.misfit, misfits[corner], 1e-6 * misfits[corner]);
+  }
 }
 
 TEST(RegularizationOptionsTest, NamesAndMessages) {

@@ -157,6 +157,7 @@ TEST(ZoneDiscrepancyTest, NoiseFreeDataNeedNoRegularisationToSpeakOf) {
   // steps), worst zone 0.55 % off, 116 evaluations of ceres_lbfgs (NLopt's L-BFGS and
   // 4 bisections: 1.15e-7, 0.50 %, 286 evaluations).
   EXPECT_TRUE(summary.regularized.weight_choice == "discrepancy" ||
+              summary.regularized.weight_choice == "l_curve" ||
               summary.regularized.weight_choice == "misfit_floor");
   EXPECT_LT(worst, 0.01) << summary.FullReport();
 }

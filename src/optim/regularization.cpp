@@ -2,7 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <sstream>
 #include <utility>
@@ -135,6 +137,43 @@ bool RegularizedObjective::Evaluate(const double* x, double* cost, double* gradi
   return true;
 }
 
+int LCurveCorner(const std::vector<double>& misfits, const std::vector<double>& roughness) {
+  assert(misfits.size() == roughness.size());
+  const int n = static_cast<int>(misfits.size());
+  if (n < 3) return -1;
+  // (ln misfit, ln roughness), each scaled to [0, 1] over the grid.
+  std::vector<double> x(n), y(n);
+  for (int k = 0; k < n; ++k) {
+    if (!(misfits[k] > 0.0 && roughness[k] > 0.0)) return -1;
+    x[k] = std::log(misfits[k]);
+    y[k] = std::log(roughness[k]);
+  }
+  const auto [x_low, x_high] = std::minmax_element(x.begin(), x.end());
+  const auto [y_low, y_high] = std::minmax_element(y.begin(), y.end());
+  const double x_range = *x_high - *x_low, y_range = *y_high - *y_low;
+  if (!(x_range > 0.0 && y_range > 0.0)) return -1;
+  const double x0 = *x_low, y0 = *y_low;
+  for (int k = 0; k < n; ++k) {
+    x[k] = (x[k] - x0) / x_range;
+    y[k] = (y[k] - y0) / y_range;
+  }
+  // The distance below the chord from the first point to the last (positive on the
+  // origin's side, where an L bends).
+  const double dx = x[n - 1] - x[0], dy = y[n - 1] - y[0];
+  const double length = std::hypot(dx, dy);
+  if (!(length > 0.0)) return -1;
+  int corner = -1;
+  double largest = kLCurveMinimumBend;
+  for (int k = 1; k + 1 < n; ++k) {
+    const double below = (dx * (y[k] - y[0]) - dy * (x[k] - x[0])) / length;
+    if (below > largest) {
+      largest = below;
+      corner = k;
+    }
+  }
+  return corner;
+}
+
 RegularizedMinimization MinimizeRegularized(
     const BoundedMinimizerOptions& options, const RegularizationOptions& regularization,
     MultiParameterObjective* data, const std::vector<double>& lower,
@@ -209,10 +248,26 @@ RegularizedMinimization MinimizeRegularized(
   double target = target_misfit;
   result.weight_choice = "discrepancy";
   if (hit_weight < 0.0) {
-    // The misfit floor: no weight reaches the noise's level (model error, or the noise
-    // underestimated). The smallest weight would fit the noise as well as it can; the
-    // principle is applied instead to the floor itself, raised by kMisfitFloorMargin.
     result.misfit_floor = last_misfit;
+    // No weight reaches the noise's level (model error, or the noise underestimated):
+    // the noise level is not to be trusted, and the L-curve needs none.
+    std::vector<double> grid_roughness;
+    for (std::size_t k = 0; k < grid.size(); ++k) grid_roughness.push_back(result.path[k].roughness);
+    const int corner = LCurveCorner(grid_misfits, grid_roughness);
+    if (corner >= 0) {
+      spdlog::warn(
+          "no regularisation weight down to {:.3g} brings the misfit {:.6g} to the noise's "
+          "level {:.6g}: the weight is the L-curve's corner, {:.3g} (misfit {:.6g})",
+          last_weight, last_misfit, target_misfit, grid_weights[corner], grid_misfits[corner]);
+      result.weight_choice = "l_curve";
+      result.minimizer = grid[corner];
+      result.weight = grid_weights[corner];
+      result.x = result.minimizer.x;
+      result.misfit = grid_misfits[corner];
+      return result;
+    }
+    // Without a corner (fewer than 3 weights, or a straight curve) the principle is
+    // applied to the floor itself, raised by kMisfitFloorMargin.
     target = (1.0 + kMisfitFloorMargin) * last_misfit;
     spdlog::warn(
         "no regularisation weight down to {:.3g} brings the misfit {:.6g} to the noise's level "

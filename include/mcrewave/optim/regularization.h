@@ -25,9 +25,11 @@
 // no lambda down to min_weight meets the target (model
 // error, or a noise level underestimated) the smallest would fit the noise as well as
 // the zones can (measured: zones between 0.59 and 1.84 E* on the paper's bar at SNR 20,
-// 10 zones, target 1.82e-6 against a floor of 1.86e-6); the principle is then applied
-// to that floor raised by kMisfitFloorMargin (weight_choice "misfit_floor", a warning):
-// the largest lambda whose misfit stays within 10 % of the least misfit reached.
+// 10 zones, target 1.82e-6 against a floor of 1.86e-6). The noise level is then not
+// to be trusted: the weight is the corner of the grid's L-curve (LCurveCorner,
+// weight_choice "l_curve", a warning), or without a corner the principle applied to
+// the floor raised by kMisfitFloorMargin (weight_choice "misfit_floor"): the largest
+// lambda whose misfit stays within 10 % of the least misfit reached.
 #pragma once
 
 #include <string>
@@ -114,13 +116,24 @@ struct RegularizedPoint {
   TerminationType termination = TerminationType::kFailure;
 };
 
-// The margin over the misfit floor of the fallback (see the top of this file).
+// The margin over the misfit floor of the last fallback (see the top of this file).
 constexpr double kMisfitFloorMargin = 0.1;
+// The least bend of an L-curve corner: its distance below the chord, in the grid's
+// (ln misfit, ln roughness) scaled to [0, 1].
+constexpr double kLCurveMinimumBend = 0.01;
+
+// The corner of the L-curve through the grid's points (ln misfit_k, ln roughness_k),
+// in the grid's order (lambda decreasing): each axis scaled to [0, 1] over the grid,
+// the interior point farthest below the chord from the first point to the last, when
+// that distance exceeds kLCurveMinimumBend. Returns its index, or -1 (fewer than 3
+// points, a value <= 0, a flat axis, or no bend).
+int LCurveCorner(const std::vector<double>& misfits, const std::vector<double>& roughness);
 
 struct RegularizedMinimization {
   double weight = -1.0;  // lambda of the result
-  // "fixed", "none" (no regularisation), "discrepancy", or "misfit_floor" (the target
-  // missed: the principle applied to the least misfit reached + kMisfitFloorMargin).
+  // "fixed", "none" (no regularisation), "discrepancy", "l_curve" (the target missed:
+  // the grid's L-curve corner), or "misfit_floor" (the target missed and no corner:
+  // the principle applied to the least misfit reached + kMisfitFloorMargin).
   std::string weight_choice = "fixed";
   double target_misfit = -1.0;         // the discrepancy target (-1: not used)
   double misfit_floor = -1.0;          // least misfit of the grid when the target was missed
