@@ -1,14 +1,14 @@
-// The jump penalty of optim/regularization.h (its gradient against central differences)
-// and the discrepancy principle's weight on a linear least-squares problem whose answer
-// is known in closed form.
+// The jump penalty of optim/regularization.h (its gradient against central differences),
+// the discrepancy principle's weight and the L-curve corner on a linear least-squares
+// problem whose answer is known in closed form.
 #include "mcrewave/optim/regularization.h"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <cmath>
-#include <utility>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "mcrewave/core/types.h"
@@ -211,8 +211,7 @@ TEST(DiscrepancyPrincipleTest, AnUnreachableTargetTakesTheCornerOfTheClosedForms
   regularization.max_weight = 1e2 / start_cost;
   regularization.min_weight = 1e-10 / start_cost;
   std::vector<double> weights, misfits, roughness;
-  for (double weight = 1e2; weight >= 1e-10 * (1.0 - 1e-12);
-       weight /= regularization.grid_factor) {
+  for (double weight = 1e2; weight >= 1e-10 * (1.0 - 1e-12); weight /= regularization.grid_factor) {
     const auto [misfit, rough] = data.MisfitAndRoughness(weight);
     weights.push_back(weight);
     misfits.push_back(misfit);

@@ -252,7 +252,8 @@ RegularizedMinimization MinimizeRegularized(
     // No weight reaches the noise's level (model error, or the noise underestimated):
     // the noise level is not to be trusted, and the L-curve needs none.
     std::vector<double> grid_roughness;
-    for (std::size_t k = 0; k < grid.size(); ++k) grid_roughness.push_back(result.path[k].roughness);
+    for (std::size_t k = 0; k < grid.size(); ++k)
+      grid_roughness.push_back(result.path[k].roughness);
     const int corner = LCurveCorner(grid_misfits, grid_roughness);
     if (corner >= 0) {
       spdlog::warn(
