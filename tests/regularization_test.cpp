@@ -88,23 +88,45 @@ class LeastSquares : public MultiParameterObjective {
   Eigen::VectorXd b_;
 };
 
+// A (40 x 10, Gaussian kernels) and b = A p_true + white noise of std 0.05 (seed 3),
+// p_true piecewise constant (-0.35 on parameter 6).
+struct SmoothingProblem {
+  static constexpr int m = 40, n = 10;
+  static constexpr double sigma = 0.05;
+  Eigen::MatrixXd a = Eigen::MatrixXd(m, n);
+  Eigen::VectorXd b;
+  SmoothingProblem() {
+    for (int i = 0; i < m; ++i) {
+      for (int j = 0; j < n; ++j) a(i, j) = std::exp(-0.5 * std::pow((i / 4.0 - j) / 1.5, 2));
+    }
+    Eigen::VectorXd truth = Eigen::VectorXd::Zero(n);
+    truth[6] = -0.35;
+    std::mt19937_64 engine(3);
+    std::normal_distribution<double> normal;
+    b = a * truth;
+    for (int i = 0; i < m; ++i) b[i] += sigma * normal(engine);
+  }
+};
+
+// Tight stopping tests, so that the weight search, not the minimiser, sets the figures.
+BoundedMinimizerOptions TightOptions(BoundedAlgorithm algorithm) {
+  BoundedMinimizerOptions options;
+  options.algorithm = algorithm;
+  options.step_tolerance = 1e-10;
+  options.function_tolerance = 0.0;
+  return options;
+}
+
 TEST(DiscrepancyPrincipleTest, ChoosesTheWeightOfTheClosedForm) {
   // b = A p_true + noise of std 0.05 over 40 rows, p_true piecewise constant; the target
   // is the expected misfit of the truth, 1/2 m sigma^2. The weight whose Tikhonov
   // misfit equals the target, lambda*, by bisection of the closed form; the discrepancy
   // principle's weight lies below it, within a factor of it that the tolerance bounds.
-  const int m = 40, n = 10;
-  std::mt19937_64 engine(3);
-  std::normal_distribution<double> normal;
-  Eigen::MatrixXd a(m, n);
-  for (int i = 0; i < m; ++i) {
-    for (int j = 0; j < n; ++j) a(i, j) = std::exp(-0.5 * std::pow((i / 4.0 - j) / 1.5, 2));
-  }
-  Eigen::VectorXd truth = Eigen::VectorXd::Zero(n);
-  truth.segment(6, 1).setConstant(-0.35);
-  const double sigma = 0.05;
-  Eigen::VectorXd b = a * truth;
-  for (int i = 0; i < m; ++i) b[i] += sigma * normal(engine);
+  const SmoothingProblem problem;
+  const int m = problem.m, n = problem.n;
+  const double sigma = problem.sigma;
+  const Eigen::VectorXd& b = problem.b;
+  const Eigen::MatrixXd& a = problem.a;
   LeastSquares data(a, b);
   const double target = 0.5 * m * sigma * sigma;
   // The weight whose misfit is `level`: misfit(lambda) increases; bisection in log lambda.
@@ -124,10 +146,7 @@ TEST(DiscrepancyPrincipleTest, ChoosesTheWeightOfTheClosedForm) {
   for (double tolerance : {RegularizationOptions().weight_tolerance, 1e-3}) {
     for (BoundedAlgorithm algorithm :
          {BoundedAlgorithm::kNloptLbfgs, BoundedAlgorithm::kCeresLbfgs}) {
-      BoundedMinimizerOptions options;
-      options.algorithm = algorithm;
-      options.step_tolerance = 1e-10;
-      options.function_tolerance = 0.0;
+      const BoundedMinimizerOptions options = TightOptions(algorithm);
       RegularizationOptions regularization;
       regularization.weight_tolerance = tolerance;
       regularization.refinement_steps = 10;
@@ -192,20 +211,14 @@ TEST(DiscrepancyPrincipleTest, AnUnreachableTargetTakesTheCornerOfTheClosedForms
   // The closed-form test's problem with rows 40..45 that no p fits (b = 1 there, A = 0):
   // its misfit floor exceeds the target. The weight is the grid's L-curve corner,
   // found here from the closed form's misfits and roughness at the grid's weights.
-  const int m = 40, n = 10;
-  std::mt19937_64 engine(3);
-  std::normal_distribution<double> normal;
+  const SmoothingProblem problem;
+  const int m = problem.m, n = problem.n;
   Eigen::MatrixXd a = Eigen::MatrixXd::Zero(m + 6, n);
-  for (int i = 0; i < m; ++i) {
-    for (int j = 0; j < n; ++j) a(i, j) = std::exp(-0.5 * std::pow((i / 4.0 - j) / 1.5, 2));
-  }
-  Eigen::VectorXd truth = Eigen::VectorXd::Zero(n);
-  truth.segment(6, 1).setConstant(-0.35);
+  a.topRows(m) = problem.a;
   Eigen::VectorXd b = Eigen::VectorXd::Ones(m + 6);
-  b.head(m) = a.topRows(m) * truth;
-  for (int i = 0; i < m; ++i) b[i] += 0.05 * normal(engine);
+  b.head(m) = problem.b;
   LeastSquares data(a, b);
-  const double target = 0.5 * m * 0.05 * 0.05;  // under the floor 3 + (noise's part)
+  const double target = 0.5 * m * problem.sigma * problem.sigma;  // under the floor 3
   RegularizationOptions regularization;
   const double start_cost = 0.5 * b.squaredNorm();
   regularization.max_weight = 1e2 / start_cost;
@@ -221,10 +234,7 @@ TEST(DiscrepancyPrincipleTest, AnUnreachableTargetTakesTheCornerOfTheClosedForms
   ASSERT_GT(corner, 0);
   for (BoundedAlgorithm algorithm :
        {BoundedAlgorithm::kNloptLbfgs, BoundedAlgorithm::kCeresLbfgs}) {
-    BoundedMinimizerOptions options;
-    options.algorithm = algorithm;
-    options.step_tolerance = 1e-10;
-    options.function_tolerance = 0.0;
+    const BoundedMinimizerOptions options = TightOptions(algorithm);
     const RegularizedMinimization result =
         MinimizeRegularized(options, regularization, &data, std::vector<double>(n, -5.0),
                             std::vector<double>(n, 5.0), std::vector<double>(n, 0.0), target);

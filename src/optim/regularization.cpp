@@ -215,7 +215,7 @@ RegularizedMinimization MinimizeRegularized(
   double last_misfit = -1.0;
   // The grid's minimisations, for the misfit-floor fallback.
   std::vector<BoundedMinimizerSummary> grid;
-  std::vector<double> grid_weights, grid_misfits;
+  std::vector<double> grid_weights, grid_misfits, grid_roughness;
   for (double weight = regularization.max_weight * start_cost;
        weight >= regularization.min_weight * start_cost * (1.0 - 1e-12);
        weight /= regularization.grid_factor) {
@@ -236,6 +236,7 @@ RegularizedMinimization MinimizeRegularized(
     grid.push_back(summary);
     grid_weights.push_back(weight);
     grid_misfits.push_back(point.misfit);
+    grid_roughness.push_back(point.roughness);
     if (point.meets_target) {
       hit = std::move(summary);
       hit_weight = weight;
@@ -251,9 +252,6 @@ RegularizedMinimization MinimizeRegularized(
     result.misfit_floor = last_misfit;
     // No weight reaches the noise's level (model error, or the noise underestimated):
     // the noise level is not to be trusted, and the L-curve needs none.
-    std::vector<double> grid_roughness;
-    for (std::size_t k = 0; k < grid.size(); ++k)
-      grid_roughness.push_back(result.path[k].roughness);
     const int corner = LCurveCorner(grid_misfits, grid_roughness);
     if (corner >= 0) {
       spdlog::warn(
