@@ -259,28 +259,28 @@ RegularizedMinimization MinimizeRegularized(
           "level {:.6g}: the weight is the L-curve's corner, {:.3g} (misfit {:.6g})",
           last_weight, last_misfit, target_misfit, grid_weights[corner], grid_misfits[corner]);
       result.weight_choice = "l_curve";
-      result.minimizer = grid[corner];
-      result.weight = grid_weights[corner];
-      result.x = result.minimizer.x;
-      result.misfit = grid_misfits[corner];
-      return result;
-    }
-    // Without a corner (fewer than 3 weights, or a straight curve) the principle is
-    // applied to the floor itself, raised by kMisfitFloorMargin.
-    target = (1.0 + kMisfitFloorMargin) * last_misfit;
-    spdlog::warn(
-        "no regularisation weight down to {:.3g} brings the misfit {:.6g} to the noise's level "
-        "{:.6g}: the target becomes the floor + {:.0f} %, {:.6g}",
-        last_weight, last_misfit, target_misfit, 100.0 * kMisfitFloorMargin, target);
-    result.weight_choice = "misfit_floor";
-    for (std::size_t k = 0; k < grid.size(); ++k) {
-      if (grid_misfits[k] <= target) {
-        hit = grid[k];
-        hit_weight = grid_weights[k];
-        hit_misfit = grid_misfits[k];
-        missed = k > 0 ? grid_weights[k - 1] : -1.0;
-        missed_misfit = k > 0 ? grid_misfits[k - 1] : -1.0;
-        break;
+      hit = grid[corner];
+      hit_weight = grid_weights[corner];
+      hit_misfit = grid_misfits[corner];
+      missed = -1.0;  // no target to refine against
+    } else {
+      // Without a corner (fewer than 3 weights, or a straight curve) the principle is
+      // applied to the floor itself, raised by kMisfitFloorMargin.
+      target = (1.0 + kMisfitFloorMargin) * last_misfit;
+      spdlog::warn(
+          "no regularisation weight down to {:.3g} brings the misfit {:.6g} to the noise's "
+          "level {:.6g}: the target becomes the floor + {:.0f} %, {:.6g}",
+          last_weight, last_misfit, target_misfit, 100.0 * kMisfitFloorMargin, target);
+      result.weight_choice = "misfit_floor";
+      for (std::size_t k = 0; k < grid.size(); ++k) {
+        if (grid_misfits[k] <= target) {
+          hit = grid[k];
+          hit_weight = grid_weights[k];
+          hit_misfit = grid_misfits[k];
+          missed = k > 0 ? grid_weights[k - 1] : -1.0;
+          missed_misfit = k > 0 ? grid_misfits[k - 1] : -1.0;
+          break;
+        }
       }
     }
   }
