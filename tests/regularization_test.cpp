@@ -247,6 +247,60 @@ TEST(DiscrepancyPrincipleTest, AnUnreachableTargetTakesTheCornerOfTheClosedForms
   }
 }
 
+// The data cost of `data` until `limit` evaluations, then failures: a minimisation
+// that cannot converge.
+class FailingAfter : public MultiParameterObjective {
+ public:
+  FailingAfter(MultiParameterObjective* data, int limit) : data_(data), limit_(limit) {}
+  int num_parameters() const override { return data_->num_parameters(); }
+  bool Evaluate(const double* x, double* cost, double* gradient) override {
+    if (++count_ > limit_) return false;
+    return data_->Evaluate(x, cost, gradient);
+  }
+
+ private:
+  MultiParameterObjective* data_;
+  int limit_;
+  int count_ = 0;
+};
+
+TEST(DiscrepancyPrincipleTest, AMinimisationThatFailsBelowTheGridsTopEndsTheDescent) {
+  // The unreachable target of the L-curve test. A first search stops the grid at its
+  // third weight (1e2, 1, 1e-2); a second one runs the whole grid on data that fail
+  // once the first search's evaluations are spent, so that the minimisation at 1e-4
+  // fails: the descent stops there and chooses among the three converged weights,
+  // as the first search did, instead of returning the failure.
+  const SmoothingProblem problem;
+  const int m = problem.m, n = problem.n;
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(m + 6, n);
+  a.topRows(m) = problem.a;
+  Eigen::VectorXd b = Eigen::VectorXd::Ones(m + 6);
+  b.head(m) = problem.b;
+  LeastSquares data(a, b);
+  const double target = 0.5 * m * problem.sigma * problem.sigma;
+  const double start_cost = 0.5 * b.squaredNorm();
+  const BoundedMinimizerOptions options = TightOptions(BoundedAlgorithm::kCeresLbfgs);
+  RegularizationOptions regularization;
+  regularization.max_weight = 1e2 / start_cost;
+  regularization.min_weight = 1e-2 / start_cost;
+  const std::vector<double> lower(n, -5.0), upper(n, 5.0), start(n, 0.0);
+  const RegularizedMinimization three =
+      MinimizeRegularized(options, regularization, &data, lower, upper, start, target);
+  ASSERT_TRUE(three.IsSolutionUsable()) << three.minimizer.FullReport();
+  ASSERT_EQ(three.path.size(), 3u);
+
+  regularization.min_weight = 1e-10 / start_cost;
+  FailingAfter failing(&data, three.evaluations);
+  const RegularizedMinimization stopped =
+      MinimizeRegularized(options, regularization, &failing, lower, upper, start, target);
+  ASSERT_TRUE(stopped.IsSolutionUsable()) << stopped.minimizer.FullReport();
+  EXPECT_EQ(stopped.path.size(), 4u);
+  EXPECT_FALSE(stopped.path.back().termination == TerminationType::kConvergence);
+  EXPECT_EQ(stopped.weight_choice, three.weight_choice);
+  EXPECT_EQ(stopped.weight, three.weight);
+  EXPECT_EQ(stopped.misfit, three.misfit);
+}
+
 TEST(RegularizationOptionsTest, NamesAndMessages) {
   RegularizationKind kind = RegularizationKind::kNone;
   ASSERT_TRUE(StringToRegularizationKind("total_variation", &kind));

@@ -32,6 +32,7 @@ BoundedMinimizerSummary MinimizeAt(const BoundedMinimizerOptions& options,
   RegularizedObjective objective(data, regularization.kind, weight, regularization.tv_smoothing);
   BoundedMinimizerSummary summary = MinimizeWithinBounds(options, &objective, lower, upper, start);
   result->evaluations += summary.evaluations;
+  *point = RegularizedPoint();
   point->weight = weight;
   point->evaluations = summary.evaluations;
   point->termination = summary.termination;
@@ -53,8 +54,13 @@ BoundedMinimizerSummary MinimizeAt(const BoundedMinimizerOptions& options,
   }
   point->meets_target =
       target_misfit >= 0.0 && summary.IsSolutionUsable() && point->misfit <= target_misfit;
-  spdlog::info("regularisation weight {:.3g}: misfit {:.6g} (target {:.6g}), roughness {:.6g}; {}",
-               weight, point->misfit, target_misfit, point->roughness, summary.BriefReport());
+  if (summary.IsSolutionUsable()) {
+    spdlog::info(
+        "regularisation weight {:.3g}: misfit {:.6g} (target {:.6g}), roughness {:.6g}; {}",
+        weight, point->misfit, target_misfit, point->roughness, summary.BriefReport());
+  } else {
+    spdlog::info("regularisation weight {:.3g}: {}", weight, summary.BriefReport());
+  }
   result->path.push_back(*point);
   return summary;
 }
@@ -221,6 +227,16 @@ RegularizedMinimization MinimizeRegularized(
        weight /= regularization.grid_factor) {
     BoundedMinimizerSummary summary = MinimizeAt(options, regularization, data, lower, upper, start,
                                                  weight, target_misfit, &result, &point);
+    if (!summary.IsSolutionUsable() && !grid.empty()) {
+      // Below a weight that converged, a minimisation that did not (out of evaluations
+      // among zones that drift to their bounds: the noise fitted) ends the descent; the
+      // weight is chosen among the converged ones, as when the target is missed.
+      spdlog::warn(
+          "the minimisation at the regularisation weight {:.3g} failed ({}): the descent "
+          "stops at {:.3g}",
+          weight, summary.message, last_weight);
+      break;
+    }
     if (!summary.IsSolutionUsable()) {
       result.minimizer = std::move(summary);
       result.weight = weight;
