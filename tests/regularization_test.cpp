@@ -36,8 +36,7 @@ TEST(JumpPenaltyTest, GradientMatchesCentralDifferences) {
     }
     // Measured: 2.0e-10 (Tikhonov: exact quadratic, round-off only) and 1.5e-10 (TV:
     // the jump of 4e-4 lies within eps = 1e-3, curvature 1 / eps).
-    EXPECT_LT(worst, 2e-9)
-        << RegularizationKindToString(kind);
+    EXPECT_LT(worst, 2e-9) << RegularizationKindToString(kind);
   }
   // The penalty adds to the gradient it is given.
   std::vector<double> gradient(n, 1.0);

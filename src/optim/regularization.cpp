@@ -56,8 +56,8 @@ BoundedMinimizerSummary MinimizeAt(const BoundedMinimizerOptions& options,
       target_misfit >= 0.0 && summary.IsSolutionUsable() && point->misfit <= target_misfit;
   if (summary.IsSolutionUsable()) {
     spdlog::info(
-        "regularisation weight {:.3g}: misfit {:.6g} (target {:.6g}), roughness {:.6g}; {}",
-        weight, point->misfit, target_misfit, point->roughness, summary.BriefReport());
+        "regularisation weight {:.3g}: misfit {:.6g} (target {:.6g}), roughness {:.6g}; {}", weight,
+        point->misfit, target_misfit, point->roughness, summary.BriefReport());
   } else {
     spdlog::info("regularisation weight {:.3g}: {}", weight, summary.BriefReport());
   }
