@@ -488,6 +488,7 @@ zone_identification:
   max_time: 12.5
   regularization: total_variation
   regularization_weight: 0.25
+  weight_rule: discrepancy
   tv_smoothing: 0.002
   max_weight: 2
   min_weight: 1e-7

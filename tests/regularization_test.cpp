@@ -147,6 +147,7 @@ TEST(DiscrepancyPrincipleTest, ChoosesTheWeightOfTheClosedForm) {
          {BoundedAlgorithm::kNloptLbfgs, BoundedAlgorithm::kCeresLbfgs}) {
       const BoundedMinimizerOptions options = TightOptions(algorithm);
       RegularizationOptions regularization;
+      regularization.weight_rule = WeightRule::kDiscrepancy;
       regularization.weight_tolerance = tolerance;
       regularization.refinement_steps = 10;
       // Absolute weights 1e2 down to 1e-10: the options are relative to the start's cost.
@@ -179,6 +180,7 @@ TEST(DiscrepancyPrincipleTest, AnUnreachableTargetFallsBackToTheMisfitFloor) {
   LeastSquares data(a, b);
   BoundedMinimizerOptions options;
   RegularizationOptions regularization;
+  regularization.weight_rule = WeightRule::kDiscrepancy;
   // Absolute weights 1 down to 1e-3: relative to the start's cost 1/2 |b|^2 = 45.5.
   regularization.max_weight = 1.0 / 45.5;
   regularization.min_weight = 1e-3 / 45.5;
@@ -206,20 +208,16 @@ TEST(LCurveCornerTest, FindsTheBendOfAnLAndNoneOfALine) {
   EXPECT_EQ(LCurveCorner({4.0, 1.0, 1.0}, {1.0, 0.0, 4.0}), -1);
 }
 
-TEST(DiscrepancyPrincipleTest, AnUnreachableTargetTakesTheCornerOfTheClosedFormsLCurve) {
-  // The closed-form test's problem with rows 40..45 that no p fits (b = 1 there, A = 0):
-  // its misfit floor exceeds the target. The weight is the grid's L-curve corner,
-  // found here from the closed form's misfits and roughness at the grid's weights.
-  const SmoothingProblem problem;
-  const int m = problem.m, n = problem.n;
-  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(m + 6, n);
-  a.topRows(m) = problem.a;
-  Eigen::VectorXd b = Eigen::VectorXd::Ones(m + 6);
-  b.head(m) = problem.b;
-  LeastSquares data(a, b);
-  const double target = 0.5 * m * problem.sigma * problem.sigma;  // under the floor 3
+// The L-curve corner of `data` on the grid 1e2 .. 1e-10 (factor 100) with both
+// minimisers and `rule`, against the closed form's corner at the same weights.
+void ExpectTheClosedFormsCorner(const LeastSquares& closed_form, WeightRule rule, double target) {
+  LeastSquares data = closed_form;
+  const int n = data.num_parameters();
   RegularizationOptions regularization;
-  const double start_cost = 0.5 * b.squaredNorm();
+  regularization.weight_rule = rule;
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  double start_cost = 0.0;
+  ASSERT_TRUE(data.Evaluate(zero.data(), &start_cost, nullptr));
   regularization.max_weight = 1e2 / start_cost;
   regularization.min_weight = 1e-10 / start_cost;
   std::vector<double> weights, misfits, roughness;
@@ -239,11 +237,61 @@ TEST(DiscrepancyPrincipleTest, AnUnreachableTargetTakesTheCornerOfTheClosedForms
                             std::vector<double>(n, 5.0), std::vector<double>(n, 0.0), target);
     ASSERT_TRUE(result.IsSolutionUsable()) << result.minimizer.FullReport();
     EXPECT_EQ(result.weight_choice, "l_curve");
-    // Measured with both minimisers: the corner at lambda = 1 (index 1 of the grid
-    // 1e2 .. 1e-10, 7 minimisations), the closed form's to 1e-12.
+    // Measured with both minimisers: the corner at lambda = 1 where the target is out
+    // of reach, 0.01 where it is not (7 minimisations), the closed form's to 1e-12.
     EXPECT_NEAR(result.weight, weights[corner], 1e-12 * weights[corner]);
     EXPECT_NEAR(result.misfit, misfits[corner], 1e-6 * misfits[corner]);
+    EXPECT_EQ(result.path.size(), weights.size());
+    EXPECT_EQ(result.target_misfit, target);
   }
+}
+
+TEST(DiscrepancyPrincipleTest, AnUnreachableTargetTakesTheCornerOfTheClosedFormsLCurve) {
+  // The closed-form test's problem with rows 40..45 that no p fits (b = 1 there, A = 0):
+  // its misfit floor exceeds the target. The weight is the grid's L-curve corner.
+  const SmoothingProblem problem;
+  const int m = problem.m, n = problem.n;
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(m + 6, n);
+  a.topRows(m) = problem.a;
+  Eigen::VectorXd b = Eigen::VectorXd::Ones(m + 6);
+  b.head(m) = problem.b;
+  const double target = 0.5 * m * problem.sigma * problem.sigma;  // under the floor 3
+  ExpectTheClosedFormsCorner(LeastSquares(a, b), WeightRule::kDiscrepancy, target);
+  ExpectTheClosedFormsCorner(LeastSquares(a, b), WeightRule::kLCurve, target);
+}
+
+TEST(LCurveRuleTest, KeepsTheLargestWeightWhenItMeetsTheTarget) {
+  // The closed-form test's problem with a target above the misfit at the grid's first
+  // weight by more than the margin: kept, as the discrepancy principle keeps it, with
+  // no other minimisation; within the margin, the L-curve's corner.
+  const SmoothingProblem problem;
+  LeastSquares data(problem.a, problem.b);
+  const double start_cost = 0.5 * problem.b.squaredNorm();
+  RegularizationOptions regularization;
+  regularization.max_weight = 1e2 / start_cost;
+  const auto minimize = [&](double target) {
+    return MinimizeRegularized(TightOptions(BoundedAlgorithm::kCeresLbfgs), regularization, &data,
+                               std::vector<double>(problem.n, -5.0),
+                               std::vector<double>(problem.n, 5.0),
+                               std::vector<double>(problem.n, 0.0), target);
+  };
+  const RegularizedMinimization kept = minimize(data.Misfit(1e2) / (0.99 * kLCurveTopShare));
+  ASSERT_TRUE(kept.IsSolutionUsable()) << kept.minimizer.FullReport();
+  EXPECT_EQ(kept.weight_choice, "discrepancy");
+  EXPECT_NEAR(kept.weight, 1e2, 1e-10);
+  EXPECT_EQ(kept.path.size(), 1u);
+  const RegularizedMinimization corner = minimize(data.Misfit(1e2) / (1.01 * kLCurveTopShare));
+  ASSERT_TRUE(corner.IsSolutionUsable()) << corner.minimizer.FullReport();
+  EXPECT_EQ(corner.weight_choice, "l_curve");
+  EXPECT_LT(corner.weight, 1e2);
+}
+
+TEST(LCurveRuleTest, TakesTheCornerWhereTheDiscrepancyTargetIsReachable) {
+  // The closed-form test's problem, whose target the discrepancy principle meets at
+  // lambda = 1.37: the L-curve rule ignores the target and takes the grid's corner.
+  const SmoothingProblem problem;
+  ExpectTheClosedFormsCorner(LeastSquares(problem.a, problem.b), WeightRule::kLCurve,
+                             0.5 * problem.m * problem.sigma * problem.sigma);
 }
 
 // The data cost of `data` until `limit` evaluations, then failures: a minimisation
@@ -306,7 +354,15 @@ TEST(RegularizationOptionsTest, NamesAndMessages) {
   EXPECT_EQ(kind, RegularizationKind::kTotalVariation);
   EXPECT_STREQ(RegularizationKindToString(RegularizationKind::kTikhonov), "tikhonov");
   EXPECT_FALSE(StringToRegularizationKind("tv", &kind));
+  for (WeightRule rule : {WeightRule::kLCurve, WeightRule::kDiscrepancy}) {
+    WeightRule back = rule == WeightRule::kLCurve ? WeightRule::kDiscrepancy : WeightRule::kLCurve;
+    ASSERT_TRUE(StringToWeightRule(WeightRuleToString(rule), &back));
+    EXPECT_EQ(back, rule);
+  }
+  WeightRule rule = WeightRule::kLCurve;
+  EXPECT_FALSE(StringToWeightRule("lcurve", &rule));
   RegularizationOptions options;
+  EXPECT_EQ(options.weight_rule, WeightRule::kLCurve);
   std::string error;
   EXPECT_TRUE(options.IsValid(&error));
   options.grid_factor = 1.0;

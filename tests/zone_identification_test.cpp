@@ -136,30 +136,40 @@ INSTANTIATE_TEST_SUITE_P(Minimizers, ZoneInverseCrimeTest,
                          });
 
 TEST(ZoneDiscrepancyTest, NoiseFreeDataNeedNoRegularisationToSpeakOf) {
-  // The automatic weight on the noise-free inverse crime: the noise levels estimated
-  // from the data's second differences are those of the signal's own curvature, small;
-  // the weight found must leave every zone within 1 %.
+  // The automatic weight on the noise-free inverse crime, by both rules: the noise
+  // levels estimated from the data's second differences are those of the signal's own
+  // curvature, small; the L-curve of exact data has no corner (the misfit falls 100-fold
+  // or more at each grid step). The weight found must leave every zone within 1 %.
   const Vector truth = SoftZoneModuli(10);
   InverseCrime crime(40, 120, 10, truth);
-  ZoneIdentificationOptions options;
   PrefilterOptions prefilter;
   prefilter.enabled = false;
-  const ZoneIdentificationSummary summary =
-      IdentifyZoneModuli(options, crime.model, crime.data, Mcre(), 0.5,
-                         Options(CoupledSolverType::kConjugateGradient, 1e-12), {}, 190e9, 100e9,
-                         400e9, DifferenceNoiseLevels(crime.data), prefilter);
-  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
-  double worst = 0.0;
-  for (int z = 0; z < 10; ++z)
-    worst = std::max(worst, std::abs(summary.moduli[z] / truth[z] - 1.0));
-  // Measured: target 8.5e-10 (e^2 / J_rest of noise drawn at the estimated levels),
-  // weight 1.29e-7 by the discrepancy principle (2 grid weights, 3 regula falsi
-  // steps), worst zone 0.55 % off, 116 evaluations of ceres_lbfgs (NLopt's L-BFGS and
-  // 4 bisections: 1.15e-7, 0.50 %, 286 evaluations).
-  EXPECT_TRUE(summary.regularized.weight_choice == "discrepancy" ||
-              summary.regularized.weight_choice == "l_curve" ||
-              summary.regularized.weight_choice == "misfit_floor");
-  EXPECT_LT(worst, 0.01) << summary.FullReport();
+  for (WeightRule rule : {WeightRule::kDiscrepancy, WeightRule::kLCurve}) {
+    ZoneIdentificationOptions options;
+    options.regularization.weight_rule = rule;
+    const ZoneIdentificationSummary summary =
+        IdentifyZoneModuli(options, crime.model, crime.data, Mcre(), 0.5,
+                           Options(CoupledSolverType::kConjugateGradient, 1e-12), {}, 190e9, 100e9,
+                           400e9, DifferenceNoiseLevels(crime.data), prefilter);
+    ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+    double worst = 0.0;
+    for (int z = 0; z < 10; ++z)
+      worst = std::max(worst, std::abs(summary.moduli[z] / truth[z] - 1.0));
+    // Measured, discrepancy: target 8.5e-10 (e^2 / J_rest of noise drawn at the
+    // estimated levels), weight 1.29e-7 (2 grid weights, 3 regula falsi steps), worst
+    // zone 0.55 % off, 116 evaluations of ceres_lbfgs (NLopt's L-BFGS and 4
+    // bisections: 1.15e-7, 0.50 %, 286 evaluations). L-curve: no corner on the 5
+    // weights 2.2e-6 .. 2.2e-14, the misfit floor's rule takes the last, worst zone
+    // 1.7e-7 off.
+    if (rule == WeightRule::kDiscrepancy) {
+      EXPECT_TRUE(summary.regularized.weight_choice == "discrepancy" ||
+                  summary.regularized.weight_choice == "l_curve" ||
+                  summary.regularized.weight_choice == "misfit_floor");
+    } else {
+      EXPECT_EQ(summary.regularized.weight_choice, "misfit_floor");
+    }
+    EXPECT_LT(worst, rule == WeightRule::kDiscrepancy ? 0.01 : 2e-6) << summary.FullReport();
+  }
 }
 
 }  // namespace

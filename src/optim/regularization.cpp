@@ -21,6 +21,11 @@ constexpr std::array<std::pair<RegularizationKind, const char*>, 3> kRegularizat
     {RegularizationKind::kTotalVariation, "total_variation"},
 }};
 
+constexpr std::array<std::pair<WeightRule, const char*>, 2> kWeightRules{{
+    {WeightRule::kLCurve, "l_curve"},
+    {WeightRule::kDiscrepancy, "discrepancy"},
+}};
+
 // One minimisation at `weight` from `start`, recorded in *result.
 BoundedMinimizerSummary MinimizeAt(const BoundedMinimizerOptions& options,
                                    const RegularizationOptions& regularization,
@@ -55,9 +60,10 @@ BoundedMinimizerSummary MinimizeAt(const BoundedMinimizerOptions& options,
   point->meets_target =
       target_misfit >= 0.0 && summary.IsSolutionUsable() && point->misfit <= target_misfit;
   if (summary.IsSolutionUsable()) {
-    spdlog::info(
-        "regularisation weight {:.3g}: misfit {:.6g} (target {:.6g}), roughness {:.6g}; {}", weight,
-        point->misfit, target_misfit, point->roughness, summary.BriefReport());
+    spdlog::info("regularisation weight {:.3g}: misfit {:.6g}{}, roughness {:.6g}; {}", weight,
+                 point->misfit,
+                 target_misfit >= 0.0 ? fmt::format(" (target {:.6g})", target_misfit) : "",
+                 point->roughness, summary.BriefReport());
   } else {
     spdlog::info("regularisation weight {:.3g}: {}", weight, summary.BriefReport());
   }
@@ -72,6 +78,10 @@ const char* RegularizationKindToString(RegularizationKind kind) {
 }
 bool StringToRegularizationKind(const std::string& name, RegularizationKind* kind) {
   return internal::FromName(kRegularizationKinds, name, kind);
+}
+const char* WeightRuleToString(WeightRule rule) { return internal::ToName(kWeightRules, rule); }
+bool StringToWeightRule(const std::string& name, WeightRule* rule) {
+  return internal::FromName(kWeightRules, name, rule);
 }
 
 bool RegularizationOptions::IsValid(std::string* error) const {
@@ -201,8 +211,12 @@ RegularizedMinimization MinimizeRegularized(
     return result;
   }
 
-  // The discrepancy principle: descend the grid, warm-started, to the first weight
-  // that meets the target.
+  // Descend the grid, warm-started: to the first weight that meets the target (the
+  // discrepancy principle), or to its end (the L-curve) unless its first, largest
+  // weight meets kLCurveTopShare of the target: data that the nearly homogeneous
+  // profile explains better than the noise would ask for no contrast, where the
+  // L-curve's corner would still lie at a lighter weight.
+  const bool l_curve = regularization.weight_rule == WeightRule::kLCurve;
   result.target_misfit = target_misfit;
   std::vector<double> start = initial;
   // c0, the data cost at the start: the grid's unit.
@@ -240,7 +254,7 @@ RegularizedMinimization MinimizeRegularized(
     if (!summary.IsSolutionUsable()) {
       result.minimizer = std::move(summary);
       result.weight = weight;
-      result.weight_choice = "discrepancy";
+      result.weight_choice = WeightRuleToString(regularization.weight_rule);
       result.x = result.minimizer.x;
       result.misfit = point.misfit;
       return result;  // a failed minimisation ends the search: its message says why
@@ -253,7 +267,8 @@ RegularizedMinimization MinimizeRegularized(
     grid_weights.push_back(weight);
     grid_misfits.push_back(point.misfit);
     grid_roughness.push_back(point.roughness);
-    if (point.meets_target) {
+    if (point.meets_target &&
+        (!l_curve || (grid.size() == 1 && point.misfit <= kLCurveTopShare * target_misfit))) {
       hit = std::move(summary);
       hit_weight = weight;
       hit_misfit = point.misfit;
@@ -266,14 +281,20 @@ RegularizedMinimization MinimizeRegularized(
   result.weight_choice = "discrepancy";
   if (hit_weight < 0.0) {
     result.misfit_floor = last_misfit;
-    // No weight reaches the noise's level (model error, or the noise underestimated):
-    // the noise level is not to be trusted, and the L-curve needs none.
+    // The L-curve rule, or no weight reaches the noise's level (model error, or the
+    // noise underestimated): the noise level is not to be trusted, and the L-curve
+    // needs none.
     const int corner = LCurveCorner(grid_misfits, grid_roughness);
-    if (corner >= 0) {
+    if (corner >= 0 && (l_curve || target_misfit < 0.0)) {
+      spdlog::info("the weight is the L-curve's corner, {:.3g} (misfit {:.6g})",
+                   grid_weights[corner], grid_misfits[corner]);
+    } else if (corner >= 0) {
       spdlog::warn(
           "no regularisation weight down to {:.3g} brings the misfit {:.6g} to the noise's "
           "level {:.6g}: the weight is the L-curve's corner, {:.3g} (misfit {:.6g})",
           last_weight, last_misfit, target_misfit, grid_weights[corner], grid_misfits[corner]);
+    }
+    if (corner >= 0) {
       result.weight_choice = "l_curve";
       hit = grid[corner];
       hit_weight = grid_weights[corner];
@@ -284,9 +305,13 @@ RegularizedMinimization MinimizeRegularized(
       // applied to the floor itself, raised by kMisfitFloorMargin.
       target = (1.0 + kMisfitFloorMargin) * last_misfit;
       spdlog::warn(
-          "no regularisation weight down to {:.3g} brings the misfit {:.6g} to the noise's "
-          "level {:.6g}: the target becomes the floor + {:.0f} %, {:.6g}",
-          last_weight, last_misfit, target_misfit, 100.0 * kMisfitFloorMargin, target);
+          "{} down to {:.3g}: the target becomes the misfit floor {:.6g} + {:.0f} %, {:.6g}",
+          l_curve || target_misfit < 0.0
+              ? std::string("the L-curve has no corner")
+              : fmt::format(
+                    "no regularisation weight brings the misfit to the noise's level {:.6g}",
+                    target_misfit),
+          last_weight, last_misfit, 100.0 * kMisfitFloorMargin, target);
       result.weight_choice = "misfit_floor";
       for (std::size_t k = 0; k < grid.size(); ++k) {
         if (grid_misfits[k] <= target) {

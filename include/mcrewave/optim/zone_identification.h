@@ -11,8 +11,9 @@
 // The cost is the scaled e^2 / J_rest of McreObjective. Bounds: outer.lower_bound and
 // outer.upper_bound on every zone, i.e. log(lower / E*) <= p_z <= log(upper / E*).
 //
-// The regularisation weight by the discrepancy principle needs the misfit the noise
-// alone explains: ExpectedNoiseCost, the mean scaled e^2 of data made of noise alone
+// The regularisation weight's discrepancy target (the whole rule with weight_rule:
+// discrepancy, the test of the grid's largest weight with the default L-curve) needs
+// the misfit the noise alone explains: ExpectedNoiseCost, the mean scaled e^2 of data made of noise alone
 // (white, at the noise levels estimated from the measurements by their second
 // differences, DifferenceNoiseLevels, passed through the same pre-filter as the data)
 // at the homogeneous E*. Why that level: the coupled solution is affine in the data
