@@ -209,7 +209,8 @@ TEST(LCurveCornerTest, FindsTheBendOfAnLAndNoneOfALine) {
 }
 
 // The L-curve corner of `data` on the grid 1e2 .. 1e-10 (factor 100) with both
-// minimisers and `rule`, against the closed form's corner at the same weights.
+// minimisers and `rule`, against the closed form's corner at the same weights, for a
+// `target` no weight meets.
 void ExpectTheClosedFormsCorner(const LeastSquares& closed_form, WeightRule rule, double target) {
   LeastSquares data = closed_form;
   const int n = data.num_parameters();
@@ -237,8 +238,8 @@ void ExpectTheClosedFormsCorner(const LeastSquares& closed_form, WeightRule rule
                             std::vector<double>(n, 5.0), std::vector<double>(n, 0.0), target);
     ASSERT_TRUE(result.IsSolutionUsable()) << result.minimizer.FullReport();
     EXPECT_EQ(result.weight_choice, "l_curve");
-    // Measured with both minimisers: the corner at lambda = 1 where the target is out
-    // of reach, 0.01 where it is not (7 minimisations), the closed form's to 1e-12.
+    // Measured with both minimisers: the corner at lambda = 1 (7 minimisations), the
+    // closed form's to 1e-12.
     EXPECT_NEAR(result.weight, weights[corner], 1e-12 * weights[corner]);
     EXPECT_NEAR(result.misfit, misfits[corner], 1e-6 * misfits[corner]);
     EXPECT_EQ(result.path.size(), weights.size());
@@ -263,7 +264,7 @@ TEST(DiscrepancyPrincipleTest, AnUnreachableTargetTakesTheCornerOfTheClosedForms
 TEST(LCurveRuleTest, KeepsTheLargestWeightWhenItMeetsTheTarget) {
   // The closed-form test's problem with a target above the misfit at the grid's first
   // weight by more than the margin: kept, as the discrepancy principle keeps it, with
-  // no other minimisation; within the margin, the L-curve's corner.
+  // no other minimisation.
   const SmoothingProblem problem;
   LeastSquares data(problem.a, problem.b);
   const double start_cost = 0.5 * problem.b.squaredNorm();
@@ -280,18 +281,46 @@ TEST(LCurveRuleTest, KeepsTheLargestWeightWhenItMeetsTheTarget) {
   EXPECT_EQ(kept.weight_choice, "discrepancy");
   EXPECT_NEAR(kept.weight, 1e2, 1e-10);
   EXPECT_EQ(kept.path.size(), 1u);
-  const RegularizedMinimization corner = minimize(data.Misfit(1e2) / (1.01 * kLCurveTopShare));
-  ASSERT_TRUE(corner.IsSolutionUsable()) << corner.minimizer.FullReport();
-  EXPECT_EQ(corner.weight_choice, "l_curve");
-  EXPECT_LT(corner.weight, 1e2);
+  // Within the margin the descent goes on, to the next weight, 1, which meets the
+  // target too: two points, no corner, that weight kept.
+  const RegularizedMinimization next = minimize(data.Misfit(1e2) / (1.01 * kLCurveTopShare));
+  ASSERT_TRUE(next.IsSolutionUsable()) << next.minimizer.FullReport();
+  EXPECT_EQ(next.path.size(), 2u);
+  EXPECT_NEAR(next.weight, 1.0, 1e-12);
 }
 
-TEST(LCurveRuleTest, TakesTheCornerWhereTheDiscrepancyTargetIsReachable) {
-  // The closed-form test's problem, whose target the discrepancy principle meets at
-  // lambda = 1.37: the L-curve rule ignores the target and takes the grid's corner.
+TEST(LCurveRuleTest, StopsAtTheFirstWeightThatMeetsTheTarget) {
+  // The closed-form test's problem with targets first met at the grid's weight 1 and
+  // at 1e-4 (absolute weights 1e2, 1, 1e-2, ...): the descent stops there, and the
+  // weight is the corner of the points so far (the closed form's), or that weight.
   const SmoothingProblem problem;
-  ExpectTheClosedFormsCorner(LeastSquares(problem.a, problem.b), WeightRule::kLCurve,
-                             0.5 * problem.m * problem.sigma * problem.sigma);
+  LeastSquares data(problem.a, problem.b);
+  const double start_cost = 0.5 * problem.b.squaredNorm();
+  RegularizationOptions regularization;
+  regularization.max_weight = 1e2 / start_cost;
+  regularization.min_weight = 1e-10 / start_cost;
+  for (int first_met : {1, 3}) {
+    std::vector<double> weights, misfits, roughness;
+    for (int k = 0; k <= first_met; ++k) {
+      weights.push_back(1e2 * std::pow(1e-2, k));
+      const auto [misfit, rough] = data.MisfitAndRoughness(weights.back());
+      misfits.push_back(misfit);
+      roughness.push_back(rough);
+    }
+    // Between the misfits at the weight first met and at the one before it.
+    const double target = std::sqrt(misfits[first_met] * misfits[first_met - 1]);
+    const int corner = LCurveCorner(misfits, roughness);
+    const double expected = corner >= 0 ? weights[corner] : weights[first_met];
+    const RegularizedMinimization result = MinimizeRegularized(
+        TightOptions(BoundedAlgorithm::kCeresLbfgs), regularization, &data,
+        std::vector<double>(problem.n, -5.0), std::vector<double>(problem.n, 5.0),
+        std::vector<double>(problem.n, 0.0), target);
+    ASSERT_TRUE(result.IsSolutionUsable()) << result.minimizer.FullReport();
+    EXPECT_EQ(result.path.size(), static_cast<std::size_t>(first_met + 1));
+    EXPECT_EQ(result.weight_choice, corner >= 0 ? "l_curve" : "discrepancy");
+    // Measured: no corner of 2 points (weight 1 kept); the corner of 4 at 0.01.
+    EXPECT_NEAR(result.weight, expected, 1e-12 * expected);
+  }
 }
 
 // The data cost of `data` until `limit` evaluations, then failures: a minimisation

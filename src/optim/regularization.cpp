@@ -211,11 +211,13 @@ RegularizedMinimization MinimizeRegularized(
     return result;
   }
 
-  // Descend the grid, warm-started: to the first weight that meets the target (the
-  // discrepancy principle), or to its end (the L-curve) unless its first, largest
-  // weight meets kLCurveTopShare of the target: data that the nearly homogeneous
-  // profile explains better than the noise would ask for no contrast, where the
-  // L-curve's corner would still lie at a lighter weight.
+  // Descend the grid, warm-started, to the first weight that meets the target. The
+  // discrepancy principle keeps it (and refines it below). The L-curve keeps the
+  // largest weight only when its misfit is within kLCurveTopShare of the target (data
+  // that the nearly homogeneous profile explains better than the noise would ask for
+  // no contrast, where the corner would still lie at a lighter weight); below it, the
+  // corner of the points down to the first weight that meets the target (lighter ones
+  // only fit the noise), or that weight; the corner of the whole grid when none does.
   const bool l_curve = regularization.weight_rule == WeightRule::kLCurve;
   result.target_misfit = target_misfit;
   std::vector<double> start = initial;
@@ -233,6 +235,7 @@ RegularizedMinimization MinimizeRegularized(
   BoundedMinimizerSummary last;
   double last_weight = -1.0;
   double last_misfit = -1.0;
+  std::string choice = "discrepancy";  // of a weight kept in the descent
   // The grid's minimisations, for the misfit-floor fallback.
   std::vector<BoundedMinimizerSummary> grid;
   std::vector<double> grid_weights, grid_misfits, grid_roughness;
@@ -274,11 +277,26 @@ RegularizedMinimization MinimizeRegularized(
       hit_misfit = point.misfit;
       break;
     }
+    if (point.meets_target && grid.size() > 1) {
+      // The L-curve below the largest weight: lighter weights than this one only fit
+      // the noise (its flat arm); the corner of the points so far, or this weight.
+      const int corner = LCurveCorner(grid_misfits, grid_roughness);
+      const std::size_t kept = corner >= 0 ? static_cast<std::size_t>(corner) : grid.size() - 1;
+      hit = grid[kept];
+      hit_weight = grid_weights[kept];
+      hit_misfit = grid_misfits[kept];
+      missed = -1.0;  // no refinement
+      spdlog::info("the weight {:.3g} meets the noise's level {:.6g}: the weight is {} {:.3g}",
+                   weight, target_misfit, corner >= 0 ? "the L-curve's corner above it," : "it,",
+                   hit_weight);
+      choice = corner >= 0 ? "l_curve" : "discrepancy";
+      break;
+    }
     missed = weight;
     missed_misfit = point.misfit;
   }
   double target = target_misfit;
-  result.weight_choice = "discrepancy";
+  result.weight_choice = choice;
   if (hit_weight < 0.0) {
     result.misfit_floor = last_misfit;
     // The L-curve rule, or no weight reaches the noise's level (model error, or the

@@ -11,11 +11,14 @@
 // not its square, so one sharp jump costs less than a ramp of the same height).
 //
 // The weight lambda: fixed (weight >= 0) or chosen automatically (weight < 0, the
-// default) by weight_rule. The L-curve (the default): unless the grid's first, largest
-// weight's misfit already lies under kLCurveTopShare of the discrepancy target below
-// (data the nearly homogeneous profile explains within the noise: kept), the grid is descended to
-// its end (or to a minimisation that fails) and the weight is its corner (LCurveCorner); without a
-// corner, the misfit-floor rule at the end of this comment. The discrepancy
+// default) by weight_rule, on the grid below descended from its largest weight. The
+// L-curve (the default): the grid's largest weight when its misfit already lies under
+// kLCurveTopShare of the discrepancy target below (data the nearly homogeneous profile
+// explains within the noise); else the descent stops at the first weight that meets the
+// target (lighter ones only fit the noise), or at a minimisation that fails, or at the
+// grid's end, and the weight is the corner of the points descended (LCurveCorner);
+// without a corner, the weight that met the target, or the misfit-floor rule at the end
+// of this comment. The discrepancy
 // principle: the largest lambda whose data misfit (the scaled e^2 at
 // the regularised minimiser) stays at or below the level the noise explains,
 // target = discrepancy_factor * (expected e^2 at the truth under the estimated noise)
