@@ -76,9 +76,13 @@ struct RegularizationOptions {
   // eps of the smoothed total variation, in log E (1e-3: jumps above 0.1 % of E count
   // by their size).
   double tv_smoothing = 1e-3;
-  // The grid of weights, relative to the data cost at the start.
+  // The grid of weights, relative to the data cost c0 at the start. At 1e-4 c0 the
+  // penalty is already a few 1e-4 of the misfit (a third of c0 or more with noise):
+  // the zones are as free as unregularised, and lighter weights only cost
+  // evaluations (100 zones, SNR 20, interior sensors: 56, 92 and 473 evaluations at
+  // 1, 1e-2 and 1e-4 c0, then 2000 without converging at 1e-6 c0).
   double max_weight = 1.0;
-  double min_weight = 1e-8;
+  double min_weight = 1e-4;
   // A factor 100: about 2 + (decades / 2) minimisations to the first weight that meets
   // the target (a factor 10 and 4 bisections took 403 evaluations and 11 s on 10 zones
   // of the paper's bar, noise-free).
