@@ -277,7 +277,7 @@ RegularizedMinimization MinimizeRegularized(
       hit_misfit = point.misfit;
       break;
     }
-    if (point.meets_target && grid.size() > 1) {
+    if (l_curve && point.meets_target && grid.size() > 1) {
       // The L-curve below the largest weight: lighter weights than this one only fit
       // the noise (its flat arm); the corner of the points so far, or this weight.
       const int corner = LCurveCorner(grid_misfits, grid_roughness);
@@ -299,9 +299,9 @@ RegularizedMinimization MinimizeRegularized(
   result.weight_choice = choice;
   if (hit_weight < 0.0) {
     result.misfit_floor = last_misfit;
-    // The L-curve rule, or no weight reaches the noise's level (model error, or the
-    // noise underestimated): the noise level is not to be trusted, and the L-curve
-    // needs none.
+    // No weight reaches the noise's level (model error, or the noise underestimated):
+    // the noise level is not to be trusted, and the L-curve needs none (the L-curve
+    // rule's own choice then, the discrepancy principle's fallback, with a warning).
     const int corner = LCurveCorner(grid_misfits, grid_roughness);
     if (corner >= 0 && (l_curve || target_misfit < 0.0)) {
       spdlog::info("the weight is the L-curve's corner, {:.3g} (misfit {:.6g})",

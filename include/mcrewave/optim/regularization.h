@@ -18,9 +18,8 @@
 // target (lighter ones only fit the noise), or at a minimisation that fails, or at the
 // grid's end, and the weight is the corner of the points descended (LCurveCorner);
 // without a corner, the weight that met the target, or the misfit-floor rule at the end
-// of this comment. The discrepancy
-// principle: the largest lambda whose data misfit (the scaled e^2 at
-// the regularised minimiser) stays at or below the level the noise explains,
+// of this comment. The discrepancy principle: the largest lambda whose data misfit (the
+// scaled e^2 at the regularised minimiser) stays at or below the level the noise explains,
 // target = discrepancy_factor * (expected e^2 at the truth under the estimated noise)
 // (zone_identification.h computes that level). The misfit grows with lambda, so the
 // grid lambda_k = c0 max_weight / grid_factor^k down to c0 min_weight, c0 the data cost
@@ -57,7 +56,7 @@ bool StringToRegularizationKind(const std::string& name, RegularizationKind* kin
 
 // How an automatic weight is chosen.
 enum class WeightRule {
-  kLCurve,       // the corner of the grid's L-curve; no noise level needed
+  kLCurve,       // the L-curve's corner, down to the first weight that meets the target
   kDiscrepancy,  // the discrepancy principle, the L-curve when its target is missed
 };
 const char* WeightRuleToString(WeightRule rule);
@@ -70,7 +69,7 @@ struct RegularizationOptions {
   double weight = -1.0;
   // The L-curve: at SNR 10 the noise's e^2 varies from one draw to the next by as much
   // as the misfit over the whole grid, and the discrepancy principle over-smooths on
-  // the draws below its mean (docs/zones_and_sensors.md, "Choosing the weight"). The
+  // the draws below its mean (docs/zones_and_sensors.md, "Regularisation and its weight"). The
   // discrepancy target still decides whether the data ask for any contrast at all.
   WeightRule weight_rule = WeightRule::kLCurve;
   // eps of the smoothed total variation, in log E (1e-3: jumps above 0.1 % of E count
