@@ -247,18 +247,37 @@ void ExpectTheClosedFormsCorner(const LeastSquares& closed_form, WeightRule rule
   }
 }
 
-TEST(DiscrepancyPrincipleTest, AnUnreachableTargetTakesTheCornerOfTheClosedFormsLCurve) {
-  // The closed-form test's problem with rows 40..45 that no p fits (b = 1 there, A = 0):
-  // its misfit floor exceeds the target. The weight is the grid's L-curve corner.
-  const SmoothingProblem problem;
+// The closed-form test's problem with rows 40..45 that no p fits (b = 1 there, A = 0):
+// its misfit floor, 3, exceeds that test's target.
+LeastSquares WithUnfittableRows(const SmoothingProblem& problem) {
   const int m = problem.m, n = problem.n;
   Eigen::MatrixXd a = Eigen::MatrixXd::Zero(m + 6, n);
   a.topRows(m) = problem.a;
   Eigen::VectorXd b = Eigen::VectorXd::Ones(m + 6);
   b.head(m) = problem.b;
-  const double target = 0.5 * m * problem.sigma * problem.sigma;  // under the floor 3
-  ExpectTheClosedFormsCorner(LeastSquares(a, b), WeightRule::kDiscrepancy, target);
-  ExpectTheClosedFormsCorner(LeastSquares(a, b), WeightRule::kLCurve, target);
+  return LeastSquares(a, b);
+}
+
+TEST(DiscrepancyPrincipleTest, AnUnreachableTargetTakesTheCornerOfTheClosedFormsLCurve) {
+  // The target is out of reach: the weight is the grid's L-curve corner.
+  const SmoothingProblem problem;
+  const double target = 0.5 * problem.m * problem.sigma * problem.sigma;
+  ExpectTheClosedFormsCorner(WithUnfittableRows(problem), WeightRule::kDiscrepancy, target);
+  ExpectTheClosedFormsCorner(WithUnfittableRows(problem), WeightRule::kLCurve, target);
+}
+
+// The closed-form test's problem by the L-curve rule (Ceres' L-BFGS) on the absolute
+// weights 1e2, 1, 1e-2, ... down to 1e-10.
+RegularizedMinimization LCurveOnTheGrid(const SmoothingProblem& problem, double target) {
+  LeastSquares data(problem.a, problem.b);
+  const double start_cost = 0.5 * problem.b.squaredNorm();
+  RegularizationOptions regularization;
+  regularization.max_weight = 1e2 / start_cost;
+  regularization.min_weight = 1e-10 / start_cost;
+  return MinimizeRegularized(TightOptions(BoundedAlgorithm::kCeresLbfgs), regularization, &data,
+                             std::vector<double>(problem.n, -5.0),
+                             std::vector<double>(problem.n, 5.0),
+                             std::vector<double>(problem.n, 0.0), target);
 }
 
 TEST(LCurveRuleTest, KeepsTheLargestWeightWhenItMeetsTheTarget) {
@@ -266,24 +285,17 @@ TEST(LCurveRuleTest, KeepsTheLargestWeightWhenItMeetsTheTarget) {
   // weight by more than the margin: kept, as the discrepancy principle keeps it, with
   // no other minimisation.
   const SmoothingProblem problem;
-  LeastSquares data(problem.a, problem.b);
-  const double start_cost = 0.5 * problem.b.squaredNorm();
-  RegularizationOptions regularization;
-  regularization.max_weight = 1e2 / start_cost;
-  const auto minimize = [&](double target) {
-    return MinimizeRegularized(TightOptions(BoundedAlgorithm::kCeresLbfgs), regularization, &data,
-                               std::vector<double>(problem.n, -5.0),
-                               std::vector<double>(problem.n, 5.0),
-                               std::vector<double>(problem.n, 0.0), target);
-  };
-  const RegularizedMinimization kept = minimize(data.Misfit(1e2) / (0.99 * kLCurveTopShare));
+  const LeastSquares data(problem.a, problem.b);
+  const RegularizedMinimization kept =
+      LCurveOnTheGrid(problem, data.Misfit(1e2) / (0.99 * kLCurveTopShare));
   ASSERT_TRUE(kept.IsSolutionUsable()) << kept.minimizer.FullReport();
   EXPECT_EQ(kept.weight_choice, "discrepancy");
   EXPECT_NEAR(kept.weight, 1e2, 1e-10);
   EXPECT_EQ(kept.path.size(), 1u);
   // Within the margin the descent goes on, to the next weight, 1, which meets the
   // target too: two points, no corner, that weight kept.
-  const RegularizedMinimization next = minimize(data.Misfit(1e2) / (1.01 * kLCurveTopShare));
+  const RegularizedMinimization next =
+      LCurveOnTheGrid(problem, data.Misfit(1e2) / (1.01 * kLCurveTopShare));
   ASSERT_TRUE(next.IsSolutionUsable()) << next.minimizer.FullReport();
   EXPECT_EQ(next.path.size(), 2u);
   EXPECT_NEAR(next.weight, 1.0, 1e-12);
@@ -291,14 +303,10 @@ TEST(LCurveRuleTest, KeepsTheLargestWeightWhenItMeetsTheTarget) {
 
 TEST(LCurveRuleTest, StopsAtTheFirstWeightThatMeetsTheTarget) {
   // The closed-form test's problem with targets first met at the grid's weight 1 and
-  // at 1e-4 (absolute weights 1e2, 1, 1e-2, ...): the descent stops there, and the
-  // weight is the corner of the points so far (the closed form's), or that weight.
+  // at 1e-4: the descent stops there, and the weight is the corner of the points so
+  // far (the closed form's), or that weight.
   const SmoothingProblem problem;
-  LeastSquares data(problem.a, problem.b);
-  const double start_cost = 0.5 * problem.b.squaredNorm();
-  RegularizationOptions regularization;
-  regularization.max_weight = 1e2 / start_cost;
-  regularization.min_weight = 1e-10 / start_cost;
+  const LeastSquares data(problem.a, problem.b);
   for (int first_met : {1, 3}) {
     std::vector<double> weights, misfits, roughness;
     for (int k = 0; k <= first_met; ++k) {
@@ -311,10 +319,7 @@ TEST(LCurveRuleTest, StopsAtTheFirstWeightThatMeetsTheTarget) {
     const double target = std::sqrt(misfits[first_met] * misfits[first_met - 1]);
     const int corner = LCurveCorner(misfits, roughness);
     const double expected = corner >= 0 ? weights[corner] : weights[first_met];
-    const RegularizedMinimization result = MinimizeRegularized(
-        TightOptions(BoundedAlgorithm::kCeresLbfgs), regularization, &data,
-        std::vector<double>(problem.n, -5.0), std::vector<double>(problem.n, 5.0),
-        std::vector<double>(problem.n, 0.0), target);
+    const RegularizedMinimization result = LCurveOnTheGrid(problem, target);
     ASSERT_TRUE(result.IsSolutionUsable()) << result.minimizer.FullReport();
     EXPECT_EQ(result.path.size(), static_cast<std::size_t>(first_met + 1));
     EXPECT_EQ(result.weight_choice, corner >= 0 ? "l_curve" : "discrepancy");
@@ -347,19 +352,16 @@ TEST(DiscrepancyPrincipleTest, AMinimisationThatFailsBelowTheGridsTopEndsTheDesc
   // fails: the descent stops there and chooses among the three converged weights,
   // as the first search did, instead of returning the failure.
   const SmoothingProblem problem;
-  const int m = problem.m, n = problem.n;
-  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(m + 6, n);
-  a.topRows(m) = problem.a;
-  Eigen::VectorXd b = Eigen::VectorXd::Ones(m + 6);
-  b.head(m) = problem.b;
-  LeastSquares data(a, b);
-  const double target = 0.5 * m * problem.sigma * problem.sigma;
-  const double start_cost = 0.5 * b.squaredNorm();
+  const int n = problem.n;
+  LeastSquares data = WithUnfittableRows(problem);
+  const double target = 0.5 * problem.m * problem.sigma * problem.sigma;
+  const std::vector<double> lower(n, -5.0), upper(n, 5.0), start(n, 0.0);
+  double start_cost = 0.0;
+  ASSERT_TRUE(data.Evaluate(start.data(), &start_cost, nullptr));
   const BoundedMinimizerOptions options = TightOptions(BoundedAlgorithm::kCeresLbfgs);
   RegularizationOptions regularization;
   regularization.max_weight = 1e2 / start_cost;
   regularization.min_weight = 1e-2 / start_cost;
-  const std::vector<double> lower(n, -5.0), upper(n, 5.0), start(n, 0.0);
   const RegularizedMinimization three =
       MinimizeRegularized(options, regularization, &data, lower, upper, start, target);
   ASSERT_TRUE(three.IsSolutionUsable()) << three.minimizer.FullReport();
