@@ -232,13 +232,18 @@ RegularizedMinimization MinimizeRegularized(
   BoundedMinimizerSummary hit;
   double hit_weight = -1.0;
   double hit_misfit = -1.0;
-  BoundedMinimizerSummary last;
   double last_weight = -1.0;
   double last_misfit = -1.0;
   std::string choice = "discrepancy";  // of a weight kept in the descent
-  // The grid's minimisations, for the misfit-floor fallback.
+  // The grid's minimisations, for the L-curve and the misfit-floor rule.
   std::vector<BoundedMinimizerSummary> grid;
   std::vector<double> grid_weights, grid_misfits, grid_roughness;
+  // The grid's k-th minimisation becomes the one kept.
+  const auto keep = [&](std::size_t k) {
+    hit = grid[k];
+    hit_weight = grid_weights[k];
+    hit_misfit = grid_misfits[k];
+  };
   for (double weight = regularization.max_weight * start_cost;
        weight >= regularization.min_weight * start_cost * (1.0 - 1e-12);
        weight /= regularization.grid_factor) {
@@ -263,7 +268,6 @@ RegularizedMinimization MinimizeRegularized(
       return result;  // a failed minimisation ends the search: its message says why
     }
     start = summary.x;
-    last = summary;
     last_weight = weight;
     last_misfit = point.misfit;
     grid.push_back(summary);
@@ -281,10 +285,7 @@ RegularizedMinimization MinimizeRegularized(
       // The L-curve below the largest weight: lighter weights than this one only fit
       // the noise (its flat arm); the corner of the points so far, or this weight.
       const int corner = LCurveCorner(grid_misfits, grid_roughness);
-      const std::size_t kept = corner >= 0 ? static_cast<std::size_t>(corner) : grid.size() - 1;
-      hit = grid[kept];
-      hit_weight = grid_weights[kept];
-      hit_misfit = grid_misfits[kept];
+      keep(corner >= 0 ? static_cast<std::size_t>(corner) : grid.size() - 1);
       missed = -1.0;  // no refinement
       spdlog::info("the weight {:.3g} meets the noise's level {:.6g}: the weight is {} {:.3g}",
                    weight, target_misfit, corner >= 0 ? "the L-curve's corner above it," : "it,",
@@ -314,9 +315,7 @@ RegularizedMinimization MinimizeRegularized(
     }
     if (corner >= 0) {
       result.weight_choice = "l_curve";
-      hit = grid[corner];
-      hit_weight = grid_weights[corner];
-      hit_misfit = grid_misfits[corner];
+      keep(static_cast<std::size_t>(corner));
       missed = -1.0;  // no target to refine against
     } else {
       // Without a corner (fewer than 3 weights, or a straight curve) the principle is
@@ -333,9 +332,7 @@ RegularizedMinimization MinimizeRegularized(
       result.weight_choice = "misfit_floor";
       for (std::size_t k = 0; k < grid.size(); ++k) {
         if (grid_misfits[k] <= target) {
-          hit = grid[k];
-          hit_weight = grid_weights[k];
-          hit_misfit = grid_misfits[k];
+          keep(k);
           missed = k > 0 ? grid_weights[k - 1] : -1.0;
           missed_misfit = k > 0 ? grid_misfits[k - 1] : -1.0;
           break;

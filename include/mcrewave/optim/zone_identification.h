@@ -16,10 +16,11 @@
 // end of its descent) needs the misfit the noise alone explains: ExpectedNoiseCost, the
 // mean scaled e^2 of data made of noise alone (white, at the noise levels estimated
 // from the measurements by their second differences, DifferenceNoiseLevels, passed
-// through the same pre-filter as the data) at the homogeneous E*. Why that level: the coupled solution is affine in the data
-// and e^2 a quadratic form of its residuals; data of the model at the true moduli give
-// a zero residual, so at the truth e^2(truth + noise) = e^2(noise) exactly (inverse
-// crime) and its mean over noise draws is the misfit the truth itself would show.
+// through the same pre-filter as the data) at the homogeneous E*. Why that level: the
+// coupled solution is affine in the data and e^2 a quadratic form of its residuals;
+// data of the model at the true moduli give a zero residual, so at the truth
+// e^2(truth + noise) = e^2(noise) exactly (inverse crime) and its mean over noise draws
+// is the misfit the truth itself would show.
 #pragma once
 
 #include <cstdint>
