@@ -281,5 +281,23 @@ TEST(BarSensorsTest, RowsInterpolateDisplacementAndDifferentiateForStrain) {
   EXPECT_EQ(model.StrainRow(0.35).nodes[0], 3);
 }
 
+// u = x^2, strain 2 x: a gauge on an interior node reads the mean of its two elements,
+// exact there; inside an element, that element's strain, exact at its midpoint; at the
+// ends, the end element's, h_e off.
+TEST(BarSensorsTest, AGaugeOnANodeReadsBothItsElements) {
+  const BarModel model(TenElementBar());
+  Vector u(11);
+  for (int i = 0; i <= 10; ++i) u[i] = model.node_position(i) * model.node_position(i);
+  EXPECT_EQ(model.StrainRow(0.3).nodes[0], 2);
+  EXPECT_EQ(model.StrainRow(0.3).nodes[1], 4);
+  EXPECT_NEAR(model.StrainRow(0.3).Apply(u.data()), 0.6, 1e-13);
+  // 0.3 / 0.1 = 2.9999999999999996: still the node.
+  EXPECT_NEAR(model.StrainRow(0.1 * 3).Apply(u.data()), 0.6, 1e-13);
+  EXPECT_NEAR(model.StrainRow(0.35).Apply(u.data()), 0.7, 1e-13);
+  EXPECT_NEAR(model.StrainRow(0.31).Apply(u.data()), 0.7, 1e-13);
+  EXPECT_NEAR(model.StrainRow(0.0).Apply(u.data()), 0.1, 1e-13);
+  EXPECT_NEAR(model.StrainRow(1.0).Apply(u.data()), 1.9, 1e-13);
+}
+
 }  // namespace
 }  // namespace mcrewave

@@ -235,7 +235,8 @@ std::string ProfilesScript(const std::string& folder, const std::vector<std::str
          << "set key outside right\nset datafile separator comma\n";
   for (std::size_t t = 0; t < DamageTruths().size(); ++t) {
     const std::string csv = GnuplotString(folder + "/profile_" + DamageTruths()[t].name + ".csv");
-    script << "set title '" << DamageTruths()[t].name << "'\nplot " << csv
+    // noenhanced: the truths' names hold underscores, subscripts in enhanced text.
+    script << "set title '" << DamageTruths()[t].name << "' noenhanced\nplot " << csv
            << " skip 1 using 1:2 with lines lw 3 lc rgb '#000000' title 'truth'";
     for (std::size_t r = 0; r < labels.size(); ++r) {
       script << ", " << csv << " skip 1 using 1:" << r + 3 << " with lines lw 2 lc rgb '"

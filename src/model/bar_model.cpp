@@ -261,9 +261,21 @@ ObservationRow BarModel::DisplacementRow(double position) const {
 }
 
 ObservationRow BarModel::StrainRow(double position) const {
+  const double nodes_from_left = position / element_length();
+  const int node = static_cast<int>(std::lround(nodes_from_left));
+  ObservationRow row;
+  if (node > 0 && node < num_elements() && std::abs(nodes_from_left - node) < 1e-9) {
+    // A gauge on node i reads both its elements: h = (e_{i+1} - e_{i-1}) / (2 h_e), the
+    // mean of their strains, exact at x_i for a quadratic field; one element's strain
+    // is centred h_e / 2 away (docs/zones_and_sensors.md, "Sensors").
+    row.nodes[0] = node - 1;
+    row.nodes[1] = node + 1;
+    row.coefficients[0] = -0.5 / element_length();
+    row.coefficients[1] = 0.5 / element_length();
+    return row;
+  }
   const int e = ElementAt(position);
   // h = (e_{e+1} - e_e) / h_e.
-  ObservationRow row;
   row.nodes[0] = e;
   row.nodes[1] = e + 1;
   row.coefficients[0] = -1.0 / element_length();

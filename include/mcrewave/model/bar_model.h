@@ -15,7 +15,9 @@
 //
 // Sensors. An observation row h (H's row) reads a channel off the nodal
 // displacements U: displacement at x in element e (local coordinate xi in [0, 1]):
-// h = (1 - xi) e_e + xi e_{e+1}; axial strain of element e: h = (e_{e+1} - e_e) / h_e.
+// h = (1 - xi) e_e + xi e_{e+1}; axial strain at x inside element e: its strain,
+// h = (e_{e+1} - e_e) / h_e; at an interior node i, the mean of its two elements'
+// strains, h = (e_{i+1} - e_{i-1}) / (2 h_e) (a gauge straddling the node).
 #pragma once
 
 #include <string>
@@ -131,7 +133,8 @@ class BarModel {
   // (a node shared by two elements belongs to the one on its right; x within 1e-9 h_e
   // below a node counts as the node).
   int ElementAt(double position) const;
-  // Observation rows (see the file comment). Precondition: 0 <= x <= L.
+  // Observation rows (see the file comment). Precondition: 0 <= x <= L. StrainRow
+  // counts x within 1e-9 h_e of an interior node as the node.
   ObservationRow DisplacementRow(double position) const;
   ObservationRow StrainRow(double position) const;
   // B = e_0 e_0^T + e_N e_N^T, the selector of the two measured end nodes.
