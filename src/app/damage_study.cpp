@@ -16,6 +16,7 @@
 #include "mcrewave/mcre/error_map.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/model/simulation.h"
+#include "mcrewave/optim/regularization.h"
 
 namespace mcrewave {
 namespace {
@@ -259,7 +260,8 @@ std::string Summary(const DamageStudy& study) {
         "`non_aligned` 0.75 E over [0.63, 0.71] m, `two_zones` 0.8 E over [0.15, 0.25] m and "
         "1.15 E over [0.55, 0.65] m. Sensors: `ends` (u0, uL, f0, fL) or `interior` (the ends "
         "with u@0.25, 0.5, 0.75 and e@0.2, 0.45, 0.65, 0.9). Zone errors against the truth's "
-        "modulus of each zone (its elements in series).\n\n";
+        "modulus of each zone (its elements in series). Settings: "
+     << study.settings << ".\n\n";
   // Goal 1: noise-free, 10 zones, every zone within 1 %.
   md << "## Noise-free, 10 zones: every zone within 1 %\n\n"
      << "| truth | sensors | max zone error | weakest zone | E_weakest / E_ref | error map peak "
@@ -388,6 +390,15 @@ DamageStudy RunDamageStudy(const Config& config) {
   study.length = config.model.length;
   study.runs.resize(cases.size());
   study.threads = internal::ResolveThreads(config.study.threads);
+  std::ostringstream settings;
+  settings << "clamp " << ClampModelToString(config.mcre.clamp)
+           << ", w_u = " << config.mcre.weights.displacement_weight
+           << ", w_f = " << config.mcre.weights.force_weight
+           << ", w_e = " << config.mcre.weights.strain_weight << "; zone penalty "
+           << RegularizationKindToString(config.zone_identification.regularization.kind)
+           << ", its weight by the rule "
+           << WeightRuleToString(config.zone_identification.regularization.weight_rule);
+  study.settings = settings.str();
   internal::Progress progress("damage", static_cast<int>(cases.size()));
   internal::ParallelFor(
       static_cast<int>(cases.size()), study.threads,

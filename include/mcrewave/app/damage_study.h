@@ -61,6 +61,9 @@ struct DamageStudy {
   std::vector<DamageRun> runs;     // the grid (truth, sensors, SNR, zoning), then the seeds
   int threads = 0;
   double wall_time_s = 0.0;
+  // The settings every run shares (clamp, weights, zone penalty and its weight's rule),
+  // as summary.md states them.
+  std::string settings;
 };
 
 // Precondition: config valid (as LoadConfig returns it), synthetic finite-element truth.

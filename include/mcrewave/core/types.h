@@ -57,7 +57,7 @@ bool StringToTruthModel(const std::string& name, TruthModel* model);
 // Kind of an interior sensor channel of the bar (CSV header `u@X`, `e@X`).
 enum class SensorKind {
   kDisplacement,  // u@X: axial displacement [m] at X m from the clamped end
-  kStrain,        // e@X: axial strain [-] of the element holding X (compression negative)
+  kStrain,        // e@X: axial strain [-] at X, BarModel::StrainRow (compression negative)
 };
 const char* SensorKindToString(SensorKind kind);
 bool StringToSensorKind(const std::string& name, SensorKind* kind);

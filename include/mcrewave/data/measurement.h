@@ -10,7 +10,7 @@
 //   fL   force applied ON the bar at x = L, positive along +x [N]     (required;
 //        the shock load)
 //   u@X  displacement [m] at X m from the clamped end                 (any number)
-//   e@X  axial strain [-] of the element holding X, compression negative (any number)
+//   e@X  axial strain [-] at X (BarModel::StrainRow), compression negative (any number)
 // e.g. `t,u0,uL,f0,fL,u@0.25,u@0.5,e@0.2,e@0.65`. The paper's file `t,u0,uL,f0,fL`
 // keeps its meaning.
 #pragma once
@@ -25,8 +25,8 @@
 namespace mcrewave {
 
 // An interior sensor channel: CSV column `u@X` (displacement [m] at X m from the
-// clamped end) or `e@X` (axial strain [-] of the element holding X, compression
-// negative).
+// clamped end) or `e@X` (axial strain [-] at X: of the element holding X, at a node
+// the mean of its two elements; compression negative).
 struct SensorChannel {
   std::string name;  // the CSV header, e.g. "u@0.25"
   SensorKind kind = SensorKind::kDisplacement;
