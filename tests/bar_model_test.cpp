@@ -290,8 +290,8 @@ TEST(BarSensorsTest, AGaugeOnANodeReadsBothItsElements) {
   for (int i = 0; i <= 10; ++i) u[i] = model.node_position(i) * model.node_position(i);
   EXPECT_EQ(model.StrainRow(0.3).nodes[0], 2);
   EXPECT_EQ(model.StrainRow(0.3).nodes[1], 4);
+  // 0.3 / 0.1 = 2.9999999999999996 and 0.1 * 3 / 0.1 = 3.0000000000000004: both the node.
   EXPECT_NEAR(model.StrainRow(0.3).Apply(u.data()), 0.6, 1e-13);
-  // 0.3 / 0.1 = 2.9999999999999996: still the node.
   EXPECT_NEAR(model.StrainRow(0.1 * 3).Apply(u.data()), 0.6, 1e-13);
   EXPECT_NEAR(model.StrainRow(0.35).Apply(u.data()), 0.7, 1e-13);
   EXPECT_NEAR(model.StrainRow(0.31).Apply(u.data()), 0.7, 1e-13);
