@@ -208,6 +208,23 @@ TEST(LCurveCornerTest, FindsTheBendOfAnLAndNoneOfALine) {
   EXPECT_EQ(LCurveCorner({4.0, 1.0, 1.0}, {1.0, 0.0, 4.0}), -1);
 }
 
+// The closed form's L-curve at the first `points` weights of the grid 1e2, 1, 1e-2, ...
+// (the default grid factor, 100).
+struct ClosedFormLCurve {
+  std::vector<double> weights, misfits, roughness;
+};
+ClosedFormLCurve ClosedFormOnTheGrid(const LeastSquares& data, int points) {
+  ClosedFormLCurve curve;
+  double weight = 1e2;
+  for (int k = 0; k < points; ++k, weight /= RegularizationOptions().grid_factor) {
+    const auto [misfit, rough] = data.MisfitAndRoughness(weight);
+    curve.weights.push_back(weight);
+    curve.misfits.push_back(misfit);
+    curve.roughness.push_back(rough);
+  }
+  return curve;
+}
+
 // The L-curve corner of `data` on the grid 1e2 .. 1e-10 (factor 100) with both
 // minimisers and `rule`, against the closed form's corner at the same weights, for a
 // `target` no weight meets.
@@ -221,13 +238,7 @@ void ExpectTheClosedFormsCorner(const LeastSquares& closed_form, WeightRule rule
   ASSERT_TRUE(data.Evaluate(zero.data(), &start_cost, nullptr));
   regularization.max_weight = 1e2 / start_cost;
   regularization.min_weight = 1e-10 / start_cost;
-  std::vector<double> weights, misfits, roughness;
-  for (double weight = 1e2; weight >= 1e-10 * (1.0 - 1e-12); weight /= regularization.grid_factor) {
-    const auto [misfit, rough] = data.MisfitAndRoughness(weight);
-    weights.push_back(weight);
-    misfits.push_back(misfit);
-    roughness.push_back(rough);
-  }
+  const auto [weights, misfits, roughness] = ClosedFormOnTheGrid(data, 7);  // 1e2 .. 1e-10
   const int corner = LCurveCorner(misfits, roughness);
   ASSERT_GT(corner, 0);
   for (BoundedAlgorithm algorithm :
@@ -308,13 +319,7 @@ TEST(LCurveRuleTest, StopsAtTheFirstWeightThatMeetsTheTarget) {
   const SmoothingProblem problem;
   const LeastSquares data(problem.a, problem.b);
   for (int first_met : {1, 3}) {
-    std::vector<double> weights, misfits, roughness;
-    for (int k = 0; k <= first_met; ++k) {
-      weights.push_back(1e2 * std::pow(1e-2, k));
-      const auto [misfit, rough] = data.MisfitAndRoughness(weights.back());
-      misfits.push_back(misfit);
-      roughness.push_back(rough);
-    }
+    const auto [weights, misfits, roughness] = ClosedFormOnTheGrid(data, first_met + 1);
     // Between the misfits at the weight first met and at the one before it.
     const double target = std::sqrt(misfits[first_met] * misfits[first_met - 1]);
     const int corner = LCurveCorner(misfits, roughness);

@@ -232,8 +232,6 @@ RegularizedMinimization MinimizeRegularized(
   BoundedMinimizerSummary hit;
   double hit_weight = -1.0;
   double hit_misfit = -1.0;
-  double last_weight = -1.0;
-  double last_misfit = -1.0;
   std::string choice = "discrepancy";  // of a weight kept in the descent
   // The grid's minimisations, for the L-curve and the misfit-floor rule.
   std::vector<BoundedMinimizerSummary> grid;
@@ -256,7 +254,7 @@ RegularizedMinimization MinimizeRegularized(
       spdlog::warn(
           "the minimisation at the regularisation weight {:.3g} failed ({}): the descent "
           "stops at {:.3g}",
-          weight, summary.message, last_weight);
+          weight, summary.message, grid_weights.back());
       break;
     }
     if (!summary.IsSolutionUsable()) {
@@ -268,17 +266,13 @@ RegularizedMinimization MinimizeRegularized(
       return result;  // a failed minimisation ends the search: its message says why
     }
     start = summary.x;
-    last_weight = weight;
-    last_misfit = point.misfit;
-    grid.push_back(summary);
+    grid.push_back(std::move(summary));
     grid_weights.push_back(weight);
     grid_misfits.push_back(point.misfit);
     grid_roughness.push_back(point.roughness);
     if (point.meets_target &&
         (!l_curve || (grid.size() == 1 && point.misfit <= kLCurveTopShare * target_misfit))) {
-      hit = std::move(summary);
-      hit_weight = weight;
-      hit_misfit = point.misfit;
+      keep(grid.size() - 1);
       break;
     }
     if (l_curve && point.meets_target && grid.size() > 1) {
@@ -299,21 +293,26 @@ RegularizedMinimization MinimizeRegularized(
   double target = target_misfit;
   result.weight_choice = choice;
   if (hit_weight < 0.0) {
+    // The grid's last, lightest weight: the first minimisation returned if it failed,
+    // and the loop runs at least once for options that are valid (max > min weight).
+    assert(!grid.empty());
+    const double last_weight = grid_weights.back();
+    const double last_misfit = grid_misfits.back();
     result.misfit_floor = last_misfit;
     // No weight reaches the noise's level (model error, or the noise underestimated):
     // the noise level is not to be trusted, and the L-curve needs none (the L-curve
     // rule's own choice then, the discrepancy principle's fallback, with a warning).
     const int corner = LCurveCorner(grid_misfits, grid_roughness);
-    if (corner >= 0 && (l_curve || target_misfit < 0.0)) {
-      spdlog::info("the weight is the L-curve's corner, {:.3g} (misfit {:.6g})",
-                   grid_weights[corner], grid_misfits[corner]);
-    } else if (corner >= 0) {
-      spdlog::warn(
-          "no regularisation weight down to {:.3g} brings the misfit {:.6g} to the noise's "
-          "level {:.6g}: the weight is the L-curve's corner, {:.3g} (misfit {:.6g})",
-          last_weight, last_misfit, target_misfit, grid_weights[corner], grid_misfits[corner]);
-    }
     if (corner >= 0) {
+      if (l_curve || target_misfit < 0.0) {
+        spdlog::info("the weight is the L-curve's corner, {:.3g} (misfit {:.6g})",
+                     grid_weights[corner], grid_misfits[corner]);
+      } else {
+        spdlog::warn(
+            "no regularisation weight down to {:.3g} brings the misfit {:.6g} to the noise's "
+            "level {:.6g}: the weight is the L-curve's corner, {:.3g} (misfit {:.6g})",
+            last_weight, last_misfit, target_misfit, grid_weights[corner], grid_misfits[corner]);
+      }
       result.weight_choice = "l_curve";
       keep(static_cast<std::size_t>(corner));
       missed = -1.0;  // no target to refine against

@@ -177,7 +177,7 @@ struct RegularizedMinimization {
 };
 
 // Minimises data cost + R within the bounds: at the fixed weight, or with the weight
-// of the discrepancy principle for target_misfit (scaled like the data cost).
+// regularization.weight_rule chooses for target_misfit (scaled like the data cost).
 // options.max_evaluations and max_time hold for each minimisation. Preconditions:
 // both options valid; target_misfit >= 0 when regularization.weight < 0 and kind is
 // not kNone.
