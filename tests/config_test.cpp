@@ -141,6 +141,7 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(zones.regularization.discrepancy_factor, zones_again.regularization.discrepancy_factor);
   EXPECT_EQ(zones.noise_samples, zones_again.noise_samples);
   EXPECT_EQ(zones.noise_seed, zones_again.noise_seed);
+  EXPECT_EQ(zones.merge_zones, zones_again.merge_zones);
 }
 
 // Runs `action`, which must throw InputError whose message contains every one of
@@ -498,6 +499,7 @@ zone_identification:
   discrepancy_factor: 1.5
   noise_samples: 6
   noise_seed: 7
+  merge_zones: true
 )";
 
 // The keys of a structure given by matrices at non-default values (they are refused

@@ -258,11 +258,13 @@ namespace mcrewave {
 namespace {
 
 TEST(IdentifyStudyDamageTest, TheDamageStudyRunsOnTheQuickCaseAndLocalisesWithInteriorSensors) {
-  // The grid at SNR inf on the quick case (25 elements): 12 runs in about 17 s.
+  // The grid at SNR inf on the quick case (25 elements), zones merged: 12 runs in about
+  // 17 s.
   const std::string folder = testing::FreshDirectory("identify_study_damage") + "/results";
   const testing::RunResult result = testing::RunIdentify(
       "study " + testing::SourcePath("configs/quick.yaml") + " -o " + folder +
-      " --set study.kind=damage --set study.damage_snr=[.inf] --set study.damage_seeds=1");
+      " --set study.kind=damage --set study.damage_snr=[.inf] --set study.damage_seeds=1"
+      " --set zone_identification.merge_zones=true");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   std::istringstream runs(testing::ReadText(folder + "/damage/runs.csv"));
   std::string line;
@@ -276,6 +278,15 @@ TEST(IdentifyStudyDamageTest, TheDamageStudyRunsOnTheQuickCaseAndLocalisesWithIn
     for (std::string field; std::getline(row, field, ',');) fields.push_back(field);
     ASSERT_GE(fields.size(), 9u) << line;
     EXPECT_EQ(fields[6], "1") << line;  // converged
+    // Merging runs on the 10 equal zones only: 1 to 10 groups left; -1 per element.
+    ASSERT_GE(fields.size(), 15u) << line;
+    const int groups = std::stoi(fields[14]);
+    if (fields[5] == "10_equal") {
+      EXPECT_GE(groups, 1) << line;
+      EXPECT_LE(groups, 10) << line;
+    } else {
+      EXPECT_EQ(groups, -1) << line;
+    }
     // With the interior sensors the error map peaks in an element (0.04 m, its
     // midpoint reported) that overlaps a zone of the truth (soft and non-aligned:
     // [0.6, 0.71] m; two zones: [0.15, 0.25] or [0.55, 0.65] m); measured 0.66 m for

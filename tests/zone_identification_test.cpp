@@ -1,12 +1,14 @@
 // IdentifyZoneModuli (optim/zone_identification.h): the adapter's gradient in
-// p = log(E / E*) against central differences, and the inverse crime: 10 zones from
-// noise-free data of the model itself, every zone recovered.
+// p = log(E / E*) against central differences, the inverse crime: 10 zones from
+// noise-free data of the model itself, every zone recovered, and the merging of its
+// zones on noisy data against the identification of the truth's groups.
 #include "mcrewave/optim/zone_identification.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include "mcrewave/mcre/objective.h"
@@ -165,6 +167,60 @@ TEST(ZoneDiscrepancyTest, NoiseFreeDataNeedNoRegularisationToSpeakOf) {
                 summary.regularized.weight_choice == "misfit_floor");
     EXPECT_LT(worst, 0.01) << summary.FullReport();
   }
+}
+
+TEST(ZoneMergeTest, NoisyInverseCrimeMergesToTheTruthsGroups) {
+  // The inverse crime with white noise at SNR 20 on the four end channels (seed 4), total
+  // variation at the L-curve's weight, then merging: the zones must come back as the
+  // truth's three groups [0, 0.6], [0.6, 0.7], [0.7, 1] L, at the moduli of the
+  // independent unregularised identification of exactly those three zones.
+  const Vector truth = SoftZoneModuli(10);
+  InverseCrime crime(40, 120, 10, truth);
+  std::mt19937_64 engine(4);
+  std::normal_distribution<double> normal;
+  const double rms_u = std::sqrt(crime.data.uL.squaredNorm() / crime.data.uL.size());
+  const double rms_f = std::sqrt(crime.data.fL.squaredNorm() / crime.data.fL.size());
+  for (Vector* channel : {&crime.data.u0, &crime.data.uL}) {
+    for (double& value : *channel) value += rms_u / 20.0 * normal(engine);
+  }
+  for (Vector* channel : {&crime.data.f0, &crime.data.fL}) {
+    for (double& value : *channel) value += rms_f / 20.0 * normal(engine);
+  }
+  PrefilterOptions prefilter;
+  prefilter.enabled = false;
+  const CoupledSolverOptions inner = Options(CoupledSolverType::kConjugateGradient, 1e-12);
+  ZoneIdentificationOptions options;
+  options.regularization.kind = RegularizationKind::kTotalVariation;
+  options.merge_zones = true;
+  const ZoneIdentificationSummary merged =
+      IdentifyZoneModuli(options, crime.model, crime.data, Mcre(), 0.5, inner, {}, 190e9, 100e9,
+                         400e9, DifferenceNoiseLevels(crime.data), prefilter);
+  ASSERT_TRUE(merged.IsSolutionUsable()) << merged.FullReport();
+  EXPECT_EQ(merged.merge.groups, 3) << merged.FullReport();
+  EXPECT_EQ(merged.merge.group_of, (std::vector<int>{0, 0, 0, 0, 0, 0, 1, 2, 2, 2}));
+
+  ZoneLayout three;
+  three.zoning = Zoning::kBoundaries;
+  three.zone_boundaries = {0.6, 0.7};
+  const BarModel three_zones(crime.small.bar, three.ElementZones(crime.small.bar));
+  ZoneIdentificationOptions plain;
+  plain.regularization.kind = RegularizationKind::kNone;
+  const ZoneIdentificationSummary reference =
+      IdentifyZoneModuli(plain, three_zones, crime.data, Mcre(), 0.5, inner, {}, 190e9, 100e9,
+                         400e9, NoiseLevels{}, prefilter);
+  ASSERT_TRUE(reference.IsSolutionUsable()) << reference.FullReport();
+  ASSERT_EQ(reference.moduli.size(), 3);
+  double worst = 0.0, worst_truth = 0.0;
+  for (int z = 0; z < 10; ++z) {
+    const int group = merged.merge.group_of[z];
+    worst = std::max(worst, std::abs(merged.moduli[z] / reference.moduli[group] - 1.0));
+    worst_truth = std::max(worst_truth, std::abs(merged.moduli[z] / truth[z] - 1.0));
+  }
+  // Measured: 1.1e-8 against the three-zone identification (the minimisers' step
+  // tolerance 1e-8 on log E), 2.4 % against the truth (the noise of the small case: 7
+  // merges kept of 9 refits, misfit 3.55e-6 against a target of 4.70e-6).
+  EXPECT_LT(worst, 1e-7);
+  EXPECT_LT(worst_truth, 0.05);
 }
 
 }  // namespace

@@ -711,6 +711,9 @@ const std::vector<Key>& KeyTable() {
       MakeKey("zone_identification.noise_seed", &Config::zone_identification,
               &ZoneIdentificationOptions::noise_seed, UnsignedInteger(), "",
               "seed of those noise draws"),
+      MakeKey("zone_identification.merge_zones", &Config::zone_identification,
+              &ZoneIdentificationOptions::merge_zones, Boolean(), "",
+              "merge neighbouring zones while a refit meets the discrepancy target"),
   };
   return table;
 }

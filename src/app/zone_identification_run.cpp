@@ -106,6 +106,10 @@ std::vector<std::string> ZonesYamlLines(const ZoneIdentificationRun& run) {
   line(1, "misfit_floor", Number(s.regularized.misfit_floor),
        "least e^2 / J_rest of the weight grid when the target was missed (-1: met)");
   line(1, "weights_tried", std::to_string(s.regularized.path.size()));
+  line(1, "groups", std::to_string(s.merge.groups),
+       "zones left distinct by merging (-1: zone_identification.merge_zones off)");
+  line(1, "merges", std::to_string(s.merge.merges), "merges kept, of " +
+       std::to_string(s.merge.refits) + " refits; with any, moduli and cost are the last refit's");
   line(1, "evaluations", std::to_string(s.evaluations));
   line(1, "sweeps", std::to_string(s.sweeps));
   line(1, "wall_time_s", Number(s.wall_time_s));

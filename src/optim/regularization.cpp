@@ -6,6 +6,7 @@
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -388,6 +389,116 @@ RegularizedMinimization MinimizeRegularized(
   result.x = result.minimizer.x;
   result.misfit = hit_misfit;
   return result;
+}
+
+namespace {
+
+// The data cost over groups of zones: zone z takes its group's parameter,
+//   p_z = q_{g(z)},  d cost / d q_g = sum_{z in g} d cost / d p_z.
+class GroupedObjective : public MultiParameterObjective {
+ public:
+  // zones must outlive this objective.
+  GroupedObjective(MultiParameterObjective* zones, std::vector<int> group_of, int groups)
+      : zones_(zones),
+        group_of_(std::move(group_of)),
+        groups_(groups),
+        zone_parameters_(group_of_.size()),
+        zone_gradient_(group_of_.size()) {}
+  int num_parameters() const override { return groups_; }
+  bool Evaluate(const double* q, double* cost, double* gradient) override {
+    for (std::size_t z = 0; z < group_of_.size(); ++z) zone_parameters_[z] = q[group_of_[z]];
+    if (!zones_->Evaluate(zone_parameters_.data(), cost,
+                          gradient != nullptr ? zone_gradient_.data() : nullptr)) {
+      return false;
+    }
+    if (gradient != nullptr) {
+      std::fill(gradient, gradient + groups_, 0.0);
+      for (std::size_t z = 0; z < group_of_.size(); ++z) {
+        gradient[group_of_[z]] += zone_gradient_[z];
+      }
+    }
+    return true;
+  }
+  std::string error_message() const override { return zones_->error_message(); }
+
+ private:
+  MultiParameterObjective* zones_;
+  std::vector<int> group_of_;
+  int groups_;
+  std::vector<double> zone_parameters_;
+  std::vector<double> zone_gradient_;
+};
+
+}  // namespace
+
+ZoneMerge MergeNeighbouringZones(const BoundedMinimizerOptions& options,
+                                 MultiParameterObjective* data, const std::vector<double>& lower,
+                                 const std::vector<double>& upper, const std::vector<double>& x,
+                                 double target_misfit) {
+  assert(target_misfit >= 0.0 && x.size() == lower.size() && x.size() == upper.size());
+  const int zones = static_cast<int>(x.size());
+  ZoneMerge merge;
+  merge.group_of.resize(zones);
+  for (int z = 0; z < zones; ++z) merge.group_of[z] = z;
+  merge.groups = zones;
+  // The current groups' log E, and the boundaries already tried on them.
+  std::vector<double> value = x;
+  std::vector<bool> refused(zones, false);  // refused[b]: removing boundary b (after group b)
+  for (;;) {
+    // The untried boundary with the smallest |jump|; the first along the bar on a tie.
+    int boundary = -1;
+    for (int b = 0; b + 1 < merge.groups; ++b) {
+      if (refused[b]) continue;
+      if (boundary < 0 ||
+          std::abs(value[b + 1] - value[b]) < std::abs(value[boundary + 1] - value[boundary])) {
+        boundary = b;
+      }
+    }
+    if (boundary < 0) break;
+    // The groups with the boundary removed: group boundary + 1 joins group boundary,
+    // started from its zones' mean log E; the others from their values.
+    std::vector<int> old_members(merge.groups, 0);
+    for (int g : merge.group_of) ++old_members[g];
+    std::vector<int> group_of = merge.group_of;
+    for (int& g : group_of) {
+      if (g > boundary) --g;
+    }
+    const int groups = merge.groups - 1;
+    std::vector<double> start(groups);
+    for (int g = 0; g < groups; ++g) start[g] = g < boundary ? value[g] : value[g + 1];
+    start[boundary] = (old_members[boundary] * value[boundary] +
+                       old_members[boundary + 1] * value[boundary + 1]) /
+                      (old_members[boundary] + old_members[boundary + 1]);
+    std::vector<double> group_lower(groups, -std::numeric_limits<double>::infinity());
+    std::vector<double> group_upper(groups, std::numeric_limits<double>::infinity());
+    for (int z = 0; z < zones; ++z) {
+      group_lower[group_of[z]] = std::max(group_lower[group_of[z]], lower[z]);
+      group_upper[group_of[z]] = std::min(group_upper[group_of[z]], upper[z]);
+    }
+    GroupedObjective grouped(data, group_of, groups);
+    const BoundedMinimizerSummary refit =
+        MinimizeWithinBounds(options, &grouped, group_lower, group_upper, start);
+    ++merge.refits;
+    merge.evaluations += refit.evaluations;
+    const bool kept = refit.IsSolutionUsable() && refit.cost <= target_misfit;
+    spdlog::info("zones: merging {} zones into {} groups: misfit {:.6g} against target {:.6g}, {}",
+                 zones, groups, refit.cost, target_misfit, kept ? "kept" : "refused");
+    if (!kept) {
+      refused[boundary] = true;
+      continue;
+    }
+    ++merge.merges;
+    merge.group_of = std::move(group_of);
+    merge.groups = groups;
+    merge.misfit = refit.cost;
+    value = refit.x;
+    std::fill(refused.begin(), refused.end(), false);
+  }
+  if (merge.merges > 0) {
+    merge.x.resize(zones);
+    for (int z = 0; z < zones; ++z) merge.x[z] = value[merge.group_of[z]];
+  }
+  return merge;
 }
 
 }  // namespace mcrewave

@@ -165,7 +165,7 @@ ZoneIdentificationSummary IdentifyZoneModuli(
     double target = -1.0;
     const bool automatic = options.regularization.kind != RegularizationKind::kNone &&
                            options.regularization.weight < 0.0;
-    if (automatic) {
+    if (automatic || options.merge_zones) {
       summary.noise_cost = ExpectedNoiseCost(
           model, data, mcre, theta, inner, ends, Vector::Constant(zones, homogeneous_modulus),
           noise, prefilter, options.noise_samples, options.noise_seed, summary.cost_scale);
@@ -189,11 +189,28 @@ ZoneIdentificationSummary IdentifyZoneModuli(
     const RegularizedMinimization& result = summary.regularized;
     summary.termination = result.minimizer.termination;
     summary.message = result.minimizer.message;
-    if (!result.x.empty()) {
-      summary.moduli = zone_objective.Moduli(result.x.data());
-      summary.cost = result.misfit * summary.cost_scale;
+    if (options.merge_zones && result.IsSolutionUsable()) {
+      // The merges' target: the discrepancy target or, when no weight of the grid met it
+      // (a draw whose noise e^2 lies above the mean the target is), the least misfit the
+      // grid reached raised by kMisfitFloorMargin, as the weight's own fallback.
+      const double merge_target =
+          result.misfit_floor >= 0.0
+              ? std::max(target, (1.0 + kMisfitFloorMargin) * result.misfit_floor)
+              : target;
+      summary.merge = MergeNeighbouringZones(options.minimizer, &zone_objective, lower, upper,
+                                             result.x, merge_target);
+      summary.evaluations = zone_objective.evaluations();
+      summary.sweeps = objective.sweeps();
+      spdlog::info("zones: {} merge(s) kept in {} refits: {} groups", summary.merge.merges,
+                   summary.merge.refits, summary.merge.groups);
+    }
+    const bool merged = !summary.merge.x.empty();
+    const std::vector<double>& x = merged ? summary.merge.x : result.x;
+    if (!x.empty()) {
+      summary.moduli = zone_objective.Moduli(x.data());
+      summary.cost = (merged ? summary.merge.misfit : result.misfit) * summary.cost_scale;
       for (int z = 0; z < zones; ++z) {
-        if (std::abs(result.x[z] - lower[z]) < 1e-6 || std::abs(result.x[z] - upper[z]) < 1e-6) {
+        if (std::abs(x[z] - lower[z]) < 1e-6 || std::abs(x[z] - upper[z]) < 1e-6) {
           summary.zones_on_bounds.push_back(z);
         }
       }

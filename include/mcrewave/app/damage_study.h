@@ -51,6 +51,7 @@ struct DamageRun {
   int weakest_zone = -1;             // index of the smallest identified E_z
   double max_zone_error = std::numeric_limits<double>::quiet_NaN();  // max |E_z / truth_z - 1|
   double regularization_weight = std::numeric_limits<double>::quiet_NaN();
+  int groups = -1;      // zones left distinct by merging (-1: not merged)
   int evaluations = 0;  // coupled solves, scalar and zones
   double wall_time_s = std::numeric_limits<double>::quiet_NaN();
 };

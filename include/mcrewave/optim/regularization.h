@@ -186,4 +186,35 @@ RegularizedMinimization MinimizeRegularized(
     MultiParameterObjective* data, const std::vector<double>& lower,
     const std::vector<double>& upper, const std::vector<double>& initial, double target_misfit);
 
+// Merging of neighbouring zones after the regularised minimisation (a debiasing
+// refit; docs/zones_and_sensors.md, "Merging neighbouring zones"). The penalty that
+// takes the noise's jumps out of equal zones also shrinks the jumps the data need
+// (total variation by an amount that grows with lambda), and a weight light enough to
+// keep those leaves some of the noise's. Merging asks the data which jumps they need:
+// from the regularised minimiser x, the boundary with the smallest |jump of log E|
+// between two neighbouring groups of zones (each zone its own group at the start) is
+// removed, every group refitted on the data cost alone (no penalty, one parameter per
+// group, started from the groups' mean log E), and the merge kept when the refit's
+// misfit stays at or below the discrepancy target; else the next smallest jump is
+// tried. It stops when no boundary of the current groups can be removed. The result is
+// the last kept refit: the fewest groups, in this order, whose unpenalised fit explains
+// the data within the noise, with no shrinkage of the jumps left.
+struct ZoneMerge {
+  std::vector<int> group_of;  // per zone, its group (numbered along the bar)
+  int groups = -1;            // groups at the end (-1: not run)
+  int merges = 0;             // merges kept
+  int refits = 0;             // refits tried (kept or not)
+  int evaluations = 0;        // of every refit
+  std::vector<double> x;      // per zone, its group's log E of the last kept refit
+                              // (empty: no merge kept, the regularised x stands)
+  double misfit = -1.0;       // data cost at x
+};
+
+// Preconditions: options valid; lower, upper and x with data->num_parameters()
+// entries, lower < upper; target_misfit >= 0 (scaled like the data cost).
+ZoneMerge MergeNeighbouringZones(const BoundedMinimizerOptions& options,
+                                 MultiParameterObjective* data, const std::vector<double>& lower,
+                                 const std::vector<double>& upper, const std::vector<double>& x,
+                                 double target_misfit);
+
 }  // namespace mcrewave

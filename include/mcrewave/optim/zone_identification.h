@@ -20,7 +20,9 @@
 // coupled solution is affine in the data and e^2 a quadratic form of its residuals;
 // data of the model at the true moduli give a zero residual, so at the truth
 // e^2(truth + noise) = e^2(noise) exactly (inverse crime) and its mean over noise draws
-// is the misfit the truth itself would show.
+// is the misfit the truth itself would show. The same target decides the merging of
+// neighbouring zones after the regularised minimisation (merge_zones,
+// MergeNeighbouringZones).
 #pragma once
 
 #include <cstdint>
@@ -65,6 +67,12 @@ struct ZoneIdentificationOptions {
   // Noise draws of the discrepancy target (ExpectedNoiseCost).
   int noise_samples = 4;
   std::uint64_t noise_seed = 1;
+  // Merge neighbouring zones after the regularised minimisation while an unpenalised
+  // refit of the groups meets the discrepancy target (MergeNeighbouringZones). Off by
+  // default: each trial is a minimisation, O(zones^2) of them at worst, for the few
+  // zones of a localisation rather than one zone per element. The damage study turns it
+  // on for its 10 zones (docs/zones_and_sensors.md, "Merging neighbouring zones").
+  bool merge_zones = false;
 
   // Messages name the zone_identification.* keys.
   bool IsValid(std::string* error) const;
@@ -83,6 +91,8 @@ struct ZoneIdentificationSummary {
   NoiseLevels noise;                    // levels of the discrepancy target's draws
   double noise_cost = -1.0;             // ExpectedNoiseCost (scaled); -1: not computed
   RegularizedMinimization regularized;  // weight, its choice, the path, the minimiser
+  ZoneMerge merge;                      // merge.groups -1: not run; with merges kept,
+                                        // moduli and cost are its last refit's
   std::vector<int> zones_on_bounds;     // zones whose modulus lies on a bound
   int evaluations = 0;                  // coupled solves of the zone identification
   long sweeps = 0;
