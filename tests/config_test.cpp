@@ -552,6 +552,8 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
        "data.sensors applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\nmcre:\n  clamp: measured\n",
        "mcre.clamp applies to the bar only"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  merge_zones: true\n",
+       "zone_identification.merge_zones applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\nouter:\n  functional: least_squares\n",
        "outer.functional must be 'mcre'"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\ninner:\n  method: riccati\n",

@@ -776,6 +776,11 @@ std::string StructureKeysProblem(const Config& config) {
              "' the zones, loads and sensors are those of the manifest (model.manifest)";
     }
   }
+  if (config.zone_identification.merge_zones) {
+    return "zone_identification.merge_zones applies to the bar only; with model.kind '" + kind +
+           "' the manifest's zones are identified without a penalty, so there is no "
+           "discrepancy target to merge them by";
+  }
   if (config.outer.functional != OuterFunctional::kMcre) {
     return "outer.functional must be 'mcre' with model.kind '" + kind +
            "' (least squares is the bar's comparator)";
