@@ -198,6 +198,8 @@ TEST(ZoneMergeTest, NoisyInverseCrimeMergesToTheTruthsGroups) {
   ASSERT_TRUE(merged.IsSolutionUsable()) << merged.FullReport();
   EXPECT_EQ(merged.merge.groups, 3) << merged.FullReport();
   EXPECT_EQ(merged.merge.group_of, (std::vector<int>{0, 0, 0, 0, 0, 0, 1, 2, 2, 2}));
+  EXPECT_NE(merged.FullReport().find("merging:            3 groups"), std::string::npos);
+  EXPECT_NE(merged.BriefReport().find("3 groups after merging"), std::string::npos);
 
   ZoneLayout three;
   three.zoning = Zoning::kBoundaries;

@@ -71,8 +71,9 @@ std::string ZoneIdentificationSummary::BriefReport() const {
   std::ostringstream out;
   out << TerminationTypeToString(termination) << ": " << moduli.size() << " zones, e^2 " << cost
       << " J s (homogeneous " << homogeneous_cost << "), weight " << regularized.weight << " ("
-      << regularized.weight_choice << "), " << evaluations << " evaluations, " << wall_time_s
-      << " s";
+      << regularized.weight_choice << ")";
+  if (merge.groups >= 0) out << ", " << merge.groups << " groups after merging";
+  out << ", " << evaluations << " evaluations, " << wall_time_s << " s";
   return out.str();
 }
 
@@ -85,8 +86,13 @@ std::string ZoneIdentificationSummary::FullReport() const {
       << "  e^2:                " << cost << " J s (at E*: " << homogeneous_cost << ")\n"
       << "  weight:             " << regularized.weight << " (" << regularized.weight_choice
       << ", target misfit " << regularized.target_misfit << ", noise e^2 / J_rest " << noise_cost
-      << ")\n"
-      << "  evaluations:        " << evaluations << ", sweeps " << sweeps << "\n"
+      << ")\n";
+  if (merge.groups >= 0) {
+    out << "  merging:            " << merge.groups << " groups, " << merge.merges
+        << " merges kept of " << merge.refits << " refits (" << merge.evaluations
+        << " evaluations)\n";
+  }
+  out << "  evaluations:        " << evaluations << ", sweeps " << sweeps << "\n"
       << "  wall time:          " << wall_time_s << " s\n";
   for (Eigen::Index z = 0; z < moduli.size(); ++z) {
     out << "  zone " << z << " [" << zone_start[z] << ", " << zone_end[z] << "] m: " << moduli[z]
