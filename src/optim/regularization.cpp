@@ -320,7 +320,7 @@ RegularizedMinimization MinimizeRegularized(
     } else {
       // Without a corner (fewer than 3 weights, or a straight curve) the principle is
       // applied to the floor itself, raised by kMisfitFloorMargin.
-      target = (1.0 + kMisfitFloorMargin) * last_misfit;
+      target = result.AttainableTarget();
       spdlog::warn(
           "{} down to {:.3g}: the target becomes the misfit floor {:.6g} + {:.0f} %, {:.6g}",
           l_curve || target_misfit < 0.0

@@ -187,8 +187,6 @@ ZoneIdentificationSummary IdentifyZoneModuli(
     }
     summary.regularized = MinimizeRegularized(options.minimizer, options.regularization,
                                               &zone_objective, lower, upper, initial, target);
-    summary.evaluations = zone_objective.evaluations();
-    summary.sweeps = objective.sweeps();
     if (!objective.evaluations().empty() && objective.evaluations().front().usable) {
       summary.homogeneous_cost = objective.evaluations().front().cost;
     }
@@ -197,19 +195,15 @@ ZoneIdentificationSummary IdentifyZoneModuli(
     summary.message = result.minimizer.message;
     if (options.merge_zones && result.IsSolutionUsable()) {
       // The merges' target: the discrepancy target or, when no weight of the grid met it
-      // (a draw whose noise e^2 lies above the mean the target is), the least misfit the
-      // grid reached raised by kMisfitFloorMargin, as the weight's own fallback.
-      const double merge_target =
-          result.misfit_floor >= 0.0
-              ? std::max(target, (1.0 + kMisfitFloorMargin) * result.misfit_floor)
-              : target;
+      // (a draw whose noise e^2 lies above the mean the target is), the misfit floor's,
+      // as the weight's own fallback.
       summary.merge = MergeNeighbouringZones(options.minimizer, &zone_objective, lower, upper,
-                                             result.x, merge_target);
-      summary.evaluations = zone_objective.evaluations();
-      summary.sweeps = objective.sweeps();
+                                             result.x, result.AttainableTarget());
       spdlog::info("zones: {} merge(s) kept in {} refits: {} groups", summary.merge.merges,
                    summary.merge.refits, summary.merge.groups);
     }
+    summary.evaluations = zone_objective.evaluations();
+    summary.sweeps = objective.sweeps();
     const bool merged = !summary.merge.x.empty();
     const std::vector<double>& x = merged ? summary.merge.x : result.x;
     if (!x.empty()) {

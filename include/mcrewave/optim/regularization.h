@@ -174,6 +174,12 @@ struct RegularizedMinimization {
   double misfit = -1.0;                // its data cost
   int evaluations = 0;                 // of every minimisation
   bool IsSolutionUsable() const { return minimizer.IsSolutionUsable(); }
+  // The misfit the data can be held to: target_misfit, or when no weight of the grid
+  // met it, the misfit floor raised by kMisfitFloorMargin (the target of weight_choice
+  // "misfit_floor", and of MergeNeighbouringZones).
+  double AttainableTarget() const {
+    return misfit_floor >= 0.0 ? (1.0 + kMisfitFloorMargin) * misfit_floor : target_misfit;
+  }
 };
 
 // Minimises data cost + R within the bounds: at the fixed weight, or with the weight
