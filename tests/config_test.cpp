@@ -115,6 +115,8 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   }
   EXPECT_EQ(expected.mcre.weights.strain_weight, actual.mcre.weights.strain_weight);
   EXPECT_EQ(expected.mcre.weights.reaction_weight, actual.mcre.weights.reaction_weight);
+  EXPECT_EQ(expected.mcre.weights.clamp_displacement_weight,
+            actual.mcre.weights.clamp_displacement_weight);
   EXPECT_EQ(expected.mcre.clamp, actual.mcre.clamp);
   EXPECT_EQ(expected.study.comparator_data, actual.study.comparator_data);
   EXPECT_EQ(expected.structure.kind, actual.structure.kind);
@@ -412,8 +414,9 @@ mcre:
   w_f: 0.14285714285714285
   w_e: 0.7
   w_r: 0.03
+  w_u0: 0.25
   reference_modulus: 70e9
-  clamp: measured
+  clamp: pinned
 inner:
   method: adaptive_relaxation
   tolerance: 1e-11
@@ -760,8 +763,9 @@ TEST_F(ConfigFileTest, UnknownEnumNameListsTheNames) {
 
 TEST_F(ConfigFileTest, UnknownClampModelAndComparatorDataAreRefused) {
   ExpectLoadError("mcre:\n  clamp: rigid\n", 2,
-                  {"mcre.clamp: expected one of 'measured', 'trusted', got 'rigid'"});
+                  {"mcre.clamp: expected one of 'measured', 'trusted', 'pinned', got 'rigid'"});
   ExpectLoadError("mcre:\n  w_r: 0\n", 2, {"mcre.w_r must be a finite positive number"});
+  ExpectLoadError("mcre:\n  w_u0: -1\n", 2, {"mcre.w_u0 must be a finite positive number"});
   ExpectLoadError("study:\n  comparator_data: [raw, raw]\n", 2,
                   {"study.comparator_data must hold raw, prefilter or both, once each"});
 }

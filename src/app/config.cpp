@@ -476,14 +476,21 @@ const std::vector<Key>& KeyTable() {
       MakeKey("mcre.w_e", &Config::mcre, &McreOptions::weights, &McreWeights::strain_weight,
               Number(), "", "strain weight: beta_e = w_e S E0 L"),
       MakeKey("mcre.w_r", &Config::mcre, &McreOptions::weights, &McreWeights::reaction_weight,
-              Number(), "", "clamp reaction weight (mcre.clamp trusted): alpha_r = w_r L / (S E0)"),
+              Number(), "",
+              "clamp reaction weight (mcre.clamp trusted: f0 an output; pinned: f0 a load): "
+              "alpha_r = w_r L / (S E0)"),
+      MakeKey("mcre.w_u0", &Config::mcre, &McreOptions::weights,
+              &McreWeights::clamp_displacement_weight, Number(), "",
+              "clamp displacement weight (mcre.clamp pinned): beta_0 = w_u0 S E0 / L"),
       MakeKey("mcre.reference_modulus", &Config::mcre, &McreOptions::reference_modulus, Number(),
               "Pa", "E0 of the weights: a fixed nominal modulus, not the unknown"),
       MakeKey("mcre.clamp", &Config::mcre, &McreOptions::clamp,
-              EnumByName<ClampModel>({ClampModel::kMeasured, ClampModel::kTrusted},
-                                     ClampModelToString, StringToClampModel),
-              "", "the clamp at x = 0: measured (free-free model, f0 a load, u0 an output) "
-              "or trusted (u(0) = 0 imposed, f0 a measured output)"),
+              EnumByName<ClampModel>(
+                  {ClampModel::kMeasured, ClampModel::kTrusted, ClampModel::kPinned},
+                  ClampModelToString, StringToClampModel),
+              "", "the clamp at x = 0: measured (free-free model, f0 a load, u0 an output), "
+              "trusted (u(0) = 0 imposed, f0 a measured output) or pinned (free-free model, "
+              "u0's datum the known 0 with weight w_u0, f0 a load with weight w_r)"),
       MakeKey("inner.method", &Config::inner, &CoupledSolverOptions::type,
               EnumByName<CoupledSolverType>(AllCoupledSolverTypes(), CoupledSolverTypeToString,
                                             StringToCoupledSolverType),
@@ -769,6 +776,8 @@ std::string StructureKeysProblem(const Config& config) {
       {"data.truth_zones", !config.data.truth_zones.empty()},
       {"mcre.clamp", config.mcre.clamp != defaults.mcre.clamp},
       {"mcre.w_r", config.mcre.weights.reaction_weight != defaults.mcre.weights.reaction_weight},
+      {"mcre.w_u0", config.mcre.weights.clamp_displacement_weight !=
+                        defaults.mcre.weights.clamp_displacement_weight},
   };
   for (const auto& [key, set] : bar_keys) {
     if (set) {

@@ -235,10 +235,18 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
   // The uncertainty figure: noise levels known for synthetic data with noise,
   // estimated from the data's second differences otherwise.
   Vector clamp_reaction;
+  const McreProblem& problem = cold.problem();
+  if (config.mcre.clamp == ClampModel::kPinned) {
+    // The model's clamp force F_0 = f0~ - W_0 / alpha_0 at E*.
+    clamp_reaction.resize(run.data.num_samples());
+    for (int j = 0; j < run.data.num_samples(); ++j) {
+      clamp_reaction[j] =
+          run.data.f0[j] - problem.inverse_alpha0() * run.solution.EndRetrograde(0, j);
+    }
+  }
   if (config.mcre.clamp == ClampModel::kTrusted) {
     // r(U_j) at E*: the reaction row of the stored fields, or the last trace row of a
     // streaming solve.
-    const McreProblem& problem = cold.problem();
     clamp_reaction.resize(run.data.num_samples());
     for (int j = 0; j < run.data.num_samples(); ++j) {
       clamp_reaction[j] = run.solution.has_fields()

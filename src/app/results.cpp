@@ -533,7 +533,7 @@ std::string SummaryYaml(const IdentificationRun& run) {
               "[m] RMS of U - u~ at both ends, at the optimum");
   yaml.Number(1, "misfit_rms_force", run.misfit.force_std,
               "[N] RMS of F - f~ = -W / alpha at both ends (a trusted clamp: r(U) - f0~ at "
-              "x = 0), at the optimum");
+              "x = 0; a pinned one: -W_0 / alpha_0), at the optimum");
   yaml.Integer(1, "sweeps", uncertainty.sweeps, "of the noise solves");
 
   OptimizerScanAndPrefilterYaml(outer, run.rest_cost, run.config, run.prefilter_cutoff, "e^2",

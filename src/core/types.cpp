@@ -26,8 +26,10 @@ constexpr std::array<std::pair<SensorKind, const char*>, 2> kSensorKinds{
     {{SensorKind::kDisplacement, "displacement"}, {SensorKind::kStrain, "strain"}}};
 constexpr std::array<std::pair<ModelKind, const char*>, 2> kModelKinds{
     {{ModelKind::kBar, "bar"}, {ModelKind::kMatrix, "matrix"}}};
-constexpr std::array<std::pair<ClampModel, const char*>, 2> kClampModels{
-    {{ClampModel::kMeasured, "measured"}, {ClampModel::kTrusted, "trusted"}}};
+constexpr std::array<std::pair<ClampModel, const char*>, 3> kClampModels{
+    {{ClampModel::kMeasured, "measured"},
+     {ClampModel::kTrusted, "trusted"},
+     {ClampModel::kPinned, "pinned"}}};
 constexpr std::array<std::pair<Zoning, const char*>, 3> kZonings{{{Zoning::kEqual, "equal"},
                                                                   {Zoning::kPerElement, "per_element"},
                                                                   {Zoning::kBoundaries, "boundaries"}}};

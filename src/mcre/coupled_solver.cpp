@@ -162,8 +162,9 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
   if (comparator && !bar->observes_ends_only()) {
     // Their transfer operators are written for H = B (the two end displacements).
     summary.message = std::string(CoupledSolverTypeToString(options.type)) +
-                      " handles the paper's end sensors only (u0 and uL, no interior sensor); "
-                      "with interior sensors or an end channel left out use inner.method: "
+                      " handles the paper's end sensors only (u0 and uL, no interior sensor, "
+                      "mcre.clamp: measured); with interior sensors, an end channel left out or "
+                      "a trusted or pinned clamp use inner.method: "
                       "conjugate_gradient, adaptive_relaxation, relaxation or all_at_once";
     return summary;
   }

@@ -23,6 +23,8 @@ bool McreWeights::IsValid(std::string* error) const {
     why << "mcre.w_e must be a finite positive number, got " << strain_weight;
   } else if (!(std::isfinite(reaction_weight) && reaction_weight > 0.0)) {
     why << "mcre.w_r must be a finite positive number, got " << reaction_weight;
+  } else if (!(std::isfinite(clamp_displacement_weight) && clamp_displacement_weight > 0.0)) {
+    why << "mcre.w_u0 must be a finite positive number, got " << clamp_displacement_weight;
   } else {
     return true;
   }
@@ -47,11 +49,23 @@ McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
   alpha_ = weights.force_weight * bar.length / (bar.section * reference_modulus);
   strain_beta_ = weights.strain_weight * bar.section * reference_modulus * bar.length;
   const bool trusted = clamp == ClampModel::kTrusted;
+  const bool pinned = clamp == ClampModel::kPinned;
   if (trusted) ends_.u0 = false;
+  // A pinned clamp always has its u0 row: the datum is the known u(0) = 0, not a
+  // channel of the data.
+  if (pinned) ends_.u0 = true;
   beta_u0_ = ends_.u0 ? beta_ : 0.0;
   beta_uL_ = ends_.uL ? beta_ : 0.0;
   inverse_alpha0_ = trusted ? 0.0 : 1.0 / alpha_;
   force0_gain_ = trusted ? 0.0 : 1.0;
+  force0_penalty_gain_ = force0_gain_;
+  if (pinned) {
+    // beta_0 = w_u0 S E0 / L on the datum u0~ = 0; alpha_0 = w_r L / (S E0) on f0.
+    beta_u0_ = weights.clamp_displacement_weight * bar.section * reference_modulus / bar.length;
+    const double alpha0 = weights.reaction_weight * bar.length / (bar.section * reference_modulus);
+    inverse_alpha0_ = 1.0 / alpha0;
+    force0_penalty_gain_ = alpha_ / alpha0;
+  }
   std::vector<double> weights_of_rows;
   for (const SensorChannel& sensor : data.sensors) {
     assert(sensor.position >= 0.0 && sensor.position <= bar.length &&
@@ -215,7 +229,7 @@ void McreProblem::RetrogradeSweep(const Matrix& displacement, bool include_data,
     double f0 = weight0 * displacement(0, j);
     double fL = weightL * displacement(last, j);
     if (include_data) {
-      f0 -= weight0 * data_.u0[j];
+      f0 -= weight0 * U0Datum(j);
       fL -= weightL * data_.uL[j];
     }
     const PointLoads* loads = nullptr;
@@ -304,7 +318,7 @@ void McreProblem::RetrogradeSweeps(const Matrix* const (&displacement)[B],
     for (int b = 0; b < B; ++b) {
       f0[b] = displacement[b] != nullptr ? weight0 * (*displacement[b])(0, j) : 0.0;
       fL[b] = displacement[b] != nullptr ? weightL * (*displacement[b])(last, j) : 0.0;
-      f0[b] -= weight0 * data_.u0[j];
+      f0[b] -= weight0 * U0Datum(j);
       fL[b] -= weightL * data_.uL[j];
       if (num_interior_sensors() > 0) {
         SensorLoads(j, displacement[b] != nullptr ? displacement[b]->col(j).data() : nullptr, true,
@@ -375,7 +389,7 @@ double McreProblem::PenaltyForm(const double* x, const double* y) const {
   const int last = num_nodes() - 1;
   // x^T K y + (x_0 y_0 + x_N y_N) / alpha (trusted clamp: x_N y_N / alpha).
   return integrator_.stiffness().BilinearForm(x, y) +
-         (force0_gain_ * x[0] * y[0] + x[last] * y[last]) / alpha_;
+         (force0_penalty_gain_ * x[0] * y[0] + x[last] * y[last]) / alpha_;
 }
 
 double McreProblem::InnerProduct(const Matrix& x, const Matrix& y) {
@@ -393,9 +407,9 @@ double McreProblem::SampleCost(int j, const double* displacement, const double* 
   const int last = num_nodes() - 1;
   const double gap = 0.5 * integrator_.stiffness().BilinearForm(retrograde, retrograde);
   const double force_misfit =
-      (force0_gain_ * retrograde[0] * retrograde[0] + retrograde[last] * retrograde[last]) /
+      (force0_penalty_gain_ * retrograde[0] * retrograde[0] + retrograde[last] * retrograde[last]) /
       (2.0 * alpha_);
-  const double u0_misfit = displacement[0] - data_.u0[j];
+  const double u0_misfit = displacement[0] - U0Datum(j);
   const double uL_misfit = displacement[last] - data_.uL[j];
   double displacement_misfit =
       observes_ends_only()
@@ -488,6 +502,13 @@ SparseMatrix McreProblem::PenaltyMatrix() const {
     penalty.coeffRef(num_nodes() - 1, num_nodes() - 1) += 1.0 / alpha_;
     return penalty;
   }
+  if (clamp_ == ClampModel::kPinned) {
+    // P = K + e_0 e_0^T / alpha_0 + e_N e_N^T / alpha.
+    SparseMatrix penalty = StiffnessMatrix();
+    penalty.coeffRef(0, 0) += inverse_alpha0_;
+    penalty.coeffRef(num_nodes() - 1, num_nodes() - 1) += 1.0 / alpha_;
+    return penalty;
+  }
   return model_.Stiffness(moduli_) + model_.boundary_selector() / alpha_;
 }
 
@@ -518,7 +539,7 @@ SparseMatrix McreProblem::WeightedObservation() const {
 
 void McreProblem::WeightedData(int j, Eigen::Ref<Vector> load) const {
   load.setZero();
-  load[0] += beta_u0_ * data_.u0[j];
+  load[0] += beta_u0_ * U0Datum(j);
   load[num_nodes() - 1] += beta_uL_ * data_.uL[j];
   for (int k = 0; k < num_interior_sensors(); ++k) {
     // beta_k h_k d~_kj.

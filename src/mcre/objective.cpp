@@ -39,9 +39,12 @@ McreObjective::McreObjective(const BarModel& model, const MeasurementSet& data,
   assert(mcre.IsValid(nullptr) && inner.IsValid(nullptr) && modulus_scale > 0.0);
   // The output part 1/2 (H U - d~)^T diag(beta_k) (H U - d~) of J at U = W = 0 is
   // Cost(0, 0); the load part is alpha/2 |F - F~|^2 with F = 0 (a trusted clamp's f0
-  // is an output, in Cost(0, 0)).
+  // is an output, in Cost(0, 0); a pinned clamp's has alpha_0 = w_r L / (S E0)).
   const Matrix zero = problem_.ZeroField();
-  const double f0_gain = mcre.clamp == ClampModel::kTrusted ? 0.0 : 1.0;
+  const double f0_gain = mcre.clamp == ClampModel::kTrusted ? 0.0
+                         : mcre.clamp == ClampModel::kPinned
+                             ? mcre.weights.reaction_weight / mcre.weights.force_weight
+                             : 1.0;
   double force_part = 0.0;
   for (int j = 0; j <= data.num_steps(); ++j) {
     // c_j h alpha/2 (f~0_j^2 + f~L_j^2)

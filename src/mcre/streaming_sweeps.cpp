@@ -71,7 +71,7 @@ void McreProblem::UseCheckpoints() {
 
 Matrix McreProblem::DataTraces() const {
   Matrix traces(num_traces(), num_steps() + 1);
-  traces.row(0) = data_.u0.transpose();
+  for (int j = 0; j < data_.num_samples(); ++j) traces(0, j) = U0Datum(j);
   traces.row(1) = data_.uL.transpose();
   for (int k = 0; k < num_interior_sensors(); ++k) traces.row(2 + k) = sensor_data_[k]->transpose();
   return traces;
@@ -108,7 +108,7 @@ void McreProblem::TraceLoads(int j, const Matrix& traces, bool include_data, dou
                              double* fL) {
   const double quadrature = QuadratureWeight(j);
   // c_j beta (y_j - d~_j) at the ends; the sensors' c_j beta_k (y_kj - d~_kj) h_k.
-  *f0 = quadrature * beta_u0_ * (traces(0, j) - (include_data ? data_.u0[j] : 0.0));
+  *f0 = quadrature * beta_u0_ * (traces(0, j) - (include_data ? U0Datum(j) : 0.0));
   *fL = quadrature * beta_uL_ * (traces(1, j) - (include_data ? data_.uL[j] : 0.0));
   double* values = load_values_.col(0).data();
   for (int k = 0; k < num_interior_sensors(); ++k) {

@@ -88,6 +88,8 @@ enum class ClampModel {
               // model, f0 a load with its alpha term, u0 an output with its beta term
   kTrusted,   // u(0) = 0 imposed exactly (the least-squares comparator's assumption);
               // f0 compared with the model's clamp reaction as a measured output
+  kPinned,    // the paper's free-free model with the known u(0) = 0 as the datum of
+              // u0 (weight w_u0, not the measured u0) and f0 a load of weight w_r
 };
 const char* ClampModelToString(ClampModel model);
 bool StringToClampModel(const std::string& name, ClampModel* model);

@@ -23,6 +23,13 @@
 // the paper's B = e_0 e_0^T + e_N e_N^T and every number is the one of the paper's case.
 // The measured end forces f0, fL are the model's loads and keep their alpha term.
 //
+// Pinned clamp (ClampModel::kPinned, docs/trusted_clamp.md section 9): the paper's
+// free-free model and data term, with two changes at x = 0. The datum of the u0 row
+// is the known u(0) = 0 instead of the measured u0, with the weight
+// beta_0 = w_u0 S E0 / L; and f0 stays a load, with alpha_0 = w_r L / (S E0) in place of
+// alpha: the direct force is f0~ - W_0 / alpha_0, P = K + e_0 e_0^T / alpha_0 +
+// e_N e_N^T / alpha and the cost's force term at x = 0 is W_0^2 / (2 alpha_0).
+//
 // Trusted clamp (ClampModel::kTrusted, docs/trusted_clamp.md): u(0) = 0 is imposed
 // exactly instead of being a measured output. Row and column 0 of M and K are
 // decoupled (their diagonals kept), so that U_0 = W_0 = 0 through every sweep: the
@@ -65,10 +72,15 @@ struct McreWeights {
   double displacement_weight = 0.01;  // w_u
   double force_weight = 1.0;          // w_f
   double strain_weight = 0.01;        // w_e
-  // w_r: the trusted clamp's reaction output, alpha_r = w_r L / (S E0) [m/N]. It
-  // counts against uL in the ratio w_r / w_u: with w_u = 1e-5 the default weighs the
-  // two about as their noise does on the paper's case (docs/trusted_clamp.md).
+  // w_r: the measured clamp reaction f0 under a trusted or pinned clamp,
+  // alpha_r = w_r L / (S E0) [m/N]. Trusted: the weight of f0 as an output; it counts
+  // against uL in the ratio w_r / w_u: with w_u = 1e-5 the default weighs the two about
+  // as their noise does on the paper's case (docs/trusted_clamp.md). Pinned: the weight
+  // of f0 as a load, in place of alpha (docs/trusted_clamp.md section 9).
   double reaction_weight = 1e-4;
+  // w_u0: a pinned clamp's displacement datum u(0) = 0, beta_0 = w_u0 S E0 / L [N/m]
+  // (docs/trusted_clamp.md section 9).
+  double clamp_displacement_weight = 0.1;
   bool IsValid(std::string* error) const;
 };
 
@@ -105,6 +117,8 @@ class McreProblem : public CoupledProblem {
   double time_step() const override { return data_.time_step; }
   double theta() const override { return theta_; }
   double alpha() const { return alpha_; }              // force weight [m/N]
+  // 1 / alpha of f0: 1 / alpha (measured), 0 (trusted), 1 / alpha_0 (pinned) [N/m].
+  double inverse_alpha0() const { return inverse_alpha0_; }
   double beta() const { return beta_; }                // displacement weight beta_u [N/m]
   double strain_beta() const { return strain_beta_; }  // strain weight beta_e [N m]
   const EndDisplacementChannels& end_channels() const { return ends_; }
@@ -113,6 +127,8 @@ class McreProblem : public CoupledProblem {
   double reaction_weight() const {
     return reaction_row_ >= 0 ? sensor_weights_[reaction_row_] : 0.0;
   }
+  // The datum of the u0 row at sample j [m]: the measured u0, or 0 under a pinned clamp.
+  double U0Datum(int j) const { return clamp_ == ClampModel::kPinned ? 0.0 : data_.u0[j]; }
   // Trusted clamp: the reaction r(U_j) = K_01(E) U_1 [N] of the displacement column
   // U_j (n entries); 0 when the clamp is measured.
   double ClampReaction(const double* displacement) const {
@@ -122,8 +138,11 @@ class McreProblem : public CoupledProblem {
   // the data (u@X, e@X), then the clamp reaction when the clamp is trusted; 0 in the
   // paper's case.
   int num_interior_sensors() const { return static_cast<int>(sensor_rows_.size()); }
-  // True when H is the paper's B: both end displacements and no interior sensor.
-  bool observes_ends_only() const { return ends_.u0 && ends_.uL && num_interior_sensors() == 0; }
+  // True when the data term is the paper's: H = B (both end displacements, weight
+  // beta, no interior sensor) and the clamp measured (f0 a load with alpha).
+  bool observes_ends_only() const {
+    return clamp_ == ClampModel::kMeasured && ends_.u0 && ends_.uL && num_interior_sensors() == 0;
+  }
   const BarModel& model() const { return model_; }
   const MeasurementSet& data() const { return data_; }
   // W -> U. With include_data the force data F~ enter; without, the sweep is the
@@ -293,8 +312,9 @@ class McreProblem : public CoupledProblem {
   ClampModel clamp_;
   double beta_u0_, beta_uL_;  // beta_u for an end displacement channel in use, else 0
   // The node-0 terms of the direct sweep: 1/alpha and the gain of f0~ (1), or 0 and 0
-  // when the clamp is trusted.
-  double inverse_alpha0_, force0_gain_;
+  // when the clamp is trusted, 1/alpha_0 and 1 when it is pinned; and alpha / alpha_0
+  // of the node-0 force term of the cost and of P (1, 0, alpha / alpha_0).
+  double inverse_alpha0_, force0_gain_, force0_penalty_gain_;
   // Trusted clamp: the index of the reaction row in sensor_rows_, else -1.
   int reaction_row_ = -1;
   Vector moduli_;             // E_z [Pa]

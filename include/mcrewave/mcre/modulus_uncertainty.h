@@ -61,7 +61,8 @@ NoiseLevels DifferenceNoiseLevels(const MeasurementSet& data);
 // sqrt(mean_{ends, j} (U_end,j - u~_end,j)^2) and force
 // sqrt(mean_{ends, j} (W_end,j / alpha)^2) (F - F~ = -B W / alpha). With a trusted
 // clamp, clamp_reaction holds the model's reaction r(U_j) [N], j = 0..m, and the
-// misfit at x = 0 is r(U_j) - f0~_j instead (f0 is an output; mcre_problem.h).
+// misfit at x = 0 is r(U_j) - f0~_j instead (f0 is an output; mcre_problem.h); with a
+// pinned clamp it holds the model's load F_0 = f0~ - W_0 / alpha_0.
 NoiseLevels MisfitLevels(const MeasurementSet& data, const CoupledSolution& solution, double alpha,
                          const Vector* clamp_reaction = nullptr);
 
