@@ -7,6 +7,7 @@
 
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "mcrewave/model/simulation.h"
 
@@ -196,6 +197,22 @@ TEST_P(TrustedClampMapTest, IsSelfAdjointAndNegativeInPInnerProduct) {
 
 INSTANTIATE_TEST_SUITE_P(Theta, TrustedClampMapTest, ::testing::Values(0.5, 1.0));
 
+// Solves `problem` by CG (tolerance 1e-12) and by the all-at-once sparse LU, expects
+// them to agree within `bounds` (relative differences of U, W and e^2) and returns
+// the all-at-once solution.
+Solved ExpectConjugateGradientsAgreeWithAllAtOnce(McreProblem* problem,
+                                                  const testing::Agreement& bounds) {
+  Solved reference = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-8), problem);
+  const Solved solved = Solve(Options(CoupledSolverType::kConjugateGradient, 1e-12), problem);
+  EXPECT_TRUE(reference.summary.IsSolutionUsable()) << reference.summary.FullReport();
+  EXPECT_TRUE(solved.summary.IsSolutionUsable()) << solved.summary.FullReport();
+  const testing::Agreement agreement = testing::Compare(solved, reference);
+  EXPECT_LT(agreement.displacement, bounds.displacement);
+  EXPECT_LT(agreement.retrograde, bounds.retrograde);
+  EXPECT_LT(agreement.cost, bounds.cost);
+  return reference;
+}
+
 TEST(TrustedClampTest, ConjugateGradientsAgreeWithTheAllAtOnceSolve) {
   ProblemBundle bundle(MakeSmallCase(12, 80, 5.0, 2), Weights(0.01, 1.0));
   const MeasurementSet data = WithClampSideSensors(bundle.data);
@@ -203,33 +220,26 @@ TEST(TrustedClampTest, ConjugateGradientsAgreeWithTheAllAtOnceSolve) {
   weights.reaction_weight = 0.01;
   McreProblem problem(bundle.model, data, weights, 200e9, 0.5, {}, ClampModel::kTrusted);
   problem.SetModulus(0.95 * 200e9);
-  const Solved reference = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-8), &problem);
-  const Solved solved = Solve(Options(CoupledSolverType::kConjugateGradient, 1e-12), &problem);
-  ASSERT_TRUE(reference.summary.IsSolutionUsable()) << reference.summary.FullReport();
-  ASSERT_TRUE(solved.summary.IsSolutionUsable()) << solved.summary.FullReport();
-  const testing::Agreement agreement = testing::Compare(solved, reference);
   // Measured 1.5e-13 (U), 2.6e-12 (W), 1.7e-15 (e^2).
-  EXPECT_LT(agreement.displacement, 1e-12);
-  EXPECT_LT(agreement.retrograde, 2e-11);
-  EXPECT_LT(agreement.cost, 1e-14);
+  ExpectConjugateGradientsAgreeWithAllAtOnce(&problem, {1e-12, 2e-11, 1e-14});
 }
 
-TEST(TrustedClampTest, AdjointGradientsMatchFiniteDifferencesOfTheCost) {
-  // Two zones: the reaction's explicit term belongs to the first.
+// The relative differences between the adjoint de^2/dE_z and central differences of
+// e^2, z = 0, 1, on two zones of the small case under `clamp` with `weights`.
+std::vector<double> ZoneGradientErrors(const McreWeights& weights, ClampModel clamp) {
   const testing::SmallCase small = MakeSmallCase(12, 80, 5.0, 2);
   ZoneLayout layout;
   layout.zone_count = 2;
   const BarModel model(small.bar, layout.ElementZones(small.bar));
   const MeasurementSet data = MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
-  McreWeights weights = Weights(0.01, 1.0);
-  weights.reaction_weight = 0.01;
-  McreProblem problem(model, data, weights, 200e9, 0.5, {}, ClampModel::kTrusted);
+  McreProblem problem(model, data, weights, 200e9, 0.5, {}, clamp);
   const CoupledSolverOptions options = Options(CoupledSolverType::kConjugateGradient, 1e-13);
   Vector moduli(2);
   moduli << 0.93 * 200e9, 1.04 * 200e9;
   problem.SetModuli(moduli);
   const Solved at = Solve(options, &problem);
-  ASSERT_TRUE(at.summary.IsSolutionUsable()) << at.summary.FullReport();
+  EXPECT_TRUE(at.summary.IsSolutionUsable()) << at.summary.FullReport();
+  std::vector<double> errors;
   for (int z = 0; z < 2; ++z) {
     const double step = 1e-5 * moduli[z];
     Vector plus = moduli, minus = moduli;
@@ -240,10 +250,19 @@ TEST(TrustedClampTest, AdjointGradientsMatchFiniteDifferencesOfTheCost) {
     problem.SetModuli(minus);
     const double cost_minus = Solve(options, &problem).solution.cost;
     const double difference = (cost_plus - cost_minus) / (2.0 * step);
-    // Measured relative differences 1.8e-9 (zone 0, with the reaction term) and 4.4e-9.
-    EXPECT_NEAR(at.solution.cost_gradients[z], difference, 2e-8 * std::abs(difference))
-        << "zone " << z;
+    errors.push_back(std::abs(at.solution.cost_gradients[z] - difference) / std::abs(difference));
   }
+  return errors;
+}
+
+TEST(TrustedClampTest, AdjointGradientsMatchFiniteDifferencesOfTheCost) {
+  // Two zones: the reaction's explicit term belongs to the first.
+  McreWeights weights = Weights(0.01, 1.0);
+  weights.reaction_weight = 0.01;
+  const std::vector<double> errors = ZoneGradientErrors(weights, ClampModel::kTrusted);
+  // Measured relative differences 1.8e-9 (zone 0, with the reaction term) and 4.4e-9.
+  EXPECT_LT(errors[0], 2e-8);
+  EXPECT_LT(errors[1], 2e-8);
 }
 
 // --- Pinned clamp ---
@@ -303,15 +322,9 @@ TEST(PinnedClampTest, ConjugateGradientsAgreeWithTheAllAtOnceSolve) {
   const MeasurementSet data = WithClampSideSensors(bundle.data);
   McreProblem problem(bundle.model, data, PinnedWeights(), 200e9, 0.5, {}, ClampModel::kPinned);
   problem.SetModulus(0.95 * 200e9);
-  const Solved reference = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-8), &problem);
-  const Solved solved = Solve(Options(CoupledSolverType::kConjugateGradient, 1e-12), &problem);
-  ASSERT_TRUE(reference.summary.IsSolutionUsable()) << reference.summary.FullReport();
-  ASSERT_TRUE(solved.summary.IsSolutionUsable()) << solved.summary.FullReport();
-  const testing::Agreement agreement = testing::Compare(solved, reference);
   // Measured 1.8e-13 (U), 3.6e-12 (W), 6.8e-16 (e^2).
-  EXPECT_LT(agreement.displacement, 1e-12);
-  EXPECT_LT(agreement.retrograde, 2e-11);
-  EXPECT_LT(agreement.cost, 5e-15);
+  const Solved reference =
+      ExpectConjugateGradientsAgreeWithAllAtOnce(&problem, {1e-12, 2e-11, 5e-15});
   // The streaming solver (traces, O(n) memory) solves the same problem.
   const Solved streamed =
       Solve(Options(CoupledSolverType::kStreamingConjugateGradient, 1e-12), &problem);
@@ -337,32 +350,10 @@ TEST(PinnedClampTest, TheMeasuredU0DoesNotEnter) {
 }
 
 TEST(PinnedClampTest, AdjointGradientsMatchFiniteDifferencesOfTheCost) {
-  const testing::SmallCase small = MakeSmallCase(12, 80, 5.0, 2);
-  ZoneLayout layout;
-  layout.zone_count = 2;
-  const BarModel model(small.bar, layout.ElementZones(small.bar));
-  const MeasurementSet data = MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
-  McreProblem problem(model, data, PinnedWeights(), 200e9, 0.5, {}, ClampModel::kPinned);
-  const CoupledSolverOptions options = Options(CoupledSolverType::kConjugateGradient, 1e-13);
-  Vector moduli(2);
-  moduli << 0.93 * 200e9, 1.04 * 200e9;
-  problem.SetModuli(moduli);
-  const Solved at = Solve(options, &problem);
-  ASSERT_TRUE(at.summary.IsSolutionUsable()) << at.summary.FullReport();
-  for (int z = 0; z < 2; ++z) {
-    const double step = 1e-5 * moduli[z];
-    Vector plus = moduli, minus = moduli;
-    plus[z] += step;
-    minus[z] -= step;
-    problem.SetModuli(plus);
-    const double cost_plus = Solve(options, &problem).solution.cost;
-    problem.SetModuli(minus);
-    const double cost_minus = Solve(options, &problem).solution.cost;
-    const double difference = (cost_plus - cost_minus) / (2.0 * step);
-    // Measured relative differences 2.4e-9 (zone 0) and 2.9e-9.
-    EXPECT_NEAR(at.solution.cost_gradients[z], difference, 2e-8 * std::abs(difference))
-        << "zone " << z;
-  }
+  const std::vector<double> errors = ZoneGradientErrors(PinnedWeights(), ClampModel::kPinned);
+  // Measured relative differences 2.4e-9 (zone 0) and 2.9e-9.
+  EXPECT_LT(errors[0], 2e-8);
+  EXPECT_LT(errors[1], 2e-8);
 }
 
 TEST(PinnedClampTest, RiccatiAndShootingRefuseIt) {
