@@ -496,20 +496,13 @@ void McreProblem::CostGradients(const Matrix& displacement, const Matrix& retrog
 }
 
 SparseMatrix McreProblem::PenaltyMatrix() const {
-  // P = K + B / alpha, B = e_0 e_0^T + e_N e_N^T (trusted clamp: e_N e_N^T).
-  if (clamp_ == ClampModel::kTrusted) {
-    SparseMatrix penalty = StiffnessMatrix();
-    penalty.coeffRef(num_nodes() - 1, num_nodes() - 1) += 1.0 / alpha_;
-    return penalty;
-  }
-  if (clamp_ == ClampModel::kPinned) {
-    // P = K + e_0 e_0^T / alpha_0 + e_N e_N^T / alpha.
-    SparseMatrix penalty = StiffnessMatrix();
-    penalty.coeffRef(0, 0) += inverse_alpha0_;
-    penalty.coeffRef(num_nodes() - 1, num_nodes() - 1) += 1.0 / alpha_;
-    return penalty;
-  }
-  return model_.Stiffness(moduli_) + model_.boundary_selector() / alpha_;
+  // P = K + e_0 e_0^T / alpha_0 + e_N e_N^T / alpha with 1 / alpha_0 = inverse_alpha0_:
+  // the paper's K + B / alpha (measured clamp), K + e_N e_N^T / alpha (trusted: 0, on the
+  // held node's kept diagonal) or the pinned clamp's alpha_0.
+  SparseMatrix penalty = StiffnessMatrix();
+  penalty.coeffRef(0, 0) += inverse_alpha0_;
+  penalty.coeffRef(num_nodes() - 1, num_nodes() - 1) += 1.0 / alpha_;
+  return penalty;
 }
 
 void McreProblem::MeasuredForce(int j, Eigen::Ref<Vector> load) const {
