@@ -10,6 +10,7 @@
 //   identify run configs/quick.yaml --set outer.optimizer=ceres --output /tmp/quick -v
 //   identify run configs/measured_csv.yaml -q
 //   identify run configs/paper_bar.yaml --set inner.method=streaming_conjugate_gradient -o /tmp/s
+//   identify run configs/paper_bar_pinned.yaml -o /tmp/pinned
 //   identify simulate configs/paper_bar.yaml --output measurements.csv
 //   identify simulate configs/paper_bar.yaml --set data.snr=.inf --output clean.csv
 //   identify simulate configs/paper_bar.yaml --set model.elements=400 --output fine.csv

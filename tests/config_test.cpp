@@ -601,6 +601,19 @@ TEST(ConfigTest, PaperBarFreeFreeDiffersInItsMcreSectionOnly) {
       expected, LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar_free_free.yaml"));
 }
 
+TEST(ConfigTest, PaperBarPinnedDiffersInItsMcreSectionAndScanPointsOnly) {
+  Config expected = LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar.yaml");
+  expected.mcre.clamp = ClampModel::kPinned;
+  expected.mcre.weights.displacement_weight = 0.01;
+  expected.mcre.weights.strain_weight = 0.01;
+  expected.mcre.weights.clamp_displacement_weight = 0.1;
+  expected.mcre.weights.reaction_weight = 0.1;
+  expected.outer.scan_points = 12;
+  expected.output.folder = "results/paper_bar_pinned";
+  ExpectSameConfig(
+      expected, LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar_pinned.yaml"));
+}
+
 TEST(ConfigTest, QuickAndMeasuredCsvConfigsLoad) {
   const Config quick = LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/quick.yaml");
   EXPECT_EQ(quick.model.elements, 25);

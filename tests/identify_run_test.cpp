@@ -269,6 +269,29 @@ TEST(IdentifyRunTest, MeasuredCsvConfigFindsTheModulusTheFileWasMadeWith) {
             std::string::npos);
 }
 
+// configs/paper_bar_pinned.yaml (the paper's case, SNR 2.5, seed 1): the pinned
+// clamp's cost has one valley, so its scan takes 4 samples per predicted spacing
+// (measured: 16 points, spacing 0.39 in ln E, one valley, E +1.54e-4 against the
+// reference, 20 CG iterations from W = 0 at E*; docs/trusted_clamp.md section 9).
+TEST(IdentifyRunTest, PinnedClampConfigFindsOneValleyWithAShortScan) {
+  const std::string folder = FreshDirectory("identify_run_pinned") + "/results";
+  const RunResult run = RunIdentify("run " + SourcePath("configs/paper_bar_pinned.yaml") +
+                                    " --set output.figures=false --set output.curve_points=5"
+                                    " --set uncertainty.samples=2 -o " + folder);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const std::string text = ReadText(folder + "/summary.yaml");
+  const auto summary = TopLevelValues(text);
+  EXPECT_NEAR(std::stod(summary.at("relative_error")), 0.0, 1.5e-3);
+  // The scan block's keys, indented under `scan:`.
+  const auto nested = [&text](const std::string& key) {
+    const std::size_t at = text.find("\n  " + key + ": ", text.find("\nscan:"));
+    return at == std::string::npos ? -1 : std::stoi(text.substr(at + key.size() + 5));
+  };
+  EXPECT_EQ(nested("local_minima"), 1);
+  EXPECT_GE(nested("points"), 12);
+  EXPECT_LE(nested("points"), 16);
+}
+
 TEST(IdentifyRunTest, WithoutGnuplotTheFiguresAreSkippedWithAWarning) {
   const std::string folder = FreshDirectory("identify_run_no_gnuplot") + "/results";
   const RunResult run =
