@@ -601,7 +601,7 @@ TEST(ConfigTest, PaperBarFreeFreeDiffersInItsMcreSectionOnly) {
       expected, LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar_free_free.yaml"));
 }
 
-TEST(ConfigTest, PaperBarPinnedDiffersInItsMcreSectionAndScanPointsOnly) {
+TEST(ConfigTest, PaperBarPinnedDiffersInItsMcreSectionScanPointsAndInnerToleranceOnly) {
   Config expected = LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar.yaml");
   expected.mcre.clamp = ClampModel::kPinned;
   expected.mcre.weights.displacement_weight = 0.01;
@@ -609,6 +609,7 @@ TEST(ConfigTest, PaperBarPinnedDiffersInItsMcreSectionAndScanPointsOnly) {
   expected.mcre.weights.clamp_displacement_weight = 0.1;
   expected.mcre.weights.reaction_weight = 0.1;
   expected.outer.scan_points = 12;
+  expected.inner.tolerance = 1e-6;
   expected.output.folder = "results/paper_bar_pinned";
   ExpectSameConfig(
       expected, LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar_pinned.yaml"));
