@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -186,6 +187,48 @@ TEST_F(ResultFilesTest, EndsCsvHoldsTheMeasuredChannelsAndTheModelAtTheIdentifie
     EXPECT_EQ(row[6], data.f0[j] - retrograde(0, j) / run_->alpha);
     EXPECT_EQ(row[7], data.fL[j]);
     EXPECT_EQ(row[8], data.fL[j] - retrograde(last, j) / run_->alpha);
+  }
+}
+
+// ends.csv's f0_model is the model's force at x = 0 of the clamp model: under a
+// pinned clamp the load f0~ - W_0 / alpha_0 with alpha_0 = w_r L / (S E0), under a
+// trusted one the reaction r(U_j) = K_01(E*) U_1 = -(E* S / l) U_1 (docs/
+// trusted_clamp.md sections 1 and 9), each recomputed here from the weights and the
+// bar; w_u0 and w_r differ so that a swap of the two shows.
+TEST(EndsCsvTest, TheModelForceAtTheClampIsTheClampModels) {
+  for (const char* clamp : {"pinned", "trusted"}) {
+    SCOPED_TRACE(clamp);
+    const Config config =
+        LoadConfig(SourcePath("configs/quick.yaml"),
+                   {std::string("mcre.clamp=") + clamp, "mcre.w_u=0.01", "mcre.w_u0=0.3",
+                    "mcre.w_r=0.05", "uncertainty.samples=2"});
+    const IdentificationRun run = RunIdentification(config, LoadMeasurements(config));
+    ASSERT_TRUE(run.IsUsable()) << run.outer.FullReport();
+    const std::string folder = FreshDirectory(std::string("ends_csv_") + clamp) + "/results";
+    WriteIdentificationResults(run, folder, false);
+    const Csv csv = ReadCsv(folder + "/ends.csv");
+    ASSERT_EQ(static_cast<int>(csv.rows.size()), run.data.num_samples());
+    const double length = 1.0, section = 1e-4, reference_modulus = 200e9;
+    const double alpha0 = 0.05 * length / (section * reference_modulus);
+    const double element_stiffness = run.identified_modulus() * section / (length / 25);
+    double largest = 0.0;
+    for (int j = 0; j < run.data.num_samples(); ++j) {
+      const double expected =
+          std::string(clamp) == "pinned"
+              ? run.data.f0[j] - run.solution.retrograde(0, j) / alpha0
+              : -element_stiffness * run.solution.displacement(1, j);
+      // alpha_0 and K_01 rounded otherwise than the library's: a few ulps (measured
+      // up to 3.7e-16 of max(1 N, |F_0|)).
+      EXPECT_NEAR(csv.rows[j][6], expected, 4e-15 * std::max(1.0, std::abs(expected)))
+          << "row " << j;
+      largest = std::max(largest, std::abs(expected));
+    }
+    // The clamp force is not the measured f0 itself (the model's differs from the data).
+    double difference = 0.0;
+    for (int j = 0; j < run.data.num_samples(); ++j) {
+      difference = std::max(difference, std::abs(csv.rows[j][6] - run.data.f0[j]));
+    }
+    EXPECT_GT(difference, 1e-3 * largest);
   }
 }
 

@@ -232,30 +232,34 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
                      run.identified_modulus(), run.ends);
   run.cold_solve = cold.EvaluateModulus(run.identified_modulus()).inner;
 
+  // The model's force at x = 0 and the RMS misfits at E*.
+  const McreProblem& problem = cold.problem();
+  run.clamp_force.resize(run.data.num_samples());
+  for (int j = 0; j < run.data.num_samples(); ++j) {
+    switch (config.mcre.clamp) {
+      case ClampModel::kMeasured:
+        // F_0 = f0~ - W_0 / alpha (docs/discrete_mcre.md section 2).
+        run.clamp_force[j] = run.data.f0[j] - run.solution.EndRetrograde(0, j) / run.alpha;
+        break;
+      case ClampModel::kPinned:
+        // F_0 = f0~ - W_0 / alpha_0 (docs/trusted_clamp.md section 9).
+        run.clamp_force[j] =
+            run.data.f0[j] - problem.inverse_alpha0() * run.solution.EndRetrograde(0, j);
+        break;
+      case ClampModel::kTrusted:
+        // r(U_j): the reaction row of the stored fields, or the last trace row of a
+        // streaming solve.
+        run.clamp_force[j] = run.solution.has_fields()
+                                 ? problem.ClampReaction(run.solution.displacement.col(j).data())
+                                 : run.solution.traces(problem.num_traces() - 1, j);
+        break;
+    }
+  }
+  // The measured clamp's f0 misfit is W_0 / alpha itself (MisfitLevels).
+  run.misfit = MisfitLevels(run.data, run.solution, run.alpha,
+                            config.mcre.clamp == ClampModel::kMeasured ? nullptr : &run.clamp_force);
   // The uncertainty figure: noise levels known for synthetic data with noise,
   // estimated from the data's second differences otherwise.
-  Vector clamp_reaction;
-  const McreProblem& problem = cold.problem();
-  if (config.mcre.clamp == ClampModel::kPinned) {
-    // The model's clamp force F_0 = f0~ - W_0 / alpha_0 at E*.
-    clamp_reaction.resize(run.data.num_samples());
-    for (int j = 0; j < run.data.num_samples(); ++j) {
-      clamp_reaction[j] =
-          run.data.f0[j] - problem.inverse_alpha0() * run.solution.EndRetrograde(0, j);
-    }
-  }
-  if (config.mcre.clamp == ClampModel::kTrusted) {
-    // r(U_j) at E*: the reaction row of the stored fields, or the last trace row of a
-    // streaming solve.
-    clamp_reaction.resize(run.data.num_samples());
-    for (int j = 0; j < run.data.num_samples(); ++j) {
-      clamp_reaction[j] = run.solution.has_fields()
-                              ? problem.ClampReaction(run.solution.displacement.col(j).data())
-                              : run.solution.traces(problem.num_traces() - 1, j);
-    }
-  }
-  run.misfit = MisfitLevels(run.data, run.solution, run.alpha,
-                            clamp_reaction.size() > 0 ? &clamp_reaction : nullptr);
   run.estimated_noise = DifferenceNoiseLevels(data);
   run.noise = MeasurementNoiseLevels(config, data, &run.noise_source);
   int curvature_points = 0;

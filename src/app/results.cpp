@@ -121,17 +121,19 @@ std::string CostCurveCsv(const std::vector<CostCurvePoint>& curve) {
   return csv;
 }
 
-// Measured and model channels at both ends; the model force at the ends is
-// F = F~ - B W / alpha.
+// Measured and model channels at both ends; the model force at x = L is
+// F_L = fL~ - W_L / alpha, at x = 0 the run's clamp_force (the load or the reaction
+// of the clamp model).
 std::string EndsCsv(const IdentificationRun& run) {
   const MeasurementSet& data = run.data;
   const CoupledSolution& solution = run.solution;
+  assert(run.clamp_force.size() == data.num_samples());
   std::string csv =
       "t,u0_measured,u0_model,uL_measured,uL_model,f0_measured,f0_model,fL_measured,fL_model\n";
   char row[512];
   for (int j = 0; j < data.num_samples(); ++j) {
-    // f_model = f~ - w_end / alpha
-    const double f0_model = data.f0[j] - solution.EndRetrograde(0, j) / run.alpha;
+    const double f0_model = run.clamp_force[j];
+    // F_L = fL~ - W_L / alpha
     const double fL_model = data.fL[j] - solution.EndRetrograde(1, j) / run.alpha;
     std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
                   data.Time(j), data.u0[j], solution.EndDisplacement(0, j), data.uL[j],

@@ -56,6 +56,10 @@ struct IdentificationRun {
   // with the pre-filter on, it overstates the spread (conservative).
   NoiseLevels estimated_noise;
   NoiseLevels misfit;  // RMS misfits at the optimum (MisfitLevels)
+  // The model's force at x = 0 at the identified E, per sample [N]: the load
+  // f0~ - W_0 / alpha (clamp measured) or f0~ - W_0 / alpha_0 (pinned), the reaction
+  // r(U_j) (trusted). ends.csv's f0_model.
+  Vector clamp_force;
 
   IdentificationSummary outer;
   // The optimiser's evaluations, in order; evaluations[best_index] is the one

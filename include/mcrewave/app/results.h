@@ -16,8 +16,10 @@
 //   valleys.csv         every valley the scan saw: bracket, estimate, and the
 //                       refined minimum of those refined (docs/global_search.md)
 //   ends.csv            measured and model end displacements and forces at the
-//                       identified E; model force F = F~ - B W / alpha
-//                       (docs/discrete_mcre.md section 2)
+//                       identified E; model force F_L = fL~ - W_L / alpha
+//                       (docs/discrete_mcre.md section 2) and, at x = 0, the
+//                       run's clamp_force (f0~ - W_0 / alpha, f0~ - W_0 / alpha_0
+//                       when pinned, the reaction r(U) when trusted)
 //   inner_residual.csv  relative residual per inner iteration of a solve from
 //                       W = 0 at the identified E (direct solvers: their final
 //                       residual)
