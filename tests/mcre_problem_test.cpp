@@ -281,11 +281,14 @@ McreWeights PinnedWeights() {
 
 TEST(PinnedClampTest, WeighsTheKnownZeroAndTheReactionLoadWithTheirOwnWeights) {
   ProblemBundle bundle(MakeSmallCase(12, 60, 5.0, 2), Weights(0.01, 1.0));
-  McreProblem problem(bundle.model, bundle.data, PinnedWeights(), 200e9, 0.5, {},
-                      ClampModel::kPinned);
+  // w_u0 and w_r unequal, so that a swap of the two shows.
+  McreWeights weights = PinnedWeights();
+  weights.clamp_displacement_weight = 0.3;
+  weights.reaction_weight = 0.05;
+  McreProblem problem(bundle.model, bundle.data, weights, 200e9, 0.5, {}, ClampModel::kPinned);
   problem.SetModulus(0.9 * 200e9);
   // alpha_0 = w_r L / (S E0), beta_0 = w_u0 S E0 / L (S = 1e-4, L = 1, E0 = 200 GPa).
-  const double alpha0 = 0.1 / (1e-4 * 200e9), beta0 = 0.1 * 1e-4 * 200e9;
+  const double alpha0 = 0.05 / (1e-4 * 200e9), beta0 = 0.3 * 1e-4 * 200e9;
   EXPECT_DOUBLE_EQ(problem.inverse_alpha0(), 1.0 / alpha0);
   const SparseMatrix penalty = problem.PenaltyMatrix(), stiffness = problem.StiffnessMatrix();
   EXPECT_DOUBLE_EQ(penalty.coeff(0, 0), stiffness.coeff(0, 0) + 1.0 / alpha0);
@@ -350,6 +353,7 @@ TEST(PinnedClampTest, TheMeasuredU0DoesNotEnter) {
   const Solved other_solved = Solve(options, &other_problem);
   ASSERT_TRUE(solved.summary.IsSolutionUsable()) << solved.summary.FullReport();
   EXPECT_EQ(solved.solution.cost, other_solved.solution.cost);
+  EXPECT_EQ(solved.solution.displacement, other_solved.solution.displacement);
   EXPECT_EQ(solved.solution.retrograde, other_solved.solution.retrograde);
 }
 

@@ -387,7 +387,8 @@ void McreProblem::RetrogradeSweepsWithData(const std::vector<const Matrix*>& dis
 
 double McreProblem::PenaltyForm(const double* x, const double* y) const {
   const int last = num_nodes() - 1;
-  // x^T K y + (x_0 y_0 + x_N y_N) / alpha (trusted clamp: x_N y_N / alpha).
+  // x^T K y + x_0 y_0 / alpha_0 + x_N y_N / alpha (1 / alpha_0: 1 / alpha measured,
+  // 0 trusted, 1 / alpha_0 pinned).
   return integrator_.stiffness().BilinearForm(x, y) +
          (force0_penalty_gain_ * x[0] * y[0] + x[last] * y[last]) / alpha_;
 }

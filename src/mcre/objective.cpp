@@ -47,7 +47,7 @@ McreObjective::McreObjective(const BarModel& model, const MeasurementSet& data,
                              : 1.0;
   double force_part = 0.0;
   for (int j = 0; j <= data.num_steps(); ++j) {
-    // c_j h alpha/2 (f~0_j^2 + f~L_j^2)
+    // c_j h [alpha_0/2 f~0_j^2 + alpha/2 f~L_j^2], alpha_0 = f0_gain alpha
     force_part += problem_.QuadratureWeight(j) * data.time_step * 0.5 * problem_.alpha() *
                   (f0_gain * data.f0[j] * data.f0[j] + data.fL[j] * data.fL[j]);
   }

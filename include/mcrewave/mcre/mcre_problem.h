@@ -98,7 +98,11 @@ class McreProblem : public CoupledProblem {
   // are the model's; every zone starts at the model's properties().modulus.
   // Precondition: data.num_steps() >= 1, weights valid, theta in [0, 1], every sensor
   // position in [0, L].
-  // clamp: kTrusted imposes u(0) = 0 (ends.u0 is then ignored) and observes f0.
+  // clamp: kTrusted imposes u(0) = 0 (ends.u0 is then ignored) and observes f0 with
+  // weights.reaction_weight; kPinned keeps the free-free model, always observes u0
+  // (ends.u0 = false is overridden) against the known 0 with
+  // weights.clamp_displacement_weight and loads node 0 with f0 weighed by
+  // weights.reaction_weight in place of alpha.
   McreProblem(const BarModel& model, const MeasurementSet& data, const McreWeights& weights,
               double reference_modulus, double theta, EndDisplacementChannels ends = {},
               ClampModel clamp = ClampModel::kMeasured);
@@ -123,14 +127,15 @@ class McreProblem : public CoupledProblem {
   double strain_beta() const { return strain_beta_; }  // strain weight beta_e [N m]
   const EndDisplacementChannels& end_channels() const { return ends_; }
   ClampModel clamp() const { return clamp_; }
-  // alpha_r [m/N], the weight of a trusted clamp's reaction; 0 when the clamp is measured.
+  // alpha_r [m/N], the weight of a trusted clamp's reaction; 0 when the clamp is
+  // measured or pinned (a pinned clamp's alpha_0: 1 / inverse_alpha0()).
   double reaction_weight() const {
     return reaction_row_ >= 0 ? sensor_weights_[reaction_row_] : 0.0;
   }
   // The datum of the u0 row at sample j [m]: the measured u0, or 0 under a pinned clamp.
   double U0Datum(int j) const { return clamp_ == ClampModel::kPinned ? 0.0 : data_.u0[j]; }
   // Trusted clamp: the reaction r(U_j) = K_01(E) U_1 [N] of the displacement column
-  // U_j (n entries); 0 when the clamp is measured.
+  // U_j (n entries); 0 when the clamp is measured or pinned.
   double ClampReaction(const double* displacement) const {
     return reaction_row_ >= 0 ? sensor_rows_[reaction_row_].Apply(displacement) : 0.0;
   }
@@ -263,9 +268,11 @@ class McreProblem : public CoupledProblem {
   void RetrogradeSweeps(const Matrix* const (&displacement)[B], Matrix* const (&retrograde)[B]);
 
   // The integrand of e^2 at sample j without c_j h:
-  // 1/2 W^T K W + W^T B W / (2 alpha) + 1/2 (H U - d~_j)^T diag(beta) (H U - d~_j).
+  // 1/2 W^T K W + W_0^2 / (2 alpha_0) + W_N^2 / (2 alpha)
+  //   + 1/2 (H U - d~_j)^T diag(beta) (H U - d~_j), 1 / alpha_0 = inverse_alpha0().
   double SampleCost(int j, const double* displacement, const double* retrograde) const;
-  // x^T (K + B/alpha) y of two nodal vectors (n entries each).
+  // x^T (K + e_0 e_0^T / alpha_0 + e_N e_N^T / alpha) y of two nodal vectors (n
+  // entries each).
   double PenaltyForm(const double* x, const double* y) const;
   // W_j^T K1 (W_j + 2 U_j) (one zone's gradient integrand, without -(1/2) c_j h).
   double SampleGradient(const double* displacement, const double* retrograde) const;

@@ -91,8 +91,9 @@ inline McreWeights TrustedClampWeights() {
 struct McreOptions {
   McreWeights weights = TrustedClampWeights();
   double reference_modulus = 200e9;  // E0 [Pa]
-  // The clamp at x = 0: trusted (u(0) = 0, f0 a measured output) or measured (the
-  // paper's free-free model); mcre_problem.h.
+  // The clamp at x = 0: trusted (u(0) = 0, f0 a measured output), measured (the
+  // paper's free-free model) or pinned (free-free, u0's datum the known 0 with w_u0,
+  // f0 a load with w_r); mcre_problem.h.
   ClampModel clamp = ClampModel::kTrusted;
 
   bool IsValid(std::string* error) const;
