@@ -25,8 +25,8 @@
 //
 // Description:
 //   `run` reads a YAML config, gets the measurements (synthetic, or the CSV file
-//   of data.path, which must be on the config's time grid), identifies E by
-//   minimising the MCRE cost e^2(E) with the outer optimiser of `outer:` (NLopt
+//   of data.path, resampled onto the config's time grid when sampled otherwise),
+//   identifies E by minimising the MCRE cost e^2(E) with the outer optimiser of `outer:` (NLopt
 //   or Ceres) over coupled direct/retrograde solves by the method of `inner:`,
 //   then computes the cost curve around the identified E, the error map of the
 //   constitutive gap and an uncertainty figure, and writes summary.yaml, CSV files and PNG figures
@@ -307,8 +307,17 @@ int RunSimulate(const SimulateArguments& arguments) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
 
-  // 1. Read and validate the config (nothing is computed if it is invalid).
+  // 1. Read and validate the config and the output file's folder (nothing is
+  //    computed if either is invalid).
   const mcrewave::Config config = mcrewave::LoadConfig(arguments.config_path, arguments.overrides);
+  const std::filesystem::path output_folder =
+      std::filesystem::absolute(arguments.output_path).parent_path();
+  std::error_code folder_error;
+  if (!std::filesystem::is_directory(output_folder, folder_error) ||
+      ::access(output_folder.c_str(), W_OK | X_OK) != 0) {
+    throw mcrewave::InputError("output file " + arguments.output_path + ": " +
+                               output_folder.string() + " is not a folder one can write in");
+  }
   if (config.structure.kind == mcrewave::ModelKind::kMatrix) {
     // A structure given by matrices: its truth's outputs and loads, under the columns
     // identify run reads (model.channel_map).
@@ -331,8 +340,7 @@ int RunSimulate(const SimulateArguments& arguments) {
                config.data.truth_refinement, config.data.snr);
 
   // 2. Simulate the truth and add measurement noise.
-  const mcrewave::MeasurementSet measurements =
-      mcrewave::MakeSyntheticMeasurements(config.model, config.load, config.time, config.data);
+  const mcrewave::MeasurementSet measurements = mcrewave::SyntheticMeasurements(config);
 
   // 3. Write the measurement set atomically.
   {

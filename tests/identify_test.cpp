@@ -47,6 +47,27 @@ TEST(IdentifyTest, BadCommandLinesExitWithTwoAndOneLine) {
   }
 }
 
+// simulate refuses synthetic data out of double range with exit 2, one line and
+// no file.
+TEST(IdentifyTest, SimulateRefusesNonFiniteData) {
+  const std::string dir = FreshDirectory("identify_simulate_bad_input");
+  const std::string quick = SourcePath("configs/quick.yaml");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"simulate " + quick + " --set data.snr=1e-307 -o " + dir + "/out.csv",
+       "the synthetic channel 'f0' is not finite: load.amplitude (1000 N) or the noise of "
+       "data.snr (1e-307) lies beyond double range"},
+      {"simulate " + quick + " --set load.amplitude=1e308 -o " + dir + "/out.csv",
+       "the synthetic channel 'u0' is not finite: load.amplitude (1e+308 N)"},
+  };
+  for (const auto& [arguments, reason] : cases) {
+    const RunResult run = RunIdentify(arguments + " -q");
+    EXPECT_EQ(run.exit_code, 2) << arguments << "\n" << run.output;
+    EXPECT_NE(run.output.find(reason), std::string::npos) << run.output;
+    EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << run.output;
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+}
+
 TEST(IdentifyTest, OverridesMayComeBeforeTheConfig) {
   const std::string dir = FreshDirectory("identify_set_first");
   const RunResult run = RunIdentify("simulate --set time.window=0.144e-3 --set data.snr=.inf " +
@@ -131,12 +152,18 @@ TEST(IdentifyTest, BadOverrideAndMissingConfigAreRefused) {
   EXPECT_NE(missing.output.find("/nonexistent/config.yaml"), std::string::npos);
 }
 
+// An output file in a folder that does not exist is bad input, refused before the
+// simulation.
 TEST(IdentifyTest, UnwritableOutputIsReportedNotCrashed) {
   const RunResult run = RunIdentify("simulate " + SourcePath("configs/paper_bar.yaml") +
                                     " --set data.truth_refinement=1 -o /nonexistent/dir/out.csv");
-  EXPECT_EQ(run.exit_code, 1);
-  EXPECT_NE(run.output.find("cannot write /nonexistent/dir/out.csv"), std::string::npos)
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.output.find("error: output file /nonexistent/dir/out.csv: /nonexistent/dir is "
+                            "not a folder one can write in"),
+            std::string::npos)
       << run.output;
+  // Nothing was simulated: not even the config's summary line was logged.
+  EXPECT_EQ(run.output.find(" elements, "), std::string::npos) << run.output;
 }
 
 }  // namespace

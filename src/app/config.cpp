@@ -437,7 +437,7 @@ const std::vector<Key>& KeyTable() {
       MakeKey("time.step", &Config::time, &TimeOptions::step, Number(), "s",
               "time step h; T / h must be a whole number"),
       MakeKey("time.theta", &Config::time, &TimeOptions::theta, Number(), "",
-              "theta-method parameter in [0, 1] (0.5: trapezoidal rule)"),
+              "theta-method parameter in [0.5, 1] (0.5: trapezoidal rule)"),
       MakeKey("data.source", &Config::data, &DataOptions::source,
               EnumByName<DataSource>({DataSource::kSynthetic, DataSource::kCsv}, DataSourceToString,
                                      StringToDataSource),
@@ -827,6 +827,18 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
         *error = StructureKeysProblem(config);
         return error->empty();
       },
+      // A load the time grid sees: the half sine of load.duration spans at least two
+      // steps, so that a sample falls inside it.
+      [](const Config& config, std::string* error) {
+        if (config.structure.kind != ModelKind::kBar ||
+            config.load.duration >= 2.0 * config.time.step) {
+          return true;
+        }
+        *error = "load.duration (" + FormatNumber(config.load.duration) +
+                 " s) must span at least two time steps, 2 time.step = " +
+                 FormatNumber(2.0 * config.time.step) + " s, or the sampled load is zero";
+        return false;
+      },
       // A cut-off at or above the Nyquist frequency is not a low-pass filter of the
       // sampled data (the bilinear transform maps Nyquist to tan(pi/2)).
       [](const Config& config, std::string* error) {
@@ -1079,7 +1091,12 @@ ParsedConfig Parse(const std::string& yaml_text, const std::string& name,
                    const std::vector<std::string>& overrides) {
   YAML::Node root;
   try {
-    root = YAML::Load(yaml_text);
+    const std::vector<YAML::Node> documents = YAML::LoadAll(yaml_text);
+    if (documents.size() > 1) {
+      throw InputError(Where(name, documents[1].Mark()) +
+                       ": a config is one YAML document; a second one ('---') starts here");
+    }
+    if (!documents.empty()) root = documents.front();
   } catch (const YAML::Exception& error) {
     throw InputError(Where(name, error.mark) + ": malformed YAML: " + error.msg);
   }

@@ -120,11 +120,29 @@ std::string Number(double value) {
 
 }  // namespace
 
+MeasurementSet SyntheticMeasurements(const Config& config) {
+  MeasurementSet data =
+      MakeSyntheticMeasurements(config.model, config.load, config.time, config.data);
+  std::vector<std::pair<std::string, const Vector*>> channels = {
+      {"u0", &data.u0}, {"uL", &data.uL}, {"f0", &data.f0}, {"fL", &data.fL}};
+  for (const SensorChannel& sensor : data.sensors) channels.push_back({sensor.name, &sensor.values});
+  for (const auto& [name, values] : channels) {
+    if (!values->allFinite()) {
+      const std::string config_name =
+          config.source_path.empty() ? "the config" : config.source_path;
+      throw InputError(config_name + ": the synthetic channel '" + name +
+                       "' is not finite: load.amplitude (" + Number(config.load.amplitude) +
+                       " N) or the noise of data.snr (" + Number(config.data.snr) +
+                       ") lies beyond double range");
+    }
+  }
+  return data;
+}
+
 MeasurementSet LoadMeasurements(const Config& config) {
   bool use_u0 = true, use_uL = true;
   if (config.data.source == DataSource::kSynthetic) {
-    MeasurementSet data =
-        MakeSyntheticMeasurements(config.model, config.load, config.time, config.data);
+    MeasurementSet data = SyntheticMeasurements(config);
     SelectChannels(data, config.data.channels, "data.channels", "the synthetic data (data.sensors)",
                    &use_u0, &use_uL);
     return data;

@@ -20,8 +20,8 @@ bool FinitePositive(double value) { return std::isfinite(value) && value > 0.0; 
 
 bool LoadOptions::IsValid(std::string* error) const {
   std::ostringstream why;
-  if (!std::isfinite(amplitude)) {
-    why << "load.amplitude must be a finite number, got " << amplitude;
+  if (!std::isfinite(amplitude) || amplitude == 0.0) {
+    why << "load.amplitude must be a finite nonzero number of newtons, got " << amplitude;
     return Fail(error, why.str());
   }
   if (!FinitePositive(duration)) {
@@ -47,8 +47,9 @@ bool TimeOptions::IsValid(std::string* error) const {
     why << "time.step must be a finite positive number of seconds, got " << step;
     return Fail(error, why.str());
   }
-  if (!(theta >= 0.0 && theta <= 1.0)) {
-    why << "time.theta must lie in [0, 1], got " << theta;
+  // The theta method is unconditionally stable for theta >= 1/2 only.
+  if (!(theta >= 0.5 && theta <= 1.0)) {
+    why << "time.theta must lie in [0.5, 1] (unconditionally stable), got " << theta;
     return Fail(error, why.str());
   }
   const double ratio = window / step;

@@ -28,10 +28,16 @@ namespace mcrewave {
 
 // The measurements of config.data: MakeSyntheticMeasurements, or the CSV file
 // data.path. Throws InputError naming the file when a CSV is malformed (see
-// ReadMeasurementCsv) or does not match the model's time grid: its time step must
-// equal time.step and its sample count time.window / time.step + 1 (both to
-// 1e-6 relative).
+// ReadMeasurementCsv) or does not fit the model's time grid. A CSV sampled at
+// another uniform rate or origin is resampled onto the grid (resample.h); on the
+// grid (time.step to 1e-6 relative) its sample count must be time.window /
+// time.step + 1. Synthetic data: see SyntheticMeasurements.
 MeasurementSet LoadMeasurements(const Config& config);
+
+// MakeSyntheticMeasurements of the config's model, load, time and data sections.
+// Throws InputError naming the config's keys when a value is not finite (a load
+// or a noise level beyond double range).
+MeasurementSet SyntheticMeasurements(const Config& config);
 
 // Everything one identification computed.
 struct IdentificationRun {

@@ -15,7 +15,7 @@ namespace mcrewave {
 // The load applied on the bar at x = L, positive along +x.
 struct LoadOptions {
   LoadKind kind = LoadKind::kHalfSine;
-  double amplitude = 1000.0;  // F0 [N]
+  double amplitude = 1000.0;  // F0 [N], finite and nonzero
   double duration = 1e-4;     // t_load [s]
 
   bool IsValid(std::string* error) const;
@@ -27,9 +27,9 @@ struct LoadOptions {
 struct TimeOptions {
   double window = 0.63e-3;  // T [s]
   double step = 0.36e-6;    // h [s]
-  double theta = 0.5;       // theta-method parameter, in [0, 1]
+  double theta = 0.5;       // theta-method parameter, in [0.5, 1]
 
-  // Valid when window and step are positive, theta is in [0, 1] and the window
+  // Valid when window and step are positive, theta is in [0.5, 1] and the window
   // holds a whole number of steps (to 1e-9 relative).
   bool IsValid(std::string* error) const;
   // m = T / h, the number of steps; samples are t_k = k h, k = 0..m.
