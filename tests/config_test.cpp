@@ -510,7 +510,7 @@ zone_identification:
 constexpr const char* kEveryMatrixKeyNotAtItsDefault = R"(model:
   kind: matrix
   manifest: "plate dir/model #2.yaml"
-  channel_map: {F: hammer_N, uy_tip: "tip y"}
+  channel_map: {F: "F [N]", uy_tip: "tip #1"}
 data:
   truth_manifest: fine/model.yaml
   truth_moduli: [2e11, 1.4000000000000001e11]

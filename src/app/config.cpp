@@ -291,10 +291,17 @@ ValueType<std::vector<std::pair<std::string, std::string>>> NameMap() {
     *value = parsed;
     return true;
   };
+  // Every name double-quoted, so that a column such as "F [N]" or "tip #1" reads
+  // back as written.
   type.write = [](const Pairs& value) {
+    const auto quoted = [](const std::string& name) {
+      YAML::Emitter emitter;
+      emitter << YAML::DoubleQuoted << name;
+      return std::string(emitter.c_str());
+    };
     std::string text = "{";
     for (std::size_t i = 0; i < value.size(); ++i) {
-      text += (i == 0 ? "" : ", ") + value[i].first + ": " + value[i].second;
+      text += (i == 0 ? "" : ", ") + quoted(value[i].first) + ": " + quoted(value[i].second);
     }
     return text + "}";
   };
