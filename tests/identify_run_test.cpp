@@ -291,6 +291,27 @@ TEST(IdentifyRunTest, PinnedClampConfigFindsOneValleyWithAShortScan) {
   EXPECT_LE(summary["inner"]["iterations_from_zero_at_optimum"].as<int>(), 18);
 }
 
+// A run into a folder that holds an earlier run's results leaves only its own files:
+// the earlier scan's scan.csv and valleys.csv go when the new run does not scan.
+TEST(IdentifyRunTest, ARunReplacesAnEarlierRunsFilesInItsFolder) {
+  const std::string folder = FreshDirectory("identify_run_replaces") + "/results";
+  const std::string quick = SourcePath("configs/quick.yaml");
+  ASSERT_EQ(RunIdentify("run " + quick + " -q --set output.figures=false -o " + folder).exit_code,
+            0);
+  ASSERT_TRUE(fs::exists(folder + "/scan.csv"));
+  ASSERT_TRUE(fs::exists(folder + "/valleys.csv"));
+  const RunResult run = RunIdentify("run " + quick +
+                                    " -q --set output.figures=false --set outer.scan_points=0 "
+                                    "--set data.seed=2 -o " + folder);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_FALSE(fs::exists(folder + "/scan.csv"));
+  EXPECT_FALSE(fs::exists(folder + "/valleys.csv"));
+  const YAML::Node summary = YAML::LoadFile(folder + "/summary.yaml");
+  EXPECT_EQ(summary["scan"]["points"].as<int>(), 0);
+  EXPECT_EQ(summary["config"]["data"]["seed"].as<int>(), 2);
+  EXPECT_EQ(TemporaryFiles(folder), 0);
+}
+
 TEST(IdentifyRunTest, WithoutGnuplotTheFiguresAreSkippedWithAWarning) {
   const std::string folder = FreshDirectory("identify_run_no_gnuplot") + "/results";
   const RunResult run =

@@ -370,14 +370,31 @@ std::string ErrorMapScript(const IdentificationRun& run, const std::string& fold
   return script.str();
 }
 
+// Every file an identification's results may hold (the MCRE, least-squares and
+// matrix writers), summary.yaml first.
+constexpr const char* kResultFileNames[] = {
+    "summary.yaml",  "evaluations.csv", "cost_curve.csv",          "ends.csv",
+    "scan.csv",      "valleys.csv",     "inner_residual.csv",      "error_map.csv",
+    "fit.csv",       "zones.csv",       "error_map_spacetime.dat", "error_map_dofs.csv",
+    "moduli.csv",    "ends.png",        "cost_curve.png",          "error_map.png",
+    "fit.png",       "zones.png",       "inner_residual.png",      "moduli.png"};
+
 // A results folder being filled: every file written atomically, its path kept.
 class ResultsFolder {
  public:
-  // Creates the folder; throws std::runtime_error when it cannot.
+  // Creates the folder and removes an earlier run's result files from it, its
+  // summary.yaml first: the folder then holds this run's files only, and says it is
+  // complete (summary.yaml) only once they are all written. Throws
+  // std::runtime_error when the folder cannot be created or a file removed.
   explicit ResultsFolder(const std::string& folder) : folder_(folder) {
     std::error_code error;
     std::filesystem::create_directories(folder, error);
     if (error) throw std::runtime_error("cannot create folder " + folder + ": " + error.message());
+    for (const char* name : kResultFileNames) {
+      const std::string path = folder + "/" + name;
+      std::filesystem::remove(path, error);
+      if (error) throw std::runtime_error("cannot remove " + path + ": " + error.message());
+    }
   }
   void Write(const std::string& name, const std::string& content) {
     const std::string path = folder_ + "/" + name;
