@@ -626,6 +626,19 @@ TEST(ConfigTest, QuickAndMeasuredCsvConfigsLoad) {
   EXPECT_EQ(measured.outer.optimizer, OptimizerType::kCeres);
 }
 
+// One YAML document, which may open with '---'; a second is refused at its marker.
+// The third text (found by the config fuzzer) made yaml-cpp's LoadAll loop forever.
+TEST(ConfigTest, AConfigIsOneYamlDocument) {
+  EXPECT_EQ(ParseConfig("# comment\n---\nmodel:\n  elements: 7\n", "a.yaml").model.elements, 7);
+  ExpectInputError([] { ParseConfig("model:\n  elements: 7\n--- \noutput: {}\n", "a.yaml"); },
+                   {"a.yaml:3: a config is one YAML document; a second one ('---') starts here"});
+  try {
+    ParseConfig(",\v: d\n-nul-\n", "fuzz.yaml");
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("fuzz.yaml", 0), 0u) << error.what();
+  }
+}
+
 TEST(ConfigTest, BooleanAcceptsTheYamlSpellings) {
   EXPECT_FALSE(ParseConfig("output:\n  figures: no\n", "a.yaml").output.figures);
   EXPECT_TRUE(ParseConfig("output:\n  figures: yes\n", "a.yaml").output.figures);

@@ -622,7 +622,7 @@ INSTANTIATE_TEST_SUITE_P(
                  nullptr,
                  "",
                  2,
-                 {"{config}:4: a config is one YAML document; a second one ('---') starts here"}},
+                 {"{config}:3: a config is one YAML document; a second one ('---') starts here"}},
         BadInput{"non_positive_snr",
                  "data:\n  snr: -3\n",
                  nullptr,

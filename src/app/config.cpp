@@ -1096,14 +1096,27 @@ void Validate(const ParsedConfig& parsed, const std::string& name) {
 
 ParsedConfig Parse(const std::string& yaml_text, const std::string& name,
                    const std::vector<std::string>& overrides) {
-  YAML::Node root;
-  try {
-    const std::vector<YAML::Node> documents = YAML::LoadAll(yaml_text);
-    if (documents.size() > 1) {
-      throw InputError(Where(name, documents[1].Mark()) +
+  // A config is one YAML document: YAML::Load would read the first of several and
+  // drop the rest silently. A line opening with the marker '---' after content
+  // starts another (yaml-cpp's LoadAll can loop forever on malformed text, so the
+  // lines are read here).
+  std::istringstream lines(yaml_text);
+  bool content_seen = false;
+  int line_number = 0;
+  for (std::string line; std::getline(lines, line);) {
+    ++line_number;
+    const bool marker = line.rfind("---", 0) == 0 &&
+                        (line.size() == 3 || line[3] == ' ' || line[3] == '\t' || line[3] == '\r');
+    if (marker && content_seen) {
+      throw InputError(name + ":" + std::to_string(line_number) +
                        ": a config is one YAML document; a second one ('---') starts here");
     }
-    if (!documents.empty()) root = documents.front();
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    if (first != std::string::npos && line[first] != '#' && !marker) content_seen = true;
+  }
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
   } catch (const YAML::Exception& error) {
     throw InputError(Where(name, error.mark) + ": malformed YAML: " + error.msg);
   }
