@@ -161,10 +161,9 @@ TEST(ZoneDiscrepancyTest, NoiseFreeDataNeedNoRegularisationToSpeakOf) {
     // estimated levels), weight 1.29e-7 (2 grid weights, 3 regula falsi steps), worst
     // zone 0.55 % off, 116 evaluations of ceres_lbfgs (NLopt's L-BFGS and 4
     // bisections: 1.15e-7, 0.50 %, 286 evaluations). L-curve: the second grid weight
-    // 2.2e-8 meets the target, no corner above it, kept: worst zone 0.095 % off.
-    EXPECT_TRUE(summary.regularized.weight_choice == "discrepancy" ||
-                summary.regularized.weight_choice == "l_curve" ||
-                summary.regularized.weight_choice == "misfit_floor");
+    // 2.2e-8 meets the target, no corner above it, kept: worst zone 0.095 % off. Both
+    // rules end on a weight that meets the noise's level.
+    EXPECT_EQ(summary.regularized.weight_choice, "discrepancy");
     EXPECT_LT(worst, 0.01) << summary.FullReport();
   }
 }
