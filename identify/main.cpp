@@ -158,6 +158,18 @@ class ResultsBeingWritten {
   ResultsBeingWritten& operator=(const ResultsBeingWritten&) = delete;
 };
 
+// Throws InputError "<what>: <folder> is not a folder" or "<what>: cannot write in
+// <folder>" unless `folder` is a folder this process can write in.
+void RequireWritableFolder(const std::filesystem::path& folder, const std::string& what) {
+  std::error_code error;
+  if (!std::filesystem::is_directory(folder, error)) {
+    throw mcrewave::InputError(what + ": " + folder.string() + " is not a folder");
+  }
+  if (::access(folder.c_str(), W_OK | X_OK) != 0) {
+    throw mcrewave::InputError(what + ": cannot write in " + folder.string());
+  }
+}
+
 // Throws InputError when `folder` cannot be created or written to: checked
 // before any computation, so that a bad --output costs nothing.
 void CheckOutputFolder(const std::string& folder) {
@@ -168,14 +180,7 @@ void CheckOutputFolder(const std::string& folder) {
          existing.parent_path() != existing) {
     existing = existing.parent_path();
   }
-  if (fs::exists(existing, error) && !fs::is_directory(existing, error)) {
-    throw mcrewave::InputError("output folder " + folder + ": " + existing.string() +
-                               " is not a folder");
-  }
-  if (::access(existing.c_str(), W_OK | X_OK) != 0) {
-    throw mcrewave::InputError("output folder " + folder + ": cannot write in " +
-                               existing.string());
-  }
+  RequireWritableFolder(existing, "output folder " + folder);
 }
 
 // Steps 3 to 5 of RunIdentify with outer.functional: least_squares: the
@@ -310,14 +315,9 @@ int RunSimulate(const SimulateArguments& arguments) {
   // 1. Read and validate the config and the output file's folder (nothing is
   //    computed if either is invalid).
   const mcrewave::Config config = mcrewave::LoadConfig(arguments.config_path, arguments.overrides);
-  const std::filesystem::path output_folder =
-      std::filesystem::absolute(arguments.output_path).parent_path();
-  std::error_code folder_error;
-  if (!std::filesystem::is_directory(output_folder, folder_error) ||
-      ::access(output_folder.c_str(), W_OK | X_OK) != 0) {
-    throw mcrewave::InputError("output file " + arguments.output_path + ": " +
-                               output_folder.string() + " is not a folder one can write in");
-  }
+  // The CSV is written into an existing folder (WriteMeasurementCsv creates none).
+  RequireWritableFolder(std::filesystem::absolute(arguments.output_path).parent_path(),
+                        "output file " + arguments.output_path);
   if (config.structure.kind == mcrewave::ModelKind::kMatrix) {
     // A structure given by matrices: its truth's outputs and loads, under the columns
     // identify run reads (model.channel_map).

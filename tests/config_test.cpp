@@ -763,7 +763,8 @@ TEST_F(ConfigFileTest, ZeroElements) {
 }
 
 TEST_F(ConfigFileTest, ThetaOutOfRange) {
-  ExpectLoadError("time:\n  theta: 1.5\n", 2, {"time.theta must lie in [0.5, 1] (unconditionally stable), got 1.5"});
+  ExpectLoadError("time:\n  theta: 1.5\n", 2,
+                  {"time.theta must lie in [0.5, 1] (unconditionally stable), got 1.5"});
 }
 
 TEST_F(ConfigFileTest, StepNotDividingWindow) {

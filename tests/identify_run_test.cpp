@@ -634,7 +634,8 @@ INSTANTIATE_TEST_SUITE_P(
                  nullptr,
                  "{dir}/results --set time.theta=1.5",
                  2,
-                 {"--set time.theta=1.5: time.theta must lie in [0.5, 1] (unconditionally stable), got 1.5"}},
+                 {"--set time.theta=1.5: time.theta must lie in [0.5, 1] (unconditionally "
+                  "stable), got 1.5"}},
         BadInput{"override_without_value",
                  "",
                  nullptr,

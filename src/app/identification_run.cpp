@@ -125,7 +125,9 @@ MeasurementSet SyntheticMeasurements(const Config& config) {
       MakeSyntheticMeasurements(config.model, config.load, config.time, config.data);
   std::vector<std::pair<std::string, const Vector*>> channels = {
       {"u0", &data.u0}, {"uL", &data.uL}, {"f0", &data.f0}, {"fL", &data.fL}};
-  for (const SensorChannel& sensor : data.sensors) channels.push_back({sensor.name, &sensor.values});
+  for (const SensorChannel& sensor : data.sensors) {
+    channels.push_back({sensor.name, &sensor.values});
+  }
   for (const auto& [name, values] : channels) {
     if (!values->allFinite()) {
       const std::string config_name =
@@ -274,8 +276,9 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
     }
   }
   // The measured clamp's f0 misfit is W_0 / alpha itself (MisfitLevels).
-  run.misfit = MisfitLevels(run.data, run.solution, run.alpha,
-                            config.mcre.clamp == ClampModel::kMeasured ? nullptr : &run.clamp_force);
+  const bool measured = config.mcre.clamp == ClampModel::kMeasured;
+  run.misfit =
+      MisfitLevels(run.data, run.solution, run.alpha, measured ? nullptr : &run.clamp_force);
   // The uncertainty figure: noise levels known for synthetic data with noise,
   // estimated from the data's second differences otherwise.
   run.estimated_noise = DifferenceNoiseLevels(data);
