@@ -131,6 +131,33 @@ TEST(AllAtOnceSolverTest, RefusesAboveTheSizeLimitWithAClearMessage) {
       << solved.summary.message;
 }
 
+TEST(IterativeSolverTest, RefusesAboveTheFieldLimitWithTheBytesItWouldNeed) {
+  ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
+  // 10 fields of 11 nodes x 51 steps' doubles: 44880 bytes.
+  ASSERT_EQ(IterativeSolverFieldBytes(11, 50), 44880.0);
+  for (const CoupledSolverType type :
+       {CoupledSolverType::kConjugateGradient, CoupledSolverType::kRelaxation,
+        CoupledSolverType::kAdaptiveRelaxation}) {
+    ASSERT_TRUE(HoldsIterativeSolverFields(type));
+    CoupledSolverOptions options = Options(type, 1e-8);
+    options.max_field_bytes = 44879;
+    const Solved refused = Solve(options, &bundle.problem);
+    EXPECT_EQ(refused.summary.termination, TerminationType::kFailure);
+    EXPECT_NE(refused.summary.message.find(
+                  "needs 44880 bytes (10 fields of n x (m + 1) doubles, n = 11 nodes, m = 50 "
+                  "steps), above the limit of 44879 bytes (inner.max_field_bytes)"),
+              std::string::npos)
+        << refused.summary.message;
+    // At the limit, the method runs.
+    options.max_field_bytes = 44880;
+    const Solved run = Solve(options, &bundle.problem);
+    EXPECT_GT(run.summary.iterations, 0) << run.summary.message;
+    EXPECT_EQ(run.summary.message.find("inner.max_field_bytes"), std::string::npos);
+  }
+  EXPECT_FALSE(HoldsIterativeSolverFields(CoupledSolverType::kAllAtOnce));
+  EXPECT_FALSE(HoldsIterativeSolverFields(CoupledSolverType::kRiccati));
+}
+
 TEST(AllAtOnceSolverTest, RefusesAboveTheMemoryLimitWithTheBytesItWouldNeed) {
   ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
   CoupledSolverOptions options = Options(CoupledSolverType::kAllAtOnce, 1e-8);

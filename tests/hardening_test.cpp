@@ -370,12 +370,12 @@ TEST(ExtremeInputTest, HundredThousandElementsAreRefusedWithTheMemoryNeeded) {
   const std::string big = " --set model.elements=100000 --set data.truth_refinement=1 -q -o ";
   const RunResult iterative =
       RunIdentify("run " + SourcePath("configs/quick.yaml") + big + dir + "/cg");
-  EXPECT_EQ(iterative.exit_code, 1) << iterative.output;
-  // 10 fields of 100001 x 301 doubles.
+  // Refused at load, before the truth is simulated: 10 fields of 100001 x 301 doubles.
+  EXPECT_EQ(iterative.exit_code, 2) << iterative.output;
   EXPECT_NE(ErrorLine(iterative.output)
-                .find("conjugate_gradient needs 2408024080 bytes (10 fields of n x (m + 1) "
-                      "doubles, n = 100001 nodes, m = 300 steps), above the limit of 2147483648 "
-                      "bytes (inner.max_field_bytes)"),
+                .find("model.elements (100000) and 300 steps (time.window / time.step) need "
+                      "2408024080 bytes for inner.method 'conjugate_gradient' (10 fields of "
+                      "(N + 1) x (steps + 1) doubles), above inner.max_field_bytes = 2147483648"),
             std::string::npos)
       << iterative.output;
   const RunResult riccati = RunIdentify("run " + SourcePath("configs/quick.yaml") + big + dir +

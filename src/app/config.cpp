@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "mcrewave/core/types.h"
+#include "mcrewave/mcre/coupled_solver.h"
 
 namespace mcrewave {
 namespace {
@@ -845,6 +846,45 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
                  " s) must span at least two time steps, 2 time.step = " +
                  FormatNumber(2.0 * config.time.step) + " s, or the sampled load is zero";
         return false;
+      },
+      // Sizes a bar's run can hold, refused here rather than by an allocation part way
+      // (the synthetic truth is simulated before the first solve): the finite-element
+      // truth's elements and steps (model.elements and the model's steps, each times
+      // data.truth_refinement) count in int, and an iterative method's fields fit
+      // inner.max_field_bytes (SolveCoupled's check, made before any work).
+      [](const Config& config, std::string* error) {
+        if (config.structure.kind != ModelKind::kBar) return true;
+        constexpr double kMaxTruthCount = 1e9;  // below INT_MAX = 2.1e9
+        const double elements = config.model.elements;
+        const double steps = config.time.NumSteps();
+        const double refinement = config.data.truth_refinement;
+        std::ostringstream why;
+        if (config.data.source == DataSource::kSynthetic &&
+            config.data.truth == TruthModel::kFiniteElement &&
+            (elements * refinement > kMaxTruthCount || steps * refinement > kMaxTruthCount)) {
+          why << "data.truth_refinement (" << config.data.truth_refinement
+              << ") gives the finite-element truth " << FormatNumber(elements * refinement)
+              << " elements (model.elements x data.truth_refinement) and "
+              << FormatNumber(steps * refinement)
+              << " steps (time.window / time.step x data.truth_refinement), more than the limit "
+                 "of 1e9 for either; use a smaller refinement, fewer elements or a larger step";
+          *error = why.str();
+          return false;
+        }
+        const double field_bytes = IterativeSolverFieldBytes(elements + 1.0, steps);
+        if (HoldsIterativeSolverFields(config.inner.type) &&
+            field_bytes > static_cast<double>(config.inner.max_field_bytes)) {
+          why << "model.elements (" << config.model.elements << ") and " << FormatNumber(steps)
+              << " steps (time.window / time.step) need "
+              << static_cast<long long>(field_bytes) << " bytes for inner.method '"
+              << CoupledSolverTypeToString(config.inner.type) << "' (" << kIterativeSolverFields
+              << " fields of (N + 1) x (steps + 1) doubles), above inner.max_field_bytes = "
+              << config.inner.max_field_bytes
+              << "; use fewer elements, a shorter window or a larger step";
+          *error = why.str();
+          return false;
+        }
+        return true;
       },
       // A cut-off at or above the Nyquist frequency is not a low-pass filter of the
       // sampled data (the bilinear transform maps Nyquist to tan(pi/2)).

@@ -118,6 +118,16 @@ std::string CoupledSolverSummary::FullReport() const {
   return out.str();
 }
 
+double IterativeSolverFieldBytes(double num_nodes, double num_steps) {
+  return static_cast<double>(kIterativeSolverFields) * sizeof(double) * num_nodes *
+         (num_steps + 1.0);
+}
+
+bool HoldsIterativeSolverFields(CoupledSolverType type) {
+  return type == CoupledSolverType::kRelaxation || type == CoupledSolverType::kAdaptiveRelaxation ||
+         type == CoupledSolverType::kConjugateGradient;
+}
+
 CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledProblem* problem,
                                   const Matrix* initial_guess, CoupledSolution* solution) {
   using Clock = std::chrono::steady_clock;
@@ -130,11 +140,8 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
     summary.message = "invalid options: " + why;
     return summary;
   }
-  const bool iterative = options.type == CoupledSolverType::kRelaxation ||
-                         options.type == CoupledSolverType::kAdaptiveRelaxation ||
-                         options.type == CoupledSolverType::kConjugateGradient;
-  const double field_bytes = static_cast<double>(kIterativeSolverFields) * sizeof(double) *
-                             problem->num_nodes() * (problem->num_steps() + 1.0);
+  const bool iterative = HoldsIterativeSolverFields(options.type);
+  const double field_bytes = IterativeSolverFieldBytes(problem->num_nodes(), problem->num_steps());
   if (iterative && field_bytes > static_cast<double>(options.max_field_bytes)) {
     std::ostringstream refusal;
     refusal << CoupledSolverTypeToString(options.type) << " needs "

@@ -19,8 +19,9 @@ bool BarProperties::IsValid(std::string* error) const {
   };
   bool ok = positive(length, "model.length") && positive(section, "model.section") &&
             positive(density, "model.density") && positive(modulus, "model.modulus");
-  if (ok && elements < 1) {
-    why << "model.elements must be at least 1, got " << elements;
+  // At most 1e8, so that node and entry counts stay far inside int.
+  if (ok && (elements < 1 || elements > 100000000)) {
+    why << "model.elements must be an integer in [1, 1e8], got " << elements;
     ok = false;
   }
   if (!ok && error != nullptr) *error = why.str();

@@ -67,6 +67,15 @@ bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type)
 // side and data response, and the caller's warm start and zero field.
 constexpr int kIterativeSolverFields = 10;
 
+// Bytes of the kIterativeSolverFields fields of an iterative solve on `num_nodes`
+// nodes and `num_steps` steps; a double, so that no product overflows. Compared with
+// CoupledSolverOptions::max_field_bytes by SolveCoupled and, for the bar, at load.
+double IterativeSolverFieldBytes(double num_nodes, double num_steps);
+
+// True for the methods whose memory is the fields above (relaxation,
+// adaptive_relaxation, conjugate_gradient).
+bool HoldsIterativeSolverFields(CoupledSolverType type);
+
 enum class TerminationType {
   kConvergence,    // the residual reached the tolerance
   kNoConvergence,  // the iteration limit was reached first
