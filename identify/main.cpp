@@ -256,9 +256,6 @@ int RunIdentify(const RunArguments& arguments) {
 
   // 2. The measurements, checked against the model's time grid.
   const mcrewave::MeasurementSet data = mcrewave::LoadMeasurements(config);
-  if (config.data.source == mcrewave::DataSource::kCsv) {
-    mcrewave::CheckMeasurementChannels(data, config.data.path);
-  }
   spdlog::info("config {}: {} elements, {} steps of {:.4g} s; data {} ({} samples)",
                arguments.config_path, config.model.elements, config.time.NumSteps(),
                config.time.step,

@@ -405,10 +405,12 @@ TEST(ExtremeInputTest, AMillionRowCsvIsReadInBoundedMemoryWithProgress) {
     std::ofstream file(csv);
     file << "t,u0,uL,f0,fL\n";
     char row[160];
+    // A spike of 1e5 N on the last row's fL, so that the whole file is read and
+    // checked before the run is refused.
     for (int k = 0; k < 1000000; ++k) {
       std::snprintf(row, sizeof(row), "%.17g,0,%.9g,%.9g,%.9g\n", k * 1.44e-6,
                     1e-6 * std::sin(1e-3 * k), -100.0 * std::sin(2e-3 * k),
-                    100.0 * std::sin(2e-3 * k));
+                    100.0 * std::sin(2e-3 * k) + (k == 999999 ? 1e5 : 0.0));
       file << row;
     }
   }
@@ -418,11 +420,9 @@ TEST(ExtremeInputTest, AMillionRowCsvIsReadInBoundedMemoryWithProgress) {
   for (const char* progress : {"read 250000 rows", "read 500000 rows", "read 1000000 rows"}) {
     EXPECT_NE(run.output.find(csv + ": " + progress), std::string::npos) << run.output;
   }
-  EXPECT_NE(ErrorLine(run.output)
-                .find(csv + ": 1000000 samples, but time.window / time.step + 1 "
-                            "= 301"),
-            std::string::npos)
+  EXPECT_NE(ErrorLine(run.output).find(csv + ":1000001: column 'fL': "), std::string::npos)
       << run.output;
+  EXPECT_NE(ErrorLine(run.output).find("is an outlier"), std::string::npos) << run.output;
   // The columns take 40 MB (80 while they are copied into the set); the peak of
   // the binary stays below the 60 MB of the file's text plus that, so the text is
   // never held whole (more under AddressSanitizer's shadow memory and quarantine).
@@ -498,6 +498,41 @@ TEST_F(SpoiledDataTest, ForceOutlierIsRefusedNamingItsLine) {
   EXPECT_NE(ErrorLine(run.output).find("/spoiled.csv:152: column 'fL': "), std::string::npos)
       << run.output;
   EXPECT_NE(ErrorLine(run.output).find("is an outlier"), std::string::npos) << run.output;
+}
+
+TEST_F(SpoiledDataTest, AnOutlierInDataAtAnotherRateIsRefusedNamingItsLineInTheFile) {
+  // The quick case sampled at twice the model's rate (600 steps of 0.72 us), resampled
+  // onto the model's grid when read: the spike at the file's sample 301 is named at its
+  // line, 303, not at the line of a resampled sample.
+  const RunResult simulated = RunIdentify("simulate " + SourcePath("configs/quick.yaml") +
+                                          " -q --set time.step=0.72e-6 -o " + dir_ + "/fast.csv");
+  ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
+  MeasurementSet data = ReadMeasurementCsv(dir_ + "/fast.csv");
+  ASSERT_EQ(data.num_samples(), 601);
+  data.fL[301] += 1e5;
+  const RunResult run = RunOn(data);
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(ErrorLine(run.output).find("/spoiled.csv:303: column 'fL': "), std::string::npos)
+      << run.output;
+  EXPECT_NE(ErrorLine(run.output).find("is an outlier"), std::string::npos) << run.output;
+}
+
+TEST_F(SpoiledDataTest, ARecordLongerThanTheWindowIsCutToIt) {
+  const RunResult clean = RunOn(clean_);
+  ASSERT_EQ(clean.exit_code, 0) << clean.output;
+  const std::string clean_summary = ReadText(dir_ + "/results/summary.yaml");
+  // 200 samples more on the model's grid, each channel held at its last value.
+  MeasurementSet longer = clean_;
+  const int samples = clean_.num_samples();
+  for (Vector* channel : {&longer.u0, &longer.uL, &longer.f0, &longer.fL}) {
+    channel->conservativeResize(samples + 200);
+    channel->tail(200).setConstant((*channel)[samples - 1]);
+  }
+  const RunResult run = RunOn(longer);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  // The same data in the window: the same E to the bit.
+  EXPECT_EQ(SummaryNumber(ReadText(dir_ + "/results/summary.yaml"), "identified_modulus"),
+            SummaryNumber(clean_summary, "identified_modulus"));
 }
 
 TEST_F(SpoiledDataTest, DisplacementOutliersAreRefused) {

@@ -310,6 +310,23 @@ TEST(MeasurementChannelsTest, OutlierIsNamedWithItsLine) {
   }
 }
 
+TEST(MeasurementChannelsTest, AnOutlierOnTheFirstOrLastSampleOrBesideItIsNamedAtItsLine) {
+  // 300 samples on lines 2 to 301; uL's peak is 1e-6.
+  for (const int sample : {0, 1, 298, 299}) {
+    MeasurementSet set = SmoothSet(300);
+    set.uL[sample] = 5e-6;
+    try {
+      CheckMeasurementChannels(set, "spike.csv");
+      ADD_FAILURE() << "no InputError thrown for sample " << sample;
+    } catch (const InputError& error) {
+      const std::string message = error.what();
+      const std::string expected =
+          "spike.csv:" + std::to_string(sample + 2) + ": column 'uL': 5e-06 is an outlier";
+      EXPECT_EQ(message.rfind(expected, 0), 0u) << message;
+    }
+  }
+}
+
 TEST_F(MeasurementTest, MissingFile) {
   const std::string path = PathOf("absent.csv");
   try {

@@ -151,6 +151,9 @@ MeasurementSet LoadMeasurements(const Config& config) {
   }
   const std::string& path = config.data.path;
   MeasurementSet data = ReadMeasurementCsv(path);
+  // Dead channels and outliers are looked for in the file's own samples, so that the
+  // line named is the file's (resampling would spread a spike over its neighbours).
+  CheckMeasurementChannels(data, path);
   const std::string config_name = config.source_path.empty() ? "the config" : config.source_path;
   const int expected_samples = config.time.NumSteps() + 1;
   if (std::abs(data.time_step - config.time.step) > kGridTolerance * config.time.step ||
@@ -167,6 +170,13 @@ MeasurementSet LoadMeasurements(const Config& config) {
                        "': the sensor lies outside the bar [0, " + Number(config.model.length) +
                        "] m (model.length of " + config_name + ")");
     }
+  }
+  if (data.num_samples() > expected_samples) {
+    // A record longer than the window on the model's grid: its first samples are the
+    // window's, as resampling would take them from data on another grid.
+    spdlog::info("{}: using the first {} of its {} samples (time.window {:.6g} s)", path,
+                 expected_samples, data.num_samples(), config.time.window);
+    KeepFirstSamples(expected_samples, &data);
   }
   if (data.num_samples() != expected_samples) {
     throw InputError(

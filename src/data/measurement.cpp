@@ -376,17 +376,37 @@ void CheckMeasurementChannels(const MeasurementSet& measurements, const std::str
                      magnitudes.end());
     const double noise_level = 1.4826 * magnitudes[magnitudes.size() / 2];
     const double threshold = std::max(kOutlierNoiseFactor * noise_level, 0.5 * peak);
-    Eigen::Index worst = 0;  // the sample k + 1 of the largest |second difference|
+    Eigen::Index worst = 0;  // second difference x[k-1] - 2 x[k] + x[k+1] of k = worst + 1
     const double largest = second_differences.cwiseAbs().maxCoeff(&worst);
     if (largest > threshold) {
-      throw InputError(name + ":" + std::to_string(worst + 3) + ": " + column + ": " +
-                       Short(x[worst + 1]) + " is an outlier: its second difference " +
+      // A spike s at an interior sample k gives second differences (s, -2 s, s) centred
+      // on k; at the first or last sample only s, at its neighbour's, with nothing
+      // beside it (below a quarter of it: a spike on the neighbour leaves half).
+      Eigen::Index spike = worst + 1;
+      const Eigen::Index last = second_differences.size() - 1;
+      if (last > 0 && worst == last &&
+          std::abs(second_differences[last - 1]) < 0.25 * largest) {
+        spike = samples - 1;
+      } else if (last > 0 && worst == 0 && std::abs(second_differences[1]) < 0.25 * largest) {
+        spike = 0;
+      }
+      throw InputError(name + ":" + std::to_string(spike + 2) + ": " + column + ": " +
+                       Short(x[spike]) + " is an outlier: its second difference " +
                        Short(second_differences[worst]) + " is above " +
                        Short(kOutlierNoiseFactor) + " times the channel's noise level " +
                        Short(noise_level) + " and half its peak " + Short(peak) +
                        "; repair or remove the file's outliers");
     }
   }
+}
+
+void KeepFirstSamples(int samples, MeasurementSet* measurements) {
+  assert(samples >= 0 && samples <= measurements->num_samples());
+  for (Vector* channel :
+       {&measurements->u0, &measurements->uL, &measurements->f0, &measurements->fL}) {
+    channel->conservativeResize(samples);
+  }
+  for (SensorChannel& sensor : measurements->sensors) sensor.values.conservativeResize(samples);
 }
 
 MeasurementSet SelectChannels(const MeasurementSet& measurements,

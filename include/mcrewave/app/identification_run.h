@@ -28,10 +28,12 @@ namespace mcrewave {
 
 // The measurements of config.data: MakeSyntheticMeasurements, or the CSV file
 // data.path. Throws InputError naming the file when a CSV is malformed (see
-// ReadMeasurementCsv) or does not fit the model's time grid. A CSV sampled at
+// ReadMeasurementCsv), has a dead channel or an outlier among the file's samples
+// (CheckMeasurementChannels) or does not fit the model's time grid. A CSV sampled at
 // another uniform rate or origin is resampled onto the grid (resample.h); on the
-// grid (time.step to 1e-6 relative) its sample count must be time.window /
-// time.step + 1. Synthetic data: see SyntheticMeasurements.
+// grid (time.step to 1e-6 relative) it must hold at least time.window / time.step + 1
+// samples, of which the first that many are kept. Synthetic data: see
+// SyntheticMeasurements.
 MeasurementSet LoadMeasurements(const Config& config);
 
 // MakeSyntheticMeasurements of the config's model, load, time and data sections.

@@ -111,10 +111,15 @@ void WriteChannelTable(const ChannelTable& table, const std::string& path);
 //   - a dead channel: uL, f0 or fL zero on every sample (u0 may be: the clamped end);
 //   - an outlier: the sample of largest second difference x[k-1] - 2 x[k] + x[k+1],
 //     when that is above both kOutlierNoiseFactor times the channel's robust noise level
-//     (1.4826 median |second difference|) and half the channel's peak |x|.
+//     (1.4826 median |second difference|) and half the channel's peak |x|; the line
+//     named is the spike's, the first or last sample's when it is there.
 // A channel in wrong units (scaled by 1e6) passes here; the identification then
 // ends on a bound of outer:, which `identify run` refuses.
 void CheckMeasurementChannels(const MeasurementSet& measurements, const std::string& name);
+
+// Keeps the first `samples` samples of every channel of *measurements (at most its
+// num_samples()); the time grid is unchanged.
+void KeepFirstSamples(int samples, MeasurementSet* measurements);
 constexpr double kOutlierNoiseFactor = 50.0;
 
 // The channels an identification uses (config data.channels): the set with only the
