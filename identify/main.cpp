@@ -369,10 +369,13 @@ int RunStudy(const StudyArguments& arguments) {
                                ": model.kind: the studies run on the bar, got 'matrix' (the "
                                "plate's study: scripts/plate_study.sh)");
   }
+  const mcrewave::StudyKind kind = config.study.kind;
+  if (mcrewave::StudySelected(kind, mcrewave::StudyKind::kDamage)) {
+    mcrewave::CheckDamageStudyConfig(config, arguments.config_path);
+  }
   CheckOutputFolder(config.study.folder);
   const std::string& folder = config.study.folder;
   const bool figures = config.study.figures;
-  const mcrewave::StudyKind kind = config.study.kind;
   mcrewave::StudyProgressLogger()->info(
       "config {}: {} elements, {} steps of {:.4g} s; study {} into {}", arguments.config_path,
       config.model.elements, config.time.NumSteps(), config.time.step,

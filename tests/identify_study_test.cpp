@@ -251,6 +251,31 @@ TEST(IdentifyStudyTest, BadStudyValuesStopBeforeAnyComputation) {
   EXPECT_FALSE(fs::exists(folder));
 }
 
+TEST(IdentifyStudyTest, ADamageStudyOnABarItsTruthsAndSensorsDoNotFitStopsBeforeAnyRun) {
+  const std::string directory = FreshDirectory("identify_study_damage_bar");
+  const std::string config = WriteConfig(directory, kTinyStudyConfig);
+  const std::string folder = directory + "/results";
+  RunResult result = RunIdentify("study " + config + " --set study.kind=damage " +
+                                 "--set model.length=0.8 --output " + folder);
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find(config + ": study.kind damage places its truth zones and sensors "
+                                        "in m on the paper's bar; its run of the soft truth with "
+                                        "interior sensors and 10 equal zones would fail on this "
+                                        "config's bar: data.sensors[6] = 'e@0.9': the sensor lies "
+                                        "outside the bar [0, 0.8] m"),
+            std::string::npos)
+      << result.output;
+  result = RunIdentify("study " + config + " --set study.kind=damage --set model.elements=8 " +
+                       "--output " + folder);
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("its run of the soft truth with end sensors and 10 equal zones "
+                               "would fail on this config's bar: model.zone_count must be "
+                               "between 1 and model.elements = 8"),
+            std::string::npos)
+      << result.output;
+  EXPECT_FALSE(fs::exists(folder));
+}
+
 }  // namespace
 }  // namespace mcrewave
 

@@ -1125,13 +1125,20 @@ std::string Locate(const std::string& message, const ParsedConfig& parsed,
   return where + ": " + message;
 }
 
-void Validate(const ParsedConfig& parsed, const std::string& name) {
+// The first failed check of `config` (sections, then across sections), or "".
+std::string FirstProblem(const Config& config) {
   for (const auto* validators : {&SectionValidators(), &CrossSectionValidators()}) {
     for (const SectionValidator& is_valid : *validators) {
       std::string error;
-      if (!is_valid(parsed.config, &error)) throw InputError(Locate(error, parsed, name));
+      if (!is_valid(config, &error)) return error;
     }
   }
+  return "";
+}
+
+void Validate(const ParsedConfig& parsed, const std::string& name) {
+  const std::string error = FirstProblem(parsed.config);
+  if (!error.empty()) throw InputError(Locate(error, parsed, name));
 }
 
 ParsedConfig Parse(const std::string& yaml_text, const std::string& name,
@@ -1313,6 +1320,8 @@ Config LoadConfig(const std::string& path, const std::vector<std::string>& overr
   }
   return config;
 }
+
+std::string ConfigProblem(const Config& config) { return FirstProblem(config); }
 
 std::string DefaultConfigYaml() {
   return "# mcrewave configuration: every key at its default value (SI units).\n"

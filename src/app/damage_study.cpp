@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -76,18 +77,11 @@ std::vector<double> TruthPerZone(const BarModel& model, const Vector& element_mo
   return moduli;
 }
 
-void RunOne(const Config& config, const DamageCase& damage, DamageRun* run) {
-  const auto start = std::chrono::steady_clock::now();
-  const double reference = config.model.modulus;
-  run->truth = damage.truth;
-  run->interior_sensors = damage.interior_sensors;
-  run->snr = damage.snr;
-  run->seed = damage.seed;
-  run->per_element = damage.per_element;
-
+// The config of one run: the user's with the case's truth, sensors, noise and zoning.
+Config RunConfig(const Config& config, const DamageCase& damage) {
   Config run_config = config;
   run_config.outer.scan_threads = 1;
-  run_config.data.truth_zones = ScaledTruth(DamageTruths()[damage.truth], reference);
+  run_config.data.truth_zones = ScaledTruth(DamageTruths()[damage.truth], config.model.modulus);
   run_config.data.sensors =
       damage.interior_sensors ? DamageInteriorSensors() : std::vector<std::string>{};
   run_config.data.channels.clear();
@@ -99,6 +93,18 @@ void RunOne(const Config& config, const DamageCase& damage, DamageRun* run) {
   // Merging costs up to zones^2 / 2 refits: minutes for 10 zones, hours for one per element.
   run_config.zone_identification.merge_zones =
       config.zone_identification.merge_zones && !damage.per_element;
+  return run_config;
+}
+
+void RunOne(const Config& config, const DamageCase& damage, DamageRun* run) {
+  const auto start = std::chrono::steady_clock::now();
+  run->truth = damage.truth;
+  run->interior_sensors = damage.interior_sensors;
+  run->snr = damage.snr;
+  run->seed = damage.seed;
+  run->per_element = damage.per_element;
+  const Config run_config = RunConfig(config, damage);
+  assert(ConfigProblem(run_config).empty());  // CheckDamageStudyConfig
 
   const MeasurementSet measured = MakeSyntheticMeasurements(run_config.model, run_config.load,
                                                             run_config.time, run_config.data);
@@ -384,6 +390,19 @@ const std::vector<std::string>& DamageInteriorSensors() {
   static const std::vector<std::string> sensors = {"u@0.25", "u@0.5",  "u@0.75", "e@0.2",
                                                    "e@0.45", "e@0.65", "e@0.9"};
   return sensors;
+}
+
+void CheckDamageStudyConfig(const Config& config, const std::string& name) {
+  for (const DamageCase& damage : Cases(config.study)) {
+    const std::string problem = ConfigProblem(RunConfig(config, damage));
+    if (problem.empty()) continue;
+    throw InputError(name + ": study.kind damage places its truth zones and sensors in m on " +
+                     "the paper's bar; its run of the " + DamageTruths()[damage.truth].name +
+                     " truth with " + (damage.interior_sensors ? "interior" : "end") +
+                     " sensors and " +
+                     (damage.per_element ? "one zone per element" : "10 equal zones") +
+                     " would fail on this config's bar: " + problem);
+  }
 }
 
 DamageStudy RunDamageStudy(const Config& config) {

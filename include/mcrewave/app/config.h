@@ -146,6 +146,11 @@ Config LoadConfig(const std::string& path, const std::vector<std::string>& overr
 Config ParseConfig(const std::string& yaml_text, const std::string& name,
                    const std::vector<std::string>& overrides = {});
 
+// The checks LoadConfig makes, on a config built in code (e.g. a study's run derived
+// from the user's config): "" when it is valid, else the first problem, naming the
+// key first, as LoadConfig's message without the file and line.
+std::string ConfigProblem(const Config& config);
+
 // A complete config with every key at its default, each commented with its unit
 // and meaning; ParseConfig(DefaultConfigYaml(), ...) gives the default Config.
 std::string DefaultConfigYaml();

@@ -67,7 +67,14 @@ struct DamageStudy {
   std::string settings;
 };
 
-// Precondition: config valid (as LoadConfig returns it), synthetic finite-element truth.
+// Throws InputError, prefixed by `name` (the config file), when a run of the study
+// would not be a valid config: its truths and sensors sit at fixed positions in m
+// (the paper's bar, L = 1 m) and its 10 zones need 10 elements, so a shorter or
+// coarser bar is refused here, before any study runs.
+void CheckDamageStudyConfig(const Config& config, const std::string& name);
+
+// Precondition: config valid (as LoadConfig returns it), synthetic finite-element
+// truth, and CheckDamageStudyConfig passed.
 DamageStudy RunDamageStudy(const Config& config);
 
 // damage/: runs.csv (one row per run), zones.csv (one row per run and zone),
