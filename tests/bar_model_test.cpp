@@ -266,6 +266,20 @@ TEST(BarZonesTest, TruthModuliPutPartlyCoveredElementsInSeries) {
       std::string::npos);
 }
 
+TEST(BarZonesTest, AZonesTruthModulusIsItsElementsInSeries) {
+  const BarProperties bar = TenElementBar();
+  ZoneLayout layout;
+  layout.zone_count = 2;
+  const BarModel model(bar, layout.ElementZones(bar));
+  Vector element_moduli = Vector::Constant(10, 200e9);
+  element_moduli.head(5) << 300e9, 100e9, 100e9, 100e9, 100e9;
+  const std::vector<double> zones = ZoneModuliInSeries(model, element_moduli);
+  ASSERT_EQ(zones.size(), 2u);
+  // 1 / E_0 = (1 / 300 + 4 / 100) / 5 per GPa: 115.38 GPa, not the arithmetic 140 GPa.
+  EXPECT_NEAR(zones[0], 5.0 / (1.0 / 300e9 + 4.0 / 100e9), 1e-15 * zones[0]);
+  EXPECT_NEAR(zones[1], 200e9, 1e-15 * 200e9);  // measured 1 ulp off
+}
+
 TEST(BarSensorsTest, RowsInterpolateDisplacementAndDifferentiateForStrain) {
   const BarModel model(TenElementBar());
   // A linear field u = 2 x + 1: u(0.25) = 1.5, strain 2 everywhere.

@@ -63,20 +63,6 @@ std::vector<ModulusZone> ScaledTruth(const DamageTruth& truth, double reference)
   return zones;
 }
 
-// The truth's modulus of each zone of `model`: its elements in series,
-// 1 / E_z = mean over the zone's elements of 1 / E_e (equal lengths).
-std::vector<double> TruthPerZone(const BarModel& model, const Vector& element_moduli) {
-  std::vector<double> compliance(model.num_zones(), 0.0);
-  std::vector<int> count(model.num_zones(), 0);
-  for (int e = 0; e < model.num_elements(); ++e) {
-    compliance[model.element_zone(e)] += 1.0 / element_moduli[e];
-    ++count[model.element_zone(e)];
-  }
-  std::vector<double> moduli(model.num_zones());
-  for (int z = 0; z < model.num_zones(); ++z) moduli[z] = count[z] / compliance[z];
-  return moduli;
-}
-
 // The config of one run: the user's with the case's truth, sensors, noise and zoning.
 Config RunConfig(const Config& config, const DamageCase& damage) {
   Config run_config = config;
@@ -142,7 +128,7 @@ void RunOne(const Config& config, const DamageCase& damage, DamageRun* run) {
   run->zone_end = summary.zone_end;
   run->moduli.assign(summary.moduli.data(), summary.moduli.data() + summary.moduli.size());
   run->truth_moduli =
-      TruthPerZone(zoned, ElementModuli(run_config.model, run_config.data.truth_zones));
+      ZoneModuliInSeries(zoned, ElementModuli(run_config.model, run_config.data.truth_zones));
   run->weakest_zone = static_cast<int>(std::min_element(run->moduli.begin(), run->moduli.end()) -
                                        run->moduli.begin());
   run->max_zone_error = 0.0;

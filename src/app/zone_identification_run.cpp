@@ -132,22 +132,14 @@ std::string ZonesCsv(const ZoneIdentificationRun& run, const BarProperties& bar)
   const ZoneIdentificationSummary& s = run.summary;
   std::ostringstream csv;
   csv << "zone,start_m,end_m,modulus_pa,relative_to_homogeneous,truth_modulus_pa\n";
+  // The truth's modulus of a zone: its elements in series.
+  const std::vector<double> truth = run.truth_element_moduli.size() > 0
+                                        ? ZoneModuliInSeries(model, run.truth_element_moduli)
+                                        : std::vector<double>{};
   for (Eigen::Index z = 0; z < s.moduli.size(); ++z) {
-    std::string truth;
-    if (run.truth_element_moduli.size() > 0) {
-      double sum = 0.0;
-      int count = 0;
-      for (int e = 0; e < model.num_elements(); ++e) {
-        if (model.element_zone(e) == z) {
-          sum += run.truth_element_moduli[e];
-          ++count;
-        }
-      }
-      truth = Number(sum / count);
-    }
     csv << z << "," << Number(s.zone_start[z]) << "," << Number(s.zone_end[z]) << ","
-        << Number(s.moduli[z]) << "," << Number(s.moduli[z] / s.homogeneous_modulus) << "," << truth
-        << "\n";
+        << Number(s.moduli[z]) << "," << Number(s.moduli[z] / s.homogeneous_modulus) << ","
+        << (truth.empty() ? std::string() : Number(truth[static_cast<std::size_t>(z)])) << "\n";
   }
   return csv.str();
 }

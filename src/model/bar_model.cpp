@@ -98,6 +98,19 @@ Vector ElementModuli(const BarProperties& bar, const std::vector<ModulusZone>& z
   return moduli;
 }
 
+std::vector<double> ZoneModuliInSeries(const BarModel& model, const Vector& element_moduli) {
+  assert(element_moduli.size() == model.num_elements());
+  std::vector<double> compliance(model.num_zones(), 0.0);
+  std::vector<int> count(model.num_zones(), 0);
+  for (int e = 0; e < model.num_elements(); ++e) {
+    compliance[model.element_zone(e)] += 1.0 / element_moduli[e];
+    ++count[model.element_zone(e)];
+  }
+  std::vector<double> moduli(model.num_zones());
+  for (int z = 0; z < model.num_zones(); ++z) moduli[z] = count[z] / compliance[z];
+  return moduli;
+}
+
 std::string ZoneLayout::Validate(const BarProperties& bar) const {
   std::ostringstream why;
   switch (zoning) {

@@ -54,6 +54,13 @@ struct ModulusZone {
 // which keeps the element's static axial stiffness exact. Precondition: the zones
 // are valid for the bar (ValidateModulusZones).
 Vector ElementModuli(const BarProperties& bar, const std::vector<ModulusZone>& zones);
+
+class BarModel;
+// The modulus of each zone of `model` [Pa] that gives its elements (of moduli
+// `element_moduli` [Pa], one per element) in series the same compliance: 1 / E_z = mean
+// over the zone's elements of 1 / E_e (the elements of a bar have equal lengths). The
+// truth's modulus of a zone, as zones.csv and the damage study report it.
+std::vector<double> ZoneModuliInSeries(const BarModel& model, const Vector& element_moduli);
 // Empty when every zone lies in [0, L] with start < end and a finite positive
 // modulus, and no two zones overlap; otherwise the reason, naming zone i as `key`[i].
 std::string ValidateModulusZones(const BarProperties& bar, const std::vector<ModulusZone>& zones,
