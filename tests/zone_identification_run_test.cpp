@@ -119,5 +119,31 @@ TEST(ZoneIdentificationRunTest, OneZoneDoesNothing) {
   EXPECT_TRUE(WriteZoneResults(run, config.model, ::testing::TempDir(), false).empty());
 }
 
+// The value of `key` in the lines of a YAML block ("  key: value  # comment").
+std::string YamlValue(const std::vector<std::string>& lines, const std::string& key) {
+  for (const std::string& line : lines) {
+    const std::size_t at = line.find(key + ": ");
+    if (at == std::string::npos || line.find_first_not_of(' ') != at) continue;
+    const std::string rest = line.substr(at + key.size() + 2);
+    return rest.substr(0, rest.find("  #"));
+  }
+  return "";
+}
+
+TEST(ZoneIdentificationRunTest, TheSummarysMisfitIsTheReportedModulis) {
+  ZoneIdentificationRun run;
+  run.ran = true;
+  run.summary.moduli = Vector::Constant(3, 200e9);
+  run.summary.zone_start = {0.0, 0.3, 0.6};
+  run.summary.zone_end = {0.3, 0.6, 1.0};
+  run.summary.homogeneous_modulus = 200e9;
+  run.summary.regularized.misfit = 0.25;  // before merging
+  EXPECT_EQ(YamlValue(ZonesYamlLines(run), "misfit"), "0.25");
+  // A merge kept: the moduli are its last refit's, and so is the misfit.
+  run.summary.merge.x = {0.0, 0.0, 0.0};
+  run.summary.merge.misfit = 0.375;
+  EXPECT_EQ(YamlValue(ZonesYamlLines(run), "misfit"), "0.375");
+}
+
 }  // namespace
 }  // namespace mcrewave

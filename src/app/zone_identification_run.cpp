@@ -102,9 +102,11 @@ std::vector<std::string> ZonesYamlLines(const ZoneIdentificationRun& run) {
   line(1, "weight_choice", s.regularized.weight_choice);
   line(1, "target_misfit", Number(s.regularized.target_misfit),
        "e^2 / J_rest the noise explains (discrepancy principle; -1: not used)");
-  line(1, "misfit", Number(s.regularized.misfit), "e^2 / J_rest at the zone moduli");
+  // The moduli reported are the merges' last refit when a merge was kept.
+  const double misfit = s.merge.x.empty() ? s.regularized.misfit : s.merge.misfit;
+  line(1, "misfit", Number(misfit), "e^2 / J_rest at the zone moduli (merged, if any merge)");
   line(1, "misfit_floor", Number(s.regularized.misfit_floor),
-       "least e^2 / J_rest of the weight grid when the target was missed (-1: met)");
+       "e^2 / J_rest at the grid's lightest weight when the target was missed (-1: met)");
   line(1, "weights_tried", std::to_string(s.regularized.path.size()));
   line(1, "groups", std::to_string(s.merge.groups),
        "zones left distinct by merging (-1: zone_identification.merge_zones off)");

@@ -46,7 +46,8 @@ ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayo
 // The lines of summary.yaml's `zones:` block (indented, no trailing newline per line).
 std::vector<std::string> ZonesYamlLines(const ZoneIdentificationRun& run);
 // zones.csv: zone,start_m,end_m,modulus_pa,relative_to_homogeneous,truth_modulus_pa
-// (truth: the mean of the truth over the zone's elements; empty when unknown).
+// (truth: the truth's elements of the zone in series, ZoneModuliInSeries; empty when
+// unknown).
 std::string ZonesCsv(const ZoneIdentificationRun& run, const BarProperties& bar);
 // Writes zones.csv (and moduli.png with figures) into folder; returns the paths written.
 std::vector<std::string> WriteZoneResults(const ZoneIdentificationRun& run,

@@ -36,7 +36,9 @@
 // to be trusted: the weight is the corner of the grid's L-curve (LCurveCorner,
 // weight_choice "l_curve", a warning), or without a corner the principle applied to
 // the floor raised by kMisfitFloorMargin (weight_choice "misfit_floor"): the largest
-// lambda whose misfit stays within 10 % of the least misfit reached.
+// lambda whose misfit stays within 10 % of the floor, the misfit at the grid's lightest
+// lambda (the least of the grid: along a path of minima, warm-started from the heavier
+// lambda, the misfit does not grow as lambda falls, up to the minimiser's tolerances).
 #pragma once
 
 #include <string>
@@ -164,10 +166,10 @@ struct RegularizedMinimization {
   double weight = -1.0;  // lambda of the result
   // "fixed", "none" (no regularisation), "discrepancy", "l_curve" (the target missed:
   // the grid's L-curve corner), or "misfit_floor" (the target missed and no corner:
-  // the principle applied to the least misfit reached + kMisfitFloorMargin).
+  // the principle applied to the misfit floor + kMisfitFloorMargin).
   std::string weight_choice = "fixed";
   double target_misfit = -1.0;         // the discrepancy target (-1: not used)
-  double misfit_floor = -1.0;          // least misfit of the grid when the target was missed
+  double misfit_floor = -1.0;  // the grid's lightest weight's misfit when the target was missed
   std::vector<RegularizedPoint> path;  // every minimisation, in order
   BoundedMinimizerSummary minimizer;   // the minimisation at `weight`
   std::vector<double> x;               // its minimiser
