@@ -389,7 +389,6 @@ constexpr const char* kEveryKeyNotAtItsDefault = R"(model:
   elements: 437
   mass: lumped
   zoning: boundaries
-  zone_count: 3
   zone_boundaries: [0.1, 0.2]
 load:
   kind: half_sine
@@ -516,14 +515,20 @@ data:
   truth_moduli: [2e11, 1.4000000000000001e11]
 )";
 
+// The key of equal zones, refused with the zoning of kEveryKeyNotAtItsDefault.
+constexpr const char* kEqualZonesKeyNotAtItsDefault = R"(model:
+  zone_count: 3
+)";
+
 TEST(ConfigTest, EveryKeyAtANonDefaultValueRoundTripsExactly) {
   const std::map<std::string, std::string> defaults = FlatKeys(ConfigToYaml(Config()));
   const std::map<std::string, std::string> documented = FlatKeys(DefaultConfigYaml());
   ASSERT_EQ(documented.size(), defaults.size());
   // Every key of the commented default config differs from its default in one of the
-  // two configs: a key added to the table but left out of both fails this test.
+  // three configs: a key added to the table but left out of all fails this test.
   std::map<std::string, int> set_somewhere;
-  for (const char* text : {kEveryKeyNotAtItsDefault, kEveryMatrixKeyNotAtItsDefault}) {
+  for (const char* text : {kEveryKeyNotAtItsDefault, kEveryMatrixKeyNotAtItsDefault,
+                           kEqualZonesKeyNotAtItsDefault}) {
     const Config config = ParseConfig(text, "every_key.yaml");
     const std::string yaml = ConfigToYaml(config);
     const std::map<std::string, std::string> keys = FlatKeys(yaml);

@@ -611,6 +611,20 @@ INSTANTIATE_TEST_SUITE_P(
                  2,
                  {"{config}:2: load.duration (1e-07 s) must span at least two time steps, 2 "
                   "time.step = 7.2e-07 s, or the sampled load is zero"}},
+        BadInput{"zone_boundaries_without_their_zoning",
+                 "model:\n  zone_boundaries: [0.6, 0.7]\n",
+                 nullptr,
+                 "",
+                 2,
+                 {"{config}:2: model.zone_boundaries applies to model.zoning 'boundaries' only "
+                  "(model.zoning is 'equal'); set model.zoning: boundaries to use them"}},
+        BadInput{"zone_count_with_another_zoning",
+                 "model:\n  zoning: per_element\n  zone_count: 10\n",
+                 nullptr,
+                 "",
+                 2,
+                 {"{config}:3: model.zone_count applies to model.zoning 'equal' only "
+                  "(model.zoning is 'per_element'); leave it out with this zoning"}},
         BadInput{"mesh_beyond_int",
                  "model:\n  elements: 600000000\n",
                  nullptr,

@@ -820,8 +820,23 @@ std::string StructureKeysProblem(const Config& config) {
 // it is compared with.
 const std::vector<SectionValidator>& CrossSectionValidators() {
   static const std::vector<SectionValidator> validators = {
-      // The identification's zones on the bar (each holds an element).
+      // The identification's zones on the bar (each holds an element), and no key of
+      // another zoning set: it would be ignored (zone_boundaries without
+      // model.zoning: boundaries left the bar uniform).
       [](const Config& config, std::string* error) {
+        const ZoneLayout defaults;
+        const std::string zoning = ZoningToString(config.zones.zoning);
+        if (config.zones.zoning != Zoning::kBoundaries && !config.zones.zone_boundaries.empty()) {
+          *error = "model.zone_boundaries applies to model.zoning 'boundaries' only (model.zoning "
+                   "is '" + zoning + "'); set model.zoning: boundaries to use them";
+          return false;
+        }
+        if (config.zones.zoning != Zoning::kEqual &&
+            config.zones.zone_count != defaults.zone_count) {
+          *error = "model.zone_count applies to model.zoning 'equal' only (model.zoning is '" +
+                   zoning + "'); leave it out with this zoning";
+          return false;
+        }
         *error = config.zones.Validate(config.model);
         return error->empty();
       },

@@ -75,7 +75,7 @@ Config RunConfig(const Config& config, const DamageCase& damage) {
   run_config.data.seed = damage.seed;
   run_config.zones = ZoneLayout();
   run_config.zones.zoning = damage.per_element ? Zoning::kPerElement : Zoning::kEqual;
-  run_config.zones.zone_count = kEqualZones;
+  if (!damage.per_element) run_config.zones.zone_count = kEqualZones;
   // Merging costs up to zones^2 / 2 refits: minutes for 10 zones, hours for one per element.
   run_config.zone_identification.merge_zones =
       config.zone_identification.merge_zones && !damage.per_element;
