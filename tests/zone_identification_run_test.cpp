@@ -103,8 +103,9 @@ TEST(ZoneIdentificationRunTest, InverseCrimeOfTenZonesThroughRunIdentification) 
     const double truth = z == 6 ? 140e9 : 200e9;
     worst = std::max(worst, std::abs(run.zones.summary.moduli[z] / truth - 1.0));
   }
-  // Measured: 1.0e-10 (46 evaluations of ceres_lbfgs; nlopt_lbfgs: 8.9e-10, 67).
-  EXPECT_LT(worst, 1e-8) << run.zones.summary.FullReport();
+  // Measured: 1.0e-10 (46 evaluations of ceres_lbfgs, the same in the sanitizer build;
+  // nlopt_lbfgs: 8.9e-10, 67).
+  EXPECT_LT(worst, 1e-9) << run.zones.summary.FullReport();
   // The truth per element for the figure: 140 GPa on elements 15 and 16.
   ASSERT_EQ(run.zones.truth_element_moduli.size(), 25);
   EXPECT_NEAR(run.zones.truth_element_moduli[15], 140e9, 1e-3);

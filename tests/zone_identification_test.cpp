@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <random>
 #include <vector>
 
@@ -117,10 +118,16 @@ TEST_P(ZoneInverseCrimeTest, RecoversEveryZone) {
   double worst = 0.0;
   for (int z = 0; z < 10; ++z)
     worst = std::max(worst, std::abs(summary.moduli[z] / truth[z] - 1.0));
-  // Measured worst relative errors (evaluations, seconds on the 2-core machine):
-  // nlopt_lbfgs 1.4e-10 (27, 0.01 s), nlopt_slsqp 5.1e-12 (48, 0.02 s), nlopt_mma 6.3e-10
-  // (524, 0.25 s), nlopt_bobyqa 2.7e-11 (436, 0.22 s), ceres_lbfgs 1.7e-11 (28, 0.02 s).
-  EXPECT_LT(worst, 1e-8) << summary.FullReport();
+  // Measured worst relative errors (evaluations, seconds on the 2-core machine), the same
+  // in the Release and the sanitizer build: nlopt_lbfgs 1.4e-10 (27, 0.01 s), nlopt_slsqp
+  // 5.1e-12 (48, 0.02 s), nlopt_mma 6.3e-10 (524, 0.25 s), nlopt_bobyqa 2.7e-11 (436,
+  // 0.22 s), ceres_lbfgs 1.7e-11 (28, 0.02 s). Each bounded at about 10 times its figure.
+  const std::map<BoundedAlgorithm, double> bound = {
+      {BoundedAlgorithm::kNloptLbfgs, 1.5e-9}, {BoundedAlgorithm::kNloptSlsqp, 5e-11},
+      {BoundedAlgorithm::kNloptMma, 6e-9},     {BoundedAlgorithm::kNloptBobyqa, 3e-10},
+      {BoundedAlgorithm::kCeresLbfgs, 2e-10}};
+  ASSERT_EQ(bound.count(GetParam()), 1u);
+  EXPECT_LT(worst, bound.at(GetParam())) << summary.FullReport();
   EXPECT_NEAR(summary.zone_start[6], 0.6, 1e-12);
   EXPECT_NEAR(summary.zone_end[6], 0.7, 1e-12);
   EXPECT_EQ(summary.regularized.weight_choice, "none");
