@@ -116,11 +116,11 @@ void WriteChannelTable(const ChannelTable& table, const std::string& path);
 // A channel in wrong units (scaled by 1e6) passes here; the identification then
 // ends on a bound of outer:, which `identify run` refuses.
 void CheckMeasurementChannels(const MeasurementSet& measurements, const std::string& name);
+constexpr double kOutlierNoiseFactor = 50.0;
 
 // Keeps the first `samples` samples of every channel of *measurements (at most its
 // num_samples()); the time grid is unchanged.
 void KeepFirstSamples(int samples, MeasurementSet* measurements);
-constexpr double kOutlierNoiseFactor = 50.0;
 
 // The channels an identification uses (config data.channels): the set with only the
 // interior sensors named in `channels` (all when `channels` is empty) and, in *use_u0
