@@ -527,8 +527,8 @@ TEST(ConfigTest, EveryKeyAtANonDefaultValueRoundTripsExactly) {
   // Every key of the commented default config differs from its default in one of the
   // three configs: a key added to the table but left out of all fails this test.
   std::map<std::string, int> set_somewhere;
-  for (const char* text : {kEveryKeyNotAtItsDefault, kEveryMatrixKeyNotAtItsDefault,
-                           kEqualZonesKeyNotAtItsDefault}) {
+  for (const char* text :
+       {kEveryKeyNotAtItsDefault, kEveryMatrixKeyNotAtItsDefault, kEqualZonesKeyNotAtItsDefault}) {
     const Config config = ParseConfig(text, "every_key.yaml");
     const std::string yaml = ConfigToYaml(config);
     const std::map<std::string, std::string> keys = FlatKeys(yaml);
@@ -655,7 +655,41 @@ TEST(ConfigTest, EveryCoupledSolverIsAnInnerMethod) {
                            "riccati", "single_shooting", "multiple_shooting"}) {
     CoupledSolverType type;
     ASSERT_TRUE(StringToCoupledSolverType(name, &type));
-    EXPECT_EQ(ParseConfig("", "a.yaml", {std::string("inner.method=") + name}).inner.type, type);
+    // mcre.clamp measured: the paper's data term, which Riccati and shooting need.
+    EXPECT_EQ(
+        ParseConfig("", "a.yaml", {std::string("inner.method=") + name, "mcre.clamp=measured"})
+            .inner.type,
+        type);
+  }
+}
+
+TEST(ConfigTest, RiccatiAndShootingWithAnotherDataTermThanThePapersAreRefused) {
+  for (const char* name : {"riccati", "single_shooting", "multiple_shooting"}) {
+    const std::string method = std::string("inner.method=") + name;
+    const std::string prefix = std::string("inner.method '") + name +
+                               "' handles the paper's data term only (u0 and uL, no interior "
+                               "sensor, the clamp measured), but ";
+    ExpectInputError([&] { ParseConfig("", "a.yaml", {method}); },
+                     {"--set " + method + ": " + prefix + "mcre.clamp is 'trusted'"});
+    ExpectInputError(
+        [&] {
+          ParseConfig("", "a.yaml", {method, "mcre.clamp=pinned"});
+        },
+        {prefix + "mcre.clamp is 'pinned'"});
+    ExpectInputError(
+        [&] {
+          ParseConfig("", "a.yaml", {method, "mcre.clamp=measured", "data.sensors=[e@0.5]"});
+        },
+        {prefix + "the identification uses interior sensors (data.sensors, data.channels)"});
+    ExpectInputError(
+        [&] {
+          ParseConfig("", "a.yaml", {method, "mcre.clamp=measured", "data.channels=[uL, f0, fL]"});
+        },
+        {prefix + "data.channels leaves out u0"});
+    // Interior sensors simulated but not used: the paper's data term.
+    EXPECT_NO_THROW(ParseConfig(
+        "", "a.yaml",
+        {method, "mcre.clamp=measured", "data.sensors=[e@0.5]", "data.channels=[u0, uL, f0, fL]"}));
   }
 }
 

@@ -122,10 +122,11 @@ TEST_P(ZoneInverseCrimeTest, RecoversEveryZone) {
   // in the Release and the sanitizer build: nlopt_lbfgs 1.4e-10 (27, 0.01 s), nlopt_slsqp
   // 5.1e-12 (48, 0.02 s), nlopt_mma 6.3e-10 (524, 0.25 s), nlopt_bobyqa 2.7e-11 (436,
   // 0.22 s), ceres_lbfgs 1.7e-11 (28, 0.02 s). Each bounded at about 10 times its figure.
-  const std::map<BoundedAlgorithm, double> bound = {
-      {BoundedAlgorithm::kNloptLbfgs, 1.5e-9}, {BoundedAlgorithm::kNloptSlsqp, 5e-11},
-      {BoundedAlgorithm::kNloptMma, 6e-9},     {BoundedAlgorithm::kNloptBobyqa, 3e-10},
-      {BoundedAlgorithm::kCeresLbfgs, 2e-10}};
+  const std::map<BoundedAlgorithm, double> bound = {{BoundedAlgorithm::kNloptLbfgs, 1.5e-9},
+                                                    {BoundedAlgorithm::kNloptSlsqp, 5e-11},
+                                                    {BoundedAlgorithm::kNloptMma, 6e-9},
+                                                    {BoundedAlgorithm::kNloptBobyqa, 3e-10},
+                                                    {BoundedAlgorithm::kCeresLbfgs, 2e-10}};
   ASSERT_EQ(bound.count(GetParam()), 1u);
   EXPECT_LT(worst, bound.at(GetParam())) << summary.FullReport();
   EXPECT_NEAR(summary.zone_start[6], 0.6, 1e-12);

@@ -827,8 +827,10 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
         const ZoneLayout defaults;
         const std::string zoning = ZoningToString(config.zones.zoning);
         if (config.zones.zoning != Zoning::kBoundaries && !config.zones.zone_boundaries.empty()) {
-          *error = "model.zone_boundaries applies to model.zoning 'boundaries' only (model.zoning "
-                   "is '" + zoning + "'); set model.zoning: boundaries to use them";
+          *error =
+              "model.zone_boundaries applies to model.zoning 'boundaries' only (model.zoning "
+              "is '" +
+              zoning + "'); set model.zoning: boundaries to use them";
           return false;
         }
         if (config.zones.zoning != Zoning::kEqual &&
@@ -890,9 +892,9 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
         if (HoldsIterativeSolverFields(config.inner.type) &&
             field_bytes > static_cast<double>(config.inner.max_field_bytes)) {
           why << "model.elements (" << config.model.elements << ") and " << FormatNumber(steps)
-              << " steps (time.window / time.step) need "
-              << static_cast<long long>(field_bytes) << " bytes for inner.method '"
-              << CoupledSolverTypeToString(config.inner.type) << "' (" << kIterativeSolverFields
+              << " steps (time.window / time.step) need " << static_cast<long long>(field_bytes)
+              << " bytes for inner.method '" << CoupledSolverTypeToString(config.inner.type)
+              << "' (" << kIterativeSolverFields
               << " fields of (N + 1) x (steps + 1) doubles), above inner.max_field_bytes = "
               << config.inner.max_field_bytes
               << "; use fewer elements, a shorter window or a larger step";
@@ -900,6 +902,49 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
           return false;
         }
         return true;
+      },
+      // Riccati and the shooting solvers are written for the paper's data term (H = B,
+      // the clamp measured): refused here with any other, rather than by every solve of
+      // the scan. Interior columns of a CSV are known once it is read; SolveCoupled
+      // refuses those.
+      [](const Config& config, std::string* error) {
+        const CoupledSolverType method = config.inner.type;
+        if (config.structure.kind != ModelKind::kBar ||
+            (method != CoupledSolverType::kRiccati &&
+             method != CoupledSolverType::kSingleShooting &&
+             method != CoupledSolverType::kMultipleShooting)) {
+          return true;
+        }
+        const std::string prefix = std::string("inner.method '") +
+                                   CoupledSolverTypeToString(method) +
+                                   "' handles the paper's data term only (u0 and uL, no interior "
+                                   "sensor, the clamp measured), ";
+        const std::string remedy =
+            "; use inner.method conjugate_gradient, adaptive_relaxation, relaxation or "
+            "all_at_once";
+        const std::vector<std::string>& channels = config.data.channels;
+        const auto uses = [&channels](const char* name) {
+          return channels.empty() ||
+                 std::find(channels.begin(), channels.end(), name) != channels.end();
+        };
+        bool interior = channels.empty() && !config.data.sensors.empty();
+        for (const std::string& channel : channels) {
+          interior = interior || channel.find('@') != std::string::npos;
+        }
+        if (config.mcre.clamp != ClampModel::kMeasured) {
+          *error = prefix + "but mcre.clamp is '" + ClampModelToString(config.mcre.clamp) + "'" +
+                   remedy + ", or mcre.clamp: measured";
+        } else if (interior) {
+          *error = prefix +
+                   "but the identification uses interior sensors (data.sensors, "
+                   "data.channels)" +
+                   remedy;
+        } else if (!uses("u0") || !uses("uL")) {
+          *error = prefix + "but data.channels leaves out " + (uses("u0") ? "uL" : "u0") + remedy;
+        } else {
+          return true;
+        }
+        return false;
       },
       // A cut-off at or above the Nyquist frequency is not a low-pass filter of the
       // sampled data (the bilinear transform maps Nyquist to tan(pi/2)).

@@ -97,8 +97,7 @@ void RunOne(const Config& config, const DamageCase& damage, DamageRun* run) {
   IdentificationRun scalar = IdentifyModulus(run_config, measured);
   // The scalar identification's coupled solves: its global scan's (on copies of the
   // objective) and those the objective recorded.
-  run->evaluations =
-      scalar.outer.scan_evaluations + static_cast<int>(scalar.evaluations.size());
+  run->evaluations = scalar.outer.scan_evaluations + static_cast<int>(scalar.evaluations.size());
   if (!scalar.IsUsable()) {
     run->message = "scalar identification: " + scalar.outer.message;
     return;

@@ -384,8 +384,7 @@ void CheckMeasurementChannels(const MeasurementSet& measurements, const std::str
       // beside it (below a quarter of it: a spike on the neighbour leaves half).
       Eigen::Index spike = worst + 1;
       const Eigen::Index last = second_differences.size() - 1;
-      if (last > 0 && worst == last &&
-          std::abs(second_differences[last - 1]) < 0.25 * largest) {
+      if (last > 0 && worst == last && std::abs(second_differences[last - 1]) < 0.25 * largest) {
         spike = samples - 1;
       } else if (last > 0 && worst == 0 && std::abs(second_differences[1]) < 0.25 * largest) {
         spike = 0;
