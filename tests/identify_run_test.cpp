@@ -699,7 +699,7 @@ INSTANTIATE_TEST_SUITE_P(
                  "uniform:101",
                  "",
                  2,
-                 {"{csv}: 101 samples, but time.window / time.step + 1 = 301 in {config}"}},
+                 {"{csv}: 101 samples, fewer than time.window / time.step + 1 = 301 in {config}"}},
         BadInput{"csv_bad_header",
                  "data:\n  source: csv\n  path: {csv}\n",
                  "t,u0,uL,f0\n0,0,0,0\n1,0,0,0\n",

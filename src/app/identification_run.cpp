@@ -178,11 +178,11 @@ MeasurementSet LoadMeasurements(const Config& config) {
                  expected_samples, data.num_samples(), config.time.window);
     KeepFirstSamples(expected_samples, &data);
   }
-  if (data.num_samples() != expected_samples) {
+  if (data.num_samples() < expected_samples) {
     throw InputError(
         path + ": " + std::to_string(data.num_samples()) +
-        " samples, but time.window / time.step + 1 = " + std::to_string(expected_samples) + " in " +
-        config_name + " (time.window " + Number(config.time.window) + " s)");
+        " samples, fewer than time.window / time.step + 1 = " + std::to_string(expected_samples) +
+        " in " + config_name + " (time.window " + Number(config.time.window) + " s)");
   }
   return data;
 }
