@@ -131,7 +131,7 @@ std::string YamlValue(const std::vector<std::string>& lines, const std::string& 
   return "";
 }
 
-TEST(ZoneIdentificationRunTest, TheSummarysMisfitIsTheReportedModulis) {
+TEST(ZoneIdentificationRunTest, TheSummarysMisfitIsThatOfTheReportedModuli) {
   ZoneIdentificationRun run;
   run.ran = true;
   run.summary.moduli = Vector::Constant(3, 200e9);
