@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "mcrewave/core/types.h"
+#include "mcrewave/data/measurement.h"
 #include "mcrewave/mcre/coupled_solver.h"
 
 namespace mcrewave {
@@ -909,10 +910,7 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
       // refuses those.
       [](const Config& config, std::string* error) {
         const CoupledSolverType method = config.inner.type;
-        if (config.structure.kind != ModelKind::kBar ||
-            (method != CoupledSolverType::kRiccati &&
-             method != CoupledSolverType::kSingleShooting &&
-             method != CoupledSolverType::kMultipleShooting)) {
+        if (config.structure.kind != ModelKind::kBar || !NeedsThePapersDataTerm(method)) {
           return true;
         }
         const std::string prefix = std::string("inner.method '") +
@@ -928,8 +926,12 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
                  std::find(channels.begin(), channels.end(), name) != channels.end();
         };
         bool interior = channels.empty() && !config.data.sensors.empty();
-        for (const std::string& channel : channels) {
-          interior = interior || channel.find('@') != std::string::npos;
+        for (const std::string& name : channels) {
+          ChannelName channel;
+          std::string why;
+          // The names are valid: DataOptions::IsValid ran first.
+          ParseChannelName(name, &channel, &why);
+          interior = interior || channel.kind == ChannelName::Kind::kSensor;
         }
         if (config.mcre.clamp != ClampModel::kMeasured) {
           *error = prefix + "but mcre.clamp is '" + ClampModelToString(config.mcre.clamp) + "'" +

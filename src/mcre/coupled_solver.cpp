@@ -128,6 +128,11 @@ bool HoldsIterativeSolverFields(CoupledSolverType type) {
          type == CoupledSolverType::kConjugateGradient;
 }
 
+bool NeedsThePapersDataTerm(CoupledSolverType type) {
+  return type == CoupledSolverType::kRiccati || type == CoupledSolverType::kSingleShooting ||
+         type == CoupledSolverType::kMultipleShooting;
+}
+
 CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledProblem* problem,
                                   const Matrix* initial_guess, CoupledSolution* solution) {
   using Clock = std::chrono::steady_clock;
@@ -153,9 +158,7 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
     summary.message = refusal.str();
     return summary;
   }
-  const bool comparator = options.type == CoupledSolverType::kRiccati ||
-                          options.type == CoupledSolverType::kSingleShooting ||
-                          options.type == CoupledSolverType::kMultipleShooting;
+  const bool comparator = NeedsThePapersDataTerm(options.type);
   // Riccati, shooting and the streaming solver are written for the built-in bar.
   McreProblem* bar = dynamic_cast<McreProblem*>(problem);
   if ((comparator || options.type == CoupledSolverType::kStreamingConjugateGradient) &&

@@ -76,6 +76,11 @@ double IterativeSolverFieldBytes(double num_nodes, double num_steps);
 // adaptive_relaxation, conjugate_gradient).
 bool HoldsIterativeSolverFields(CoupledSolverType type);
 
+// True for the comparators written for the paper's data term only (riccati,
+// single_shooting, multiple_shooting: H = B, the clamp measured, no interior sensor);
+// SolveCoupled refuses them on any other problem, and the config at load.
+bool NeedsThePapersDataTerm(CoupledSolverType type);
+
 enum class TerminationType {
   kConvergence,    // the residual reached the tolerance
   kNoConvergence,  // the iteration limit was reached first
