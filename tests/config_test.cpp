@@ -118,6 +118,14 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.mcre.weights.clamp_displacement_weight,
             actual.mcre.weights.clamp_displacement_weight);
   EXPECT_EQ(expected.mcre.clamp, actual.mcre.clamp);
+  EXPECT_EQ(expected.search.functional, actual.search.functional);
+  EXPECT_EQ(expected.search.displacement_weight, actual.search.displacement_weight);
+  EXPECT_EQ(expected.search.strain_weight, actual.search.strain_weight);
+  EXPECT_EQ(expected.search.clamp_displacement_weight, actual.search.clamp_displacement_weight);
+  EXPECT_EQ(expected.search.reaction_weight, actual.search.reaction_weight);
+  EXPECT_EQ(expected.search.inner_tolerance, actual.search.inner_tolerance);
+  EXPECT_EQ(expected.search.scan_points, actual.search.scan_points);
+  EXPECT_EQ(expected.search.refine_window, actual.search.refine_window);
   EXPECT_EQ(expected.study.comparator_data, actual.study.comparator_data);
   EXPECT_EQ(expected.structure.kind, actual.structure.kind);
   EXPECT_EQ(expected.structure.manifest, actual.structure.manifest);
@@ -447,6 +455,14 @@ outer:
   scan_threads: 3
   refine_margin: 0.25
   refine_candidates: 4
+search:
+  w_u: 0.02
+  w_e: 0.03
+  w_u0: 0.2
+  w_r: 0.3
+  inner_tolerance: 1e-5
+  scan_points: 9
+  refine_window: 0.05
 prefilter:
   enabled: false
   cutoff_frequency: 12345.5
@@ -518,6 +534,8 @@ data:
 // The key of equal zones, refused with the zoning of kEveryKeyNotAtItsDefault.
 constexpr const char* kEqualZonesKeyNotAtItsDefault = R"(model:
   zone_count: 3
+search:
+  functional: same
 )";
 
 TEST(ConfigTest, EveryKeyAtANonDefaultValueRoundTripsExactly) {
@@ -560,6 +578,10 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
        "data.sensors applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\nmcre:\n  clamp: measured\n",
        "mcre.clamp applies to the bar only"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\nsearch:\n  functional: same\n",
+       "search.functional applies to the bar only"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\nsearch:\n  refine_window: 0.1\n",
+       "search.refine_window applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  merge_zones: true\n",
        "zone_identification.merge_zones applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\nouter:\n  functional: least_squares\n",
@@ -596,17 +618,18 @@ TEST(ConfigTest, PaperBarConfigLoads) {
   EXPECT_EQ(config.time.NumSteps(), 1750);
 }
 
-TEST(ConfigTest, PaperBarFreeFreeDiffersInItsMcreSectionOnly) {
+TEST(ConfigTest, PaperBarFreeFreeDiffersInItsMcreSectionAndSearchFunctionalOnly) {
   Config expected = LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar.yaml");
   expected.mcre.clamp = ClampModel::kMeasured;
   expected.mcre.weights.displacement_weight = 0.01;
   expected.mcre.weights.strain_weight = 0.01;
+  expected.search.functional = SearchFunctional::kSame;
   expected.output.folder = "results/paper_bar_free_free";
   ExpectSameConfig(
       expected, LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar_free_free.yaml"));
 }
 
-TEST(ConfigTest, PaperBarPinnedDiffersInItsMcreSectionScanPointsAndInnerToleranceOnly) {
+TEST(ConfigTest, PaperBarPinnedDiffersInItsMcreSectionScanInnerToleranceAndSearchOnly) {
   Config expected = LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar.yaml");
   expected.mcre.clamp = ClampModel::kPinned;
   expected.mcre.weights.displacement_weight = 0.01;
@@ -615,6 +638,7 @@ TEST(ConfigTest, PaperBarPinnedDiffersInItsMcreSectionScanPointsAndInnerToleranc
   expected.mcre.weights.reaction_weight = 0.1;
   expected.outer.scan_points = 12;
   expected.inner.tolerance = 1e-6;
+  expected.search.functional = SearchFunctional::kSame;
   expected.output.folder = "results/paper_bar_pinned";
   ExpectSameConfig(
       expected, LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar_pinned.yaml"));
@@ -655,11 +679,13 @@ TEST(ConfigTest, EveryCoupledSolverIsAnInnerMethod) {
                            "riccati", "single_shooting", "multiple_shooting"}) {
     CoupledSolverType type;
     ASSERT_TRUE(StringToCoupledSolverType(name, &type));
-    // mcre.clamp measured: the paper's data term, which Riccati and shooting need.
-    EXPECT_EQ(
-        ParseConfig("", "a.yaml", {std::string("inner.method=") + name, "mcre.clamp=measured"})
-            .inner.type,
-        type);
+    // mcre.clamp measured and its own scan: the paper's data term, which Riccati and
+    // shooting need.
+    EXPECT_EQ(ParseConfig("", "a.yaml",
+                          {std::string("inner.method=") + name, "mcre.clamp=measured",
+                           "search.functional=same"})
+                  .inner.type,
+              type);
   }
 }
 
@@ -686,10 +712,22 @@ TEST(ConfigTest, RiccatiAndShootingWithAnotherDataTermThanThePapersAreRefused) {
           ParseConfig("", "a.yaml", {method, "mcre.clamp=measured", "data.channels=[uL, f0, fL]"});
         },
         {prefix + "data.channels leaves out u0"});
+    // The pinned search functional of the default global scan.
+    ExpectInputError(
+        [&] {
+          ParseConfig("", "a.yaml", {method, "mcre.clamp=measured"});
+        },
+        {prefix + "search.functional is 'pinned' (the global scan's clamp is "
+                  "pinned); use inner.method conjugate_gradient, "
+                  "adaptive_relaxation, relaxation or all_at_once, or "
+                  "search.functional: same"});
     // Interior sensors simulated but not used: the paper's data term.
-    EXPECT_NO_THROW(ParseConfig(
-        "", "a.yaml",
-        {method, "mcre.clamp=measured", "data.sensors=[e@0.5]", "data.channels=[u0, uL, f0, fL]"}));
+    EXPECT_NO_THROW(ParseConfig("", "a.yaml",
+                                {method, "mcre.clamp=measured", "search.functional=same",
+                                 "data.sensors=[e@0.5]", "data.channels=[u0, uL, f0, fL]"}));
+    // No global scan: no search functional.
+    EXPECT_NO_THROW(
+        ParseConfig("", "a.yaml", {method, "mcre.clamp=measured", "outer.scan_points=0"}));
   }
 }
 
@@ -837,6 +875,24 @@ TEST_F(ConfigFileTest, UnknownClampModelAndComparatorDataAreRefused) {
                   {"study.comparator_data must hold raw, prefilter or both, once each"});
 }
 
+TEST_F(ConfigFileTest, SearchKeysAreCheckedAndBelongToThePinnedSearchFunctional) {
+  ExpectLoadError("search:\n  functional: other\n", 2,
+                  {"search.functional: expected one of 'pinned', 'same', got 'other'"});
+  ExpectLoadError("search:\n  w_u: 0\n", 2, {"search.w_u must be a finite positive number, got 0"});
+  ExpectLoadError("search:\n  w_r: -1\n", 2,
+                  {"search.w_r must be a finite positive number, got -1"});
+  ExpectLoadError("search:\n  inner_tolerance: 1\n", 2,
+                  {"search.inner_tolerance must lie in (0, 1), got 1"});
+  ExpectLoadError("search:\n  scan_points: 2\n", 2,
+                  {"search.scan_points must lie in [3, 100000], got 2"});
+  ExpectLoadError("search:\n  refine_window: 0.6\n", 2,
+                  {"search.refine_window must lie in (0, 0.5], got 0.6"});
+  // A key of the pinned search functional with the functional `same`: ignored, refused.
+  ExpectLoadError("search:\n  functional: same\n  w_u0: 0.2\n", 3,
+                  {"search.w_u0 applies to search.functional 'pinned' only (search.functional "
+                   "is 'same', the scan runs on mcre:'s e^2); leave it out with this functional"});
+}
+
 TEST_F(ConfigFileTest, NegativeSeed) {
   ExpectLoadError("data:\n  seed: -1\n", 2, {"data.seed: expected an integer", "got '-1'"});
 }
@@ -911,7 +967,7 @@ TEST_F(ConfigFileTest, SectionThatIsNotAMap) {
 TEST_F(ConfigFileTest, TopLevelThatIsNotAMap) {
   ExpectLoadError("- model\n- load\n", 1,
                   {"expected a map of sections (model, load, time, data, mcre, inner, outer, "
-                   "prefilter, uncertainty, output, study, zone_identification)",
+                   "search, prefilter, uncertainty, output, study, zone_identification)",
                    "got a list"});
 }
 

@@ -319,6 +319,87 @@ TEST(IdentificationTest, AValleyHiddenBetweenTwoSamplesOfOneSlopeIsSeen) {
   EXPECT_FALSE(summary.valleys[1].refined);  // far above the bound's cost
 }
 
+// A rugged objective: a parabola of minimum `minimum` plus ripple of 5 valleys per unit x,
+// d/dx included.
+ScriptedObjective Rippled(double minimum) {
+  return ScriptedObjective(
+      [minimum](double x) {
+        return (x - minimum) * (x - minimum) + 0.02 * (1.0 - std::cos(10.0 * M_PI * (x - minimum)));
+      },
+      [minimum](double x) {
+        return 2.0 * (x - minimum) + 0.2 * M_PI * std::sin(10.0 * M_PI * (x - minimum));
+      });
+}
+
+TEST(IdentificationTest, TwoStagesRefineTheObjectiveNearTheSearchsMinimum) {
+  for (const OptimizerType optimizer : {OptimizerType::kNlopt, OptimizerType::kCeres}) {
+    SCOPED_TRACE(OptimizerTypeToString(optimizer));
+    // The search: one valley at 1.31; the objective: several valleys, the lowest at 1.3,
+    // 0.8 % from the search's minimum (inside a window of 3 %).
+    ScriptedObjective search = Parabola(1.31);
+    ScriptedObjective objective = Rippled(1.3);
+    IdentificationOptions options = ScanOptions(optimizer);
+    options.relative_tolerance = 1e-9;
+    const IdentificationSummary summary =
+        IdentifyInTwoStages(options, &search, 7, 0.03, &objective);
+    ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+    EXPECT_TRUE(summary.scan_of_search);
+    // The search's scan (7 points, one valley at 1.31) and the objective's minimum.
+    EXPECT_EQ(summary.scan_moduli.size(), 7u);
+    EXPECT_EQ(summary.local_minima, 1);
+    EXPECT_NEAR(summary.search_modulus, 1.31e9, 1e-6 * 1.31e9);
+    EXPECT_NEAR(summary.modulus, 1.3e9, 1e-6 * 1.3e9);
+    // Every objective evaluation within the window around the search's minimum.
+    for (const double x : objective.evaluated) {
+      EXPECT_GE(x * objective.scale, summary.search_modulus * 0.97);
+      EXPECT_LE(x * objective.scale, summary.search_modulus * 1.03);
+    }
+    EXPECT_EQ(summary.evaluations, static_cast<int>(objective.evaluated.size()));
+    EXPECT_EQ(summary.scan_evaluations, static_cast<int>(search.evaluated.size()));
+  }
+}
+
+TEST(IdentificationTest, TwoStagesScanTheObjectiveWhenItsMinimumLiesBeyondTheWindow) {
+  // The objective's minimum at 1.3 lies 13 % from the search's at 1.5: the refinement
+  // ends on the window's lower edge, and the objective's own scan finds 1.3.
+  ScriptedObjective search = Parabola(1.5);
+  ScriptedObjective objective = Parabola(1.3);
+  IdentificationOptions options = ScanOptions(OptimizerType::kNlopt);
+  options.scan_points = 41;
+  const IdentificationSummary summary = IdentifyInTwoStages(options, &search, 7, 0.03, &objective);
+  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+  EXPECT_FALSE(summary.scan_of_search);
+  EXPECT_NEAR(summary.search_modulus, 1.5e9, 1e-6 * 1.5e9);
+  EXPECT_EQ(summary.scan_moduli.size(), 41u);
+  EXPECT_EQ(summary.local_minima, 1);
+  EXPECT_NEAR(summary.modulus, 1.3e9, 1e-6 * 1.3e9);
+  EXPECT_EQ(summary.evaluations + 41, static_cast<int>(objective.evaluated.size()));
+  EXPECT_EQ(summary.scan_evaluations, static_cast<int>(search.evaluated.size()) + 41);
+}
+
+TEST(IdentificationTest, TwoStagesStopWithTheSearchsFailure) {
+  ScriptedObjective search = Parabola(1.31);
+  search.fails = [](int, double) { return true; };
+  ScriptedObjective objective = Parabola(1.3);
+  const IdentificationSummary summary =
+      IdentifyInTwoStages(ScanOptions(OptimizerType::kNlopt), &search, 7, 0.03, &objective);
+  EXPECT_EQ(summary.termination, TerminationType::kFailure);
+  EXPECT_EQ(summary.message.rfind("the global search: no usable evaluation in the scan", 0), 0u)
+      << summary.message;
+  EXPECT_TRUE(objective.evaluated.empty());
+}
+
+TEST(IdentificationTest, TwoStagesShareTheEvaluationLimit) {
+  // 7 scan samples and the search's refinement leave fewer than 2 of 13 evaluations.
+  ScriptedObjective search = Parabola(1.31);
+  ScriptedObjective objective = Parabola(1.3);
+  IdentificationOptions options = ScanOptions(OptimizerType::kNlopt);
+  options.max_evaluations = 13;
+  const IdentificationSummary summary = IdentifyInTwoStages(options, &search, 7, 0.03, &objective);
+  EXPECT_EQ(summary.termination, TerminationType::kNoConvergence) << summary.FullReport();
+  EXPECT_LE(static_cast<int>(search.evaluated.size() + objective.evaluated.size()), 13);
+}
+
 TEST(IdentificationTest, AFailedRefinementOfAnyValleyFailsTheIdentification) {
   for (const OptimizerType optimizer : {OptimizerType::kNlopt, OptimizerType::kCeres}) {
     // Two valleys: the deeper at x = 2 (cost 1), the other at x = 0.8 (cost 1.1,

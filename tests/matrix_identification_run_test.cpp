@@ -62,10 +62,11 @@ TEST(MatrixIdentificationRunTest, TheBarAsMatricesIdentifiesTheBuiltInBarsModulu
       " --set data.source=csv --set data.path=" + dir + "/data.csv --set prefilter.enabled=false";
   const RunResult bar = RunIdentify("run " + quick + data + " -q -o " + dir + "/bar");
   ASSERT_EQ(bar.exit_code, 0) << bar.output;
-  // mcre.clamp back at its default: the bar's key, which a matrix model refuses when set.
-  const RunResult matrices = RunIdentify("run " + quick + data + " --set model.kind=matrix" +
-                                         " --set model.manifest=" + manifest +
-                                         " --set mcre.clamp=trusted -q -o " + dir + "/matrices");
+  // mcre.clamp and search.functional back at their defaults: the bar's keys, which a
+  // matrix model refuses when set.
+  const RunResult matrices = RunIdentify(
+      "run " + quick + data + " --set model.kind=matrix" + " --set model.manifest=" + manifest +
+      " --set mcre.clamp=trusted --set search.functional=pinned -q -o " + dir + "/matrices");
   ASSERT_EQ(matrices.exit_code, 0) << matrices.output;
   const double bar_modulus =
       YAML::LoadFile(dir + "/bar/summary.yaml")["identified_modulus"].as<double>();

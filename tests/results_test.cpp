@@ -7,6 +7,7 @@
 #include "mcrewave/app/results.h"
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
@@ -257,6 +258,38 @@ TEST_F(ResultFilesTest, ErrorMapCsvHoldsTheElementSharesOfTheConstitutiveGap) {
     total += csv.rows[e][2];
   }
   for (int e = 0; e < 25; ++e) EXPECT_NEAR(csv.rows[e][3], csv.rows[e][2] / total, 1e-14);
+}
+
+TEST(TwoStageResultsTest, TheScanFilesHoldTheSearchFunctionalsCostsInItsOwnScale) {
+  // The quick case with the default global search: the scan of the pinned search
+  // functional, then the paper's e^2 refined near its minimum.
+  Config config = LoadConfig(SourcePath("configs/quick.yaml"));
+  config.search.functional = SearchFunctional::kPinned;
+  const IdentificationRun run = RunIdentification(config, LoadMeasurements(config));
+  ASSERT_TRUE(run.IsUsable()) << run.outer.FullReport();
+  ASSERT_TRUE(run.outer.scan_of_search);
+  EXPECT_EQ(run.outer.local_minima, 1);
+  // Its scale is the search functional's J_rest, not the paper's e^2's.
+  EXPECT_GT(std::abs(run.scan_cost_scale / run.rest_cost - 1.0), 1e-3);
+  // Every evaluation of e^2 within search.refine_window of the search's minimiser.
+  for (const ObjectiveEvaluation& evaluation : run.evaluations) {
+    EXPECT_LE(std::abs(evaluation.modulus / run.outer.search_modulus - 1.0),
+              config.search.refine_window * (1.0 + 1e-12));
+  }
+  const std::string folder = FreshDirectory("result_files_two_stages") + "/results";
+  WriteIdentificationResults(run, folder, false);
+  const Csv scan = ReadCsv(folder + "/scan.csv");
+  ASSERT_EQ(scan.rows.size(), run.outer.scan_moduli.size());
+  for (std::size_t i = 0; i < scan.rows.size(); ++i) {
+    EXPECT_EQ(scan.rows[i][1], run.outer.scan_costs[i] * run.scan_cost_scale);
+  }
+  const YAML::Node summary = YAML::LoadFile(folder + "/summary.yaml");
+  EXPECT_EQ(summary["scan"]["functional"].as<std::string>(), "search_pinned");
+  EXPECT_EQ(summary["scan"]["search_modulus"].as<double>(), run.outer.search_modulus);
+  EXPECT_EQ(summary["scan"]["local_minima"].as<int>(), 1);
+  EXPECT_EQ(summary["evaluations"].as<int>(), run.outer.scan_evaluations + run.outer.evaluations);
+  EXPECT_EQ(summary["optimizer"]["evaluations"].as<int>(),
+            static_cast<int>(run.evaluations.size()));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include "app/study_internal.h"
 #include "mcrewave/app/config.h"
+#include "mcrewave/app/identification_run.h"
 #include "mcrewave/app/study.h"
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/data/noise.h"
@@ -53,8 +54,8 @@ std::vector<DataSet> DataSets(const StudyOptions& options) {
 void Identify(const Config& config, const BarModel& model, const MeasurementSet& data,
               bool least_squares, ComparatorRun* run) {
   const auto start = std::chrono::steady_clock::now();
-  IdentificationOptions outer = config.outer;
-  outer.scan_threads = 1;
+  Config one_thread = config;
+  one_thread.outer.scan_threads = 1;
   IdentificationSummary summary;
   if (least_squares) {
     // s = RMS(measured) / SNR; at SNR inf the RMS alone (the weights' ratio).
@@ -62,12 +63,11 @@ void Identify(const Config& config, const BarModel& model, const MeasurementSet&
     NoiseLevels noise;
     noise.displacement_std = RootMeanSquare(data.uL) / snr;
     noise.force_std = RootMeanSquare(data.f0) / snr;
-    OutputErrorObjective objective(model, data, noise, config.time.theta, outer.initial);
-    summary = mcrewave::Identify(outer, &objective);
+    OutputErrorObjective objective(model, data, noise, config.time.theta, config.outer.initial);
+    summary = mcrewave::Identify(one_thread.outer, &objective);
   } else {
-    McreObjective objective(model, data, config.mcre, config.time.theta, config.inner,
-                            outer.initial);
-    summary = mcrewave::Identify(outer, &objective);
+    // As identify run: the search functional's scan, then mcre:'s e^2 (search:).
+    summary = IdentifyWithMcre(one_thread, model, data, EndDisplacementChannels()).outer;
   }
   run->converged = summary.IsSolutionUsable();
   if (!run->converged) run->message = summary.message;

@@ -493,13 +493,14 @@ const std::vector<Key>& KeyTable() {
               "clamp displacement weight (mcre.clamp pinned): beta_0 = w_u0 S E0 / L"),
       MakeKey("mcre.reference_modulus", &Config::mcre, &McreOptions::reference_modulus, Number(),
               "Pa", "E0 of the weights: a fixed nominal modulus, not the unknown"),
-      MakeKey("mcre.clamp", &Config::mcre, &McreOptions::clamp,
-              EnumByName<ClampModel>(
-                  {ClampModel::kMeasured, ClampModel::kTrusted, ClampModel::kPinned},
-                  ClampModelToString, StringToClampModel),
-              "", "the clamp at x = 0: measured (free-free model, f0 a load, u0 an output), "
-              "trusted (u(0) = 0 imposed, f0 a measured output) or pinned (free-free model, "
-              "u0's datum the known 0 with weight w_u0, f0 a load with weight w_r)"),
+      MakeKey(
+          "mcre.clamp", &Config::mcre, &McreOptions::clamp,
+          EnumByName<ClampModel>({ClampModel::kMeasured, ClampModel::kTrusted, ClampModel::kPinned},
+                                 ClampModelToString, StringToClampModel),
+          "",
+          "the clamp at x = 0: measured (free-free model, f0 a load, u0 an output), "
+          "trusted (u(0) = 0 imposed, f0 a measured output) or pinned (free-free model, "
+          "u0's datum the known 0 with weight w_u0, f0 a load with weight w_r)"),
       MakeKey("inner.method", &Config::inner, &CoupledSolverOptions::type,
               EnumByName<CoupledSolverType>(AllCoupledSolverTypes(), CoupledSolverTypeToString,
                                             StringToCoupledSolverType),
@@ -587,6 +588,30 @@ const std::vector<Key>& KeyTable() {
       MakeKey("outer.refine_candidates", &Config::outer, &IdentificationOptions::refine_candidates,
               PositiveInteger<int>(), "",
               "most valleys of the scan refined by the local optimiser"),
+      MakeKey("search.functional", &Config::search, &SearchOptions::functional,
+              EnumByName<SearchFunctional>({SearchFunctional::kPinned, SearchFunctional::kSame},
+                                           SearchFunctionalToString, StringToSearchFunctional),
+              "",
+              "the functional the global scan runs on: pinned (the pinned clamp's e^2 with "
+              "search.w_*, one valley; mcre:'s e^2 then refined near its minimum) or same "
+              "(mcre:'s e^2 itself)"),
+      MakeKey("search.w_u", &Config::search, &SearchOptions::displacement_weight, Number(), "",
+              "search functional pinned: displacement weight, beta = w_u S E0 / L"),
+      MakeKey("search.w_e", &Config::search, &SearchOptions::strain_weight, Number(), "",
+              "search functional pinned: strain weight, beta_e = w_e S E0 L"),
+      MakeKey("search.w_u0", &Config::search, &SearchOptions::clamp_displacement_weight, Number(),
+              "", "search functional pinned: weight of u(0) = 0, beta_0 = w_u0 S E0 / L"),
+      MakeKey("search.w_r", &Config::search, &SearchOptions::reaction_weight, Number(), "",
+              "search functional pinned: weight of the load f0, alpha_0 = w_r L / (S E0)"),
+      MakeKey("search.inner_tolerance", &Config::search, &SearchOptions::inner_tolerance, Number(),
+              "", "search functional pinned: relative residual of its inner solves, in (0, 1)"),
+      MakeKey(
+          "search.scan_points", &Config::search, &SearchOptions::scan_points,
+          PositiveInteger<int>(), "",
+          "search functional pinned: fewest moduli of its scan (in place of outer.scan_points)"),
+      MakeKey("search.refine_window", &Config::search, &SearchOptions::refine_window, Number(), "",
+              "search functional pinned: mcre:'s e^2 is refined within E_search (1 -+ this), "
+              "in (0, 0.5]"),
       MakeKey("prefilter.enabled", &Config::prefilter, &PrefilterOptions::enabled, Boolean(), "",
               "zero-phase Butterworth low-pass of the four measured channels"),
       MakeKey("prefilter.cutoff_frequency", &Config::prefilter, &PrefilterOptions::cutoff_frequency,
@@ -659,9 +684,8 @@ const std::vector<Key>& KeyTable() {
               TextList(), "",
               "MCRE against least squares: model errors (none, density, force_gain, "
               "displacement_gain, soft_zone)"),
-      MakeKey("study.comparator_data", &Config::study, &StudyOptions::comparator_data,
-              TextList(), "",
-              "MCRE against least squares: the data identified from (raw, prefilter)"),
+      MakeKey("study.comparator_data", &Config::study, &StudyOptions::comparator_data, TextList(),
+              "", "MCRE against least squares: the data identified from (raw, prefilter)"),
       MakeKey("zone_identification.algorithm", &Config::zone_identification,
               &ZoneIdentificationOptions::minimizer, &BoundedMinimizerOptions::algorithm,
               EnumByName<BoundedAlgorithm>(
@@ -714,8 +738,8 @@ const std::vector<Key>& KeyTable() {
               NonNegativeInteger(), "",
               "regula falsi steps on log lambda after the grid, in [0, 30]"),
       MakeKey("zone_identification.weight_tolerance", &Config::zone_identification,
-              &ZoneIdentificationOptions::regularization,
-              &RegularizationOptions::weight_tolerance, Number(), "",
+              &ZoneIdentificationOptions::regularization, &RegularizationOptions::weight_tolerance,
+              Number(), "",
               "the refinement stops once the next weight is within a factor 1 + this"),
       MakeKey("zone_identification.discrepancy_factor", &Config::zone_identification,
               &ZoneIdentificationOptions::regularization,
@@ -749,14 +773,33 @@ SectionValidator ValidatorOf(Section Config::*section) {
 const std::vector<SectionValidator>& SectionValidators() {
   static const std::vector<SectionValidator> validators = {
       ValidatorOf(&Config::structure),   ValidatorOf(&Config::model),
-      ValidatorOf(&Config::load),
-      ValidatorOf(&Config::time),        ValidatorOf(&Config::data),
-      ValidatorOf(&Config::mcre),        ValidatorOf(&Config::inner),
-      ValidatorOf(&Config::outer),       ValidatorOf(&Config::prefilter),
+      ValidatorOf(&Config::load),        ValidatorOf(&Config::time),
+      ValidatorOf(&Config::data),        ValidatorOf(&Config::mcre),
+      ValidatorOf(&Config::inner),       ValidatorOf(&Config::outer),
+      ValidatorOf(&Config::search),      ValidatorOf(&Config::prefilter),
       ValidatorOf(&Config::uncertainty), ValidatorOf(&Config::output),
       ValidatorOf(&Config::study),       ValidatorOf(&Config::zone_identification),
   };
   return validators;
+}
+
+// The first key of the search: section but search.functional that is not at its
+// default, or null.
+const char* SearchKeyNotAtItsDefault(const SearchOptions& search) {
+  const SearchOptions defaults;
+  const std::pair<const char*, bool> keys[] = {
+      {"search.w_u", search.displacement_weight != defaults.displacement_weight},
+      {"search.w_e", search.strain_weight != defaults.strain_weight},
+      {"search.w_u0", search.clamp_displacement_weight != defaults.clamp_displacement_weight},
+      {"search.w_r", search.reaction_weight != defaults.reaction_weight},
+      {"search.inner_tolerance", search.inner_tolerance != defaults.inner_tolerance},
+      {"search.scan_points", search.scan_points != defaults.scan_points},
+      {"search.refine_window", search.refine_window != defaults.refine_window},
+  };
+  for (const auto& [key, set] : keys) {
+    if (set) return key;
+  }
+  return nullptr;
 }
 
 // "" when the keys that apply to one kind of structure only are at their defaults
@@ -787,6 +830,8 @@ std::string StructureKeysProblem(const Config& config) {
       {"mcre.w_r", config.mcre.weights.reaction_weight != defaults.mcre.weights.reaction_weight},
       {"mcre.w_u0", config.mcre.weights.clamp_displacement_weight !=
                         defaults.mcre.weights.clamp_displacement_weight},
+      {"search.functional", config.search.functional != defaults.search.functional},
+      {SearchKeyNotAtItsDefault(config.search), SearchKeyNotAtItsDefault(config.search) != nullptr},
   };
   for (const auto& [key, set] : bar_keys) {
     if (set) {
@@ -842,6 +887,16 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
         }
         *error = config.zones.Validate(config.model);
         return error->empty();
+      },
+      // The search: section's other keys belong to the pinned search functional: set
+      // with search.functional same they would be ignored.
+      [](const Config& config, std::string* error) {
+        const char* key = SearchKeyNotAtItsDefault(config.search);
+        if (config.search.functional == SearchFunctional::kPinned || key == nullptr) return true;
+        *error = std::string(key) +
+                 " applies to search.functional 'pinned' only (search.functional is 'same', "
+                 "the scan runs on mcre:'s e^2); leave it out with this functional";
+        return false;
       },
       // Sensors on the bar, truth zones inside it and apart, a truth that can give them.
       [](const Config& config, std::string* error) {
@@ -943,6 +998,11 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
                    remedy;
         } else if (!uses("u0") || !uses("uL")) {
           *error = prefix + "but data.channels leaves out " + (uses("u0") ? "uL" : "u0") + remedy;
+        } else if (config.search.functional == SearchFunctional::kPinned &&
+                   config.outer.scan_points > 0) {
+          *error = prefix +
+                   "but search.functional is 'pinned' (the global scan's clamp is pinned)" +
+                   remedy + ", or search.functional: same";
         } else {
           return true;
         }

@@ -187,6 +187,27 @@ MeasurementSet LoadMeasurements(const Config& config) {
   return data;
 }
 
+McreIdentification IdentifyWithMcre(const Config& config, const BarModel& model,
+                                    const MeasurementSet& data, EndDisplacementChannels ends) {
+  McreIdentification result;
+  result.objective = std::make_unique<McreObjective>(model, data, config.mcre, config.time.theta,
+                                                     config.inner, config.outer.initial, ends);
+  result.scan_cost_scale = result.objective->cost_scale();
+  if (config.outer.scan_points == 0 || config.search.functional == SearchFunctional::kSame) {
+    result.outer = Identify(config.outer, result.objective.get());
+    return result;
+  }
+  CoupledSolverOptions search_inner = config.inner;
+  search_inner.tolerance = config.search.inner_tolerance;
+  McreObjective search(model, data, SearchMcreOptions(config.mcre, config.search),
+                       config.time.theta, search_inner, config.outer.initial, ends);
+  result.outer = IdentifyInTwoStages(config.outer, &search, config.search.scan_points,
+                                     config.search.refine_window, result.objective.get());
+  result.search_sweeps = search.sweeps();
+  if (result.outer.scan_of_search) result.scan_cost_scale = search.cost_scale();
+  return result;
+}
+
 IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& data) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
@@ -196,20 +217,26 @@ IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& da
   run.data = IdentificationData(config, data, &run.ends, &run.prefilter_cutoff);
 
   const BarModel model(config.model);
-  McreObjective objective(model, run.data, config.mcre, config.time.theta, config.inner,
-                          config.outer.initial, run.ends);
-  run.alpha = objective.problem().alpha();
-  run.beta = objective.problem().beta();
-  run.rest_cost = objective.rest_cost();
+  const bool two_stages =
+      config.outer.scan_points > 0 && config.search.functional == SearchFunctional::kPinned;
   spdlog::info(
-      "identifying E with {}/{} from {:.6g} Pa in [{:.6g}, {:.6g}] Pa; inner {}",
+      "identifying E with {}/{} from {:.6g} Pa in [{:.6g}, {:.6g}] Pa; inner {}; global scan on {}",
       OptimizerTypeToString(config.outer.optimizer),
       OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
       config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
-      CoupledSolverTypeToString(config.inner.type));
-  run.outer = Identify(config.outer, &objective);
+      CoupledSolverTypeToString(config.inner.type),
+      config.outer.scan_points == 0 ? "none (outer.scan_points 0)"
+      : two_stages                  ? "the pinned search functional (search:)"
+                                    : "mcre:'s e^2");
+  McreIdentification identification = IdentifyWithMcre(config, model, run.data, run.ends);
+  McreObjective& objective = *identification.objective;
+  run.alpha = objective.problem().alpha();
+  run.beta = objective.problem().beta();
+  run.rest_cost = objective.rest_cost();
+  run.scan_cost_scale = identification.scan_cost_scale;
+  run.outer = identification.outer;
   run.evaluations = objective.evaluations();
-  run.sweeps = objective.sweeps();
+  run.sweeps = objective.sweeps() + identification.search_sweeps;
   spdlog::info("{}", run.outer.BriefReport());
   if (run.IsUsable()) {
     // Every field reported belongs to the identified E: the objective's best
@@ -225,7 +252,7 @@ IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& da
             "the coupled solve at the identified E is not usable: " + at_optimum.inner.message;
       }
       run.evaluations = objective.evaluations();
-      run.sweeps = objective.sweeps();
+      run.sweeps = objective.sweeps() + identification.search_sweeps;
       run.best_index = static_cast<int>(run.evaluations.size()) - 1;
       run.solution = objective.last_solution();
     }

@@ -209,16 +209,16 @@ std::string ValleysCsv(const IdentificationSummary& outer, double cost_scale) {
 // Figures.
 
 // The gnuplot plot items of scan.csv and valleys.csv (E in GPa), each ending in ", ".
-std::string ScanPlots(const std::string& folder) {
-  return GnuplotString(folder + "/scan.csv") +
-         " skip 1 using ($1/1e9):($4 > 0 ? $2 : 1/0) with linespoints pt 5 ps 0.6 "
-         "lc rgb '#2ca02c' title 'global scan', " +
-         GnuplotString(folder + "/valleys.csv") +
-         " skip 1 using ($4/1e9):5 with points pt 9 ps 1.6 lc rgb '#ff7f0e' "
-         "title 'valleys seen (estimate)', " +
-         GnuplotString(folder + "/valleys.csv") +
-         " skip 1 using ($6 > 0 ? $7/1e9 : 1/0):8 with points pt 4 ps 2 lw 2 "
-         "lc rgb '#1f77b4' title 'valleys refined', ";
+// search: the scan is of the search functional, drawn on the right axis.
+std::string ScanPlots(const std::string& folder, bool search) {
+  const std::string axes = search ? " axes x1y2" : "";
+  const std::string of = search ? " of e^2_{search} (right axis)" : "";
+  return GnuplotString(folder + "/scan.csv") + " skip 1 using ($1/1e9):($4 > 0 ? $2 : 1/0)" + axes +
+         " with linespoints pt 5 ps 0.6 lc rgb '#2ca02c' title 'global scan" + of + "', " +
+         GnuplotString(folder + "/valleys.csv") + " skip 1 using ($4/1e9):5" + axes +
+         " with points pt 9 ps 1.6 lc rgb '#ff7f0e' title 'valleys seen (estimate)', " +
+         GnuplotString(folder + "/valleys.csv") + " skip 1 using ($6 > 0 ? $7/1e9 : 1/0):8" + axes +
+         " with points pt 4 ps 2 lw 2 lc rgb '#1f77b4' title 'valleys refined', ";
 }
 
 std::string CostCurveScript(const IdentificationRun& run, const std::string& folder) {
@@ -242,7 +242,11 @@ std::string CostCurveScript(const IdentificationRun& run, const std::string& fol
   const bool scanned = !outer.scan_moduli.empty();
   // The scan's samples and the valleys it saw (estimates; refined minima), on both
   // panels: the bottom one shows the valleys near E* that the top one's scale hides.
-  const std::string scan_plot = scanned ? ScanPlots(folder) : std::string();
+  const std::string scan_plot = scanned ? ScanPlots(folder, outer.scan_of_search) : std::string();
+  if (outer.scan_of_search) {
+    script << "set y2label 'e^2_{search} [J s] (search: functional)'\nset y2tics\n"
+           << "set format y2 '%.5g'\nset ytics nomirror\n";
+  }
   for (int panel = 0; panel < 2; ++panel) {
     if (panel == 0 && scanned) {
       // Bounds over a decade or more: log E, as the scan is spaced.
@@ -436,11 +440,12 @@ void ConfigYaml(const Config& config, YamlWriter* yaml) {
 }
 
 // The optimizer:, scan: and prefilter: blocks of a summary, for a cost named
-// `cost` (e^2 or J) in `unit` (J s or s) whose scale is cost_scale.
+// `cost` (e^2 or J) in `unit` (J s or s) whose scale is cost_scale; the scan's costs
+// are scaled by scan_cost_scale (the search functional's, outer.scan_of_search).
 void OptimizerScanAndPrefilterYaml(const IdentificationSummary& outer, double cost_scale,
-                                   const Config& config, double prefilter_cutoff,
-                                   const std::string& cost, const std::string& unit,
-                                   YamlWriter* yaml) {
+                                   double scan_cost_scale, const Config& config,
+                                   double prefilter_cutoff, const std::string& cost,
+                                   const std::string& unit, YamlWriter* yaml) {
   yaml->Line(0, "optimizer", "");
   yaml->Text(1, "name", OptimizerTypeToString(outer.optimizer));
   yaml->Text(1, "algorithm", OuterAlgorithmToString(outer.algorithm));
@@ -457,31 +462,39 @@ void OptimizerScanAndPrefilterYaml(const IdentificationSummary& outer, double co
                "[" + unit + "] " + cost + " of the bar left at rest, the scale of the cost");
   yaml->Number(1, "wall_time_s", outer.wall_time_s, "[s] scan and refinements");
 
-  yaml->Line(0, "scan", "",
-             "global scan of " + cost + " and d" + cost + "/dE over the bounds (outer.scan_*)");
+  const std::string scanned = outer.scan_of_search ? cost + "_search" : cost;
+  yaml->Line(
+      0, "scan", "",
+      "global scan of " + scanned + " and d" + scanned + "/dE over the bounds (outer.scan_*)");
+  yaml->Text(1, "functional", outer.scan_of_search ? "search_pinned" : "same",
+             "search_pinned: the search: functional, e^2_search (the pinned clamp); same: " + cost +
+                 " itself");
+  yaml->Number(
+      1, "search_modulus", outer.search_modulus > 0.0 ? outer.search_modulus : NAN,
+      "[Pa] e^2_search's minimiser, near which " + cost + " was refined (null: one stage)");
   yaml->Integer(1, "points", static_cast<long>(outer.scan_moduli.size()), "0: no scan");
   yaml->Number(1, "predicted_valley_spacing", outer.predicted_valley_spacing,
-               "mean spacing of the valleys of " + cost + " in ln E (0: not predicted)");
+               "mean spacing of the valleys of " + scanned + " in ln E (0: not predicted)");
   yaml->Line(1, "resolution_limited", outer.scan_resolution_limited ? "true" : "false",
              "true: more samples wanted than outer.scan_max_points");
   yaml->Integer(1, "local_minima", outer.local_minima,
-                "valleys of " + cost + " seen (valleys.csv)");
+                "valleys of " + scanned + " seen (valleys.csv)");
   yaml->Integer(1, "failed_points", outer.scan_failures, "samples without a usable cost");
   yaml->Number(1, "second_modulus", outer.second_modulus > 0.0 ? outer.second_modulus : NAN,
                "[Pa] the second-lowest valley (null: fewer than two)");
   yaml->Number(1, "scaled_cost_gap", outer.cost_gap,
-               cost + " / cost_scale of the second-lowest valley minus the lowest");
-  yaml->Number(1, "cost_gap", outer.cost_gap * cost_scale,
-               "[" + unit + "] the same gap of " + cost);
+               scanned + " / its cost scale, of the second-lowest valley minus the lowest");
+  yaml->Number(1, "cost_gap", outer.cost_gap * scan_cost_scale,
+               "[" + unit + "] the same gap of " + scanned);
   yaml->Integer(1, "refinements", outer.refinements,
                 "valleys refined (within outer.refine_margin of the lowest)");
-  yaml->Line(
-      1, "valleys", "",
-      "every valley: estimate [Pa], refined minimiser [Pa] or null, " + cost + " [" + unit + "]");
+  yaml->Line(1, "valleys", "",
+             "every valley: estimate [Pa], refined minimiser [Pa] or null, " + scanned + " [" +
+                 unit + "]");
   for (const ScanValley& valley : outer.valleys) {
     yaml->Raw("    - {estimate: " + Format(valley.estimated_modulus) +
               ", modulus: " + Format(valley.refined ? valley.modulus : NAN) + ", cost: " +
-              Format((valley.refined ? valley.cost : valley.estimated_cost) * cost_scale) +
+              Format((valley.refined ? valley.cost : valley.estimated_cost) * scan_cost_scale) +
               ", refined: " + (valley.refined ? "true" : "false") + "}");
   }
   yaml->Integer(1, "sweeps", outer.scan_sweeps, "sweeps of the scan");
@@ -555,8 +568,8 @@ std::string SummaryYaml(const IdentificationRun& run) {
               "x = 0; a pinned one: -W_0 / alpha_0), at the optimum");
   yaml.Integer(1, "sweeps", uncertainty.sweeps, "of the noise solves");
 
-  OptimizerScanAndPrefilterYaml(outer, run.rest_cost, run.config, run.prefilter_cutoff, "e^2",
-                                "J s", &yaml);
+  OptimizerScanAndPrefilterYaml(outer, run.rest_cost, run.scan_cost_scale, run.config,
+                                run.prefilter_cutoff, "e^2", "J s", &yaml);
 
   long inner_iterations = 0;
   int max_inner_iterations = 0;
@@ -611,8 +624,8 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
   results.Write("ends.csv", EndsCsv(run));
   results.Write("inner_residual.csv", InnerResidualCsv(run));
   if (!run.outer.scan_moduli.empty()) {
-    results.Write("scan.csv", ScanCsv(run.outer, run.rest_cost, run.config.outer.initial));
-    results.Write("valleys.csv", ValleysCsv(run.outer, run.rest_cost));
+    results.Write("scan.csv", ScanCsv(run.outer, run.scan_cost_scale, run.config.outer.initial));
+    results.Write("valleys.csv", ValleysCsv(run.outer, run.scan_cost_scale));
   }
   if (run.error_map.share.size() > 0) {
     results.Write("error_map.csv", ErrorMapCsv(run));
@@ -681,11 +694,11 @@ std::string LeastSquaresCostCurveScript(const LeastSquaresRun& run, const std::s
     if (run.outer.scan_moduli.back() >= 10.0 * run.outer.scan_moduli.front())
       script << "set logscale x\n";
     script << "set title 'global scan over the bounds, its valleys and the local refinements'\n"
-           << "plot " << ScanPlots(folder) << curve << "\nunset logscale x\n";
+           << "plot " << ScanPlots(folder, false) << curve << "\nunset logscale x\n";
   }
   script << "set title 'within 5 % of the identified E'\nset xrange ["
          << identified * (1.0 - kCurvatureWindow) << ":" << identified * (1.0 + kCurvatureWindow)
-         << "]\nplot " << (scanned ? ScanPlots(folder) : std::string()) << curve
+         << "]\nplot " << (scanned ? ScanPlots(folder, false) : std::string()) << curve
          << "\nunset multiplot\n";
   return script.str();
 }
@@ -750,8 +763,8 @@ std::string LeastSquaresSummaryYaml(const LeastSquaresRun& run) {
             "synthetic_snr: the data's own noise; data_differences: estimated from the data; "
             "channel_rms: noise-free data, the channels' RMS");
 
-  OptimizerScanAndPrefilterYaml(outer, run.rest_cost, run.config, run.prefilter_cutoff, "J", "s",
-                                &yaml);
+  OptimizerScanAndPrefilterYaml(outer, run.rest_cost, run.rest_cost, run.config,
+                                run.prefilter_cutoff, "J", "s", &yaml);
 
   yaml.Line(0, "cost_curve", "");
   yaml.Integer(1, "points", static_cast<long>(run.cost_curve.size()));

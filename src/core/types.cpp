@@ -30,6 +30,8 @@ constexpr std::array<std::pair<ClampModel, const char*>, 3> kClampModels{
     {{ClampModel::kMeasured, "measured"},
      {ClampModel::kTrusted, "trusted"},
      {ClampModel::kPinned, "pinned"}}};
+constexpr std::array<std::pair<SearchFunctional, const char*>, 2> kSearchFunctionals{
+    {{SearchFunctional::kPinned, "pinned"}, {SearchFunctional::kSame, "same"}}};
 constexpr std::array<std::pair<Zoning, const char*>, 3> kZonings{{{Zoning::kEqual, "equal"},
                                                                   {Zoning::kPerElement, "per_element"},
                                                                   {Zoning::kBoundaries, "boundaries"}}};
@@ -69,6 +71,13 @@ bool StringToModelKind(const std::string& name, ModelKind* kind) {
 const char* ClampModelToString(ClampModel model) { return ToName(kClampModels, model); }
 bool StringToClampModel(const std::string& name, ClampModel* model) {
   return FromName(kClampModels, name, model);
+}
+
+const char* SearchFunctionalToString(SearchFunctional functional) {
+  return ToName(kSearchFunctionals, functional);
+}
+bool StringToSearchFunctional(const std::string& name, SearchFunctional* functional) {
+  return FromName(kSearchFunctionals, name, functional);
 }
 
 }  // namespace mcrewave

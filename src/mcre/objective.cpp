@@ -24,6 +24,42 @@ bool McreOptions::IsValid(std::string* error) const {
   return true;
 }
 
+bool SearchOptions::IsValid(std::string* error) const {
+  const std::pair<const char*, double> weights[] = {{"search.w_u", displacement_weight},
+                                                    {"search.w_e", strain_weight},
+                                                    {"search.w_u0", clamp_displacement_weight},
+                                                    {"search.w_r", reaction_weight}};
+  std::ostringstream why;
+  for (const auto& [key, weight] : weights) {
+    if (!(std::isfinite(weight) && weight > 0.0)) {
+      why << key << " must be a finite positive number, got " << weight;
+      if (error != nullptr) *error = why.str();
+      return false;
+    }
+  }
+  if (!(inner_tolerance > 0.0 && inner_tolerance < 1.0)) {
+    why << "search.inner_tolerance must lie in (0, 1), got " << inner_tolerance;
+  } else if (scan_points < 3 || scan_points > 100000) {
+    why << "search.scan_points must lie in [3, 100000], got " << scan_points;
+  } else if (!(refine_window > 0.0 && refine_window <= 0.5)) {
+    why << "search.refine_window must lie in (0, 0.5], got " << refine_window;
+  } else {
+    return true;
+  }
+  if (error != nullptr) *error = why.str();
+  return false;
+}
+
+McreOptions SearchMcreOptions(const McreOptions& mcre, const SearchOptions& search) {
+  McreOptions options = mcre;
+  options.clamp = ClampModel::kPinned;
+  options.weights.displacement_weight = search.displacement_weight;
+  options.weights.strain_weight = search.strain_weight;
+  options.weights.clamp_displacement_weight = search.clamp_displacement_weight;
+  options.weights.reaction_weight = search.reaction_weight;
+  return options;
+}
+
 McreObjective::McreObjective(const BarModel& model, const MeasurementSet& data,
                              const McreOptions& mcre, double theta,
                              const CoupledSolverOptions& inner, double modulus_scale,

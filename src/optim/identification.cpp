@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -760,6 +761,108 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
   summary.scan_wall_time_s = scan_wall_time_s;
   summary.wall_time_s = SecondsSince(start);
   return summary;
+}
+
+IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
+                                          ModulusObjective* search, int search_scan_points,
+                                          double refine_window, ModulusObjective* objective) {
+  assert(options.scan_points > 0 && search_scan_points >= 3 && refine_window > 0.0 &&
+         refine_window <= 0.5);
+  const Clock::time_point start = Clock::now();
+  // 1. The global search.
+  IdentificationOptions global = options;
+  global.scan_points = search_scan_points;
+  const IdentificationSummary found = Identify(global, search);
+  const int search_evaluations = found.scan_evaluations + found.evaluations;
+  // The result: the objective's minimisation with the search's count, and its scan
+  // fields unless the objective's own scan replaced them.
+  auto with_search = [&](IdentificationSummary result, bool scan_of_search) {
+    if (scan_of_search) {
+      result.scan_moduli = found.scan_moduli;
+      result.scan_costs = found.scan_costs;
+      result.scan_gradients = found.scan_gradients;
+      result.scan_sweeps = found.scan_sweeps;
+      result.scan_failures = found.scan_failures;
+      result.predicted_valley_spacing = found.predicted_valley_spacing;
+      result.scan_resolution_limited = found.scan_resolution_limited;
+      result.valleys = found.valleys;
+      result.local_minima = found.local_minima;
+      result.cost_gap = found.cost_gap;
+      result.second_modulus = found.second_modulus;
+      result.refinements = found.refinements;
+      result.scan_wall_time_s = found.scan_wall_time_s;
+      result.scan_evaluations = search_evaluations;
+    } else {
+      result.scan_evaluations += search_evaluations;
+      result.scan_sweeps += found.scan_sweeps;
+      result.scan_wall_time_s += found.wall_time_s;
+    }
+    result.search_modulus = found.modulus;
+    result.scan_of_search = scan_of_search;
+    result.wall_time_s = SecondsSince(start);
+    return result;
+  };
+  // The result when the objective is not minimised.
+  IdentificationSummary not_run;
+  not_run.optimizer = options.optimizer;
+  not_run.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm);
+  not_run.initial_modulus = options.initial;
+  if (!found.IsSolutionUsable()) {
+    IdentificationSummary result = with_search(not_run, true);
+    result.termination = found.termination;
+    result.message = "the global search: " + found.message;
+    return result;
+  }
+  // 2. The objective near the search's minimiser, with what the search left.
+  IdentificationOptions local = options;
+  local.scan_points = 0;
+  local.lower_bound = std::max(options.lower_bound, found.modulus * (1.0 - refine_window));
+  local.upper_bound = std::min(options.upper_bound, found.modulus * (1.0 + refine_window));
+  const double width = local.upper_bound - local.lower_bound;
+  local.initial =
+      std::clamp(found.modulus, local.lower_bound + 1e-3 * width, local.upper_bound - 1e-3 * width);
+  local.max_evaluations = options.max_evaluations - search_evaluations;
+  local.max_time = options.max_time - SecondsSince(start);
+  if (local.max_evaluations < 2 || !(local.max_time > 0.0)) {
+    IdentificationSummary result = with_search(not_run, true);
+    result.termination = TerminationType::kNoConvergence;
+    result.message = local.max_evaluations < 2
+                         ? "outer.max_evaluations (" + std::to_string(options.max_evaluations) +
+                               ") reached by the global search (" +
+                               std::to_string(search_evaluations) + " evaluations)"
+                         : "outer.max_time reached by the global search";
+    return result;
+  }
+  spdlog::info("refining the objective near the search's E = {:.9g} Pa within [{:.6g}, {:.6g}] Pa",
+               found.modulus, local.lower_bound, local.upper_bound);
+  IdentificationSummary refined = Identify(local, objective);
+  const double tolerance = 4.0 * options.relative_tolerance * refined.modulus;
+  const bool on_lower =
+      local.lower_bound > options.lower_bound && refined.modulus - local.lower_bound <= tolerance;
+  const bool on_upper =
+      local.upper_bound < options.upper_bound && local.upper_bound - refined.modulus <= tolerance;
+  if (!refined.IsSolutionUsable() || !(on_lower || on_upper)) return with_search(refined, true);
+
+  // 3. Its minimum lies beyond the window: the objective's own global search.
+  spdlog::warn(
+      "the objective's minimum lies beyond {:.3g} % of the search's E = {:.9g} Pa "
+      "(search.refine_window): scanning the objective itself",
+      100.0 * refine_window, found.modulus);
+  IdentificationOptions own = options;
+  own.max_evaluations = local.max_evaluations - refined.evaluations;
+  own.max_time = options.max_time - SecondsSince(start);
+  if (own.max_evaluations < own.scan_points + 2 || !(own.max_time > 0.0)) {
+    IdentificationSummary result = with_search(refined, true);
+    result.termination = TerminationType::kNoConvergence;
+    result.message =
+        "outer.max_evaluations or outer.max_time reached before the objective's own scan, which "
+        "the refinement on an edge of search.refine_window asked for";
+    return result;
+  }
+  IdentificationSummary scanned = Identify(own, objective);
+  scanned.evaluations += refined.evaluations;
+  scanned.gradient_evaluations += refined.gradient_evaluations;
+  return with_search(scanned, false);
 }
 
 }  // namespace mcrewave

@@ -18,8 +18,9 @@
 //          truth_refinement [4], snr [.inf], seed [1], sensors [[]: u@X, e@X],
 //          channels [[]: every channel], truth_zones [[]: {start, end, modulus}],
 //          truth_manifest [""], truth_moduli [[]]
-//   mcre:  w_u [0.01], w_f [1], w_e [0.01], reference_modulus [200e9 Pa] (E0 of
-//          the weights; objective.h)
+//   mcre:  w_u [1e-7], w_f [1], w_e [1e-7], w_r [1e-6], w_u0 [0.1],
+//          reference_modulus [200e9 Pa] (E0 of the weights), clamp [trusted | measured
+//          | pinned] (McreOptions, objective.h)
 //   inner: method [conjugate_gradient | all_at_once | relaxation | adaptive_relaxation
 //          | any other CoupledSolverType], tolerance [1e-8], max_iterations [5000],
 //          omega [0.5], spectrum_steps [12], spectrum_safety_factor [1.05],
@@ -37,6 +38,9 @@
 //          scan_max_points [2000], scan_tolerance [1e-4], scan_threads [2],
 //          refine_margin [0.05], refine_candidates [10] (IdentificationOptions,
 //          identification.h)
+//   search: functional [pinned | same], w_u [0.01], w_e [0.01], w_u0 [0.1], w_r [0.1],
+//          inner_tolerance [1e-6], scan_points [12], refine_window [0.03]
+//          (SearchOptions, objective.h; the bar's global scan)
 //   prefilter: enabled [true], cutoff_frequency [0 Hz: derived from the data;
 //          else below the Nyquist frequency 0.5 / time.step], order [4],
 //          at_rest_before_start [true] (PrefilterOptions,
@@ -125,6 +129,7 @@ struct Config {
   McreOptions mcre;
   CoupledSolverOptions inner;
   IdentificationOptions outer;
+  SearchOptions search;  // the functional of the global scan (mcre/objective.h)
   PrefilterOptions prefilter;
   UncertaintyOptions uncertainty;
   OutputOptions output;

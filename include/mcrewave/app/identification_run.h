@@ -4,14 +4,17 @@
 //   1. LoadMeasurements: synthetic data (data.source: synthetic) or the CSV file,
 //      checked against the model's time grid.
 //   2. The pre-filter (prefilter.h) of the measurements when prefilter.enabled.
-//   3. Identify (identification.h) on an McreObjective (objective.h) with
-//      x = E / outer.initial: the global scan and local refinements.
+//   3. IdentifyWithMcre: the global scan and local refinements of e^2 (objective.h,
+//      identification.h) with x = E / outer.initial; by default the scan runs on the
+//      search functional (search:, the pinned clamp's e^2) and mcre:'s e^2 is refined
+//      near its minimum (IdentifyInTwoStages).
 //   4. At the identified E*: the cost curve e^2(E) on output.curve_points points
 //      around E*, warm-started point to point, the error map of the constitutive
 //      gap (error_map.h) and the uncertainty figure (modulus_uncertainty.h).
 #pragma once
 
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -78,7 +81,12 @@ struct IdentificationRun {
   double alpha = 0.0;      // force weight used [m/N]
   double beta = 0.0;       // displacement weight used [N/m]
   double rest_cost = 0.0;  // J_rest, the cost scale [J s]
-  long sweeps = 0;         // sweeps of the optimiser's evaluations
+  // The cost scale of outer's scan fields [J s]: J_rest of the search functional when
+  // outer.scan_of_search, else rest_cost.
+  double scan_cost_scale = 0.0;
+  // Sweeps of the optimiser's evaluations, the search objective's own included (the
+  // scan's copies: outer.scan_sweeps).
+  long sweeps = 0;
 
   std::vector<CostCurvePoint> cost_curve;  // ascending E
   long cost_curve_sweeps = 0;
@@ -99,6 +107,23 @@ struct IdentificationRun {
   // e^2 at the identified E [J s].
   double cost() const { return best_index >= 0 ? evaluations[best_index].cost : -1.0; }
 };
+
+// Step 3 on mcre:'s e^2.
+struct McreIdentification {
+  std::unique_ptr<McreObjective> objective;  // mcre:'s e^2, with every evaluation of it
+  IdentificationSummary outer;
+  long search_sweeps = 0;        // the search objective's own sweeps (0: one stage)
+  double scan_cost_scale = 0.0;  // [J s] J_rest of the functional outer's scan ran on
+};
+
+// The outer loop of config.outer on mcre:'s e^2 of `data` (the identification's
+// measurements: selected and pre-filtered) with the model `model` and the end channels
+// `ends`; both must outlive the result's objective. With outer.scan_points > 0 and
+// search.functional pinned: IdentifyInTwoStages with the search functional
+// (SearchMcreOptions, its inner solves to search.inner_tolerance); else Identify.
+// Precondition: config valid.
+McreIdentification IdentifyWithMcre(const Config& config, const BarModel& model,
+                                    const MeasurementSet& data, EndDisplacementChannels ends);
 
 // Runs steps 2 and 3 on measurements made by LoadMeasurements(config): the
 // fields up to `solution` (and wall_time_s); no cost curve, no uncertainty.

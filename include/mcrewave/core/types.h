@@ -94,4 +94,14 @@ enum class ClampModel {
 const char* ClampModelToString(ClampModel model);
 bool StringToClampModel(const std::string& name, ClampModel* model);
 
+// The functional the global search of a bar's identification scans (config key
+// search.functional; docs/trusted_clamp.md section 10).
+enum class SearchFunctional {
+  kPinned,  // the pinned clamp's e^2 with the search: section's weights (one valley over
+            // the bounds), then mcre:'s e^2 refined near its minimum
+  kSame,    // mcre:'s e^2 itself, scanned and refined
+};
+const char* SearchFunctionalToString(SearchFunctional functional);
+bool StringToSearchFunctional(const std::string& name, SearchFunctional* functional);
+
 }  // namespace mcrewave

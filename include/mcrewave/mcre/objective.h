@@ -99,6 +99,43 @@ struct McreOptions {
   bool IsValid(std::string* error) const;
 };
 
+// The `search:` section: the functional the global search of a bar's identification
+// scans (docs/trusted_clamp.md section 10). The trusted clamp's e^2 of the defaults is
+// as accurate as least squares but, like it, has several valleys over the bounds: its
+// outputs f0 and uL skip cycles as E changes. The pinned clamp's e^2 at heavier data
+// weights has one valley, 2 to 3 % of rms error of E apart from it. With functional
+// pinned, Identify scans and refines that one (search_scan_points samples at least, its
+// inner solves to inner_tolerance), then mcre:'s e^2 is refined locally within
+// E_search (1 -+ refine_window) (IdentifyInTwoStages, identification.h).
+struct SearchOptions {
+  SearchFunctional functional = SearchFunctional::kPinned;
+  // The search functional's weights w_u, w_e, w_u0 and w_r; w_f and E0 are mcre:'s.
+  // Those of configs/paper_bar_pinned.yaml: one valley on 300 of 300 comparator data
+  // sets (docs/trusted_clamp.md section 9).
+  double displacement_weight = 0.01;       // search.w_u
+  double strain_weight = 0.01;             // search.w_e
+  double clamp_displacement_weight = 0.1;  // search.w_u0
+  double reaction_weight = 0.1;            // search.w_r
+  // Relative residual of the search's inner solves: 1e-6 moves its E* by 8e-9 from
+  // 1e-8's, far inside refine_window.
+  double inner_tolerance = 1e-6;
+  // Fewest moduli of its scan (outer.scan_points for the functional `same`): with one
+  // valley, 4 samples per predicted valley spacing make 12 to 16 over the default bounds.
+  int scan_points = 12;
+  // Half width of the refinement of mcre:'s e^2 around the search's E*, relative: the
+  // two minima differed by at most 1.2 % on the comparator's 1100 data sets.
+  double refine_window = 0.03;
+
+  // Valid when the weights and inner_tolerance are finite and positive,
+  // inner_tolerance < 1, scan_points in [3, 100000] and refine_window in (0, 0.5].
+  // Messages name the search.* keys.
+  bool IsValid(std::string* error) const;
+};
+
+// The McreOptions of the search functional: mcre's w_f and E0, the clamp pinned and
+// the search's weights.
+McreOptions SearchMcreOptions(const McreOptions& mcre, const SearchOptions& search);
+
 // One evaluation of e^2(E) by McreObjective.
 struct ObjectiveEvaluation {
   double modulus = -1.0;            // E [Pa] when every zone has it; -1 when they differ

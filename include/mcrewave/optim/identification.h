@@ -201,6 +201,15 @@ struct IdentificationSummary {
   int refinements = 0;           // local refinements run
   double scan_wall_time_s = 0.0;
 
+  // Two stages (IdentifyInTwoStages): the search functional's minimiser [Pa] (-1: one
+  // stage, Identify).
+  double search_modulus = -1.0;
+  // The scan fields above (samples, valleys, gap, refinements) are the search
+  // functional's, their costs scaled by its own cost scale: true in two stages unless
+  // the refinement reached an inner edge of its window and the objective's own scan
+  // replaced the search.
+  bool scan_of_search = false;
+
   // Convergence: a tolerance was met (NLopt xtol/ftol or roundoff-limited;
   // Ceres convergence). Limits reached, a failed evaluation or an exception in
   // the objective are not usable.
@@ -221,5 +230,26 @@ struct IdentificationSummary {
 // makes that sample unusable) with termination kFailure and its what() in the
 // message. Precondition: options.IsValid().
 IdentificationSummary Identify(const IdentificationOptions& options, ModulusObjective* objective);
+
+// Two stages: a global search on another functional, a local refinement of the objective.
+//   1. Identify(options with scan_points = search_scan_points, search): the scan and its
+//      valleys' refinements on `search`, a cost of one valley over the bounds whose
+//      minimiser E_s lies near the objective's.
+//   2. The local search of `objective` from E_s within E_s (1 -+ refine_window), cut to
+//      the bounds (scan_points = 0).
+//   3. When stage 2 ends on an edge of its window inside the bounds (the objective's
+//      minimum lies farther from E_s), Identify(options, objective): the objective's own
+//      scan and refinements, as in one stage.
+// max_evaluations and max_time hold for the whole. The result is stage 2's (or 3's)
+// with search_modulus = E_s, scan_evaluations = the search's evaluations (scan and
+// refinements) plus stage 3's scan, evaluations = the objective's, scan_sweeps = the
+// search's scan's (the search objective's own sweeps are its sweeps()), and, unless stage
+// 3 ran, the search's scan fields (scan_of_search). A search that does not converge
+// ends the identification with its termination and message. Preconditions:
+// options.IsValid(), options.scan_points > 0, search_scan_points in [3, 100000],
+// refine_window in (0, 0.5].
+IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
+                                          ModulusObjective* search, int search_scan_points,
+                                          double refine_window, ModulusObjective* objective);
 
 }  // namespace mcrewave
