@@ -354,8 +354,12 @@ TEST(IdentificationTest, TwoStagesRefineTheObjectiveNearTheSearchsMinimum) {
       EXPECT_GE(x * objective.scale, summary.search_modulus * 0.97);
       EXPECT_LE(x * objective.scale, summary.search_modulus * 1.03);
     }
-    EXPECT_EQ(summary.evaluations, static_cast<int>(objective.evaluated.size()));
-    EXPECT_EQ(summary.scan_evaluations, static_cast<int>(search.evaluated.size()));
+    // The objective's window scan (on the objective itself: it has no copies) counts
+    // with the search's evaluations.
+    EXPECT_EQ(summary.evaluations + kTwoStageWindowScanPoints,
+              static_cast<int>(objective.evaluated.size()));
+    EXPECT_EQ(summary.scan_evaluations,
+              static_cast<int>(search.evaluated.size()) + kTwoStageWindowScanPoints);
   }
 }
 
@@ -373,8 +377,10 @@ TEST(IdentificationTest, TwoStagesScanTheObjectiveWhenItsMinimumLiesBeyondTheWin
   EXPECT_EQ(summary.scan_moduli.size(), 41u);
   EXPECT_EQ(summary.local_minima, 1);
   EXPECT_NEAR(summary.modulus, 1.3e9, 1e-6 * 1.3e9);
-  EXPECT_EQ(summary.evaluations + 41, static_cast<int>(objective.evaluated.size()));
-  EXPECT_EQ(summary.scan_evaluations, static_cast<int>(search.evaluated.size()) + 41);
+  EXPECT_EQ(summary.evaluations + kTwoStageWindowScanPoints + 41,
+            static_cast<int>(objective.evaluated.size()));
+  EXPECT_EQ(summary.scan_evaluations,
+            static_cast<int>(search.evaluated.size()) + kTwoStageWindowScanPoints + 41);
 }
 
 TEST(IdentificationTest, TwoStagesStopWithTheSearchsFailure) {
@@ -390,7 +396,8 @@ TEST(IdentificationTest, TwoStagesStopWithTheSearchsFailure) {
 }
 
 TEST(IdentificationTest, TwoStagesShareTheEvaluationLimit) {
-  // 7 scan samples and the search's refinement leave fewer than 2 of 13 evaluations.
+  // 7 scan samples and the search's refinement leave fewer than the window scan's 5 + 2
+  // of 13 evaluations.
   ScriptedObjective search = Parabola(1.31);
   ScriptedObjective objective = Parabola(1.3);
   IdentificationOptions options = ScanOptions(OptimizerType::kNlopt);

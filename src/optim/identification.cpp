@@ -769,19 +769,26 @@ IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
   assert(options.scan_points > 0 && search_scan_points >= 3 && refine_window > 0.0 &&
          refine_window <= 0.5);
   const Clock::time_point start = Clock::now();
-  // 1. The global search.
+  // 1. The global search, its valleys refined by NLopt BOBYQA whatever the optimiser.
   IdentificationOptions global = options;
   global.scan_points = search_scan_points;
+  global.optimizer = OptimizerType::kNlopt;
+  global.algorithm = OuterAlgorithm::kBobyqa;
   const IdentificationSummary found = Identify(global, search);
   const int search_evaluations = found.scan_evaluations + found.evaluations;
-  // The result: the objective's minimisation with the search's count, and its scan
-  // fields unless the objective's own scan replaced them.
+  // The result: the objective's minimisation with the search's count, and the search's
+  // scan fields unless the objective's own scan (stage 3) replaced them. The scan
+  // counts add the search's (scan and refinements) and stage 2's window scan.
+  int window_evaluations = 0;
+  long window_sweeps = 0;
   auto with_search = [&](IdentificationSummary result, bool scan_of_search) {
     if (scan_of_search) {
+      result.scan_evaluations = 0;
+      result.scan_sweeps = 0;
+      result.scan_wall_time_s = 0.0;
       result.scan_moduli = found.scan_moduli;
       result.scan_costs = found.scan_costs;
       result.scan_gradients = found.scan_gradients;
-      result.scan_sweeps = found.scan_sweeps;
       result.scan_failures = found.scan_failures;
       result.predicted_valley_spacing = found.predicted_valley_spacing;
       result.scan_resolution_limited = found.scan_resolution_limited;
@@ -790,13 +797,10 @@ IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
       result.cost_gap = found.cost_gap;
       result.second_modulus = found.second_modulus;
       result.refinements = found.refinements;
-      result.scan_wall_time_s = found.scan_wall_time_s;
-      result.scan_evaluations = search_evaluations;
-    } else {
-      result.scan_evaluations += search_evaluations;
-      result.scan_sweeps += found.scan_sweeps;
-      result.scan_wall_time_s += found.wall_time_s;
     }
+    result.scan_evaluations += search_evaluations + window_evaluations;
+    result.scan_sweeps += found.scan_sweeps + window_sweeps;
+    result.scan_wall_time_s += found.wall_time_s;
     result.search_modulus = found.modulus;
     result.scan_of_search = scan_of_search;
     result.wall_time_s = SecondsSince(start);
@@ -813,9 +817,10 @@ IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
     result.message = "the global search: " + found.message;
     return result;
   }
-  // 2. The objective near the search's minimiser, with what the search left.
+  // 2. The objective near the search's minimiser, with what the search left: a scan of
+  // the window (cost and gradient, as the global scan's), its valleys refined.
   IdentificationOptions local = options;
-  local.scan_points = 0;
+  local.scan_points = kTwoStageWindowScanPoints;
   local.lower_bound = std::max(options.lower_bound, found.modulus * (1.0 - refine_window));
   local.upper_bound = std::min(options.upper_bound, found.modulus * (1.0 + refine_window));
   const double width = local.upper_bound - local.lower_bound;
@@ -823,10 +828,10 @@ IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
       std::clamp(found.modulus, local.lower_bound + 1e-3 * width, local.upper_bound - 1e-3 * width);
   local.max_evaluations = options.max_evaluations - search_evaluations;
   local.max_time = options.max_time - SecondsSince(start);
-  if (local.max_evaluations < 2 || !(local.max_time > 0.0)) {
+  if (local.max_evaluations < local.scan_points + 2 || !(local.max_time > 0.0)) {
     IdentificationSummary result = with_search(not_run, true);
     result.termination = TerminationType::kNoConvergence;
-    result.message = local.max_evaluations < 2
+    result.message = local.max_evaluations < local.scan_points + 2
                          ? "outer.max_evaluations (" + std::to_string(options.max_evaluations) +
                                ") reached by the global search (" +
                                std::to_string(search_evaluations) + " evaluations)"
@@ -836,6 +841,8 @@ IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
   spdlog::info("refining the objective near the search's E = {:.9g} Pa within [{:.6g}, {:.6g}] Pa",
                found.modulus, local.lower_bound, local.upper_bound);
   IdentificationSummary refined = Identify(local, objective);
+  window_evaluations = refined.scan_evaluations;
+  window_sweeps = refined.scan_sweeps;
   const double tolerance = 4.0 * options.relative_tolerance * refined.modulus;
   const bool on_lower =
       local.lower_bound > options.lower_bound && refined.modulus - local.lower_bound <= tolerance;
@@ -849,7 +856,7 @@ IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
       "(search.refine_window): scanning the objective itself",
       100.0 * refine_window, found.modulus);
   IdentificationOptions own = options;
-  own.max_evaluations = local.max_evaluations - refined.evaluations;
+  own.max_evaluations = local.max_evaluations - refined.evaluations - window_evaluations;
   own.max_time = options.max_time - SecondsSince(start);
   if (own.max_evaluations < own.scan_points + 2 || !(own.max_time > 0.0)) {
     IdentificationSummary result = with_search(refined, true);

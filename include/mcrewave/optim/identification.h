@@ -234,20 +234,28 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
 // Two stages: a global search on another functional, a local refinement of the objective.
 //   1. Identify(options with scan_points = search_scan_points, search): the scan and its
 //      valleys' refinements on `search`, a cost of one valley over the bounds whose
-//      minimiser E_s lies near the objective's.
-//   2. The local search of `objective` from E_s within E_s (1 -+ refine_window), cut to
-//      the bounds (scan_points = 0).
+//      minimiser E_s lies near the objective's. The refinements are NLopt BOBYQA's
+//      whatever options' optimiser: derivative-free, they do not depend on the accuracy
+//      of the search's gradient, which its looser inner solves limit (NLopt L-BFGS
+//      failed on the paper's case at the inner tolerance 1e-6), and every optimiser then
+//      refines the objective around the same E_s.
+//   2. Identify(options with scan_points = kTwoStageWindowScanPoints, objective) within
+//      E_s (1 -+ refine_window), cut to the bounds: a scan of the window (cost and
+//      gradient) that brackets the objective's valleys there and gives the local
+//      optimiser its curvature, then their refinements.
 //   3. When stage 2 ends on an edge of its window inside the bounds (the objective's
 //      minimum lies farther from E_s), Identify(options, objective): the objective's own
 //      scan and refinements, as in one stage.
 // max_evaluations and max_time hold for the whole. The result is stage 2's (or 3's)
 // with search_modulus = E_s, scan_evaluations = the search's evaluations (scan and
-// refinements) plus stage 3's scan, evaluations = the objective's, scan_sweeps = the
-// search's scan's (the search objective's own sweeps are its sweeps()), and, unless stage
-// 3 ran, the search's scan fields (scan_of_search). A search that does not converge
-// ends the identification with its termination and message. Preconditions:
+// refinements) plus the scans of stages 2 and 3, evaluations = the objective's own,
+// scan_sweeps = those scans' (on copies; the search objective's own sweeps are its
+// sweeps()), and, unless stage 3 ran, the search's scan fields (scan_of_search). A
+// search that does not converge ends the identification with its termination and
+// message. Preconditions:
 // options.IsValid(), options.scan_points > 0, search_scan_points in [3, 100000],
 // refine_window in (0, 0.5].
+constexpr int kTwoStageWindowScanPoints = 5;
 IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
                                           ModulusObjective* search, int search_scan_points,
                                           double refine_window, ModulusObjective* objective);
