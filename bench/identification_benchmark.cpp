@@ -3,10 +3,11 @@
 // For each config (default: configs/paper_bar.yaml and configs/quick.yaml, paths
 // relative to the working directory) it loads the data exactly as `identify run`
 // does (synthetic data, pre-filter) and reports:
-//   (a) Identify alone (scan + bracketed refinements, the outer options of the
-//       config): the identified E, the evaluations of the scan and of the
-//       refinements, their sweeps, and the CPU time (user + system of the whole
-//       process, so the scan's threads count);
+//   (a) IdentifyWithMcre alone (the scans and refinements of the config's outer and
+//       search sections, two stages by default): the identified E, the evaluations
+//       of the scans (the search functional's included) and of e^2's refinements,
+//       their sweeps, and the CPU time (user + system of the whole process, so the
+//       scan's threads count);
 //   (b) RunIdentification (Identify, then the cost curve and the uncertainty of
 //       `identify run`, without writing files): CPU time and sweeps;
 //   (c) one direct and one retrograde sweep of the config's problem at E_ref: CPU
@@ -70,16 +71,16 @@ struct IdentifyFigures {
 IdentifyFigures IdentifyOnce(const mcrewave::Config& config, const mcrewave::MeasurementSet& data) {
   IdentifyFigures figures;
   const mcrewave::BarModel model(config.model);
-  mcrewave::McreObjective objective(model, data, config.mcre, config.time.theta, config.inner,
-                                    config.outer.initial);
   const double start = ProcessCpuSeconds();
-  const mcrewave::IdentificationSummary summary = mcrewave::Identify(config.outer, &objective);
+  const mcrewave::McreIdentification identification =
+      mcrewave::IdentifyWithMcre(config, model, data, mcrewave::EndDisplacementChannels());
   figures.cpu_s = ProcessCpuSeconds() - start;
+  const mcrewave::IdentificationSummary& summary = identification.outer;
   figures.modulus = summary.modulus;
   figures.scan_evaluations = summary.scan_evaluations;
   figures.evaluations = summary.evaluations;
   figures.scan_sweeps = summary.scan_sweeps;
-  figures.refinement_sweeps = objective.sweeps();
+  figures.refinement_sweeps = identification.objective->sweeps() + identification.search_sweeps;
   figures.usable = summary.IsSolutionUsable();
   return figures;
 }

@@ -5,12 +5,12 @@
 // derived cut-off, the global scan and its density against a local search from
 // outer.initial).
 //
-// Each identification is Identify (identification.h) as `identify run` calls
-// it, with the outer defaults except scan_threads = 1 (the two cores run two
-// identifications at a time instead) and relative_tolerance = 1e-6. Per setting and SNR it reports
-// the mean error, the 2.5 % and 97.5 % quantiles (the 95 % band), the share of seeds within +-2 %
-// of E_ref, the mean number of sampled local minima of the scan and the mean wall time of one
-// identification; plus the noise-free error (bias).
+// Each identification is Identify (identification.h) on the free-free e^2 as `identify
+// run` calls it with search.functional same, with the outer defaults except scan_threads = 1 (the
+// two cores run two identifications at a time instead) and relative_tolerance = 1e-6. Per setting
+// and SNR it reports the mean error, the 2.5 % and 97.5 % quantiles (the 95 % band), the share of
+// seeds within +-2 % of E_ref, the mean number of sampled local minima of the scan and the mean
+// wall time of one identification; plus the noise-free error (bias).
 //
 // Usage: robustness_benchmark OUTPUT_DIR [seeds]
 //   writes OUTPUT_DIR/identifications.csv (one row per identification) and

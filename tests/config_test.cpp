@@ -887,6 +887,13 @@ TEST_F(ConfigFileTest, SearchKeysAreCheckedAndBelongToThePinnedSearchFunctional)
                   {"search.scan_points must lie in [3, 100000], got 2"});
   ExpectLoadError("search:\n  refine_window: 0.6\n", 2,
                   {"search.refine_window must lie in (0, 0.5], got 0.6"});
+  // The two stages' scans within outer's limits.
+  ExpectLoadError("outer:\n  scan_points: 3\n  scan_max_points: 10\n", 3,
+                  {"search.scan_points (12) must not exceed outer.scan_max_points (10)"});
+  ExpectLoadError("outer:\n  scan_points: 3\n  max_evaluations: 20\n", 3,
+                  {"outer.max_evaluations (20) must be at least search.scan_points + 9 = 21 with "
+                   "search.functional 'pinned'"});
+  EXPECT_NO_THROW(ParseConfig("outer:\n  scan_points: 3\n  max_evaluations: 21\n", "a.yaml"));
   // A key of the pinned search functional with the functional `same`: ignored, refused.
   ExpectLoadError("search:\n  functional: same\n  w_u0: 0.2\n", 3,
                   {"search.w_u0 applies to search.functional 'pinned' only (search.functional "

@@ -274,9 +274,16 @@ std::string Summary(const ComparatorStudy& study) {
   md << "# MCRE against output-error least squares\n\n"
      << study.runs.size() << " identifications on " << study.threads << " threads in "
      << internal::Duration(study.wall_time_s)
-     << ". The same data for both functionals, the same scan, optimiser and bounds; "
+     << ". The same data for both functionals, the same optimiser and bounds; "
         "least squares: the clamped model driven by the measured fL, misfit of uL and f0 "
-        "normalised by RMS(channel) / SNR. Model errors: `density` the model 3 % denser, "
+        "normalised by RMS(channel) / SNR, its global scan on J. "
+     << (study.mcre_scans_search
+             ? "The MCRE's global scan runs on the search functional (search:, the pinned "
+               "clamp's e^2), then e^2 is scanned and refined within search.refine_window of "
+               "its minimiser, as identify run does; its `one valley` and `valleys` are the "
+               "search functional's. "
+             : "The MCRE's global scan runs on e^2 itself. ")
+     << "Model errors: `density` the model 3 % denser, "
         "`force_gain` fL measured 5 % high, `displacement_gain` uL measured 3 % high, "
         "`soft_zone` the bar 10 % softer over the 10 % of its length by the clamp. Errors "
         "of E relative to the bar's modulus; `within 2 %` and `one valley` as shares of "
@@ -338,6 +345,8 @@ ComparatorStudy RunComparatorStudy(const Config& config) {
   study.reference_modulus = config.model.modulus;
   study.model_errors = config.study.comparator_errors;
   study.snrs = config.study.comparator_snr;
+  study.mcre_scans_search =
+      config.outer.scan_points > 0 && config.search.functional == SearchFunctional::kPinned;
   for (const std::string& data : config.study.comparator_data) {
     study.prefilters.push_back(data == "prefilter");
   }

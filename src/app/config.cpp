@@ -898,6 +898,39 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
                  "the scan runs on mcre:'s e^2); leave it out with this functional";
         return false;
       },
+      // The two stages' scans fit outer's limits (IdentifyInTwoStages): the search's
+      // search.scan_points and the window's kTwoStageWindowScanPoints samples within
+      // outer.scan_max_points, and both with two evaluations of a refinement each
+      // within outer.max_evaluations.
+      [](const Config& config, std::string* error) {
+        if (config.structure.kind != ModelKind::kBar || config.outer.scan_points == 0 ||
+            config.outer.functional != OuterFunctional::kMcre ||
+            config.search.functional != SearchFunctional::kPinned) {
+          return true;
+        }
+        const int least_evaluations = config.search.scan_points + kTwoStageWindowScanPoints + 4;
+        std::ostringstream why;
+        if (config.search.scan_points > config.outer.scan_max_points) {
+          why << "search.scan_points (" << config.search.scan_points
+              << ") must not exceed outer.scan_max_points (" << config.outer.scan_max_points << ")";
+        } else if (config.outer.scan_max_points < kTwoStageWindowScanPoints) {
+          why << "outer.scan_max_points (" << config.outer.scan_max_points << ") must be at least "
+              << kTwoStageWindowScanPoints
+              << " with search.functional 'pinned': e^2 is scanned over that many moduli near "
+                 "the search's minimiser";
+        } else if (config.outer.max_evaluations < least_evaluations) {
+          why << "outer.max_evaluations (" << config.outer.max_evaluations
+              << ") must be at least search.scan_points + " << kTwoStageWindowScanPoints + 4
+              << " = " << least_evaluations
+              << " with search.functional 'pinned': the search's scan, e^2's "
+              << kTwoStageWindowScanPoints << " near its minimiser and two evaluations of each "
+              << "refinement";
+        } else {
+          return true;
+        }
+        *error = why.str();
+        return false;
+      },
       // Sensors on the bar, truth zones inside it and apart, a truth that can give them.
       [](const Config& config, std::string* error) {
         *error = ValidateDataAgainstBar(config.data, config.model);

@@ -95,8 +95,8 @@ void RunOne(const Config& config, const DamageCase& damage, DamageRun* run) {
   const MeasurementSet measured = MakeSyntheticMeasurements(run_config.model, run_config.load,
                                                             run_config.time, run_config.data);
   IdentificationRun scalar = IdentifyModulus(run_config, measured);
-  // The scalar identification's coupled solves: its global scan's (on copies of the
-  // objective) and those the objective recorded.
+  // The scalar identification's coupled solves: its scans' and search's (on copies of
+  // the objective and on the search functional) and those the objective recorded.
   run->evaluations = scalar.outer.scan_evaluations + static_cast<int>(scalar.evaluations.size());
   if (!scalar.IsUsable()) {
     run->message = "scalar identification: " + scalar.outer.message;

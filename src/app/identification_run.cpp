@@ -236,7 +236,8 @@ IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& da
   run.scan_cost_scale = identification.scan_cost_scale;
   run.outer = identification.outer;
   run.evaluations = objective.evaluations();
-  run.sweeps = objective.sweeps() + identification.search_sweeps;
+  run.search_sweeps = identification.search_sweeps;
+  run.sweeps = objective.sweeps() + run.search_sweeps;
   spdlog::info("{}", run.outer.BriefReport());
   if (run.IsUsable()) {
     // Every field reported belongs to the identified E: the objective's best
@@ -252,7 +253,7 @@ IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& da
             "the coupled solve at the identified E is not usable: " + at_optimum.inner.message;
       }
       run.evaluations = objective.evaluations();
-      run.sweeps = objective.sweeps() + identification.search_sweeps;
+      run.sweeps = objective.sweeps() + run.search_sweeps;
       run.best_index = static_cast<int>(run.evaluations.size()) - 1;
       run.solution = objective.last_solution();
     }

@@ -163,9 +163,10 @@ std::string InnerResidualCsv(const IdentificationRun& run) {
   return csv;
 }
 
-// The global scan: e^2 = scaled cost x J_rest and de^2/dE at each scan modulus
-// (solved at outer.scan_tolerance); usable 0 where the sample's solve failed.
-// cost_scale: J_rest of the objective; modulus_scale: its E_scale (outer.initial).
+// The global scan: cost = scaled cost x J_rest and its gradient d cost/dE at each scan
+// modulus (solved at outer.scan_tolerance); usable 0 where the sample's solve failed.
+// cost_scale: J_rest of the functional scanned (e^2's, or the search functional's);
+// modulus_scale: its E_scale (outer.initial).
 std::string ScanCsv(const IdentificationSummary& outer, double cost_scale, double modulus_scale) {
   std::string csv = "modulus,cost,cost_gradient,usable\n";
   char row[160];
@@ -463,9 +464,10 @@ void OptimizerScanAndPrefilterYaml(const IdentificationSummary& outer, double co
   yaml->Number(1, "wall_time_s", outer.wall_time_s, "[s] scan and refinements");
 
   const std::string scanned = outer.scan_of_search ? cost + "_search" : cost;
-  yaml->Line(
-      0, "scan", "",
-      "global scan of " + scanned + " and d" + scanned + "/dE over the bounds (outer.scan_*)");
+  yaml->Line(0, "scan", "",
+             "global scan of " + scanned + " and d" + scanned +
+                 "/dE over the bounds (outer.scan_*" +
+                 (outer.scan_of_search ? ", search.scan_points)" : ")"));
   yaml->Text(1, "functional", outer.scan_of_search ? "search_pinned" : "same",
              "search_pinned: the search: functional, e^2_search (the pinned clamp); same: " + cost +
                  " itself");
@@ -586,7 +588,9 @@ std::string SummaryYaml(const IdentificationRun& run) {
                "coupled solves of the optimiser");
   yaml.Integer(1, "iterations", inner_iterations, "sweep pairs over those solves");
   yaml.Integer(1, "max_iterations_one_solve", max_inner_iterations);
-  yaml.Integer(1, "sweeps", run.sweeps);
+  yaml.Integer(1, "sweeps", run.sweeps - run.search_sweeps, "of those solves");
+  yaml.Integer(1, "search_sweeps", run.search_sweeps,
+               "of the search functional's own solves (its valleys' refinement; 0: one stage)");
   yaml.Number(1, "wall_time_s", inner_time, "[s] in those solves");
   yaml.Integer(1, "iterations_at_optimum", best_inner.iterations,
                "of the solve at the identified modulus");

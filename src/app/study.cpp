@@ -485,8 +485,9 @@ std::string RobustnessSummary(const RobustnessStudy& study) {
        << Percent(s.quantile_025) << " | " << Percent(s.quantile_975) << " | "
        << Brief(s.mean_evaluations, 4) << " | " << Brief(s.mean_sweeps, 5) << " |\n";
   }
-  md << "\nEvaluations: outer evaluations of e^2 (the scan's included), means over all runs; "
-        "sweeps: inner sweeps of the scan and the local refinements.\n\n";
+  md << "\nEvaluations: outer evaluations of the functionals scanned and refined (the "
+        "search functional's and e^2's, the scans' included), means over all runs; "
+        "sweeps: inner sweeps of those evaluations.\n\n";
   for (const RobustnessStatistics& s : study.statistics) {
     if (std::isinf(s.snr)) {
       md << "- SNR inf: error " << Percent(s.mean_error)

@@ -163,9 +163,11 @@ std::string IdentificationSummary::BriefReport() const {
   out << OptimizerTypeToString(optimizer) << "/" << OuterAlgorithmToString(algorithm) << ": "
       << TerminationTypeToString(termination) << ", E = " << modulus << " Pa after " << evaluations
       << " evaluations (" << gradient_evaluations << " with gradient), " << wall_time_s << " s";
+  if (search_modulus > 0.0) out << "; search functional's E = " << search_modulus << " Pa";
   if (!scan_moduli.empty()) {
-    out << "; scan of " << scan_moduli.size() << " points saw " << local_minima << " valleys ("
-        << refinements << " refined)";
+    out << "; scan " << (scan_of_search ? "of the search functional " : "") << "of "
+        << scan_moduli.size() << " points saw " << local_minima << " valleys (" << refinements
+        << " refined)";
     if (std::isnan(cost_gap)) {
       out << ", no second valley";
     } else {
@@ -188,6 +190,11 @@ std::string IdentificationSummary::FullReport() const {
       << "  scaled cost            " << cost << "\n"
       << "  evaluations            " << evaluations << "\n"
       << "  with gradient          " << gradient_evaluations << "\n";
+  if (search_modulus > 0.0) {
+    out << "  search modulus         " << search_modulus << " Pa (the search functional's)\n"
+        << "  scan of the search     " << (scan_of_search ? "yes" : "no (the objective's own)")
+        << "\n";
+  }
   if (!scan_moduli.empty()) {
     out << "  scan points            " << scan_moduli.size() << " over [" << scan_moduli.front()
         << ", " << scan_moduli.back() << "] Pa\n"
@@ -781,6 +788,7 @@ IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
   // counts add the search's (scan and refinements) and stage 2's window scan.
   int window_evaluations = 0;
   long window_sweeps = 0;
+  double window_wall_time_s = 0.0;
   auto with_search = [&](IdentificationSummary result, bool scan_of_search) {
     if (scan_of_search) {
       result.scan_evaluations = 0;
@@ -800,7 +808,7 @@ IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
     }
     result.scan_evaluations += search_evaluations + window_evaluations;
     result.scan_sweeps += found.scan_sweeps + window_sweeps;
-    result.scan_wall_time_s += found.wall_time_s;
+    result.scan_wall_time_s += found.wall_time_s + window_wall_time_s;
     result.search_modulus = found.modulus;
     result.scan_of_search = scan_of_search;
     result.wall_time_s = SecondsSince(start);
@@ -843,6 +851,7 @@ IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
   IdentificationSummary refined = Identify(local, objective);
   window_evaluations = refined.scan_evaluations;
   window_sweeps = refined.scan_sweeps;
+  window_wall_time_s = refined.scan_wall_time_s;
   const double tolerance = 4.0 * options.relative_tolerance * refined.modulus;
   const bool on_lower =
       local.lower_bound > options.lower_bound && refined.modulus - local.lower_bound <= tolerance;

@@ -1,7 +1,8 @@
 // The comparator study (`identify study --set study.kind=comparator`): the MCRE and
 // output-error least squares (least_squares/output_error_objective.h) identify E from
-// the same data, with the same global scan, optimiser and bounds (outer:), with and
-// without the pre-filter, over noise seeds, on the config's case as it is ("none")
+// the same data, with the same optimiser and bounds (outer:), each as identify run does
+// (the MCRE's global scan on the search functional of search:, least squares' on J), with
+// and without the pre-filter, over noise seeds, on the config's case as it is ("none")
 // and with the model errors real tests have:
 //
 //   density            the identification's model 3 % denser than the bar measured
@@ -38,8 +39,8 @@ struct ComparatorRun {
   std::string message;  // the outer loop's, when not converged
   double modulus = std::numeric_limits<double>::quiet_NaN();  // identified E [Pa]
   double error = std::numeric_limits<double>::quiet_NaN();    // E / E_ref - 1
-  int local_minima = 0;                                       // of the global scan
-  int evaluations = 0;                                        // scan and refinement
+  int local_minima = 0;  // valleys of the functional the global scan ran on
+  int evaluations = 0;   // of every functional: scans and refinements
   double wall_time_s = std::numeric_limits<double>::quiet_NaN();
 };
 
@@ -68,6 +69,9 @@ struct ComparatorStudy {
   std::vector<std::string> model_errors;  // study.comparator_errors
   std::vector<double> snrs;               // study.comparator_snr
   std::vector<bool> prefilters;           // study.comparator_data: false raw, true prefilter
+  // The MCRE's global scan ran on the pinned search functional (search.functional
+  // pinned), not on e^2 itself: its valleys are the search functional's.
+  bool mcre_scans_search = false;
   std::vector<ComparatorRun> runs;
   std::vector<ComparatorStatistics> statistics;
   int threads = 0;

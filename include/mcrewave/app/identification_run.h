@@ -85,8 +85,9 @@ struct IdentificationRun {
   // outer.scan_of_search, else rest_cost.
   double scan_cost_scale = 0.0;
   // Sweeps of the optimiser's evaluations, the search objective's own included (the
-  // scan's copies: outer.scan_sweeps).
+  // scans' copies: outer.scan_sweeps).
   long sweeps = 0;
+  long search_sweeps = 0;  // of which the search objective's own (0: one stage)
 
   std::vector<CostCurvePoint> cost_curve;  // ascending E
   long cost_curve_sweeps = 0;
@@ -161,7 +162,7 @@ NoiseLevels MeasurementNoiseLevels(const Config& config, const MeasurementSet& d
 
 // One identification by output-error least squares (outer.functional:
 // least_squares; least_squares/output_error_objective.h): the same data path,
-// pre-filter, global scan and optimiser as the MCRE's, on J(E), the misfit of
+// pre-filter and optimiser as the MCRE's, the global scan on J(E), the misfit of
 // the clamped model driven by the measured fL, normalised by the noise levels.
 struct LeastSquaresRun {
   Config config;

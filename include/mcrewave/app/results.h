@@ -11,8 +11,10 @@
 //                       the version
 //   evaluations.csv     the optimiser's evaluations: E, e^2, de^2/dE, inner solve
 //   cost_curve.csv      e^2(E) and de^2/dE around the identified E
-//   scan.csv            e^2 and de^2/dE at the moduli of the global scan (when
-//                       outer.scan_points > 0), solved at outer.scan_tolerance
+//   scan.csv            the scanned cost and its gradient at the moduli of the global
+//                       scan (when outer.scan_points > 0), solved at
+//                       outer.scan_tolerance: e^2, or the search functional's
+//                       (summary.yaml scan.functional, its own cost scale)
 //   valleys.csv         every valley the scan saw: bracket, estimate, and the
 //                       refined minimum of those refined (docs/global_search.md)
 //   ends.csv            measured and model end displacements and forces at the
