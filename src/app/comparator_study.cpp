@@ -74,6 +74,7 @@ void Identify(const Config& config, const BarModel& model, const MeasurementSet&
   run->modulus = summary.modulus;
   run->error = summary.modulus / config.model.modulus - 1.0;
   run->local_minima = summary.local_minima;
+  if (summary.search_modulus > 0.0) run->search_modulus = summary.search_modulus;
   run->evaluations = summary.scan_evaluations + summary.evaluations;
   run->wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -174,13 +175,13 @@ std::string FilterText(bool prefilter) { return prefilter ? "prefilter" : "raw";
 std::string RunsCsv(const ComparatorStudy& study) {
   std::ostringstream csv;
   csv << "model_error,snr,seed,functional,data,converged,modulus_pa,relative_error,local_minima,"
-         "evaluations,wall_time_s,message\n";
+         "evaluations,wall_time_s,search_modulus_pa,message\n";
   for (const ComparatorRun& run : study.runs) {
     csv << run.model_error << "," << SnrText(run.snr) << "," << run.seed << ","
         << FunctionalText(run.least_squares) << "," << FilterText(run.prefilter) << ","
         << (run.converged ? 1 : 0) << "," << Csv(run.modulus) << "," << Csv(run.error) << ","
-        << run.local_minima << "," << run.evaluations << "," << Csv(run.wall_time_s) << ",\""
-        << run.message << "\"\n";
+        << run.local_minima << "," << run.evaluations << "," << Csv(run.wall_time_s) << ","
+        << Csv(run.search_modulus) << ",\"" << run.message << "\"\n";
   }
   return csv.str();
 }

@@ -40,6 +40,8 @@ struct ComparatorRun {
   double modulus = std::numeric_limits<double>::quiet_NaN();  // identified E [Pa]
   double error = std::numeric_limits<double>::quiet_NaN();    // E / E_ref - 1
   int local_minima = 0;  // valleys of the functional the global scan ran on
+  // The search functional's minimiser E_search [Pa] (two stages), NaN otherwise.
+  double search_modulus = std::numeric_limits<double>::quiet_NaN();
   int evaluations = 0;   // of every functional: scans and refinements
   double wall_time_s = std::numeric_limits<double>::quiet_NaN();
 };
