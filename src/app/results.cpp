@@ -528,7 +528,8 @@ std::string SummaryYaml(const IdentificationRun& run) {
               "(identified - reference) / reference (null when unknown)");
   yaml.Number(0, "cost", run.cost(), "[J s] e^2 at the identified modulus");
   yaml.Integer(0, "evaluations", outer.scan_evaluations + outer.evaluations,
-               "e^2 evaluations of the identification: the scan's and the refinements'");
+               "evaluations of the identification: the scans' and the refinements' (the search "
+               "functional's included)");
   yaml.Integer(0, "sweeps", outer.scan_sweeps + run.sweeps,
                "direct + retrograde sweeps of those evaluations");
   yaml.Number(0, "wall_time_s", run.wall_time_s,
