@@ -567,7 +567,7 @@ const std::vector<Key>& KeyTable() {
               "stop when a step changes E by less than this fraction of E"),
       MakeKey("outer.max_evaluations", &Config::outer, &IdentificationOptions::max_evaluations,
               PositiveInteger<int>(), "",
-              "e^2 evaluations allowed to the identification, the scan's included"),
+              "evaluations allowed to the identification, the scans' and the search's included"),
       MakeKey("outer.max_time", &Config::outer, &IdentificationOptions::max_time, Number(), "s",
               "wall time allowed to the identification, scan included"),
       MakeKey("outer.scan_points", &Config::outer, &IdentificationOptions::scan_points,

@@ -106,8 +106,8 @@ struct IdentificationOptions {
   // Stop when a step changes E by less than this fraction of E (NLopt xtol_rel;
   // Ceres parameter_tolerance on x).
   double relative_tolerance = 1e-7;
-  // e^2 evaluations allowed to the whole identification, the scan's included;
-  // reaching the limit is not convergence.
+  // Evaluations allowed to the whole identification, the scans' included (and, in
+  // two stages, the search functional's); reaching the limit is not convergence.
   int max_evaluations = 1000;
   // Wall time allowed to the whole identification (scan and refinements) [s];
   // reaching it is not convergence.
