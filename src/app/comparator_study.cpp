@@ -346,8 +346,7 @@ ComparatorStudy RunComparatorStudy(const Config& config) {
   study.reference_modulus = config.model.modulus;
   study.model_errors = config.study.comparator_errors;
   study.snrs = config.study.comparator_snr;
-  study.mcre_scans_search =
-      config.outer.scan_points > 0 && config.search.functional == SearchFunctional::kPinned;
+  study.mcre_scans_search = ScansTheSearchFunctional(config);
   for (const std::string& data : config.study.comparator_data) {
     study.prefilters.push_back(data == "prefilter");
   }

@@ -819,6 +819,7 @@ std::string StructureKeysProblem(const Config& config) {
     }
     return "";
   }
+  const char* search_key = SearchKeyNotAtItsDefault(config.search);
   const std::pair<const char*, bool> bar_keys[] = {
       {"model.zoning", config.zones.zoning != defaults.zones.zoning},
       {"model.zone_count", config.zones.zone_count != defaults.zones.zone_count},
@@ -831,7 +832,7 @@ std::string StructureKeysProblem(const Config& config) {
       {"mcre.w_u0", config.mcre.weights.clamp_displacement_weight !=
                         defaults.mcre.weights.clamp_displacement_weight},
       {"search.functional", config.search.functional != defaults.search.functional},
-      {SearchKeyNotAtItsDefault(config.search), SearchKeyNotAtItsDefault(config.search) != nullptr},
+      {search_key, search_key != nullptr},
   };
   for (const auto& [key, set] : bar_keys) {
     if (set) {
@@ -903,9 +904,9 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
       // outer.scan_max_points, and both with two evaluations of a refinement each
       // within outer.max_evaluations.
       [](const Config& config, std::string* error) {
-        if (config.structure.kind != ModelKind::kBar || config.outer.scan_points == 0 ||
+        if (config.structure.kind != ModelKind::kBar ||
             config.outer.functional != OuterFunctional::kMcre ||
-            config.search.functional != SearchFunctional::kPinned) {
+            !ScansTheSearchFunctional(config)) {
           return true;
         }
         const int least_evaluations = config.search.scan_points + kTwoStageWindowScanPoints + 4;
@@ -1031,8 +1032,7 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
                    remedy;
         } else if (!uses("u0") || !uses("uL")) {
           *error = prefix + "but data.channels leaves out " + (uses("u0") ? "uL" : "u0") + remedy;
-        } else if (config.search.functional == SearchFunctional::kPinned &&
-                   config.outer.scan_points > 0) {
+        } else if (ScansTheSearchFunctional(config)) {
           *error = prefix +
                    "but search.functional is 'pinned' (the global scan's clamp is pinned)" +
                    remedy + ", or search.functional: same";
@@ -1477,6 +1477,10 @@ Config LoadConfig(const std::string& path, const std::vector<std::string>& overr
 }
 
 std::string ConfigProblem(const Config& config) { return FirstProblem(config); }
+
+bool ScansTheSearchFunctional(const Config& config) {
+  return config.outer.scan_points > 0 && config.search.functional == SearchFunctional::kPinned;
+}
 
 std::string DefaultConfigYaml() {
   return "# mcrewave configuration: every key at its default value (SI units).\n"

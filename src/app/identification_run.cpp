@@ -193,7 +193,7 @@ McreIdentification IdentifyWithMcre(const Config& config, const BarModel& model,
   result.objective = std::make_unique<McreObjective>(model, data, config.mcre, config.time.theta,
                                                      config.inner, config.outer.initial, ends);
   result.scan_cost_scale = result.objective->cost_scale();
-  if (config.outer.scan_points == 0 || config.search.functional == SearchFunctional::kSame) {
+  if (!ScansTheSearchFunctional(config)) {
     result.outer = Identify(config.outer, result.objective.get());
     return result;
   }
@@ -217,17 +217,15 @@ IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& da
   run.data = IdentificationData(config, data, &run.ends, &run.prefilter_cutoff);
 
   const BarModel model(config.model);
-  const bool two_stages =
-      config.outer.scan_points > 0 && config.search.functional == SearchFunctional::kPinned;
   spdlog::info(
       "identifying E with {}/{} from {:.6g} Pa in [{:.6g}, {:.6g}] Pa; inner {}; global scan on {}",
       OptimizerTypeToString(config.outer.optimizer),
       OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
       config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
       CoupledSolverTypeToString(config.inner.type),
-      config.outer.scan_points == 0 ? "none (outer.scan_points 0)"
-      : two_stages                  ? "the pinned search functional (search:)"
-                                    : "mcre:'s e^2");
+      config.outer.scan_points == 0      ? "none (outer.scan_points 0)"
+      : ScansTheSearchFunctional(config) ? "the pinned search functional (search:)"
+                                         : "mcre:'s e^2");
   McreIdentification identification = IdentifyWithMcre(config, model, run.data, run.ends);
   McreObjective& objective = *identification.objective;
   run.alpha = objective.problem().alpha();
