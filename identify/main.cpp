@@ -18,6 +18,8 @@
 //   identify study configs/studies.yaml --set study.kind=robustness --set study.robustness_seeds=10
 //   identify study configs/paper_bar.yaml --set study.kind=comparator
 //   identify run configs/paper_bar.yaml --set outer.functional=least_squares -o /tmp/ls
+//   identify run configs/quick.yaml --set outer.functional=least_squares --set model.zone_count=10
+//       --set 'data.truth_zones=[{start: 0.6, end: 0.7, modulus: 140e9}]' -o /tmp/ls_zones
 //   identify run configs/plate.yaml --output /tmp/plate
 //   identify simulate configs/plate.yaml --output plate.csv
 //   identify run configs/plate.yaml --set data.source=csv --set data.path=$PWD/plate.csv -o /tmp/p
@@ -246,13 +248,6 @@ int RunIdentify(const RunArguments& arguments) {
   if (!arguments.output_folder.empty()) config.output.folder = arguments.output_folder;
   CheckOutputFolder(config.output.folder);
   if (config.structure.kind == mcrewave::ModelKind::kMatrix) return IdentifyMatrixModel(config);
-  if (config.outer.functional == mcrewave::OuterFunctional::kLeastSquares &&
-      config.zones.ElementZones(config.model).back() > 0) {
-    throw mcrewave::InputError(arguments.config_path +
-                               ": outer.functional 'least_squares' identifies one modulus; the "
-                               "zones of model.zoning / model.zone_count are identified by the "
-                               "MCRE only (outer.functional 'mcre')");
-  }
 
   // 2. The measurements, checked against the model's time grid.
   const mcrewave::MeasurementSet data = mcrewave::LoadMeasurements(config);

@@ -357,6 +357,23 @@ NoiseLevels MeasurementNoiseLevels(const Config& config, const MeasurementSet& d
   return noise;
 }
 
+NoiseLevels LeastSquaresMisfitLevels(const Config& config, const MeasurementSet& data,
+                                     const MeasurementSet& used, std::string* source) {
+  NoiseLevels levels = MeasurementNoiseLevels(config, data, source);
+  // Noise-free data have no level to normalise by: the RMS of the channels instead
+  // (only the ratio of the weights matters then, as in the comparator study).
+  for (auto [level, rms] :
+       {std::pair<double*, double>{&levels.displacement_std, RootMeanSquare(used.uL)},
+        {&levels.force_std, RootMeanSquare(used.fL)},
+        {&levels.strain_std, StrainRms(used)}}) {
+    if (!(*level > 0.0) && rms > 0.0) {
+      *level = rms;
+      *source = "channel_rms";
+    }
+  }
+  return levels;
+}
+
 LeastSquaresRun RunLeastSquares(const Config& config, const MeasurementSet& data) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
@@ -364,18 +381,8 @@ LeastSquaresRun RunLeastSquares(const Config& config, const MeasurementSet& data
   run.config = config;
   run.reference_known = config.data.source == DataSource::kSynthetic;
   run.data = IdentificationData(config, data, &run.ends, &run.prefilter_cutoff);
-  run.noise = MeasurementNoiseLevels(config, data, &run.noise_source);
-  // Noise-free data have no level to normalise by: the RMS of the channels instead
-  // (only the ratio of the weights matters then, as in the comparator study).
-  for (auto [level, rms] :
-       {std::pair<double*, double>{&run.noise.displacement_std, RootMeanSquare(run.data.uL)},
-        {&run.noise.force_std, RootMeanSquare(run.data.fL)},
-        {&run.noise.strain_std, StrainRms(run.data)}}) {
-    if (!(*level > 0.0) && rms > 0.0) {
-      *level = rms;
-      run.noise_source = "channel_rms";
-    }
-  }
+  run.noise = LeastSquaresMisfitLevels(config, data, run.data, &run.noise_source);
+  run.estimated_noise = DifferenceNoiseLevels(data);
   const BarModel model(config.model);
   OutputErrorObjective objective(model, run.data, run.noise, config.time.theta,
                                  config.outer.initial, run.ends);
@@ -414,6 +421,10 @@ LeastSquaresRun RunLeastSquares(const Config& config, const MeasurementSet& data
     }
   }
   run.sweeps = objective.sweeps() + run.outer.scan_sweeps;
+  if (run.IsUsable()) {
+    run.zones = RunLeastSquaresZoneIdentification(config, IdentificationZoneLayout(config), run,
+                                                  TruthZones(config));
+  }
   run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return run;
 }

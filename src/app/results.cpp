@@ -777,6 +777,9 @@ std::string LeastSquaresSummaryYaml(const LeastSquaresRun& run) {
               "[Pa]");
   yaml.Number(1, "highest_modulus", run.cost_curve.empty() ? NAN : run.cost_curve.back().modulus,
               "[Pa]");
+  if (run.zones.ran) {
+    for (const std::string& line : ZonesYamlLines(run.zones)) yaml.Raw(line);
+  }
   ConfigYaml(run.config, &yaml);
   return yaml.str();
 }
@@ -794,6 +797,7 @@ std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
     results.Draw({{"cost_curve", LeastSquaresCostCurveScript(run, folder)},
                   {"fit", FitScript(run, folder)}});
   }
+  results.Add(WriteZoneResults(run.zones, run.config.model, folder, figures));
   // The summary last: its presence says the folder is complete.
   results.Write("summary.yaml", LeastSquaresSummaryYaml(run));
   return results.written();

@@ -59,9 +59,14 @@ std::vector<ModulusZone> TruthZones(const Config& config) {
   return config.data.truth_zones;
 }
 
-ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayout& layout,
-                                            const IdentificationRun& scalar,
-                                            const std::vector<ModulusZone>& truth_zones) {
+namespace {
+
+// The run's layout, truth and pre-filter, and `identify` (the zones' identification on
+// the zoned model with that pre-filter) when the layout has more than one zone.
+template <typename Scalar, typename Identify>
+ZoneIdentificationRun RunZones(const Config& config, const ZoneLayout& layout, const Scalar& scalar,
+                               const std::vector<ModulusZone>& truth_zones, const char* functional,
+                               Identify&& identify) {
   ZoneIdentificationRun run;
   run.layout = layout;
   const BarModel model(config.model, layout.ElementZones(config.model));
@@ -70,15 +75,40 @@ ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayo
   if (scalar.reference_known) run.truth_element_moduli = ElementModuli(config.model, truth_zones);
   PrefilterOptions prefilter = config.prefilter;
   prefilter.cutoff_frequency = scalar.prefilter_cutoff;
-  spdlog::info("zones: identifying {} zone moduli from E* = {:.9g} Pa", model.num_zones(),
-               scalar.identified_modulus());
-  run.summary = IdentifyZoneModuli(
-      config.zone_identification, model, scalar.data, config.mcre, config.time.theta, config.inner,
-      scalar.ends, scalar.identified_modulus(), config.outer.lower_bound, config.outer.upper_bound,
-      scalar.estimated_noise, prefilter,
-      scalar.solution.WarmStart().size() > 0 ? &scalar.solution.WarmStart() : nullptr);
+  spdlog::info("zones: identifying {} zone moduli by {} from E* = {:.9g} Pa", model.num_zones(),
+               functional, scalar.identified_modulus());
+  run.summary = identify(model, prefilter);
   spdlog::info("zones: {}", run.summary.BriefReport());
   return run;
+}
+
+}  // namespace
+
+ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayout& layout,
+                                            const IdentificationRun& scalar,
+                                            const std::vector<ModulusZone>& truth_zones) {
+  return RunZones(
+      config, layout, scalar, truth_zones, "the MCRE",
+      [&](const BarModel& model, const PrefilterOptions& prefilter) {
+        return IdentifyZoneModuli(
+            config.zone_identification, model, scalar.data, config.mcre, config.time.theta,
+            config.inner, scalar.ends, scalar.identified_modulus(), config.outer.lower_bound,
+            config.outer.upper_bound, scalar.estimated_noise, prefilter,
+            scalar.solution.WarmStart().size() > 0 ? &scalar.solution.WarmStart() : nullptr);
+      });
+}
+
+ZoneIdentificationRun RunLeastSquaresZoneIdentification(
+    const Config& config, const ZoneLayout& layout, const LeastSquaresRun& scalar,
+    const std::vector<ModulusZone>& truth_zones) {
+  return RunZones(config, layout, scalar, truth_zones, "output-error least squares",
+                  [&](const BarModel& model, const PrefilterOptions& prefilter) {
+                    return IdentifyZoneModuliByLeastSquares(
+                        config.zone_identification, model, scalar.data, scalar.noise,
+                        config.time.theta, scalar.ends, scalar.identified_modulus(),
+                        config.outer.lower_bound, config.outer.upper_bound, scalar.estimated_noise,
+                        prefilter);
+                  });
 }
 
 std::vector<std::string> ZonesYamlLines(const ZoneIdentificationRun& run) {
@@ -89,24 +119,28 @@ std::vector<std::string> ZonesYamlLines(const ZoneIdentificationRun& run) {
     lines.push_back(std::string(2 * indent, ' ') + key + ":" + (value.empty() ? "" : " " + value) +
                     (comment.empty() ? "" : "  # " + comment));
   };
+  // The cost: the MCRE's e^2 [J s], or least squares' J [s] (outer.functional).
+  const std::string cost = s.least_squares ? "J" : "e^2";
+  const std::string unit = s.least_squares ? "[s] " : "[J s] ";
   line(0, "zones", "", "identification of every zone modulus from the homogeneous E*");
+  line(1, "functional", s.least_squares ? "least_squares" : "mcre", "outer.functional");
   line(1, "count", std::to_string(s.moduli.size()));
   line(1, "termination", TerminationTypeToString(s.termination));
   line(1, "message", "\"" + s.message + "\"");
   line(1, "homogeneous_modulus", Number(s.homogeneous_modulus), "[Pa] E*, the start");
-  line(1, "cost", Number(s.cost), "[J s] e^2 at the zone moduli");
-  line(1, "homogeneous_cost", Number(s.homogeneous_cost), "[J s] e^2 at E* in every zone");
+  line(1, "cost", Number(s.cost), unit + cost + " at the zone moduli");
+  line(1, "homogeneous_cost", Number(s.homogeneous_cost), unit + cost + " at E* in every zone");
   line(1, "algorithm", BoundedAlgorithmToString(s.regularized.minimizer.algorithm));
   line(1, "regularization_weight", Number(s.regularized.weight),
        "lambda of the jump penalty on log E");
   line(1, "weight_choice", s.regularized.weight_choice);
   line(1, "target_misfit", Number(s.regularized.target_misfit),
-       "e^2 / J_rest the noise explains (discrepancy principle; -1: not used)");
+       cost + " / J_rest the noise explains (discrepancy principle; -1: not used)");
   // The moduli reported are the merges' last refit when a merge was kept.
   const double misfit = s.merge.x.empty() ? s.regularized.misfit : s.merge.misfit;
-  line(1, "misfit", Number(misfit), "e^2 / J_rest at the zone moduli (merged, if any merge)");
+  line(1, "misfit", Number(misfit), cost + " / J_rest at the zone moduli (merged, if any merge)");
   line(1, "misfit_floor", Number(s.regularized.misfit_floor),
-       "e^2 / J_rest at the grid's lightest weight when the target was missed (-1: met)");
+       cost + " / J_rest at the grid's lightest weight when the target was missed (-1: met)");
   line(1, "weights_tried", std::to_string(s.regularized.path.size()));
   line(1, "groups", std::to_string(s.merge.groups),
        "zones left distinct by merging (-1: zone_identification.merge_zones off)");

@@ -9,6 +9,42 @@
 
 namespace mcrewave {
 
+void OutputErrorSensorRows(const BarModel& model, const MeasurementSet& data,
+                           const NoiseLevels& noise, std::vector<ObservationRow>* rows,
+                           std::vector<double>* weights) {
+  rows->clear();
+  weights->clear();
+  for (const SensorChannel& sensor : data.sensors) {
+    const bool strain = sensor.kind == SensorKind::kStrain;
+    assert(!strain || noise.strain_std > 0.0);
+    rows->push_back(strain ? model.StrainRow(sensor.position)
+                           : model.DisplacementRow(sensor.position));
+    const double level = strain ? noise.strain_std : noise.displacement_std;
+    weights->push_back(1.0 / (level * level));
+  }
+}
+
+double OutputErrorRestCost(const MeasurementSet& data, const NoiseLevels& noise,
+                           const std::vector<double>& sensor_weights,
+                           EndDisplacementChannels ends) {
+  const int samples = data.num_samples();
+  const double h = data.time_step;
+  const double weight_u = 1.0 / (noise.displacement_std * noise.displacement_std);
+  const double weight_f = 1.0 / (noise.force_std * noise.force_std);
+  double rest_cost = 0.0;
+  for (int k = 0; k < samples; ++k) {
+    // c_k h / 2 [uL~^2 / s_u^2 + f0~^2 / s_f^2 + sum sensors]
+    const double c = (k == 0 || k == samples - 1) ? 0.5 : 1.0;
+    double sum = weight_f * data.f0[k] * data.f0[k];
+    if (ends.uL) sum += weight_u * data.uL[k] * data.uL[k];
+    for (std::size_t i = 0; i < data.sensors.size(); ++i) {
+      sum += sensor_weights[i] * data.sensors[i].values[k] * data.sensors[i].values[k];
+    }
+    rest_cost += 0.5 * c * h * sum;
+  }
+  return rest_cost;
+}
+
 OutputErrorObjective::OutputErrorObjective(const BarModel& model, const MeasurementSet& data,
                                            const NoiseLevels& noise, double theta,
                                            double modulus_scale, EndDisplacementChannels ends)
@@ -27,14 +63,7 @@ OutputErrorObjective::OutputErrorObjective(const BarModel& model, const Measurem
   if (!mass_factor_.Compute(SymmetricBandMatrix(free_mass_))) {
     throw std::runtime_error("output-error model: the mass matrix is not positive definite");
   }
-  for (const SensorChannel& sensor : data.sensors) {
-    const bool strain = sensor.kind == SensorKind::kStrain;
-    assert(!strain || noise.strain_std > 0.0);
-    sensor_rows_.push_back(strain ? model.StrainRow(sensor.position)
-                                  : model.DisplacementRow(sensor.position));
-    const double level = strain ? noise.strain_std : noise.displacement_std;
-    sensor_weights_.push_back(1.0 / (level * level));
-  }
+  OutputErrorSensorRows(model, data, noise, &sensor_rows_, &sensor_weights_);
   const int free = model.num_nodes() - 1;
   for (Vector* scratch :
        {&velocity_, &displacement_, &next_velocity_, &next_displacement_, &sensitivity_velocity_,
@@ -47,21 +76,7 @@ OutputErrorObjective::OutputErrorObjective(const BarModel& model, const Measurem
   prediction_.uL.setZero(samples);
   prediction_.f0.setZero(samples);
   prediction_.sensors.assign(data.sensors.size(), Vector::Zero(samples));
-
-  // J_rest: every prediction 0.
-  const double h = data.time_step;
-  const double weight_u = 1.0 / (noise.displacement_std * noise.displacement_std);
-  const double weight_f = 1.0 / (noise.force_std * noise.force_std);
-  for (int k = 0; k < samples; ++k) {
-    // c_k h / 2 [uL~^2 / s_u^2 + f0~^2 / s_f^2 + sum sensors]
-    const double c = (k == 0 || k == samples - 1) ? 0.5 : 1.0;
-    double sum = weight_f * data.f0[k] * data.f0[k];
-    if (ends_.uL) sum += weight_u * data.uL[k] * data.uL[k];
-    for (std::size_t i = 0; i < data.sensors.size(); ++i) {
-      sum += sensor_weights_[i] * data.sensors[i].values[k] * data.sensors[i].values[k];
-    }
-    rest_cost_ += 0.5 * c * h * sum;
-  }
+  rest_cost_ = OutputErrorRestCost(data, noise, sensor_weights_, ends_);
 }
 
 std::unique_ptr<ModulusObjective> OutputErrorObjective::CloneForScan(double) const {

@@ -9,6 +9,8 @@
 #include <random>
 #include <sstream>
 
+#include "mcrewave/least_squares/zone_output_error_objective.h"
+
 namespace mcrewave {
 
 ZoneMcreObjective::ZoneMcreObjective(McreObjective* objective, double modulus_scale)
@@ -69,8 +71,9 @@ bool ZoneIdentificationOptions::IsValid(std::string* error) const {
 
 std::string ZoneIdentificationSummary::BriefReport() const {
   std::ostringstream out;
-  out << TerminationTypeToString(termination) << ": " << moduli.size() << " zones, e^2 " << cost
-      << " J s (homogeneous " << homogeneous_cost << "), weight " << regularized.weight << " ("
+  out << TerminationTypeToString(termination) << ": " << moduli.size() << " zones, "
+      << (least_squares ? "J " : "e^2 ") << cost << (least_squares ? " s" : " J s")
+      << " (homogeneous " << homogeneous_cost << "), weight " << regularized.weight << " ("
       << regularized.weight_choice << ")";
   if (merge.groups >= 0) out << ", " << merge.groups << " groups after merging";
   out << ", " << evaluations << " evaluations, " << wall_time_s << " s";
@@ -83,7 +86,8 @@ std::string ZoneIdentificationSummary::FullReport() const {
       << "  termination:        " << TerminationTypeToString(termination) << "\n"
       << "  message:            " << message << "\n"
       << "  homogeneous E*:     " << homogeneous_modulus << " Pa\n"
-      << "  e^2:                " << cost << " J s (at E*: " << homogeneous_cost << ")\n"
+      << (least_squares ? "  J:                  " : "  e^2:                ") << cost
+      << (least_squares ? " s" : " J s") << " (at E*: " << homogeneous_cost << ")\n"
       << "  weight:             " << regularized.weight << " (" << regularized.weight_choice
       << ", target misfit " << regularized.target_misfit << ", noise e^2 / J_rest " << noise_cost
       << ")\n";
@@ -102,35 +106,136 @@ std::string ZoneIdentificationSummary::FullReport() const {
   return out.str();
 }
 
+namespace {
+
+// `drawn` (a copy of the data) with every channel replaced by white noise at `noise`'s
+// levels, then pre-filtered as `prefilter` says.
+MeasurementSet DrawNoiseAlone(const PrefilterOptions& prefilter, const NoiseLevels& noise,
+                              std::mt19937_64* engine, MeasurementSet* drawn) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (Vector* channel : {&drawn->u0, &drawn->uL}) {
+    for (double& value : *channel) value = noise.displacement_std * normal(*engine);
+  }
+  for (Vector* channel : {&drawn->f0, &drawn->fL}) {
+    for (double& value : *channel) value = noise.force_std * normal(*engine);
+  }
+  for (SensorChannel& sensor : drawn->sensors) {
+    const double level =
+        sensor.kind == SensorKind::kStrain ? noise.strain_std : noise.displacement_std;
+    for (double& value : sensor.values) value = level * normal(*engine);
+  }
+  return prefilter.enabled ? PrefilterMeasurements(*drawn, prefilter) : *drawn;
+}
+
+// The zone extents [m] of `model`'s zones, from the elements each holds.
+void ZoneExtents(const BarModel& model, ZoneIdentificationSummary* summary) {
+  const int zones = model.num_zones();
+  summary->zone_start.assign(zones, model.properties().length);
+  summary->zone_end.assign(zones, 0.0);
+  for (int e = 0; e < model.num_elements(); ++e) {
+    const int z = model.element_zone(e);
+    summary->zone_start[z] = std::min(summary->zone_start[z], model.node_position(e));
+    summary->zone_end[z] = std::max(summary->zone_end[z], model.node_position(e + 1));
+  }
+}
+
+// The steps both functionals share, on zone_objective (a function of p_z =
+// log(E_z / E*), its cost scaled by summary->cost_scale, which the caller has set):
+// the discrepancy target from expected_noise_cost() (the scaled cost of noise alone;
+// negative: not usable) when the weight rule or the merging needs it, the regularised
+// minimisation from E* in every zone, the merging, and the moduli, cost and zones on a
+// bound. False (the summary says why) when the target's noise cost is not usable.
+template <typename NoiseCost>
+bool MinimizeOverZones(const ZoneIdentificationOptions& options, int zones,
+                       MultiParameterObjective* zone_objective, double lower_bound,
+                       double upper_bound, NoiseCost&& expected_noise_cost,
+                       ZoneIdentificationSummary* summary) {
+  const double homogeneous_modulus = summary->homogeneous_modulus;
+  const std::vector<double> lower(zones, std::log(lower_bound / homogeneous_modulus));
+  const std::vector<double> upper(zones, std::log(upper_bound / homogeneous_modulus));
+  const std::vector<double> initial(zones, 0.0);
+
+  double target = -1.0;
+  const bool automatic = options.regularization.kind != RegularizationKind::kNone &&
+                         options.regularization.weight < 0.0;
+  if (automatic || options.merge_zones) {
+    summary->noise_cost = expected_noise_cost();
+    if (summary->noise_cost < 0.0) {
+      summary->termination = TerminationType::kFailure;
+      summary->message = "a noise solve of the discrepancy target is not usable";
+      return false;
+    }
+    target = options.regularization.discrepancy_factor * summary->noise_cost;
+    spdlog::info("zones: discrepancy target {:.6g} (noise alone, {} draws)", target,
+                 options.noise_samples);
+  }
+  summary->regularized = MinimizeRegularized(options.minimizer, options.regularization,
+                                             zone_objective, lower, upper, initial, target);
+  const RegularizedMinimization& result = summary->regularized;
+  summary->termination = result.minimizer.termination;
+  summary->message = result.minimizer.message;
+  if (options.merge_zones && result.IsSolutionUsable()) {
+    // The merges' target: the discrepancy target or, when no weight of the grid met it
+    // (a draw whose noise cost lies above the mean the target is), the misfit floor's,
+    // as the weight's own fallback.
+    summary->merge = MergeNeighbouringZones(options.minimizer, zone_objective, lower, upper,
+                                            result.x, result.AttainableTarget());
+    spdlog::info("zones: {} merge(s) kept in {} refits: {} groups", summary->merge.merges,
+                 summary->merge.refits, summary->merge.groups);
+  }
+  const bool merged = !summary->merge.x.empty();
+  const std::vector<double>& x = merged ? summary->merge.x : result.x;
+  if (!x.empty()) {
+    summary->moduli.resize(zones);
+    for (int z = 0; z < zones; ++z) summary->moduli[z] = homogeneous_modulus * std::exp(x[z]);
+    summary->cost = (merged ? summary->merge.misfit : result.misfit) * summary->cost_scale;
+    for (int z = 0; z < zones; ++z) {
+      if (std::abs(x[z] - lower[z]) < 1e-6 || std::abs(x[z] - upper[z]) < 1e-6) {
+        summary->zones_on_bounds.push_back(z);
+      }
+    }
+    if (!summary->zones_on_bounds.empty()) {
+      spdlog::warn("zones: {} zone(s) on a bound of [outer.lower_bound, outer.upper_bound]",
+                   summary->zones_on_bounds.size());
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 double ExpectedNoiseCost(const BarModel& model, const MeasurementSet& data, const McreOptions& mcre,
                          double theta, const CoupledSolverOptions& inner,
                          EndDisplacementChannels ends, const Vector& moduli,
                          const NoiseLevels& noise, const PrefilterOptions& prefilter, int samples,
                          std::uint64_t seed, double cost_scale) {
   std::mt19937_64 engine(seed);
-  std::normal_distribution<double> normal(0.0, 1.0);
   MeasurementSet drawn = data;
   double sum = 0.0;
   for (int sample = 0; sample < samples; ++sample) {
-    for (Vector* channel : {&drawn.u0, &drawn.uL}) {
-      for (double& value : *channel) value = noise.displacement_std * normal(engine);
-    }
-    for (Vector* channel : {&drawn.f0, &drawn.fL}) {
-      for (double& value : *channel) value = noise.force_std * normal(engine);
-    }
-    for (SensorChannel& sensor : drawn.sensors) {
-      const double level =
-          sensor.kind == SensorKind::kStrain ? noise.strain_std : noise.displacement_std;
-      for (double& value : sensor.values) value = level * normal(engine);
-    }
-    const MeasurementSet noise_data =
-        prefilter.enabled ? PrefilterMeasurements(drawn, prefilter) : drawn;
+    const MeasurementSet noise_data = DrawNoiseAlone(prefilter, noise, &engine, &drawn);
     McreObjective objective(model, noise_data, mcre, theta, inner, moduli[0], ends);
     const ObjectiveEvaluation& record = objective.EvaluateModuli(moduli, false);
     if (!record.usable) return -1.0;
     sum += record.cost;
   }
   return sum / samples / cost_scale;
+}
+
+double ExpectedLeastSquaresNoiseCost(const BarModel& model, const MeasurementSet& data,
+                                     const NoiseLevels& misfit_levels, double theta,
+                                     EndDisplacementChannels ends, const Vector& moduli,
+                                     const NoiseLevels& noise, const PrefilterOptions& prefilter,
+                                     int samples, std::uint64_t seed, double cost_scale) {
+  std::mt19937_64 engine(seed);
+  MeasurementSet drawn = data;
+  double sum = 0.0;
+  for (int sample = 0; sample < samples; ++sample) {
+    const MeasurementSet noise_data = DrawNoiseAlone(prefilter, noise, &engine, &drawn);
+    ZoneOutputErrorObjective objective(model, noise_data, misfit_levels, theta, moduli[0], ends);
+    sum += objective.Cost(moduli, nullptr);
+  }
+  return std::isfinite(sum) ? sum / samples / cost_scale : -1.0;
 }
 
 ZoneIdentificationSummary IdentifyZoneModuli(
@@ -140,21 +245,11 @@ ZoneIdentificationSummary IdentifyZoneModuli(
     double upper_bound, const NoiseLevels& noise, const PrefilterOptions& prefilter,
     const Matrix* warm_start) {
   const auto start = std::chrono::steady_clock::now();
-  const auto elapsed = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  };
   ZoneIdentificationSummary summary;
   summary.homogeneous_modulus = homogeneous_modulus;
   summary.noise = noise;
+  ZoneExtents(model, &summary);
   const int zones = model.num_zones();
-  // Zone extents from the elements each holds.
-  summary.zone_start.assign(zones, model.properties().length);
-  summary.zone_end.assign(zones, 0.0);
-  for (int e = 0; e < model.num_elements(); ++e) {
-    const int z = model.element_zone(e);
-    summary.zone_start[z] = std::min(summary.zone_start[z], model.node_position(e));
-    summary.zone_end[z] = std::max(summary.zone_end[z], model.node_position(e + 1));
-  }
   try {
     McreObjective objective(model, data, mcre, theta, inner, homogeneous_modulus, ends);
     const McreProblem& problem = objective.problem();
@@ -164,66 +259,62 @@ ZoneIdentificationSummary IdentifyZoneModuli(
     }
     summary.cost_scale = objective.cost_scale();
     ZoneMcreObjective zone_objective(&objective, homogeneous_modulus);
-    const std::vector<double> lower(zones, std::log(lower_bound / homogeneous_modulus));
-    const std::vector<double> upper(zones, std::log(upper_bound / homogeneous_modulus));
-    const std::vector<double> initial(zones, 0.0);
-
-    double target = -1.0;
-    const bool automatic = options.regularization.kind != RegularizationKind::kNone &&
-                           options.regularization.weight < 0.0;
-    if (automatic || options.merge_zones) {
-      summary.noise_cost = ExpectedNoiseCost(
-          model, data, mcre, theta, inner, ends, Vector::Constant(zones, homogeneous_modulus),
-          noise, prefilter, options.noise_samples, options.noise_seed, summary.cost_scale);
-      if (summary.noise_cost < 0.0) {
-        summary.termination = TerminationType::kFailure;
-        summary.message = "a noise solve of the discrepancy target is not usable";
-        summary.wall_time_s = elapsed();
-        return summary;
-      }
-      target = options.regularization.discrepancy_factor * summary.noise_cost;
-      spdlog::info("zones: discrepancy target e^2 / J_rest = {:.6g} (noise alone, {} draws)",
-                   target, options.noise_samples);
-    }
-    summary.regularized = MinimizeRegularized(options.minimizer, options.regularization,
-                                              &zone_objective, lower, upper, initial, target);
+    MinimizeOverZones(
+        options, zones, &zone_objective, lower_bound, upper_bound,
+        [&] {
+          return ExpectedNoiseCost(model, data, mcre, theta, inner, ends,
+                                   Vector::Constant(zones, homogeneous_modulus), noise, prefilter,
+                                   options.noise_samples, options.noise_seed, summary.cost_scale);
+        },
+        &summary);
     if (!objective.evaluations().empty() && objective.evaluations().front().usable) {
       summary.homogeneous_cost = objective.evaluations().front().cost;
     }
-    const RegularizedMinimization& result = summary.regularized;
-    summary.termination = result.minimizer.termination;
-    summary.message = result.minimizer.message;
-    if (options.merge_zones && result.IsSolutionUsable()) {
-      // The merges' target: the discrepancy target or, when no weight of the grid met it
-      // (a draw whose noise e^2 lies above the mean the target is), the misfit floor's,
-      // as the weight's own fallback.
-      summary.merge = MergeNeighbouringZones(options.minimizer, &zone_objective, lower, upper,
-                                             result.x, result.AttainableTarget());
-      spdlog::info("zones: {} merge(s) kept in {} refits: {} groups", summary.merge.merges,
-                   summary.merge.refits, summary.merge.groups);
-    }
     summary.evaluations = zone_objective.evaluations();
     summary.sweeps = objective.sweeps();
-    const bool merged = !summary.merge.x.empty();
-    const std::vector<double>& x = merged ? summary.merge.x : result.x;
-    if (!x.empty()) {
-      summary.moduli = zone_objective.Moduli(x.data());
-      summary.cost = (merged ? summary.merge.misfit : result.misfit) * summary.cost_scale;
-      for (int z = 0; z < zones; ++z) {
-        if (std::abs(x[z] - lower[z]) < 1e-6 || std::abs(x[z] - upper[z]) < 1e-6) {
-          summary.zones_on_bounds.push_back(z);
-        }
-      }
-      if (!summary.zones_on_bounds.empty()) {
-        spdlog::warn("zones: {} zone(s) on a bound of [outer.lower_bound, outer.upper_bound]",
-                     summary.zones_on_bounds.size());
-      }
-    }
   } catch (const std::exception& error) {
     summary.termination = TerminationType::kFailure;
     summary.message = std::string("the zone identification failed: ") + error.what();
   }
-  summary.wall_time_s = elapsed();
+  summary.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+ZoneIdentificationSummary IdentifyZoneModuliByLeastSquares(
+    const ZoneIdentificationOptions& options, const BarModel& model, const MeasurementSet& data,
+    const NoiseLevels& misfit_levels, double theta, EndDisplacementChannels ends,
+    double homogeneous_modulus, double lower_bound, double upper_bound, const NoiseLevels& noise,
+    const PrefilterOptions& prefilter) {
+  const auto start = std::chrono::steady_clock::now();
+  ZoneIdentificationSummary summary;
+  summary.least_squares = true;
+  summary.homogeneous_modulus = homogeneous_modulus;
+  summary.noise = noise;
+  ZoneExtents(model, &summary);
+  const int zones = model.num_zones();
+  try {
+    ZoneOutputErrorObjective objective(model, data, misfit_levels, theta, homogeneous_modulus,
+                                       ends);
+    summary.cost_scale = objective.cost_scale();
+    summary.homogeneous_cost =
+        objective.Cost(Vector::Constant(zones, homogeneous_modulus), nullptr);
+    MinimizeOverZones(
+        options, zones, &objective, lower_bound, upper_bound,
+        [&] {
+          return ExpectedLeastSquaresNoiseCost(
+              model, data, misfit_levels, theta, ends, Vector::Constant(zones, homogeneous_modulus),
+              noise, prefilter, options.noise_samples, options.noise_seed, summary.cost_scale);
+        },
+        &summary);
+    summary.evaluations = objective.evaluations();
+    summary.sweeps = objective.sweeps();
+  } catch (const std::exception& error) {
+    summary.termination = TerminationType::kFailure;
+    summary.message = std::string("the least-squares zone identification failed: ") + error.what();
+  }
+  summary.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }
 

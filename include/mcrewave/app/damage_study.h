@@ -35,6 +35,23 @@ const std::vector<DamageTruth>& DamageTruths();
 // The interior sensors of the study.
 const std::vector<std::string>& DamageInteriorSensors();
 
+// The zones of one run identified by output-error least squares (10 equal zones only):
+// the MCRE's comparator on the same data, zones, start E*, penalty, weight rule and
+// merging (IdentifyZoneModuliByLeastSquares).
+struct DamageLeastSquaresFit {
+  bool ran = false;
+  bool converged = false;
+  std::string message;                                               // why not, when not
+  std::vector<double> moduli;                                        // E_z [Pa]
+  int weakest_zone = -1;                                             // smallest E_z
+  double max_zone_error = std::numeric_limits<double>::quiet_NaN();  // max |E_z / truth_z - 1|
+  int groups = -1;                                                   // after merging
+  // J at the truth's zone moduli in series over J at the identified ones.
+  double reference_cost_ratio = std::numeric_limits<double>::quiet_NaN();
+  int evaluations = 0;  // simulations' evaluations
+  double wall_time_s = std::numeric_limits<double>::quiet_NaN();
+};
+
 struct DamageRun {
   int truth = 0;  // index in DamageTruths()
   bool interior_sensors = false;
@@ -52,8 +69,13 @@ struct DamageRun {
   double max_zone_error = std::numeric_limits<double>::quiet_NaN();  // max |E_z / truth_z - 1|
   double regularization_weight = std::numeric_limits<double>::quiet_NaN();
   int groups = -1;      // zones left distinct by merging (-1: not merged)
+  // e^2 at the truth's zone moduli in series over e^2 at the identified ones (10 equal
+  // zones): above 1, the data are better explained by the identified moduli than by
+  // the truth's zone values (a truth the zones cannot represent).
+  double reference_cost_ratio = std::numeric_limits<double>::quiet_NaN();
   int evaluations = 0;  // coupled solves, scalar and zones
   double wall_time_s = std::numeric_limits<double>::quiet_NaN();
+  DamageLeastSquaresFit least_squares;  // the same zones by least squares (10 equal zones)
 };
 
 struct DamageStudy {

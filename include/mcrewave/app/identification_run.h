@@ -160,6 +160,13 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
 NoiseLevels MeasurementNoiseLevels(const Config& config, const MeasurementSet& data,
                                    std::string* source);
 
+// The noise levels that normalise the output-error misfit: MeasurementNoiseLevels of
+// the measurements `data` or, for a kind without noise (noise-free data), the RMS of
+// the channels in use (`used`: uL, fL, the strain channels), *source then
+// "channel_rms".
+NoiseLevels LeastSquaresMisfitLevels(const Config& config, const MeasurementSet& data,
+                                     const MeasurementSet& used, std::string* source);
+
 // One identification by output-error least squares (outer.functional:
 // least_squares; least_squares/output_error_objective.h): the same data path,
 // pre-filter and optimiser as the MCRE's, the global scan on J(E), the misfit of
@@ -171,7 +178,8 @@ struct LeastSquaresRun {
   double prefilter_cutoff = 0.0;  // [Hz]; 0 when off
   bool reference_known = false;   // synthetic data: E_ref = config.model.modulus
   NoiseLevels noise;              // s_u, s_f, s_e of the misfit's normalisation
-  std::string noise_source;       // as MeasurementNoiseLevels says
+  std::string noise_source;       // as LeastSquaresMisfitLevels says
+  NoiseLevels estimated_noise;    // DifferenceNoiseLevels of the measurements (zones' target)
   IdentificationSummary outer;
   double rest_cost = 0.0;     // J_rest [s], the cost scale
   OutputErrorPrediction fit;  // the model's outputs and J at the identified E
@@ -187,6 +195,9 @@ struct LeastSquaresRun {
   // when the information is not positive.
   double modulus_std_bound = std::numeric_limits<double>::quiet_NaN();
   long sweeps = 0;  // of every simulation (scan, refinement, fit, curve)
+  // Every zone's modulus from E* by least squares when the identification has zones
+  // (RunLeastSquaresZoneIdentification; ran = false with one zone).
+  ZoneIdentificationRun zones;
   double wall_time_s = -1.0;
 
   bool IsUsable() const { return outer.IsSolutionUsable(); }

@@ -1,6 +1,7 @@
 // The identification of zone moduli within `identify run` (docs/zones_and_sensors.md,
 // "Identification of zone moduli"): after the scalar identification, from its
-// homogeneous E*, every zone modulus at once (optim/zone_identification.h), and its
+// homogeneous E*, every zone modulus at once (optim/zone_identification.h; by the
+// MCRE, or by output-error least squares with outer.functional: least_squares), and its
 // outputs: the `zones:` block of summary.yaml, zones.csv and the figure moduli.png of
 // E(x) (a step plot) against the truth's E(x) when the data are synthetic.
 #pragma once
@@ -15,6 +16,7 @@
 namespace mcrewave {
 
 struct IdentificationRun;
+struct LeastSquaresRun;
 
 struct ZoneIdentificationRun {
   bool ran = false;  // false: one zone, nothing done (the scalar result stands alone)
@@ -42,6 +44,14 @@ std::vector<ModulusZone> TruthZones(const Config& config);
 ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayout& layout,
                                             const IdentificationRun& scalar,
                                             const std::vector<ModulusZone>& truth_zones);
+
+// The same with outer.functional: least_squares: the zones by output-error least
+// squares (IdentifyZoneModuliByLeastSquares) from scalar.identified_modulus(), on
+// scalar.data with its misfit levels scalar.noise, the discrepancy target from
+// scalar.estimated_noise. Precondition: scalar.IsUsable(), the layout valid.
+ZoneIdentificationRun RunLeastSquaresZoneIdentification(
+    const Config& config, const ZoneLayout& layout, const LeastSquaresRun& scalar,
+    const std::vector<ModulusZone>& truth_zones);
 
 // The lines of summary.yaml's `zones:` block (indented, no trailing newline per line).
 std::vector<std::string> ZonesYamlLines(const ZoneIdentificationRun& run);

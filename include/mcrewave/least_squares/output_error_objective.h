@@ -58,6 +58,18 @@ struct OutputErrorPrediction {
   std::vector<Vector> sensors;  // per interior sensor of the data [m] or [-]
 };
 
+// The observation rows of the data's interior sensors on `model`'s mesh, in the
+// data's order, and the weight 1 / s^2 of each one's kind (noise: > 0 for every kind
+// the data hold). Overwrites rows and weights.
+void OutputErrorSensorRows(const BarModel& model, const MeasurementSet& data,
+                           const NoiseLevels& noise, std::vector<ObservationRow>* rows,
+                           std::vector<double>* weights);
+// J_rest [s]: J with every prediction 0,
+//   1/2 sum_k c_k h [uL~_k^2 / s_u^2 (when ends.uL) + f0~_k^2 / s_f^2
+//                    + sum_sensors sensor_weight y~_k^2].
+double OutputErrorRestCost(const MeasurementSet& data, const NoiseLevels& noise,
+                           const std::vector<double>& sensor_weights, EndDisplacementChannels ends);
+
 class OutputErrorObjective : public ModulusObjective {
  public:
   // Keeps references to model and data: both must outlive the objective. The

@@ -81,12 +81,13 @@ struct ZoneIdentificationOptions {
 struct ZoneIdentificationSummary {
   TerminationType termination = TerminationType::kFailure;
   std::string message = "not run";
+  bool least_squares = false;           // the cost is least squares' J [s], not e^2 [J s]
   double homogeneous_modulus = -1.0;    // E*, the start and the scale [Pa]
   Vector moduli;                        // E_z [Pa], one per zone (empty: none usable)
   std::vector<double> zone_start;       // [m], per zone: the first element's left node
   std::vector<double> zone_end;         // [m], per zone: the last element's right node
-  double cost = -1.0;                   // e^2 at moduli [J s]
-  double homogeneous_cost = -1.0;       // e^2 at E* in every zone [J s]
+  double cost = -1.0;                   // e^2 at moduli [J s] (least squares: J [s])
+  double homogeneous_cost = -1.0;       // e^2 at E* in every zone [J s] (J [s])
   double cost_scale = -1.0;             // J_rest [J s]
   NoiseLevels noise;                    // levels of the discrepancy target's draws
   double noise_cost = -1.0;             // ExpectedNoiseCost (scaled); -1: not computed
@@ -113,6 +114,17 @@ double ExpectedNoiseCost(const BarModel& model, const MeasurementSet& data, cons
                          const NoiseLevels& noise, const PrefilterOptions& prefilter, int samples,
                          std::uint64_t seed, double cost_scale);
 
+// ExpectedNoiseCost for the output-error misfit (ZoneOutputErrorObjective with the
+// normalisation misfit_levels): the mean over `samples` draws of J(noise alone) /
+// cost_scale at the zone moduli, the model driven by the load's noise and compared
+// with the other channels' (white at `noise`'s levels, then pre-filtered as
+// `prefilter` says). -1 when J is not finite.
+double ExpectedLeastSquaresNoiseCost(const BarModel& model, const MeasurementSet& data,
+                                     const NoiseLevels& misfit_levels, double theta,
+                                     EndDisplacementChannels ends, const Vector& moduli,
+                                     const NoiseLevels& noise, const PrefilterOptions& prefilter,
+                                     int samples, std::uint64_t seed, double cost_scale);
+
 // Identifies the zone moduli of `model` (its zones) from `data` (as the objective sees
 // them: pre-filtered when the pre-filter is on), from the homogeneous E* within
 // [lower_bound, upper_bound] on every zone. noise: the estimated noise levels of the
@@ -127,5 +139,18 @@ ZoneIdentificationSummary IdentifyZoneModuli(
     EndDisplacementChannels ends, double homogeneous_modulus, double lower_bound,
     double upper_bound, const NoiseLevels& noise, const PrefilterOptions& prefilter,
     const Matrix* warm_start = nullptr);
+
+// The same identification on the output-error misfit J of least squares
+// (ZoneOutputErrorObjective, normalised by misfit_levels: > 0 for every kind the data
+// hold) instead of the MCRE's e^2: the same parameters, bounds, start, regularisation,
+// weight rule (its target ExpectedLeastSquaresNoiseCost with the noise levels `noise`)
+// and merging. summary.cost and homogeneous_cost are J [s], cost_scale J_rest [s],
+// sweeps the simulations (1 + zones with the gradient). Never throws for a failed
+// identification. Preconditions as IdentifyZoneModuli's.
+ZoneIdentificationSummary IdentifyZoneModuliByLeastSquares(
+    const ZoneIdentificationOptions& options, const BarModel& model, const MeasurementSet& data,
+    const NoiseLevels& misfit_levels, double theta, EndDisplacementChannels ends,
+    double homogeneous_modulus, double lower_bound, double upper_bound, const NoiseLevels& noise,
+    const PrefilterOptions& prefilter);
 
 }  // namespace mcrewave

@@ -1,0 +1,105 @@
+// Output-error least squares with zone moduli: the practitioners' comparator of the
+// MCRE's zone identification (docs/zones_and_sensors.md, "Zones: the MCRE against
+// least squares"). The misfit is OutputErrorObjective's (output_error_objective.h):
+// the bar clamped at x = 0, driven at x = L by the measured fL~, its predicted
+// outputs (uL, the clamp reaction f0, the interior sensors) against the measured
+// ones, normalised by the noise levels of each kind,
+//
+//   J(E_1..E_Z) = 1/2 sum_k c_k h sum_channels (y_k - y~_k)^2 / s^2      [s],
+//
+// with K = sum_z E_z K1_z (bar_model.h) in the theta scheme of theta_integrator.h.
+//
+// Gradient by forward sensitivities: s_z,k = du_k/dE_z obeys the same scheme
+// (differentiate M_r (v_{k+1} - v_k) = -h K_r (theta u_{k+1} + (1 - theta) u_k) + h f)
+// with the input
+//   f_theta = -K1_z,r (theta u_{k+1} + (1 - theta) u_k),
+// and the reaction f0_k = M_01 a_1,k + K_01 u_1,k (M_r a_k = fL~_k e_N - K_r u_k) has
+//   df0_k/dE_z = M_01 da_1 + K_01 s_z,1 + K1_z,01 u_1,   M_r da = -K_r s_z - K1_z,r u.
+// Then dJ/dE_z = sum_k c_k h sum_channels (y_k - y~_k) dy_k/dE_z / s^2. One sweep per
+// evaluation without the gradient, 1 + Z with it: meant for the few zones of a
+// localisation (10 zones: 11 sweeps), not for one zone per element.
+//
+// Seen by the optimisers (bounded_minimizer.h) as a function of p_z =
+// log(E_z / modulus_scale), as ZoneMcreObjective (zone_identification.h), with the
+// cost J / J_rest (J_rest: every prediction 0, OutputErrorRestCost) and its gradient
+// d cost / d p_z = (dJ/dE_z) E_z / J_rest.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "mcrewave/core/types.h"
+#include "mcrewave/data/measurement.h"
+#include "mcrewave/linalg/band_matrix.h"
+#include "mcrewave/linalg/theta_integrator.h"
+#include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/mcre/modulus_uncertainty.h"
+#include "mcrewave/model/bar_model.h"
+#include "mcrewave/optim/bounded_minimizer.h"
+
+namespace mcrewave {
+
+class ZoneOutputErrorObjective : public MultiParameterObjective {
+ public:
+  // Keeps references to model and data: both must outlive the objective. model: the
+  // identification's zones (one or more). noise: the levels s_u, s_f, s_e of the
+  // misfit's normalisation (> 0 for every kind the data hold). ends: whether uL
+  // enters (u0 never does: it is zero in the clamped model). theta in [0, 1],
+  // modulus_scale > 0 [Pa].
+  ZoneOutputErrorObjective(const BarModel& model, const MeasurementSet& data,
+                           const NoiseLevels& noise, double theta, double modulus_scale,
+                           EndDisplacementChannels ends = {});
+
+  int num_parameters() const override { return num_zones_; }
+  // p_z = log(E_z / modulus_scale): cost = J / cost_scale() and, when gradient is not
+  // null, d cost / d p_z. False when a modulus or J is not a finite positive number
+  // (the reason in error_message()). Logs one line per evaluation.
+  bool Evaluate(const double* p, double* cost, double* gradient) override;
+  std::string error_message() const override { return error_message_; }
+
+  // J at the zone moduli [s] (num_zones() entries [Pa], positive), and dJ/dE_z [s / Pa]
+  // into *gradient when it is not null (resized to num_zones()). Re-initialises the
+  // integrator (the moduli change K). No allocation in the time loop.
+  double Cost(const Vector& zone_moduli, Vector* gradient);
+
+  // E_z = modulus_scale exp(p_z) [Pa].
+  Vector Moduli(const double* p) const;
+  // J_rest [s]; the cost scale (1 when J_rest = 0).
+  double rest_cost() const { return rest_cost_; }
+  double cost_scale() const { return rest_cost_ > 0.0 ? rest_cost_ : 1.0; }
+  int evaluations() const { return evaluations_; }
+  long sweeps() const { return sweeps_; }
+
+ private:
+  const BarModel& model_;
+  const MeasurementSet& data_;
+  double theta_;
+  double modulus_scale_;
+  EndDisplacementChannels ends_;
+  int num_zones_;
+  double weight_u_;  // 1 / s_u^2
+  double weight_f_;  // 1 / s_f^2
+
+  SparseMatrix free_mass_;
+  double mass_01_ = 0.0;                             // M(0, 1)
+  BandLdlt mass_factor_;                             // of M_r
+  std::vector<SymmetricBandMatrix> zone_stiffness_;  // K1_z,r on the free nodes [m]
+  std::vector<double> zone_stiffness_01_;            // K1_z(0, 1) [m]
+  std::vector<ObservationRow> sensor_rows_;          // the data's interior sensors
+  std::vector<double> sensor_weights_;               // 1 / s^2 of each sensor's kind
+  ThetaIntegrator integrator_;
+
+  // Scratch of Cost, sized in the constructor: the state, the theta-weighted
+  // displacement of a step, the sensitivities (one column per zone) and the
+  // accelerations.
+  Vector velocity_, displacement_, next_velocity_, next_displacement_, weighted_, force_;
+  Matrix sensitivity_velocity_, sensitivity_, next_sensitivity_velocity_, next_sensitivity_;
+  Vector acceleration_, acceleration_sensitivity_, nodal_, residuals_;
+
+  double rest_cost_ = 0.0;
+  int evaluations_ = 0;
+  long sweeps_ = 0;
+  std::string error_message_;
+};
+
+}  // namespace mcrewave

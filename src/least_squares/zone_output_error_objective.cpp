@@ -1,0 +1,178 @@
+#include "mcrewave/least_squares/zone_output_error_objective.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cassert>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include "mcrewave/least_squares/output_error_objective.h"
+
+namespace mcrewave {
+
+ZoneOutputErrorObjective::ZoneOutputErrorObjective(const BarModel& model,
+                                                   const MeasurementSet& data,
+                                                   const NoiseLevels& noise, double theta,
+                                                   double modulus_scale,
+                                                   EndDisplacementChannels ends)
+    : model_(model),
+      data_(data),
+      theta_(theta),
+      modulus_scale_(modulus_scale),
+      ends_(ends),
+      num_zones_(model.num_zones()),
+      weight_u_(1.0 / (noise.displacement_std * noise.displacement_std)),
+      weight_f_(1.0 / (noise.force_std * noise.force_std)),
+      free_mass_(BarModel::ClampedBlock(model.mass())),
+      mass_01_(model.mass().coeff(0, 1)) {
+  assert(theta >= 0.0 && theta <= 1.0 && modulus_scale > 0.0);
+  assert(data.num_steps() >= 1 && noise.displacement_std > 0.0 && noise.force_std > 0.0);
+  if (!mass_factor_.Compute(SymmetricBandMatrix(free_mass_))) {
+    throw std::runtime_error("output-error model: the mass matrix is not positive definite");
+  }
+  for (int z = 0; z < num_zones_; ++z) {
+    // K1_z = K(E = 1 Pa in zone z, 0 elsewhere).
+    const SparseMatrix unit_zone = model.Stiffness(Vector::Unit(num_zones_, z));
+    zone_stiffness_.emplace_back(BarModel::ClampedBlock(unit_zone));
+    zone_stiffness_01_.push_back(unit_zone.coeff(0, 1));
+  }
+  OutputErrorSensorRows(model, data, noise, &sensor_rows_, &sensor_weights_);
+  const int free = model.num_nodes() - 1;
+  for (Vector* scratch : {&velocity_, &displacement_, &next_velocity_, &next_displacement_,
+                          &weighted_, &force_, &acceleration_, &acceleration_sensitivity_}) {
+    scratch->setZero(free);
+  }
+  for (Matrix* scratch :
+       {&sensitivity_velocity_, &sensitivity_, &next_sensitivity_velocity_, &next_sensitivity_}) {
+    scratch->setZero(free, num_zones_);
+  }
+  nodal_.setZero(model.num_nodes());
+  residuals_.setZero(static_cast<Eigen::Index>(sensor_rows_.size()));
+  rest_cost_ = OutputErrorRestCost(data, noise, sensor_weights_, ends_);
+}
+
+Vector ZoneOutputErrorObjective::Moduli(const double* p) const {
+  Vector moduli(num_zones_);
+  for (int z = 0; z < num_zones_; ++z) moduli[z] = modulus_scale_ * std::exp(p[z]);
+  return moduli;
+}
+
+double ZoneOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradient) {
+  assert(zone_moduli.size() == num_zones_ && zone_moduli.allFinite() &&
+         zone_moduli.minCoeff() > 0.0);
+  ThetaIntegratorOptions options;
+  options.time_step = data_.time_step;
+  options.theta = theta_;
+  integrator_.Init(free_mass_, BarModel::ClampedBlock(model_.Stiffness(zone_moduli)), options);
+  assert(integrator_.factorization() == Factorization::kBand);
+  // K_01 = sum_z E_z K1_z(0, 1).
+  double stiffness_01 = 0.0;
+  for (int z = 0; z < num_zones_; ++z) stiffness_01 += zone_moduli[z] * zone_stiffness_01_[z];
+
+  const bool gradient_requested = gradient != nullptr;
+  if (gradient_requested) gradient->setZero(num_zones_);
+  const int samples = data_.num_samples();
+  const int loaded = static_cast<int>(velocity_.size()) - 1;  // node N, free numbering
+  const double h = data_.time_step;
+  velocity_.setZero();
+  displacement_.setZero();
+  sensitivity_velocity_.setZero();
+  sensitivity_.setZero();
+  double cost = 0.0;
+  for (int k = 0; k < samples; ++k) {
+    if (k > 0) {
+      // f_theta = (theta fL~_k + (1 - theta) fL~_{k-1}) e_N on the step t_{k-1} -> t_k.
+      const double load = theta_ * data_.fL[k] + (1.0 - theta_) * data_.fL[k - 1];
+      integrator_.StepWithEndLoads(velocity_, displacement_, 0.0, load, next_velocity_,
+                                   next_displacement_);
+      if (gradient_requested) {
+        weighted_ = theta_ * next_displacement_ + (1.0 - theta_) * displacement_;
+        for (int z = 0; z < num_zones_; ++z) {
+          // ds_z: the same scheme with f_theta = -K1_z,r (theta u_k + (1 - theta) u_{k-1}).
+          zone_stiffness_[z].Multiply(weighted_, force_);
+          force_ = -force_;
+          integrator_.Step(sensitivity_velocity_.col(z), sensitivity_.col(z), force_,
+                           next_sensitivity_velocity_.col(z), next_sensitivity_.col(z));
+        }
+        sensitivity_velocity_.swap(next_sensitivity_velocity_);
+        sensitivity_.swap(next_sensitivity_);
+      }
+      velocity_.swap(next_velocity_);
+      displacement_.swap(next_displacement_);
+    }
+    // M_r a_k = fL~_k e_N - K_r u_k;  f0_k = M_01 a_1 + K_01 u_1 (free node 1 is index 0).
+    integrator_.stiffness().Multiply(displacement_, acceleration_);
+    acceleration_ = -acceleration_;
+    acceleration_[loaded] += data_.fL[k];
+    mass_factor_.SolveInPlace(acceleration_);
+    const double residual_f =
+        mass_01_ * acceleration_[0] + stiffness_01 * displacement_[0] - data_.f0[k];
+    const double residual_u = displacement_[loaded] - data_.uL[k];
+    // c_k h / 2 [(uL - uL~)^2 / s_u^2 + (f0 - f0~)^2 / s_f^2 + sensors]
+    double sum = weight_f_ * residual_f * residual_f;
+    if (ends_.uL) sum += weight_u_ * residual_u * residual_u;
+    if (!sensor_rows_.empty()) nodal_.tail(nodal_.size() - 1) = displacement_;
+    for (std::size_t i = 0; i < sensor_rows_.size(); ++i) {
+      residuals_[i] = sensor_rows_[i].Apply(nodal_.data()) - data_.sensors[i].values[k];
+      sum += sensor_weights_[i] * residuals_[i] * residuals_[i];
+    }
+    const double c = (k == 0 || k == samples - 1) ? 0.5 : 1.0;
+    cost += 0.5 * c * h * sum;
+    if (!gradient_requested) continue;
+    for (int z = 0; z < num_zones_; ++z) {
+      const auto s = sensitivity_.col(z);
+      // M_r da = -K_r s_z - K1_z,r u;  df0 = M_01 da_1 + K_01 s_z,1 + K1_z(0, 1) u_1.
+      integrator_.stiffness().Multiply(s, acceleration_sensitivity_);
+      zone_stiffness_[z].MultiplyAdd(1.0, displacement_, acceleration_sensitivity_);
+      acceleration_sensitivity_ = -acceleration_sensitivity_;
+      mass_factor_.SolveInPlace(acceleration_sensitivity_);
+      const double df0 = mass_01_ * acceleration_sensitivity_[0] + stiffness_01 * s[0] +
+                         zone_stiffness_01_[z] * displacement_[0];
+      // d/dE_z of the bracket above, times c_k h / 2.
+      double dsum = 2.0 * weight_f_ * residual_f * df0;
+      if (ends_.uL) dsum += 2.0 * weight_u_ * residual_u * s[loaded];
+      if (!sensor_rows_.empty()) nodal_.tail(nodal_.size() - 1) = s;
+      for (std::size_t i = 0; i < sensor_rows_.size(); ++i) {
+        dsum += 2.0 * sensor_weights_[i] * residuals_[i] * sensor_rows_[i].Apply(nodal_.data());
+      }
+      (*gradient)[z] += 0.5 * c * h * dsum;
+    }
+  }
+  sweeps_ += gradient_requested ? 1 + num_zones_ : 1;
+  return cost;
+}
+
+bool ZoneOutputErrorObjective::Evaluate(const double* p, double* cost, double* gradient) {
+  ++evaluations_;
+  const Vector moduli = Moduli(p);
+  if (!(moduli.allFinite() && moduli.minCoeff() > 0.0)) {
+    error_message_ = "a trial zone modulus is not a positive finite number";
+    return false;
+  }
+  Vector moduli_gradient;
+  const double misfit = Cost(moduli, gradient != nullptr ? &moduli_gradient : nullptr);
+  if (!std::isfinite(misfit) || (gradient != nullptr && !moduli_gradient.allFinite())) {
+    error_message_ = "the output-error misfit at the zone moduli of evaluation " +
+                     std::to_string(evaluations_) + " is not finite";
+    return false;
+  }
+  // cost = J / J_rest
+  *cost = misfit / cost_scale();
+  double gradient_norm = 0.0;
+  if (gradient != nullptr) {
+    for (int z = 0; z < num_zones_; ++z) {
+      // d cost / d p_z = (dJ/dE_z) (dE_z/dp_z) / J_rest,  dE_z/dp_z = E_z
+      gradient[z] = moduli_gradient[z] * moduli[z] / cost_scale();
+      gradient_norm = std::max(gradient_norm, std::abs(gradient[z]));
+    }
+  }
+  error_message_.clear();
+  spdlog::info(
+      "least-squares zones evaluation {}: J / J_rest = {:.10g}, |grad|_inf = {:.3g}, E in "
+      "[{:.6g}, {:.6g}] GPa",
+      evaluations_, *cost, gradient_norm, moduli.minCoeff() * 1e-9, moduli.maxCoeff() * 1e-9);
+  return true;
+}
+
+}  // namespace mcrewave
