@@ -186,7 +186,8 @@ void CheckOutputFolder(const std::string& folder) {
 }
 
 // Steps 3 to 5 of RunIdentify with outer.functional: least_squares: the
-// comparator's estimate of E, its fit and cost curve.
+// comparator's estimate of E, its fit and cost curve, and its zone moduli when the
+// identification has zones.
 int IdentifyByLeastSquares(const mcrewave::Config& config, const mcrewave::MeasurementSet& data) {
   const mcrewave::LeastSquaresRun run = mcrewave::RunLeastSquares(config, data);
   const std::string on_bound =

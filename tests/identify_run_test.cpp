@@ -221,8 +221,13 @@ TEST(IdentifyRunTest, LeastSquaresIdentifiesZoneModuli) {
             std::string::npos)
       << run.result.output;
   const std::string summary = ReadText(run.folder + "/summary.yaml");
-  EXPECT_NE(summary.find("  functional: least_squares  # outer.functional"), std::string::npos);
-  EXPECT_NE(summary.find("  termination: convergence"), std::string::npos) << summary;
+  const std::size_t zones_block = summary.find("\nzones:");
+  ASSERT_NE(zones_block, std::string::npos) << summary;
+  EXPECT_EQ(summary.find("\n  functional: least_squares  # outer.functional\n  count: 5\n"
+                         "  termination: convergence\n",
+                         zones_block),
+            summary.find('\n', zones_block + 1))
+      << summary;
   const std::vector<std::vector<double>> zones = CsvRows(ReadText(run.folder + "/zones.csv"));
   ASSERT_EQ(zones.size(), 5u);
   double worst = 0.0;

@@ -283,8 +283,8 @@ namespace mcrewave {
 namespace {
 
 TEST(IdentifyStudyDamageTest, TheDamageStudyRunsOnTheQuickCaseAndLocalisesWithInteriorSensors) {
-  // The grid at SNR inf on the quick case (25 elements), zones merged: 12 runs in about
-  // 17 s.
+  // The grid at SNR inf on the quick case (25 elements), zones merged, the 10 equal zones
+  // by both functionals: 12 runs in about 6 s on 2 cores.
   const std::string folder = testing::FreshDirectory("identify_study_damage") + "/results";
   const testing::RunResult result = testing::RunIdentify(
       "study " + testing::SourcePath("configs/quick.yaml") + " -o " + folder +
@@ -306,18 +306,21 @@ TEST(IdentifyStudyDamageTest, TheDamageStudyRunsOnTheQuickCaseAndLocalisesWithIn
     // Merging runs on the 10 equal zones only: 1 to 10 groups left; -1 per element.
     ASSERT_GE(fields.size(), 15u) << line;
     const int groups = std::stoi(fields[14]);
-    // The 10 equal zones are also identified by least squares (ls_converged, field 19),
-    // and neither functional's data cost is lower at the truth's zone moduli in series
-    // than at its identified ones (reference_cost_ratio, field 18; ls_..., field 24):
-    // measured 1.018 to 50 for the MCRE, 1.58 to 8.8 for least squares (on 25
-    // elements even the soft zone's edge at 0.7 m falls inside an element).
+    // The 10 equal zones are also identified by least squares (ls_converged, field 19).
+    // With the interior sensors, the truths the zones cannot represent (non-aligned, two
+    // zones) are far better explained by the identified moduli than by the truth's in
+    // series, by both functionals: the data cost ratio (reference_cost_ratio, field 18;
+    // ls_reference_cost_ratio, field 24) measured 31 and 50 for the MCRE, 8.0 and 8.8
+    // for least squares.
     ASSERT_EQ(fields.size(), 28u) << line;
     if (fields[5] == "10_equal") {
       EXPECT_GE(groups, 1) << line;
       EXPECT_LE(groups, 10) << line;
       EXPECT_EQ(fields[19], "1") << line;
-      EXPECT_GT(std::stod(fields[18]), 1.0) << line;
-      EXPECT_GT(std::stod(fields[24]), 1.0) << line;
+      if (fields[2] == "interior" && fields[1] != "soft") {
+        EXPECT_GT(std::stod(fields[18]), 4.0) << line;
+        EXPECT_GT(std::stod(fields[24]), 4.0) << line;
+      }
     } else {
       EXPECT_EQ(groups, -1) << line;
       EXPECT_EQ(fields[19], "") << line;

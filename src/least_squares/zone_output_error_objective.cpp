@@ -2,10 +2,10 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <stdexcept>
-#include <utility>
 
 #include "mcrewave/least_squares/output_error_objective.h"
 
@@ -87,6 +87,7 @@ double ZoneOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradien
       integrator_.StepWithEndLoads(velocity_, displacement_, 0.0, load, next_velocity_,
                                    next_displacement_);
       if (gradient_requested) {
+        // theta u_k + (1 - theta) u_{k-1}
         weighted_ = theta_ * next_displacement_ + (1.0 - theta_) * displacement_;
         for (int z = 0; z < num_zones_; ++z) {
           // ds_z: the same scheme with f_theta = -K1_z,r (theta u_k + (1 - theta) u_{k-1}).

@@ -89,8 +89,8 @@ std::string ZoneIdentificationSummary::FullReport() const {
       << (least_squares ? "  J:                  " : "  e^2:                ") << cost
       << (least_squares ? " s" : " J s") << " (at E*: " << homogeneous_cost << ")\n"
       << "  weight:             " << regularized.weight << " (" << regularized.weight_choice
-      << ", target misfit " << regularized.target_misfit << ", noise e^2 / J_rest " << noise_cost
-      << ")\n";
+      << ", target misfit " << regularized.target_misfit << ", noise "
+      << (least_squares ? "J" : "e^2") << " / J_rest " << noise_cost << ")\n";
   if (merge.groups >= 0) {
     out << "  merging:            " << merge.groups << " groups, " << merge.merges
         << " merges kept of " << merge.refits << " refits (" << merge.evaluations
@@ -144,9 +144,10 @@ void ZoneExtents(const BarModel& model, ZoneIdentificationSummary* summary) {
 // the discrepancy target from expected_noise_cost() (the scaled cost of noise alone;
 // negative: not usable) when the weight rule or the merging needs it, the regularised
 // minimisation from E* in every zone, the merging, and the moduli, cost and zones on a
-// bound. False (the summary says why) when the target's noise cost is not usable.
+// bound. When the target's noise cost is not usable the summary says so and nothing is
+// minimised.
 template <typename NoiseCost>
-bool MinimizeOverZones(const ZoneIdentificationOptions& options, int zones,
+void MinimizeOverZones(const ZoneIdentificationOptions& options, int zones,
                        MultiParameterObjective* zone_objective, double lower_bound,
                        double upper_bound, NoiseCost&& expected_noise_cost,
                        ZoneIdentificationSummary* summary) {
@@ -162,12 +163,14 @@ bool MinimizeOverZones(const ZoneIdentificationOptions& options, int zones,
     summary->noise_cost = expected_noise_cost();
     if (summary->noise_cost < 0.0) {
       summary->termination = TerminationType::kFailure;
-      summary->message = "a noise solve of the discrepancy target is not usable";
-      return false;
+      summary->message = summary->least_squares
+                             ? "a noise simulation of the discrepancy target is not finite"
+                             : "a noise solve of the discrepancy target is not usable";
+      return;
     }
     target = options.regularization.discrepancy_factor * summary->noise_cost;
-    spdlog::info("zones: discrepancy target {:.6g} (noise alone, {} draws)", target,
-                 options.noise_samples);
+    spdlog::info("zones: discrepancy target {} / J_rest = {:.6g} (noise alone, {} draws)",
+                 summary->least_squares ? "J" : "e^2", target, options.noise_samples);
   }
   summary->regularized = MinimizeRegularized(options.minimizer, options.regularization,
                                              zone_objective, lower, upper, initial, target);
@@ -199,7 +202,6 @@ bool MinimizeOverZones(const ZoneIdentificationOptions& options, int zones,
                    summary->zones_on_bounds.size());
     }
   }
-  return true;
 }
 
 }  // namespace

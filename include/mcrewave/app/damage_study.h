@@ -12,7 +12,10 @@
 // element. Then study.damage_seeds seeds of the soft truth with the interior sensors at
 // SNR 10 and 10 zones. Each run: the scalar identification (E*), the error map at E*
 // (its peak), the zone identification from E* (every zone's modulus), against the
-// truth's modulus of each zone (its elements in series).
+// truth's modulus of each zone (its elements in series). With 10 equal zones also the
+// same zones by output-error least squares (DamageLeastSquaresFit; attempted when the
+// MCRE's zones converged), and for both functionals the data cost at the truth's zone
+// moduli in series over the cost at the identified ones.
 #pragma once
 
 #include <cstdint>
@@ -70,8 +73,9 @@ struct DamageRun {
   double regularization_weight = std::numeric_limits<double>::quiet_NaN();
   int groups = -1;      // zones left distinct by merging (-1: not merged)
   // e^2 at the truth's zone moduli in series over e^2 at the identified ones (10 equal
-  // zones): above 1, the data are better explained by the identified moduli than by
-  // the truth's zone values (a truth the zones cannot represent).
+  // zones; NaN otherwise). Noise-free, far above 1 says the data are better explained
+  // by other moduli than the truth's zone values (a truth the zones cannot represent);
+  // with noise the identified moduli also fit the noise, which alone raises it above 1.
   double reference_cost_ratio = std::numeric_limits<double>::quiet_NaN();
   int evaluations = 0;  // coupled solves, scalar and zones
   double wall_time_s = std::numeric_limits<double>::quiet_NaN();

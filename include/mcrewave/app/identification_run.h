@@ -205,7 +205,8 @@ struct LeastSquaresRun {
 };
 
 // Runs the least-squares identification on measurements made by
-// LoadMeasurements(config), then its fit and cost curve at E*. Precondition:
+// LoadMeasurements(config), then its fit and cost curve at E* and, with zones, every
+// zone from E* (RunLeastSquaresZoneIdentification). Precondition:
 // config valid with outer.functional = least_squares. Never throws for a failed
 // identification: see IsUsable() and outer.message.
 LeastSquaresRun RunLeastSquares(const Config& config, const MeasurementSet& data);

@@ -58,6 +58,9 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
 //   cost_curve.csv   J(E) and dJ/dE over E* +- 5 %
 //   fit.csv          measured and predicted uL, f0 and interior sensors at E*
 //   cost_curve.png, fit.png
+//   zones.csv, moduli.csv, moduli.png and summary.yaml's `zones:` block (functional
+//                    least_squares, costs J [s]) when the identification has zones
+//                    (zone_identification_run.h)
 // written as WriteIdentificationResults writes (atomically, summary last).
 // Precondition: run.IsUsable().
 std::string LeastSquaresSummaryYaml(const LeastSquaresRun& run);

@@ -52,13 +52,14 @@ class ZoneOutputErrorObjective : public MultiParameterObjective {
 
   int num_parameters() const override { return num_zones_; }
   // p_z = log(E_z / modulus_scale): cost = J / cost_scale() and, when gradient is not
-  // null, d cost / d p_z. False when a modulus or J is not a finite positive number
-  // (the reason in error_message()). Logs one line per evaluation.
+  // null, d cost / d p_z. False when a modulus is not a finite positive number or J or
+  // its gradient is not finite (the reason in error_message()). Logs one line per
+  // evaluation.
   bool Evaluate(const double* p, double* cost, double* gradient) override;
   std::string error_message() const override { return error_message_; }
 
-  // J at the zone moduli [s] (num_zones() entries [Pa], positive), and dJ/dE_z [s / Pa]
-  // into *gradient when it is not null (resized to num_zones()). Re-initialises the
+  // J at the zone moduli [s] (num_parameters() entries [Pa], positive), and dJ/dE_z
+  // [s / Pa] into *gradient when it is not null (resized to num_parameters()). Re-initialises the
   // integrator (the moduli change K). No allocation in the time loop.
   double Cost(const Vector& zone_moduli, Vector* gradient);
 
@@ -90,8 +91,9 @@ class ZoneOutputErrorObjective : public MultiParameterObjective {
   ThetaIntegrator integrator_;
 
   // Scratch of Cost, sized in the constructor: the state, the theta-weighted
-  // displacement of a step, the sensitivities (one column per zone) and the
-  // accelerations.
+  // displacement of a step and a sensitivity's input, the sensitivities (one column
+  // per zone), the accelerations, the displacement over every node (the sensors' rows)
+  // and the sensors' residuals of a step.
   Vector velocity_, displacement_, next_velocity_, next_displacement_, weighted_, force_;
   Matrix sensitivity_velocity_, sensitivity_, next_sensitivity_velocity_, next_sensitivity_;
   Vector acceleration_, acceleration_sensitivity_, nodal_, residuals_;

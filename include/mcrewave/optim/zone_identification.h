@@ -1,5 +1,8 @@
 // Identification of every zone modulus at once (docs/zones_and_sensors.md,
-// "Identification of zone moduli"; formulation: the project's MCRE problem with zones,
+// "Identification of zone moduli"), by the MCRE (IdentifyZoneModuli) or, as its
+// comparator, by output-error least squares (IdentifyZoneModuliByLeastSquares, the same
+// steps on J; "Zones: the MCRE against least squares"). The MCRE's formulation: the
+// project's MCRE problem with zones,
 // K = sum_z E_z K1_z, and the gradient of every zone from the one coupled solve,
 //   de^2/dE_z = -(1/(2 E_z)) sum_j c_j h W_j^T K_z (W_j + 2 U_j)
 // (McreProblem::CostGradients; docs/zones_and_sensors.md).
@@ -8,7 +11,8 @@
 // Parameters p_z = log(E_z / E*): positivity for free, a step in p is a relative step in
 // E, and the regularisation penalises jumps of log E (regularization.h). Chain rule:
 //   d cost / d p_z = (d cost / d E_z) E_z.
-// The cost is the scaled e^2 / J_rest of McreObjective. Bounds: outer.lower_bound and
+// The cost is the scaled e^2 / J_rest of McreObjective (least squares: the scaled
+// J / J_rest of ZoneOutputErrorObjective). Bounds: outer.lower_bound and
 // outer.upper_bound on every zone, i.e. log(lower / E*) <= p_z <= log(upper / E*).
 //
 // The regularisation weight's discrepancy target (the whole rule with weight_rule:
@@ -64,7 +68,8 @@ class ZoneMcreObjective : public MultiParameterObjective {
 struct ZoneIdentificationOptions {
   BoundedMinimizerOptions minimizer;
   RegularizationOptions regularization;
-  // Noise draws of the discrepancy target (ExpectedNoiseCost).
+  // Noise draws of the discrepancy target (ExpectedNoiseCost; least squares:
+  // ExpectedLeastSquaresNoiseCost).
   int noise_samples = 4;
   std::uint64_t noise_seed = 1;
   // Merge neighbouring zones after the regularised minimisation while an unpenalised
@@ -88,14 +93,16 @@ struct ZoneIdentificationSummary {
   std::vector<double> zone_end;         // [m], per zone: the last element's right node
   double cost = -1.0;                   // e^2 at moduli [J s] (least squares: J [s])
   double homogeneous_cost = -1.0;       // e^2 at E* in every zone [J s] (J [s])
-  double cost_scale = -1.0;             // J_rest [J s]
+  double cost_scale = -1.0;             // J_rest [J s] (least squares: [s])
   NoiseLevels noise;                    // levels of the discrepancy target's draws
-  double noise_cost = -1.0;             // ExpectedNoiseCost (scaled); -1: not computed
+  double noise_cost = -1.0;             // ExpectedNoiseCost or ExpectedLeastSquaresNoiseCost
+                                        // (scaled); -1: not computed
   RegularizedMinimization regularized;  // weight, its choice, the path, the minimiser
   ZoneMerge merge;                      // merge.groups -1: not run; with merges kept,
                                         // moduli and cost are its last refit's
   std::vector<int> zones_on_bounds;     // zones whose modulus lies on a bound
-  int evaluations = 0;                  // coupled solves of the zone identification
+  int evaluations = 0;                  // cost evaluations of the zone identification (MCRE:
+                                        // coupled solves)
   long sweeps = 0;
   double wall_time_s = -1.0;
 
