@@ -260,9 +260,15 @@ int FindRun(const DamageStudy& study, int truth, bool interior, double snr, bool
   return -1;
 }
 
-// profile_<truth>.csv: x and E(x) / E_ref of the truth and of three runs (NaN when
+// A profile's curve: the run (-1: absent) and whether its moduli are least squares'.
+struct ProfileCurve {
+  int run;
+  bool least_squares;
+};
+
+// profile_<truth>.csv: x and E(x) / E_ref of the truth and of the curves (NaN when
 // absent), sampled at 1000 points.
-std::string ProfileCsv(const DamageStudy& study, int truth, const std::vector<int>& runs,
+std::string ProfileCsv(const DamageStudy& study, int truth, const std::vector<ProfileCurve>& runs,
                        double length) {
   std::ostringstream csv;
   csv << "x_m,truth";
@@ -276,13 +282,15 @@ std::string ProfileCsv(const DamageStudy& study, int truth, const std::vector<in
       if (x >= zone.start && x <= zone.end) truth_value = zone.modulus;
     }
     csv << Csv(x) << "," << Csv(truth_value);
-    for (int index : runs) {
+    for (const ProfileCurve& curve : runs) {
       double value = std::nan("");
-      if (index >= 0 && study.runs[index].converged) {
-        const DamageRun& run = study.runs[index];
-        for (std::size_t z = 0; z < run.moduli.size(); ++z) {
+      if (curve.run >= 0 && study.runs[curve.run].converged) {
+        const DamageRun& run = study.runs[curve.run];
+        const std::vector<double>& moduli =
+            curve.least_squares ? run.least_squares.moduli : run.moduli;
+        for (std::size_t z = 0; z < moduli.size(); ++z) {
           if (x >= run.zone_start[z] && x <= run.zone_end[z]) {
-            value = run.moduli[z] / study.reference_modulus;
+            value = moduli[z] / study.reference_modulus;
           }
         }
       }
@@ -473,7 +481,8 @@ std::string Summary(const DamageStudy& study) {
     }
   }
   md << "\nFigures: profiles.png (identified E(x) against the truth with the interior sensors: "
-        "10 zones noise-free and at SNR 10, one zone per element at SNR 20).\n";
+        "10 zones noise-free (MCRE and least squares) and at SNR 10, one zone per element at "
+        "SNR 20).\n";
   return md.str();
 }
 
@@ -541,15 +550,17 @@ std::vector<std::string> WriteDamageResults(const DamageStudy& study, const std:
   std::vector<std::pair<std::string, std::string>> files = {{"runs.csv", RunsCsv(study)},
                                                             {"zones.csv", ZonesCsvOf(study)}};
   for (int t = 0; t < static_cast<int>(DamageTruths().size()); ++t) {
-    const std::vector<int> runs = {
-        FindRun(study, t, true, std::numeric_limits<double>::infinity(), false),
-        FindRun(study, t, true, 10.0, false), FindRun(study, t, true, 20.0, true)};
+    const int noise_free = FindRun(study, t, true, std::numeric_limits<double>::infinity(), false);
+    const std::vector<ProfileCurve> runs = {{noise_free, false},
+                                            {noise_free, true},
+                                            {FindRun(study, t, true, 10.0, false), false},
+                                            {FindRun(study, t, true, 20.0, true), false}};
     files.emplace_back("profile_" + DamageTruths()[t].name + ".csv",
                        ProfileCsv(study, t, runs, study.length));
   }
   const std::vector<std::pair<std::string, std::string>> drawings = {
-      {"profiles",
-       ProfilesScript(folder, {"10 zones, SNR inf", "10 zones, SNR 10", "per element, SNR 20"})}};
+      {"profiles", ProfilesScript(folder, {"10 zones, SNR inf", "10 zones, SNR inf, least squares",
+                                           "10 zones, SNR 10", "per element, SNR 20"})}};
   return internal::WriteStudyFolder(folder, files, drawings, figures, Summary(study));
 }
 
