@@ -24,6 +24,18 @@ void OutputErrorSensorRows(const BarModel& model, const MeasurementSet& data,
   }
 }
 
+double ClampReaction(const SymmetricBandMatrix& stiffness, const BandLdlt& mass_factor,
+                     double mass_01, double stiffness_01, const Vector& displacement, double fL,
+                     Vector* acceleration) {
+  // M_r a = fL e_N - K_r u
+  stiffness.Multiply(displacement, *acceleration);
+  *acceleration = -*acceleration;
+  (*acceleration)[acceleration->size() - 1] += fL;
+  mass_factor.SolveInPlace(*acceleration);
+  // f0 = M_01 a_1 + K_01 u_1
+  return mass_01 * (*acceleration)[0] + stiffness_01 * displacement[0];
+}
+
 double OutputErrorRestCost(const MeasurementSet& data, const NoiseLevels& noise,
                            const std::vector<double>& sensor_weights,
                            EndDisplacementChannels ends) {
@@ -137,12 +149,8 @@ const OutputErrorPrediction& OutputErrorObjective::Predict(double modulus,
       velocity_.swap(next_velocity_);
       displacement_.swap(next_displacement_);
     }
-    // M_r a_k = fL~_k e_N - K_r u_k;  f0_k = M_01 a_1 + K_01 u_1 (free node 1 is index 0).
-    integrator_.stiffness().Multiply(displacement_, acceleration_);
-    acceleration_ = -acceleration_;
-    acceleration_[loaded] += data_.fL[k];
-    mass_factor_.SolveInPlace(acceleration_);
-    const double f0 = mass_01_ * acceleration_[0] + stiffness_01 * displacement_[0];
+    const double f0 = ClampReaction(integrator_.stiffness(), mass_factor_, mass_01_, stiffness_01,
+                                    displacement_, data_.fL[k], &acceleration_);
     prediction_.uL[k] = displacement_[loaded];
     prediction_.f0[k] = f0;
     const double c = (k == 0 || k == samples - 1) ? 0.5 : 1.0;

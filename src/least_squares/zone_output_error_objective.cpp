@@ -102,13 +102,10 @@ double ZoneOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradien
       velocity_.swap(next_velocity_);
       displacement_.swap(next_displacement_);
     }
-    // M_r a_k = fL~_k e_N - K_r u_k;  f0_k = M_01 a_1 + K_01 u_1 (free node 1 is index 0).
-    integrator_.stiffness().Multiply(displacement_, acceleration_);
-    acceleration_ = -acceleration_;
-    acceleration_[loaded] += data_.fL[k];
-    mass_factor_.SolveInPlace(acceleration_);
     const double residual_f =
-        mass_01_ * acceleration_[0] + stiffness_01 * displacement_[0] - data_.f0[k];
+        ClampReaction(integrator_.stiffness(), mass_factor_, mass_01_, stiffness_01, displacement_,
+                      data_.fL[k], &acceleration_) -
+        data_.f0[k];
     const double residual_u = displacement_[loaded] - data_.uL[k];
     // c_k h / 2 [(uL - uL~)^2 / s_u^2 + (f0 - f0~)^2 / s_f^2 + sensors]
     double sum = weight_f_ * residual_f * residual_f;

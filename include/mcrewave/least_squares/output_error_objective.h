@@ -70,6 +70,14 @@ void OutputErrorSensorRows(const BarModel& model, const MeasurementSet& data,
 double OutputErrorRestCost(const MeasurementSet& data, const NoiseLevels& noise,
                            const std::vector<double>& sensor_weights, EndDisplacementChannels ends);
 
+// The clamp reaction of the clamped model at one sample: the accelerations of the free
+// nodes from M_r a = fL e_N - K_r u into *acceleration (size of u), then
+//   f0 = M_01 a_1 + K_01 u_1  [N]   (free node 1 is index 0).
+// stiffness: K_r of the integrator's band path; mass_factor: of M_r.
+double ClampReaction(const SymmetricBandMatrix& stiffness, const BandLdlt& mass_factor,
+                     double mass_01, double stiffness_01, const Vector& displacement, double fL,
+                     Vector* acceleration);
+
 class OutputErrorObjective : public ModulusObjective {
  public:
   // Keeps references to model and data: both must outlive the objective. The
