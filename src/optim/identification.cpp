@@ -277,6 +277,7 @@ bool GuardedObjective::Evaluate(double x, double* cost, double* gradient) {
                  OptimizerTypeToString(options_.optimizer), evaluations_, modulus, stop_message_);
     return false;
   }
+  if (!has_best_) initial_cost_ = *cost;
   if (!has_best_ || *cost < best_cost_) {
     has_best_ = true;
     best_x_ = x;

@@ -31,6 +31,8 @@ class GuardedObjective {
   const std::string& stop_message() const { return stop_message_; }
   bool has_best() const { return has_best_; }
   double best_x() const { return best_x_; }
+  // Whether a usable evaluation has a lower cost than the first usable one.
+  bool improved() const { return has_best_ && best_cost_ < initial_cost_; }
   double modulus_scale() const { return objective_->modulus_scale(); }
   double ElapsedSeconds() const;
 
@@ -49,6 +51,7 @@ class GuardedObjective {
   int evaluations_ = 0;
   int gradient_evaluations_ = 0;
   bool has_best_ = false;
+  double initial_cost_ = 0.0;  // of the first usable evaluation
   double best_x_ = 0.0;
   double best_cost_ = 0.0;
   bool best_has_gradient_ = false;
