@@ -1,6 +1,7 @@
 // No heap allocation in the time loops: once initialised, ThetaIntegrator's steps
 // and sweeps and McreProblem's sweeps (outputs preallocated) neither allocate nor
-// free memory.
+// free memory; the least-squares zone objective's time loop neither (its heap calls
+// do not grow with the number of steps).
 //
 // Allocations are counted by replacing the C allocator of this test binary (malloc,
 // calloc, realloc, free: glibc's documented way of replacing malloc) with
@@ -19,10 +20,12 @@
 #include <string>
 #include <vector>
 
+#include "mcrewave/least_squares/zone_output_error_objective.h"
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/mcre/mcre_problem.h"
 #include "mcrewave/model/bar_model.h"
+#include "mcrewave/model/simulation.h"
 #include "test_problems.h"
 
 #if defined(__GLIBC__) && !defined(MCREWAVE_ADDRESS_SANITIZER)
@@ -460,6 +463,33 @@ TEST(McreProblemAllocationTest, StreamingMapAllocatesNothingAfterItsFirstCall) {
   EXPECT_EQ(calls.allocations, 0);
   EXPECT_EQ(calls.deallocations, 0);
   EXPECT_GT(totals.cost, 0.0);
+}
+
+// ZoneOutputErrorObjective::Cost re-initialises the integrator for the new moduli
+// (allocations before the loop); the loop over the steps, with a sensitivity per zone
+// and interior sensors, allocates nothing: the same heap calls for 100 and 200 steps.
+TEST(ZoneOutputErrorAllocationTest, TheTimeLoopAllocatesNothing) {
+  SKIP_WITHOUT_ALLOCATION_COUNTING();
+  HeapCalls calls[2];
+  for (int i = 0; i < 2; ++i) {
+    testing::SmallCase small = MakeSmallCase(kElements, 100 * (i + 1), INFINITY, 1);
+    ZoneLayout layout;
+    layout.zone_count = 4;
+    const BarModel model(small.bar, layout.ElementZones(small.bar));
+    const MeasurementSet data =
+        SimulateClampedBar(small.bar, small.load, small.time, {}, {"u@0.3", "e@0.6"});
+    NoiseLevels noise;
+    noise.displacement_std = 1e-7;
+    noise.force_std = 1.0;
+    noise.strain_std = 1e-7;
+    ZoneOutputErrorObjective objective(model, data, noise, 0.5, kModulus);
+    const Vector moduli = Vector::Constant(4, 0.9 * kModulus);
+    Vector gradient(4);
+    objective.Cost(moduli, &gradient);
+    calls[i] = CountHeapCalls([&] { objective.Cost(moduli, &gradient); });
+  }
+  EXPECT_EQ(calls[0].allocations, calls[1].allocations);
+  EXPECT_EQ(calls[0].deallocations, calls[1].deallocations);
 }
 
 }  // namespace
