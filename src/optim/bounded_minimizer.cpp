@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "core/enum_names.h"
+#include "optim/nlopt_results.h"
 
 namespace mcrewave {
 namespace {
@@ -169,25 +170,6 @@ nlopt::algorithm NloptAlgorithm(BoundedAlgorithm algorithm) {
   }
 }
 
-std::string NloptResultName(nlopt::result result) {
-  switch (result) {
-    case nlopt::SUCCESS:
-      return "success";
-    case nlopt::STOPVAL_REACHED:
-      return "stopval reached";
-    case nlopt::FTOL_REACHED:
-      return "ftol reached";
-    case nlopt::XTOL_REACHED:
-      return "xtol reached";
-    case nlopt::MAXEVAL_REACHED:
-      return "maxeval reached";
-    case nlopt::MAXTIME_REACHED:
-      return "maxtime reached";
-    default:
-      return "result code " + std::to_string(static_cast<int>(result));
-  }
-}
-
 void RunNlopt(const BoundedMinimizerOptions& options, const std::vector<double>& lower,
               const std::vector<double>& upper, std::vector<double> x, Guard* guard,
               BoundedMinimizerSummary* summary) {
@@ -211,7 +193,7 @@ void RunNlopt(const BoundedMinimizerOptions& options, const std::vector<double>&
   double cost = HUGE_VAL;
   try {
     const nlopt::result result = optimizer.optimize(x, cost);
-    summary->optimizer_message = NloptResultName(result);
+    summary->optimizer_message = internal::NloptResultName(result);
     if (result == nlopt::MAXEVAL_REACHED || result == nlopt::MAXTIME_REACHED) {
       summary->termination = TerminationType::kNoConvergence;
       summary->message = "NLopt stopped before convergence (" + summary->optimizer_message + ")";
@@ -233,15 +215,11 @@ void RunNlopt(const BoundedMinimizerOptions& options, const std::vector<double>&
     summary->message = "NLopt ran out of memory";
   } catch (const std::exception& error) {
     summary->optimizer_message = error.what();
-    if (guard->stop() == StopReason::kNone && guard->improved() &&
-        UsesGradient(options.algorithm) && std::string(error.what()) == "nlopt failure") {
-      // NLOPT_FAILURE of a gradient-based algorithm that made progress: its line
-      // search found no decrease along a descent direction, i.e. the cost is flat to
-      // the objective's precision there (the inner solves' tolerance), as
-      // roundoff_limited says for the scalar loop.
+    if (internal::IsLineSearchStallAfterProgress(error, UsesGradient(options.algorithm),
+                                                 guard->improved(),
+                                                 guard->stop() != StopReason::kNone)) {
       summary->termination = TerminationType::kConvergence;
-      summary->message =
-          "converged to the objective's precision (NLopt: line search without decrease)";
+      summary->message = internal::kLineSearchStallMessage;
     } else {
       summary->termination = TerminationType::kFailure;
       summary->message = std::string("NLopt failed: ") + error.what();

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "optim/identification_internal.h"
+#include "optim/nlopt_results.h"
 
 namespace mcrewave::internal {
 namespace {
@@ -50,25 +51,6 @@ double NloptObjective(const std::vector<double>& x, std::vector<double>& gradien
   return cost / callback->cost_unit;
 }
 
-std::string ResultName(nlopt::result result) {
-  switch (result) {
-    case nlopt::SUCCESS:
-      return "success";
-    case nlopt::STOPVAL_REACHED:
-      return "stopval reached";
-    case nlopt::FTOL_REACHED:
-      return "ftol reached";
-    case nlopt::XTOL_REACHED:
-      return "xtol reached";
-    case nlopt::MAXEVAL_REACHED:
-      return "maxeval reached";
-    case nlopt::MAXTIME_REACHED:
-      return "maxtime reached";
-    default:
-      return "result code " + std::to_string(static_cast<int>(result));
-  }
-}
-
 }  // namespace
 
 void MinimizeWithNlopt(const IdentificationOptions& options, GuardedObjective* objective,
@@ -95,7 +77,7 @@ void MinimizeWithNlopt(const IdentificationOptions& options, GuardedObjective* o
   double cost = HUGE_VAL;
   try {
     const nlopt::result result = optimizer.optimize(x, cost);
-    summary->optimizer_message = ResultName(result);
+    summary->optimizer_message = NloptResultName(result);
     if (result == nlopt::MAXEVAL_REACHED || result == nlopt::MAXTIME_REACHED) {
       summary->termination = TerminationType::kNoConvergence;
       summary->message = result == nlopt::MAXEVAL_REACHED
@@ -130,17 +112,11 @@ void MinimizeWithNlopt(const IdentificationOptions& options, GuardedObjective* o
     summary->message = "NLopt ran out of memory";
   } catch (const std::runtime_error& error) {
     summary->optimizer_message = error.what();
-    if (objective->stop() == StopReason::kNone && objective->improved() &&
-        UsesGradient(options.optimizer, summary->algorithm) &&
-        std::string(error.what()) == "nlopt failure") {
-      // NLOPT_FAILURE of a gradient-based algorithm that made progress: its line
-      // search found no decrease along a descent direction, i.e. the cost is flat to
-      // the objective's precision there (the inner solves' tolerance), as the zones'
-      // bounded minimiser counts it (measured: configs/paper_bar_pinned.yaml, inner
-      // tolerance 1e-6, NLopt L-BFGS stops 1.4e-6 from BOBYQA's E).
+    if (IsLineSearchStallAfterProgress(error, UsesGradient(options.optimizer, summary->algorithm),
+                                       objective->improved(),
+                                       objective->stop() != StopReason::kNone)) {
       summary->termination = TerminationType::kConvergence;
-      summary->message =
-          "converged to the objective's precision (NLopt: line search without decrease)";
+      summary->message = kLineSearchStallMessage;
     } else {
       summary->termination = TerminationType::kFailure;
       summary->message = std::string("NLopt failed: ") + error.what();
