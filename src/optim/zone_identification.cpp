@@ -240,47 +240,70 @@ double ExpectedLeastSquaresNoiseCost(const BarModel& model, const MeasurementSet
   return std::isfinite(sum) ? sum / samples / cost_scale : -1.0;
 }
 
+namespace {
+
+// The frame both functionals' identifications share: the summary's start (functional,
+// E*, noise levels, zone extents), then `identify` (the objective, the cost scale and
+// MinimizeOverZones into the summary), its exception a failure of the summary, and the
+// wall time.
+template <typename Identify>
+ZoneIdentificationSummary IdentifyZones(const BarModel& model, double homogeneous_modulus,
+                                        const NoiseLevels& noise, bool least_squares,
+                                        Identify&& identify) {
+  const auto start = std::chrono::steady_clock::now();
+  ZoneIdentificationSummary summary;
+  summary.least_squares = least_squares;
+  summary.homogeneous_modulus = homogeneous_modulus;
+  summary.noise = noise;
+  ZoneExtents(model, &summary);
+  try {
+    identify(&summary);
+  } catch (const std::exception& error) {
+    summary.termination = TerminationType::kFailure;
+    summary.message = std::string(least_squares ? "the least-squares zone identification failed: "
+                                                : "the zone identification failed: ") +
+                      error.what();
+  }
+  summary.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+}  // namespace
+
 ZoneIdentificationSummary IdentifyZoneModuli(
     const ZoneIdentificationOptions& options, const BarModel& model, const MeasurementSet& data,
     const McreOptions& mcre, double theta, const CoupledSolverOptions& inner,
     EndDisplacementChannels ends, double homogeneous_modulus, double lower_bound,
     double upper_bound, const NoiseLevels& noise, const PrefilterOptions& prefilter,
     const Matrix* warm_start) {
-  const auto start = std::chrono::steady_clock::now();
-  ZoneIdentificationSummary summary;
-  summary.homogeneous_modulus = homogeneous_modulus;
-  summary.noise = noise;
-  ZoneExtents(model, &summary);
   const int zones = model.num_zones();
-  try {
-    McreObjective objective(model, data, mcre, theta, inner, homogeneous_modulus, ends);
-    const McreProblem& problem = objective.problem();
-    if (warm_start != nullptr && warm_start->cols() == problem.num_steps() + 1 &&
-        (warm_start->rows() == problem.num_nodes() || warm_start->rows() == problem.num_traces())) {
-      objective.SetWarmStart(*warm_start);
-    }
-    summary.cost_scale = objective.cost_scale();
-    ZoneMcreObjective zone_objective(&objective, homogeneous_modulus);
-    MinimizeOverZones(
-        options, zones, &zone_objective, lower_bound, upper_bound,
-        [&] {
-          return ExpectedNoiseCost(model, data, mcre, theta, inner, ends,
-                                   Vector::Constant(zones, homogeneous_modulus), noise, prefilter,
-                                   options.noise_samples, options.noise_seed, summary.cost_scale);
-        },
-        &summary);
-    if (!objective.evaluations().empty() && objective.evaluations().front().usable) {
-      summary.homogeneous_cost = objective.evaluations().front().cost;
-    }
-    summary.evaluations = zone_objective.evaluations();
-    summary.sweeps = objective.sweeps();
-  } catch (const std::exception& error) {
-    summary.termination = TerminationType::kFailure;
-    summary.message = std::string("the zone identification failed: ") + error.what();
-  }
-  summary.wall_time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return summary;
+  return IdentifyZones(
+      model, homogeneous_modulus, noise, false, [&](ZoneIdentificationSummary* summary) {
+        McreObjective objective(model, data, mcre, theta, inner, homogeneous_modulus, ends);
+        const McreProblem& problem = objective.problem();
+        if (warm_start != nullptr && warm_start->cols() == problem.num_steps() + 1 &&
+            (warm_start->rows() == problem.num_nodes() ||
+             warm_start->rows() == problem.num_traces())) {
+          objective.SetWarmStart(*warm_start);
+        }
+        summary->cost_scale = objective.cost_scale();
+        ZoneMcreObjective zone_objective(&objective, homogeneous_modulus);
+        MinimizeOverZones(
+            options, zones, &zone_objective, lower_bound, upper_bound,
+            [&] {
+              return ExpectedNoiseCost(model, data, mcre, theta, inner, ends,
+                                       Vector::Constant(zones, homogeneous_modulus), noise,
+                                       prefilter, options.noise_samples, options.noise_seed,
+                                       summary->cost_scale);
+            },
+            summary);
+        if (!objective.evaluations().empty() && objective.evaluations().front().usable) {
+          summary->homogeneous_cost = objective.evaluations().front().cost;
+        }
+        summary->evaluations = zone_objective.evaluations();
+        summary->sweeps = objective.sweeps();
+      });
 }
 
 ZoneIdentificationSummary IdentifyZoneModuliByLeastSquares(
@@ -288,36 +311,26 @@ ZoneIdentificationSummary IdentifyZoneModuliByLeastSquares(
     const NoiseLevels& misfit_levels, double theta, EndDisplacementChannels ends,
     double homogeneous_modulus, double lower_bound, double upper_bound, const NoiseLevels& noise,
     const PrefilterOptions& prefilter) {
-  const auto start = std::chrono::steady_clock::now();
-  ZoneIdentificationSummary summary;
-  summary.least_squares = true;
-  summary.homogeneous_modulus = homogeneous_modulus;
-  summary.noise = noise;
-  ZoneExtents(model, &summary);
   const int zones = model.num_zones();
-  try {
-    ZoneOutputErrorObjective objective(model, data, misfit_levels, theta, homogeneous_modulus,
-                                       ends);
-    summary.cost_scale = objective.cost_scale();
-    summary.homogeneous_cost =
-        objective.Cost(Vector::Constant(zones, homogeneous_modulus), nullptr);
-    MinimizeOverZones(
-        options, zones, &objective, lower_bound, upper_bound,
-        [&] {
-          return ExpectedLeastSquaresNoiseCost(
-              model, data, misfit_levels, theta, ends, Vector::Constant(zones, homogeneous_modulus),
-              noise, prefilter, options.noise_samples, options.noise_seed, summary.cost_scale);
-        },
-        &summary);
-    summary.evaluations = objective.evaluations();
-    summary.sweeps = objective.sweeps();
-  } catch (const std::exception& error) {
-    summary.termination = TerminationType::kFailure;
-    summary.message = std::string("the least-squares zone identification failed: ") + error.what();
-  }
-  summary.wall_time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return summary;
+  return IdentifyZones(
+      model, homogeneous_modulus, noise, true, [&](ZoneIdentificationSummary* summary) {
+        ZoneOutputErrorObjective objective(model, data, misfit_levels, theta, homogeneous_modulus,
+                                           ends);
+        summary->cost_scale = objective.cost_scale();
+        summary->homogeneous_cost =
+            objective.Cost(Vector::Constant(zones, homogeneous_modulus), nullptr);
+        MinimizeOverZones(
+            options, zones, &objective, lower_bound, upper_bound,
+            [&] {
+              return ExpectedLeastSquaresNoiseCost(model, data, misfit_levels, theta, ends,
+                                                   Vector::Constant(zones, homogeneous_modulus),
+                                                   noise, prefilter, options.noise_samples,
+                                                   options.noise_seed, summary->cost_scale);
+            },
+            summary);
+        summary->evaluations = objective.evaluations();
+        summary->sweeps = objective.sweeps();
+      });
 }
 
 }  // namespace mcrewave
