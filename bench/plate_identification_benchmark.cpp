@@ -44,7 +44,7 @@
 #include "mcrewave/app/matrix_identification_run.h"
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
-#include "mcrewave/optim/matrix_zone_objective.h"
+#include "mcrewave/mcre/matrix_zone_objective.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// Wall time of the identification of zone moduli (optim/zone_identification.h) on the
+// Wall time of the identification of zone moduli (identification/zone_identification.h) on the
 // paper's case (configs/paper_bar_free_free.yaml, or the config given), after the
 // scalar identification that gives the homogeneous start E*. The data below are those
 // of the free-free model (driven by both measured end forces), hence its config: the
@@ -30,7 +30,7 @@
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/mcre/mcre_problem.h"
-#include "mcrewave/optim/zone_identification.h"
+#include "mcrewave/identification/zone_identification.h"
 
 namespace {
 

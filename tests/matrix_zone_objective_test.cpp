@@ -1,7 +1,7 @@
 // Tests of the zone-moduli objective of a structure given by matrices
-// (optim/matrix_zone_objective.h): the inverse crime on the coarse plate recovers
+// (mcre/matrix_zone_objective.h): the inverse crime on the coarse plate recovers
 // both zones from the nominal start; a solve that fails is reported, not thrown.
-#include "mcrewave/optim/matrix_zone_objective.h"
+#include "mcrewave/mcre/matrix_zone_objective.h"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
-// IdentifyZoneModuli (optim/zone_identification.h): the adapter's gradient in
+// IdentifyZoneModuli (identification/zone_identification.h): the adapter's gradient in
 // p = log(E / E*) against central differences, the inverse crime: 10 zones from
 // noise-free data of the model itself, every zone recovered, and the merging of its
 // zones on noisy data against the identification of the truth's groups.
-#include "mcrewave/optim/zone_identification.h"
+#include "mcrewave/identification/zone_identification.h"
 
 #include <gtest/gtest.h>
 

@@ -16,7 +16,7 @@
 #include "mcrewave/data/noise.h"
 #include "mcrewave/least_squares/output_error_objective.h"
 #include "mcrewave/model/simulation.h"
-#include "mcrewave/optim/zone_identification.h"
+#include "mcrewave/identification/zone_identification.h"
 #include "test_problems.h"
 
 namespace mcrewave {

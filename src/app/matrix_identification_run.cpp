@@ -12,7 +12,7 @@
 
 #include "mcrewave/data/prefilter.h"
 #include "mcrewave/data/resample.h"
-#include "mcrewave/optim/matrix_zone_objective.h"
+#include "mcrewave/mcre/matrix_zone_objective.h"
 
 namespace mcrewave {
 namespace {

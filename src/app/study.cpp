@@ -211,36 +211,6 @@ std::string Colour(int index) {
 
 using namespace internal;
 
-const char* StudyKindToString(StudyKind kind) {
-  switch (kind) {
-    case StudyKind::kRobustness:
-      return "robustness";
-    case StudyKind::kRelaxation:
-      return "relaxation";
-    case StudyKind::kCostCurves:
-      return "cost_curves";
-    case StudyKind::kAll:
-      return "all";
-    case StudyKind::kDamage:
-      return "damage";
-    case StudyKind::kComparator:
-      return "comparator";
-  }
-  return "unknown";
-}
-
-bool StringToStudyKind(const std::string& name, StudyKind* kind) {
-  for (StudyKind candidate :
-       {StudyKind::kRobustness, StudyKind::kRelaxation, StudyKind::kCostCurves, StudyKind::kAll,
-        StudyKind::kDamage, StudyKind::kComparator}) {
-    if (name == StudyKindToString(candidate)) {
-      *kind = candidate;
-      return true;
-    }
-  }
-  return false;
-}
-
 bool StudySelected(StudyKind kind, StudyKind part) {
   return (kind == StudyKind::kAll && part != StudyKind::kDamage &&
           part != StudyKind::kComparator) ||

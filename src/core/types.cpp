@@ -1,83 +1,110 @@
 #include "mcrewave/core/types.h"
 
-#include <array>
-#include <utility>
-
 #include "core/enum_names.h"
 
 namespace mcrewave {
-namespace {
 
-using internal::FromName;
-using internal::ToName;
+// Each pair reads the enum's table in types.h, the only place where a name is tied
+// to a value.
 
-// One table per enum: the only place where a name is tied to a value.
-
-constexpr std::array<std::pair<MassType, const char*>, 2> kMassTypes{
-    {{MassType::kConsistent, "consistent"}, {MassType::kLumped, "lumped"}}};
-constexpr std::array<std::pair<LoadKind, const char*>, 1> kLoadKinds{
-    {{LoadKind::kHalfSine, "half_sine"}}};
-constexpr std::array<std::pair<DataSource, const char*>, 2> kDataSources{
-    {{DataSource::kSynthetic, "synthetic"}, {DataSource::kCsv, "csv"}}};
-constexpr std::array<std::pair<TruthModel, const char*>, 2> kTruthModels{
-    {{TruthModel::kFiniteElement, "finite_element"}, {TruthModel::kExact, "exact"}}};
-
-constexpr std::array<std::pair<SensorKind, const char*>, 2> kSensorKinds{
-    {{SensorKind::kDisplacement, "displacement"}, {SensorKind::kStrain, "strain"}}};
-constexpr std::array<std::pair<ModelKind, const char*>, 2> kModelKinds{
-    {{ModelKind::kBar, "bar"}, {ModelKind::kMatrix, "matrix"}}};
-constexpr std::array<std::pair<ClampModel, const char*>, 3> kClampModels{
-    {{ClampModel::kMeasured, "measured"},
-     {ClampModel::kTrusted, "trusted"},
-     {ClampModel::kPinned, "pinned"}}};
-constexpr std::array<std::pair<SearchFunctional, const char*>, 2> kSearchFunctionals{
-    {{SearchFunctional::kPinned, "pinned"}, {SearchFunctional::kSame, "same"}}};
-constexpr std::array<std::pair<Zoning, const char*>, 3> kZonings{{{Zoning::kEqual, "equal"},
-                                                                  {Zoning::kPerElement, "per_element"},
-                                                                  {Zoning::kBoundaries, "boundaries"}}};
-
-}  // namespace
-
-const char* SensorKindToString(SensorKind kind) { return ToName(kSensorKinds, kind); }
-bool StringToSensorKind(const std::string& name, SensorKind* kind) {
-  return FromName(kSensorKinds, name, kind);
-}
-const char* ZoningToString(Zoning zoning) { return ToName(kZonings, zoning); }
-bool StringToZoning(const std::string& name, Zoning* zoning) {
-  return FromName(kZonings, name, zoning);
-}
-const char* MassTypeToString(MassType type) { return ToName(kMassTypes, type); }
+const char* MassTypeToString(MassType type) { return internal::ToName(kMassTypeNames, type); }
 bool StringToMassType(const std::string& name, MassType* type) {
-  return FromName(kMassTypes, name, type);
+  return internal::FromName(kMassTypeNames, name, type);
 }
-const char* LoadKindToString(LoadKind kind) { return ToName(kLoadKinds, kind); }
+
+const char* LoadKindToString(LoadKind kind) { return internal::ToName(kLoadKindNames, kind); }
 bool StringToLoadKind(const std::string& name, LoadKind* kind) {
-  return FromName(kLoadKinds, name, kind);
+  return internal::FromName(kLoadKindNames, name, kind);
 }
-const char* DataSourceToString(DataSource source) { return ToName(kDataSources, source); }
+
+const char* DataSourceToString(DataSource source) { return internal::ToName(kDataSourceNames, source); }
 bool StringToDataSource(const std::string& name, DataSource* source) {
-  return FromName(kDataSources, name, source);
+  return internal::FromName(kDataSourceNames, name, source);
 }
-const char* TruthModelToString(TruthModel model) { return ToName(kTruthModels, model); }
+
+const char* TruthModelToString(TruthModel model) { return internal::ToName(kTruthModelNames, model); }
 bool StringToTruthModel(const std::string& name, TruthModel* model) {
-  return FromName(kTruthModels, name, model);
+  return internal::FromName(kTruthModelNames, name, model);
 }
 
-const char* ModelKindToString(ModelKind kind) { return ToName(kModelKinds, kind); }
+const char* SensorKindToString(SensorKind kind) { return internal::ToName(kSensorKindNames, kind); }
+bool StringToSensorKind(const std::string& name, SensorKind* kind) {
+  return internal::FromName(kSensorKindNames, name, kind);
+}
+
+const char* ZoningToString(Zoning zoning) { return internal::ToName(kZoningNames, zoning); }
+bool StringToZoning(const std::string& name, Zoning* zoning) {
+  return internal::FromName(kZoningNames, name, zoning);
+}
+
+const char* ModelKindToString(ModelKind kind) { return internal::ToName(kModelKindNames, kind); }
 bool StringToModelKind(const std::string& name, ModelKind* kind) {
-  return FromName(kModelKinds, name, kind);
+  return internal::FromName(kModelKindNames, name, kind);
 }
 
-const char* ClampModelToString(ClampModel model) { return ToName(kClampModels, model); }
+const char* ClampModelToString(ClampModel model) { return internal::ToName(kClampModelNames, model); }
 bool StringToClampModel(const std::string& name, ClampModel* model) {
-  return FromName(kClampModels, name, model);
+  return internal::FromName(kClampModelNames, name, model);
 }
 
-const char* SearchFunctionalToString(SearchFunctional functional) {
-  return ToName(kSearchFunctionals, functional);
-}
+const char* SearchFunctionalToString(SearchFunctional functional) { return internal::ToName(kSearchFunctionalNames, functional); }
 bool StringToSearchFunctional(const std::string& name, SearchFunctional* functional) {
-  return FromName(kSearchFunctionals, name, functional);
+  return internal::FromName(kSearchFunctionalNames, name, functional);
+}
+
+const char* FactorizationToString(Factorization factorization) { return internal::ToName(kFactorizationNames, factorization); }
+bool StringToFactorization(const std::string& name, Factorization* factorization) {
+  return internal::FromName(kFactorizationNames, name, factorization);
+}
+
+const char* MatrixMarketStorageToString(MatrixMarketStorage storage) { return internal::ToName(kMatrixMarketStorageNames, storage); }
+bool StringToMatrixMarketStorage(const std::string& name, MatrixMarketStorage* storage) {
+  return internal::FromName(kMatrixMarketStorageNames, name, storage);
+}
+
+const char* CoupledSolverTypeToString(CoupledSolverType type) { return internal::ToName(kCoupledSolverTypeNames, type); }
+bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type) {
+  return internal::FromName(kCoupledSolverTypeNames, name, type);
+}
+
+const char* TerminationTypeToString(TerminationType type) { return internal::ToName(kTerminationTypeNames, type); }
+bool StringToTerminationType(const std::string& name, TerminationType* type) {
+  return internal::FromName(kTerminationTypeNames, name, type);
+}
+
+const char* BoundedAlgorithmToString(BoundedAlgorithm algorithm) { return internal::ToName(kBoundedAlgorithmNames, algorithm); }
+bool StringToBoundedAlgorithm(const std::string& name, BoundedAlgorithm* algorithm) {
+  return internal::FromName(kBoundedAlgorithmNames, name, algorithm);
+}
+
+const char* OuterFunctionalToString(OuterFunctional functional) { return internal::ToName(kOuterFunctionalNames, functional); }
+bool StringToOuterFunctional(const std::string& name, OuterFunctional* functional) {
+  return internal::FromName(kOuterFunctionalNames, name, functional);
+}
+
+const char* OptimizerTypeToString(OptimizerType type) { return internal::ToName(kOptimizerTypeNames, type); }
+bool StringToOptimizerType(const std::string& name, OptimizerType* type) {
+  return internal::FromName(kOptimizerTypeNames, name, type);
+}
+
+const char* OuterAlgorithmToString(OuterAlgorithm algorithm) { return internal::ToName(kOuterAlgorithmNames, algorithm); }
+bool StringToOuterAlgorithm(const std::string& name, OuterAlgorithm* algorithm) {
+  return internal::FromName(kOuterAlgorithmNames, name, algorithm);
+}
+
+const char* RegularizationKindToString(RegularizationKind kind) { return internal::ToName(kRegularizationKindNames, kind); }
+bool StringToRegularizationKind(const std::string& name, RegularizationKind* kind) {
+  return internal::FromName(kRegularizationKindNames, name, kind);
+}
+
+const char* WeightRuleToString(WeightRule rule) { return internal::ToName(kWeightRuleNames, rule); }
+bool StringToWeightRule(const std::string& name, WeightRule* rule) {
+  return internal::FromName(kWeightRuleNames, name, rule);
+}
+
+const char* StudyKindToString(StudyKind kind) { return internal::ToName(kStudyKindNames, kind); }
+bool StringToStudyKind(const std::string& name, StudyKind* kind) {
+  return internal::FromName(kStudyKindNames, name, kind);
 }
 
 }  // namespace mcrewave

@@ -9,26 +9,8 @@
 #include <stdexcept>
 #include <utility>
 
-#include "core/enum_names.h"
 
 namespace mcrewave {
-namespace {
-
-constexpr std::array<std::pair<Factorization, const char*>, 3> kFactorizationNames = {{
-    {Factorization::kAutomatic, "automatic"},
-    {Factorization::kBand, "band"},
-    {Factorization::kSparse, "sparse"},
-}};
-
-}  // namespace
-
-const char* FactorizationToString(Factorization factorization) {
-  return internal::ToName(kFactorizationNames, factorization);
-}
-
-bool StringToFactorization(const std::string& name, Factorization* factorization) {
-  return internal::FromName(kFactorizationNames, name, factorization);
-}
 
 int HalfBandwidth(const SparseMatrix& matrix) {
   int bandwidth = 0;

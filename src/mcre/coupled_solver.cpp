@@ -10,42 +10,6 @@
 #include "mcre/coupled_solver_internal.h"
 
 namespace mcrewave {
-namespace {
-
-constexpr std::array<std::pair<CoupledSolverType, const char*>, 8> kSolverTypes{{
-    {CoupledSolverType::kAllAtOnce, "all_at_once"},
-    {CoupledSolverType::kRelaxation, "relaxation"},
-    {CoupledSolverType::kAdaptiveRelaxation, "adaptive_relaxation"},
-    {CoupledSolverType::kConjugateGradient, "conjugate_gradient"},
-    {CoupledSolverType::kRiccati, "riccati"},
-    {CoupledSolverType::kSingleShooting, "single_shooting"},
-    {CoupledSolverType::kMultipleShooting, "multiple_shooting"},
-    {CoupledSolverType::kStreamingConjugateGradient, "streaming_conjugate_gradient"},
-}};
-
-}  // namespace
-
-const char* CoupledSolverTypeToString(CoupledSolverType type) {
-  return internal::ToName(kSolverTypes, type);
-}
-
-bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type) {
-  return internal::FromName(kSolverTypes, name, type);
-}
-
-const char* TerminationTypeToString(TerminationType type) {
-  switch (type) {
-    case TerminationType::kConvergence:
-      return "convergence";
-    case TerminationType::kNoConvergence:
-      return "no_convergence";
-    case TerminationType::kDivergence:
-      return "divergence";
-    case TerminationType::kFailure:
-      return "failure";
-  }
-  return "unknown";
-}
 
 bool CoupledSolverOptions::IsValid(std::string* error) const {
   std::ostringstream why;

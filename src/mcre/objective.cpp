@@ -176,15 +176,6 @@ const ObjectiveEvaluation& McreObjective::Solve(double modulus, bool gradient_re
   return evaluations_.back();
 }
 
-bool TrialModulus(double parameter, double modulus_scale, double* modulus, std::string* why) {
-  *modulus = parameter * modulus_scale;
-  if (std::isfinite(*modulus) && *modulus > 0.0) return true;
-  std::ostringstream message;
-  message << "trial modulus " << *modulus << " Pa is not a positive finite number";
-  *why = message.str();
-  return false;
-}
-
 bool McreObjective::Evaluate(const double* parameters, double* cost, double* gradient) {
   double modulus = 0.0;
   if (!TrialModulus(parameters[0], modulus_scale_, &modulus, &error_message_)) return false;

@@ -19,14 +19,6 @@
 namespace mcrewave {
 namespace {
 
-constexpr std::array<std::pair<BoundedAlgorithm, const char*>, 5> kBoundedAlgorithms{{
-    {BoundedAlgorithm::kNloptLbfgs, "nlopt_lbfgs"},
-    {BoundedAlgorithm::kNloptMma, "nlopt_mma"},
-    {BoundedAlgorithm::kNloptSlsqp, "nlopt_slsqp"},
-    {BoundedAlgorithm::kNloptBobyqa, "nlopt_bobyqa"},
-    {BoundedAlgorithm::kCeresLbfgs, "ceres_lbfgs"},
-}};
-
 enum class StopReason { kNone, kEvaluationLimit, kTimeLimit, kFailure };
 
 // The objective as the optimisers must see it: counted, limited, exceptions caught
@@ -359,12 +351,6 @@ void RunCeres(const BoundedMinimizerOptions& options, const std::vector<double>&
 
 }  // namespace
 
-const char* BoundedAlgorithmToString(BoundedAlgorithm algorithm) {
-  return internal::ToName(kBoundedAlgorithms, algorithm);
-}
-bool StringToBoundedAlgorithm(const std::string& name, BoundedAlgorithm* algorithm) {
-  return internal::FromName(kBoundedAlgorithms, name, algorithm);
-}
 bool UsesGradient(BoundedAlgorithm algorithm) {
   return algorithm != BoundedAlgorithm::kNloptBobyqa;
 }

@@ -21,34 +21,10 @@
 namespace mcrewave {
 namespace {
 
-using internal::FromName;
-using internal::ToName;
-
-constexpr std::array<std::pair<OuterFunctional, const char*>, 2> kOuterFunctionals{{
-    {OuterFunctional::kMcre, "mcre"},
-    {OuterFunctional::kLeastSquares, "least_squares"},
-}};
-
-constexpr std::array<std::pair<OptimizerType, const char*>, 2> kOptimizerTypes{{
-    {OptimizerType::kNlopt, "nlopt"},
-    {OptimizerType::kCeres, "ceres"},
-}};
-
-constexpr std::array<std::pair<OuterAlgorithm, const char*>, 8> kOuterAlgorithms{{
-    {OuterAlgorithm::kDefault, "default"},
-    {OuterAlgorithm::kBobyqa, "bobyqa"},
-    {OuterAlgorithm::kCobyla, "cobyla"},
-    {OuterAlgorithm::kSbplx, "sbplx"},
-    {OuterAlgorithm::kMma, "mma"},
-    {OuterAlgorithm::kLbfgs, "lbfgs"},
-    {OuterAlgorithm::kBfgs, "bfgs"},
-    {OuterAlgorithm::kBrent, "brent"},
-}};
-
 // "a, b or c": the algorithms the optimiser offers, for messages.
 std::string AvailableAlgorithms(OptimizerType optimizer) {
   std::vector<std::string> names;
-  for (const auto& [algorithm, name] : kOuterAlgorithms) {
+  for (const auto& [algorithm, name] : kOuterAlgorithmNames) {
     if (IsAlgorithmAvailable(optimizer, algorithm)) names.push_back(name);
   }
   std::string text;
@@ -59,24 +35,6 @@ std::string AvailableAlgorithms(OptimizerType optimizer) {
 }
 
 }  // namespace
-
-const char* OuterFunctionalToString(OuterFunctional functional) {
-  return ToName(kOuterFunctionals, functional);
-}
-bool StringToOuterFunctional(const std::string& name, OuterFunctional* functional) {
-  return FromName(kOuterFunctionals, name, functional);
-}
-
-const char* OptimizerTypeToString(OptimizerType type) { return ToName(kOptimizerTypes, type); }
-bool StringToOptimizerType(const std::string& name, OptimizerType* type) {
-  return FromName(kOptimizerTypes, name, type);
-}
-const char* OuterAlgorithmToString(OuterAlgorithm algorithm) {
-  return ToName(kOuterAlgorithms, algorithm);
-}
-bool StringToOuterAlgorithm(const std::string& name, OuterAlgorithm* algorithm) {
-  return FromName(kOuterAlgorithms, name, algorithm);
-}
 
 bool IsAlgorithmAvailable(OptimizerType optimizer, OuterAlgorithm algorithm) {
   switch (algorithm) {

@@ -11,21 +11,9 @@
 #include <utility>
 #include <vector>
 
-#include "core/enum_names.h"
 
 namespace mcrewave {
 namespace {
-
-constexpr std::array<std::pair<RegularizationKind, const char*>, 3> kRegularizationKinds{{
-    {RegularizationKind::kNone, "none"},
-    {RegularizationKind::kTikhonov, "tikhonov"},
-    {RegularizationKind::kTotalVariation, "total_variation"},
-}};
-
-constexpr std::array<std::pair<WeightRule, const char*>, 2> kWeightRules{{
-    {WeightRule::kLCurve, "l_curve"},
-    {WeightRule::kDiscrepancy, "discrepancy"},
-}};
 
 // One minimisation at `weight` from `start`, recorded in *result.
 BoundedMinimizerSummary MinimizeAt(const BoundedMinimizerOptions& options,
@@ -73,17 +61,6 @@ BoundedMinimizerSummary MinimizeAt(const BoundedMinimizerOptions& options,
 }
 
 }  // namespace
-
-const char* RegularizationKindToString(RegularizationKind kind) {
-  return internal::ToName(kRegularizationKinds, kind);
-}
-bool StringToRegularizationKind(const std::string& name, RegularizationKind* kind) {
-  return internal::FromName(kRegularizationKinds, name, kind);
-}
-const char* WeightRuleToString(WeightRule rule) { return internal::ToName(kWeightRules, rule); }
-bool StringToWeightRule(const std::string& name, WeightRule* rule) {
-  return internal::FromName(kWeightRules, name, rule);
-}
 
 bool RegularizationOptions::IsValid(std::string* error) const {
   std::ostringstream why;

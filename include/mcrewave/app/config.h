@@ -82,7 +82,7 @@
 #include "mcrewave/model/bar_model.h"
 #include "mcrewave/model/experiment.h"
 #include "mcrewave/optim/identification.h"
-#include "mcrewave/optim/zone_identification.h"
+#include "mcrewave/identification/zone_identification.h"
 
 namespace mcrewave {
 
@@ -134,7 +134,7 @@ struct Config {
   UncertaintyOptions uncertainty;
   OutputOptions output;
   StudyOptions study;
-  // The identification of zone moduli after the scalar one (optim/zone_identification.h).
+  // The identification of zone moduli after the scalar one (identification/zone_identification.h).
   ZoneIdentificationOptions zone_identification;
 };
 

@@ -52,17 +52,6 @@ namespace mcrewave {
 
 struct Config;
 
-enum class StudyKind {
-  kRobustness,
-  kRelaxation,
-  kCostCurves,
-  kAll,         // the three above
-  kDamage,      // damage localisation with zones and sensors (damage_study.h); not in kAll
-  kComparator,  // MCRE against output-error least squares (comparator_study.h); not in kAll
-};
-const char* StudyKindToString(StudyKind kind);
-bool StringToStudyKind(const std::string& name, StudyKind* kind);
-
 // The `study:` section of the config.
 struct StudyOptions {
   StudyKind kind = StudyKind::kAll;

@@ -1,6 +1,6 @@
 // The identification of zone moduli within `identify run` (docs/zones_and_sensors.md,
 // "Identification of zone moduli"): after the scalar identification, from its
-// homogeneous E*, every zone modulus at once (optim/zone_identification.h; by the
+// homogeneous E*, every zone modulus at once (identification/zone_identification.h; by the
 // MCRE, or by output-error least squares with outer.functional: least_squares), and its
 // outputs: the `zones:` block of summary.yaml, zones.csv and the figure moduli.png of
 // E(x) (a step plot) against the truth's E(x) when the data are synthetic.
@@ -11,7 +11,7 @@
 
 #include "mcrewave/app/config.h"
 #include "mcrewave/model/bar_model.h"
-#include "mcrewave/optim/zone_identification.h"
+#include "mcrewave/identification/zone_identification.h"
 
 namespace mcrewave {
 

@@ -1,12 +1,15 @@
-// Common types of mcrewave: linear algebra aliases, the enums that travel through
-// YAML as names (each with a to/from-string pair, as Ceres' types.h), and the
-// exception that reports bad user input.
+// Common types of mcrewave: linear algebra aliases, the exception that reports bad
+// user input, and every enum of the library, each with its name table (the names
+// that travel through YAML and reports) and a to/from-string pair, as Ceres'
+// types.h. Iterate a table (kXNames) to list the names of an enum in a message.
 #pragma once
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <array>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace mcrewave {
 
@@ -27,6 +30,10 @@ enum class MassType {
   kConsistent,  // consistent linear-element mass (rho S h_e / 6) [2 1; 1 2]
   kLumped,      // row-sum lumped mass (rho S h_e / 2) diag(1, 1)
 };
+inline constexpr std::array<std::pair<MassType, const char*>, 2> kMassTypeNames{{
+    {MassType::kConsistent, "consistent"},
+    {MassType::kLumped, "lumped"},
+}};
 const char* MassTypeToString(MassType type);
 // Returns false (and leaves *type unchanged) when name is not a MassType name.
 bool StringToMassType(const std::string& name, MassType* type);
@@ -35,6 +42,9 @@ bool StringToMassType(const std::string& name, MassType* type);
 enum class LoadKind {
   kHalfSine,  // F(t) = F0 sin(pi t / t_load) for t <= t_load, 0 after
 };
+inline constexpr std::array<std::pair<LoadKind, const char*>, 1> kLoadKindNames{{
+    {LoadKind::kHalfSine, "half_sine"},
+}};
 const char* LoadKindToString(LoadKind kind);
 bool StringToLoadKind(const std::string& name, LoadKind* kind);
 
@@ -43,6 +53,10 @@ enum class DataSource {
   kSynthetic,  // simulated on a truth discretisation, then noise is added
   kCsv,        // read from a measurement CSV file (t,u0,uL,f0,fL)
 };
+inline constexpr std::array<std::pair<DataSource, const char*>, 2> kDataSourceNames{{
+    {DataSource::kSynthetic, "synthetic"},
+    {DataSource::kCsv, "csv"},
+}};
 const char* DataSourceToString(DataSource source);
 bool StringToDataSource(const std::string& name, DataSource* source);
 
@@ -51,6 +65,10 @@ enum class TruthModel {
   kFiniteElement,  // the FE + theta model on a mesh and step refined by truth_refinement
   kExact,          // the exact solution of the continuous bar (d'Alembert's reflected pulses)
 };
+inline constexpr std::array<std::pair<TruthModel, const char*>, 2> kTruthModelNames{{
+    {TruthModel::kFiniteElement, "finite_element"},
+    {TruthModel::kExact, "exact"},
+}};
 const char* TruthModelToString(TruthModel model);
 bool StringToTruthModel(const std::string& name, TruthModel* model);
 
@@ -59,6 +77,10 @@ enum class SensorKind {
   kDisplacement,  // u@X: axial displacement [m] at X m from the clamped end
   kStrain,        // e@X: axial strain [-] at X, BarModel::StrainRow (compression negative)
 };
+inline constexpr std::array<std::pair<SensorKind, const char*>, 2> kSensorKindNames{{
+    {SensorKind::kDisplacement, "displacement"},
+    {SensorKind::kStrain, "strain"},
+}};
 const char* SensorKindToString(SensorKind kind);
 bool StringToSensorKind(const std::string& name, SensorKind* kind);
 
@@ -69,6 +91,11 @@ enum class Zoning {
   kPerElement,  // one zone per element
   kBoundaries,  // zones between the interior boundaries model.zone_boundaries [m]
 };
+inline constexpr std::array<std::pair<Zoning, const char*>, 3> kZoningNames{{
+    {Zoning::kEqual, "equal"},
+    {Zoning::kPerElement, "per_element"},
+    {Zoning::kBoundaries, "boundaries"},
+}};
 const char* ZoningToString(Zoning zoning);
 bool StringToZoning(const std::string& name, Zoning* zoning);
 
@@ -78,6 +105,10 @@ enum class ModelKind {
   kMatrix,  // matrices from another finite-element code, named by model.manifest
             // (model/matrix_export.h, docs/matrix_models.md)
 };
+inline constexpr std::array<std::pair<ModelKind, const char*>, 2> kModelKindNames{{
+    {ModelKind::kBar, "bar"},
+    {ModelKind::kMatrix, "matrix"},
+}};
 const char* ModelKindToString(ModelKind kind);
 bool StringToModelKind(const std::string& name, ModelKind* kind);
 
@@ -91,6 +122,11 @@ enum class ClampModel {
   kPinned,    // the paper's free-free model with the known u(0) = 0 as the datum of
               // u0 (weight w_u0, not the measured u0) and f0 a load of weight w_r
 };
+inline constexpr std::array<std::pair<ClampModel, const char*>, 3> kClampModelNames{{
+    {ClampModel::kMeasured, "measured"},
+    {ClampModel::kTrusted, "trusted"},
+    {ClampModel::kPinned, "pinned"},
+}};
 const char* ClampModelToString(ClampModel model);
 bool StringToClampModel(const std::string& name, ClampModel* model);
 
@@ -101,7 +137,188 @@ enum class SearchFunctional {
             // the bounds), then mcre:'s e^2 refined near its minimum
   kSame,    // mcre:'s e^2 itself, scanned and refined
 };
+inline constexpr std::array<std::pair<SearchFunctional, const char*>, 2> kSearchFunctionalNames{{
+    {SearchFunctional::kPinned, "pinned"},
+    {SearchFunctional::kSame, "same"},
+}};
 const char* SearchFunctionalToString(SearchFunctional functional);
 bool StringToSearchFunctional(const std::string& name, SearchFunctional* functional);
+
+// How the iteration matrix S = M + h^2 theta^2 K is factorised.
+enum class Factorization {
+  kAutomatic,  // kBand when the band of S is narrow (ChooseFactorization), else kSparse
+  kBand,       // band LDL^T (tridiagonal: the twisted factorisation), band_matrix.h
+  kSparse,     // sparse LDL^T with AMD ordering, sparse_theta_step.h
+};
+inline constexpr std::array<std::pair<Factorization, const char*>, 3> kFactorizationNames{{
+    {Factorization::kAutomatic, "automatic"},
+    {Factorization::kBand, "band"},
+    {Factorization::kSparse, "sparse"},
+}};
+const char* FactorizationToString(Factorization factorization);
+bool StringToFactorization(const std::string& name, Factorization* factorization);
+
+// How a sparse matrix is written.
+enum class MatrixMarketStorage {
+  kGeneral,    // every stored entry
+  kSymmetric,  // the lower triangle (i >= j) only; the matrix is taken as symmetric
+};
+inline constexpr std::array<std::pair<MatrixMarketStorage, const char*>, 2> kMatrixMarketStorageNames{{
+    {MatrixMarketStorage::kGeneral, "general"},
+    {MatrixMarketStorage::kSymmetric, "symmetric"},
+}};
+const char* MatrixMarketStorageToString(MatrixMarketStorage storage);
+bool StringToMatrixMarketStorage(const std::string& name, MatrixMarketStorage* storage);
+
+enum class CoupledSolverType {
+  kAllAtOnce,
+  kRelaxation,
+  kAdaptiveRelaxation,
+  kConjugateGradient,
+  kRiccati,
+  kSingleShooting,
+  kMultipleShooting,
+  // Conjugate gradients on the sensor traces with O(n) memory (docs/streaming.md):
+  // no space-time field is stored (theta = 1/2: O(n) memory; other theta: checkpoints,
+  // O(n sqrt(m))).
+  kStreamingConjugateGradient,
+};
+inline constexpr std::array<std::pair<CoupledSolverType, const char*>, 8> kCoupledSolverTypeNames{{
+    {CoupledSolverType::kAllAtOnce, "all_at_once"},
+    {CoupledSolverType::kRelaxation, "relaxation"},
+    {CoupledSolverType::kAdaptiveRelaxation, "adaptive_relaxation"},
+    {CoupledSolverType::kConjugateGradient, "conjugate_gradient"},
+    {CoupledSolverType::kRiccati, "riccati"},
+    {CoupledSolverType::kSingleShooting, "single_shooting"},
+    {CoupledSolverType::kMultipleShooting, "multiple_shooting"},
+    {CoupledSolverType::kStreamingConjugateGradient, "streaming_conjugate_gradient"},
+}};
+const char* CoupledSolverTypeToString(CoupledSolverType type);
+bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type);
+
+enum class TerminationType {
+  kConvergence,    // the residual reached the tolerance
+  kNoConvergence,  // the iteration limit was reached first
+  kDivergence,     // the residual grew (or became non-finite): the iteration diverges
+  kFailure,        // refused or broke down (problem too large, singular system...)
+};
+inline constexpr std::array<std::pair<TerminationType, const char*>, 4> kTerminationTypeNames{{
+    {TerminationType::kConvergence, "convergence"},
+    {TerminationType::kNoConvergence, "no_convergence"},
+    {TerminationType::kDivergence, "divergence"},
+    {TerminationType::kFailure, "failure"},
+}};
+const char* TerminationTypeToString(TerminationType type);
+bool StringToTerminationType(const std::string& name, TerminationType* type);
+
+enum class BoundedAlgorithm {
+  kNloptLbfgs,
+  kNloptMma,
+  kNloptSlsqp,
+  kNloptBobyqa,
+  kCeresLbfgs,
+};
+inline constexpr std::array<std::pair<BoundedAlgorithm, const char*>, 5> kBoundedAlgorithmNames{{
+    {BoundedAlgorithm::kNloptLbfgs, "nlopt_lbfgs"},
+    {BoundedAlgorithm::kNloptMma, "nlopt_mma"},
+    {BoundedAlgorithm::kNloptSlsqp, "nlopt_slsqp"},
+    {BoundedAlgorithm::kNloptBobyqa, "nlopt_bobyqa"},
+    {BoundedAlgorithm::kCeresLbfgs, "ceres_lbfgs"},
+}};
+const char* BoundedAlgorithmToString(BoundedAlgorithm algorithm);
+bool StringToBoundedAlgorithm(const std::string& name, BoundedAlgorithm* algorithm);
+
+// The functional the outer loop minimises over E. Identify minimises whatever
+// ModulusObjective it is given; identify run (app/identification_run.h) builds it
+// from this choice.
+enum class OuterFunctional {
+  kMcre,          // the MCRE cost e^2(E) (McreObjective)
+  kLeastSquares,  // output-error least squares J(E) (OutputErrorObjective), the comparator
+};
+inline constexpr std::array<std::pair<OuterFunctional, const char*>, 2> kOuterFunctionalNames{{
+    {OuterFunctional::kMcre, "mcre"},
+    {OuterFunctional::kLeastSquares, "least_squares"},
+}};
+const char* OuterFunctionalToString(OuterFunctional functional);
+bool StringToOuterFunctional(const std::string& name, OuterFunctional* functional);
+
+enum class OptimizerType {
+  kNlopt,
+  kCeres,
+};
+inline constexpr std::array<std::pair<OptimizerType, const char*>, 2> kOptimizerTypeNames{{
+    {OptimizerType::kNlopt, "nlopt"},
+    {OptimizerType::kCeres, "ceres"},
+}};
+const char* OptimizerTypeToString(OptimizerType type);
+bool StringToOptimizerType(const std::string& name, OptimizerType* type);
+
+// The algorithm of the outer optimiser; not every one exists in both.
+enum class OuterAlgorithm {
+  kDefault,  // bobyqa for nlopt, lbfgs for ceres
+  kBobyqa,   // nlopt: Powell's BOBYQA, quadratic models, derivative-free, bounded
+  kCobyla,   // nlopt: Powell's COBYLA, linear models, derivative-free, bounded
+  kSbplx,    // nlopt: Subplex (Nelder-Mead on subspaces), derivative-free, bounded
+  kMma,      // nlopt: method of moving asymptotes, adjoint gradient, bounded
+  kLbfgs,    // nlopt or ceres: limited-memory BFGS, adjoint gradient
+  kBfgs,     // ceres: dense BFGS, adjoint gradient
+  kBrent,    // under nlopt: Brent's bounded 1-D minimiser (mcrewave's own), derivative-free
+};
+inline constexpr std::array<std::pair<OuterAlgorithm, const char*>, 8> kOuterAlgorithmNames{{
+    {OuterAlgorithm::kDefault, "default"},
+    {OuterAlgorithm::kBobyqa, "bobyqa"},
+    {OuterAlgorithm::kCobyla, "cobyla"},
+    {OuterAlgorithm::kSbplx, "sbplx"},
+    {OuterAlgorithm::kMma, "mma"},
+    {OuterAlgorithm::kLbfgs, "lbfgs"},
+    {OuterAlgorithm::kBfgs, "bfgs"},
+    {OuterAlgorithm::kBrent, "brent"},
+}};
+const char* OuterAlgorithmToString(OuterAlgorithm algorithm);
+bool StringToOuterAlgorithm(const std::string& name, OuterAlgorithm* algorithm);
+
+enum class RegularizationKind {
+  kNone,
+  kTikhonov,
+  kTotalVariation,
+};
+inline constexpr std::array<std::pair<RegularizationKind, const char*>, 3> kRegularizationKindNames{{
+    {RegularizationKind::kNone, "none"},
+    {RegularizationKind::kTikhonov, "tikhonov"},
+    {RegularizationKind::kTotalVariation, "total_variation"},
+}};
+const char* RegularizationKindToString(RegularizationKind kind);
+bool StringToRegularizationKind(const std::string& name, RegularizationKind* kind);
+
+// How an automatic weight is chosen.
+enum class WeightRule {
+  kLCurve,       // the L-curve's corner, down to the first weight that meets the target
+  kDiscrepancy,  // the discrepancy principle, the L-curve when its target is missed
+};
+inline constexpr std::array<std::pair<WeightRule, const char*>, 2> kWeightRuleNames{{
+    {WeightRule::kLCurve, "l_curve"},
+    {WeightRule::kDiscrepancy, "discrepancy"},
+}};
+const char* WeightRuleToString(WeightRule rule);
+bool StringToWeightRule(const std::string& name, WeightRule* rule);
+
+enum class StudyKind {
+  kRobustness,
+  kRelaxation,
+  kCostCurves,
+  kAll,         // the three above
+  kDamage,      // damage localisation with zones and sensors (damage_study.h); not in kAll
+  kComparator,  // MCRE against output-error least squares (comparator_study.h); not in kAll
+};
+inline constexpr std::array<std::pair<StudyKind, const char*>, 6> kStudyKindNames{{
+    {StudyKind::kRobustness, "robustness"},
+    {StudyKind::kRelaxation, "relaxation"},
+    {StudyKind::kCostCurves, "cost_curves"},
+    {StudyKind::kAll, "all"},
+    {StudyKind::kDamage, "damage"},
+    {StudyKind::kComparator, "comparator"},
+}};
+const char* StudyKindToString(StudyKind kind);
+bool StringToStudyKind(const std::string& name, StudyKind* kind);
 
 }  // namespace mcrewave

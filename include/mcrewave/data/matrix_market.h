@@ -54,12 +54,6 @@ Vector ReadMatrixMarketVector(const std::string& path, const MatrixMarketReadOpt
 Vector ParseMatrixMarketVector(std::istream& text, const std::string& name,
                                const MatrixMarketReadOptions& options = {});
 
-// How a sparse matrix is written.
-enum class MatrixMarketStorage {
-  kGeneral,    // every stored entry
-  kSymmetric,  // the lower triangle (i >= j) only; the matrix is taken as symmetric
-};
-
 // The text of a coordinate real file of `matrix` (its stored entries, explicit zeros
 // included, column by column), every value with 17 significant digits, so that it
 // reads back bit for bit. `comment` (may hold several lines, may be empty) goes on

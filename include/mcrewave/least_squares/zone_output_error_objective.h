@@ -19,8 +19,8 @@
 // evaluation without the gradient, 1 + Z with it: meant for the few zones of a
 // localisation (10 zones: 11 sweeps), not for one zone per element.
 //
-// Seen by the optimisers (bounded_minimizer.h) as a function of p_z =
-// log(E_z / modulus_scale), as ZoneMcreObjective (zone_identification.h), with the
+// Seen by the optimisers (optim/bounded_minimizer.h) as a function of p_z =
+// log(E_z / modulus_scale), as ZoneMcreObjective (identification/zone_identification.h), with the
 // cost J / J_rest (J_rest: every prediction 0, OutputErrorRestCost) and its gradient
 // d cost / d p_z = (dJ/dE_z) E_z / J_rest.
 #pragma once

@@ -72,15 +72,6 @@ struct PointLoads {
   const double* values = nullptr;  // [N]
 };
 
-// How the iteration matrix S = M + h^2 theta^2 K is factorised.
-enum class Factorization {
-  kAutomatic,  // kBand when the band of S is narrow (ChooseFactorization), else kSparse
-  kBand,       // band LDL^T (tridiagonal: the twisted factorisation), band_matrix.h
-  kSparse,     // sparse LDL^T with AMD ordering, sparse_theta_step.h
-};
-const char* FactorizationToString(Factorization factorization);
-bool StringToFactorization(const std::string& name, Factorization* factorization);
-
 // kAutomatic's choice for M and K: kBand when the half bandwidth p of their union
 // is at most kMaxAutomaticBandwidth (the bar: p = 1; a band LDL^T of p <= 32 is dense
 // contiguous work of a few times the sparse factor's), else kSparse. Other values are

@@ -46,22 +46,6 @@
 
 namespace mcrewave {
 
-enum class CoupledSolverType {
-  kAllAtOnce,
-  kRelaxation,
-  kAdaptiveRelaxation,
-  kConjugateGradient,
-  kRiccati,
-  kSingleShooting,
-  kMultipleShooting,
-  // Conjugate gradients on the sensor traces with O(n) memory (docs/streaming.md):
-  // no space-time field is stored (theta = 1/2: O(n) memory; other theta: checkpoints,
-  // O(n sqrt(m))).
-  kStreamingConjugateGradient,
-};
-const char* CoupledSolverTypeToString(CoupledSolverType type);
-bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type);
-
 // Fields of n x (m + 1) doubles an iterative solve holds at once: its iterates U
 // and W, residual, search direction, image and scratch, the start's right-hand
 // side and data response, and the caller's warm start and zero field.
@@ -80,14 +64,6 @@ bool HoldsIterativeSolverFields(CoupledSolverType type);
 // single_shooting, multiple_shooting: H = B, the clamp measured, no interior sensor);
 // SolveCoupled refuses them on any other problem, and the config at load.
 bool NeedsThePapersDataTerm(CoupledSolverType type);
-
-enum class TerminationType {
-  kConvergence,    // the residual reached the tolerance
-  kNoConvergence,  // the iteration limit was reached first
-  kDivergence,     // the residual grew (or became non-finite): the iteration diverges
-  kFailure,        // refused or broke down (problem too large, singular system...)
-};
-const char* TerminationTypeToString(TerminationType type);
 
 struct CoupledSolverOptions {
   CoupledSolverType type = CoupledSolverType::kConjugateGradient;

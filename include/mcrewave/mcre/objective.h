@@ -1,11 +1,7 @@
 // The objective of the outer loop: the MCRE cost e^2 as a function of the
-// trial modulus E, seen by every optimiser through one interface.
-//
-// ModulusObjective is that interface (shaped like ceres::FirstOrderFunction):
-// one scaled parameter x = E / modulus_scale(), a scaled cost, an optional
-// gradient, and false (never a made-up number) when the value cannot be had.
-// McreObjective implements it with an McreProblem and the coupled solver of
-// coupled_solver.h: each evaluation sets E, solves the coupled problem
+// trial modulus E. McreObjective implements the optimisers' interface
+// (ModulusObjective, optim/modulus_objective.h) with an McreProblem and the coupled
+// solver of coupled_solver.h: each evaluation sets E, solves the coupled problem
 // warm-started from the previous usable solutions and records what it did.
 //
 // Warm start: with the last two usable solutions W(E1) (last) and W(E0) at
@@ -26,49 +22,9 @@
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/mcre_problem.h"
 #include "mcrewave/model/bar_model.h"
+#include "mcrewave/optim/modulus_objective.h"
 
 namespace mcrewave {
-
-// A scalar objective of one parameter x = E / modulus_scale() (x of order 1).
-class ModulusObjective {
- public:
-  virtual ~ModulusObjective() = default;
-
-  // E [Pa] per unit of the parameter x.
-  virtual double modulus_scale() const = 0;
-
-  // Writes the cost at x = parameters[0] to *cost and, when gradient is not
-  // null, d cost / d x to gradient[0]. Returns false when the value could not be
-  // computed (error_message() then says why); *cost and *gradient are then
-  // meaningless. May throw: the optimisers of identification.h catch.
-  virtual bool Evaluate(const double* parameters, double* cost, double* gradient) = 0;
-
-  // Why the last failed Evaluate failed ("" when none failed).
-  virtual std::string error_message() const = 0;
-
-  // An independent objective of the same cost (same scale, same cost scaling),
-  // its inner solves run to the relative tolerance inner_tolerance, usable on
-  // another thread while this one is not evaluated; null when the objective
-  // cannot be copied (the default).
-  virtual std::unique_ptr<ModulusObjective> CloneForScan(double inner_tolerance) const {
-    (void)inner_tolerance;
-    return nullptr;
-  }
-
-  // Inner sweeps (direct + retrograde) of every evaluation so far; 0 when the
-  // objective has no inner solver (the default).
-  virtual long sweeps() const { return 0; }
-
-  // The predicted mean spacing, in ln E, of the valleys of the cost
-  // (PredictedValleySpacing of optim/valley_spacing.h on the model's response to
-  // the measured loads); 0 when the objective cannot tell (the default). Runs the
-  // model once (counted in sweeps()).
-  virtual double ValleySpacing() { return 0.0; }
-};
-
-// E = parameter x modulus_scale [Pa], the trial modulus of an optimiser's parameter;
-// false, with the reason in *why, when it is not a positive finite number.
-bool TrialModulus(double parameter, double modulus_scale, double* modulus, std::string* why);
 
 // The config's default weights, chosen with the clamp trusted on the comparator
 // study (docs/trusted_clamp.md section 7): w_u = w_e = 1e-7, w_f = 1, w_r = 1e-6.

@@ -1,5 +1,5 @@
 // Minimisation of a function of several parameters within bounds: the outer loop of
-// the identification of zone moduli (zone_identification.h; the problem:
+// the identification of zone moduli (identification/zone_identification.h; the problem:
 // docs/zones_and_sensors.md, "Identification of zone moduli").
 //
 // The objective is a MultiParameterObjective, shaped like ceres::FirstOrderFunction:
@@ -45,7 +45,7 @@
 #include <string>
 #include <vector>
 
-#include "mcrewave/mcre/coupled_solver.h"
+#include "mcrewave/core/types.h"
 
 namespace mcrewave {
 
@@ -62,15 +62,6 @@ class MultiParameterObjective {
   virtual std::string error_message() const { return ""; }
 };
 
-enum class BoundedAlgorithm {
-  kNloptLbfgs,
-  kNloptMma,
-  kNloptSlsqp,
-  kNloptBobyqa,
-  kCeresLbfgs,
-};
-const char* BoundedAlgorithmToString(BoundedAlgorithm algorithm);
-bool StringToBoundedAlgorithm(const std::string& name, BoundedAlgorithm* algorithm);
 bool UsesGradient(BoundedAlgorithm algorithm);
 
 // The `zone_identification:` options of the minimiser.

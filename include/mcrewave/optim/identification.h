@@ -52,41 +52,11 @@
 #include <string>
 #include <vector>
 
-#include "mcrewave/mcre/coupled_solver.h"
-#include "mcrewave/mcre/objective.h"
+#include "mcrewave/core/types.h"
+#include "mcrewave/optim/modulus_objective.h"
 
 namespace mcrewave {
 
-// The functional the outer loop minimises over E. Identify minimises whatever
-// ModulusObjective it is given; identify run (app/identification_run.h) builds it
-// from this choice.
-enum class OuterFunctional {
-  kMcre,          // the MCRE cost e^2(E) (McreObjective)
-  kLeastSquares,  // output-error least squares J(E) (OutputErrorObjective), the comparator
-};
-const char* OuterFunctionalToString(OuterFunctional functional);
-bool StringToOuterFunctional(const std::string& name, OuterFunctional* functional);
-
-enum class OptimizerType {
-  kNlopt,
-  kCeres,
-};
-const char* OptimizerTypeToString(OptimizerType type);
-bool StringToOptimizerType(const std::string& name, OptimizerType* type);
-
-// The algorithm of the outer optimiser; not every one exists in both.
-enum class OuterAlgorithm {
-  kDefault,  // bobyqa for nlopt, lbfgs for ceres
-  kBobyqa,   // nlopt: Powell's BOBYQA, quadratic models, derivative-free, bounded
-  kCobyla,   // nlopt: Powell's COBYLA, linear models, derivative-free, bounded
-  kSbplx,    // nlopt: Subplex (Nelder-Mead on subspaces), derivative-free, bounded
-  kMma,      // nlopt: method of moving asymptotes, adjoint gradient, bounded
-  kLbfgs,    // nlopt or ceres: limited-memory BFGS, adjoint gradient
-  kBfgs,     // ceres: dense BFGS, adjoint gradient
-  kBrent,    // under nlopt: Brent's bounded 1-D minimiser (mcrewave's own), derivative-free
-};
-const char* OuterAlgorithmToString(OuterAlgorithm algorithm);
-bool StringToOuterAlgorithm(const std::string& name, OuterAlgorithm* algorithm);
 // True when the optimiser offers the algorithm (kDefault: always).
 bool IsAlgorithmAvailable(OptimizerType optimizer, OuterAlgorithm algorithm);
 // kDefault resolved for the optimiser; other values unchanged.

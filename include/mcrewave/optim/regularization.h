@@ -21,7 +21,7 @@
 // of this comment. The discrepancy principle: the largest lambda whose data misfit (the
 // scaled e^2 at the regularised minimiser) stays at or below the level the noise explains,
 // target = discrepancy_factor * (expected e^2 at the truth under the estimated noise)
-// (zone_identification.h computes that level). The misfit grows with lambda, so the
+// (identification/zone_identification.h computes that level). The misfit grows with lambda, so the
 // grid lambda_k = c0 max_weight / grid_factor^k down to c0 min_weight, c0 the data cost
 // at the start (the weights are relative to it: the scaled e^2 of nearly consistent data
 // is 1e-6 or less, where a weight of 1 would freeze every zone), is descended, each minimisation
@@ -47,22 +47,6 @@
 #include "mcrewave/optim/bounded_minimizer.h"
 
 namespace mcrewave {
-
-enum class RegularizationKind {
-  kNone,
-  kTikhonov,
-  kTotalVariation,
-};
-const char* RegularizationKindToString(RegularizationKind kind);
-bool StringToRegularizationKind(const std::string& name, RegularizationKind* kind);
-
-// How an automatic weight is chosen.
-enum class WeightRule {
-  kLCurve,       // the L-curve's corner, down to the first weight that meets the target
-  kDiscrepancy,  // the discrepancy principle, the L-curve when its target is missed
-};
-const char* WeightRuleToString(WeightRule rule);
-bool StringToWeightRule(const std::string& name, WeightRule* rule);
 
 // The `zone_identification.*` options.
 struct RegularizationOptions {

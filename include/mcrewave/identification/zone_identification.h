@@ -7,9 +7,9 @@
 //   de^2/dE_z = -(1/(2 E_z)) sum_j c_j h W_j^T K_z (W_j + 2 U_j)
 // (McreProblem::CostGradients; docs/zones_and_sensors.md).
 //
-// Started from the homogeneous E* of the scalar identification (identification.h).
+// Started from the homogeneous E* of the scalar identification (optim/identification.h).
 // Parameters p_z = log(E_z / E*): positivity for free, a step in p is a relative step in
-// E, and the regularisation penalises jumps of log E (regularization.h). Chain rule:
+// E, and the regularisation penalises jumps of log E (optim/regularization.h). Chain rule:
 //   d cost / d p_z = (d cost / d E_z) E_z.
 // The cost is the scaled e^2 / J_rest of McreObjective (least squares: the scaled
 // J / J_rest of ZoneOutputErrorObjective). Bounds: outer.lower_bound and

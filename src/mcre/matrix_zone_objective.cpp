@@ -1,4 +1,4 @@
-#include "mcrewave/optim/matrix_zone_objective.h"
+#include "mcrewave/mcre/matrix_zone_objective.h"
 
 #include <cassert>
 #include <cmath>

@@ -1,5 +1,5 @@
 // The MCRE cost of a structure given by matrices as a function of its zone moduli
-// (docs/matrix_models.md), for MinimizeWithinBounds (bounded_minimizer.h): the
+// (docs/matrix_models.md), for MinimizeWithinBounds (optim/bounded_minimizer.h): the
 // parameters are p_z = log(E_z / E_z,nom), so that a step in p is a relative step in E
 // and positivity comes free, and
 //

@@ -1,4 +1,4 @@
-#include "mcrewave/optim/zone_identification.h"
+#include "mcrewave/identification/zone_identification.h"
 
 #include <spdlog/spdlog.h>
 

@@ -1,0 +1,55 @@
+// The scalar objective of the outer loop, seen by every optimiser of
+// identification.h through one interface (shaped like ceres::FirstOrderFunction):
+// one scaled parameter x = E / modulus_scale(), a scaled cost, an optional gradient,
+// and false (never a made-up number) when the value cannot be had. The MCRE's
+// McreObjective (mcre/objective.h) and least squares' OutputErrorObjective
+// (least_squares/output_error_objective.h) implement it.
+#pragma once
+
+#include <memory>
+#include <string>
+
+namespace mcrewave {
+
+// A scalar objective of one parameter x = E / modulus_scale() (x of order 1).
+class ModulusObjective {
+ public:
+  virtual ~ModulusObjective() = default;
+
+  // E [Pa] per unit of the parameter x.
+  virtual double modulus_scale() const = 0;
+
+  // Writes the cost at x = parameters[0] to *cost and, when gradient is not
+  // null, d cost / d x to gradient[0]. Returns false when the value could not be
+  // computed (error_message() then says why); *cost and *gradient are then
+  // meaningless. May throw: the optimisers of identification.h catch.
+  virtual bool Evaluate(const double* parameters, double* cost, double* gradient) = 0;
+
+  // Why the last failed Evaluate failed ("" when none failed).
+  virtual std::string error_message() const = 0;
+
+  // An independent objective of the same cost (same scale, same cost scaling),
+  // its inner solves run to the relative tolerance inner_tolerance, usable on
+  // another thread while this one is not evaluated; null when the objective
+  // cannot be copied (the default).
+  virtual std::unique_ptr<ModulusObjective> CloneForScan(double inner_tolerance) const {
+    (void)inner_tolerance;
+    return nullptr;
+  }
+
+  // Inner sweeps (direct + retrograde) of every evaluation so far; 0 when the
+  // objective has no inner solver (the default).
+  virtual long sweeps() const { return 0; }
+
+  // The predicted mean spacing, in ln E, of the valleys of the cost
+  // (PredictedValleySpacing of valley_spacing.h on the model's response to
+  // the measured loads); 0 when the objective cannot tell (the default). Runs the
+  // model once (counted in sweeps()).
+  virtual double ValleySpacing() { return 0.0; }
+};
+
+// E = parameter x modulus_scale [Pa], the trial modulus of an optimiser's parameter;
+// false, with the reason in *why, when it is not a positive finite number.
+bool TrialModulus(double parameter, double modulus_scale, double* modulus, std::string* why);
+
+}  // namespace mcrewave
