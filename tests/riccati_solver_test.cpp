@@ -51,15 +51,15 @@ TEST(RiccatiSolverOptionsTest, InvalidDenseOptionsAreRefusedWithTheKey) {
 }
 
 // 20 elements, 200 steps, noisy data from a finer truth (SNR 5).
-struct AgreementCase {
+struct RiccatiCase {
   double w_u;
   double theta;
 };
 
-class RiccatiAgreementTest : public ::testing::TestWithParam<AgreementCase> {};
+class RiccatiAgreementTest : public ::testing::TestWithParam<RiccatiCase> {};
 
 TEST_P(RiccatiAgreementTest, AgreesWithAllAtOnceToOneInOneHundredMillion) {
-  const AgreementCase& param = GetParam();
+  const RiccatiCase& param = GetParam();
   ProblemBundle bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(param.w_u, 1.0), param.theta);
   McreProblem& problem = bundle.problem;
   problem.SetModulus(0.9 * kReferenceModulus);
@@ -82,8 +82,8 @@ TEST_P(RiccatiAgreementTest, AgreesWithAllAtOnceToOneInOneHundredMillion) {
 }
 
 INSTANTIATE_TEST_SUITE_P(WeightsAndTheta, RiccatiAgreementTest,
-                         ::testing::Values(AgreementCase{0.01, 0.5}, AgreementCase{1.0, 0.5},
-                                           AgreementCase{0.01, 1.0}, AgreementCase{1.0, 0.75}));
+                         ::testing::Values(RiccatiCase{0.01, 0.5}, RiccatiCase{1.0, 0.5},
+                                           RiccatiCase{0.01, 1.0}, RiccatiCase{1.0, 0.75}));
 
 TEST(RiccatiSolverTest, AgreesWithConjugateGradientsOnThePapersCase) {
   // 100 elements, 1750 steps (the paper's window), noisy data, default weights.

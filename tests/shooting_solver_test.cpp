@@ -22,17 +22,17 @@ using testing::Solve;
 using testing::Solved;
 using testing::Weights;
 
-struct AgreementCase {
+struct ShootingCase {
   double w_u;
   double theta;
   int steps;
   CoupledSolverType type;
 };
 
-class ShootingAgreementTest : public ::testing::TestWithParam<AgreementCase> {};
+class ShootingAgreementTest : public ::testing::TestWithParam<ShootingCase> {};
 
 TEST_P(ShootingAgreementTest, AgreesWithAllAtOnceToOneInOneHundredMillion) {
-  const AgreementCase& param = GetParam();
+  const ShootingCase& param = GetParam();
   ProblemBundle bundle(MakeSmallCase(20, param.steps, 5.0, 2), Weights(param.w_u, 1.0),
                        param.theta);
   McreProblem& problem = bundle.problem;
@@ -61,14 +61,14 @@ TEST_P(ShootingAgreementTest, AgreesWithAllAtOnceToOneInOneHundredMillion) {
 // fundamental matrix grows by orders of magnitude per step at high frequencies.
 INSTANTIATE_TEST_SUITE_P(
     WeightsAndTheta, ShootingAgreementTest,
-    ::testing::Values(AgreementCase{0.01, 0.5, 200, CoupledSolverType::kSingleShooting},
-                      AgreementCase{1.0, 0.5, 200, CoupledSolverType::kSingleShooting},
-                      AgreementCase{1.0, 0.75, 20, CoupledSolverType::kSingleShooting},
-                      AgreementCase{0.01, 1.0, 10, CoupledSolverType::kSingleShooting},
-                      AgreementCase{0.01, 0.5, 200, CoupledSolverType::kMultipleShooting},
-                      AgreementCase{1.0, 0.5, 200, CoupledSolverType::kMultipleShooting},
-                      AgreementCase{0.01, 1.0, 200, CoupledSolverType::kMultipleShooting},
-                      AgreementCase{1.0, 0.75, 200, CoupledSolverType::kMultipleShooting}));
+    ::testing::Values(ShootingCase{0.01, 0.5, 200, CoupledSolverType::kSingleShooting},
+                      ShootingCase{1.0, 0.5, 200, CoupledSolverType::kSingleShooting},
+                      ShootingCase{1.0, 0.75, 20, CoupledSolverType::kSingleShooting},
+                      ShootingCase{0.01, 1.0, 10, CoupledSolverType::kSingleShooting},
+                      ShootingCase{0.01, 0.5, 200, CoupledSolverType::kMultipleShooting},
+                      ShootingCase{1.0, 0.5, 200, CoupledSolverType::kMultipleShooting},
+                      ShootingCase{0.01, 1.0, 200, CoupledSolverType::kMultipleShooting},
+                      ShootingCase{1.0, 0.75, 200, CoupledSolverType::kMultipleShooting}));
 
 TEST(ShootingBreakdownTest, LongWindowFailsSingleShootingWhileMultipleShootingAndRiccatiAgree) {
   // 20 elements, 1600 steps: 4.6 times the paper's window, w_u = 1.

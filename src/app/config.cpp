@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "mcrewave/core/format.h"
 #include "mcrewave/core/types.h"
 #include "mcrewave/data/measurement.h"
 #include "mcrewave/mcre/coupled_solver.h"
@@ -43,23 +44,7 @@ struct ValueType {
 
 // The shortest decimal text that reads back as exactly `value`, in fixed notation
 // below 1e6 (800, not 8e+02); ".inf"/"-.inf" for infinities (YAML spelling).
-std::string FormatNumber(double value) {
-  if (std::isinf(value)) return value > 0 ? ".inf" : "-.inf";
-  int precision = 1;
-  char text[64];
-  while (precision < 17) {
-    std::snprintf(text, sizeof(text), "%.*g", precision, value);
-    if (std::strtod(text, nullptr) == value) break;
-    ++precision;
-  }
-  const double magnitude = std::abs(value);
-  if (magnitude >= 1.0 && magnitude < 1e6) {
-    // %g switches to exponents once the exponent reaches the precision.
-    precision = std::max(precision, 1 + static_cast<int>(std::floor(std::log10(magnitude))));
-  }
-  std::snprintf(text, sizeof(text), "%.*g", precision, value);
-  return text;
-}
+std::string FormatNumber(double value) { return mcrewave::FormatNumber(value, kConfigRoundTrip); }
 
 // Any number except NaN; .inf and -.inf are numbers (ranges are checked by the
 // sections' IsValid).

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "mcrewave/app/zone_identification_run.h"
+#include "mcrewave/core/format.h"
 #include "mcrewave/data/noise.h"
 #include "mcrewave/data/prefilter.h"
 #include "mcrewave/data/resample.h"
@@ -112,11 +113,7 @@ std::vector<CostCurvePoint> ComputeCostCurve(const Config& config, const BarMode
   return curve;
 }
 
-std::string Number(double value) {
-  std::ostringstream text;
-  text << value;
-  return text.str();
-}
+std::string Number(double value) { return FormatNumber(value, kSixDigits); }
 
 }  // namespace
 

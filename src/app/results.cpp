@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "mcrewave/core/file_util.h"
+#include "mcrewave/core/format.h"
 #include "mcrewave/core/version.h"
 
 namespace mcrewave {
@@ -30,16 +31,7 @@ constexpr const char* kUncertaintyMeaning =
 
 // The shortest decimal text that reads back as exactly `value` ("null" for NaN,
 // ".inf" for infinities, YAML spelling).
-std::string Format(double value) {
-  if (std::isnan(value)) return "null";
-  if (std::isinf(value)) return value > 0 ? ".inf" : "-.inf";
-  char text[64];
-  for (int precision = 1; precision <= 17; ++precision) {
-    std::snprintf(text, sizeof(text), "%.*g", precision, value);
-    if (std::strtod(text, nullptr) == value) break;
-  }
-  return text;
-}
+std::string Format(double value) { return FormatNumber(value, kYamlRoundTrip); }
 
 std::string Quoted(const std::string& text) {
   YAML::Emitter emitter;

@@ -22,6 +22,7 @@
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/core/file_util.h"
+#include "mcrewave/core/format.h"
 #include "mcrewave/data/noise.h"
 #include "mcrewave/data/prefilter.h"
 #include "mcrewave/mcre/objective.h"
@@ -127,27 +128,15 @@ std::vector<std::uint64_t> SeedsOf(double snr, int seeds) {
 // ---------------------------------------------------------------------------
 // Text.
 
-std::string Csv(double value) {
-  if (std::isnan(value)) return "nan";
-  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-  char text[64];
-  std::snprintf(text, sizeof(text), "%.10g", value);
-  return text;
-}
+std::string Csv(double value) { return FormatNumber(value, kTenDigits); }
 
 std::string Brief(double value, int digits) {
-  if (std::isnan(value)) return "-";
-  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-  char text[64];
-  std::snprintf(text, sizeof(text), "%.*g", digits, value);
-  return text;
+  return FormatNumber(value, {NumberFormat::Notation::kSignificant, digits, false, false, "-"});
 }
 
 std::string Percent(double ratio) {
   if (std::isnan(ratio)) return "-";
-  char text[64];
-  std::snprintf(text, sizeof(text), "%+.3f %%", 100.0 * ratio);
-  return text;
+  return FormatNumber(100.0 * ratio, {NumberFormat::Notation::kFixed, 3, true}) + " %";
 }
 
 std::string SnrText(double snr) { return std::isinf(snr) ? "inf" : Brief(snr); }

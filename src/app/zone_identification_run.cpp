@@ -8,16 +8,12 @@
 
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/core/file_util.h"
+#include "mcrewave/core/format.h"
 
 namespace mcrewave {
 namespace {
 
-std::string Number(double value) {
-  if (std::isnan(value)) return "null";
-  char text[64];
-  std::snprintf(text, sizeof(text), "%.10g", value);
-  return text;
-}
+std::string Number(double value) { return FormatNumber(value, kTenDigitsYaml); }
 
 // Per element: x_start, x_end, identified E, truth E (empty when unknown).
 std::string ElementModuliCsv(const ZoneIdentificationRun& run, const BarModel& model) {

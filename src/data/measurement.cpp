@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "mcrewave/core/file_util.h"
+#include "mcrewave/core/format.h"
 
 namespace mcrewave {
 namespace {
@@ -48,11 +49,7 @@ bool ParseNumber(const std::string& field, double* value) {
 }
 
 // Formats "%g" with the default 6 significant digits, for messages.
-std::string Short(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", value);
-  return text;
-}
+std::string Short(double value) { return FormatNumber(value, kSixDigits); }
 
 // The step of t_0 + k h that reproduces every time of the file exactly, searched
 // among the doubles within a few ulps of the mean step; the mean step itself when

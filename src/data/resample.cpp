@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "mcrewave/core/format.h"
 #include "mcrewave/data/prefilter.h"
 
 namespace mcrewave {
@@ -41,11 +42,7 @@ Vector Interpolate(const Vector& values, double start, double h, double step, in
   return out;
 }
 
-std::string Short(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", value);
-  return text;
-}
+std::string Short(double value) { return FormatNumber(value, kSixDigits); }
 
 }  // namespace
 

@@ -4,14 +4,11 @@
 #include <cmath>
 #include <sstream>
 
+#include "mcrewave/core/format.h"
+
 namespace mcrewave::internal {
 
-std::string ScientificString(double value) {
-  std::ostringstream out;
-  out.precision(3);
-  out << std::scientific << value;
-  return out.str();
-}
+std::string ScientificString(double value) { return FormatNumber(value, kScientificThreeDecimals); }
 
 void CheckDirectSolution(const CoupledSolverOptions& options, const std::string& method_description,
                          CoupledProblem* problem, const CoupledSolution& solution,

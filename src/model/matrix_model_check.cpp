@@ -7,14 +7,12 @@
 #include <cstdio>
 #include <string>
 
+#include "mcrewave/core/format.h"
+
 namespace mcrewave {
 namespace {
 
-std::string Short(double value) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.6g", value);
-  return text;
-}
+std::string Short(double value) { return FormatNumber(value, kSixDigits); }
 
 std::string Dimensions(Eigen::Index rows, Eigen::Index columns) {
   return std::to_string(rows) + " x " + std::to_string(columns);
