@@ -644,6 +644,26 @@ TEST(ConfigTest, PaperBarPinnedDiffersInItsMcreSectionScanInnerToleranceAndSearc
       expected, LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar_pinned.yaml"));
 }
 
+// configs/bar_zones.yaml: the paper's bar with the damage study's settings that
+// localise (scripts/studies.sh), each one named here.
+TEST(ConfigTest, BarZonesDiffersFromPaperBarInTheSettingsThatLocalise) {
+  Config expected = LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar.yaml");
+  expected.zones.zoning = Zoning::kEqual;
+  expected.zones.zone_count = 10;
+  expected.data.truth_zones = {ModulusZone{0.6, 0.7, 140e9}};
+  expected.data.sensors = {"u@0.25", "u@0.5", "u@0.75", "e@0.2", "e@0.45", "e@0.65", "e@0.9"};
+  expected.data.snr = 10.0;
+  expected.mcre.clamp = ClampModel::kMeasured;
+  expected.mcre.weights.displacement_weight = 0.01;
+  expected.mcre.weights.strain_weight = 1e-4;
+  expected.search.functional = SearchFunctional::kSame;
+  expected.zone_identification.regularization.kind = RegularizationKind::kTotalVariation;
+  expected.zone_identification.merge_zones = true;
+  expected.output.folder = "results/bar_zones";
+  ExpectSameConfig(expected,
+                   LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/bar_zones.yaml"));
+}
+
 TEST(ConfigTest, QuickAndMeasuredCsvConfigsLoad) {
   const Config quick = LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/quick.yaml");
   EXPECT_EQ(quick.model.elements, 25);
