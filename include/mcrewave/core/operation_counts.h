@@ -1,21 +1,9 @@
-// Multiply-accumulate (MAC) counts of the kernels the coupled solvers are built from.
-//
-// One MAC is one floating-point multiplication together with the addition that
-// usually follows it (a division counts as one MAC, a lone addition or a copy as
-// none). The counts follow the loop structure of mcrewave's kernels:
-//
-//   band kernels      band_matrix.cpp: a product touches every stored entry of the
-//                     symmetric band once, an LDL^T solve every entry of L twice
-//                     (forward and backward) plus one scaling by D^-1 per row;
-//   sweeps            mcre_problem.cpp and theta_integrator.cpp: one theta step per
-//                     time step plus the force formation of the sweep;
-//   dense kernels     the textbook operation counts of the algorithms Eigen runs
-//                     (a blocked implementation does the same arithmetic):
-//                     product, LU with partial pivoting, Householder QR.
-//
-// The Riccati and shooting solvers add these counts as they call the kernels
-// (summary.multiply_accumulates); the complexity study (bench/complexity_benchmark.cpp)
-// uses the sweep counts for the sweep-based solvers, whose loops are not instrumented.
+// Multiply-accumulate (MAC) counts of the kernels the coupled solvers are built from,
+// following the loops of mcrewave's kernels (band products and LDL^T solves, theta
+// steps, sweeps) and the textbook counts of the dense algorithms Eigen runs. One MAC is
+// one multiplication with the addition that follows it; a division counts as one, a
+// lone addition or a copy as none. The convention and the resulting per-method costs:
+// docs/riccati_shooting.md section 4.
 #pragma once
 
 namespace mcrewave::operation_counts {

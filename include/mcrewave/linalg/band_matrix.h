@@ -1,10 +1,6 @@
-// Symmetric band matrices: storage, product and LDL^T factorisation.
-//
-// The FE matrices of the bar are tridiagonal (linear elements), so every
-// operation of a time step is O(n p) with p the half bandwidth. Eigen's general
-// sparse classes pay an index indirection per entry; these classes keep the band
-// densely, one contiguous array per diagonal (so that a product is a few
-// vectorisable passes):
+// Symmetric band matrices: storage, product and LDL^T factorisation. Every operation
+// is O(n p), p the half bandwidth (p = 1 for the bar's linear elements). The band is
+// kept densely, one contiguous array per diagonal:
 //   lower(d, i) = A(i, i - d),  d = 0..p,  i = d..n-1  (entries i < d unused, zero).
 #pragma once
 
@@ -71,21 +67,21 @@ class BandLdlt {
 };
 
 // Twisted ("burn at both ends") factorisation of a symmetric positive definite
-// tridiagonal matrix A (diagonal a_i, sub-diagonal s_i = A(i, i-1)): rows above
-// the middle row k = (n - 1) / 2 are eliminated downward (LDL^T), rows below it
-// upward (UDU^T), and the two meet at row k:
+// tridiagonal matrix A (diagonal a_i, sub-diagonal s_i = A(i, i-1)): rows above the
+// middle row k = (n - 1) / 2 are eliminated downward (LDL^T), rows below it upward
+// (UDU^T), and the two meet at row k:
 //
-//   top     d_0 = a_0,          l_i = s_i / d_{i-1},      d_i = a_i - l_i s_i,          i = 1..k-1
-//   bottom  e_{n-1} = a_{n-1},  m_i = s_{i+1} / e_{i+1},  e_i = a_i - m_i s_{i+1},      i =
-//   n-2..k+1 middle  l_k = s_k / d_{k-1},  m_k = s_{k+1} / e_{k+1},  g_k = a_k - l_k s_k - m_k
-//   s_{k+1}.
+//   top     d_0 = a_0,
+//           l_i = s_i / d_{i-1},          d_i = a_i - l_i s_i,          i = 1..k-1;
+//   bottom  e_{n-1} = a_{n-1},
+//           m_i = s_{i+1} / e_{i+1},      e_i = a_i - m_i s_{i+1},      i = n-2..k+1;
+//   middle  l_k = s_k / d_{k-1},  m_k = s_{k+1} / e_{k+1},
+//           g_k = a_k - l_k s_k - m_k s_{k+1}.
 //
-// A solve runs the two eliminations and then the two back-substitutions side by
-// side: two independent recurrences of about n/2 steps each instead of the one
-// of n steps of the Thomas algorithm, so the latency of the dependency chain is
-// halved (the solve of a time step is latency-bound for the bar's sizes). The
-// result is the solution of the same system; it differs from BandLdlt's by
-// round-off only. Pivots are Schur complements of A, positive when A is SPD.
+// A solve runs the two eliminations, then the two back-substitutions, side by side: two
+// independent recurrences of about n/2 steps instead of the Thomas algorithm's one of n,
+// so the latency of the dependency chain is halved. The solution differs from BandLdlt's
+// by round-off only. The pivots are Schur complements of A, positive when A is SPD.
 class TwistedTridiagonalLdlt {
  public:
   // Factorises. Precondition: matrix.half_bandwidth() <= 1. Returns false when a

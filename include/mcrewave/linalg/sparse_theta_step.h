@@ -14,8 +14,7 @@
 //   - P, the forward solve with L, D^-1, the backward solve with L^T, P^T on the
 //     factor's own arrays into preallocated scratch;
 //   - the displacement update,
-// and allocates nothing. Measured cost: bench/sparse_step_benchmark.cpp,
-// docs/matrix_models.md.
+// and allocates nothing. Its cost: docs/matrix_models.md section 5.
 #pragma once
 
 #include <Eigen/OrderingMethods>

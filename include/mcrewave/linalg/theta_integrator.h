@@ -1,59 +1,25 @@
-// The theta-method time integrator of the structural system
+// The theta-method time integrator of M u'' + K u = f(t) (docs/formulation.md section 5),
+// in first-order form with v = u':
 //
-//     M u'' + K u = f(t),
+//     rhs = R v_k - h K u_k,          R = M - h^2 theta (1 - theta) K   (free state)
+//     S v_{k+1} = rhs + h f_theta,    S = M + h^2 theta^2 K             (input)
+//     u_{k+1} = u_k + h (1 - theta) v_k + h theta v_{k+1},
 //
-// written in first-order form x = (v, u), v = u' (second source document,
-// formulation.md section 5):
+// f_theta the step's theta-weighted force, formed by the caller. S (the Schur complement
+// of the first-order iteration matrix; SPD) is factorised once in Init. theta = 1/2 is
+// the trapezoidal rule (second order, energy conserving), theta = 1 backward Euler.
 //
-//     [M 0] x' = [0 -K] x + [f]        i.e.  Mx x' = A x + b + r.
-//     [0 I]      [I  0]     [0]
+// Paths, chosen by ThetaIntegratorOptions::factorization (kAutomatic: ChooseFactorization):
+// tridiagonal M and K (the bar) one branch-free pass for the right-hand side and the
+// twisted factorisation of band_matrix.h; other bands SymmetricBandMatrix and BandLdlt;
+// general sparse M and K the sparse LDL^T of sparse_theta_step.h. They solve the same
+// system and differ by round-off.
 //
-// Scheme, with f_theta the theta-weighted force of the step (the caller's input):
-//
-//     (Mx - h theta A) x_{k+1} = (Mx + h (1 - theta) A) x_k + h (f_theta, 0).
-//
-// The iteration matrix W = Mx - h theta A = [M, h theta K; -h theta I, I] is
-// factorised once in Init through its Schur complement
-//
-//     S = M + h^2 theta^2 K           (symmetric positive definite, banded),
-//
-// so a step is, with the free state formed first and the input added after,
-//
-//     rhs_free = R v_k - h K u_k,  R = M - h^2 theta (1 - theta) K    (free state)
-//     S v_{k+1} = rhs_free + h f_theta                               (input)
-//     u_{k+1}   = u_k + h (1 - theta) v_k + h theta v_{k+1}.
-//
-// (Substituting u_{k+1} from the second block row into the first gives
-// rhs_free = M v_k - h K (u_k + h theta (1 - theta) v_k).)
-//
-// By linearity v_{k+1} = S^-1 rhs_free + S^-1 h f_theta: the input's effect is
-// added to the free state's right-hand side and both go through one solve.
-//
-// Tridiagonal M and K (linear elements, the bar's case) take a fast path: the
-// right-hand side in one branch-free pass over the bands, S solved by the twisted
-// factorisation of band_matrix.h (two independent recurrences of n/2 steps), u
-// updated in one more pass. Other bandwidths use SymmetricBandMatrix and BandLdlt.
-// Both solve the same system; they differ by round-off.
-//
-// StepWithEndLoads takes a force of the form the MCRE sweeps need without forming
-// it: f_theta = -K z + f0 e_0 + fL e_{n-1} (z optional), so that
-//   rhs = R v_k - h K (u_k + z) + h (f0 e_0 + fL e_{n-1})
-// is one pass. Optional point loads (PointLoads) add sum_i p_i e_{node_i} to f_theta
-// in the same pass: the interior sensors' loads of the retrograde sweep.
-// General sparse M and K (a structure from another finite-element code, whose
-// bandwidth the band path would fill in) take the sparse path of sparse_theta_step.h:
-// S factorised by a sparse LDL^T with a fill-reducing ordering, the right-hand side
-// in one pass over the union pattern of M and K. ThetaIntegratorOptions::factorization
-// chooses (kAutomatic: by the bandwidth, see ChooseFactorization); the bar's banded
-// paths are unchanged.
-//
-// theta = 1/2 is the trapezoidal rule (second order, energy conserving); theta = 1
-// is backward Euler (first order).
-//
-// The same integrator runs the retrograde problem in reversed time
-// tau = T - t: SweepBackward starts from a final state and steps from index m down
-// to 0; the "velocity" it carries is then du/dtau = -du/dt. The integrator knows
-// nothing of MCRE: the caller forms f_theta for each step.
+// StepWithEndLoads forms, in the same pass, the force of the MCRE sweeps
+// f_theta = -K z + f0 e_0 + fL e_{n-1} (+ point loads: the interior sensors' loads of
+// the retrograde sweep). SweepBackward runs the retrograde problem in reversed time
+// tau = T - t from a final state, from index m down to 0; the "velocity" it carries is
+// then du/dtau = -du/dt. The integrator knows nothing of MCRE.
 #pragma once
 
 #include <utility>
@@ -73,9 +39,8 @@ struct PointLoads {
 };
 
 // kAutomatic's choice for M and K: kBand when the half bandwidth p of their union
-// is at most kMaxAutomaticBandwidth (the bar: p = 1; a band LDL^T of p <= 32 is dense
-// contiguous work of a few times the sparse factor's), else kSparse. Other values are
-// returned as they are.
+// is at most kMaxAutomaticBandwidth (the bar: p = 1), else kSparse
+// (docs/matrix_models.md section 5). Other values are returned as they are.
 constexpr int kMaxAutomaticBandwidth = 32;
 Factorization ChooseFactorization(Factorization requested, const SparseMatrix& mass,
                                   const SparseMatrix& stiffness);
@@ -93,7 +58,7 @@ struct ThetaIntegratorOptions {
 class ThetaIntegrator {
  public:
   // Builds and factorises S = M + h^2 theta^2 K and allocates every scratch vector.
-  // M must be SPD and K symmetric positive semi-definite, both banded. Call again
+  // M must be SPD and K symmetric positive semi-definite. Call again
   // (re-initialise) whenever K (the modulus), h or theta changes. Throws
   // std::runtime_error if S is not positive definite.
   void Init(const SparseMatrix& mass, const SparseMatrix& stiffness,
