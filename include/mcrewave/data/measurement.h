@@ -59,12 +59,10 @@ struct MeasurementSet {
 
 // Reads a measurement CSV. Validates the header (every name a channel, the required
 // ones present, none twice: the same name, or the same sensor kind and position), the
-// column count, every number
-// (finite, no NaN/Inf), at least two rows, and a strictly increasing uniform time
-// column (relative spread of the steps at most 1e-6). Throws InputError naming the
-// file and the line on any failure. Logs a progress line every 250000 rows;
-// memory is the five columns of doubles (at most about 100 bytes per row while
-// they grow), never the whole text.
+// column count, every number (finite, no NaN/Inf), at least two rows, and a strictly
+// increasing uniform time column (relative spread of the steps at most 1e-6). Throws
+// InputError naming the file and the line on any failure. Logs a progress line every
+// 250000 rows; memory is the columns of doubles, never the whole text.
 MeasurementSet ReadMeasurementCsv(const std::string& path);
 
 // The same from a stream; `name` stands for the file name in messages.
@@ -131,10 +129,9 @@ MeasurementSet SelectChannels(const MeasurementSet& measurements,
                               const std::vector<std::string>& channels, const std::string& key,
                               const std::string& source, bool* use_u0, bool* use_uL);
 
-// Writes the set as CSV (t,u0,uL,f0,fL, then the sensors by name) with full precision
-// (17 significant digits), atomically
-// (temporary file then rename). Throws std::runtime_error if the file cannot be
-// written.
+// Writes the set as CSV (t,u0,uL,f0,fL, then the sensors by name) with 17 significant
+// digits, atomically (temporary file then rename). Throws std::runtime_error if the
+// file cannot be written.
 void WriteMeasurementCsv(const MeasurementSet& measurements, const std::string& path);
 
 }  // namespace mcrewave

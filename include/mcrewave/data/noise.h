@@ -1,16 +1,11 @@
-// Measurement noise.
-//
-// SNR definition (the paper gives none): per quantity type, SNR = RMS(signal) /
-// std(noise), the same noise standard deviation applied to every channel of that type:
-//   displacements (u0, uL and every u@X):  std_u = RMS(uL) / snr,
-//   strains (every e@X):                   std_e = RMS over all strain channels / snr,
-//   forces (f0, fL):                       std_f = RMS(fL) / snr.
-// The noise is Gaussian and white, drawn in the order u0, uL, f0, fL, then the
-// interior sensors in their order (all samples of one channel, then the next) from a
-// 64-bit Mersenne twister seeded with `seed` and a Box-Muller transform written here,
-// so the same seed gives the same numbers on every platform and the end channels the
-// same draws with or without sensors; the same seed at two SNRs gives the same
-// standard-normal draw, scaled by each std.
+// Measurement noise (docs/zones_and_sensors.md, "Noise"). SNR = RMS(signal) / std(noise)
+// per quantity, one std per quantity: displacements (u0, uL, every u@X) RMS(uL) / snr,
+// strains RMS over all strain channels / snr, forces (f0, fL) RMS(fL) / snr. White
+// Gaussian draws in the order u0, uL, f0, fL, then the interior sensors (a channel's
+// samples, then the next), from a 64-bit Mersenne twister seeded with `seed` and a
+// Box-Muller transform written here: the same numbers on every platform, the end
+// channels' draws unchanged by added sensors, and the same standard-normal draw at
+// every SNR for one seed.
 #pragma once
 
 #include <cstdint>

@@ -1,24 +1,17 @@
-// Zero-phase low-pass pre-filter of measured channels.
+// Zero-phase low-pass pre-filter of measured channels (docs/robustness.md, step 3).
 //
-// The shock load's spectrum lies far below the sampling rate (a 0.1 ms half sine
-// has its main lobe below 15 kHz; the paper's sampling rate is 2.8 MHz), so most of
-// the power of white measurement noise lies where the signal has none. A low-pass
-// filter applied identically to every channel removes it without changing what the
-// MCRE compares: the bar is linear and time-invariant, so the model driven by the
-// filtered forces responds with the filtered displacements (up to edge effects).
+// The same low-pass on every channel removes the white noise above the load's band
+// without changing what the MCRE compares: the model is linear and time-invariant, so
+// driven by the filtered forces it responds with the filtered displacements (up to edge
+// effects).
 //
-// Filter: Butterworth of even order N as N/2 second-order sections (bilinear
-// transform with pre-warping), run forward then backward (filtfilt): zero phase,
-// magnitude |H(f)|^2. Edges: the record is extended at both ends over three periods
-// of the cut-off by odd reflection of its residual from a cubic fitted over one
-// period (plain odd reflection, as scipy's filtfilt, flips the curvature at the
-// junction and leaves a transient of 4e-3 of an 8 kHz sine at a 100 kHz cut-off;
-// with the cubic, 7e-4), and each section starts in its steady state for the first
-// padded sample. A record of a structure at rest before its first sample (the
-// shock load's experiment: every channel is 0 for t < t_0) is instead extended at
-// its start by those zeros, the filter starting at rest: the first samples' noise
-// is then averaged like any other sample's, where the reflection keeps it (it pins
-// the extension to x_0).
+// Filter: Butterworth of even order N as N/2 second-order sections (bilinear transform
+// with pre-warping), run forward then backward (filtfilt): zero phase, magnitude
+// |H(f)|^2. Edges: the record is extended over three periods of the cut-off by odd
+// reflection of its residual from a cubic fitted over one period, each section started
+// in its steady state for the first padded sample. A record at rest before its first
+// sample (at_rest_before_start) is instead extended at its start by zeros, the filter
+// starting at rest.
 #pragma once
 
 #include <string>
@@ -29,9 +22,7 @@
 namespace mcrewave {
 
 struct PrefilterOptions {
-  // On by default: at SNR 2.5 on the paper's case it takes the share of noise
-  // seeds identifying E within +-2 % from 78 % to 96 %, with no noise-free bias
-  // (docs/robustness.md).
+  // On by default (why: docs/robustness.md, "Measurements").
   bool enabled = true;
   // Cut-off frequency [Hz]; 0 derives it from the data (EstimateCutoffFrequency).
   double cutoff_frequency = 0.0;
