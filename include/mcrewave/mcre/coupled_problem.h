@@ -87,10 +87,9 @@ class CoupledProblem {
   long sweep_count() const { return sweep_count_; }
 
   // Work fields of the iterative coupled solvers, kept with the problem between
-  // solves so that a solve on a problem solved before allocates no field (a fresh
-  // n x (m + 1) field costs its page faults, measured at about 15 % of an
-  // identification's CPU time). Each is resized by its user; `zero` is the zero
-  // field, never written.
+  // solves so that a solve on a problem solved before allocates no field (no page
+  // faults of fresh fields; docs/performance.md). Each is resized by its user; `zero`
+  // is the zero field, never written.
   struct SolverWorkspace {
     Matrix residual, direction, image, scratch, rhs, data_response;
     Matrix zero;

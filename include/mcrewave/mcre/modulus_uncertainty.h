@@ -1,23 +1,18 @@
-// An uncertainty figure for the identified modulus: the first-order standard
-// deviation of E* under white measurement noise.
+// An uncertainty figure for the identified modulus: the first-order standard deviation
+// of E* under white measurement noise (README, "Uncertainty figure").
 //
-// E* is where g(E) = de^2/dE vanishes. The coupled solution s = (U, W) is linear
-// in the data d (zero data give the bar at rest), and g is a quadratic form
-// Q(s) of it, so fresh noise n added to the data changes g at E* by
-//   dg = 2 Q(s_d, s_n) + Q(s_n, s_n),
-// and, to first order in n, moves the minimum by dE = -dg_1 / k with
+// E* is where g(E) = de^2/dE vanishes. The coupled solution s = (U, W) is linear in the
+// data d and g a quadratic form Q(s) of it, so noise n added to the data moves the
+// minimum, to first order in n, by dE = -dg_1 / k with
 //   dg_1 = 2 Q(s_d, s_n) = (Q(s_d + s_n) - Q(s_d - s_n)) / 2   (polarisation),
-//   k    = d^2 e^2 / dE^2, the slope of g around E*.
-// s_n is one coupled solve with the noise alone as data, at E*. The standard
-// deviation of dE is estimated over `samples` seeded noise draws:
-//   std(E*) = sqrt(mean_i dE_i^2)   (dE is linear in n, so its mean is zero).
+//   k    = d^2 e^2 / dE^2,
+// s_n one coupled solve with the noise alone as data, at E*. Over `samples` seeded
+// draws, std(E*) = sqrt(mean_i dE_i^2) (dE is linear in n: zero mean).
 //
 // k is the least-squares slope of g over the cost-curve points within
-// +- kCurvatureWindow E* of E*, not the local second derivative: at low SNR the
-// cost has noise-made ripples a few per cent of E apart whose local curvature
-// says nothing about how far the minimum moves. The figure is first order: it
-// is trustworthy when it is small compared with that window, indicative
-// otherwise.
+// +- kCurvatureWindow E* of E*, not the local second derivative: at low SNR the cost has
+// noise-made ripples whose local curvature says nothing about how far the minimum
+// moves. The figure is trustworthy when small against that window, indicative otherwise.
 #pragma once
 
 #include <cstdint>
@@ -39,8 +34,7 @@ struct UncertaintyOptions {
   bool IsValid(std::string* error) const;
 };
 
-// Standard deviations of white noise on the two displacement and the two force
-// channels.
+// Standard deviations of white noise per quantity.
 struct NoiseLevels {
   double displacement_std = 0.0;  // [m], every displacement channel (u0, uL, u@X)
   double force_std = 0.0;         // [N]

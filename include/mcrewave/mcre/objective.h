@@ -7,11 +7,9 @@
 // Warm start: with the last two usable solutions W(E1) (last) and W(E0) at
 // E0 != E1, the next solve at E starts from the linear extrapolation
 //   W^(0) = W(E1) + t (W(E1) - W(E0)),  t = (E - E1) / (E1 - E0),
-// when |t| <= kMaxExtrapolation (W depends smoothly on E between resonances; a
-// scan step or a local optimiser's step is then much closer to the line through the
-// last two solutions than to the last one); otherwise from W(E1) alone. The
-// streaming solver's unknown is the traces H U instead of W (CoupledSolution::
-// WarmStart()), extrapolated the same way.
+// when |t| <= kMaxExtrapolation (W depends smoothly on E between resonances); otherwise
+// from W(E1) alone. The streaming solver's unknown is the traces H U instead of W
+// (CoupledSolution::WarmStart()), extrapolated the same way.
 #pragma once
 
 #include <memory>
@@ -26,11 +24,8 @@
 
 namespace mcrewave {
 
-// The config's default weights, chosen with the clamp trusted on the comparator
-// study (docs/trusted_clamp.md section 7): w_u = w_e = 1e-7, w_f = 1, w_r = 1e-6.
-// Data weights this small put the coupled problem near its least-squares limit,
-// where it is mildly conditioned (a few CG iterations), and w_r / w_u = 10 weighs uL
-// and the clamp reaction about as their noise does on the paper's case.
+// The config's default weights with the clamp trusted: w_u = w_e = 1e-7, w_r = 1e-6
+// (w_f: McreWeights' 1). Why these: docs/trusted_clamp.md section 7.
 inline McreWeights TrustedClampWeights() {
   McreWeights weights;
   weights.displacement_weight = 1e-7;
@@ -56,30 +51,27 @@ struct McreOptions {
 };
 
 // The `search:` section: the functional the global search of a bar's identification
-// scans (docs/trusted_clamp.md section 10). The trusted clamp's e^2 of the defaults is
-// as accurate as least squares but, like it, has several valleys over the bounds: its
-// outputs f0 and uL skip cycles as E changes. The pinned clamp's e^2 at heavier data
-// weights has one valley, its minimiser within 0.83 % of the trusted one's. With
-// functional pinned, Identify scans and refines that one (scan_points samples at least,
-// its inner solves to inner_tolerance), then mcre:'s e^2 is scanned and refined within
-// E_search (1 -+ refine_window) (IdentifyInTwoStages, identification.h).
+// scans (docs/trusted_clamp.md section 10). The trusted clamp's e^2 has several valleys
+// over the bounds, the pinned clamp's e^2 at heavier data weights one, near the trusted
+// one's minimiser. With functional pinned, the pinned e^2 is scanned and refined
+// (scan_points samples at least, its inner solves to inner_tolerance), then mcre:'s e^2
+// is scanned and refined within E_search (1 -+ refine_window) (IdentifyInTwoStages,
+// identification.h).
 struct SearchOptions {
   SearchFunctional functional = SearchFunctional::kPinned;
   // The search functional's weights w_u, w_e, w_u0 and w_r; w_f and E0 are mcre:'s.
-  // Those of configs/paper_bar_pinned.yaml: one valley on 300 of 300 comparator data
-  // sets (docs/trusted_clamp.md section 9).
+  // The defaults are configs/paper_bar_pinned.yaml's (docs/trusted_clamp.md section 9).
   double displacement_weight = 0.01;       // search.w_u
   double strain_weight = 0.01;             // search.w_e
   double clamp_displacement_weight = 0.1;  // search.w_u0
   double reaction_weight = 0.1;            // search.w_r
-  // Relative residual of the search's inner solves: 1e-6 moves its E* by 8e-9 from
-  // 1e-8's, far inside refine_window.
+  // Relative residual of the search's inner solves (docs/trusted_clamp.md section 9,
+  // "The inner tolerance").
   double inner_tolerance = 1e-6;
-  // Fewest moduli of its scan (outer.scan_points for the functional `same`): with one
-  // valley, 4 samples per predicted valley spacing make 12 to 16 over the default bounds.
+  // Fewest moduli of its scan (outer.scan_points for the functional `same`).
   int scan_points = 12;
-  // Half width of the refinement of mcre:'s e^2 around the search's E*, relative: the
-  // two minima differed by at most 0.83 % on the comparator's 2000 data sets.
+  // Half width of the refinement of mcre:'s e^2 around the search's E*, relative
+  // (its choice: docs/trusted_clamp.md section 10).
   double refine_window = 0.03;
 
   // Valid when the weights and inner_tolerance are finite and positive,

@@ -49,10 +49,9 @@ struct ModulusZone {
 };
 
 // The moduli of the N elements of `bar` [Pa] under the zones (which do not overlap).
-// An element partly covered gets the
-// modulus of its pieces in series, 1 / E_e = sum_pieces (length / h_e) / E_piece,
-// which keeps the element's static axial stiffness exact. Precondition: the zones
-// are valid for the bar (ValidateModulusZones).
+// An element partly covered gets the modulus of its pieces in series,
+// 1 / E_e = sum_pieces (length / h_e) / E_piece, which keeps the element's static axial
+// stiffness exact. Precondition: the zones are valid for the bar (ValidateModulusZones).
 Vector ElementModuli(const BarProperties& bar, const std::vector<ModulusZone>& zones);
 
 class BarModel;
@@ -125,9 +124,8 @@ class BarModel {
   // Zone of element e, in [0, num_zones()).
   int element_zone(int element) const { return element_zones_[element]; }
   const std::vector<int>& element_zones() const { return element_zones_; }
-  // The axial stiffness per unit modulus of element e, k1_e = S / h_e [m]:
-  // K1_e = k1_e [1 -1; -1 1] on nodes (e, e + 1).
-  // (The mesh is uniform: the same for every element.)
+  // The axial stiffness per unit modulus of element e, k1_e = S / h_e [m] (the same for
+  // every element: the mesh is uniform): K1_e = k1_e [1 -1; -1 1] on nodes (e, e + 1).
   double element_unit_stiffness([[maybe_unused]] int element) const {
     return properties_.section / element_length();
   }
