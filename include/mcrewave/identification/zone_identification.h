@@ -1,32 +1,21 @@
 // Identification of every zone modulus at once (docs/zones_and_sensors.md,
 // "Identification of zone moduli"), by the MCRE (IdentifyZoneModuli) or, as its
-// comparator, by output-error least squares (IdentifyZoneModuliByLeastSquares, the same
-// steps on J; "Zones: the MCRE against least squares"). The MCRE's formulation: the
-// project's MCRE problem with zones,
-// K = sum_z E_z K1_z, and the gradient of every zone from the one coupled solve,
-//   de^2/dE_z = -(1/(2 E_z)) sum_j c_j h W_j^T K_z (W_j + 2 U_j)
-// (McreProblem::CostGradients; docs/zones_and_sensors.md).
+// comparator, by output-error least squares (IdentifyZoneModuliByLeastSquares: the same
+// steps on J). K = sum_z E_z K1_z, and every zone's gradient comes from the one coupled
+// solve, de^2/dE_z = -(1/(2 E_z)) sum_j c_j h W_j^T K_z (W_j + 2 U_j)
+// (McreProblem::CostGradients).
 //
-// Started from the homogeneous E* of the scalar identification (optim/identification.h).
-// Parameters p_z = log(E_z / E*): positivity for free, a step in p is a relative step in
-// E, and the regularisation penalises jumps of log E (optim/regularization.h). Chain rule:
-//   d cost / d p_z = (d cost / d E_z) E_z.
-// The cost is the scaled e^2 / J_rest of McreObjective (least squares: the scaled
-// J / J_rest of ZoneOutputErrorObjective). Bounds: outer.lower_bound and
-// outer.upper_bound on every zone, i.e. log(lower / E*) <= p_z <= log(upper / E*).
+// Started from the homogeneous E* of the scalar identification, on p_z = log(E_z / E*)
+// with d cost / d p_z = (d cost / d E_z) E_z, the cost the scaled e^2 / J_rest (least
+// squares: J / J_rest), every zone within [outer.lower_bound, outer.upper_bound].
 //
-// The regularisation weight's discrepancy target (the whole rule with weight_rule:
-// discrepancy; with the default L-curve, the test of the grid's largest weight and the
-// end of its descent) needs the misfit the noise alone explains: ExpectedNoiseCost, the
-// mean scaled e^2 of data made of noise alone (white, at the noise levels estimated
-// from the measurements by their second differences, DifferenceNoiseLevels, passed
-// through the same pre-filter as the data) at the homogeneous E*. Why that level: the
-// coupled solution is affine in the data and e^2 a quadratic form of its residuals;
-// data of the model at the true moduli give a zero residual, so at the truth
-// e^2(truth + noise) = e^2(noise) exactly (inverse crime) and its mean over noise draws
-// is the misfit the truth itself would show. The same target decides the merging of
-// neighbouring zones after the regularised minimisation (merge_zones,
-// MergeNeighbouringZones).
+// The regularisation's discrepancy target (optim/regularization.h) and the merging of
+// zones need the misfit the noise alone explains: ExpectedNoiseCost, the mean scaled e^2
+// of data made of noise alone (white, at the levels DifferenceNoiseLevels estimates from
+// the measurements, passed through the data's pre-filter) at E*. The coupled solution is
+// affine in the data and e^2 a quadratic form of its residuals, which vanish for data of
+// the model at the true moduli, so e^2(truth + noise) = e^2(noise) exactly: the mean is
+// the misfit the truth itself would show.
 #pragma once
 
 #include <cstdint>
@@ -74,9 +63,8 @@ struct ZoneIdentificationOptions {
   std::uint64_t noise_seed = 1;
   // Merge neighbouring zones after the regularised minimisation while an unpenalised
   // refit of the groups meets the discrepancy target (MergeNeighbouringZones). Off by
-  // default: each trial is a minimisation, O(zones^2) of them at worst, for the few
-  // zones of a localisation rather than one zone per element. The damage study turns it
-  // on for its 10 zones (docs/zones_and_sensors.md, "Merging neighbouring zones").
+  // default: each trial is a minimisation, O(zones^2) of them at worst
+  // (docs/zones_and_sensors.md, "Merging neighbouring zones").
   bool merge_zones = false;
 
   // Messages name the zone_identification.* keys.

@@ -1,31 +1,20 @@
-// Output-error least squares (finite-element model updating, FEMU): the comparator
-// practitioners use instead of the MCRE. The bar is clamped at x = 0 (the clamp
-// taken as rigid, u_0 = 0), driven at x = L by the measured force fL~, and its
-// predicted outputs are compared with the other measured channels:
+// Output-error least squares (finite-element model updating, FEMU), the MCRE's
+// comparator (docs/formulation.md section 8, docs/comparator.md): the bar clamped at
+// x = 0 (u_0 = 0), driven at x = L by the measured fL~ in the theta scheme of
+// linalg/theta_integrator.h, its predicted outputs against the other measured channels,
+// each kind normalised by its noise level:
 //
 //   J(E) = 1/2 sum_k c_k h [ sum_{u channels} (u_k - u~_k)^2 / s_u^2
 //                           + (f0_k - f0~_k)^2 / s_f^2
-//                           + sum_{e channels} (e_k - e~_k)^2 / s_e^2 ]      [s]
+//                           + sum_{e channels} (e_k - e~_k)^2 / s_e^2 ]      [s],
 //
-// (c_k the trapezoidal weights, 1/2 at both ends; s_u, s_f, s_e the noise levels
-// of each kind: the misfit normalised by the noise). The u channels are uL and the
-// interior displacement sensors u@X in use (u0 is zero in the model whatever E:
-// it does not enter); the e channels the strain gauges e@X; f0 the clamp reaction,
-// f0_k = row_0(M a_k + K u_k) with the accelerations of the free nodes from
-// M_r a_k = fL~_k e_N - K_r u_k (as model/simulation.h makes the synthetic f0).
-//
-// The model is the theta scheme of linalg/theta_integrator.h on the free nodes,
-//   M_r (v_{k+1} - v_k) = -h K_r (theta u_{k+1} + (1 - theta) u_k) + h f_theta,k,
-//   f_theta,k = (theta fL~_{k+1} + (1 - theta) fL~_k) e_N.
-// With K = E K1 (one modulus), its exact derivative s_k = du_k/dE obeys the same
-// scheme with the input -K1 (theta u_{k+1} + (1 - theta) u_k) = -K (...) / E:
-// one more sweep, run beside the first (forward sensitivity), gives
-//   dJ/dE = sum_k c_k h [ sum (u_k - u~_k) s_k / s_u^2 + (f0_k - f0~_k) df0_k / s_f^2 + ... ],
-//   df0_k = row_0(M da_k + K s_k + K u_k / E),  M_r da_k = -K_r s_k - K_r u_k / E.
-// Two sweeps per evaluation with the gradient, one without; no inner iteration.
-//
-// The cost seen by the optimisers is J / J_rest with J_rest = J of the bar at rest
-// (every prediction 0), and the gradient dJ/dx / J_rest with x = E / modulus_scale.
+// c_k the trapezoidal weights. The u channels are uL and the interior u@X in use (u0 is
+// zero in the model and never enters), f0 the clamp reaction
+// f0_k = row_0(M a_k + K u_k), M_r a_k = fL~_k e_N - K_r u_k (as model/simulation.h
+// makes the synthetic f0). dJ/dE comes from the forward sensitivity du_k/dE, which obeys
+// the same scheme with the input -K1 (theta u_{k+1} + (1 - theta) u_k): two sweeps per
+// evaluation with the gradient, one without, no inner iteration. The optimisers see
+// J / J_rest (J_rest: every prediction 0) and dJ/dx / J_rest, x = E / modulus_scale.
 #pragma once
 
 #include <memory>

@@ -1,28 +1,16 @@
-// Output-error least squares with zone moduli: the practitioners' comparator of the
-// MCRE's zone identification (docs/zones_and_sensors.md, "Zones: the MCRE against
-// least squares"). The misfit is OutputErrorObjective's (output_error_objective.h):
-// the bar clamped at x = 0, driven at x = L by the measured fL~, its predicted
-// outputs (uL, the clamp reaction f0, the interior sensors) against the measured
-// ones, normalised by the noise levels of each kind,
+// Output-error least squares with zone moduli, the comparator of the MCRE's zone
+// identification (docs/zones_and_sensors.md, "Zones: the MCRE against least squares"):
+// OutputErrorObjective's misfit (output_error_objective.h) with K = sum_z E_z K1_z,
 //
-//   J(E_1..E_Z) = 1/2 sum_k c_k h sum_channels (y_k - y~_k)^2 / s^2      [s],
+//   J(E_1..E_Z) = 1/2 sum_k c_k h sum_channels (y_k - y~_k)^2 / s^2      [s].
 //
-// with K = sum_z E_z K1_z (bar_model.h) in the theta scheme of theta_integrator.h.
-//
-// Gradient by forward sensitivities: s_z,k = du_k/dE_z obeys the same scheme
-// (differentiate M_r (v_{k+1} - v_k) = -h K_r (theta u_{k+1} + (1 - theta) u_k) + h f)
-// with the input
-//   f_theta = -K1_z,r (theta u_{k+1} + (1 - theta) u_k),
-// and the reaction f0_k = M_01 a_1,k + K_01 u_1,k (M_r a_k = fL~_k e_N - K_r u_k) has
-//   df0_k/dE_z = M_01 da_1 + K_01 s_z,1 + K1_z,01 u_1,   M_r da = -K_r s_z - K1_z,r u.
-// Then dJ/dE_z = sum_k c_k h sum_channels (y_k - y~_k) dy_k/dE_z / s^2. One sweep per
-// evaluation without the gradient, 1 + Z with it: meant for the few zones of a
-// localisation (10 zones: 11 sweeps), not for one zone per element.
-//
-// Seen by the optimisers (optim/bounded_minimizer.h) as a function of p_z =
-// log(E_z / modulus_scale), as ZoneMcreObjective (identification/zone_identification.h), with the
-// cost J / J_rest (J_rest: every prediction 0, OutputErrorRestCost) and its gradient
-// d cost / d p_z = (dJ/dE_z) E_z / J_rest.
+// Gradient by forward sensitivities s_z,k = du_k/dE_z, each obeying the theta scheme
+// with the input -K1_z,r (theta u_{k+1} + (1 - theta) u_k), and
+//   df0_k/dE_z = M_01 da_1 + K_01 s_z,1 + K1_z,01 u_1,   M_r da = -K_r s_z - K1_z,r u:
+// one sweep per evaluation without the gradient, 1 + Z with it (for the few zones of a
+// localisation, not one zone per element). Seen by the optimisers
+// (optim/bounded_minimizer.h) as a function of p_z = log(E_z / modulus_scale), with the
+// cost J / J_rest (OutputErrorRestCost) and d cost / d p_z = (dJ/dE_z) E_z / J_rest.
 #pragma once
 
 #include <string>

@@ -1,44 +1,31 @@
 // Minimisation of a function of several parameters within bounds: the outer loop of
-// the identification of zone moduli (identification/zone_identification.h; the problem:
-// docs/zones_and_sensors.md, "Identification of zone moduli").
+// the identification of zone moduli (identification/zone_identification.h;
+// docs/zones_and_sensors.md, "Optimisers").
 //
 // The objective is a MultiParameterObjective, shaped like ceres::FirstOrderFunction:
 // a cost, an optional gradient, and false (never a made-up number) when the value
 // cannot be had. Back ends, all started from the same point within the same bounds:
 //
-//   nlopt_lbfgs   NLopt's low-storage BFGS (LD_LBFGS), bounded, with the gradient
+//   nlopt_lbfgs   NLopt's low-storage BFGS (LD_LBFGS), with the gradient
 //   nlopt_mma     NLopt's method of moving asymptotes (LD_MMA), with the gradient
 //   nlopt_slsqp   NLopt's sequential quadratic programming (LD_SLSQP), with the gradient
 //   nlopt_bobyqa  Powell's BOBYQA (LN_BOBYQA), derivative-free: for a few parameters
-//                 only (it needs (n + 1)(n + 2) / 2 evaluations for its first model)
-//   ceres_lbfgs   ceres::GradientProblemSolver, L-BFGS with a Wolfe line search, on
-//                 free variables y_i with the bound transform of every parameter
-//                   x_i = lo_i + (hi_i - lo_i) (1 + sin y_i) / 2
-//                 (MINUIT's). Chosen over the logistic map of the scalar loop
-//                 (identification.h) because a bound is reached at a finite y
-//                 (y = +-pi/2), where the cost is smooth and quadratic in y: an optimum
-//                 on a bound (a zone pushed to a bound of the search) converges like
-//                 an interior one, while the logistic map only reaches it as y -> inf
-//                 with a gradient that vanishes exponentially. The price: dx/dy = 0 on
-//                 the bounds makes them stationary points in y, so the start is kept
-//                 strictly inside (a start on a bound is moved in by 1e-6 of the width).
+//                 only (its first model takes (n + 1)(n + 2) / 2 evaluations)
+//   ceres_lbfgs   ceres::GradientProblemSolver, L-BFGS with a Wolfe line search, on free
+//                 variables y_i with MINUIT's bound transform
+//                   x_i = lo_i + (hi_i - lo_i) (1 + sin y_i) / 2,
+//                 which reaches a bound at a finite y; a start on a bound (a stationary
+//                 point in y) is moved inside by 1e-6 of the width.
 //
-// Guarded as the scalar loop is (nlopt_identification.cpp): every evaluation is
-// counted, the evaluation and time limits are enforced before each one, an exception
-// or a false return of the objective is caught in the adapter, its message kept and
-// the optimiser stopped (NLopt force-stopped: its C++ wrapper would report a bare
-// "nlopt failure"); a non-finite cost is a failure. The best point seen is reported,
-// not the optimiser's last. NLopt's generic failure of a gradient-based algorithm
-// after progress (its line search found no decrease: the cost is flat to the
-// objective's precision, measured on the paper's bar with inner solves at 1e-8) counts
-// as convergence, as roundoff_limited does.
+// Guards: every evaluation is counted, the evaluation and time limits are enforced
+// before each one, an exception or a false return of the objective stops the optimiser
+// with its message (NLopt force-stopped), a non-finite cost is a failure, and the best
+// point seen is reported, not the optimiser's last. NLopt's generic failure of a
+// gradient-based algorithm after progress (its line search found no decrease: the cost
+// is flat to the objective's precision) counts as convergence, as roundoff_limited does.
 //
-// Scaling: the cost is evaluated once at the start before the optimiser runs, and the
-// optimiser sees cost / |cost(start)| (and the gradient likewise): its internal tests
-// (NLopt L-BFGS's gradient test, Ceres' line search) assume a cost of order one, while
-// the scaled e^2 / J_rest of nearly consistent data starts at 1e-6 or below (measured:
-// NLopt L-BFGS stopped with "success" at 3.6e-4 relative error of the zone moduli on
-// the 10-zone inverse crime without this scaling).
+// Scaling: the optimiser sees cost / |cost(start)| (the gradient likewise), the cost
+// being evaluated once at the start, since its internal tests assume a cost of order one.
 #pragma once
 
 #include <limits>
@@ -66,8 +53,7 @@ bool UsesGradient(BoundedAlgorithm algorithm);
 
 // The `zone_identification:` options of the minimiser.
 struct BoundedMinimizerOptions {
-  // Ceres' L-BFGS: the paper's bar, noise-free, 10 zones in 133 evaluations and 100 in
-  // 189, against 264 and 373 for NLopt's (docs/zones_and_sensors.md).
+  // Ceres' L-BFGS by default (docs/zones_and_sensors.md, "Measured on the paper's bar").
   BoundedAlgorithm algorithm = BoundedAlgorithm::kCeresLbfgs;
   // Stop when a step changes every parameter by at most this much (absolute: on
   // p = log(E / E_scale) it is a relative change of E). NLopt xtol_abs; Ceres: the

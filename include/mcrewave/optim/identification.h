@@ -1,51 +1,32 @@
-// The outer loop: minimises a ModulusObjective (objective.h) over E within
-// bounds with NLopt or Ceres.
+// The outer loop: minimises a ModulusObjective (modulus_objective.h) over E within
+// bounds with NLopt or Ceres. Both see x = E / E_scale of order 1 (E_scale =
+// objective->modulus_scale()) and the objective's scaled cost.
 //
-//   nlopt  derivative-free BOBYQA (default), COBYLA or Sbplx on x = E / E_scale
-//          within the bounds; or gradient-based MMA / L-BFGS with the adjoint
-//          gradient. Guarded against NLopt's traps: the objective's exceptions
-//          and failures are caught in the callback, their message kept and the
-//          run force-stopped (the C++ wrapper would turn them into a bare
-//          "nlopt failure"); the best point seen is reported, not NLopt's last;
-//          roundoff_limited is a usable stop; the evaluation and time limits are
-//          enforced in the callback as well.
+//   nlopt  derivative-free BOBYQA (default), COBYLA or Sbplx, or MMA / L-BFGS with the
+//          adjoint gradient, within the bounds. The objective's exceptions and failures
+//          are caught in the callback, their message kept and the run force-stopped; the
+//          best point seen is reported, not NLopt's last; roundoff_limited is a usable
+//          stop; the evaluation and time limits are enforced in the callback.
 //   ceres  ceres::GradientProblemSolver (line search, L-BFGS by default) with the
-//          adjoint gradient, no numeric differentiation. Ceres has no bounds for
-//          a GradientProblem: it works on z with the smooth bounded map
+//          adjoint gradient, on z with the bounded map
 //            x(z) = x_lo + (x_hi - x_lo) / (1 + exp(-z)),
 //          so every trial E lies strictly inside (lower_bound, upper_bound).
 //
-// Both see the same objective: x = E / E_scale of order 1 (E_scale =
-// objective->modulus_scale()) and the cost scaled by the objective.
-//
-// Global search (scan_points > 0, the default; docs/global_search.md): e^2(E) of
-// noisy data is rugged (the noise shifts the model's resonances in and out of
-// phase with it as E changes), so a local optimiser started anywhere stops in the
-// nearest valley, and different optimisers in different valleys. Identify first
-// samples the cost AND its gradient over [lower_bound, upper_bound], evenly in
-// log E, finely enough to see every valley: the objective predicts the mean
-// spacing of the valleys in ln E from the model's response to the measured loads
-// (ModulusObjective::ValleySpacing, valley_spacing.h), and the scan takes
-// scan_samples_per_valley samples per spacing (never fewer than scan_points, never
-// more than scan_max_points). The samples run at the loose inner tolerance
-// scan_tolerance, on copies of the objective in 8 fixed contiguous chunks, each a
-// fresh copy warm-started point to point, spread over scan_threads threads: every
-// sample is the same bits whatever the thread count or timing.
-//
-// Valleys. Between neighbouring samples x_i < x_{i+1} with costs c and
-// gradients g, the cubic Hermite interpolant p of (c_i, g_i, c_{i+1}, g_{i+1})
-// locates a valley when it has a local minimum inside: always when g_i < 0 <=
-// g_{i+1} (a sign change of de^2/dE brackets a minimum), and also when two
-// extrema hide between samples of one sign. A positive gradient at the lower
-// bound (negative at the upper) is a valley at that bound. Each valley gets its
-// estimate x* (p's minimum), p(x*) and the curvature p''(x*). Every valley whose
-// estimated cost lies within refine_margin (relative) of the lowest estimate is
-// refined (at most refine_candidates, lowest first) by the local optimiser inside
-// its bracket [x_i, x_{i+1}], started at x* with the curvature (Ceres' parameter is
-// scaled so that its first step is the Newton step of p); a refinement that ends on
-// an inner edge of its bracket is run again over the two neighbouring intervals.
-// The refined valley of least cost is the result; every valley is reported.
-// scan_points = 0 keeps the local search from `initial` alone.
+// Global search (scan_points > 0, the default; docs/global_search.md sections 2 to 4):
+// e^2(E) of noisy data has several valleys, so Identify first samples the cost and its
+// gradient evenly in log E over the bounds, scan_samples_per_valley samples per
+// predicted valley spacing (ModulusObjective::ValleySpacing), at least scan_points and
+// at most scan_max_points, at the inner tolerance scan_tolerance, on copies of the
+// objective in 8 fixed contiguous chunks spread over scan_threads threads: every sample
+// is the same bits whatever the thread count. Between neighbouring samples the cubic
+// Hermite interpolant p of the costs and gradients locates a valley when it has a local
+// minimum inside; a gradient pointing out of the bounds at a bound is a valley there.
+// Every valley whose estimate p(x*) lies within refine_margin (relative) of the lowest
+// is refined (at most refine_candidates, lowest first) by the local optimiser inside its
+// bracket, started at x* with the curvature p''(x*); a refinement that ends on an inner
+// edge of its bracket is run again over the two neighbouring intervals. The refined
+// valley of least cost is the result; every valley is reported. scan_points = 0 keeps
+// the local search from `initial` alone.
 #pragma once
 
 #include <limits>
@@ -83,15 +64,12 @@ struct IdentificationOptions {
   // reaching it is not convergence.
   double max_time = 600.0;
   // Fewest moduli of the global scan, evenly spaced in log E over the bounds
-  // (ends included); 0: no scan, local search from `initial` only. 41 over the
-  // default bounds is a step of 3.5 % in E.
+  // (ends included); 0: no scan, local search from `initial` only.
   int scan_points = 41;
   // Samples per predicted valley spacing (ModulusObjective::ValleySpacing); the
   // scan takes max(scan_points, this many per spacing over the bounds). With the
   // gradient at every sample, a valley is missed only when a maximum and a minimum
-  // fall between two samples; at 4 per mean spacing, the scans of the paper's raw
-  // SNR-2.5 data (seeds 1 to 3) saw 23 of the 24 valleys a 0.06 % grid sees, the
-  // one missed 1.9 % above the lowest (docs/global_search.md). 0: scan_points alone.
+  // fall between two samples (docs/global_search.md section 3). 0: scan_points alone.
   double scan_samples_per_valley = 4.0;
   // Most samples of the scan; a scan that would need more is cut to this and
   // reported (summary.scan_resolution_limited, a warning).
@@ -103,10 +81,9 @@ struct IdentificationOptions {
   // Threads of the scan (each its own copy of the objective).
   int scan_threads = 2;
   // Every valley whose estimated scaled cost is within refine_margin x the lowest
-  // estimate (relative) is refined: at its minimum, e^2 of noisy data is mostly the
-  // noise's energy, whose relative spread between noise draws is sqrt(2 / N) for N
-  // independent samples (1.7 % for the unfiltered record of the paper's case, 9 %
-  // filtered), so valleys closer than that cannot be told apart by their cost.
+  // estimate (relative) is refined: valleys whose costs differ by less than the noise
+  // energy's spread between draws, sqrt(2 / N) for N independent samples, cannot be
+  // told apart by their cost (docs/global_search.md section 4).
   double refine_margin = 0.05;
   // Most valleys refined.
   int refine_candidates = 10;
@@ -195,10 +172,9 @@ struct IdentificationSummary {
 // max_time hold for the whole identification: each refinement gets what the
 // scan and the earlier refinements left, and a limit reached anywhere makes the
 // result kNoConvergence (samples the scan could not reach in time stay NaN).
-// Never throws for what the objective
-// does: an exception thrown by the objective ends the run (or, in the scan,
-// makes that sample unusable) with termination kFailure and its what() in the
-// message. Precondition: options.IsValid().
+// Never throws for what the objective does: an exception thrown by the objective
+// ends the run (or, in the scan, makes that sample unusable) with termination
+// kFailure and its what() in the message. Precondition: options.IsValid().
 IdentificationSummary Identify(const IdentificationOptions& options, ModulusObjective* objective);
 
 // Two stages: a global search on another functional, a local refinement of the objective.
@@ -206,9 +182,8 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
 //      valleys' refinements on `search`, a cost of one valley over the bounds whose
 //      minimiser E_s lies near the objective's. The refinements are NLopt BOBYQA's
 //      whatever options' optimiser: derivative-free, they do not depend on the accuracy
-//      of the search's gradient, which its looser inner solves limit (NLopt L-BFGS
-//      failed on the paper's case at the inner tolerance 1e-6), and every optimiser then
-//      refines the objective around the same E_s.
+//      of the search's gradient, which its looser inner solves limit, and every
+//      optimiser then refines the objective around the same E_s.
 //   2. Identify(options with scan_points = kTwoStageWindowScanPoints, objective) within
 //      E_s (1 -+ refine_window), cut to the bounds: a scan of the window (cost and
 //      gradient) that brackets the objective's valleys there and gives the local
@@ -222,9 +197,8 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
 // scan_sweeps = those scans' (on copies; the search objective's own sweeps are its
 // sweeps()), and, unless stage 3 ran, the search's scan fields (scan_of_search). A
 // search that does not converge ends the identification with its termination and
-// message. Preconditions:
-// options.IsValid(), options.scan_points > 0, search_scan_points in [3, 100000],
-// refine_window in (0, 0.5].
+// message. Preconditions: options.IsValid(), options.scan_points > 0,
+// search_scan_points in [3, 100000], refine_window in (0, 0.5].
 constexpr int kTwoStageWindowScanPoints = 5;
 IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
                                           ModulusObjective* search, int search_scan_points,

@@ -1,5 +1,5 @@
-// Regularisation of the identification of many zone moduli, and the automatic
-// choice of its weight (docs/zones_and_sensors.md, "Identification of zone moduli").
+// Regularisation of the identification of many zone moduli, and the automatic choice
+// of its weight (docs/zones_and_sensors.md, "Regularisation and its weight").
 //
 // With parameters p_z = log(E_z / E_scale) (one per zone, in order along the bar) the
 // penalty on the jumps of log E between neighbouring zones is
@@ -7,38 +7,29 @@
 //   phi(d) = d^2                            (tikhonov)
 //   phi(d) = sqrt(d^2 + eps^2) - eps        (total_variation, smoothed by eps)
 // added to the scaled data cost e^2 / J_rest. Tikhonov favours smooth profiles, the
-// smoothed total variation piecewise-constant ones (it penalises a jump by its size,
-// not its square, so one sharp jump costs less than a ramp of the same height).
+// total variation piecewise-constant ones (a jump costs its size, not its square).
 //
-// The weight lambda: fixed (weight >= 0) or chosen automatically (weight < 0, the
-// default) by weight_rule, on the grid below descended from its largest weight. The
-// L-curve (the default): the grid's largest weight when its misfit already lies under
-// kLCurveTopShare of the discrepancy target below (data the nearly homogeneous profile
-// explains within the noise); else the descent stops at the first weight that meets the
-// target (lighter ones only fit the noise), or at a minimisation that fails, or at the
-// grid's end, and the weight is the corner of the points descended (LCurveCorner);
-// without a corner, the weight that met the target, or the misfit-floor rule at the end
-// of this comment. The discrepancy principle: the largest lambda whose data misfit (the
-// scaled e^2 at the regularised minimiser) stays at or below the level the noise explains,
-// target = discrepancy_factor * (expected e^2 at the truth under the estimated noise)
-// (identification/zone_identification.h computes that level). The misfit grows with lambda, so the
-// grid lambda_k = c0 max_weight / grid_factor^k down to c0 min_weight, c0 the data cost
-// at the start (the weights are relative to it: the scaled e^2 of nearly consistent data
-// is 1e-6 or less, where a weight of 1 would freeze every zone), is descended, each minimisation
-// warm-started from the previous one, down to the first lambda that meets the
-// target; then regula falsi (Illinois) on ln(misfit / target) against ln lambda
-// between it and the last lambda that missed, until the chord's root lies within a
-// factor 1 + weight_tolerance of the lambda kept or refinement_steps are spent. When
-// no lambda down to min_weight meets the target (model
-// error, or a noise level underestimated) the smallest would fit the noise as well as
-// the zones can (measured: zones between 0.59 and 1.84 E* on the paper's bar at SNR 20,
-// 10 zones, target 1.82e-6 against a floor of 1.86e-6). The noise level is then not
-// to be trusted: the weight is the corner of the grid's L-curve (LCurveCorner,
-// weight_choice "l_curve", a warning), or without a corner the principle applied to
-// the floor raised by kMisfitFloorMargin (weight_choice "misfit_floor"): the largest
-// lambda whose misfit stays within 10 % of the floor, the misfit at the grid's lightest
-// lambda (the least of the grid: along a path of minima, warm-started from the heavier
-// lambda, the misfit does not grow as lambda falls, up to the minimiser's tolerances).
+// The weight lambda: fixed (weight >= 0) or chosen (weight < 0, the default) by
+// weight_rule from the target misfit (the discrepancy target: the scaled e^2 the noise
+// alone explains, identification/zone_identification.h). The grid
+// lambda_k = c0 max_weight / grid_factor^k down to c0 min_weight is descended from its
+// largest weight, each minimisation warm-started from the previous one, to the first
+// weight that meets the target (or a minimisation that fails, or the grid's end). The
+// weights are relative to c0, the data cost at the start: the scaled e^2 of nearly
+// consistent data is 1e-6 or less, where an absolute weight of 1 would freeze every
+// zone. Then:
+//   l_curve (the default): the grid's largest weight when its misfit lies under
+//     kLCurveTopShare of the target; else the corner of the points descended
+//     (LCurveCorner); without a corner, the weight that met the target;
+//   discrepancy: regula falsi (Illinois) on ln(misfit / target) against ln lambda
+//     between the weight that met the target and the last that missed, until the chord's
+//     root lies within a factor 1 + weight_tolerance of the lambda kept or
+//     refinement_steps are spent.
+// When no weight meets the target (model error, or the noise underestimated), the
+// weight is the corner of the grid's L-curve (weight_choice "l_curve", a warning), or
+// without a corner the largest lambda whose misfit stays within a factor
+// 1 + kMisfitFloorMargin of the misfit floor, the misfit at the grid's lightest lambda
+// (weight_choice "misfit_floor").
 #pragma once
 
 #include <string>
@@ -53,29 +44,24 @@ struct RegularizationOptions {
   RegularizationKind kind = RegularizationKind::kTikhonov;
   // lambda; < 0: chosen by weight_rule.
   double weight = -1.0;
-  // The L-curve: at SNR 10 the noise's e^2 varies from one draw to the next by as much
-  // as the misfit over the whole grid, and the discrepancy principle over-smooths on
-  // the draws below its mean (docs/zones_and_sensors.md, "Regularisation and its weight"). The
-  // discrepancy target still decides whether the data ask for any contrast at all.
+  // The L-curve by default (why: docs/zones_and_sensors.md, "Regularisation and its
+  // weight"). The discrepancy target still decides whether the data ask for any
+  // contrast at all.
   WeightRule weight_rule = WeightRule::kLCurve;
   // eps of the smoothed total variation, in log E (1e-3: jumps above 0.1 % of E count
   // by their size).
   double tv_smoothing = 1e-3;
-  // The grid of weights, relative to the data cost c0 at the start. At 1e-4 c0 the
-  // penalty is already a few 1e-4 of the misfit (a third of c0 or more with noise):
-  // the zones are as free as unregularised, and lighter weights only cost
-  // evaluations (100 zones, SNR 20, interior sensors: 56, 92 and 473 evaluations at
-  // 1, 1e-2 and 1e-4 c0, then 2000 without converging at 1e-6 c0).
+  // The grid of weights, relative to the data cost c0 at the start. Below 1e-4 c0 the
+  // zones are as free as unregularised (docs/zones_and_sensors.md, "Measured on the
+  // paper's bar").
   double max_weight = 1.0;
   double min_weight = 1e-4;
-  // A factor 100: about 2 + (decades / 2) minimisations to the first weight that meets
-  // the target (a factor 10 and 4 bisections took 403 evaluations and 11 s on 10 zones
-  // of the paper's bar, noise-free).
+  // The ratio of neighbouring grid weights: about 2 + (decades / 2) minimisations to
+  // the first weight that meets the target.
   double grid_factor = 100.0;
-  // The refinement after the grid: at most refinement_steps regula falsi steps,
-  // stopped once the chord's root lies within a factor 1 + weight_tolerance of the
-  // lambda kept. The misfit follows nearly a power of lambda, so the chord lands
-  // close where 3 bisections left the weight within a factor 100^(1/8) = 1.78.
+  // The refinement after the grid (rule discrepancy): at most refinement_steps regula
+  // falsi steps, stopped once the chord's root lies within a factor 1 + weight_tolerance
+  // of the lambda kept.
   int refinement_steps = 4;
   double weight_tolerance = 0.25;
   // tau of the target misfit tau * (expected e^2 of the noise).
@@ -130,10 +116,8 @@ struct RegularizedPoint {
 constexpr double kMisfitFloorMargin = 0.1;
 
 // The L-curve rule keeps the grid's largest weight when its misfit is at most this
-// share of the discrepancy target: one draw's e^2 lies up to about 15 % from the mean
-// the target is (13 % under it on seed 17 of the damage study's case at SNR 10, where
-// the largest weight met the target with the soft zone 13 % stiff; the quick case's
-// homogeneous truth, 5 zones, SNR 20: 0.61 of the target).
+// share of the discrepancy target (below 1: one draw's e^2 differs from the mean the
+// target is; docs/zones_and_sensors.md, "Regularisation and its weight").
 constexpr double kLCurveTopShare = 0.8;
 // The least bend of an L-curve corner: its distance below the chord, in the grid's
 // (ln misfit, ln roughness) scaled to [0, 1].
@@ -178,19 +162,15 @@ RegularizedMinimization MinimizeRegularized(
     MultiParameterObjective* data, const std::vector<double>& lower,
     const std::vector<double>& upper, const std::vector<double>& initial, double target_misfit);
 
-// Merging of neighbouring zones after the regularised minimisation (a debiasing
-// refit; docs/zones_and_sensors.md, "Merging neighbouring zones"). The penalty that
-// takes the noise's jumps out of equal zones also shrinks the jumps the data need
-// (total variation by an amount that grows with lambda), and a weight light enough to
-// keep those leaves some of the noise's. Merging asks the data which jumps they need:
-// from the regularised minimiser x, the boundary with the smallest |jump of log E|
-// between two neighbouring groups of zones (each zone its own group at the start) is
-// removed, every group refitted on the data cost alone (no penalty, one parameter per
-// group, started from the groups' mean log E), and the merge kept when the refit's
-// misfit stays at or below the discrepancy target; else the next smallest jump is
-// tried. It stops when no boundary of the current groups can be removed. The result is
-// the last kept refit: the fewest groups, in this order, whose unpenalised fit explains
-// the data within the noise, with no shrinkage of the jumps left.
+// Merging of neighbouring zones after the regularised minimisation, a debiasing refit
+// (docs/zones_and_sensors.md, "Merging neighbouring zones"): from the regularised
+// minimiser x, each zone its own group, the boundary with the smallest |jump of log E|
+// between two neighbouring groups is removed, every group refitted on the data cost
+// alone (no penalty, one parameter per group, started from the groups' mean log E), and
+// the merge kept when the refit's misfit stays at or below the target; else the next
+// smallest jump is tried. It stops when no boundary can be removed. The result is the
+// last kept refit: the fewest groups, in this order, whose unpenalised fit explains the
+// data within the noise.
 struct ZoneMerge {
   std::vector<int> group_of;  // per zone, its group (numbered along the bar)
   int groups = -1;            // groups at the end (-1: not run)

@@ -1,19 +1,9 @@
-// How far apart the valleys of a data misfit lie along log E: the spacing the
-// global scan of Identify (identification.h) must resolve (docs/global_search.md).
-//
-// Scheme. Along s = ln E the cost of noisy data is a smooth trend plus the
-// correlation of the noise n(t) with the model's predicted outputs y(t; s),
-//   g(s) = -2 sum_k w_k int_0^T n_k(t) y_k(t; s) dt,
-// a Gaussian random function of s. A structure whose moduli all scale by e^s
-// responds to a given load like itself with time scaled by e^{s/2} (its
-// frequencies go as sqrt(E)), so dy/ds = (t/2) dy/dt, and for white noise the
-// spectral moments of g are
-//   lambda_2 = E[g'^2]  ~ sum_k w_k int (t/2)^2 |dy_k/dt|^2 dt,
-//   lambda_4 = E[g''^2] ~ sum_k w_k int (t/2)^4 |d^2y_k/dt^2|^2 dt
-// (the terms of highest order in t d/dt kept). Rice's formula gives the mean
-// distance between neighbouring minima of g: 2 pi sqrt(lambda_2 / lambda_4).
-// A mode of frequency f alone gives 2 / (sqrt(3/5) f T): the phase shift pi f T
-// dE / E of the estimate, averaged over the window.
+// How far apart the valleys of a data misfit lie along log E: the spacing the global
+// scan of Identify (identification.h) must resolve. Scheme (docs/global_search.md
+// section 1): along s = ln E the noise's share of the cost is a Gaussian random function
+// of s; with dy/ds = (t/2) dy/dt (a structure whose moduli scale by e^s runs its
+// response faster by e^{s/2}), Rice's formula gives the mean distance between its
+// neighbouring minima, 2 pi sqrt(lambda_2 / lambda_4), from the spectral moments below.
 #pragma once
 
 #include "mcrewave/core/types.h"
