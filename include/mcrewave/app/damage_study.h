@@ -1,5 +1,5 @@
 // The damage-localisation study (docs/zones_and_sensors.md, "Damage localisation"),
-// run by `identify study` with study.kind: damage (or all):
+// run by `identify study` with study.kind: damage (not part of all):
 //
 // On the config's bar (the paper's: 100 elements, 1750 steps, truth 4x finer) with
 // three truths:

@@ -141,10 +141,9 @@ std::string ModulusOnBoundMessage(double modulus, const IdentificationOptions& o
 // displacements (or forces) by an RMS misfit (run.misfit) above
 // kImplausibleMisfitFactor times the RMS of those measurements (run.data, both
 // ends), i.e. it explains nothing of them, as data in wrong units or from
-// another structure give, whatever the bounds; "" otherwise. Measured: correct
-// data at SNR 2.5 to inf give misfits below their RMS; a channel scaled by 1e6
-// gives 1e4 to 1e6 times it. Precondition: run.IsUsable() and RunIdentification
-// ran (run.misfit is set).
+// another structure give, whatever the bounds; "" otherwise (the factor's margins:
+// docs/hardening.md). Precondition: run.IsUsable() and RunIdentification ran
+// (run.misfit is set).
 constexpr double kImplausibleMisfitFactor = 10.0;
 std::string ImplausibleMisfitMessage(const IdentificationRun& run);
 
@@ -191,8 +190,8 @@ struct LeastSquaresRun {
   // 1 / sqrt(fit.fisher_information) [Pa]: the Cramer-Rao bound of E under white
   // noise of the levels `noise` on the outputs with the measured load taken as
   // exact. The noise of the load that drives the model is not counted, so the
-  // spread of E over noise draws is larger (measured: results/comparator). NaN
-  // when the information is not positive.
+  // spread of E over noise draws is larger (docs/comparator.md). NaN when the
+  // information is not positive.
   double modulus_std_bound = std::numeric_limits<double>::quiet_NaN();
   long sweeps = 0;  // of every simulation (scan, refinement, fit, curve)
   // Every zone's modulus from E* by least squares when the identification has zones

@@ -1,34 +1,29 @@
-// The results of `identify run` in its output folder. Every file is written
-// atomically (file_util.h; gnuplot draws to a temporary name that is then
-// renamed), and only once everything is computed, so a reader never sees a
-// half-written file and a failed run leaves none behind.
+// The results of `identify run` in its output folder (README, "Results"). Every file is
+// written atomically (file_util.h; gnuplot draws to a temporary name), summary.yaml
+// last, and only once everything is computed: a reader never sees a half-written file
+// and a failed run leaves none behind.
 //
-//   summary.yaml        identified_modulus [Pa], reference_modulus and
-//                       relative_error (null for CSV data), cost e^2 [J s],
-//                       evaluations, sweeps, wall_time_s, the uncertainty figure
-//                       and its meaning, optimiser and inner-solver totals, the
-//                       weights, the cost curve's extent, the resolved config and
-//                       the version
+//   summary.yaml        identified_modulus [Pa], reference_modulus and relative_error
+//                       (null for CSV data), cost e^2 [J s], evaluations, sweeps,
+//                       wall_time_s, the uncertainty figure, optimiser and inner-solver
+//                       totals, the weights, the cost curve's extent, the resolved
+//                       config and the version
 //   evaluations.csv     the optimiser's evaluations: E, e^2, de^2/dE, inner solve
 //   cost_curve.csv      e^2(E) and de^2/dE around the identified E
-//   scan.csv            the scanned cost and its gradient at the moduli of the global
-//                       scan (when outer.scan_points > 0), solved at
-//                       outer.scan_tolerance: e^2, or the search functional's
-//                       (summary.yaml scan.functional, its own cost scale)
-//   valleys.csv         every valley the scan saw: bracket, estimate, and the
-//                       refined minimum of those refined (docs/global_search.md)
+//   scan.csv            the global scan's cost and gradient (outer.scan_points > 0), of
+//                       e^2 or the search functional (summary.yaml scan.functional)
+//   valleys.csv         every valley the scan saw (docs/global_search.md)
 //   ends.csv            measured and model end displacements and forces at the
-//                       identified E; model force F_L = fL~ - W_L / alpha
-//                       (docs/discrete_mcre.md section 2) and, at x = 0, the
-//                       run's clamp_force (f0~ - W_0 / alpha, f0~ - W_0 / alpha_0
-//                       when pinned, the reaction r(U) when trusted)
-//   inner_residual.csv  relative residual per inner iteration of a solve from
-//                       W = 0 at the identified E (direct solvers: their final
-//                       residual)
-//   cost_curve.png (the scan over the bounds, then E* +- 5 %), ends.png,
-//   inner_residual.png  the same drawn by gnuplot
-//                       (pngcairo), when figures are asked for (inner_residual.png
-//                       only when there is a residual to draw)
+//                       identified E (model force F_L = fL~ - W_L / alpha; at x = 0 the
+//                       run's clamp_force)
+//   inner_residual.csv  relative residual per inner iteration of a solve from W = 0 at
+//                       the identified E (direct solvers: their final residual)
+//   error_map.csv       each element's share of the constitutive gap at the identified
+//                       E, and error_map_spacetime.dat its space-time density
+//                       (mcre/error_map.h)
+//   zones.csv, ...      with zones, WriteZoneResults' files (zone_identification_run.h)
+//   cost_curve.png, ends.png, error_map.png, inner_residual.png (when there is a
+//                       residual to draw): with figures (gnuplot, pngcairo)
 #pragma once
 
 #include <string>

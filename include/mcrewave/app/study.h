@@ -1,41 +1,29 @@
-// Studies of the identification, run by `identify study CONFIG` from the
-// `study:` section of a config (config.h), each into a folder of its own:
+// Studies of the identification, run by `identify study CONFIG` from the `study:`
+// section of a config (README, "Studies"), each into a folder of its own:
 //
-//   robustness   For every SNR of robustness_snr and noise seeds 1..robustness_seeds
-//                (one run at SNR inf: without noise every seed gives the same data),
-//                the identification of `identify run` (pre-filter, global scan,
-//                local refinement; identification_run.h) on data from the finer
-//                truth of `data:` (no inverse crime). The noise-free truth is
-//                simulated once; only the noise differs from run to run. Per SNR:
-//                mean, standard deviation and 2.5 / 97.5 % quantiles of the
-//                relative error of E, the share of runs that converged, mean outer
-//                evaluations and inner sweeps (the paper identifies E down to
-//                SNR 2.5).
-//   relaxation   For every SNR of relaxation_snr (noise seed data.seed) and E =
-//                f E_ref, f in relaxation_moduli: the sweeps the fixed-omega
-//                relaxation needs to reach relaxation_tolerance on a grid of omega
-//                (the paper's Fig. 3), beside what the spectrum of A = I - G
-//                predicts (Lanczos estimate of the adaptive relaxation): the
-//                convergence limit omega < 2 / a_max, the optimal omega
-//                2 / (a_min + a_max), the adaptive rule's omega and the iterations
-//                ln(tol) / ln(rho(omega)), rho = max |1 - omega a|; and the residual
-//                against iteration of the fixed omega (the grid's fastest), the
-//                adaptive relaxation and conjugate gradients (Fig. 4 extended),
-//                each to inner.tolerance.
-//   cost_curves  For every SNR of cost_curve_snr and seeds 1..cost_curve_seeds (one
-//                at SNR inf): e^2(E) on cost_curve_points moduli evenly spaced over
-//                [cost_curve_low, cost_curve_high] E_ref, and the modulus the
-//                identification finds on the same data (the paper's Fig. 6).
+//   robustness   for every SNR of robustness_snr and noise seeds 1..robustness_seeds
+//                (one run at SNR inf), the identification of `identify run`
+//                (identification_run.h) on data from the finer truth of `data:`; per
+//                SNR the statistics of the relative error of E, the converged share,
+//                mean outer evaluations and inner sweeps.
+//   relaxation   for every SNR of relaxation_snr (noise seed data.seed) and E = f E_ref,
+//                f in relaxation_moduli: the sweeps of the fixed-omega relaxation to
+//                relaxation_tolerance on a grid of omega (the paper's Fig. 3) beside what
+//                the Lanczos estimate of the spectrum of A = I - G predicts (limit
+//                2 / a_max, optimum 2 / (a_min + a_max), the adaptive omega, iterations
+//                ln(tol) / ln(rho(omega)), rho = max |1 - omega a|), and the residual
+//                histories of the fixed, adaptive and CG solves (Fig. 4 extended).
+//   cost_curves  for every SNR of cost_curve_snr and seeds 1..cost_curve_seeds (one at
+//                SNR inf): e^2(E) on cost_curve_points moduli evenly spaced over
+//                [cost_curve_low, cost_curve_high] E_ref, and the identified E on the
+//                same data (the paper's Fig. 6).
 //
-// E_ref is model.modulus, the modulus of the synthetic data. Every study uses
-// the config's model, load, time grid, data truth, weights, inner solver,
-// pre-filter and outer loop; the measurements of one (SNR, seed) are the truth
-// plus AddMeasurementNoise(snr, seed) (noise.h), then the pre-filter.
-//
-// Runs are spread over `threads` threads (0: every core), each run on one thread
-// (the identifications' scans with outer.scan_threads = 1), and stored by index:
-// the numbers do not depend on the number of threads. Progress lines with an
-// estimate of the time left go to StudyProgressLogger() as runs complete.
+// E_ref is model.modulus. Every study uses the config's model, load, time grid, data
+// truth, weights, inner solver, pre-filter and outer loop; the measurements of one
+// (SNR, seed) are the truth plus AddMeasurementNoise(snr, seed), then the pre-filter.
+// Runs are spread over `threads` threads (0: every core), each run on one thread, and
+// stored by index: the numbers do not depend on the number of threads. Progress lines
+// go to StudyProgressLogger().
 #pragma once
 
 #include <spdlog/logger.h>
@@ -107,7 +95,8 @@ struct StudyOptions {
   bool IsValid(std::string* error) const;
 };
 
-// Whether `kind` runs the study `part` (kAll runs every one).
+// Whether `kind` runs the study `part`: kAll runs robustness, relaxation and cost
+// curves, not damage or comparator, which run only when asked for by name.
 bool StudySelected(StudyKind kind, StudyKind part);
 
 // ---------------------------------------------------------------------------
