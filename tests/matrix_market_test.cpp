@@ -230,6 +230,32 @@ TEST(MatrixMarketTest, DuplicatesAreSummedOnRequest) {
   EXPECT_EQ(a.nonZeros(), 2);
 }
 
+// Found by fuzz/matrix_market_fuzzer (its seed duplicates.mtx): two finite duplicates
+// whose sum overflows gave an accepted matrix (and vector) holding inf.
+TEST(MatrixMarketTest, DuplicatesWhoseSumIsNotFiniteAreRefused) {
+  MatrixMarketReadOptions options;
+  options.sum_duplicates = true;
+  const std::string text =
+      "%%MatrixMarket matrix coordinate real general\n1 3 3\n1 1 1e308\n1 2 4\n% a comment\n"
+      "1 1 1e308\n";
+  const std::string expected =
+      "k.mtx:6: duplicate entry (1, 1): its sum with the same entry on earlier lines is not "
+      "finite (expected duplicates that sum to a finite value)";
+  EXPECT_EQ(MatrixError(text, options), expected);
+  std::istringstream stream(text);
+  try {
+    ParseMatrixMarketVector(stream, "k.mtx", options);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_EQ(error.what(), expected);
+  }
+  EXPECT_NE(MatrixError("%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n2 1 -1e308\n"
+                        "1 2 -1e308\n",
+                        options)
+                .find("k.mtx:4: duplicate entry (2, 1) or its mirror: its sum"),
+            std::string::npos);
+}
+
 TEST(MatrixMarketTest, AVectorFileMustHoldOneColumnOrOneRow) {
   EXPECT_NE(VectorError("%%MatrixMarket matrix array real general\n2 2\n1\n2\n3\n4\n")
                 .find("f.mtx:2: expected a vector (one column or one row), the size line gives "

@@ -311,6 +311,14 @@ void MergeDuplicates(const std::string& name, bool symmetric, bool sum_duplicate
                            (symmetric ? "; a symmetric file stores one triangle" : "") + ")");
         }
         previous.value += entry.value;
+        if (!std::isfinite(previous.value)) {
+          const Entry& later = previous.line > entry.line ? previous : entry;
+          throw InputError(name + ":" + std::to_string(later.line) + ": duplicate entry (" +
+                           std::to_string(entry.row + 1) + ", " + std::to_string(entry.column + 1) +
+                           ")" + (symmetric && entry.row != entry.column ? " or its mirror" : "") +
+                           ": its sum with the same entry on earlier lines is not finite "
+                           "(expected duplicates that sum to a finite value)");
+        }
         continue;
       }
     }

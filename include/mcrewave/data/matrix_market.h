@@ -21,7 +21,8 @@
 // refused by default, naming both lines: an assembled matrix has none, and a
 // duplicate usually means a file written twice or both triangles of a symmetric
 // matrix. MatrixMarketReadOptions::sum_duplicates sums them instead (the convention
-// of scipy's coo_matrix.tocsr, for unassembled element contributions).
+// of scipy's coo_matrix.tocsr, for unassembled element contributions); a sum that
+// overflows to infinity is refused like a value that is not finite.
 //
 // Rows and columns are limited to 1e8 (a bound on what a mistyped size line makes the
 // reader allocate). Every error is an InputError "FILE:LINE: what was found, what was
