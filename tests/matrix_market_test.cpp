@@ -290,6 +290,14 @@ TEST(MatrixMarketTest, AMissingFileIsNamed) {
     EXPECT_NE(std::string(error.what()).find("cannot read Matrix Market file /nonexistent/k.mtx"),
               std::string::npos);
   }
+  // A directory opens, and reads as an empty file ("empty file: expected the banner").
+  try {
+    ReadMatrixMarketVector(::testing::TempDir());
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "cannot read Matrix Market file " + ::testing::TempDir() + ": it is a directory");
+  }
 }
 
 }  // namespace

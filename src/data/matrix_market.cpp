@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -379,6 +380,10 @@ SparseMatrix ToSparse(const std::string& name, const MatrixMarketReadOptions& op
 }
 
 std::ifstream OpenForReading(const std::string& path) {
+  std::error_code status_error;
+  if (std::filesystem::is_directory(path, status_error)) {  // it opens, and reads as empty
+    throw InputError("cannot read Matrix Market file " + path + ": it is a directory");
+  }
   std::ifstream file(path);
   if (!file) {
     throw InputError("cannot read Matrix Market file " + path + ": " + std::strerror(errno));
