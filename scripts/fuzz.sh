@@ -12,7 +12,8 @@ seconds="${2:-30}"
 export ASAN_OPTIONS="${ASAN_OPTIONS:-exitcode=86}"
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1:exitcode=87}"
 mkdir -p "$build_dir/fuzz_artifacts"
-for target in config:config_fuzzer csv:measurement_csv_fuzzer; do
+for target in config:config_fuzzer csv:measurement_csv_fuzzer \
+    matrix_market:matrix_market_fuzzer manifest:model_manifest_fuzzer; do
   corpus="${target%%:*}"
   binary="$build_dir/fuzz/${target#*:}"
   work="$build_dir/fuzz_corpus/$corpus"

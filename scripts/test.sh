@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Set up, build, and run the whole test suite with ctest; then build it again
 # with AddressSanitizer + UndefinedBehaviorSanitizer (clang, into build-sanitize/
-# or $MCREWAVE_SANITIZE_BUILD_DIR), run it there, and fuzz both parsers for
-# $MCREWAVE_FUZZ_SECONDS (default 15) seconds each (fuzz/README.md).
+# or $MCREWAVE_SANITIZE_BUILD_DIR), run it there, and fuzz each of the four readers for
+# $MCREWAVE_FUZZ_SECONDS (default 15) seconds (fuzz/README.md).
 # The benchmarks are compiled in the first build (so that bench/ cannot break
 # unnoticed) but not run (scripts/main.sh and the study scripts run them); the
 # sanitizer build leaves them out, as no test runs them. The sanitizer build is

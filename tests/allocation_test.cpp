@@ -1,7 +1,8 @@
 // No heap allocation in the time loops: once initialised, ThetaIntegrator's steps
 // and sweeps and McreProblem's sweeps (outputs preallocated) neither allocate nor
 // free memory; the least-squares zone objective's time loop neither (its heap calls
-// do not grow with the number of steps).
+// do not grow with the number of steps); the Matrix Market reader allocates for the
+// entries a file holds, not for what its size line declares.
 //
 // Allocations are counted by replacing the C allocator of this test binary (malloc,
 // calloc, realloc, free: glibc's documented way of replacing malloc) with
@@ -14,12 +15,15 @@
 // brings its own allocator, nothing is replaced and these tests are skipped.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdlib>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "mcrewave/data/matrix_market.h"
 #include "mcrewave/least_squares/zone_output_error_objective.h"
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
@@ -39,8 +43,16 @@ namespace {
 // Heap calls of this thread while counting_heap_calls is set. Constant-initialised
 // thread_local of the executable: reading them from malloc allocates nothing.
 thread_local bool counting_heap_calls = false;
-thread_local long allocation_count = 0;    // malloc, calloc, realloc
-thread_local long deallocation_count = 0;  // free of a non-null pointer
+thread_local long allocation_count = 0;           // malloc, calloc, realloc
+thread_local long deallocation_count = 0;         // free of a non-null pointer
+thread_local std::size_t allocated_bytes = 0;     // their sizes, summed
+thread_local std::size_t largest_allocation = 0;  // and the largest
+
+void CountAllocation(std::size_t size) {
+  ++allocation_count;
+  allocated_bytes += size;
+  largest_allocation = std::max(largest_allocation, size);
+}
 
 }  // namespace
 
@@ -52,15 +64,15 @@ void* __libc_realloc(void* pointer, std::size_t size) noexcept;
 void __libc_free(void* pointer) noexcept;
 
 void* malloc(std::size_t size) noexcept {
-  if (counting_heap_calls) ++allocation_count;
+  if (counting_heap_calls) CountAllocation(size);
   return __libc_malloc(size);
 }
 void* calloc(std::size_t count, std::size_t size) noexcept {
-  if (counting_heap_calls) ++allocation_count;
+  if (counting_heap_calls) CountAllocation(count * size);
   return __libc_calloc(count, size);
 }
 void* realloc(void* pointer, std::size_t size) noexcept {
-  if (counting_heap_calls) ++allocation_count;
+  if (counting_heap_calls) CountAllocation(size);
   return __libc_realloc(pointer, size);
 }
 void free(void* pointer) noexcept {
@@ -80,6 +92,8 @@ using testing::Weights;
 struct HeapCalls {
   long allocations = 0;
   long deallocations = 0;
+  std::size_t bytes = 0;    // allocated, summed (a realloc counts its new size)
+  std::size_t largest = 0;  // the largest allocation
 };
 
 // The heap calls `work` makes on this thread.
@@ -87,10 +101,12 @@ template <typename Work>
 HeapCalls CountHeapCalls(Work&& work) {
   allocation_count = 0;
   deallocation_count = 0;
+  allocated_bytes = 0;
+  largest_allocation = 0;
   counting_heap_calls = true;
   work();
   counting_heap_calls = false;
-  return {allocation_count, deallocation_count};
+  return {allocation_count, deallocation_count, allocated_bytes, largest_allocation};
 }
 
 // Keeps a pointer observable so that the compiler cannot elide its allocation.
@@ -118,6 +134,8 @@ TEST(AllocationCounterTest, CountsDeliberateAllocations) {
   });
   EXPECT_EQ(eigen_vector.allocations, 1);
   EXPECT_EQ(eigen_vector.deallocations, 1);
+  EXPECT_EQ(eigen_vector.bytes, 100 * sizeof(double));
+  EXPECT_EQ(eigen_vector.largest, 100 * sizeof(double));
   const HeapCalls nothing = CountHeapCalls([] { pointer_sink = nullptr; });
   EXPECT_EQ(nothing.allocations, 0);
   EXPECT_EQ(nothing.deallocations, 0);
@@ -490,6 +508,37 @@ TEST(ZoneOutputErrorAllocationTest, TheTimeLoopAllocatesNothing) {
   }
   EXPECT_EQ(calls[0].allocations, calls[1].allocations);
   EXPECT_EQ(calls[0].deallocations, calls[1].deallocations);
+}
+
+// The heap calls of parsing `text` as a Matrix Market matrix (InputError or not).
+HeapCalls MatrixMarketHeapCalls(const std::string& text) {
+  std::istringstream stream(text);
+  return CountHeapCalls([&] {
+    try {
+      pointer_sink = ParseMatrixMarketMatrix(stream, "k.mtx").outerIndexPtr();
+    } catch (const InputError&) {
+    }
+  });
+}
+
+// What a size line declares is not allocated ahead: 1e7 entries declared and one given
+// reserved 240 MB (24 bytes an entry, up to 2^26 entries: 1.6 GB for the 1e8 declared
+// of a 40-byte file), now at most 2^14 entries. A matrix of 1e7 columns allocates its
+// column starts once, 40 MB (4 bytes a column): Eigen's triplet path, which built it,
+// allocated 160 MB in all for 1 x 1e7 as for 1e7 x 1e7 (1.6 GB for 1e8 x 1e8, which
+// the size line then allowed).
+TEST(MatrixMarketAllocationTest, ASizeLineAloneAllocatesLittle) {
+  SKIP_WITHOUT_ALLOCATION_COUNTING();
+  const std::string banner = "%%MatrixMarket matrix coordinate real general\n";
+  const HeapCalls declared = MatrixMarketHeapCalls(banner + "10000000 1 10000000\n1 1 1\n");
+  EXPECT_LT(declared.largest, std::size_t{1} << 20);
+  EXPECT_LT(declared.bytes, std::size_t{2} << 20);
+  const std::size_t column_starts = (10000000 + 1) * sizeof(int);
+  for (const char* size_line : {"1 10000000 1\n1 10000000 2\n", "10000000 10000000 0\n"}) {
+    const HeapCalls wide = MatrixMarketHeapCalls(banner + size_line);
+    EXPECT_EQ(wide.largest, column_starts) << size_line;
+    EXPECT_LT(wide.bytes, column_starts + (std::size_t{1} << 20)) << size_line;
+  }
 }
 
 }  // namespace

@@ -285,6 +285,19 @@ TEST(ConfigTest, DefaultConfigYamlCommentsEveryKey) {
   EXPECT_GE(keys, 40);
 }
 
+// PrefilterMeasurements filters every channel (the end channels and the interior
+// sensors), the matrix run every load and output; the description said "the four
+// measured channels".
+TEST(ConfigTest, ThePrefilterIsDescribedAsFilteringEveryChannel) {
+  const std::string yaml = DefaultConfigYaml();
+  const std::size_t key = yaml.find("\n  enabled: true", yaml.find("\nprefilter:"));
+  ASSERT_NE(key, std::string::npos) << yaml;
+  const std::string line = yaml.substr(key + 1, yaml.find('\n', key + 1) - key - 1);
+  EXPECT_NE(line.find("the same on every channel the identification uses"), std::string::npos)
+      << line;
+  EXPECT_EQ(line.find("four"), std::string::npos) << line;
+}
+
 TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   Config config;
   config.model.length = 0.1 + 0.2;

@@ -4,7 +4,10 @@
 #include <sys/stat.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -201,6 +204,45 @@ TEST(MatrixExportTest, BadModelsGiveOneClearError) {
   });
   EXPECT_TRUE(Contains(why, "model.yaml:9: kind must be displacement or strain, got 'force'"))
       << why;
+}
+
+// A manifest naming absolute paths reads them as they are: they were glued onto the
+// manifest's folder ("cannot read Matrix Market file /data/plate//data/plate/M.mtx").
+// A relative name beside them stays relative to the manifest's folder.
+TEST(MatrixExportTest, AbsolutePathsInAManifestAreUsedAsTheyAre) {
+  const MatrixModelData data = BarMatrixModel(ThreeZoneBar(), 200e9, kSensors);
+  const std::string files = std::filesystem::absolute(MakeFolder("absolute_files")).string();
+  std::ifstream written(WriteMatrixModel(files, data));
+  std::stringstream text;
+  text << written.rdbuf();
+  // The manifest in another folder: the zones', loads' and sensors' files named by their
+  // absolute paths, the mass by a name relative to that folder (a copy of M.mtx there).
+  const std::string manifest_text = std::regex_replace(
+      text.str(), std::regex("(K_|load_|sensor_)([A-Za-z0-9_.]+\\.mtx)"), files + "/$1$2");
+  ASSERT_NE(manifest_text.find("stiffness: " + files + "/K_zone0.mtx"), std::string::npos)
+      << manifest_text;
+  ASSERT_NE(manifest_text.find("row: " + files + "/sensor_e_at_0.65.mtx"), std::string::npos)
+      << manifest_text;
+  ASSERT_NE(manifest_text.find("mass: M.mtx"), std::string::npos) << manifest_text;
+  const std::string elsewhere = MakeFolder("absolute_manifest");
+  std::filesystem::copy_file(files + "/M.mtx", elsewhere + "/M.mtx",
+                             std::filesystem::copy_options::overwrite_existing);
+  WriteText(elsewhere, "model.yaml", manifest_text);
+
+  const MatrixModelData back = ReadMatrixModel(elsewhere + "/model.yaml");
+  EXPECT_EQ(MaxDifference(back.mass, data.mass), 0.0);
+  ASSERT_EQ(back.zones.size(), data.zones.size());
+  for (std::size_t z = 0; z < data.zones.size(); ++z) {
+    EXPECT_EQ(MaxDifference(back.zones[z].stiffness, data.zones[z].stiffness), 0.0) << z;
+  }
+  ASSERT_EQ(back.loads.size(), data.loads.size());
+  for (std::size_t i = 0; i < data.loads.size(); ++i) {
+    EXPECT_EQ(back.loads[i].vector, data.loads[i].vector) << i;
+  }
+  ASSERT_EQ(back.sensors.size(), data.sensors.size());
+  for (std::size_t i = 0; i < data.sensors.size(); ++i) {
+    EXPECT_EQ(MaxDifference(back.sensors[i].row, data.sensors[i].row), 0.0) << i;
+  }
 }
 
 }  // namespace

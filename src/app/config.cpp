@@ -598,7 +598,8 @@ const std::vector<Key>& KeyTable() {
               "search functional pinned: mcre:'s e^2 is refined within E_search (1 -+ this), "
               "in (0, 0.5]"),
       MakeKey("prefilter.enabled", &Config::prefilter, &PrefilterOptions::enabled, Boolean(), "",
-              "zero-phase Butterworth low-pass of the four measured channels"),
+              "zero-phase Butterworth low-pass, the same on every channel the identification "
+              "uses (loads, displacements, strains)"),
       MakeKey("prefilter.cutoff_frequency", &Config::prefilter, &PrefilterOptions::cutoff_frequency,
               Number(), "Hz", "cut-off of the pre-filter; 0: derived from the measured load"),
       MakeKey("prefilter.order", &Config::prefilter, &PrefilterOptions::order,

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -15,6 +16,9 @@
 
 namespace mcrewave {
 namespace {
+
+// The most values or entries reserved ahead from a size line (a few hundred kB).
+constexpr long long kReserveLimit = 1LL << 14;
 
 enum class Format { kCoordinate, kArray };
 enum class Field { kReal, kInteger, kPattern };
@@ -197,11 +201,13 @@ ParsedFile ParseFile(std::istream& text, const std::string& name) {
                   " is not a non-negative integer");
     }
   }
-  // At most 1e8 rows and columns: beyond any structure mcrewave can integrate, and a
-  // bound on what a mistyped size line makes the reader allocate.
-  constexpr long long kMaxDimension = 100000000LL;
+  // At most 1e7 rows and columns: ten times the largest model of the benchmarks (1e6
+  // dofs, docs/matrix_models.md), and a bound on what a mistyped size line makes the
+  // reader allocate before the entries: a matrix's column starts (4 bytes a column) or
+  // a vector (8 bytes an entry), 80 MB at most.
+  constexpr long long kMaxDimension = 10000000LL;
   if (sizes[0] < 1 || sizes[1] < 1 || sizes[0] > kMaxDimension || sizes[1] > kMaxDimension) {
-    reader.Fail("size line: rows and columns must lie in [1, 1e8], got " +
+    reader.Fail("size line: rows and columns must lie in [1, 1e7], got " +
                 std::to_string(sizes[0]) + " x " + std::to_string(sizes[1]));
   }
   file.rows = static_cast<long>(sizes[0]);
@@ -216,7 +222,7 @@ ParsedFile ParseFile(std::istream& text, const std::string& name) {
     if (count > 500000000LL) {
       reader.Fail("array of " + std::to_string(count) + " values: too large for a dense file");
     }
-    file.dense.reserve(static_cast<std::size_t>(std::min<long long>(count, 1LL << 20)));
+    file.dense.reserve(static_cast<std::size_t>(std::min<long long>(count, kReserveLimit)));
     while (reader.NextData(&line)) {
       if (static_cast<long long>(file.dense.size()) == count) {
         reader.Fail("value beyond the " + std::to_string(count) + " (" + std::to_string(file.rows) +
@@ -246,7 +252,9 @@ ParsedFile ParseFile(std::istream& text, const std::string& name) {
                 std::to_string(file.columns) + (file.symmetric ? " symmetric" : "") +
                 " matrix holds");
   }
-  file.entries.reserve(static_cast<std::size_t>(std::min<long long>(declared, 1LL << 26)));
+  // Room for what the size line declares, up to kReserveLimit: beyond, the entries
+  // grow with what the file holds, not with what a mistyped size line claims.
+  file.entries.reserve(static_cast<std::size_t>(std::min<long long>(declared, kReserveLimit)));
   const int entry_tokens = field == Field::kPattern ? 2 : 3;
   const std::string entry_form = field == Field::kPattern ? "'row column'" : "'row column value'";
   while (reader.NextData(&line)) {
@@ -311,6 +319,14 @@ void MergeDuplicates(const std::string& name, bool symmetric, bool sum_duplicate
                            (symmetric ? "; a symmetric file stores one triangle" : "") + ")");
         }
         previous.value += entry.value;
+        if (!std::isfinite(previous.value)) {
+          const Entry& later = previous.line > entry.line ? previous : entry;
+          throw InputError(name + ":" + std::to_string(later.line) + ": duplicate entry (" +
+                           std::to_string(entry.row + 1) + ", " + std::to_string(entry.column + 1) +
+                           ")" + (symmetric && entry.row != entry.column ? " or its mirror" : "") +
+                           ": its sum with the same entry on earlier lines is not finite "
+                           "(expected duplicates that sum to a finite value)");
+        }
         continue;
       }
     }
@@ -319,39 +335,55 @@ void MergeDuplicates(const std::string& name, bool symmetric, bool sum_duplicate
   entries->resize(kept);
 }
 
-SparseMatrix ToSparse(const std::string& name, const MatrixMarketReadOptions& options,
-                      ParsedFile* file) {
-  const int rows = static_cast<int>(file->rows), columns = static_cast<int>(file->columns);
-  SparseMatrix matrix(rows, columns);
-  if (file->format == Format::kArray) {
-    std::vector<Eigen::Triplet<double>> triplets;
-    for (long j = 0; j < file->columns; ++j) {
-      for (long i = 0; i < file->rows; ++i) {
-        const double value = file->dense[static_cast<std::size_t>(j * file->rows + i)];
-        if (value != 0.0) triplets.emplace_back(static_cast<int>(i), static_cast<int>(j), value);
-      }
-    }
-    matrix.setFromTriplets(triplets.begin(), triplets.end());
-    return matrix;
+// The compressed matrix of `entries`, sorted by (column, row), each position once. Built
+// directly: the only array of the matrix's size is its column starts (no triplet
+// pass, whose work and temporaries grow with both dimensions).
+SparseMatrix Compress(long rows, long columns, const std::vector<Entry>& entries) {
+  SparseMatrix matrix(static_cast<int>(rows), static_cast<int>(columns));
+  matrix.resizeNonZeros(static_cast<Eigen::Index>(entries.size()));
+  int* starts = matrix.outerIndexPtr();  // columns + 1, zero
+  for (const Entry& entry : entries) ++starts[entry.column + 1];
+  for (long j = 0; j < columns; ++j) starts[j + 1] += starts[j];
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    matrix.innerIndexPtr()[k] = entries[k].row;
+    matrix.valuePtr()[k] = entries[k].value;
   }
-  MergeDuplicates(name, file->symmetric, options.sum_duplicates, &file->entries);
-  // Column counts, then the entries in (column, row) order: already sorted for the
-  // general part; the mirrored upper triangle goes through the triplet path.
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(file->entries.size() * (file->symmetric ? 2 : 1));
-  for (const Entry& entry : file->entries) {
-    triplets.emplace_back(entry.row, entry.column, entry.value);
-    if (file->symmetric && entry.row != entry.column) {
-      triplets.emplace_back(entry.column, entry.row, entry.value);
-    }
-  }
-  std::vector<Entry>().swap(file->entries);
-  matrix.setFromTriplets(triplets.begin(), triplets.end());
-  matrix.makeCompressed();
   return matrix;
 }
 
+SparseMatrix ToSparse(const std::string& name, const MatrixMarketReadOptions& options,
+                      ParsedFile* file) {
+  std::vector<Entry>& entries = file->entries;
+  if (file->format == Format::kArray) {  // column-major: already in (column, row) order
+    for (long j = 0; j < file->columns; ++j) {
+      for (long i = 0; i < file->rows; ++i) {
+        const double value = file->dense[static_cast<std::size_t>(j * file->rows + i)];
+        if (value != 0.0) entries.push_back({static_cast<int>(i), static_cast<int>(j), value, 0});
+      }
+    }
+    std::vector<double>().swap(file->dense);
+    return Compress(file->rows, file->columns, entries);
+  }
+  MergeDuplicates(name, file->symmetric, options.sum_duplicates, &entries);
+  if (file->symmetric) {  // the mirrored upper triangle, then (column, row) order again
+    const std::size_t stored = entries.size();
+    for (std::size_t k = 0; k < stored; ++k) {
+      if (entries[k].row != entries[k].column) {
+        entries.push_back({entries[k].column, entries[k].row, entries[k].value, entries[k].line});
+      }
+    }
+    std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+      return a.column != b.column ? a.column < b.column : a.row < b.row;
+    });
+  }
+  return Compress(file->rows, file->columns, entries);
+}
+
 std::ifstream OpenForReading(const std::string& path) {
+  std::error_code status_error;
+  if (std::filesystem::is_directory(path, status_error)) {  // it opens, and reads as empty
+    throw InputError("cannot read Matrix Market file " + path + ": it is a directory");
+  }
   std::ifstream file(path);
   if (!file) {
     throw InputError("cannot read Matrix Market file " + path + ": " + std::strerror(errno));

@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <filesystem>
 #include <set>
 #include <sstream>
 #include <string>
@@ -33,6 +34,12 @@ std::string FileSafe(const std::string& name) {
 std::string Folder(const std::string& path) {
   const std::size_t slash = path.find_last_of('/');
   return slash == std::string::npos ? std::string(".") : path.substr(0, slash);
+}
+
+// A file the manifest names: an absolute path as it is, a relative one relative to
+// the manifest's folder.
+std::string ManifestFile(const std::string& folder, const std::string& name) {
+  return std::filesystem::path(name).is_absolute() ? name : folder + "/" + name;
 }
 
 std::string Where(const std::string& name, const YAML::Node& node) {
@@ -198,11 +205,11 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
                        "' (expected mass, stiffness_length, length, zones, loads, sensors)");
     }
   }
-  const std::string folder = Folder(manifest_path) + "/";
+  const std::string folder = Folder(manifest_path);
   MatrixModelData data;
   data.stiffness_length = RequiredLength(manifest_path, root, "stiffness_length");
   data.length = RequiredLength(manifest_path, root, "length");
-  const std::string mass_file = folder + RequiredString(manifest_path, root, "mass");
+  const std::string mass_file = ManifestFile(folder, RequiredString(manifest_path, root, "mass"));
   data.mass = ReadMatrixMarketMatrix(mass_file);
   Refuse(CheckSquare(data.mass, mass_file));
   Refuse(CheckSymmetric(data.mass, mass_file));
@@ -224,7 +231,8 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
     if (!names.insert(zone.name).second) {
       throw InputError(Where(manifest_path, entry) + ": zone '" + zone.name + "' given twice");
     }
-    const std::string file = folder + RequiredString(manifest_path, entry, "stiffness");
+    const std::string file =
+        ManifestFile(folder, RequiredString(manifest_path, entry, "stiffness"));
     double modulus = 0.0;
     if (!entry["nominal_modulus"] ||
         !YAML::convert<double>::decode(entry["nominal_modulus"], modulus) ||
@@ -247,7 +255,7 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
       throw InputError(Where(manifest_path, entry) + ": channel '" + load.channel +
                        "' given twice");
     }
-    const std::string file = folder + RequiredString(manifest_path, entry, "vector");
+    const std::string file = ManifestFile(folder, RequiredString(manifest_path, entry, "vector"));
     load.vector = ReadMatrixMarketVector(file);
     Refuse(CheckVectorSize(load.vector, file, n, mass_file));
     data.loads.push_back(std::move(load));
@@ -271,7 +279,7 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
       throw InputError(Where(manifest_path, entry) + ": channel '" + sensor.channel +
                        "' given twice");
     }
-    const std::string file = folder + RequiredString(manifest_path, entry, "row");
+    const std::string file = ManifestFile(folder, RequiredString(manifest_path, entry, "row"));
     SparseMatrix row = ReadMatrixMarketMatrix(file);
     Refuse(CheckSensorRow(row, sensor.channel, file, n, mass_file));
     if (row.rows() != 1) row = SparseMatrix(row.transpose());

@@ -21,11 +21,14 @@
 // refused by default, naming both lines: an assembled matrix has none, and a
 // duplicate usually means a file written twice or both triangles of a symmetric
 // matrix. MatrixMarketReadOptions::sum_duplicates sums them instead (the convention
-// of scipy's coo_matrix.tocsr, for unassembled element contributions).
+// of scipy's coo_matrix.tocsr, for unassembled element contributions); a sum that
+// overflows to infinity is refused like a value that is not finite.
 //
-// Rows and columns are limited to 1e8 (a bound on what a mistyped size line makes the
-// reader allocate). Every error is an InputError "FILE:LINE: what was found, what was
-// expected" (no line for a file that cannot be opened or ends early: "FILE: ...").
+// Rows and columns are limited to 1e7 (ten times the largest benchmarked model; a bound
+// on what a mistyped size line makes the reader allocate: a matrix's column starts or a
+// vector, 80 MB at most, the rest grows with the entries the file holds). Every error is
+// an InputError "FILE:LINE: what was found, what was expected" (no line for a file that
+// cannot be opened or ends early: "FILE: ...").
 #pragma once
 
 #include <istream>

@@ -17,8 +17,9 @@
 //     - {channel: uL, row: sensor_uL.mtx}
 //     - {channel: e@0.5, row: sensor_e_at_0.5.mtx, kind: strain}
 //
-// (file names relative to the manifest's folder). WriteBarMatrixModel exports the
-// built-in bar this way, so that the general path can be tested against it.
+// (a relative file name is relative to the manifest's folder, an absolute one is used
+// as it is). WriteBarMatrixModel exports the built-in bar this way, so that the general
+// path can be tested against it.
 #pragma once
 
 #include <string>
