@@ -48,11 +48,13 @@ thread_local long deallocation_count = 0;         // free of a non-null pointer
 thread_local std::size_t allocated_bytes = 0;     // their sizes, summed
 thread_local std::size_t largest_allocation = 0;  // and the largest
 
+#if MCREWAVE_COUNTS_ALLOCATIONS
 void CountAllocation(std::size_t size) {
   ++allocation_count;
   allocated_bytes += size;
   largest_allocation = std::max(largest_allocation, size);
 }
+#endif
 
 }  // namespace
 
