@@ -214,6 +214,7 @@ int IdentifyByLeastSquares(const mcrewave::Config& config, const mcrewave::Measu
 // structure given by matrices (app/matrix_identification_run.h).
 int IdentifyMatrixModel(const mcrewave::Config& config) {
   const mcrewave::MatrixModelData model = mcrewave::LoadMatrixModel(config);
+  mcrewave::CheckMatrixModelFieldBytes(config, model);
   const mcrewave::MatrixMeasurements data = mcrewave::LoadMatrixMeasurements(config, model);
   const mcrewave::MatrixIdentificationRun run =
       mcrewave::RunMatrixIdentification(config, model, data);

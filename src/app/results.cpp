@@ -967,6 +967,11 @@ std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& 
   yaml.Integer(1, "evaluations", run.outer.evaluations);
   yaml.Integer(1, "gradient_evaluations", run.outer.gradient_evaluations);
   yaml.Number(1, "scaled_cost", run.outer.cost, "e^2 / cost_scale at the identified moduli");
+  yaml.Line(0, "inner", "");
+  yaml.Text(1, "method", CoupledSolverTypeToString(run.inner_method),
+            config.inner.type == CoupledSolverType::kAuto
+                ? "inner.method auto: its fields fit inner.max_field_bytes (matrices do not stream)"
+                : "");
   yaml.Line(0, "prefilter", "");
   yaml.Line(1, "enabled", config.prefilter.enabled ? "true" : "false");
   yaml.Number(1, "cutoff_frequency", run.prefilter_cutoff, "[Hz] the cut-off used (0: off)");

@@ -68,7 +68,8 @@ std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
 //                       zone's nominal, identified and (synthetic data) truth modulus
 //                       and its share of the constitutive gap at the nominal and the
 //                       identified moduli, e^2 and J_rest [J s], the optimiser, the
-//                       pre-filter, the resolved config
+//                       inner solver that ran (inner.method), the pre-filter, the
+//                       resolved config
 //   zones.csv           the same per zone
 //   evaluations.csv     every evaluation: the zone moduli [Pa], e^2 / J_rest, usable,
 //                       |gradient|
