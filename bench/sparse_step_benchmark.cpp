@@ -124,7 +124,7 @@ void MeasureSweeps(const SparseMatrix& mass, const SparseMatrix& stiffness, doub
   long_data.outputs = Matrix::Zero(3, kFieldSteps + 1);
   MatrixMcreProblem long_problem(model, long_data, McreWeights(), 1.0, 0.5,
                                  Factorization::kSparse);
-  CoupledSolverOptions options;  // conjugate gradients, the default max_field_bytes
+  CoupledSolverOptions options;  // auto: stored-field CG on matrices; the default max_field_bytes
   CoupledSolution solution;
   const double field_bytes = static_cast<double>(kIterativeSolverFields) * sizeof(double) * n *
                              (kFieldSteps + 1.0);

@@ -29,13 +29,14 @@
 //   `run` reads a YAML config, gets the measurements (synthetic, or the CSV file
 //   of data.path, resampled onto the config's time grid when sampled otherwise),
 //   identifies E by minimising the MCRE cost e^2(E) with the outer optimiser of `outer:` (NLopt
-//   or Ceres) over coupled direct/retrograde solves by the method of `inner:`,
-//   then computes the cost curve around the identified E, the error map of the
-//   constitutive gap and an uncertainty figure, and writes summary.yaml, CSV files and PNG figures
-//   into the output folder (include/mcrewave/app/results.h), each file atomically and only at the
-//   end. One progress line per outer evaluation at the default level. SIGINT,
-//   SIGTERM or SIGHUP stop a run at once, but not while it writes its results:
-//   an interrupted run leaves the earlier results of its folder as they were.
+//   or Ceres) over coupled direct/retrograde solves by the method of `inner:` (auto:
+//   the stored-field CG, or the streaming CG when its fields exceed
+//   inner.max_field_bytes), then computes the cost curve around the identified E, the
+//   error map of the constitutive gap and an uncertainty figure, and writes summary.yaml,
+//   CSV files and PNG figures into the output folder (include/mcrewave/app/results.h), each
+//   file atomically and only at the end. One progress line per outer evaluation at the
+//   default level. SIGINT, SIGTERM or SIGHUP stop a run at once, but not while it writes
+//   its results: an interrupted run leaves the earlier results of its folder as they were.
 //
 //   With model.kind: matrix, `run` reads the matrices of model.manifest and identifies
 //   every zone modulus at once (include/mcrewave/app/matrix_identification_run.h),
@@ -213,6 +214,7 @@ int IdentifyByLeastSquares(const mcrewave::Config& config, const mcrewave::Measu
 // structure given by matrices (app/matrix_identification_run.h).
 int IdentifyMatrixModel(const mcrewave::Config& config) {
   const mcrewave::MatrixModelData model = mcrewave::LoadMatrixModel(config);
+  mcrewave::CheckMatrixModelFieldBytes(config, model);
   const mcrewave::MatrixMeasurements data = mcrewave::LoadMatrixMeasurements(config, model);
   const mcrewave::MatrixIdentificationRun run =
       mcrewave::RunMatrixIdentification(config, model, data);

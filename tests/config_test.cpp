@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mcrewave/core/types.h"
+#include "mcrewave/mcre/coupled_solver.h"
 
 namespace mcrewave {
 namespace {
@@ -211,6 +212,65 @@ TEST(ConfigTest, DefaultOptionsAreValid) {
   EXPECT_TRUE(config.time.IsValid(&error)) << error;
   EXPECT_TRUE(config.data.IsValid(&error)) << error;
   EXPECT_EQ(config.time.NumSteps(), 1750);
+}
+
+TEST(ConfigTest, DefaultInnerMethodIsAutoAndValid) {
+  const Config config;
+  EXPECT_EQ(config.inner.type, CoupledSolverType::kAuto);
+  std::string error;
+  EXPECT_TRUE(config.inner.IsValid(&error)) << error;
+  EXPECT_EQ(ConfigProblem(config), "");
+  const std::string yaml = DefaultConfigYaml();
+  EXPECT_NE(yaml.find("\n  method: auto "), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("| streaming_conjugate_gradient | auto)"), std::string::npos) << yaml;
+  EXPECT_EQ(ParseConfig("inner:\n  method: auto\n", "a.yaml").inner.type, CoupledSolverType::kAuto);
+}
+
+// The bar's fields are checked at load as SolveCoupled checks them: auto never refused
+// (it streams), a stored-field method refused naming the ways out.
+TEST(ConfigTest, FieldsAboveTheLimitStreamWithAutoAndAreRefusedWithStoredFieldMethods) {
+  // 1e5 elements, 1750 steps: 14008140080 bytes of fields, above the default 2^31.
+  const Config streamed = ParseConfig("", "a.yaml", {"model.elements=100000"});
+  EXPECT_EQ(streamed.inner.type, CoupledSolverType::kAuto);
+  EXPECT_EQ(ResolveCoupledSolverType(streamed.inner, 100001, 1750, true),
+            CoupledSolverType::kStreamingConjugateGradient);
+  for (const char* method : {"conjugate_gradient", "relaxation", "adaptive_relaxation"}) {
+    ExpectInputError(
+        [method] {
+          ParseConfig("", "a.yaml",
+                      {"model.elements=100000", std::string("inner.method=") + method});
+        },
+        {"--set model.elements=100000: model.elements (100000) and 1750 steps (time.window / "
+         "time.step) need 14008140080 bytes for inner.method '" +
+             std::string(method) + "'",
+         "above inner.max_field_bytes = 2147483648; use inner.method: "
+         "streaming_conjugate_gradient (or auto), which stores no space-time field, raise "
+         "inner.max_field_bytes, or use fewer elements, a shorter window or a larger step"});
+  }
+  // Raised above the fields, the stored-field CG loads; lowered below the paper's bar
+  // (14148080 bytes), auto streams there too.
+  EXPECT_NO_THROW(ParseConfig("", "a.yaml",
+                              {"model.elements=100000", "inner.method=conjugate_gradient",
+                               "inner.max_field_bytes=14008140080"}));
+  const Config small = ParseConfig("", "a.yaml", {"inner.max_field_bytes=14148079"});
+  EXPECT_EQ(ResolveCoupledSolverType(small.inner, 101, 1750, true),
+            CoupledSolverType::kStreamingConjugateGradient);
+  EXPECT_EQ(ResolveCoupledSolverType(Config().inner, 101, 1750, true),
+            CoupledSolverType::kConjugateGradient);
+}
+
+TEST(ConfigTest, AMatrixModelTakesAutoAndIsToldOfItWhenItAsksForABarSolver) {
+  const std::string matrix = "model:\n  kind: matrix\n  manifest: m.yaml\n";
+  EXPECT_EQ(ParseConfig(matrix, "a.yaml").inner.type, CoupledSolverType::kAuto);
+  EXPECT_EQ(ParseConfig(matrix + "inner:\n  method: conjugate_gradient\n", "a.yaml").inner.type,
+            CoupledSolverType::kConjugateGradient);
+  ExpectInputError(
+      [&matrix] {
+        ParseConfig(matrix + "inner:\n  method: streaming_conjugate_gradient\n", "a.yaml");
+      },
+      {"a.yaml:5: inner.method 'streaming_conjugate_gradient' solves the bar only; with "
+       "model.kind 'matrix' use auto, conjugate_gradient, relaxation, adaptive_relaxation or "
+       "all_at_once"});
 }
 
 TEST(ConfigTest, DefaultConfigYamlParsesToTheDefaultConfig) {

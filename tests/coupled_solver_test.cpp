@@ -158,14 +158,107 @@ TEST(IterativeSolverTest, RefusesAboveTheFieldLimitWithTheBytesItWouldNeed) {
   EXPECT_FALSE(HoldsIterativeSolverFields(CoupledSolverType::kRiccati));
 }
 
+TEST(IterativeSolverTest, ARefusalForTheFieldsNamesTheStreamingSolverAndTheLimit) {
+  ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
+  CoupledSolverOptions options = Options(CoupledSolverType::kConjugateGradient, 1e-8);
+  options.max_field_bytes = 44879;  // one byte below the 10 fields of 11 x 51 doubles
+  const long sweeps = bundle.problem.sweep_count();
+  const Solved refused = Solve(options, &bundle.problem);
+  const std::string& message = refused.summary.message;
+  EXPECT_EQ(refused.summary.termination, TerminationType::kFailure);
+  EXPECT_EQ(bundle.problem.sweep_count(), sweeps) << message;  // refused before any work
+  EXPECT_EQ(message.rfind("conjugate_gradient needs 44880 bytes", 0), 0u) << message;
+  // The ways out: the streaming solver (or auto, which takes it), the limit, the grid.
+  EXPECT_NE(message.find("use inner.method: streaming_conjugate_gradient (or auto), which "
+                         "stores no space-time field, raise inner.max_field_bytes, or use "
+                         "fewer elements or a shorter window"),
+            std::string::npos)
+      << message;
+}
+
+TEST(AutoSolverTest, TheDefaultIsAutoAndValid) {
+  const CoupledSolverOptions defaults;
+  EXPECT_EQ(defaults.type, CoupledSolverType::kAuto);
+  std::string why;
+  EXPECT_TRUE(defaults.IsValid(&why)) << why;
+  CoupledSolverType parsed = CoupledSolverType::kRelaxation;
+  ASSERT_TRUE(StringToCoupledSolverType("auto", &parsed));
+  EXPECT_EQ(parsed, CoupledSolverType::kAuto);
+  EXPECT_STREQ(CoupledSolverTypeToString(CoupledSolverType::kAuto), "auto");
+}
+
+TEST(AutoSolverTest, ResolvesToStoredFieldsWhenTheyFitAndToStreamingWhenTheyDoNot) {
+  // 11 nodes, 50 steps: 44880 bytes of fields.
+  CoupledSolverOptions options;
+  options.max_field_bytes = 44880;
+  EXPECT_EQ(ResolveCoupledSolverType(options, 11, 50, true), CoupledSolverType::kConjugateGradient);
+  options.max_field_bytes = 44879;
+  EXPECT_EQ(ResolveCoupledSolverType(options, 11, 50, true),
+            CoupledSolverType::kStreamingConjugateGradient);
+  // Without the streaming solver (a structure given by matrices): stored fields, which
+  // SolveCoupled then refuses.
+  EXPECT_EQ(ResolveCoupledSolverType(options, 11, 50, false),
+            CoupledSolverType::kConjugateGradient);
+  // At the defaults: the paper's bar (101 nodes, 1750 steps: 14 MB) keeps stored fields;
+  // 1e5 elements (14 GB) stream.
+  EXPECT_EQ(ResolveCoupledSolverType(CoupledSolverOptions(), 101, 1750, true),
+            CoupledSolverType::kConjugateGradient);
+  EXPECT_EQ(ResolveCoupledSolverType(CoupledSolverOptions(), 100001, 1750, true),
+            CoupledSolverType::kStreamingConjugateGradient);
+  // A method named is the method used, fields or not.
+  for (const CoupledSolverType type :
+       {CoupledSolverType::kConjugateGradient, CoupledSolverType::kRelaxation,
+        CoupledSolverType::kAllAtOnce, CoupledSolverType::kStreamingConjugateGradient}) {
+    options.type = type;
+    EXPECT_EQ(ResolveCoupledSolverType(options, 11, 50, true), type);
+    EXPECT_EQ(ResolveCoupledSolverType(options, 11, 50, false), type);
+    EXPECT_EQ(CoupledSolverName(type, type), CoupledSolverTypeToString(type));
+  }
+  EXPECT_EQ(CoupledSolverName(CoupledSolverType::kAuto, CoupledSolverType::kConjugateGradient),
+            "auto (conjugate_gradient)");
+}
+
+TEST(AutoSolverTest, SolvesAsTheMethodItResolvesToAndReportsThatMethod) {
+  ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(0.01, 1.0));
+  McreProblem& problem = bundle.problem;
+  problem.SetModulus(0.95 * kReferenceModulus);
+  const Solved stored = Solve(Options(CoupledSolverType::kConjugateGradient, 1e-10), &problem);
+  const Solved streamed =
+      Solve(Options(CoupledSolverType::kStreamingConjugateGradient, 1e-10), &problem);
+  ASSERT_TRUE(stored.summary.IsSolutionUsable()) << stored.summary.message;
+  ASSERT_TRUE(streamed.summary.IsSolutionUsable()) << streamed.summary.message;
+  // The fields fit: the stored-field CG, bit for bit.
+  CoupledSolverOptions options = Options(CoupledSolverType::kAuto, 1e-10);
+  const Solved fits = Solve(options, &problem);
+  EXPECT_EQ(fits.summary.type, CoupledSolverType::kConjugateGradient);
+  EXPECT_TRUE(fits.solution.has_fields());
+  EXPECT_EQ(fits.solution.cost, stored.solution.cost);
+  EXPECT_EQ(fits.summary.iterations, stored.summary.iterations);
+  EXPECT_EQ(fits.summary.BriefReport().rfind("conjugate_gradient: convergence", 0), 0u)
+      << fits.summary.BriefReport();
+  // One byte short: the streaming CG, bit for bit, no field stored.
+  options.max_field_bytes = 44879;
+  const Solved streams = Solve(options, &problem);
+  EXPECT_EQ(streams.summary.type, CoupledSolverType::kStreamingConjugateGradient);
+  EXPECT_FALSE(streams.solution.has_fields());
+  EXPECT_EQ(streams.solution.cost, streamed.solution.cost);
+  EXPECT_EQ(streams.summary.iterations, streamed.summary.iterations);
+  // The two solvers at the tolerance 1e-10: e^2 measured 8.9e-16 apart, de^2/dE 2.4e-11
+  // (6 iterations stored, 7 streamed).
+  EXPECT_NEAR(streams.solution.cost, stored.solution.cost, 1e-13 * stored.solution.cost);
+  EXPECT_NEAR(streams.solution.cost_gradient, stored.solution.cost_gradient,
+              1e-9 * std::abs(stored.solution.cost_gradient));
+}
+
 TEST(AllAtOnceSolverTest, RefusesAboveTheMemoryLimitWithTheBytesItWouldNeed) {
   ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
   CoupledSolverOptions options = Options(CoupledSolverType::kAllAtOnce, 1e-8);
   options.max_all_at_once_bytes = 1000;
+  const long sweeps = bundle.problem.sweep_count();
   const Solved refused = Solve(options, &bundle.problem);
   const std::string& message = refused.summary.message;
   EXPECT_EQ(refused.summary.termination, TerminationType::kFailure);
-  EXPECT_EQ(refused.summary.sweeps, 0) << message;
+  EXPECT_EQ(bundle.problem.sweep_count(), sweeps) << message;  // refused before any work
   // 21716 = the entries of the assembled matrix for n = 11 nodes, m = 50 steps
   // (counted from its triplets when the estimate was fitted).
   EXPECT_NE(message.find("the all-at-once solver would need about "), std::string::npos) << message;

@@ -86,6 +86,7 @@ TEST(MatrixIdentificationRunTest, TheBarAsMatricesIdentifiesTheBuiltInBarsModulu
   const YAML::Node summary = YAML::LoadFile(dir + "/matrices/summary.yaml");
   EXPECT_EQ(summary["zones"][0]["modulus"].as<double>(), matrix_modulus);
   EXPECT_EQ(summary["model"]["dofs"].as<int>(), 26);
+  EXPECT_EQ(summary["inner"]["method"].as<std::string>(), "conjugate_gradient");  // auto's
   EXPECT_GT(summary["cost"].as<double>(), 0.0);
   EXPECT_LT(summary["cost"].as<double>(), summary["nominal_cost"].as<double>());
   EXPECT_LT(summary["nominal_cost"].as<double>(), summary["cost_scale"].as<double>());
@@ -159,6 +160,44 @@ TEST(MatrixIdentificationRunTest, BadInputsExitWithOneLineAndWriteNothing) {
   EXPECT_EQ(study.exit_code, 2) << study.output;
   EXPECT_NE(study.output.find("model.kind: the studies run on the bar"), std::string::npos)
       << study.output;
+}
+
+// Fields above inner.max_field_bytes are refused before the data are simulated, auto
+// included (it does not stream on matrices), exit 2, naming what fits instead.
+TEST(MatrixIdentificationRunTest, FieldsAboveTheLimitAreRefusedAtLoadNamingWhatFits) {
+  const std::string dir = FreshDirectory("matrix_run_field_bytes");
+  WriteQuickBarMatrices(dir + "/bar_matrices");
+  const std::string base = dir + "/base.yaml";
+  std::ofstream(base) << "model:\n  kind: matrix\n  manifest: bar_matrices/model.yaml\n"
+                         "time:\n  window: 0.432e-3\n  step: 1.44e-6\n";
+  // 26 dofs, 300 steps: 10 fields of 26 x 301 doubles, 626080 bytes.
+  for (const char* method : {"auto", "conjugate_gradient"}) {
+    const std::string out = dir + "/out";
+    const RunResult run = RunIdentify(
+        "run " + base + " --set inner.max_field_bytes=626079 --set inner.method=" + method +
+        " -o " + out);
+    EXPECT_EQ(run.exit_code, 2) << run.output;
+    EXPECT_EQ(std::count(run.output.begin(), run.output.end(), '\n'), 1) << run.output;
+    const std::string name =
+        std::string(method) == "auto" ? "auto (conjugate_gradient)" : "conjugate_gradient";
+    EXPECT_NE(run.output.find("error: " + base + ": model.manifest " + dir +
+                              "/bar_matrices/model.yaml (26 dofs) and 300 steps (time.window / "
+                              "time.step) need 626080 bytes for inner.method '" +
+                              name + "'"),
+              std::string::npos)
+        << run.output;
+    EXPECT_NE(run.output.find("above inner.max_field_bytes = 626079; "
+                              "streaming_conjugate_gradient, which stores no space-time field, "
+                              "handles the built-in bar only: raise inner.max_field_bytes, or "
+                              "use a coarser mesh (fewer dofs), a shorter window or a larger "
+                              "time step"),
+              std::string::npos)
+        << run.output;
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+  // At the fields' bytes the check passes.
+  const Config config = LoadConfig(base, {"inner.max_field_bytes=626080"});
+  EXPECT_NO_THROW(CheckMatrixModelFieldBytes(config, LoadMatrixModel(config)));
 }
 
 // The plate example's config (configs/plate.yaml) on half its window: both zones from

@@ -128,6 +128,54 @@ TEST_F(BarThroughMatricesTest, SweepsWeightsCostAndZoneGradientsAreTheBuiltInBar
   }
 }
 
+// The streaming solver is the bar's: on the same bar given by matrices, auto keeps the
+// stored-field CG, and when its fields do not fit it is refused, naming what fits.
+TEST_F(BarThroughMatricesTest, AutoStreamsTheBarButKeepsStoredFieldsOnMatrices) {
+  McreProblem bar(*model_, data_, weights_, 200e9, 0.5);
+  MatrixMcreProblem general(matrices_, histories_, weights_, 200e9, 0.5);
+  const Vector moduli = (Vector(3) << 180e9, 200e9, 230e9).finished();
+  bar.SetModuli(moduli);
+  general.SetModuli(moduli);
+  // 31 nodes (dofs), 240 steps: 10 fields of 31 x 241 doubles, 597680 bytes.
+  ASSERT_EQ(IterativeSolverFieldBytes(31, 240), 597680.0);
+  CoupledSolution stored, automatic;
+  ASSERT_TRUE(SolveCoupled(Tight(CoupledSolverType::kConjugateGradient), &general, nullptr, &stored)
+                  .IsSolutionUsable());
+  const CoupledSolverSummary fits =
+      SolveCoupled(Tight(CoupledSolverType::kAuto), &general, nullptr, &automatic);
+  EXPECT_EQ(fits.type, CoupledSolverType::kConjugateGradient);
+  EXPECT_EQ(automatic.cost, stored.cost);
+
+  CoupledSolverOptions short_of_the_fields = Tight(CoupledSolverType::kAuto);
+  short_of_the_fields.max_field_bytes = 597679;
+  CoupledSolution streamed, refused;
+  const CoupledSolverSummary on_the_bar =
+      SolveCoupled(short_of_the_fields, &bar, nullptr, &streamed);
+  EXPECT_EQ(on_the_bar.type, CoupledSolverType::kStreamingConjugateGradient);
+  EXPECT_TRUE(on_the_bar.IsSolutionUsable()) << on_the_bar.message;
+  // The bar streamed against the matrices' stored-field CG, both to 1e-12: e^2 measured
+  // 5.0e-14 apart.
+  EXPECT_NEAR(streamed.cost, stored.cost, 2e-13 * stored.cost);
+  const long sweeps = general.sweep_count();
+  const CoupledSolverSummary on_matrices =
+      SolveCoupled(short_of_the_fields, &general, nullptr, &refused);
+  EXPECT_EQ(on_matrices.termination, TerminationType::kFailure);
+  EXPECT_EQ(general.sweep_count(), sweeps);  // refused before any work
+  EXPECT_EQ(on_matrices.message,
+            "auto (conjugate_gradient) needs 597680 bytes (10 fields of n x (m + 1) doubles, n "
+            "= 31 nodes, m = 240 steps), above the limit of 597679 bytes (inner.max_field_bytes); "
+            "streaming_conjugate_gradient, which stores no space-time field, handles the "
+            "built-in bar only: raise inner.max_field_bytes, or use a coarser mesh (fewer dofs), "
+            "a shorter window or a larger time step");
+  // Named, the streaming solver is refused on matrices, naming auto among those that work.
+  const CoupledSolverSummary named = SolveCoupled(
+      Tight(CoupledSolverType::kStreamingConjugateGradient), &general, nullptr, &refused);
+  EXPECT_NE(named.message.find("handles the built-in bar only; for a structure given by "
+                               "matrices use inner.method: auto, conjugate_gradient"),
+            std::string::npos)
+      << named.message;
+}
+
 TEST_F(BarThroughMatricesTest, TheSparsePathGivesTheSameSolution) {
   MatrixMcreProblem band(matrices_, histories_, weights_, 200e9, 0.5, Factorization::kBand);
   MatrixMcreProblem sparse(matrices_, histories_, weights_, 200e9, 0.5, Factorization::kSparse);

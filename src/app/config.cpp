@@ -489,7 +489,10 @@ const std::vector<Key>& KeyTable() {
       MakeKey("inner.method", &Config::inner, &CoupledSolverOptions::type,
               EnumByName<CoupledSolverType>(AllCoupledSolverTypes(), CoupledSolverTypeToString,
                                             StringToCoupledSolverType),
-              "", "solver of the coupled direct/retrograde problem for one E"),
+              "",
+              "solver of the coupled direct/retrograde problem for one E; auto: "
+              "conjugate_gradient when its fields fit inner.max_field_bytes, else (the bar) "
+              "streaming_conjugate_gradient, which stores none"),
       MakeKey("inner.tolerance", &Config::inner, &CoupledSolverOptions::tolerance, Number(), "",
               "stop when ||c - A W||_P / ||c||_P falls below this, in (0, 1)"),
       MakeKey("inner.max_iterations", &Config::inner, &CoupledSolverOptions::max_iterations,
@@ -512,7 +515,8 @@ const std::vector<Key>& KeyTable() {
               "all_at_once refuses when its matrix and LU factors would need more memory"),
       MakeKey("inner.max_field_bytes", &Config::inner, &CoupledSolverOptions::max_field_bytes,
               PositiveInteger<long>(), "bytes",
-              "iterative methods refuse when their fields would need more memory"),
+              "relaxation and conjugate_gradient refuse when their fields would need more "
+              "memory; auto then streams"),
       MakeKey("inner.max_dense_solver_bytes", &Config::inner,
               &CoupledSolverOptions::max_dense_solver_bytes, PositiveInteger<long>(), "bytes",
               "riccati and multiple_shooting refuse to store more"),
@@ -835,14 +839,14 @@ std::string StructureKeysProblem(const Config& config) {
     return "outer.functional must be 'mcre' with model.kind '" + kind +
            "' (least squares is the bar's comparator)";
   }
+  // auto keeps conjugate_gradient on a matrix model (ResolveCoupledSolverType).
   const CoupledSolverType method = config.inner.type;
-  if (method != CoupledSolverType::kConjugateGradient &&
+  if (method != CoupledSolverType::kAuto && method != CoupledSolverType::kConjugateGradient &&
       method != CoupledSolverType::kRelaxation &&
-      method != CoupledSolverType::kAdaptiveRelaxation &&
-      method != CoupledSolverType::kAllAtOnce) {
+      method != CoupledSolverType::kAdaptiveRelaxation && method != CoupledSolverType::kAllAtOnce) {
     return std::string("inner.method '") + CoupledSolverTypeToString(method) +
            "' solves the bar only; with model.kind '" + kind +
-           "' use conjugate_gradient, relaxation, adaptive_relaxation or all_at_once";
+           "' use auto, conjugate_gradient, relaxation, adaptive_relaxation or all_at_once";
   }
   return "";
 }
@@ -944,7 +948,8 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
       // (the synthetic truth is simulated before the first solve): the finite-element
       // truth's elements and steps (model.elements and the model's steps, each times
       // data.truth_refinement) count in int, and an iterative method's fields fit
-      // inner.max_field_bytes (SolveCoupled's check, made before any work).
+      // inner.max_field_bytes (SolveCoupled's check, made before any work; auto resolved
+      // as SolveCoupled resolves it, so it is never refused here).
       [](const Config& config, std::string* error) {
         if (config.structure.kind != ModelKind::kBar) return true;
         constexpr double kMaxTruthCount = 1e9;  // below INT_MAX = 2.1e9
@@ -965,15 +970,19 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
           return false;
         }
         const double field_bytes = IterativeSolverFieldBytes(elements + 1.0, steps);
-        if (HoldsIterativeSolverFields(config.inner.type) &&
+        const CoupledSolverType method =
+            ResolveCoupledSolverType(config.inner, elements + 1.0, steps, true);
+        if (HoldsIterativeSolverFields(method) &&
             field_bytes > static_cast<double>(config.inner.max_field_bytes)) {
           why << "model.elements (" << config.model.elements << ") and " << FormatNumber(steps)
               << " steps (time.window / time.step) need " << static_cast<long long>(field_bytes)
-              << " bytes for inner.method '" << CoupledSolverTypeToString(config.inner.type)
-              << "' (" << kIterativeSolverFields
+              << " bytes for inner.method '" << CoupledSolverTypeToString(method) << "' ("
+              << kIterativeSolverFields
               << " fields of (N + 1) x (steps + 1) doubles), above inner.max_field_bytes = "
               << config.inner.max_field_bytes
-              << "; use fewer elements, a shorter window or a larger step";
+              << "; use inner.method: streaming_conjugate_gradient (or auto), which stores no "
+                 "space-time field, raise inner.max_field_bytes, or use fewer elements, a "
+                 "shorter window or a larger step";
           *error = why.str();
           return false;
         }

@@ -14,6 +14,7 @@
 #include "mcrewave/data/noise.h"
 #include "mcrewave/data/prefilter.h"
 #include "mcrewave/data/resample.h"
+#include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/model/simulation.h"
 
 namespace mcrewave {
@@ -214,12 +215,15 @@ IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& da
   run.data = IdentificationData(config, data, &run.ends, &run.prefilter_cutoff);
 
   const BarModel model(config.model);
+  // The solver every coupled solve of this run takes (SolveCoupled resolves auto alike).
+  run.inner_method = ResolveCoupledSolverType(config.inner, model.num_nodes(), run.data.num_steps(),
+                                              /*streaming_available=*/true);
   spdlog::info(
       "identifying E with {}/{} from {:.6g} Pa in [{:.6g}, {:.6g}] Pa; inner {}; global scan on {}",
       OptimizerTypeToString(config.outer.optimizer),
       OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
       config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
-      CoupledSolverTypeToString(config.inner.type),
+      CoupledSolverName(config.inner.type, run.inner_method),
       config.outer.scan_points == 0      ? "none (outer.scan_points 0)"
       : ScansTheSearchFunctional(config) ? "the pinned search functional (search:)"
                                          : "mcre:'s e^2");

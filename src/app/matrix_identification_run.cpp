@@ -12,6 +12,7 @@
 
 #include "mcrewave/data/prefilter.h"
 #include "mcrewave/data/resample.h"
+#include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/matrix_zone_objective.h"
 
 namespace mcrewave {
@@ -239,6 +240,27 @@ MatrixModelData LoadMatrixModel(const Config& config) {
   return model;
 }
 
+void CheckMatrixModelFieldBytes(const Config& config, const MatrixModelData& model) {
+  const double dofs = model.dofs();
+  const double steps = config.time.NumSteps();
+  const CoupledSolverType method =
+      ResolveCoupledSolverType(config.inner, dofs, steps, /*streaming_available=*/false);
+  const double bytes = IterativeSolverFieldBytes(dofs, steps);
+  if (!HoldsIterativeSolverFields(method) ||
+      bytes <= static_cast<double>(config.inner.max_field_bytes)) {
+    return;
+  }
+  throw InputError(fmt::format(
+      "{}: model.manifest {} ({} dofs) and {:g} steps (time.window / time.step) need {} bytes "
+      "for inner.method '{}' ({} fields of dofs x (steps + 1) doubles), above "
+      "inner.max_field_bytes = {}; streaming_conjugate_gradient, which stores no space-time "
+      "field, handles the built-in bar only: raise inner.max_field_bytes, or use a coarser "
+      "mesh (fewer dofs), a shorter window or a larger time step",
+      ConfigName(config), config.structure.manifest, model.dofs(), steps,
+      static_cast<long long>(bytes), CoupledSolverName(config.inner.type, method),
+      kIterativeSolverFields, config.inner.max_field_bytes));
+}
+
 MatrixMeasurements LoadMatrixMeasurements(const Config& config, const MatrixModelData& model) {
   MatrixMeasurements measurements;
   if (config.data.source == DataSource::kCsv) {
@@ -322,6 +344,8 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config,
   run.manifest = config.structure.manifest;
   run.dofs = model.dofs();
   run.steps = measurements.histories.num_steps();
+  run.inner_method = ResolveCoupledSolverType(config.inner, run.dofs, run.steps,
+                                              /*streaming_available=*/false);
   run.time_step = measurements.histories.time_step;
   run.data_source = measurements.source;
   run.truth_moduli = measurements.truth_moduli;
@@ -366,9 +390,10 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config,
     lower[z] = std::log(config.outer.lower_bound / run.nominal_moduli[static_cast<int>(z)]);
     upper[z] = std::log(config.outer.upper_bound / run.nominal_moduli[static_cast<int>(z)]);
   }
-  spdlog::info("matrix model {}: {} dofs, {} zones, {} loads, {} sensors, {} steps of {:.4g} s",
-               run.manifest, run.dofs, zones, model.loads.size(), model.sensors.size(), run.steps,
-               run.time_step);
+  spdlog::info(
+      "matrix model {}: {} dofs, {} zones, {} loads, {} sensors, {} steps of {:.4g} s; inner {}",
+      run.manifest, run.dofs, zones, model.loads.size(), model.sensors.size(), run.steps,
+      run.time_step, CoupledSolverName(config.inner.type, run.inner_method));
   run.outer = MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper,
                                    std::vector<double>(zones, 0.0));
   spdlog::info("zones: {}", run.outer.BriefReport());

@@ -18,6 +18,7 @@
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/core/format.h"
 #include "mcrewave/core/version.h"
+#include "mcrewave/mcre/coupled_solver.h"
 
 namespace mcrewave {
 namespace {
@@ -293,9 +294,23 @@ std::string EndsScript(const IdentificationRun& run, const std::string& folder) 
   return script.str();
 }
 
+// summary.yaml's comment on inner.method: why auto chose the solver that ran ("" when
+// the config named it).
+std::string InnerMethodComment(const IdentificationRun& run) {
+  if (run.config.inner.type != CoupledSolverType::kAuto) return "";
+  const double bytes =
+      IterativeSolverFieldBytes(run.config.model.elements + 1.0, run.data.num_steps());
+  std::ostringstream comment;
+  comment << "inner.method auto: the stored fields, " << static_cast<long long>(bytes) << " bytes, "
+          << (run.inner_method == CoupledSolverType::kStreamingConjugateGradient ? "exceed" : "fit")
+          << " inner.max_field_bytes";
+  return comment.str();
+}
+
 std::string InnerResidualScript(const IdentificationRun& run, const std::string& folder) {
   // The method's name with spaces for underscores (gnuplot's subscripts).
-  std::string method = CoupledSolverTypeToString(run.config.inner.type);
+  std::string method = CoupledSolverTypeToString(run.inner_method);
+  if (run.config.inner.type == CoupledSolverType::kAuto) method = "auto: " + method;
   std::replace(method.begin(), method.end(), '_', ' ');
   std::ostringstream script;
   script << GnuplotPngTerminal() << "set title 'Inner solver (" << method
@@ -576,7 +591,7 @@ std::string SummaryYaml(const IdentificationRun& run) {
   }
   const CoupledSolverSummary& best_inner = run.evaluations[run.best_index].inner;
   yaml.Line(0, "inner", "");
-  yaml.Text(1, "method", CoupledSolverTypeToString(run.config.inner.type));
+  yaml.Text(1, "method", CoupledSolverTypeToString(run.inner_method), InnerMethodComment(run));
   yaml.Integer(1, "solves", static_cast<long>(run.evaluations.size()),
                "coupled solves of the optimiser");
   yaml.Integer(1, "iterations", inner_iterations, "sweep pairs over those solves");
@@ -952,6 +967,11 @@ std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& 
   yaml.Integer(1, "evaluations", run.outer.evaluations);
   yaml.Integer(1, "gradient_evaluations", run.outer.gradient_evaluations);
   yaml.Number(1, "scaled_cost", run.outer.cost, "e^2 / cost_scale at the identified moduli");
+  yaml.Line(0, "inner", "");
+  yaml.Text(1, "method", CoupledSolverTypeToString(run.inner_method),
+            config.inner.type == CoupledSolverType::kAuto
+                ? "inner.method auto: its fields fit inner.max_field_bytes (matrices do not stream)"
+                : "");
   yaml.Line(0, "prefilter", "");
   yaml.Line(1, "enabled", config.prefilter.enabled ? "true" : "false");
   yaml.Number(1, "cutoff_frequency", run.prefilter_cutoff, "[Hz] the cut-off used (0: off)");

@@ -92,6 +92,22 @@ bool HoldsIterativeSolverFields(CoupledSolverType type) {
          type == CoupledSolverType::kConjugateGradient;
 }
 
+CoupledSolverType ResolveCoupledSolverType(const CoupledSolverOptions& options, double num_nodes,
+                                           double num_steps, bool streaming_available) {
+  if (options.type != CoupledSolverType::kAuto) return options.type;
+  const bool fits = IterativeSolverFieldBytes(num_nodes, num_steps) <=
+                    static_cast<double>(options.max_field_bytes);
+  return fits || !streaming_available ? CoupledSolverType::kConjugateGradient
+                                      : CoupledSolverType::kStreamingConjugateGradient;
+}
+
+std::string CoupledSolverName(CoupledSolverType requested, CoupledSolverType used) {
+  if (requested == CoupledSolverType::kAuto && used != CoupledSolverType::kAuto) {
+    return std::string("auto (") + CoupledSolverTypeToString(used) + ")";
+  }
+  return CoupledSolverTypeToString(used);
+}
+
 bool NeedsThePapersDataTerm(CoupledSolverType type) {
   return type == CoupledSolverType::kRiccati || type == CoupledSolverType::kSingleShooting ||
          type == CoupledSolverType::kMultipleShooting;
@@ -109,64 +125,81 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
     summary.message = "invalid options: " + why;
     return summary;
   }
-  const bool iterative = HoldsIterativeSolverFields(options.type);
+  // Riccati, shooting and the streaming solver are written for the built-in bar.
+  McreProblem* bar = dynamic_cast<McreProblem*>(problem);
+  const CoupledSolverType type =
+      ResolveCoupledSolverType(options, problem->num_nodes(), problem->num_steps(), bar != nullptr);
+  summary.type = type;
+  const std::string name = CoupledSolverName(options.type, type);
   const double field_bytes = IterativeSolverFieldBytes(problem->num_nodes(), problem->num_steps());
-  if (iterative && field_bytes > static_cast<double>(options.max_field_bytes)) {
+  if (HoldsIterativeSolverFields(type) &&
+      field_bytes > static_cast<double>(options.max_field_bytes)) {
     std::ostringstream refusal;
-    refusal << CoupledSolverTypeToString(options.type) << " needs "
-            << static_cast<long long>(field_bytes) << " bytes (" << kIterativeSolverFields
+    refusal << name << " needs " << static_cast<long long>(field_bytes) << " bytes ("
+            << kIterativeSolverFields
             << " fields of n x (m + 1) doubles, n = " << problem->num_nodes()
             << " nodes, m = " << problem->num_steps() << " steps), above the limit of "
-            << options.max_field_bytes
-            << " bytes (inner.max_field_bytes); use fewer elements or a shorter window";
+            << options.max_field_bytes << " bytes (inner.max_field_bytes); ";
+    if (bar != nullptr) {
+      refusal << "use inner.method: streaming_conjugate_gradient (or auto), which stores no "
+                 "space-time field, raise inner.max_field_bytes, or use fewer elements or a "
+                 "shorter window";
+    } else {
+      refusal << "streaming_conjugate_gradient, which stores no space-time field, handles the "
+                 "built-in bar only: raise inner.max_field_bytes, or use a coarser mesh (fewer "
+                 "dofs), a shorter window or a larger time step";
+    }
     summary.message = refusal.str();
     return summary;
   }
-  const bool comparator = NeedsThePapersDataTerm(options.type);
-  // Riccati, shooting and the streaming solver are written for the built-in bar.
-  McreProblem* bar = dynamic_cast<McreProblem*>(problem);
-  if ((comparator || options.type == CoupledSolverType::kStreamingConjugateGradient) &&
-      bar == nullptr) {
-    summary.message = std::string(CoupledSolverTypeToString(options.type)) +
+  const bool comparator = NeedsThePapersDataTerm(type);
+  if ((comparator || type == CoupledSolverType::kStreamingConjugateGradient) && bar == nullptr) {
+    summary.message = std::string(CoupledSolverTypeToString(type)) +
                       " handles the built-in bar only; for a structure given by matrices use "
-                      "inner.method: conjugate_gradient, adaptive_relaxation, relaxation or "
-                      "all_at_once";
+                      "inner.method: auto, conjugate_gradient, adaptive_relaxation, relaxation "
+                      "or all_at_once";
     return summary;
   }
   if (comparator && !bar->observes_ends_only()) {
     // Their transfer operators are written for H = B (the two end displacements).
-    summary.message = std::string(CoupledSolverTypeToString(options.type)) +
+    summary.message = std::string(CoupledSolverTypeToString(type)) +
                       " handles the paper's end sensors only (u0 and uL, no interior sensor, "
                       "mcre.clamp: measured); with interior sensors, an end channel left out or "
                       "a trusted or pinned clamp use inner.method: "
                       "conjugate_gradient, adaptive_relaxation, relaxation or all_at_once";
     return summary;
   }
-  switch (options.type) {
+  // The solvers below see the resolved method.
+  CoupledSolverOptions resolved = options;
+  resolved.type = type;
+  switch (type) {
     case CoupledSolverType::kAllAtOnce:
-      internal::SolveAllAtOnce(options, problem, solution, &summary);
+      internal::SolveAllAtOnce(resolved, problem, solution, &summary);
       break;
     case CoupledSolverType::kRelaxation:
     case CoupledSolverType::kAdaptiveRelaxation:
-      internal::SolveByRelaxation(options, problem, initial_guess, solution, &summary);
+      internal::SolveByRelaxation(resolved, problem, initial_guess, solution, &summary);
       break;
     case CoupledSolverType::kConjugateGradient:
-      internal::SolveByConjugateGradient(options, problem, initial_guess, solution, &summary);
+      internal::SolveByConjugateGradient(resolved, problem, initial_guess, solution, &summary);
       break;
     case CoupledSolverType::kRiccati:
-      internal::SolveByRiccati(options, bar, solution, &summary);
+      internal::SolveByRiccati(resolved, bar, solution, &summary);
       break;
     case CoupledSolverType::kSingleShooting:
     case CoupledSolverType::kMultipleShooting:
-      internal::SolveByShooting(options, bar, solution, &summary);
+      internal::SolveByShooting(resolved, bar, solution, &summary);
       break;
     case CoupledSolverType::kStreamingConjugateGradient:
       // Fills the cost and the gradients itself, from its final streaming pass.
-      internal::SolveByStreamingConjugateGradient(options, bar, initial_guess, solution, &summary);
+      internal::SolveByStreamingConjugateGradient(resolved, bar, initial_guess, solution, &summary);
       break;
+    case CoupledSolverType::kAuto:
+      // ResolveCoupledSolverType never returns it.
+      summary.message = "inner.method auto was not resolved";
+      return summary;
   }
-  if (summary.IsSolutionUsable() &&
-      options.type != CoupledSolverType::kStreamingConjugateGradient) {
+  if (summary.IsSolutionUsable() && type != CoupledSolverType::kStreamingConjugateGradient) {
     solution->cost = problem->Cost(solution->displacement, solution->retrograde);
     problem->CostGradients(solution->displacement, solution->retrograde, &solution->cost_gradients);
     // One zone: de^2/dE; several: the derivative along a common change of every zone.

@@ -140,7 +140,8 @@ ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
   if (!solution.has_fields()) {
     result.message =
         "the first-order figure needs the stored fields U and W, which the streaming solver "
-        "does not keep (inner.method: conjugate_gradient gives it)";
+        "does not keep (inner.method: conjugate_gradient gives it when its fields fit "
+        "inner.max_field_bytes)";
     return result;
   }
   if (!(curvature > 0.0)) {

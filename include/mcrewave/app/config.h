@@ -21,9 +21,11 @@
 //   mcre:  w_u [1e-7], w_f [1], w_e [1e-7], w_r [1e-6], w_u0 [0.1],
 //          reference_modulus [200e9 Pa] (E0 of the weights), clamp [trusted | measured
 //          | pinned] (McreOptions, objective.h)
-//   inner: method [conjugate_gradient | all_at_once | relaxation | adaptive_relaxation
-//          | any other CoupledSolverType], tolerance [1e-8], max_iterations [5000],
-//          omega [0.5], spectrum_steps [12], spectrum_safety_factor [1.05],
+//   inner: method [auto: conjugate_gradient, or streaming_conjugate_gradient when the
+//          fields exceed max_field_bytes | conjugate_gradient | all_at_once | relaxation
+//          | adaptive_relaxation | any other CoupledSolverType], tolerance [1e-8],
+//          max_iterations [5000], omega [0.5], spectrum_steps [12],
+//          spectrum_safety_factor [1.05],
 //          divergence_factor [1e3], max_all_at_once_unknowns [1500000],
 //          max_all_at_once_bytes [2^31], max_field_bytes [2^31],
 //          max_dense_solver_bytes [2^31],

@@ -72,6 +72,9 @@ struct IdentificationRun {
   // r(U_j) (trusted). ends.csv's f0_model.
   Vector clamp_force;
 
+  // The coupled solver that ran: config.inner.type, or what auto resolved to on this
+  // bar and time grid (ResolveCoupledSolverType).
+  CoupledSolverType inner_method = CoupledSolverType::kConjugateGradient;
   IdentificationSummary outer;
   // The optimiser's evaluations, in order; evaluations[best_index] is the one
   // at the identified E, and `solution` its coupled solution.

@@ -55,6 +55,16 @@ MatrixModelData LoadMatrixModel(const Config& config);
 // have one modulus per truth zone.
 MatrixMeasurements LoadMatrixMeasurements(const Config& config, const MatrixModelData& model);
 
+// Throws InputError, naming the config, the bytes and what fits instead, when the
+// coupled solves of `identify run` on `model` would hold stored fields above
+// inner.max_field_bytes (kIterativeSolverFields fields of dofs x (steps + 1) doubles,
+// the steps the config's time grid, onto which the data are resampled). inner.method
+// auto does not stream on a matrix model (the streaming solver handles the built-in
+// bar only): it keeps conjugate_gradient and is refused alike. `identify run` calls it
+// between LoadMatrixModel and LoadMatrixMeasurements, before a synthetic truth is
+// simulated; SolveCoupled would refuse every solve with the same reason.
+void CheckMatrixModelFieldBytes(const Config& config, const MatrixModelData& model);
+
 // The outputs H U of `truth` at zone_moduli [Pa] from rest, driven by `loads` (one row
 // per load channel [N], sampled at t_j = j time_step) with the theta method: the
 // noise-free data of that structure (sensor rows, model order).
@@ -86,6 +96,9 @@ struct MatrixIdentificationRun {
   std::string manifest;  // the model's manifest path
   int dofs = 0;
   int steps = 0;
+  // The coupled solver of every solve: config.inner.type, auto resolved
+  // (conjugate_gradient on a matrix model; ResolveCoupledSolverType).
+  CoupledSolverType inner_method = CoupledSolverType::kConjugateGradient;
   double time_step = 0.0;                // h [s]
   std::string data_source;               // CSV path or "synthetic"
   double prefilter_cutoff = 0.0;         // [Hz]; 0: no pre-filter

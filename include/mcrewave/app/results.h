@@ -6,8 +6,9 @@
 //   summary.yaml        identified_modulus [Pa], reference_modulus and relative_error
 //                       (null for CSV data), cost e^2 [J s], evaluations, sweeps,
 //                       wall_time_s, the uncertainty figure, optimiser and inner-solver
-//                       totals, the weights, the cost curve's extent, the resolved
-//                       config and the version
+//                       totals (inner.method: the solver that ran, auto resolved), the
+//                       weights, the cost curve's extent, the resolved config and the
+//                       version
 //   evaluations.csv     the optimiser's evaluations: E, e^2, de^2/dE, inner solve
 //   cost_curve.csv      e^2(E) and de^2/dE around the identified E
 //   scan.csv            the global scan's cost and gradient (outer.scan_points > 0), of
@@ -67,7 +68,8 @@ std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
 //                       zone's nominal, identified and (synthetic data) truth modulus
 //                       and its share of the constitutive gap at the nominal and the
 //                       identified moduli, e^2 and J_rest [J s], the optimiser, the
-//                       pre-filter, the resolved config
+//                       inner solver that ran (inner.method), the pre-filter, the
+//                       resolved config
 //   zones.csv           the same per zone
 //   evaluations.csv     every evaluation: the zone moduli [Pa], e^2 / J_rest, usable,
 //                       |gradient|

@@ -182,8 +182,14 @@ enum class CoupledSolverType {
   // no space-time field is stored (theta = 1/2: O(n) memory; other theta: checkpoints,
   // O(n sqrt(m))).
   kStreamingConjugateGradient,
+  // Not a solver of its own: conjugate_gradient when its stored fields fit
+  // CoupledSolverOptions::max_field_bytes, streaming_conjugate_gradient when they do not
+  // (the built-in bar; a structure given by matrices keeps conjugate_gradient). Resolved
+  // by ResolveCoupledSolverType (mcre/coupled_solver.h). Last, so that the solvers keep
+  // their order in the lists of names.
+  kAuto,
 };
-inline constexpr std::array<std::pair<CoupledSolverType, const char*>, 8> kCoupledSolverTypeNames{{
+inline constexpr std::array<std::pair<CoupledSolverType, const char*>, 9> kCoupledSolverTypeNames{{
     {CoupledSolverType::kAllAtOnce, "all_at_once"},
     {CoupledSolverType::kRelaxation, "relaxation"},
     {CoupledSolverType::kAdaptiveRelaxation, "adaptive_relaxation"},
@@ -192,6 +198,7 @@ inline constexpr std::array<std::pair<CoupledSolverType, const char*>, 8> kCoupl
     {CoupledSolverType::kSingleShooting, "single_shooting"},
     {CoupledSolverType::kMultipleShooting, "multiple_shooting"},
     {CoupledSolverType::kStreamingConjugateGradient, "streaming_conjugate_gradient"},
+    {CoupledSolverType::kAuto, "auto"},
 }};
 const char* CoupledSolverTypeToString(CoupledSolverType type);
 bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type);

@@ -25,6 +25,13 @@
 //                        the shooting matrix is too ill-conditioned.
 //   multiple_shooting    the same on segments whose length follows the measured growth
 //                        rate of the recursion, joined by continuity (robust variant).
+//   streaming_conjugate_gradient
+//                        CG on the sensor traces, storing no n x (m + 1) field
+//                        (docs/streaming.md); the built-in bar only.
+//   auto (the default)   conjugate_gradient when its fields fit max_field_bytes,
+//                        streaming_conjugate_gradient when they do not
+//                        (ResolveCoupledSolverType); a structure given by matrices keeps
+//                        conjugate_gradient, refused when its fields do not fit.
 //
 // all_at_once and the last three are direct: they report the same relative
 // residual, computed afterwards from 5 sweeps, and converge when it meets the
@@ -66,7 +73,9 @@ bool HoldsIterativeSolverFields(CoupledSolverType type);
 bool NeedsThePapersDataTerm(CoupledSolverType type);
 
 struct CoupledSolverOptions {
-  CoupledSolverType type = CoupledSolverType::kConjugateGradient;
+  // inner.method; auto: conjugate_gradient or, when its fields do not fit
+  // max_field_bytes, streaming_conjugate_gradient (ResolveCoupledSolverType).
+  CoupledSolverType type = CoupledSolverType::kAuto;
   // Stopping test on ||c - A W||_P / ||c||_P (the paper used 1e-4).
   double tolerance = 1e-8;
   // Iterations (sweep pairs) allowed to the iterative solvers.
@@ -89,7 +98,7 @@ struct CoupledSolverOptions {
   long max_dense_solver_bytes = 2L << 30;
   // The iterative solvers (relaxation, adaptive_relaxation, conjugate_gradient)
   // refuse when the fields they hold at once (kIterativeSolverFields fields of
-  // n x (m + 1) doubles) would exceed this many bytes.
+  // n x (m + 1) doubles) would exceed this many bytes; auto then streams (the bar).
   long max_field_bytes = 2L << 30;
   // streaming_conjugate_gradient at theta = 1/2: when the retrograde state rebuilt by
   // the reversed recursion drifts by more than this (||omega_0 rebuilt to omega_m|| /
@@ -108,7 +117,22 @@ struct CoupledSolverOptions {
   bool IsValid(std::string* error) const;
 };
 
+// The solver that runs for `options` on a problem of `num_nodes` nodes and `num_steps`
+// steps: options.type itself, unless it is kAuto, which takes conjugate_gradient when
+// its fields (IterativeSolverFieldBytes) fit options.max_field_bytes, and
+// streaming_conjugate_gradient when they do not and `streaming_available` (the built-in
+// bar, McreProblem); without it (a structure given by matrices) conjugate_gradient,
+// which SolveCoupled then refuses. The one place where auto is resolved: SolveCoupled,
+// the config's load-time check of the bar and the reports call it.
+CoupledSolverType ResolveCoupledSolverType(const CoupledSolverOptions& options, double num_nodes,
+                                           double num_steps, bool streaming_available);
+
+// How the logs and messages name the solver `used` for inner.method `requested`:
+// "auto (conjugate_gradient)" when auto was resolved, the solver's own name otherwise.
+std::string CoupledSolverName(CoupledSolverType requested, CoupledSolverType used);
+
 struct CoupledSolverSummary {
+  // The solver that ran: options.type, or what auto resolved to.
   CoupledSolverType type = CoupledSolverType::kConjugateGradient;
   TerminationType termination = TerminationType::kFailure;
   std::string message = "not run";
@@ -166,8 +190,11 @@ struct CoupledSolution {
 };
 
 // Solves the coupled problem at the problem's current moduli: the bar (McreProblem)
-// with every solver, a structure given by matrices (MatrixMcreProblem) with the
-// iterative solvers and all_at_once (the others refuse it in the summary).
+// with every solver, a structure given by matrices (MatrixMcreProblem) with auto,
+// conjugate_gradient, the relaxations and all_at_once (the others refuse it in the
+// summary). auto is resolved first (ResolveCoupledSolverType), the summary's `type`
+// the solver that ran. A method that would hold fields above max_field_bytes is
+// refused before any work, its message naming the ways out.
 // initial_guess (nullable) is the iterative solver's unknown at the start (warm start,
 // e.g. the previous E's solution): W^(0), the problem's ZeroField() shape, for
 // relaxation and conjugate_gradient; the traces y^(0), McreProblem::ZeroTraces()
