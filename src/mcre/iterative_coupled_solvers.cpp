@@ -122,6 +122,59 @@ std::string ConvergenceMessage(const StartingPoint& start, double relative, doub
          " (c = T(0) nearly cancels: the data are close to consistent with the model)";
 }
 
+// The relaxation coefficient to start with: options.relaxation_coefficient, or for
+// the adaptive relaxation 2 / (a_min + a_max) from a Lanczos estimate of A's
+// spectrum started from `residual` (a_max, inflated by the safety factor, into
+// *spectrum_max). The spectrum and omega go into the summary too.
+double InitialRelaxationCoefficient(const CoupledSolverOptions& options, CoupledProblem* problem,
+                                    const Matrix& residual, double* spectrum_max,
+                                    CoupledSolverSummary* summary) {
+  double omega = options.relaxation_coefficient;
+  if (options.type == CoupledSolverType::kAdaptiveRelaxation) {
+    // omega = 2 / (a_min + a_max), a_max inflated by the safety factor; a >= 1 always.
+    const auto [a_min, a_max] =
+        EstimateSpectrum(problem, residual, options.spectrum_estimation_steps);
+    summary->spectrum_min = std::max(1.0, a_min);
+    *spectrum_max = options.spectrum_safety_factor * a_max;
+    summary->spectrum_max = *spectrum_max;
+    omega = 2.0 / (summary->spectrum_min + *spectrum_max);
+  }
+  summary->relaxation_coefficient = omega;
+  return omega;
+}
+
+constexpr int kMaxSafeguardRestarts = 10;
+
+// The adaptive relaxation's safeguard: raises *spectrum_max to the a that the
+// residual's growth factor reveals and sets *omega (and the summary) from it.
+// False, with the summary's divergence, after kMaxSafeguardRestarts re-estimates.
+bool ReestimateRelaxationCoefficient(const CoupledSolverOptions& options, double growth,
+                                     double* omega, double* spectrum_max,
+                                     CoupledSolverSummary* summary) {
+  if (summary->safeguard_restarts >= kMaxSafeguardRestarts) {
+    summary->termination = TerminationType::kDivergence;
+    summary->message = "the adaptive relaxation kept diverging after " +
+                       std::to_string(kMaxSafeguardRestarts) + " re-estimates of omega";
+    return false;
+  }
+  ++summary->safeguard_restarts;
+  *spectrum_max =
+      options.spectrum_safety_factor * std::max(1.2 * *spectrum_max, (1.0 + growth) / *omega);
+  summary->spectrum_max = *spectrum_max;
+  *omega = 2.0 / (summary->spectrum_min + *spectrum_max);
+  summary->relaxation_coefficient = *omega;
+  return true;
+}
+
+// The message of a relaxation whose residual grew from best to relative.
+std::string RelaxationDivergenceMessage(double best, double relative, int iteration, double omega) {
+  return "the relaxation diverges: the relative residual grew from " + ScientificString(best) +
+         " to " + ScientificString(relative) + " by iteration " + std::to_string(iteration) +
+         "; omega = " + ScientificString(omega) +
+         " is above the convergence limit 2 / (1 - lambda_min(G)): use a "
+         "smaller omega, adaptive_relaxation or conjugate_gradient";
+}
+
 }  // namespace
 
 void SolveByRelaxation(const CoupledSolverOptions& options, CoupledProblem* problem,
@@ -134,24 +187,13 @@ void SolveByRelaxation(const CoupledSolverOptions& options, CoupledProblem* prob
   const StartingPoint start = Start(problem, initial_retrograde, solution, &residual, summary);
   if (start.solved) return;
 
-  double omega = options.relaxation_coefficient;
   double spectrum_max = 0.0;
-  if (adaptive) {
-    // omega = 2 / (a_min + a_max), a_max inflated by the safety factor; a >= 1 always.
-    const auto [a_min, a_max] =
-        EstimateSpectrum(problem, residual, options.spectrum_estimation_steps);
-    summary->spectrum_min = std::max(1.0, a_min);
-    spectrum_max = options.spectrum_safety_factor * a_max;
-    summary->spectrum_max = spectrum_max;
-    omega = 2.0 / (summary->spectrum_min + spectrum_max);
-  }
-  summary->relaxation_coefficient = omega;
+  double omega = InitialRelaxationCoefficient(options, problem, residual, &spectrum_max, summary);
 
   Matrix best_retrograde = retrograde;
   double best_residual = std::numeric_limits<double>::infinity();
   double previous_residual = std::numeric_limits<double>::infinity();
   int growth_streak = 0;
-  constexpr int kMaxSafeguardRestarts = 10;
   // Growth over this many consecutive iterations, to this factor above the best
   // residual, triggers the safeguard (smaller wiggles are round-off).
   constexpr int kGrowthStreak = 3;
@@ -184,18 +226,7 @@ void SolveByRelaxation(const CoupledSolverOptions& options, CoupledProblem* prob
       // sustained growth well above round-off means a_max was underestimated. The
       // growing component has |1 - omega a| = growth, so a = (1 + growth) / omega;
       // restart from the best iterate.
-      if (summary->safeguard_restarts >= kMaxSafeguardRestarts) {
-        summary->termination = TerminationType::kDivergence;
-        summary->message = "the adaptive relaxation kept diverging after " +
-                           std::to_string(kMaxSafeguardRestarts) + " re-estimates of omega";
-        return;
-      }
-      ++summary->safeguard_restarts;
-      spectrum_max =
-          options.spectrum_safety_factor * std::max(1.2 * spectrum_max, (1.0 + growth) / omega);
-      summary->spectrum_max = spectrum_max;
-      omega = 2.0 / (summary->spectrum_min + spectrum_max);
-      summary->relaxation_coefficient = omega;
+      if (!ReestimateRelaxationCoefficient(options, growth, &omega, &spectrum_max, summary)) return;
       retrograde = best_retrograde;
       problem->FixedPointMap(retrograde, &displacement, &residual);
       residual -= retrograde;
@@ -205,12 +236,7 @@ void SolveByRelaxation(const CoupledSolverOptions& options, CoupledProblem* prob
     }
     if (relative > options.divergence_factor * best_residual) {
       summary->termination = TerminationType::kDivergence;
-      summary->message = "the relaxation diverges: the relative residual grew from " +
-                         ScientificString(best_residual) + " to " + ScientificString(relative) +
-                         " by iteration " + std::to_string(iteration) +
-                         "; omega = " + ScientificString(omega) +
-                         " is above the convergence limit 2 / (1 - lambda_min(G)): use a "
-                         "smaller omega, adaptive_relaxation or conjugate_gradient";
+      summary->message = RelaxationDivergenceMessage(best_residual, relative, iteration, omega);
       return;
     }
     if (iteration == options.max_iterations) {

@@ -59,11 +59,288 @@ double RiccatiBytes(int num_nodes, int num_steps) {
   return 8.0 * (num_steps * (2.0 * n * n + n) + kWorkingMatrices * n * n);
 }
 
+// The sweep's operators, its constant end vectors and its working matrices (those
+// counted by kWorkingMatrices), the stored gains G_k and inputs e_k, and one helper
+// per stage of the backward step k+1 -> k and of the forward pass (the formulas of
+// the top of this file; docs/riccati_shooting.md section 2).
+class RiccatiSweep {
+ public:
+  // Factorises the operators at the problem's modulus and forms the end vectors; the
+  // problem must outlive the sweep.
+  explicit RiccatiSweep(const McreProblem& problem);
+
+  // The backward sweep from P_m = 0, q_m = 0: the gains G_k and inputs e_k, k = m-1..0.
+  void Backward();
+  // The forward pass from Y_0 = 0 into displacement (columns 1..m; column 0 stays).
+  void Forward(Matrix* displacement);
+  // The operators, which count the sweep's multiply-accumulates.
+  DiscreteMcreOperators& ops() { return ops_; }
+
+ private:
+  // A_k = Phi P_{k+1} + c_{k+1} beta Psi B E_U and a_k, then E_w Phi A_k and E_w Phi a_k.
+  void Propagate(int k);
+  // C_k into coupling_; returns d_k.
+  Vector Coupling(int k);
+  // N_k and G_k = N_k^-1 C_k into gains_[k].
+  void Gain(int k);
+  // Q_k = A_k - (A_k Psi Kp) G_k into projected_.
+  void Project(int k);
+  // e_k = F~theta_k - Kp d_k into input_ and forward_inputs_.col(k).
+  void ForwardInput(int k, const Vector& coupling_offset);
+  // q_k = Q_k Psi e_k + a_k into offset_.
+  void UpdateOffset();
+  // P_k = Q_k Phi - h delta (T S^-1) Kp S^-1 B E_U into riccati_.
+  void UpdateRiccati();
+
+  DiscreteMcreOperators ops_;
+  const int n_, m_, two_n_;
+  const double h_, theta_, beta_;
+  // delta = theta^2 (1 - theta) beta h^2: the weight of U_k in W_k through omega_{k-1}.
+  const double delta_;
+  const std::array<int, 2> end_nodes_;
+  // S^-1 e_i, Kp S^-1 e_i and Psi e_i = (h^2 theta S^-1 e_i, h S^-1 e_i), i = 0, N.
+  std::array<Vector, 2> step_solved_end_, penalty_step_solved_end_, psi_end_;
+
+  Matrix riccati_;                     // P_{k+1}, then P_k
+  Vector offset_;                      // q_{k+1}, then q_k
+  std::vector<Matrix> gains_;          // G_k, n x 2n
+  Matrix forward_inputs_;              // e_k
+  Matrix propagated_;                  // A_k
+  Matrix propagated_step_top_;         // E_w Phi A_k
+  Matrix coupling_;                    // C_k
+  Matrix combined_transposed_;         // Chat^T, then S^-1 Chat^T
+  Matrix woodbury_image_;              // Kp S^-1 Chat^T
+  Matrix projected_;                   // Q_k
+  Matrix columns_transposed_;          // Ahat^T, then T^T (solved in place)
+  Matrix penalty_columns_transposed_;  // (A Psi Kp)^T / h
+  Matrix stiffness_columns_, free_state_columns_;
+  Eigen::PartialPivLU<Matrix> woodbury_lu_;
+  Vector force_, offset_propagated_, offset_step_top_, scratch_, scratch_v_;
+  Vector data_term_, input_, psi_input_;
+};
+
+RiccatiSweep::RiccatiSweep(const McreProblem& problem)
+    : ops_(problem),
+      n_(ops_.num_nodes()),
+      m_(ops_.num_steps()),
+      two_n_(2 * n_),
+      h_(ops_.time_step()),
+      theta_(ops_.theta()),
+      beta_(ops_.beta()),
+      delta_(theta_ * theta_ * (1.0 - theta_) * beta_ * h_ * h_),
+      end_nodes_{0, n_ - 1},
+      riccati_(Matrix::Zero(two_n_, two_n_)),
+      offset_(Vector::Zero(two_n_)),
+      gains_(m_),
+      forward_inputs_(n_, m_),
+      propagated_(two_n_, two_n_),
+      propagated_step_top_(n_, two_n_),
+      coupling_(n_, two_n_),
+      combined_transposed_(n_, n_),
+      woodbury_image_(n_, n_),
+      projected_(two_n_, two_n_),
+      columns_transposed_(n_, two_n_),
+      penalty_columns_transposed_(n_, two_n_),
+      stiffness_columns_(n_, two_n_),
+      free_state_columns_(n_, two_n_),
+      woodbury_lu_(n_),
+      force_(n_),
+      offset_propagated_(two_n_),
+      offset_step_top_(n_),
+      scratch_(n_),
+      scratch_v_(n_),
+      data_term_(n_),
+      input_(n_),
+      psi_input_(two_n_) {
+  for (int i = 0; i < 2; ++i) {
+    step_solved_end_[i] = Vector::Unit(n_, end_nodes_[i]);
+    ops_.SolveStep(step_solved_end_[i]);
+    penalty_step_solved_end_[i] = Vector::Zero(n_);
+    ops_.PenaltyProduct(step_solved_end_[i], penalty_step_solved_end_[i]);
+    psi_end_[i].resize(two_n_);
+    psi_end_[i] << (h_ * h_ * theta_) * step_solved_end_[i], h_ * step_solved_end_[i];
+    ops_.CountMacs(2.0 * n_);
+  }
+}
+
+void RiccatiSweep::Backward() {
+  for (int k = m_ - 1; k >= 0; --k) {
+    Propagate(k);
+    const Vector coupling_offset = Coupling(k);
+    Gain(k);
+    Project(k);
+    ForwardInput(k, coupling_offset);
+    if (k == 0) break;  // P_0, q_0 are not needed: Y_0 = 0 is known.
+    UpdateOffset();
+    UpdateRiccati();
+  }
+}
+
+void RiccatiSweep::Propagate(int k) {
+  const int n = n_, two_n = two_n_;
+  const double c_next = ops_.QuadratureWeight(k + 1);
+  // A_k = Phi P_{k+1} + c_{k+1} beta Psi B E_U  (B E_U: the U columns of the end nodes).
+  for (int j = 0; j < two_n; ++j) {
+    ops_.ThetaStep(riccati_.col(j).head(n), riccati_.col(j).tail(n), nullptr,
+                   propagated_.col(j).head(n), propagated_.col(j).tail(n));
+  }
+  for (int i = 0; i < 2; ++i) propagated_.col(end_nodes_[i]) += (c_next * beta_) * psi_end_[i];
+  ops_.CountMacs(2.0 * two_n);
+  // a_k = Phi q_{k+1} + Psi (-c_{k+1} beta U~_{k+1}).
+  force_.setZero();
+  ops_.AddDisplacementData(k + 1, -c_next * beta_, force_);
+  ops_.ThetaStep(offset_.head(n), offset_.tail(n), &force_, offset_propagated_.head(n),
+                 offset_propagated_.tail(n));
+
+  // E_w Phi A_k and E_w Phi a_k: the omega part of one more retrograde step, which
+  // gives omega_{k-1} (its force c_k beta (B U_k - U~_k) enters through delta and d).
+  for (int j = 0; j < two_n; ++j) {
+    ops_.ThetaStep(propagated_.col(j).head(n), propagated_.col(j).tail(n), nullptr,
+                   propagated_step_top_.col(j), scratch_v_);
+  }
+  ops_.ThetaStep(offset_propagated_.head(n), offset_propagated_.tail(n), nullptr, offset_step_top_,
+                 scratch_v_);
+}
+
+Vector RiccatiSweep::Coupling(int k) {
+  const int n = n_, two_n = two_n_;
+  const double theta = theta_;
+  const double c_next = ops_.QuadratureWeight(k + 1), c_now = ops_.QuadratureWeight(k);
+  const double chi = k >= 1 ? 1.0 : 0.0;
+  // C_k = (theta/c_{k+1}) [theta A_w + (1 - theta) P_w]
+  //       + ((1 - theta)/c_k) [chi theta (E_w Phi A) + (1 - theta) A_w],  A_w = E_w A_k.
+  const double weight_next = theta / c_next, weight_now = (1.0 - theta) / c_now;
+  const double on_propagated = weight_next * theta + weight_now * (1.0 - theta);
+  const double on_riccati = weight_next * (1.0 - theta);
+  const double on_step = weight_now * chi * theta;
+  coupling_ = on_propagated * propagated_.topRows(n) + on_riccati * riccati_.topRows(n) +
+              on_step * propagated_step_top_;
+  ops_.CountMacs(3.0 * n * two_n);
+  // d_k: the same combination of the offsets, minus delta S^-1 U~_k (the data part of
+  // omega_{k-1}'s force, chi theta (1 - theta) beta E_w Psi U~_k).
+  Vector coupling_offset = on_propagated * offset_propagated_.head(n) +
+                           on_riccati * offset_.head(n) + on_step * offset_step_top_;
+  data_term_.setZero();
+  ops_.AddDisplacementData(k, 1.0, data_term_);
+  ops_.SolveStep(data_term_);
+  coupling_offset -= (chi * delta_) * data_term_;
+  ops_.CountMacs(4.0 * n);
+  return coupling_offset;
+}
+
+void RiccatiSweep::Gain(int k) {
+  const int n = n_, two_n = two_n_;
+  const double h = h_, theta = theta_;
+  // N_k = I + h Chat S^-1 Kp = I + h (Kp S^-1 Chat^T)^T,  Chat = h theta C_U + C_V.
+  combined_transposed_ = ((h * theta) * coupling_.leftCols(n) + coupling_.rightCols(n)).transpose();
+  ops_.CountMacs(static_cast<double>(n) * n);
+  for (int j = 0; j < n; ++j) {
+    ops_.SolveStep(combined_transposed_.col(j));
+    ops_.PenaltyProduct(combined_transposed_.col(j), woodbury_image_.col(j));
+  }
+  Matrix woodbury = h * woodbury_image_.transpose();
+  woodbury.diagonal().array() += 1.0;
+  ops_.CountMacs(static_cast<double>(n) * n);
+  // G_k = N_k^-1 C_k.
+  woodbury_lu_.compute(woodbury);
+  gains_[k] = woodbury_lu_.solve(coupling_);
+  ops_.CountMacs(counts::LuFactorization(n) + counts::LuSolve(n, two_n));
+}
+
+void RiccatiSweep::Project(int k) {
+  const int n = n_, two_n = two_n_;
+  const double h = h_, theta = theta_;
+  // A_k Psi Kp = h Ahat S^-1 Kp = h (Kp S^-1 Ahat^T)^T,  Ahat = h theta A_U + A_V.
+  columns_transposed_ =
+      ((h * theta) * propagated_.leftCols(n) + propagated_.rightCols(n)).transpose();
+  ops_.CountMacs(static_cast<double>(two_n) * n);
+  for (int j = 0; j < two_n; ++j) {
+    ops_.SolveStep(columns_transposed_.col(j));
+    ops_.PenaltyProduct(columns_transposed_.col(j), penalty_columns_transposed_.col(j));
+  }
+  // Q_k = A_k - (A_k Psi Kp) G_k.
+  projected_ = propagated_;
+  projected_.noalias() -= h * (penalty_columns_transposed_.transpose() * gains_[k]);
+  ops_.CountMacs(counts::DenseProduct(two_n, n, two_n));
+}
+
+void RiccatiSweep::ForwardInput(int k, const Vector& coupling_offset) {
+  // e_k = F~theta_k - Kp d_k, F~theta_k = theta F~_{k+1} + (1 - theta) F~_k.
+  ops_.PenaltyProduct(coupling_offset, input_);
+  input_ = -input_;
+  ops_.AddForceData(k + 1, theta_, input_);
+  ops_.AddForceData(k, 1.0 - theta_, input_);
+  forward_inputs_.col(k) = input_;
+}
+
+void RiccatiSweep::UpdateOffset() {
+  const int n = n_, two_n = two_n_;
+  const double h = h_, theta = theta_;
+  // q_k = Q_k Psi e_k + a_k.
+  scratch_ = input_;
+  ops_.SolveStep(scratch_);
+  psi_input_ << (h * h * theta) * scratch_, h * scratch_;
+  offset_ = offset_propagated_;
+  offset_.noalias() += projected_ * psi_input_;
+  ops_.CountMacs(2.0 * n + counts::DenseProduct(two_n, two_n, 1));
+}
+
+void RiccatiSweep::UpdateRiccati() {
+  const int n = n_, two_n = two_n_;
+  const double h = h_, theta = theta_;
+  // P_k = Q_k Phi - h delta (T S^-1) Kp S^-1 B E_U with T = Q_V + h theta Q_U:
+  //   Q Phi = [Q_U - h (T S^-1) K,  h (1 - theta) Q_U + (T S^-1) R].
+  columns_transposed_ =
+      ((h * theta) * projected_.leftCols(n) + projected_.rightCols(n)).transpose();
+  ops_.CountMacs(static_cast<double>(two_n) * n);
+  for (int j = 0; j < two_n; ++j) {
+    ops_.SolveStep(columns_transposed_.col(j));
+    ops_.StiffnessProduct(columns_transposed_.col(j), stiffness_columns_.col(j));
+    ops_.FreeStateProduct(columns_transposed_.col(j), free_state_columns_.col(j));
+  }
+  riccati_.leftCols(n) = projected_.leftCols(n) - h * stiffness_columns_.transpose();
+  riccati_.rightCols(n) =
+      (h * (1.0 - theta)) * projected_.leftCols(n) + free_state_columns_.transpose();
+  ops_.CountMacs(3.0 * two_n * n);
+  for (int i = 0; i < 2; ++i) {
+    riccati_.col(end_nodes_[i]).noalias() -=
+        (h * delta_) * (columns_transposed_.transpose() * penalty_step_solved_end_[i]);
+  }
+  ops_.CountMacs(2.0 * counts::DenseProduct(two_n, n, 1));
+}
+
+void RiccatiSweep::Forward(Matrix* displacement) {
+  const int n = n_, two_n = two_n_;
+  const double h = h_, theta = theta_;
+  // z = Phi Y_k + Psi (e_k - delta_k Kp S^-1 B U_k),  Y_{k+1} = z - Psi Kp (G_k z).
+  Vector velocity = Vector::Zero(n), position = Vector::Zero(n);
+  Vector next_position(n), next_velocity(n), gain_image(n), correction(n);
+  for (int k = 0; k < m_; ++k) {
+    force_ = forward_inputs_.col(k);
+    if (k >= 1) {
+      for (int i = 0; i < 2; ++i) {
+        force_ -= (delta_ * position[end_nodes_[i]]) * penalty_step_solved_end_[i];
+      }
+      ops_.CountMacs(2.0 * n);
+    }
+    ops_.ThetaStep(position, velocity, &force_, next_position, next_velocity);
+    gain_image.noalias() = gains_[k].leftCols(n) * next_position;
+    gain_image.noalias() += gains_[k].rightCols(n) * next_velocity;
+    ops_.CountMacs(counts::DenseProduct(n, two_n, 1));
+    ops_.PenaltyProduct(gain_image, correction);
+    ops_.SolveStep(correction);
+    position = next_position - (h * h * theta) * correction;
+    velocity = next_velocity - h * correction;
+    ops_.CountMacs(2.0 * n);
+    displacement->col(k + 1) = position;
+  }
+}
+
 }  // namespace
 
 void SolveByRiccati(const CoupledSolverOptions& options, McreProblem* problem,
                     CoupledSolution* solution, CoupledSolverSummary* summary) {
-  const int n = problem->num_nodes(), m = problem->num_steps(), two_n = 2 * n, last = n - 1;
+  const int n = problem->num_nodes(), m = problem->num_steps();
   summary->iterations = 0;
   const double bytes = RiccatiBytes(n, m);
   if (bytes > static_cast<double>(options.max_dense_solver_bytes)) {
@@ -76,175 +353,12 @@ void SolveByRiccati(const CoupledSolverOptions& options, McreProblem* problem,
     summary->message = why.str();
     return;
   }
-  DiscreteMcreOperators ops(*problem);
-  const double h = ops.time_step(), theta = ops.theta(), beta = ops.beta();
-  // delta = theta^2 (1 - theta) beta h^2: the weight of U_k in W_k through omega_{k-1}.
-  const double delta = theta * theta * (1.0 - theta) * beta * h * h;
-
-  // S^-1 e_i, Kp S^-1 e_i and Psi e_i = (h^2 theta S^-1 e_i, h S^-1 e_i), i = 0, N.
-  const std::array<int, 2> end_nodes{0, last};
-  std::array<Vector, 2> step_solved_end, penalty_step_solved_end, psi_end;
-  for (int i = 0; i < 2; ++i) {
-    step_solved_end[i] = Vector::Unit(n, end_nodes[i]);
-    ops.SolveStep(step_solved_end[i]);
-    penalty_step_solved_end[i] = Vector::Zero(n);
-    ops.PenaltyProduct(step_solved_end[i], penalty_step_solved_end[i]);
-    psi_end[i].resize(two_n);
-    psi_end[i] << (h * h * theta) * step_solved_end[i], h * step_solved_end[i];
-    ops.CountMacs(2.0 * n);
-  }
-
-  Matrix riccati = Matrix::Zero(two_n, two_n);  // P_{k+1}, then P_k
-  Vector offset = Vector::Zero(two_n);          // q_{k+1}, then q_k
-  std::vector<Matrix> gains(m);                 // G_k, n x 2n
-  Matrix forward_inputs(n, m);                  // e_k
-  Matrix propagated(two_n, two_n);              // A_k
-  Matrix propagated_step_top(n, two_n);         // E_w Phi A_k
-  Matrix coupling(n, two_n);                    // C_k
-  Matrix combined_transposed(n, n);             // Chat^T, then S^-1 Chat^T
-  Matrix woodbury_image(n, n);                  // Kp S^-1 Chat^T
-  Matrix projected(two_n, two_n);               // Q_k
-  Matrix columns_transposed(n, two_n);          // Ahat^T, then T^T (solved in place)
-  Matrix penalty_columns_transposed(n, two_n);  // (A Psi Kp)^T / h
-  Matrix stiffness_columns(n, two_n), free_state_columns(n, two_n);
-  Eigen::PartialPivLU<Matrix> woodbury_lu(n);
-  Vector force(n), offset_propagated(two_n), offset_step_top(n), scratch(n), scratch_v(n);
-  Vector data_term(n), input(n), psi_input(two_n);
-
-  for (int k = m - 1; k >= 0; --k) {
-    const double c_next = ops.QuadratureWeight(k + 1), c_now = ops.QuadratureWeight(k);
-    const double chi = k >= 1 ? 1.0 : 0.0;
-
-    // A_k = Phi P_{k+1} + c_{k+1} beta Psi B E_U  (B E_U: the U columns of the end nodes).
-    for (int j = 0; j < two_n; ++j) {
-      ops.ThetaStep(riccati.col(j).head(n), riccati.col(j).tail(n), nullptr,
-                    propagated.col(j).head(n), propagated.col(j).tail(n));
-    }
-    for (int i = 0; i < 2; ++i) propagated.col(end_nodes[i]) += (c_next * beta) * psi_end[i];
-    ops.CountMacs(2.0 * two_n);
-    // a_k = Phi q_{k+1} + Psi (-c_{k+1} beta U~_{k+1}).
-    force.setZero();
-    ops.AddDisplacementData(k + 1, -c_next * beta, force);
-    ops.ThetaStep(offset.head(n), offset.tail(n), &force, offset_propagated.head(n),
-                  offset_propagated.tail(n));
-
-    // E_w Phi A_k and E_w Phi a_k: the omega part of one more retrograde step, which
-    // gives omega_{k-1} (its force c_k beta (B U_k - U~_k) enters through delta and d).
-    for (int j = 0; j < two_n; ++j) {
-      ops.ThetaStep(propagated.col(j).head(n), propagated.col(j).tail(n), nullptr,
-                    propagated_step_top.col(j), scratch_v);
-    }
-    ops.ThetaStep(offset_propagated.head(n), offset_propagated.tail(n), nullptr, offset_step_top,
-                  scratch_v);
-
-    // C_k = (theta/c_{k+1}) [theta A_w + (1 - theta) P_w]
-    //       + ((1 - theta)/c_k) [chi theta (E_w Phi A) + (1 - theta) A_w],  A_w = E_w A_k.
-    const double weight_next = theta / c_next, weight_now = (1.0 - theta) / c_now;
-    const double on_propagated = weight_next * theta + weight_now * (1.0 - theta);
-    const double on_riccati = weight_next * (1.0 - theta);
-    const double on_step = weight_now * chi * theta;
-    coupling = on_propagated * propagated.topRows(n) + on_riccati * riccati.topRows(n) +
-               on_step * propagated_step_top;
-    ops.CountMacs(3.0 * n * two_n);
-    // d_k: the same combination of the offsets, minus delta S^-1 U~_k (the data part of
-    // omega_{k-1}'s force, chi theta (1 - theta) beta E_w Psi U~_k).
-    Vector coupling_offset = on_propagated * offset_propagated.head(n) +
-                             on_riccati * offset.head(n) + on_step * offset_step_top;
-    data_term.setZero();
-    ops.AddDisplacementData(k, 1.0, data_term);
-    ops.SolveStep(data_term);
-    coupling_offset -= (chi * delta) * data_term;
-    ops.CountMacs(4.0 * n);
-
-    // N_k = I + h Chat S^-1 Kp = I + h (Kp S^-1 Chat^T)^T,  Chat = h theta C_U + C_V.
-    combined_transposed = ((h * theta) * coupling.leftCols(n) + coupling.rightCols(n)).transpose();
-    ops.CountMacs(static_cast<double>(n) * n);
-    for (int j = 0; j < n; ++j) {
-      ops.SolveStep(combined_transposed.col(j));
-      ops.PenaltyProduct(combined_transposed.col(j), woodbury_image.col(j));
-    }
-    Matrix woodbury = h * woodbury_image.transpose();
-    woodbury.diagonal().array() += 1.0;
-    ops.CountMacs(static_cast<double>(n) * n);
-    // G_k = N_k^-1 C_k.
-    woodbury_lu.compute(woodbury);
-    gains[k] = woodbury_lu.solve(coupling);
-    ops.CountMacs(counts::LuFactorization(n) + counts::LuSolve(n, two_n));
-
-    // A_k Psi Kp = h Ahat S^-1 Kp = h (Kp S^-1 Ahat^T)^T,  Ahat = h theta A_U + A_V.
-    columns_transposed =
-        ((h * theta) * propagated.leftCols(n) + propagated.rightCols(n)).transpose();
-    ops.CountMacs(static_cast<double>(two_n) * n);
-    for (int j = 0; j < two_n; ++j) {
-      ops.SolveStep(columns_transposed.col(j));
-      ops.PenaltyProduct(columns_transposed.col(j), penalty_columns_transposed.col(j));
-    }
-    // Q_k = A_k - (A_k Psi Kp) G_k.
-    projected = propagated;
-    projected.noalias() -= h * (penalty_columns_transposed.transpose() * gains[k]);
-    ops.CountMacs(counts::DenseProduct(two_n, n, two_n));
-
-    // e_k = F~theta_k - Kp d_k, F~theta_k = theta F~_{k+1} + (1 - theta) F~_k.
-    ops.PenaltyProduct(coupling_offset, input);
-    input = -input;
-    ops.AddForceData(k + 1, theta, input);
-    ops.AddForceData(k, 1.0 - theta, input);
-    forward_inputs.col(k) = input;
-    if (k == 0) break;  // P_0, q_0 are not needed: Y_0 = 0 is known.
-
-    // q_k = Q_k Psi e_k + a_k.
-    scratch = input;
-    ops.SolveStep(scratch);
-    psi_input << (h * h * theta) * scratch, h * scratch;
-    offset = offset_propagated;
-    offset.noalias() += projected * psi_input;
-    ops.CountMacs(2.0 * n + counts::DenseProduct(two_n, two_n, 1));
-
-    // P_k = Q_k Phi - h delta (T S^-1) Kp S^-1 B E_U with T = Q_V + h theta Q_U:
-    //   Q Phi = [Q_U - h (T S^-1) K,  h (1 - theta) Q_U + (T S^-1) R].
-    columns_transposed = ((h * theta) * projected.leftCols(n) + projected.rightCols(n)).transpose();
-    ops.CountMacs(static_cast<double>(two_n) * n);
-    for (int j = 0; j < two_n; ++j) {
-      ops.SolveStep(columns_transposed.col(j));
-      ops.StiffnessProduct(columns_transposed.col(j), stiffness_columns.col(j));
-      ops.FreeStateProduct(columns_transposed.col(j), free_state_columns.col(j));
-    }
-    riccati.leftCols(n) = projected.leftCols(n) - h * stiffness_columns.transpose();
-    riccati.rightCols(n) =
-        (h * (1.0 - theta)) * projected.leftCols(n) + free_state_columns.transpose();
-    ops.CountMacs(3.0 * two_n * n);
-    for (int i = 0; i < 2; ++i) {
-      riccati.col(end_nodes[i]).noalias() -=
-          (h * delta) * (columns_transposed.transpose() * penalty_step_solved_end[i]);
-    }
-    ops.CountMacs(2.0 * counts::DenseProduct(two_n, n, 1));
-  }
-
-  // Forward pass: z = Phi Y_k + Psi (e_k - delta_k Kp S^-1 B U_k),
-  // Y_{k+1} = z - Psi Kp (G_k z).
+  RiccatiSweep sweep(*problem);
+  DiscreteMcreOperators& ops = sweep.ops();
+  sweep.Backward();
   Matrix& displacement = solution->displacement;
   displacement = problem->ZeroField();
-  Vector velocity = Vector::Zero(n), position = Vector::Zero(n);
-  Vector next_position(n), next_velocity(n), gain_image(n), correction(n);
-  for (int k = 0; k < m; ++k) {
-    force = forward_inputs.col(k);
-    if (k >= 1) {
-      for (int i = 0; i < 2; ++i) {
-        force -= (delta * position[end_nodes[i]]) * penalty_step_solved_end[i];
-      }
-      ops.CountMacs(2.0 * n);
-    }
-    ops.ThetaStep(position, velocity, &force, next_position, next_velocity);
-    gain_image.noalias() = gains[k].leftCols(n) * next_position;
-    gain_image.noalias() += gains[k].rightCols(n) * next_velocity;
-    ops.CountMacs(counts::DenseProduct(n, two_n, 1));
-    ops.PenaltyProduct(gain_image, correction);
-    ops.SolveStep(correction);
-    position = next_position - (h * h * theta) * correction;
-    velocity = next_velocity - h * correction;
-    ops.CountMacs(2.0 * n);
-    displacement.col(k + 1) = position;
-  }
+  sweep.Forward(&displacement);
   // W from U: (R) backward from Z_m = 0 and (R3).
   problem->RetrogradeSweep(displacement, true, &solution->retrograde);
   ops.CountMacs(counts::RetrogradeSweep(n, ops.half_bandwidth(), m));

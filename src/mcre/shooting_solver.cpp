@@ -235,6 +235,238 @@ struct StageFactor {
   Vector rhs;         // f_s
 };
 
+// The staircase QR as it goes, segment by segment: the segments' first levels, the
+// stages eliminated so far, the rows carried into the next block, and the extremes
+// of |diag R| over all stages (the multiple-shooting condition estimate).
+struct Staircase {
+  std::vector<int> starts;
+  std::vector<StageFactor> stages;
+  Matrix carry;  // rows left over for the next block, and their right-hand side
+  Vector carry_rhs;
+  Vector start_solution;  // the unknown of the last block, once solved
+  double condition = 0.0;
+  double largest_diagonal = 0.0, smallest_diagonal = std::numeric_limits<double>::infinity();
+
+  // Widens the extremes of |diag R| by the diagonal of one more triangular factor.
+  void TrackDiagonal(const Vector& diagonal) {
+    largest_diagonal = std::max(largest_diagonal, diagonal.maxCoeff());
+    smallest_diagonal = std::min(smallest_diagonal, diagonal.minCoeff());
+  }
+};
+
+// The failure message when `segments` segments' dense storage exceeds the limit.
+std::string ShootingMemoryMessage(const char* name, double bytes, int segments, int num_nodes,
+                                  long limit) {
+  std::ostringstream why;
+  why << name << " needs at least " << static_cast<long long>(bytes) << " bytes (" << segments
+      << " segments of 4n x 4n factors, n = " << num_nodes << " nodes), above the limit of "
+      << limit << " bytes (inner.max_dense_solver_bytes); use riccati or conjugate_gradient";
+  return why.str();
+}
+
+// Sets columns to the particular column 0 and `block` unit columns (coordinates
+// offset.. of the state) at level first, then marches them with the data until the
+// fundamental columns have grown by shooting_segment_growth (multiple shooting,
+// checked every kGrowthCheckInterval steps) or to level m; returns the level reached.
+int MarchSegment(const CoupledSolverOptions& options, bool multiple, int first, int block,
+                 int offset, DiscreteMcreOperators* ops, CoupledMarch* march,
+                 CoupledColumns* columns) {
+  const int n = ops->num_nodes(), m = ops->num_steps();
+  columns->SetZero(n, 1 + block);
+  Vector unit(4 * n);
+  for (int i = 0; i < block; ++i) {
+    unit.setZero();
+    unit[offset + i] = 1.0;
+    SetStateFromCoordinates(unit, 1 + i, ops, columns);
+  }
+  if (first >= 1) march->SetPreviousOmega(first, true, columns);
+  int end = first;
+  while (end < m) {
+    march->Step(end, true, columns);
+    ++end;
+    // The growth is checked every kGrowthCheckInterval steps (its cost is a fifth of
+    // a step's), so a segment may overshoot the limit by a few steps' growth.
+    if (multiple && end < m && (end - first) % kGrowthCheckInterval == 0 &&
+        FundamentalGrowth(*columns, ops, &unit) > options.shooting_segment_growth) {
+      break;
+    }
+  }
+  return end;
+}
+
+// Eliminates block s (width `block`) of an inner segment: the rows
+// [carry; x_{s+1} - G_s x_s = g_s] over the columns [block s | block s+1 | rhs] are
+// reduced by a Householder QR of block s's columns into a stage and new carried rows.
+void EliminateStage(const Matrix& transition, const Vector& particular, int block,
+                    DiscreteMcreOperators* ops, Staircase* staircase) {
+  const int four_n = 4 * ops->num_nodes();
+  Matrix& carry = staircase->carry;
+  Vector& carry_rhs = staircase->carry_rhs;
+  const int carried = static_cast<int>(carry.rows());
+  Matrix panel = Matrix::Zero(carried + four_n, block + four_n + 1);
+  if (carried > 0) {
+    panel.topLeftCorner(carried, block) = carry;
+    panel.block(0, block + four_n, carried, 1) = carry_rhs;
+  }
+  panel.block(carried, 0, four_n, block) = -transition;
+  panel.block(carried, block, four_n, four_n).setIdentity();
+  panel.block(carried, block + four_n, four_n, 1) = particular;
+  Eigen::HouseholderQR<Matrix> qr(panel.leftCols(block));
+  Matrix rest = qr.householderQ().transpose() * panel.rightCols(four_n + 1);
+  ops->CountMacs(counts::HouseholderQr(carried + four_n, block) +
+                 counts::ApplyHouseholderReflectors(carried + four_n, block, four_n + 1));
+  StageFactor stage;
+  stage.triangular = qr.matrixQR().topRows(block).triangularView<Eigen::Upper>();
+  stage.coupling = rest.topLeftCorner(block, four_n);
+  stage.rhs = rest.topRightCorner(block, 1);
+  carry = rest.bottomLeftCorner(carried + four_n - block, four_n);
+  carry_rhs = rest.bottomRightCorner(carried + four_n - block, 1);
+  const Vector diagonal = stage.triangular.diagonal().cwiseAbs();
+  staircase->TrackDiagonal(diagonal);
+  staircase->stages.push_back(std::move(stage));
+}
+
+// The last block's rows [carry; E_Z G x = -E_Z g] (square) and their right-hand side.
+void AssembleLastBlock(const Staircase& staircase, const Matrix& transition,
+                       const Vector& particular, int block, Matrix* last_rows, Vector* last_rhs) {
+  const int carried = static_cast<int>(staircase.carry.rows());
+  const int two_n = static_cast<int>(transition.rows()) / 2;
+  last_rows->resize(carried + two_n, block);
+  last_rhs->resize(carried + two_n);
+  if (carried > 0) {
+    last_rows->topRows(carried) = staircase.carry;
+    last_rhs->head(carried) = staircase.carry_rhs;
+  }
+  last_rows->bottomRows(two_n) = transition.bottomRows(two_n);
+  last_rhs->tail(two_n) = -particular.tail(two_n);
+}
+
+// The failure message when the final system's condition number is over the limit.
+std::string ConditionMessage(const char* name, bool multiple, int s, double condition, double limit,
+                             int m, double window) {
+  std::ostringstream why;
+  why << name << " breaks down: the " << (s == 0 ? "shooting matrix" : "multiple-shooting system")
+      << " has condition number " << condition << " > " << limit
+      << " (inner.shooting_condition_limit) over the window of " << m << " steps (" << window
+      << " s, " << s + 1 << " segment" << (s == 0 ? "" : "s") << ")";
+  if (!multiple) why << "; use multiple_shooting or riccati";
+  return why.str();
+}
+
+// Solves the last block (block s, width `block`) into staircase->start_solution by
+// an equilibrated (single shooting) Householder QR, after the condition number
+// (into staircase->condition and the summary) has passed the limit. Returns the
+// failure message, or an empty string on success.
+std::string SolveLastBlock(const CoupledSolverOptions& options, const char* name, int s,
+                           const Matrix& transition, const Vector& particular, int block,
+                           DiscreteMcreOperators* ops, Staircase* staircase,
+                           CoupledSolverSummary* summary) {
+  const bool multiple = options.type == CoupledSolverType::kMultipleShooting;
+  const int m = ops->num_steps();
+  const double window = m * ops->time_step();
+  Matrix last_rows;
+  Vector last_rhs;
+  AssembleLastBlock(*staircase, transition, particular, block, &last_rows, &last_rhs);
+  // Single shooting: equilibrate the shooting matrix (rows, then columns, to unit
+  // largest entry) so that its condition number does not depend on units. Multiple
+  // shooting keeps the scaling of the earlier stages (one global QR).
+  Vector row_scale = Vector::Ones(block), column_scale = Vector::Ones(block);
+  if (s == 0) {
+    row_scale = last_rows.rowwise().lpNorm<Eigen::Infinity>().cwiseInverse();
+    column_scale = (row_scale.asDiagonal() * last_rows)
+                       .colwise()
+                       .lpNorm<Eigen::Infinity>()
+                       .transpose()
+                       .cwiseInverse();
+  }
+  const Matrix equilibrated = row_scale.asDiagonal() * last_rows * column_scale.asDiagonal();
+  ops->CountMacs(2.0 * last_rows.size() + block);
+  if (!equilibrated.allFinite()) {
+    return std::string(name) + " breaks down: the final shooting block has a zero or " +
+           "non-finite row or column over the window of " + std::to_string(m) + " steps";
+  }
+  Eigen::HouseholderQR<Matrix> qr(equilibrated);
+  ops->CountMacs(counts::HouseholderQr(block, block));
+  const Vector diagonal = qr.matrixQR().diagonal().cwiseAbs();
+  staircase->TrackDiagonal(diagonal);
+  double& condition = staircase->condition;
+  if (s == 0) {
+    const Vector singular = Eigen::BDCSVD<Matrix>(equilibrated).singularValues();
+    ops->CountMacs(counts::SingularValues(block));
+    condition = singular[0] / singular[singular.size() - 1];
+  } else {
+    condition = staircase->largest_diagonal / staircase->smallest_diagonal;
+  }
+  summary->shooting_condition_number = condition;
+  if (!std::isfinite(condition) || condition > options.shooting_condition_limit) {
+    return ConditionMessage(name, multiple, s, condition, options.shooting_condition_limit, m,
+                            window);
+  }
+  Vector transformed = qr.householderQ().transpose() * (row_scale.asDiagonal() * last_rhs);
+  qr.matrixQR().triangularView<Eigen::Upper>().solveInPlace(transformed);
+  staircase->start_solution = column_scale.asDiagonal() * transformed;
+  ops->CountMacs(counts::ApplyHouseholderReflectors(block, block, 1) +
+                 counts::TriangularSolve(block, 1) + 2.0 * block);
+  return "";
+}
+
+// Back substitution x_s = R_s^-1 (f_s - F_s x_{s+1}): the start states of the
+// segments (in coordinates; the first one is Z_0 alone, 2n).
+std::vector<Vector> BackSubstitute(const Staircase& staircase, DiscreteMcreOperators* ops) {
+  const int four_n = 4 * ops->num_nodes();
+  const std::vector<StageFactor>& stages = staircase.stages;
+  const int segments = static_cast<int>(staircase.starts.size());
+  std::vector<Vector> start_states(segments);
+  start_states[segments - 1] = staircase.start_solution;
+  for (int s = segments - 2; s >= 0; --s) {
+    Vector x = stages[s].rhs - stages[s].coupling * start_states[s + 1];
+    stages[s].triangular.triangularView<Eigen::Upper>().solveInPlace(x);
+    start_states[s] = x;
+    ops->CountMacs(counts::DenseProduct(stages[s].rhs.size(), four_n, 1) +
+                   counts::TriangularSolve(stages[s].rhs.size(), 1));
+  }
+  return start_states;
+}
+
+// Marches each segment once more from its start state with the data, recording U
+// and W_k = (chi theta omega_{k-1} + (1 - theta) omega_k) / c_k into the solution.
+void RecordShootingSolution(const std::vector<int>& starts, const std::vector<Vector>& start_states,
+                            McreProblem* problem, DiscreteMcreOperators* ops, CoupledMarch* march,
+                            CoupledColumns* columns, CoupledSolution* solution) {
+  const int n = problem->num_nodes(), m = problem->num_steps(), two_n = 2 * n, four_n = 4 * n;
+  const int segments = static_cast<int>(starts.size());
+  const double theta = problem->theta();
+  Matrix& displacement = solution->displacement;
+  Matrix& retrograde = solution->retrograde;
+  displacement = problem->ZeroField();
+  retrograde = problem->ZeroField();
+  auto record = [&](int k, const CoupledColumns& x) {
+    const double chi = k >= 1 ? 1.0 : 0.0;
+    displacement.col(k) = x.displacement.col(0);
+    retrograde.col(k) = (chi * theta * x.previous_omega.col(0) + (1.0 - theta) * x.omega.col(0)) /
+                        problem->QuadratureWeight(k);
+    ops->CountMacs(3.0 * n);
+  };
+  Vector state(four_n);
+  for (int s = 0; s < segments; ++s) {
+    const int first = starts[s], end = s + 1 < segments ? starts[s + 1] : m;
+    columns->SetZero(n, 1);
+    state.setZero();
+    if (s == 0) {
+      state.tail(two_n) = start_states[0];
+    } else {
+      state = start_states[s];
+    }
+    SetStateFromCoordinates(state, 0, ops, columns);
+    if (first >= 1) march->SetPreviousOmega(first, true, columns);
+    for (int k = first; k < end; ++k) {
+      record(k, *columns);
+      march->Step(k, true, columns);
+    }
+    if (end == m) record(m, *columns);
+  }
+}
+
 }  // namespace
 
 void SolveByShooting(const CoupledSolverOptions& options, McreProblem* problem,
@@ -256,50 +488,21 @@ void SolveByShooting(const CoupledSolverOptions& options, McreProblem* problem,
   // columns of the segment's unknown start state until the fundamental columns have
   // grown by shooting_segment_growth (multiple shooting) or to the end, then
   // eliminate the segment's block of unknowns.
-  std::vector<int> starts;
-  std::vector<StageFactor> stages;
-  Matrix carry;  // rows left over for the next block, and their right-hand side
-  Vector carry_rhs;
-  Vector start_solution;  // the unknown of the last block, once solved
-  double condition = 0.0;
-  double largest_diagonal = 0.0, smallest_diagonal = std::numeric_limits<double>::infinity();
+  Staircase staircase;
   CoupledColumns columns;
   for (int first = 0; first < m;) {
-    const int s = static_cast<int>(starts.size());
-    starts.push_back(first);
+    const int s = static_cast<int>(staircase.starts.size());
+    staircase.starts.push_back(first);
     summary->shooting_segments = s + 1;
     const double bytes = ShootingBytes(n, s + 1);
     if (bytes > static_cast<double>(options.max_dense_solver_bytes)) {
-      std::ostringstream why;
-      why << name << " needs at least " << static_cast<long long>(bytes) << " bytes (" << s + 1
-          << " segments of 4n x 4n factors, n = " << n << " nodes), above the limit of "
-          << options.max_dense_solver_bytes
-          << " bytes (inner.max_dense_solver_bytes); use riccati or conjugate_gradient";
-      fail(why.str());
+      fail(ShootingMemoryMessage(name, bytes, s + 1, n, options.max_dense_solver_bytes));
       return;
     }
     // Block s: Z_0 (2n) for the first segment, the full state (4n) after.
     const int block = s == 0 ? two_n : four_n;
     const int offset = s == 0 ? two_n : 0;  // where the block's unknowns sit in the state
-    columns.SetZero(n, 1 + block);
-    Vector unit(four_n);
-    for (int i = 0; i < block; ++i) {
-      unit.setZero();
-      unit[offset + i] = 1.0;
-      SetStateFromCoordinates(unit, 1 + i, &ops, &columns);
-    }
-    if (first >= 1) march.SetPreviousOmega(first, true, &columns);
-    int end = first;
-    while (end < m) {
-      march.Step(end, true, &columns);
-      ++end;
-      // The growth is checked every kGrowthCheckInterval steps (its cost is a fifth of
-      // a step's), so a segment may overshoot the limit by a few steps' growth.
-      if (multiple && end < m && (end - first) % kGrowthCheckInterval == 0 &&
-          FundamentalGrowth(columns, &ops, &unit) > options.shooting_segment_growth) {
-        break;
-      }
-    }
+    const int end = MarchSegment(options, multiple, first, block, offset, &ops, &march, &columns);
     // End states: G_s (4n x block) and g_s.
     Matrix transition(four_n, block);
     Vector particular(four_n);
@@ -311,144 +514,27 @@ void SolveByShooting(const CoupledSolverOptions& options, McreProblem* problem,
            std::to_string(m) + " steps)" + (multiple ? "" : "; use multiple_shooting or riccati"));
       return;
     }
-    const int carried = static_cast<int>(carry.rows());
     if (end < m) {
-      // Rows [carry; x_{s+1} - G_s x_s = g_s] over the columns [block s | block s+1 | rhs].
-      Matrix panel = Matrix::Zero(carried + four_n, block + four_n + 1);
-      if (carried > 0) {
-        panel.topLeftCorner(carried, block) = carry;
-        panel.block(0, block + four_n, carried, 1) = carry_rhs;
-      }
-      panel.block(carried, 0, four_n, block) = -transition;
-      panel.block(carried, block, four_n, four_n).setIdentity();
-      panel.block(carried, block + four_n, four_n, 1) = particular;
-      Eigen::HouseholderQR<Matrix> qr(panel.leftCols(block));
-      Matrix rest = qr.householderQ().transpose() * panel.rightCols(four_n + 1);
-      ops.CountMacs(counts::HouseholderQr(carried + four_n, block) +
-                    counts::ApplyHouseholderReflectors(carried + four_n, block, four_n + 1));
-      StageFactor stage;
-      stage.triangular = qr.matrixQR().topRows(block).triangularView<Eigen::Upper>();
-      stage.coupling = rest.topLeftCorner(block, four_n);
-      stage.rhs = rest.topRightCorner(block, 1);
-      carry = rest.bottomLeftCorner(carried + four_n - block, four_n);
-      carry_rhs = rest.bottomRightCorner(carried + four_n - block, 1);
-      const Vector diagonal = stage.triangular.diagonal().cwiseAbs();
-      largest_diagonal = std::max(largest_diagonal, diagonal.maxCoeff());
-      smallest_diagonal = std::min(smallest_diagonal, diagonal.minCoeff());
-      stages.push_back(std::move(stage));
-      first = end;
-      continue;
-    }
-    // Last block: [carry; E_Z G x = -E_Z g], square.
-    Matrix last_rows(carried + two_n, block);
-    Vector last_rhs(carried + two_n);
-    if (carried > 0) {
-      last_rows.topRows(carried) = carry;
-      last_rhs.head(carried) = carry_rhs;
-    }
-    last_rows.bottomRows(two_n) = transition.bottomRows(two_n);
-    last_rhs.tail(two_n) = -particular.tail(two_n);
-    // Single shooting: equilibrate the shooting matrix (rows, then columns, to unit
-    // largest entry) so that its condition number does not depend on units. Multiple
-    // shooting keeps the scaling of the earlier stages (one global QR).
-    Vector row_scale = Vector::Ones(block), column_scale = Vector::Ones(block);
-    if (s == 0) {
-      row_scale = last_rows.rowwise().lpNorm<Eigen::Infinity>().cwiseInverse();
-      column_scale = (row_scale.asDiagonal() * last_rows)
-                         .colwise()
-                         .lpNorm<Eigen::Infinity>()
-                         .transpose()
-                         .cwiseInverse();
-    }
-    const Matrix equilibrated = row_scale.asDiagonal() * last_rows * column_scale.asDiagonal();
-    ops.CountMacs(2.0 * last_rows.size() + block);
-    if (!equilibrated.allFinite()) {
-      fail(std::string(name) + " breaks down: the final shooting block has a zero or " +
-           "non-finite row or column over the window of " + std::to_string(m) + " steps");
-      return;
-    }
-    Eigen::HouseholderQR<Matrix> qr(equilibrated);
-    ops.CountMacs(counts::HouseholderQr(block, block));
-    const Vector diagonal = qr.matrixQR().diagonal().cwiseAbs();
-    largest_diagonal = std::max(largest_diagonal, diagonal.maxCoeff());
-    smallest_diagonal = std::min(smallest_diagonal, diagonal.minCoeff());
-    if (s == 0) {
-      const Vector singular = Eigen::BDCSVD<Matrix>(equilibrated).singularValues();
-      ops.CountMacs(counts::SingularValues(block));
-      condition = singular[0] / singular[singular.size() - 1];
+      EliminateStage(transition, particular, block, &ops, &staircase);
     } else {
-      condition = largest_diagonal / smallest_diagonal;
+      const std::string why = SolveLastBlock(options, name, s, transition, particular, block, &ops,
+                                             &staircase, summary);
+      if (!why.empty()) {
+        fail(why);
+        return;
+      }
     }
-    summary->shooting_condition_number = condition;
-    if (!std::isfinite(condition) || condition > options.shooting_condition_limit) {
-      std::ostringstream why;
-      why << name << " breaks down: the "
-          << (s == 0 ? "shooting matrix" : "multiple-shooting system") << " has condition number "
-          << condition << " > " << options.shooting_condition_limit
-          << " (inner.shooting_condition_limit) over the window of " << m << " steps (" << window
-          << " s, " << s + 1 << " segment" << (s == 0 ? "" : "s") << ")";
-      if (!multiple) why << "; use multiple_shooting or riccati";
-      fail(why.str());
-      return;
-    }
-    Vector transformed = qr.householderQ().transpose() * (row_scale.asDiagonal() * last_rhs);
-    qr.matrixQR().triangularView<Eigen::Upper>().solveInPlace(transformed);
-    start_solution = column_scale.asDiagonal() * transformed;
-    ops.CountMacs(counts::ApplyHouseholderReflectors(block, block, 1) +
-                  counts::TriangularSolve(block, 1) + 2.0 * block);
     first = end;
   }
-  const int segments = static_cast<int>(starts.size());
-
-  // Back substitution: x_s = R_s^-1 (f_s - F_s x_{s+1}), the start states of the segments.
-  std::vector<Vector> start_states(segments);
-  start_states[segments - 1] = start_solution;
-  for (int s = segments - 2; s >= 0; --s) {
-    Vector x = stages[s].rhs - stages[s].coupling * start_states[s + 1];
-    stages[s].triangular.triangularView<Eigen::Upper>().solveInPlace(x);
-    start_states[s] = x;
-    ops.CountMacs(counts::DenseProduct(stages[s].rhs.size(), four_n, 1) +
-                  counts::TriangularSolve(stages[s].rhs.size(), 1));
-  }
-
-  // March each segment once more from its start state with the data, recording U
-  // and W_k = (chi theta omega_{k-1} + (1 - theta) omega_k) / c_k.
-  const double theta = problem->theta();
-  Matrix& displacement = solution->displacement;
-  Matrix& retrograde = solution->retrograde;
-  displacement = problem->ZeroField();
-  retrograde = problem->ZeroField();
-  auto record = [&](int k, const CoupledColumns& x) {
-    const double chi = k >= 1 ? 1.0 : 0.0;
-    displacement.col(k) = x.displacement.col(0);
-    retrograde.col(k) = (chi * theta * x.previous_omega.col(0) + (1.0 - theta) * x.omega.col(0)) /
-                        problem->QuadratureWeight(k);
-    ops.CountMacs(3.0 * n);
-  };
-  Vector state(four_n);
-  for (int s = 0; s < segments; ++s) {
-    const int first = starts[s], end = s + 1 < segments ? starts[s + 1] : m;
-    columns.SetZero(n, 1);
-    state.setZero();
-    if (s == 0) {
-      state.tail(two_n) = start_states[0];
-    } else {
-      state = start_states[s];
-    }
-    SetStateFromCoordinates(state, 0, &ops, &columns);
-    if (first >= 1) march.SetPreviousOmega(first, true, &columns);
-    for (int k = first; k < end; ++k) {
-      record(k, columns);
-      march.Step(k, true, &columns);
-    }
-    if (end == m) record(m, columns);
-  }
+  const int segments = static_cast<int>(staircase.starts.size());
+  const std::vector<Vector> start_states = BackSubstitute(staircase, &ops);
+  RecordShootingSolution(staircase.starts, start_states, problem, &ops, &march, &columns, solution);
   summary->multiply_accumulates = ops.macs();
 
   std::ostringstream description;
   description << name << " over " << m << " steps (" << window << " s) in " << segments
               << " segment" << (segments == 1 ? "" : "s") << ", condition number "
-              << ScientificString(condition) << (segments == 1 ? "" : " (lower bound)");
+              << ScientificString(staircase.condition) << (segments == 1 ? "" : " (lower bound)");
   CheckDirectSolution(options, description.str(), problem, *solution, summary);
 }
 

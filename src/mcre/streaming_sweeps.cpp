@@ -128,46 +128,53 @@ void McreProblem::RetrogradeTraceStep(int j, const Matrix& traces, bool include_
                                num_interior_sensors() > 0 ? &point_loads_[0] : nullptr);
 }
 
+void McreProblem::ResetStreamingTotals(int picture_stride, StreamingTotals* totals) {
+  const int m = num_steps();
+  totals->cost = 0.0;
+  totals->cost_gradients.setZero(num_zones());
+  totals->error_map.setZero(model_.num_elements());
+  totals->gap_density.resize(m / picture_stride + 1, stream_density_row_.size());
+  totals->end_retrograde.resize(2, m + 1);
+  totals->rebuild_error = 0.0;
+}
+
+void McreProblem::AddStreamingSample(int j, const Vector& displacement, const Vector& retrograde,
+                                     int picture_stride, StreamingTotals* totals) {
+  const int last = num_nodes() - 1;
+  const double weight = QuadratureWeight(j) * time_step();
+  totals->cost += weight * SampleCost(j, displacement.data(), retrograde.data());
+  if (num_zones() == 1) {
+    totals->cost_gradients[0] +=
+        -0.5 * weight * SampleGradient(displacement.data(), retrograde.data());
+  } else {
+    AddSampleZoneGradients(-0.5 * weight, displacement.data(), retrograde.data(),
+                           &totals->cost_gradients);
+  }
+  if (reaction_row_ >= 0) {
+    totals->cost_gradients[model_.element_zone(0)] +=
+        weight * ReactionGradient(j, displacement.data());
+  }
+  AddSampleGapShares(model_, moduli_, retrograde.data(), weight, &totals->error_map);
+  if (j % picture_stride == 0) {
+    SampleGapDensity(model_, moduli_, retrograde.data(), stream_density_row_.data());
+    totals->gap_density.row(j / picture_stride) = stream_density_row_.transpose();
+  }
+  totals->end_retrograde(0, j) = retrograde[0];
+  totals->end_retrograde(1, j) = retrograde[last];
+}
+
 void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
                                StreamingTotals* totals) {
   assert(traces.rows() == num_traces() && traces.cols() == num_steps() + 1 && image != &traces);
   const int m = num_steps(), last = num_nodes() - 1;
-  const double h = time_step();
   image->resize(num_traces(), m + 1);
   // Every picture_stride-th sample goes into the error map's space-time picture.
   const int picture_stride = SpaceTimeStride(m);
-  if (totals != nullptr) {
-    totals->cost = 0.0;
-    totals->cost_gradients.setZero(num_zones());
-    totals->error_map.setZero(model_.num_elements());
-    totals->gap_density.resize(m / picture_stride + 1, stream_density_row_.size());
-    totals->end_retrograde.resize(2, m + 1);
-    totals->rebuild_error = 0.0;
-  }
+  if (totals != nullptr) ResetStreamingTotals(picture_stride, totals);
   // y_j = H U_j into the image, and the totals of sample j.
   auto observe = [&](int j, const Vector& displacement, const Vector& retrograde) {
     ObserveTraces(displacement, image->col(j).data());
-    if (totals == nullptr) return;
-    const double weight = QuadratureWeight(j) * h;
-    totals->cost += weight * SampleCost(j, displacement.data(), retrograde.data());
-    if (num_zones() == 1) {
-      totals->cost_gradients[0] +=
-          -0.5 * weight * SampleGradient(displacement.data(), retrograde.data());
-    } else {
-      AddSampleZoneGradients(-0.5 * weight, displacement.data(), retrograde.data(),
-                             &totals->cost_gradients);
-    }
-    if (reaction_row_ >= 0) {
-      totals->cost_gradients[model_.element_zone(0)] +=
-          weight * ReactionGradient(j, displacement.data());
-    }
-    AddSampleGapShares(model_, moduli_, retrograde.data(), weight, &totals->error_map);
-    if (j % picture_stride == 0) {
-      SampleGapDensity(model_, moduli_, retrograde.data(), stream_density_row_.data());
-      totals->gap_density.row(j / picture_stride) = stream_density_row_.transpose();
-    }
-    totals->end_retrograde(0, j) = retrograde[0];
-    totals->end_retrograde(1, j) = retrograde[last];
+    if (totals != nullptr) AddStreamingSample(j, displacement, retrograde, picture_stride, totals);
   };
   // The direct step t_{j-1} -> t_j from (V, U)[current] into [next], given W_{j-1} and
   // W_j, with f_theta = -K W_theta + (F~_theta - B W_theta / alpha),

@@ -283,6 +283,15 @@ class McreProblem : public CoupledProblem {
   void AddSampleZoneGradients(double weight, const double* displacement, const double* retrograde,
                               Vector* gradient) const;
 
+  // Sets the totals of a streaming application to zero and sizes them (the error
+  // map's picture takes every picture_stride-th sample).
+  void ResetStreamingTotals(int picture_stride, StreamingTotals* totals);
+  // Adds sample j of a streaming application (U_j, W_j) to the totals: cost,
+  // gradients, error map, the picture's row when j is a multiple of picture_stride,
+  // and W at the ends. No allocation.
+  void AddStreamingSample(int j, const Vector& displacement, const Vector& retrograde,
+                          int picture_stride, StreamingTotals* totals);
+
   // StreamingMap from checkpoints, for theta != 1/2 (the step is not its own inverse)
   // or after UseCheckpoints: the
   // retrograde sweep keeps its state every checkpoint_stride_ steps, then each segment
