@@ -5,7 +5,8 @@
 # 48 x 12 mesh (configs/plate/fine, 1248 dofs); the truth a 96 x 24 mesh (4800 dofs)
 # made here by scripts/make_plate_example.py into a temporary folder (Debian's
 # python3-numpy: `apt-get install python3-numpy`; the build and the tests never need
-# it); an axial impact on the free edge. About 35 minutes on 2 cores with 20 seeds.
+# it); an axial impact on the free edge; then results/README.md is gathered again.
+# About 35 minutes on 2 cores with 20 seeds.
 # Usage: scripts/plate_study.sh [seeds]     (default 20)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -19,4 +20,4 @@ trap 'rm -rf "$work"' EXIT
   --output "$work" > /dev/null
 mkdir -p "$out"
 "$build_dir/bench/plate_identification_benchmark" "$out" --seeds="${1:-20}" --load=axial \
-  --model="$root/configs/plate/fine" --truth="$work/fine"
+  --model="$root/configs/plate/fine" --truth="$work/fine" --studies-readme="$root/results"

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "mcrewave/app/config.h"
+#include "mcrewave/core/file_util.h"
 #include "mcrewave/core/types.h"
 
 namespace mcrewave {
@@ -257,6 +258,17 @@ TEST(StudyTest, CostCurvesHaveTheirMinimaWhereTheIdentificationFindsThem) {
   EXPECT_NE(readme.find("# Results of the studies"), std::string::npos);
   EXPECT_NE(readme.find("## Cost curves"), std::string::npos) << readme;
   EXPECT_EQ(readme.find("## Robustness"), std::string::npos) << readme;
+
+  // A summary that opens at level 1 (the damage and plate studies' own) comes in at
+  // level 2, naming its folder, its subsections one level down with it.
+  std::filesystem::create_directories(parent + "/plate");
+  WriteFileAtomically(parent + "/plate/summary.md",
+                      "# The plate\n\ntext\n\n## Runs\n\n```\n# not a heading\n```\n");
+  const std::string gathered = ReadText(WriteStudiesReadme(parent));
+  EXPECT_NE(gathered.find("\n## The plate (`plate/`)\n"), std::string::npos) << gathered;
+  EXPECT_NE(gathered.find("\n### Runs\n"), std::string::npos) << gathered;
+  EXPECT_NE(gathered.find("\n# not a heading\n"), std::string::npos) << gathered;
+  EXPECT_EQ(gathered.find("\n# The plate"), std::string::npos) << gathered;
 }
 
 // Each bad `study:` value is refused with a message naming its key.

@@ -996,21 +996,54 @@ std::vector<std::string> WriteCostCurveResults(const CostCurveStudy& study,
       {{"cost_curves", CostCurvesScript(study, folder)}}, figures, CostCurvesSummary(study));
 }
 
+namespace {
+
+// A study's summary.md as a section of results/README.md: its headings shifted so
+// that the first is a level-2 heading (some summaries open at level 1), and that
+// heading naming the folder, as "## Title (`study/`)", when it does not already.
+std::string AsReadmeSection(const std::string& summary, const std::string& study) {
+  std::istringstream lines(summary);
+  std::ostringstream section;
+  std::string line;
+  int shift = 0;
+  bool first_heading = true, in_code = false;
+  while (std::getline(lines, line)) {
+    if (line.rfind("```", 0) == 0) in_code = !in_code;
+    if (!in_code && !line.empty() && line[0] == '#') {
+      const int level = static_cast<int>(line.find_first_not_of('#'));
+      if (first_heading) {
+        shift = 2 - level;
+        if (line.find("(`" + study + "/`)") == std::string::npos) {
+          line += " (`" + study + "/`)";
+        }
+        first_heading = false;
+      }
+      const int shifted = std::max(1, level + shift);
+      line = std::string(static_cast<std::size_t>(shifted), '#') +
+             line.substr(static_cast<std::size_t>(level));
+    }
+    section << line << "\n";
+  }
+  return section.str();
+}
+
+}  // namespace
+
 std::string WriteStudiesReadme(const std::string& folder) {
   std::ostringstream md;
   md << "# Results of the studies\n\n"
      << "Written by `identify study` (`bash scripts/studies.sh` regenerates every study, figure "
         "and this file: the studies of configs/studies.yaml, then the robustness settings, the "
-        "complexity and the weights studies of bench/); do not edit by hand. Each section below "
-        "is the `summary.md` of its folder.\n\n";
+        "complexity and the weights studies of bench/; `bash scripts/plate_study.sh` the plate's); "
+        "do not edit by hand. Each section below is the `summary.md` of its folder.\n\n";
   for (const char* study : {"robustness", "relaxation", "cost_curves", "damage", "comparator",
-                            "robustness_settings", "complexity", "weights"}) {
+                            "robustness_settings", "complexity", "weights", "plate"}) {
     const std::string summary = folder + "/" + study + "/summary.md";
     std::ifstream file(summary);
     if (!file) continue;
     std::ostringstream text;
     text << file.rdbuf();
-    md << text.str();
+    md << AsReadmeSection(text.str(), study);
   }
   const std::string path = folder + "/README.md";
   WriteFileAtomically(path, md.str());

@@ -245,8 +245,10 @@ std::vector<std::string> WriteCostCurveResults(const CostCurveStudy& study,
                                                const std::string& folder, bool figures);
 
 // Writes folder/README.md: the summary.md of each study subfolder present
-// (robustness, relaxation, cost_curves), in that order, under a short header.
-// Returns its path.
+// (robustness, relaxation, cost_curves, damage, comparator, robustness_settings,
+// complexity, weights, plate), in that order, under a short header. Each summary's
+// headings are shifted so that its first is a level-2 heading naming the folder,
+// "## Title (`study/`)". Returns its path.
 std::string WriteStudiesReadme(const std::string& folder);
 
 // The logger of the studies' progress lines: the default logger's sinks under
