@@ -47,7 +47,8 @@ double ZoneModulus(const std::string& zones_csv, int zone) {
   for (int z = 0; z <= zone; ++z) std::getline(lines, line);
   std::istringstream cells(line);
   std::string cell;
-  for (int c = 0; c < 4; ++c) std::getline(cells, cell, ',');
+  // zone,name,start_m,end_m,nominal_modulus_pa,modulus_pa,... (app/zones_csv.h)
+  for (int c = 0; c < 6; ++c) std::getline(cells, cell, ',');
   return std::stod(cell);
 }
 

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "mcrewave/app/zones_csv.h"
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/core/format.h"
 #include "mcrewave/core/version.h"
@@ -813,23 +814,20 @@ std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
 namespace {
 
 std::string MatrixZonesCsv(const MatrixIdentificationRun& run) {
-  std::string csv =
-      "zone,name,nominal_modulus_pa,identified_modulus_pa,relative_to_nominal,truth_modulus_pa,"
-      "relative_error,error_share_nominal,error_share_identified,relative_gap_nominal,"
-      "relative_gap_identified\n";
   const Vector nominal_share = GapFractions(run.nominal_zone_map), share = GapFractions(run.zone_map);
+  std::vector<ZoneRow> rows(static_cast<std::size_t>(run.nominal_moduli.size()));
   for (int z = 0; z < run.nominal_moduli.size(); ++z) {
-    const double identified = run.identified_moduli[z];
-    const bool truth = run.truth_moduli.size() > 0;
-    csv += std::to_string(z) + "," + run.zone_names[static_cast<std::size_t>(z)] + "," +
-           Format(run.nominal_moduli[z]) + "," + Format(identified) + "," +
-           Format(identified / run.nominal_moduli[z]) + "," +
-           (truth ? Format(run.truth_moduli[z]) : "") + "," +
-           (truth ? Format(identified / run.truth_moduli[z] - 1.0) : "") + "," +
-           Format(nominal_share[z]) + "," + Format(share[z]) + "," +
-           Format(run.nominal_zone_gap[z]) + "," + Format(run.zone_gap[z]) + "\n";
+    ZoneRow& row = rows[static_cast<std::size_t>(z)];
+    row.name = run.zone_names[static_cast<std::size_t>(z)];
+    row.nominal_modulus = run.nominal_moduli[z];
+    row.modulus = run.identified_moduli[z];
+    if (run.truth_moduli.size() > 0) row.truth_modulus = run.truth_moduli[z];
+    row.error_share_nominal = nominal_share[z];
+    row.error_share_identified = share[z];
+    row.relative_gap_nominal = run.nominal_zone_gap[z];
+    row.relative_gap_identified = run.zone_gap[z];
   }
-  return csv;
+  return ZonesCsv(rows);
 }
 
 // t, each load as used, each sensor as used and as the identified model gives it.
@@ -885,15 +883,15 @@ std::string MatrixZonesScript(const MatrixIdentificationRun& run, const std::str
             "set style fill solid 0.8 border -1\nset xtics rotate by -30\n"
             "set key top right\nset yrange [0:*]\nset offsets 0, 0, graph 0.25, 0\n"
             "set title 'Zone moduli'\nset ylabel 'E [GPa]'\nplot "
-         << csv << " skip 1 using ($3*1e-9):xtic(2) title 'nominal' lc rgb '#aaaaaa', '' skip 1 "
-         << "using ($4*1e-9) title 'identified' lc rgb '#d62728'";
+         << csv << " skip 1 using ($5*1e-9):xtic(2) title 'nominal' lc rgb '#aaaaaa', '' skip 1 "
+         << "using ($6*1e-9) title 'identified' lc rgb '#d62728'";
   if (run.truth_moduli.size() > 0) {
-    script << ", '' skip 1 using ($6*1e-9) title 'truth' lc rgb '#000000'";
+    script << ", '' skip 1 using ($8*1e-9) title 'truth' lc rgb '#000000'";
   }
   script << "\nset title 'MCRE error map: constitutive gap / strain energy of the zone'\n"
             "set ylabel 'relative gap'\nplot "
-         << csv << " skip 1 using 10:xtic(2) title 'at the nominal moduli' lc rgb '#fdae61', '' "
-         << "skip 1 using 11 title 'at the identified moduli' lc rgb '#2c7bb6'\n"
+         << csv << " skip 1 using 12:xtic(2) title 'at the nominal moduli' lc rgb '#fdae61', '' "
+         << "skip 1 using 13 title 'at the identified moduli' lc rgb '#2c7bb6'\n"
             "unset multiplot\n";
   return script.str();
 }

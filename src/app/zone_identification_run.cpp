@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "mcrewave/app/identification_run.h"
+#include "mcrewave/app/zones_csv.h"
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/core/format.h"
 
@@ -162,18 +163,21 @@ std::vector<std::string> ZonesYamlLines(const ZoneIdentificationRun& run) {
 std::string ZonesCsv(const ZoneIdentificationRun& run, const BarProperties& bar) {
   const BarModel model(bar, run.layout.ElementZones(bar));
   const ZoneIdentificationSummary& s = run.summary;
-  std::ostringstream csv;
-  csv << "zone,start_m,end_m,modulus_pa,relative_to_homogeneous,truth_modulus_pa\n";
   // The truth's modulus of a zone: its elements in series.
   const std::vector<double> truth = run.truth_element_moduli.size() > 0
                                         ? ZoneModuliInSeries(model, run.truth_element_moduli)
                                         : std::vector<double>{};
-  for (Eigen::Index z = 0; z < s.moduli.size(); ++z) {
-    csv << z << "," << Number(s.zone_start[z]) << "," << Number(s.zone_end[z]) << ","
-        << Number(s.moduli[z]) << "," << Number(s.moduli[z] / s.homogeneous_modulus) << ","
-        << (truth.empty() ? std::string() : Number(truth[static_cast<std::size_t>(z)])) << "\n";
+  std::vector<ZoneRow> rows(static_cast<std::size_t>(s.moduli.size()));
+  for (std::size_t z = 0; z < rows.size(); ++z) {
+    ZoneRow& row = rows[z];
+    row.name = "zone" + std::to_string(z);
+    row.start_m = s.zone_start[z];
+    row.end_m = s.zone_end[z];
+    row.nominal_modulus = s.homogeneous_modulus;
+    row.modulus = s.moduli[static_cast<Eigen::Index>(z)];
+    if (!truth.empty()) row.truth_modulus = truth[z];
   }
-  return csv.str();
+  return ZonesCsv(rows);
 }
 
 std::vector<std::string> WriteZoneResults(const ZoneIdentificationRun& run,

@@ -55,9 +55,9 @@ ZoneIdentificationRun RunLeastSquaresZoneIdentification(
 
 // The lines of summary.yaml's `zones:` block (indented, no trailing newline per line).
 std::vector<std::string> ZonesYamlLines(const ZoneIdentificationRun& run);
-// zones.csv: zone,start_m,end_m,modulus_pa,relative_to_homogeneous,truth_modulus_pa
-// (truth: the truth's elements of the zone in series, ZoneModuliInSeries; empty when
-// unknown).
+// zones.csv in the layout of app/zones_csv.h: each zone's extent, its start E* as the
+// nominal modulus, and the truth's modulus (its elements in series,
+// ZoneModuliInSeries; empty when unknown).
 std::string ZonesCsv(const ZoneIdentificationRun& run, const BarProperties& bar);
 // Writes zones.csv (and moduli.png with figures) into folder; returns the paths written.
 std::vector<std::string> WriteZoneResults(const ZoneIdentificationRun& run,
