@@ -640,6 +640,41 @@ TEST(ConfigTest, EveryKeyAtANonDefaultValueRoundTripsExactly) {
   }
 }
 
+// A summary's config block lists the keys its model kind reads: a matrix run's no
+// clamp, search or bar geometry; the bar's no manifest. Every key named by
+// KeyApplies' lists is a key of the table (the counts below fail on a misspelling).
+TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
+  const std::map<std::string, std::string> every = FlatKeys(ConfigToYaml(Config()));
+  const Config matrix = ParseConfig(kEveryMatrixKeyNotAtItsDefault, "matrix.yaml");
+  const std::map<std::string, std::string> matrix_keys = FlatKeys(AppliedConfigToYaml(matrix));
+  const std::map<std::string, std::string> bar_keys = FlatKeys(AppliedConfigToYaml(Config()));
+  for (const char* key : {"model.manifest", "model.channel_map", "data.truth_manifest",
+                          "data.truth_moduli", "mcre.w_u", "mcre.reference_modulus", "inner.method",
+                          "outer.lower_bound", "prefilter.cutoff_frequency",
+                          "zone_identification.algorithm", "time.step", "load.amplitude"}) {
+    EXPECT_EQ(matrix_keys.count(key), 1u) << key;
+    EXPECT_TRUE(KeyApplies(key, ModelKind::kMatrix)) << key;
+  }
+  for (const char* key :
+       {"mcre.clamp", "mcre.w_r", "mcre.w_u0", "search.functional", "model.length",
+        "model.zone_count", "outer.scan_points", "zone_identification.merge_zones",
+        "uncertainty.samples", "study.kind", "data.sensors"}) {
+    EXPECT_EQ(matrix_keys.count(key), 0u) << key;
+    EXPECT_EQ(bar_keys.count(key), 1u) << key;
+  }
+  // The bar reads all but the 4 matrix keys; a matrix run none of the 3 sections
+  // search:, uncertainty:, study: and 47 single keys fewer.
+  EXPECT_EQ(bar_keys.size(), every.size() - 4);
+  std::size_t sections = 0;
+  for (const auto& [key, value] : every) {
+    const std::string section = key.substr(0, key.find('.'));
+    sections += section == "search" || section == "uncertainty" || section == "study" ? 1 : 0;
+  }
+  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 47);
+  // Values as resolved: the matrix run's own.
+  EXPECT_EQ(matrix_keys.at("model.manifest"), FlatKeys(ConfigToYaml(matrix)).at("model.manifest"));
+}
+
 TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"model:\n  manifest: m.yaml\n", "model.manifest applies to model.kind 'matrix' only"},

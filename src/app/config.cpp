@@ -14,6 +14,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -1358,10 +1359,11 @@ std::string WhyUnreadable(const std::string& path) {
 
 // The config as YAML, one section per table section; with comments, each key
 // line ends with "# [unit] description (choices)".
-std::string WriteYaml(const Config& config, bool with_comments) {
+std::string WriteYaml(const Config& config, bool with_comments, bool applied_only = false) {
   std::vector<std::pair<std::string, std::string>> lines;  // text, comment
   std::string section;
   for (const Key& key : KeyTable()) {
+    if (applied_only && !KeyApplies(key.path, config.structure.kind)) continue;
     if (key.section() != section) {
       section = key.section();
       lines.emplace_back(section + ":", "");
@@ -1485,6 +1487,66 @@ std::string DefaultConfigYaml() {
 
 std::string ConfigToYaml(const Config& config) {
   return WriteYaml(config, /*with_comments=*/false);
+}
+
+bool KeyApplies(const std::string& path, ModelKind kind) {
+  static const std::set<std::string> matrix_only = {"model.manifest", "model.channel_map",
+                                                    "data.truth_manifest", "data.truth_moduli"};
+  if (kind == ModelKind::kBar) return matrix_only.count(path) == 0;
+  // Whole sections, then single keys, that a matrix run does not read.
+  static const std::set<std::string> bar_sections = {"search", "uncertainty", "study"};
+  static const std::set<std::string> bar_only = {"model.length",
+                                                 "model.section",
+                                                 "model.density",
+                                                 "model.modulus",
+                                                 "model.elements",
+                                                 "model.mass",
+                                                 "model.zoning",
+                                                 "model.zone_count",
+                                                 "model.zone_boundaries",
+                                                 "data.truth",
+                                                 "data.truth_refinement",
+                                                 "data.sensors",
+                                                 "data.channels",
+                                                 "data.truth_zones",
+                                                 "mcre.w_r",
+                                                 "mcre.w_u0",
+                                                 "mcre.clamp",
+                                                 "inner.max_dense_solver_bytes",
+                                                 "inner.shooting_condition_limit",
+                                                 "inner.shooting_segment_growth",
+                                                 "outer.optimizer",
+                                                 "outer.algorithm",
+                                                 "outer.initial",
+                                                 "outer.relative_tolerance",
+                                                 "outer.max_evaluations",
+                                                 "outer.max_time",
+                                                 "outer.scan_points",
+                                                 "outer.scan_samples_per_valley",
+                                                 "outer.scan_max_points",
+                                                 "outer.scan_tolerance",
+                                                 "outer.scan_threads",
+                                                 "outer.refine_margin",
+                                                 "outer.refine_candidates",
+                                                 "output.curve_points",
+                                                 "zone_identification.regularization",
+                                                 "zone_identification.regularization_weight",
+                                                 "zone_identification.weight_rule",
+                                                 "zone_identification.tv_smoothing",
+                                                 "zone_identification.max_weight",
+                                                 "zone_identification.min_weight",
+                                                 "zone_identification.grid_factor",
+                                                 "zone_identification.refinement_steps",
+                                                 "zone_identification.weight_tolerance",
+                                                 "zone_identification.discrepancy_factor",
+                                                 "zone_identification.noise_samples",
+                                                 "zone_identification.noise_seed",
+                                                 "zone_identification.merge_zones"};
+  return bar_sections.count(path.substr(0, path.find('.'))) == 0 && bar_only.count(path) == 0;
+}
+
+std::string AppliedConfigToYaml(const Config& config) {
+  return WriteYaml(config, /*with_comments=*/false, /*applied_only=*/true);
 }
 
 }  // namespace mcrewave

@@ -441,10 +441,11 @@ class ResultsFolder {
   std::vector<std::string> written_;
 };
 
-// The closing config: block of a summary, every key as resolved.
+// The closing config: block of a summary, every key that applies to the model's
+// kind, as resolved.
 void ConfigYaml(const Config& config, YamlWriter* yaml) {
-  yaml->Line(0, "config", "", "as resolved (every key)");
-  std::istringstream text(ConfigToYaml(config));
+  yaml->Line(0, "config", "", "as resolved (every key that applies to model.kind)");
+  std::istringstream text(AppliedConfigToYaml(config));
   for (std::string line; std::getline(text, line);) yaml->Raw("  " + line);
 }
 

@@ -167,7 +167,21 @@ bool ScansTheSearchFunctional(const Config& config);
 // and meaning; ParseConfig(DefaultConfigYaml(), ...) gives the default Config.
 std::string DefaultConfigYaml();
 
-// The config as resolved (every key, current values) in YAML, for summaries.
+// The config as resolved (every key, current values) in YAML;
+// ParseConfig(ConfigToYaml(config), ...) gives the config back.
 std::string ConfigToYaml(const Config& config);
+
+// Whether a run on a structure of `kind` reads key `path` ("section.name"). The bar
+// reads every key but the matrix model's own (model.manifest, model.channel_map,
+// data.truth_manifest, data.truth_moduli). A structure given by matrices does not
+// read the bar's geometry and zoning, its truth and sensor keys, the clamp's weights,
+// the shooting solvers' limits, the scalar identification's outer: keys (its zones
+// are minimised under zone_identification:), search:, uncertainty:, study:, nor the
+// penalty and merging keys of zone_identification: (docs/matrix_models.md).
+bool KeyApplies(const std::string& path, ModelKind kind);
+
+// ConfigToYaml with only the keys that apply to config.structure.kind: the config
+// block of a run's summary.yaml.
+std::string AppliedConfigToYaml(const Config& config);
 
 }  // namespace mcrewave
