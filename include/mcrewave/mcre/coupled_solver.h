@@ -102,8 +102,8 @@ struct CoupledSolverOptions {
   long max_field_bytes = 2L << 30;
   // streaming_conjugate_gradient at theta = 1/2: when the retrograde state rebuilt by
   // the reversed recursion drifts by more than this (||omega_0 rebuilt to omega_m|| /
-  // max_j ||omega_j||, 0 in exact arithmetic; measured 1e-15 to 1e-12 on the tests'
-  // grids, 1.1e-8 at a Courant number of 570 and 1.1e-6 at 5700), the solver switches
+  // max_j ||omega_j||, 0 in exact arithmetic, growing with the Courant number:
+  // docs/streaming.md gives the measured values), the solver switches
   // the problem to checkpoints (McreProblem::UseCheckpoints) and goes on from its
   // traces. Library option, no config key.
   double max_rebuild_error = 1e-7;

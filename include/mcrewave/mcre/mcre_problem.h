@@ -214,7 +214,7 @@ class McreProblem : public CoupledProblem {
   Matrix DataTraces() const;
   // From now on, StreamingMap takes the retrograde field from checkpoints (four sweeps,
   // W the stored sweep's to the bit) instead of the reversed recursion, whose
-  // round-off grows with the Courant number (1.1e-6 of omega over 1750 steps at 5700).
+  // round-off grows with the Courant number (docs/streaming.md).
   // Allocates the checkpoints, O(n sqrt(m)), on the first call; theta != 1/2 always
   // uses them.
   void UseCheckpoints();
