@@ -88,16 +88,16 @@ struct PaperCase {
   }
   BarProperties bar;
   BarModel model;
-  MeasurementSet data;
+  ChannelSet data;
 };
 
 // The first `steps` steps of a measurement set.
-MeasurementSet Truncate(const MeasurementSet& data, int steps) {
-  MeasurementSet head = data;
-  head.u0 = data.u0.head(steps + 1);
-  head.uL = data.uL.head(steps + 1);
-  head.f0 = data.f0.head(steps + 1);
-  head.fL = data.fL.head(steps + 1);
+ChannelSet Truncate(const ChannelSet& data, int steps) {
+  ChannelSet head = data;
+  head.Values("u0") = data.Values("u0").head(steps + 1);
+  head.Values("uL") = data.Values("uL").head(steps + 1);
+  head.Values("f0") = data.Values("f0").head(steps + 1);
+  head.Values("fL") = data.Values("fL").head(steps + 1);
   return head;
 }
 
@@ -150,7 +150,7 @@ struct RunResult {
 };
 
 RunResult RunOnce(const CoupledSolverOptions& options, const BarModel& model,
-                  const MeasurementSet& data, double reference_modulus) {
+                  const ChannelSet& data, double reference_modulus) {
   McreProblem problem(model, data, McreWeights(), reference_modulus, 0.5);
   problem.SetModulus(0.9 * reference_modulus);
   RunResult result;
@@ -311,7 +311,7 @@ std::string ShootingBreakdownScan() {
     data_options.seed = 7;
     data_options.truth_refinement = 2;
     const BarModel model(bar);
-    const MeasurementSet data = MakeSyntheticMeasurements(bar, load, time, data_options);
+    const ChannelSet data = MakeSyntheticMeasurements(bar, load, time, data_options);
     McreWeights weights;
     weights.displacement_weight = window.w_u;
     McreProblem problem(model, data, weights, bar.modulus, window.theta);

@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
   for (double snr : {std::numeric_limits<double>::infinity(), 2.5}) {
     mcrewave::DataOptions data;
     data.snr = snr;
-    const mcrewave::MeasurementSet measurements =
+    const mcrewave::ChannelSet measurements =
         mcrewave::MakeSyntheticMeasurements(bar, load, time, data);
     McreProblem problem(model, measurements, mcrewave::McreWeights(), reference, time.theta);
     if (sweep_seconds == 0.0) sweep_seconds = SecondsOfOneDirectSweep(&problem);

@@ -68,7 +68,7 @@ struct IdentifyFigures {
   bool usable = false;
 };
 
-IdentifyFigures IdentifyOnce(const mcrewave::Config& config, const mcrewave::MeasurementSet& data) {
+IdentifyFigures IdentifyOnce(const mcrewave::Config& config, const mcrewave::ChannelSet& data) {
   IdentifyFigures figures;
   const mcrewave::BarModel model(config.model);
   const double start = ProcessCpuSeconds();
@@ -91,8 +91,7 @@ struct SweepStepTimes {
   double direct = 0.0, retrograde = 0.0, batched_direct = 0.0;
 };
 
-SweepStepTimes SweepStepSeconds(const mcrewave::Config& config,
-                                const mcrewave::MeasurementSet& data) {
+SweepStepTimes SweepStepSeconds(const mcrewave::Config& config, const mcrewave::ChannelSet& data) {
   const mcrewave::BarModel model(config.model);
   mcrewave::McreProblem problem(model, data, config.mcre.weights, config.mcre.reference_modulus,
                                 config.time.theta, {}, config.mcre.clamp);
@@ -143,9 +142,9 @@ int main(int argc, char** argv) {
   if (paths.empty()) paths = {"configs/paper_bar.yaml", "configs/quick.yaml"};
   for (const std::string& path : paths) {
     const mcrewave::Config config = mcrewave::LoadConfig(path, overrides);
-    const mcrewave::MeasurementSet measured = mcrewave::LoadMeasurements(config);
+    const mcrewave::ChannelSet measured = mcrewave::LoadMeasurements(config);
     double cutoff = 0.0;
-    const mcrewave::MeasurementSet data =
+    const mcrewave::ChannelSet data =
         mcrewave::PrefilterMeasurements(measured, config.prefilter, &cutoff);
     std::printf("%s: %d nodes, %d steps, scan %d points on %d threads\n", path.c_str(),
                 config.model.elements + 1, config.time.NumSteps(), config.outer.scan_points,

@@ -64,17 +64,15 @@ constexpr double kNominal = 2e11;         // [Pa], E0 of the weights and the sta
 Vector TruthModuli() { return (Vector(2) << 2e11, 1.4e11).finished(); }
 
 // The measured load F and the fine plate's outputs at the truth, noise-free.
-ChannelHistories FineTruth(const MatrixModelData& fine) {
-  ChannelHistories data;
-  data.time_step = kTimeStep;
-  data.loads = Matrix::Zero(1, kSteps + 1);
+// (The fine and the coarse plate name their channels alike.)
+ChannelSet FineTruth(const MatrixModelData& fine) {
+  Matrix loads = Matrix::Zero(1, kSteps + 1);
   for (int j = 0; j <= kSteps; ++j) {
     const double t = j * kTimeStep;
-    if (t < kImpactDuration)
-      data.loads(0, j) = kImpactAmplitude * std::sin(M_PI * t / kImpactDuration);
+    if (t < kImpactDuration) loads(0, j) = kImpactAmplitude * std::sin(M_PI * t / kImpactDuration);
   }
-  data.outputs = SimulateMatrixModel(fine, TruthModuli(), data.loads, kTimeStep, 0.5);
-  return data;
+  return MatrixChannelSet(fine, kTimeStep, loads,
+                          SimulateMatrixModel(fine, TruthModuli(), loads, kTimeStep, 0.5));
 }
 
 struct Run {
@@ -87,9 +85,9 @@ struct Run {
   double wall_time_s = 0.0;
 };
 
-void Identify(const MatrixModelData& coarse, const ChannelHistories& truth, Run* run) {
+void Identify(const MatrixModelData& coarse, const ChannelSet& truth, Run* run) {
   const auto start = std::chrono::steady_clock::now();
-  ChannelHistories data = truth;
+  ChannelSet data = truth;
   AddMatrixModelNoise(coarse, run->snr, run->seed, &data);
   MatrixMcreProblem problem(coarse, data, McreWeights(), kNominal, 0.5);
   CoupledSolverOptions inner;
@@ -153,7 +151,7 @@ Vector AxialEdgeLoad(const std::string& nodes_csv, int dofs) {
 // as shares of the total. Writes error_map.csv (element, x_centre, y_centre, half
 // width, half height, zone, share) and draws error_map.png.
 void WriteErrorMap(const MatrixModelData& coarse, const std::string& coarse_folder,
-                   const ChannelHistories& truth, const std::string& folder) {
+                   const ChannelSet& truth, const std::string& folder) {
   MatrixMcreProblem problem(coarse, truth, McreWeights(), kNominal, 0.5);
   CoupledSolverOptions inner;
   inner.tolerance = 1e-10;
@@ -256,7 +254,7 @@ int main(int argc, char** argv) {
     coarse.loads[0].vector = AxialEdgeLoad(model_folder + "/nodes.csv", coarse.dofs());
     fine.loads[0].vector = AxialEdgeLoad(truth_folder + "/nodes.csv", fine.dofs());
   }
-  const ChannelHistories truth = FineTruth(fine);
+  const ChannelSet truth = FineTruth(fine);
   WriteErrorMap(coarse, model_folder, truth, folder);
 
   std::vector<Run> runs;

@@ -58,13 +58,13 @@ struct Outcome {
   bool usable = false;
 };
 
-Outcome IdentifyOnce(const mcrewave::BarModel& model, const mcrewave::MeasurementSet& measured,
+Outcome IdentifyOnce(const mcrewave::BarModel& model, const mcrewave::ChannelSet& measured,
                      const Setting& setting, double reference) {
   const auto start = std::chrono::steady_clock::now();
   Outcome outcome;
   mcrewave::PrefilterOptions prefilter;
   prefilter.enabled = setting.prefilter;
-  const mcrewave::MeasurementSet data =
+  const mcrewave::ChannelSet data =
       mcrewave::PrefilterMeasurements(measured, prefilter, &outcome.cutoff);
   // The settings of docs/robustness.md, in the paper's free-free formulation they
   // were chosen in (the trusted clamp's defaults: results/robustness).
@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
   const mcrewave::DataOptions truth_options;  // finite-element truth, refinement 4
   const mcrewave::BarModel model(bar);
   const double reference = bar.modulus;
-  const mcrewave::MeasurementSet truth = mcrewave::SimulateTruth(bar, load, time, truth_options);
+  const mcrewave::ChannelSet truth = mcrewave::SimulateTruth(bar, load, time, truth_options);
 
   const std::vector<Setting> settings = {
       {"local_only_w0.01", 0.01, 1.0, false, 0},
@@ -143,7 +143,7 @@ int main(int argc, char** argv) {
   auto worker = [&]() {
     for (int j = next++; j < static_cast<int>(jobs.size()); j = next++) {
       const Job& job = jobs[j];
-      mcrewave::MeasurementSet measured = truth;
+      mcrewave::ChannelSet measured = truth;
       mcrewave::AddMeasurementNoise(snrs[job.snr], static_cast<std::uint64_t>(job.seed), &measured);
       outcomes[j] = IdentifyOnce(model, measured, settings[job.setting], reference);
       std::lock_guard<std::mutex> lock(progress_mutex);

@@ -27,8 +27,8 @@ void BM_SimulateClampedBar(benchmark::State& state) {
   const LoadOptions load;
   const TimeOptions time;  // 0.63 ms / 0.36 us = 1750 steps
   for (auto _ : state) {
-    MeasurementSet measurements = SimulateClampedBar(bar, load, time);
-    benchmark::DoNotOptimize(measurements.uL.data());
+    ChannelSet measurements = SimulateClampedBar(bar, load, time);
+    benchmark::DoNotOptimize(measurements.Values("uL").data());
   }
   state.counters["steps"] = time.NumSteps();
   state.counters["time_per_step"] = benchmark::Counter(

@@ -102,11 +102,9 @@ void MeasureSweeps(const SparseMatrix& mass, const SparseMatrix& stiffness, doub
                    double* retrograde, std::string* refusal) {
   const MatrixModelData model = GridModel(mass, stiffness);
   const auto n = static_cast<int>(mass.rows());
-  ChannelHistories data;
-  data.time_step = 0.5;
-  data.loads = Matrix::Zero(1, kSweepSteps + 1);
-  for (int j = 0; j <= kSweepSteps; ++j) data.loads(0, j) = std::sin(0.3 * j);
-  data.outputs = Matrix::Zero(3, kSweepSteps + 1);
+  Matrix loads = Matrix::Zero(1, kSweepSteps + 1);
+  for (int j = 0; j <= kSweepSteps; ++j) loads(0, j) = std::sin(0.3 * j);
+  const ChannelSet data = MatrixChannelSet(model, 0.5, loads, Matrix::Zero(3, kSweepSteps + 1));
   MatrixMcreProblem problem(model, data, McreWeights(), 1.0, 0.5, Factorization::kSparse);
   problem.SetModuli(Vector::Ones(1));
   Matrix displacement(n, kSweepSteps + 1), field(n, kSweepSteps + 1);
@@ -118,10 +116,8 @@ void MeasureSweeps(const SparseMatrix& mass, const SparseMatrix& stiffness, doub
   problem.RetrogradeSweep(displacement, true, &field);
   *retrograde = Seconds(start) / kSweepSteps;
 
-  ChannelHistories long_data;
-  long_data.time_step = 0.5;
-  long_data.loads = Matrix::Zero(1, kFieldSteps + 1);
-  long_data.outputs = Matrix::Zero(3, kFieldSteps + 1);
+  const ChannelSet long_data = MatrixChannelSet(model, 0.5, Matrix::Zero(1, kFieldSteps + 1),
+                                                Matrix::Zero(3, kFieldSteps + 1));
   MatrixMcreProblem long_problem(model, long_data, McreWeights(), 1.0, 0.5,
                                  Factorization::kSparse);
   CoupledSolverOptions options;  // auto: stored-field CG on matrices; the default max_field_bytes

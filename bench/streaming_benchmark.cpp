@@ -80,7 +80,7 @@ McreOptions formulation = [] {
 
 // Builds the problem at 0.95 E_ref and solves it once; the time is the solve's, the
 // memory that of the problem and the solve.
-Measured SolveOnce(const BarModel& model, const MeasurementSet& data, CoupledSolverType type) {
+Measured SolveOnce(const BarModel& model, const ChannelSet& data, CoupledSolverType type) {
   CoupledSolverOptions options;
   options.type = type;
   options.tolerance = tolerance;
@@ -126,7 +126,7 @@ Row Case(int elements, int steps, double max_stored_bytes) {
   data.snr = 10.0;
   data.truth_refinement = 1;
   const BarModel model(bar);
-  const MeasurementSet measured = MakeSyntheticMeasurements(bar, load, time, data);
+  const ChannelSet measured = MakeSyntheticMeasurements(bar, load, time, data);
   Row row{elements + 1, steps, {}, {}};
   const double stored_bytes = kIterativeSolverFields * 8.0 * (elements + 1.0) * (steps + 1.0);
   if (stored_bytes <= max_stored_bytes) {

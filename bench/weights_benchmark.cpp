@@ -43,7 +43,7 @@ struct CurveFacts {
 
 double GridFactor(int i) { return kGridLow + (kGridHigh - kGridLow) * i / (kGridPoints - 1); }
 
-CurveFacts CostCurve(const mcrewave::BarModel& model, const mcrewave::MeasurementSet& data,
+CurveFacts CostCurve(const mcrewave::BarModel& model, const mcrewave::ChannelSet& data,
                      const mcrewave::McreWeights& weights, double reference) {
   mcrewave::McreProblem problem(model, data, weights, reference, 0.5);
   mcrewave::CoupledSolverOptions options;
@@ -91,7 +91,7 @@ int main(int argc, char** argv) {
       {0.001, 1.0}, {0.01, 1.0}, {0.1, 1.0}, {1.0, 1.0}, {0.01, 0.1}, {0.01, 10.0}};
 
   // Data sets: index 0 noise-free, then seeds 1..n at SNR 2.5.
-  std::vector<mcrewave::MeasurementSet> data_sets;
+  std::vector<mcrewave::ChannelSet> data_sets;
   mcrewave::DataOptions data;
   data_sets.push_back(mcrewave::MakeSyntheticMeasurements(bar, load, time, data));
   data.snr = 2.5;

@@ -41,7 +41,7 @@ struct Figures {
   long sweeps = 0;
 };
 
-Figures Measure(const mcrewave::Config& config, const mcrewave::MeasurementSet& data, int zones,
+Figures Measure(const mcrewave::Config& config, const mcrewave::ChannelSet& data, int zones,
                 int repeats) {
   using namespace mcrewave;
   ZoneLayout layout;
@@ -87,9 +87,9 @@ int main(int argc, char** argv) {
   spdlog::set_level(spdlog::level::warn);
   try {
     const mcrewave::Config config = mcrewave::LoadConfig(path);
-    const mcrewave::MeasurementSet measured = mcrewave::LoadMeasurements(config);
+    const mcrewave::ChannelSet measured = mcrewave::LoadMeasurements(config);
     double cutoff = 0.0;
-    const mcrewave::MeasurementSet data =
+    const mcrewave::ChannelSet data =
         config.prefilter.enabled
             ? mcrewave::PrefilterMeasurements(measured, config.prefilter, &cutoff)
             : measured;

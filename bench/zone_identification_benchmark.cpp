@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
   try {
     Config config = LoadConfig(path, {"data.snr=.inf"});
     if (!algorithm_given) algorithm = config.zone_identification.minimizer.algorithm;
-    MeasurementSet data = LoadMeasurements(config);
+    ChannelSet data = LoadMeasurements(config);
     // The truth: a soft zone of 0.7 E over [0.6, 0.7] L, one modulus per element.
     ZoneLayout per_element;
     per_element.zoning = Zoning::kPerElement;
@@ -86,17 +86,17 @@ int main(int argc, char** argv) {
     truth_problem.SetModuli(truth);
     Matrix displacement;
     truth_problem.DirectSweep(truth_problem.ZeroField(), true, &displacement);
-    data.u0 = displacement.row(0).transpose();
-    data.uL = displacement.row(truth_model.num_nodes() - 1).transpose();
+    data.Values("u0") = displacement.row(0).transpose();
+    data.Values("uL") = displacement.row(truth_model.num_nodes() - 1).transpose();
     if (std::isfinite(snr)) {
       std::mt19937_64 engine(1);
       std::normal_distribution<double> normal;
-      const double u_std = Rms(data.uL) / snr;
-      const double f_std = Rms(data.fL) / snr;
-      for (Vector* v : {&data.u0, &data.uL}) {
+      const double u_std = Rms(data.Values("uL")) / snr;
+      const double f_std = Rms(data.Values("fL")) / snr;
+      for (Vector* v : {&data.Values("u0"), &data.Values("uL")}) {
         for (double& value : *v) value += u_std * normal(engine);
       }
-      for (Vector* v : {&data.f0, &data.fL}) {
+      for (Vector* v : {&data.Values("f0"), &data.Values("fL")}) {
         for (double& value : *v) value += f_std * normal(engine);
       }
     }

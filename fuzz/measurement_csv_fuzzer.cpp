@@ -14,12 +14,14 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::istringstream text(std::string(reinterpret_cast<const char*>(data), size));
   try {
-    const mcrewave::MeasurementSet set = mcrewave::ParseMeasurementCsv(text, "fuzz.csv");
-    const bool usable = set.num_samples() >= 2 && set.uL.size() == set.u0.size() &&
-                        set.f0.size() == set.u0.size() && set.fL.size() == set.u0.size() &&
-                        std::isfinite(set.time_step) && set.time_step > 0.0 &&
-                        std::isfinite(set.start_time) && set.u0.allFinite() && set.uL.allFinite() &&
-                        set.f0.allFinite() && set.fL.allFinite();
+    const mcrewave::ChannelSet set = mcrewave::ParseMeasurementCsv(text, "fuzz.csv");
+    const bool usable =
+        set.num_samples() >= 2 && set.Values("uL").size() == set.Values("u0").size() &&
+        set.Values("f0").size() == set.Values("u0").size() &&
+        set.Values("fL").size() == set.Values("u0").size() && std::isfinite(set.time_step) &&
+        set.time_step > 0.0 && std::isfinite(set.start_time) && set.Values("u0").allFinite() &&
+        set.Values("uL").allFinite() && set.Values("f0").allFinite() &&
+        set.Values("fL").allFinite();
     if (!usable) __builtin_trap();
   } catch (const mcrewave::InputError&) {
   }

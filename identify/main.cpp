@@ -189,7 +189,7 @@ void CheckOutputFolder(const std::string& folder) {
 // Steps 3 to 5 of RunIdentify with outer.functional: least_squares: the
 // comparator's estimate of E, its fit and cost curve, and its zone moduli when the
 // identification has zones.
-int IdentifyByLeastSquares(const mcrewave::Config& config, const mcrewave::MeasurementSet& data) {
+int IdentifyByLeastSquares(const mcrewave::Config& config, const mcrewave::ChannelSet& data) {
   const mcrewave::LeastSquaresRun run = mcrewave::RunLeastSquares(config, data);
   const std::string on_bound =
       run.IsUsable() ? mcrewave::ModulusOnBoundMessage(run.identified_modulus(), config.outer)
@@ -253,7 +253,7 @@ int RunIdentify(const RunArguments& arguments) {
   if (config.structure.kind == mcrewave::ModelKind::kMatrix) return IdentifyMatrixModel(config);
 
   // 2. The measurements, checked against the model's time grid.
-  const mcrewave::MeasurementSet data = mcrewave::LoadMeasurements(config);
+  const mcrewave::ChannelSet data = mcrewave::LoadMeasurements(config);
   spdlog::info("config {}: {} elements, {} steps of {:.4g} s; data {} ({} samples)",
                arguments.config_path, config.model.elements, config.time.NumSteps(),
                config.time.step,
@@ -320,8 +320,8 @@ int RunSimulate(const SimulateArguments& arguments) {
     const mcrewave::MatrixMeasurements data = mcrewave::LoadMatrixMeasurements(config, model);
     {
       const ResultsBeingWritten held;
-      mcrewave::WriteChannelTable(
-          mcrewave::MatrixMeasurementTable(config, model, data.histories), arguments.output_path);
+      mcrewave::WriteChannelCsv(mcrewave::MatrixMeasurementTable(config, model, data.histories),
+                                arguments.output_path);
     }
     spdlog::info("wrote {} samples of {} channels to {} in {:.3f} s",
                  data.histories.num_steps() + 1, model.loads.size() + model.sensors.size(),
@@ -335,7 +335,7 @@ int RunSimulate(const SimulateArguments& arguments) {
                config.data.truth_refinement, config.data.snr);
 
   // 2. Simulate the truth and add measurement noise.
-  const mcrewave::MeasurementSet measurements = mcrewave::SyntheticMeasurements(config);
+  const mcrewave::ChannelSet measurements = mcrewave::SyntheticMeasurements(config);
 
   // 3. Write the measurement set atomically.
   {
@@ -347,8 +347,8 @@ int RunSimulate(const SimulateArguments& arguments) {
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   spdlog::info("wrote {} samples to {} in {:.3f} s (RMS uL {:.4g} m, RMS fL {:.4g} N)",
                measurements.num_samples(), arguments.output_path, seconds,
-               mcrewave::RootMeanSquare(measurements.uL),
-               mcrewave::RootMeanSquare(measurements.fL));
+               mcrewave::RootMeanSquare(measurements.Values("uL")),
+               mcrewave::RootMeanSquare(measurements.Values("fL")));
   return 0;
 }
 

@@ -406,9 +406,9 @@ TEST(McreProblemAllocationTest, RetrogradeSweepsWithInteriorSensorsAllocateNothi
   SKIP_WITHOUT_ALLOCATION_COUNTING();
   ProblemBundle bundle(MakeSmallCase(kElements, kSteps, 5.0, 2), Weights(0.01, 1.0));
   // A displacement and a strain sensor inside the bar, read off the data's own model.
-  MeasurementSet data = bundle.data;
-  data.sensors.push_back({"u@0.4", SensorKind::kDisplacement, 0.4, 1e-6 * data.uL});
-  data.sensors.push_back({"e@0.7", SensorKind::kStrain, 0.7, 1e-3 * data.uL});
+  ChannelSet data = bundle.data;
+  data.Add("u@0.4", ChannelKind::kDisplacement, 1e-6 * data.Values("uL"));
+  data.Add("e@0.7", ChannelKind::kStrain, 1e-3 * data.Values("uL"));
   McreProblem problem(bundle.model, data, Weights(0.01, 1.0), testing::kReferenceModulus, 0.5);
   problem.SetModulus(0.9 * testing::kReferenceModulus);
   Matrix displacement = problem.ZeroField(), retrograde = problem.ZeroField();
@@ -433,11 +433,10 @@ TEST(MatrixMcreProblemAllocationTest, SweepsAndSumsAllocateNothing) {
   SKIP_WITHOUT_ALLOCATION_COUNTING();
   const MatrixModelData plate =
       ReadMatrixModel(std::string(MCREWAVE_SOURCE_DIR) + "/configs/plate/coarse/model.yaml");
-  ChannelHistories data;
-  data.time_step = 1e-6;
-  data.loads = Matrix::Zero(1, 21);
-  data.loads(0, 3) = 1e3;
-  data.outputs = Matrix::Constant(static_cast<int>(plate.sensors.size()), 21, 1e-7);
+  Matrix loads = Matrix::Zero(1, 21);
+  loads(0, 3) = 1e3;
+  const ChannelSet data = MatrixChannelSet(
+      plate, 1e-6, loads, Matrix::Constant(static_cast<int>(plate.sensors.size()), 21, 1e-7));
   MatrixMcreProblem problem(plate, data, Weights(0.01, 1.0), 2e11, 0.5);
   ASSERT_EQ(problem.integrator().factorization(), Factorization::kSparse);
   Matrix displacement = problem.ZeroField(), retrograde = problem.ZeroField();
@@ -466,8 +465,8 @@ TEST(MatrixMcreProblemAllocationTest, SweepsAndSumsAllocateNothing) {
 TEST(McreProblemAllocationTest, StreamingMapAllocatesNothingAfterItsFirstCall) {
   SKIP_WITHOUT_ALLOCATION_COUNTING();
   ProblemBundle bundle(MakeSmallCase(kElements, kSteps, 5.0, 2), Weights(0.01, 1.0));
-  MeasurementSet data = bundle.data;
-  data.sensors.push_back({"e@0.7", SensorKind::kStrain, 0.7, 1e-3 * data.uL});
+  ChannelSet data = bundle.data;
+  data.Add("e@0.7", ChannelKind::kStrain, 1e-3 * data.Values("uL"));
   McreProblem problem(bundle.model, data, Weights(0.01, 1.0), testing::kReferenceModulus, 0.5);
   problem.SetModulus(0.9 * testing::kReferenceModulus);
   const Matrix traces = Matrix::Constant(problem.num_traces(), problem.num_steps() + 1, 1e-7);
@@ -496,7 +495,7 @@ TEST(ZoneOutputErrorAllocationTest, TheTimeLoopAllocatesNothing) {
     ZoneLayout layout;
     layout.zone_count = 4;
     const BarModel model(small.bar, layout.ElementZones(small.bar));
-    const MeasurementSet data =
+    const ChannelSet data =
         SimulateClampedBar(small.bar, small.load, small.time, {}, {"u@0.3", "e@0.6"});
     NoiseLevels noise;
     noise.displacement_std = 1e-7;

@@ -11,11 +11,11 @@ namespace {
 
 TEST(AssertsTest, AViolatedPreconditionStopsTheSanitizerBuild) {
 #if defined(MCREWAVE_EXPECT_ASSERTS)
-  ChannelTable table;
+  ChannelSet table;
   table.time_step = 1.0;
-  table.samples = 2;
-  // ResampleChannelTable's precondition: a positive step.
-  EXPECT_DEATH(ResampleChannelTable(table, -1.0, 2, "table.csv"), "step > 0");
+  table.Add("x", ChannelKind::kDisplacement, Vector::Zero(2));
+  // ResampleMeasurements's precondition: a positive step.
+  EXPECT_DEATH(ResampleMeasurements(table, -1.0, 2, "table.csv"), "step > 0");
 #else
   GTEST_SKIP() << "NDEBUG build: the asserts are compiled out (the sanitizer pass runs them)";
 #endif

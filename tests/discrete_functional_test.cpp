@@ -35,8 +35,8 @@ struct KktSolution {
   double cost = 0.0;             // J at the minimum [J s]
 };
 
-KktSolution MinimiseDenseFunctional(const BarModel& model, const MeasurementSet& data,
-                                    double modulus, double alpha, double beta, double theta) {
+KktSolution MinimiseDenseFunctional(const BarModel& model, const ChannelSet& data, double modulus,
+                                    double alpha, double beta, double theta) {
   const Eigen::MatrixXd mass = Eigen::MatrixXd(model.mass());
   const Eigen::MatrixXd stiffness = modulus * Eigen::MatrixXd(model.unit_stiffness());
   const int n = model.num_nodes(), m = data.num_steps();
@@ -58,8 +58,8 @@ KktSolution MinimiseDenseFunctional(const BarModel& model, const MeasurementSet&
   for (int j = 0; j <= m; ++j) {
     const double weight = c(j) * h;
     hessian.block(w(j), w(j), n, n) += weight * stiffness;
-    const double measured_force[2] = {data.f0[j], data.fL[j]};
-    const double measured_displacement[2] = {data.u0[j], data.uL[j]};
+    const double measured_force[2] = {data.Values("f0")[j], data.Values("fL")[j]};
+    const double measured_displacement[2] = {data.Values("u0")[j], data.Values("uL")[j]};
     for (int e = 0; e < 2; ++e) {
       hessian(f(j) + e, f(j) + e) += weight * alpha;
       linear[f(j) + e] += weight * alpha * measured_force[e];
@@ -179,8 +179,10 @@ TEST_P(DiscreteFunctionalTest, CoupledSolutionIsTheMinimumOfTheConstrainedFuncti
     Eigen::MatrixXd forces(2, solution.retrograde.cols());
     for (int j = 0; j < forces.cols(); ++j) {
       // F = F~ - B W / alpha (docs/discrete_mcre.md section 2).
-      forces(0, j) = bundle.data.f0[j] - solution.retrograde(0, j) / bundle.problem.alpha();
-      forces(1, j) = bundle.data.fL[j] - solution.retrograde(last, j) / bundle.problem.alpha();
+      forces(0, j) =
+          bundle.data.Values("f0")[j] - solution.retrograde(0, j) / bundle.problem.alpha();
+      forces(1, j) =
+          bundle.data.Values("fL")[j] - solution.retrograde(last, j) / bundle.problem.alpha();
     }
     EXPECT_LT(testing::RelativeDifference(forces, kkt.end_forces), tolerance.end_force) << name;
     EXPECT_NEAR(solution.cost, kkt.cost, tolerance.cost * kkt.cost) << name;

@@ -241,16 +241,16 @@ TEST(ExactBarSolutionTest, SampleHoldsTheFourChannels) {
   time.window = 1e-4;
   time.step = 1e-6;
   const ExactBarSolution exact(bar, load);
-  const MeasurementSet samples = exact.Sample(time);
+  const ChannelSet samples = exact.Sample(time);
   ASSERT_EQ(samples.num_samples(), 101);
   EXPECT_EQ(samples.start_time, 0.0);
   EXPECT_EQ(samples.time_step, time.step);
   for (int k = 0; k <= 100; ++k) {
     const double t = k * time.step;
-    EXPECT_EQ(samples.u0[k], 0.0);
-    EXPECT_EQ(samples.uL[k], exact.Displacement(bar.length, t));
-    EXPECT_EQ(samples.f0[k], exact.ClampForce(t));
-    EXPECT_EQ(samples.fL[k], load.Value(t));
+    EXPECT_EQ(samples.Values("u0")[k], 0.0);
+    EXPECT_EQ(samples.Values("uL")[k], exact.Displacement(bar.length, t));
+    EXPECT_EQ(samples.Values("f0")[k], exact.ClampForce(t));
+    EXPECT_EQ(samples.Values("fL")[k], load.Value(t));
   }
 }
 

@@ -38,9 +38,8 @@ McreOptions WeightsOf(double w_u) { return testing::FreeFreeMcre(w_u); }
 // tight inner tolerance, then bisection on the sign of the adjoint gradient in
 // every bracket [E_i, E_i+1] where it changes from - to +, to 1e-10 relative; the
 // lowest of those minima. Writes the minimisers of every valley (sign change) seen.
-double DenseGlobalMinimiser(const BarModel& model, const MeasurementSet& data,
-                            const McreOptions& mcre, double lower, double upper, int points,
-                            std::vector<double>* valleys) {
+double DenseGlobalMinimiser(const BarModel& model, const ChannelSet& data, const McreOptions& mcre,
+                            double lower, double upper, int points, std::vector<double>* valleys) {
   CoupledSolverOptions inner;
   inner.tolerance = 1e-10;
   McreObjective objective(model, data, mcre, 0.5, inner, kReference);
@@ -86,7 +85,7 @@ struct RuggedCase {
             }())) {}
   SmallCase small;
   BarModel model;
-  MeasurementSet data;
+  ChannelSet data;
 };
 
 struct OptimizerCase {
@@ -274,7 +273,7 @@ double NoiseFreeError(const McreOptions& mcre, bool prefilter_enabled, double* c
   const BarModel model(small.bar);
   PrefilterOptions prefilter;
   prefilter.enabled = prefilter_enabled;
-  const MeasurementSet data = PrefilterMeasurements(
+  const ChannelSet data = PrefilterMeasurements(
       MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data), prefilter, cutoff);
   const IdentificationOptions options;
   McreObjective objective(model, data, mcre, 0.5, CoupledSolverOptions(), options.initial);

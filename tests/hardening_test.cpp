@@ -262,7 +262,7 @@ struct WindowCase {
   }
   Config config;
   BarModel model;
-  MeasurementSet data;
+  ChannelSet data;
   McreProblem problem;
 };
 
@@ -449,7 +449,7 @@ class SpoiledDataTest : public ::testing::Test {
 
   // Writes `data` and runs the quick case on it; the folder must stay unwritten
   // whenever the run fails.
-  RunResult RunOn(const MeasurementSet& data, const std::string& overrides = "") {
+  RunResult RunOn(const ChannelSet& data, const std::string& overrides = "") {
     WriteMeasurementCsv(data, dir_ + "/spoiled.csv");
     const RunResult run = RunIdentify(
         "run " + SourcePath("configs/quick.yaml") + " -q -o " + dir_ +
@@ -462,7 +462,7 @@ class SpoiledDataTest : public ::testing::Test {
   }
 
   std::string dir_;
-  MeasurementSet clean_;
+  ChannelSet clean_;
 };
 
 TEST_F(SpoiledDataTest, TheCleanFileIdentifiesTheModulus) {
@@ -473,8 +473,8 @@ TEST_F(SpoiledDataTest, TheCleanFileIdentifiesTheModulus) {
 }
 
 TEST_F(SpoiledDataTest, DeadForceChannelIsRefused) {
-  MeasurementSet data = clean_;
-  data.fL.setZero();
+  ChannelSet data = clean_;
+  data.Values("fL").setZero();
   const RunResult run = RunOn(data);
   EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_EQ(ErrorLine(run.output), "error: " + dir_ +
@@ -483,8 +483,8 @@ TEST_F(SpoiledDataTest, DeadForceChannelIsRefused) {
 }
 
 TEST_F(SpoiledDataTest, DeadDisplacementChannelIsRefused) {
-  MeasurementSet data = clean_;
-  data.uL.setZero();
+  ChannelSet data = clean_;
+  data.Values("uL").setZero();
   const RunResult run = RunOn(data);
   EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_NE(ErrorLine(run.output).find("column 'uL' is zero on every row"), std::string::npos)
@@ -492,8 +492,8 @@ TEST_F(SpoiledDataTest, DeadDisplacementChannelIsRefused) {
 }
 
 TEST_F(SpoiledDataTest, ForceOutlierIsRefusedNamingItsLine) {
-  MeasurementSet data = clean_;
-  data.fL[150] += 1e5;  // a 100 kN spike on a 1 kN load (sample 150: line 152)
+  ChannelSet data = clean_;
+  data.Values("fL")[150] += 1e5;  // a 100 kN spike on a 1 kN load (sample 150: line 152)
   const RunResult run = RunOn(data);
   EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_NE(ErrorLine(run.output).find("/spoiled.csv:152: column 'fL': "), std::string::npos)
@@ -508,9 +508,9 @@ TEST_F(SpoiledDataTest, AnOutlierInDataAtAnotherRateIsRefusedNamingItsLineInTheF
   const RunResult simulated = RunIdentify("simulate " + SourcePath("configs/quick.yaml") +
                                           " -q --set time.step=0.72e-6 -o " + dir_ + "/fast.csv");
   ASSERT_EQ(simulated.exit_code, 0) << simulated.output;
-  MeasurementSet data = ReadMeasurementCsv(dir_ + "/fast.csv");
+  ChannelSet data = ReadMeasurementCsv(dir_ + "/fast.csv");
   ASSERT_EQ(data.num_samples(), 601);
-  data.fL[301] += 1e5;
+  data.Values("fL")[301] += 1e5;
   const RunResult run = RunOn(data);
   EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_NE(ErrorLine(run.output).find("/spoiled.csv:303: column 'fL': "), std::string::npos)
@@ -523,9 +523,10 @@ TEST_F(SpoiledDataTest, ARecordLongerThanTheWindowIsCutToIt) {
   ASSERT_EQ(clean.exit_code, 0) << clean.output;
   const std::string clean_summary = ReadText(dir_ + "/results/summary.yaml");
   // 200 samples more on the model's grid, each channel held at its last value.
-  MeasurementSet longer = clean_;
+  ChannelSet longer = clean_;
   const int samples = clean_.num_samples();
-  for (Vector* channel : {&longer.u0, &longer.uL, &longer.f0, &longer.fL}) {
+  for (Vector* channel :
+       {&longer.Values("u0"), &longer.Values("uL"), &longer.Values("f0"), &longer.Values("fL")}) {
     channel->conservativeResize(samples + 200);
     channel->tail(200).setConstant((*channel)[samples - 1]);
   }
@@ -537,8 +538,8 @@ TEST_F(SpoiledDataTest, ARecordLongerThanTheWindowIsCutToIt) {
 }
 
 TEST_F(SpoiledDataTest, DisplacementOutliersAreRefused) {
-  MeasurementSet data = clean_;
-  for (int k = 40; k < data.num_samples(); k += 50) data.uL[k] += 1e-3;
+  ChannelSet data = clean_;
+  for (int k = 40; k < data.num_samples(); k += 50) data.Values("uL")[k] += 1e-3;
   const RunResult run = RunOn(data);
   EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_NE(ErrorLine(run.output).find("column 'uL': "), std::string::npos) << run.output;
@@ -546,8 +547,8 @@ TEST_F(SpoiledDataTest, DisplacementOutliersAreRefused) {
 }
 
 TEST_F(SpoiledDataTest, DisplacementInMicrometresEndsOnABoundAndIsRefused) {
-  MeasurementSet data = clean_;
-  data.uL *= 1e6;
+  ChannelSet data = clean_;
+  data.Values("uL") *= 1e6;
   const RunResult run = RunOn(data);
   EXPECT_EQ(run.exit_code, 1) << run.output;
   EXPECT_NE(ErrorLine(run.output)
@@ -559,8 +560,8 @@ TEST_F(SpoiledDataTest, DisplacementInMicrometresEndsOnABoundAndIsRefused) {
 }
 
 TEST_F(SpoiledDataTest, ForceScaledByAMillionEndsOnABoundAndIsRefused) {
-  MeasurementSet data = clean_;
-  data.fL *= 1e6;
+  ChannelSet data = clean_;
+  data.Values("fL") *= 1e6;
   const RunResult run = RunOn(data);
   EXPECT_EQ(run.exit_code, 1) << run.output;
   EXPECT_NE(ErrorLine(run.output).find("lies on outer.upper_bound (4e+11 Pa)"), std::string::npos)
@@ -575,13 +576,11 @@ TEST_F(SpoiledDataTest, WrongUnitsWithBoundsOverDecadesAreRefusedByTheMisfit) {
   const RunResult clean = RunOn(clean_, wide);
   ASSERT_EQ(clean.exit_code, 0) << clean.output;
   fs::remove_all(dir_ + "/results");
-  const std::vector<std::pair<Vector MeasurementSet::*, std::string>> channels = {
-      {&MeasurementSet::uL, "forces"},
-      {&MeasurementSet::f0, "displacements"},
-      {&MeasurementSet::fL, "displacements"}};
+  const std::vector<std::pair<std::string, std::string>> channels = {
+      {"uL", "forces"}, {"f0", "displacements"}, {"fL", "displacements"}};
   for (const auto& [channel, missed] : channels) {
-    MeasurementSet data = clean_;
-    data.*channel *= 1e6;
+    ChannelSet data = clean_;
+    data.Values(channel) *= 1e6;
     const RunResult run = RunOn(data, wide);
     EXPECT_EQ(run.exit_code, 1) << run.output;
     EXPECT_NE(ErrorLine(run.output).find("the model misses the measured end " + missed),
@@ -596,14 +595,14 @@ TEST_F(SpoiledDataTest, TimeStepOtherThanTheConfigsIsResampledNotRefused) {
   // The samples relabelled on a 0.1 % longer step: resampled onto the model's grid and
   // identified; against the identification on the data's own grid (time.step and
   // time.window stretched alike), measured 2.7e-5 apart.
-  auto identified = [this](const MeasurementSet& data, const std::string& overrides) {
+  auto identified = [this](const ChannelSet& data, const std::string& overrides) {
     const RunResult run = RunOn(data, overrides);
     EXPECT_EQ(run.exit_code, 0) << run.output;
     const std::string summary = ReadText(dir_ + "/results/summary.yaml");
     const std::size_t at = summary.find("identified_modulus: ");
     return at == std::string::npos ? NAN : std::stod(summary.substr(at + 20, 30));
   };
-  MeasurementSet data = clean_;
+  ChannelSet data = clean_;
   data.time_step *= 1.001;
   const double resampled = identified(data, "");
   const double own_grid =

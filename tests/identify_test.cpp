@@ -86,7 +86,7 @@ TEST(IdentifyTest, PrintsADefaultConfigThatSimulateAccepts) {
   EXPECT_EQ(ReadMeasurementCsv(dir + "/out.csv").num_samples(), 101);
 }
 
-TEST(IdentifyTest, SimulateWritesTheMeasurementSetOfThePaperCase) {
+TEST(IdentifyTest, SimulateWritesTheChannelSetOfThePaperCase) {
   const std::string dir = FreshDirectory("identify_simulate");
   const std::string csv = dir + "/paper.csv";
   const RunResult run = RunIdentify("simulate " + SourcePath("configs/paper_bar.yaml") +
@@ -94,23 +94,28 @@ TEST(IdentifyTest, SimulateWritesTheMeasurementSetOfThePaperCase) {
                                     "data.sensors=[u@0.25,e@0.65] --output " +
                                     csv);
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  const MeasurementSet measurements = ReadMeasurementCsv(csv);
+  const ChannelSet measurements = ReadMeasurementCsv(csv);
   EXPECT_EQ(measurements.num_samples(), 1751);
   EXPECT_NEAR(measurements.time_step, 0.36e-6, 1e-15);
   // Every channel holds the bits of the library's synthetic measurements of the
   // same config (written with 17 significant digits).
-  const MeasurementSet library =
+  const ChannelSet library =
       LoadMeasurements(LoadConfig(SourcePath("configs/paper_bar.yaml"),
                                   {"data.truth_refinement=1", "data.sensors=[u@0.25,e@0.65]"}));
-  EXPECT_EQ(measurements.u0, library.u0);
-  EXPECT_EQ(measurements.uL, library.uL);
-  EXPECT_EQ(measurements.f0, library.f0);
-  EXPECT_EQ(measurements.fL, library.fL);
-  ASSERT_EQ(measurements.sensors.size(), 2u);
-  ASSERT_EQ(library.sensors.size(), 2u);
+  EXPECT_EQ(measurements.Values("u0"), library.Values("u0"));
+  EXPECT_EQ(measurements.Values("uL"), library.Values("uL"));
+  EXPECT_EQ(measurements.Values("f0"), library.Values("f0"));
+  EXPECT_EQ(measurements.Values("fL"), library.Values("fL"));
+  const std::vector<BarSensor> measured_sensors = BarSensors(measurements);
+  const std::vector<BarSensor> library_sensors = BarSensors(library);
+  ASSERT_EQ(measured_sensors.size(), 2u);
+  ASSERT_EQ(library_sensors.size(), 2u);
   for (int i = 0; i < 2; ++i) {
-    EXPECT_EQ(measurements.sensors[i].name, library.sensors[i].name);
-    EXPECT_EQ(measurements.sensors[i].values, library.sensors[i].values);
+    const Channel& measured =
+        measurements.channels[static_cast<std::size_t>(measured_sensors[i].index)];
+    const Channel& simulated = library.channels[static_cast<std::size_t>(library_sensors[i].index)];
+    EXPECT_EQ(measured.name, simulated.name);
+    EXPECT_EQ(measured.values, simulated.values);
   }
   for (int j = 0; j < measurements.num_samples(); ++j) {
     ASSERT_EQ(measurements.Time(j), library.Time(j)) << "sample " << j;
@@ -128,7 +133,7 @@ TEST(IdentifyTest, SimulateWritesTheMeasurementSetOfThePaperCase) {
                         " --set data.truth_refinement=1 --output " + again)
                 .exit_code,
             0);
-  EXPECT_EQ(ReadMeasurementCsv(again).uL, measurements.uL);
+  EXPECT_EQ(ReadMeasurementCsv(again).Values("uL"), measurements.Values("uL"));
 }
 
 TEST(IdentifyTest, BadConfigFailsWithOneLineNamingFileLineAndKeyAndWritesNothing) {

@@ -26,22 +26,14 @@ using testing::Weights;
 
 const std::string kPlate = std::string(MCREWAVE_SOURCE_DIR) + "/configs/plate/";
 
-// The bar's measurements as the channel histories of BarMatrixModel's channels:
-// loads f0, fL; sensors u0, uL, then the interior sensors in the data's order.
-ChannelHistories BarHistories(const MeasurementSet& data) {
-  ChannelHistories histories;
-  histories.time_step = data.time_step;
-  const int samples = data.num_samples();
-  histories.loads.resize(2, samples);
-  histories.loads.row(0) = data.f0.transpose();
-  histories.loads.row(1) = data.fL.transpose();
-  histories.outputs.resize(2 + static_cast<int>(data.sensors.size()), samples);
-  histories.outputs.row(0) = data.u0.transpose();
-  histories.outputs.row(1) = data.uL.transpose();
-  for (std::size_t k = 0; k < data.sensors.size(); ++k) {
-    histories.outputs.row(2 + static_cast<int>(k)) = data.sensors[k].values.transpose();
+// The bar's measurements as the channels of BarMatrixModel: loads f0, fL; sensors u0,
+// uL, then the interior sensors, under the same names (the set itself; this checks it).
+ChannelSet BarHistories(const MatrixModelData& matrices, const ChannelSet& data) {
+  for (const MatrixModelLoad& load : matrices.loads) EXPECT_GE(data.Find(load.channel), 0);
+  for (const MatrixModelSensor& sensor : matrices.sensors) {
+    EXPECT_GE(data.Find(sensor.channel), 0) << sensor.channel;
   }
-  return histories;
+  return data;
 }
 
 CoupledSolverOptions Tight(CoupledSolverType type) {
@@ -66,14 +58,14 @@ class BarThroughMatricesTest : public ::testing::Test {
                                             {SensorKind::kStrain, 0.65}};
     const std::string folder = testing::FreshDirectory("bar_through_matrices");
     matrices_ = ReadMatrixModel(WriteMatrixModel(folder, BarMatrixModel(*model_, 200e9, sensors)));
-    histories_ = BarHistories(data_);
+    histories_ = BarHistories(matrices_, data_);
     weights_ = Weights(0.01, 1.0);
     weights_.strain_weight = 0.003;
   }
   std::unique_ptr<BarModel> model_;
-  MeasurementSet data_;
+  ChannelSet data_;
   MatrixModelData matrices_;
-  ChannelHistories histories_;
+  ChannelSet histories_;
   McreWeights weights_;
 };
 
@@ -249,32 +241,31 @@ MatrixModelData Lattice() {
 // Histories on m steps of h: a half-sine load of `duration` and outputs of `truth`'s
 // model at `truth_moduli` (its own mesh: model outputs) plus a deterministic wiggle of
 // relative size `spoil` (so that the data are not the model's).
-ChannelHistories Histories(const MatrixModelData& truth, const Vector& truth_moduli, int steps,
-                           double time_step, double duration, double spoil) {
-  ChannelHistories histories;
-  histories.time_step = time_step;
-  histories.loads = Matrix::Zero(1, steps + 1);
+ChannelSet Histories(const MatrixModelData& truth, const Vector& truth_moduli, int steps,
+                     double time_step, double duration, double spoil) {
+  Matrix loads = Matrix::Zero(1, steps + 1);
   for (int j = 0; j <= steps; ++j) {
     const double t = j * time_step;
-    if (t < duration) histories.loads(0, j) = 1e3 * std::sin(M_PI * t / duration);
+    if (t < duration) loads(0, j) = 1e3 * std::sin(M_PI * t / duration);
   }
-  histories.outputs = Matrix::Zero(static_cast<int>(truth.sensors.size()), steps + 1);
-  MatrixMcreProblem simulation(truth, histories, Weights(0.01, 1.0), 2e11, 0.5);
+  const ChannelSet at_rest = MatrixChannelSet(
+      truth, time_step, loads, Matrix::Zero(static_cast<int>(truth.sensors.size()), steps + 1));
+  MatrixMcreProblem simulation(truth, at_rest, Weights(0.01, 1.0), 2e11, 0.5);
   simulation.SetModuli(truth_moduli);
-  histories.outputs = simulation.ModelOutputs();
-  for (int k = 0; k < histories.outputs.rows(); ++k) {
-    const double scale = histories.outputs.row(k).cwiseAbs().maxCoeff();
+  Matrix outputs = simulation.ModelOutputs();
+  for (int k = 0; k < outputs.rows(); ++k) {
+    const double scale = outputs.row(k).cwiseAbs().maxCoeff();
     for (int j = 0; j <= steps; ++j) {
-      histories.outputs(k, j) += spoil * scale * std::sin(0.37 * j + k);
+      outputs(k, j) += spoil * scale * std::sin(0.37 * j + k);
     }
   }
-  return histories;
+  return MatrixChannelSet(truth, time_step, loads, outputs);
 }
 
 TEST(MatrixMcreProblemTest, AllAtOnceAndIterativeSolversAgreeOnASparseLattice) {
   const MatrixModelData lattice = Lattice();
   const Vector truth = (Vector(2) << 2e11, 1.6e11).finished();
-  const ChannelHistories data = Histories(lattice, truth, 120, 2e-3, 0.05, 0.05);
+  const ChannelSet data = Histories(lattice, truth, 120, 2e-3, 0.05, 0.05);
   MatrixMcreProblem problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5, Factorization::kSparse);
   problem.SetModuli((Vector(2) << 1.8e11, 2.1e11).finished());
   CoupledSolution reference;
@@ -313,7 +304,7 @@ TEST(MatrixMcreProblemTest, EveryZoneGradientOfThePlateMatchesACentralDifference
   const MatrixModelData coarse = ReadMatrixModel(kPlate + "coarse/model.yaml");
   const MatrixModelData fine = ReadMatrixModel(kPlate + "fine/model.yaml");
   // Data from the fine mesh (inclusion 25 % softer), 150 steps of 1 us.
-  const ChannelHistories data =
+  const ChannelSet data =
       Histories(fine, (Vector(2) << 2e11, 1.5e11).finished(), 150, 1e-6, 2e-5, 0.0);
   MatrixMcreProblem problem(coarse, data, Weights(0.01, 1.0), 2e11, 0.5);
   const Vector moduli = (Vector(2) << 1.9e11, 1.7e11).finished();

@@ -22,16 +22,16 @@ struct PlateInverseCrime {
   explicit PlateInverseCrime(const Vector& truth)
       : plate(ReadMatrixModel(std::string(MCREWAVE_SOURCE_DIR) +
                               "/configs/plate/coarse/model.yaml")) {
-    data.time_step = 1e-6;
-    data.loads = Matrix::Zero(1, 101);
-    for (int j = 0; j * 1e-6 < 2e-5; ++j) data.loads(0, j) = 1e3 * std::sin(M_PI * j / 20.0);
-    data.outputs = Matrix::Zero(static_cast<int>(plate.sensors.size()), 101);
-    MatrixMcreProblem simulation(plate, data, Weights(0.01, 1.0), 2e11, 0.5);
+    Matrix loads = Matrix::Zero(1, 101);
+    for (int j = 0; j * 1e-6 < 2e-5; ++j) loads(0, j) = 1e3 * std::sin(M_PI * j / 20.0);
+    const ChannelSet at_rest = MatrixChannelSet(
+        plate, 1e-6, loads, Matrix::Zero(static_cast<int>(plate.sensors.size()), 101));
+    MatrixMcreProblem simulation(plate, at_rest, Weights(0.01, 1.0), 2e11, 0.5);
     simulation.SetModuli(truth);
-    data.outputs = simulation.ModelOutputs();
+    data = MatrixChannelSet(plate, 1e-6, loads, simulation.ModelOutputs());
   }
   MatrixModelData plate;
-  ChannelHistories data;
+  ChannelSet data;
 };
 
 TEST(MatrixZoneObjectiveTest, InverseCrimeOnThePlateRecoversBothZones) {

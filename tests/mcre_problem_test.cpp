@@ -127,9 +127,10 @@ TEST(McreProblemTest, ConsistentDataGiveZeroCostAtZeroRetrogradeField) {
   Matrix displacement, image;
   problem.FixedPointMap(zero, &displacement, &image);
   // The free bar driven by the measured forces reproduces the clamped motion...
-  EXPECT_LT(displacement.row(0).cwiseAbs().maxCoeff(), 1e-9 * bundle.data.uL.cwiseAbs().maxCoeff());
-  EXPECT_LT((displacement.row(16).transpose() - bundle.data.uL).cwiseAbs().maxCoeff(),
-            1e-9 * bundle.data.uL.cwiseAbs().maxCoeff());
+  EXPECT_LT(displacement.row(0).cwiseAbs().maxCoeff(),
+            1e-9 * bundle.data.Values("uL").cwiseAbs().maxCoeff());
+  EXPECT_LT((displacement.row(16).transpose() - bundle.data.Values("uL")).cwiseAbs().maxCoeff(),
+            1e-9 * bundle.data.Values("uL").cwiseAbs().maxCoeff());
   // ...so T(0) = 0 and the cost vanishes.
   EXPECT_LT(problem.Cost(displacement, zero), 1e-18);
   EXPECT_EQ(problem.sweep_count(), 2);
@@ -139,10 +140,10 @@ TEST(McreProblemTest, ConsistentDataGiveZeroCostAtZeroRetrogradeField) {
 
 // The data of a small case with an interior displacement sensor inside the first
 // element (its node-0 part must be dropped) and a strain gauge further on.
-MeasurementSet WithClampSideSensors(const MeasurementSet& data) {
-  MeasurementSet with = data;
-  with.sensors.push_back({"u@0.03", SensorKind::kDisplacement, 0.03, 0.02 * data.uL});
-  with.sensors.push_back({"e@0.6", SensorKind::kStrain, 0.6, 1e-3 * data.uL});
+ChannelSet WithClampSideSensors(const ChannelSet& data) {
+  ChannelSet with = data;
+  with.Add("u@0.03", ChannelKind::kDisplacement, 0.02 * data.Values("uL"));
+  with.Add("e@0.6", ChannelKind::kStrain, 1e-3 * data.Values("uL"));
   return with;
 }
 
@@ -151,7 +152,7 @@ TEST(TrustedClampTest, HoldsTheClampAndDrivesTheBarByFLAlone) {
   // fL alone is the clamped bar of the data.
   const testing::SmallCase small = MakeSmallCase(16, 120, std::numeric_limits<double>::infinity(), 1);
   const BarModel model(small.bar);
-  const MeasurementSet data = MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
+  const ChannelSet data = MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
   McreProblem problem(model, data, Weights(0.01, 1.0), 200e9, 0.5, {}, ClampModel::kTrusted);
   EXPECT_FALSE(problem.end_channels().u0);
   EXPECT_EQ(problem.num_interior_sensors(), 1);  // the reaction
@@ -159,17 +160,19 @@ TEST(TrustedClampTest, HoldsTheClampAndDrivesTheBarByFLAlone) {
   Matrix displacement, retrograde;
   problem.DirectSweep(zero, true, &displacement);
   EXPECT_EQ(displacement.row(0).cwiseAbs().maxCoeff(), 0.0);
-  const double uL_scale = data.uL.cwiseAbs().maxCoeff();
-  EXPECT_LT((displacement.row(16).transpose() - data.uL).cwiseAbs().maxCoeff(), 1e-9 * uL_scale);
+  const double uL_scale = data.Values("uL").cwiseAbs().maxCoeff();
+  EXPECT_LT((displacement.row(16).transpose() - data.Values("uL")).cwiseAbs().maxCoeff(),
+            1e-9 * uL_scale);
   // The reaction row K_01 U_1 against the data's f0 = row_0(M a + K u): they differ by
   // the inertia of the first element, O(l^2) at a fixed end (measured 65.5 N, 3.3 %
   // of max |f0|, on 16 elements).
   double largest_gap = 0.0;
   for (int j = 0; j <= problem.num_steps(); ++j) {
     largest_gap = std::max(largest_gap, std::abs(problem.ClampReaction(displacement.col(j).data()) -
-                                                 data.f0[j]));
+                                                 data.Values("f0")[j]));
   }
-  EXPECT_LT(largest_gap, 0.1 * data.f0.cwiseAbs().maxCoeff()) << data.f0.cwiseAbs().maxCoeff();
+  EXPECT_LT(largest_gap, 0.1 * data.Values("f0").cwiseAbs().maxCoeff())
+      << data.Values("f0").cwiseAbs().maxCoeff();
   EXPECT_GT(largest_gap, 0.0);
   problem.RetrogradeSweep(displacement, true, &retrograde);
   EXPECT_EQ(retrograde.row(0).cwiseAbs().maxCoeff(), 0.0);
@@ -181,7 +184,7 @@ class TrustedClampMapTest : public ::testing::TestWithParam<double> {};
 TEST_P(TrustedClampMapTest, IsSelfAdjointAndNegativeInPInnerProduct) {
   const double theta = GetParam();
   ProblemBundle bundle(MakeSmallCase(12, 60, 5.0, 2), Weights(1.0, 1.0), theta);
-  const MeasurementSet data = WithClampSideSensors(bundle.data);
+  const ChannelSet data = WithClampSideSensors(bundle.data);
   McreWeights weights = Weights(1.0, 1.0);
   weights.reaction_weight = 0.1;
   McreProblem problem(bundle.model, data, weights, 200e9, theta, {}, ClampModel::kTrusted);
@@ -218,7 +221,7 @@ Solved ExpectConjugateGradientsAgreeWithAllAtOnce(McreProblem* problem,
 
 TEST(TrustedClampTest, ConjugateGradientsAgreeWithTheAllAtOnceSolve) {
   ProblemBundle bundle(MakeSmallCase(12, 80, 5.0, 2), Weights(0.01, 1.0));
-  const MeasurementSet data = WithClampSideSensors(bundle.data);
+  const ChannelSet data = WithClampSideSensors(bundle.data);
   McreWeights weights = Weights(0.01, 1.0);
   weights.reaction_weight = 0.01;
   McreProblem problem(bundle.model, data, weights, 200e9, 0.5, {}, ClampModel::kTrusted);
@@ -234,7 +237,7 @@ std::vector<double> ZoneGradientErrors(const McreWeights& weights, ClampModel cl
   ZoneLayout layout;
   layout.zone_count = 2;
   const BarModel model(small.bar, layout.ElementZones(small.bar));
-  const MeasurementSet data = MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
+  const ChannelSet data = MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
   McreProblem problem(model, data, weights, 200e9, 0.5, {}, clamp);
   const CoupledSolverOptions options = Options(CoupledSolverType::kConjugateGradient, 1e-13);
   Vector moduli(2);
@@ -300,12 +303,12 @@ TEST(PinnedClampTest, WeighsTheKnownZeroAndTheReactionLoadWithTheirOwnWeights) {
   problem.DirectSweep(zero, true, &displacement);
   double expected = 0.0;
   for (int j = 0; j <= problem.num_steps(); ++j) {
-    const double uL_misfit = displacement(12, j) - bundle.data.uL[j];
+    const double uL_misfit = displacement(12, j) - bundle.data.Values("uL")[j];
     expected += problem.QuadratureWeight(j) * problem.time_step() * 0.5 *
                 (beta0 * displacement(0, j) * displacement(0, j) +
                  problem.beta() * uL_misfit * uL_misfit);
   }
-  EXPECT_GT(bundle.data.u0.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_GT(bundle.data.Values("u0").cwiseAbs().maxCoeff(), 0.0);
   // Measured: equal to the last bit.
   EXPECT_NEAR(problem.Cost(displacement, zero), expected, 1e-15 * expected);
 }
@@ -315,7 +318,7 @@ class PinnedClampMapTest : public ::testing::TestWithParam<double> {};
 TEST_P(PinnedClampMapTest, IsSelfAdjointAndNegativeInPInnerProduct) {
   const double theta = GetParam();
   ProblemBundle bundle(MakeSmallCase(12, 60, 5.0, 2), Weights(1.0, 1.0), theta);
-  const MeasurementSet data = WithClampSideSensors(bundle.data);
+  const ChannelSet data = WithClampSideSensors(bundle.data);
   McreProblem problem(bundle.model, data, PinnedWeights(), 200e9, theta, {}, ClampModel::kPinned);
   problem.SetModulus(0.9 * 200e9);
   // Measured 8.9e-17 (theta 1/2) and 4.4e-17 (theta 1) of the scale.
@@ -326,7 +329,7 @@ INSTANTIATE_TEST_SUITE_P(Theta, PinnedClampMapTest, ::testing::Values(0.5, 1.0))
 
 TEST(PinnedClampTest, ConjugateGradientsAgreeWithTheAllAtOnceSolve) {
   ProblemBundle bundle(MakeSmallCase(12, 80, 5.0, 2), Weights(0.01, 1.0));
-  const MeasurementSet data = WithClampSideSensors(bundle.data);
+  const ChannelSet data = WithClampSideSensors(bundle.data);
   McreProblem problem(bundle.model, data, PinnedWeights(), 200e9, 0.5, {}, ClampModel::kPinned);
   problem.SetModulus(0.95 * 200e9);
   // Measured 1.8e-13 (U), 3.6e-12 (W), 6.8e-16 (e^2).
@@ -342,8 +345,8 @@ TEST(PinnedClampTest, ConjugateGradientsAgreeWithTheAllAtOnceSolve) {
 
 TEST(PinnedClampTest, TheMeasuredU0DoesNotEnter) {
   ProblemBundle bundle(MakeSmallCase(12, 80, 5.0, 2), Weights(0.01, 1.0));
-  MeasurementSet other = bundle.data;
-  other.u0 *= -3.0;
+  ChannelSet other = bundle.data;
+  other.Values("u0") *= -3.0;
   McreProblem problem(bundle.model, bundle.data, PinnedWeights(), 200e9, 0.5, {},
                       ClampModel::kPinned);
   McreProblem other_problem(bundle.model, other, PinnedWeights(), 200e9, 0.5, {},

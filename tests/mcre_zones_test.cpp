@@ -4,10 +4,14 @@
 // solver that handles sensors against the all-at-once reference.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <memory>
 #include <random>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "mcrewave/mcre/coupled_solver.h"
@@ -27,24 +31,26 @@ using testing::Weights;
 
 // Interior sensors of the tests: displacements at 0.25 L and 0.5 L, strains at 0.2 L,
 // 0.65 L and 0.9 L (off the nodes).
-std::vector<SensorChannel> SensorsAlong(const BarModel& model, int samples) {
+// (Named by their positions to 17 digits: the name gives the position back exactly.)
+void AddSensorsAlong(const BarModel& model, int samples, ChannelSet* data) {
   const double length = model.properties().length;
-  std::vector<SensorChannel> sensors;
+  auto name = [](const char* prefix, double position) {
+    std::ostringstream text;
+    text << prefix << std::setprecision(17) << position;
+    return text.str();
+  };
   for (double x : {0.25, 0.5}) {
-    sensors.push_back(
-        {"u@" + std::to_string(x), SensorKind::kDisplacement, x * length, Vector::Zero(samples)});
+    data->Add(name("u@", x * length), ChannelKind::kDisplacement, Vector::Zero(samples));
   }
   for (double x : {0.2, 0.6549, 0.9013}) {
-    sensors.push_back(
-        {"e@" + std::to_string(x), SensorKind::kStrain, x * length, Vector::Zero(samples)});
+    data->Add(name("e@", x * length), ChannelKind::kStrain, Vector::Zero(samples));
   }
-  return sensors;
 }
 
 // The channels that H reads off the displacement field U, with seeded Gaussian noise of
 // relative level `noise` (of each channel's RMS; 0: exact).
 void ObserveField(const BarModel& model, const Matrix& displacement, double noise,
-                  MeasurementSet* data) {
+                  ChannelSet* data) {
   std::mt19937_64 engine(11);
   std::normal_distribution<double> normal;
   auto noisy = [&](Vector values) {
@@ -52,9 +58,9 @@ void ObserveField(const BarModel& model, const Matrix& displacement, double nois
     for (Eigen::Index k = 0; k < values.size(); ++k) values[k] += noise * rms * normal(engine);
     return values;
   };
-  data->u0 = noisy(displacement.row(0).transpose());
-  data->uL = noisy(displacement.row(model.num_nodes() - 1).transpose());
-  for (SensorChannel& sensor : data->sensors) {
+  data->Values("u0") = noisy(displacement.row(0).transpose());
+  data->Values("uL") = noisy(displacement.row(model.num_nodes() - 1).transpose());
+  for (const BarSensor& sensor : BarSensors(*data)) {
     const ObservationRow row = sensor.kind == SensorKind::kStrain
                                    ? model.StrainRow(sensor.position)
                                    : model.DisplacementRow(sensor.position);
@@ -62,7 +68,7 @@ void ObserveField(const BarModel& model, const Matrix& displacement, double nois
     for (Eigen::Index j = 0; j < displacement.cols(); ++j) {
       values[j] = row.Apply(displacement.col(j).data());
     }
-    sensor.values = noisy(values);
+    data->channels[static_cast<std::size_t>(sensor.index)].values = noisy(values);
   }
 }
 
@@ -75,7 +81,7 @@ struct ZonedCase {
       : small(MakeSmallCase(elements, steps, std::numeric_limits<double>::infinity(), 1)),
         model(small.bar, layout.ElementZones(small.bar)),
         data(MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data)) {
-    data.sensors = SensorsAlong(model, data.num_samples());
+    AddSensorsAlong(model, data.num_samples(), &data);
     // The response of the truth to the measured forces: the direct sweep at W = 0.
     McreProblem truth(model, data, Weights(0.01, 1.0), 200e9, 0.5, ends);
     truth.SetModuli(truth_moduli);
@@ -86,7 +92,7 @@ struct ZonedCase {
   }
   testing::SmallCase small;
   BarModel model;
-  MeasurementSet data;
+  ChannelSet data;
   std::unique_ptr<McreProblem> problem;
 };
 
@@ -114,19 +120,20 @@ TEST(McreZonesTest, DataResponseTracesAreTheDirectSweepAtZeroObservedByH) {
   Matrix traces, displacement;
   problem.DataResponseTraces(&traces);
   problem.DirectSweep(problem.ZeroField(), true, &displacement);
-  ASSERT_EQ(traces.rows(), 2 + static_cast<int>(zoned.data.sensors.size()));
+  const std::vector<BarSensor> sensors = BarSensors(zoned.data);
+  ASSERT_EQ(traces.rows(), 2 + static_cast<int>(sensors.size()));
   ASSERT_EQ(traces.cols(), displacement.cols());
   const int last = problem.num_nodes() - 1;
   for (Eigen::Index j = 0; j < traces.cols(); ++j) {
     EXPECT_EQ(traces(0, j), displacement(0, j)) << j;
     EXPECT_EQ(traces(1, j), displacement(last, j)) << j;
-    for (std::size_t k = 0; k < zoned.data.sensors.size(); ++k) {
-      const SensorChannel& sensor = zoned.data.sensors[k];
+    for (std::size_t k = 0; k < sensors.size(); ++k) {
+      const BarSensor& sensor = sensors[k];
       const ObservationRow row = sensor.kind == SensorKind::kStrain
                                      ? zoned.model.StrainRow(sensor.position)
                                      : zoned.model.DisplacementRow(sensor.position);
       EXPECT_EQ(traces(2 + k, j), row.Apply(displacement.col(j).data()))
-          << sensor.name << ", " << j;
+          << zoned.data.channels[static_cast<std::size_t>(sensor.index)].name << ", " << j;
     }
   }
   // The weights of the rows: beta_u at both ends, beta_u or beta_e per sensor.
@@ -318,7 +325,12 @@ TEST(McreZonesTest, RiccatiAndShootingSolveZonedBarsWithEndSensors) {
   // the space-time LU. Measured at most 5.4e-15 in e^2 and 2.8e-14 in W (Riccati; the
   // shootings 4.4e-16 and 6.6e-15).
   ZonedCase zoned(12, 40, EqualZones(3), Vector::Constant(3, 200e9), 0.05);
-  zoned.data.sensors.clear();
+  // Without the interior channels (u@X, e@X).
+  std::vector<Channel>& channels = zoned.data.channels;
+  channels.erase(
+      std::remove_if(channels.begin(), channels.end(),
+                     [](const Channel& c) { return c.name.find('@') != std::string::npos; }),
+      channels.end());
   McreProblem problem(zoned.model, zoned.data, Weights(0.01, 1.0), 200e9, 0.5);
   Vector trial(3);
   trial << 190e9, 230e9, 150e9;

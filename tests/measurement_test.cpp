@@ -56,19 +56,14 @@ class MeasurementTest : public ::testing::Test {
 };
 
 // A set whose values exercise full precision: irrational-looking, tiny, huge, signed.
-MeasurementSet MakeSet(int samples, double start_time, double time_step) {
-  MeasurementSet set;
-  set.start_time = start_time;
-  set.time_step = time_step;
-  set.u0.resize(samples);
-  set.uL.resize(samples);
-  set.f0.resize(samples);
-  set.fL.resize(samples);
+ChannelSet MakeSet(int samples, double start_time, double time_step) {
+  ChannelSet set = BarChannelSet(start_time, time_step, Vector(samples), Vector(samples),
+                                 Vector(samples), Vector(samples));
   for (int k = 0; k < samples; ++k) {
-    set.u0[k] = std::sin(0.1 * k) * 1e-7 / 3.0;
-    set.uL[k] = -std::exp(-0.01 * k) * 1e-300;
-    set.f0[k] = std::cos(0.37 * k) * 1e3 + 1e-9;
-    set.fL[k] = (k % 7) * 123456789.123456789 - 1.0 / (k + 1.0);
+    set.Values("u0")[k] = std::sin(0.1 * k) * 1e-7 / 3.0;
+    set.Values("uL")[k] = -std::exp(-0.01 * k) * 1e-300;
+    set.Values("f0")[k] = std::cos(0.37 * k) * 1e3 + 1e-9;
+    set.Values("fL")[k] = (k % 7) * 123456789.123456789 - 1.0 / (k + 1.0);
   }
   return set;
 }
@@ -83,16 +78,16 @@ void ExpectBitwiseEqual(const Vector& expected, const Vector& actual) {
 TEST_F(MeasurementTest, WriteThenReadIsExact) {
   for (const auto& [start_time, time_step] :
        std::vector<std::pair<double, double>>{{0.0, 0.36e-6}, {1.25e-3, 1.0 / 3.0 * 1e-6}}) {
-    const MeasurementSet written = MakeSet(1751, start_time, time_step);
+    const ChannelSet written = MakeSet(1751, start_time, time_step);
     const std::string path = PathOf("round_trip.csv");
     WriteMeasurementCsv(written, path);
-    const MeasurementSet read = ReadMeasurementCsv(path);
+    const ChannelSet read = ReadMeasurementCsv(path);
     EXPECT_EQ(read.start_time, written.start_time);
     EXPECT_EQ(read.time_step, written.time_step);
-    ExpectBitwiseEqual(written.u0, read.u0);
-    ExpectBitwiseEqual(written.uL, read.uL);
-    ExpectBitwiseEqual(written.f0, read.f0);
-    ExpectBitwiseEqual(written.fL, read.fL);
+    ExpectBitwiseEqual(written.Values("u0"), read.Values("u0"));
+    ExpectBitwiseEqual(written.Values("uL"), read.Values("uL"));
+    ExpectBitwiseEqual(written.Values("f0"), read.Values("f0"));
+    ExpectBitwiseEqual(written.Values("fL"), read.Values("fL"));
   }
 }
 
@@ -109,14 +104,14 @@ TEST_F(MeasurementTest, WindowsLineEndsByteOrderMarkAndSpacesAreAccepted) {
   const std::string path = WriteFile(
       "windows.csv",
       "\xEF\xBB\xBFt,u0,uL,f0,fL \r\n0, 1,2 ,3,4\r\n1e-6,5,6,7,8\r\n2e-6,9,10,11,12\r\n\r\n\r\n");
-  const MeasurementSet set = ReadMeasurementCsv(path);
+  const ChannelSet set = ReadMeasurementCsv(path);
   ASSERT_EQ(set.num_samples(), 3);
   EXPECT_EQ(set.start_time, 0.0);
   EXPECT_DOUBLE_EQ(set.time_step, 1e-6);
-  EXPECT_EQ(set.u0[0], 1.0);
-  EXPECT_EQ(set.uL[0], 2.0);
-  EXPECT_EQ(set.f0[2], 11.0);
-  EXPECT_EQ(set.fL[2], 12.0);
+  EXPECT_EQ(set.Values("u0")[0], 1.0);
+  EXPECT_EQ(set.Values("uL")[0], 2.0);
+  EXPECT_EQ(set.Values("f0")[2], 11.0);
+  EXPECT_EQ(set.Values("fL")[2], 12.0);
 }
 
 TEST_F(MeasurementTest, BadHeader) {
@@ -129,25 +124,30 @@ TEST_F(MeasurementTest, ChannelsInAnyOrderWithInteriorSensors) {
       "sensors.csv",
       "fL,t,u@0.25,uL,e@0.65,f0,u0\n1,0,0.5,2,-1e-4,3,4\n5,1e-6,0.6,6,-2e-4,7,8\n"
       "9,2e-6,0.7,10,-3e-4,11,12\n");
-  const MeasurementSet set = ReadMeasurementCsv(path);
+  const ChannelSet set = ReadMeasurementCsv(path);
   ASSERT_EQ(set.num_samples(), 3);
-  EXPECT_EQ(set.fL[1], 5.0);
-  EXPECT_EQ(set.uL[2], 10.0);
-  EXPECT_EQ(set.f0[0], 3.0);
-  EXPECT_EQ(set.u0[2], 12.0);
-  ASSERT_EQ(set.sensors.size(), 2u);
-  EXPECT_EQ(set.sensors[0].name, "u@0.25");
-  EXPECT_EQ(set.sensors[0].kind, SensorKind::kDisplacement);
-  EXPECT_EQ(set.sensors[0].position, 0.25);
-  EXPECT_EQ(set.sensors[0].values[2], 0.7);
-  EXPECT_EQ(set.sensors[1].kind, SensorKind::kStrain);
-  EXPECT_EQ(set.sensors[1].position, 0.65);
-  EXPECT_EQ(set.sensors[1].values[1], -2e-4);
+  EXPECT_EQ(set.Values("fL")[1], 5.0);
+  EXPECT_EQ(set.Values("uL")[2], 10.0);
+  EXPECT_EQ(set.Values("f0")[0], 3.0);
+  EXPECT_EQ(set.Values("u0")[2], 12.0);
+  const std::vector<BarSensor> sensors = BarSensors(set);
+  ASSERT_EQ(sensors.size(), 2u);
+  EXPECT_EQ(set.channels[sensors[0].index].name, "u@0.25");
+  EXPECT_EQ(sensors[0].kind, SensorKind::kDisplacement);
+  EXPECT_EQ(sensors[0].position, 0.25);
+  EXPECT_EQ(set.channels[sensors[0].index].values[2], 0.7);
+  EXPECT_EQ(sensors[1].kind, SensorKind::kStrain);
+  EXPECT_EQ(sensors[1].position, 0.65);
+  EXPECT_EQ(set.channels[sensors[1].index].values[1], -2e-4);
+  // The kinds, from the names.
+  EXPECT_EQ(set.channels[set.Find("f0")].kind, ChannelKind::kForce);
+  EXPECT_EQ(set.channels[set.Find("u0")].kind, ChannelKind::kDisplacement);
+  EXPECT_EQ(set.channels[sensors[1].index].kind, ChannelKind::kStrain);
   // Written back in the canonical order, read back bit for bit.
   const std::string copy = PathOf("copy.csv");
   WriteMeasurementCsv(set, copy);
-  const MeasurementSet again = ReadMeasurementCsv(copy);
-  EXPECT_EQ(again.sensors[1].values, set.sensors[1].values);
+  const ChannelSet again = ReadMeasurementCsv(copy);
+  EXPECT_EQ(again.Values("e@0.65"), set.Values("e@0.65"));
   EXPECT_EQ(again.time_step, set.time_step);
   std::ifstream file(copy);
   std::string header;
@@ -240,7 +240,7 @@ TEST_F(MeasurementTest, MissingSampleIsReportedWhereItsGapEnds) {
 }
 
 TEST_F(MeasurementTest, UniformFileIsRead) {
-  const MeasurementSet set = ReadMeasurementCsv(WriteFile("data.csv", UniformFile(101, {})));
+  const ChannelSet set = ReadMeasurementCsv(WriteFile("data.csv", UniformFile(101, {})));
   EXPECT_EQ(set.num_steps(), 100);
   EXPECT_EQ(set.time_step, 0.5);
 }
@@ -266,17 +266,13 @@ TEST_F(MeasurementTest, TimeSpanTooWideForADouble) {
 
 // A smooth set with the clamped end's u0 at zero, as `identify simulate` writes
 // clean data.
-MeasurementSet SmoothSet(int samples) {
-  MeasurementSet set;
-  set.time_step = 1e-6;
-  set.u0 = Vector::Zero(samples);
-  set.uL.resize(samples);
-  set.f0.resize(samples);
-  set.fL.resize(samples);
+ChannelSet SmoothSet(int samples) {
+  ChannelSet set = BarChannelSet(0.0, 1e-6, Vector::Zero(samples), Vector(samples), Vector(samples),
+                                 Vector(samples));
   for (int k = 0; k < samples; ++k) {
-    set.uL[k] = 1e-6 * std::sin(0.05 * k);
-    set.f0[k] = -1e3 * std::sin(0.03 * k);
-    set.fL[k] = 1e3 * std::sin(0.03 * k);
+    set.Values("uL")[k] = 1e-6 * std::sin(0.05 * k);
+    set.Values("f0")[k] = -1e3 * std::sin(0.03 * k);
+    set.Values("fL")[k] = 1e3 * std::sin(0.03 * k);
   }
   return set;
 }
@@ -286,8 +282,8 @@ TEST(MeasurementChannelsTest, SmoothDataWithAZeroClampDisplacementPass) {
 }
 
 TEST(MeasurementChannelsTest, DeadChannelIsNamed) {
-  MeasurementSet set = SmoothSet(300);
-  set.f0.setZero();
+  ChannelSet set = SmoothSet(300);
+  set.Values("f0").setZero();
   try {
     CheckMeasurementChannels(set, "dead.csv");
     ADD_FAILURE() << "no InputError thrown";
@@ -299,8 +295,8 @@ TEST(MeasurementChannelsTest, DeadChannelIsNamed) {
 }
 
 TEST(MeasurementChannelsTest, OutlierIsNamedWithItsLine) {
-  MeasurementSet set = SmoothSet(300);
-  set.uL[100] = 5e-6;  // five times the peak; sample 100 is on line 102
+  ChannelSet set = SmoothSet(300);
+  set.Values("uL")[100] = 5e-6;  // five times the peak; sample 100 is on line 102
   try {
     CheckMeasurementChannels(set, "spike.csv");
     ADD_FAILURE() << "no InputError thrown";
@@ -313,8 +309,8 @@ TEST(MeasurementChannelsTest, OutlierIsNamedWithItsLine) {
 TEST(MeasurementChannelsTest, AnOutlierOnTheFirstOrLastSampleOrBesideItIsNamedAtItsLine) {
   // 300 samples on lines 2 to 301; uL's peak is 1e-6.
   for (const int sample : {0, 1, 298, 299}) {
-    MeasurementSet set = SmoothSet(300);
-    set.uL[sample] = 5e-6;
+    ChannelSet set = SmoothSet(300);
+    set.Values("uL")[sample] = 5e-6;
     try {
       CheckMeasurementChannels(set, "spike.csv");
       ADD_FAILURE() << "no InputError thrown for sample " << sample;
@@ -335,58 +331,6 @@ TEST_F(MeasurementTest, MissingFile) {
   } catch (const InputError& error) {
     EXPECT_EQ(std::string(error.what()),
               "cannot read measurement file " + path + ": No such file or directory");
-  }
-}
-
-// A CSV of any channels (a structure given by matrices): t anywhere, the other
-// columns by name in the file's order, written back bit for bit.
-TEST_F(MeasurementTest, AChannelTableReadsAnyNamedColumnsAndWritesThemBack) {
-  const std::string path =
-      WriteFile("table.csv", "F,t, uy tip ,exx\n1,0,0.5,-1e-6\n2,1e-6,0.25,3e-7\n4,2e-6,0,1e-300\n");
-  const ChannelTable table = ReadChannelTable(path);
-  EXPECT_EQ(table.names, (std::vector<std::string>{"F", "uy tip", "exx"}));
-  ASSERT_EQ(table.samples, 3);
-  EXPECT_EQ(table.start_time, 0.0);
-  EXPECT_EQ(table.time_step, 1e-6);
-  EXPECT_EQ(table.columns[0], (Vector(3) << 1, 2, 4).finished());
-  EXPECT_EQ(table.columns[2][2], 1e-300);
-  EXPECT_EQ(table.Find("uy tip"), 1);
-  EXPECT_EQ(table.Find("t"), -1);
-  WriteChannelTable(table, PathOf("again.csv"));
-  const ChannelTable again = ReadChannelTable(PathOf("again.csv"));
-  EXPECT_EQ(again.names, table.names);
-  EXPECT_EQ(again.time_step, table.time_step);
-  for (std::size_t c = 0; c < table.columns.size(); ++c) EXPECT_EQ(again.columns[c], table.columns[c]);
-}
-
-TEST_F(MeasurementTest, AChannelTableRefusesABadHeaderNamingTheLine) {
-  const std::vector<std::pair<std::string, std::string>> cases = {
-      {"F,uy\n1,2\n3,4\n", "lacks the time column 't'"},
-      {"t,F,F\n0,1,2\n1,1,2\n", "column 3 'F' repeats column 2 'F'"},
-      {"t,,F\n0,1,2\n1,1,2\n", "column 2 has no name"},
-      {"t,F\n0,1\n1,x\n", "column 'F': 'x' is not a number"},
-  };
-  for (const auto& [content, what] : cases) {
-    const std::string path = WriteFile("table.csv", content);
-    try {
-      ReadChannelTable(path);
-      ADD_FAILURE() << "accepted:\n" << content;
-    } catch (const InputError& error) {
-      EXPECT_EQ(std::string(error.what()).rfind(path + ":", 0), 0u) << error.what();
-      EXPECT_NE(std::string(error.what()).find(what), std::string::npos) << error.what();
-    }
-  }
-  // The caller's own check runs on the header before any row.
-  const HeaderCheck needs_uy = [](const std::vector<std::string>& names, const std::string&) {
-    return std::find(names.begin(), names.end(), "uy") == names.end() ? std::string("no uy")
-                                                                       : std::string();
-  };
-  const std::string path = WriteFile("table.csv", "t,F\n0,1\n1,bad\n");
-  try {
-    ReadChannelTable(path, needs_uy);
-    ADD_FAILURE() << "accepted";
-  } catch (const InputError& error) {
-    EXPECT_EQ(std::string(error.what()), path + ":1: no uy");
   }
 }
 

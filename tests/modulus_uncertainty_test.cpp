@@ -34,9 +34,9 @@ TEST(UncertaintyOptionsTest, SamplesAreChecked) {
 TEST(DifferenceNoiseLevelsTest, RecoversTheNoiseAddedToSmoothSignals) {
   // The paper's sampling: 1751 samples of a smooth signal, noise at SNR 5.
   testing::SmallCase c = MakeSmallCase(100, 1750, std::numeric_limits<double>::infinity(), 1);
-  MeasurementSet data = MakeSyntheticMeasurements(c.bar, c.load, c.time, c.data);
-  const double displacement_std = RootMeanSquare(data.uL) / 5.0;
-  const double force_std = RootMeanSquare(data.fL) / 5.0;
+  ChannelSet data = MakeSyntheticMeasurements(c.bar, c.load, c.time, c.data);
+  const double displacement_std = RootMeanSquare(data.Values("uL")) / 5.0;
+  const double force_std = RootMeanSquare(data.Values("fL")) / 5.0;
   AddMeasurementNoise(5.0, 11, &data);
   const NoiseLevels levels = DifferenceNoiseLevels(data);
   EXPECT_NEAR(levels.displacement_std, displacement_std, 0.05 * displacement_std);
@@ -87,7 +87,7 @@ class ModulusUncertaintyTest : public ::testing::Test {
   const McreOptions mcre_ = testing::FreeFreeMcre();
   testing::SmallCase case_;
   BarModel model_;
-  MeasurementSet data_;
+  ChannelSet data_;
   McreProblem problem_;
   CoupledSolution solution_;
 };
@@ -114,8 +114,7 @@ TEST(ModulusUncertaintyTrustedClampTest, TheFirstOrderChangeIsTheDifferenceOverD
   // (g(d + n) - g(d - n)) / 2 is its exact part linear in n.
   const testing::SmallCase small = MakeSmallCase(20, 120, 20.0, 2);
   const BarModel model(small.bar);
-  const MeasurementSet data =
-      MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
+  const ChannelSet data = MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
   McreOptions mcre;
   mcre.clamp = ClampModel::kTrusted;
   mcre.weights = testing::Weights(0.01, 1.0);
@@ -139,21 +138,21 @@ TEST(ModulusUncertaintyTrustedClampTest, TheFirstOrderChangeIsTheDifferenceOverD
   std::normal_distribution<double> normal(0.0, 1.0);
   double sum_of_squares = 0.0;
   for (int sample = 0; sample < options.samples; ++sample) {
-    MeasurementSet drawn = data;
-    for (Vector* channel : {&drawn.u0, &drawn.uL}) {
+    ChannelSet drawn = data;
+    for (Vector* channel : {&drawn.Values("u0"), &drawn.Values("uL")}) {
       for (double& value : *channel) value = noise.displacement_std * normal(engine);
     }
-    for (Vector* channel : {&drawn.f0, &drawn.fL}) {
+    for (Vector* channel : {&drawn.Values("f0"), &drawn.Values("fL")}) {
       for (double& value : *channel) value = noise.force_std * normal(engine);
     }
     double gradient[2];
     for (int sign = 0; sign < 2; ++sign) {
       const double s = sign == 0 ? 1.0 : -1.0;
-      MeasurementSet shifted = data;
-      shifted.u0 += s * drawn.u0;
-      shifted.uL += s * drawn.uL;
-      shifted.f0 += s * drawn.f0;
-      shifted.fL += s * drawn.fL;
+      ChannelSet shifted = data;
+      shifted.Values("u0") += s * drawn.Values("u0");
+      shifted.Values("uL") += s * drawn.Values("uL");
+      shifted.Values("f0") += s * drawn.Values("f0");
+      shifted.Values("fL") += s * drawn.Values("fL");
       McreProblem shifted_problem(model, shifted, mcre.weights, mcre.reference_modulus, 0.5, {},
                                   mcre.clamp);
       shifted_problem.SetModulus(kModulus);
@@ -186,14 +185,14 @@ TEST_F(ModulusUncertaintyTest, MisfitLevelsAreTheRmsEndMisfits) {
   const int last = model_.right_node();
   double sum = 0.0;
   for (int j = 0; j < data_.num_samples(); ++j) {
-    sum += std::pow(solution_.displacement(0, j) - data_.u0[j], 2) +
-           std::pow(solution_.displacement(last, j) - data_.uL[j], 2);
+    sum += std::pow(solution_.displacement(0, j) - data_.Values("u0")[j], 2) +
+           std::pow(solution_.displacement(last, j) - data_.Values("uL")[j], 2);
   }
   EXPECT_NEAR(misfit.displacement_std, std::sqrt(sum / (2.0 * data_.num_samples())),
               1e-12 * misfit.displacement_std);
   EXPECT_GT(misfit.force_std, 0.0);
   // A trusted clamp's misfit at x = 0 is r(U) - f0~: a reaction 3 N above the data.
-  const Vector reaction = data_.f0.array() + 3.0;
+  const Vector reaction = data_.Values("f0").array() + 3.0;
   const NoiseLevels trusted = MisfitLevels(data_, solution_, problem_.alpha(), &reaction);
   double force_sum = 0.0;
   for (int j = 0; j < data_.num_samples(); ++j) {

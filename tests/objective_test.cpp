@@ -30,7 +30,7 @@ class ObjectiveTest : public ::testing::Test {
   static constexpr double kScale = 160e9;  // E per unit of x [Pa]
   testing::SmallCase case_;
   BarModel model_;
-  MeasurementSet data_;
+  ChannelSet data_;
 };
 
 TEST(McreOptionsTest, DefaultsAreValidAndBadValuesNameTheirKey) {
@@ -99,7 +99,8 @@ TEST_F(ObjectiveTest, RestCostIsTheCostOfTheBarAtRestForEveryClamp) {
     double expected = 0.0;
     for (int j = 0; j <= data_.num_steps(); ++j) {
       const double c = (j == 0 || j == data_.num_steps()) ? 0.5 : 1.0;
-      const double f0 = data_.f0[j], fL = data_.fL[j], u0 = data_.u0[j], uL = data_.uL[j];
+      const double f0 = data_.Values("f0")[j], fL = data_.Values("fL")[j],
+                   u0 = data_.Values("u0")[j], uL = data_.Values("uL")[j];
       const double clamp_terms = clamp == ClampModel::kMeasured ? alpha * f0 * f0 + beta * u0 * u0
                                                                 : alpha_w_r * f0 * f0;
       expected += c * data_.time_step * 0.5 * (clamp_terms + alpha * fL * fL + beta * uL * uL);

@@ -236,8 +236,7 @@ TEST(OperationCountsTest, DenseKernelsCountedOnRealFactorisations) {
 // the retrograde sweep's end forces per step and W_j per level). They compute what the
 // library's sweeps compute (checked on a tiny bar) and count what they execute.
 struct CountedSweeps {
-  CountedSweeps(const McreProblem& problem, const MeasurementSet& data)
-      : problem(problem), data(data) {
+  CountedSweeps(const McreProblem& problem, const ChannelSet& data) : problem(problem), data(data) {
     const Eigen::MatrixXd mass(problem.MassMatrix()), stiffness(problem.StiffnessMatrix());
     h = problem.time_step();
     theta = problem.theta();
@@ -266,8 +265,8 @@ struct CountedSweeps {
     Eigen::MatrixXd g(n, m + 1);
     for (int j = 0; j <= m; ++j) {
       g.col(j) = -CountedBandProduct(k, 1, w.col(j), counter);
-      g(0, j) += data.f0[j] - counter->Divide(w(0, j), problem.alpha());
-      g(n - 1, j) += data.fL[j] - counter->Divide(w(n - 1, j), problem.alpha());
+      g(0, j) += data.Values("f0")[j] - counter->Divide(w(0, j), problem.alpha());
+      g(n - 1, j) += data.Values("fL")[j] - counter->Divide(w(n - 1, j), problem.alpha());
     }
     Eigen::MatrixXd u = Eigen::MatrixXd::Zero(n, m + 1);
     Eigen::VectorXd v = Eigen::VectorXd::Zero(n), v_next, u_next, f(n);
@@ -290,8 +289,8 @@ struct CountedSweeps {
     for (int j = m; j > 0; --j) {
       const double weight = problem.QuadratureWeight(j) * problem.beta();
       f.setZero();
-      f[0] = counter->Multiply(weight, u(0, j) - data.u0[j]);
-      f[n - 1] = counter->Multiply(weight, u(n - 1, j) - data.uL[j]);
+      f[0] = counter->Multiply(weight, u(0, j) - data.Values("u0")[j]);
+      f[n - 1] = counter->Multiply(weight, u(n - 1, j) - data.Values("uL")[j]);
       Step(v, omega.col(j), f, &v_next, &omega_next, counter);
       v = v_next;
       omega.col(j - 1) = omega_next;
@@ -324,7 +323,7 @@ struct CountedSweeps {
   }
 
   const McreProblem& problem;
-  const MeasurementSet& data;
+  const ChannelSet& data;
   double h = 0.0, theta = 0.0;
   Eigen::MatrixXd k, r, s;
 };

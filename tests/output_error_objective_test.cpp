@@ -36,7 +36,7 @@ struct InverseCrime {
   }
   testing::SmallCase small;
   BarModel model;
-  MeasurementSet data;
+  ChannelSet data;
   NoiseLevels noise;
 };
 
@@ -46,14 +46,17 @@ TEST(OutputErrorObjectiveTest, DataOfTheSameModelGiveZeroMisfitAtTheirModulus) {
   const OutputErrorPrediction& prediction = objective.Predict(kModulus, true);
   // Measured: uL, f0 and the sensors the same bits as the simulation's (the same
   // steps in the same order); 1e-15 of their peaks leaves room for another order.
-  EXPECT_LE((prediction.uL - crime.data.uL).lpNorm<Eigen::Infinity>(),
-            1e-15 * crime.data.uL.lpNorm<Eigen::Infinity>());
-  EXPECT_LE((prediction.f0 - crime.data.f0).lpNorm<Eigen::Infinity>(),
-            1e-15 * crime.data.f0.lpNorm<Eigen::Infinity>());
+  EXPECT_LE((prediction.uL - crime.data.Values("uL")).lpNorm<Eigen::Infinity>(),
+            1e-15 * crime.data.Values("uL").lpNorm<Eigen::Infinity>());
+  EXPECT_LE((prediction.f0 - crime.data.Values("f0")).lpNorm<Eigen::Infinity>(),
+            1e-15 * crime.data.Values("f0").lpNorm<Eigen::Infinity>());
+  const std::vector<BarSensor> sensors = BarSensors(crime.data);
+  ASSERT_EQ(sensors.size(), 2u);
   for (std::size_t i = 0; i < 2; ++i) {
-    EXPECT_LT((prediction.sensors[i] - crime.data.sensors[i].values).lpNorm<Eigen::Infinity>(),
-              1e-15 * crime.data.sensors[i].values.lpNorm<Eigen::Infinity>())
-        << crime.data.sensors[i].name;
+    const Channel& channel = crime.data.channels[static_cast<std::size_t>(sensors[i].index)];
+    EXPECT_LT((prediction.sensors[i] - channel.values).lpNorm<Eigen::Infinity>(),
+              1e-15 * channel.values.lpNorm<Eigen::Infinity>())
+        << channel.name;
   }
   // J / J_rest: measured 0; 1e-30 is (1e-15)^2.
   EXPECT_LE(prediction.cost / objective.rest_cost(), 1e-30);

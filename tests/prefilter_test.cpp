@@ -42,9 +42,8 @@ TEST(ZeroPhaseLowPassTest, RefusesACutoffAtOrAboveNyquistAndABadOrder) {
 }
 
 TEST(PrefilterTest, RefusesACutoffAtOrAboveNyquistOfTheMeasurements) {
-  MeasurementSet data;
-  data.time_step = 2e-6;  // Nyquist 250 kHz
-  for (Vector* channel : {&data.u0, &data.uL, &data.f0, &data.fL}) *channel = Vector::Ones(100);
+  const ChannelSet data = BarChannelSet(0.0, 2e-6, Vector::Ones(100), Vector::Ones(100),
+                                        Vector::Ones(100), Vector::Ones(100));  // Nyquist 250 kHz
   PrefilterOptions options;
   options.cutoff_frequency = 250e3;
   try {
@@ -60,11 +59,11 @@ TEST(PrefilterTest, RefusesACutoffAtOrAboveNyquistOfTheMeasurements) {
   options.cutoff_frequency = -1.0;  // invalid options: no assert, an exception
   EXPECT_THROW(PrefilterMeasurements(data, options), std::invalid_argument);
   options.cutoff_frequency = 200e3;
-  EXPECT_EQ(PrefilterMeasurements(data, options).fL.size(), 100);
+  EXPECT_EQ(PrefilterMeasurements(data, options).Values("fL").size(), 100);
   // Disabled: the cut-off is not used, the data are returned as they are.
   options.enabled = false;
   options.cutoff_frequency = 1e9;
-  EXPECT_EQ(PrefilterMeasurements(data, options).fL, data.fL);
+  EXPECT_EQ(PrefilterMeasurements(data, options).Values("fL"), data.Values("fL"));
 }
 
 TEST(ZeroPhaseLowPassTest, GainIsOneHalfAtTheCutoffAndOneAtZero) {
@@ -139,7 +138,7 @@ TEST(PrefilterTest, CutoffDerivedFromTheLoadLiesAboveItsSpectrum) {
   data.truth_refinement = 1;
   for (double snr : {std::numeric_limits<double>::infinity(), 2.5}) {
     data.snr = snr;
-    const MeasurementSet measurements = MakeSyntheticMeasurements(bar, load, time, data);
+    const ChannelSet measurements = MakeSyntheticMeasurements(bar, load, time, data);
     const double cutoff = EstimateCutoffFrequency(measurements);
     EXPECT_GT(cutoff, 30e3) << "SNR " << snr;
     EXPECT_LT(cutoff, 300e3) << "SNR " << snr;
@@ -153,21 +152,25 @@ TEST(PrefilterTest, DisabledLeavesTheDataAndEnabledFiltersEveryChannel) {
   DataOptions data;
   data.truth_refinement = 1;
   data.snr = 2.5;
-  const MeasurementSet noisy = MakeSyntheticMeasurements(bar, load, time, data);
+  const ChannelSet noisy = MakeSyntheticMeasurements(bar, load, time, data);
   data.snr = std::numeric_limits<double>::infinity();
-  const MeasurementSet clean = MakeSyntheticMeasurements(bar, load, time, data);
+  const ChannelSet clean = MakeSyntheticMeasurements(bar, load, time, data);
   PrefilterOptions options;
   options.enabled = false;
-  EXPECT_EQ(PrefilterMeasurements(noisy, options).uL, noisy.uL);
+  EXPECT_EQ(PrefilterMeasurements(noisy, options).Values("uL"), noisy.Values("uL"));
   options.enabled = true;
   double cutoff = 0.0;
-  const MeasurementSet filtered = PrefilterMeasurements(noisy, options, &cutoff);
+  const ChannelSet filtered = PrefilterMeasurements(noisy, options, &cutoff);
   EXPECT_GT(cutoff, 0.0);
   // Every channel is much closer to the noise-free one after filtering.
-  EXPECT_LT((filtered.uL - clean.uL).norm(), 0.5 * (noisy.uL - clean.uL).norm());
-  EXPECT_LT((filtered.u0 - clean.u0).norm(), 0.5 * (noisy.u0 - clean.u0).norm());
-  EXPECT_LT((filtered.fL - clean.fL).norm(), 0.5 * (noisy.fL - clean.fL).norm());
-  EXPECT_LT((filtered.f0 - clean.f0).norm(), 0.5 * (noisy.f0 - clean.f0).norm());
+  EXPECT_LT((filtered.Values("uL") - clean.Values("uL")).norm(),
+            0.5 * (noisy.Values("uL") - clean.Values("uL")).norm());
+  EXPECT_LT((filtered.Values("u0") - clean.Values("u0")).norm(),
+            0.5 * (noisy.Values("u0") - clean.Values("u0")).norm());
+  EXPECT_LT((filtered.Values("fL") - clean.Values("fL")).norm(),
+            0.5 * (noisy.Values("fL") - clean.Values("fL")).norm());
+  EXPECT_LT((filtered.Values("f0") - clean.Values("f0")).norm(),
+            0.5 * (noisy.Values("f0") - clean.Values("f0")).norm());
 }
 
 }  // namespace
@@ -206,12 +209,12 @@ TEST(ZeroPhaseLowPassTest, StartFromRestIsTheRecordPrecededByZeros) {
   // too: the same bits as the record with 2000 leading zeros filtered with the
   // reflection (the reflection of zeros is zeros), cut back to the record.
   BarProperties bar;
-  const MeasurementSet exact = ExactBarSolution(bar, LoadOptions()).Sample(TimeOptions());
+  const ChannelSet exact = ExactBarSolution(bar, LoadOptions()).Sample(TimeOptions());
   const ZeroPhaseLowPass filter(100e3, 1.0 / exact.time_step, 4);
   const int n = exact.num_samples();
   Vector preceded = Vector::Zero(n + 2000);
-  preceded.tail(n) = exact.fL;
-  EXPECT_EQ(filter.Apply(exact.fL, true), filter.Apply(preceded, false).tail(n));
+  preceded.tail(n) = exact.Values("fL");
+  EXPECT_EQ(filter.Apply(exact.Values("fL"), true), filter.Apply(preceded, false).tail(n));
 }
 
 }  // namespace

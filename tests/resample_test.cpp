@@ -8,29 +8,26 @@
 #include <string>
 #include <utility>
 
+#include "mcrewave/data/measurement.h"
+
 namespace mcrewave {
 namespace {
 
 // A set of `samples` samples of step h from t = 0: sines at `frequency` [Hz] on every
 // channel and on a strain sensor, starting at rest (sin(2 pi f t) vanishes at t = 0).
-MeasurementSet Sines(double h, int samples, double frequency) {
-  MeasurementSet set;
-  set.time_step = h;
+ChannelSet Sines(double h, int samples, double frequency) {
   Vector values(samples);
   for (int k = 0; k < samples; ++k) {
     const double t = k * h;
     values[k] =
         std::sin(2 * M_PI * frequency * t) + 0.3 * std::sin(2 * M_PI * 0.37 * frequency * t);
   }
-  set.u0 = values;
-  set.uL = 2.0 * values;
-  set.f0 = -values;
-  set.fL = 3.0 * values;
-  set.sensors.push_back({"e@0.5", SensorKind::kStrain, 0.5, 1e-4 * values});
+  ChannelSet set = BarChannelSet(0.0, h, values, 2.0 * values, -values, 3.0 * values);
+  set.Add("e@0.5", ChannelKind::kStrain, 1e-4 * values);
   return set;
 }
 
-double MaxError(const MeasurementSet& resampled, double frequency) {
+double MaxError(const ChannelSet& resampled, double frequency) {
   double worst = 0.0;
   // Away from both ends: the start from rest is a kink (its ringing decays over the
   // kernel's 8 lobes) and the last value is held past the end.
@@ -39,24 +36,24 @@ double MaxError(const MeasurementSet& resampled, double frequency) {
     const double t = k * resampled.time_step;
     const double exact =
         std::sin(2 * M_PI * frequency * t) + 0.3 * std::sin(2 * M_PI * 0.37 * frequency * t);
-    worst = std::max(worst, std::abs(resampled.uL[k] / 2.0 - exact));
-    worst = std::max(worst, std::abs(resampled.sensors[0].values[k] / 1e-4 - exact));
+    worst = std::max(worst, std::abs(resampled.Values("uL")[k] / 2.0 - exact));
+    worst = std::max(worst, std::abs(resampled.Values("e@0.5")[k] / 1e-4 - exact));
   }
   return worst;
 }
 
 TEST(ResampleTest, TheDataOwnGridIsReproducedExactly) {
-  const MeasurementSet data = Sines(1e-6, 200, 2e4);
-  const MeasurementSet same = ResampleMeasurements(data, 1e-6, 200, "data.csv");
-  EXPECT_EQ(same.uL, data.uL);
-  EXPECT_EQ(same.sensors[0].values, data.sensors[0].values);
+  const ChannelSet data = Sines(1e-6, 200, 2e4);
+  const ChannelSet same = ResampleMeasurements(data, 1e-6, 200, "data.csv");
+  EXPECT_EQ(same.Values("uL"), data.Values("uL"));
+  EXPECT_EQ(same.Values("e@0.5"), data.Values("e@0.5"));
 }
 
 TEST(ResampleTest, UpSamplingASmoothSignalIsAccurate) {
   // Data at 2.5 us, content at 0.05 and 0.0185 of the sample rate, onto 1 us:
   // measured 6.9e-4 of the amplitude.
-  const MeasurementSet data = Sines(2.5e-6, 400, 2e4);
-  const MeasurementSet fine = ResampleMeasurements(data, 1e-6, 901, "data.csv");
+  const ChannelSet data = Sines(2.5e-6, 400, 2e4);
+  const ChannelSet fine = ResampleMeasurements(data, 1e-6, 901, "data.csv");
   ASSERT_EQ(fine.num_samples(), 901);
   EXPECT_EQ(fine.time_step, 1e-6);
   EXPECT_LT(MaxError(fine, 2e4), 5e-3);
@@ -65,17 +62,17 @@ TEST(ResampleTest, UpSamplingASmoothSignalIsAccurate) {
 TEST(ResampleTest, DownSamplingFiltersBelowTheNewNyquistFrequency) {
   // Data at 0.4 us onto 1.2 us, content at 0.024 of the new rate (kept) plus a tone
   // at 0.6 of the new rate (above its Nyquist frequency: it must not fold back).
-  MeasurementSet data = Sines(0.4e-6, 3000, 2e4);
+  ChannelSet data = Sines(0.4e-6, 3000, 2e4);
   for (int k = 0; k < data.num_samples(); ++k) {
-    data.uL[k] += 0.5 * std::sin(2 * M_PI * 5e5 * k * 0.4e-6);
+    data.Values("uL")[k] += 0.5 * std::sin(2 * M_PI * 5e5 * k * 0.4e-6);
   }
-  const MeasurementSet coarse = ResampleMeasurements(data, 1.2e-6, 900, "data.csv");
+  const ChannelSet coarse = ResampleMeasurements(data, 1.2e-6, 900, "data.csv");
   // Measured 9.4e-5 of the amplitude: the tone is gone, nothing folded back.
   EXPECT_LT(MaxError(coarse, 2e4), 9e-4);
 }
 
 TEST(ResampleTest, DataThatDoNotCoverTheWindowAreRefused) {
-  const MeasurementSet data = Sines(1e-6, 100, 2e4);
+  const ChannelSet data = Sines(1e-6, 100, 2e4);
   try {
     ResampleMeasurements(data, 2e-6, 60, "short.csv");
     ADD_FAILURE() << "no InputError";
@@ -88,28 +85,32 @@ TEST(ResampleTest, DataThatDoNotCoverTheWindowAreRefused) {
   }
 }
 
-// The bar's set is resampled as a table of its channels: each channel of
-// ResampleMeasurements is the same bits as its column of ResampleChannelTable, up and
-// down (the down-sampling's low-pass included), sensors after the four end channels.
+// Any channel set is resampled channel by channel: each channel of a set of other
+// names (a structure given by matrices) is the same bits as the bar's channel it
+// copies, up and down (the down-sampling's low-pass included), names and kinds kept.
 TEST(ResampleTest, AChannelTableIsResampledAsTheBarsSet) {
-  const MeasurementSet data = Sines(1e-6, 400, 2e4);
-  ChannelTable table;
+  const ChannelSet data = Sines(1e-6, 400, 2e4);
+  ChannelSet table;
   table.time_step = data.time_step;
-  table.samples = data.num_samples();
-  table.names = {"fL", "tip", "gauge"};
-  table.columns = {data.fL, data.uL, data.sensors[0].values};
+  table.Add("fL", ChannelKind::kForce, data.Values("fL"));
+  table.Add("tip", ChannelKind::kDisplacement, data.Values("uL"));
+  table.Add("gauge", ChannelKind::kStrain, data.Values("e@0.5"));
   for (const auto& [step, samples] : {std::pair<double, int>{0.4e-6, 900},
                                       std::pair<double, int>{2.5e-6, 150}}) {
-    const MeasurementSet set = ResampleMeasurements(data, step, samples, "data.csv");
-    const ChannelTable resampled = ResampleChannelTable(table, step, samples, "data.csv");
-    ASSERT_EQ(resampled.samples, samples);
+    const ChannelSet set = ResampleMeasurements(data, step, samples, "data.csv");
+    const ChannelSet resampled = ResampleMeasurements(table, step, samples, "data.csv");
+    ASSERT_EQ(resampled.num_samples(), samples);
     EXPECT_EQ(resampled.time_step, step);
-    EXPECT_EQ(resampled.names, table.names);
-    EXPECT_EQ(resampled.columns[0], set.fL) << step;
-    EXPECT_EQ(resampled.columns[1], set.uL) << step;
-    EXPECT_EQ(resampled.columns[2], set.sensors[0].values) << step;
+    ASSERT_EQ(resampled.channels.size(), 3u);
+    for (std::size_t c = 0; c < 3; ++c) {
+      EXPECT_EQ(resampled.channels[c].name, table.channels[c].name);
+      EXPECT_EQ(resampled.channels[c].kind, table.channels[c].kind);
+    }
+    EXPECT_EQ(resampled.channels[0].values, set.Values("fL")) << step;
+    EXPECT_EQ(resampled.channels[1].values, set.Values("uL")) << step;
+    EXPECT_EQ(resampled.channels[2].values, set.Values("e@0.5")) << step;
   }
-  EXPECT_THROW(ResampleChannelTable(table, 1e-6, 500, "data.csv"), InputError);
+  EXPECT_THROW(ResampleMeasurements(table, 1e-6, 500, "data.csv"), InputError);
 }
 
 }  // namespace

@@ -170,7 +170,7 @@ TEST_F(ResultFilesTest, InnerResidualCsvHoldsTheColdSolveHistoryDownToTheToleran
 
 TEST_F(ResultFilesTest, EndsCsvHoldsTheMeasuredChannelsAndTheModelAtTheIdentifiedModulus) {
   const Csv csv = ReadCsv(File("ends.csv"));
-  const MeasurementSet& data = run_->data;
+  const ChannelSet& data = run_->data;
   const Matrix& displacement = run_->solution.displacement;
   const Matrix& retrograde = run_->solution.retrograde;
   const int last = static_cast<int>(displacement.rows()) - 1;
@@ -179,15 +179,15 @@ TEST_F(ResultFilesTest, EndsCsvHoldsTheMeasuredChannelsAndTheModelAtTheIdentifie
   for (int j = 0; j < data.num_samples(); ++j) {
     const std::vector<double>& row = csv.rows[j];
     EXPECT_EQ(row[0], j * data.time_step);
-    EXPECT_EQ(row[1], data.u0[j]);
+    EXPECT_EQ(row[1], data.Values("u0")[j]);
     EXPECT_EQ(row[2], displacement(0, j));
-    EXPECT_EQ(row[3], data.uL[j]);
+    EXPECT_EQ(row[3], data.Values("uL")[j]);
     EXPECT_EQ(row[4], displacement(last, j));
-    EXPECT_EQ(row[5], data.f0[j]);
+    EXPECT_EQ(row[5], data.Values("f0")[j]);
     // Model force at an end: F = F~ - w_end / alpha (docs/discrete_mcre.md section 2).
-    EXPECT_EQ(row[6], data.f0[j] - retrograde(0, j) / run_->alpha);
-    EXPECT_EQ(row[7], data.fL[j]);
-    EXPECT_EQ(row[8], data.fL[j] - retrograde(last, j) / run_->alpha);
+    EXPECT_EQ(row[6], data.Values("f0")[j] - retrograde(0, j) / run_->alpha);
+    EXPECT_EQ(row[7], data.Values("fL")[j]);
+    EXPECT_EQ(row[8], data.Values("fL")[j] - retrograde(last, j) / run_->alpha);
   }
 }
 
@@ -216,14 +216,14 @@ TEST(EndsCsvTest, TheModelForceAtTheClampIsTheClampModels) {
     for (int j = 0; j < run.data.num_samples(); ++j) {
       const double expected =
           std::string(clamp) == "pinned"
-              ? run.data.f0[j] - run.solution.retrograde(0, j) / alpha0
+              ? run.data.Values("f0")[j] - run.solution.retrograde(0, j) / alpha0
               : -element_stiffness * run.solution.displacement(1, j);
       // alpha_0 and K_01 rounded otherwise than the library's: a few ulps (measured
       // up to 3.7e-16 of max(1 N, |F_0|)).
       EXPECT_NEAR(csv.rows[j][6], expected, 4e-15 * std::max(1.0, std::abs(expected)))
           << "row " << j;
       largest = std::max(largest, std::abs(expected));
-      difference = std::max(difference, std::abs(csv.rows[j][6] - run.data.f0[j]));
+      difference = std::max(difference, std::abs(csv.rows[j][6] - run.data.Values("f0")[j]));
     }
     // The clamp force is not the measured f0 itself (the model's differs from the data).
     EXPECT_GT(difference, 1e-3 * largest);

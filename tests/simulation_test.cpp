@@ -62,19 +62,19 @@ struct ChannelErrors {
 
 constexpr double kFilterWidth = 4e-6;  // sigma [s], fixed under refinement
 
-ChannelErrors ErrorsAgainstExact(const MeasurementSet& simulated, const BarProperties& bar,
+ChannelErrors ErrorsAgainstExact(const ChannelSet& simulated, const BarProperties& bar,
                                  const LoadOptions& load, const TimeOptions& time) {
-  const MeasurementSet exact = ExactBarSolution(bar, load).Sample(time);
+  const ChannelSet exact = ExactBarSolution(bar, load).Sample(time);
   EXPECT_EQ(simulated.num_samples(), exact.num_samples());
-  const Vector uL_error = simulated.uL - exact.uL;
-  const Vector f0_error = simulated.f0 - exact.f0;
-  const double uL_scale = exact.uL.lpNorm<Eigen::Infinity>();
-  const double f0_scale = exact.f0.lpNorm<Eigen::Infinity>();
+  const Vector uL_error = simulated.Values("uL") - exact.Values("uL");
+  const Vector f0_error = simulated.Values("f0") - exact.Values("f0");
+  const double uL_scale = exact.Values("uL").lpNorm<Eigen::Infinity>();
+  const double f0_scale = exact.Values("f0").lpNorm<Eigen::Infinity>();
   ChannelErrors errors;
   errors.uL_max = uL_error.lpNorm<Eigen::Infinity>() / uL_scale;
   errors.f0_max = f0_error.lpNorm<Eigen::Infinity>() / f0_scale;
-  errors.uL_rms = uL_error.norm() / exact.uL.norm();
-  errors.f0_rms = f0_error.norm() / exact.f0.norm();
+  errors.uL_rms = uL_error.norm() / exact.Values("uL").norm();
+  errors.f0_rms = f0_error.norm() / exact.Values("f0").norm();
   errors.uL_filtered =
       GaussianFilter(uL_error, time.step, kFilterWidth).lpNorm<Eigen::Infinity>() / uL_scale;
   errors.f0_filtered =
@@ -192,7 +192,7 @@ TEST_P(ClampReactionTest, FreeBarDrivenByBothEndForcesReproducesTheClampedMotion
   const LoadOptions load;
   TimeOptions time;
   time.theta = theta;
-  const MeasurementSet clamped = SimulateClampedBar(bar, load, time);
+  const ChannelSet clamped = SimulateClampedBar(bar, load, time);
 
   const BarModel model(bar);
   const int n = model.num_nodes();
@@ -208,24 +208,24 @@ TEST_P(ClampReactionTest, FreeBarDrivenByBothEndForcesReproducesTheClampedMotion
       [&](int k, Eigen::Ref<Vector> f) {
         // f_theta = theta f_{k+1} + (1 - theta) f_k on the two end nodes.
         f.setZero();
-        f[0] = theta * clamped.f0[k + 1] + (1.0 - theta) * clamped.f0[k];
-        f[n - 1] = theta * clamped.fL[k + 1] + (1.0 - theta) * clamped.fL[k];
+        f[0] = theta * clamped.Values("f0")[k + 1] + (1.0 - theta) * clamped.Values("f0")[k];
+        f[n - 1] = theta * clamped.Values("fL")[k + 1] + (1.0 - theta) * clamped.Values("fL")[k];
       },
       [&](int k, const Vector& /*velocity*/, const Vector& u) {
         free_u0[k] = u[0];
         free_uL[k] = u[n - 1];
       });
-  const double scale = clamped.uL.lpNorm<Eigen::Infinity>();
+  const double scale = clamped.Values("uL").lpNorm<Eigen::Infinity>();
   RecordProperty("free_u0", Scientific(free_u0.lpNorm<Eigen::Infinity>() / scale));
-  RecordProperty("free_uL", Scientific(RelativeMaxError(free_uL, clamped.uL)));
+  RecordProperty("free_uL", Scientific(RelativeMaxError(free_uL, clamped.Values("uL"))));
   // Round-off only (measured 4.1e-14 and 4.4e-14 over the 1750 steps, theta 1/2; 3.5e-14
   // and 3.3e-14, theta 1).
   EXPECT_LT(free_u0.lpNorm<Eigen::Infinity>(), 3e-13 * scale);
-  EXPECT_LT(RelativeMaxError(free_uL, clamped.uL), 3e-13);
+  EXPECT_LT(RelativeMaxError(free_uL, clamped.Values("uL")), 3e-13);
   // The clamped output holds u0 = 0 exactly and the applied load.
-  EXPECT_EQ(clamped.u0.lpNorm<Eigen::Infinity>(), 0.0);
+  EXPECT_EQ(clamped.Values("u0").lpNorm<Eigen::Infinity>(), 0.0);
   for (int k = 0; k < clamped.num_samples(); k += 97) {
-    EXPECT_EQ(clamped.fL[k], load.Value(k * time.step));
+    EXPECT_EQ(clamped.Values("fL")[k], load.Value(k * time.step));
   }
 }
 
@@ -238,7 +238,7 @@ TEST(SimulationTest, RefinedTruthIsCloserToTheExactSolution) {
   DataOptions data;
   data.truth = TruthModel::kFiniteElement;
   data.truth_refinement = 4;
-  const MeasurementSet truth = SimulateTruth(bar, load, time, data);
+  const ChannelSet truth = SimulateTruth(bar, load, time, data);
   ASSERT_EQ(truth.num_samples(), time.NumSteps() + 1);
   EXPECT_EQ(truth.time_step, time.step);
   const ChannelErrors truth_errors = ErrorsAgainstExact(truth, bar, load, time);
@@ -255,14 +255,14 @@ TEST(SimulationTest, RefinedTruthIsCloserToTheExactSolution) {
 
   // truth_refinement = 1 is the model's own grid.
   data.truth_refinement = 1;
-  const MeasurementSet same_grid = SimulateTruth(bar, load, time, data);
-  EXPECT_EQ(same_grid.uL, SimulateClampedBar(bar, load, time).uL);
+  const ChannelSet same_grid = SimulateTruth(bar, load, time, data);
+  EXPECT_EQ(same_grid.Values("uL"), SimulateClampedBar(bar, load, time).Values("uL"));
 
   // The exact truth is ExactBarSolution itself.
   data.truth = TruthModel::kExact;
-  const MeasurementSet exact_truth = SimulateTruth(bar, load, time, data);
-  EXPECT_EQ(exact_truth.uL, ExactBarSolution(bar, load).Sample(time).uL);
-  EXPECT_EQ(exact_truth.f0, ExactBarSolution(bar, load).Sample(time).f0);
+  const ChannelSet exact_truth = SimulateTruth(bar, load, time, data);
+  EXPECT_EQ(exact_truth.Values("uL"), ExactBarSolution(bar, load).Sample(time).Values("uL"));
+  EXPECT_EQ(exact_truth.Values("f0"), ExactBarSolution(bar, load).Sample(time).Values("f0"));
 }
 
 // Sample mean and standard deviation of a vector.
@@ -280,17 +280,17 @@ TEST(NoiseTest, NoiseLevelMatchesTheSnr) {
   time.window = 6.3e-3;
   DataOptions data;
   data.truth = TruthModel::kExact;
-  const MeasurementSet clean = SimulateTruth(bar, load, time, data);
+  const ChannelSet clean = SimulateTruth(bar, load, time, data);
   for (double snr : {5.0, 40.0}) {
-    MeasurementSet noisy = clean;
+    ChannelSet noisy = clean;
     AddMeasurementNoise(snr, 7, &noisy);
-    const double std_u = RootMeanSquare(clean.uL) / snr;
-    const double std_f = RootMeanSquare(clean.fL) / snr;
+    const double std_u = RootMeanSquare(clean.Values("uL")) / snr;
+    const double std_f = RootMeanSquare(clean.Values("fL")) / snr;
     const std::vector<std::tuple<const char*, Vector, double>> channels{
-        {"u0", noisy.u0 - clean.u0, std_u},
-        {"uL", noisy.uL - clean.uL, std_u},
-        {"f0", noisy.f0 - clean.f0, std_f},
-        {"fL", noisy.fL - clean.fL, std_f}};
+        {"u0", noisy.Values("u0") - clean.Values("u0"), std_u},
+        {"uL", noisy.Values("uL") - clean.Values("uL"), std_u},
+        {"f0", noisy.Values("f0") - clean.Values("f0"), std_f},
+        {"fL", noisy.Values("fL") - clean.Values("fL"), std_f}};
     for (const auto& [name, noise, expected_std] : channels) {
       double mean = 0.0, std = 0.0;
       MeanAndStd(noise, &mean, &std);
@@ -301,8 +301,8 @@ TEST(NoiseTest, NoiseLevelMatchesTheSnr) {
     }
     // The SNR as defined (RMS(uL) / std of the noise on uL) is recovered.
     double mean = 0.0, std = 0.0;
-    MeanAndStd(noisy.uL - clean.uL, &mean, &std);
-    EXPECT_NEAR(RootMeanSquare(clean.uL) / std, snr, 0.05 * snr);
+    MeanAndStd(noisy.Values("uL") - clean.Values("uL"), &mean, &std);
+    EXPECT_NEAR(RootMeanSquare(clean.Values("uL")) / std, snr, 0.05 * snr);
   }
 }
 
@@ -314,24 +314,28 @@ TEST(NoiseTest, SeedDecidesTheNoise) {
   data.truth = TruthModel::kExact;
   data.snr = 20.0;
   data.seed = 3;
-  const MeasurementSet first = MakeSyntheticMeasurements(bar, load, time, data);
-  const MeasurementSet again = MakeSyntheticMeasurements(bar, load, time, data);
-  for (const auto& [a, b] : {std::pair{&first.u0, &again.u0}, std::pair{&first.uL, &again.uL},
-                             std::pair{&first.f0, &again.f0}, std::pair{&first.fL, &again.fL}}) {
+  const ChannelSet first = MakeSyntheticMeasurements(bar, load, time, data);
+  const ChannelSet again = MakeSyntheticMeasurements(bar, load, time, data);
+  for (const auto& [a, b] : {std::pair{&first.Values("u0"), &again.Values("u0")},
+                             std::pair{&first.Values("uL"), &again.Values("uL")},
+                             std::pair{&first.Values("f0"), &again.Values("f0")},
+                             std::pair{&first.Values("fL"), &again.Values("fL")}}) {
     EXPECT_EQ(*a, *b);
   }
   data.seed = 4;
-  const MeasurementSet other = MakeSyntheticMeasurements(bar, load, time, data);
-  for (const auto& [a, b] : {std::pair{&first.u0, &other.u0}, std::pair{&first.uL, &other.uL},
-                             std::pair{&first.f0, &other.f0}, std::pair{&first.fL, &other.fL}}) {
+  const ChannelSet other = MakeSyntheticMeasurements(bar, load, time, data);
+  for (const auto& [a, b] : {std::pair{&first.Values("u0"), &other.Values("u0")},
+                             std::pair{&first.Values("uL"), &other.Values("uL")},
+                             std::pair{&first.Values("f0"), &other.Values("f0")},
+                             std::pair{&first.Values("fL"), &other.Values("fL")}}) {
     // Independent draws: no sample coincides.
     EXPECT_EQ(((*a - *b).array() == 0.0).count(), 0);
   }
   // MakeSyntheticMeasurements is SimulateTruth followed by AddMeasurementNoise.
-  MeasurementSet composed = SimulateTruth(bar, load, time, data);
+  ChannelSet composed = SimulateTruth(bar, load, time, data);
   AddMeasurementNoise(data.snr, data.seed, &composed);
-  EXPECT_EQ(composed.uL, other.uL);
-  EXPECT_EQ(composed.f0, other.f0);
+  EXPECT_EQ(composed.Values("uL"), other.Values("uL"));
+  EXPECT_EQ(composed.Values("f0"), other.Values("f0"));
 }
 
 TEST(NoiseTest, InfiniteSnrAddsNothing) {
@@ -340,15 +344,15 @@ TEST(NoiseTest, InfiniteSnrAddsNothing) {
   const TimeOptions time;
   DataOptions data;
   data.truth = TruthModel::kExact;
-  const MeasurementSet clean = SimulateTruth(bar, load, time, data);
-  MeasurementSet same = clean;
+  const ChannelSet clean = SimulateTruth(bar, load, time, data);
+  ChannelSet same = clean;
   AddMeasurementNoise(std::numeric_limits<double>::infinity(), 11, &same);
-  EXPECT_EQ(same.u0, clean.u0);
-  EXPECT_EQ(same.uL, clean.uL);
-  EXPECT_EQ(same.f0, clean.f0);
-  EXPECT_EQ(same.fL, clean.fL);
+  EXPECT_EQ(same.Values("u0"), clean.Values("u0"));
+  EXPECT_EQ(same.Values("uL"), clean.Values("uL"));
+  EXPECT_EQ(same.Values("f0"), clean.Values("f0"));
+  EXPECT_EQ(same.Values("fL"), clean.Values("fL"));
   data.snr = std::numeric_limits<double>::infinity();
-  EXPECT_EQ(MakeSyntheticMeasurements(bar, load, time, data).uL, clean.uL);
+  EXPECT_EQ(MakeSyntheticMeasurements(bar, load, time, data).Values("uL"), clean.Values("uL"));
 }
 
 }  // namespace

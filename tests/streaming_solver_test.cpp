@@ -35,17 +35,17 @@ Matrix RandomTraces(const McreProblem& problem, unsigned seed) {
 }
 
 // Interior sensors on the bundle's data: a displacement and two strain gauges.
-MeasurementSet WithSensors(const MeasurementSet& data) {
-  MeasurementSet with = data;
-  with.sensors.push_back({"u@0.35", SensorKind::kDisplacement, 0.35, 0.5 * data.uL});
-  with.sensors.push_back({"e@0.2", SensorKind::kStrain, 0.2, 1e-3 * data.uL});
-  with.sensors.push_back({"e@0.81", SensorKind::kStrain, 0.81, -2e-3 * data.uL});
+ChannelSet WithSensors(const ChannelSet& data) {
+  ChannelSet with = data;
+  with.Add("u@0.35", ChannelKind::kDisplacement, 0.5 * data.Values("uL"));
+  with.Add("e@0.2", ChannelKind::kStrain, 1e-3 * data.Values("uL"));
+  with.Add("e@0.81", ChannelKind::kStrain, -2e-3 * data.Values("uL"));
   return with;
 }
 
 TEST(StreamingMapTest, TheTraceOperatorIsSelfAdjointAndPositive) {
   ProblemBundle bundle(MakeSmallCase(12, 60, 5.0, 2), Weights(1.0, 1.0));
-  const MeasurementSet data = WithSensors(bundle.data);
+  const ChannelSet data = WithSensors(bundle.data);
   McreProblem problem(bundle.model, data, Weights(1.0, 1.0), 200e9, 0.5);
   problem.SetModulus(0.9 * 200e9);
   const Matrix x = RandomTraces(problem, 1), y = RandomTraces(problem, 2);
@@ -79,7 +79,7 @@ TEST_P(StreamingAgreementTest, MatchesStoredFieldConjugateGradients) {
   ZoneLayout layout;
   layout.zone_count = param.zones;
   const BarModel model(small.bar, layout.ElementZones(small.bar));
-  MeasurementSet data = MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
+  ChannelSet data = MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
   if (param.sensors) data = WithSensors(data);
   EndDisplacementChannels ends;
   ends.u0 = param.use_u0;
@@ -163,7 +163,7 @@ TEST(StreamingSolverTest, AWarmStartFromANearbyModulusGivesTheSameSolutionInFewe
   // is left for the data. Small case with interior sensors, tolerance 1e-10.
   // Measured: the same e^2 to the bit; iterations cold / warm 206 / 152.
   ProblemBundle bundle(MakeSmallCase(30, 400, 10.0, 2), Weights(0.01, 1.0));
-  const MeasurementSet data = WithSensors(bundle.data);
+  const ChannelSet data = WithSensors(bundle.data);
   McreProblem problem(bundle.model, data, Weights(0.01, 1.0), 200e9, 0.5);
   const CoupledSolverOptions options =
       Options(CoupledSolverType::kStreamingConjugateGradient, 1e-10);
@@ -279,8 +279,7 @@ TEST(StreamingMemoryTest, PeakResidentMemoryStaysFarBelowOneSpaceTimeField) {
   if (testing::kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer's shadow memory";
   const testing::SmallCase small = MakeSmallCase(2000, 4000, 10.0, 1);
   const BarModel model(small.bar);
-  const MeasurementSet data =
-      MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
+  const ChannelSet data = MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
   McreProblem problem(model, data, Weights(0.01, 1.0), 200e9, 0.5);
   problem.SetModulus(190e9);
   const double field_bytes = 8.0 * problem.num_nodes() * (problem.num_steps() + 1.0);

@@ -59,7 +59,7 @@ std::string FreshFolder(const std::string& name) {
   return folder.string();
 }
 
-std::string ReadText(const std::string& path) {
+std::string ReadStudyText(const std::string& path) {
   std::ifstream file(path);
   std::ostringstream text;
   text << file.rdbuf();
@@ -143,20 +143,20 @@ TEST(StudyTest, RobustnessIsAccurateConvergedAndIndependentOfThreads) {
   WriteRobustnessResults(one, folder_one, /*figures=*/false);
   WriteRobustnessResults(two, folder_two, /*figures=*/false);
   for (const char* name : {"runs.csv", "statistics.csv"}) {
-    const std::string text = ReadText(folder_one + "/" + name);
-    EXPECT_EQ(text, ReadText(folder_two + "/" + name)) << name;
+    const std::string text = ReadStudyText(folder_one + "/" + name);
+    EXPECT_EQ(text, ReadStudyText(folder_two + "/" + name)) << name;
   }
-  const std::string runs = ReadText(folder_one + "/runs.csv");
+  const std::string runs = ReadStudyText(folder_one + "/runs.csv");
   EXPECT_EQ(FirstLine(runs),
             "snr,snr_index,seed,converged,identified_modulus,relative_error,evaluations,"
             "scan_evaluations,sweeps,local_minima");
   EXPECT_EQ(Lines(runs), 5);
-  const std::string statistics = ReadText(folder_one + "/statistics.csv");
+  const std::string statistics = ReadStudyText(folder_one + "/statistics.csv");
   EXPECT_EQ(FirstLine(statistics),
             "snr,snr_index,runs,converged_share,mean_error,std_error,q2.5_error,q97.5_error,"
             "mean_evaluations,mean_sweeps");
   EXPECT_EQ(Lines(statistics), 3);
-  const std::string summary = ReadText(folder_one + "/summary.md");
+  const std::string summary = ReadStudyText(folder_one + "/summary.md");
   EXPECT_NE(summary.find("| inf | 1 | 100 % |"), std::string::npos) << summary;
   EXPECT_NE(summary.find("SNR 10: 3 of 3 runs converged"), std::string::npos) << summary;
 }
@@ -209,14 +209,15 @@ TEST(StudyTest, RelaxationDivergesBeyondThePredictedLimitAndFollowsTheSpectrum) 
 
   const std::string folder = FreshFolder("study_relaxation");
   WriteRelaxationResults(study, folder, /*figures=*/false);
-  EXPECT_EQ(FirstLine(ReadText(folder + "/sweeps.csv")),
+  EXPECT_EQ(FirstLine(ReadStudyText(folder + "/sweeps.csv")),
             "case,snr,modulus_factor,omega,termination,converged,iterations,sweeps,"
             "relative_residual,predicted_iterations");
-  EXPECT_EQ(Lines(ReadText(folder + "/sweeps.csv")), 15);
-  EXPECT_EQ(Lines(ReadText(folder + "/cases.csv")), 3);
-  EXPECT_EQ(FirstLine(ReadText(folder + "/residuals.csv")),
+  EXPECT_EQ(Lines(ReadStudyText(folder + "/sweeps.csv")), 15);
+  EXPECT_EQ(Lines(ReadStudyText(folder + "/cases.csv")), 3);
+  EXPECT_EQ(FirstLine(ReadStudyText(folder + "/residuals.csv")),
             "history,case,snr,modulus_factor,method,omega,iteration,relative_residual");
-  EXPECT_NE(ReadText(folder + "/summary.md").find("## Relaxation coefficient"), std::string::npos);
+  EXPECT_NE(ReadStudyText(folder + "/summary.md").find("## Relaxation coefficient"),
+            std::string::npos);
 }
 
 TEST(StudyTest, CostCurvesHaveTheirMinimaWhereTheIdentificationFindsThem) {
@@ -249,12 +250,12 @@ TEST(StudyTest, CostCurvesHaveTheirMinimaWhereTheIdentificationFindsThem) {
   const std::string parent = FreshFolder("study_cost_curves");
   const std::string folder = parent + "/cost_curves";
   WriteCostCurveResults(study, folder, /*figures=*/false);
-  EXPECT_EQ(FirstLine(ReadText(folder + "/curves.csv")),
+  EXPECT_EQ(FirstLine(ReadStudyText(folder + "/curves.csv")),
             "curve,snr,seed,modulus,modulus_factor,cost");
-  EXPECT_EQ(Lines(ReadText(folder + "/curves.csv")), 1 + 3 * 21);
-  EXPECT_EQ(Lines(ReadText(folder + "/minima.csv")), 4);
+  EXPECT_EQ(Lines(ReadStudyText(folder + "/curves.csv")), 1 + 3 * 21);
+  EXPECT_EQ(Lines(ReadStudyText(folder + "/minima.csv")), 4);
   // The README gathers the summaries of the study folders present.
-  const std::string readme = ReadText(WriteStudiesReadme(parent));
+  const std::string readme = ReadStudyText(WriteStudiesReadme(parent));
   EXPECT_NE(readme.find("# Results of the studies"), std::string::npos);
   EXPECT_NE(readme.find("## Cost curves"), std::string::npos) << readme;
   EXPECT_EQ(readme.find("## Robustness"), std::string::npos) << readme;

@@ -64,7 +64,7 @@ struct ProblemBundle {
             c.data)),
         problem(model, data, weights, c.bar.modulus, theta) {}
   BarModel model;
-  MeasurementSet data;
+  ChannelSet data;
   McreProblem problem;
 };
 

@@ -40,6 +40,7 @@ TEST(TypesTest, EveryEnumRoundTripsThroughItsNameTable) {
   ExpectTableRoundTrips(kDataSourceNames, DataSourceToString, StringToDataSource);
   ExpectTableRoundTrips(kTruthModelNames, TruthModelToString, StringToTruthModel);
   ExpectTableRoundTrips(kSensorKindNames, SensorKindToString, StringToSensorKind);
+  ExpectTableRoundTrips(kChannelKindNames, ChannelKindToString, StringToChannelKind);
   ExpectTableRoundTrips(kZoningNames, ZoningToString, StringToZoning);
   ExpectTableRoundTrips(kModelKindNames, ModelKindToString, StringToModelKind);
   ExpectTableRoundTrips(kClampModelNames, ClampModelToString, StringToClampModel);

@@ -45,7 +45,7 @@ TEST(ZoneIdentificationRunTest, FiveZonesOnTheQuickCaseAndTheirFiles) {
   // five zones from E*, the weight by the discrepancy principle; every zone near the
   // homogeneous truth, and the files.
   Config config = LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/quick.yaml");
-  const MeasurementSet data = LoadMeasurements(config);
+  const ChannelSet data = LoadMeasurements(config);
   IdentificationRun scalar = IdentifyModulus(config, data);
   ASSERT_TRUE(scalar.IsUsable()) << scalar.outer.message;
   scalar.estimated_noise = DifferenceNoiseLevels(data);

@@ -51,12 +51,12 @@ struct InverseCrime {
     problem.SetModuli(truth);
     Matrix displacement;
     problem.DirectSweep(problem.ZeroField(), true, &displacement);
-    data.u0 = displacement.row(0).transpose();
-    data.uL = displacement.row(model.num_nodes() - 1).transpose();
+    data.Values("u0") = displacement.row(0).transpose();
+    data.Values("uL") = displacement.row(model.num_nodes() - 1).transpose();
   }
   testing::SmallCase small;
   BarModel model;
-  MeasurementSet data;
+  ChannelSet data;
 };
 
 // The paper's free-free formulation: the inverse crime's data are the model's own
@@ -185,12 +185,14 @@ TEST(ZoneMergeTest, NoisyInverseCrimeMergesToTheTruthsGroups) {
   InverseCrime crime(40, 120, 10, truth);
   std::mt19937_64 engine(4);
   std::normal_distribution<double> normal;
-  const double rms_u = std::sqrt(crime.data.uL.squaredNorm() / crime.data.uL.size());
-  const double rms_f = std::sqrt(crime.data.fL.squaredNorm() / crime.data.fL.size());
-  for (Vector* channel : {&crime.data.u0, &crime.data.uL}) {
+  const double rms_u =
+      std::sqrt(crime.data.Values("uL").squaredNorm() / crime.data.Values("uL").size());
+  const double rms_f =
+      std::sqrt(crime.data.Values("fL").squaredNorm() / crime.data.Values("fL").size());
+  for (Vector* channel : {&crime.data.Values("u0"), &crime.data.Values("uL")}) {
     for (double& value : *channel) value += rms_u / 20.0 * normal(engine);
   }
-  for (Vector* channel : {&crime.data.f0, &crime.data.fL}) {
+  for (Vector* channel : {&crime.data.Values("f0"), &crime.data.Values("fL")}) {
     for (double& value : *channel) value += rms_f / 20.0 * normal(engine);
   }
   PrefilterOptions prefilter;

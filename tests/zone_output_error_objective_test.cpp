@@ -44,14 +44,14 @@ struct ZonedCase {
                                             {0.6 * length, 0.7 * length, truth[6]}};
     data = SimulateClampedBar(small.bar, small.load, small.time, zones, sensors);
     AddMeasurementNoise(snr, 5, &data);
-    noise.displacement_std = RootMeanSquare(data.uL);
-    noise.force_std = RootMeanSquare(data.fL);
+    noise.displacement_std = RootMeanSquare(data.Values("uL"));
+    noise.force_std = RootMeanSquare(data.Values("fL"));
     noise.strain_std = 1e-6;
   }
   testing::SmallCase small;
   BarModel model;
   Vector truth;
-  MeasurementSet data;
+  ChannelSet data;
   NoiseLevels noise;
 };
 
@@ -148,14 +148,15 @@ TEST(ZoneOutputErrorObjectiveTest, NoiseTargetIsTheMeanCostAtTheTruthOfNoisyData
   constexpr double kSnr = 10.0;
   constexpr int kDraws = 400;
   NoiseLevels noise;
-  noise.displacement_std = RootMeanSquare(zoned.data.uL) / kSnr;
-  noise.force_std = RootMeanSquare(zoned.data.fL) / kSnr;
+  noise.displacement_std = RootMeanSquare(zoned.data.Values("uL")) / kSnr;
+  noise.force_std = RootMeanSquare(zoned.data.Values("fL")) / kSnr;
   double strain_squares = 0.0;
   int strain_samples = 0;
-  for (const SensorChannel& sensor : zoned.data.sensors) {
+  for (const BarSensor& sensor : BarSensors(zoned.data)) {
     if (sensor.kind != SensorKind::kStrain) continue;
-    strain_squares += sensor.values.squaredNorm();
-    strain_samples += static_cast<int>(sensor.values.size());
+    const Vector& values = zoned.data.channels[static_cast<std::size_t>(sensor.index)].values;
+    strain_squares += values.squaredNorm();
+    strain_samples += static_cast<int>(values.size());
   }
   noise.strain_std = std::sqrt(strain_squares / strain_samples) / kSnr;
   const ZoneOutputErrorObjective clean(zoned.model, zoned.data, noise, 0.5, 200e9);
@@ -166,7 +167,7 @@ TEST(ZoneOutputErrorObjectiveTest, NoiseTargetIsTheMeanCostAtTheTruthOfNoisyData
       zoned.model, zoned.data, noise, 0.5, {}, zoned.truth, noise, no_prefilter, kDraws, 1, scale);
   double mean = 0.0;
   for (int seed = 1; seed <= kDraws; ++seed) {
-    MeasurementSet noisy = zoned.data;
+    ChannelSet noisy = zoned.data;
     AddMeasurementNoise(kSnr, 1000 + seed, &noisy);
     ZoneOutputErrorObjective objective(zoned.model, noisy, noise, 0.5, 200e9);
     mean += objective.Cost(zoned.truth, nullptr) / scale / kDraws;

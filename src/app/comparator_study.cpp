@@ -51,7 +51,7 @@ std::vector<DataSet> DataSets(const StudyOptions& options) {
 }
 
 // One identification of `functional` on `data` with the model `model`.
-void Identify(const Config& config, const BarModel& model, const MeasurementSet& data,
+void Identify(const Config& config, const BarModel& model, const ChannelSet& data,
               bool least_squares, ComparatorRun* run) {
   const auto start = std::chrono::steady_clock::now();
   Config one_thread = config;
@@ -61,8 +61,8 @@ void Identify(const Config& config, const BarModel& model, const MeasurementSet&
     // s = RMS(measured) / SNR; at SNR inf the RMS alone (the weights' ratio).
     const double snr = std::isinf(run->snr) ? 1.0 : run->snr;
     NoiseLevels noise;
-    noise.displacement_std = RootMeanSquare(data.uL) / snr;
-    noise.force_std = RootMeanSquare(data.f0) / snr;
+    noise.displacement_std = RootMeanSquare(data.Values("uL")) / snr;
+    noise.force_std = RootMeanSquare(data.Values("f0")) / snr;
     OutputErrorObjective objective(model, data, noise, config.time.theta, config.outer.initial);
     summary = mcrewave::Identify(one_thread.outer, &objective);
   } else {
@@ -91,10 +91,9 @@ void RunDataSet(const Config& config, const DataSet& set, const std::vector<bool
     truth.data.truth_zones = {
         {0.0, kSoftZoneLength * config.model.length, kSoftZoneFactor * config.model.modulus}};
   }
-  MeasurementSet measured =
-      MakeSyntheticMeasurements(truth.model, truth.load, truth.time, truth.data);
-  if (set.model_error == "force_gain") measured.fL *= kForceGain;
-  if (set.model_error == "displacement_gain") measured.uL *= kDisplacementGain;
+  ChannelSet measured = MakeSyntheticMeasurements(truth.model, truth.load, truth.time, truth.data);
+  if (set.model_error == "force_gain") measured.Values("fL") *= kForceGain;
+  if (set.model_error == "displacement_gain") measured.Values("uL") *= kDisplacementGain;
   BarProperties identified = config.model;
   if (set.model_error == "density") identified.density *= kDensityError;
   const BarModel model(identified);
@@ -108,7 +107,7 @@ void RunDataSet(const Config& config, const DataSet& set, const std::vector<bool
     run.prefilter = prefilters[k % filters];
     PrefilterOptions prefilter = config.prefilter;
     prefilter.enabled = run.prefilter;
-    const MeasurementSet data = PrefilterMeasurements(measured, prefilter, nullptr);
+    const ChannelSet data = PrefilterMeasurements(measured, prefilter, nullptr);
     Identify(config, model, data, run.least_squares, &run);
   }
 }

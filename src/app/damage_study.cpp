@@ -88,7 +88,7 @@ Config RunConfig(const Config& config, const DamageCase& damage) {
 // options, by output-error least squares on the same (pre-filtered) data, its
 // misfit normalised by LeastSquaresMisfitLevels and its discrepancy target from the
 // noise levels the MCRE's target uses.
-void FitLeastSquaresZones(const Config& config, const MeasurementSet& measured,
+void FitLeastSquaresZones(const Config& config, const ChannelSet& measured,
                           const IdentificationRun& scalar, const BarModel& zoned,
                           const std::vector<double>& truth_moduli, DamageLeastSquaresFit* fit) {
   fit->ran = true;
@@ -133,8 +133,8 @@ void RunOne(const Config& config, const DamageCase& damage, DamageRun* run) {
   const Config run_config = RunConfig(config, damage);
   assert(ConfigProblem(run_config).empty());  // CheckDamageStudyConfig
 
-  const MeasurementSet measured = MakeSyntheticMeasurements(run_config.model, run_config.load,
-                                                            run_config.time, run_config.data);
+  const ChannelSet measured = MakeSyntheticMeasurements(run_config.model, run_config.load,
+                                                        run_config.time, run_config.data);
   IdentificationRun scalar = IdentifyModulus(run_config, measured);
   // The scalar identification's coupled solves: its scans' and search's (on copies of
   // the objective and on the search functional) and those the objective recorded.

@@ -23,9 +23,9 @@ namespace {
 // The measurements an identification compares with: the channels of
 // data.channels (LoadMeasurements checked they exist), then the pre-filter
 // (its cut-off into *cutoff, 0 when off); *ends: the end displacements in use.
-MeasurementSet IdentificationData(const Config& config, const MeasurementSet& data,
-                                  EndDisplacementChannels* ends, double* cutoff) {
-  MeasurementSet selected = PrefilterMeasurements(
+ChannelSet IdentificationData(const Config& config, const ChannelSet& data,
+                              EndDisplacementChannels* ends, double* cutoff) {
+  ChannelSet selected = PrefilterMeasurements(
       SelectChannels(data, config.data.channels, "data.channels", "the data", &ends->u0, &ends->uL),
       config.prefilter, cutoff);
   if (config.prefilter.enabled) {
@@ -37,13 +37,14 @@ MeasurementSet IdentificationData(const Config& config, const MeasurementSet& da
 }
 
 // RMS over every strain channel (e@X) of the set; 0 without any.
-double StrainRms(const MeasurementSet& set) {
+double StrainRms(const ChannelSet& set) {
   double squares = 0.0;
   Eigen::Index samples = 0;
-  for (const SensorChannel& sensor : set.sensors) {
+  for (const BarSensor& sensor : BarSensors(set)) {
     if (sensor.kind != SensorKind::kStrain) continue;
-    squares += sensor.values.squaredNorm();
-    samples += sensor.values.size();
+    const Vector& values = set.channels[static_cast<std::size_t>(sensor.index)].values;
+    squares += values.squaredNorm();
+    samples += values.size();
   }
   return samples > 0 ? std::sqrt(squares / static_cast<double>(samples)) : 0.0;
 }
@@ -86,8 +87,8 @@ std::vector<double> CostCurveModuli(const Config& config, const IdentificationRu
 // The cost curve at CostCurveModuli, each solve warm-started from the previous
 // point's (the first from the solution at E*).
 std::vector<CostCurvePoint> ComputeCostCurve(const Config& config, const BarModel& model,
-                                             const MeasurementSet& data,
-                                             const IdentificationRun& run, long* sweeps) {
+                                             const ChannelSet& data, const IdentificationRun& run,
+                                             long* sweeps) {
   const double center = run.identified_modulus();
   const std::vector<double> moduli = CostCurveModuli(config, run);
   spdlog::info("cost curve: {} points over [{:.6g}, {:.6g}] Pa", moduli.size(), moduli.front(),
@@ -118,13 +119,16 @@ std::string Number(double value) { return FormatNumber(value, kSixDigits); }
 
 }  // namespace
 
-MeasurementSet SyntheticMeasurements(const Config& config) {
-  MeasurementSet data =
-      MakeSyntheticMeasurements(config.model, config.load, config.time, config.data);
-  std::vector<std::pair<std::string, const Vector*>> channels = {
-      {"u0", &data.u0}, {"uL", &data.uL}, {"f0", &data.f0}, {"fL", &data.fL}};
-  for (const SensorChannel& sensor : data.sensors) {
-    channels.push_back({sensor.name, &sensor.values});
+ChannelSet SyntheticMeasurements(const Config& config) {
+  ChannelSet data = MakeSyntheticMeasurements(config.model, config.load, config.time, config.data);
+  // The end channels first, then the interior ones (the first non-finite one is named).
+  std::vector<std::pair<std::string, const Vector*>> channels = {{"u0", &data.Values("u0")},
+                                                                 {"uL", &data.Values("uL")},
+                                                                 {"f0", &data.Values("f0")},
+                                                                 {"fL", &data.Values("fL")}};
+  for (const BarSensor& sensor : BarSensors(data)) {
+    const Channel& channel = data.channels[static_cast<std::size_t>(sensor.index)];
+    channels.push_back({channel.name, &channel.values});
   }
   for (const auto& [name, values] : channels) {
     if (!values->allFinite()) {
@@ -139,16 +143,16 @@ MeasurementSet SyntheticMeasurements(const Config& config) {
   return data;
 }
 
-MeasurementSet LoadMeasurements(const Config& config) {
+ChannelSet LoadMeasurements(const Config& config) {
   bool use_u0 = true, use_uL = true;
   if (config.data.source == DataSource::kSynthetic) {
-    MeasurementSet data = SyntheticMeasurements(config);
+    ChannelSet data = SyntheticMeasurements(config);
     SelectChannels(data, config.data.channels, "data.channels", "the synthetic data (data.sensors)",
                    &use_u0, &use_uL);
     return data;
   }
   const std::string& path = config.data.path;
-  MeasurementSet data = ReadMeasurementCsv(path);
+  ChannelSet data = ReadMeasurementCsv(path);
   // Dead channels and outliers are looked for in the file's own samples, so that the
   // line named is the file's (resampling would spread a spike over its neighbours).
   CheckMeasurementChannels(data, path);
@@ -162,9 +166,10 @@ MeasurementSet LoadMeasurements(const Config& config) {
     data = ResampleMeasurements(data, config.time.step, expected_samples, path);
   }
   SelectChannels(data, config.data.channels, "data.channels", path, &use_u0, &use_uL);
-  for (std::size_t k = 0; k < data.sensors.size(); ++k) {
-    if (data.sensors[k].position > config.model.length) {
-      throw InputError(path + ":1: column '" + data.sensors[k].name +
+  for (const BarSensor& sensor : BarSensors(data)) {
+    if (sensor.position > config.model.length) {
+      throw InputError(path + ":1: column '" +
+                       data.channels[static_cast<std::size_t>(sensor.index)].name +
                        "': the sensor lies outside the bar [0, " + Number(config.model.length) +
                        "] m (model.length of " + config_name + ")");
     }
@@ -186,7 +191,7 @@ MeasurementSet LoadMeasurements(const Config& config) {
 }
 
 McreIdentification IdentifyWithMcre(const Config& config, const BarModel& model,
-                                    const MeasurementSet& data, EndDisplacementChannels ends) {
+                                    const ChannelSet& data, EndDisplacementChannels ends) {
   McreIdentification result;
   result.objective = std::make_unique<McreObjective>(model, data, config.mcre, config.time.theta,
                                                      config.inner, config.outer.initial, ends);
@@ -206,7 +211,7 @@ McreIdentification IdentifyWithMcre(const Config& config, const BarModel& model,
   return result;
 }
 
-IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& data) {
+IdentificationRun IdentifyModulus(const Config& config, const ChannelSet& data) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   IdentificationRun run;
@@ -261,7 +266,7 @@ IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& da
   return run;
 }
 
-IdentificationRun RunIdentification(const Config& config, const MeasurementSet& data) {
+IdentificationRun RunIdentification(const Config& config, const ChannelSet& data) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   IdentificationRun run = IdentifyModulus(config, data);
@@ -291,17 +296,18 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
 
   // The model's force at x = 0 and the RMS misfits at E*.
   const McreProblem& problem = cold.problem();
+  const Vector& measured_f0 = run.data.Values("f0");
   run.clamp_force.resize(run.data.num_samples());
   for (int j = 0; j < run.data.num_samples(); ++j) {
     switch (config.mcre.clamp) {
       case ClampModel::kMeasured:
         // F_0 = f0~ - W_0 / alpha (docs/discrete_mcre.md section 2).
-        run.clamp_force[j] = run.data.f0[j] - run.solution.EndRetrograde(0, j) / run.alpha;
+        run.clamp_force[j] = measured_f0[j] - run.solution.EndRetrograde(0, j) / run.alpha;
         break;
       case ClampModel::kPinned:
         // F_0 = f0~ - W_0 / alpha_0 (docs/trusted_clamp.md section 9).
         run.clamp_force[j] =
-            run.data.f0[j] - problem.inverse_alpha0() * run.solution.EndRetrograde(0, j);
+            measured_f0[j] - problem.inverse_alpha0() * run.solution.EndRetrograde(0, j);
         break;
       case ClampModel::kTrusted:
         // r(U_j): the reaction row of the stored fields, or the last trace row of a
@@ -341,31 +347,31 @@ IdentificationRun RunIdentification(const Config& config, const MeasurementSet& 
   return run;
 }
 
-NoiseLevels MeasurementNoiseLevels(const Config& config, const MeasurementSet& data,
+NoiseLevels MeasurementNoiseLevels(const Config& config, const ChannelSet& data,
                                    std::string* source) {
   if (!(config.data.source == DataSource::kSynthetic && std::isfinite(config.data.snr))) {
     *source = "data_differences";
     return DifferenceNoiseLevels(data);
   }
   NoiseLevels noise;
-  const MeasurementSet truth = SimulateTruth(config.model, config.load, config.time, config.data);
+  const ChannelSet truth = SimulateTruth(config.model, config.load, config.time, config.data);
   // std = RMS(signal) / SNR (noise.h)
-  noise.displacement_std = RootMeanSquare(truth.uL) / config.data.snr;
-  noise.force_std = RootMeanSquare(truth.fL) / config.data.snr;
+  noise.displacement_std = RootMeanSquare(truth.Values("uL")) / config.data.snr;
+  noise.force_std = RootMeanSquare(truth.Values("fL")) / config.data.snr;
   // Strains: RMS over every strain channel / SNR (noise.h).
   noise.strain_std = StrainRms(truth) / config.data.snr;
   *source = "synthetic_snr";
   return noise;
 }
 
-NoiseLevels LeastSquaresMisfitLevels(const Config& config, const MeasurementSet& data,
-                                     const MeasurementSet& used, std::string* source) {
+NoiseLevels LeastSquaresMisfitLevels(const Config& config, const ChannelSet& data,
+                                     const ChannelSet& used, std::string* source) {
   NoiseLevels levels = MeasurementNoiseLevels(config, data, source);
   // Noise-free data have no level to normalise by: the RMS of the channels instead
   // (only the ratio of the weights matters then, as in the comparator study).
   for (auto [level, rms] :
-       {std::pair<double*, double>{&levels.displacement_std, RootMeanSquare(used.uL)},
-        {&levels.force_std, RootMeanSquare(used.fL)},
+       {std::pair<double*, double>{&levels.displacement_std, RootMeanSquare(used.Values("uL"))},
+        {&levels.force_std, RootMeanSquare(used.Values("fL"))},
         {&levels.strain_std, StrainRms(used)}}) {
     if (!(*level > 0.0) && rms > 0.0) {
       *level = rms;
@@ -375,7 +381,7 @@ NoiseLevels LeastSquaresMisfitLevels(const Config& config, const MeasurementSet&
   return levels;
 }
 
-LeastSquaresRun RunLeastSquares(const Config& config, const MeasurementSet& data) {
+LeastSquaresRun RunLeastSquares(const Config& config, const ChannelSet& data) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   LeastSquaresRun run;
@@ -447,7 +453,7 @@ std::string ModulusOnBoundMessage(double modulus, const IdentificationOptions& o
 }
 
 std::string ImplausibleMisfitMessage(const IdentificationRun& run) {
-  const MeasurementSet& data = run.data;
+  const ChannelSet& data = run.data;
   // RMS over both ends: sqrt((|a|^2 + |b|^2) / (2 samples)).
   auto both_ends_rms = [&](const Vector& a, const Vector& b) {
     return std::sqrt((a.squaredNorm() + b.squaredNorm()) / (2.0 * data.num_samples()));
@@ -459,8 +465,9 @@ std::string ImplausibleMisfitMessage(const IdentificationRun& run) {
     double measured;
   };
   const QuantityType types[] = {
-      {"displacements", "m", run.misfit.displacement_std, both_ends_rms(data.u0, data.uL)},
-      {"forces", "N", run.misfit.force_std, both_ends_rms(data.f0, data.fL)}};
+      {"displacements", "m", run.misfit.displacement_std,
+       both_ends_rms(data.Values("u0"), data.Values("uL"))},
+      {"forces", "N", run.misfit.force_std, both_ends_rms(data.Values("f0"), data.Values("fL"))}};
   for (const QuantityType& type : types) {
     if (!(type.misfit <= kImplausibleMisfitFactor * type.measured)) {
       char message[512];

@@ -36,8 +36,9 @@ std::string ConfigName(const Config& config) {
   return config.source_path.empty() ? std::string("config") : config.source_path;
 }
 
-// The CSV of data.path on the config's grid, rows in the model's channel order.
-ChannelHistories ReadMatrixMeasurementCsv(const Config& config, const MatrixModelData& model) {
+// The CSV of data.path on the config's grid: the model's channels (named as the model
+// names them, of their kinds), in its order.
+ChannelSet ReadMatrixMeasurementCsv(const Config& config, const MatrixModelData& model) {
   const std::string& path = config.data.path;
   const auto channels = ChannelColumns(config, model);
   // Every channel's column must be in the header (checked before any row is read).
@@ -53,35 +54,31 @@ ChannelHistories ReadMatrixMeasurementCsv(const Config& config, const MatrixMode
     }
     return "";
   };
-  ChannelTable table = ReadChannelTable(path, check_header);
+  ChannelSet table = ReadChannelCsv(path, check_header);
   const int samples = config.time.NumSteps() + 1;
   if (table.time_step != config.time.step || table.start_time != 0.0 ||
-      table.samples != samples) {
+      table.num_samples() != samples) {
     spdlog::info("{}: resampling {} samples of {:.4g} s onto {} samples of {:.4g} s", path,
-                 table.samples, table.time_step, samples, config.time.step);
-    table = ResampleChannelTable(table, config.time.step, samples, path);
+                 table.num_samples(), table.time_step, samples, config.time.step);
+    table = ResampleMeasurements(table, config.time.step, samples, path);
   }
-  ChannelHistories histories;
-  histories.time_step = config.time.step;
-  const auto loads = static_cast<int>(model.loads.size());
-  histories.loads.resize(loads, samples);
-  histories.outputs.resize(static_cast<int>(model.sensors.size()), samples);
+  ChannelSet set;
+  set.time_step = config.time.step;
+  const auto loads = model.loads.size();
   for (std::size_t c = 0; c < channels.size(); ++c) {
-    const Vector& column = table.columns[static_cast<std::size_t>(table.Find(channels[c].second))];
-    const auto row = static_cast<int>(c);
-    if (row < loads) {
-      histories.loads.row(row) = column.transpose();
-    } else {
-      histories.outputs.row(row - loads) = column.transpose();
-    }
+    const ChannelKind kind = c < loads ? ChannelKind::kForce
+                             : model.sensors[c - loads].kind == SensorKind::kStrain
+                                 ? ChannelKind::kStrain
+                                 : ChannelKind::kDisplacement;
+    set.Add(channels[c].first, kind, table.Values(channels[c].second));
   }
-  return histories;
+  return set;
 }
 
 // Synthetic data: the truth's outputs at its moduli, with noise; the truth's moduli of
 // the model's zones in *truth_moduli (empty when a zone name is not the truth's).
-ChannelHistories SyntheticMatrixMeasurements(const Config& config, const MatrixModelData& model,
-                                             Vector* truth_moduli) {
+ChannelSet SyntheticMatrixMeasurements(const Config& config, const MatrixModelData& model,
+                                       Vector* truth_moduli) {
   const std::string manifest = config.data.truth_manifest.empty() ? config.structure.manifest
                                                                   : config.data.truth_manifest;
   const MatrixModelData truth =
@@ -120,16 +117,15 @@ ChannelHistories SyntheticMatrixMeasurements(const Config& config, const MatrixM
   }
   const Matrix outputs =
       SimulateMatrixModel(truth, moduli, truth_loads, config.time.step, config.time.theta);
-  ChannelHistories histories;
-  histories.time_step = config.time.step;
-  histories.loads.resize(static_cast<int>(load_rows.size()), steps + 1);
-  histories.outputs.resize(static_cast<int>(sensor_rows.size()), steps + 1);
+  Matrix loads(static_cast<int>(load_rows.size()), steps + 1);
+  Matrix sensors(static_cast<int>(sensor_rows.size()), steps + 1);
   for (std::size_t c = 0; c < load_rows.size(); ++c) {
-    histories.loads.row(static_cast<int>(c)) = truth_loads.row(load_rows[c]);
+    loads.row(static_cast<int>(c)) = truth_loads.row(load_rows[c]);
   }
   for (std::size_t k = 0; k < sensor_rows.size(); ++k) {
-    histories.outputs.row(static_cast<int>(k)) = outputs.row(sensor_rows[k]);
+    sensors.row(static_cast<int>(k)) = outputs.row(sensor_rows[k]);
   }
+  ChannelSet histories = MatrixChannelSet(model, config.time.step, loads, sensors);
   AddMatrixModelNoise(model, config.data.snr, config.data.seed, &histories);
 
   truth_moduli->resize(static_cast<int>(model.zones.size()));
@@ -276,10 +272,8 @@ MatrixMeasurements LoadMatrixMeasurements(const Config& config, const MatrixMode
 
 Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_moduli,
                            const Matrix& loads, double time_step, double theta) {
-  ChannelHistories data;
-  data.time_step = time_step;
-  data.loads = loads;
-  data.outputs = Matrix::Zero(static_cast<int>(truth.sensors.size()), loads.cols());
+  const ChannelSet data = MatrixChannelSet(
+      truth, time_step, loads, Matrix::Zero(static_cast<int>(truth.sensors.size()), loads.cols()));
   // The weights and their reference modulus do not enter the direct sweep from W = 0.
   MatrixMcreProblem simulation(truth, data, McreWeights(), truth.zones[0].nominal_modulus, theta);
   simulation.SetModuli(zone_moduli);
@@ -287,51 +281,58 @@ Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_modu
 }
 
 void AddMatrixModelNoise(const MatrixModelData& model, double snr, std::uint64_t seed,
-                         ChannelHistories* data) {
+                         ChannelSet* data) {
   if (std::isinf(snr)) return;
-  // The sensor rows of each quantity, gathered for their RMS.
-  const auto samples = data->outputs.cols();
+  // The channels of each quantity, gathered as rows for their RMS.
+  const auto samples = data->num_samples();
+  const auto num_loads = static_cast<int>(model.loads.size());
+  const auto num_sensors = static_cast<int>(model.sensors.size());
+  std::vector<Vector*> load_values, sensor_values;
+  for (const MatrixModelLoad& load : model.loads)
+    load_values.push_back(&data->Values(load.channel));
+  for (const MatrixModelSensor& sensor : model.sensors) {
+    sensor_values.push_back(&data->Values(sensor.channel));
+  }
   int strain_count = 0;
   for (const MatrixModelSensor& sensor : model.sensors) {
     strain_count += sensor.kind == SensorKind::kStrain ? 1 : 0;
   }
-  Matrix displacements(data->outputs.rows() - strain_count, samples), strains(strain_count, samples);
-  for (int k = 0, u = 0, e = 0; k < data->outputs.rows(); ++k) {
+  Matrix displacements(num_sensors - strain_count, samples), strains(strain_count, samples);
+  for (int k = 0, u = 0, e = 0; k < num_sensors; ++k) {
     if (model.sensors[k].kind == SensorKind::kStrain) {
-      strains.row(e++) = data->outputs.row(k);
+      strains.row(e++) = sensor_values[k]->transpose();
     } else {
-      displacements.row(u++) = data->outputs.row(k);
+      displacements.row(u++) = sensor_values[k]->transpose();
     }
   }
+  Matrix loads(num_loads, samples);
+  for (int c = 0; c < num_loads; ++c) loads.row(c) = load_values[c]->transpose();
   const double std_u = RootMeanSquareOfRows(displacements) / snr;
   const double std_e = RootMeanSquareOfRows(strains) / snr;
-  const double std_f = RootMeanSquareOfRows(data->loads) / snr;
+  const double std_f = RootMeanSquareOfRows(loads) / snr;
   std::mt19937_64 generator(seed);
   // Uniform in (0, 1) from 53 random bits; a standard normal draw by Box-Muller.
   auto uniform = [&] { return (static_cast<double>(generator() >> 11) + 0.5) * 0x1.0p-53; };
   auto normal = [&] {
     return std::sqrt(-2.0 * std::log(uniform())) * std::cos(2.0 * M_PI * uniform());
   };
-  for (int c = 0; c < data->loads.rows(); ++c) {
-    for (int j = 0; j < data->loads.cols(); ++j) data->loads(c, j) += std_f * normal();
+  for (int c = 0; c < num_loads; ++c) {
+    for (int j = 0; j < samples; ++j) (*load_values[c])[j] += std_f * normal();
   }
-  for (int k = 0; k < data->outputs.rows(); ++k) {
+  for (int k = 0; k < num_sensors; ++k) {
     const double deviation = model.sensors[k].kind == SensorKind::kStrain ? std_e : std_u;
-    for (int j = 0; j < samples; ++j) data->outputs(k, j) += deviation * normal();
+    for (int j = 0; j < samples; ++j) (*sensor_values[k])[j] += deviation * normal();
   }
 }
 
-ChannelTable MatrixMeasurementTable(const Config& config, const MatrixModelData& model,
-                                    const ChannelHistories& histories) {
-  ChannelTable table;
+ChannelSet MatrixMeasurementTable(const Config& config, const MatrixModelData& model,
+                                  const ChannelSet& histories) {
+  ChannelSet table;
+  table.start_time = histories.start_time;
   table.time_step = histories.time_step;
-  table.samples = static_cast<int>(histories.loads.cols());
-  const auto loads = static_cast<int>(model.loads.size());
   for (const auto& [channel, column] : ChannelColumns(config, model)) {
-    const auto row = static_cast<int>(table.names.size());
-    table.names.push_back(column);
-    table.columns.emplace_back(row < loads ? histories.loads.row(row).transpose()
-                                           : histories.outputs.row(row - loads).transpose());
+    const Channel& source = histories.channels[static_cast<std::size_t>(histories.Find(channel))];
+    table.Add(column, source.kind, source.values);
   }
   return table;
 }
@@ -360,18 +361,16 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config,
   if (config.prefilter.enabled) {
     double cutoff = config.prefilter.cutoff_frequency;
     if (cutoff <= 0.0) {
-      const Matrix& source = run.data.loads.rows() > 0 ? run.data.loads : run.data.outputs;
-      for (int c = 0; c < source.rows(); ++c) {
-        cutoff = std::max(cutoff, EstimateCutoffFrequency(source.row(c).transpose(), run.time_step));
+      // From the loads, or the sensors when there is no load.
+      const std::vector<std::string>& source =
+          run.load_names.empty() ? run.sensor_names : run.load_names;
+      for (const std::string& channel : source) {
+        cutoff = std::max(cutoff, EstimateCutoffFrequency(run.data.Values(channel), run.time_step));
       }
     }
     const ZeroPhaseLowPass filter(cutoff, 1.0 / run.time_step, config.prefilter.order);
-    for (Matrix* rows : {&run.data.loads, &run.data.outputs}) {
-      for (int r = 0; r < rows->rows(); ++r) {
-        rows->row(r) =
-            filter.Apply(rows->row(r).transpose(), config.prefilter.at_rest_before_start)
-                .transpose();
-      }
+    for (Channel& channel : run.data.channels) {
+      channel.values = filter.Apply(channel.values, config.prefilter.at_rest_before_start);
     }
     run.prefilter_cutoff = cutoff;
     spdlog::info("pre-filter: zero-phase Butterworth, cut-off {:.6g} Hz", cutoff);

@@ -119,19 +119,21 @@ std::string CostCurveCsv(const std::vector<CostCurvePoint>& curve) {
 // F_L = fL~ - W_L / alpha, at x = 0 the run's clamp_force (the load or the reaction
 // of the clamp model).
 std::string EndsCsv(const IdentificationRun& run) {
-  const MeasurementSet& data = run.data;
+  const ChannelSet& data = run.data;
   const CoupledSolution& solution = run.solution;
   assert(run.clamp_force.size() == data.num_samples());
   std::string csv =
       "t,u0_measured,u0_model,uL_measured,uL_model,f0_measured,f0_model,fL_measured,fL_model\n";
+  const BarEnds measured = BarEndChannels(data);
   char row[512];
   for (int j = 0; j < data.num_samples(); ++j) {
     const double f0_model = run.clamp_force[j];
     // F_L = fL~ - W_L / alpha
-    const double fL_model = data.fL[j] - solution.EndRetrograde(1, j) / run.alpha;
+    const double fL_model = measured.fL[j] - solution.EndRetrograde(1, j) / run.alpha;
     std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
-                  data.Time(j), data.u0[j], solution.EndDisplacement(0, j), data.uL[j],
-                  solution.EndDisplacement(1, j), data.f0[j], f0_model, data.fL[j], fL_model);
+                  data.Time(j), measured.u0[j], solution.EndDisplacement(0, j), measured.uL[j],
+                  solution.EndDisplacement(1, j), measured.f0[j], f0_model, measured.fL[j],
+                  fL_model);
     csv += row;
   }
   return csv;
@@ -670,20 +672,24 @@ namespace {
 // Measured and predicted channels of the least-squares fit at the identified E:
 // uL (x = L) and f0 (the clamp reaction), then each interior sensor.
 std::string FitCsv(const LeastSquaresRun& run) {
-  const MeasurementSet& data = run.data;
+  const ChannelSet& data = run.data;
   const OutputErrorPrediction& fit = run.fit;
   std::string csv = "t,uL_measured,uL_model,f0_measured,f0_model";
-  for (const SensorChannel& sensor : data.sensors) {
-    csv += "," + sensor.name + "_measured," + sensor.name + "_model";
+  const std::vector<BarSensor> sensors = BarSensors(data);
+  for (const BarSensor& sensor : sensors) {
+    const std::string& name = data.channels[static_cast<std::size_t>(sensor.index)].name;
+    csv += "," + name + "_measured," + name + "_model";
   }
   csv += "\n";
+  const BarEnds measured = BarEndChannels(data);
+  const std::vector<const Vector*> sensor_values = BarSensorValues(data);
   char row[128];
   for (int j = 0; j < data.num_samples(); ++j) {
-    std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g,%.17g", data.Time(j), data.uL[j],
-                  fit.uL[j], data.f0[j], fit.f0[j]);
+    std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g,%.17g", data.Time(j), measured.uL[j],
+                  fit.uL[j], measured.f0[j], fit.f0[j]);
     csv += row;
-    for (std::size_t k = 0; k < data.sensors.size(); ++k) {
-      std::snprintf(row, sizeof(row), ",%.17g,%.17g", data.sensors[k].values[j], fit.sensors[k][j]);
+    for (std::size_t k = 0; k < sensor_values.size(); ++k) {
+      std::snprintf(row, sizeof(row), ",%.17g,%.17g", (*sensor_values[k])[j], fit.sensors[k][j]);
       csv += row;
     }
     csv += "\n";
@@ -839,11 +845,15 @@ std::string MatrixFitCsv(const MatrixIdentificationRun& run) {
     csv += "," + sensor + "_measured," + sensor + "_model";
   }
   csv += "\n";
+  std::vector<const Vector*> loads, sensors;
+  for (const std::string& load : run.load_names) loads.push_back(&run.data.Values(load));
+  for (const std::string& sensor : run.sensor_names) sensors.push_back(&run.data.Values(sensor));
   for (int j = 0; j <= run.steps; ++j) {
     csv += Format(j * run.time_step);
-    for (int c = 0; c < run.data.loads.rows(); ++c) csv += "," + Format(run.data.loads(c, j));
-    for (int k = 0; k < run.data.outputs.rows(); ++k) {
-      csv += "," + Format(run.data.outputs(k, j)) + "," + Format(run.model_outputs(k, j));
+    for (const Vector* load : loads) csv += "," + Format((*load)[j]);
+    for (std::size_t k = 0; k < sensors.size(); ++k) {
+      csv +=
+          "," + Format((*sensors[k])[j]) + "," + Format(run.model_outputs(static_cast<int>(k), j));
     }
     csv += "\n";
   }

@@ -88,21 +88,20 @@ void ParallelFor(int count, int threads, const std::function<void(int)>& task, P
 
 // The measurements of one (SNR, seed): the noise-free truth plus white noise
 // (noise.h); the truth itself at SNR inf.
-MeasurementSet NoisyMeasurements(const MeasurementSet& truth, double snr, std::uint64_t seed) {
-  MeasurementSet measured = truth;
+ChannelSet NoisyMeasurements(const ChannelSet& truth, double snr, std::uint64_t seed) {
+  ChannelSet measured = truth;
   AddMeasurementNoise(snr, seed, &measured);
   return measured;
 }
 
-MeasurementSet SimulateStudyTruth(const Config& config) {
+ChannelSet SimulateStudyTruth(const Config& config) {
   return SimulateTruth(config.model, config.load, config.time, config.data);
 }
 
 // The identification of one run as `identify run` does it, with the scan on
 // the run's own thread; *converged when the outer loop converged inside the bounds.
-IdentificationRun IdentifyOnOneThread(const Config& config, const MeasurementSet& measured,
-                                      double snr, std::uint64_t seed, bool* converged,
-                                      std::string* message) {
+IdentificationRun IdentifyOnOneThread(const Config& config, const ChannelSet& measured, double snr,
+                                      std::uint64_t seed, bool* converged, std::string* message) {
   Config run_config = config;
   run_config.outer.scan_threads = 1;
   run_config.data.snr = snr;
@@ -316,7 +315,7 @@ RobustnessStudy RunRobustnessStudy(const Config& config) {
     }
   }
   // The noise-free truth once; each run adds its own noise.
-  const MeasurementSet truth = SimulateStudyTruth(config);
+  const ChannelSet truth = SimulateStudyTruth(config);
   StudyProgressLogger()->info(
       "robustness: {} identifications ({} SNRs, {} seeds per finite SNR) on {} threads",
       study.runs.size(), options.robustness_snr.size(), options.robustness_seeds, study.threads);
@@ -325,7 +324,7 @@ RobustnessStudy RunRobustnessStudy(const Config& config) {
       static_cast<int>(study.runs.size()), study.threads,
       [&](int i) {
         RobustnessRun& run = study.runs[i];
-        const MeasurementSet measured = NoisyMeasurements(truth, run.snr, run.seed);
+        const ChannelSet measured = NoisyMeasurements(truth, run.snr, run.seed);
         const IdentificationRun identification =
             IdentifyOnOneThread(config, measured, run.snr, run.seed, &run.converged, &run.message);
         const IdentificationSummary& outer = identification.outer;
@@ -535,7 +534,7 @@ RelaxationStudy RunRelaxationStudy(const Config& config) {
   std::vector<std::vector<RelaxationPoint>> points(cases);
   std::vector<std::vector<ResidualHistory>> histories(cases);
 
-  const MeasurementSet truth = SimulateStudyTruth(config);
+  const ChannelSet truth = SimulateStudyTruth(config);
   const BarModel model(config.model);
   StudyProgressLogger()->info(
       "relaxation: {} cases ({} SNRs x {} moduli), {} omegas each, on {} threads", cases,
@@ -546,7 +545,7 @@ RelaxationStudy RunRelaxationStudy(const Config& config) {
       cases, study.threads,
       [&](int c) {
         RelaxationCase& relaxation_case = study.cases[c];
-        const MeasurementSet data = PrefilterMeasurements(
+        const ChannelSet data = PrefilterMeasurements(
             NoisyMeasurements(truth, relaxation_case.snr, config.data.seed), config.prefilter);
         McreProblem problem(model, data, config.mcre.weights, config.mcre.reference_modulus,
                             config.time.theta, {}, config.mcre.clamp);
@@ -855,7 +854,7 @@ CostCurveStudy RunCostCurveStudy(const Config& config) {
       study.curves.push_back(curve);
     }
   }
-  const MeasurementSet truth = SimulateStudyTruth(config);
+  const ChannelSet truth = SimulateStudyTruth(config);
   const BarModel model(config.model);
   StudyProgressLogger()->info(
       "cost curves: {} curves of {} points, each with an identification, "
@@ -866,7 +865,7 @@ CostCurveStudy RunCostCurveStudy(const Config& config) {
       static_cast<int>(study.curves.size()), study.threads,
       [&](int i) {
         CostCurveRun& curve = study.curves[i];
-        const MeasurementSet measured = NoisyMeasurements(truth, curve.snr, curve.seed);
+        const ChannelSet measured = NoisyMeasurements(truth, curve.snr, curve.seed);
         std::string message;
         const IdentificationRun identification = IdentifyOnOneThread(
             config, measured, curve.snr, curve.seed, &curve.converged, &message);

@@ -32,6 +32,13 @@ bool StringToSensorKind(const std::string& name, SensorKind* kind) {
   return internal::FromName(kSensorKindNames, name, kind);
 }
 
+const char* ChannelKindToString(ChannelKind kind) {
+  return internal::ToName(kChannelKindNames, kind);
+}
+bool StringToChannelKind(const std::string& name, ChannelKind* kind) {
+  return internal::FromName(kChannelKindNames, name, kind);
+}
+
 const char* ZoningToString(Zoning zoning) { return internal::ToName(kZoningNames, zoning); }
 bool StringToZoning(const std::string& name, Zoning* zoning) {
   return internal::FromName(kZoningNames, name, zoning);

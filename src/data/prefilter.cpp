@@ -155,8 +155,8 @@ Vector ZeroPhaseLowPass::Apply(const Vector& signal, bool at_rest_before_start) 
   return Eigen::Map<const Vector>(extended.data() + pad, n);
 }
 
-double EstimateCutoffFrequency(const MeasurementSet& measurements) {
-  return EstimateCutoffFrequency(measurements.fL, measurements.time_step);
+double EstimateCutoffFrequency(const ChannelSet& measurements) {
+  return EstimateCutoffFrequency(measurements.Values("fL"), measurements.time_step);
 }
 
 double EstimateCutoffFrequency(const Vector& load, double time_step) {
@@ -194,8 +194,8 @@ double EstimateCutoffFrequency(const Vector& load, double time_step) {
   return std::clamp(kCutoffOverEdge * frequency, lowest, highest);
 }
 
-MeasurementSet PrefilterMeasurements(const MeasurementSet& measurements,
-                                     const PrefilterOptions& options, double* cutoff_used) {
+ChannelSet PrefilterMeasurements(const ChannelSet& measurements, const PrefilterOptions& options,
+                                 double* cutoff_used) {
   std::string why;
   if (!options.IsValid(&why)) throw std::invalid_argument(why);
   if (!options.enabled) return measurements;
@@ -211,15 +211,9 @@ MeasurementSet PrefilterMeasurements(const MeasurementSet& measurements,
                                                        : EstimateCutoffFrequency(measurements);
   if (cutoff_used != nullptr) *cutoff_used = cutoff;
   const ZeroPhaseLowPass filter(cutoff, 1.0 / measurements.time_step, options.order);
-  MeasurementSet filtered = measurements;
+  ChannelSet filtered = measurements;
   const bool rest = options.at_rest_before_start;
-  filtered.u0 = filter.Apply(measurements.u0, rest);
-  filtered.uL = filter.Apply(measurements.uL, rest);
-  filtered.f0 = filter.Apply(measurements.f0, rest);
-  filtered.fL = filter.Apply(measurements.fL, rest);
-  for (SensorChannel& sensor : filtered.sensors) {
-    sensor.values = filter.Apply(sensor.values, rest);
-  }
+  for (Channel& channel : filtered.channels) channel.values = filter.Apply(channel.values, rest);
   return filtered;
 }
 

@@ -46,60 +46,36 @@ std::string Short(double value) { return FormatNumber(value, kSixDigits); }
 
 }  // namespace
 
-MeasurementSet ResampleMeasurements(const MeasurementSet& data, double step, int samples,
-                                    const std::string& name) {
-  // The set as a table (u0, uL, f0, fL, then the sensors), resampled channel by channel.
-  ChannelTable table;
-  table.start_time = data.start_time;
-  table.time_step = data.time_step;
-  table.samples = data.num_samples();
-  table.columns = {data.u0, data.uL, data.f0, data.fL};
-  for (const SensorChannel& sensor : data.sensors) table.columns.push_back(sensor.values);
-  table.names.resize(table.columns.size());
-  ChannelTable resampled = ResampleChannelTable(table, step, samples, name);
-  MeasurementSet out;
-  out.start_time = 0.0;
-  out.time_step = step;
-  out.u0 = std::move(resampled.columns[0]);
-  out.uL = std::move(resampled.columns[1]);
-  out.f0 = std::move(resampled.columns[2]);
-  out.fL = std::move(resampled.columns[3]);
-  for (std::size_t k = 0; k < data.sensors.size(); ++k) {
-    const SensorChannel& sensor = data.sensors[k];
-    out.sensors.push_back(
-        {sensor.name, sensor.kind, sensor.position, std::move(resampled.columns[4 + k])});
-  }
-  return out;
-}
-
-ChannelTable ResampleChannelTable(const ChannelTable& data, double step, int samples,
-                                  const std::string& name) {
+ChannelSet ResampleMeasurements(const ChannelSet& data, double step, int samples,
+                                const std::string& name) {
   assert(step > 0.0 && samples >= 2);
   const double h = data.time_step;
   const double tolerance = 1e-6 * h;
-  const double end = data.Time(data.samples - 1);
+  const double end = data.Time(data.num_samples() - 1);
   const double window = (samples - 1) * step;
   if (data.start_time > tolerance || end < window - tolerance) {
     throw InputError(name + ": the data span [" + Short(data.start_time) + ", " + Short(end) +
                      "] s does not cover the model's window [0, " + Short(window) +
                      "] s (time.window)");
   }
-  ChannelTable out;
+  ChannelSet out;
   out.start_time = 0.0;
   out.time_step = step;
-  out.samples = samples;
-  out.names = data.names;
+  out.channels.reserve(data.channels.size());
   if (step > h) {
     // Down-sampling: low-pass below the new Nyquist frequency first (order 8, from
     // rest: the record is at rest before its first sample).
     const ZeroPhaseLowPass filter(0.4 / step, 1.0 / h, 8);
-    for (const Vector& column : data.columns) {
-      out.columns.push_back(Interpolate(filter.Apply(column, /*at_rest_before_start=*/true),
-                                        data.start_time, h, step, samples));
+    for (const Channel& channel : data.channels) {
+      out.channels.push_back(
+          {channel.name, channel.kind,
+           Interpolate(filter.Apply(channel.values, /*at_rest_before_start=*/true), data.start_time,
+                       h, step, samples)});
     }
   } else {
-    for (const Vector& column : data.columns) {
-      out.columns.push_back(Interpolate(column, data.start_time, h, step, samples));
+    for (const Channel& channel : data.channels) {
+      out.channels.push_back({channel.name, channel.kind,
+                              Interpolate(channel.values, data.start_time, h, step, samples)});
     }
   }
   return out;

@@ -110,19 +110,21 @@ namespace {
 
 // `drawn` (a copy of the data) with every channel replaced by white noise at `noise`'s
 // levels, then pre-filtered as `prefilter` says.
-MeasurementSet DrawNoiseAlone(const PrefilterOptions& prefilter, const NoiseLevels& noise,
-                              std::mt19937_64* engine, MeasurementSet* drawn) {
+ChannelSet DrawNoiseAlone(const PrefilterOptions& prefilter, const NoiseLevels& noise,
+                          std::mt19937_64* engine, ChannelSet* drawn) {
   std::normal_distribution<double> normal(0.0, 1.0);
-  for (Vector* channel : {&drawn->u0, &drawn->uL}) {
-    for (double& value : *channel) value = noise.displacement_std * normal(*engine);
+  for (const char* name : {"u0", "uL"}) {
+    for (double& value : drawn->Values(name)) value = noise.displacement_std * normal(*engine);
   }
-  for (Vector* channel : {&drawn->f0, &drawn->fL}) {
-    for (double& value : *channel) value = noise.force_std * normal(*engine);
+  for (const char* name : {"f0", "fL"}) {
+    for (double& value : drawn->Values(name)) value = noise.force_std * normal(*engine);
   }
-  for (SensorChannel& sensor : drawn->sensors) {
+  for (const BarSensor& sensor : BarSensors(*drawn)) {
     const double level =
         sensor.kind == SensorKind::kStrain ? noise.strain_std : noise.displacement_std;
-    for (double& value : sensor.values) value = level * normal(*engine);
+    for (double& value : drawn->channels[static_cast<std::size_t>(sensor.index)].values) {
+      value = level * normal(*engine);
+    }
   }
   return prefilter.enabled ? PrefilterMeasurements(*drawn, prefilter) : *drawn;
 }
@@ -206,16 +208,16 @@ void MinimizeOverZones(const ZoneIdentificationOptions& options, int zones,
 
 }  // namespace
 
-double ExpectedNoiseCost(const BarModel& model, const MeasurementSet& data, const McreOptions& mcre,
+double ExpectedNoiseCost(const BarModel& model, const ChannelSet& data, const McreOptions& mcre,
                          double theta, const CoupledSolverOptions& inner,
                          EndDisplacementChannels ends, const Vector& moduli,
                          const NoiseLevels& noise, const PrefilterOptions& prefilter, int samples,
                          std::uint64_t seed, double cost_scale) {
   std::mt19937_64 engine(seed);
-  MeasurementSet drawn = data;
+  ChannelSet drawn = data;
   double sum = 0.0;
   for (int sample = 0; sample < samples; ++sample) {
-    const MeasurementSet noise_data = DrawNoiseAlone(prefilter, noise, &engine, &drawn);
+    const ChannelSet noise_data = DrawNoiseAlone(prefilter, noise, &engine, &drawn);
     McreObjective objective(model, noise_data, mcre, theta, inner, moduli[0], ends);
     const ObjectiveEvaluation& record = objective.EvaluateModuli(moduli, false);
     if (!record.usable) return -1.0;
@@ -224,16 +226,16 @@ double ExpectedNoiseCost(const BarModel& model, const MeasurementSet& data, cons
   return sum / samples / cost_scale;
 }
 
-double ExpectedLeastSquaresNoiseCost(const BarModel& model, const MeasurementSet& data,
+double ExpectedLeastSquaresNoiseCost(const BarModel& model, const ChannelSet& data,
                                      const NoiseLevels& misfit_levels, double theta,
                                      EndDisplacementChannels ends, const Vector& moduli,
                                      const NoiseLevels& noise, const PrefilterOptions& prefilter,
                                      int samples, std::uint64_t seed, double cost_scale) {
   std::mt19937_64 engine(seed);
-  MeasurementSet drawn = data;
+  ChannelSet drawn = data;
   double sum = 0.0;
   for (int sample = 0; sample < samples; ++sample) {
-    const MeasurementSet noise_data = DrawNoiseAlone(prefilter, noise, &engine, &drawn);
+    const ChannelSet noise_data = DrawNoiseAlone(prefilter, noise, &engine, &drawn);
     ZoneOutputErrorObjective objective(model, noise_data, misfit_levels, theta, moduli[0], ends);
     sum += objective.Cost(moduli, nullptr);
   }
@@ -272,7 +274,7 @@ ZoneIdentificationSummary IdentifyZones(const BarModel& model, double homogeneou
 }  // namespace
 
 ZoneIdentificationSummary IdentifyZoneModuli(
-    const ZoneIdentificationOptions& options, const BarModel& model, const MeasurementSet& data,
+    const ZoneIdentificationOptions& options, const BarModel& model, const ChannelSet& data,
     const McreOptions& mcre, double theta, const CoupledSolverOptions& inner,
     EndDisplacementChannels ends, double homogeneous_modulus, double lower_bound,
     double upper_bound, const NoiseLevels& noise, const PrefilterOptions& prefilter,
@@ -307,7 +309,7 @@ ZoneIdentificationSummary IdentifyZoneModuli(
 }
 
 ZoneIdentificationSummary IdentifyZoneModuliByLeastSquares(
-    const ZoneIdentificationOptions& options, const BarModel& model, const MeasurementSet& data,
+    const ZoneIdentificationOptions& options, const BarModel& model, const ChannelSet& data,
     const NoiseLevels& misfit_levels, double theta, EndDisplacementChannels ends,
     double homogeneous_modulus, double lower_bound, double upper_bound, const NoiseLevels& noise,
     const PrefilterOptions& prefilter) {

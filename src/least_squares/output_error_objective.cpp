@@ -9,12 +9,11 @@
 
 namespace mcrewave {
 
-void OutputErrorSensorRows(const BarModel& model, const MeasurementSet& data,
-                           const NoiseLevels& noise, std::vector<ObservationRow>* rows,
-                           std::vector<double>* weights) {
+void OutputErrorSensorRows(const BarModel& model, const ChannelSet& data, const NoiseLevels& noise,
+                           std::vector<ObservationRow>* rows, std::vector<double>* weights) {
   rows->clear();
   weights->clear();
-  for (const SensorChannel& sensor : data.sensors) {
+  for (const BarSensor& sensor : BarSensors(data)) {
     const bool strain = sensor.kind == SensorKind::kStrain;
     assert(!strain || noise.strain_std > 0.0);
     rows->push_back(strain ? model.StrainRow(sensor.position)
@@ -36,32 +35,36 @@ double ClampReaction(const SymmetricBandMatrix& stiffness, const BandLdlt& mass_
   return mass_01 * (*acceleration)[0] + stiffness_01 * displacement[0];
 }
 
-double OutputErrorRestCost(const MeasurementSet& data, const NoiseLevels& noise,
+double OutputErrorRestCost(const ChannelSet& data, const NoiseLevels& noise,
                            const std::vector<double>& sensor_weights,
                            EndDisplacementChannels ends) {
   const int samples = data.num_samples();
   const double h = data.time_step;
+  const BarEnds ends_data = BarEndChannels(data);
+  const std::vector<const Vector*> sensors = BarSensorValues(data);
   const double weight_u = 1.0 / (noise.displacement_std * noise.displacement_std);
   const double weight_f = 1.0 / (noise.force_std * noise.force_std);
   double rest_cost = 0.0;
   for (int k = 0; k < samples; ++k) {
     // c_k h / 2 [uL~^2 / s_u^2 + f0~^2 / s_f^2 + sum sensors]
     const double c = (k == 0 || k == samples - 1) ? 0.5 : 1.0;
-    double sum = weight_f * data.f0[k] * data.f0[k];
-    if (ends.uL) sum += weight_u * data.uL[k] * data.uL[k];
-    for (std::size_t i = 0; i < data.sensors.size(); ++i) {
-      sum += sensor_weights[i] * data.sensors[i].values[k] * data.sensors[i].values[k];
+    double sum = weight_f * ends_data.f0[k] * ends_data.f0[k];
+    if (ends.uL) sum += weight_u * ends_data.uL[k] * ends_data.uL[k];
+    for (std::size_t i = 0; i < sensors.size(); ++i) {
+      sum += sensor_weights[i] * (*sensors[i])[k] * (*sensors[i])[k];
     }
     rest_cost += 0.5 * c * h * sum;
   }
   return rest_cost;
 }
 
-OutputErrorObjective::OutputErrorObjective(const BarModel& model, const MeasurementSet& data,
+OutputErrorObjective::OutputErrorObjective(const BarModel& model, const ChannelSet& data,
                                            const NoiseLevels& noise, double theta,
                                            double modulus_scale, EndDisplacementChannels ends)
     : model_(model),
       data_(data),
+      measured_(BarEndChannels(data)),
+      sensor_data_(BarSensorValues(data)),
       noise_(noise),
       theta_(theta),
       modulus_scale_(modulus_scale),
@@ -87,7 +90,7 @@ OutputErrorObjective::OutputErrorObjective(const BarModel& model, const Measurem
   const int samples = data.num_samples();
   prediction_.uL.setZero(samples);
   prediction_.f0.setZero(samples);
-  prediction_.sensors.assign(data.sensors.size(), Vector::Zero(samples));
+  prediction_.sensors.assign(sensor_data_.size(), Vector::Zero(samples));
   rest_cost_ = OutputErrorRestCost(data, noise, sensor_weights_, ends_);
 }
 
@@ -135,7 +138,7 @@ const OutputErrorPrediction& OutputErrorObjective::Predict(double modulus,
   for (int k = 0; k < samples; ++k) {
     if (k > 0) {
       // f_theta = (theta fL~_k + (1 - theta) fL~_{k-1}) e_N on the step t_{k-1} -> t_k.
-      const double load = theta_ * data_.fL[k] + (1.0 - theta_) * data_.fL[k - 1];
+      const double load = theta_ * measured_.fL[k] + (1.0 - theta_) * measured_.fL[k - 1];
       integrator_.StepWithEndLoads(velocity_, displacement_, 0.0, load, next_velocity_,
                                    next_displacement_);
       if (gradient_requested) {
@@ -150,12 +153,12 @@ const OutputErrorPrediction& OutputErrorObjective::Predict(double modulus,
       displacement_.swap(next_displacement_);
     }
     const double f0 = ClampReaction(integrator_.stiffness(), mass_factor_, mass_01_, stiffness_01,
-                                    displacement_, data_.fL[k], &acceleration_);
+                                    displacement_, measured_.fL[k], &acceleration_);
     prediction_.uL[k] = displacement_[loaded];
     prediction_.f0[k] = f0;
     const double c = (k == 0 || k == samples - 1) ? 0.5 : 1.0;
-    const double residual_f = f0 - data_.f0[k];
-    const double residual_u = displacement_[loaded] - data_.uL[k];
+    const double residual_f = f0 - measured_.f0[k];
+    const double residual_u = displacement_[loaded] - measured_.uL[k];
     // c_k h / 2 [(uL - uL~)^2 / s_u^2 + (f0 - f0~)^2 / s_f^2 + sensors]
     double sum = weight_f * residual_f * residual_f;
     if (ends_.uL) sum += weight_u * residual_u * residual_u;
@@ -163,7 +166,7 @@ const OutputErrorPrediction& OutputErrorObjective::Predict(double modulus,
     for (std::size_t i = 0; i < sensor_rows_.size(); ++i) {
       const double predicted = sensor_rows_[i].Apply(nodal_.data());
       prediction_.sensors[i][k] = predicted;
-      const double residual = predicted - data_.sensors[i].values[k];
+      const double residual = predicted - (*sensor_data_[i])[k];
       sum += sensor_weights_[i] * residual * residual;
     }
     cost += 0.5 * c * h * sum;
@@ -184,7 +187,7 @@ const OutputErrorPrediction& OutputErrorObjective::Predict(double modulus,
       }
       if (!sensor_rows_.empty()) nodal_.tail(nodal_.size() - 1) = sensitivity_;
       for (std::size_t i = 0; i < sensor_rows_.size(); ++i) {
-        const double residual = prediction_.sensors[i][k] - data_.sensors[i].values[k];
+        const double residual = prediction_.sensors[i][k] - (*sensor_data_[i])[k];
         const double derivative = sensor_rows_[i].Apply(nodal_.data());
         dsum += 2.0 * sensor_weights_[i] * residual * derivative;
         isum += sensor_weights_[i] * derivative * derivative;

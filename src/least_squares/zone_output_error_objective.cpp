@@ -11,13 +11,14 @@
 
 namespace mcrewave {
 
-ZoneOutputErrorObjective::ZoneOutputErrorObjective(const BarModel& model,
-                                                   const MeasurementSet& data,
+ZoneOutputErrorObjective::ZoneOutputErrorObjective(const BarModel& model, const ChannelSet& data,
                                                    const NoiseLevels& noise, double theta,
                                                    double modulus_scale,
                                                    EndDisplacementChannels ends)
     : model_(model),
       data_(data),
+      measured_(BarEndChannels(data)),
+      sensor_data_(BarSensorValues(data)),
       theta_(theta),
       modulus_scale_(modulus_scale),
       ends_(ends),
@@ -83,7 +84,7 @@ double ZoneOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradien
   for (int k = 0; k < samples; ++k) {
     if (k > 0) {
       // f_theta = (theta fL~_k + (1 - theta) fL~_{k-1}) e_N on the step t_{k-1} -> t_k.
-      const double load = theta_ * data_.fL[k] + (1.0 - theta_) * data_.fL[k - 1];
+      const double load = theta_ * measured_.fL[k] + (1.0 - theta_) * measured_.fL[k - 1];
       integrator_.StepWithEndLoads(velocity_, displacement_, 0.0, load, next_velocity_,
                                    next_displacement_);
       if (gradient_requested) {
@@ -104,15 +105,15 @@ double ZoneOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradien
     }
     const double residual_f =
         ClampReaction(integrator_.stiffness(), mass_factor_, mass_01_, stiffness_01, displacement_,
-                      data_.fL[k], &acceleration_) -
-        data_.f0[k];
-    const double residual_u = displacement_[loaded] - data_.uL[k];
+                      measured_.fL[k], &acceleration_) -
+        measured_.f0[k];
+    const double residual_u = displacement_[loaded] - measured_.uL[k];
     // c_k h / 2 [(uL - uL~)^2 / s_u^2 + (f0 - f0~)^2 / s_f^2 + sensors]
     double sum = weight_f_ * residual_f * residual_f;
     if (ends_.uL) sum += weight_u_ * residual_u * residual_u;
     if (!sensor_rows_.empty()) nodal_.tail(nodal_.size() - 1) = displacement_;
     for (std::size_t i = 0; i < sensor_rows_.size(); ++i) {
-      residuals_[i] = sensor_rows_[i].Apply(nodal_.data()) - data_.sensors[i].values[k];
+      residuals_[i] = sensor_rows_[i].Apply(nodal_.data()) - (*sensor_data_[i])[k];
       sum += sensor_weights_[i] * residuals_[i] * residuals_[i];
     }
     const double c = (k == 0 || k == samples - 1) ? 0.5 : 1.0;

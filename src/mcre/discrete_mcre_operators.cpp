@@ -86,13 +86,13 @@ DiscreteMcreOperators::DiscreteMcreOperators(const McreProblem& problem)
 }
 
 void DiscreteMcreOperators::AddForceData(int j, double scale, Eigen::Ref<Vector> x) const {
-  const MeasurementSet& data = problem_.data();
+  const BarEnds& data = problem_.measured();
   x[0] += scale * data.f0[j];
   x[last_node()] += scale * data.fL[j];
 }
 
 void DiscreteMcreOperators::AddDisplacementData(int j, double scale, Eigen::Ref<Vector> x) const {
-  const MeasurementSet& data = problem_.data();
+  const BarEnds& data = problem_.measured();
   x[0] += scale * data.u0[j];
   x[last_node()] += scale * data.uL[j];
 }

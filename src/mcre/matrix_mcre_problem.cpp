@@ -5,17 +5,45 @@
 
 namespace mcrewave {
 
-MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const ChannelHistories& data,
+ChannelSet MatrixChannelSet(const MatrixModelData& model, double time_step, const Matrix& loads,
+                            const Matrix& outputs) {
+  assert(loads.rows() == static_cast<Eigen::Index>(model.loads.size()) &&
+         outputs.rows() == static_cast<Eigen::Index>(model.sensors.size()) &&
+         outputs.cols() == loads.cols());
+  ChannelSet set;
+  set.time_step = time_step;
+  for (std::size_t c = 0; c < model.loads.size(); ++c) {
+    set.Add(model.loads[c].channel, ChannelKind::kForce,
+            loads.row(static_cast<Eigen::Index>(c)).transpose());
+  }
+  for (std::size_t k = 0; k < model.sensors.size(); ++k) {
+    set.Add(model.sensors[k].channel,
+            model.sensors[k].kind == SensorKind::kStrain ? ChannelKind::kStrain
+                                                         : ChannelKind::kDisplacement,
+            outputs.row(static_cast<Eigen::Index>(k)).transpose());
+  }
+  return set;
+}
+
+MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const ChannelSet& data,
                                      const McreWeights& weights, double reference_modulus,
                                      double theta, Factorization factorization)
-    : model_(model), data_(data), theta_(theta), factorization_(factorization) {
+    : model_(model), time_step_(data.time_step), theta_(theta), factorization_(factorization) {
   const int n = model.dofs();
   const int num_loads = static_cast<int>(model.loads.size());
   const int num_sensors = static_cast<int>(model.sensors.size());
-  assert(weights.IsValid(nullptr) && reference_modulus > 0.0 && data.num_steps() >= 1 &&
-         data.loads.rows() == num_loads && data.outputs.rows() == num_sensors &&
-         data.outputs.cols() == data.loads.cols() && model.stiffness_length > 0.0 &&
-         model.length > 0.0);
+  // The data's channels of the model, gathered once into rows (columns t_j for the sweeps).
+  const int samples = data.num_samples();
+  measured_loads_.resize(num_loads, samples);
+  for (int c = 0; c < num_loads; ++c) {
+    measured_loads_.row(c) = data.Values(model.loads[c].channel).transpose();
+  }
+  measured_outputs_.resize(num_sensors, samples);
+  for (int k = 0; k < num_sensors; ++k) {
+    measured_outputs_.row(k) = data.Values(model.sensors[k].channel).transpose();
+  }
+  assert(weights.IsValid(nullptr) && reference_modulus > 0.0 && num_steps() >= 1 &&
+         model.stiffness_length > 0.0 && model.length > 0.0);
   // k* = E0 a*; alpha_c = w_f / k*, beta_k = w_u k* or w_e k* l*^2
   // (docs/matrix_models.md section 3).
   const double stiffness_scale = reference_modulus * model.stiffness_length;
@@ -67,7 +95,7 @@ void MatrixMcreProblem::SetModuli(const Vector& zone_moduli) {
   // K = sum_z (E_z / E_z,nom) K_z.
   stiffness_ = model_.Stiffness(moduli_);
   ThetaIntegratorOptions options;
-  options.time_step = data_.time_step;
+  options.time_step = time_step_;
   options.theta = theta_;
   options.factorization = factorization_;
   integrator_.Init(model_.mass, stiffness_, options);
@@ -89,7 +117,7 @@ void MatrixMcreProblem::DirectSweep(const Matrix& retrograde, bool include_data,
     channel_.noalias() = loads_transposed_ * shift_;
     channel_ = -channel_.cwiseQuotient(alphas_);
     if (include_data) {
-      channel_ += theta_ * data_.loads.col(k + 1) + (1.0 - theta_) * data_.loads.col(k);
+      channel_ += theta_ * measured_loads_.col(k + 1) + (1.0 - theta_) * measured_loads_.col(k);
     }
     force_.noalias() = loads_ * channel_;
     integrator_.StepShifted(velocity_[current], displacement->col(k), shift_, force_,
@@ -110,7 +138,7 @@ void MatrixMcreProblem::RetrogradeSweep(const Matrix& displacement, bool include
     const int current = s & 1, next = current ^ 1;
     // Step t_j -> t_{j-1} carries c_j H^T diag(beta) (H U_j - d~_j).
     trace_.noalias() = observation_ * displacement.col(j);
-    if (include_data) trace_ -= data_.outputs.col(j);
+    if (include_data) trace_ -= measured_outputs_.col(j);
     trace_ = (QuadratureWeight(j) * betas_).cwiseProduct(trace_);
     force_.noalias() = observation_transposed_ * trace_;
     integrator_.Step(velocity_[current], state_[current], force_, velocity_[next], state_[next]);
@@ -147,7 +175,7 @@ double MatrixMcreProblem::Cost(const Matrix& displacement, const Matrix& retrogr
     product_.noalias() = stiffness_ * retrograde.col(j);
     channel_.noalias() = loads_transposed_ * retrograde.col(j);
     trace_.noalias() = observation_ * displacement.col(j);
-    trace_ -= data_.outputs.col(j);
+    trace_ -= measured_outputs_.col(j);
     const double integrand = 0.5 * retrograde.col(j).dot(product_) +
                              0.5 * channel_.cwiseQuotient(alphas_).dot(channel_) +
                              0.5 * betas_.dot(trace_.cwiseProduct(trace_));
@@ -212,12 +240,12 @@ SparseMatrix MatrixMcreProblem::WeightedObservation() const {
 
 void MatrixMcreProblem::WeightedData(int j, Eigen::Ref<Vector> load) const {
   // H^T diag(beta) d~_j.
-  load.noalias() = observation_transposed_ * betas_.cwiseProduct(data_.outputs.col(j));
+  load.noalias() = observation_transposed_ * betas_.cwiseProduct(measured_outputs_.col(j));
 }
 
 void MatrixMcreProblem::MeasuredForce(int j, Eigen::Ref<Vector> load) const {
   // G F~_j.
-  load.noalias() = loads_ * data_.loads.col(j);
+  load.noalias() = loads_ * measured_loads_.col(j);
 }
 
 double MatrixMcreProblem::RestCost() const {
@@ -225,8 +253,8 @@ double MatrixMcreProblem::RestCost() const {
   for (int j = 0; j <= num_steps(); ++j) {
     // c_j h [1/2 F~^T diag(alpha) F~ + 1/2 d~^T diag(beta) d~].
     sum += QuadratureWeight(j) * time_step() * 0.5 *
-           (alphas_.dot(data_.loads.col(j).cwiseAbs2()) +
-            betas_.dot(data_.outputs.col(j).cwiseAbs2()));
+           (alphas_.dot(measured_loads_.col(j).cwiseAbs2()) +
+            betas_.dot(measured_outputs_.col(j).cwiseAbs2()));
   }
   return sum;
 }

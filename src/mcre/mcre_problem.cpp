@@ -32,11 +32,12 @@ bool McreWeights::IsValid(std::string* error) const {
   return false;
 }
 
-McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
-                         const McreWeights& weights, double reference_modulus, double theta,
-                         EndDisplacementChannels ends, ClampModel clamp)
+McreProblem::McreProblem(const BarModel& model, const ChannelSet& data, const McreWeights& weights,
+                         double reference_modulus, double theta, EndDisplacementChannels ends,
+                         ClampModel clamp)
     : model_(model),
       data_(data),
+      measured_(BarEndChannels(data)),
       theta_(theta),
       ends_(ends),
       clamp_(clamp),
@@ -67,9 +68,10 @@ McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
     force0_penalty_gain_ = alpha_ / alpha0;
   }
   std::vector<double> weights_of_rows;
-  for (const SensorChannel& sensor : data.sensors) {
+  for (const BarSensor& sensor : BarSensors(data)) {
+    const Vector& values = data.channels[static_cast<std::size_t>(sensor.index)].values;
     assert(sensor.position >= 0.0 && sensor.position <= bar.length &&
-           sensor.values.size() == data.num_samples());
+           values.size() == data.num_samples());
     const bool strain = sensor.kind == SensorKind::kStrain;
     sensor_rows_.push_back(strain ? model.StrainRow(sensor.position)
                                   : model.DisplacementRow(sensor.position));
@@ -77,7 +79,7 @@ McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
     // would load the held node.
     if (trusted && sensor_rows_.back().nodes[0] == 0) sensor_rows_.back().coefficients[0] = 0.0;
     weights_of_rows.push_back(strain ? strain_beta_ : beta_);
-    sensor_data_.push_back(&sensor.values);
+    sensor_data_.push_back(&values);
   }
   if (trusted) {
     // The clamp reaction r(U) = K_01(E) U_1, weight alpha_r, data f0~; its coefficient
@@ -90,7 +92,7 @@ McreProblem::McreProblem(const BarModel& model, const MeasurementSet& data,
     // alpha_r = w_r L / (S E0).
     weights_of_rows.push_back(weights.reaction_weight * bar.length /
                               (bar.section * reference_modulus));
-    sensor_data_.push_back(&data.f0);
+    sensor_data_.push_back(&measured_.f0);
   }
   const int num_sensors = static_cast<int>(sensor_rows_.size());
   sensor_weights_ = Eigen::Map<const Vector>(weights_of_rows.data(), num_sensors);
@@ -203,8 +205,8 @@ void McreProblem::DirectSweep(const Matrix& retrograde, bool include_data, Matri
     double f0 = -inverse_alpha0_ * shift_[0];
     double fL = -inverse_alpha * shift_[last];
     if (include_data) {
-      f0 += force0_gain_ * (theta_ * data_.f0[k + 1] + (1.0 - theta_) * data_.f0[k]);
-      fL += theta_ * data_.fL[k + 1] + (1.0 - theta_) * data_.fL[k];
+      f0 += force0_gain_ * (theta_ * measured_.f0[k + 1] + (1.0 - theta_) * measured_.f0[k]);
+      fL += theta_ * measured_.fL[k + 1] + (1.0 - theta_) * measured_.fL[k];
     }
     integrator_.StepWithEndLoads(velocity_[current], displacement->col(k), shift_, f0, fL,
                                  velocity_[next], displacement->col(k + 1));
@@ -230,7 +232,7 @@ void McreProblem::RetrogradeSweep(const Matrix& displacement, bool include_data,
     double fL = weightL * displacement(last, j);
     if (include_data) {
       f0 -= weight0 * U0Datum(j);
-      fL -= weightL * data_.uL[j];
+      fL -= weightL * measured_.uL[j];
     }
     const PointLoads* loads = nullptr;
     if (num_interior_sensors() > 0) {
@@ -271,8 +273,8 @@ void McreProblem::DirectSweeps(const Matrix* const (&retrograde)[B],
     double* u_next[B];
     for (int b = 0; b < B; ++b) {
       // As DirectSweep: f_theta = -K W_theta + (F~_theta - B W_theta / alpha).
-      f0[b] = force0_gain_ * (theta_ * data_.f0[k + 1] + (1.0 - theta_) * data_.f0[k]);
-      fL[b] = theta_ * data_.fL[k + 1] + (1.0 - theta_) * data_.fL[k];
+      f0[b] = force0_gain_ * (theta_ * measured_.f0[k + 1] + (1.0 - theta_) * measured_.f0[k]);
+      fL[b] = theta_ * measured_.fL[k + 1] + (1.0 - theta_) * measured_.fL[k];
       z[b] = nullptr;
       if (retrograde[b] != nullptr) {
         batch_shift_.col(b) =
@@ -319,7 +321,7 @@ void McreProblem::RetrogradeSweeps(const Matrix* const (&displacement)[B],
       f0[b] = displacement[b] != nullptr ? weight0 * (*displacement[b])(0, j) : 0.0;
       fL[b] = displacement[b] != nullptr ? weightL * (*displacement[b])(last, j) : 0.0;
       f0[b] -= weight0 * U0Datum(j);
-      fL[b] -= weightL * data_.uL[j];
+      fL[b] -= weightL * measured_.uL[j];
       if (num_interior_sensors() > 0) {
         SensorLoads(j, displacement[b] != nullptr ? displacement[b]->col(j).data() : nullptr, true,
                     load_values_.col(b).data());
@@ -411,7 +413,7 @@ double McreProblem::SampleCost(int j, const double* displacement, const double* 
       (force0_penalty_gain_ * retrograde[0] * retrograde[0] + retrograde[last] * retrograde[last]) /
       (2.0 * alpha_);
   const double u0_misfit = displacement[0] - U0Datum(j);
-  const double uL_misfit = displacement[last] - data_.uL[j];
+  const double uL_misfit = displacement[last] - measured_.uL[j];
   double displacement_misfit =
       observes_ends_only()
           ? 0.5 * beta_ * (u0_misfit * u0_misfit + uL_misfit * uL_misfit)
@@ -460,7 +462,7 @@ double McreProblem::ReactionGradient(int j, const double* displacement) const {
   // r = E_1 K1_01 U_1.
   const double reaction = ClampReaction(displacement);
   return sensor_weights_[reaction_row_] * (reaction / moduli_[model_.element_zone(0)]) *
-         (reaction - data_.f0[j]);
+         (reaction - measured_.f0[j]);
 }
 
 double McreProblem::CostGradient(const Matrix& displacement, const Matrix& retrograde) {
@@ -508,8 +510,8 @@ SparseMatrix McreProblem::PenaltyMatrix() const {
 
 void McreProblem::MeasuredForce(int j, Eigen::Ref<Vector> load) const {
   load.setZero();
-  load[0] = force0_gain_ * data_.f0[j];
-  load[num_nodes() - 1] = data_.fL[j];
+  load[0] = force0_gain_ * measured_.f0[j];
+  load[num_nodes() - 1] = measured_.fL[j];
 }
 
 SparseMatrix McreProblem::WeightedObservation() const {
@@ -534,7 +536,7 @@ SparseMatrix McreProblem::WeightedObservation() const {
 void McreProblem::WeightedData(int j, Eigen::Ref<Vector> load) const {
   load.setZero();
   load[0] += beta_u0_ * U0Datum(j);
-  load[num_nodes() - 1] += beta_uL_ * data_.uL[j];
+  load[num_nodes() - 1] += beta_uL_ * measured_.uL[j];
   for (int k = 0; k < num_interior_sensors(); ++k) {
     // beta_k h_k d~_kj.
     const ObservationRow& row = sensor_rows_[k];

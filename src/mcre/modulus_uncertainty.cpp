@@ -42,22 +42,25 @@ double DifferenceNoiseStd(const Vector& channel) {
 
 }  // namespace
 
-NoiseLevels DifferenceNoiseLevels(const MeasurementSet& data) {
+NoiseLevels DifferenceNoiseLevels(const ChannelSet& data) {
+  const BarEnds ends = BarEndChannels(data);
+  const std::vector<BarSensor> sensors = BarSensors(data);
   NoiseLevels levels;
   // s^2 averaged over the two ends
   levels.displacement_std = std::sqrt(
-      0.5 * (std::pow(DifferenceNoiseStd(data.u0), 2) + std::pow(DifferenceNoiseStd(data.uL), 2)));
+      0.5 * (std::pow(DifferenceNoiseStd(ends.u0), 2) + std::pow(DifferenceNoiseStd(ends.uL), 2)));
   levels.force_std = std::sqrt(
-      0.5 * (std::pow(DifferenceNoiseStd(data.f0), 2) + std::pow(DifferenceNoiseStd(data.fL), 2)));
-  if (data.sensors.empty()) return levels;
+      0.5 * (std::pow(DifferenceNoiseStd(ends.f0), 2) + std::pow(DifferenceNoiseStd(ends.fL), 2)));
+  if (sensors.empty()) return levels;
   // With interior sensors: s^2 averaged over every channel of the kind.
   double displacement_sum =
-      std::pow(DifferenceNoiseStd(data.u0), 2) + std::pow(DifferenceNoiseStd(data.uL), 2);
+      std::pow(DifferenceNoiseStd(ends.u0), 2) + std::pow(DifferenceNoiseStd(ends.uL), 2);
   int displacement_count = 2;
   double strain_sum = 0.0;
   int strain_count = 0;
-  for (const SensorChannel& sensor : data.sensors) {
-    const double variance = std::pow(DifferenceNoiseStd(sensor.values), 2);
+  for (const BarSensor& sensor : sensors) {
+    const double variance = std::pow(
+        DifferenceNoiseStd(data.channels[static_cast<std::size_t>(sensor.index)].values), 2);
     if (sensor.kind == SensorKind::kStrain) {
       strain_sum += variance;
       ++strain_count;
@@ -71,16 +74,17 @@ NoiseLevels DifferenceNoiseLevels(const MeasurementSet& data) {
   return levels;
 }
 
-NoiseLevels MisfitLevels(const MeasurementSet& data, const CoupledSolution& solution,
-                         double alpha, const Vector* clamp_reaction) {
+NoiseLevels MisfitLevels(const ChannelSet& data, const CoupledSolution& solution, double alpha,
+                         const Vector* clamp_reaction) {
+  const BarEnds ends = BarEndChannels(data);
   assert(clamp_reaction == nullptr || clamp_reaction->size() == data.num_samples());
   double displacement_sum = 0.0;
   double force_sum = 0.0;
   for (int j = 0; j < data.num_samples(); ++j) {
-    displacement_sum += std::pow(solution.EndDisplacement(0, j) - data.u0[j], 2) +
-                        std::pow(solution.EndDisplacement(1, j) - data.uL[j], 2);
+    displacement_sum += std::pow(solution.EndDisplacement(0, j) - ends.u0[j], 2) +
+                        std::pow(solution.EndDisplacement(1, j) - ends.uL[j], 2);
     // F - F~ = -B W / alpha at the two ends; r(U) - f0~ at a trusted clamp.
-    const double f0_misfit = clamp_reaction != nullptr ? (*clamp_reaction)[j] - data.f0[j]
+    const double f0_misfit = clamp_reaction != nullptr ? (*clamp_reaction)[j] - ends.f0[j]
                                                        : solution.EndRetrograde(0, j) / alpha;
     force_sum += std::pow(f0_misfit, 2) + std::pow(solution.EndRetrograde(1, j) / alpha, 2);
   }
@@ -126,7 +130,7 @@ double CostGradientSlope(const std::vector<CostCurvePoint>& curve, double center
 }
 
 ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
-                                              const BarModel& model, const MeasurementSet& data,
+                                              const BarModel& model, const ChannelSet& data,
                                               const McreOptions& mcre, double theta,
                                               const CoupledSolverOptions& inner, double modulus,
                                               const CoupledSolution& solution,
@@ -152,22 +156,30 @@ ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
     result.message = "no noise to propagate (both noise levels are 0)";
     return result;
   }
-  MeasurementSet noise_data = data;
+  ChannelSet noise_data = data;
+  Vector& noise_u0 = noise_data.Values("u0");
+  Vector& noise_uL = noise_data.Values("uL");
+  Vector& noise_f0 = noise_data.Values("f0");
+  Vector& noise_fL = noise_data.Values("fL");
+  const std::vector<BarSensor> noise_sensors = BarSensors(noise_data);
+  const Vector& data_f0 = data.Values("f0");
   std::mt19937_64 engine(options.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   Matrix plus_displacement, plus_retrograde, minus_displacement, minus_retrograde;
   double sum_of_squares = 0.0;
   for (int sample = 0; sample < options.samples; ++sample) {
-    for (Vector* channel : {&noise_data.u0, &noise_data.uL}) {
+    for (Vector* channel : {&noise_u0, &noise_uL}) {
       for (double& value : *channel) value = noise.displacement_std * normal(engine);
     }
-    for (Vector* channel : {&noise_data.f0, &noise_data.fL}) {
+    for (Vector* channel : {&noise_f0, &noise_fL}) {
       for (double& value : *channel) value = noise.force_std * normal(engine);
     }
-    for (SensorChannel& sensor : noise_data.sensors) {
+    for (const BarSensor& sensor : noise_sensors) {
       const double level =
           sensor.kind == SensorKind::kStrain ? noise.strain_std : noise.displacement_std;
-      for (double& value : sensor.values) value = level * normal(engine);
+      for (double& value : noise_data.channels[static_cast<std::size_t>(sensor.index)].values) {
+        value = level * normal(engine);
+      }
     }
     McreProblem problem(model, noise_data, mcre.weights, mcre.reference_modulus, theta, ends,
                         mcre.clamp);
@@ -197,7 +209,7 @@ ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
       for (int j = 0; j <= problem.num_steps(); ++j) {
         const double r_d = problem.ClampReaction(solution.displacement.col(j).data());
         const double r_n = problem.ClampReaction(noise_solution.displacement.col(j).data());
-        const double f_n = noise_data.f0[j], f_d = data.f0[j];
+        const double f_n = noise_f0[j], f_d = data_f0[j];
         gradient_change += problem.QuadratureWeight(j) * problem.time_step() *
                            problem.reaction_weight() / modulus *
                            (r_n * (f_n - f_d) - r_d * f_n);

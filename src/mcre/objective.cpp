@@ -60,9 +60,8 @@ McreOptions SearchMcreOptions(const McreOptions& mcre, const SearchOptions& sear
   return options;
 }
 
-McreObjective::McreObjective(const BarModel& model, const MeasurementSet& data,
-                             const McreOptions& mcre, double theta,
-                             const CoupledSolverOptions& inner, double modulus_scale,
+McreObjective::McreObjective(const BarModel& model, const ChannelSet& data, const McreOptions& mcre,
+                             double theta, const CoupledSolverOptions& inner, double modulus_scale,
                              EndDisplacementChannels ends)
     : model_(model),
       data_(data),
@@ -81,11 +80,13 @@ McreObjective::McreObjective(const BarModel& model, const MeasurementSet& data,
                          : mcre.clamp == ClampModel::kPinned
                              ? mcre.weights.reaction_weight / mcre.weights.force_weight
                              : 1.0;
+  const Vector& f0 = data.Values("f0");
+  const Vector& fL = data.Values("fL");
   double force_part = 0.0;
   for (int j = 0; j <= data.num_steps(); ++j) {
     // c_j h [alpha_0/2 f~0_j^2 + alpha/2 f~L_j^2], alpha_0 = f0_gain alpha
     force_part += problem_.QuadratureWeight(j) * data.time_step * 0.5 * problem_.alpha() *
-                  (f0_gain * data.f0[j] * data.f0[j] + data.fL[j] * data.fL[j]);
+                  (f0_gain * f0[j] * f0[j] + fL[j] * fL[j]);
   }
   rest_cost_ = problem_.Cost(zero, zero) + force_part;
 }

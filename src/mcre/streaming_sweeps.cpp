@@ -72,7 +72,7 @@ void McreProblem::UseCheckpoints() {
 Matrix McreProblem::DataTraces() const {
   Matrix traces(num_traces(), num_steps() + 1);
   for (int j = 0; j < data_.num_samples(); ++j) traces(0, j) = U0Datum(j);
-  traces.row(1) = data_.uL.transpose();
+  traces.row(1) = measured_.uL.transpose();
   for (int k = 0; k < num_interior_sensors(); ++k) traces.row(2 + k) = sensor_data_[k]->transpose();
   return traces;
 }
@@ -87,8 +87,9 @@ void McreProblem::DataResponseTraces(Matrix* traces) {
   for (int k = 0; k < m; ++k) {
     const int current = k & 1, next = current ^ 1;
     // f_theta = theta F~_{k+1} + (1 - theta) F~_k at both ends.
-    const double f0 = force0_gain_ * (theta_ * data_.f0[k + 1] + (1.0 - theta_) * data_.f0[k]);
-    const double fL = theta_ * data_.fL[k + 1] + (1.0 - theta_) * data_.fL[k];
+    const double f0 =
+        force0_gain_ * (theta_ * measured_.f0[k + 1] + (1.0 - theta_) * measured_.f0[k]);
+    const double fL = theta_ * measured_.fL[k + 1] + (1.0 - theta_) * measured_.fL[k];
     integrator_.StepWithEndLoads(stream_velocity_[current], stream_displacement_[current], f0, fL,
                                  stream_velocity_[next], stream_displacement_[next]);
     ObserveTraces(stream_displacement_[next], traces->col(k + 1).data());
@@ -109,7 +110,7 @@ void McreProblem::TraceLoads(int j, const Matrix& traces, bool include_data, dou
   const double quadrature = QuadratureWeight(j);
   // c_j beta (y_j - d~_j) at the ends; the sensors' c_j beta_k (y_kj - d~_kj) h_k.
   *f0 = quadrature * beta_u0_ * (traces(0, j) - (include_data ? U0Datum(j) : 0.0));
-  *fL = quadrature * beta_uL_ * (traces(1, j) - (include_data ? data_.uL[j] : 0.0));
+  *fL = quadrature * beta_uL_ * (traces(1, j) - (include_data ? measured_.uL[j] : 0.0));
   double* values = load_values_.col(0).data();
   for (int k = 0; k < num_interior_sensors(); ++k) {
     const double misfit = traces(2 + k, j) - (include_data ? (*sensor_data_[k])[j] : 0.0);
@@ -186,8 +187,8 @@ void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* 
     double direct_f0 = -inverse_alpha0_ * stream_shift_[0];
     double direct_fL = -inverse_alpha * stream_shift_[last];
     if (include_data) {
-      direct_f0 += force0_gain_ * (theta_ * data_.f0[j] + (1.0 - theta_) * data_.f0[j - 1]);
-      direct_fL += theta_ * data_.fL[j] + (1.0 - theta_) * data_.fL[j - 1];
+      direct_f0 += force0_gain_ * (theta_ * measured_.f0[j] + (1.0 - theta_) * measured_.f0[j - 1]);
+      direct_fL += theta_ * measured_.fL[j] + (1.0 - theta_) * measured_.fL[j - 1];
     }
     integrator_.StepWithEndLoads(stream_direct_velocity_[current], stream_displacement_[current],
                                  stream_shift_, direct_f0, direct_fL, stream_direct_velocity_[next],

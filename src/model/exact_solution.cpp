@@ -28,6 +28,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <utility>
 
 namespace mcrewave {
 namespace {
@@ -82,22 +83,17 @@ double ExactBarSolution::ClampForce(double time) const {
   return force;
 }
 
-MeasurementSet ExactBarSolution::Sample(const TimeOptions& time) const {
+ChannelSet ExactBarSolution::Sample(const TimeOptions& time) const {
   const int num_samples = time.NumSteps() + 1;
-  MeasurementSet out;
-  out.start_time = 0.0;
-  out.time_step = time.step;
-  out.u0 = Vector::Zero(num_samples);
-  out.uL = Vector(num_samples);
-  out.f0 = Vector(num_samples);
-  out.fL = Vector(num_samples);
+  Vector uL(num_samples), f0(num_samples), fL(num_samples);
   for (int k = 0; k < num_samples; ++k) {
     const double t = k * time.step;
-    out.uL[k] = Displacement(bar_.length, t);
-    out.f0[k] = ClampForce(t);
-    out.fL[k] = load_.Value(t);
+    uL[k] = Displacement(bar_.length, t);
+    f0[k] = ClampForce(t);
+    fL[k] = load_.Value(t);
   }
-  return out;
+  return BarChannelSet(0.0, time.step, Vector::Zero(num_samples), std::move(uL), std::move(f0),
+                       std::move(fL));
 }
 
 }  // namespace mcrewave

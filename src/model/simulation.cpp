@@ -15,10 +15,10 @@ namespace {
 
 // Clamped simulation on `bar` with `steps_per_sample` steps of `time.step /
 // steps_per_sample` between two samples of the output grid t_k = k time.step.
-MeasurementSet SimulateClamped(const BarProperties& bar, const LoadOptions& load,
-                               const TimeOptions& time, int steps_per_sample,
-                               const std::vector<ModulusZone>& zones,
-                               const std::vector<std::string>& sensors) {
+ChannelSet SimulateClamped(const BarProperties& bar, const LoadOptions& load,
+                           const TimeOptions& time, int steps_per_sample,
+                           const std::vector<ModulusZone>& zones,
+                           const std::vector<std::string>& sensors) {
   const BarModel model(bar);
   // K = sum_e E_e K1_e with the truth's element moduli (in series where a zone ends
   // inside an element); without zones, E K1 as the paper's bar.
@@ -48,12 +48,9 @@ MeasurementSet SimulateClamped(const BarProperties& bar, const LoadOptions& load
   const int num_steps = time.NumSteps() * steps_per_sample;
   const double h = integrator_options.time_step;
   const double theta = time.theta;
-  MeasurementSet out;
-  out.time_step = time.step;
-  out.u0 = Vector::Zero(num_samples);
-  out.uL = Vector::Zero(num_samples);
-  out.f0 = Vector::Zero(num_samples);
-  out.fL = Vector::Zero(num_samples);
+  ChannelSet out =
+      BarChannelSet(0.0, time.step, Vector::Zero(num_samples), Vector::Zero(num_samples),
+                    Vector::Zero(num_samples), Vector::Zero(num_samples));
   // The interior sensors' rows on this mesh (node 0 is clamped: u_0 = 0).
   std::vector<ObservationRow> rows;
   for (const std::string& name : sensors) {
@@ -65,7 +62,18 @@ MeasurementSet SimulateClamped(const BarProperties& bar, const LoadOptions& load
     rows.push_back(channel.sensor_kind == SensorKind::kStrain
                        ? model.StrainRow(channel.position)
                        : model.DisplacementRow(channel.position));
-    out.sensors.push_back({name, channel.sensor_kind, channel.position, Vector::Zero(num_samples)});
+    out.Add(name,
+            channel.sensor_kind == SensorKind::kStrain ? ChannelKind::kStrain
+                                                       : ChannelKind::kDisplacement,
+            Vector::Zero(num_samples));
+  }
+  // The channels written in the time loop, looked up once (the set is complete).
+  Vector& out_uL = out.Values("uL");
+  Vector& out_f0 = out.Values("f0");
+  Vector& out_fL = out.Values("fL");
+  std::vector<Vector*> out_sensors;
+  for (const BarSensor& sensor : BarSensors(out)) {
+    out_sensors.push_back(&out.channels[static_cast<std::size_t>(sensor.index)].values);
   }
   Vector nodal = Vector::Zero(model.num_nodes());  // all nodes, u_0 = 0
 
@@ -87,29 +95,29 @@ MeasurementSet SimulateClamped(const BarProperties& bar, const LoadOptions& load
         acceleration = -acceleration;
         acceleration[loaded] += applied;
         mass_factor.SolveInPlace(acceleration);
-        out.uL[sample] = displacement[loaded];
+        out_uL[sample] = displacement[loaded];
         if (!rows.empty()) {
           nodal.tail(num_free) = displacement;
           for (std::size_t r = 0; r < rows.size(); ++r) {
-            out.sensors[r].values[sample] = rows[r].Apply(nodal.data());
+            (*out_sensors[r])[sample] = rows[r].Apply(nodal.data());
           }
         }
-        out.f0[sample] = mass_01 * acceleration[0] + stiffness_01 * displacement[0];
-        out.fL[sample] = applied;
+        out_f0[sample] = mass_01 * acceleration[0] + stiffness_01 * displacement[0];
+        out_fL[sample] = applied;
       });
   return out;
 }
 
 }  // namespace
 
-MeasurementSet SimulateClampedBar(const BarProperties& bar, const LoadOptions& load,
-                                  const TimeOptions& time, const std::vector<ModulusZone>& zones,
-                                  const std::vector<std::string>& sensors) {
+ChannelSet SimulateClampedBar(const BarProperties& bar, const LoadOptions& load,
+                              const TimeOptions& time, const std::vector<ModulusZone>& zones,
+                              const std::vector<std::string>& sensors) {
   return SimulateClamped(bar, load, time, 1, zones, sensors);
 }
 
-MeasurementSet SimulateTruth(const BarProperties& bar, const LoadOptions& load,
-                             const TimeOptions& time, const DataOptions& data) {
+ChannelSet SimulateTruth(const BarProperties& bar, const LoadOptions& load, const TimeOptions& time,
+                         const DataOptions& data) {
   if (data.truth == TruthModel::kExact) {
     assert(data.truth_zones.empty() && data.sensors.empty());
     return ExactBarSolution(bar, load).Sample(time);
@@ -119,9 +127,9 @@ MeasurementSet SimulateTruth(const BarProperties& bar, const LoadOptions& load,
   return SimulateClamped(fine, load, time, data.truth_refinement, data.truth_zones, data.sensors);
 }
 
-MeasurementSet MakeSyntheticMeasurements(const BarProperties& bar, const LoadOptions& load,
-                                         const TimeOptions& time, const DataOptions& data) {
-  MeasurementSet measurements = SimulateTruth(bar, load, time, data);
+ChannelSet MakeSyntheticMeasurements(const BarProperties& bar, const LoadOptions& load,
+                                     const TimeOptions& time, const DataOptions& data) {
+  ChannelSet measurements = SimulateTruth(bar, load, time, data);
   AddMeasurementNoise(data.snr, data.seed, &measurements);
   return measurements;
 }

@@ -37,19 +37,19 @@ namespace mcrewave {
 // grid (time.step to 1e-6 relative) it must hold at least time.window / time.step + 1
 // samples, of which the first that many are kept. Synthetic data: see
 // SyntheticMeasurements.
-MeasurementSet LoadMeasurements(const Config& config);
+ChannelSet LoadMeasurements(const Config& config);
 
 // MakeSyntheticMeasurements of the config's model, load, time and data sections.
 // Throws InputError naming the config's keys when a value is not finite (a load
 // or a noise level beyond double range).
-MeasurementSet SyntheticMeasurements(const Config& config);
+ChannelSet SyntheticMeasurements(const Config& config);
 
 // Everything one identification computed.
 struct IdentificationRun {
   Config config;
   // The measurements the MCRE compared with: the channels of data.channels,
   // pre-filtered when prefilter.enabled.
-  MeasurementSet data;
+  ChannelSet data;
   // The end displacement channels among them (data.channels).
   EndDisplacementChannels ends;
   // The pre-filter's cut-off frequency [Hz] (given or derived); 0 when off.
@@ -127,12 +127,12 @@ struct McreIdentification {
 // (SearchMcreOptions, its inner solves to search.inner_tolerance); else Identify.
 // Precondition: config valid.
 McreIdentification IdentifyWithMcre(const Config& config, const BarModel& model,
-                                    const MeasurementSet& data, EndDisplacementChannels ends);
+                                    const ChannelSet& data, EndDisplacementChannels ends);
 
 // Runs steps 2 and 3 on measurements made by LoadMeasurements(config): the
 // fields up to `solution` (and wall_time_s); no cost curve, no uncertainty.
 // Precondition: config valid. Never throws for a failed identification.
-IdentificationRun IdentifyModulus(const Config& config, const MeasurementSet& data);
+IdentificationRun IdentifyModulus(const Config& config, const ChannelSet& data);
 
 // Why `modulus` [Pa] cannot be reported as identified: it lies on a bound of
 // the search (within kOnBoundTolerance relative), where e^2 has no minimum but
@@ -153,21 +153,21 @@ std::string ImplausibleMisfitMessage(const IdentificationRun& run);
 // Runs steps 2 to 4 on measurements made by LoadMeasurements(config).
 // Precondition: config valid (as LoadConfig returns it). Never throws for a
 // failed identification: see IsUsable() and outer.message.
-IdentificationRun RunIdentification(const Config& config, const MeasurementSet& data);
+IdentificationRun RunIdentification(const Config& config, const ChannelSet& data);
 
 // The noise levels of the measurements `data` (as LoadMeasurements made them):
 // for synthetic data with noise, those the noise was drawn with (RMS of the
 // truth's channel / SNR, noise.h; *source = "synthetic_snr"); otherwise estimated
 // from the data's second differences (DifferenceNoiseLevels; "data_differences").
-NoiseLevels MeasurementNoiseLevels(const Config& config, const MeasurementSet& data,
+NoiseLevels MeasurementNoiseLevels(const Config& config, const ChannelSet& data,
                                    std::string* source);
 
 // The noise levels that normalise the output-error misfit: MeasurementNoiseLevels of
 // the measurements `data` or, for a kind without noise (noise-free data), the RMS of
 // the channels in use (`used`: uL, fL, the strain channels), *source then
 // "channel_rms".
-NoiseLevels LeastSquaresMisfitLevels(const Config& config, const MeasurementSet& data,
-                                     const MeasurementSet& used, std::string* source);
+NoiseLevels LeastSquaresMisfitLevels(const Config& config, const ChannelSet& data,
+                                     const ChannelSet& used, std::string* source);
 
 // One identification by output-error least squares (outer.functional:
 // least_squares; least_squares/output_error_objective.h): the same data path,
@@ -175,7 +175,7 @@ NoiseLevels LeastSquaresMisfitLevels(const Config& config, const MeasurementSet&
 // the clamped model driven by the measured fL, normalised by the noise levels.
 struct LeastSquaresRun {
   Config config;
-  MeasurementSet data;  // the channels in use, pre-filtered as for the MCRE
+  ChannelSet data;  // the channels in use, pre-filtered as for the MCRE
   EndDisplacementChannels ends;
   double prefilter_cutoff = 0.0;  // [Hz]; 0 when off
   bool reference_known = false;   // synthetic data: E_ref = config.model.modulus
@@ -211,6 +211,6 @@ struct LeastSquaresRun {
 // zone from E* (RunLeastSquaresZoneIdentification). Precondition:
 // config valid with outer.functional = least_squares. Never throws for a failed
 // identification: see IsUsable() and outer.message.
-LeastSquaresRun RunLeastSquares(const Config& config, const MeasurementSet& data);
+LeastSquaresRun RunLeastSquares(const Config& config, const ChannelSet& data);
 
 }  // namespace mcrewave

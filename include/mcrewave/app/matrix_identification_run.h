@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "mcrewave/app/config.h"
-#include "mcrewave/data/measurement.h"
+#include "mcrewave/data/channel_set.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/optim/bounded_minimizer.h"
 
@@ -34,8 +34,10 @@ namespace mcrewave {
 
 // The measurements of a matrix model on the config's time grid.
 struct MatrixMeasurements {
-  ChannelHistories histories;  // rows in the model's channel order (loads, sensors)
-  std::string source;          // the CSV's path, or "synthetic"
+  // The model's channels, named as the model names them, in its order (loads then
+  // sensors, MatrixChannelSet), on t_j = j time.step.
+  ChannelSet histories;
+  std::string source;  // the CSV's path, or "synthetic"
   // Synthetic data: the truth's modulus of each of the model's zones [Pa], matched by
   // zone name; empty for CSV data or when a zone of the model is not one of the truth's.
   Vector truth_moduli;
@@ -77,12 +79,13 @@ Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_modu
 // with `seed` (Box-Muller), the loads first, then the sensors in order, sample by
 // sample. Nothing when snr is infinite.
 void AddMatrixModelNoise(const MatrixModelData& model, double snr, std::uint64_t seed,
-                         ChannelHistories* data);
+                         ChannelSet* data);
 
-// The measurements as the CSV identify run reads back: t, then every channel under
-// its column (model.channel_map).
-ChannelTable MatrixMeasurementTable(const Config& config, const MatrixModelData& model,
-                                    const ChannelHistories& histories);
+// The measurements as the CSV identify run reads back (WriteChannelCsv): every channel
+// of the model, in its order, under its column (model.channel_map).
+// Precondition: histories has the model's channels.
+ChannelSet MatrixMeasurementTable(const Config& config, const MatrixModelData& model,
+                                  const ChannelSet& histories);
 
 // One evaluation of the identification's cost.
 struct MatrixEvaluation {
@@ -120,7 +123,7 @@ struct MatrixIdentificationRun {
   Vector nominal_zone_gap, zone_gap;
   // Channels and names, as used (pre-filtered), and the model's outputs H U at the
   // identified moduli.
-  ChannelHistories data;
+  ChannelSet data;  // the model's channels, in its order (loads, then sensors)
   std::vector<std::string> load_names, sensor_names;
   Matrix model_outputs;
   std::string failure;                   // why the run is not usable ("" when it is)

@@ -84,6 +84,20 @@ inline constexpr std::array<std::pair<SensorKind, const char*>, 2> kSensorKindNa
 const char* SensorKindToString(SensorKind kind);
 bool StringToSensorKind(const std::string& name, SensorKind* kind);
 
+// Kind of a measured channel (data/channel_set.h): what its values are.
+enum class ChannelKind {
+  kDisplacement,  // a displacement [m]
+  kStrain,        // a strain [-]
+  kForce,         // a force [N]
+};
+inline constexpr std::array<std::pair<ChannelKind, const char*>, 3> kChannelKindNames{{
+    {ChannelKind::kDisplacement, "displacement"},
+    {ChannelKind::kStrain, "strain"},
+    {ChannelKind::kForce, "force"},
+}};
+const char* ChannelKindToString(ChannelKind kind);
+bool StringToChannelKind(const std::string& name, ChannelKind* kind);
+
 // How the identification's zones of constant modulus are laid over the bar's elements
 // (model/bar_model.h, ZoneLayout).
 enum class Zoning {

@@ -15,7 +15,7 @@
 namespace mcrewave {
 
 // Adds noise in place. snr = +inf adds nothing. Precondition: snr > 0.
-void AddMeasurementNoise(double snr, std::uint64_t seed, MeasurementSet* measurements);
+void AddMeasurementNoise(double snr, std::uint64_t seed, ChannelSet* measurements);
 
 // Root mean square of a channel.
 double RootMeanSquare(const Vector& channel);

@@ -58,21 +58,20 @@ class ZeroPhaseLowPass {
   int pad_;  // samples of odd reflection at each end
 };
 
-// A cut-off derived from the measured load fL [Hz]: twice the highest frequency at
+// A cut-off derived from the bar's measured load fL [Hz]: twice the highest frequency at
 // which its periodogram (averaged over 9 bins) stands above both 3 x the white-noise
 // level (estimated from the upper half of the band) and 1e-5 x its peak, clamped to
 // [2 / T, 0.45 x sample rate].
-double EstimateCutoffFrequency(const MeasurementSet& measurements);
+double EstimateCutoffFrequency(const ChannelSet& measurements);
 // The same from any measured load history sampled at time_step [s].
 double EstimateCutoffFrequency(const Vector& load, double time_step);
 
-// Every channel (the four end channels and the interior sensors) filtered by the same
+// Every channel of the set filtered by the same
 // ZeroPhaseLowPass (cut-off from options or estimated). Returns the set unchanged when
 // !options.enabled. Writes the cut-off used to *cutoff_used when not null. Throws
 // std::invalid_argument when the options are not valid or a given cut-off is not below the Nyquist
 // frequency 0.5 / measurements.time_step (LoadConfig refuses both at load time).
-MeasurementSet PrefilterMeasurements(const MeasurementSet& measurements,
-                                     const PrefilterOptions& options,
-                                     double* cutoff_used = nullptr);
+ChannelSet PrefilterMeasurements(const ChannelSet& measurements, const PrefilterOptions& options,
+                                 double* cutoff_used = nullptr);
 
 }  // namespace mcrewave

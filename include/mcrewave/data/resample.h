@@ -13,17 +13,14 @@
 
 #include <string>
 
-#include "mcrewave/data/measurement.h"
+#include "mcrewave/data/channel_set.h"
 
 namespace mcrewave {
 
-// The set on t_k = k step, k = 0..samples - 1. Throws InputError naming `name` when
-// the data do not cover [0, (samples - 1) step]. Preconditions: step > 0, samples >= 2.
-MeasurementSet ResampleMeasurements(const MeasurementSet& data, double step, int samples,
-                                    const std::string& name);
-
-// The same for a table of any channels (a structure given by matrices).
-ChannelTable ResampleChannelTable(const ChannelTable& data, double step, int samples,
-                                  const std::string& name);
+// The set on t_k = k step, k = 0..samples - 1, channel by channel (names and kinds
+// kept). Throws InputError naming `name` when the data do not cover
+// [0, (samples - 1) step]. Preconditions: step > 0, samples >= 2.
+ChannelSet ResampleMeasurements(const ChannelSet& data, double step, int samples,
+                                const std::string& name);
 
 }  // namespace mcrewave

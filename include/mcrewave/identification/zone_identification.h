@@ -103,7 +103,7 @@ struct ZoneIdentificationSummary {
 // the noise white at `noise`'s levels on every channel the data have, then pre-filtered
 // as `prefilter` says (enabled with its cutoff; disabled: as drawn). -1 when a solve is
 // not usable.
-double ExpectedNoiseCost(const BarModel& model, const MeasurementSet& data, const McreOptions& mcre,
+double ExpectedNoiseCost(const BarModel& model, const ChannelSet& data, const McreOptions& mcre,
                          double theta, const CoupledSolverOptions& inner,
                          EndDisplacementChannels ends, const Vector& moduli,
                          const NoiseLevels& noise, const PrefilterOptions& prefilter, int samples,
@@ -114,7 +114,7 @@ double ExpectedNoiseCost(const BarModel& model, const MeasurementSet& data, cons
 // cost_scale at the zone moduli, the model driven by the load's noise and compared
 // with the other channels' (white at `noise`'s levels, then pre-filtered as
 // `prefilter` says). -1 when J is not finite.
-double ExpectedLeastSquaresNoiseCost(const BarModel& model, const MeasurementSet& data,
+double ExpectedLeastSquaresNoiseCost(const BarModel& model, const ChannelSet& data,
                                      const NoiseLevels& misfit_levels, double theta,
                                      EndDisplacementChannels ends, const Vector& moduli,
                                      const NoiseLevels& noise, const PrefilterOptions& prefilter,
@@ -129,7 +129,7 @@ double ExpectedLeastSquaresNoiseCost(const BarModel& model, const MeasurementSet
 // identification.
 // Preconditions: options valid, 0 < lower_bound < E* < upper_bound.
 ZoneIdentificationSummary IdentifyZoneModuli(
-    const ZoneIdentificationOptions& options, const BarModel& model, const MeasurementSet& data,
+    const ZoneIdentificationOptions& options, const BarModel& model, const ChannelSet& data,
     const McreOptions& mcre, double theta, const CoupledSolverOptions& inner,
     EndDisplacementChannels ends, double homogeneous_modulus, double lower_bound,
     double upper_bound, const NoiseLevels& noise, const PrefilterOptions& prefilter,
@@ -143,7 +143,7 @@ ZoneIdentificationSummary IdentifyZoneModuli(
 // sweeps the simulations (1 + zones with the gradient). Never throws for a failed
 // identification. Preconditions as IdentifyZoneModuli's.
 ZoneIdentificationSummary IdentifyZoneModuliByLeastSquares(
-    const ZoneIdentificationOptions& options, const BarModel& model, const MeasurementSet& data,
+    const ZoneIdentificationOptions& options, const BarModel& model, const ChannelSet& data,
     const NoiseLevels& misfit_levels, double theta, EndDisplacementChannels ends,
     double homogeneous_modulus, double lower_bound, double upper_bound, const NoiseLevels& noise,
     const PrefilterOptions& prefilter);

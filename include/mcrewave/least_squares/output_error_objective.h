@@ -50,13 +50,12 @@ struct OutputErrorPrediction {
 // The observation rows of the data's interior sensors on `model`'s mesh, in the
 // data's order, and the weight 1 / s^2 of each one's kind (noise: > 0 for every kind
 // the data hold). Overwrites rows and weights.
-void OutputErrorSensorRows(const BarModel& model, const MeasurementSet& data,
-                           const NoiseLevels& noise, std::vector<ObservationRow>* rows,
-                           std::vector<double>* weights);
+void OutputErrorSensorRows(const BarModel& model, const ChannelSet& data, const NoiseLevels& noise,
+                           std::vector<ObservationRow>* rows, std::vector<double>* weights);
 // J_rest [s]: J with every prediction 0,
 //   1/2 sum_k c_k h [uL~_k^2 / s_u^2 (when ends.uL) + f0~_k^2 / s_f^2
 //                    + sum_sensors sensor_weight y~_k^2].
-double OutputErrorRestCost(const MeasurementSet& data, const NoiseLevels& noise,
+double OutputErrorRestCost(const ChannelSet& data, const NoiseLevels& noise,
                            const std::vector<double>& sensor_weights, EndDisplacementChannels ends);
 
 // The clamp reaction of the clamped model at one sample: the accelerations of the free
@@ -73,7 +72,7 @@ class OutputErrorObjective : public ModulusObjective {
   // model must have one zone. noise: the levels s_u, s_f, s_e of the misfit's
   // normalisation (> 0 for every kind the data hold). ends: whether uL enters
   // (ends.uL; u0 never does). theta in [0, 1], modulus_scale > 0 [Pa].
-  OutputErrorObjective(const BarModel& model, const MeasurementSet& data, const NoiseLevels& noise,
+  OutputErrorObjective(const BarModel& model, const ChannelSet& data, const NoiseLevels& noise,
                        double theta, double modulus_scale, EndDisplacementChannels ends = {});
 
   double modulus_scale() const override { return modulus_scale_; }
@@ -98,7 +97,9 @@ class OutputErrorObjective : public ModulusObjective {
 
  private:
   const BarModel& model_;
-  const MeasurementSet& data_;
+  const ChannelSet& data_;
+  BarEnds measured_;                        // data_'s end channels
+  std::vector<const Vector*> sensor_data_;  // data_'s interior sensors (BarSensorValues)
   NoiseLevels noise_;
   double theta_;
   double modulus_scale_;

@@ -34,9 +34,8 @@ class ZoneOutputErrorObjective : public MultiParameterObjective {
   // misfit's normalisation (> 0 for every kind the data hold). ends: whether uL
   // enters (u0 never does: it is zero in the clamped model). theta in [0, 1],
   // modulus_scale > 0 [Pa].
-  ZoneOutputErrorObjective(const BarModel& model, const MeasurementSet& data,
-                           const NoiseLevels& noise, double theta, double modulus_scale,
-                           EndDisplacementChannels ends = {});
+  ZoneOutputErrorObjective(const BarModel& model, const ChannelSet& data, const NoiseLevels& noise,
+                           double theta, double modulus_scale, EndDisplacementChannels ends = {});
 
   int num_parameters() const override { return num_zones_; }
   // p_z = log(E_z / modulus_scale): cost = J / cost_scale() and, when gradient is not
@@ -61,7 +60,9 @@ class ZoneOutputErrorObjective : public MultiParameterObjective {
 
  private:
   const BarModel& model_;
-  const MeasurementSet& data_;
+  const ChannelSet& data_;
+  BarEnds measured_;                        // data_'s end channels
+  std::vector<const Vector*> sensor_data_;  // data_'s interior sensors (BarSensorValues)
   double theta_;
   double modulus_scale_;
   EndDisplacementChannels ends_;

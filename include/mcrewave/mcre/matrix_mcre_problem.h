@@ -25,6 +25,7 @@
 
 #include <vector>
 
+#include "mcrewave/data/channel_set.h"
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/coupled_problem.h"
 #include "mcrewave/mcre/mcre_problem.h"
@@ -32,29 +33,28 @@
 
 namespace mcrewave {
 
-// The measured histories of a matrix model's channels, sampled at t_j = j h,
-// j = 0..m: one row per load channel and one per sensor channel, in the model's order
-// (MatrixModelData::loads, ::sensors).
-struct ChannelHistories {
-  double time_step = 0.0;  // h [s]
-  Matrix loads;            // F~ [N], C x (m + 1)
-  Matrix outputs;          // d~ [m] or [-], S x (m + 1)
-  int num_steps() const { return static_cast<int>(loads.cols()) - 1; }
-};
+// The channel set of a model's channels from their histories at t_j = j h, j = 0..m,
+// in the model's order (MatrixModelData::loads, ::sensors): a channel per load (named
+// as it, kForce, a row of loads, C x (m + 1)) then per sensor (named as it, of its
+// kind, a row of outputs, S x (m + 1)).
+ChannelSet MatrixChannelSet(const MatrixModelData& model, double time_step, const Matrix& loads,
+                            const Matrix& outputs);
 
 class MatrixMcreProblem : public CoupledProblem {
  public:
-  // Keeps references to model and data: both must outlive the problem.
+  // Keeps a reference to model, which must outlive the problem; copies the histories
+  // of data's channels named as the model's loads and sensors (data may go).
   // reference_modulus is E0 of the weights [Pa]; every zone starts at its nominal
-  // modulus. Preconditions: data has the model's channels (rows) and m >= 1 steps,
-  // the model's scales positive, weights valid, theta in [0, 1].
-  MatrixMcreProblem(const MatrixModelData& model, const ChannelHistories& data,
+  // modulus. Preconditions: data has a channel of each of the model's loads and
+  // sensors (else throws std::logic_error) on t_j = j h and m >= 1 steps, the model's
+  // scales positive, weights valid, theta in [0, 1].
+  MatrixMcreProblem(const MatrixModelData& model, const ChannelSet& data,
                     const McreWeights& weights, double reference_modulus, double theta,
                     Factorization factorization = Factorization::kAutomatic);
 
   int num_nodes() const override { return model_.dofs(); }
-  int num_steps() const override { return data_.num_steps(); }
-  double time_step() const override { return data_.time_step; }
+  int num_steps() const override { return static_cast<int>(measured_loads_.cols()) - 1; }
+  double time_step() const override { return time_step_; }
   double theta() const override { return theta_; }
   const Vector& moduli() const override { return moduli_; }
   // K = sum_z (E_z / E_z,nom) K_z, refactorised when the moduli changed.
@@ -84,7 +84,7 @@ class MatrixMcreProblem : public CoupledProblem {
   void MeasuredForce(int j, Eigen::Ref<Vector> load) const override;
 
   // H U of DirectSweep(0) with the data: the model's outputs driven by the measured
-  // loads alone, S x (m + 1) (synthetic data of this model: ChannelHistories::outputs).
+  // loads alone, S x (m + 1) (synthetic data of this model, MatrixChannelSet's outputs).
   Matrix ModelOutputs();
 
   // J_rest = sum_j c_j h [1/2 F~_j^T diag(alpha) F~_j + 1/2 d~_j^T diag(beta) d~_j]
@@ -101,7 +101,9 @@ class MatrixMcreProblem : public CoupledProblem {
 
  private:
   const MatrixModelData& model_;
-  const ChannelHistories& data_;
+  double time_step_;         // h [s]
+  Matrix measured_loads_;    // F~ [N], C x (m + 1), rows in the model's order
+  Matrix measured_outputs_;  // d~ [m] or [-], S x (m + 1)
   double theta_;
   Factorization factorization_;
   Vector moduli_;                        // E_z [Pa]

@@ -103,7 +103,7 @@ class McreProblem : public CoupledProblem {
   // (ends.u0 = false is overridden) against the known 0 with
   // weights.clamp_displacement_weight and loads node 0 with f0 weighed by
   // weights.reaction_weight in place of alpha.
-  McreProblem(const BarModel& model, const MeasurementSet& data, const McreWeights& weights,
+  McreProblem(const BarModel& model, const ChannelSet& data, const McreWeights& weights,
               double reference_modulus, double theta, EndDisplacementChannels ends = {},
               ClampModel clamp = ClampModel::kMeasured);
 
@@ -133,7 +133,7 @@ class McreProblem : public CoupledProblem {
     return reaction_row_ >= 0 ? sensor_weights_[reaction_row_] : 0.0;
   }
   // The datum of the u0 row at sample j [m]: the measured u0, or 0 under a pinned clamp.
-  double U0Datum(int j) const { return clamp_ == ClampModel::kPinned ? 0.0 : data_.u0[j]; }
+  double U0Datum(int j) const { return clamp_ == ClampModel::kPinned ? 0.0 : measured_.u0[j]; }
   // Trusted clamp: the reaction r(U_j) = K_01(E) U_1 [N] of the displacement column
   // U_j (n entries); 0 when the clamp is measured or pinned.
   double ClampReaction(const double* displacement) const {
@@ -149,7 +149,9 @@ class McreProblem : public CoupledProblem {
     return clamp_ == ClampModel::kMeasured && ends_.u0 && ends_.uL && num_interior_sensors() == 0;
   }
   const BarModel& model() const { return model_; }
-  const MeasurementSet& data() const { return data_; }
+  const ChannelSet& data() const { return data_; }
+  // The end channels of data(), looked up once.
+  const BarEnds& measured() const { return measured_; }
   // W -> U. With include_data the force data F~ enter; without, the sweep is the
   // linear part only. U is resized if needed (outside the time loop).
   void DirectSweep(const Matrix& retrograde, bool include_data, Matrix* displacement) override;
@@ -319,7 +321,8 @@ class McreProblem : public CoupledProblem {
   void SensorLoads(int j, const double* displacement_j, bool include_data, double* values) const;
 
   const BarModel& model_;
-  const MeasurementSet& data_;
+  const ChannelSet& data_;
+  BarEnds measured_;  // data_'s end channels
   double theta_;
   double alpha_;
   double beta_;

@@ -49,7 +49,7 @@ struct NoiseLevels {
 // then s^2 averaged over the channels of each type (displacements: the two ends and
 // every u@X; forces: the two ends; strains: every e@X). For measured data, whose noise
 // is not known.
-NoiseLevels DifferenceNoiseLevels(const MeasurementSet& data);
+NoiseLevels DifferenceNoiseLevels(const ChannelSet& data);
 
 // RMS misfits of the coupled solution at the optimum: displacement
 // sqrt(mean_{ends, j} (U_end,j - u~_end,j)^2) and force
@@ -57,7 +57,7 @@ NoiseLevels DifferenceNoiseLevels(const MeasurementSet& data);
 // clamp, clamp_reaction holds the model's reaction r(U_j) [N], j = 0..m, and the
 // misfit at x = 0 is r(U_j) - f0~_j instead (f0 is an output; mcre_problem.h); with a
 // pinned clamp it holds the model's load F_0 = f0~ - W_0 / alpha_0.
-NoiseLevels MisfitLevels(const MeasurementSet& data, const CoupledSolution& solution, double alpha,
+NoiseLevels MisfitLevels(const ChannelSet& data, const CoupledSolution& solution, double alpha,
                          const Vector* clamp_reaction = nullptr);
 
 // A point of the cost curve e^2(E).
@@ -97,13 +97,10 @@ struct ModulusUncertainty {
 // draws); `ends` as in McreProblem.
 // Not available (with a message) when curvature <= 0, both noise levels are 0,
 // or a noise solve is not usable. Precondition: options.IsValid().
-ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
-                                              const BarModel& model, const MeasurementSet& data,
-                                              const McreOptions& mcre, double theta,
-                                              const CoupledSolverOptions& inner, double modulus,
-                                              const CoupledSolution& solution,
-                                              const NoiseLevels& noise, double curvature,
-                                              int curvature_points,
-                                              EndDisplacementChannels ends = {});
+ModulusUncertainty EstimateModulusUncertainty(
+    const UncertaintyOptions& options, const BarModel& model, const ChannelSet& data,
+    const McreOptions& mcre, double theta, const CoupledSolverOptions& inner, double modulus,
+    const CoupledSolution& solution, const NoiseLevels& noise, double curvature,
+    int curvature_points, EndDisplacementChannels ends = {});
 
 }  // namespace mcrewave

@@ -103,7 +103,7 @@ class McreObjective : public ModulusObjective {
   // inner.IsValid(), theta in [0, 1], modulus_scale > 0, data.num_steps() >= 1.
   // ends: the end displacement channels in use (data.channels); the interior sensors
   // are those of data.
-  McreObjective(const BarModel& model, const MeasurementSet& data, const McreOptions& mcre,
+  McreObjective(const BarModel& model, const ChannelSet& data, const McreOptions& mcre,
                 double theta, const CoupledSolverOptions& inner, double modulus_scale,
                 EndDisplacementChannels ends = {});
 
@@ -167,7 +167,7 @@ class McreObjective : public ModulusObjective {
   const ObjectiveEvaluation& Solve(double modulus, bool gradient_requested, const Matrix* initial);
 
   const BarModel& model_;
-  const MeasurementSet& data_;
+  const ChannelSet& data_;
   McreOptions mcre_;
   double theta_;
   EndDisplacementChannels ends_;

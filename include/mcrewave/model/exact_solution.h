@@ -22,7 +22,7 @@ class ExactBarSolution {
   // f0(t) = -S sigma(0, t) = -S E u_x(0, t) [N].
   double ClampForce(double time) const;
   // The four channels (u0 = 0, uL, f0, fL = F) at t_k = k h, k = 0..m.
-  MeasurementSet Sample(const TimeOptions& time) const;
+  ChannelSet Sample(const TimeOptions& time) const;
 
  private:
   BarProperties bar_;

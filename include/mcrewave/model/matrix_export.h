@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "mcrewave/core/types.h"
+#include "mcrewave/data/measurement.h"
 #include "mcrewave/model/bar_model.h"
 
 namespace mcrewave {
@@ -68,15 +69,10 @@ struct MatrixModelData {
 // The observation row of a channel as a 1 x n sparse matrix.
 SparseMatrix ObservationRowMatrix(const ObservationRow& row, int dofs);
 
-// A sensor of the bar to export: `u@X` (kDisplacement) or `e@X` (kStrain).
-struct BarSensor {
-  SensorKind kind = SensorKind::kDisplacement;
-  double position = 0.0;  // X [m]
-};
-
 // The bar as matrices (scales a* = S / L, l* = L): M, K1_z times nominal_modulus per zone (zone z
 // named "zone<z>"), the end loads (channels f0: e_0, fL: e_N), the end displacement rows (u0, uL)
-// and the rows of `sensors` (channels u@X / e@X, as the measurement CSV names them).
+// and the rows of `sensors` (channels u@X / e@X, as the measurement CSV names them; their
+// index is not used).
 MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
                                const std::vector<BarSensor>& sensors = {});
 

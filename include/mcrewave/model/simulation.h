@@ -22,21 +22,20 @@ namespace mcrewave {
 // free nodes from M_r a_k = f_k - K_r u_k. For any theta this makes the free bar,
 // driven by (f0, fL) with the same scheme, reproduce the clamped trajectory to
 // round-off (v_{k+1} - v_k = h (theta a_{k+1} + (1 - theta) a_k) holds exactly).
-MeasurementSet SimulateClampedBar(const BarProperties& bar, const LoadOptions& load,
-                                  const TimeOptions& time,
-                                  const std::vector<ModulusZone>& zones = {},
-                                  const std::vector<std::string>& sensors = {});
+ChannelSet SimulateClampedBar(const BarProperties& bar, const LoadOptions& load,
+                              const TimeOptions& time, const std::vector<ModulusZone>& zones = {},
+                              const std::vector<std::string>& sensors = {});
 
 // The noise-free "truth" sampled on the model's grid t_k = k h: the clamped
 // simulation on a mesh and step refined by data.truth_refinement (every r-th step
 // kept) with data.truth_zones and data.sensors, or the exact solution
 // (exact_solution.h; uniform bar, end channels only: ValidateDataAgainstBar refuses
 // the rest).
-MeasurementSet SimulateTruth(const BarProperties& bar, const LoadOptions& load,
-                             const TimeOptions& time, const DataOptions& data);
+ChannelSet SimulateTruth(const BarProperties& bar, const LoadOptions& load, const TimeOptions& time,
+                         const DataOptions& data);
 
 // SimulateTruth, then AddMeasurementNoise(data.snr, data.seed).
-MeasurementSet MakeSyntheticMeasurements(const BarProperties& bar, const LoadOptions& load,
-                                         const TimeOptions& time, const DataOptions& data);
+ChannelSet MakeSyntheticMeasurements(const BarProperties& bar, const LoadOptions& load,
+                                     const TimeOptions& time, const DataOptions& data);
 
 }  // namespace mcrewave
