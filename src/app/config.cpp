@@ -852,205 +852,219 @@ std::string StructureKeysProblem(const Config& config) {
   return "";
 }
 
+// The cross-section checks of CrossSectionValidators, one a function: true when
+// the config passes, else false with *error set, naming the offending key first.
+
+// The identification's zones on the bar (each holds an element), and no key of
+// another zoning set: it would be ignored (zone_boundaries without
+// model.zoning: boundaries left the bar uniform).
+bool CheckZoneLayout(const Config& config, std::string* error) {
+  const ZoneLayout defaults;
+  const std::string zoning = ZoningToString(config.zones.zoning);
+  if (config.zones.zoning != Zoning::kBoundaries && !config.zones.zone_boundaries.empty()) {
+    *error =
+        "model.zone_boundaries applies to model.zoning 'boundaries' only (model.zoning "
+        "is '" +
+        zoning + "'); set model.zoning: boundaries to use them";
+    return false;
+  }
+  if (config.zones.zoning != Zoning::kEqual && config.zones.zone_count != defaults.zone_count) {
+    *error = "model.zone_count applies to model.zoning 'equal' only (model.zoning is '" + zoning +
+             "'); leave it out with this zoning";
+    return false;
+  }
+  *error = config.zones.Validate(config.model);
+  return error->empty();
+}
+
+// The search: section's other keys belong to the pinned search functional: set
+// with search.functional same they would be ignored.
+bool CheckSearchKeysApply(const Config& config, std::string* error) {
+  const char* key = SearchKeyNotAtItsDefault(config.search);
+  if (config.search.functional == SearchFunctional::kPinned || key == nullptr) return true;
+  *error = std::string(key) +
+           " applies to search.functional 'pinned' only (search.functional is 'same', "
+           "the scan runs on mcre:'s e^2); leave it out with this functional";
+  return false;
+}
+
+// The two stages' scans fit outer's limits (IdentifyInTwoStages): the search's
+// search.scan_points and the window's kTwoStageWindowScanPoints samples within
+// outer.scan_max_points, and both with two evaluations of a refinement each
+// within outer.max_evaluations.
+bool CheckTwoStageScansFitLimits(const Config& config, std::string* error) {
+  if (config.structure.kind != ModelKind::kBar ||
+      config.outer.functional != OuterFunctional::kMcre || !ScansTheSearchFunctional(config)) {
+    return true;
+  }
+  const int least_evaluations = config.search.scan_points + kTwoStageWindowScanPoints + 4;
+  std::ostringstream why;
+  if (config.search.scan_points > config.outer.scan_max_points) {
+    why << "search.scan_points (" << config.search.scan_points
+        << ") must not exceed outer.scan_max_points (" << config.outer.scan_max_points << ")";
+  } else if (config.outer.scan_max_points < kTwoStageWindowScanPoints) {
+    why << "outer.scan_max_points (" << config.outer.scan_max_points << ") must be at least "
+        << kTwoStageWindowScanPoints
+        << " with search.functional 'pinned': e^2 is scanned over that many moduli near "
+           "the search's minimiser";
+  } else if (config.outer.max_evaluations < least_evaluations) {
+    why << "outer.max_evaluations (" << config.outer.max_evaluations
+        << ") must be at least search.scan_points + " << kTwoStageWindowScanPoints + 4 << " = "
+        << least_evaluations << " with search.functional 'pinned': the search's scan, e^2's "
+        << kTwoStageWindowScanPoints << " near its minimiser and two evaluations of each "
+        << "refinement";
+  } else {
+    return true;
+  }
+  *error = why.str();
+  return false;
+}
+
+// Sensors on the bar, truth zones inside it and apart, a truth that can give them.
+bool CheckDataAgainstBar(const Config& config, std::string* error) {
+  *error = ValidateDataAgainstBar(config.data, config.model);
+  return error->empty();
+}
+
+// The keys of one kind of structure are left at their defaults with the other.
+bool CheckStructureKeys(const Config& config, std::string* error) {
+  *error = StructureKeysProblem(config);
+  return error->empty();
+}
+
+// A load the time grid sees: the half sine of load.duration spans at least two
+// steps, so that a sample falls inside it.
+bool CheckLoadSpansTwoSteps(const Config& config, std::string* error) {
+  if (config.structure.kind != ModelKind::kBar || config.load.duration >= 2.0 * config.time.step) {
+    return true;
+  }
+  *error = "load.duration (" + FormatNumber(config.load.duration) +
+           " s) must span at least two time steps, 2 time.step = " +
+           FormatNumber(2.0 * config.time.step) + " s, or the sampled load is zero";
+  return false;
+}
+
+// Sizes a bar's run can hold, refused here rather than by an allocation part way
+// (the synthetic truth is simulated before the first solve): the finite-element
+// truth's elements and steps (model.elements and the model's steps, each times
+// data.truth_refinement) count in int, and an iterative method's fields fit
+// inner.max_field_bytes (SolveCoupled's check, made before any work; auto resolved
+// as SolveCoupled resolves it, so it is never refused here).
+bool CheckBarRunSizes(const Config& config, std::string* error) {
+  if (config.structure.kind != ModelKind::kBar) return true;
+  constexpr double kMaxTruthCount = 1e9;  // below INT_MAX = 2.1e9
+  const double elements = config.model.elements;
+  const double steps = config.time.NumSteps();
+  const double refinement = config.data.truth_refinement;
+  std::ostringstream why;
+  if (config.data.source == DataSource::kSynthetic &&
+      config.data.truth == TruthModel::kFiniteElement &&
+      (elements * refinement > kMaxTruthCount || steps * refinement > kMaxTruthCount)) {
+    why << "data.truth_refinement (" << config.data.truth_refinement
+        << ") gives the finite-element truth " << FormatNumber(elements * refinement)
+        << " elements (model.elements x data.truth_refinement) and "
+        << FormatNumber(steps * refinement)
+        << " steps (time.window / time.step x data.truth_refinement), more than the limit "
+           "of 1e9 for either; use a smaller refinement, fewer elements or a larger step";
+    *error = why.str();
+    return false;
+  }
+  const double field_bytes = IterativeSolverFieldBytes(elements + 1.0, steps);
+  const CoupledSolverType method =
+      ResolveCoupledSolverType(config.inner, elements + 1.0, steps, true);
+  if (HoldsIterativeSolverFields(method) &&
+      field_bytes > static_cast<double>(config.inner.max_field_bytes)) {
+    why << "model.elements (" << config.model.elements << ") and " << FormatNumber(steps)
+        << " steps (time.window / time.step) need " << static_cast<long long>(field_bytes)
+        << " bytes for inner.method '" << CoupledSolverTypeToString(method) << "' ("
+        << kIterativeSolverFields
+        << " fields of (N + 1) x (steps + 1) doubles), above inner.max_field_bytes = "
+        << config.inner.max_field_bytes
+        << "; use inner.method: streaming_conjugate_gradient (or auto), which stores no "
+           "space-time field, raise inner.max_field_bytes, or use fewer elements, a "
+           "shorter window or a larger step";
+    *error = why.str();
+    return false;
+  }
+  return true;
+}
+
+// Riccati and the shooting solvers are written for the paper's data term (H = B,
+// the clamp measured): refused here with any other, rather than by every solve of
+// the scan. Interior columns of a CSV are known once it is read; SolveCoupled
+// refuses those.
+bool CheckPapersDataTerm(const Config& config, std::string* error) {
+  const CoupledSolverType method = config.inner.type;
+  if (config.structure.kind != ModelKind::kBar || !NeedsThePapersDataTerm(method)) {
+    return true;
+  }
+  const std::string prefix = std::string("inner.method '") + CoupledSolverTypeToString(method) +
+                             "' handles the paper's data term only (u0 and uL, no interior "
+                             "sensor, the clamp measured), ";
+  const std::string remedy =
+      "; use inner.method conjugate_gradient, adaptive_relaxation, relaxation or "
+      "all_at_once";
+  const std::vector<std::string>& channels = config.data.channels;
+  const auto uses = [&channels](const char* name) {
+    return channels.empty() || std::find(channels.begin(), channels.end(), name) != channels.end();
+  };
+  bool interior = channels.empty() && !config.data.sensors.empty();
+  for (const std::string& name : channels) {
+    ChannelName channel;
+    std::string why;
+    // The names are valid: DataOptions::IsValid ran first.
+    ParseChannelName(name, &channel, &why);
+    interior = interior || channel.kind == ChannelName::Kind::kSensor;
+  }
+  if (config.mcre.clamp != ClampModel::kMeasured) {
+    *error = prefix + "but mcre.clamp is '" + ClampModelToString(config.mcre.clamp) + "'" + remedy +
+             ", or mcre.clamp: measured";
+  } else if (interior) {
+    *error = prefix +
+             "but the identification uses interior sensors (data.sensors, "
+             "data.channels)" +
+             remedy;
+  } else if (!uses("u0") || !uses("uL")) {
+    *error = prefix + "but data.channels leaves out " + (uses("u0") ? "uL" : "u0") + remedy;
+  } else if (ScansTheSearchFunctional(config)) {
+    *error = prefix + "but search.functional is 'pinned' (the global scan's clamp is pinned)" +
+             remedy + ", or search.functional: same";
+  } else {
+    return true;
+  }
+  return false;
+}
+
+// A cut-off at or above the Nyquist frequency is not a low-pass filter of the
+// sampled data (the bilinear transform maps Nyquist to tan(pi/2)).
+bool CheckPrefilterBelowNyquist(const Config& config, std::string* error) {
+  const double cutoff = config.prefilter.cutoff_frequency;
+  const double nyquist = 0.5 / config.time.step;
+  if (cutoff > 0.0 && !(cutoff < nyquist)) {
+    *error = "prefilter.cutoff_frequency (" + FormatNumber(cutoff) +
+             " Hz) must be below the Nyquist frequency 0.5 / time.step = " + FormatNumber(nyquist) +
+             " Hz (time.step = " + FormatNumber(config.time.step) +
+             " s), or 0 to derive it from the data";
+    return false;
+  }
+  return true;
+}
+
 // Checks of keys from more than one section, run once every section is valid on
 // its own. The same convention as the sections' IsValid: the message names the
 // offending key first (Locate places it where that key was set), then the keys
 // it is compared with.
 const std::vector<SectionValidator>& CrossSectionValidators() {
   static const std::vector<SectionValidator> validators = {
-      // The identification's zones on the bar (each holds an element), and no key of
-      // another zoning set: it would be ignored (zone_boundaries without
-      // model.zoning: boundaries left the bar uniform).
-      [](const Config& config, std::string* error) {
-        const ZoneLayout defaults;
-        const std::string zoning = ZoningToString(config.zones.zoning);
-        if (config.zones.zoning != Zoning::kBoundaries && !config.zones.zone_boundaries.empty()) {
-          *error =
-              "model.zone_boundaries applies to model.zoning 'boundaries' only (model.zoning "
-              "is '" +
-              zoning + "'); set model.zoning: boundaries to use them";
-          return false;
-        }
-        if (config.zones.zoning != Zoning::kEqual &&
-            config.zones.zone_count != defaults.zone_count) {
-          *error = "model.zone_count applies to model.zoning 'equal' only (model.zoning is '" +
-                   zoning + "'); leave it out with this zoning";
-          return false;
-        }
-        *error = config.zones.Validate(config.model);
-        return error->empty();
-      },
-      // The search: section's other keys belong to the pinned search functional: set
-      // with search.functional same they would be ignored.
-      [](const Config& config, std::string* error) {
-        const char* key = SearchKeyNotAtItsDefault(config.search);
-        if (config.search.functional == SearchFunctional::kPinned || key == nullptr) return true;
-        *error = std::string(key) +
-                 " applies to search.functional 'pinned' only (search.functional is 'same', "
-                 "the scan runs on mcre:'s e^2); leave it out with this functional";
-        return false;
-      },
-      // The two stages' scans fit outer's limits (IdentifyInTwoStages): the search's
-      // search.scan_points and the window's kTwoStageWindowScanPoints samples within
-      // outer.scan_max_points, and both with two evaluations of a refinement each
-      // within outer.max_evaluations.
-      [](const Config& config, std::string* error) {
-        if (config.structure.kind != ModelKind::kBar ||
-            config.outer.functional != OuterFunctional::kMcre ||
-            !ScansTheSearchFunctional(config)) {
-          return true;
-        }
-        const int least_evaluations = config.search.scan_points + kTwoStageWindowScanPoints + 4;
-        std::ostringstream why;
-        if (config.search.scan_points > config.outer.scan_max_points) {
-          why << "search.scan_points (" << config.search.scan_points
-              << ") must not exceed outer.scan_max_points (" << config.outer.scan_max_points << ")";
-        } else if (config.outer.scan_max_points < kTwoStageWindowScanPoints) {
-          why << "outer.scan_max_points (" << config.outer.scan_max_points << ") must be at least "
-              << kTwoStageWindowScanPoints
-              << " with search.functional 'pinned': e^2 is scanned over that many moduli near "
-                 "the search's minimiser";
-        } else if (config.outer.max_evaluations < least_evaluations) {
-          why << "outer.max_evaluations (" << config.outer.max_evaluations
-              << ") must be at least search.scan_points + " << kTwoStageWindowScanPoints + 4
-              << " = " << least_evaluations
-              << " with search.functional 'pinned': the search's scan, e^2's "
-              << kTwoStageWindowScanPoints << " near its minimiser and two evaluations of each "
-              << "refinement";
-        } else {
-          return true;
-        }
-        *error = why.str();
-        return false;
-      },
-      // Sensors on the bar, truth zones inside it and apart, a truth that can give them.
-      [](const Config& config, std::string* error) {
-        *error = ValidateDataAgainstBar(config.data, config.model);
-        return error->empty();
-      },
-      // The keys of one kind of structure are left at their defaults with the other.
-      [](const Config& config, std::string* error) {
-        *error = StructureKeysProblem(config);
-        return error->empty();
-      },
-      // A load the time grid sees: the half sine of load.duration spans at least two
-      // steps, so that a sample falls inside it.
-      [](const Config& config, std::string* error) {
-        if (config.structure.kind != ModelKind::kBar ||
-            config.load.duration >= 2.0 * config.time.step) {
-          return true;
-        }
-        *error = "load.duration (" + FormatNumber(config.load.duration) +
-                 " s) must span at least two time steps, 2 time.step = " +
-                 FormatNumber(2.0 * config.time.step) + " s, or the sampled load is zero";
-        return false;
-      },
-      // Sizes a bar's run can hold, refused here rather than by an allocation part way
-      // (the synthetic truth is simulated before the first solve): the finite-element
-      // truth's elements and steps (model.elements and the model's steps, each times
-      // data.truth_refinement) count in int, and an iterative method's fields fit
-      // inner.max_field_bytes (SolveCoupled's check, made before any work; auto resolved
-      // as SolveCoupled resolves it, so it is never refused here).
-      [](const Config& config, std::string* error) {
-        if (config.structure.kind != ModelKind::kBar) return true;
-        constexpr double kMaxTruthCount = 1e9;  // below INT_MAX = 2.1e9
-        const double elements = config.model.elements;
-        const double steps = config.time.NumSteps();
-        const double refinement = config.data.truth_refinement;
-        std::ostringstream why;
-        if (config.data.source == DataSource::kSynthetic &&
-            config.data.truth == TruthModel::kFiniteElement &&
-            (elements * refinement > kMaxTruthCount || steps * refinement > kMaxTruthCount)) {
-          why << "data.truth_refinement (" << config.data.truth_refinement
-              << ") gives the finite-element truth " << FormatNumber(elements * refinement)
-              << " elements (model.elements x data.truth_refinement) and "
-              << FormatNumber(steps * refinement)
-              << " steps (time.window / time.step x data.truth_refinement), more than the limit "
-                 "of 1e9 for either; use a smaller refinement, fewer elements or a larger step";
-          *error = why.str();
-          return false;
-        }
-        const double field_bytes = IterativeSolverFieldBytes(elements + 1.0, steps);
-        const CoupledSolverType method =
-            ResolveCoupledSolverType(config.inner, elements + 1.0, steps, true);
-        if (HoldsIterativeSolverFields(method) &&
-            field_bytes > static_cast<double>(config.inner.max_field_bytes)) {
-          why << "model.elements (" << config.model.elements << ") and " << FormatNumber(steps)
-              << " steps (time.window / time.step) need " << static_cast<long long>(field_bytes)
-              << " bytes for inner.method '" << CoupledSolverTypeToString(method) << "' ("
-              << kIterativeSolverFields
-              << " fields of (N + 1) x (steps + 1) doubles), above inner.max_field_bytes = "
-              << config.inner.max_field_bytes
-              << "; use inner.method: streaming_conjugate_gradient (or auto), which stores no "
-                 "space-time field, raise inner.max_field_bytes, or use fewer elements, a "
-                 "shorter window or a larger step";
-          *error = why.str();
-          return false;
-        }
-        return true;
-      },
-      // Riccati and the shooting solvers are written for the paper's data term (H = B,
-      // the clamp measured): refused here with any other, rather than by every solve of
-      // the scan. Interior columns of a CSV are known once it is read; SolveCoupled
-      // refuses those.
-      [](const Config& config, std::string* error) {
-        const CoupledSolverType method = config.inner.type;
-        if (config.structure.kind != ModelKind::kBar || !NeedsThePapersDataTerm(method)) {
-          return true;
-        }
-        const std::string prefix = std::string("inner.method '") +
-                                   CoupledSolverTypeToString(method) +
-                                   "' handles the paper's data term only (u0 and uL, no interior "
-                                   "sensor, the clamp measured), ";
-        const std::string remedy =
-            "; use inner.method conjugate_gradient, adaptive_relaxation, relaxation or "
-            "all_at_once";
-        const std::vector<std::string>& channels = config.data.channels;
-        const auto uses = [&channels](const char* name) {
-          return channels.empty() ||
-                 std::find(channels.begin(), channels.end(), name) != channels.end();
-        };
-        bool interior = channels.empty() && !config.data.sensors.empty();
-        for (const std::string& name : channels) {
-          ChannelName channel;
-          std::string why;
-          // The names are valid: DataOptions::IsValid ran first.
-          ParseChannelName(name, &channel, &why);
-          interior = interior || channel.kind == ChannelName::Kind::kSensor;
-        }
-        if (config.mcre.clamp != ClampModel::kMeasured) {
-          *error = prefix + "but mcre.clamp is '" + ClampModelToString(config.mcre.clamp) + "'" +
-                   remedy + ", or mcre.clamp: measured";
-        } else if (interior) {
-          *error = prefix +
-                   "but the identification uses interior sensors (data.sensors, "
-                   "data.channels)" +
-                   remedy;
-        } else if (!uses("u0") || !uses("uL")) {
-          *error = prefix + "but data.channels leaves out " + (uses("u0") ? "uL" : "u0") + remedy;
-        } else if (ScansTheSearchFunctional(config)) {
-          *error = prefix +
-                   "but search.functional is 'pinned' (the global scan's clamp is pinned)" +
-                   remedy + ", or search.functional: same";
-        } else {
-          return true;
-        }
-        return false;
-      },
-      // A cut-off at or above the Nyquist frequency is not a low-pass filter of the
-      // sampled data (the bilinear transform maps Nyquist to tan(pi/2)).
-      [](const Config& config, std::string* error) {
-        const double cutoff = config.prefilter.cutoff_frequency;
-        const double nyquist = 0.5 / config.time.step;
-        if (cutoff > 0.0 && !(cutoff < nyquist)) {
-          *error = "prefilter.cutoff_frequency (" + FormatNumber(cutoff) +
-                   " Hz) must be below the Nyquist frequency 0.5 / time.step = " +
-                   FormatNumber(nyquist) + " Hz (time.step = " + FormatNumber(config.time.step) +
-                   " s), or 0 to derive it from the data";
-          return false;
-        }
-        return true;
-      },
+      CheckZoneLayout,              // model.zoning, zone_count, zone_boundaries
+      CheckSearchKeysApply,         // search.* against search.functional
+      CheckTwoStageScansFitLimits,  // search.scan_points against outer.*
+      CheckDataAgainstBar,          // data.* against model.*
+      CheckStructureKeys,           // keys of the other model.kind
+      CheckLoadSpansTwoSteps,       // load.duration against time.step
+      CheckBarRunSizes,             // model.elements, time.*, data.truth_refinement, inner.*
+      CheckPapersDataTerm,          // inner.method against mcre.clamp, data.*, search.*
+      CheckPrefilterBelowNyquist,   // prefilter.cutoff_frequency against time.step
   };
   return validators;
 }

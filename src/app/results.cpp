@@ -524,6 +524,70 @@ void OptimizerScanAndPrefilterYaml(const IdentificationSummary& outer, double co
              "config: prefilter.cutoff_frequency; derived_from_load: EstimateCutoffFrequency");
 }
 
+namespace {
+
+// The uncertainty: block of an identification's summary: the modulus' standard
+// deviation, its curvature, and the noise it was drawn with, estimated and left.
+void UncertaintyYaml(const IdentificationRun& run, YamlWriter* yaml) {
+  const ModulusUncertainty& uncertainty = run.uncertainty;
+  yaml->Line(0, "uncertainty", "");
+  yaml->Number(1, "modulus_std_dev", uncertainty.available ? uncertainty.std_dev : NAN,
+               "[Pa] null when not available (see message)");
+  yaml->Number(1, "relative_std_dev", uncertainty.available ? uncertainty.relative_std_dev : NAN,
+               "modulus_std_dev / identified_modulus");
+  yaml->Text(1, "meaning", kUncertaintyMeaning);
+  yaml->Text(1, "message", uncertainty.message);
+  yaml->Number(1, "curvature", uncertainty.curvature,
+               "[J s/Pa^2] k, least-squares slope of de^2/dE over E +- 5 %");
+  yaml->Integer(1, "curvature_points", uncertainty.curvature_points, "cost-curve points of k");
+  yaml->Integer(1, "samples", uncertainty.samples, "noise draws");
+  yaml->Number(1, "noise_std_displacement", run.noise.displacement_std, "[m] drawn on u0 and uL");
+  yaml->Number(1, "noise_std_force", run.noise.force_std, "[N] drawn on f0 and fL");
+  yaml->Text(1, "noise_source", run.noise_source,
+             "synthetic_snr: the data's own noise; data_differences: estimated from the data");
+  yaml->Number(1, "estimated_noise_std_displacement", run.estimated_noise.displacement_std,
+               "[m] from the second differences of the data (MAD)");
+  yaml->Number(1, "estimated_noise_std_force", run.estimated_noise.force_std,
+               "[N] from the second differences of the data (MAD)");
+  yaml->Number(1, "misfit_rms_displacement", run.misfit.displacement_std,
+               "[m] RMS of U - u~ at both ends, at the optimum");
+  yaml->Number(1, "misfit_rms_force", run.misfit.force_std,
+               "[N] RMS of F - f~ = -W / alpha at both ends (a trusted clamp: r(U) - f0~ at "
+               "x = 0; a pinned one: -W_0 / alpha_0), at the optimum");
+  yaml->Integer(1, "sweeps", uncertainty.sweeps, "of the noise solves");
+}
+
+// The inner: block of an identification's summary: the coupled solves of the
+// optimiser, their iterations, sweeps and time, and the solve at the optimum.
+void InnerSolvesYaml(const IdentificationRun& run, YamlWriter* yaml) {
+  long inner_iterations = 0;
+  int max_inner_iterations = 0;
+  double inner_time = 0.0;
+  for (const ObjectiveEvaluation& evaluation : run.evaluations) {
+    inner_iterations += std::max(0, evaluation.inner.iterations);
+    max_inner_iterations = std::max(max_inner_iterations, evaluation.inner.iterations);
+    inner_time += std::max(0.0, evaluation.inner.wall_time_s);
+  }
+  const CoupledSolverSummary& best_inner = run.evaluations[run.best_index].inner;
+  yaml->Line(0, "inner", "");
+  yaml->Text(1, "method", CoupledSolverTypeToString(run.inner_method), InnerMethodComment(run));
+  yaml->Integer(1, "solves", static_cast<long>(run.evaluations.size()),
+                "coupled solves of the optimiser");
+  yaml->Integer(1, "iterations", inner_iterations, "sweep pairs over those solves");
+  yaml->Integer(1, "max_iterations_one_solve", max_inner_iterations);
+  yaml->Integer(1, "sweeps", run.sweeps - run.search_sweeps, "of those solves");
+  yaml->Integer(1, "search_sweeps", run.search_sweeps,
+                "of the search functional's own solves (its valleys' refinement; 0: one stage)");
+  yaml->Number(1, "wall_time_s", inner_time, "[s] in those solves");
+  yaml->Integer(1, "iterations_at_optimum", best_inner.iterations,
+                "of the solve at the identified modulus");
+  yaml->Number(1, "relative_residual_at_optimum", best_inner.relative_residual);
+  yaml->Integer(1, "iterations_from_zero_at_optimum", run.cold_solve.iterations,
+                "of a solve from W = 0 at the identified modulus (inner_residual.csv)");
+}
+
+}  // namespace
+
 std::string SummaryYaml(const IdentificationRun& run) {
   const IdentificationSummary& outer = run.outer;
   const double identified = run.identified_modulus();
@@ -555,60 +619,12 @@ std::string SummaryYaml(const IdentificationRun& run) {
                 "its share of the constitutive gap");
   }
 
-  const ModulusUncertainty& uncertainty = run.uncertainty;
-  yaml.Line(0, "uncertainty", "");
-  yaml.Number(1, "modulus_std_dev", uncertainty.available ? uncertainty.std_dev : NAN,
-              "[Pa] null when not available (see message)");
-  yaml.Number(1, "relative_std_dev", uncertainty.available ? uncertainty.relative_std_dev : NAN,
-              "modulus_std_dev / identified_modulus");
-  yaml.Text(1, "meaning", kUncertaintyMeaning);
-  yaml.Text(1, "message", uncertainty.message);
-  yaml.Number(1, "curvature", uncertainty.curvature,
-              "[J s/Pa^2] k, least-squares slope of de^2/dE over E +- 5 %");
-  yaml.Integer(1, "curvature_points", uncertainty.curvature_points, "cost-curve points of k");
-  yaml.Integer(1, "samples", uncertainty.samples, "noise draws");
-  yaml.Number(1, "noise_std_displacement", run.noise.displacement_std, "[m] drawn on u0 and uL");
-  yaml.Number(1, "noise_std_force", run.noise.force_std, "[N] drawn on f0 and fL");
-  yaml.Text(1, "noise_source", run.noise_source,
-            "synthetic_snr: the data's own noise; data_differences: estimated from the data");
-  yaml.Number(1, "estimated_noise_std_displacement", run.estimated_noise.displacement_std,
-              "[m] from the second differences of the data (MAD)");
-  yaml.Number(1, "estimated_noise_std_force", run.estimated_noise.force_std,
-              "[N] from the second differences of the data (MAD)");
-  yaml.Number(1, "misfit_rms_displacement", run.misfit.displacement_std,
-              "[m] RMS of U - u~ at both ends, at the optimum");
-  yaml.Number(1, "misfit_rms_force", run.misfit.force_std,
-              "[N] RMS of F - f~ = -W / alpha at both ends (a trusted clamp: r(U) - f0~ at "
-              "x = 0; a pinned one: -W_0 / alpha_0), at the optimum");
-  yaml.Integer(1, "sweeps", uncertainty.sweeps, "of the noise solves");
+  UncertaintyYaml(run, &yaml);
 
   OptimizerScanAndPrefilterYaml(outer, run.rest_cost, run.scan_cost_scale, run.config,
                                 run.prefilter_cutoff, "e^2", "J s", &yaml);
 
-  long inner_iterations = 0;
-  int max_inner_iterations = 0;
-  double inner_time = 0.0;
-  for (const ObjectiveEvaluation& evaluation : run.evaluations) {
-    inner_iterations += std::max(0, evaluation.inner.iterations);
-    max_inner_iterations = std::max(max_inner_iterations, evaluation.inner.iterations);
-    inner_time += std::max(0.0, evaluation.inner.wall_time_s);
-  }
-  const CoupledSolverSummary& best_inner = run.evaluations[run.best_index].inner;
-  yaml.Line(0, "inner", "");
-  yaml.Text(1, "method", CoupledSolverTypeToString(run.inner_method), InnerMethodComment(run));
-  yaml.Integer(1, "solves", static_cast<long>(run.evaluations.size()),
-               "coupled solves of the optimiser");
-  yaml.Integer(1, "iterations", inner_iterations, "sweep pairs over those solves");
-  yaml.Integer(1, "max_iterations_one_solve", max_inner_iterations);
-  yaml.Integer(1, "sweeps", run.sweeps - run.search_sweeps, "of those solves");
-  yaml.Integer(1, "search_sweeps", run.search_sweeps,
-               "of the search functional's own solves (its valleys' refinement; 0: one stage)");
-  yaml.Number(1, "wall_time_s", inner_time, "[s] in those solves");
-  yaml.Integer(1, "iterations_at_optimum", best_inner.iterations,
-               "of the solve at the identified modulus");
-  yaml.Number(1, "relative_residual_at_optimum", best_inner.relative_residual);
-  yaml.Integer(1, "iterations_from_zero_at_optimum", run.cold_solve.iterations,
-               "of a solve from W = 0 at the identified modulus (inner_residual.csv)");
+  InnerSolvesYaml(run, &yaml);
 
   yaml.Line(0, "weights", "");
   yaml.Number(1, "alpha", run.alpha, "[m/N] force weight w_f L / (S E0)");
@@ -622,7 +638,7 @@ std::string SummaryYaml(const IdentificationRun& run) {
               "[Pa]");
   yaml.Integer(1, "sweeps", run.cost_curve_sweeps);
   yaml.Integer(0, "total_sweeps",
-               run.outer.scan_sweeps + run.sweeps + run.cost_curve_sweeps + uncertainty.sweeps,
+               run.outer.scan_sweeps + run.sweeps + run.cost_curve_sweeps + run.uncertainty.sweeps,
                "scan, optimiser, cost curve and uncertainty");
 
   if (run.zones.ran) {

@@ -133,8 +133,10 @@ double ParseValue(const LineReader& reader, Field field, const char* begin, cons
   return value;
 }
 
-ParsedFile ParseFile(std::istream& text, const std::string& name) {
-  LineReader reader(text, name);
+// Reads the banner '%%MatrixMarket matrix format field symmetry' (the first line)
+// into file->format and file->symmetric; returns its field. Fails on a banner of
+// another form, or a format, field or symmetry the reader does not take.
+Field ParseBanner(LineReader& reader, ParsedFile* file) {
   std::string line;
   if (!reader.NextRaw(&line)) {
     reader.FailAtEnd("empty file: expected the banner '%%MatrixMarket matrix ...'");
@@ -150,14 +152,13 @@ ParsedFile ParseFile(std::istream& text, const std::string& name) {
       Lower(std::string(begin[1], end[1])) != "matrix") {
     reader.Fail(expected_banner + std::string(", got '") + line + "'");
   }
-  ParsedFile file;
   const std::string format = Lower(std::string(begin[2], end[2]));
   const std::string field_name = Lower(std::string(begin[3], end[3]));
   const std::string symmetry = Lower(std::string(begin[4], end[4]));
   if (format == "coordinate") {
-    file.format = Format::kCoordinate;
+    file->format = Format::kCoordinate;
   } else if (format == "array") {
-    file.format = Format::kArray;
+    file->format = Format::kArray;
   } else {
     reader.Fail("format " + Quote(begin[2], end[2]) + ": expected coordinate or array");
   }
@@ -166,30 +167,39 @@ ParsedFile ParseFile(std::istream& text, const std::string& name) {
     field = Field::kReal;
   } else if (field_name == "integer") {
     field = Field::kInteger;
-  } else if (field_name == "pattern" && file.format == Format::kCoordinate) {
+  } else if (field_name == "pattern" && file->format == Format::kCoordinate) {
     field = Field::kPattern;
   } else {
     reader.Fail("field " + Quote(begin[3], end[3]) + ": expected real, integer" +
-                (file.format == Format::kCoordinate ? " or pattern" : "") +
+                (file->format == Format::kCoordinate ? " or pattern" : "") +
                 " (complex matrices are not structural matrices)");
   }
   if (symmetry == "general") {
-    file.symmetric = false;
-  } else if (symmetry == "symmetric" && file.format == Format::kCoordinate) {
-    file.symmetric = true;
+    file->symmetric = false;
+  } else if (symmetry == "symmetric" && file->format == Format::kCoordinate) {
+    file->symmetric = true;
   } else {
     reader.Fail("symmetry " + Quote(begin[4], end[4]) + ": expected general" +
-                (file.format == Format::kCoordinate ? " or symmetric" : " (array files)"));
+                (file->format == Format::kCoordinate ? " or symmetric" : " (array files)"));
   }
+  return field;
+}
 
-  // Size line.
+// Reads the size line after the banner ('rows columns entries', coordinate, or
+// 'rows columns', array) into file->size_line, rows and columns; returns the
+// entries it declares (0 for an array). Fails on a malformed line, a dimension
+// outside [1, 1e7] or a symmetric matrix that is not square.
+long long ParseSizeLine(LineReader& reader, ParsedFile* file) {
+  std::string line;
   if (!reader.NextData(&line)) {
     reader.FailAtEnd("ends after the banner: expected the size line");
   }
-  file.size_line = reader.line_number();
-  const int size_count = file.format == Format::kCoordinate ? 3 : 2;
+  file->size_line = reader.line_number();
+  const int size_count = file->format == Format::kCoordinate ? 3 : 2;
   const char* size_form =
-      file.format == Format::kCoordinate ? "'rows columns entries'" : "'rows columns'";
+      file->format == Format::kCoordinate ? "'rows columns entries'" : "'rows columns'";
+  const char* begin[3] = {};
+  const char* end[3] = {};
   long long sizes[3] = {0, 0, 0};
   if (Tokenize(line, size_count, begin, end) != size_count) {
     reader.Fail(std::string("expected the size line ") + size_form + " (" +
@@ -210,63 +220,76 @@ ParsedFile ParseFile(std::istream& text, const std::string& name) {
     reader.Fail("size line: rows and columns must lie in [1, 1e7], got " +
                 std::to_string(sizes[0]) + " x " + std::to_string(sizes[1]));
   }
-  file.rows = static_cast<long>(sizes[0]);
-  file.columns = static_cast<long>(sizes[1]);
-  if (file.symmetric && file.rows != file.columns) {
+  file->rows = static_cast<long>(sizes[0]);
+  file->columns = static_cast<long>(sizes[1]);
+  if (file->symmetric && file->rows != file->columns) {
     reader.Fail("a symmetric matrix must be square, the size line gives " +
-                std::to_string(file.rows) + " x " + std::to_string(file.columns));
+                std::to_string(file->rows) + " x " + std::to_string(file->columns));
   }
+  return sizes[2];
+}
 
-  if (file.format == Format::kArray) {
-    const long long count = sizes[0] * sizes[1];
-    if (count > 500000000LL) {
-      reader.Fail("array of " + std::to_string(count) + " values: too large for a dense file");
-    }
-    file.dense.reserve(static_cast<std::size_t>(std::min<long long>(count, kReserveLimit)));
-    while (reader.NextData(&line)) {
-      if (static_cast<long long>(file.dense.size()) == count) {
-        reader.Fail("value beyond the " + std::to_string(count) + " (" + std::to_string(file.rows) +
-                    " x " + std::to_string(file.columns) + ") declared on line " +
-                    std::to_string(file.size_line));
-      }
-      if (Tokenize(line, 1, begin, end) != 1) {
-        reader.Fail("expected one value per line, got '" + line + "'");
-      }
-      file.dense.push_back(ParseValue(reader, field, begin[0], end[0]));
-    }
-    if (static_cast<long long>(file.dense.size()) != count) {
-      reader.FailAtEnd("ends after " + std::to_string(file.dense.size()) + " of the " +
-                       std::to_string(count) + " values declared on line " +
-                       std::to_string(file.size_line));
-    }
-    return file;
+// Reads the values of an array file after its size line, one a line, into
+// file->dense (column-major). Fails unless there are exactly rows x columns, at
+// most 5e8.
+void ReadArrayValues(LineReader& reader, Field field, ParsedFile* file) {
+  std::string line;
+  const char* begin[1] = {};
+  const char* end[1] = {};
+  const long long count = static_cast<long long>(file->rows) * file->columns;
+  if (count > 500000000LL) {
+    reader.Fail("array of " + std::to_string(count) + " values: too large for a dense file");
   }
+  file->dense.reserve(static_cast<std::size_t>(std::min<long long>(count, kReserveLimit)));
+  while (reader.NextData(&line)) {
+    if (static_cast<long long>(file->dense.size()) == count) {
+      reader.Fail("value beyond the " + std::to_string(count) + " (" + std::to_string(file->rows) +
+                  " x " + std::to_string(file->columns) + ") declared on line " +
+                  std::to_string(file->size_line));
+    }
+    if (Tokenize(line, 1, begin, end) != 1) {
+      reader.Fail("expected one value per line, got '" + line + "'");
+    }
+    file->dense.push_back(ParseValue(reader, field, begin[0], end[0]));
+  }
+  if (static_cast<long long>(file->dense.size()) != count) {
+    reader.FailAtEnd("ends after " + std::to_string(file->dense.size()) + " of the " +
+                     std::to_string(count) + " values declared on line " +
+                     std::to_string(file->size_line));
+  }
+}
 
-  // Coordinate entries.
-  const long long declared = sizes[2];
+// Reads the entries of a coordinate file after its size line into file->entries
+// (0-based; symmetric: normalised to the lower triangle). Fails unless there are
+// exactly `declared`, at most what the matrix holds, each with indices in range.
+void ReadCoordinateEntries(LineReader& reader, Field field, long long declared, ParsedFile* file) {
+  std::string line;
+  const char* begin[3] = {};
+  const char* end[3] = {};
+  const long long rows = file->rows, columns = file->columns;
   const long long capacity =
-      file.symmetric ? sizes[0] * (sizes[0] + 1) / 2 : sizes[0] * sizes[1];  // no overflow: < 2^62
+      file->symmetric ? rows * (rows + 1) / 2 : rows * columns;  // no overflow: < 2^62
   if (declared > capacity) {
     reader.Fail("size line declares " + std::to_string(declared) + " entries, more than the " +
-                std::to_string(capacity) + " a " + std::to_string(file.rows) + " x " +
-                std::to_string(file.columns) + (file.symmetric ? " symmetric" : "") +
+                std::to_string(capacity) + " a " + std::to_string(file->rows) + " x " +
+                std::to_string(file->columns) + (file->symmetric ? " symmetric" : "") +
                 " matrix holds");
   }
   // Room for what the size line declares, up to kReserveLimit: beyond, the entries
   // grow with what the file holds, not with what a mistyped size line claims.
-  file.entries.reserve(static_cast<std::size_t>(std::min<long long>(declared, kReserveLimit)));
+  file->entries.reserve(static_cast<std::size_t>(std::min<long long>(declared, kReserveLimit)));
   const int entry_tokens = field == Field::kPattern ? 2 : 3;
   const std::string entry_form = field == Field::kPattern ? "'row column'" : "'row column value'";
   while (reader.NextData(&line)) {
-    if (static_cast<long long>(file.entries.size()) == declared) {
+    if (static_cast<long long>(file->entries.size()) == declared) {
       reader.Fail("entry beyond the " + std::to_string(declared) + " declared on line " +
-                  std::to_string(file.size_line));
+                  std::to_string(file->size_line));
     }
     if (Tokenize(line, entry_tokens, begin, end) != entry_tokens) {
       reader.Fail("expected an entry " + entry_form + ", got '" + line + "'");
     }
     long long index[2] = {0, 0};
-    const long bound[2] = {file.rows, file.columns};
+    const long bound[2] = {file->rows, file->columns};
     const char* what[2] = {"row", "column"};
     for (int i = 0; i < 2; ++i) {
       if (!ParseInteger(begin[i], end[i], &index[i])) {
@@ -285,13 +308,25 @@ ParsedFile ParseFile(std::istream& text, const std::string& name) {
     entry.value = field == Field::kPattern ? 1.0 : ParseValue(reader, field, begin[2], end[2]);
     entry.line = reader.line_number();
     // Symmetric storage: one triangle, normalised to the lower one.
-    if (file.symmetric && entry.row < entry.column) std::swap(entry.row, entry.column);
-    file.entries.push_back(entry);
+    if (file->symmetric && entry.row < entry.column) std::swap(entry.row, entry.column);
+    file->entries.push_back(entry);
   }
-  if (static_cast<long long>(file.entries.size()) != declared) {
-    reader.FailAtEnd("ends after " + std::to_string(file.entries.size()) + " of the " +
+  if (static_cast<long long>(file->entries.size()) != declared) {
+    reader.FailAtEnd("ends after " + std::to_string(file->entries.size()) + " of the " +
                      std::to_string(declared) + " entries declared on line " +
-                     std::to_string(file.size_line));
+                     std::to_string(file->size_line));
+  }
+}
+
+ParsedFile ParseFile(std::istream& text, const std::string& name) {
+  LineReader reader(text, name);
+  ParsedFile file;
+  const Field field = ParseBanner(reader, &file);
+  const long long declared = ParseSizeLine(reader, &file);
+  if (file.format == Format::kArray) {
+    ReadArrayValues(reader, field, &file);
+  } else {
+    ReadCoordinateEntries(reader, field, declared, &file);
   }
   return file;
 }

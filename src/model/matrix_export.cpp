@@ -187,7 +187,11 @@ std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& d
   return path;
 }
 
-MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
+namespace {
+
+// The manifest at manifest_path, checked to be a map of the keys mass,
+// stiffness_length, length, zones, loads and sensors only.
+YAML::Node LoadManifest(const std::string& manifest_path) {
   YAML::Node root;
   try {
     root = YAML::LoadFile(manifest_path);
@@ -205,25 +209,26 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
                        "' (expected mass, stiffness_length, length, zones, loads, sensors)");
     }
   }
-  const std::string folder = Folder(manifest_path);
-  MatrixModelData data;
-  data.stiffness_length = RequiredLength(manifest_path, root, "stiffness_length");
-  data.length = RequiredLength(manifest_path, root, "length");
-  const std::string mass_file = ManifestFile(folder, RequiredString(manifest_path, root, "mass"));
-  data.mass = ReadMatrixMarketMatrix(mass_file);
-  Refuse(CheckSquare(data.mass, mass_file));
-  Refuse(CheckSymmetric(data.mass, mass_file));
-  Refuse(CheckPositiveDefinite(data.mass, mass_file));
-  const int n = data.dofs();
-  auto sequence = [&](const char* key) {
-    const YAML::Node node = root[key];
-    if (!node || !node.IsSequence() || node.size() == 0) {
-      throw InputError(manifest_path + ": expected '" + key + "', a non-empty list");
-    }
-    return node;
-  };
+  return root;
+}
+
+// The value of top-level key `key`: a non-empty list.
+YAML::Node RequiredList(const std::string& manifest_path, const YAML::Node& root, const char* key) {
+  const YAML::Node node = root[key];
+  if (!node || !node.IsSequence() || node.size() == 0) {
+    throw InputError(manifest_path + ": expected '" + key + "', a non-empty list");
+  }
+  return node;
+}
+
+// Appends the manifest's zones to data->zones: each named once, its stiffness
+// file (relative to `folder`) symmetric and of the mass matrix's size (mass_file),
+// its nominal modulus finite and positive.
+void ReadZones(const std::string& manifest_path, const YAML::Node& root, const std::string& folder,
+               const std::string& mass_file, MatrixModelData* data) {
+  const int n = data->dofs();
   std::set<std::string> names;
-  for (const YAML::Node& entry : sequence("zones")) {
+  for (const YAML::Node& entry : RequiredList(manifest_path, root, "zones")) {
     CheckEntryKeys(manifest_path, entry, {"name", "stiffness", "nominal_modulus"},
                    "name, stiffness, nominal_modulus");
     MatrixModelZone zone;
@@ -244,23 +249,41 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
     zone.stiffness = ReadMatrixMarketMatrix(file);
     Refuse(CheckSameSize(zone.stiffness, file, n, mass_file));
     Refuse(CheckSymmetric(zone.stiffness, file));
-    data.zones.push_back(std::move(zone));
+    data->zones.push_back(std::move(zone));
   }
-  std::set<std::string> channels;
-  for (const YAML::Node& entry : sequence("loads")) {
+}
+
+// Appends the manifest's loads to data->loads: each channel not already in
+// *channels (then added), its vector file (relative to `folder`) of the mass
+// matrix's size (mass_file).
+void ReadLoads(const std::string& manifest_path, const YAML::Node& root, const std::string& folder,
+               const std::string& mass_file, std::set<std::string>* channels,
+               MatrixModelData* data) {
+  const int n = data->dofs();
+  for (const YAML::Node& entry : RequiredList(manifest_path, root, "loads")) {
     CheckEntryKeys(manifest_path, entry, {"channel", "vector"}, "channel, vector");
     MatrixModelLoad load;
     load.channel = RequiredString(manifest_path, entry, "channel");
-    if (!channels.insert(load.channel).second) {
+    if (!channels->insert(load.channel).second) {
       throw InputError(Where(manifest_path, entry) + ": channel '" + load.channel +
                        "' given twice");
     }
     const std::string file = ManifestFile(folder, RequiredString(manifest_path, entry, "vector"));
     load.vector = ReadMatrixMarketVector(file);
     Refuse(CheckVectorSize(load.vector, file, n, mass_file));
-    data.loads.push_back(std::move(load));
+    data->loads.push_back(std::move(load));
   }
-  for (const YAML::Node& entry : sequence("sensors")) {
+}
+
+// Appends the manifest's sensors to data->sensors: each of kind displacement
+// (the default) or strain, its channel not already in *channels (then added),
+// its observation row file (relative to `folder`) checked against the mass
+// matrix (mass_file) and stored as a row.
+void ReadSensors(const std::string& manifest_path, const YAML::Node& root,
+                 const std::string& folder, const std::string& mass_file,
+                 std::set<std::string>* channels, MatrixModelData* data) {
+  const int n = data->dofs();
+  for (const YAML::Node& entry : RequiredList(manifest_path, root, "sensors")) {
     CheckEntryKeys(manifest_path, entry, {"channel", "row", "kind"}, "channel, row, kind");
     MatrixModelSensor sensor;
     sensor.channel = RequiredString(manifest_path, entry, "channel");
@@ -275,7 +298,7 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
                          kind + "'");
       }
     }
-    if (!channels.insert(sensor.channel).second) {
+    if (!channels->insert(sensor.channel).second) {
       throw InputError(Where(manifest_path, entry) + ": channel '" + sensor.channel +
                        "' given twice");
     }
@@ -284,8 +307,28 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
     Refuse(CheckSensorRow(row, sensor.channel, file, n, mass_file));
     if (row.rows() != 1) row = SparseMatrix(row.transpose());
     sensor.row = std::move(row);
-    data.sensors.push_back(std::move(sensor));
+    data->sensors.push_back(std::move(sensor));
   }
+}
+
+}  // namespace
+
+MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
+  const YAML::Node root = LoadManifest(manifest_path);
+  const std::string folder = Folder(manifest_path);
+  MatrixModelData data;
+  data.stiffness_length = RequiredLength(manifest_path, root, "stiffness_length");
+  data.length = RequiredLength(manifest_path, root, "length");
+  const std::string mass_file = ManifestFile(folder, RequiredString(manifest_path, root, "mass"));
+  data.mass = ReadMatrixMarketMatrix(mass_file);
+  Refuse(CheckSquare(data.mass, mass_file));
+  Refuse(CheckSymmetric(data.mass, mass_file));
+  Refuse(CheckPositiveDefinite(data.mass, mass_file));
+  ReadZones(manifest_path, root, folder, mass_file, &data);
+  // Load and sensor channels share one namespace.
+  std::set<std::string> channels;
+  ReadLoads(manifest_path, root, folder, mass_file, &channels, &data);
+  ReadSensors(manifest_path, root, folder, mass_file, &channels, &data);
   return data;
 }
 

@@ -516,6 +516,247 @@ std::vector<double> ScanGrid(const IdentificationOptions& options, double x_lowe
   return xs;
 }
 
+// The scan of the bounds [options.lower_bound, options.upper_bound]: its samples,
+// the valleys between them and what failed.
+struct BoundsScan {
+  std::vector<double> xs;                // scaled moduli, ascending
+  std::vector<double> costs, gradients;  // scaled, NaN where failed
+  std::vector<ValleyEstimate> valleys;   // lowest estimated cost first
+  double valley_spacing = 0.0;           // predicted, in ln E (0: none)
+  bool limited = false;                  // capped at outer.scan_max_points
+  std::string scan_failure;              // why the lowest failed sample failed
+  long scan_sweeps = 0;                  // inner sweeps the scan ran
+  int scan_failures = 0;                 // samples without a usable cost
+  double scan_wall_time_s = 0.0;         // from `start` to the valleys found
+};
+
+// Samples the bounds on ScanGrid's grid (ScanSamples) and finds their valleys
+// (FindValleys), warning about a grid capped at scan_max_points, a scan that
+// leaves fewer than 2 evaluations and failed samples.
+BoundsScan ScanBounds(const IdentificationOptions& options, ModulusObjective* objective,
+                      double scale, Clock::time_point start) {
+  BoundsScan scan;
+  const double x_lower = options.lower_bound / scale;
+  const double x_upper = options.upper_bound / scale;
+  if (options.scan_samples_per_valley > 0.0) {
+    try {
+      scan.valley_spacing = objective->ValleySpacing();
+    } catch (const std::exception& error) {
+      spdlog::warn("scan: no predicted valley spacing ({}): scan_points alone", error.what());
+    }
+  }
+  scan.xs = ScanGrid(options, x_lower, x_upper, scan.valley_spacing, &scan.limited);
+  const int points = static_cast<int>(scan.xs.size());
+  if (scan.limited) {
+    spdlog::warn(
+        "scan: the predicted valley spacing {:.3g} in ln E asks for more than "
+        "outer.scan_max_points ({}) samples: valleys narrower than the scan's step may be "
+        "missed",
+        scan.valley_spacing, options.scan_max_points);
+  }
+  if (points + 2 > options.max_evaluations) {
+    spdlog::warn(
+        "scan: {} samples leave fewer than 2 of outer.max_evaluations ({}) to the refinements: "
+        "raise outer.max_evaluations",
+        points, options.max_evaluations);
+  }
+  ScanSamples(options, objective, scan.xs, start, &scan.costs, &scan.gradients, &scan.scan_failure,
+              &scan.scan_sweeps);
+  scan.valleys = FindValleys(scan.xs, scan.costs, scan.gradients);
+  scan.scan_wall_time_s = SecondsSince(start);
+  scan.scan_failures = static_cast<int>(std::count_if(
+      scan.costs.begin(), scan.costs.end(), [](double cost) { return !std::isfinite(cost); }));
+  if (scan.scan_failures > 0) {
+    spdlog::warn("scan: {} of {} samples have no usable cost (first: {})", scan.scan_failures,
+                 points, scan.scan_failure);
+  }
+  spdlog::info(
+      "scan of {} moduli over [{:.6g}, {:.6g}] Pa (predicted valley spacing {:.3g} in ln E): {} "
+      "valleys, {:.3g} s",
+      points, options.lower_bound, options.upper_bound, scan.valley_spacing, scan.valleys.size(),
+      scan.scan_wall_time_s);
+  return scan;
+}
+
+// The refinements of the scan's valleys and what stopped them.
+struct ValleyRefinements {
+  std::vector<IdentificationSummary> refined;  // in the order the valleys were refined
+  std::vector<ScanValley> reported;            // one per valley of the scan
+  std::string limit_message;  // which limit stopped the search, in the user's terms
+  // A refinement that failed leaves its valley unknown: no result is reported
+  // over it, whatever the other refinements found.
+  std::string refinement_failure;
+};
+
+// Which limit stopped the search `when`, in the user's terms: max_evaluations if
+// fewer than 2 of them are left after evaluations_used (the scan's `points`
+// included), else max_time.
+std::string LimitReached(const IdentificationOptions& options, int evaluations_used, int points,
+                         const std::string& when) {
+  std::ostringstream why;
+  if (evaluations_used + 2 > options.max_evaluations) {
+    why << "outer.max_evaluations (" << options.max_evaluations << ", the scan's " << points
+        << " included) reached " << when;
+  } else {
+    why << "outer.max_time (" << options.max_time << " s) reached " << when;
+  }
+  return why.str();
+}
+
+// A refinement (MinimizeLocally) of valley k of the scan within the samples
+// [first, last], started at its estimate moved strictly inside, with what
+// *evaluations_used and `start` left of max_evaluations and max_time; adds its
+// evaluations to *evaluations_used.
+IdentificationSummary RefineValley(const IdentificationOptions& options,
+                                   ModulusObjective* objective, const BoundsScan& scan,
+                                   double scale, int k, int first, int last,
+                                   Clock::time_point start, int* evaluations_used) {
+  const ValleyEstimate& valley = scan.valleys[k];
+  IdentificationOptions local = options;
+  local.max_evaluations = options.max_evaluations - *evaluations_used;
+  local.max_time = options.max_time - SecondsSince(start);
+  local.lower_bound = scan.xs[first] * scale;
+  local.upper_bound = scan.xs[last] * scale;
+  // Start at the estimate, moved strictly inside the bracket.
+  const double width = local.upper_bound - local.lower_bound;
+  local.initial = std::clamp(valley.x * scale, local.lower_bound + 1e-3 * width,
+                             local.upper_bound - 1e-3 * width);
+  spdlog::info("refining valley {} (estimate E = {:.9g} Pa) within [{:.6g}, {:.6g}] Pa", k + 1,
+               valley.x * scale, local.lower_bound, local.upper_bound);
+  IdentificationSummary result = MinimizeLocally(local, objective, valley.curvature);
+  *evaluations_used += result.evaluations;
+  return result;
+}
+
+// Local refinements of the valleys within refine_margin of the lowest estimate
+// (at most refine_candidates, the lowest always), each within its bracket and
+// with what the scan and the earlier refinements left of max_evaluations and
+// max_time, none once a limit is reached; a refinement ending on an inner edge of
+// its bracket is redone once over the neighbouring intervals. Every valley is
+// reported, refined or not.
+ValleyRefinements RefineValleys(const IdentificationOptions& options, ModulusObjective* objective,
+                                const BoundsScan& scan, double scale, Clock::time_point start) {
+  const std::vector<ValleyEstimate>& valleys = scan.valleys;
+  const int points = static_cast<int>(scan.xs.size());
+  ValleyRefinements out;
+  out.reported.resize(valleys.size());
+  int evaluations_used = points;
+  const double lowest = valleys.empty() ? 0.0 : valleys.front().cost;
+  const double threshold = lowest + options.refine_margin * std::abs(lowest);
+  for (int k = 0; k < static_cast<int>(valleys.size()); ++k) {
+    const ValleyEstimate& valley = valleys[k];
+    ScanValley& report = out.reported[k];
+    report.lower_modulus = scan.xs[valley.left] * scale;
+    report.upper_modulus = scan.xs[valley.left + 1] * scale;
+    report.estimated_modulus = valley.x * scale;
+    report.estimated_cost = valley.cost;
+    const bool wanted = k == 0 || (valley.cost <= threshold && k < options.refine_candidates);
+    if (!wanted || !out.limit_message.empty()) continue;
+    if (options.max_evaluations - evaluations_used < 2 || SecondsSince(start) >= options.max_time) {
+      out.limit_message = LimitReached(options, evaluations_used, points,
+                                       "before valley " + std::to_string(k + 1) + " was refined");
+      continue;
+    }
+    IdentificationSummary result = RefineValley(options, objective, scan, scale, k, valley.left,
+                                                valley.left + 1, start, &evaluations_used);
+    // Ended on an inner edge of its bracket (the scan's gradient, at its loose
+    // tolerance, misplaced the sign change): once more over the neighbouring intervals.
+    const double tolerance = 4.0 * options.relative_tolerance * result.modulus;
+    const bool on_left = valley.left > 0 && result.modulus - report.lower_modulus <= tolerance;
+    const bool on_right =
+        valley.left + 2 < points && report.upper_modulus - result.modulus <= tolerance;
+    if (result.IsSolutionUsable() && (on_left || on_right) &&
+        options.max_evaluations - evaluations_used >= 2) {
+      const int evaluations_before = result.evaluations;
+      result = RefineValley(options, objective, scan, scale, k, std::max(valley.left - 1, 0),
+                            std::min(valley.left + 2, points - 1), start, &evaluations_used);
+      result.evaluations += evaluations_before;
+    }
+    report.refined = true;
+    report.termination = result.termination;
+    report.modulus = result.modulus;
+    report.cost = result.cost;
+    report.evaluations = result.evaluations;
+    if (result.termination == TerminationType::kNoConvergence) {
+      out.limit_message = LimitReached(options, evaluations_used, points, "before convergence");
+    }
+    if (result.termination == TerminationType::kFailure && out.refinement_failure.empty()) {
+      std::ostringstream why;
+      why << "the refinement of valley " << k + 1 << " (E = " << report.estimated_modulus
+          << " Pa) failed: " << result.message;
+      out.refinement_failure = why.str();
+    }
+    out.refined.push_back(std::move(result));
+  }
+  return out;
+}
+
+// The index of the usable refinement of least cost (the first of equal costs),
+// -1 if none is usable.
+int BestRefinement(const std::vector<IdentificationSummary>& refined) {
+  int best = -1;
+  for (int k = 0; k < static_cast<int>(refined.size()); ++k) {
+    if (refined[k].IsSolutionUsable() && (best < 0 || refined[k].cost < refined[best].cost)) {
+      best = k;
+    }
+  }
+  return best;
+}
+
+// Sets *summary to the outcome of the scan and its refinements: refinement `best`,
+// else the first refinement's, else the scan's failure; then a failed
+// refinement's failure, and a limit reached (the scan's max_time included) as no
+// convergence, whatever an earlier refinement found.
+void SetOutcome(const IdentificationOptions& options, const BoundsScan& scan,
+                const ValleyRefinements& refinements, int best, Clock::time_point start,
+                IdentificationSummary* summary) {
+  const std::vector<IdentificationSummary>& refined = refinements.refined;
+  const int points = static_cast<int>(scan.xs.size());
+  std::string limit_message = refinements.limit_message;
+  if (best >= 0) {
+    *summary = refined[best];
+  } else if (!refined.empty()) {
+    *summary = refined.front();
+  } else if (scan.scan_failures == points) {
+    summary->termination = TerminationType::kFailure;
+    summary->message = "no usable evaluation in the scan of the bounds: " + scan.scan_failure;
+  } else if (limit_message.empty()) {
+    summary->termination = TerminationType::kFailure;
+    summary->message = "the scan saw no minimum between usable samples (" +
+                       std::to_string(scan.scan_failures) + " of " + std::to_string(points) +
+                       " samples failed; first: " + scan.scan_failure + ")";
+  }
+  if (!refinements.refinement_failure.empty()) {
+    summary->termination = TerminationType::kFailure;
+    summary->message = refinements.refinement_failure;
+  }
+  if (SecondsSince(start) >= options.max_time && limit_message.empty() && refined.empty()) {
+    limit_message = "outer.max_time reached during the scan of the bounds";
+  }
+  if (!limit_message.empty()) {
+    // A limit reached is not convergence, whatever an earlier refinement found.
+    summary->termination = TerminationType::kNoConvergence;
+    summary->message = limit_message;
+  }
+}
+
+// Sets summary->second_modulus and cost_gap from the valleys other than the
+// result's: the lowest refined cost of a converged refinement, or the
+// estimated cost of a valley not refined. Unchanged if there is none.
+void SetSecondValley(const std::vector<ScanValley>& reported, IdentificationSummary* summary) {
+  double second_cost = std::numeric_limits<double>::infinity();
+  for (const ScanValley& valley : reported) {
+    if (valley.refined && valley.modulus == summary->modulus) continue;
+    if (valley.refined && valley.termination != TerminationType::kConvergence) continue;
+    const double cost = valley.refined ? valley.cost : valley.estimated_cost;
+    if (cost < second_cost) {
+      second_cost = cost;
+      summary->second_modulus = valley.refined ? valley.modulus : valley.estimated_modulus;
+    }
+  }
+  if (std::isfinite(second_cost)) summary->cost_gap = second_cost - summary->cost;
+}
+
 }  // namespace
 
 IdentificationSummary Identify(const IdentificationOptions& options, ModulusObjective* objective) {
@@ -532,166 +773,11 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
 
   const Clock::time_point start = Clock::now();
   const double scale = objective->modulus_scale();
-  const double x_lower = options.lower_bound / scale;
-  const double x_upper = options.upper_bound / scale;
-  double valley_spacing = 0.0;
-  if (options.scan_samples_per_valley > 0.0) {
-    try {
-      valley_spacing = objective->ValleySpacing();
-    } catch (const std::exception& error) {
-      spdlog::warn("scan: no predicted valley spacing ({}): scan_points alone", error.what());
-    }
-  }
-  bool limited = false;
-  const std::vector<double> xs = ScanGrid(options, x_lower, x_upper, valley_spacing, &limited);
-  const int points = static_cast<int>(xs.size());
-  if (limited) {
-    spdlog::warn(
-        "scan: the predicted valley spacing {:.3g} in ln E asks for more than "
-        "outer.scan_max_points ({}) samples: valleys narrower than the scan's step may be "
-        "missed",
-        valley_spacing, options.scan_max_points);
-  }
-  if (points + 2 > options.max_evaluations) {
-    spdlog::warn(
-        "scan: {} samples leave fewer than 2 of outer.max_evaluations ({}) to the refinements: "
-        "raise outer.max_evaluations",
-        points, options.max_evaluations);
-  }
-  std::string scan_failure;
-  long scan_sweeps = 0;
-  std::vector<double> costs, gradients;
-  ScanSamples(options, objective, xs, start, &costs, &gradients, &scan_failure, &scan_sweeps);
-  const std::vector<ValleyEstimate> valleys = FindValleys(xs, costs, gradients);
-  const double scan_wall_time_s = SecondsSince(start);
-  const int scan_failures = static_cast<int>(
-      std::count_if(costs.begin(), costs.end(), [](double cost) { return !std::isfinite(cost); }));
-  if (scan_failures > 0) {
-    spdlog::warn("scan: {} of {} samples have no usable cost (first: {})", scan_failures, points,
-                 scan_failure);
-  }
-  spdlog::info(
-      "scan of {} moduli over [{:.6g}, {:.6g}] Pa (predicted valley spacing {:.3g} in ln E): {} "
-      "valleys, {:.3g} s",
-      points, options.lower_bound, options.upper_bound, valley_spacing, valleys.size(),
-      scan_wall_time_s);
-
-  // Local refinements of the valleys within refine_margin of the lowest estimate,
-  // each within its bracket and with what the scan and the earlier refinements
-  // left of max_evaluations and max_time.
-  std::vector<IdentificationSummary> refined;
-  std::vector<ScanValley> reported(valleys.size());
-  std::string limit_message;
-  // A refinement that failed leaves its valley unknown: no result is reported
-  // over it, whatever the other refinements found.
-  std::string refinement_failure;
-  int evaluations_used = points;
-  // Which limit stopped the search, in the user's terms.
-  auto limit_reached = [&](const std::string& when) {
-    std::ostringstream why;
-    if (evaluations_used + 2 > options.max_evaluations) {
-      why << "outer.max_evaluations (" << options.max_evaluations << ", the scan's " << points
-          << " included) reached " << when;
-    } else {
-      why << "outer.max_time (" << options.max_time << " s) reached " << when;
-    }
-    return why.str();
-  };
-  // A refinement of valley k within the samples [first, last].
-  auto refine = [&](int k, int first, int last) {
-    const ValleyEstimate& valley = valleys[k];
-    IdentificationOptions local = options;
-    local.max_evaluations = options.max_evaluations - evaluations_used;
-    local.max_time = options.max_time - SecondsSince(start);
-    local.lower_bound = xs[first] * scale;
-    local.upper_bound = xs[last] * scale;
-    // Start at the estimate, moved strictly inside the bracket.
-    const double width = local.upper_bound - local.lower_bound;
-    local.initial = std::clamp(valley.x * scale, local.lower_bound + 1e-3 * width,
-                               local.upper_bound - 1e-3 * width);
-    spdlog::info("refining valley {} (estimate E = {:.9g} Pa) within [{:.6g}, {:.6g}] Pa", k + 1,
-                 valley.x * scale, local.lower_bound, local.upper_bound);
-    IdentificationSummary result = MinimizeLocally(local, objective, valley.curvature);
-    evaluations_used += result.evaluations;
-    return result;
-  };
-  const double lowest = valleys.empty() ? 0.0 : valleys.front().cost;
-  const double threshold = lowest + options.refine_margin * std::abs(lowest);
-  for (int k = 0; k < static_cast<int>(valleys.size()); ++k) {
-    const ValleyEstimate& valley = valleys[k];
-    ScanValley& report = reported[k];
-    report.lower_modulus = xs[valley.left] * scale;
-    report.upper_modulus = xs[valley.left + 1] * scale;
-    report.estimated_modulus = valley.x * scale;
-    report.estimated_cost = valley.cost;
-    const bool wanted = k == 0 || (valley.cost <= threshold && k < options.refine_candidates);
-    if (!wanted || !limit_message.empty()) continue;
-    if (options.max_evaluations - evaluations_used < 2 || SecondsSince(start) >= options.max_time) {
-      limit_message = limit_reached("before valley " + std::to_string(k + 1) + " was refined");
-      continue;
-    }
-    IdentificationSummary result = refine(k, valley.left, valley.left + 1);
-    // Ended on an inner edge of its bracket (the scan's gradient, at its loose
-    // tolerance, misplaced the sign change): once more over the neighbouring intervals.
-    const double tolerance = 4.0 * options.relative_tolerance * result.modulus;
-    const bool on_left = valley.left > 0 && result.modulus - report.lower_modulus <= tolerance;
-    const bool on_right =
-        valley.left + 2 < points && report.upper_modulus - result.modulus <= tolerance;
-    if (result.IsSolutionUsable() && (on_left || on_right) &&
-        options.max_evaluations - evaluations_used >= 2) {
-      const int evaluations_before = result.evaluations;
-      result = refine(k, std::max(valley.left - 1, 0), std::min(valley.left + 2, points - 1));
-      result.evaluations += evaluations_before;
-    }
-    report.refined = true;
-    report.termination = result.termination;
-    report.modulus = result.modulus;
-    report.cost = result.cost;
-    report.evaluations = result.evaluations;
-    if (result.termination == TerminationType::kNoConvergence) {
-      limit_message = limit_reached("before convergence");
-    }
-    if (result.termination == TerminationType::kFailure && refinement_failure.empty()) {
-      std::ostringstream why;
-      why << "the refinement of valley " << k + 1 << " (E = " << report.estimated_modulus
-          << " Pa) failed: " << result.message;
-      refinement_failure = why.str();
-    }
-    refined.push_back(std::move(result));
-  }
-
-  // The usable refinement of least cost; the first refinement's failure if none is.
-  int best = -1;
-  for (int k = 0; k < static_cast<int>(refined.size()); ++k) {
-    if (refined[k].IsSolutionUsable() && (best < 0 || refined[k].cost < refined[best].cost)) {
-      best = k;
-    }
-  }
-  if (best >= 0) {
-    summary = refined[best];
-  } else if (!refined.empty()) {
-    summary = refined.front();
-  } else if (scan_failures == points) {
-    summary.termination = TerminationType::kFailure;
-    summary.message = "no usable evaluation in the scan of the bounds: " + scan_failure;
-  } else if (limit_message.empty()) {
-    summary.termination = TerminationType::kFailure;
-    summary.message = "the scan saw no minimum between usable samples (" +
-                      std::to_string(scan_failures) + " of " + std::to_string(points) +
-                      " samples failed; first: " + scan_failure + ")";
-  }
-  if (!refinement_failure.empty()) {
-    summary.termination = TerminationType::kFailure;
-    summary.message = refinement_failure;
-  }
-  if (SecondsSince(start) >= options.max_time && limit_message.empty() && refined.empty()) {
-    limit_message = "outer.max_time reached during the scan of the bounds";
-  }
-  if (!limit_message.empty()) {
-    // A limit reached is not convergence, whatever an earlier refinement found.
-    summary.termination = TerminationType::kNoConvergence;
-    summary.message = limit_message;
-  }
+  const BoundsScan scan = ScanBounds(options, objective, scale, start);
+  ValleyRefinements refinements = RefineValleys(options, objective, scan, scale, start);
+  const std::vector<IdentificationSummary>& refined = refinements.refined;
+  const int best = BestRefinement(refined);
+  SetOutcome(options, scan, refinements, best, start, &summary);
   summary.initial_modulus = options.initial;
   summary.evaluations = 0;
   summary.gradient_evaluations = 0;
@@ -700,31 +786,19 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
     summary.gradient_evaluations += local.gradient_evaluations;
   }
   summary.refinements = static_cast<int>(refined.size());
-  for (const double x : xs) summary.scan_moduli.push_back(x * scale);
-  summary.scan_costs = costs;
-  summary.scan_gradients = gradients;
-  summary.scan_evaluations = points;
-  summary.scan_sweeps = scan_sweeps;
-  summary.scan_failures = scan_failures;
-  summary.predicted_valley_spacing = valley_spacing;
-  summary.scan_resolution_limited = limited;
-  summary.local_minima = static_cast<int>(valleys.size());
+  for (const double x : scan.xs) summary.scan_moduli.push_back(x * scale);
+  summary.scan_costs = scan.costs;
+  summary.scan_gradients = scan.gradients;
+  summary.scan_evaluations = static_cast<int>(scan.xs.size());
+  summary.scan_sweeps = scan.scan_sweeps;
+  summary.scan_failures = scan.scan_failures;
+  summary.predicted_valley_spacing = scan.valley_spacing;
+  summary.scan_resolution_limited = scan.limited;
+  summary.local_minima = static_cast<int>(scan.valleys.size());
   // The second valley: its refined cost when refined, else its estimated cost.
-  if (best >= 0) {
-    double second_cost = std::numeric_limits<double>::infinity();
-    for (const ScanValley& valley : reported) {
-      if (valley.refined && valley.modulus == summary.modulus) continue;
-      if (valley.refined && valley.termination != TerminationType::kConvergence) continue;
-      const double cost = valley.refined ? valley.cost : valley.estimated_cost;
-      if (cost < second_cost) {
-        second_cost = cost;
-        summary.second_modulus = valley.refined ? valley.modulus : valley.estimated_modulus;
-      }
-    }
-    if (std::isfinite(second_cost)) summary.cost_gap = second_cost - summary.cost;
-  }
-  summary.valleys = std::move(reported);
-  summary.scan_wall_time_s = scan_wall_time_s;
+  if (best >= 0) SetSecondValley(refinements.reported, &summary);
+  summary.valleys = std::move(refinements.reported);
+  summary.scan_wall_time_s = scan.scan_wall_time_s;
   summary.wall_time_s = SecondsSince(start);
   return summary;
 }
