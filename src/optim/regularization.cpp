@@ -168,15 +168,243 @@ int LCurveCorner(const std::vector<double>& misfits, const std::vector<double>& 
   return corner;
 }
 
+namespace {
+
+// The automatic weight of MinimizeRegularized, one member per stage: the descent of
+// the weight grid (Descend), the choice when no weight of the grid met the target
+// (ChooseWithoutHit), and the regula falsi between the last miss and the hit
+// (Refine). The members share the grid and the current hit and miss.
+class WeightSearch {
+ public:
+  WeightSearch(const BoundedMinimizerOptions& options, const RegularizationOptions& regularization,
+               MultiParameterObjective* data, const std::vector<double>& lower,
+               const std::vector<double>& upper, double target_misfit,
+               RegularizedMinimization* result)
+      : options_(options),
+        regularization_(regularization),
+        data_(data),
+        lower_(lower),
+        upper_(upper),
+        target_misfit_(target_misfit),
+        target_(target_misfit),
+        l_curve_(regularization.weight_rule == WeightRule::kLCurve),
+        result_(*result) {}
+
+  // The search from `initial`; fills *result.
+  void Run(const std::vector<double>& initial) {
+    result_.target_misfit = target_misfit_;
+    if (!Descend(initial)) return;
+    result_.weight_choice = choice_;
+    if (hit_weight_ < 0.0) ChooseWithoutHit();
+    if (missed_ > 0.0) Refine();
+    result_.minimizer = std::move(hit_);
+    result_.weight = hit_weight_;
+    result_.x = result_.minimizer.x;
+    result_.misfit = hit_misfit_;
+  }
+
+ private:
+  // The grid's k-th minimisation becomes the one kept.
+  void Keep(std::size_t k) {
+    hit_ = grid_[k];
+    hit_weight_ = grid_weights_[k];
+    hit_misfit_ = grid_misfits_[k];
+  }
+
+  // Descends the grid, warm-started, to the first weight that meets the target. The
+  // discrepancy principle keeps it (and refines it below). The L-curve keeps the
+  // largest weight only when its misfit is within kLCurveTopShare of the target (data
+  // that the nearly homogeneous profile explains better than the noise would ask for
+  // no contrast, where the corner would still lie at a lighter weight); below it, the
+  // corner of the points down to the first weight that meets the target (lighter ones
+  // only fit the noise), or that weight; the corner of the whole grid when none does.
+  // False when the first minimisation failed: *result is then final.
+  bool Descend(const std::vector<double>& initial) {
+    std::vector<double> start = initial;
+    // c0, the data cost at the start: the grid's unit.
+    double start_cost = 0.0;
+    if (!data_->Evaluate(initial.data(), &start_cost, nullptr) || !(start_cost > 0.0)) {
+      start_cost = 1.0;  // a failure shows in the first minimisation
+    }
+    ++result_.evaluations;
+    for (double weight = regularization_.max_weight * start_cost;
+         weight >= regularization_.min_weight * start_cost * (1.0 - 1e-12);
+         weight /= regularization_.grid_factor) {
+      BoundedMinimizerSummary summary =
+          MinimizeAt(options_, regularization_, data_, lower_, upper_, start, weight,
+                     target_misfit_, &result_, &point_);
+      if (!summary.IsSolutionUsable() && !grid_.empty()) {
+        // Below a weight that converged, a minimisation that did not (out of
+        // evaluations among zones that drift to their bounds: the noise fitted) ends the
+        // descent; the weight is chosen among the converged ones, as when the target is
+        // missed.
+        spdlog::warn(
+            "the minimisation at the regularisation weight {:.3g} failed ({}): the descent "
+            "stops at {:.3g}",
+            weight, summary.message, grid_weights_.back());
+        break;
+      }
+      if (!summary.IsSolutionUsable()) {
+        result_.minimizer = std::move(summary);
+        result_.weight = weight;
+        result_.weight_choice = WeightRuleToString(regularization_.weight_rule);
+        result_.x = result_.minimizer.x;
+        result_.misfit = point_.misfit;
+        return false;  // a failed minimisation ends the search: its message says why
+      }
+      start = summary.x;
+      grid_.push_back(std::move(summary));
+      grid_weights_.push_back(weight);
+      grid_misfits_.push_back(point_.misfit);
+      grid_roughness_.push_back(point_.roughness);
+      if (point_.meets_target &&
+          (!l_curve_ || (grid_.size() == 1 && point_.misfit <= kLCurveTopShare * target_misfit_))) {
+        Keep(grid_.size() - 1);
+        break;
+      }
+      if (l_curve_ && point_.meets_target && grid_.size() > 1) {
+        // The L-curve below the largest weight: lighter weights than this one only fit
+        // the noise (its flat arm); the corner of the points so far, or this weight.
+        const int corner = LCurveCorner(grid_misfits_, grid_roughness_);
+        Keep(corner >= 0 ? static_cast<std::size_t>(corner) : grid_.size() - 1);
+        missed_ = -1.0;  // no refinement
+        spdlog::info("the weight {:.3g} meets the noise's level {:.6g}: the weight is {} {:.3g}",
+                     weight, target_misfit_, corner >= 0 ? "the L-curve's corner above it," : "it,",
+                     hit_weight_);
+        choice_ = corner >= 0 ? "l_curve" : "discrepancy";
+        break;
+      }
+      missed_ = weight;
+      missed_misfit_ = point_.misfit;
+    }
+    return true;
+  }
+
+  // No weight of the grid met the target: the grid's last, lightest weight gives the
+  // misfit floor (the first minimisation returned if it failed, and the loop runs at
+  // least once for options that are valid, max > min weight).
+  void ChooseWithoutHit() {
+    assert(!grid_.empty());
+    const double last_weight = grid_weights_.back();
+    const double last_misfit = grid_misfits_.back();
+    result_.misfit_floor = last_misfit;
+    // No weight reaches the noise's level (model error, or the noise underestimated):
+    // the noise level is not to be trusted, and the L-curve needs none (the L-curve
+    // rule's own choice then, the discrepancy principle's fallback, with a warning).
+    const int corner = LCurveCorner(grid_misfits_, grid_roughness_);
+    if (corner >= 0) {
+      if (l_curve_ || target_misfit_ < 0.0) {
+        spdlog::info("the weight is the L-curve's corner, {:.3g} (misfit {:.6g})",
+                     grid_weights_[corner], grid_misfits_[corner]);
+      } else {
+        spdlog::warn(
+            "no regularisation weight down to {:.3g} brings the misfit {:.6g} to the noise's "
+            "level {:.6g}: the weight is the L-curve's corner, {:.3g} (misfit {:.6g})",
+            last_weight, last_misfit, target_misfit_, grid_weights_[corner], grid_misfits_[corner]);
+      }
+      result_.weight_choice = "l_curve";
+      Keep(static_cast<std::size_t>(corner));
+      missed_ = -1.0;  // no target to refine against
+      return;
+    }
+    // Without a corner (fewer than 3 weights, or a straight curve) the principle is
+    // applied to the floor itself, raised by kMisfitFloorMargin.
+    target_ = result_.AttainableTarget();
+    spdlog::warn(
+        "{} down to {:.3g}: the target becomes the misfit floor {:.6g} + {:.0f} %, {:.6g}",
+        l_curve_ || target_misfit_ < 0.0
+            ? std::string("the L-curve has no corner")
+            : fmt::format("no regularisation weight brings the misfit to the noise's level {:.6g}",
+                          target_misfit_),
+        last_weight, last_misfit, 100.0 * kMisfitFloorMargin, target_);
+    result_.weight_choice = "misfit_floor";
+    for (std::size_t k = 0; k < grid_.size(); ++k) {
+      if (grid_misfits_[k] <= target_) {
+        Keep(k);
+        missed_ = k > 0 ? grid_weights_[k - 1] : -1.0;
+        missed_misfit_ = k > 0 ? grid_misfits_[k - 1] : -1.0;
+        break;
+      }
+    }
+  }
+
+  // Regula falsi (Illinois) between the weight that missed (larger) and the hit on
+  // f(s) = ln(misfit / target), s = ln lambda, nearly linear where the misfit follows
+  // a power of lambda: stops once the chord's root lies within a factor
+  // 1 + weight_tolerance of the hit (the weight, not the misfit: near the noise's level
+  // the misfit can vary by 10 % over 4 decades of lambda, where the zones change the
+  // most), or after refinement_steps.
+  void Refine() {
+    const auto log_ratio = [&](double misfit) { return std::log(misfit / target_); };
+    double hit_log = std::log(hit_weight_), missed_log = std::log(missed_);
+    double hit_f = target_ > 0.0 && hit_misfit_ > 0.0 ? log_ratio(hit_misfit_) : 0.0;
+    double missed_f = target_ > 0.0 ? log_ratio(missed_misfit_) : 0.0;
+    int last_side = 0;  // +1: the last step replaced the missed end, -1: the hit
+    for (int step = 0; step < regularization_.refinement_steps; ++step) {
+      // The root of the chord; the midpoint when the chord is not usable (a zero
+      // misfit at the hit, or a misfit that did not grow with lambda).
+      double s = 0.5 * (hit_log + missed_log);
+      if (target_ > 0.0 && hit_misfit_ > 0.0 && missed_f > hit_f) {
+        s = hit_log - hit_f * (missed_log - hit_log) / (missed_f - hit_f);
+      }
+      if (s - hit_log <= std::log1p(regularization_.weight_tolerance)) break;
+      const double weight = std::exp(s);
+      if (!(weight < missed_)) break;
+      BoundedMinimizerSummary summary = MinimizeAt(options_, regularization_, data_, lower_, upper_,
+                                                   hit_.x, weight, target_, &result_, &point_);
+      if (!summary.IsSolutionUsable() || !(point_.misfit > 0.0)) break;  // keep the hit
+      const double f = log_ratio(point_.misfit);
+      if (point_.meets_target) {
+        hit_ = std::move(summary);
+        hit_weight_ = weight;
+        hit_misfit_ = point_.misfit;
+        hit_log = s;
+        hit_f = f;
+        // Illinois: an end kept twice has its value halved, so that the chord moves it.
+        if (last_side == -1) missed_f *= 0.5;
+        last_side = -1;
+      } else {
+        missed_ = weight;
+        missed_log = s;
+        missed_f = f;
+        if (last_side == +1) hit_f *= 0.5;
+        last_side = +1;
+      }
+    }
+  }
+
+  const BoundedMinimizerOptions& options_;
+  const RegularizationOptions& regularization_;
+  MultiParameterObjective* data_;
+  const std::vector<double>& lower_;
+  const std::vector<double>& upper_;
+  const double target_misfit_;  // the caller's target
+  double target_;               // the refinement's: the caller's, or the misfit floor's
+  const bool l_curve_;
+  RegularizedMinimization& result_;
+  RegularizedPoint point_;
+  double missed_ = -1.0;  // the last weight that missed the target
+  double missed_misfit_ = -1.0;
+  BoundedMinimizerSummary hit_;
+  double hit_weight_ = -1.0;
+  double hit_misfit_ = -1.0;
+  std::string choice_ = "discrepancy";  // of a weight kept in the descent
+  // The grid's minimisations, for the L-curve and the misfit-floor rule.
+  std::vector<BoundedMinimizerSummary> grid_;
+  std::vector<double> grid_weights_, grid_misfits_, grid_roughness_;
+};
+
+}  // namespace
+
 RegularizedMinimization MinimizeRegularized(
     const BoundedMinimizerOptions& options, const RegularizationOptions& regularization,
     MultiParameterObjective* data, const std::vector<double>& lower,
     const std::vector<double>& upper, const std::vector<double>& initial, double target_misfit) {
   RegularizedMinimization result;
-  RegularizedPoint point;
   const bool automatic =
       regularization.kind != RegularizationKind::kNone && regularization.weight < 0.0;
   if (!automatic) {
+    RegularizedPoint point;
     const double weight =
         regularization.kind == RegularizationKind::kNone ? 0.0 : regularization.weight;
     result.weight_choice = regularization.kind == RegularizationKind::kNone ? "none" : "fixed";
@@ -188,183 +416,8 @@ RegularizedMinimization MinimizeRegularized(
     result.misfit = point.misfit;
     return result;
   }
-
-  // Descend the grid, warm-started, to the first weight that meets the target. The
-  // discrepancy principle keeps it (and refines it below). The L-curve keeps the
-  // largest weight only when its misfit is within kLCurveTopShare of the target (data
-  // that the nearly homogeneous profile explains better than the noise would ask for
-  // no contrast, where the corner would still lie at a lighter weight); below it, the
-  // corner of the points down to the first weight that meets the target (lighter ones
-  // only fit the noise), or that weight; the corner of the whole grid when none does.
-  const bool l_curve = regularization.weight_rule == WeightRule::kLCurve;
-  result.target_misfit = target_misfit;
-  std::vector<double> start = initial;
-  // c0, the data cost at the start: the grid's unit.
-  double start_cost = 0.0;
-  if (!data->Evaluate(initial.data(), &start_cost, nullptr) || !(start_cost > 0.0)) {
-    start_cost = 1.0;  // a failure shows in the first minimisation
-  }
-  ++result.evaluations;
-  double missed = -1.0;  // the last weight that missed the target
-  double missed_misfit = -1.0;
-  BoundedMinimizerSummary hit;
-  double hit_weight = -1.0;
-  double hit_misfit = -1.0;
-  std::string choice = "discrepancy";  // of a weight kept in the descent
-  // The grid's minimisations, for the L-curve and the misfit-floor rule.
-  std::vector<BoundedMinimizerSummary> grid;
-  std::vector<double> grid_weights, grid_misfits, grid_roughness;
-  // The grid's k-th minimisation becomes the one kept.
-  const auto keep = [&](std::size_t k) {
-    hit = grid[k];
-    hit_weight = grid_weights[k];
-    hit_misfit = grid_misfits[k];
-  };
-  for (double weight = regularization.max_weight * start_cost;
-       weight >= regularization.min_weight * start_cost * (1.0 - 1e-12);
-       weight /= regularization.grid_factor) {
-    BoundedMinimizerSummary summary = MinimizeAt(options, regularization, data, lower, upper, start,
-                                                 weight, target_misfit, &result, &point);
-    if (!summary.IsSolutionUsable() && !grid.empty()) {
-      // Below a weight that converged, a minimisation that did not (out of evaluations
-      // among zones that drift to their bounds: the noise fitted) ends the descent; the
-      // weight is chosen among the converged ones, as when the target is missed.
-      spdlog::warn(
-          "the minimisation at the regularisation weight {:.3g} failed ({}): the descent "
-          "stops at {:.3g}",
-          weight, summary.message, grid_weights.back());
-      break;
-    }
-    if (!summary.IsSolutionUsable()) {
-      result.minimizer = std::move(summary);
-      result.weight = weight;
-      result.weight_choice = WeightRuleToString(regularization.weight_rule);
-      result.x = result.minimizer.x;
-      result.misfit = point.misfit;
-      return result;  // a failed minimisation ends the search: its message says why
-    }
-    start = summary.x;
-    grid.push_back(std::move(summary));
-    grid_weights.push_back(weight);
-    grid_misfits.push_back(point.misfit);
-    grid_roughness.push_back(point.roughness);
-    if (point.meets_target &&
-        (!l_curve || (grid.size() == 1 && point.misfit <= kLCurveTopShare * target_misfit))) {
-      keep(grid.size() - 1);
-      break;
-    }
-    if (l_curve && point.meets_target && grid.size() > 1) {
-      // The L-curve below the largest weight: lighter weights than this one only fit
-      // the noise (its flat arm); the corner of the points so far, or this weight.
-      const int corner = LCurveCorner(grid_misfits, grid_roughness);
-      keep(corner >= 0 ? static_cast<std::size_t>(corner) : grid.size() - 1);
-      missed = -1.0;  // no refinement
-      spdlog::info("the weight {:.3g} meets the noise's level {:.6g}: the weight is {} {:.3g}",
-                   weight, target_misfit, corner >= 0 ? "the L-curve's corner above it," : "it,",
-                   hit_weight);
-      choice = corner >= 0 ? "l_curve" : "discrepancy";
-      break;
-    }
-    missed = weight;
-    missed_misfit = point.misfit;
-  }
-  double target = target_misfit;
-  result.weight_choice = choice;
-  if (hit_weight < 0.0) {
-    // The grid's last, lightest weight: the first minimisation returned if it failed,
-    // and the loop runs at least once for options that are valid (max > min weight).
-    assert(!grid.empty());
-    const double last_weight = grid_weights.back();
-    const double last_misfit = grid_misfits.back();
-    result.misfit_floor = last_misfit;
-    // No weight reaches the noise's level (model error, or the noise underestimated):
-    // the noise level is not to be trusted, and the L-curve needs none (the L-curve
-    // rule's own choice then, the discrepancy principle's fallback, with a warning).
-    const int corner = LCurveCorner(grid_misfits, grid_roughness);
-    if (corner >= 0) {
-      if (l_curve || target_misfit < 0.0) {
-        spdlog::info("the weight is the L-curve's corner, {:.3g} (misfit {:.6g})",
-                     grid_weights[corner], grid_misfits[corner]);
-      } else {
-        spdlog::warn(
-            "no regularisation weight down to {:.3g} brings the misfit {:.6g} to the noise's "
-            "level {:.6g}: the weight is the L-curve's corner, {:.3g} (misfit {:.6g})",
-            last_weight, last_misfit, target_misfit, grid_weights[corner], grid_misfits[corner]);
-      }
-      result.weight_choice = "l_curve";
-      keep(static_cast<std::size_t>(corner));
-      missed = -1.0;  // no target to refine against
-    } else {
-      // Without a corner (fewer than 3 weights, or a straight curve) the principle is
-      // applied to the floor itself, raised by kMisfitFloorMargin.
-      target = result.AttainableTarget();
-      spdlog::warn(
-          "{} down to {:.3g}: the target becomes the misfit floor {:.6g} + {:.0f} %, {:.6g}",
-          l_curve || target_misfit < 0.0
-              ? std::string("the L-curve has no corner")
-              : fmt::format(
-                    "no regularisation weight brings the misfit to the noise's level {:.6g}",
-                    target_misfit),
-          last_weight, last_misfit, 100.0 * kMisfitFloorMargin, target);
-      result.weight_choice = "misfit_floor";
-      for (std::size_t k = 0; k < grid.size(); ++k) {
-        if (grid_misfits[k] <= target) {
-          keep(k);
-          missed = k > 0 ? grid_weights[k - 1] : -1.0;
-          missed_misfit = k > 0 ? grid_misfits[k - 1] : -1.0;
-          break;
-        }
-      }
-    }
-  }
-  // Regula falsi (Illinois) between the weight that missed (larger) and the hit on
-  // f(s) = ln(misfit / target), s = ln lambda, nearly linear where the misfit follows
-  // a power of lambda: stops once the chord's root lies within a factor
-  // 1 + weight_tolerance of the hit (the weight, not the misfit: near the noise's level
-  // the misfit can vary by 10 % over 4 decades of lambda, where the zones change the
-  // most), or after refinement_steps.
-  if (missed > 0.0) {
-    const auto log_ratio = [&](double misfit) { return std::log(misfit / target); };
-    double hit_log = std::log(hit_weight), missed_log = std::log(missed);
-    double hit_f = target > 0.0 && hit_misfit > 0.0 ? log_ratio(hit_misfit) : 0.0;
-    double missed_f = target > 0.0 ? log_ratio(missed_misfit) : 0.0;
-    int last_side = 0;  // +1: the last step replaced the missed end, -1: the hit
-    for (int step = 0; step < regularization.refinement_steps; ++step) {
-      // The root of the chord; the midpoint when the chord is not usable (a zero
-      // misfit at the hit, or a misfit that did not grow with lambda).
-      double s = 0.5 * (hit_log + missed_log);
-      if (target > 0.0 && hit_misfit > 0.0 && missed_f > hit_f) {
-        s = hit_log - hit_f * (missed_log - hit_log) / (missed_f - hit_f);
-      }
-      if (s - hit_log <= std::log1p(regularization.weight_tolerance)) break;
-      const double weight = std::exp(s);
-      if (!(weight < missed)) break;
-      BoundedMinimizerSummary summary = MinimizeAt(options, regularization, data, lower, upper,
-                                                   hit.x, weight, target, &result, &point);
-      if (!summary.IsSolutionUsable() || !(point.misfit > 0.0)) break;  // keep the hit
-      const double f = log_ratio(point.misfit);
-      if (point.meets_target) {
-        hit = std::move(summary);
-        hit_weight = weight;
-        hit_misfit = point.misfit;
-        hit_log = s;
-        hit_f = f;
-        // Illinois: an end kept twice has its value halved, so that the chord moves it.
-        if (last_side == -1) missed_f *= 0.5;
-        last_side = -1;
-      } else {
-        missed = weight;
-        missed_log = s;
-        missed_f = f;
-        if (last_side == +1) hit_f *= 0.5;
-        last_side = +1;
-      }
-    }
-  }
-  result.minimizer = std::move(hit);
-  result.weight = hit_weight;
-  result.x = result.minimizer.x;
-  result.misfit = hit_misfit;
+  WeightSearch search(options, regularization, data, lower, upper, target_misfit, &result);
+  search.Run(initial);
   return result;
 }
 
