@@ -803,26 +803,22 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
   return summary;
 }
 
-IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
-                                          ModulusObjective* search, int search_scan_points,
-                                          double refine_window, ModulusObjective* objective) {
-  assert(options.scan_points > 0 && search_scan_points >= 3 && refine_window > 0.0 &&
-         refine_window <= 0.5);
-  const Clock::time_point start = Clock::now();
-  // 1. The global search, its valleys refined by NLopt BOBYQA whatever the optimiser.
-  IdentificationOptions global = options;
-  global.scan_points = search_scan_points;
-  global.optimizer = OptimizerType::kNlopt;
-  global.algorithm = OuterAlgorithm::kBobyqa;
-  const IdentificationSummary found = Identify(global, search);
-  const int search_evaluations = found.scan_evaluations + found.evaluations;
-  // The result: the objective's minimisation with the search's count, and the search's
-  // scan fields unless the objective's own scan (stage 3) replaced them. The scan
-  // counts add the search's (scan and refinements) and stage 2's window scan.
-  int window_evaluations = 0;
+namespace {
+
+// What the two-stage identification's result takes from its global search (stage 1)
+// and its window scan (stage 2).
+struct TwoStageRecord {
+  Clock::time_point start;
+  IdentificationSummary found;  // the global search's
+  int search_evaluations = 0;   // the search's scan and refinements
+  int window_evaluations = 0;   // stage 2's window scan
   long window_sweeps = 0;
   double window_wall_time_s = 0.0;
-  auto with_search = [&](IdentificationSummary result, bool scan_of_search) {
+
+  // `result` with the search's count, and the search's scan fields unless the
+  // objective's own scan (stage 3) replaced them (scan_of_search false). The scan
+  // counts add the search's (scan and refinements) and stage 2's window scan.
+  IdentificationSummary With(IdentificationSummary result, bool scan_of_search) const {
     if (scan_of_search) {
       result.scan_evaluations = 0;
       result.scan_sweeps = 0;
@@ -846,51 +842,84 @@ IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
     result.scan_of_search = scan_of_search;
     result.wall_time_s = SecondsSince(start);
     return result;
-  };
-  // The result when the objective is not minimised.
-  IdentificationSummary not_run;
-  not_run.optimizer = options.optimizer;
-  not_run.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm);
-  not_run.initial_modulus = options.initial;
-  if (!found.IsSolutionUsable()) {
-    IdentificationSummary result = with_search(not_run, true);
-    result.termination = found.termination;
-    result.message = "the global search: " + found.message;
+  }
+
+  // The result when the objective is not minimised: `termination` and `message`, the
+  // options' optimiser and start.
+  IdentificationSummary NotRun(const IdentificationOptions& options, TerminationType termination,
+                               const std::string& message,
+                               const IdentificationSummary* refined = nullptr) const {
+    IdentificationSummary not_run;
+    not_run.optimizer = options.optimizer;
+    not_run.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm);
+    not_run.initial_modulus = options.initial;
+    IdentificationSummary result = With(refined != nullptr ? *refined : not_run, true);
+    result.termination = termination;
+    result.message = message;
     return result;
+  }
+};
+
+// Stage 2's options: a scan of kTwoStageWindowScanPoints over the search's modulus
+// +- refine_window (within the bounds), started at that modulus, with the evaluations
+// and the time the search left.
+IdentificationOptions WindowOptions(const IdentificationOptions& options,
+                                    const TwoStageRecord& record, double refine_window) {
+  IdentificationOptions local = options;
+  local.scan_points = kTwoStageWindowScanPoints;
+  local.lower_bound = std::max(options.lower_bound, record.found.modulus * (1.0 - refine_window));
+  local.upper_bound = std::min(options.upper_bound, record.found.modulus * (1.0 + refine_window));
+  const double width = local.upper_bound - local.lower_bound;
+  local.initial = std::clamp(record.found.modulus, local.lower_bound + 1e-3 * width,
+                             local.upper_bound - 1e-3 * width);
+  local.max_evaluations = options.max_evaluations - record.search_evaluations;
+  local.max_time = options.max_time - SecondsSince(record.start);
+  return local;
+}
+
+}  // namespace
+
+IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
+                                          ModulusObjective* search, int search_scan_points,
+                                          double refine_window, ModulusObjective* objective) {
+  assert(options.scan_points > 0 && search_scan_points >= 3 && refine_window > 0.0 &&
+         refine_window <= 0.5);
+  TwoStageRecord record;
+  record.start = Clock::now();
+  // 1. The global search, its valleys refined by NLopt BOBYQA whatever the optimiser.
+  IdentificationOptions global = options;
+  global.scan_points = search_scan_points;
+  global.optimizer = OptimizerType::kNlopt;
+  global.algorithm = OuterAlgorithm::kBobyqa;
+  record.found = Identify(global, search);
+  const IdentificationSummary& found = record.found;
+  record.search_evaluations = found.scan_evaluations + found.evaluations;
+  if (!found.IsSolutionUsable()) {
+    return record.NotRun(options, found.termination, "the global search: " + found.message);
   }
   // 2. The objective near the search's minimiser, with what the search left: a scan of
   // the window (cost and gradient, as the global scan's), its valleys refined.
-  IdentificationOptions local = options;
-  local.scan_points = kTwoStageWindowScanPoints;
-  local.lower_bound = std::max(options.lower_bound, found.modulus * (1.0 - refine_window));
-  local.upper_bound = std::min(options.upper_bound, found.modulus * (1.0 + refine_window));
-  const double width = local.upper_bound - local.lower_bound;
-  local.initial =
-      std::clamp(found.modulus, local.lower_bound + 1e-3 * width, local.upper_bound - 1e-3 * width);
-  local.max_evaluations = options.max_evaluations - search_evaluations;
-  local.max_time = options.max_time - SecondsSince(start);
+  const IdentificationOptions local = WindowOptions(options, record, refine_window);
   if (local.max_evaluations < local.scan_points + 2 || !(local.max_time > 0.0)) {
-    IdentificationSummary result = with_search(not_run, true);
-    result.termination = TerminationType::kNoConvergence;
-    result.message = local.max_evaluations < local.scan_points + 2
-                         ? "outer.max_evaluations (" + std::to_string(options.max_evaluations) +
-                               ") reached by the global search (" +
-                               std::to_string(search_evaluations) + " evaluations)"
-                         : "outer.max_time reached by the global search";
-    return result;
+    return record.NotRun(options, TerminationType::kNoConvergence,
+                         local.max_evaluations < local.scan_points + 2
+                             ? "outer.max_evaluations (" + std::to_string(options.max_evaluations) +
+                                   ") reached by the global search (" +
+                                   std::to_string(record.search_evaluations) + " evaluations)"
+                             : "outer.max_time reached by the global search");
   }
   spdlog::info("refining the objective near the search's E = {:.9g} Pa within [{:.6g}, {:.6g}] Pa",
                found.modulus, local.lower_bound, local.upper_bound);
   IdentificationSummary refined = Identify(local, objective);
-  window_evaluations = refined.scan_evaluations;
-  window_sweeps = refined.scan_sweeps;
-  window_wall_time_s = refined.scan_wall_time_s;
+  record.window_evaluations = refined.scan_evaluations;
+  record.window_sweeps = refined.scan_sweeps;
+  record.window_wall_time_s = refined.scan_wall_time_s;
   const double tolerance = 4.0 * options.relative_tolerance * refined.modulus;
   const bool on_lower =
       local.lower_bound > options.lower_bound && refined.modulus - local.lower_bound <= tolerance;
   const bool on_upper =
       local.upper_bound < options.upper_bound && local.upper_bound - refined.modulus <= tolerance;
-  if (!refined.IsSolutionUsable() || !(on_lower || on_upper)) return with_search(refined, true);
+  if (!refined.IsSolutionUsable() || !(on_lower || on_upper)) return record.With(refined, true);
 
   // 3. Its minimum lies beyond the window: the objective's own global search.
   spdlog::warn(
@@ -898,20 +927,19 @@ IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
       "(search.refine_window): scanning the objective itself",
       100.0 * refine_window, found.modulus);
   IdentificationOptions own = options;
-  own.max_evaluations = local.max_evaluations - refined.evaluations - window_evaluations;
-  own.max_time = options.max_time - SecondsSince(start);
+  own.max_evaluations = local.max_evaluations - refined.evaluations - record.window_evaluations;
+  own.max_time = options.max_time - SecondsSince(record.start);
   if (own.max_evaluations < own.scan_points + 2 || !(own.max_time > 0.0)) {
-    IdentificationSummary result = with_search(refined, true);
-    result.termination = TerminationType::kNoConvergence;
-    result.message =
+    return record.NotRun(
+        options, TerminationType::kNoConvergence,
         "outer.max_evaluations or outer.max_time reached before the objective's own scan, which "
-        "the refinement on an edge of search.refine_window asked for";
-    return result;
+        "the refinement on an edge of search.refine_window asked for",
+        &refined);
   }
   IdentificationSummary scanned = Identify(own, objective);
   scanned.evaluations += refined.evaluations;
   scanned.gradient_evaluations += refined.gradient_evaluations;
-  return with_search(scanned, false);
+  return record.With(scanned, false);
 }
 
 }  // namespace mcrewave
