@@ -508,6 +508,84 @@ int PredictedIterations(double omega, double a_min, double a_max, double toleran
   return static_cast<int>(std::ceil(std::log(tolerance) / std::log(rho)));
 }
 
+// One case of the relaxation study: its spectrum estimate and omegas, the grid's
+// fixed-omega solves to study.relaxation_tolerance (into *points), and the reference
+// solves to inner.tolerance with their residual histories (into *histories).
+void RunRelaxationCase(const Config& config, const BarModel& model, const ChannelSet& truth,
+                       const std::vector<double>& omegas, int c, RelaxationCase* case_out,
+                       std::vector<RelaxationPoint>* points,
+                       std::vector<ResidualHistory>* histories) {
+  const StudyOptions& options = config.study;
+  RelaxationCase& relaxation_case = *case_out;
+  const ChannelSet data = PrefilterMeasurements(
+      NoisyMeasurements(truth, relaxation_case.snr, config.data.seed), config.prefilter);
+  McreProblem problem(model, data, config.mcre.weights, config.mcre.reference_modulus,
+                      config.time.theta, {}, config.mcre.clamp);
+  problem.SetModulus(relaxation_case.modulus);
+  const auto [a_min, a_max] = EstimateSpectrum(config.inner, &problem);
+  relaxation_case.spectrum_min = a_min;
+  relaxation_case.spectrum_max = a_max;
+  // the fixed relaxation contracts every component iff |1 - omega a| < 1: omega < 2 / a_max
+  relaxation_case.omega_limit = 2.0 / a_max;
+  // least max |1 - omega a| over [a_min, a_max]
+  relaxation_case.omega_optimal = 2.0 / (a_min + a_max);
+
+  auto solve = [&](CoupledSolverType type, double omega, double tolerance) {
+    CoupledSolverOptions solver = config.inner;
+    solver.type = type;
+    if (type == CoupledSolverType::kRelaxation) solver.relaxation_coefficient = omega;
+    solver.tolerance = tolerance;
+    CoupledSolution solution;
+    return SolveCoupled(solver, &problem, nullptr, &solution);
+  };
+  long fewest_sweeps = -1;
+  relaxation_case.omega_fastest = std::numeric_limits<double>::quiet_NaN();
+  for (const double omega : omegas) {
+    const CoupledSolverSummary summary =
+        solve(CoupledSolverType::kRelaxation, omega, options.relaxation_tolerance);
+    RelaxationPoint point;
+    point.case_index = c;
+    point.omega = omega;
+    point.termination = summary.termination;
+    point.iterations = summary.iterations;
+    point.sweeps = summary.sweeps;
+    point.relative_residual = summary.relative_residual;
+    point.predicted_iterations =
+        PredictedIterations(omega, a_min, a_max, options.relaxation_tolerance);
+    points->push_back(point);
+    if (summary.IsSolutionUsable() && (fewest_sweeps < 0 || summary.sweeps < fewest_sweeps)) {
+      fewest_sweeps = summary.sweeps;
+      relaxation_case.omega_fastest = omega;
+    }
+  }
+
+  // The reference solves to inner.tolerance, with their residual histories.
+  auto record = [&](CoupledSolverType type, double omega, const CoupledSolverSummary& summary) {
+    ResidualHistory history;
+    history.case_index = c;
+    history.method = type;
+    history.omega = omega;
+    history.residuals = summary.residual_history;
+    histories->push_back(history);
+  };
+  if (!std::isnan(relaxation_case.omega_fastest)) {
+    const CoupledSolverSummary fixed = solve(CoupledSolverType::kRelaxation,
+                                             relaxation_case.omega_fastest, config.inner.tolerance);
+    relaxation_case.fixed_sweeps = fixed.sweeps;
+    record(CoupledSolverType::kRelaxation, relaxation_case.omega_fastest, fixed);
+  }
+  const double unused_omega = std::numeric_limits<double>::quiet_NaN();
+  const CoupledSolverSummary adaptive =
+      solve(CoupledSolverType::kAdaptiveRelaxation, unused_omega, config.inner.tolerance);
+  relaxation_case.omega_adaptive = adaptive.relaxation_coefficient;
+  relaxation_case.adaptive_sweeps = adaptive.sweeps;
+  record(CoupledSolverType::kAdaptiveRelaxation, adaptive.relaxation_coefficient, adaptive);
+  const CoupledSolverSummary krylov =
+      solve(CoupledSolverType::kConjugateGradient, unused_omega, config.inner.tolerance);
+  relaxation_case.conjugate_gradient_sweeps = krylov.sweeps;
+  record(CoupledSolverType::kConjugateGradient, std::numeric_limits<double>::quiet_NaN(), krylov);
+}
+
 }  // namespace
 
 RelaxationStudy RunRelaxationStudy(const Config& config) {
@@ -544,77 +622,8 @@ RelaxationStudy RunRelaxationStudy(const Config& config) {
   ParallelFor(
       cases, study.threads,
       [&](int c) {
-        RelaxationCase& relaxation_case = study.cases[c];
-        const ChannelSet data = PrefilterMeasurements(
-            NoisyMeasurements(truth, relaxation_case.snr, config.data.seed), config.prefilter);
-        McreProblem problem(model, data, config.mcre.weights, config.mcre.reference_modulus,
-                            config.time.theta, {}, config.mcre.clamp);
-        problem.SetModulus(relaxation_case.modulus);
-        const auto [a_min, a_max] = EstimateSpectrum(config.inner, &problem);
-        relaxation_case.spectrum_min = a_min;
-        relaxation_case.spectrum_max = a_max;
-        // the fixed relaxation contracts every component iff |1 - omega a| < 1: omega < 2 / a_max
-        relaxation_case.omega_limit = 2.0 / a_max;
-        // least max |1 - omega a| over [a_min, a_max]
-        relaxation_case.omega_optimal = 2.0 / (a_min + a_max);
-
-        auto solve = [&](CoupledSolverType type, double omega, double tolerance) {
-          CoupledSolverOptions solver = config.inner;
-          solver.type = type;
-          if (type == CoupledSolverType::kRelaxation) solver.relaxation_coefficient = omega;
-          solver.tolerance = tolerance;
-          CoupledSolution solution;
-          return SolveCoupled(solver, &problem, nullptr, &solution);
-        };
-        long fewest_sweeps = -1;
-        relaxation_case.omega_fastest = std::numeric_limits<double>::quiet_NaN();
-        for (const double omega : omegas) {
-          const CoupledSolverSummary summary =
-              solve(CoupledSolverType::kRelaxation, omega, options.relaxation_tolerance);
-          RelaxationPoint point;
-          point.case_index = c;
-          point.omega = omega;
-          point.termination = summary.termination;
-          point.iterations = summary.iterations;
-          point.sweeps = summary.sweeps;
-          point.relative_residual = summary.relative_residual;
-          point.predicted_iterations =
-              PredictedIterations(omega, a_min, a_max, options.relaxation_tolerance);
-          points[c].push_back(point);
-          if (summary.IsSolutionUsable() && (fewest_sweeps < 0 || summary.sweeps < fewest_sweeps)) {
-            fewest_sweeps = summary.sweeps;
-            relaxation_case.omega_fastest = omega;
-          }
-        }
-
-        // The reference solves to inner.tolerance, with their residual histories.
-        auto record = [&](CoupledSolverType type, double omega,
-                          const CoupledSolverSummary& summary) {
-          ResidualHistory history;
-          history.case_index = c;
-          history.method = type;
-          history.omega = omega;
-          history.residuals = summary.residual_history;
-          histories[c].push_back(history);
-        };
-        if (!std::isnan(relaxation_case.omega_fastest)) {
-          const CoupledSolverSummary fixed =
-              solve(CoupledSolverType::kRelaxation, relaxation_case.omega_fastest,
-                    config.inner.tolerance);
-          relaxation_case.fixed_sweeps = fixed.sweeps;
-          record(CoupledSolverType::kRelaxation, relaxation_case.omega_fastest, fixed);
-        }
-        const double unused_omega = std::numeric_limits<double>::quiet_NaN();
-        const CoupledSolverSummary adaptive =
-            solve(CoupledSolverType::kAdaptiveRelaxation, unused_omega, config.inner.tolerance);
-        relaxation_case.omega_adaptive = adaptive.relaxation_coefficient;
-        relaxation_case.adaptive_sweeps = adaptive.sweeps;
-        record(CoupledSolverType::kAdaptiveRelaxation, adaptive.relaxation_coefficient, adaptive);
-        const CoupledSolverSummary krylov =
-            solve(CoupledSolverType::kConjugateGradient, unused_omega, config.inner.tolerance);
-        relaxation_case.conjugate_gradient_sweeps = krylov.sweeps;
-        record(CoupledSolverType::kConjugateGradient, std::numeric_limits<double>::quiet_NaN(),
-               krylov);
+        RunRelaxationCase(config, model, truth, omegas, c, &study.cases[c], &points[c],
+                          &histories[c]);
       },
       &progress);
   for (int c = 0; c < cases; ++c) {
