@@ -322,9 +322,35 @@ std::string ProfilesScript(const std::string& folder, const std::vector<std::str
   return script.str();
 }
 
-std::string Summary(const DamageStudy& study) {
-  std::ostringstream md;
-  const double reference = study.reference_modulus;
+// The counts of the SNR-10 seeds of the soft truth (goal 2), for one functional.
+struct SeedCounts {
+  int weakest = 0, soft_within = 0, others_within = 0, converged = 0;
+  double worst_soft = 0.0, worst_other = 0.0;
+  void Add(const std::vector<double>& moduli, int weakest_zone,
+           const std::vector<double>& truth_moduli) {
+    ++converged;
+    int soft = -1;  // the zone of the smallest truth
+    for (std::size_t z = 0; z < truth_moduli.size(); ++z) {
+      if (soft < 0 || truth_moduli[z] < truth_moduli[soft]) soft = static_cast<int>(z);
+    }
+    if (weakest_zone == soft) ++weakest;
+    double other = 0.0;
+    for (std::size_t z = 0; z < moduli.size(); ++z) {
+      const double error = std::abs(moduli[z] / truth_moduli[z] - 1.0);
+      if (static_cast<int>(z) == soft) {
+        worst_soft = std::max(worst_soft, error);
+        if (error <= 0.05) ++soft_within;
+      } else {
+        other = std::max(other, error);
+      }
+    }
+    worst_other = std::max(worst_other, other);
+    if (other <= 0.05) ++others_within;
+  }
+};
+
+// The summary's title and the description of the runs.
+void SummaryHeader(const DamageStudy& study, std::ostringstream& md) {
   md << "# Damage localisation (zones and sensors)\n\n"
      << study.runs.size() << " runs on " << study.threads << " threads in "
      << internal::Duration(study.wall_time_s)
@@ -337,9 +363,15 @@ std::string Summary(const DamageStudy& study) {
         "with u@0.25, 0.5, 0.75 and e@0.2, 0.45, 0.65, 0.9). Zone errors against the truth's "
         "modulus of each zone (its elements in series). Settings: "
      << study.settings << ".\n\n";
-  // Goal 1: noise-free, 10 zones, every zone within 1 %: the soft truth, the one the
-  // 10 equal zones represent (the goals are the soft truth's); the other truths are
-  // reported beside it, with the costs that say why they cannot be met.
+}
+
+// Goal 1: noise-free, 10 zones, every zone within 1 % (the soft truth); the other
+// truths beside it.
+void NoiseFreeSection(const DamageStudy& study, std::ostringstream& md) {
+  const double reference = study.reference_modulus;
+  // The soft truth, the one the 10 equal zones represent (the goals are the soft
+  // truth's); the other truths are reported beside it, with the costs that say why
+  // they cannot be met.
   md << "## Noise-free, 10 zones: every zone within 1 % (soft truth)\n\n"
      << "The goals concern the soft truth, whose zone lies on the identification's zone "
         "boundaries. The other truths are reported, not judged: their boundaries fall inside "
@@ -378,32 +410,10 @@ std::string Summary(const DamageStudy& study) {
          << " |\n";
     }
   }
-  // Goal 2: the seeds at SNR 10, for the MCRE's zones and least squares'.
-  struct SeedCounts {
-    int weakest = 0, soft_within = 0, others_within = 0, converged = 0;
-    double worst_soft = 0.0, worst_other = 0.0;
-    void Add(const std::vector<double>& moduli, int weakest_zone,
-             const std::vector<double>& truth_moduli) {
-      ++converged;
-      int soft = -1;  // the zone of the smallest truth
-      for (std::size_t z = 0; z < truth_moduli.size(); ++z) {
-        if (soft < 0 || truth_moduli[z] < truth_moduli[soft]) soft = static_cast<int>(z);
-      }
-      if (weakest_zone == soft) ++weakest;
-      double other = 0.0;
-      for (std::size_t z = 0; z < moduli.size(); ++z) {
-        const double error = std::abs(moduli[z] / truth_moduli[z] - 1.0);
-        if (static_cast<int>(z) == soft) {
-          worst_soft = std::max(worst_soft, error);
-          if (error <= 0.05) ++soft_within;
-        } else {
-          other = std::max(other, error);
-        }
-      }
-      worst_other = std::max(worst_other, other);
-      if (other <= 0.05) ++others_within;
-    }
-  };
+}
+
+// Goal 2: the seeds at SNR 10, for the MCRE's zones and least squares'.
+void SeedsSection(const DamageStudy& study, std::ostringstream& md) {
   int seeds = 0;
   SeedCounts mcre, least_squares;
   for (const DamageRun& run : study.runs) {
@@ -427,7 +437,11 @@ std::string Summary(const DamageStudy& study) {
   }
   md << "\nGoal (the MCRE's): the soft zone the weakest in at least 19 of 20, its modulus and "
         "every other zone within 5 %.\n";
-  // Goal 3: one zone per element at SNR 20.
+}
+
+// Goal 3: one zone per element at SNR 20.
+void PerElementSection(const DamageStudy& study, std::ostringstream& md) {
+  const double reference = study.reference_modulus;
   const int per_element = FindRun(study, 0, true, 20.0, true);
   if (per_element >= 0 && study.runs[per_element].converged) {
     const DamageRun& run = study.runs[per_element];
@@ -453,7 +467,11 @@ std::string Summary(const DamageStudy& study) {
        << "); regularisation weight " << Brief(run.regularization_weight) << ", " << run.evaluations
        << " evaluations, " << internal::Duration(run.wall_time_s) << ".\n";
   }
-  // The grid: every run.
+}
+
+// The grid: every run (seed 1), and the figures.
+void GridSection(const DamageStudy& study, std::ostringstream& md) {
+  const double reference = study.reference_modulus;
   md << "\n## Every run of the grid\n\n| truth | sensors | SNR | zoning | E* / E_ref | error map "
         "peak [m] | weakest zone | E_weakest / E_ref | max zone error | evaluations | time | "
         "least squares: max zone error | evaluations | time |\n"
@@ -483,6 +501,15 @@ std::string Summary(const DamageStudy& study) {
   md << "\nFigures: profiles.png (identified E(x) against the truth with the interior sensors: "
         "10 zones noise-free (MCRE and least squares) and at SNR 10, one zone per element at "
         "SNR 20).\n";
+}
+
+std::string Summary(const DamageStudy& study) {
+  std::ostringstream md;
+  SummaryHeader(study, md);
+  NoiseFreeSection(study, md);
+  SeedsSection(study, md);
+  PerElementSection(study, md);
+  GridSection(study, md);
   return md.str();
 }
 
