@@ -88,110 +88,72 @@ ChannelSet ReadChannelCsv(const std::string& path, const HeaderCheck& check_head
   return ParseChannelCsv(file, path, check_header, kind_of);
 }
 
-ChannelSet ParseChannelCsv(std::istream& file, const std::string& path,
-                           const HeaderCheck& check_header, const ChannelKindOf& kind_of) {
-  auto fail = [&path](long line_number, const std::string& what) {
-    throw InputError(path + ":" + std::to_string(line_number) + ": " + what);
-  };
+namespace {
 
-  // The header: column c holds names[c]; time_column is the column of t.
-  std::vector<std::string> names;
-  std::size_t time_column = 0;
-  std::vector<std::vector<double>> columns;
-  std::string line;
-  std::vector<std::string> fields;  // the fields of the current row
-  long line_number = 0;
-  long first_blank_line = 0;  // first empty line seen so far, 0 if none
-  auto split = [&fields](const std::string& text) {
-    fields.clear();
-    for (std::size_t field_start = 0;;) {
-      const std::size_t comma = text.find(',', field_start);
-      fields.push_back(text.substr(field_start, comma - field_start));
-      if (comma == std::string::npos) break;
-      field_start = comma + 1;
-    }
-  };
-  while (std::getline(file, line)) {
-    ++line_number;
-    line = StripLineEnd(line);
-    if (line_number == 1) {
-      if (line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // UTF-8 byte order mark
-      split(line);
-      for (std::string field : fields) {
-        const std::size_t first = field.find_first_not_of(" \t");
-        const std::size_t last = field.find_last_not_of(" \t");
-        names.push_back(first == std::string::npos ? "" : field.substr(first, last - first + 1));
-      }
-      if (check_header) {
-        const std::string why = check_header(names, line);
-        if (!why.empty()) fail(1, why);
-      }
-      for (std::size_t c = 0; c < names.size(); ++c) {
-        if (names[c].empty()) fail(1, "column " + std::to_string(c + 1) + " has no name");
-        for (std::size_t other = 0; other < c; ++other) {
-          if (names[other] == names[c]) {
-            fail(1, "column " + std::to_string(c + 1) + " '" + names[c] + "' repeats column " +
-                        std::to_string(other + 1) + " '" + names[other] + "'");
-          }
-        }
-      }
-      const auto time = std::find(names.begin(), names.end(), "t");
-      if (time == names.end()) {
-        fail(1, "the header '" + line + "' lacks the time column 't' [s]");
-      }
-      time_column = static_cast<std::size_t>(time - names.begin());
-      columns.resize(names.size());
-      continue;
-    }
-    if (line.empty()) {
-      if (first_blank_line == 0) first_blank_line = line_number;
-      continue;
-    }
-    if (first_blank_line != 0) fail(first_blank_line, "empty line between data rows");
+// Throws the InputError "path:line: what".
+[[noreturn]] void FailAt(const std::string& path, long line_number, const std::string& what) {
+  throw InputError(path + ":" + std::to_string(line_number) + ": " + what);
+}
 
-    split(line);
-    if (fields.size() != names.size()) {
-      fail(line_number, "expected " + std::to_string(names.size()) + " columns, got " +
-                            std::to_string(fields.size()));
-    }
-    for (std::size_t c = 0; c < names.size(); ++c) {
-      double value = 0.0;
-      if (!ParseNumber(fields[c], &value)) {
-        fail(line_number, "column '" + names[c] + "': '" + fields[c] + "' is not a number");
+// The comma-separated fields of `text` into *fields.
+void SplitFields(const std::string& text, std::vector<std::string>* fields) {
+  fields->clear();
+  for (std::size_t field_start = 0;;) {
+    const std::size_t comma = text.find(',', field_start);
+    fields->push_back(text.substr(field_start, comma - field_start));
+    if (comma == std::string::npos) break;
+    field_start = comma + 1;
+  }
+}
+
+// The header line (line 1, byte order mark removed): the column names, trimmed, each
+// named once, `t` among them (its index in *time_column), then check_header's own
+// conditions.
+std::vector<std::string> ParseHeader(std::string line, const std::string& path,
+                                     const HeaderCheck& check_header, std::size_t* time_column) {
+  if (line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // UTF-8 byte order mark
+  std::vector<std::string> fields, names;
+  SplitFields(line, &fields);
+  for (const std::string& field : fields) {
+    const std::size_t first = field.find_first_not_of(" \t");
+    const std::size_t last = field.find_last_not_of(" \t");
+    names.push_back(first == std::string::npos ? "" : field.substr(first, last - first + 1));
+  }
+  if (check_header) {
+    const std::string why = check_header(names, line);
+    if (!why.empty()) FailAt(path, 1, why);
+  }
+  for (std::size_t c = 0; c < names.size(); ++c) {
+    if (names[c].empty()) FailAt(path, 1, "column " + std::to_string(c + 1) + " has no name");
+    for (std::size_t other = 0; other < c; ++other) {
+      if (names[other] == names[c]) {
+        FailAt(path, 1,
+               "column " + std::to_string(c + 1) + " '" + names[c] + "' repeats column " +
+                   std::to_string(other + 1) + " '" + names[other] + "'");
       }
-      if (!std::isfinite(value)) {
-        fail(line_number, "column '" + names[c] + "': '" + fields[c] + "' is not a finite number");
-      }
-      if (c == time_column && !columns[c].empty() && !(value > columns[c].back())) {
-        fail(line_number, "time is not strictly increasing (t = " + ShortNumber(value) +
-                              " s after " + ShortNumber(columns[c].back()) + " s)");
-      }
-      columns[c].push_back(value);
-    }
-    if (columns[time_column].size() % kProgressRows == 0) {
-      spdlog::info("{}: read {} rows", path, columns[time_column].size());
     }
   }
-  if (file.bad()) {
-    throw InputError("cannot read measurement file " + path + ": " + std::strerror(errno));
+  const auto time = std::find(names.begin(), names.end(), "t");
+  if (time == names.end()) {
+    FailAt(path, 1, "the header '" + line + "' lacks the time column 't' [s]");
   }
-  if (line_number == 0) {
-    const std::string expected = check_header ? check_header({}, "") : "";
-    fail(1, "expected " +
-                (expected.empty() ? std::string("a header naming the columns, t among them")
-                                  : expected) +
-                ", got an empty file");
-  }
+  *time_column = static_cast<std::size_t>(time - names.begin());
+  return names;
+}
 
-  const std::vector<double>& times = columns[time_column];
+// The step of a time column read to its last line (line_number): at least 2 rows, a
+// finite span, every step the median step within kStepTolerance.
+double UniformTimeStep(const std::vector<double>& times, const std::string& path,
+                       long line_number) {
   const std::size_t rows = times.size();
   if (rows < 2) {
-    fail(line_number, "expected at least 2 data rows, got " + std::to_string(rows));
+    FailAt(path, line_number, "expected at least 2 data rows, got " + std::to_string(rows));
   }
   const double mean_step = (times.back() - times.front()) / static_cast<double>(rows - 1);
   if (!std::isfinite(mean_step)) {
-    fail(line_number, "time span " + ShortNumber(times.front()) + " s to " +
-                          ShortNumber(times.back()) + " s is too wide for a double");
+    FailAt(path, line_number,
+           "time span " + ShortNumber(times.front()) + " s to " + ShortNumber(times.back()) +
+               " s is too wide for a double");
   }
   // Each step against the median step: a sample missing (or one too many) anywhere
   // changes only the steps next to it, and the row where the first bad step ends (the
@@ -209,17 +171,84 @@ ChannelSet ParseChannelCsv(std::istream& file, const std::string& path,
     const double step = times[k] - times[k - 1];
     if (std::abs(step - reference_step) > kStepTolerance * reference_step) {
       // Data row k is on line k + 2: the header is line 1 and an empty line between
-      // data rows is refused above.
-      fail(static_cast<long>(k) + 2,
-           "time step " + ShortNumber(step) + " s (from t = " + ShortNumber(times[k - 1]) +
-               " s on the previous row), expected the file's step " + ShortNumber(reference_step) +
-               " s (the median step) within 1e-6 relative");
+      // data rows is refused.
+      FailAt(path, static_cast<long>(k) + 2,
+             "time step " + ShortNumber(step) + " s (from t = " + ShortNumber(times[k - 1]) +
+                 " s on the previous row), expected the file's step " +
+                 ShortNumber(reference_step) + " s (the median step) within 1e-6 relative");
     }
   }
+  return ExactStep(times, mean_step);
+}
 
+}  // namespace
+
+ChannelSet ParseChannelCsv(std::istream& file, const std::string& path,
+                           const HeaderCheck& check_header, const ChannelKindOf& kind_of) {
+  // The header: column c holds names[c]; time_column is the column of t.
+  std::vector<std::string> names;
+  std::size_t time_column = 0;
+  std::vector<std::vector<double>> columns;
+  std::string line;
+  std::vector<std::string> fields;  // the fields of the current row
+  long line_number = 0;
+  long first_blank_line = 0;  // first empty line seen so far, 0 if none
+  while (std::getline(file, line)) {
+    ++line_number;
+    line = StripLineEnd(line);
+    if (line_number == 1) {
+      names = ParseHeader(line, path, check_header, &time_column);
+      columns.resize(names.size());
+      continue;
+    }
+    if (line.empty()) {
+      if (first_blank_line == 0) first_blank_line = line_number;
+      continue;
+    }
+    if (first_blank_line != 0) FailAt(path, first_blank_line, "empty line between data rows");
+
+    SplitFields(line, &fields);
+    if (fields.size() != names.size()) {
+      FailAt(path, line_number,
+             "expected " + std::to_string(names.size()) + " columns, got " +
+                 std::to_string(fields.size()));
+    }
+    for (std::size_t c = 0; c < names.size(); ++c) {
+      double value = 0.0;
+      if (!ParseNumber(fields[c], &value)) {
+        FailAt(path, line_number, "column '" + names[c] + "': '" + fields[c] + "' is not a number");
+      }
+      if (!std::isfinite(value)) {
+        FailAt(path, line_number,
+               "column '" + names[c] + "': '" + fields[c] + "' is not a finite number");
+      }
+      if (c == time_column && !columns[c].empty() && !(value > columns[c].back())) {
+        FailAt(path, line_number,
+               "time is not strictly increasing (t = " + ShortNumber(value) + " s after " +
+                   ShortNumber(columns[c].back()) + " s)");
+      }
+      columns[c].push_back(value);
+    }
+    if (columns[time_column].size() % kProgressRows == 0) {
+      spdlog::info("{}: read {} rows", path, columns[time_column].size());
+    }
+  }
+  if (file.bad()) {
+    throw InputError("cannot read measurement file " + path + ": " + std::strerror(errno));
+  }
+  if (line_number == 0) {
+    const std::string expected = check_header ? check_header({}, "") : "";
+    FailAt(path, 1,
+           "expected " +
+               (expected.empty() ? std::string("a header naming the columns, t among them")
+                                 : expected) +
+               ", got an empty file");
+  }
+
+  const std::vector<double>& times = columns[time_column];
   ChannelSet set;
+  set.time_step = UniformTimeStep(times, path, line_number);
   set.start_time = times.front();
-  set.time_step = ExactStep(times, mean_step);
   set.channels.reserve(names.size() - 1);
   // Each column is freed once copied: at most one column is held twice.
   for (std::size_t c = 0; c < names.size(); ++c) {
