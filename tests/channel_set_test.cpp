@@ -1,17 +1,15 @@
 #include "mcrewave/data/channel_set.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "file_fixture.h"
 #include "mcrewave/core/types.h"
 #include "mcrewave/data/measurement.h"
 
@@ -19,28 +17,9 @@ namespace mcrewave {
 namespace {
 
 // Writes channel files into a fresh directory of its own.
-class ChannelSetTest : public ::testing::Test {
+class ChannelSetTest : public FileFixture {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    directory_ =
-        std::filesystem::path(::testing::TempDir()) /
-        ("mcrewave_channel_set_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    std::filesystem::remove_all(directory_);
-    std::filesystem::create_directories(directory_);
-  }
-  void TearDown() override { std::filesystem::remove_all(directory_); }
-
-  std::string PathOf(const std::string& name) const { return (directory_ / name).string(); }
-
-  // Writes `content` byte for byte to `name`; returns its path.
-  std::string WriteFile(const std::string& name, const std::string& content) const {
-    const std::string path = PathOf(name);
-    std::ofstream(path, std::ios::binary) << content;
-    return path;
-  }
-
-  std::filesystem::path directory_;
+  ChannelSetTest() : FileFixture("channel_set") {}
 };
 
 TEST(ChannelSetBasicsTest, FindAndValuesByName) {

@@ -1,42 +1,23 @@
 #include "mcrewave/data/measurement.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "file_fixture.h"
 #include "mcrewave/core/types.h"
 
 namespace mcrewave {
 namespace {
 
 // Writes measurement files into a fresh directory of its own.
-class MeasurementTest : public ::testing::Test {
+class MeasurementTest : public FileFixture {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    directory_ =
-        std::filesystem::path(::testing::TempDir()) /
-        ("mcrewave_measurement_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    std::filesystem::remove_all(directory_);
-    std::filesystem::create_directories(directory_);
-  }
-  void TearDown() override { std::filesystem::remove_all(directory_); }
-
-  std::string PathOf(const std::string& name) const { return (directory_ / name).string(); }
-
-  // Writes `content` byte for byte to `name`; returns its path.
-  std::string WriteFile(const std::string& name, const std::string& content) const {
-    const std::string path = PathOf(name);
-    std::ofstream(path, std::ios::binary) << content;
-    return path;
-  }
+  MeasurementTest() : FileFixture("measurement") {}
 
   // Writes `content` as data.csv and expects ReadMeasurementCsv to throw an
   // InputError whose message starts with "<path>:<line>: " and contains `what`.
@@ -51,8 +32,6 @@ class MeasurementTest : public ::testing::Test {
       EXPECT_NE(message.find(what), std::string::npos) << message << "\nlacks: " << what;
     }
   }
-
-  std::filesystem::path directory_;
 };
 
 // A set whose values exercise full precision: irrational-looking, tiny, huge, signed.
