@@ -20,11 +20,8 @@
 //
 // Usage: plate_identification_benchmark OUTPUT_DIR [--seeds=20] [--threads=2]
 //            [--load=transverse|axial] [--model=FOLDER] [--truth=FOLDER]
-//            [--studies-readme=FOLDER]
 //   (model and truth: folders of make_plate_example.py; default configs/plate/coarse
-//   and configs/plate/fine; scripts/plate_study.sh runs the study of results/plate;
-//   --studies-readme rewrites FOLDER/README.md from the study folders there, as
-//   `identify study` does, once this study's files are written).
+//   and configs/plate/fine; scripts/plate_study.sh runs the study of results/plate).
 //   Writes OUTPUT_DIR/runs.csv (one row per identification), summary.md (statistics
 //   per SNR and the goals), error_map.csv and error_map.png (the dof map of
 //   MatrixMcreProblem::DofErrorMap summed per node, averaged per element), moduli.png.
@@ -45,7 +42,6 @@
 #include <vector>
 
 #include "mcrewave/app/matrix_identification_run.h"
-#include "mcrewave/app/study.h"
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/mcre/matrix_zone_objective.h"
@@ -215,7 +211,7 @@ void WriteErrorMap(const MatrixModelData& coarse, const std::string& coarse_fold
 int main(int argc, char** argv) {
   // OUTPUT_DIR, then --key=value options.
   std::string folder, load = "transverse", model_folder = kPlate + "coarse",
-                      truth_folder = kPlate + "fine", studies_folder;
+                      truth_folder = kPlate + "fine";
   int seeds = 20, threads = 2;
   for (int a = 1; a < argc; ++a) {
     const std::string argument = argv[a];
@@ -234,8 +230,6 @@ int main(int argc, char** argv) {
       model_folder = value;
     } else if (key == "--truth") {
       truth_folder = value;
-    } else if (key == "--studies-readme") {
-      studies_folder = value;
     } else {
       std::fprintf(stderr, "error: unknown option %s\n", argument.c_str());
       return 2;
@@ -244,7 +238,7 @@ int main(int argc, char** argv) {
   if (folder.empty() || seeds < 1 || threads < 1 || (load != "transverse" && load != "axial")) {
     std::fprintf(stderr,
                  "usage: %s OUTPUT_DIR [--seeds=20] [--threads=2] [--load=transverse|axial] "
-                 "[--model=FOLDER] [--truth=FOLDER] [--studies-readme=FOLDER]\n",
+                 "[--model=FOLDER] [--truth=FOLDER]\n",
                  argv[0]);
     return 2;
   }
@@ -352,6 +346,5 @@ int main(int argc, char** argv) {
   bool gnuplot_missing = false;
   const std::string why = DrawGnuplotFigure(folder, "moduli", script.str(), &gnuplot_missing);
   if (!why.empty()) std::fprintf(stderr, "moduli.png skipped: %s\n", why.c_str());
-  if (!studies_folder.empty()) WriteStudiesReadme(studies_folder);
   return 0;
 }

@@ -20,4 +20,6 @@ trap 'rm -rf "$work"' EXIT
   --output "$work" > /dev/null
 mkdir -p "$out"
 "$build_dir/bench/plate_identification_benchmark" "$out" --seeds="${1:-20}" --load=axial \
-  --model="$root/configs/plate/fine" --truth="$work/fine" --studies-readme="$root/results"
+  --model="$root/configs/plate/fine" --truth="$work/fine"
+"$build_dir/identify/identify" study "$root/configs/studies.yaml" --output "$root/results" \
+  --set study.kind=readme

@@ -96,6 +96,28 @@ TEST(IdentifyStudyTest, OneKindRunsThatStudyOnly) {
   EXPECT_FALSE(fs::exists(folder + "/relaxation"));
 }
 
+// study.kind readme runs no study: it gathers README.md again from the folders
+// there, the one the cost-curve study wrote among them.
+TEST(IdentifyStudyTest, TheReadmeKindGathersTheSummariesAndRunsNothing) {
+  const std::string directory = FreshDirectory("identify_study_readme");
+  const std::string config = WriteConfig(directory, kTinyStudyConfig);
+  const std::string folder = directory + "/results";
+  ASSERT_EQ(RunIdentify("study " + config + " --set study.kind=cost_curves " +
+                        "--set study.figures=false -q --output " + folder)
+                .exit_code,
+            0);
+  fs::remove(folder + "/README.md");
+  const RunResult result =
+      RunIdentify("study " + config + " --set study.kind=readme -q --output " + folder);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  std::ifstream readme(folder + "/README.md");
+  std::ostringstream text;
+  text << readme.rdbuf();
+  EXPECT_NE(text.str().find("## Cost curves (`cost_curves/`)"), std::string::npos) << text.str();
+  EXPECT_FALSE(fs::exists(folder + "/robustness"));
+  EXPECT_FALSE(fs::exists(folder + "/relaxation"));
+}
+
 // The text of a study's file without the lines that give its wall time and
 // thread count ("... in 0 s on 4 threads.").
 std::string WithoutTimingLines(const std::string& text) {

@@ -625,7 +625,7 @@ const std::vector<Key>& KeyTable() {
       MakeKey("study.kind", &Config::study, &StudyOptions::kind,
               EnumByName<StudyKind>(
                   {StudyKind::kRobustness, StudyKind::kRelaxation, StudyKind::kCostCurves,
-                   StudyKind::kAll, StudyKind::kDamage, StudyKind::kComparator},
+                   StudyKind::kAll, StudyKind::kDamage, StudyKind::kComparator, StudyKind::kReadme},
                   StudyKindToString, StringToStudyKind),
               "", "which study `identify study` runs (study.h)"),
       MakeKey("study.folder", &Config::study, &StudyOptions::folder, Text(), "",

@@ -330,14 +330,16 @@ enum class StudyKind {
   kAll,         // the three above
   kDamage,      // damage localisation with zones and sensors (damage_study.h); not in kAll
   kComparator,  // MCRE against output-error least squares (comparator_study.h); not in kAll
+  kReadme,      // no study: only results/README.md gathered from the study folders there
 };
-inline constexpr std::array<std::pair<StudyKind, const char*>, 6> kStudyKindNames{{
+inline constexpr std::array<std::pair<StudyKind, const char*>, 7> kStudyKindNames{{
     {StudyKind::kRobustness, "robustness"},
     {StudyKind::kRelaxation, "relaxation"},
     {StudyKind::kCostCurves, "cost_curves"},
     {StudyKind::kAll, "all"},
     {StudyKind::kDamage, "damage"},
     {StudyKind::kComparator, "comparator"},
+    {StudyKind::kReadme, "readme"},
 }};
 const char* StudyKindToString(StudyKind kind);
 bool StringToStudyKind(const std::string& name, StudyKind* kind);
