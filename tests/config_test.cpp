@@ -692,8 +692,6 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
        "search.refine_window applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  merge_zones: true\n",
        "zone_identification.merge_zones applies to the bar only"},
-      {"model:\n  kind: matrix\n  manifest: m.yaml\nouter:\n  functional: least_squares\n",
-       "outer.functional must be 'mcre'"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\ninner:\n  method: riccati\n",
        "inner.method 'riccati' solves the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  channel_map: {F: t}\n",
@@ -713,6 +711,16 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
       EXPECT_EQ(std::string(error.what()).rfind("kinds.yaml:", 0), 0u) << error.what();
     }
   }
+}
+
+// Least squares is the MCRE's comparator on matrix models too
+// (app/matrix_identification_run.h).
+TEST(ConfigTest, LeastSquaresIsAcceptedOnAMatrixModel) {
+  const Config config = ParseConfig(
+      "model:\n  kind: matrix\n  manifest: m.yaml\nouter:\n  functional: least_squares\n",
+      "matrix_least_squares.yaml");
+  EXPECT_EQ(config.outer.functional, OuterFunctional::kLeastSquares);
+  EXPECT_EQ(config.structure.kind, ModelKind::kMatrix);
 }
 
 TEST(ConfigTest, PaperBarConfigLoads) {

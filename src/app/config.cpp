@@ -836,10 +836,8 @@ std::string StructureKeysProblem(const Config& config) {
            "' the manifest's zones are identified without a penalty, so there is no "
            "discrepancy target to merge them by";
   }
-  if (config.outer.functional != OuterFunctional::kMcre) {
-    return "outer.functional must be 'mcre' with model.kind '" + kind +
-           "' (least squares is the bar's comparator)";
-  }
+  // outer.functional: both run on a matrix model (least squares by
+  // MatrixOutputErrorObjective, app/matrix_identification_run.h).
   // auto keeps conjugate_gradient on a matrix model (ResolveCoupledSolverType).
   const CoupledSolverType method = config.inner.type;
   if (method != CoupledSolverType::kAuto && method != CoupledSolverType::kConjugateGradient &&

@@ -12,6 +12,7 @@
 
 #include "mcrewave/data/prefilter.h"
 #include "mcrewave/data/resample.h"
+#include "mcrewave/least_squares/matrix_output_error_objective.h"
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/matrix_zone_objective.h"
 
@@ -75,10 +76,11 @@ ChannelSet ReadMatrixMeasurementCsv(const Config& config, const MatrixModelData&
   return set;
 }
 
-// Synthetic data: the truth's outputs at its moduli, with noise; the truth's moduli of
-// the model's zones in *truth_moduli (empty when a zone name is not the truth's).
+// Synthetic data: the truth's outputs at its moduli, with noise (its levels in *noise);
+// the truth's moduli of the model's zones in *truth_moduli (empty when a zone name is
+// not the truth's).
 ChannelSet SyntheticMatrixMeasurements(const Config& config, const MatrixModelData& model,
-                                       Vector* truth_moduli) {
+                                       Vector* truth_moduli, NoiseLevels* noise) {
   const std::string manifest = config.data.truth_manifest.empty() ? config.structure.manifest
                                                                   : config.data.truth_manifest;
   const MatrixModelData truth =
@@ -126,7 +128,7 @@ ChannelSet SyntheticMatrixMeasurements(const Config& config, const MatrixModelDa
     sensors.row(static_cast<int>(k)) = outputs.row(sensor_rows[k]);
   }
   ChannelSet histories = MatrixChannelSet(model, config.time.step, loads, sensors);
-  AddMatrixModelNoise(model, config.data.snr, config.data.seed, &histories);
+  AddMatrixModelNoise(model, config.data.snr, config.data.seed, &histories, noise);
 
   truth_moduli->resize(static_cast<int>(model.zones.size()));
   for (std::size_t z = 0; z < model.zones.size(); ++z) {
@@ -147,11 +149,14 @@ double RootMeanSquareOfRows(const Matrix& rows) {
   return rows.size() > 0 ? std::sqrt(rows.squaredNorm() / static_cast<double>(rows.size())) : 0.0;
 }
 
-// Records every evaluation of the zone objective and logs a progress line.
+// Records every evaluation of a zone objective (MatrixZoneObjective,
+// MatrixOutputErrorObjective) and logs a progress line naming its cost.
+template <typename ZoneObjective>
 class RecordingObjective : public MultiParameterObjective {
  public:
-  RecordingObjective(MatrixZoneObjective* objective, std::vector<MatrixEvaluation>* records)
-      : objective_(objective), records_(records) {}
+  RecordingObjective(ZoneObjective* objective, std::vector<MatrixEvaluation>* records,
+                     const char* cost_name)
+      : objective_(objective), records_(records), cost_name_(cost_name) {}
   int num_parameters() const override { return objective_->num_parameters(); }
   bool Evaluate(const double* p, double* cost, double* gradient) override {
     MatrixEvaluation record;
@@ -166,15 +171,17 @@ class RecordingObjective : public MultiParameterObjective {
     for (int z = 0; z < record.moduli.size(); ++z) {
       moduli += (z == 0 ? "" : ", ") + fmt::format("{:.6g}", record.moduli[z] * 1e-9);
     }
-    spdlog::info("evaluation {}: E = [{}] GPa, e^2 / J_rest = {:.9e}{}", records_->size(), moduli,
-                 record.cost, record.usable ? "" : " (" + objective_->error_message() + ")");
+    spdlog::info("evaluation {}: E = [{}] GPa, {} / J_rest = {:.9e}{}", records_->size(), moduli,
+                 cost_name_, record.cost,
+                 record.usable ? "" : " (" + objective_->error_message() + ")");
     return record.usable;
   }
   std::string error_message() const override { return objective_->error_message(); }
 
  private:
-  MatrixZoneObjective* objective_;
+  ZoneObjective* objective_;
   std::vector<MatrixEvaluation>* records_;
+  const char* cost_name_;
 };
 
 // e^2 and the zone and dof maps of a usable coupled solution at the problem's moduli.
@@ -203,6 +210,81 @@ bool SolveAt(const Vector& moduli, const CoupledSolverOptions& inner, MatrixMcre
   }
   CostAndMaps(problem, solution, cost, zone_map, zone_gap, dof_map);
   return true;
+}
+
+// After the minimiser: the identified moduli of run->outer and why the run is not
+// usable (no usable point, no tolerance met, a zone on a bound of p in [lower, upper]).
+template <typename ZoneObjective>
+void TakeZoneOutcome(const ZoneObjective& objective, const std::vector<double>& lower,
+                     const std::vector<double>& upper, MatrixIdentificationRun* out) {
+  MatrixIdentificationRun& run = *out;
+  const std::size_t zones = lower.size();
+  spdlog::info("zones: {}", run.outer.BriefReport());
+  if (run.outer.x.empty()) {
+    run.failure = "no usable evaluation: " + run.outer.message;
+  } else {
+    run.identified_moduli = objective.Moduli(run.outer.x.data());
+    if (!run.outer.IsSolutionUsable()) {
+      run.failure = "the optimiser stopped before a tolerance was met: " + run.outer.message;
+    }
+    for (std::size_t z = 0; z < zones && run.failure.empty(); ++z) {
+      // A modulus on a bound is where the search stopped, not where the data point.
+      const double p = run.outer.x[z];
+      if (std::abs(p - lower[z]) < 1e-6 || std::abs(p - upper[z]) < 1e-6) {
+        run.failure = fmt::format(
+            "zone '{}' ends on a bound of outer.lower_bound / outer.upper_bound ({:.6g} Pa): "
+            "widen the bounds or check the data's units",
+            run.zone_names[z], run.identified_moduli[static_cast<int>(z)]);
+      }
+    }
+  }
+}
+
+// The bounds of p_z = log(E_z / E_z,nom): outer.lower_bound and outer.upper_bound.
+void ZoneParameterBounds(const Config& config, const Vector& nominal, std::vector<double>* lower,
+                         std::vector<double>* upper) {
+  const auto zones = static_cast<std::size_t>(nominal.size());
+  lower->resize(zones);
+  upper->resize(zones);
+  for (std::size_t z = 0; z < zones; ++z) {
+    (*lower)[z] = std::log(config.outer.lower_bound / nominal[static_cast<int>(z)]);
+    (*upper)[z] = std::log(config.outer.upper_bound / nominal[static_cast<int>(z)]);
+  }
+}
+
+// Step 2 with outer.functional: least_squares: every zone modulus by the output-error
+// misfit J (docs/formulation.md section 8), then J and the model's outputs at the
+// identified moduli and J at the nominal ones. run->data is the pre-filtered data.
+void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelData& model,
+                                       const MatrixMeasurements& measurements,
+                                       MatrixIdentificationRun* out) {
+  MatrixIdentificationRun& run = *out;
+  run.least_squares = true;
+  run.misfit_levels =
+      MatrixLeastSquaresMisfitLevels(config, model, measurements, run.data, &run.misfit_source);
+  MatrixOutputErrorObjective objective(model, run.data, run.misfit_levels, config.time.theta);
+  run.nominal_moduli = objective.nominal_moduli();
+  run.rest_cost = objective.rest_cost();
+  RecordingObjective<MatrixOutputErrorObjective> recorder(&objective, &run.evaluations, "J");
+  std::vector<double> lower, upper;
+  ZoneParameterBounds(config, run.nominal_moduli, &lower, &upper);
+  spdlog::info(
+      "matrix model {}: {} dofs, {} zones, {} loads, {} sensors, {} steps of {:.4g} s; "
+      "output-error least squares, misfit levels {:.4g} m, {:.4g} ({})",
+      run.manifest, run.dofs, lower.size(), model.loads.size(), model.sensors.size(), run.steps,
+      run.time_step, run.misfit_levels.displacement_std, run.misfit_levels.strain_std,
+      run.misfit_source);
+  run.outer = MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper,
+                                   std::vector<double>(lower.size(), 0.0));
+  TakeZoneOutcome(objective, lower, upper, &run);
+  if (run.identified_moduli.size() > 0) {
+    run.cost = objective.Cost(run.identified_moduli, nullptr);
+    run.model_outputs = objective.outputs();
+  }
+  run.nominal_cost = objective.Cost(run.nominal_moduli, nullptr);
+  if (!(std::isfinite(run.cost) && std::isfinite(run.nominal_cost)) && run.failure.empty()) {
+    run.failure = "the output-error misfit is not finite at the identified or nominal moduli";
+  }
 }
 
 }  // namespace
@@ -264,7 +346,7 @@ MatrixMeasurements LoadMatrixMeasurements(const Config& config, const MatrixMode
     measurements.source = config.data.path;
   } else {
     measurements.histories =
-        SyntheticMatrixMeasurements(config, model, &measurements.truth_moduli);
+        SyntheticMatrixMeasurements(config, model, &measurements.truth_moduli, &measurements.noise);
     measurements.source = "synthetic";
   }
   return measurements;
@@ -281,7 +363,8 @@ Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_modu
 }
 
 void AddMatrixModelNoise(const MatrixModelData& model, double snr, std::uint64_t seed,
-                         ChannelSet* data) {
+                         ChannelSet* data, NoiseLevels* levels) {
+  if (levels != nullptr) *levels = NoiseLevels();
   if (std::isinf(snr)) return;
   // The channels of each quantity, gathered as rows for their RMS.
   const auto samples = data->num_samples();
@@ -310,6 +393,11 @@ void AddMatrixModelNoise(const MatrixModelData& model, double snr, std::uint64_t
   const double std_u = RootMeanSquareOfRows(displacements) / snr;
   const double std_e = RootMeanSquareOfRows(strains) / snr;
   const double std_f = RootMeanSquareOfRows(loads) / snr;
+  if (levels != nullptr) {
+    levels->displacement_std = std_u;
+    levels->strain_std = std_e;
+    levels->force_std = std_f;
+  }
   std::mt19937_64 generator(seed);
   // Uniform in (0, 1) from 53 random bits; a standard normal draw by Box-Muller.
   auto uniform = [&] { return (static_cast<double>(generator() >> 11) + 0.5) * 0x1.0p-53; };
@@ -323,6 +411,48 @@ void AddMatrixModelNoise(const MatrixModelData& model, double snr, std::uint64_t
     const double deviation = model.sensors[k].kind == SensorKind::kStrain ? std_e : std_u;
     for (int j = 0; j < samples; ++j) (*sensor_values[k])[j] += deviation * normal();
   }
+}
+
+NoiseLevels MatrixLeastSquaresMisfitLevels(const Config& config, const MatrixModelData& model,
+                                           const MatrixMeasurements& measurements,
+                                           const ChannelSet& used, std::string* source) {
+  NoiseLevels levels;
+  if (config.data.source == DataSource::kSynthetic && std::isfinite(config.data.snr)) {
+    // std = RMS(signal) / SNR of the sensors of each kind (AddMatrixModelNoise)
+    levels = measurements.noise;
+    *source = "synthetic_snr";
+  } else {
+    // s^2 averaged over the sensors of each kind (DifferenceNoiseStd)
+    double sums[2] = {0.0, 0.0};
+    int counts[2] = {0, 0};
+    for (const MatrixModelSensor& sensor : model.sensors) {
+      const int kind = sensor.kind == SensorKind::kStrain ? 1 : 0;
+      sums[kind] += std::pow(DifferenceNoiseStd(measurements.histories.Values(sensor.channel)), 2);
+      ++counts[kind];
+    }
+    if (counts[0] > 0) levels.displacement_std = std::sqrt(sums[0] / counts[0]);
+    if (counts[1] > 0) levels.strain_std = std::sqrt(sums[1] / counts[1]);
+    *source = "data_differences";
+  }
+  levels.force_std = 0.0;
+  // Noise-free data have no level to normalise by: the RMS of the kind's channels in use
+  // instead (only the ratio of the weights matters then).
+  for (const bool strain : {false, true}) {
+    double& level = strain ? levels.strain_std : levels.displacement_std;
+    double sum = 0.0;
+    int count = 0;
+    for (const MatrixModelSensor& sensor : model.sensors) {
+      if ((sensor.kind == SensorKind::kStrain) != strain) continue;
+      sum += used.Values(sensor.channel).squaredNorm() / used.num_samples();
+      ++count;
+    }
+    const double rms = count > 0 ? std::sqrt(sum / count) : 0.0;
+    if (!(level > 0.0) && rms > 0.0) {
+      level = rms;
+      *source = "channel_rms";
+    }
+  }
+  return levels;
 }
 
 ChannelSet MatrixMeasurementTable(const Config& config, const MatrixModelData& model,
@@ -376,44 +506,30 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config,
     spdlog::info("pre-filter: zero-phase Butterworth, cut-off {:.6g} Hz", cutoff);
   }
 
-  // 2. Every zone modulus at once, p_z = log(E_z / E_z,nom), from p = 0.
+  // 2. Every zone modulus at once, p_z = log(E_z / E_z,nom), from p = 0 (by least
+  //    squares with outer.functional: least_squares, without error maps).
+  if (config.outer.functional == OuterFunctional::kLeastSquares) {
+    IdentifyMatrixZonesByLeastSquares(config, model, measurements, &run);
+    run.wall_time_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return run;
+  }
   MatrixMcreProblem problem(model, run.data, config.mcre.weights, config.mcre.reference_modulus,
                             config.time.theta);
   run.nominal_moduli = problem.NominalModuli();
   run.rest_cost = problem.RestCost();
   MatrixZoneObjective objective(&problem, config.inner);
-  RecordingObjective recorder(&objective, &run.evaluations);
+  RecordingObjective<MatrixZoneObjective> recorder(&objective, &run.evaluations, "e^2");
   const auto zones = static_cast<std::size_t>(model.zones.size());
-  std::vector<double> lower(zones), upper(zones);
-  for (std::size_t z = 0; z < zones; ++z) {
-    lower[z] = std::log(config.outer.lower_bound / run.nominal_moduli[static_cast<int>(z)]);
-    upper[z] = std::log(config.outer.upper_bound / run.nominal_moduli[static_cast<int>(z)]);
-  }
+  std::vector<double> lower, upper;
+  ZoneParameterBounds(config, run.nominal_moduli, &lower, &upper);
   spdlog::info(
       "matrix model {}: {} dofs, {} zones, {} loads, {} sensors, {} steps of {:.4g} s; inner {}",
       run.manifest, run.dofs, zones, model.loads.size(), model.sensors.size(), run.steps,
       run.time_step, CoupledSolverName(config.inner.type, run.inner_method));
   run.outer = MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper,
                                    std::vector<double>(zones, 0.0));
-  spdlog::info("zones: {}", run.outer.BriefReport());
-  if (run.outer.x.empty()) {
-    run.failure = "no usable evaluation: " + run.outer.message;
-  } else {
-    run.identified_moduli = objective.Moduli(run.outer.x.data());
-    if (!run.outer.IsSolutionUsable()) {
-      run.failure = "the optimiser stopped before a tolerance was met: " + run.outer.message;
-    }
-    for (std::size_t z = 0; z < zones && run.failure.empty(); ++z) {
-      // A modulus on a bound is where the search stopped, not where the data point.
-      const double p = run.outer.x[z];
-      if (std::abs(p - lower[z]) < 1e-6 || std::abs(p - upper[z]) < 1e-6) {
-        run.failure = fmt::format(
-            "zone '{}' ends on a bound of outer.lower_bound / outer.upper_bound ({:.6g} Pa): "
-            "widen the bounds or check the data's units",
-            run.zone_names[z], run.identified_moduli[static_cast<int>(z)]);
-      }
-    }
-  }
+  TakeZoneOutcome(objective, lower, upper, &run);
 
   // 3. The error maps and the model's outputs at the identified moduli (from the last
   //    evaluation's solve when it was there, as it usually is), then the maps at the

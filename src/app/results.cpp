@@ -836,8 +836,8 @@ std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
 
 namespace {
 
+// Least squares has no error map: its columns are left empty.
 std::string MatrixZonesCsv(const MatrixIdentificationRun& run) {
-  const Vector nominal_share = GapFractions(run.nominal_zone_map), share = GapFractions(run.zone_map);
   std::vector<ZoneRow> rows(static_cast<std::size_t>(run.nominal_moduli.size()));
   for (int z = 0; z < run.nominal_moduli.size(); ++z) {
     ZoneRow& row = rows[static_cast<std::size_t>(z)];
@@ -845,6 +845,12 @@ std::string MatrixZonesCsv(const MatrixIdentificationRun& run) {
     row.nominal_modulus = run.nominal_moduli[z];
     row.modulus = run.identified_moduli[z];
     if (run.truth_moduli.size() > 0) row.truth_modulus = run.truth_moduli[z];
+  }
+  if (run.least_squares) return ZonesCsv(rows);
+  const Vector nominal_share = GapFractions(run.nominal_zone_map),
+               share = GapFractions(run.zone_map);
+  for (int z = 0; z < run.nominal_moduli.size(); ++z) {
+    ZoneRow& row = rows[static_cast<std::size_t>(z)];
     row.error_share_nominal = nominal_share[z];
     row.error_share_identified = share[z];
     row.relative_gap_nominal = run.nominal_zone_gap[z];
@@ -915,6 +921,13 @@ std::string MatrixZonesScript(const MatrixIdentificationRun& run, const std::str
   if (run.truth_moduli.size() > 0) {
     script << ", '' skip 1 using ($8*1e-9) title 'truth' lc rgb '#000000'";
   }
+  if (run.least_squares) {
+    // No error map by least squares: the right panel says so.
+    script << "\nunset xtics\nunset ytics\nunset ylabel\nset border 0\nset title 'no error map: "
+              "output-error "
+              "least squares'\nplot [0:1] [0:1] NaN notitle\nunset multiplot\n";
+    return script.str();
+  }
   script << "\nset title 'MCRE error map: constitutive gap / strain energy of the zone'\n"
             "set ylabel 'relative gap'\nplot "
          << csv << " skip 1 using 12:xtic(2) title 'at the nominal moduli' lc rgb '#fdae61', '' "
@@ -948,9 +961,63 @@ std::string MatrixFitScript(const MatrixIdentificationRun& run, const std::strin
   return script.str();
 }
 
+// summary.yaml of a matrix run by least squares: MatrixSummaryYaml's layout with J [s]
+// for e^2, the misfit levels for the error map, and no inner solver.
+std::string MatrixLeastSquaresSummaryYaml(const MatrixIdentificationRun& run,
+                                          const Config& config) {
+  YamlWriter yaml;
+  yaml.Raw(
+      "# mcrewave identify run: the zone moduli of a structure given by matrices, by output-error "
+      "least squares");
+  if (!config.source_path.empty()) yaml.Raw("# config: " + config.source_path);
+  yaml.Text(0, "version", kVersion, "mcrewave version");
+  yaml.Text(0, "functional", "least_squares", "outer.functional (docs/formulation.md section 8)");
+  yaml.Line(0, "model", "");
+  yaml.Text(1, "kind", ModelKindToString(config.structure.kind));
+  yaml.Text(1, "manifest", run.manifest);
+  yaml.Integer(1, "dofs", run.dofs);
+  yaml.Integer(1, "zones", static_cast<long>(run.zone_names.size()));
+  yaml.Integer(1, "loads", static_cast<long>(run.load_names.size()));
+  yaml.Integer(1, "sensors", static_cast<long>(run.sensor_names.size()));
+  yaml.Line(0, "data", "");
+  yaml.Text(1, "source", run.data_source);
+  yaml.Integer(1, "steps", run.steps);
+  yaml.Number(1, "time_step", run.time_step, "[s]");
+  yaml.Line(0, "zones", "", "identified modulus per zone (zones.csv)");
+  for (int z = 0; z < run.nominal_moduli.size(); ++z) {
+    const bool truth = run.truth_moduli.size() > 0;
+    yaml.Raw("  - {name: " + Quoted(run.zone_names[static_cast<std::size_t>(z)]) + ", nominal: " +
+             Format(run.nominal_moduli[z]) + ", modulus: " + Format(run.identified_moduli[z]) +
+             ", truth: " + Format(truth ? run.truth_moduli[z] : NAN) + ", relative_error: " +
+             Format(truth ? run.identified_moduli[z] / run.truth_moduli[z] - 1.0 : NAN) + "}");
+  }
+  yaml.Number(0, "cost", run.cost, "[s] J at the identified moduli");
+  yaml.Number(0, "nominal_cost", run.nominal_cost, "[s] J at the nominal moduli");
+  yaml.Number(0, "cost_scale", run.rest_cost, "[s] J_rest, J with every prediction 0");
+  yaml.Line(0, "misfit_levels", "", "each sensor kind's misfit divided by its level");
+  yaml.Number(1, "displacement", run.misfit_levels.displacement_std, "[m] s_u (0: no such sensor)");
+  yaml.Number(1, "strain", run.misfit_levels.strain_std, "[-] s_e (0: no such sensor)");
+  yaml.Text(1, "source", run.misfit_source);
+  yaml.Line(0, "optimizer", "", "zone_identification: (the zone moduli in log E)");
+  yaml.Text(1, "algorithm", BoundedAlgorithmToString(run.outer.algorithm));
+  yaml.Text(1, "termination", TerminationTypeToString(run.outer.termination));
+  yaml.Text(1, "message", run.outer.message);
+  yaml.Text(1, "optimizer_message", run.outer.optimizer_message, "the optimiser's own words");
+  yaml.Integer(1, "evaluations", run.outer.evaluations);
+  yaml.Integer(1, "gradient_evaluations", run.outer.gradient_evaluations);
+  yaml.Number(1, "scaled_cost", run.outer.cost, "J / cost_scale at the identified moduli");
+  yaml.Line(0, "prefilter", "");
+  yaml.Line(1, "enabled", config.prefilter.enabled ? "true" : "false");
+  yaml.Number(1, "cutoff_frequency", run.prefilter_cutoff, "[Hz] the cut-off used (0: off)");
+  yaml.Number(0, "wall_time_s", run.wall_time_s, "[s] identification and fit");
+  ConfigYaml(config, &yaml);
+  return yaml.str();
+}
+
 }  // namespace
 
 std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& config) {
+  if (run.least_squares) return MatrixLeastSquaresSummaryYaml(run, config);
   YamlWriter yaml;
   yaml.Raw("# mcrewave identify run: the zone moduli of a structure given by matrices, by the MCRE");
   if (!config.source_path.empty()) yaml.Raw("# config: " + config.source_path);
@@ -1015,7 +1082,7 @@ std::vector<std::string> WriteMatrixIdentificationResults(const MatrixIdentifica
   results.Write("zones.csv", MatrixZonesCsv(run));
   results.Write("evaluations.csv", MatrixEvaluationsCsv(run));
   results.Write("fit.csv", MatrixFitCsv(run));
-  results.Write("error_map_dofs.csv", MatrixDofMapCsv(run));
+  if (!run.least_squares) results.Write("error_map_dofs.csv", MatrixDofMapCsv(run));
   if (figures) {
     std::vector<SensorKind> kinds;
     for (const MatrixModelSensor& sensor : model.sensors) kinds.push_back(sensor.kind);

@@ -29,7 +29,8 @@ double Median(std::vector<double> values) {
   return values[middle];
 }
 
-// s = 1.4826 MAD(d2) / sqrt(6) of one channel (0 with fewer than 3 samples).
+}  // namespace
+
 double DifferenceNoiseStd(const Vector& channel) {
   std::vector<double> second_differences;
   for (Eigen::Index j = 1; j + 1 < channel.size(); ++j) {
@@ -39,8 +40,6 @@ double DifferenceNoiseStd(const Vector& channel) {
   for (double& value : second_differences) value = std::abs(value - median);
   return 1.4826 * Median(second_differences) / std::sqrt(6.0);
 }
-
-}  // namespace
 
 NoiseLevels DifferenceNoiseLevels(const ChannelSet& data) {
   const BarEnds ends = BarEndChannels(data);

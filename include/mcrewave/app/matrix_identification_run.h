@@ -17,6 +17,10 @@
 //      inner:; no jump penalty (matrices do not say which zones are neighbours).
 //      Then the error maps (zone and dof) at the nominal and the identified moduli
 //      and the model's outputs at the identified moduli.
+//      With outer.functional: least_squares, the same minimiser, bounds and start on
+//      the output-error misfit J instead (least_squares/matrix_output_error_objective.h),
+//      each sensor kind normalised by its misfit level (MatrixLeastSquaresMisfitLevels);
+//      no error map.
 //
 // Results: WriteMatrixIdentificationResults (app/results.h).
 #pragma once
@@ -28,6 +32,7 @@
 #include "mcrewave/app/config.h"
 #include "mcrewave/data/channel_set.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
+#include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/optim/bounded_minimizer.h"
 
 namespace mcrewave {
@@ -41,6 +46,9 @@ struct MatrixMeasurements {
   // Synthetic data: the truth's modulus of each of the model's zones [Pa], matched by
   // zone name; empty for CSV data or when a zone of the model is not one of the truth's.
   Vector truth_moduli;
+  // Synthetic data: the standard deviations of the noise added (AddMatrixModelNoise;
+  // all 0 without noise); CSV data: all 0.
+  NoiseLevels noise;
 };
 
 // Reads the manifest of config.structure.manifest. Throws InputError naming the file
@@ -77,9 +85,21 @@ Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_modu
 // channels of the same quantity (the displacement sensors together, the strain
 // sensors together, the loads together), drawn by a 64-bit Mersenne twister seeded
 // with `seed` (Box-Muller), the loads first, then the sensors in order, sample by
-// sample. Nothing when snr is infinite.
+// sample. Nothing when snr is infinite. levels (nullable): the standard deviations drawn
+// (displacement_std, strain_std, force_std; all 0 when snr is infinite).
 void AddMatrixModelNoise(const MatrixModelData& model, double snr, std::uint64_t seed,
-                         ChannelSet* data);
+                         ChannelSet* data, NoiseLevels* levels = nullptr);
+
+// The misfit levels that normalise least squares on a matrix model, the bar's convention
+// (LeastSquaresMisfitLevels): per sensor kind, the noise of synthetic data at a finite
+// data.snr (measurements.noise, *source "synthetic_snr"), else the estimate from the
+// second differences of the measurements (DifferenceNoiseStd, s^2 averaged over the
+// sensors of the kind, *source "data_differences"); a kind with a level 0 (noise-free
+// data) takes the RMS of its channels in `used` instead (*source "channel_rms").
+// force_std is 0: the loads are inputs.
+NoiseLevels MatrixLeastSquaresMisfitLevels(const Config& config, const MatrixModelData& model,
+                                           const MatrixMeasurements& measurements,
+                                           const ChannelSet& used, std::string* source);
 
 // The measurements as the CSV identify run reads back (WriteChannelCsv): every channel
 // of the model, in its order, under its column (model.channel_map).
@@ -90,13 +110,18 @@ ChannelSet MatrixMeasurementTable(const Config& config, const MatrixModelData& m
 // One evaluation of the identification's cost.
 struct MatrixEvaluation {
   Vector moduli;                      // E_z [Pa]
-  double cost = 0.0;                  // e^2 / J_rest
-  bool usable = false;                // the inner solve was usable
+  double cost = 0.0;                  // e^2 / J_rest (least squares: J / J_rest)
+  bool usable = false;                // the inner solve was usable (least squares: J finite)
   double gradient_norm = -1.0;        // |d cost / d p|; -1 without gradient
 };
 
 struct MatrixIdentificationRun {
   std::string manifest;  // the model's manifest path
+  // outer.functional: least_squares: the costs are J [s] and there is no error map
+  // (the maps and gaps below are empty).
+  bool least_squares = false;
+  NoiseLevels misfit_levels;  // least squares: s_u, s_e of the normalisation
+  std::string misfit_source;  // as MatrixLeastSquaresMisfitLevels says
   int dofs = 0;
   int steps = 0;
   // The coupled solver of every solve: config.inner.type, auto resolved
@@ -111,9 +136,9 @@ struct MatrixIdentificationRun {
   Vector truth_moduli;                   // [Pa]; empty when unknown
   BoundedMinimizerSummary outer;
   std::vector<MatrixEvaluation> evaluations;
-  double rest_cost = 0.0;                // J_rest [J s]
-  double nominal_cost = 0.0;             // e^2 at the nominal moduli [J s]
-  double cost = 0.0;                     // e^2 at the identified moduli [J s]
+  double rest_cost = 0.0;     // J_rest [J s] (least squares: [s])
+  double nominal_cost = 0.0;  // e^2 at the nominal moduli [J s] (J [s])
+  double cost = 0.0;          // e^2 at the identified moduli [J s] (J [s])
   // Constitutive part of e^2 per zone and per dof [J s], at the nominal moduli (where
   // the model is wrong) and at the identified ones.
   Vector nominal_zone_map, zone_map, nominal_dof_map, dof_map;

@@ -78,7 +78,10 @@ std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
 //   error_map_dofs.csv  the constitutive gap per dof [J s] at the nominal and the
 //                       identified moduli (MatrixMcreProblem::DofErrorMap)
 //   zones.png, fit.png  moduli and error shares per zone; the first six sensors
-// written as WriteIdentificationResults writes (atomically, summary last).
+// written as WriteIdentificationResults writes (atomically, summary last). By least
+// squares (run.least_squares): summary.yaml says `functional: least_squares`, with J,
+// J_rest [s] and the misfit levels in place of e^2 and the inner solver; zones.csv
+// has its error-map columns empty; no error_map_dofs.csv; zones.png the moduli alone.
 // Precondition: run.IsUsable().
 std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& config);
 std::vector<std::string> WriteMatrixIdentificationResults(const MatrixIdentificationRun& run,

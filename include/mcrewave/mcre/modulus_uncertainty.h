@@ -50,6 +50,9 @@ struct NoiseLevels {
 // every u@X; forces: the two ends; strains: every e@X). For measured data, whose noise
 // is not known.
 NoiseLevels DifferenceNoiseLevels(const ChannelSet& data);
+// s = 1.4826 MAD(d2) / sqrt(6) of one channel, the estimate above (0 with fewer than 3
+// samples).
+double DifferenceNoiseStd(const Vector& channel);
 
 // RMS misfits of the coupled solution at the optimum: displacement
 // sqrt(mean_{ends, j} (U_end,j - u~_end,j)^2) and force

@@ -1,0 +1,171 @@
+#include "mcrewave/least_squares/matrix_output_error_objective.h"
+
+#include <cassert>
+#include <cmath>
+
+namespace mcrewave {
+
+MatrixOutputErrorObjective::MatrixOutputErrorObjective(const MatrixModelData& model,
+                                                       const ChannelSet& data,
+                                                       const NoiseLevels& misfit_levels,
+                                                       double theta, Factorization factorization)
+    : model_(model), time_step_(data.time_step), theta_(theta), factorization_(factorization) {
+  const int n = model.dofs();
+  const int zones = static_cast<int>(model.zones.size());
+  const int num_loads = static_cast<int>(model.loads.size());
+  const int num_sensors = static_cast<int>(model.sensors.size());
+  const int samples = data.num_samples();
+  // The data's channels of the model, gathered once into rows (columns t_j).
+  measured_loads_.resize(num_loads, samples);
+  for (int c = 0; c < num_loads; ++c) {
+    measured_loads_.row(c) = data.Values(model.loads[c].channel).transpose();
+  }
+  measured_outputs_.resize(num_sensors, samples);
+  for (int k = 0; k < num_sensors; ++k) {
+    measured_outputs_.row(k) = data.Values(model.sensors[k].channel).transpose();
+  }
+  assert(samples >= 2 && theta >= 0.0 && theta <= 1.0);
+  nominal_.resize(zones);
+  for (int z = 0; z < zones; ++z) {
+    nominal_[z] = model.zones[z].nominal_modulus;
+    // dK/dE_z = K_z / E_z,nom (docs/formulation.md section 6).
+    zone_stiffness_.push_back(model.zones[z].stiffness / nominal_[z]);
+  }
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int c = 0; c < num_loads; ++c) {
+    const Vector& g = model.loads[c].vector;
+    for (int i = 0; i < n; ++i) {
+      if (g[i] != 0.0) entries.emplace_back(i, c, g[i]);
+    }
+  }
+  loads_.resize(n, num_loads);
+  loads_.setFromTriplets(entries.begin(), entries.end());
+  entries.clear();
+  weights_.resize(num_sensors);
+  for (int k = 0; k < num_sensors; ++k) {
+    const MatrixModelSensor& sensor = model.sensors[k];
+    // w_k = 1 / s^2 of the sensor's kind (docs/formulation.md section 8).
+    const bool strain = sensor.kind == SensorKind::kStrain;
+    const double level = strain ? misfit_levels.strain_std : misfit_levels.displacement_std;
+    assert(level > 0.0);
+    weights_[k] = 1.0 / (level * level);
+    for (int outer = 0; outer < sensor.row.outerSize(); ++outer) {
+      for (SparseMatrix::InnerIterator it(sensor.row, outer); it; ++it) {
+        entries.emplace_back(k, static_cast<int>(it.col()), it.value());
+      }
+    }
+  }
+  observation_.resize(num_sensors, n);
+  observation_.setFromTriplets(entries.begin(), entries.end());
+  for (int b = 0; b < 2; ++b) {
+    velocity_[b] = Vector::Zero(n);
+    displacement_[b] = Vector::Zero(n);
+    sensitivity_velocity_[b] = Matrix::Zero(n, zones);
+    sensitivity_[b] = Matrix::Zero(n, zones);
+  }
+  weighted_ = Vector::Zero(n);
+  force_ = Vector::Zero(n);
+  channel_ = Vector::Zero(num_loads);
+  residual_ = Vector::Zero(num_sensors);
+  trace_ = Vector::Zero(num_sensors);
+  outputs_ = Matrix::Zero(num_sensors, samples);
+  // J_rest = 1/2 sum_j c_j h sum_k w_k d~_kj^2
+  for (int j = 0; j < samples; ++j) {
+    const double c = (j == 0 || j == samples - 1) ? 0.5 : 1.0;
+    rest_cost_ += 0.5 * c * time_step_ * measured_outputs_.col(j).cwiseAbs2().dot(weights_);
+  }
+}
+
+Vector MatrixOutputErrorObjective::Moduli(const double* p) const {
+  Vector moduli(nominal_.size());
+  for (int z = 0; z < nominal_.size(); ++z) moduli[z] = nominal_[z] * std::exp(p[z]);
+  return moduli;
+}
+
+double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradient) {
+  const int zones = num_parameters();
+  assert(zone_moduli.size() == zones && zone_moduli.allFinite() && zone_moduli.minCoeff() > 0.0);
+  ThetaIntegratorOptions options;
+  options.time_step = time_step_;
+  options.theta = theta_;
+  options.factorization = factorization_;
+  // K = sum_z (E_z / E_z,nom) K_z, factorised once for the state and every sensitivity.
+  integrator_.Init(model_.mass, model_.Stiffness(zone_moduli), options);
+
+  const bool gradient_requested = gradient != nullptr;
+  if (gradient_requested) gradient->setZero(zones);
+  const int samples = static_cast<int>(measured_outputs_.cols());
+  const double h = time_step_;
+  int current = 0;
+  // From rest: U_0 = V_0 = 0, S_z,0 = S_z,0' = 0.
+  velocity_[0].setZero();
+  displacement_[0].setZero();
+  sensitivity_velocity_[0].setZero();
+  sensitivity_[0].setZero();
+  double cost = 0.0;
+  for (int j = 0; j < samples; ++j) {
+    if (j > 0) {
+      const int next = current ^ 1;
+      // f_theta = G (theta F~_j + (1 - theta) F~_{j-1}) on the step t_{j-1} -> t_j.
+      channel_ = theta_ * measured_loads_.col(j) + (1.0 - theta_) * measured_loads_.col(j - 1);
+      force_.noalias() = loads_ * channel_;
+      integrator_.Step(velocity_[current], displacement_[current], force_, velocity_[next],
+                       displacement_[next]);
+      if (gradient_requested) {
+        // U_theta = theta U_j + (1 - theta) U_{j-1}
+        weighted_ = theta_ * displacement_[next] + (1.0 - theta_) * displacement_[current];
+        for (int z = 0; z < zones; ++z) {
+          // dS_z: the same scheme with f_theta = -(1/E_z,nom) K_z U_theta.
+          force_.noalias() = zone_stiffness_[z] * weighted_;
+          force_ = -force_;
+          integrator_.Step(sensitivity_velocity_[current].col(z), sensitivity_[current].col(z),
+                           force_, sensitivity_velocity_[next].col(z), sensitivity_[next].col(z));
+        }
+      }
+      current = next;
+    }
+    // r_j = H U_j - d~_j
+    trace_.noalias() = observation_ * displacement_[current];
+    outputs_.col(j) = trace_;
+    residual_ = trace_ - measured_outputs_.col(j);
+    const double c = (j == 0 || j == samples - 1) ? 0.5 : 1.0;
+    // c_j h / 2 sum_k w_k r_kj^2
+    cost += 0.5 * c * h * residual_.cwiseAbs2().dot(weights_);
+    if (!gradient_requested) continue;
+    for (int z = 0; z < zones; ++z) {
+      // c_j h sum_k w_k r_kj (H S_z,j)_k
+      trace_.noalias() = observation_ * sensitivity_[current].col(z);
+      (*gradient)[z] += c * h * residual_.cwiseProduct(weights_).dot(trace_);
+    }
+  }
+  sweeps_ += gradient_requested ? 1 + zones : 1;
+  return cost;
+}
+
+bool MatrixOutputErrorObjective::Evaluate(const double* p, double* cost, double* gradient) {
+  ++evaluations_;
+  const Vector moduli = Moduli(p);
+  if (!(moduli.allFinite() && moduli.minCoeff() > 0.0)) {
+    error_message_ = "a trial zone modulus is not a positive finite number";
+    return false;
+  }
+  Vector moduli_gradient;
+  const double misfit = Cost(moduli, gradient != nullptr ? &moduli_gradient : nullptr);
+  if (!std::isfinite(misfit) || (gradient != nullptr && !moduli_gradient.allFinite())) {
+    error_message_ = "the output-error misfit at the zone moduli of evaluation " +
+                     std::to_string(evaluations_) + " is not finite";
+    return false;
+  }
+  // cost = J / J_rest
+  *cost = misfit / cost_scale();
+  if (gradient != nullptr) {
+    for (int z = 0; z < moduli.size(); ++z) {
+      // d cost / d p_z = (dJ/dE_z) (dE_z/dp_z) / J_rest,  dE_z/dp_z = E_z
+      gradient[z] = moduli_gradient[z] * moduli[z] / cost_scale();
+    }
+  }
+  error_message_.clear();
+  return true;
+}
+
+}  // namespace mcrewave
