@@ -641,38 +641,54 @@ TEST(ConfigTest, EveryKeyAtANonDefaultValueRoundTripsExactly) {
 }
 
 // A summary's config block lists the keys its model kind reads: a matrix run's no
-// clamp, search or bar geometry; the bar's no manifest. Every key named by
-// KeyApplies' lists is a key of the table (the counts below fail on a misspelling).
+// search or bar geometry (its clamp keys treat the manifest's supports); the bar's no manifest.
+// Every key named by KeyApplies' lists is a key of the table (the counts below fail on a
+// misspelling).
 TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
   const std::map<std::string, std::string> every = FlatKeys(ConfigToYaml(Config()));
   const Config matrix = ParseConfig(kEveryMatrixKeyNotAtItsDefault, "matrix.yaml");
   const std::map<std::string, std::string> matrix_keys = FlatKeys(AppliedConfigToYaml(matrix));
   const std::map<std::string, std::string> bar_keys = FlatKeys(AppliedConfigToYaml(Config()));
-  for (const char* key : {"model.manifest", "model.channel_map", "data.truth_manifest",
-                          "data.truth_moduli", "mcre.w_u", "mcre.reference_modulus", "inner.method",
-                          "outer.lower_bound", "prefilter.cutoff_frequency",
-                          "zone_identification.algorithm", "time.step", "load.amplitude"}) {
+  for (const char* key :
+       {"model.manifest", "model.channel_map", "data.truth_manifest", "data.truth_moduli",
+        "mcre.w_u", "mcre.reference_modulus", "mcre.clamp", "mcre.w_r", "mcre.w_u0", "inner.method",
+        "outer.lower_bound", "prefilter.cutoff_frequency", "zone_identification.algorithm",
+        "time.step", "load.amplitude"}) {
     EXPECT_EQ(matrix_keys.count(key), 1u) << key;
     EXPECT_TRUE(KeyApplies(key, ModelKind::kMatrix)) << key;
   }
   for (const char* key :
-       {"mcre.clamp", "mcre.w_r", "mcre.w_u0", "search.functional", "model.length",
-        "model.zone_count", "outer.scan_points", "zone_identification.merge_zones",
-        "uncertainty.samples", "study.kind", "data.sensors"}) {
+       {"search.functional", "model.length", "model.zone_count", "outer.scan_points",
+        "zone_identification.merge_zones", "uncertainty.samples", "study.kind", "data.sensors"}) {
     EXPECT_EQ(matrix_keys.count(key), 0u) << key;
     EXPECT_EQ(bar_keys.count(key), 1u) << key;
   }
   // The bar reads all but the 4 matrix keys; a matrix run none of the 3 sections
-  // search:, uncertainty:, study: and 47 single keys fewer.
+  // search:, uncertainty:, study: and 44 single keys fewer.
   EXPECT_EQ(bar_keys.size(), every.size() - 4);
   std::size_t sections = 0;
   for (const auto& [key, value] : every) {
     const std::string section = key.substr(0, key.find('.'));
     sections += section == "search" || section == "uncertainty" || section == "study" ? 1 : 0;
   }
-  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 47);
+  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 44);
   // Values as resolved: the matrix run's own.
   EXPECT_EQ(matrix_keys.at("model.manifest"), FlatKeys(ConfigToYaml(matrix)).at("model.manifest"));
+}
+
+// The clamp's treatment and weights apply to a matrix model's supports
+// (docs/matrix_models.md section 11).
+TEST(ConfigTest, MatrixModelsReadTheClampKeysForTheirSupports) {
+  const Config config = ParseConfig(
+      "model:\n  kind: matrix\n  manifest: m.yaml\nmcre:\n  clamp: pinned\n  w_r: 0.01\n"
+      "  w_u0: 0.2\n",
+      "a.yaml");
+  EXPECT_EQ(config.mcre.clamp, ClampModel::kPinned);
+  EXPECT_EQ(config.mcre.weights.reaction_weight, 0.01);
+  EXPECT_EQ(config.mcre.weights.clamp_displacement_weight, 0.2);
+  for (const char* key : {"mcre.clamp", "mcre.w_r", "mcre.w_u0"}) {
+    EXPECT_TRUE(KeyApplies(key, ModelKind::kMatrix)) << key;
+  }
 }
 
 TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
@@ -684,8 +700,6 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
        "model.zone_count applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\ndata:\n  sensors: [u@0.5]\n",
        "data.sensors applies to the bar only"},
-      {"model:\n  kind: matrix\n  manifest: m.yaml\nmcre:\n  clamp: measured\n",
-       "mcre.clamp applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\nsearch:\n  functional: same\n",
        "search.functional applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\nsearch:\n  refine_window: 0.1\n",

@@ -473,10 +473,11 @@ const std::vector<Key>& KeyTable() {
       MakeKey("mcre.w_r", &Config::mcre, &McreOptions::weights, &McreWeights::reaction_weight,
               Number(), "",
               "clamp reaction weight (mcre.clamp trusted: f0 an output; pinned: f0 a load): "
-              "alpha_r = w_r L / (S E0)"),
+              "alpha_r = w_r L / (S E0) (a matrix model's supports: w_r / k*)"),
       MakeKey("mcre.w_u0", &Config::mcre, &McreOptions::weights,
               &McreWeights::clamp_displacement_weight, Number(), "",
-              "clamp displacement weight (mcre.clamp pinned): beta_0 = w_u0 S E0 / L"),
+              "clamp displacement weight (mcre.clamp pinned): beta_0 = w_u0 S E0 / L (a "
+              "matrix model's supports: w_u0 k*)"),
       MakeKey("mcre.reference_modulus", &Config::mcre, &McreOptions::reference_modulus, Number(),
               "Pa", "E0 of the weights: a fixed nominal modulus, not the unknown"),
       MakeKey(
@@ -486,7 +487,8 @@ const std::vector<Key>& KeyTable() {
           "",
           "the clamp at x = 0: measured (free-free model, f0 a load, u0 an output), "
           "trusted (u(0) = 0 imposed, f0 a measured output) or pinned (free-free model, "
-          "u0's datum the known 0 with weight w_u0, f0 a load with weight w_r)"),
+          "u0's datum the known 0 with weight w_u0, f0 a load with weight w_r); a matrix "
+          "model's supports alike (docs/matrix_models.md section 11)"),
       MakeKey("inner.method", &Config::inner, &CoupledSolverOptions::type,
               EnumByName<CoupledSolverType>(AllCoupledSolverTypes(), CoupledSolverTypeToString,
                                             StringToCoupledSolverType),
@@ -818,10 +820,6 @@ std::string StructureKeysProblem(const Config& config) {
       {"data.sensors", !config.data.sensors.empty()},
       {"data.channels", !config.data.channels.empty()},
       {"data.truth_zones", !config.data.truth_zones.empty()},
-      {"mcre.clamp", config.mcre.clamp != defaults.mcre.clamp},
-      {"mcre.w_r", config.mcre.weights.reaction_weight != defaults.mcre.weights.reaction_weight},
-      {"mcre.w_u0", config.mcre.weights.clamp_displacement_weight !=
-                        defaults.mcre.weights.clamp_displacement_weight},
       {"search.functional", config.search.functional != defaults.search.functional},
       {search_key, search_key != nullptr},
   };
@@ -1521,9 +1519,6 @@ bool KeyApplies(const std::string& path, ModelKind kind) {
                                                  "data.sensors",
                                                  "data.channels",
                                                  "data.truth_zones",
-                                                 "mcre.w_r",
-                                                 "mcre.w_u0",
-                                                 "mcre.clamp",
                                                  "inner.max_dense_solver_bytes",
                                                  "inner.shooting_condition_limit",
                                                  "inner.shooting_segment_growth",

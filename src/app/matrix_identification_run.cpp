@@ -19,15 +19,29 @@
 namespace mcrewave {
 namespace {
 
-// Every channel of the model, loads then sensors, with its CSV column.
-std::vector<std::pair<std::string, std::string>> ChannelColumns(const Config& config,
-                                                                const MatrixModelData& model) {
-  std::vector<std::pair<std::string, std::string>> channels;
-  for (const MatrixModelLoad& load : model.loads) {
-    channels.emplace_back(load.channel, config.structure.Column(load.channel));
-  }
+// A channel of the model with its CSV column and kind.
+struct ChannelColumn {
+  std::string channel, column;
+  ChannelKind kind;
+};
+
+// Every channel of the model, loads, sensors, then each support's force and
+// displacement channels, with its CSV column.
+std::vector<ChannelColumn> ChannelColumns(const Config& config, const MatrixModelData& model) {
+  std::vector<ChannelColumn> channels;
+  auto add = [&](const std::string& channel, ChannelKind kind) {
+    channels.push_back({channel, config.structure.Column(channel), kind});
+  };
+  for (const MatrixModelLoad& load : model.loads) add(load.channel, ChannelKind::kForce);
   for (const MatrixModelSensor& sensor : model.sensors) {
-    channels.emplace_back(sensor.channel, config.structure.Column(sensor.channel));
+    add(sensor.channel,
+        sensor.kind == SensorKind::kStrain ? ChannelKind::kStrain : ChannelKind::kDisplacement);
+  }
+  for (const MatrixModelSupport& support : model.supports) {
+    add(support.force_channel, ChannelKind::kForce);
+    if (!support.displacement_channel.empty()) {
+      add(support.displacement_channel, ChannelKind::kDisplacement);
+    }
   }
   return channels;
 }
@@ -46,7 +60,7 @@ ChannelSet ReadMatrixMeasurementCsv(const Config& config, const MatrixModelData&
   const HeaderCheck check_header = [&](const std::vector<std::string>& names,
                                        const std::string&) -> std::string {
     if (names.empty()) return "a header naming the columns: t and the model's channels";
-    for (const auto& [channel, column] : channels) {
+    for (const auto& [channel, column, kind] : channels) {
       if (std::find(names.begin(), names.end(), column) != names.end()) continue;
       return "the header lacks the column '" + column + "' of the model's channel '" + channel +
              "'" +
@@ -65,14 +79,7 @@ ChannelSet ReadMatrixMeasurementCsv(const Config& config, const MatrixModelData&
   }
   ChannelSet set;
   set.time_step = config.time.step;
-  const auto loads = model.loads.size();
-  for (std::size_t c = 0; c < channels.size(); ++c) {
-    const ChannelKind kind = c < loads ? ChannelKind::kForce
-                             : model.sensors[c - loads].kind == SensorKind::kStrain
-                                 ? ChannelKind::kStrain
-                                 : ChannelKind::kDisplacement;
-    set.Add(channels[c].first, kind, table.Values(channels[c].second));
-  }
+  for (const auto& [channel, column, kind] : channels) set.Add(channel, kind, table.Values(column));
   return set;
 }
 
@@ -117,8 +124,24 @@ ChannelSet SyntheticMatrixMeasurements(const Config& config, const MatrixModelDa
   for (int j = 0; j <= steps; ++j) {
     truth_loads.col(j).setConstant(config.load.Value(j * config.time.step));
   }
-  const Matrix outputs =
-      SimulateMatrixModel(truth, moduli, truth_loads, config.time.step, config.time.theta);
+  Matrix support_forces;
+  const Matrix outputs = SimulateMatrixModel(truth, moduli, truth_loads, config.time.step,
+                                             config.time.theta, &support_forces);
+  // The model's supports from the truth's of the same force channel: the truth is held
+  // by them, so their displacement is 0.
+  std::vector<int> support_rows;
+  for (const MatrixModelSupport& support : model.supports) {
+    int found = -1;
+    for (std::size_t s = 0; s < truth.supports.size(); ++s) {
+      if (truth.supports[s].force_channel == support.force_channel) found = static_cast<int>(s);
+    }
+    if (found < 0) {
+      throw InputError(manifest + ": the truth has no support of force channel '" +
+                       support.force_channel + "' of the model's manifest " +
+                       config.structure.manifest);
+    }
+    support_rows.push_back(found);
+  }
   Matrix loads(static_cast<int>(load_rows.size()), steps + 1);
   Matrix sensors(static_cast<int>(sensor_rows.size()), steps + 1);
   for (std::size_t c = 0; c < load_rows.size(); ++c) {
@@ -128,6 +151,15 @@ ChannelSet SyntheticMatrixMeasurements(const Config& config, const MatrixModelDa
     sensors.row(static_cast<int>(k)) = outputs.row(sensor_rows[k]);
   }
   ChannelSet histories = MatrixChannelSet(model, config.time.step, loads, sensors);
+  for (std::size_t s = 0; s < support_rows.size(); ++s) {
+    const MatrixModelSupport& support = model.supports[s];
+    histories.Add(support.force_channel, ChannelKind::kForce,
+                  support_forces.row(support_rows[s]).transpose());
+    if (!support.displacement_channel.empty()) {
+      histories.Add(support.displacement_channel, ChannelKind::kDisplacement,
+                    Vector::Zero(steps + 1));
+    }
+  }
   AddMatrixModelNoise(model, config.data.snr, config.data.seed, &histories, noise);
 
   truth_moduli->resize(static_cast<int>(model.zones.size()));
@@ -298,7 +330,11 @@ MatrixModelData LoadMatrixModel(const Config& config) {
         std::any_of(model.loads.begin(), model.loads.end(),
                     [&](const MatrixModelLoad& load) { return load.channel == channel; }) ||
         std::any_of(model.sensors.begin(), model.sensors.end(),
-                    [&](const MatrixModelSensor& sensor) { return sensor.channel == channel; });
+                    [&](const MatrixModelSensor& sensor) { return sensor.channel == channel; }) ||
+        std::any_of(
+            model.supports.begin(), model.supports.end(), [&](const MatrixModelSupport& support) {
+              return support.force_channel == channel || support.displacement_channel == channel;
+            });
     if (!known) {
       throw InputError(ConfigName(config) + ": model.channel_map: '" + channel +
                        "' is not a channel of the manifest " + config.structure.manifest);
@@ -353,12 +389,21 @@ MatrixMeasurements LoadMatrixMeasurements(const Config& config, const MatrixMode
 }
 
 Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_moduli,
-                           const Matrix& loads, double time_step, double theta) {
-  const ChannelSet data = MatrixChannelSet(
+                           const Matrix& loads, double time_step, double theta,
+                           Matrix* support_forces) {
+  ChannelSet data = MatrixChannelSet(
       truth, time_step, loads, Matrix::Zero(static_cast<int>(truth.sensors.size()), loads.cols()));
-  // The weights and their reference modulus do not enter the direct sweep from W = 0.
-  MatrixMcreProblem simulation(truth, data, McreWeights(), truth.zones[0].nominal_modulus, theta);
+  for (const MatrixModelSupport& support : truth.supports) {
+    data.Add(support.force_channel, ChannelKind::kForce, Vector::Zero(loads.cols()));
+  }
+  // The weights and their reference modulus do not enter the direct sweep from W = 0;
+  // the supports hold their dofs (the trusted treatment).
+  MatrixMcreProblem simulation(truth, data, McreWeights(), truth.zones[0].nominal_modulus, theta,
+                               Factorization::kAutomatic, ClampModel::kTrusted);
   simulation.SetModuli(zone_moduli);
+  if (support_forces != nullptr) {
+    *support_forces = truth.supports.empty() ? Matrix() : simulation.ModelSupportForces();
+  }
   return simulation.ModelOutputs();
 }
 
@@ -411,6 +456,14 @@ void AddMatrixModelNoise(const MatrixModelData& model, double snr, std::uint64_t
     const double deviation = model.sensors[k].kind == SensorKind::kStrain ? std_e : std_u;
     for (int j = 0; j < samples; ++j) (*sensor_values[k])[j] += deviation * normal();
   }
+  // Then the supports' channels, a force as the loads, a displacement as the sensors.
+  for (const MatrixModelSupport& support : model.supports) {
+    Vector& force = data->Values(support.force_channel);
+    for (int j = 0; j < samples; ++j) force[j] += std_f * normal();
+    if (support.displacement_channel.empty()) continue;
+    Vector& displacement = data->Values(support.displacement_channel);
+    for (int j = 0; j < samples; ++j) displacement[j] += std_u * normal();
+  }
 }
 
 NoiseLevels MatrixLeastSquaresMisfitLevels(const Config& config, const MatrixModelData& model,
@@ -460,7 +513,7 @@ ChannelSet MatrixMeasurementTable(const Config& config, const MatrixModelData& m
   ChannelSet table;
   table.start_time = histories.start_time;
   table.time_step = histories.time_step;
-  for (const auto& [channel, column] : ChannelColumns(config, model)) {
+  for (const auto& [channel, column, kind] : ChannelColumns(config, model)) {
     const Channel& source = histories.channels[static_cast<std::size_t>(histories.Find(channel))];
     table.Add(column, source.kind, source.values);
   }
@@ -507,15 +560,22 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config,
   }
 
   // 2. Every zone modulus at once, p_z = log(E_z / E_z,nom), from p = 0 (by least
-  //    squares with outer.functional: least_squares, without error maps).
+  //    squares with outer.functional: least_squares, without error maps). The supports
+  //    (if any) treated as mcre.clamp says (docs/matrix_models.md, "Supports").
   if (config.outer.functional == OuterFunctional::kLeastSquares) {
+    if (!model.supports.empty()) {
+      throw InputError(ConfigName(config) +
+                       ": outer.functional least_squares does not treat the supports of " +
+                       run.manifest +
+                       " yet; use outer.functional mcre, or a manifest without supports");
+    }
     IdentifyMatrixZonesByLeastSquares(config, model, measurements, &run);
     run.wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return run;
   }
   MatrixMcreProblem problem(model, run.data, config.mcre.weights, config.mcre.reference_modulus,
-                            config.time.theta);
+                            config.time.theta, Factorization::kAutomatic, config.mcre.clamp);
   run.nominal_moduli = problem.NominalModuli();
   run.rest_cost = problem.RestCost();
   MatrixZoneObjective objective(&problem, config.inner);
@@ -527,6 +587,10 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config,
       "matrix model {}: {} dofs, {} zones, {} loads, {} sensors, {} steps of {:.4g} s; inner {}",
       run.manifest, run.dofs, zones, model.loads.size(), model.sensors.size(), run.steps,
       run.time_step, CoupledSolverName(config.inner.type, run.inner_method));
+  if (!model.supports.empty()) {
+    spdlog::info("{} supports, treated as mcre.clamp: {}", model.supports.size(),
+                 ClampModelToString(config.mcre.clamp));
+  }
   run.outer = MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper,
                                    std::vector<double>(zones, 0.0));
   TakeZoneOutcome(objective, lower, upper, &run);

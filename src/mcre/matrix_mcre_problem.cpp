@@ -1,6 +1,7 @@
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 
 #include <cassert>
+#include <string>
 #include <vector>
 
 namespace mcrewave {
@@ -25,55 +26,176 @@ ChannelSet MatrixChannelSet(const MatrixModelData& model, double time_step, cons
   return set;
 }
 
+namespace {
+
+// The matrix with the rows and columns of the held dofs decoupled from the others
+// (diagonals kept): a held dof stays at rest while its load is zero
+// (docs/formulation.md section 7, the bar's node 0).
+SparseMatrix WithHeldDofs(SparseMatrix matrix, const std::vector<char>& held) {
+  for (int column = 0; column < matrix.outerSize(); ++column) {
+    for (SparseMatrix::InnerIterator entry(matrix, column); entry; ++entry) {
+      if (entry.row() != entry.col() && (held[entry.row()] != 0 || held[entry.col()] != 0)) {
+        entry.valueRef() = 0.0;
+      }
+    }
+  }
+  matrix.prune(0.0);
+  return matrix;
+}
+
+// One load channel or one row of H as the constructor gathers them: the spatial vector
+// or row, its weight and the data's channel ("" for the datum 0).
+struct LoadColumn {
+  const Vector* vector;
+  double alpha;
+  std::string channel;
+};
+struct ObservedRow {
+  SparseMatrix row;  // 1 x n
+  double beta;
+  std::string channel;
+};
+
+// The sparse 1 x n row of a dense vector's nonzero entries.
+SparseMatrix RowOf(const Vector& vector) {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int i = 0; i < vector.size(); ++i) {
+    if (vector[i] != 0.0) entries.emplace_back(0, i, vector[i]);
+  }
+  SparseMatrix row(1, vector.size());
+  row.setFromTriplets(entries.begin(), entries.end());
+  return row;
+}
+
+}  // namespace
+
 MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const ChannelSet& data,
                                      const McreWeights& weights, double reference_modulus,
-                                     double theta, Factorization factorization)
-    : model_(model), time_step_(data.time_step), theta_(theta), factorization_(factorization) {
+                                     double theta, Factorization factorization, ClampModel supports)
+    : model_(model),
+      time_step_(data.time_step),
+      theta_(theta),
+      factorization_(factorization),
+      treatment_(supports) {
   const int n = model.dofs();
-  const int num_loads = static_cast<int>(model.loads.size());
-  const int num_sensors = static_cast<int>(model.sensors.size());
-  // The data's channels of the model, gathered once into rows (columns t_j for the sweeps).
-  const int samples = data.num_samples();
-  measured_loads_.resize(num_loads, samples);
-  for (int c = 0; c < num_loads; ++c) {
-    measured_loads_.row(c) = data.Values(model.loads[c].channel).transpose();
-  }
-  measured_outputs_.resize(num_sensors, samples);
-  for (int k = 0; k < num_sensors; ++k) {
-    measured_outputs_.row(k) = data.Values(model.sensors[k].channel).transpose();
-  }
-  assert(weights.IsValid(nullptr) && reference_modulus > 0.0 && num_steps() >= 1 &&
+  assert(weights.IsValid(nullptr) && reference_modulus > 0.0 && data.num_steps() >= 1 &&
          model.stiffness_length > 0.0 && model.length > 0.0);
   // k* = E0 a*; alpha_c = w_f / k*, beta_k = w_u k* or w_e k* l*^2
-  // (docs/matrix_models.md section 3).
+  // (docs/matrix_models.md section 3); a support's alpha_r = alpha_0 = w_r / k* and
+  // beta_0 = w_u0 k* (section 11).
   const double stiffness_scale = reference_modulus * model.stiffness_length;
-  alphas_ = Vector::Constant(num_loads, weights.force_weight / stiffness_scale);
-  betas_.resize(num_sensors);
+  const double force_alpha = weights.force_weight / stiffness_scale;
+  reaction_weight_ = weights.reaction_weight / stiffness_scale;
+  const bool has_supports = !model.supports.empty();
+  const bool trusted = has_supports && supports == ClampModel::kTrusted;
+  const bool pinned = has_supports && supports == ClampModel::kPinned;
+  const bool measured = has_supports && supports == ClampModel::kMeasured;
+  if (trusted) {
+    held_.assign(static_cast<std::size_t>(n), 0);
+    for (const MatrixModelSupport& support : model.supports) {
+      for (const int dof : support.dofs) held_[static_cast<std::size_t>(dof)] = 1;
+    }
+  }
+  // G: the model's loads, then the supports' forces (measured: alpha; pinned: alpha_0).
+  std::vector<LoadColumn> columns;
+  for (const MatrixModelLoad& load : model.loads) {
+    columns.push_back({&load.vector, force_alpha, load.channel});
+  }
+  if (measured || pinned) {
+    for (const MatrixModelSupport& support : model.supports) {
+      columns.push_back(
+          {&support.reaction, measured ? force_alpha : reaction_weight_, support.force_channel});
+    }
+  }
+  // H: the model's sensors, then the supports' displacement rows g^T / (g^T g)
+  // (measured, with a displacement channel) or the data 0 of e_i^T (pinned).
+  std::vector<ObservedRow> rows;
+  for (const MatrixModelSensor& sensor : model.sensors) {
+    rows.push_back({sensor.row,
+                    sensor.kind == SensorKind::kStrain
+                        ? weights.strain_weight * stiffness_scale * model.length * model.length
+                        : weights.displacement_weight * stiffness_scale,
+                    sensor.channel});
+  }
+  for (const MatrixModelSupport& support : model.supports) {
+    if (measured && !support.displacement_channel.empty()) {
+      rows.push_back({RowOf(support.reaction / support.reaction.squaredNorm()),
+                      weights.displacement_weight * stiffness_scale, support.displacement_channel});
+    }
+    if (pinned) {
+      for (const int dof : support.dofs) {
+        rows.push_back(
+            {RowOf(Vector::Unit(n, dof)), weights.clamp_displacement_weight * stiffness_scale, ""});
+      }
+    }
+  }
+  if (trusted) num_reactions_ = static_cast<int>(model.supports.size());
+  const int num_loads = static_cast<int>(columns.size());
+  const int num_fixed = static_cast<int>(rows.size());
+  const int num_rows = num_fixed + num_reactions_;
+  // The data's channels, gathered once into rows (columns t_j for the sweeps).
+  const int samples = data.num_samples();
+  measured_loads_.resize(num_loads, samples);
+  alphas_.resize(num_loads);
   std::vector<Eigen::Triplet<double>> entries;
   for (int c = 0; c < num_loads; ++c) {
-    const Vector& g = model.loads[c].vector;
+    measured_loads_.row(c) = data.Values(columns[c].channel).transpose();
+    alphas_[c] = columns[c].alpha;
+    const Vector& g = *columns[c].vector;
     for (int i = 0; i < n; ++i) {
-      if (g[i] != 0.0) entries.emplace_back(i, c, g[i]);
+      // A load on a held dof goes into the support.
+      if (g[i] != 0.0 && (held_.empty() || held_[i] == 0)) entries.emplace_back(i, c, g[i]);
     }
   }
   loads_.resize(n, num_loads);
   loads_.setFromTriplets(entries.begin(), entries.end());
   loads_transposed_ = loads_.transpose();
+  measured_outputs_.resize(num_rows, samples);
+  betas_.resize(num_rows);
   entries.clear();
-  for (int k = 0; k < num_sensors; ++k) {
-    const MatrixModelSensor& sensor = model.sensors[k];
-    betas_[k] = sensor.kind == SensorKind::kStrain
-                    ? weights.strain_weight * stiffness_scale * model.length * model.length
-                    : weights.displacement_weight * stiffness_scale;
-    for (int outer = 0; outer < sensor.row.outerSize(); ++outer) {
-      for (SparseMatrix::InnerIterator it(sensor.row, outer); it; ++it) {
+  for (int k = 0; k < num_fixed; ++k) {
+    if (rows[k].channel.empty()) {
+      measured_outputs_.row(k).setZero();
+    } else {
+      measured_outputs_.row(k) = data.Values(rows[k].channel).transpose();
+    }
+    betas_[k] = rows[k].beta;
+    for (int outer = 0; outer < rows[k].row.outerSize(); ++outer) {
+      for (SparseMatrix::InnerIterator it(rows[k].row, outer); it; ++it) {
+        // U = 0 on a held dof: the row's entry there observes nothing and would load it.
+        if (!held_.empty() && held_[it.col()] != 0) continue;
         entries.emplace_back(k, static_cast<int>(it.col()), it.value());
       }
     }
   }
-  observation_.resize(num_sensors, n);
-  observation_.setFromTriplets(entries.begin(), entries.end());
-  observation_transposed_ = observation_.transpose();
+  fixed_observation_.resize(num_fixed, n);
+  fixed_observation_.setFromTriplets(entries.begin(), entries.end());
+  if (trusted) {
+    // The reactions r_s(U) = g_s^T K(E) U = sum_z E_z (g_s^T K_z / E_z,nom) U, held columns
+    // dropped (U = 0 there), against the force channels with alpha_r.
+    for (const MatrixModelZone& zone : model.zones) {
+      entries.clear();
+      for (int s = 0; s < num_reactions_; ++s) {
+        const Vector row = (zone.stiffness.transpose() * model.supports[s].reaction) *
+                           (1.0 / zone.nominal_modulus);
+        for (int i = 0; i < n; ++i) {
+          if (row[i] != 0.0 && held_[i] == 0) entries.emplace_back(s, i, row[i]);
+        }
+      }
+      SparseMatrix zone_rows(num_reactions_, n);
+      zone_rows.setFromTriplets(entries.begin(), entries.end());
+      reaction_zone_rows_.push_back(std::move(zone_rows));
+    }
+    for (int s = 0; s < num_reactions_; ++s) {
+      measured_outputs_.row(num_fixed + s) =
+          data.Values(model.supports[s].force_channel).transpose();
+      betas_[num_fixed + s] = reaction_weight_;
+    }
+  } else {
+    observation_ = fixed_observation_;
+    observation_transposed_ = observation_.transpose();
+  }
+  mass_ = trusted ? WithHeldDofs(model.mass, held_) : model.mass;
   for (int b = 0; b < 2; ++b) {
     velocity_[b] = Vector::Zero(n);
     state_[b] = Vector::Zero(n);
@@ -83,7 +205,9 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
   product_ = Vector::Zero(n);
   channel_ = Vector::Zero(num_loads);
   other_channel_ = Vector::Zero(num_loads);
-  trace_ = Vector::Zero(num_sensors);
+  trace_ = Vector::Zero(num_rows);
+  reaction_trace_ = Vector::Zero(num_reactions_);
+  reaction_zone_trace_ = Vector::Zero(num_reactions_);
   SetModuli(NominalModuli());
 }
 
@@ -92,13 +216,35 @@ void MatrixMcreProblem::SetModuli(const Vector& zone_moduli) {
          zone_moduli.minCoeff() > 0.0);
   if (moduli_.size() == zone_moduli.size() && moduli_ == zone_moduli) return;
   moduli_ = zone_moduli;
-  // K = sum_z (E_z / E_z,nom) K_z.
+  // K = sum_z (E_z / E_z,nom) K_z, the held dofs decoupled (docs/formulation.md section 7).
   stiffness_ = model_.Stiffness(moduli_);
+  if (!held_.empty()) stiffness_ = WithHeldDofs(std::move(stiffness_), held_);
+  if (num_reactions_ > 0) {
+    // r(U) = g^T K(E) U: the rows sum_z E_z (g^T K_z / E_z,nom), below the fixed rows.
+    reactions_ = moduli_[0] * reaction_zone_rows_[0];
+    for (std::size_t z = 1; z < reaction_zone_rows_.size(); ++z) {
+      reactions_ += moduli_[static_cast<Eigen::Index>(z)] * reaction_zone_rows_[z];
+    }
+    const int num_fixed = static_cast<int>(fixed_observation_.rows());
+    std::vector<Eigen::Triplet<double>> entries;
+    for (const SparseMatrix* part : {&fixed_observation_, &reactions_}) {
+      const int offset = part == &reactions_ ? num_fixed : 0;
+      for (int outer = 0; outer < part->outerSize(); ++outer) {
+        for (SparseMatrix::InnerIterator it(*part, outer); it; ++it) {
+          entries.emplace_back(offset + static_cast<int>(it.row()), static_cast<int>(it.col()),
+                               it.value());
+        }
+      }
+    }
+    observation_.resize(num_fixed + num_reactions_, model_.dofs());
+    observation_.setFromTriplets(entries.begin(), entries.end());
+    observation_transposed_ = observation_.transpose();
+  }
   ThetaIntegratorOptions options;
   options.time_step = time_step_;
   options.theta = theta_;
   options.factorization = factorization_;
-  integrator_.Init(model_.mass, stiffness_, options);
+  integrator_.Init(mass_, stiffness_, options);
 }
 
 void MatrixMcreProblem::DirectSweep(const Matrix& retrograde, bool include_data,
@@ -197,6 +343,16 @@ void MatrixMcreProblem::CostGradients(const Matrix& displacement, const Matrix& 
       (*gradient)[z] += -0.5 * QuadratureWeight(j) * h * retrograde.col(j).dot(product_) /
                         model_.zones[z].nominal_modulus;
     }
+    if (num_reactions_ == 0) continue;
+    // Trusted: c_j h alpha_r sum_s (r_s(U_j) - f~_sj) g_s^T K_z U_j / E_z,nom, the bar's
+    // alpha_r (r(U_j) / E_1) (r(U_j) - f0~_j) (docs/formulation.md section 7).
+    reaction_trace_.noalias() = reactions_ * displacement.col(j);
+    reaction_trace_ -= measured_outputs_.col(j).tail(num_reactions_);
+    for (int z = 0; z < zones; ++z) {
+      reaction_zone_trace_.noalias() = reaction_zone_rows_[z] * displacement.col(j);
+      (*gradient)[z] +=
+          QuadratureWeight(j) * h * reaction_weight_ * reaction_trace_.dot(reaction_zone_trace_);
+    }
   }
 }
 
@@ -270,7 +426,16 @@ Vector MatrixMcreProblem::NominalModuli() const {
 Matrix MatrixMcreProblem::ModelOutputs() {
   Matrix displacement;
   DirectSweep(ZeroField(), true, &displacement);
-  return observation_ * displacement;
+  const Matrix outputs = observation_ * displacement;
+  return outputs.topRows(static_cast<Eigen::Index>(model_.sensors.size()));
+}
+
+Matrix MatrixMcreProblem::ModelSupportForces() {
+  assert(num_reactions_ == static_cast<int>(model_.supports.size()));
+  Matrix displacement;
+  DirectSweep(ZeroField(), true, &displacement);
+  // r_s(U_j) = g_s^T K(E) U_j.
+  return reactions_ * displacement;
 }
 
 }  // namespace mcrewave

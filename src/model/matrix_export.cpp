@@ -86,6 +86,15 @@ void Refuse(const std::string& why) {
   if (!why.empty()) throw InputError(why);
 }
 
+// A support's default reaction vector: ones on its dofs.
+Vector DefaultSupportReaction(const std::vector<int>& support_dofs, int dofs) {
+  Vector reaction = Vector::Zero(dofs);
+  for (const int dof : support_dofs) {
+    if (dof >= 0 && dof < dofs) reaction[dof] = 1.0;
+  }
+  return reaction;
+}
+
 }  // namespace
 
 SparseMatrix MatrixModelData::Stiffness(const Vector& zone_moduli) const {
@@ -108,7 +117,7 @@ SparseMatrix ObservationRowMatrix(const ObservationRow& row, int dofs) {
 }
 
 MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
-                               const std::vector<BarSensor>& sensors) {
+                               const std::vector<BarSensor>& sensors, BarClampExport clamp) {
   MatrixModelData data;
   const int n = model.num_nodes();
   data.mass = model.mass();
@@ -121,12 +130,13 @@ MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
     zone.stiffness = model.Stiffness(Vector::Unit(model.num_zones(), z) * nominal_modulus);
     data.zones.push_back(std::move(zone));
   }
-  data.loads.push_back({"f0", Vector::Unit(n, model.left_node())});
+  const bool support = clamp == BarClampExport::kSupport;
+  if (!support) data.loads.push_back({"f0", Vector::Unit(n, model.left_node())});
   data.loads.push_back({"fL", Vector::Unit(n, model.right_node())});
   ObservationRow end;
   end.coefficients[0] = 1.0;
   end.nodes[0] = end.nodes[1] = model.left_node();
-  data.sensors.push_back({"u0", ObservationRowMatrix(end, n)});
+  if (!support) data.sensors.push_back({"u0", ObservationRowMatrix(end, n)});
   end.nodes[0] = end.nodes[1] = model.right_node();
   data.sensors.push_back({"uL", ObservationRowMatrix(end, n)});
   for (const BarSensor& sensor : sensors) {
@@ -136,6 +146,11 @@ MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
     std::ostringstream name;
     name << (sensor.kind == SensorKind::kDisplacement ? "u@" : "e@") << sensor.position;
     data.sensors.push_back({name.str(), ObservationRowMatrix(row, n), sensor.kind});
+  }
+  if (support) {
+    // The clamp: dof 0 held, g = e_0, its force f0 and displacement u0.
+    data.supports.push_back(
+        {"clamp", {model.left_node()}, Vector::Unit(n, model.left_node()), "f0", "u0"});
   }
   return data;
 }
@@ -180,7 +195,28 @@ std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& d
     }
     manifest << YAML::EndMap;
   }
-  manifest << YAML::EndSeq << YAML::EndMap;
+  manifest << YAML::EndSeq;
+  if (!data.supports.empty()) {
+    manifest << YAML::Key << "supports" << YAML::Value << YAML::BeginSeq;
+    for (const MatrixModelSupport& support : data.supports) {
+      manifest << YAML::Flow << YAML::BeginMap << YAML::Key << "name" << YAML::Value << support.name
+               << YAML::Key << "dofs" << YAML::Value << YAML::Flow << support.dofs << YAML::Key
+               << "force_channel" << YAML::Value << support.force_channel;
+      if (!support.displacement_channel.empty()) {
+        manifest << YAML::Key << "displacement_channel" << YAML::Value
+                 << support.displacement_channel;
+      }
+      if (support.reaction != DefaultSupportReaction(support.dofs, data.dofs())) {
+        const std::string file = "support_" + FileSafe(support.name) + ".mtx";
+        WriteMatrixMarketVector(folder + "/" + file, support.reaction,
+                                "reaction vector g of support " + support.name);
+        manifest << YAML::Key << "reaction" << YAML::Value << file;
+      }
+      manifest << YAML::EndMap;
+    }
+    manifest << YAML::EndSeq;
+  }
+  manifest << YAML::EndMap;
   const std::string path = folder + "/model.yaml";
   WriteFileAtomically(path, std::string("# mcrewave matrix model (docs/matrix_models.md)\n") +
                                 manifest.c_str() + "\n");
@@ -204,9 +240,10 @@ YAML::Node LoadManifest(const std::string& manifest_path) {
   for (const auto& key : root) {
     const std::string name = key.first.Scalar();
     if (name != "mass" && name != "stiffness_length" && name != "length" && name != "zones" &&
-        name != "loads" && name != "sensors") {
+        name != "loads" && name != "sensors" && name != "supports") {
       throw InputError(Where(manifest_path, key.first) + ": unknown key '" + name +
-                       "' (expected mass, stiffness_length, length, zones, loads, sensors)");
+                       "' (expected mass, stiffness_length, length, zones, loads, sensors, "
+                       "supports)");
     }
   }
   return root;
@@ -311,6 +348,97 @@ void ReadSensors(const std::string& manifest_path, const YAML::Node& root,
   }
 }
 
+// Appends the manifest's supports (an optional list) to data->supports: each named once
+// (a map of name, dofs, force_channel and the optional displacement_channel and
+// reaction), its dofs distinct, in range and held by no other support, its reaction
+// vector (a file relative to `folder`, default ones on the dofs) checked against them,
+// its channels not already in *channels (then added).
+void ReadSupports(const std::string& manifest_path, const YAML::Node& root,
+                  const std::string& folder, const std::string& mass_file,
+                  std::set<std::string>* channels, MatrixModelData* data) {
+  const YAML::Node list = root["supports"];
+  if (!list) return;
+  if (!list.IsSequence()) {
+    throw InputError(Where(manifest_path, list) +
+                     ": expected 'supports', a list of {name, dofs, force_channel, ...}");
+  }
+  const int n = data->dofs();
+  std::set<std::string> names;
+  std::set<int> held;
+  for (const YAML::Node& entry : list) {
+    if (!entry.IsMap()) {
+      throw InputError(Where(manifest_path, entry) +
+                       ": expected a support, a map {name, dofs, force_channel, ...}");
+    }
+    MatrixModelSupport support;
+    support.name = RequiredString(manifest_path, entry, "name");
+    const std::string which = Where(manifest_path, entry) + ": support '" + support.name + "'";
+    for (const auto& key : entry) {
+      const std::string& name = key.first.Scalar();
+      if (name != "name" && name != "dofs" && name != "force_channel" &&
+          name != "displacement_channel" && name != "reaction") {
+        throw InputError(which + ": unknown key '" + name +
+                         "' (expected name, dofs, force_channel, displacement_channel, "
+                         "reaction)");
+      }
+    }
+    // The string of key `key` (a channel or file name).
+    auto string_of = [&](const char* key) {
+      const YAML::Node value = entry[key];
+      if (!value || !value.IsScalar() || value.Scalar().empty()) {
+        throw InputError(which + ": expected key '" + key + "' (a name)");
+      }
+      return value.Scalar();
+    };
+    if (!names.insert(support.name).second) throw InputError(which + " given twice");
+    const YAML::Node dofs = entry["dofs"];
+    if (!dofs || !dofs.IsSequence()) {
+      throw InputError(which + ": expected dofs, a list of held dofs (0-based integers)");
+    }
+    for (const YAML::Node& dof : dofs) {
+      int index = 0;
+      if (!dof.IsScalar() || !YAML::convert<int>::decode(dof, index)) {
+        throw InputError(which + ": dofs: expected 0-based integers, got '" +
+                         (dof.IsScalar() ? dof.Scalar() : std::string("a list or map")) + "'");
+      }
+      support.dofs.push_back(index);
+    }
+    const std::string bad_dofs =
+        CheckSupportDofs(support.dofs, support.name, manifest_path, n, mass_file);
+    if (!bad_dofs.empty()) throw InputError(Where(manifest_path, entry) + ": " + bad_dofs);
+    for (const int dof : support.dofs) {
+      if (!held.insert(dof).second) {
+        throw InputError(which + ": dof " + std::to_string(dof) +
+                         " is held by another support, expected each dof in one support");
+      }
+    }
+    if (entry["reaction"]) {
+      const std::string file = ManifestFile(folder, string_of("reaction"));
+      support.reaction = ReadMatrixMarketVector(file);
+      const std::string bad_reaction =
+          CheckSupportReaction(support.reaction, support.dofs, support.name, file, n, mass_file);
+      if (!bad_reaction.empty()) {
+        throw InputError(Where(manifest_path, entry) + ": " + bad_reaction);
+      }
+    } else {
+      support.reaction = DefaultSupportReaction(support.dofs, n);
+    }
+    support.force_channel = string_of("force_channel");
+    if (entry["displacement_channel"]) {
+      support.displacement_channel = string_of("displacement_channel");
+    }
+    for (const std::string* channel : {&support.force_channel, &support.displacement_channel}) {
+      if (channel->empty()) continue;
+      if (!channels->insert(*channel).second) {
+        throw InputError(which + ": channel '" + *channel +
+                         "' is already a channel of the model (a load's, a sensor's or a "
+                         "support's), expected a channel of its own");
+      }
+    }
+    data->supports.push_back(std::move(support));
+  }
+}
+
 }  // namespace
 
 MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
@@ -329,6 +457,7 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
   std::set<std::string> channels;
   ReadLoads(manifest_path, root, folder, mass_file, &channels, &data);
   ReadSensors(manifest_path, root, folder, mass_file, &channels, &data);
+  ReadSupports(manifest_path, root, folder, mass_file, &channels, &data);
   return data;
 }
 

@@ -126,4 +126,45 @@ std::string CheckSensorRow(const SparseMatrix& row, const std::string& sensor,
   return "";
 }
 
+std::string CheckSupportDofs(const std::vector<int>& support_dofs, const std::string& support,
+                             const std::string& manifest, int dofs,
+                             const std::string& reference_name) {
+  const std::string which = "support '" + support + "' of " + manifest;
+  if (support_dofs.empty()) return which + ": expected dofs, a non-empty list of held dofs";
+  for (std::size_t a = 0; a < support_dofs.size(); ++a) {
+    const int dof = support_dofs[a];
+    if (dof < 0 || dof >= dofs) {
+      return which + ": dof " + std::to_string(dof) + " out of range, expected 0 to " +
+             std::to_string(dofs - 1) + " (0-based, the dofs of " + reference_name + ")";
+    }
+    for (std::size_t b = 0; b < a; ++b) {
+      if (support_dofs[b] == dof) {
+        return which + ": dof " + std::to_string(dof) + " given twice, expected distinct dofs";
+      }
+    }
+  }
+  return "";
+}
+
+std::string CheckSupportReaction(const Vector& reaction, const std::vector<int>& support_dofs,
+                                 const std::string& support, const std::string& name, int dofs,
+                                 const std::string& reference_name) {
+  const std::string which = "support '" + support + "' (" + name + ")";
+  if (reaction.size() != dofs) {
+    return which + ": " + std::to_string(reaction.size()) + " entries, but " + reference_name +
+           " has " + std::to_string(dofs) + " dofs";
+  }
+  bool held = false;
+  for (int i = 0; i < dofs; ++i) {
+    if (reaction[i] == 0.0) continue;
+    if (std::find(support_dofs.begin(), support_dofs.end(), i) == support_dofs.end()) {
+      return which + ": entry " + Short(reaction[i]) + " at dof " + std::to_string(i) +
+             ", which the support does not hold (expected nonzero entries on its dofs only)";
+    }
+    held = true;
+  }
+  if (!held) return which + ": every entry on the support's dofs is zero, expected a nonzero one";
+  return "";
+}
+
 }  // namespace mcrewave

@@ -174,10 +174,11 @@ std::string ConfigToYaml(const Config& config);
 // Whether a run on a structure of `kind` reads key `path` ("section.name"). The bar
 // reads every key but the matrix model's own (model.manifest, model.channel_map,
 // data.truth_manifest, data.truth_moduli). A structure given by matrices does not
-// read the bar's geometry and zoning, its truth and sensor keys, the clamp's weights,
-// the shooting solvers' limits, the scalar identification's outer: keys (its zones
-// are minimised under zone_identification:), search:, uncertainty:, study:, nor the
-// penalty and merging keys of zone_identification: (docs/matrix_models.md).
+// read the bar's geometry and zoning, its truth and sensor keys (mcre.clamp, mcre.w_r and
+// mcre.w_u0 it reads: they treat the manifest's supports), the shooting solvers' limits, the scalar
+// identification's outer: keys (its zones are minimised under zone_identification:), search:,
+// uncertainty:, study:, nor the penalty and merging keys of zone_identification:
+// (docs/matrix_models.md).
 bool KeyApplies(const std::string& path, ModelKind kind);
 
 // ConfigToYaml with only the keys that apply to config.structure.kind: the config

@@ -77,16 +77,22 @@ void CheckMatrixModelFieldBytes(const Config& config, const MatrixModelData& mod
 
 // The outputs H U of `truth` at zone_moduli [Pa] from rest, driven by `loads` (one row
 // per load channel [N], sampled at t_j = j time_step) with the theta method: the
-// noise-free data of that structure (sensor rows, model order).
+// noise-free data of that structure (sensor rows, model order). A truth with supports
+// is held by them (their dofs at rest, docs/matrix_models.md section 11); with
+// support_forces not null, it receives their reactions g^T K U [N] (one row per support,
+// model order; no row without supports).
 Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_moduli,
-                           const Matrix& loads, double time_step, double theta);
+                           const Matrix& loads, double time_step, double theta,
+                           Matrix* support_forces = nullptr);
 
 // Adds white Gaussian noise to every channel: standard deviation RMS / snr of the
 // channels of the same quantity (the displacement sensors together, the strain
 // sensors together, the loads together), drawn by a 64-bit Mersenne twister seeded
 // with `seed` (Box-Muller), the loads first, then the sensors in order, sample by
-// sample. Nothing when snr is infinite. levels (nullable): the standard deviations drawn
-// (displacement_std, strain_std, force_std; all 0 when snr is infinite).
+// sample, then each support's force (the loads' deviation) and displacement channel
+// (the displacement sensors'). Nothing when snr is infinite. levels (nullable): the
+// standard deviations drawn (displacement_std, strain_std, force_std; all 0 when snr is
+// infinite).
 void AddMatrixModelNoise(const MatrixModelData& model, double snr, std::uint64_t seed,
                          ChannelSet* data, NoiseLevels* levels = nullptr);
 

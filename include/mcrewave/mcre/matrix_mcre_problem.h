@@ -18,6 +18,21 @@
 //   beta_k = w_u k* (displacement row), w_e k* l*^2 (strain row),  alpha_c = w_f / k*,
 // so that the bar exported with a* = S / L and l* = L has the bar's weights.
 //
+// Supports (MatrixModelData::supports, docs/matrix_models.md section 11), each with its
+// reaction vector g and held dofs D, enter by one treatment per problem (mcre.clamp;
+// the bar's clamp of docs/formulation.md section 7 is the support g = e_0, D = {0}):
+//   measured: D free; g a load with the force channel's history, alpha = w_f / k*; the
+//             displacement channel (if any) an output of row g^T / (g^T g), beta = w_u k*;
+//   trusted:  D held (rows and columns of M and K decoupled, diagonals kept; the
+//             entries of the loads and rows on D dropped), so U = W = 0 on D; the
+//             reaction r(U) = g^T K(E) U an output against the force channel,
+//             alpha_r = w_r / k*; the displacement channel ignored;
+//   pinned:   D free; g a load with alpha_0 = w_r / k*; a datum 0 of row e_i^T for
+//             every i in D with beta_0 = w_u0 k*; the displacement channel ignored.
+// So the loads G are the model's then (measured, pinned) the supports', the rows H
+// the model's sensors, then the supports' rows (measured: displacement; pinned: the
+// data 0; trusted: the reactions, which depend on the moduli).
+//
 // The integrator is factorised once per set of moduli (SetModuli), by the sparse
 // LDL^T or the band path (ThetaIntegratorOptions::factorization). The sweeps allocate
 // nothing: every scratch vector is sized in the constructor.
@@ -43,28 +58,35 @@ ChannelSet MatrixChannelSet(const MatrixModelData& model, double time_step, cons
 class MatrixMcreProblem : public CoupledProblem {
  public:
   // Keeps a reference to model, which must outlive the problem; copies the histories
-  // of data's channels named as the model's loads and sensors (data may go).
-  // reference_modulus is E0 of the weights [Pa]; every zone starts at its nominal
-  // modulus. Preconditions: data has a channel of each of the model's loads and
-  // sensors (else throws std::logic_error) on t_j = j h and m >= 1 steps, the model's
-  // scales positive, weights valid, theta in [0, 1].
+  // of data's channels named as the model's loads and sensors and the supports'
+  // channels the treatment reads (data may go). reference_modulus is E0 of the weights
+  // [Pa]; every zone starts at its nominal modulus. supports is the treatment of every
+  // support of the model (ignored without supports). Preconditions: data has a channel
+  // of each of the model's loads and sensors and each support's force channel, and its
+  // displacement channel when it has one and supports is kMeasured (else throws
+  // std::logic_error), on t_j = j h and m >= 1 steps, the model's scales positive,
+  // weights valid, theta in [0, 1].
   MatrixMcreProblem(const MatrixModelData& model, const ChannelSet& data,
                     const McreWeights& weights, double reference_modulus, double theta,
-                    Factorization factorization = Factorization::kAutomatic);
+                    Factorization factorization = Factorization::kAutomatic,
+                    ClampModel supports = ClampModel::kMeasured);
 
   int num_nodes() const override { return model_.dofs(); }
   int num_steps() const override { return static_cast<int>(measured_loads_.cols()) - 1; }
   double time_step() const override { return time_step_; }
   double theta() const override { return theta_; }
   const Vector& moduli() const override { return moduli_; }
-  // K = sum_z (E_z / E_z,nom) K_z, refactorised when the moduli changed.
+  // K = sum_z (E_z / E_z,nom) K_z (held dofs decoupled under a trusted treatment) and the
+  // trusted reaction rows g^T K(E), refactorised when the moduli changed.
   void SetModuli(const Vector& zone_moduli) override;
 
   void DirectSweep(const Matrix& retrograde, bool include_data, Matrix* displacement) override;
   void RetrogradeSweep(const Matrix& displacement, bool include_data, Matrix* retrograde) override;
   double InnerProduct(const Matrix& x, const Matrix& y) override;
   double Cost(const Matrix& displacement, const Matrix& retrograde) override;
-  // de^2/dE_z = -(1/(2 E_z,nom)) sum_j c_j h W_j^T K_z (W_j + 2 U_j) [J s / Pa].
+  // de^2/dE_z = -(1/(2 E_z,nom)) sum_j c_j h W_j^T K_z (W_j + 2 U_j) [J s / Pa], plus
+  // under a trusted treatment the reactions' dependence on the moduli,
+  //   sum_j c_j h sum_s alpha_r (r_s(U_j) - f~_sj) g_s^T K_z U_j / E_z,nom.
   void CostGradients(const Matrix& displacement, const Matrix& retrograde,
                      Vector* gradient) override;
   // Each zone's share of the constitutive part of e^2,
@@ -76,7 +98,7 @@ class MatrixMcreProblem : public CoupledProblem {
   // density for a figure over the mesh; an entry can be slightly negative).
   Vector DofErrorMap(const Matrix& retrograde);
 
-  SparseMatrix MassMatrix() const override { return model_.mass; }
+  SparseMatrix MassMatrix() const override { return mass_; }
   SparseMatrix StiffnessMatrix() const override { return stiffness_; }
   SparseMatrix PenaltyMatrix() const override;
   SparseMatrix WeightedObservation() const override;
@@ -84,8 +106,12 @@ class MatrixMcreProblem : public CoupledProblem {
   void MeasuredForce(int j, Eigen::Ref<Vector> load) const override;
 
   // H U of DirectSweep(0) with the data: the model's outputs driven by the measured
-  // loads alone, S x (m + 1) (synthetic data of this model, MatrixChannelSet's outputs).
+  // loads alone, S x (m + 1), the rows of the model's sensors only (synthetic data of
+  // this model, MatrixChannelSet's outputs).
   Matrix ModelOutputs();
+  // The supports' reactions r_s(U) = g_s^T K(E) U of the same U, one row per support in
+  // the model's order [N]. Precondition: the treatment is trusted (the supports held).
+  Matrix ModelSupportForces();
 
   // J_rest = sum_j c_j h [1/2 F~_j^T diag(alpha) F~_j + 1/2 d~_j^T diag(beta) d~_j]
   // [J s]: the functional of the structure left at rest (U = W = 0, zero loads), which
@@ -94,30 +120,45 @@ class MatrixMcreProblem : public CoupledProblem {
   // E_z,nom of every zone [Pa].
   Vector NominalModuli() const;
 
-  const Vector& alphas() const { return alphas_; }  // alpha_c [m/N], per load channel
-  const Vector& betas() const { return betas_; }    // beta_k [N/m or N m], per sensor
+  // alpha_c [m/N]: the model's load channels, then (measured, pinned) the supports'.
+  const Vector& alphas() const { return alphas_; }
+  // beta_k [N/m, N m or m/N]: the model's sensors, then the supports' rows (above).
+  const Vector& betas() const { return betas_; }
+  ClampModel support_treatment() const { return treatment_; }
   int factorization_count() const { return integrator_.factorization_count(); }
   const ThetaIntegrator& integrator() const { return integrator_; }
 
  private:
   const MatrixModelData& model_;
   double time_step_;         // h [s]
-  Matrix measured_loads_;    // F~ [N], C x (m + 1), rows in the model's order
-  Matrix measured_outputs_;  // d~ [m] or [-], S x (m + 1)
+  Matrix measured_loads_;    // F~ [N], C x (m + 1), rows in G's order
+  Matrix measured_outputs_;  // d~ [m], [-] or [N], S x (m + 1), rows in H's order
   double theta_;
   Factorization factorization_;
+  ClampModel treatment_;
+  // Trusted treatment: 1 on the held dofs, else 0 (empty otherwise).
+  std::vector<char> held_;
+  int num_reactions_ = 0;                // trusted: one reaction row per support (H's last rows)
+  double reaction_weight_;               // alpha_r = w_r / k* [m/N]
   Vector moduli_;                        // E_z [Pa]
   Vector alphas_, betas_;                // alpha_c [m/N], beta_k
+  SparseMatrix mass_;                    // M, held dofs decoupled under a trusted treatment
   SparseMatrix loads_;                   // G, n x C
   SparseMatrix loads_transposed_;        // G^T, C x n
+  SparseMatrix fixed_observation_;       // H's rows that do not depend on the moduli
+  // Trusted: per zone z, the rows g_s^T K_z / E_z,nom (held columns dropped), R x n; and
+  // their sum at moduli_, sum_z E_z (...) = g_s^T K(E).
+  std::vector<SparseMatrix> reaction_zone_rows_;
+  SparseMatrix reactions_;
   SparseMatrix observation_;             // H, S x n
   SparseMatrix observation_transposed_;  // H^T, n x S
-  SparseMatrix stiffness_;               // K at moduli_
+  SparseMatrix stiffness_;               // K at moduli_ (held dofs decoupled when trusted)
   ThetaIntegrator integrator_;
   // Scratch, allocated in the constructor: double buffers of the sweeps' velocity and
-  // state, W_theta, the step's force, a product K x, two vectors per load channel and
-  // one per sensor channel.
-  Vector velocity_[2], state_[2], shift_, force_, product_, channel_, other_channel_, trace_;
+  // state, W_theta, the step's force, a product K x, two vectors per load channel, one
+  // per row of H and two per reaction.
+  Vector velocity_[2], state_[2], shift_, force_, product_, channel_, other_channel_, trace_,
+      reaction_trace_, reaction_zone_trace_;
 };
 
 }  // namespace mcrewave

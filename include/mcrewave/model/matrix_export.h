@@ -16,6 +16,8 @@
 //   sensors:
 //     - {channel: uL, row: sensor_uL.mtx}
 //     - {channel: e@0.5, row: sensor_e_at_0.5.mtx, kind: strain}
+//   supports:                  # optional (docs/matrix_models.md section 11)
+//     - {name: clamp, dofs: [0], force_channel: f0, displacement_channel: u0}
 //
 // (a relative file name is relative to the manifest's folder, an absolute one is used
 // as it is). WriteBarMatrixModel exports the built-in bar this way, so that the general
@@ -50,6 +52,21 @@ struct MatrixModelSensor {
   SensorKind kind = SensorKind::kDisplacement;
 };
 
+// A support: a set of dofs the structure is held by, with the measured force it takes
+// (docs/matrix_models.md section 11). How it enters the MCRE problem, free with its force
+// as a load (measured, pinned) or held with its reaction as an output (trusted), is the
+// run's choice (mcre.clamp), not the model's.
+struct MatrixModelSupport {
+  std::string name;
+  std::vector<int> dofs;  // the held dofs, 0-based, distinct, in [0, n)
+  // g [-], n entries, nonzero only on `dofs`: the support's force is g^T times the dofs'
+  // reaction forces, and its displacement g^T U / (g^T g). Manifest key `reaction` (a
+  // vector file); default: ones on the dofs.
+  Vector reaction;
+  std::string force_channel;         // the CSV column of the measured force [N]
+  std::string displacement_channel;  // the CSV column of the measured displacement [m]; "" if none
+};
+
 struct MatrixModelData {
   SparseMatrix mass;  // M [kg], n x n
   // The structure's own scales that make the MCRE weights dimensionless
@@ -60,6 +77,7 @@ struct MatrixModelData {
   std::vector<MatrixModelZone> zones;
   std::vector<MatrixModelLoad> loads;
   std::vector<MatrixModelSensor> sensors;
+  std::vector<MatrixModelSupport> supports;  // none: a structure held by nothing but its data
 
   int dofs() const { return static_cast<int>(mass.rows()); }
   // K = sum_z (E_z / E_z,nominal) K_z; zone_moduli has zones.size() entries [Pa].
@@ -69,15 +87,23 @@ struct MatrixModelData {
 // The observation row of a channel as a 1 x n sparse matrix.
 SparseMatrix ObservationRowMatrix(const ObservationRow& row, int dofs);
 
+// How BarMatrixModel exports the clamp at x = 0: as the load f0 (e_0) and the sensor u0
+// (e_0^T), the free-free model; or as a support "clamp" at dof 0 with the force channel f0
+// and the displacement channel u0, whose treatment the run chooses (mcre.clamp).
+enum class BarClampExport { kLoadAndSensor, kSupport };
+
 // The bar as matrices (scales a* = S / L, l* = L): M, K1_z times nominal_modulus per zone (zone z
 // named "zone<z>"), the end loads (channels f0: e_0, fL: e_N), the end displacement rows (u0, uL)
 // and the rows of `sensors` (channels u@X / e@X, as the measurement CSV names them; their
-// index is not used).
+// index is not used). With clamp kSupport, f0 and u0 are the channels of the support
+// "clamp" at dof 0 instead: the loads are fL alone, the sensors uL and `sensors`.
 MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
-                               const std::vector<BarSensor>& sensors = {});
+                               const std::vector<BarSensor>& sensors = {},
+                               BarClampExport clamp = BarClampExport::kLoadAndSensor);
 
 // Writes `data` into `folder` (which must exist): M.mtx, K_<zone>.mtx,
-// load_<channel>.mtx, sensor_<channel>.mtx ('@' of a channel becomes '_at_') and the
+// load_<channel>.mtx, sensor_<channel>.mtx ('@' of a channel becomes '_at_'),
+// support_<name>.mtx (a support's reaction g, only when it is not the default) and the
 // manifest model.yaml, each atomically, matrices in symmetric storage, 17 digits.
 // Returns the manifest's path. Throws std::runtime_error when a file cannot be
 // written.
@@ -87,7 +113,10 @@ std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& d
 // square, symmetric, positive definite; every K_z symmetric and of M's size; the
 // load vectors of M's size; the sensor rows within M's dofs; zone names and channels
 // distinct; nominal moduli and the scales stiffness_length and length finite and
-// positive; a sensor's kind displacement or strain. Throws InputError naming the file
+// positive; a sensor's kind displacement or strain; every support named once, its dofs
+// distinct, in range and held by no other support, its reaction of M's size and
+// nonzero on its dofs only, its channels distinct from every other channel (loads',
+// sensors', supports'). Throws InputError naming the file
 // (and line, for the manifest and the Matrix Market files) on the first problem.
 MatrixModelData ReadMatrixModel(const std::string& manifest_path);
 

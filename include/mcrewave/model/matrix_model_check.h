@@ -6,6 +6,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "mcrewave/core/types.h"
 
@@ -49,5 +50,20 @@ std::string CheckVectorSize(const Vector& vector, const std::string& name, int d
 // the size mismatch. A row of only zeros reads nothing: refused too.
 std::string CheckSensorRow(const SparseMatrix& row, const std::string& sensor,
                            const std::string& name, int dofs, const std::string& reference_name);
+
+// A support's held dofs (docs/matrix_models.md section 11): "" when there is at least one,
+// each in [0, dofs) and none twice; otherwise e.g. "support 'clamp' of model.yaml: dof 812
+// out of range, expected 0 to 799 (0-based, the dofs of M.mtx)". Indices in messages
+// 0-based, as the manifest gives them.
+std::string CheckSupportDofs(const std::vector<int>& support_dofs, const std::string& support,
+                             const std::string& manifest, int dofs,
+                             const std::string& reference_name);
+
+// A support's reaction vector g: "" when it has `dofs` entries, is nonzero on at least one
+// of `support_dofs` and zero elsewhere; otherwise one sentence naming the support, the
+// file (`name`) and the first offending dof (0-based).
+std::string CheckSupportReaction(const Vector& reaction, const std::vector<int>& support_dofs,
+                                 const std::string& support, const std::string& name, int dofs,
+                                 const std::string& reference_name);
 
 }  // namespace mcrewave
