@@ -267,7 +267,7 @@ TEST(IdentifyStudyTest, BadStudyValuesStopBeforeAnyComputation) {
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(
       result.output.find("--set study.kind=every: expected one of 'robustness', 'relaxation', "
-                         "'cost_curves', 'all', 'damage', 'comparator', got 'every'"),
+                         "'cost_curves', 'all', 'damage', 'comparator', 'readme', got 'every'"),
       std::string::npos)
       << result.output;
   EXPECT_FALSE(fs::exists(folder));
