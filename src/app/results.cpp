@@ -961,6 +961,22 @@ std::string MatrixFitScript(const MatrixIdentificationRun& run, const std::strin
   return script.str();
 }
 
+// The model: and data: blocks of a matrix run's summary.yaml.
+void MatrixModelAndDataYaml(const MatrixIdentificationRun& run, const Config& config,
+                            YamlWriter* yaml) {
+  yaml->Line(0, "model", "");
+  yaml->Text(1, "kind", ModelKindToString(config.structure.kind));
+  yaml->Text(1, "manifest", run.manifest);
+  yaml->Integer(1, "dofs", run.dofs);
+  yaml->Integer(1, "zones", static_cast<long>(run.zone_names.size()));
+  yaml->Integer(1, "loads", static_cast<long>(run.load_names.size()));
+  yaml->Integer(1, "sensors", static_cast<long>(run.sensor_names.size()));
+  yaml->Line(0, "data", "");
+  yaml->Text(1, "source", run.data_source);
+  yaml->Integer(1, "steps", run.steps);
+  yaml->Number(1, "time_step", run.time_step, "[s]");
+}
+
 // summary.yaml of a matrix run by least squares: MatrixSummaryYaml's layout with J [s]
 // for e^2, the misfit levels for the error map, and no inner solver.
 std::string MatrixLeastSquaresSummaryYaml(const MatrixIdentificationRun& run,
@@ -972,17 +988,7 @@ std::string MatrixLeastSquaresSummaryYaml(const MatrixIdentificationRun& run,
   if (!config.source_path.empty()) yaml.Raw("# config: " + config.source_path);
   yaml.Text(0, "version", kVersion, "mcrewave version");
   yaml.Text(0, "functional", "least_squares", "outer.functional (docs/formulation.md section 8)");
-  yaml.Line(0, "model", "");
-  yaml.Text(1, "kind", ModelKindToString(config.structure.kind));
-  yaml.Text(1, "manifest", run.manifest);
-  yaml.Integer(1, "dofs", run.dofs);
-  yaml.Integer(1, "zones", static_cast<long>(run.zone_names.size()));
-  yaml.Integer(1, "loads", static_cast<long>(run.load_names.size()));
-  yaml.Integer(1, "sensors", static_cast<long>(run.sensor_names.size()));
-  yaml.Line(0, "data", "");
-  yaml.Text(1, "source", run.data_source);
-  yaml.Integer(1, "steps", run.steps);
-  yaml.Number(1, "time_step", run.time_step, "[s]");
+  MatrixModelAndDataYaml(run, config, &yaml);
   yaml.Line(0, "zones", "", "identified modulus per zone (zones.csv)");
   for (int z = 0; z < run.nominal_moduli.size(); ++z) {
     const bool truth = run.truth_moduli.size() > 0;
@@ -1022,17 +1028,7 @@ std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& 
   yaml.Raw("# mcrewave identify run: the zone moduli of a structure given by matrices, by the MCRE");
   if (!config.source_path.empty()) yaml.Raw("# config: " + config.source_path);
   yaml.Text(0, "version", kVersion, "mcrewave version");
-  yaml.Line(0, "model", "");
-  yaml.Text(1, "kind", ModelKindToString(config.structure.kind));
-  yaml.Text(1, "manifest", run.manifest);
-  yaml.Integer(1, "dofs", run.dofs);
-  yaml.Integer(1, "zones", static_cast<long>(run.zone_names.size()));
-  yaml.Integer(1, "loads", static_cast<long>(run.load_names.size()));
-  yaml.Integer(1, "sensors", static_cast<long>(run.sensor_names.size()));
-  yaml.Line(0, "data", "");
-  yaml.Text(1, "source", run.data_source);
-  yaml.Integer(1, "steps", run.steps);
-  yaml.Number(1, "time_step", run.time_step, "[s]");
+  MatrixModelAndDataYaml(run, config, &yaml);
   yaml.Line(0, "zones", "", "identified modulus per zone (zones.csv)");
   const Vector nominal_share = GapFractions(run.nominal_zone_map), share = GapFractions(run.zone_map);
   for (int z = 0; z < run.nominal_moduli.size(); ++z) {
