@@ -44,6 +44,7 @@ TEST(TypesTest, EveryEnumRoundTripsThroughItsNameTable) {
   ExpectTableRoundTrips(kZoningNames, ZoningToString, StringToZoning);
   ExpectTableRoundTrips(kModelKindNames, ModelKindToString, StringToModelKind);
   ExpectTableRoundTrips(kClampModelNames, ClampModelToString, StringToClampModel);
+  ExpectTableRoundTrips(kBarClampExportNames, BarClampExportToString, StringToBarClampExport);
   ExpectTableRoundTrips(kSearchFunctionalNames, SearchFunctionalToString, StringToSearchFunctional);
   ExpectTableRoundTrips(kFactorizationNames, FactorizationToString, StringToFactorization);
   ExpectTableRoundTrips(kMatrixMarketStorageNames, MatrixMarketStorageToString,

@@ -54,6 +54,13 @@ bool StringToClampModel(const std::string& name, ClampModel* model) {
   return internal::FromName(kClampModelNames, name, model);
 }
 
+const char* BarClampExportToString(BarClampExport clamp) {
+  return internal::ToName(kBarClampExportNames, clamp);
+}
+bool StringToBarClampExport(const std::string& name, BarClampExport* clamp) {
+  return internal::FromName(kBarClampExportNames, name, clamp);
+}
+
 const char* SearchFunctionalToString(SearchFunctional functional) { return internal::ToName(kSearchFunctionalNames, functional); }
 bool StringToSearchFunctional(const std::string& name, SearchFunctional* functional) {
   return internal::FromName(kSearchFunctionalNames, name, functional);

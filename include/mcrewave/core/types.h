@@ -144,6 +144,18 @@ inline constexpr std::array<std::pair<ClampModel, const char*>, 3> kClampModelNa
 const char* ClampModelToString(ClampModel model);
 bool StringToClampModel(const std::string& name, ClampModel* model);
 
+// How BarMatrixModel (model/matrix_export.h) exports the bar's clamp at x = 0.
+enum class BarClampExport {
+  kLoadAndSensor,  // the load f0 (e_0) and the sensor u0 (e_0^T): the free-free model
+  kSupport,        // a support "clamp" at dof 0, channels f0 and u0, treated as mcre.clamp says
+};
+inline constexpr std::array<std::pair<BarClampExport, const char*>, 2> kBarClampExportNames{{
+    {BarClampExport::kLoadAndSensor, "load_and_sensor"},
+    {BarClampExport::kSupport, "support"},
+}};
+const char* BarClampExportToString(BarClampExport clamp);
+bool StringToBarClampExport(const std::string& name, BarClampExport* clamp);
+
 // The functional the global search of a bar's identification scans (config key
 // search.functional; docs/trusted_clamp.md section 10).
 enum class SearchFunctional {

@@ -87,11 +87,6 @@ struct MatrixModelData {
 // The observation row of a channel as a 1 x n sparse matrix.
 SparseMatrix ObservationRowMatrix(const ObservationRow& row, int dofs);
 
-// How BarMatrixModel exports the clamp at x = 0: as the load f0 (e_0) and the sensor u0
-// (e_0^T), the free-free model; or as a support "clamp" at dof 0 with the force channel f0
-// and the displacement channel u0, whose treatment the run chooses (mcre.clamp).
-enum class BarClampExport { kLoadAndSensor, kSupport };
-
 // The bar as matrices (scales a* = S / L, l* = L): M, K1_z times nominal_modulus per zone (zone z
 // named "zone<z>"), the end loads (channels f0: e_0, fL: e_N), the end displacement rows (u0, uL)
 // and the rows of `sensors` (channels u@X / e@X, as the measurement CSV names them; their
