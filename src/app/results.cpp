@@ -977,6 +977,19 @@ void MatrixModelAndDataYaml(const MatrixIdentificationRun& run, const Config& co
   yaml->Number(1, "time_step", run.time_step, "[s]");
 }
 
+// The optimizer: block of a matrix run's summary.yaml; `cost` names its cost (J, e^2).
+void MatrixOptimizerYaml(const MatrixIdentificationRun& run, const std::string& cost,
+                         YamlWriter* yaml) {
+  yaml->Line(0, "optimizer", "", "zone_identification: (the zone moduli in log E)");
+  yaml->Text(1, "algorithm", BoundedAlgorithmToString(run.outer.algorithm));
+  yaml->Text(1, "termination", TerminationTypeToString(run.outer.termination));
+  yaml->Text(1, "message", run.outer.message);
+  yaml->Text(1, "optimizer_message", run.outer.optimizer_message, "the optimiser's own words");
+  yaml->Integer(1, "evaluations", run.outer.evaluations);
+  yaml->Integer(1, "gradient_evaluations", run.outer.gradient_evaluations);
+  yaml->Number(1, "scaled_cost", run.outer.cost, cost + " / cost_scale at the identified moduli");
+}
+
 // summary.yaml of a matrix run by least squares: MatrixSummaryYaml's layout with J [s]
 // for e^2, the misfit levels for the error map, and no inner solver.
 std::string MatrixLeastSquaresSummaryYaml(const MatrixIdentificationRun& run,
@@ -1004,14 +1017,7 @@ std::string MatrixLeastSquaresSummaryYaml(const MatrixIdentificationRun& run,
   yaml.Number(1, "displacement", run.misfit_levels.displacement_std, "[m] s_u (0: no such sensor)");
   yaml.Number(1, "strain", run.misfit_levels.strain_std, "[-] s_e (0: no such sensor)");
   yaml.Text(1, "source", run.misfit_source);
-  yaml.Line(0, "optimizer", "", "zone_identification: (the zone moduli in log E)");
-  yaml.Text(1, "algorithm", BoundedAlgorithmToString(run.outer.algorithm));
-  yaml.Text(1, "termination", TerminationTypeToString(run.outer.termination));
-  yaml.Text(1, "message", run.outer.message);
-  yaml.Text(1, "optimizer_message", run.outer.optimizer_message, "the optimiser's own words");
-  yaml.Integer(1, "evaluations", run.outer.evaluations);
-  yaml.Integer(1, "gradient_evaluations", run.outer.gradient_evaluations);
-  yaml.Number(1, "scaled_cost", run.outer.cost, "J / cost_scale at the identified moduli");
+  MatrixOptimizerYaml(run, "J", &yaml);
   yaml.Line(0, "prefilter", "");
   yaml.Line(1, "enabled", config.prefilter.enabled ? "true" : "false");
   yaml.Number(1, "cutoff_frequency", run.prefilter_cutoff, "[Hz] the cut-off used (0: off)");
@@ -1047,14 +1053,7 @@ std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& 
   yaml.Number(0, "nominal_cost", run.nominal_cost, "[J s] e^2 at the nominal moduli");
   yaml.Number(0, "cost_scale", run.rest_cost,
               "[J s] J_rest, e^2 of the structure left at rest (0 <= e^2 <= J_rest)");
-  yaml.Line(0, "optimizer", "", "zone_identification: (the zone moduli in log E)");
-  yaml.Text(1, "algorithm", BoundedAlgorithmToString(run.outer.algorithm));
-  yaml.Text(1, "termination", TerminationTypeToString(run.outer.termination));
-  yaml.Text(1, "message", run.outer.message);
-  yaml.Text(1, "optimizer_message", run.outer.optimizer_message, "the optimiser's own words");
-  yaml.Integer(1, "evaluations", run.outer.evaluations);
-  yaml.Integer(1, "gradient_evaluations", run.outer.gradient_evaluations);
-  yaml.Number(1, "scaled_cost", run.outer.cost, "e^2 / cost_scale at the identified moduli");
+  MatrixOptimizerYaml(run, "e^2", &yaml);
   yaml.Line(0, "inner", "");
   yaml.Text(1, "method", CoupledSolverTypeToString(run.inner_method),
             config.inner.type == CoupledSolverType::kAuto
