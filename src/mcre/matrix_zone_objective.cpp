@@ -1,5 +1,7 @@
 #include "mcrewave/mcre/matrix_zone_objective.h"
 
+#include <spdlog/spdlog.h>
+
 #include <cassert>
 #include <cmath>
 
@@ -34,6 +36,9 @@ bool MatrixZoneObjective::Evaluate(const double* p, double* cost, double* gradie
                      " is not usable: " + summary.BriefReport() + " (" + summary.message + ")";
     return false;
   }
+  spdlog::debug("evaluation {}: e^2 = {:.9g} J s; inner {} (from {:.3g})", evaluations_,
+                solution_.cost, summary.BriefReport(),
+                summary.residual_history.empty() ? -1.0 : summary.residual_history.front());
   warm_start_ = solution_.retrograde;
   // cost = e^2 / J_rest
   *cost = solution_.cost / cost_scale_;
