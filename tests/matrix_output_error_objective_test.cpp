@@ -194,7 +194,7 @@ TEST(MatrixOutputErrorObjectiveTest, InverseCrimeOnThePlateRecoversBothZones) {
   MatrixOutputErrorObjective objective(coarse, data, LsPlateLevels(coarse, data), 0.5);
   // At the truth J = 0 to round-off (the simulation's steps in the same order).
   EXPECT_LE(objective.Cost(truth, nullptr), 1e-24 * objective.rest_cost());
-  EXPECT_GT(objective.Cost(objective.nominal_moduli(), nullptr), 1e-3 * objective.rest_cost());
+  EXPECT_GT(objective.Cost(objective.reference_moduli(), nullptr), 1e-3 * objective.rest_cost());
 
   BoundedMinimizerOptions options;
   options.step_tolerance = 1e-10;

@@ -183,10 +183,9 @@ double RootMeanSquareOfRows(const Matrix& rows) {
 
 // Records every evaluation of a zone objective (MatrixZoneObjective,
 // MatrixOutputErrorObjective) and logs a progress line naming its cost.
-template <typename ZoneObjective>
 class RecordingObjective : public MultiParameterObjective {
  public:
-  RecordingObjective(ZoneObjective* objective, std::vector<MatrixEvaluation>* records,
+  RecordingObjective(LogModuliObjective* objective, std::vector<MatrixEvaluation>* records,
                      const char* cost_name)
       : objective_(objective), records_(records), cost_name_(cost_name) {}
   int num_parameters() const override { return objective_->num_parameters(); }
@@ -211,7 +210,7 @@ class RecordingObjective : public MultiParameterObjective {
   std::string error_message() const override { return objective_->error_message(); }
 
  private:
-  ZoneObjective* objective_;
+  LogModuliObjective* objective_;
   std::vector<MatrixEvaluation>* records_;
   const char* cost_name_;
 };
@@ -295,9 +294,9 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
   run.misfit_levels =
       MatrixLeastSquaresMisfitLevels(config, model, measurements, run.data, &run.misfit_source);
   MatrixOutputErrorObjective objective(model, run.data, run.misfit_levels, config.time.theta);
-  run.nominal_moduli = objective.nominal_moduli();
+  run.nominal_moduli = objective.reference_moduli();
   run.rest_cost = objective.rest_cost();
-  RecordingObjective<MatrixOutputErrorObjective> recorder(&objective, &run.evaluations, "J");
+  RecordingObjective recorder(&objective, &run.evaluations, "J");
   std::vector<double> lower, upper;
   ZoneParameterBounds(config, run.nominal_moduli, &lower, &upper);
   spdlog::info(
@@ -579,7 +578,7 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config,
   run.nominal_moduli = problem.NominalModuli();
   run.rest_cost = problem.RestCost();
   MatrixZoneObjective objective(&problem, config.inner);
-  RecordingObjective<MatrixZoneObjective> recorder(&objective, &run.evaluations, "e^2");
+  RecordingObjective recorder(&objective, &run.evaluations, "e^2");
   const auto zones = static_cast<std::size_t>(model.zones.size());
   std::vector<double> lower, upper;
   ZoneParameterBounds(config, run.nominal_moduli, &lower, &upper);

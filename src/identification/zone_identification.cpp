@@ -14,47 +14,31 @@
 namespace mcrewave {
 
 ZoneMcreObjective::ZoneMcreObjective(McreObjective* objective, double modulus_scale)
-    : objective_(objective),
-      modulus_scale_(modulus_scale),
-      num_zones_(objective->problem().num_zones()) {}
+    : LogModuliObjective(Vector::Constant(objective->problem().num_zones(), modulus_scale)),
+      objective_(objective) {}
 
-Vector ZoneMcreObjective::Moduli(const double* p) const {
-  Vector moduli(num_zones_);
-  for (int z = 0; z < num_zones_; ++z) moduli[z] = modulus_scale_ * std::exp(p[z]);
-  return moduli;
-}
+double ZoneMcreObjective::cost_scale() const { return objective_->cost_scale(); }
 
-bool ZoneMcreObjective::Evaluate(const double* p, double* cost, double* gradient) {
-  ++evaluations_;
-  const Vector moduli = Moduli(p);
-  if (!(moduli.allFinite() && moduli.minCoeff() > 0.0)) {
-    error_message_ = "a trial zone modulus is not a positive finite number";
-    return false;
-  }
+bool ZoneMcreObjective::ModuliCost(const Vector& moduli, double* cost, Vector* gradient,
+                                   std::string* why) {
   const ObjectiveEvaluation& record = objective_->EvaluateModuli(moduli, gradient != nullptr);
   if (!record.usable) {
-    error_message_ =
-        "the coupled solve at the zone moduli of evaluation " + std::to_string(evaluations_) +
-        " is not usable: " + record.inner.BriefReport() + " (" + record.inner.message + ")";
+    *why = "the coupled solve at the zone moduli of evaluation " + std::to_string(evaluations()) +
+           " is not usable: " + record.inner.BriefReport() + " (" + record.inner.message + ")";
     return false;
   }
-  const double scale = objective_->cost_scale();
-  // cost = e^2 / J_rest
-  *cost = record.cost / scale;
-  double gradient_norm = 0.0;
-  if (gradient != nullptr) {
-    for (int z = 0; z < num_zones_; ++z) {
-      // d cost / d p_z = (de^2/dE_z) (dE_z/dp_z) / J_rest,  dE_z/dp_z = E_z
-      gradient[z] = record.cost_gradients[z] * moduli[z] / scale;
-      gradient_norm = std::max(gradient_norm, std::abs(gradient[z]));
-    }
-  }
+  *cost = record.cost;
+  if (gradient != nullptr) *gradient = record.cost_gradients;
+  inner_report_ = record.inner.BriefReport();
+  return true;
+}
+
+void ZoneMcreObjective::OnEvaluated(const Vector& moduli, double cost, double gradient_norm) {
   spdlog::info(
       "zones evaluation {}: e^2 / J_rest = {:.10g}, |grad|_inf = {:.3g}, E in [{:.6g}, "
       "{:.6g}] GPa; inner {}",
-      evaluations_, *cost, gradient_norm, moduli.minCoeff() * 1e-9, moduli.maxCoeff() * 1e-9,
-      record.inner.BriefReport());
-  return true;
+      evaluations(), cost, gradient_norm, moduli.minCoeff() * 1e-9, moduli.maxCoeff() * 1e-9,
+      inner_report_);
 }
 
 bool ZoneIdentificationOptions::IsValid(std::string* error) const {

@@ -9,7 +9,11 @@ MatrixOutputErrorObjective::MatrixOutputErrorObjective(const MatrixModelData& mo
                                                        const ChannelSet& data,
                                                        const NoiseLevels& misfit_levels,
                                                        double theta, Factorization factorization)
-    : model_(model), time_step_(data.time_step), theta_(theta), factorization_(factorization) {
+    : LogModuliObjective(model.NominalModuli()),
+      model_(model),
+      time_step_(data.time_step),
+      theta_(theta),
+      factorization_(factorization) {
   const int n = model.dofs();
   const int zones = static_cast<int>(model.zones.size());
   const int num_loads = static_cast<int>(model.loads.size());
@@ -25,11 +29,9 @@ MatrixOutputErrorObjective::MatrixOutputErrorObjective(const MatrixModelData& mo
     measured_outputs_.row(k) = data.Values(model.sensors[k].channel).transpose();
   }
   assert(samples >= 2 && theta >= 0.0 && theta <= 1.0);
-  nominal_.resize(zones);
   for (int z = 0; z < zones; ++z) {
-    nominal_[z] = model.zones[z].nominal_modulus;
     // dK/dE_z = K_z / E_z,nom (docs/formulation.md section 6).
-    zone_stiffness_.push_back(model.zones[z].stiffness / nominal_[z]);
+    zone_stiffness_.push_back(model.zones[z].stiffness / model.zones[z].nominal_modulus);
   }
   std::vector<Eigen::Triplet<double>> entries;
   for (int c = 0; c < num_loads; ++c) {
@@ -74,12 +76,6 @@ MatrixOutputErrorObjective::MatrixOutputErrorObjective(const MatrixModelData& mo
     const double c = (j == 0 || j == samples - 1) ? 0.5 : 1.0;
     rest_cost_ += 0.5 * c * time_step_ * measured_outputs_.col(j).cwiseAbs2().dot(weights_);
   }
-}
-
-Vector MatrixOutputErrorObjective::Moduli(const double* p) const {
-  Vector moduli(nominal_.size());
-  for (int z = 0; z < nominal_.size(); ++z) moduli[z] = nominal_[z] * std::exp(p[z]);
-  return moduli;
 }
 
 double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradient) {
@@ -142,29 +138,10 @@ double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradi
   return cost;
 }
 
-bool MatrixOutputErrorObjective::Evaluate(const double* p, double* cost, double* gradient) {
-  ++evaluations_;
-  const Vector moduli = Moduli(p);
-  if (!(moduli.allFinite() && moduli.minCoeff() > 0.0)) {
-    error_message_ = "a trial zone modulus is not a positive finite number";
-    return false;
-  }
-  Vector moduli_gradient;
-  const double misfit = Cost(moduli, gradient != nullptr ? &moduli_gradient : nullptr);
-  if (!std::isfinite(misfit) || (gradient != nullptr && !moduli_gradient.allFinite())) {
-    error_message_ = "the output-error misfit at the zone moduli of evaluation " +
-                     std::to_string(evaluations_) + " is not finite";
-    return false;
-  }
-  // cost = J / J_rest
-  *cost = misfit / cost_scale();
-  if (gradient != nullptr) {
-    for (int z = 0; z < moduli.size(); ++z) {
-      // d cost / d p_z = (dJ/dE_z) (dE_z/dp_z) / J_rest,  dE_z/dp_z = E_z
-      gradient[z] = moduli_gradient[z] * moduli[z] / cost_scale();
-    }
-  }
-  error_message_.clear();
+bool MatrixOutputErrorObjective::ModuliCost(const Vector& moduli, double* cost, Vector* gradient,
+                                            std::string* why) {
+  (void)why;  // the misfit is always had; Evaluate tests that it is finite
+  *cost = Cost(moduli, gradient);
   return true;
 }
 

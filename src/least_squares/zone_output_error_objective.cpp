@@ -15,12 +15,12 @@ ZoneOutputErrorObjective::ZoneOutputErrorObjective(const BarModel& model, const 
                                                    const NoiseLevels& noise, double theta,
                                                    double modulus_scale,
                                                    EndDisplacementChannels ends)
-    : model_(model),
+    : LogModuliObjective(Vector::Constant(model.num_zones(), modulus_scale)),
+      model_(model),
       data_(data),
       measured_(BarEndChannels(data)),
       sensor_data_(BarSensorValues(data)),
       theta_(theta),
-      modulus_scale_(modulus_scale),
       ends_(ends),
       num_zones_(model.num_zones()),
       weight_u_(1.0 / (noise.displacement_std * noise.displacement_std)),
@@ -51,12 +51,6 @@ ZoneOutputErrorObjective::ZoneOutputErrorObjective(const BarModel& model, const 
   nodal_.setZero(model.num_nodes());
   residuals_.setZero(static_cast<Eigen::Index>(sensor_rows_.size()));
   rest_cost_ = OutputErrorRestCost(data, noise, sensor_weights_, ends_);
-}
-
-Vector ZoneOutputErrorObjective::Moduli(const double* p) const {
-  Vector moduli(num_zones_);
-  for (int z = 0; z < num_zones_; ++z) moduli[z] = modulus_scale_ * std::exp(p[z]);
-  return moduli;
 }
 
 double ZoneOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradient) {
@@ -142,36 +136,19 @@ double ZoneOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradien
   return cost;
 }
 
-bool ZoneOutputErrorObjective::Evaluate(const double* p, double* cost, double* gradient) {
-  ++evaluations_;
-  const Vector moduli = Moduli(p);
-  if (!(moduli.allFinite() && moduli.minCoeff() > 0.0)) {
-    error_message_ = "a trial zone modulus is not a positive finite number";
-    return false;
-  }
-  Vector moduli_gradient;
-  const double misfit = Cost(moduli, gradient != nullptr ? &moduli_gradient : nullptr);
-  if (!std::isfinite(misfit) || (gradient != nullptr && !moduli_gradient.allFinite())) {
-    error_message_ = "the output-error misfit at the zone moduli of evaluation " +
-                     std::to_string(evaluations_) + " is not finite";
-    return false;
-  }
-  // cost = J / J_rest
-  *cost = misfit / cost_scale();
-  double gradient_norm = 0.0;
-  if (gradient != nullptr) {
-    for (int z = 0; z < num_zones_; ++z) {
-      // d cost / d p_z = (dJ/dE_z) (dE_z/dp_z) / J_rest,  dE_z/dp_z = E_z
-      gradient[z] = moduli_gradient[z] * moduli[z] / cost_scale();
-      gradient_norm = std::max(gradient_norm, std::abs(gradient[z]));
-    }
-  }
-  error_message_.clear();
+bool ZoneOutputErrorObjective::ModuliCost(const Vector& moduli, double* cost, Vector* gradient,
+                                          std::string* why) {
+  (void)why;  // the misfit is always had; Evaluate tests that it is finite
+  *cost = Cost(moduli, gradient);
+  return true;
+}
+
+void ZoneOutputErrorObjective::OnEvaluated(const Vector& moduli, double cost,
+                                           double gradient_norm) {
   spdlog::info(
       "least-squares zones evaluation {}: J / J_rest = {:.10g}, |grad|_inf = {:.3g}, E in "
       "[{:.6g}, {:.6g}] GPa",
-      evaluations_, *cost, gradient_norm, moduli.minCoeff() * 1e-9, moduli.maxCoeff() * 1e-9);
-  return true;
+      evaluations(), cost, gradient_norm, moduli.minCoeff() * 1e-9, moduli.maxCoeff() * 1e-9);
 }
 
 }  // namespace mcrewave

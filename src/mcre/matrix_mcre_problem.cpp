@@ -415,13 +415,7 @@ double MatrixMcreProblem::RestCost() const {
   return sum;
 }
 
-Vector MatrixMcreProblem::NominalModuli() const {
-  Vector nominal(model_.zones.size());
-  for (std::size_t z = 0; z < model_.zones.size(); ++z) {
-    nominal[static_cast<Eigen::Index>(z)] = model_.zones[z].nominal_modulus;
-  }
-  return nominal;
-}
+Vector MatrixMcreProblem::NominalModuli() const { return model_.NominalModuli(); }
 
 Matrix MatrixMcreProblem::ModelOutputs() {
   Matrix displacement;

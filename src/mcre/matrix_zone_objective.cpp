@@ -9,45 +9,28 @@ namespace mcrewave {
 
 MatrixZoneObjective::MatrixZoneObjective(MatrixMcreProblem* problem,
                                          const CoupledSolverOptions& inner)
-    : problem_(problem), inner_(inner), nominal_(problem->NominalModuli()) {
+    : LogModuliObjective(problem->NominalModuli()), problem_(problem), inner_(inner) {
   assert(inner.IsValid(nullptr));
   const double rest = problem->RestCost();
   cost_scale_ = rest > 0.0 ? rest : 1.0;
 }
 
-Vector MatrixZoneObjective::Moduli(const double* p) const {
-  Vector moduli(nominal_.size());
-  for (int z = 0; z < nominal_.size(); ++z) moduli[z] = nominal_[z] * std::exp(p[z]);
-  return moduli;
-}
-
-bool MatrixZoneObjective::Evaluate(const double* p, double* cost, double* gradient) {
-  ++evaluations_;
-  const Vector moduli = Moduli(p);
-  if (!(moduli.allFinite() && moduli.minCoeff() > 0.0)) {
-    error_message_ = "a trial zone modulus is not a positive finite number";
-    return false;
-  }
+bool MatrixZoneObjective::ModuliCost(const Vector& moduli, double* cost, Vector* gradient,
+                                     std::string* why) {
   problem_->SetModuli(moduli);
   const CoupledSolverSummary summary =
       SolveCoupled(inner_, problem_, warm_start_.size() > 0 ? &warm_start_ : nullptr, &solution_);
   if (!summary.IsSolutionUsable() || !std::isfinite(solution_.cost)) {
-    error_message_ = "the coupled solve of evaluation " + std::to_string(evaluations_) +
-                     " is not usable: " + summary.BriefReport() + " (" + summary.message + ")";
+    *why = "the coupled solve of evaluation " + std::to_string(evaluations()) +
+           " is not usable: " + summary.BriefReport() + " (" + summary.message + ")";
     return false;
   }
-  spdlog::debug("evaluation {}: e^2 = {:.9g} J s; inner {} (from {:.3g})", evaluations_,
+  spdlog::debug("evaluation {}: e^2 = {:.9g} J s; inner {} (from {:.3g})", evaluations(),
                 solution_.cost, summary.BriefReport(),
                 summary.residual_history.empty() ? -1.0 : summary.residual_history.front());
   warm_start_ = solution_.retrograde;
-  // cost = e^2 / J_rest
-  *cost = solution_.cost / cost_scale_;
-  if (gradient != nullptr) {
-    for (int z = 0; z < moduli.size(); ++z) {
-      // d cost / d p_z = (de^2/dE_z) E_z / J_rest
-      gradient[z] = solution_.cost_gradients[z] * moduli[z] / cost_scale_;
-    }
-  }
+  *cost = solution_.cost;
+  if (gradient != nullptr) *gradient = solution_.cost_gradients;
   return true;
 }
 

@@ -106,6 +106,14 @@ SparseMatrix MatrixModelData::Stiffness(const Vector& zone_moduli) const {
   return stiffness;
 }
 
+Vector MatrixModelData::NominalModuli() const {
+  Vector nominal(zones.size());
+  for (std::size_t z = 0; z < zones.size(); ++z) {
+    nominal[static_cast<Eigen::Index>(z)] = zones[z].nominal_modulus;
+  }
+  return nominal;
+}
+
 SparseMatrix ObservationRowMatrix(const ObservationRow& row, int dofs) {
   std::vector<Eigen::Triplet<double>> entries;
   for (int i = 0; i < 2; ++i) {

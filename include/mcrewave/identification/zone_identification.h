@@ -26,31 +26,28 @@
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/mcre/objective.h"
 #include "mcrewave/optim/bounded_minimizer.h"
+#include "mcrewave/optim/log_moduli_objective.h"
 #include "mcrewave/optim/regularization.h"
 
 namespace mcrewave {
 
-// McreObjective::EvaluateModuli seen as a function of p_z = log(E_z / modulus_scale).
-// Logs one line per evaluation.
-class ZoneMcreObjective : public MultiParameterObjective {
+// McreObjective::EvaluateModuli seen as a function of p_z = log(E_z / modulus_scale)
+// (optim/log_moduli_objective.h), J_scale = McreObjective::cost_scale(). Logs one line
+// per usable evaluation.
+class ZoneMcreObjective : public LogModuliObjective {
  public:
   // objective must outlive this adapter; its model has the identification's zones.
   ZoneMcreObjective(McreObjective* objective, double modulus_scale);
 
-  int num_parameters() const override { return num_zones_; }
-  bool Evaluate(const double* p, double* cost, double* gradient) override;
-  std::string error_message() const override { return error_message_; }
+  double cost_scale() const override;
 
-  // E_z = modulus_scale exp(p_z) [Pa].
-  Vector Moduli(const double* p) const;
-  int evaluations() const { return evaluations_; }
+ protected:
+  bool ModuliCost(const Vector& moduli, double* cost, Vector* gradient, std::string* why) override;
+  void OnEvaluated(const Vector& moduli, double cost, double gradient_norm) override;
 
  private:
   McreObjective* objective_;
-  double modulus_scale_;
-  int num_zones_;
-  int evaluations_ = 0;
-  std::string error_message_;
+  std::string inner_report_;  // the last usable solve's BriefReport()
 };
 
 // The `zone_identification:` section.

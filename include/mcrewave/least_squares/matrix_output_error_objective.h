@@ -22,9 +22,9 @@
 // One sweep per evaluation without the gradient, 1 + Z with it; no allocation in the
 // time loop (every scratch is sized in the constructor).
 //
-// Seen by the optimisers (optim/bounded_minimizer.h) as MatrixZoneObjective is: as a
-// function of p_z = log(E_z / E_z,nom), with the cost J / J_rest (J_rest: J with every
-// prediction 0) and d cost / d p_z = (dJ/dE_z) E_z / J_rest.
+// Seen by the optimisers as MatrixZoneObjective is (optim/log_moduli_objective.h): as a
+// function of p_z = log(E_z / E_z,nom), with J_scale = J_rest (J with every prediction
+// 0).
 #pragma once
 
 #include <string>
@@ -35,11 +35,11 @@
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/model/matrix_export.h"
-#include "mcrewave/optim/bounded_minimizer.h"
+#include "mcrewave/optim/log_moduli_objective.h"
 
 namespace mcrewave {
 
-class MatrixOutputErrorObjective : public MultiParameterObjective {
+class MatrixOutputErrorObjective : public LogModuliObjective {
  public:
   // Keeps a reference to model, which must outlive the objective; copies the histories
   // of data's channels named as the model's loads and sensors (data may go).
@@ -51,22 +51,11 @@ class MatrixOutputErrorObjective : public MultiParameterObjective {
                              const NoiseLevels& misfit_levels, double theta,
                              Factorization factorization = Factorization::kAutomatic);
 
-  int num_parameters() const override { return static_cast<int>(nominal_.size()); }
-  // p_z = log(E_z / E_z,nom): cost = J / cost_scale() and, when gradient is not null,
-  // d cost / d p_z. False when a modulus is not a finite positive number or J or its
-  // gradient is not finite (the reason in error_message()).
-  bool Evaluate(const double* p, double* cost, double* gradient) override;
-  std::string error_message() const override { return error_message_; }
-
   // J at the zone moduli [s] (num_parameters() entries [Pa], positive), and dJ/dE_z
   // [s / Pa] into *gradient when it is not null (resized to num_parameters()). Leaves
   // the outputs H U_j in outputs(). Re-initialises the integrator (the moduli change K).
   double Cost(const Vector& zone_moduli, Vector* gradient);
 
-  // E_z = E_z,nom exp(p_z) [Pa].
-  Vector Moduli(const double* p) const;
-  // E_z,nom of every zone [Pa].
-  const Vector& nominal_moduli() const { return nominal_; }
   // The outputs H U_j of the last Cost, one row per sensor in the model's order, one
   // column per sample [m] or [-].
   const Matrix& outputs() const { return outputs_; }
@@ -74,18 +63,19 @@ class MatrixOutputErrorObjective : public MultiParameterObjective {
   const Vector& sensor_weights() const { return weights_; }
   // J_rest = 1/2 sum_j c_j h sum_k w_k d~_kj^2 [s]; the cost scale (1 when J_rest = 0).
   double rest_cost() const { return rest_cost_; }
-  double cost_scale() const { return rest_cost_ > 0.0 ? rest_cost_ : 1.0; }
-  int evaluations() const { return evaluations_; }
+  double cost_scale() const override { return rest_cost_ > 0.0 ? rest_cost_ : 1.0; }
   // Simulations run: 1 per Cost, plus one per zone with the gradient.
   long sweeps() const { return sweeps_; }
   const ThetaIntegrator& integrator() const { return integrator_; }
+
+ protected:
+  bool ModuliCost(const Vector& moduli, double* cost, Vector* gradient, std::string* why) override;
 
  private:
   const MatrixModelData& model_;
   double time_step_;  // h [s]
   double theta_;
   Factorization factorization_;
-  Vector nominal_;                            // E_z,nom [Pa]
   Matrix measured_loads_;                     // F~ [N], C x (m + 1), rows in the model's order
   Matrix measured_outputs_;                   // d~ [m] or [-], S x (m + 1)
   Vector weights_;                            // w_k
@@ -102,9 +92,7 @@ class MatrixOutputErrorObjective : public MultiParameterObjective {
   Matrix outputs_;
 
   double rest_cost_ = 0.0;
-  int evaluations_ = 0;
   long sweeps_ = 0;
-  std::string error_message_;
 };
 
 }  // namespace mcrewave

@@ -9,8 +9,8 @@
 //   df0_k/dE_z = M_01 da_1 + K_01 s_z,1 + K1_z,01 u_1,   M_r da = -K_r s_z - K1_z,r u:
 // one sweep per evaluation without the gradient, 1 + Z with it (for the few zones of a
 // localisation, not one zone per element). Seen by the optimisers
-// (optim/bounded_minimizer.h) as a function of p_z = log(E_z / modulus_scale), with the
-// cost J / J_rest (OutputErrorRestCost) and d cost / d p_z = (dJ/dE_z) E_z / J_rest.
+// (optim/log_moduli_objective.h) as a function of p_z = log(E_z / modulus_scale), with
+// J_scale = J_rest (OutputErrorRestCost).
 #pragma once
 
 #include <string>
@@ -23,11 +23,11 @@
 #include "mcrewave/mcre/mcre_problem.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/model/bar_model.h"
-#include "mcrewave/optim/bounded_minimizer.h"
+#include "mcrewave/optim/log_moduli_objective.h"
 
 namespace mcrewave {
 
-class ZoneOutputErrorObjective : public MultiParameterObjective {
+class ZoneOutputErrorObjective : public LogModuliObjective {
  public:
   // Keeps references to model and data: both must outlive the objective. model: the
   // identification's zones (one or more). noise: the levels s_u, s_f, s_e of the
@@ -37,26 +37,20 @@ class ZoneOutputErrorObjective : public MultiParameterObjective {
   ZoneOutputErrorObjective(const BarModel& model, const ChannelSet& data, const NoiseLevels& noise,
                            double theta, double modulus_scale, EndDisplacementChannels ends = {});
 
-  int num_parameters() const override { return num_zones_; }
-  // p_z = log(E_z / modulus_scale): cost = J / cost_scale() and, when gradient is not
-  // null, d cost / d p_z. False when a modulus is not a finite positive number or J or
-  // its gradient is not finite (the reason in error_message()). Logs one line per
-  // evaluation.
-  bool Evaluate(const double* p, double* cost, double* gradient) override;
-  std::string error_message() const override { return error_message_; }
-
   // J at the zone moduli [s] (num_parameters() entries [Pa], positive), and dJ/dE_z
   // [s / Pa] into *gradient when it is not null (resized to num_parameters()). Re-initialises the
   // integrator (the moduli change K). No allocation in the time loop.
   double Cost(const Vector& zone_moduli, Vector* gradient);
 
-  // E_z = modulus_scale exp(p_z) [Pa].
-  Vector Moduli(const double* p) const;
   // J_rest [s]; the cost scale (1 when J_rest = 0).
   double rest_cost() const { return rest_cost_; }
-  double cost_scale() const { return rest_cost_ > 0.0 ? rest_cost_ : 1.0; }
-  int evaluations() const { return evaluations_; }
+  double cost_scale() const override { return rest_cost_ > 0.0 ? rest_cost_ : 1.0; }
   long sweeps() const { return sweeps_; }
+
+ protected:
+  // J and dJ/dE_z by Cost; logs one line per usable evaluation.
+  bool ModuliCost(const Vector& moduli, double* cost, Vector* gradient, std::string* why) override;
+  void OnEvaluated(const Vector& moduli, double cost, double gradient_norm) override;
 
  private:
   const BarModel& model_;
@@ -64,7 +58,6 @@ class ZoneOutputErrorObjective : public MultiParameterObjective {
   BarEnds measured_;                        // data_'s end channels
   std::vector<const Vector*> sensor_data_;  // data_'s interior sensors (BarSensorValues)
   double theta_;
-  double modulus_scale_;
   EndDisplacementChannels ends_;
   int num_zones_;
   double weight_u_;  // 1 / s_u^2
@@ -88,9 +81,7 @@ class ZoneOutputErrorObjective : public MultiParameterObjective {
   Vector acceleration_, acceleration_sensitivity_, nodal_, residuals_;
 
   double rest_cost_ = 0.0;
-  int evaluations_ = 0;
   long sweeps_ = 0;
-  std::string error_message_;
 };
 
 }  // namespace mcrewave

@@ -82,6 +82,8 @@ struct MatrixModelData {
   int dofs() const { return static_cast<int>(mass.rows()); }
   // K = sum_z (E_z / E_z,nominal) K_z; zone_moduli has zones.size() entries [Pa].
   SparseMatrix Stiffness(const Vector& zone_moduli) const;
+  // E_z,nominal of every zone [Pa].
+  Vector NominalModuli() const;
 };
 
 // The observation row of a channel as a 1 x n sparse matrix.
