@@ -526,6 +526,7 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config,
   MatrixIdentificationRun run;
   run.manifest = config.structure.manifest;
   run.dofs = model.dofs();
+  run.supports = static_cast<int>(model.supports.size());
   run.steps = measurements.histories.num_steps();
   run.inner_method = ResolveCoupledSolverType(config.inner, run.dofs, run.steps,
                                               /*streaming_available=*/false);

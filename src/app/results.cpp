@@ -971,6 +971,7 @@ void MatrixModelAndDataYaml(const MatrixIdentificationRun& run, const Config& co
   yaml->Integer(1, "zones", static_cast<long>(run.zone_names.size()));
   yaml->Integer(1, "loads", static_cast<long>(run.load_names.size()));
   yaml->Integer(1, "sensors", static_cast<long>(run.sensor_names.size()));
+  yaml->Integer(1, "supports", run.supports);
   yaml->Line(0, "data", "");
   yaml->Text(1, "source", run.data_source);
   yaml->Integer(1, "steps", run.steps);

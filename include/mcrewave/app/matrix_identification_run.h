@@ -129,6 +129,7 @@ struct MatrixIdentificationRun {
   NoiseLevels misfit_levels;  // least squares: s_u, s_e of the normalisation
   std::string misfit_source;  // as MatrixLeastSquaresMisfitLevels says
   int dofs = 0;
+  int supports = 0;  // the manifest's supports (mcre.clamp treats them)
   int steps = 0;
   // The coupled solver of every solve: config.inner.type, auto resolved
   // (conjugate_gradient on a matrix model; ResolveCoupledSolverType).
