@@ -134,6 +134,22 @@ TEST(MatrixIdentificationRunTest, TheBarWithItsClampAsASupportIdentifiesTheBuilt
     const YAML::Node summary = YAML::LoadFile(dir + "/matrices_" + clamp + "/summary.yaml");
     EXPECT_EQ(summary["model"]["supports"].as<int>(), 1);
   }
+  // With the pre-filter on, both roads take its cut-off from fL alone (the clamp's
+  // force f0 is the support's channel, no load), the same frequency to the bit.
+  const std::string filtered = " --set data.source=csv --set data.path=" + dir + "/data.csv";
+  const RunResult bar = RunIdentify("run " + quick + filtered + " -q -o " + dir + "/bar_filtered");
+  ASSERT_EQ(bar.exit_code, 0) << bar.output;
+  const RunResult matrices = RunIdentify(
+      "run " + quick + filtered + " --set model.kind=matrix --set model.manifest=" + manifest +
+      " --set search.functional=pinned -q -o " + dir + "/matrices_filtered");
+  ASSERT_EQ(matrices.exit_code, 0) << matrices.output;
+  const double bar_cutoff =
+      YAML::LoadFile(dir + "/bar_filtered/summary.yaml")["prefilter"]["cutoff_frequency"]
+          .as<double>();
+  EXPECT_GT(bar_cutoff, 0.0);
+  EXPECT_EQ(YAML::LoadFile(dir + "/matrices_filtered/summary.yaml")["prefilter"]["cutoff_frequency"]
+                .as<double>(),
+            bar_cutoff);
 }
 
 TEST(MatrixIdentificationRunTest, ASimulatedCsvReadBackGivesTheSyntheticRunsModuli) {
