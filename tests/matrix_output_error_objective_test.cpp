@@ -196,12 +196,7 @@ TEST(MatrixOutputErrorObjectiveTest, InverseCrimeOnThePlateRecoversBothZones) {
   EXPECT_LE(objective.Cost(truth, nullptr), 1e-24 * objective.rest_cost());
   EXPECT_GT(objective.Cost(objective.reference_moduli(), nullptr), 1e-3 * objective.rest_cost());
 
-  BoundedMinimizerOptions options;
-  options.step_tolerance = 1e-10;
-  options.function_tolerance = 0.0;
-  const double log_half = std::log(0.5), log_two = std::log(2.0);
-  const BoundedMinimizerSummary summary = MinimizeWithinBounds(
-      options, &objective, {log_half, log_half}, {log_two, log_two}, {0.0, 0.0});
+  const BoundedMinimizerSummary summary = testing::MinimizeWithinHalfAndTwice(&objective);
   ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
   const Vector found = objective.Moduli(summary.x.data());
   // Measured: 2.0e-15 (matrix) and 2.6e-14 (inclusion) off in 12 evaluations.

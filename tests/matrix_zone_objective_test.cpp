@@ -47,12 +47,7 @@ TEST(MatrixZoneObjectiveTest, InverseCrimeOnThePlateRecoversBothZones) {
   ASSERT_TRUE(objective.Evaluate(at_truth, &cost, nullptr)) << objective.error_message();
   EXPECT_LT(cost, 1e-20);
 
-  BoundedMinimizerOptions options;
-  options.step_tolerance = 1e-10;
-  options.function_tolerance = 0.0;
-  const double log_half = std::log(0.5), log_two = std::log(2.0);
-  const BoundedMinimizerSummary summary = MinimizeWithinBounds(
-      options, &objective, {log_half, log_half}, {log_two, log_two}, {0.0, 0.0});
+  const BoundedMinimizerSummary summary = testing::MinimizeWithinHalfAndTwice(&objective);
   ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
   const Vector found = objective.Moduli(summary.x.data());
   // Measured: 5.0e-12 (matrix) and 1.2e-12 (inclusion) off, in 14 evaluations; the

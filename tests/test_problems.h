@@ -9,6 +9,7 @@
 #include "mcrewave/mcre/objective.h"
 #include "mcrewave/model/bar_model.h"
 #include "mcrewave/model/simulation.h"
+#include "mcrewave/optim/bounded_minimizer.h"
 
 // MCREWAVE_ADDRESS_SANITIZER: defined when this build runs under AddressSanitizer
 // (gcc's macro or clang's feature test), whose allocator and memory overhead some
@@ -67,6 +68,19 @@ struct ProblemBundle {
   ChannelSet data;
   McreProblem problem;
 };
+
+// Minimises a zone objective in p_z = log(E_z / E_z,ref) from p = 0 within
+// [log 1/2, log 2] for every zone, at the step tolerance 1e-10 and no cost tolerance
+// (the inverse crimes' setting).
+inline BoundedMinimizerSummary MinimizeWithinHalfAndTwice(MultiParameterObjective* objective) {
+  BoundedMinimizerOptions options;
+  options.step_tolerance = 1e-10;
+  options.function_tolerance = 0.0;
+  const auto zones = static_cast<std::size_t>(objective->num_parameters());
+  return MinimizeWithinBounds(options, objective, std::vector<double>(zones, std::log(0.5)),
+                              std::vector<double>(zones, std::log(2.0)),
+                              std::vector<double>(zones, 0.0));
+}
 
 inline McreWeights Weights(double w_u, double w_f) {
   McreWeights weights;
