@@ -653,23 +653,23 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
        {"model.manifest", "model.channel_map", "data.truth_manifest", "data.truth_moduli",
         "mcre.w_u", "mcre.reference_modulus", "mcre.clamp", "mcre.w_r", "mcre.w_u0", "inner.method",
         "outer.lower_bound", "prefilter.cutoff_frequency", "zone_identification.algorithm",
-        "time.step", "load.amplitude"}) {
+        "time.step", "load.amplitude", "uncertainty.samples"}) {
     EXPECT_EQ(matrix_keys.count(key), 1u) << key;
     EXPECT_TRUE(KeyApplies(key, ModelKind::kMatrix)) << key;
   }
   for (const char* key :
        {"search.functional", "model.length", "model.zone_count", "outer.scan_points",
-        "zone_identification.merge_zones", "uncertainty.samples", "study.kind", "data.sensors"}) {
+        "zone_identification.merge_zones", "study.kind", "data.sensors"}) {
     EXPECT_EQ(matrix_keys.count(key), 0u) << key;
     EXPECT_EQ(bar_keys.count(key), 1u) << key;
   }
-  // The bar reads all but the 4 matrix keys; a matrix run none of the 3 sections
-  // search:, uncertainty:, study: and 44 single keys fewer.
+  // The bar reads all but the 4 matrix keys; a matrix run none of the 2 sections
+  // search:, study: and 44 single keys fewer.
   EXPECT_EQ(bar_keys.size(), every.size() - 4);
   std::size_t sections = 0;
   for (const auto& [key, value] : every) {
     const std::string section = key.substr(0, key.find('.'));
-    sections += section == "search" || section == "uncertainty" || section == "study" ? 1 : 0;
+    sections += section == "search" || section == "study" ? 1 : 0;
   }
   EXPECT_EQ(matrix_keys.size(), every.size() - sections - 44);
   // Values as resolved: the matrix run's own.

@@ -273,6 +273,17 @@ TEST(MatrixIdentificationRunTest, ThePlateConfigIdentifiesBothZones) {
   EXPECT_NEAR(ZoneModulus(dir + "/zones.csv", 0) / 200e9 - 1.0, -0.0243, 0.005);
   EXPECT_NEAR(ZoneModulus(dir + "/zones.csv", 1) / 140e9 - 1.0, -0.0706, 0.005);
   EXPECT_TRUE(std::filesystem::exists(dir + "/zones.png"));
+  // The uncertainty of both moduli from the config's 8 noise draws at the data's SNR
+  // (zone_uncertainty_test.cpp checks the figure against re-identification).
+  const YAML::Node uncertainty = YAML::LoadFile(dir + "/summary.yaml")["uncertainty"];
+  EXPECT_EQ(uncertainty["message"].as<std::string>(), "ok");
+  EXPECT_EQ(uncertainty["samples"].as<int>(), 8);
+  EXPECT_EQ(uncertainty["noise_source"].as<std::string>(), "synthetic_snr");
+  for (int z = 0; z < 2; ++z) {
+    const double relative = uncertainty["zones"][z]["relative_std_dev"].as<double>();
+    EXPECT_GT(relative, 0.0) << z;
+    EXPECT_LT(relative, 0.05) << z;
+  }
 }
 
 // The plate example's config by output-error least squares (outer.functional:

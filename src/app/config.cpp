@@ -1504,7 +1504,7 @@ bool KeyApplies(const std::string& path, ModelKind kind) {
                                                     "data.truth_manifest", "data.truth_moduli"};
   if (kind == ModelKind::kBar) return matrix_only.count(path) == 0;
   // Whole sections, then single keys, that a matrix run does not read.
-  static const std::set<std::string> bar_sections = {"search", "uncertainty", "study"};
+  static const std::set<std::string> bar_sections = {"search", "study"};
   static const std::set<std::string> bar_only = {"model.length",
                                                  "model.section",
                                                  "model.density",

@@ -230,17 +230,50 @@ void CostAndMaps(MatrixMcreProblem* problem, const CoupledSolution& solution, do
 // The coupled solve at `moduli`, then CostAndMaps; false with the reason in *failure
 // when it is not usable.
 bool SolveAt(const Vector& moduli, const CoupledSolverOptions& inner, MatrixMcreProblem* problem,
-             double* cost, Vector* zone_map, Vector* zone_gap, Vector* dof_map,
-             std::string* failure) {
+             CoupledSolution* solution, double* cost, Vector* zone_map, Vector* zone_gap,
+             Vector* dof_map, std::string* failure) {
   problem->SetModuli(moduli);
-  CoupledSolution solution;
-  const CoupledSolverSummary summary = SolveCoupled(inner, problem, nullptr, &solution);
-  if (!summary.IsSolutionUsable() || !std::isfinite(solution.cost)) {
+  const CoupledSolverSummary summary = SolveCoupled(inner, problem, nullptr, solution);
+  if (!summary.IsSolutionUsable() || !std::isfinite(solution->cost)) {
     *failure = "the coupled solve is not usable: " + summary.BriefReport();
     return false;
   }
-  CostAndMaps(problem, solution, cost, zone_map, zone_gap, dof_map);
+  CostAndMaps(problem, *solution, cost, zone_map, zone_gap, dof_map);
   return true;
+}
+
+// Step 3 of RunMatrixIdentification: the error maps and the model's outputs at the
+// identified moduli (from the last evaluation's solve when it was there, as it usually
+// is), then the maps at the nominal moduli. Returns the coupled solution at the
+// identified moduli, the objective's or one solved into *storage (null when there is
+// none usable: a failure goes to run->failure).
+const CoupledSolution* MapsAtIdentifiedAndNominal(const Config& config,
+                                                  const MatrixZoneObjective& objective,
+                                                  MatrixMcreProblem* problem,
+                                                  CoupledSolution* storage,
+                                                  MatrixIdentificationRun* run) {
+  const CoupledSolution* identified = nullptr;
+  std::string why;
+  if (run->identified_moduli.size() > 0) {
+    const MatrixEvaluation& last = run->evaluations.back();
+    if (last.usable && last.moduli == run->identified_moduli) {
+      identified = &objective.last_solution();
+      CostAndMaps(problem, *identified, &run->cost, &run->zone_map, &run->zone_gap, &run->dof_map);
+    } else if (SolveAt(run->identified_moduli, config.inner, problem, storage, &run->cost,
+                       &run->zone_map, &run->zone_gap, &run->dof_map, &why)) {
+      identified = storage;
+    } else if (run->failure.empty()) {
+      run->failure = "at the identified moduli, " + why;
+    }
+    run->model_outputs = problem->ModelOutputs();
+  }
+  CoupledSolution nominal;
+  if (!SolveAt(run->nominal_moduli, config.inner, problem, &nominal, &run->nominal_cost,
+               &run->nominal_zone_map, &run->nominal_zone_gap, &run->nominal_dof_map, &why) &&
+      run->failure.empty()) {
+    run->failure = "at the nominal moduli, " + why;
+  }
+  return identified;
 }
 
 // After the minimiser: the identified moduli of run->outer and why the run is not
@@ -465,6 +498,31 @@ void AddMatrixModelNoise(const MatrixModelData& model, double snr, std::uint64_t
   }
 }
 
+NoiseLevels MatrixNoiseLevels(const Config& config, const MatrixMeasurements& measurements,
+                              std::string* source) {
+  if (config.data.source == DataSource::kSynthetic && std::isfinite(config.data.snr)) {
+    *source = "synthetic_snr";
+    return measurements.noise;
+  }
+  // s^2 averaged over the channels of each kind
+  double sums[3] = {0.0, 0.0, 0.0};
+  int counts[3] = {0, 0, 0};
+  for (const Channel& channel : measurements.histories.channels) {
+    const int kind = channel.kind == ChannelKind::kStrain  ? 1
+                     : channel.kind == ChannelKind::kForce ? 2
+                                                           : 0;
+    sums[kind] += std::pow(DifferenceNoiseStd(channel.values), 2);
+    ++counts[kind];
+  }
+  NoiseLevels levels;
+  double* stds[3] = {&levels.displacement_std, &levels.strain_std, &levels.force_std};
+  for (int kind = 0; kind < 3; ++kind) {
+    if (counts[kind] > 0) *stds[kind] = std::sqrt(sums[kind] / counts[kind]);
+  }
+  *source = "data_differences";
+  return levels;
+}
+
 NoiseLevels MatrixLeastSquaresMisfitLevels(const Config& config, const MatrixModelData& model,
                                            const MatrixMeasurements& measurements,
                                            const ChannelSet& used, std::string* source) {
@@ -595,26 +653,17 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config,
                                    std::vector<double>(zones, 0.0));
   TakeZoneOutcome(objective, lower, upper, &run);
 
-  // 3. The error maps and the model's outputs at the identified moduli (from the last
-  //    evaluation's solve when it was there, as it usually is), then the maps at the
-  //    nominal moduli.
-  std::string why;
-  if (run.identified_moduli.size() > 0) {
-    const MatrixEvaluation& last = run.evaluations.back();
-    if (last.usable && last.moduli == run.identified_moduli) {
-      CostAndMaps(&problem, objective.last_solution(), &run.cost, &run.zone_map, &run.zone_gap,
-                  &run.dof_map);
-    } else if (!SolveAt(run.identified_moduli, config.inner, &problem, &run.cost, &run.zone_map,
-                        &run.zone_gap, &run.dof_map, &why) &&
-               run.failure.empty()) {
-      run.failure = "at the identified moduli, " + why;
-    }
-    run.model_outputs = problem.ModelOutputs();
-  }
-  if (!SolveAt(run.nominal_moduli, config.inner, &problem, &run.nominal_cost,
-               &run.nominal_zone_map, &run.nominal_zone_gap, &run.nominal_dof_map, &why) &&
-      run.failure.empty()) {
-    run.failure = "at the nominal moduli, " + why;
+  // 3. The error maps and the model's outputs at the identified moduli, then the maps
+  //    at the nominal moduli; 4. the uncertainty of the identified moduli.
+  CoupledSolution storage;
+  const CoupledSolution* identified =
+      MapsAtIdentifiedAndNominal(config, objective, &problem, &storage, &run);
+  if (identified != nullptr) {
+    run.noise = MatrixNoiseLevels(config, measurements, &run.noise_source);
+    run.uncertainty =
+        EstimateZoneUncertainty(config.uncertainty, model, run.data, config.mcre, config.time.theta,
+                                config.inner, run.identified_moduli, *identified, run.noise);
+    spdlog::info("uncertainty: {}", run.uncertainty.message);
   }
   run.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

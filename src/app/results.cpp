@@ -978,6 +978,27 @@ void MatrixModelAndDataYaml(const MatrixIdentificationRun& run, const Config& co
   yaml->Number(1, "time_step", run.time_step, "[s]");
 }
 
+// The uncertainty: block of a matrix run's summary.yaml (EstimateZoneUncertainty).
+void MatrixUncertaintyYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) {
+  const ZoneUncertainty& uncertainty = run.uncertainty;
+  yaml->Line(0, "uncertainty", "", "first order, from the noise drawn (uncertainty:)");
+  yaml->Text(1, "message", uncertainty.message);
+  yaml->Line(1, "zones", "", "std_dev [Pa] null when not available");
+  for (std::size_t z = 0; z < run.zone_names.size(); ++z) {
+    const auto index = static_cast<Eigen::Index>(z);
+    const double std_dev = uncertainty.available ? uncertainty.std_dev[index] : NAN;
+    yaml->Raw("    - {name: " + Quoted(run.zone_names[z]) + ", std_dev: " + Format(std_dev) +
+              ", relative_std_dev: " + Format(std_dev / run.identified_moduli[index]) + "}");
+  }
+  yaml->Integer(1, "samples", uncertainty.samples, "noise draws");
+  yaml->Number(1, "noise_std_displacement", run.noise.displacement_std, "[m]");
+  yaml->Number(1, "noise_std_strain", run.noise.strain_std, "[-]");
+  yaml->Number(1, "noise_std_force", run.noise.force_std, "[N]");
+  yaml->Text(1, "noise_source", run.noise_source,
+             "synthetic_snr: the data's own noise; data_differences: estimated from the data");
+  yaml->Integer(1, "sweeps", uncertainty.sweeps, "of the curvature's and the noise's solves");
+}
+
 // The optimizer: block of a matrix run's summary.yaml; `cost` names its cost (J, e^2).
 void MatrixOptimizerYaml(const MatrixIdentificationRun& run, const std::string& cost,
                          YamlWriter* yaml) {
@@ -1063,7 +1084,8 @@ std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& 
   yaml.Line(0, "prefilter", "");
   yaml.Line(1, "enabled", config.prefilter.enabled ? "true" : "false");
   yaml.Number(1, "cutoff_frequency", run.prefilter_cutoff, "[Hz] the cut-off used (0: off)");
-  yaml.Number(0, "wall_time_s", run.wall_time_s, "[s] identification and error maps");
+  MatrixUncertaintyYaml(run, &yaml);
+  yaml.Number(0, "wall_time_s", run.wall_time_s, "[s] identification, error maps and uncertainty");
   ConfigYaml(config, &yaml);
   return yaml.str();
 }

@@ -2,38 +2,11 @@
 
 #include <cassert>
 #include <cmath>
-#include <random>
 #include <vector>
 
+#include "mcrewave/core/random.h"
+
 namespace mcrewave {
-namespace {
-
-// Standard normal deviates by the Box-Muller transform, so that the sequence
-// does not depend on the standard library's normal_distribution.
-class StandardNormal {
- public:
-  explicit StandardNormal(std::uint64_t seed) : engine_(seed) {}
-  double operator()() {
-    if (has_spare_) {
-      has_spare_ = false;
-      return spare_;
-    }
-    // u1 in (0, 1], u2 in [0, 1): 53-bit uniforms from the raw engine output.
-    const double u1 = ((engine_() >> 11) + 1.0) * 0x1.0p-53;
-    const double u2 = (engine_() >> 11) * 0x1.0p-53;
-    const double radius = std::sqrt(-2.0 * std::log(u1));
-    spare_ = radius * std::sin(2.0 * M_PI * u2);
-    has_spare_ = true;
-    return radius * std::cos(2.0 * M_PI * u2);
-  }
-
- private:
-  std::mt19937_64 engine_;
-  double spare_ = 0.0;
-  bool has_spare_ = false;
-};
-
-}  // namespace
 
 double RootMeanSquare(const Vector& channel) {
   if (channel.size() == 0) return 0.0;

@@ -177,7 +177,7 @@ std::string ConfigToYaml(const Config& config);
 // read the bar's geometry and zoning, its truth and sensor keys (mcre.clamp, mcre.w_r and
 // mcre.w_u0 it reads: they treat the manifest's supports), the shooting solvers' limits, the scalar
 // identification's outer: keys (its zones are minimised under zone_identification:), search:,
-// uncertainty:, study:, nor the penalty and merging keys of zone_identification:
+// study:, nor the penalty and merging keys of zone_identification:
 // (docs/matrix_models.md).
 bool KeyApplies(const std::string& path, ModelKind kind);
 

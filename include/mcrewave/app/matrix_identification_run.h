@@ -33,6 +33,7 @@
 #include "mcrewave/data/channel_set.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
+#include "mcrewave/mcre/zone_uncertainty.h"
 #include "mcrewave/optim/bounded_minimizer.h"
 
 namespace mcrewave {
@@ -107,6 +108,14 @@ NoiseLevels MatrixLeastSquaresMisfitLevels(const Config& config, const MatrixMod
                                            const MatrixMeasurements& measurements,
                                            const ChannelSet& used, std::string* source);
 
+// The noise levels the uncertainty of a matrix run draws (EstimateZoneUncertainty): the
+// noise of synthetic data at a finite data.snr (measurements.noise, *source
+// "synthetic_snr"), else per channel kind (displacement, strain, force) the estimate
+// from the second differences of the measurements (DifferenceNoiseStd, s^2 averaged
+// over the channels of the kind, *source "data_differences").
+NoiseLevels MatrixNoiseLevels(const Config& config, const MatrixMeasurements& measurements,
+                              std::string* source);
+
 // The measurements as the CSV identify run reads back (WriteChannelCsv): every channel
 // of the model, in its order, under its column (model.channel_map).
 // Precondition: histories has the model's channels.
@@ -130,6 +139,11 @@ struct MatrixIdentificationRun {
   std::string misfit_source;  // as MatrixLeastSquaresMisfitLevels says
   int dofs = 0;
   int supports = 0;  // the manifest's supports (mcre.clamp treats them)
+  // The MCRE: the first-order uncertainty of the identified moduli (uncertainty:), drawn
+  // at `noise`, whose origin noise_source names (MatrixNoiseLevels).
+  ZoneUncertainty uncertainty;
+  NoiseLevels noise;
+  std::string noise_source;
   int steps = 0;
   // The coupled solver of every solve: config.inner.type, auto resolved
   // (conjugate_gradient on a matrix model; ResolveCoupledSolverType).

@@ -1,0 +1,143 @@
+#include "mcrewave/mcre/zone_uncertainty.h"
+
+#include <spdlog/spdlog.h>
+
+#include <Eigen/Cholesky>
+#include <cassert>
+#include <cmath>
+
+#include "mcrewave/core/random.h"
+#include "mcrewave/mcre/matrix_mcre_problem.h"
+
+namespace mcrewave {
+namespace {
+
+// The noise level of a channel's kind.
+double KindLevel(const NoiseLevels& noise, ChannelKind kind) {
+  switch (kind) {
+    case ChannelKind::kStrain:
+      return noise.strain_std;
+    case ChannelKind::kForce:
+      return noise.force_std;
+    default:
+      return noise.displacement_std;
+  }
+}
+
+// The coupled solve at `moduli` (warm start nullable); false with *why when not usable.
+bool SolveUsable(const CoupledSolverOptions& inner, const Vector& moduli,
+                 MatrixMcreProblem* problem, const Matrix* warm_start, CoupledSolution* solution,
+                 long* sweeps, std::string* why) {
+  problem->SetModuli(moduli);
+  const CoupledSolverSummary summary = SolveCoupled(inner, problem, warm_start, solution);
+  *sweeps += summary.sweeps;
+  if (summary.IsSolutionUsable() && std::isfinite(solution->cost)) return true;
+  *why = summary.BriefReport() + " (" + summary.message + ")";
+  return false;
+}
+
+// H by the secants of the adjoint gradient over +- kCurvatureWindow E*_z, symmetrised;
+// false with *why when a solve is not usable.
+bool SecantCurvature(const CoupledSolverOptions& inner, const Vector& moduli,
+                     const CoupledSolution& solution, MatrixMcreProblem* problem, Matrix* curvature,
+                     long* sweeps, std::string* why) {
+  const int zones = static_cast<int>(moduli.size());
+  curvature->resize(zones, zones);
+  CoupledSolution trial;
+  for (int z = 0; z < zones; ++z) {
+    Vector gradients[2];
+    for (int side = 0; side < 2; ++side) {
+      Vector shifted = moduli;
+      shifted[z] *= side == 0 ? 1.0 + kCurvatureWindow : 1.0 - kCurvatureWindow;
+      if (!SolveUsable(inner, shifted, problem, &solution.retrograde, &trial, sweeps, why)) {
+        *why = "the curvature's solve at zone " + std::to_string(z) + " is not usable: " + *why;
+        return false;
+      }
+      gradients[side] = trial.cost_gradients;
+    }
+    // H_{:,z} = (g(E* + w E*_z e_z) - g(E* - w E*_z e_z)) / (2 w E*_z)
+    curvature->col(z) = (gradients[0] - gradients[1]) / (2.0 * kCurvatureWindow * moduli[z]);
+  }
+  *curvature = 0.5 * (*curvature + curvature->transpose()).eval();
+  return true;
+}
+
+}  // namespace
+
+ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
+                                        const MatrixModelData& model, const ChannelSet& data,
+                                        const McreOptions& mcre, double theta,
+                                        const CoupledSolverOptions& inner, const Vector& moduli,
+                                        const CoupledSolution& solution, const NoiseLevels& noise) {
+  assert(options.IsValid(nullptr) &&
+         moduli.size() == static_cast<Eigen::Index>(model.zones.size()));
+  ZoneUncertainty result;
+  result.noise = noise;
+  if (!(noise.displacement_std > 0.0 || noise.strain_std > 0.0 || noise.force_std > 0.0)) {
+    result.message = "no noise to propagate (every noise level is 0)";
+    return result;
+  }
+  auto make_problem = [&](const ChannelSet& set) {
+    return MatrixMcreProblem(model, set, mcre.weights, mcre.reference_modulus, theta,
+                             Factorization::kAutomatic, mcre.clamp);
+  };
+  MatrixMcreProblem problem = make_problem(data);
+  std::string why;
+  if (!SecantCurvature(inner, moduli, solution, &problem, &result.curvature, &result.sweeps,
+                       &why)) {
+    result.message = why;
+    return result;
+  }
+  const Eigen::LLT<Matrix> factor(result.curvature);
+  if (factor.info() != Eigen::Success) {
+    result.message =
+        "the cost is not convex around the identified moduli (the secant curvature over +- 5 % "
+        "is not positive definite)";
+    return result;
+  }
+  const int zones = static_cast<int>(moduli.size());
+  ChannelSet noise_data = data, plus_data = data, minus_data = data;
+  StandardNormal normal(options.seed);
+  Matrix sum = Matrix::Zero(zones, zones);
+  CoupledSolution noise_solution;
+  Vector plus_gradient, minus_gradient;
+  for (int sample = 0; sample < options.samples; ++sample) {
+    for (std::size_t c = 0; c < data.channels.size(); ++c) {
+      const double level = KindLevel(noise, data.channels[c].kind);
+      Vector& values = noise_data.channels[c].values;
+      for (double& value : values) value = level * normal();
+      plus_data.channels[c].values = data.channels[c].values + values;
+      minus_data.channels[c].values = data.channels[c].values - values;
+    }
+    MatrixMcreProblem noise_problem = make_problem(noise_data);
+    if (!SolveUsable(inner, moduli, &noise_problem, nullptr, &noise_solution, &result.sweeps,
+                     &why)) {
+      result.message = "a noise solve is not usable: " + why;
+      return result;
+    }
+    // dg = (g(s_d + s_n; d + n) - g(s_d - s_n; d - n)) / 2
+    MatrixMcreProblem plus = make_problem(plus_data), minus = make_problem(minus_data);
+    plus.SetModuli(moduli);
+    minus.SetModuli(moduli);
+    plus.CostGradients(solution.displacement + noise_solution.displacement,
+                       solution.retrograde + noise_solution.retrograde, &plus_gradient);
+    minus.CostGradients(solution.displacement - noise_solution.displacement,
+                        solution.retrograde - noise_solution.retrograde, &minus_gradient);
+    // dE = -H^-1 dg
+    const Vector change = -factor.solve(0.5 * (plus_gradient - minus_gradient));
+    sum += change * change.transpose();
+    std::string changes;
+    for (int z = 0; z < zones; ++z)
+      changes += (z == 0 ? "" : ", ") + fmt::format("{:.4g}", change[z]);
+    spdlog::debug("uncertainty sample {}: dE = [{}] Pa", sample + 1, changes);
+  }
+  result.samples = options.samples;
+  // Cov(E*) = mean_i dE_i dE_i^T
+  result.covariance = sum / options.samples;
+  result.std_dev = result.covariance.diagonal().cwiseSqrt();
+  result.available = true;
+  result.message = "ok";
+  return result;
+}
+
+}  // namespace mcrewave
