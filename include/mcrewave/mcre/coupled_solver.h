@@ -165,10 +165,15 @@ struct CoupledSolution {
   // its traces and end retrograde values are kept.
   Matrix displacement;    // U, n x (m + 1) [m]
   Matrix retrograde;      // W, n x (m + 1) [m]
-  Matrix traces;          // H U (streaming only), McreProblem::num_traces() x (m + 1)
-  Matrix end_retrograde;  // W at nodes 0 and N (streaming only), 2 x (m + 1) [m]
-  Vector error_map;       // e_el^2 per element (streaming only) [J s]
-  Matrix gap_density;     // the error map's space-time picture (streaming only) [J/m]
+  // H U (streaming only), StreamingCoupledProblem::num_traces() x (m + 1).
+  Matrix traces;
+  Matrix end_retrograde;  // W at nodes 0 and N (streaming on the bar), 2 x (m + 1) [m]
+  // Streaming only: on the bar e_el^2 per element, on a matrix model the dof map
+  // (MatrixMcreProblem::DofErrorMap) [J s].
+  Vector error_map;
+  Matrix gap_density;  // the error map's space-time picture (streaming on the bar) [J/m]
+  // Streaming on a matrix model: MatrixMcreProblem::ZoneErrorMap of W and of U [J s].
+  Vector zone_error_map, zone_strain_energy;
 
   // Whether U and W are stored (every solver but the streaming one).
   bool has_fields() const { return displacement.size() > 0; }
