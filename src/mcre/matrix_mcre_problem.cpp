@@ -208,6 +208,12 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
   trace_ = Vector::Zero(num_rows);
   reaction_trace_ = Vector::Zero(num_reactions_);
   reaction_zone_trace_ = Vector::Zero(num_reactions_);
+  for (int b = 0; b < 2; ++b) {
+    stream_velocity_[b] = Vector::Zero(n);
+    stream_displacement_[b] = Vector::Zero(n);
+    stream_retrograde_[b] = Vector::Zero(n);
+  }
+  stream_zone_product_ = Vector::Zero(n);
   SetModuli(NominalModuli());
 }
 
