@@ -39,7 +39,8 @@ bool MatrixZoneObjective::Evaluate(const double* p, double* cost, double* gradie
   spdlog::debug("evaluation {}: e^2 = {:.9g} J s; inner {} (from {:.3g})", evaluations_,
                 solution_.cost, summary.BriefReport(),
                 summary.residual_history.empty() ? -1.0 : summary.residual_history.front());
-  warm_start_ = solution_.retrograde;
+  // W, or the traces after a streaming solve.
+  warm_start_ = solution_.WarmStart();
   // cost = e^2 / J_rest
   *cost = solution_.cost / cost_scale_;
   if (gradient != nullptr) {
