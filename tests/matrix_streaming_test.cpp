@@ -3,7 +3,7 @@
 // streaming application is the stored sweeps' to the bit; the streaming CG gives the
 // stored-field CG's e^2, zone gradients, traces and maps under every support treatment;
 // auto streams when the fields do not fit; the zone objective evaluates alike with
-// either solver.
+// either solver; the model's outputs need no stored field.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -192,6 +192,25 @@ TEST(MatrixStreamingTest, TheZoneObjectiveEvaluatesAlikeWithEitherSolver) {
   }
   EXPECT_FALSE(streamed.last_solution().has_fields());
   EXPECT_GT(streamed.last_solution().traces.size(), 0);
+}
+
+// The model's outputs and its supports' forces come from one direct sweep keeping its
+// state (no field: a run that streams stores none): the stored sweep's numbers.
+TEST(MatrixStreamingTest, ModelOutputsAreTheStoredSweepsWithoutItsField) {
+  const MatrixModelData lattice = SupportedLattice();
+  const ChannelSet data = SupportedLatticeHistories(lattice);
+  MatrixMcreProblem problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5, Factorization::kSparse,
+                            ClampModel::kTrusted);
+  problem.SetModuli((Vector(2) << 1.8e11, 2.1e11).finished());
+  Matrix displacement;
+  problem.DirectSweep(problem.ZeroField(), true, &displacement);
+  // H's rows: the three sensors, then the support's reaction.
+  const Matrix traces = problem.ObservedTraces(displacement);
+  ASSERT_EQ(traces.rows(), 4);
+  const long sweeps = problem.sweep_count();
+  EXPECT_EQ(problem.ModelOutputs(), traces.topRows(3));
+  EXPECT_EQ(problem.ModelSupportForces(), traces.bottomRows(1));
+  EXPECT_EQ(problem.sweep_count() - sweeps, 2);
 }
 
 }  // namespace

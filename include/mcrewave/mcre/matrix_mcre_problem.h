@@ -118,10 +118,12 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
 
   // H U of DirectSweep(0) with the data: the model's outputs driven by the measured
   // loads alone, S x (m + 1), the rows of the model's sensors only (synthetic data of
-  // this model, MatrixChannelSet's outputs).
+  // this model, MatrixChannelSet's outputs). One direct sweep keeping its state only:
+  // no n x (m + 1) field (the stored sweep's numbers to the bit).
   Matrix ModelOutputs();
   // The supports' reactions r_s(U) = g_s^T K(E) U of the same U, one row per support in
-  // the model's order [N]. Precondition: the treatment is trusted (the supports held).
+  // the model's order [N], by the same sweep. Precondition: the treatment is trusted
+  // (the supports held).
   Matrix ModelSupportForces();
 
   // J_rest = sum_j c_j h [1/2 F~_j^T diag(alpha) F~_j + 1/2 d~_j^T diag(beta) d~_j]
@@ -167,6 +169,10 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // x^T P y = x^T (K + G diag(1/alpha) G^T) y of two columns; uses product_ and the
   // channel vectors.
   double PenaltyForm(const Vector& x, const Vector& y);
+  // The direct sweep from rest with W = 0 and the measured loads, DirectSweep's steps
+  // with its state only: observe(j, U_j) for j = 0..m.
+  template <typename Observe>
+  void DataResponseSweep(Observe&& observe);
   // Adds sample j (U_j, W_j) of a streaming application to the totals. No allocation.
   void AddStreamingSample(int j, const Vector& displacement, const Vector& retrograde,
                           StreamingTotals* totals);
