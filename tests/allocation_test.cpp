@@ -485,6 +485,36 @@ TEST(McreProblemAllocationTest, StreamingMapAllocatesNothingAfterItsFirstCall) {
   EXPECT_GT(totals.cost, 0.0);
 }
 
+// The streaming map of a structure given by matrices (the coarse plate, sparse path,
+// its checkpoints allocated by the first call) and the retrograde energy allocate
+// nothing.
+TEST(MatrixMcreProblemAllocationTest, StreamingMapAllocatesNothingAfterItsFirstCall) {
+  SKIP_WITHOUT_ALLOCATION_COUNTING();
+  const MatrixModelData plate =
+      ReadMatrixModel(std::string(MCREWAVE_SOURCE_DIR) + "/configs/plate/coarse/model.yaml");
+  Matrix loads = Matrix::Zero(1, 21);
+  loads(0, 3) = 1e3;
+  const ChannelSet data = MatrixChannelSet(
+      plate, 1e-6, loads, Matrix::Constant(static_cast<int>(plate.sensors.size()), 21, 1e-7));
+  MatrixMcreProblem problem(plate, data, Weights(0.01, 1.0), 2e11, 0.5);
+  const Matrix traces = Matrix::Constant(problem.num_traces(), problem.num_steps() + 1, 1e-7);
+  Matrix image;
+  StreamingCoupledProblem::StreamingTotals totals;
+  // The first call sizes the checkpoints, the image and the totals.
+  problem.StreamingMap(traces, true, &image, &totals);
+  double energy = 0.0;
+  const HeapCalls calls = CountHeapCalls([&] {
+    problem.StreamingMap(traces, true, &image);
+    problem.StreamingMap(traces, false, &image);
+    problem.StreamingMap(traces, true, &image, &totals);
+    energy = problem.RetrogradeEnergy(traces) + problem.TraceInnerProduct(traces, image);
+  });
+  EXPECT_EQ(calls.allocations, 0);
+  EXPECT_EQ(calls.deallocations, 0);
+  EXPECT_GT(totals.cost, 0.0);
+  EXPECT_TRUE(std::isfinite(energy));
+}
+
 // ZoneOutputErrorObjective::Cost re-initialises the integrator for the new moduli
 // (allocations before the loop); the loop over the steps, with a sensitivity per zone
 // and interior sensors, allocates nothing: the same heap calls for 100 and 200 steps.

@@ -264,13 +264,14 @@ TEST(ConfigTest, AMatrixModelTakesAutoAndIsToldOfItWhenItAsksForABarSolver) {
   EXPECT_EQ(ParseConfig(matrix, "a.yaml").inner.type, CoupledSolverType::kAuto);
   EXPECT_EQ(ParseConfig(matrix + "inner:\n  method: conjugate_gradient\n", "a.yaml").inner.type,
             CoupledSolverType::kConjugateGradient);
+  EXPECT_EQ(
+      ParseConfig(matrix + "inner:\n  method: streaming_conjugate_gradient\n", "a.yaml").inner.type,
+      CoupledSolverType::kStreamingConjugateGradient);
   ExpectInputError(
-      [&matrix] {
-        ParseConfig(matrix + "inner:\n  method: streaming_conjugate_gradient\n", "a.yaml");
-      },
-      {"a.yaml:5: inner.method 'streaming_conjugate_gradient' solves the bar only; with "
-       "model.kind 'matrix' use auto, conjugate_gradient, relaxation, adaptive_relaxation or "
-       "all_at_once"});
+      [&matrix] { ParseConfig(matrix + "inner:\n  method: riccati\n", "a.yaml"); },
+      {"a.yaml:5: inner.method 'riccati' solves the bar only; with model.kind 'matrix' use "
+       "auto, conjugate_gradient, streaming_conjugate_gradient, relaxation, adaptive_relaxation "
+       "or all_at_once"});
 }
 
 TEST(ConfigTest, DefaultConfigYamlParsesToTheDefaultConfig) {

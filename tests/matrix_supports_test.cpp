@@ -24,6 +24,8 @@ namespace {
 using testing::MakeSmallCase;
 using testing::RelativeDifference;
 using testing::SmallCase;
+using testing::SupportedLattice;
+using testing::SupportedLatticeHistories;
 using testing::Weights;
 
 CoupledSolverOptions SupportsTightSolver(CoupledSolverType type) {
@@ -113,110 +115,6 @@ TEST(MatrixSupportsTest, BarClampAsASupportIsTheBuiltInClampUnderEveryTreatment)
        {ClampModel::kTrusted, ClampModel::kPinned, ClampModel::kMeasured}) {
     for (const int zones : {1, 3}) ExpectBarSupportIsTheBuiltInClamp(zones, clamp);
   }
-}
-
-// The 1 x dofs row e_dof^T.
-SparseMatrix SupportsTestDofRow(int dof, int dofs) {
-  SparseMatrix row(1, dofs);
-  row.insert(0, dof) = 1.0;
-  return row;
-}
-
-// A 2-D-like lattice of 6 columns x 3 rows of unit dofs (mass 2 on the diagonal, 0.25
-// coupling), springs along rows, columns and diagonals, zone 0 the first three
-// columns, zone 1 the rest; held by the support "left" on the first column's dofs with
-// g = (1, 2, 1) (force channel R, displacement channel uR), loaded on the last column
-// (channel F), observed at two dofs and by a difference row.
-MatrixModelData SupportedLattice() {
-  constexpr int kColumns = 6, kRows = 3, kDofs = kColumns * kRows;
-  auto dof = [](int column, int row) { return column * kRows + row; };
-  std::vector<Eigen::Triplet<double>> mass, stiffness[2];
-  for (int i = 0; i < kDofs; ++i) mass.emplace_back(i, i, 2.0);
-  auto spring = [&](int a, int b, int zone, double k) {
-    stiffness[zone].emplace_back(a, a, k);
-    stiffness[zone].emplace_back(b, b, k);
-    stiffness[zone].emplace_back(a, b, -k);
-    stiffness[zone].emplace_back(b, a, -k);
-    mass.emplace_back(a, b, 0.25);
-    mass.emplace_back(b, a, 0.25);
-  };
-  for (int c = 0; c < kColumns; ++c) {
-    const int zone = c < 3 ? 0 : 1;
-    for (int r = 0; r < kRows; ++r) {
-      if (c + 1 < kColumns) spring(dof(c, r), dof(c + 1, r), zone, 3e3);
-      if (r + 1 < kRows) spring(dof(c, r), dof(c, r + 1), zone, 1e3);
-      if (c + 1 < kColumns && r + 1 < kRows) spring(dof(c, r), dof(c + 1, r + 1), zone, 5e2);
-    }
-  }
-  MatrixModelData model;
-  model.stiffness_length = 1e-8;  // k* = E0 a* = 2e3 N/m at E0 = 2e11 Pa
-  model.length = 0.1;
-  model.mass.resize(kDofs, kDofs);
-  model.mass.setFromTriplets(mass.begin(), mass.end());
-  for (int z = 0; z < 2; ++z) {
-    MatrixModelZone zone;
-    zone.name = "zone" + std::to_string(z);
-    zone.nominal_modulus = 2e11;
-    zone.stiffness.resize(kDofs, kDofs);
-    zone.stiffness.setFromTriplets(stiffness[z].begin(), stiffness[z].end());
-    model.zones.push_back(zone);
-  }
-  Vector load = Vector::Zero(kDofs);
-  for (int r = 0; r < kRows; ++r) load[dof(kColumns - 1, r)] = 1.0 / kRows;
-  model.loads.push_back({"F", load});
-  model.sensors.push_back({"u_tip", SupportsTestDofRow(dof(kColumns - 1, 1), kDofs)});
-  model.sensors.push_back({"u_mid", SupportsTestDofRow(dof(2, 0), kDofs)});
-  SparseMatrix gauge(1, kDofs);
-  gauge.insert(0, dof(1, 2)) = -10.0;  // a strain-like difference that touches column 1
-  gauge.insert(0, dof(2, 2)) = 10.0;
-  model.sensors.push_back({"e_top", gauge, SensorKind::kStrain});
-  MatrixModelSupport left;
-  left.name = "left";
-  left.dofs = {dof(0, 0), dof(0, 1), dof(0, 2)};
-  left.reaction = Vector::Zero(kDofs);
-  left.reaction[dof(0, 0)] = 1.0;
-  left.reaction[dof(0, 1)] = 2.0;
-  left.reaction[dof(0, 2)] = 1.0;
-  left.force_channel = "R";
-  left.displacement_channel = "uR";
-  model.supports.push_back(left);
-  return model;
-}
-
-// The lattice's histories: a half sine on F; the sensors and the support force of the
-// held lattice (trusted) at truth moduli, with a deterministic wiggle of 5 % so that the
-// data are not the model's; a support displacement of a few % of the tip's.
-ChannelSet SupportedLatticeHistories(const MatrixModelData& model) {
-  const int steps = 120;
-  const double time_step = 2e-3, duration = 0.05;
-  Matrix loads = Matrix::Zero(1, steps + 1);
-  for (int j = 0; j <= steps; ++j) {
-    const double t = j * time_step;
-    if (t < duration) loads(0, j) = 1e3 * std::sin(M_PI * t / duration);
-  }
-  ChannelSet at_rest = MatrixChannelSet(
-      model, time_step, loads, Matrix::Zero(static_cast<int>(model.sensors.size()), steps + 1));
-  at_rest.Add("R", ChannelKind::kForce, Vector::Zero(steps + 1));
-  at_rest.Add("uR", ChannelKind::kDisplacement, Vector::Zero(steps + 1));
-  MatrixMcreProblem truth(model, at_rest, Weights(0.01, 1.0), 2e11, 0.5, Factorization::kSparse,
-                          ClampModel::kTrusted);
-  truth.SetModuli((Vector(2) << 2e11, 1.6e11).finished());
-  Matrix outputs = truth.ModelOutputs();
-  Matrix forces = truth.ModelSupportForces();
-  auto spoil = [](Matrix* rows, int seed) {
-    for (int k = 0; k < rows->rows(); ++k) {
-      const double scale = rows->row(k).cwiseAbs().maxCoeff();
-      for (int j = 0; j < rows->cols(); ++j) {
-        (*rows)(k, j) += 0.05 * scale * std::sin(0.37 * j + k + seed);
-      }
-    }
-  };
-  spoil(&outputs, 0);
-  spoil(&forces, 5);
-  ChannelSet data = MatrixChannelSet(model, time_step, loads, outputs);
-  data.Add("R", ChannelKind::kForce, forces.row(0).transpose());
-  data.Add("uR", ChannelKind::kDisplacement, (0.03 * outputs.row(0)).transpose());
-  return data;
 }
 
 TEST(MatrixSupportsTest, TrustedGradientMatchesCentralDifferencesOnALattice) {

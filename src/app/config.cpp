@@ -494,7 +494,7 @@ const std::vector<Key>& KeyTable() {
                                             StringToCoupledSolverType),
               "",
               "solver of the coupled direct/retrograde problem for one E; auto: "
-              "conjugate_gradient when its fields fit inner.max_field_bytes, else (the bar) "
+              "conjugate_gradient when its fields fit inner.max_field_bytes, else "
               "streaming_conjugate_gradient, which stores none"),
       MakeKey("inner.tolerance", &Config::inner, &CoupledSolverOptions::tolerance, Number(), "",
               "stop when ||c - A W||_P / ||c||_P falls below this, in (0, 1)"),
@@ -836,14 +836,16 @@ std::string StructureKeysProblem(const Config& config) {
   }
   // outer.functional: both run on a matrix model (least squares by
   // MatrixOutputErrorObjective, app/matrix_identification_run.h).
-  // auto keeps conjugate_gradient on a matrix model (ResolveCoupledSolverType).
+  // auto streams on a matrix model when its fields do not fit (ResolveCoupledSolverType).
   const CoupledSolverType method = config.inner.type;
   if (method != CoupledSolverType::kAuto && method != CoupledSolverType::kConjugateGradient &&
+      method != CoupledSolverType::kStreamingConjugateGradient &&
       method != CoupledSolverType::kRelaxation &&
       method != CoupledSolverType::kAdaptiveRelaxation && method != CoupledSolverType::kAllAtOnce) {
     return std::string("inner.method '") + CoupledSolverTypeToString(method) +
            "' solves the bar only; with model.kind '" + kind +
-           "' use auto, conjugate_gradient, relaxation, adaptive_relaxation or all_at_once";
+           "' use auto, conjugate_gradient, streaming_conjugate_gradient, relaxation, "
+           "adaptive_relaxation or all_at_once";
   }
   return "";
 }

@@ -215,16 +215,19 @@ class RecordingObjective : public MultiParameterObjective {
   const char* cost_name_;
 };
 
-// e^2 and the zone and dof maps of a usable coupled solution at the problem's moduli.
+// e^2 and the zone and dof maps of a usable coupled solution at the problem's moduli:
+// from its fields, or as a streaming solve summed them.
 void CostAndMaps(MatrixMcreProblem* problem, const CoupledSolution& solution, double* cost,
                  Vector* zone_map, Vector* zone_gap, Vector* dof_map) {
   *cost = solution.cost;
-  *zone_map = problem->ZoneErrorMap(solution.retrograde);
+  const bool fields = solution.has_fields();
+  *zone_map = fields ? problem->ZoneErrorMap(solution.retrograde) : solution.zone_error_map;
   // The gap relative to the zone's own strain energy: the same sum over U,
   //   e_z^2 / ((E_z / E_z,nom) sum_j c_j h 1/2 U_j^T K_z U_j).
-  const Vector energy = problem->ZoneErrorMap(solution.displacement);
+  const Vector energy =
+      fields ? problem->ZoneErrorMap(solution.displacement) : solution.zone_strain_energy;
   *zone_gap = zone_map->cwiseQuotient(energy.cwiseMax(std::numeric_limits<double>::min()));
-  *dof_map = problem->DofErrorMap(solution.retrograde);
+  *dof_map = fields ? problem->DofErrorMap(solution.retrograde) : solution.error_map;
 }
 
 // The coupled solve at `moduli`, then CostAndMaps; false with the reason in *failure
@@ -390,7 +393,7 @@ void CheckMatrixModelFieldBytes(const Config& config, const MatrixModelData& mod
   const double dofs = model.dofs();
   const double steps = config.time.NumSteps();
   const CoupledSolverType method =
-      ResolveCoupledSolverType(config.inner, dofs, steps, /*streaming_available=*/false);
+      ResolveCoupledSolverType(config.inner, dofs, steps, /*streaming_available=*/true);
   const double bytes = IterativeSolverFieldBytes(dofs, steps);
   if (!HoldsIterativeSolverFields(method) ||
       bytes <= static_cast<double>(config.inner.max_field_bytes)) {
@@ -399,9 +402,9 @@ void CheckMatrixModelFieldBytes(const Config& config, const MatrixModelData& mod
   throw InputError(fmt::format(
       "{}: model.manifest {} ({} dofs) and {:g} steps (time.window / time.step) need {} bytes "
       "for inner.method '{}' ({} fields of dofs x (steps + 1) doubles), above "
-      "inner.max_field_bytes = {}; streaming_conjugate_gradient, which stores no space-time "
-      "field, handles the built-in bar only: raise inner.max_field_bytes, or use a coarser "
-      "mesh (fewer dofs), a shorter window or a larger time step",
+      "inner.max_field_bytes = {}; use inner.method: streaming_conjugate_gradient (or auto), "
+      "which stores no space-time field, raise inner.max_field_bytes, or use a coarser mesh "
+      "(fewer dofs), a shorter window or a larger time step",
       ConfigName(config), config.structure.manifest, model.dofs(), steps,
       static_cast<long long>(bytes), CoupledSolverName(config.inner.type, method),
       kIterativeSolverFields, config.inner.max_field_bytes));
@@ -587,7 +590,7 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config,
   run.supports = static_cast<int>(model.supports.size());
   run.steps = measurements.histories.num_steps();
   run.inner_method = ResolveCoupledSolverType(config.inner, run.dofs, run.steps,
-                                              /*streaming_available=*/false);
+                                              /*streaming_available=*/true);
   run.time_step = measurements.histories.time_step;
   run.data_source = measurements.source;
   run.truth_moduli = measurements.truth_moduli;

@@ -1077,10 +1077,17 @@ std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& 
               "[J s] J_rest, e^2 of the structure left at rest (0 <= e^2 <= J_rest)");
   MatrixOptimizerYaml(run, "e^2", &yaml);
   yaml.Line(0, "inner", "");
-  yaml.Text(1, "method", CoupledSolverTypeToString(run.inner_method),
-            config.inner.type == CoupledSolverType::kAuto
-                ? "inner.method auto: its fields fit inner.max_field_bytes (matrices do not stream)"
-                : "");
+  std::string inner_comment;
+  if (config.inner.type == CoupledSolverType::kAuto) {
+    // Why auto chose the solver that ran, as InnerMethodComment says it for the bar.
+    const double bytes = IterativeSolverFieldBytes(run.dofs, run.steps);
+    inner_comment =
+        "inner.method auto: the stored fields, " + std::to_string(static_cast<long long>(bytes)) +
+        " bytes, " +
+        (run.inner_method == CoupledSolverType::kStreamingConjugateGradient ? "exceed" : "fit") +
+        " inner.max_field_bytes";
+  }
+  yaml.Text(1, "method", CoupledSolverTypeToString(run.inner_method), inner_comment);
   yaml.Line(0, "prefilter", "");
   yaml.Line(1, "enabled", config.prefilter.enabled ? "true" : "false");
   yaml.Number(1, "cutoff_frequency", run.prefilter_cutoff, "[Hz] the cut-off used (0: off)");

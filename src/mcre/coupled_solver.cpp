@@ -125,10 +125,12 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
     summary.message = "invalid options: " + why;
     return summary;
   }
-  // Riccati, shooting and the streaming solver are written for the built-in bar.
+  // Riccati and shooting are written for the built-in bar; the streaming solver for
+  // any problem on sensor traces (the bar and a structure given by matrices).
   McreProblem* bar = dynamic_cast<McreProblem*>(problem);
-  const CoupledSolverType type =
-      ResolveCoupledSolverType(options, problem->num_nodes(), problem->num_steps(), bar != nullptr);
+  StreamingCoupledProblem* streaming = dynamic_cast<StreamingCoupledProblem*>(problem);
+  const CoupledSolverType type = ResolveCoupledSolverType(
+      options, problem->num_nodes(), problem->num_steps(), streaming != nullptr);
   summary.type = type;
   const std::string name = CoupledSolverName(options.type, type);
   const double field_bytes = IterativeSolverFieldBytes(problem->num_nodes(), problem->num_steps());
@@ -144,20 +146,29 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
       refusal << "use inner.method: streaming_conjugate_gradient (or auto), which stores no "
                  "space-time field, raise inner.max_field_bytes, or use fewer elements or a "
                  "shorter window";
-    } else {
-      refusal << "streaming_conjugate_gradient, which stores no space-time field, handles the "
-                 "built-in bar only: raise inner.max_field_bytes, or use a coarser mesh (fewer "
+    } else if (streaming != nullptr) {
+      refusal << "use inner.method: streaming_conjugate_gradient (or auto), which stores no "
+                 "space-time field, raise inner.max_field_bytes, or use a coarser mesh (fewer "
                  "dofs), a shorter window or a larger time step";
+    } else {
+      refusal << "raise inner.max_field_bytes, or use a coarser mesh (fewer dofs), a shorter "
+                 "window or a larger time step";
     }
     summary.message = refusal.str();
     return summary;
   }
   const bool comparator = NeedsThePapersDataTerm(type);
-  if ((comparator || type == CoupledSolverType::kStreamingConjugateGradient) && bar == nullptr) {
+  if (comparator && bar == nullptr) {
     summary.message = std::string(CoupledSolverTypeToString(type)) +
                       " handles the built-in bar only; for a structure given by matrices use "
-                      "inner.method: auto, conjugate_gradient, adaptive_relaxation, relaxation "
-                      "or all_at_once";
+                      "inner.method: auto, conjugate_gradient, streaming_conjugate_gradient, "
+                      "adaptive_relaxation, relaxation or all_at_once";
+    return summary;
+  }
+  if (type == CoupledSolverType::kStreamingConjugateGradient && streaming == nullptr) {
+    summary.message =
+        "streaming_conjugate_gradient needs a problem on sensor traces (StreamingCoupledProblem); "
+        "use inner.method: conjugate_gradient, adaptive_relaxation, relaxation or all_at_once";
     return summary;
   }
   if (comparator && !bar->observes_ends_only()) {
@@ -192,7 +203,8 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
       break;
     case CoupledSolverType::kStreamingConjugateGradient:
       // Fills the cost and the gradients itself, from its final streaming pass.
-      internal::SolveByStreamingConjugateGradient(resolved, bar, initial_guess, solution, &summary);
+      internal::SolveByStreamingConjugateGradient(resolved, streaming, initial_guess, solution,
+                                                  &summary);
       break;
     case CoupledSolverType::kAuto:
       // ResolveCoupledSolverType never returns it.

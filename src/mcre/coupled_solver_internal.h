@@ -21,10 +21,12 @@ void SolveByRiccati(const CoupledSolverOptions& options, McreProblem* problem,
                     CoupledSolution* solution, CoupledSolverSummary* summary);
 void SolveByShooting(const CoupledSolverOptions& options, McreProblem* problem,
                      CoupledSolution* solution, CoupledSolverSummary* summary);
-// Also fills the solution's cost, gradients, traces, end retrograde values and
-// error map (its fields U and W stay empty). initial_traces (nullable): a warm start
-// y^(0) of the problem's ZeroTraces() shape.
-void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, McreProblem* problem,
+// Also fills the solution's cost, gradients, traces and what the problem's streaming
+// totals hold (the bar: end retrograde values, error map and its picture; a matrix
+// model: the dof and zone maps); its fields U and W stay empty. initial_traces
+// (nullable): a warm start y^(0) of the problem's ZeroTraces() shape.
+void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options,
+                                       StreamingCoupledProblem* problem,
                                        const Matrix* initial_traces, CoupledSolution* solution,
                                        CoupledSolverSummary* summary);
 

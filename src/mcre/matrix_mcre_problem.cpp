@@ -208,6 +208,12 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
   trace_ = Vector::Zero(num_rows);
   reaction_trace_ = Vector::Zero(num_reactions_);
   reaction_zone_trace_ = Vector::Zero(num_reactions_);
+  for (int b = 0; b < 2; ++b) {
+    stream_velocity_[b] = Vector::Zero(n);
+    stream_displacement_[b] = Vector::Zero(n);
+    stream_retrograde_[b] = Vector::Zero(n);
+  }
+  stream_zone_product_ = Vector::Zero(n);
   SetModuli(NominalModuli());
 }
 
@@ -417,19 +423,48 @@ double MatrixMcreProblem::RestCost() const {
 
 Vector MatrixMcreProblem::NominalModuli() const { return model_.NominalModuli(); }
 
+template <typename Observe>
+void MatrixMcreProblem::DataResponseSweep(Observe&& observe) {
+  const int m = num_steps();
+  // From rest: U_0 = V_0 = 0.
+  stream_velocity_[0].setZero();
+  stream_displacement_[0].setZero();
+  observe(0, stream_displacement_[0]);
+  for (int k = 0; k < m; ++k) {
+    const int current = k & 1, next = current ^ 1;
+    // DirectSweep's step at W = 0: f_theta = G F~_theta (the same operations, so the
+    // same bits).
+    shift_.setZero();
+    channel_.noalias() = loads_transposed_ * shift_;
+    channel_ = -channel_.cwiseQuotient(alphas_);
+    channel_ += theta_ * measured_loads_.col(k + 1) + (1.0 - theta_) * measured_loads_.col(k);
+    force_.noalias() = loads_ * channel_;
+    integrator_.StepShifted(stream_velocity_[current], stream_displacement_[current], shift_,
+                            force_, stream_velocity_[next], stream_displacement_[next]);
+    observe(k + 1, stream_displacement_[next]);
+  }
+  ++sweep_count_;
+}
+
 Matrix MatrixMcreProblem::ModelOutputs() {
-  Matrix displacement;
-  DirectSweep(ZeroField(), true, &displacement);
-  const Matrix outputs = observation_ * displacement;
-  return outputs.topRows(static_cast<Eigen::Index>(model_.sensors.size()));
+  const auto sensors = static_cast<Eigen::Index>(model_.sensors.size());
+  Matrix outputs(sensors, num_steps() + 1);
+  DataResponseSweep([&](int j, const Vector& displacement) {
+    trace_.noalias() = observation_ * displacement;
+    outputs.col(j) = trace_.head(sensors);
+  });
+  return outputs;
 }
 
 Matrix MatrixMcreProblem::ModelSupportForces() {
   assert(num_reactions_ == static_cast<int>(model_.supports.size()));
-  Matrix displacement;
-  DirectSweep(ZeroField(), true, &displacement);
-  // r_s(U_j) = g_s^T K(E) U_j.
-  return reactions_ * displacement;
+  Matrix forces(num_reactions_, num_steps() + 1);
+  DataResponseSweep([&](int j, const Vector& displacement) {
+    // r_s(U_j) = g_s^T K(E) U_j.
+    reaction_trace_.noalias() = reactions_ * displacement;
+    forces.col(j) = reaction_trace_;
+  });
+  return forces;
 }
 
 }  // namespace mcrewave

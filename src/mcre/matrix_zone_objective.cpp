@@ -28,7 +28,8 @@ bool MatrixZoneObjective::ModuliCost(const Vector& moduli, double* cost, Vector*
   spdlog::debug("evaluation {}: e^2 = {:.9g} J s; inner {} (from {:.3g})", evaluations(),
                 solution_.cost, summary.BriefReport(),
                 summary.residual_history.empty() ? -1.0 : summary.residual_history.front());
-  warm_start_ = solution_.retrograde;
+  // W, or the traces after a streaming solve.
+  warm_start_ = solution_.WarmStart();
   *cost = solution_.cost;
   if (gradient != nullptr) *gradient = solution_.cost_gradients;
   return true;

@@ -1,5 +1,6 @@
 // Conjugate gradients on the sensor traces (docs/streaming.md). With
-// Phi(y) = H Direct(Retrograde(y)) (McreProblem::StreamingMap), b = Phi(0) and
+// Phi(y) = H Direct(Retrograde(y)) (StreamingCoupledProblem::StreamingMap: the bar's
+// McreProblem or a matrix model's MatrixMcreProblem), b = Phi(0) and
 // L y = Phi(y) - Phi(0), the coupled solution's traces solve
 //
 //   (I - L) y = b,
@@ -31,7 +32,7 @@
 //
 // three terms >= 0, free of the cancellation of <r, (I - L) r> - <r, r> where -L is
 // small beside I. The true residual of the final pass is measured by one more
-// backward sweep (McreProblem::RetrogradeEnergy). (A first version stopped on
+// backward sweep (StreamingCoupledProblem::RetrogradeEnergy). (A first version stopped on
 // ||r||_beta / ||Phi(0)||_beta, which grows with the window: at the tolerance 1e-8 on
 // 101 nodes, e^2 was 2.2e-3 off the stored-field CG's at 1e5 steps.)
 #include <algorithm>
@@ -65,7 +66,7 @@ constexpr double kStalledResidualFactor = 100.0;
 // and the notes of its final message.
 class StreamingConjugateGradient {
  public:
-  StreamingConjugateGradient(const CoupledSolverOptions& options, McreProblem* problem,
+  StreamingConjugateGradient(const CoupledSolverOptions& options, StreamingCoupledProblem* problem,
                              CoupledSolution* solution, CoupledSolverSummary* summary)
       : options_(options), problem_(problem), solution_(solution), summary_(summary) {}
 
@@ -98,12 +99,12 @@ class StreamingConjugateGradient {
   void StopAfterRestarts(double true_relative);
 
   const CoupledSolverOptions& options_;
-  McreProblem* problem_;
+  StreamingCoupledProblem* problem_;
   CoupledSolution* solution_;
   CoupledSolverSummary* summary_;
   Matrix traces_, residual_, direction_, image_;
   double rhs_norm_ = 0.0;
-  McreProblem::StreamingTotals totals_;
+  StreamingCoupledProblem::StreamingTotals totals_;
   // Said in the message when the solve started from the warm start or switched to
   // checkpoints.
   std::string start_note_, switch_note_;
@@ -174,6 +175,8 @@ void StreamingConjugateGradient::Accept(const std::string& message) {
   solution_->traces = traces_;
   solution_->end_retrograde = totals_.end_retrograde;
   solution_->error_map = totals_.error_map;
+  solution_->zone_error_map = totals_.zone_error_map;
+  solution_->zone_strain_energy = totals_.zone_strain_energy;
   solution_->gap_density = totals_.gap_density;
 }
 
@@ -311,7 +314,8 @@ void StreamingConjugateGradient::StopAfterRestarts(double true_relative) {
 
 }  // namespace
 
-void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options, McreProblem* problem,
+void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options,
+                                       StreamingCoupledProblem* problem,
                                        const Matrix* initial_traces, CoupledSolution* solution,
                                        CoupledSolverSummary* summary) {
   assert(initial_traces == nullptr || (initial_traces->rows() == problem->num_traces() &&

@@ -77,6 +77,12 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
     result.message = "no noise to propagate (every noise level is 0)";
     return result;
   }
+  if (!solution.has_fields()) {
+    result.message =
+        "the figure needs the coupled solution's fields, which the streaming solver does not "
+        "store: use inner.method conjugate_gradient when the fields fit inner.max_field_bytes";
+    return result;
+  }
   auto make_problem = [&](const ChannelSet& set) {
     return MatrixMcreProblem(model, set, mcre.weights, mcre.reference_modulus, theta,
                              Factorization::kAutomatic, mcre.clamp);

@@ -69,9 +69,9 @@ MatrixMeasurements LoadMatrixMeasurements(const Config& config, const MatrixMode
 // Throws InputError, naming the config, the bytes and what fits instead, when the
 // coupled solves of `identify run` on `model` would hold stored fields above
 // inner.max_field_bytes (kIterativeSolverFields fields of dofs x (steps + 1) doubles,
-// the steps the config's time grid, onto which the data are resampled). inner.method
-// auto does not stream on a matrix model (the streaming solver handles the built-in
-// bar only): it keeps conjugate_gradient and is refused alike. `identify run` calls it
+// the steps the config's time grid, onto which the data are resampled): a stored-field
+// method named (conjugate_gradient, the relaxations); auto streams instead when they do
+// not fit (ResolveCoupledSolverType), and is never refused here. `identify run` calls it
 // between LoadMatrixModel and LoadMatrixMeasurements, before a synthetic truth is
 // simulated; SolveCoupled would refuse every solve with the same reason.
 void CheckMatrixModelFieldBytes(const Config& config, const MatrixModelData& model);

@@ -27,11 +27,11 @@
 //                        rate of the recursion, joined by continuity (robust variant).
 //   streaming_conjugate_gradient
 //                        CG on the sensor traces, storing no n x (m + 1) field
-//                        (docs/streaming.md); the built-in bar only.
+//                        (docs/streaming.md); any StreamingCoupledProblem: the bar and
+//                        a structure given by matrices.
 //   auto (the default)   conjugate_gradient when its fields fit max_field_bytes,
 //                        streaming_conjugate_gradient when they do not
-//                        (ResolveCoupledSolverType); a structure given by matrices keeps
-//                        conjugate_gradient, refused when its fields do not fit.
+//                        (ResolveCoupledSolverType).
 //
 // all_at_once and the last three are direct: they report the same relative
 // residual, computed afterwards from 5 sweeps, and converge when it meets the
@@ -98,7 +98,7 @@ struct CoupledSolverOptions {
   long max_dense_solver_bytes = 2L << 30;
   // The iterative solvers (relaxation, adaptive_relaxation, conjugate_gradient)
   // refuse when the fields they hold at once (kIterativeSolverFields fields of
-  // n x (m + 1) doubles) would exceed this many bytes; auto then streams (the bar).
+  // n x (m + 1) doubles) would exceed this many bytes; auto then streams.
   long max_field_bytes = 2L << 30;
   // streaming_conjugate_gradient at theta = 1/2: when the retrograde state rebuilt by
   // the reversed recursion drifts by more than this (||omega_0 rebuilt to omega_m|| /
@@ -120,10 +120,10 @@ struct CoupledSolverOptions {
 // The solver that runs for `options` on a problem of `num_nodes` nodes and `num_steps`
 // steps: options.type itself, unless it is kAuto, which takes conjugate_gradient when
 // its fields (IterativeSolverFieldBytes) fit options.max_field_bytes, and
-// streaming_conjugate_gradient when they do not and `streaming_available` (the built-in
-// bar, McreProblem); without it (a structure given by matrices) conjugate_gradient,
-// which SolveCoupled then refuses. The one place where auto is resolved: SolveCoupled,
-// the config's load-time check of the bar and the reports call it.
+// streaming_conjugate_gradient when they do not and `streaming_available` (a
+// StreamingCoupledProblem: the built-in bar and a structure given by matrices); without
+// it conjugate_gradient, which SolveCoupled then refuses. The one place where auto is
+// resolved: SolveCoupled, the configs' load-time checks and the reports call it.
 CoupledSolverType ResolveCoupledSolverType(const CoupledSolverOptions& options, double num_nodes,
                                            double num_steps, bool streaming_available);
 
@@ -165,10 +165,15 @@ struct CoupledSolution {
   // its traces and end retrograde values are kept.
   Matrix displacement;    // U, n x (m + 1) [m]
   Matrix retrograde;      // W, n x (m + 1) [m]
-  Matrix traces;          // H U (streaming only), McreProblem::num_traces() x (m + 1)
-  Matrix end_retrograde;  // W at nodes 0 and N (streaming only), 2 x (m + 1) [m]
-  Vector error_map;       // e_el^2 per element (streaming only) [J s]
-  Matrix gap_density;     // the error map's space-time picture (streaming only) [J/m]
+  // H U (streaming only), StreamingCoupledProblem::num_traces() x (m + 1).
+  Matrix traces;
+  Matrix end_retrograde;  // W at nodes 0 and N (streaming on the bar), 2 x (m + 1) [m]
+  // Streaming only: on the bar e_el^2 per element, on a matrix model the dof map
+  // (MatrixMcreProblem::DofErrorMap) [J s].
+  Vector error_map;
+  Matrix gap_density;  // the error map's space-time picture (streaming on the bar) [J/m]
+  // Streaming on a matrix model: MatrixMcreProblem::ZoneErrorMap of W and of U [J s].
+  Vector zone_error_map, zone_strain_energy;
 
   // Whether U and W are stored (every solver but the streaming one).
   bool has_fields() const { return displacement.size() > 0; }
@@ -191,14 +196,16 @@ struct CoupledSolution {
 
 // Solves the coupled problem at the problem's current moduli: the bar (McreProblem)
 // with every solver, a structure given by matrices (MatrixMcreProblem) with auto,
-// conjugate_gradient, the relaxations and all_at_once (the others refuse it in the
-// summary). auto is resolved first (ResolveCoupledSolverType), the summary's `type`
-// the solver that ran. A method that would hold fields above max_field_bytes is
-// refused before any work, its message naming the ways out.
+// conjugate_gradient, streaming_conjugate_gradient, the relaxations and all_at_once
+// (Riccati and shooting refuse it in the summary). auto is resolved first
+// (ResolveCoupledSolverType), the summary's `type` the solver that ran. A method that
+// would hold fields above max_field_bytes is refused before any work, its message
+// naming the ways out.
 // initial_guess (nullable) is the iterative solver's unknown at the start (warm start,
 // e.g. the previous E's solution): W^(0), the problem's ZeroField() shape, for
-// relaxation and conjugate_gradient; the traces y^(0), McreProblem::ZeroTraces()
-// shape (a solution's `traces`), for streaming_conjugate_gradient, which starts from
+// relaxation and conjugate_gradient; the traces y^(0),
+// StreamingCoupledProblem::ZeroTraces() shape (a solution's `traces`), for
+// streaming_conjugate_gradient, which starts from
 // the data instead when they are farther from the solution. The direct solvers ignore
 // it. Precondition: options.IsValid(). The solution's fields are meaningful only when
 // the summary says so.

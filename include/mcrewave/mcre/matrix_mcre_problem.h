@@ -36,6 +36,16 @@
 // The integrator is factorised once per set of moduli (SetModuli), by the sparse
 // LDL^T or the band path (ThetaIntegratorOptions::factorization). The sweeps allocate
 // nothing: every scratch vector is sized in the constructor.
+//
+// Streaming (StreamingCoupledProblem, docs/streaming.md section 5): the trace rows are
+// H's rows, the reactions' included under a trusted treatment. StreamingMap takes the
+// retrograde field from checkpoints, always: a backward sweep driven by the traces
+// keeps the state (v, omega) every s = ceil(sqrt(2 m)) steps; then, segment by segment
+// from t = 0, the segment's omega is swept again from its upper checkpoint into an
+// n x (s + 1) buffer and consumed in forward order by the direct sweep. Three sweeps
+// per application, memory 2 n m / s + n s = O(n sqrt(m)), W the stored sweep's to the
+// bit (the same steps), no drift. Its totals are the cost, the zone gradients, the
+// zone maps of W and U and the dof map, summed as the fields pass.
 #pragma once
 
 #include <vector>
@@ -44,6 +54,7 @@
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/coupled_problem.h"
 #include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/mcre/streaming_coupled_problem.h"
 #include "mcrewave/model/matrix_export.h"
 
 namespace mcrewave {
@@ -55,7 +66,7 @@ namespace mcrewave {
 ChannelSet MatrixChannelSet(const MatrixModelData& model, double time_step, const Matrix& loads,
                             const Matrix& outputs);
 
-class MatrixMcreProblem : public CoupledProblem {
+class MatrixMcreProblem : public StreamingCoupledProblem {
  public:
   // Keeps a reference to model, which must outlive the problem; copies the histories
   // of data's channels named as the model's loads and sensors and the supports'
@@ -107,10 +118,12 @@ class MatrixMcreProblem : public CoupledProblem {
 
   // H U of DirectSweep(0) with the data: the model's outputs driven by the measured
   // loads alone, S x (m + 1), the rows of the model's sensors only (synthetic data of
-  // this model, MatrixChannelSet's outputs).
+  // this model, MatrixChannelSet's outputs). One direct sweep keeping its state only:
+  // no n x (m + 1) field (the stored sweep's numbers to the bit).
   Matrix ModelOutputs();
   // The supports' reactions r_s(U) = g_s^T K(E) U of the same U, one row per support in
-  // the model's order [N]. Precondition: the treatment is trusted (the supports held).
+  // the model's order [N], by the same sweep. Precondition: the treatment is trusted
+  // (the supports held).
   Matrix ModelSupportForces();
 
   // J_rest = sum_j c_j h [1/2 F~_j^T diag(alpha) F~_j + 1/2 d~_j^T diag(beta) d~_j]
@@ -128,7 +141,42 @@ class MatrixMcreProblem : public CoupledProblem {
   int factorization_count() const { return integrator_.factorization_count(); }
   const ThetaIntegrator& integrator() const { return integrator_; }
 
+  // --- Streaming: the coupled problem on the traces H U (StreamingCoupledProblem) ---
+  // One trace row per row of H: the sensors, then the supports' rows (betas()).
+  int num_traces() const override { return static_cast<int>(betas_.size()); }
+  // d~ in H's rows' order (a trusted reaction's row: the support's force f~_s).
+  Matrix DataTraces() const override { return measured_outputs_; }
+  double TraceInnerProduct(const Matrix& a, const Matrix& b) const override;
+  // One backward sweep, its state only; no allocation.
+  double RetrogradeEnergy(const Matrix& traces) override;
+  // From checkpoints (above): three sweeps. Allocates the checkpoints on its first call
+  // (and the image and totals when not of their size); nothing in the time loops.
+  void StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
+                    StreamingTotals* totals = nullptr) override;
+  // The checkpoints are always used: nothing to switch.
+  void UseCheckpoints() override {}
+  // H U of a displacement field, num_traces() x (m + 1): the traces of stored fields.
+  Matrix ObservedTraces(const Matrix& displacement) const { return observation_ * displacement; }
+  // The checkpoints' stride s (0 before the first StreamingMap).
+  int checkpoint_stride() const { return checkpoint_stride_; }
+
  private:
+  // The retrograde step t_j -> t_{j-1} driven by the traces y_j: the force
+  // c_j H^T diag(beta) (y_j - d~_j) (without d~ when include_data is false), from
+  // (v, omega) into (v_next, omega_next). No allocation.
+  void RetrogradeTraceStep(int j, const Matrix& traces, bool include_data, const Vector& velocity,
+                           const Vector& state, Vector& velocity_next, Vector& state_next);
+  // x^T P y = x^T (K + G diag(1/alpha) G^T) y of two columns; uses product_ and the
+  // channel vectors.
+  double PenaltyForm(const Vector& x, const Vector& y);
+  // The direct sweep from rest with W = 0 and the measured loads, DirectSweep's steps
+  // with its state only: observe(j, U_j) for j = 0..m.
+  template <typename Observe>
+  void DataResponseSweep(Observe&& observe);
+  // Adds sample j (U_j, W_j) of a streaming application to the totals. No allocation.
+  void AddStreamingSample(int j, const Vector& displacement, const Vector& retrograde,
+                          StreamingTotals* totals);
+
   const MatrixModelData& model_;
   double time_step_;         // h [s]
   Matrix measured_loads_;    // F~ [N], C x (m + 1), rows in G's order
@@ -159,6 +207,13 @@ class MatrixMcreProblem : public CoupledProblem {
   // per row of H and two per reaction.
   Vector velocity_[2], state_[2], shift_, force_, product_, channel_, other_channel_, trace_,
       reaction_trace_, reaction_zone_trace_;
+  // Streaming: the checkpoints (v over omega, 2n x (m / s + 1)) and one segment's omega
+  // (n x (s + 1)), allocated by the first StreamingMap; the double buffers of the
+  // direct sweep (velocity, displacement), W_{j-1} and W_j, and K_z U_j, allocated in the
+  // constructor.
+  int checkpoint_stride_ = 0;
+  Matrix checkpoints_, segment_;
+  Vector stream_velocity_[2], stream_displacement_[2], stream_retrograde_[2], stream_zone_product_;
 };
 
 }  // namespace mcrewave

@@ -3,9 +3,9 @@
 // p_z = log(E_z / E_z,nom) (optim/log_moduli_objective.h): J = e^2 with de^2/dE_z from
 // the one coupled solve (MatrixMcreProblem::CostGradients), and J_scale =
 // MatrixMcreProblem::RestCost(), the functional of the structure left at rest
-// (0 <= e^2 <= J_rest). Each solve starts from the previous usable one's W (warm
-// start). A solve that is not usable makes Evaluate return false with the solver's
-// report; nothing is thrown.
+// (0 <= e^2 <= J_rest). Each solve starts from the previous usable one's W, or its
+// traces after a streaming solve (warm start). A solve that is not usable makes
+// Evaluate return false with the solver's report; nothing is thrown.
 #pragma once
 
 #include <string>

@@ -49,6 +49,7 @@
 #include "mcrewave/data/measurement.h"
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/coupled_problem.h"
+#include "mcrewave/mcre/streaming_coupled_problem.h"
 #include "mcrewave/model/bar_model.h"
 
 namespace mcrewave {
@@ -91,7 +92,7 @@ struct EndDisplacementChannels {
   bool uL = true;
 };
 
-class McreProblem : public CoupledProblem {
+class McreProblem : public StreamingCoupledProblem {
  public:
   // Keeps references to model and data: both must outlive the problem.
   // reference_modulus is E0 of the weights [Pa]; theta of the time scheme. The zones
@@ -209,47 +210,35 @@ class McreProblem : public CoupledProblem {
   // sweep beside it. Three sweeps per application. For theta != 1/2 the retrograde
   // field comes from checkpoints instead (CheckpointedStreamingMap: four sweeps, memory
   // O(n sqrt(m))).
-  int num_traces() const { return 2 + num_interior_sensors(); }
-  Matrix ZeroTraces() const { return Matrix::Zero(num_traces(), num_steps() + 1); }
+  int num_traces() const override { return 2 + num_interior_sensors(); }
   // The data d~ in the trace rows' order (u0, uL, the sensors; f0 in the reaction
   // row): the traces at which the retrograde field vanishes (W = 0).
-  Matrix DataTraces() const;
+  Matrix DataTraces() const override;
   // From now on, StreamingMap takes the retrograde field from checkpoints (four sweeps,
   // W the stored sweep's to the bit) instead of the reversed recursion, whose
   // round-off grows with the Courant number (docs/streaming.md).
   // Allocates the checkpoints, O(n sqrt(m)), on the first call; theta != 1/2 always
   // uses them.
-  void UseCheckpoints();
+  void UseCheckpoints() override;
   bool uses_checkpoints() const { return checkpoints_.size() > 0; }
   // <a, b>_beta = sum_j c_j h sum_k beta_k a_kj b_kj, in which I - (Phi - Phi(0)) is
   // self-adjoint and positive definite on the weighted rows.
-  double TraceInnerProduct(const Matrix& a, const Matrix& b) const;
+  double TraceInnerProduct(const Matrix& a, const Matrix& b) const override;
   // ||R r||_P^2 = sum_j c_j h W_j^T (K + B/alpha) W_j for W = R r, the retrograde field
   // driven by the traces r without data; in trace terms <r, -L r>_beta with
   // L = Phi - Phi(0). For a trace residual r = Phi(y) - y it is the squared P-norm of the
   // stored-field solvers' residual at W = Retrograde(y), whose tolerance is relative
   // to it. One backward sweep, its state only (O(n) memory, no allocation).
-  double RetrogradeEnergy(const Matrix& traces);
-  // What a streaming application gathers at each sample when asked (the cost,
-  // gradient and error map of the fields it passes through, never stored).
-  struct StreamingTotals {
-    double cost = 0.0;      // e^2 [J s]
-    Vector cost_gradients;  // de^2/dE_z [J s / Pa]
-    Vector error_map;       // e_el^2 [J s] per element
-    // The error map's space-time picture (error_map.h): the gap energy density [J/m]
-    // at every SpaceTimeStride(m)-th sample (rows) on SpaceTimeColumnPositions (columns).
-    Matrix gap_density;
-    Matrix end_retrograde;  // W at nodes 0 and N, 2 x (m + 1) [m]
-    // ||omega_m|| / max_j ||omega_j|| of the rebuilt retrograde state: 0 in exact
-    // arithmetic (the sweep started from omega_m = 0), the rebuild's round-off.
-    double rebuild_error = 0.0;
-  };
+  double RetrogradeEnergy(const Matrix& traces) override;
+  // The sums a streaming application gathers (StreamingCoupledProblem): cost,
+  // gradients, the error map per element, its space-time picture, W at the ends and the
+  // rebuild's round-off; the zone maps stay empty.
   // image = Phi(traces) with the data (include_data), or its linear part without.
   // With totals (not null), the sums of the fields of that application are gathered.
   // traces and image of shape ZeroTraces(), distinct. No
   // allocation but image's and totals' (resized once).
   void StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
-                    StreamingTotals* totals = nullptr);
+                    StreamingTotals* totals = nullptr) override;
 
   // The weight beta_k [N/m or N m] of each trace row (0 for an end channel left out).
   Vector TraceWeights() const;

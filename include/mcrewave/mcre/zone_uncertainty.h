@@ -41,8 +41,9 @@ struct ZoneUncertainty {
 // supports; noise holds the levels to draw: displacement_std on every displacement
 // channel of data, strain_std on every strain channel, force_std on every force channel
 // (in the set's order, a channel's samples, then the next; StandardNormal seeded with
-// options.seed). Not available (with a message) when no level is positive, a solve is
-// not usable, or H is not positive definite. Precondition: options.IsValid().
+// options.seed). Not available (with a message) when no level is positive, the solution
+// holds no fields (a streaming solve), a solve is not usable, or H is not positive
+// definite. Precondition: options.IsValid().
 ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
                                         const MatrixModelData& model, const ChannelSet& data,
                                         const McreOptions& mcre, double theta,

@@ -1,0 +1,70 @@
+// The coupled problem on the sensor traces, as the streaming conjugate-gradient solver
+// sees it (docs/streaming.md): what a coupled problem offers so that it is solved with
+// O(n) states (or O(n sqrt(m)) checkpoints) instead of stored n x (m + 1) fields. The
+// built-in bar (McreProblem, mcre_problem.h) and a structure given by matrices
+// (MatrixMcreProblem, matrix_mcre_problem.h) implement it.
+//
+// A trace field y holds one row per observation row of H and one column per sample:
+// num_traces() x (m + 1). The retrograde field depends on U only through y = H U, so
+// the coupled problem is the fixed point y = Phi(y) with
+//
+//   Phi(y) = H Direct(Retrograde(y)),
+//
+// Retrograde(y) taking its load c_j H^T diag(beta) (y_j - d~_j) from y. With
+// L y = Phi(y) - Phi(0), I - L is self-adjoint and positive definite in
+// <a, b>_beta = sum_j c_j h sum_k beta_k a_kj b_kj on the weighted rows.
+#pragma once
+
+#include "mcrewave/mcre/coupled_problem.h"
+
+namespace mcrewave {
+
+class StreamingCoupledProblem : public CoupledProblem {
+ public:
+  // What a streaming application gathers at each sample when asked: the cost,
+  // gradients and error maps of the fields it passes through, never stored. Entries a
+  // structure has no use for stay empty (the bar: the zone maps; a matrix model: the
+  // picture and the end values).
+  struct StreamingTotals {
+    double cost = 0.0;      // e^2 [J s]
+    Vector cost_gradients;  // de^2/dE_z [J s / Pa]
+    // The bar: e_el^2 [J s] per element. A matrix model: the dof map
+    // sum_j c_j h 1/2 W_ij (K W_j)_i [J s] (MatrixMcreProblem::DofErrorMap).
+    Vector error_map;
+    // A matrix model: each zone's share (E_z / E_z,nom) sum_j c_j h 1/2 W_j^T K_z W_j
+    // [J s] (MatrixMcreProblem::ZoneErrorMap of W), and the same sum over U, the zone's
+    // own strain energy (ZoneErrorMap of U).
+    Vector zone_error_map, zone_strain_energy;
+    // The bar: the error map's space-time picture (error_map.h), the gap energy
+    // density [J/m] at every SpaceTimeStride(m)-th sample (rows) on
+    // SpaceTimeColumnPositions (columns).
+    Matrix gap_density;
+    Matrix end_retrograde;  // the bar: W at nodes 0 and N, 2 x (m + 1) [m]
+    // ||omega_m|| / max_j ||omega_j|| of a retrograde state rebuilt by the reversed
+    // recursion: 0 in exact arithmetic, the rebuild's round-off; 0 from checkpoints.
+    double rebuild_error = 0.0;
+  };
+
+  // Rows of a trace field (the rows of H).
+  virtual int num_traces() const = 0;
+  Matrix ZeroTraces() const { return Matrix::Zero(num_traces(), num_steps() + 1); }
+  // The data d~ in the trace rows' order: the traces at which the retrograde field
+  // vanishes (W = 0).
+  virtual Matrix DataTraces() const = 0;
+  // <a, b>_beta = sum_j c_j h sum_k beta_k a_kj b_kj.
+  virtual double TraceInnerProduct(const Matrix& a, const Matrix& b) const = 0;
+  // ||R r||_P^2 = sum_j c_j h W_j^T P W_j for W = R r, the retrograde field driven by
+  // the traces r without data: <r, -L r>_beta. One backward sweep, its state only.
+  virtual double RetrogradeEnergy(const Matrix& traces) = 0;
+  // image = Phi(traces) with the data (include_data), or its linear part without.
+  // With totals (not null), the sums of the fields of that application are gathered.
+  // traces and image of shape ZeroTraces(), distinct.
+  virtual void StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
+                            StreamingTotals* totals = nullptr) = 0;
+  // From now on, StreamingMap takes the retrograde field from checkpoints (exact)
+  // rather than from a reversed recursion whose round-off drifted; nothing to do for a
+  // problem that always uses them.
+  virtual void UseCheckpoints() = 0;
+};
+
+}  // namespace mcrewave

@@ -1,0 +1,210 @@
+// The streaming application of the coupled map of a structure given by matrices
+// (matrix_mcre_problem.h, docs/streaming.md section 5): the retrograde sweep driven by
+// the traces backward keeping its state at checkpoints, then segment by segment from
+// t = 0 the retrograde field swept again from its checkpoint and consumed in forward
+// order by the direct sweep, the totals summed as the fields pass.
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include "mcrewave/mcre/matrix_mcre_problem.h"
+
+namespace mcrewave {
+
+double MatrixMcreProblem::TraceInnerProduct(const Matrix& a, const Matrix& b) const {
+  assert(a.rows() == num_traces() && b.rows() == num_traces() && a.cols() == b.cols());
+  double sum = 0.0;
+  for (int j = 0; j <= num_steps(); ++j) {
+    // c_j h sum_k beta_k a_kj b_kj.
+    sum += QuadratureWeight(j) * time_step() * betas_.dot(a.col(j).cwiseProduct(b.col(j)));
+  }
+  return sum;
+}
+
+void MatrixMcreProblem::RetrogradeTraceStep(int j, const Matrix& traces, bool include_data,
+                                            const Vector& velocity, const Vector& state,
+                                            Vector& velocity_next, Vector& state_next) {
+  // The force of RetrogradeSweep with y_j in place of H U_j:
+  // c_j H^T diag(beta) (y_j - d~_j).
+  trace_ = traces.col(j);
+  if (include_data) trace_ -= measured_outputs_.col(j);
+  trace_ = (QuadratureWeight(j) * betas_).cwiseProduct(trace_);
+  force_.noalias() = observation_transposed_ * trace_;
+  integrator_.Step(velocity, state, force_, velocity_next, state_next);
+}
+
+double MatrixMcreProblem::PenaltyForm(const Vector& x, const Vector& y) {
+  // x^T (K + G diag(1/alpha) G^T) y, as InnerProduct's term.
+  product_.noalias() = stiffness_ * y;
+  channel_.noalias() = loads_transposed_ * x;
+  other_channel_.noalias() = loads_transposed_ * y;
+  return x.dot(product_) + channel_.cwiseQuotient(alphas_).dot(other_channel_);
+}
+
+double MatrixMcreProblem::RetrogradeEnergy(const Matrix& traces) {
+  assert(traces.rows() == num_traces() && traces.cols() == num_steps() + 1);
+  const int m = num_steps();
+  const double h = time_step();
+  double energy = 0.0;
+  // The retrograde sweep from rest at T driven by the traces alone, W_j formed as the
+  // state passes: W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j, omega_m = 0.
+  velocity_[0].setZero();
+  state_[0].setZero();
+  for (int j = m, s = 0; j > 0; --j, ++s) {
+    const int current = s & 1, next = current ^ 1;
+    RetrogradeTraceStep(j, traces, false, velocity_[current], state_[current], velocity_[next],
+                        state_[next]);
+    stream_retrograde_[0] =
+        (theta_ * state_[next] + (1.0 - theta_) * state_[current]) * (1.0 / QuadratureWeight(j));
+    // + c_j h W_j^T P W_j.
+    energy += QuadratureWeight(j) * h * PenaltyForm(stream_retrograde_[0], stream_retrograde_[0]);
+  }
+  // W_0 = (1 - theta) omega_0 / c_0.
+  stream_retrograde_[0] = ((1.0 - theta_) / QuadratureWeight(0)) * state_[m & 1];
+  energy += QuadratureWeight(0) * h * PenaltyForm(stream_retrograde_[0], stream_retrograde_[0]);
+  ++sweep_count_;
+  return energy;
+}
+
+void MatrixMcreProblem::AddStreamingSample(int j, const Vector& displacement,
+                                           const Vector& retrograde, StreamingTotals* totals) {
+  const int zones = static_cast<int>(model_.zones.size());
+  const double weight = QuadratureWeight(j) * time_step();
+  // e^2: c_j h [1/2 W^T K W + 1/2 (G^T W)^T diag(1/alpha) G^T W
+  //             + 1/2 (H U - d~)^T diag(beta) (H U - d~)] (Cost), trace_ = H U_j - d~_j.
+  product_.noalias() = stiffness_ * retrograde;
+  channel_.noalias() = loads_transposed_ * retrograde;
+  totals->cost += weight * (0.5 * retrograde.dot(product_) +
+                            0.5 * channel_.cwiseQuotient(alphas_).dot(channel_) +
+                            0.5 * betas_.dot(trace_.cwiseProduct(trace_)));
+  // The dof map c_j h 1/2 W_ij (K W_j)_i (DofErrorMap).
+  totals->error_map += (0.5 * weight) * retrograde.cwiseProduct(product_);
+  for (int z = 0; z < zones; ++z) {
+    const MatrixModelZone& zone = model_.zones[z];
+    product_.noalias() = zone.stiffness * retrograde;
+    stream_zone_product_.noalias() = zone.stiffness * displacement;
+    const double gap = retrograde.dot(product_);
+    // -(1/(2 E_z,nom)) c_j h W_j^T K_z (W_j + 2 U_j) (CostGradients).
+    totals->cost_gradients[z] +=
+        -0.5 * weight * (gap + 2.0 * retrograde.dot(stream_zone_product_)) / zone.nominal_modulus;
+    // (E_z / E_z,nom) c_j h 1/2 X_j^T K_z X_j of W and U (ZoneErrorMap).
+    const double scale = moduli_[z] / zone.nominal_modulus;
+    totals->zone_error_map[z] += scale * weight * 0.5 * gap;
+    totals->zone_strain_energy[z] += scale * weight * 0.5 * displacement.dot(stream_zone_product_);
+  }
+  if (num_reactions_ == 0) return;
+  // Trusted: c_j h alpha_r sum_s (r_s(U_j) - f~_sj) g_s^T K_z U_j / E_z,nom.
+  reaction_trace_.noalias() = reactions_ * displacement;
+  reaction_trace_ -= measured_outputs_.col(j).tail(num_reactions_);
+  for (int z = 0; z < zones; ++z) {
+    reaction_zone_trace_.noalias() = reaction_zone_rows_[z] * displacement;
+    totals->cost_gradients[z] +=
+        weight * reaction_weight_ * reaction_trace_.dot(reaction_zone_trace_);
+  }
+}
+
+void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
+                                     StreamingTotals* totals) {
+  assert(traces.rows() == num_traces() && traces.cols() == num_steps() + 1 && image != &traces);
+  const int n = num_nodes(), m = num_steps();
+  if (checkpoint_stride_ == 0) {
+    // s = ceil(sqrt(2 m)): memory 2 n m / s + n s, about 2 n sqrt(2 m) doubles.
+    checkpoint_stride_ = std::max(1, static_cast<int>(std::ceil(std::sqrt(2.0 * m))));
+    checkpoints_ = Matrix::Zero(2 * n, m / checkpoint_stride_ + 1);
+    segment_ = Matrix::Zero(n, checkpoint_stride_ + 1);
+  }
+  const int stride = checkpoint_stride_;
+  image->resize(num_traces(), m + 1);
+  if (totals != nullptr) {
+    const int zones = num_zones();
+    totals->cost = 0.0;
+    totals->cost_gradients.setZero(zones);
+    totals->error_map.setZero(n);
+    totals->zone_error_map.setZero(zones);
+    totals->zone_strain_energy.setZero(zones);
+    totals->gap_density.resize(0, 0);
+    totals->end_retrograde.resize(0, 0);
+    totals->rebuild_error = 0.0;  // W from checkpoints: the stored sweep's
+  }
+  // y_j = H U_j into the image, and sample j into the totals.
+  auto observe = [&](int j, const Vector& displacement, const Vector& retrograde) {
+    trace_.noalias() = observation_ * displacement;
+    image->col(j) = trace_;
+    if (totals == nullptr) return;
+    trace_ -= measured_outputs_.col(j);
+    AddStreamingSample(j, displacement, retrograde, totals);
+  };
+  // The direct step t_{j-1} -> t_j of DirectSweep from (V, U)[current] into [next],
+  // f_theta = -K W_theta + G (F~_theta - diag(1/alpha) G^T W_theta),
+  // W_theta = theta W_j + (1 - theta) W_{j-1}; then observe(j).
+  auto direct_step = [&](int j, const Vector& previous_retrograde, const Vector& retrograde) {
+    const int current = (j - 1) & 1, next = current ^ 1;
+    shift_ = theta_ * retrograde + (1.0 - theta_) * previous_retrograde;
+    channel_.noalias() = loads_transposed_ * shift_;
+    channel_ = -channel_.cwiseQuotient(alphas_);
+    if (include_data) {
+      channel_ += theta_ * measured_loads_.col(j) + (1.0 - theta_) * measured_loads_.col(j - 1);
+    }
+    force_.noalias() = loads_ * channel_;
+    integrator_.StepShifted(stream_velocity_[current], stream_displacement_[current], shift_,
+                            force_, stream_velocity_[next], stream_displacement_[next]);
+    observe(j, stream_displacement_[next], retrograde);
+  };
+
+  // 1. The retrograde sweep from rest at T keeping its state (v_j, omega_j) at the
+  // checkpoints j = m - i s (column i: v over omega).
+  velocity_[0].setZero();
+  state_[0].setZero();
+  checkpoints_.col(0).setZero();
+  for (int j = m, s = 0; j > 0; --j, ++s) {
+    const int current = s & 1, next = current ^ 1;
+    RetrogradeTraceStep(j, traces, include_data, velocity_[current], state_[current],
+                        velocity_[next], state_[next]);
+    if ((m - (j - 1)) % stride == 0) {
+      const int column = (m - (j - 1)) / stride;
+      checkpoints_.col(column).head(n) = velocity_[next];
+      checkpoints_.col(column).tail(n) = state_[next];
+    }
+  }
+
+  // 2. Forward over the segments [a, b] between checkpoints, earliest first: from the
+  // checkpoint at b the retrograde steps b -> a again (the same steps, so the same bits
+  // as the first pass and as RetrogradeSweep), omega_j kept in column j - a of
+  // segment_, then W_j in forward order and the direct steps beside them.
+  stream_velocity_[0].setZero();
+  stream_displacement_[0].setZero();
+  const int lowest_checkpoint = m % stride;
+  int a = 0;
+  int b = lowest_checkpoint > 0 ? lowest_checkpoint : std::min(stride, m);
+  while (a < m) {
+    const int column = (m - b) / stride;
+    velocity_[0] = checkpoints_.col(column).head(n);
+    state_[0] = checkpoints_.col(column).tail(n);
+    segment_.col(b - a) = state_[0];
+    for (int j = b, s = 0; j > a; --j, ++s) {
+      const int current = s & 1, next = current ^ 1;
+      RetrogradeTraceStep(j, traces, include_data, velocity_[current], state_[current],
+                          velocity_[next], state_[next]);
+      segment_.col(j - 1 - a) = state_[next];
+    }
+    if (a == 0) {
+      // W_0 = (1 - theta) omega_0 / c_0; U_0 = 0.
+      stream_retrograde_[0] = ((1.0 - theta_) / QuadratureWeight(0)) * segment_.col(0);
+      observe(0, stream_displacement_[0], stream_retrograde_[0]);
+    }
+    for (int j = a + 1; j <= b; ++j) {
+      const int current = (j - 1) & 1, next = current ^ 1;
+      // W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j (omega_m = 0: the
+      // checkpoint at m is the rest state).
+      stream_retrograde_[next] =
+          (theta_ * segment_.col(j - 1 - a) + (1.0 - theta_) * segment_.col(j - a)) *
+          (1.0 / QuadratureWeight(j));
+      direct_step(j, stream_retrograde_[current], stream_retrograde_[next]);
+    }
+    a = b;
+    b = std::min(b + stride, m);
+  }
+  sweep_count_ += 3;
+}
+
+}  // namespace mcrewave
