@@ -219,19 +219,7 @@ MatrixModelData Lattice() {
       if (r + 1 < kRows && c < kColumns) spring(c, r, c + 1, r + 1, 5e2);
     }
   }
-  MatrixModelData model;
-  model.stiffness_length = 1e-8;  // k* = E0 a* = 2e3 N/m at E0 = 2e11 Pa
-  model.length = 0.1;
-  model.mass.resize(kDofs, kDofs);
-  model.mass.setFromTriplets(mass.begin(), mass.end());
-  for (int z = 0; z < 2; ++z) {
-    MatrixModelZone zone;
-    zone.name = "zone" + std::to_string(z);
-    zone.nominal_modulus = 2e11;
-    zone.stiffness.resize(kDofs, kDofs);
-    zone.stiffness.setFromTriplets(stiffness[z].begin(), stiffness[z].end());
-    model.zones.push_back(zone);
-  }
+  MatrixModelData model = testing::TwoZoneLatticeModel(kDofs, mass, stiffness);
   Vector load = Vector::Zero(kDofs);
   for (int r = 0; r < kRows; ++r) load[dof(kColumns, r)] = 0.25;
   model.loads.push_back({"F", load});

@@ -148,6 +148,27 @@ inline SparseMatrix SupportsTestDofRow(int dof, int dofs) {
   return row;
 }
 
+// The model of a spring lattice's triplets: M, and zones zone0 and zone1 at the nominal
+// 2e11 Pa, with a* = 1e-8 m (k* = E0 a* = 2e3 N/m at E0 = 2e11 Pa) and l* = 0.1 m.
+inline MatrixModelData TwoZoneLatticeModel(
+    int dofs, const std::vector<Eigen::Triplet<double>>& mass,
+    const std::vector<Eigen::Triplet<double>> (&stiffness)[2]) {
+  MatrixModelData model;
+  model.stiffness_length = 1e-8;
+  model.length = 0.1;
+  model.mass.resize(dofs, dofs);
+  model.mass.setFromTriplets(mass.begin(), mass.end());
+  for (int z = 0; z < 2; ++z) {
+    MatrixModelZone zone;
+    zone.name = "zone" + std::to_string(z);
+    zone.nominal_modulus = 2e11;
+    zone.stiffness.resize(dofs, dofs);
+    zone.stiffness.setFromTriplets(stiffness[z].begin(), stiffness[z].end());
+    model.zones.push_back(zone);
+  }
+  return model;
+}
+
 // A 2-D-like lattice of 6 columns x 3 rows of unit dofs (mass 2 on the diagonal, 0.25
 // coupling), springs along rows, columns and diagonals, zone 0 the first three
 // columns, zone 1 the rest; held by the support "left" on the first column's dofs with
@@ -174,19 +195,7 @@ inline MatrixModelData SupportedLattice() {
       if (c + 1 < kColumns && r + 1 < kRows) spring(dof(c, r), dof(c + 1, r + 1), zone, 5e2);
     }
   }
-  MatrixModelData model;
-  model.stiffness_length = 1e-8;  // k* = E0 a* = 2e3 N/m at E0 = 2e11 Pa
-  model.length = 0.1;
-  model.mass.resize(kDofs, kDofs);
-  model.mass.setFromTriplets(mass.begin(), mass.end());
-  for (int z = 0; z < 2; ++z) {
-    MatrixModelZone zone;
-    zone.name = "zone" + std::to_string(z);
-    zone.nominal_modulus = 2e11;
-    zone.stiffness.resize(kDofs, kDofs);
-    zone.stiffness.setFromTriplets(stiffness[z].begin(), stiffness[z].end());
-    model.zones.push_back(zone);
-  }
+  MatrixModelData model = TwoZoneLatticeModel(kDofs, mass, stiffness);
   Vector load = Vector::Zero(kDofs);
   for (int r = 0; r < kRows; ++r) load[dof(kColumns - 1, r)] = 1.0 / kRows;
   model.loads.push_back({"F", load});
