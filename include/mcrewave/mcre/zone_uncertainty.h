@@ -43,7 +43,8 @@ struct ZoneUncertainty {
 // (in the set's order, a channel's samples, then the next; StandardNormal seeded with
 // options.seed). Not available (with a message) when no level is positive, the solution
 // holds no fields (a streaming solve), a solve is not usable, or H is not positive
-// definite. Precondition: options.IsValid().
+// definite. Precondition: options.samples >= 1 (one draw is the covariance of that draw;
+// the config asks for 2 to 1000, UncertaintyOptions::IsValid).
 ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
                                         const MatrixModelData& model, const ChannelSet& data,
                                         const McreOptions& mcre, double theta,
