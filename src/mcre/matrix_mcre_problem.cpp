@@ -307,13 +307,8 @@ double MatrixMcreProblem::InnerProduct(const Matrix& x, const Matrix& y) {
   const double h = time_step();
   double sum = 0.0;
   for (int j = 0; j <= num_steps(); ++j) {
-    // x_j^T (K + G diag(1/alpha) G^T) y_j.
-    product_.noalias() = stiffness_ * y.col(j);
-    channel_.noalias() = loads_transposed_ * x.col(j);
-    other_channel_.noalias() = loads_transposed_ * y.col(j);
-    const double term =
-        x.col(j).dot(product_) + channel_.cwiseQuotient(alphas_).dot(other_channel_);
-    sum += QuadratureWeight(j) * h * term;
+    // c_j h x_j^T (K + G diag(1/alpha) G^T) y_j.
+    sum += QuadratureWeight(j) * h * PenaltyForm(x.col(j), y.col(j));
   }
   return sum;
 }

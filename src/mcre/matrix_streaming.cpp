@@ -33,8 +33,9 @@ void MatrixMcreProblem::RetrogradeTraceStep(int j, const Matrix& traces, bool in
   integrator_.Step(velocity, state, force_, velocity_next, state_next);
 }
 
-double MatrixMcreProblem::PenaltyForm(const Vector& x, const Vector& y) {
-  // x^T (K + G diag(1/alpha) G^T) y, as InnerProduct's term.
+double MatrixMcreProblem::PenaltyForm(const Eigen::Ref<const Vector>& x,
+                                      const Eigen::Ref<const Vector>& y) {
+  // x^T (K + G diag(1/alpha) G^T) y, the integrand of InnerProduct.
   product_.noalias() = stiffness_ * y;
   channel_.noalias() = loads_transposed_ * x;
   other_channel_.noalias() = loads_transposed_ * y;

@@ -168,7 +168,7 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
                            const Vector& state, Vector& velocity_next, Vector& state_next);
   // x^T P y = x^T (K + G diag(1/alpha) G^T) y of two columns; uses product_ and the
   // channel vectors.
-  double PenaltyForm(const Vector& x, const Vector& y);
+  double PenaltyForm(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& y);
   // The direct sweep from rest with W = 0 and the measured loads, DirectSweep's steps
   // with its state only: observe(j, U_j) for j = 0..m.
   template <typename Observe>
