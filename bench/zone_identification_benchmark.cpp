@@ -11,10 +11,11 @@
 // zones and one zone per element it reports the scalar E*, the zone identification's
 // time, evaluations, weight, the worst zone error and the mean over [0.6, 0.7] L.
 // The zone identification options are the config's (zone_identification.*), the
-// algorithm that of --algorithm when given.
+// optimiser and algorithm those of --optimizer and --algorithm when given.
 // Goals (issue 13): 10 zones under 5 s, 100 zones under 20 s on one core.
 //
-// Usage: zone_identification_benchmark [--snr S] [--algorithm NAME] [--zones Z] [--verbose]
+// Usage: zone_identification_benchmark [--snr S] [--optimizer nlopt|ceres] [--algorithm NAME]
+//        [--zones Z] [--verbose]
 //        [CONFIG.yaml]
 #include <spdlog/spdlog.h>
 
@@ -46,7 +47,9 @@ int main(int argc, char** argv) {
   using namespace mcrewave;
   std::string path = "configs/paper_bar_free_free.yaml";
   double snr = std::numeric_limits<double>::infinity();
-  BoundedAlgorithm algorithm = BoundedAlgorithm::kNloptLbfgs;
+  OptimizerType optimizer = OptimizerType::kNlopt;
+  OuterAlgorithm algorithm = OuterAlgorithm::kLbfgs;
+  bool optimizer_given = false;
   bool algorithm_given = false;
   bool verbose = false;
   int only_zones = 0;  // 0: both
@@ -57,9 +60,15 @@ int main(int argc, char** argv) {
       verbose = true;
     } else if (std::strcmp(argv[i], "--zones") == 0 && i + 1 < argc) {
       only_zones = std::atoi(argv[++i]);
+    } else if (std::strcmp(argv[i], "--optimizer") == 0 && i + 1 < argc) {
+      optimizer_given = true;
+      if (!StringToOptimizerType(argv[++i], &optimizer)) {
+        std::fprintf(stderr, "unknown optimizer %s\n", argv[i]);
+        return 2;
+      }
     } else if (std::strcmp(argv[i], "--algorithm") == 0 && i + 1 < argc) {
       algorithm_given = true;
-      if (!StringToBoundedAlgorithm(argv[++i], &algorithm)) {
+      if (!StringToOuterAlgorithm(argv[++i], &algorithm)) {
         std::fprintf(stderr, "unknown algorithm %s\n", argv[i]);
         return 2;
       }
@@ -70,6 +79,7 @@ int main(int argc, char** argv) {
   spdlog::set_level(verbose ? spdlog::level::info : spdlog::level::warn);
   try {
     Config config = LoadConfig(path, {"data.snr=.inf"});
+    if (!optimizer_given) optimizer = config.zone_identification.minimizer.optimizer;
     if (!algorithm_given) algorithm = config.zone_identification.minimizer.algorithm;
     ChannelSet data = LoadMeasurements(config);
     // The truth: a soft zone of 0.7 E over [0.6, 0.7] L, one modulus per element.
@@ -108,9 +118,10 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "scalar identification failed: %s\n", scalar.outer.message.c_str());
       return 1;
     }
-    std::printf("%s: %d elements, %d steps, SNR %g, %s; scalar E* = %.6g GPa in %.2f s\n",
+    std::printf("%s: %d elements, %d steps, SNR %g, %s %s; scalar E* = %.6g GPa in %.2f s\n",
                 path.c_str(), config.model.elements, data.num_steps(), snr,
-                BoundedAlgorithmToString(algorithm), scalar.identified_modulus() * 1e-9, scalar_s);
+                OptimizerTypeToString(optimizer), OuterAlgorithmToString(algorithm),
+                scalar.identified_modulus() * 1e-9, scalar_s);
     std::printf("%6s %8s %12s %10s %12s %14s %14s %s\n", "zones", "time [s]", "evaluations",
                 "sweeps", "weight", "worst error", "soft mean/0.7E", "choice");
     PrefilterOptions prefilter = config.prefilter;
@@ -122,6 +133,7 @@ int main(int argc, char** argv) {
       if (zones == config.model.elements) layout.zoning = Zoning::kPerElement;
       const BarModel model(config.model, layout.ElementZones(config.model));
       ZoneIdentificationOptions options = config.zone_identification;
+      options.minimizer.optimizer = optimizer;
       options.minimizer.algorithm = algorithm;
       const auto start = std::chrono::steady_clock::now();
       const ZoneIdentificationSummary summary = IdentifyZoneModuli(

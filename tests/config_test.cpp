@@ -135,6 +135,7 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.data.truth_moduli, actual.data.truth_moduli);
   const ZoneIdentificationOptions& zones = expected.zone_identification;
   const ZoneIdentificationOptions& zones_again = actual.zone_identification;
+  EXPECT_EQ(zones.minimizer.optimizer, zones_again.minimizer.optimizer);
   EXPECT_EQ(zones.minimizer.algorithm, zones_again.minimizer.algorithm);
   EXPECT_EQ(zones.minimizer.step_tolerance, zones_again.minimizer.step_tolerance);
   EXPECT_EQ(zones.minimizer.function_tolerance, zones_again.minimizer.function_tolerance);
@@ -574,7 +575,8 @@ study:
   comparator_errors: [density, soft_zone]
   comparator_data: [prefilter]
 zone_identification:
-  algorithm: nlopt_slsqp
+  optimizer: nlopt
+  algorithm: slsqp
   step_tolerance: 1e-9
   function_tolerance: 1e-11
   max_evaluations: 321

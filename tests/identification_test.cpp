@@ -87,7 +87,7 @@ TEST_P(EveryAlgorithmTest, FindsTheMinimumOfAParabola) {
   ScriptedObjective objective = Parabola();
   const IdentificationSummary summary = Identify(Options(optimizer, algorithm), &objective);
   EXPECT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
-  // relative_tolerance 1e-8: measured 0 (BOBYQA, L-BFGS, Brent), 1.4e-9 (MMA),
+  // relative_tolerance 1e-8: measured 0 (BOBYQA, L-BFGS, SLSQP, Brent), 1.4e-9 (MMA),
   // 2.3e-9 (Sbplx), 5.3e-9 (COBYLA), 9.5e-12 (Ceres).
   EXPECT_NEAR(summary.modulus, 1.3e9, 5e-8 * 1.3e9) << summary.FullReport();
   // cost 0.5 + (x - 1.3)^2: measured 0.5 to the last bit for every algorithm; x within
@@ -108,6 +108,7 @@ INSTANTIATE_TEST_SUITE_P(NloptAndCeres, EveryAlgorithmTest,
                                            Case{OptimizerType::kNlopt, OuterAlgorithm::kSbplx},
                                            Case{OptimizerType::kNlopt, OuterAlgorithm::kMma},
                                            Case{OptimizerType::kNlopt, OuterAlgorithm::kLbfgs},
+                                           Case{OptimizerType::kNlopt, OuterAlgorithm::kSlsqp},
                                            Case{OptimizerType::kNlopt, OuterAlgorithm::kBrent},
                                            Case{OptimizerType::kCeres, OuterAlgorithm::kDefault},
                                            Case{OptimizerType::kCeres, OuterAlgorithm::kBfgs}),

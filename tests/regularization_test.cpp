@@ -12,9 +12,14 @@
 #include <vector>
 
 #include "mcrewave/core/types.h"
+#include "optimizer_choices.h"
 
 namespace mcrewave {
 namespace {
+
+using testing::kCeresLbfgs;
+using testing::kNloptLbfgs;
+using testing::OptimizerChoice;
 
 TEST(JumpPenaltyTest, GradientMatchesCentralDifferences) {
   const std::vector<double> p{0.1, -0.2, 0.35, 0.35, 0.0004, -0.7, 0.2};
@@ -55,7 +60,7 @@ TEST(JumpPenaltyTest, ValuesOfBothKinds) {
 }
 
 // 1/2 |A p - b|^2 over 10 parameters.
-class LeastSquares : public MultiParameterObjective {
+class LeastSquares : public FirstOrderObjective {
  public:
   LeastSquares(Eigen::MatrixXd a, Eigen::VectorXd b) : a_(std::move(a)), b_(std::move(b)) {}
   int num_parameters() const override { return static_cast<int>(a_.cols()); }
@@ -108,9 +113,8 @@ struct SmoothingProblem {
 };
 
 // Tight stopping tests, so that the weight search, not the minimiser, sets the figures.
-BoundedMinimizerOptions TightOptions(BoundedAlgorithm algorithm) {
-  BoundedMinimizerOptions options;
-  options.algorithm = algorithm;
+BoundedMinimizerOptions TightOptions(OptimizerChoice algorithm) {
+  BoundedMinimizerOptions options = algorithm.Apply({});
   options.step_tolerance = 1e-10;
   options.function_tolerance = 0.0;
   return options;
@@ -143,8 +147,7 @@ TEST(DiscrepancyPrincipleTest, ChoosesTheWeightOfTheClosedForm) {
 
   // The default tolerance and a tight one.
   for (double tolerance : {RegularizationOptions().weight_tolerance, 1e-3}) {
-    for (BoundedAlgorithm algorithm :
-         {BoundedAlgorithm::kNloptLbfgs, BoundedAlgorithm::kCeresLbfgs}) {
+    for (OptimizerChoice algorithm : {kNloptLbfgs, kCeresLbfgs}) {
       const BoundedMinimizerOptions options = TightOptions(algorithm);
       RegularizationOptions regularization;
       regularization.weight_rule = WeightRule::kDiscrepancy;
@@ -241,8 +244,7 @@ void ExpectTheClosedFormsCorner(const LeastSquares& closed_form, WeightRule rule
   const auto [weights, misfits, roughness] = ClosedFormOnTheGrid(data, 7);  // 1e2 .. 1e-10
   const int corner = LCurveCorner(misfits, roughness);
   ASSERT_GT(corner, 0);
-  for (BoundedAlgorithm algorithm :
-       {BoundedAlgorithm::kNloptLbfgs, BoundedAlgorithm::kCeresLbfgs}) {
+  for (OptimizerChoice algorithm : {kNloptLbfgs, kCeresLbfgs}) {
     const BoundedMinimizerOptions options = TightOptions(algorithm);
     const RegularizedMinimization result =
         MinimizeRegularized(options, regularization, &data, std::vector<double>(n, -5.0),
@@ -285,10 +287,9 @@ RegularizedMinimization LCurveOnTheGrid(const SmoothingProblem& problem, double 
   RegularizationOptions regularization;
   regularization.max_weight = 1e2 / start_cost;
   regularization.min_weight = 1e-10 / start_cost;
-  return MinimizeRegularized(TightOptions(BoundedAlgorithm::kCeresLbfgs), regularization, &data,
-                             std::vector<double>(problem.n, -5.0),
-                             std::vector<double>(problem.n, 5.0),
-                             std::vector<double>(problem.n, 0.0), target);
+  return MinimizeRegularized(
+      TightOptions(kCeresLbfgs), regularization, &data, std::vector<double>(problem.n, -5.0),
+      std::vector<double>(problem.n, 5.0), std::vector<double>(problem.n, 0.0), target);
 }
 
 TEST(LCurveRuleTest, KeepsTheLargestWeightWhenItMeetsTheTarget) {
@@ -335,9 +336,9 @@ TEST(LCurveRuleTest, StopsAtTheFirstWeightThatMeetsTheTarget) {
 
 // The data cost of `data` until `limit` evaluations, then failures: a minimisation
 // that cannot converge.
-class FailingAfter : public MultiParameterObjective {
+class FailingAfter : public FirstOrderObjective {
  public:
-  FailingAfter(MultiParameterObjective* data, int limit) : data_(data), limit_(limit) {}
+  FailingAfter(FirstOrderObjective* data, int limit) : data_(data), limit_(limit) {}
   int num_parameters() const override { return data_->num_parameters(); }
   bool Evaluate(const double* x, double* cost, double* gradient) override {
     if (++count_ > limit_) return false;
@@ -345,7 +346,7 @@ class FailingAfter : public MultiParameterObjective {
   }
 
  private:
-  MultiParameterObjective* data_;
+  FirstOrderObjective* data_;
   int limit_;
   int count_ = 0;
 };
@@ -363,7 +364,7 @@ TEST(DiscrepancyPrincipleTest, AMinimisationThatFailsBelowTheGridsTopEndsTheDesc
   const std::vector<double> lower(n, -5.0), upper(n, 5.0), start(n, 0.0);
   double start_cost = 0.0;
   ASSERT_TRUE(data.Evaluate(start.data(), &start_cost, nullptr));
-  const BoundedMinimizerOptions options = TightOptions(BoundedAlgorithm::kCeresLbfgs);
+  const BoundedMinimizerOptions options = TightOptions(kCeresLbfgs);
   RegularizationOptions regularization;
   regularization.max_weight = 1e2 / start_cost;
   regularization.min_weight = 1e-2 / start_cost;
@@ -432,8 +433,8 @@ TEST(MergeNeighbouringZonesTest, KeepsTheFewestGroupsTheNoiseExplains) {
   // The truth's three groups: [0, 2], [3, 4], [5, 7].
   ASSERT_EQ(best, 1u | 1u << 3 | 1u << 5);
 
-  const ZoneMerge merge = MergeNeighbouringZones(TightOptions(BoundedAlgorithm::kCeresLbfgs),
-                                                 &data, lower, upper, start, target);
+  const ZoneMerge merge =
+      MergeNeighbouringZones(TightOptions(kCeresLbfgs), &data, lower, upper, start, target);
   EXPECT_EQ(merge.groups, 3);
   EXPECT_EQ(merge.merges, n - 3);
   EXPECT_EQ(merge.group_of, (std::vector<int>{0, 0, 0, 1, 1, 2, 2, 2}));
@@ -450,15 +451,15 @@ TEST(MergeNeighbouringZonesTest, KeepsTheFewestGroupsTheNoiseExplains) {
   EXPECT_NEAR(merge.misfit, problem.Misfit(best), 1e-14 * problem.Misfit(best));
 
   // No merge meets a target of 0: the regularised point stands (x empty).
-  const ZoneMerge none = MergeNeighbouringZones(TightOptions(BoundedAlgorithm::kCeresLbfgs),
-                                                &data, lower, upper, start, 0.0);
+  const ZoneMerge none =
+      MergeNeighbouringZones(TightOptions(kCeresLbfgs), &data, lower, upper, start, 0.0);
   EXPECT_EQ(none.merges, 0);
   EXPECT_EQ(none.groups, n);
   EXPECT_EQ(none.refits, n - 1);
   EXPECT_TRUE(none.x.empty());
   // A target above the homogeneous misfit merges every zone into b's mean.
-  const ZoneMerge all = MergeNeighbouringZones(TightOptions(BoundedAlgorithm::kCeresLbfgs),
-                                               &data, lower, upper, start, 1.0);
+  const ZoneMerge all =
+      MergeNeighbouringZones(TightOptions(kCeresLbfgs), &data, lower, upper, start, 1.0);
   EXPECT_EQ(all.groups, 1);
   ASSERT_EQ(all.x.size(), static_cast<std::size_t>(n));
   EXPECT_NEAR(all.x[0], problem.b.mean(), 5e-12);

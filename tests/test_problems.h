@@ -75,7 +75,7 @@ struct ProblemBundle {
 // Minimises a zone objective in p_z = log(E_z / E_z,ref) from p = 0 within
 // [log 1/2, log 2] for every zone, at the step tolerance 1e-10 and no cost tolerance
 // (the inverse crimes' setting).
-inline BoundedMinimizerSummary MinimizeWithinHalfAndTwice(MultiParameterObjective* objective) {
+inline BoundedMinimizerSummary MinimizeWithinHalfAndTwice(FirstOrderObjective* objective) {
   BoundedMinimizerOptions options;
   options.step_tolerance = 1e-10;
   options.function_tolerance = 0.0;

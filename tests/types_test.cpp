@@ -52,7 +52,6 @@ TEST(TypesTest, EveryEnumRoundTripsThroughItsNameTable) {
   ExpectTableRoundTrips(kCoupledSolverTypeNames, CoupledSolverTypeToString,
                         StringToCoupledSolverType);
   ExpectTableRoundTrips(kTerminationTypeNames, TerminationTypeToString, StringToTerminationType);
-  ExpectTableRoundTrips(kBoundedAlgorithmNames, BoundedAlgorithmToString, StringToBoundedAlgorithm);
   ExpectTableRoundTrips(kOuterFunctionalNames, OuterFunctionalToString, StringToOuterFunctional);
   ExpectTableRoundTrips(kOptimizerTypeNames, OptimizerTypeToString, StringToOptimizerType);
   ExpectTableRoundTrips(kOuterAlgorithmNames, OuterAlgorithmToString, StringToOuterAlgorithm);

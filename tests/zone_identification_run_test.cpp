@@ -20,10 +20,12 @@ namespace {
 
 TEST(ZoneIdentificationConfigTest, KeysAreReadAndChecked) {
   const Config config = ParseConfig(
-      "zone_identification:\n  algorithm: ceres_lbfgs\n  regularization: total_variation\n"
+      "zone_identification:\n  optimizer: nlopt\n  algorithm: slsqp\n  regularization: "
+      "total_variation\n"
       "  regularization_weight: 1e-6\n  noise_samples: 2\n",
       "test.yaml");
-  EXPECT_EQ(config.zone_identification.minimizer.algorithm, BoundedAlgorithm::kCeresLbfgs);
+  EXPECT_EQ(config.zone_identification.minimizer.optimizer, OptimizerType::kNlopt);
+  EXPECT_EQ(config.zone_identification.minimizer.algorithm, OuterAlgorithm::kSlsqp);
   EXPECT_EQ(config.zone_identification.regularization.kind, RegularizationKind::kTotalVariation);
   EXPECT_EQ(config.zone_identification.regularization.weight, 1e-6);
   EXPECT_EQ(config.zone_identification.noise_samples, 2);

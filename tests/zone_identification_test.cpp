@@ -15,10 +15,18 @@
 #include "mcrewave/mcre/objective.h"
 #include "mcrewave/model/bar_model.h"
 #include "mcrewave/model/simulation.h"
+#include "optimizer_choices.h"
 #include "test_problems.h"
 
 namespace mcrewave {
 namespace {
+
+using testing::kCeresLbfgs;
+using testing::kNloptBobyqa;
+using testing::kNloptLbfgs;
+using testing::kNloptMma;
+using testing::kNloptSlsqp;
+using testing::OptimizerChoice;
 
 using testing::MakeSmallCase;
 using testing::Options;
@@ -95,7 +103,7 @@ TEST(ZoneMcreObjectiveTest, GradientInLogModuliMatchesCentralDifferences) {
   EXPECT_NEAR(moduli[3], 190e9 * std::exp(p[3]), 1e-6);
 }
 
-class ZoneInverseCrimeTest : public ::testing::TestWithParam<BoundedAlgorithm> {};
+class ZoneInverseCrimeTest : public ::testing::TestWithParam<OptimizerChoice> {};
 
 TEST_P(ZoneInverseCrimeTest, RecoversEveryZone) {
   // 10 zones on 40 elements, a soft zone at 0.7 E aligned with zone 6, noise-free data
@@ -103,7 +111,7 @@ TEST_P(ZoneInverseCrimeTest, RecoversEveryZone) {
   const Vector truth = SoftZoneModuli(10);
   InverseCrime crime(40, 120, 10, truth);
   ZoneIdentificationOptions options;
-  options.minimizer.algorithm = GetParam();
+  options.minimizer = GetParam().Apply(options.minimizer);
   options.minimizer.step_tolerance = 1e-10;
   options.minimizer.function_tolerance = 0.0;
   options.regularization.kind = RegularizationKind::kNone;
@@ -122,11 +130,11 @@ TEST_P(ZoneInverseCrimeTest, RecoversEveryZone) {
   // in the Release and the sanitizer build: nlopt_lbfgs 1.4e-10 (27, 0.01 s), nlopt_slsqp
   // 5.1e-12 (48, 0.02 s), nlopt_mma 6.3e-10 (524, 0.25 s), nlopt_bobyqa 2.7e-11 (436,
   // 0.22 s), ceres_lbfgs 1.7e-11 (28, 0.02 s). Each bounded at about 10 times its figure.
-  const std::map<BoundedAlgorithm, double> bound = {{BoundedAlgorithm::kNloptLbfgs, 1.5e-9},
-                                                    {BoundedAlgorithm::kNloptSlsqp, 5e-11},
-                                                    {BoundedAlgorithm::kNloptMma, 6e-9},
-                                                    {BoundedAlgorithm::kNloptBobyqa, 3e-10},
-                                                    {BoundedAlgorithm::kCeresLbfgs, 2e-10}};
+  const std::map<OptimizerChoice, double> bound = {{kNloptLbfgs, 1.5e-9},
+                                                   {kNloptSlsqp, 5e-11},
+                                                   {kNloptMma, 6e-9},
+                                                   {kNloptBobyqa, 3e-10},
+                                                   {kCeresLbfgs, 2e-10}};
   ASSERT_EQ(bound.count(GetParam()), 1u);
   EXPECT_LT(worst, bound.at(GetParam())) << summary.FullReport();
   EXPECT_NEAR(summary.zone_start[6], 0.6, 1e-12);
@@ -136,13 +144,10 @@ TEST_P(ZoneInverseCrimeTest, RecoversEveryZone) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Minimizers, ZoneInverseCrimeTest,
-                         ::testing::Values(BoundedAlgorithm::kNloptLbfgs,
-                                           BoundedAlgorithm::kNloptSlsqp,
-                                           BoundedAlgorithm::kNloptMma,
-                                           BoundedAlgorithm::kNloptBobyqa,
-                                           BoundedAlgorithm::kCeresLbfgs),
-                         [](const ::testing::TestParamInfo<BoundedAlgorithm>& info) {
-                           return std::string(BoundedAlgorithmToString(info.param));
+                         ::testing::Values(kNloptLbfgs, kNloptSlsqp, kNloptMma, kNloptBobyqa,
+                                           kCeresLbfgs),
+                         [](const ::testing::TestParamInfo<OptimizerChoice>& info) {
+                           return info.param.Name();
                          });
 
 TEST(ZoneDiscrepancyTest, NoiseFreeDataNeedNoRegularisationToSpeakOf) {

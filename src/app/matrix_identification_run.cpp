@@ -183,7 +183,7 @@ double RootMeanSquareOfRows(const Matrix& rows) {
 
 // Records every evaluation of a zone objective (MatrixZoneObjective,
 // MatrixOutputErrorObjective) and logs a progress line naming its cost.
-class RecordingObjective : public MultiParameterObjective {
+class RecordingObjective : public FirstOrderObjective {
  public:
   RecordingObjective(LogModuliObjective* objective, std::vector<MatrixEvaluation>* records,
                      const char* cost_name)

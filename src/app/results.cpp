@@ -1003,7 +1003,8 @@ void MatrixUncertaintyYaml(const MatrixIdentificationRun& run, YamlWriter* yaml)
 void MatrixOptimizerYaml(const MatrixIdentificationRun& run, const std::string& cost,
                          YamlWriter* yaml) {
   yaml->Line(0, "optimizer", "", "zone_identification: (the zone moduli in log E)");
-  yaml->Text(1, "algorithm", BoundedAlgorithmToString(run.outer.algorithm));
+  yaml->Text(1, "optimizer", OptimizerTypeToString(run.outer.optimizer));
+  yaml->Text(1, "algorithm", OuterAlgorithmToString(run.outer.algorithm));
   yaml->Text(1, "termination", TerminationTypeToString(run.outer.termination));
   yaml->Text(1, "message", run.outer.message);
   yaml->Text(1, "optimizer_message", run.outer.optimizer_message, "the optimiser's own words");

@@ -127,7 +127,8 @@ std::vector<std::string> ZonesYamlLines(const ZoneIdentificationRun& run) {
   line(1, "homogeneous_modulus", Number(s.homogeneous_modulus), "[Pa] E*, the start");
   line(1, "cost", Number(s.cost), unit + cost + " at the zone moduli");
   line(1, "homogeneous_cost", Number(s.homogeneous_cost), unit + cost + " at E* in every zone");
-  line(1, "algorithm", BoundedAlgorithmToString(s.regularized.minimizer.algorithm));
+  line(1, "optimizer", OptimizerTypeToString(s.regularized.minimizer.optimizer));
+  line(1, "algorithm", OuterAlgorithmToString(s.regularized.minimizer.algorithm));
   line(1, "regularization_weight", Number(s.regularized.weight),
        "lambda of the jump penalty on log E");
   line(1, "weight_choice", s.regularized.weight_choice);

@@ -86,11 +86,6 @@ bool StringToTerminationType(const std::string& name, TerminationType* type) {
   return internal::FromName(kTerminationTypeNames, name, type);
 }
 
-const char* BoundedAlgorithmToString(BoundedAlgorithm algorithm) { return internal::ToName(kBoundedAlgorithmNames, algorithm); }
-bool StringToBoundedAlgorithm(const std::string& name, BoundedAlgorithm* algorithm) {
-  return internal::FromName(kBoundedAlgorithmNames, name, algorithm);
-}
-
 const char* OuterFunctionalToString(OuterFunctional functional) { return internal::ToName(kOuterFunctionalNames, functional); }
 bool StringToOuterFunctional(const std::string& name, OuterFunctional* functional) {
   return internal::FromName(kOuterFunctionalNames, name, functional);

@@ -134,9 +134,8 @@ void ZoneExtents(const BarModel& model, ZoneIdentificationSummary* summary) {
 // minimised.
 template <typename NoiseCost>
 void MinimizeOverZones(const ZoneIdentificationOptions& options, int zones,
-                       MultiParameterObjective* zone_objective, double lower_bound,
-                       double upper_bound, NoiseCost&& expected_noise_cost,
-                       ZoneIdentificationSummary* summary) {
+                       FirstOrderObjective* zone_objective, double lower_bound, double upper_bound,
+                       NoiseCost&& expected_noise_cost, ZoneIdentificationSummary* summary) {
   const double homogeneous_modulus = summary->homogeneous_modulus;
   const std::vector<double> lower(zones, std::log(lower_bound / homogeneous_modulus));
   const std::vector<double> upper(zones, std::log(upper_bound / homogeneous_modulus));

@@ -20,11 +20,17 @@ namespace {
 // Absolute floor of the tolerance on x = E / E_scale (x is of order 1).
 constexpr double kAbsoluteTolerance = 1e-12;
 
+// Stops at the guard's stop, with its termination and message.
+void ReportStop(const GuardedObjective& objective, IdentificationSummary* summary) {
+  summary->termination = objective.StopTermination();
+  summary->message = objective.stop_message();
+}
+
 }  // namespace
 
 void MinimizeWithBrent(const IdentificationOptions& options, GuardedObjective* objective,
-                       IdentificationSummary* summary) {
-  const double scale = objective->modulus_scale();
+                       double modulus_scale, IdentificationSummary* summary) {
+  const double scale = modulus_scale;
   // (3 - sqrt(5)) / 2: the golden-section fraction.
   const double golden = 0.5 * (3.0 - std::sqrt(5.0));
   double a = options.lower_bound / scale;
@@ -32,8 +38,8 @@ void MinimizeWithBrent(const IdentificationOptions& options, GuardedObjective* o
   // x: best point so far; w: second best; v: the previous w.
   double x = options.initial / scale;
   double fx = 0.0;
-  if (!objective->Evaluate(x, &fx, nullptr)) {
-    objective->ReportStop(summary);
+  if (!objective->Evaluate(&x, &fx, nullptr)) {
+    ReportStop(*objective, summary);
     return;
   }
   double w = x, v = x, fw = fx, fv = fx;
@@ -69,8 +75,8 @@ void MinimizeWithBrent(const IdentificationOptions& options, GuardedObjective* o
     // Never closer than tol to x.
     const double u = std::abs(step) >= tol ? x + step : (step > 0.0 ? x + tol : x - tol);
     double fu = 0.0;
-    if (!objective->Evaluate(u, &fu, nullptr)) {
-      objective->ReportStop(summary);
+    if (!objective->Evaluate(&u, &fu, nullptr)) {
+      ReportStop(*objective, summary);
       return;
     }
     if (fu <= fx) {

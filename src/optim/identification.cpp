@@ -19,55 +19,6 @@
 #include "optim/identification_internal.h"
 
 namespace mcrewave {
-namespace {
-
-// "a, b or c": the algorithms the optimiser offers, for messages.
-std::string AvailableAlgorithms(OptimizerType optimizer) {
-  std::vector<std::string> names;
-  for (const auto& [algorithm, name] : kOuterAlgorithmNames) {
-    if (IsAlgorithmAvailable(optimizer, algorithm)) names.push_back(name);
-  }
-  std::string text;
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    text += (i == 0 ? "" : (i + 1 == names.size() ? " or " : ", ")) + names[i];
-  }
-  return text;
-}
-
-}  // namespace
-
-bool IsAlgorithmAvailable(OptimizerType optimizer, OuterAlgorithm algorithm) {
-  switch (algorithm) {
-    case OuterAlgorithm::kDefault:
-    case OuterAlgorithm::kLbfgs:
-      return true;
-    case OuterAlgorithm::kBobyqa:
-    case OuterAlgorithm::kCobyla:
-    case OuterAlgorithm::kSbplx:
-    case OuterAlgorithm::kMma:
-    case OuterAlgorithm::kBrent:
-      return optimizer == OptimizerType::kNlopt;
-    case OuterAlgorithm::kBfgs:
-      return optimizer == OptimizerType::kCeres;
-  }
-  return false;
-}
-
-OuterAlgorithm ResolveAlgorithm(OptimizerType optimizer, OuterAlgorithm algorithm) {
-  if (algorithm != OuterAlgorithm::kDefault) return algorithm;
-  return optimizer == OptimizerType::kNlopt ? OuterAlgorithm::kBobyqa : OuterAlgorithm::kLbfgs;
-}
-
-bool UsesGradient(OptimizerType optimizer, OuterAlgorithm algorithm) {
-  switch (ResolveAlgorithm(optimizer, algorithm)) {
-    case OuterAlgorithm::kMma:
-    case OuterAlgorithm::kLbfgs:
-    case OuterAlgorithm::kBfgs:
-      return true;
-    default:
-      return false;
-  }
-}
 
 bool IdentificationOptions::IsValid(std::string* error) const {
   std::ostringstream why;
@@ -184,99 +135,25 @@ std::string IdentificationSummary::FullReport() const {
   return out.str();
 }
 
-namespace internal {
+namespace {
 
-GuardedObjective::GuardedObjective(const IdentificationOptions& options,
-                                   ModulusObjective* objective)
-    : options_(options), objective_(objective), start_(std::chrono::steady_clock::now()) {}
-
-double GuardedObjective::ElapsedSeconds() const {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-}
-
-bool GuardedObjective::Evaluate(double x, double* cost, double* gradient) {
-  if (stop_ != StopReason::kNone) return false;
-  if (evaluations_ >= options_.max_evaluations) {
-    stop_ = StopReason::kEvaluationLimit;
-    stop_message_ = "outer.max_evaluations (" + std::to_string(options_.max_evaluations) +
-                    ") reached before convergence";
-    return false;
-  }
-  if (ElapsedSeconds() >= options_.max_time) {
-    std::ostringstream why;
-    why << "outer.max_time (" << options_.max_time << " s) reached before convergence";
-    stop_ = StopReason::kTimeLimit;
-    stop_message_ = why.str();
-    return false;
-  }
-  ++evaluations_;
-  if (gradient != nullptr) ++gradient_evaluations_;
-  const double modulus = x * objective_->modulus_scale();
-  bool usable = false;
-  try {
-    usable = objective_->Evaluate(&x, cost, gradient);
-    if (usable && !std::isfinite(*cost)) {
-      usable = false;
-      stop_message_ = "the objective returned a non-finite cost";
-    } else if (usable && gradient != nullptr && !std::isfinite(*gradient)) {
-      usable = false;
-      stop_message_ = "the objective returned a non-finite gradient";
-    } else if (!usable) {
-      stop_message_ = objective_->error_message();
-    }
-  } catch (const std::exception& error) {
-    stop_message_ = std::string("the objective threw: ") + error.what();
-  } catch (...) {
-    stop_message_ = "the objective threw an exception that is not a std::exception";
-  }
-  if (!usable) {
-    stop_ = StopReason::kFailure;
-    spdlog::info("{} evaluation {}: E = {:.9g} Pa failed: {}",
-                 OptimizerTypeToString(options_.optimizer), evaluations_, modulus, stop_message_);
-    return false;
-  }
-  if (!has_best_) initial_cost_ = *cost;
-  if (!has_best_ || *cost < best_cost_) {
-    has_best_ = true;
-    best_x_ = x;
-    best_cost_ = *cost;
-    best_has_gradient_ = gradient != nullptr;
-    best_gradient_ = gradient != nullptr ? gradient[0] : 0.0;
-  }
-  if (gradient != nullptr) {
+// The progress line of one evaluation of the local search at E = modulus [Pa] (cost null:
+// it failed).
+void LogEvaluation(const char* optimizer, const internal::GuardedObjective& guard, double modulus,
+                   const double* cost, const double* gradient, double scale) {
+  if (cost == nullptr) {
+    spdlog::info("{} evaluation {}: E = {:.9g} Pa failed: {}", optimizer, guard.evaluations(),
+                 modulus, guard.stop_message());
+  } else if (gradient != nullptr) {
     spdlog::info(
         "{} evaluation {}: E = {:.9g} Pa, cost e^2/J_rest {:.9g}, gradient {:.3e}; best E = {:.9g} "
         "Pa",
-        OptimizerTypeToString(options_.optimizer), evaluations_, modulus, *cost, gradient[0],
-        best_x_ * objective_->modulus_scale());
+        optimizer, guard.evaluations(), modulus, *cost, gradient[0], guard.best_x()[0] * scale);
   } else {
     spdlog::info("{} evaluation {}: E = {:.9g} Pa, cost e^2/J_rest {:.9g}; best E = {:.9g} Pa",
-                 OptimizerTypeToString(options_.optimizer), evaluations_, modulus, *cost,
-                 best_x_ * objective_->modulus_scale());
+                 optimizer, guard.evaluations(), modulus, *cost, guard.best_x()[0] * scale);
   }
-  return true;
 }
-
-void GuardedObjective::ReportStop(IdentificationSummary* summary) const {
-  summary->termination =
-      stop_ == StopReason::kFailure ? TerminationType::kFailure : TerminationType::kNoConvergence;
-  summary->message = stop_message_;
-}
-
-void GuardedObjective::FillSummary(IdentificationSummary* summary) const {
-  summary->evaluations = evaluations_;
-  summary->gradient_evaluations = gradient_evaluations_;
-  if (has_best_) {
-    summary->modulus = best_x_ * objective_->modulus_scale();
-    summary->cost = best_cost_;
-    summary->gradient = best_has_gradient_ ? best_gradient_ : 0.0;
-  }
-  summary->wall_time_s = ElapsedSeconds();
-}
-
-}  // namespace internal
-
-namespace {
 
 // One local search from options.initial within options' bounds. curvature: an
 // estimate of d^2 cost / dx^2 near the start (0: unknown), for the step scale of
@@ -287,15 +164,29 @@ IdentificationSummary MinimizeLocally(const IdentificationOptions& options,
   summary.optimizer = options.optimizer;
   summary.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm);
   summary.initial_modulus = options.initial;
-  internal::GuardedObjective guarded(options, objective);
+  const double scale = objective->modulus_scale();
+  internal::GuardedObjective guarded(objective,
+                                     {options.max_evaluations, options.max_time, "outer"});
+  guarded.set_observer([&options, scale](const internal::GuardedObjective& guard, const double* x,
+                                         const double* cost, const double* gradient) {
+    LogEvaluation(OptimizerTypeToString(options.optimizer), guard, x[0] * scale, cost, gradient,
+                  scale);
+  });
   if (summary.algorithm == OuterAlgorithm::kBrent) {
-    internal::MinimizeWithBrent(options, &guarded, &summary);
+    internal::MinimizeWithBrent(options, &guarded, scale, &summary);
   } else if (options.optimizer == OptimizerType::kNlopt) {
-    internal::MinimizeWithNlopt(options, &guarded, curvature, &summary);
+    internal::MinimizeWithNlopt(options, &guarded, scale, curvature, &summary);
   } else {
-    internal::MinimizeWithCeres(options, &guarded, curvature, &summary);
+    internal::MinimizeWithCeres(options, &guarded, scale, curvature, &summary);
   }
-  guarded.FillSummary(&summary);
+  summary.evaluations = guarded.evaluations();
+  summary.gradient_evaluations = guarded.gradient_evaluations();
+  if (guarded.has_best()) {
+    summary.modulus = guarded.best_x()[0] * scale;
+    summary.cost = guarded.best_cost();
+    summary.gradient = guarded.best_gradient().empty() ? 0.0 : guarded.best_gradient()[0];
+  }
+  summary.wall_time_s = guarded.ElapsedSeconds();
   if (!guarded.has_best() && summary.termination == TerminationType::kConvergence) {
     summary.termination = TerminationType::kFailure;
     summary.message = "no usable evaluation of the objective";

@@ -18,7 +18,7 @@ namespace {
 // One minimisation at `weight` from `start`, recorded in *result.
 BoundedMinimizerSummary MinimizeAt(const BoundedMinimizerOptions& options,
                                    const RegularizationOptions& regularization,
-                                   MultiParameterObjective* data, const std::vector<double>& lower,
+                                   FirstOrderObjective* data, const std::vector<double>& lower,
                                    const std::vector<double>& upper,
                                    const std::vector<double>& start, double weight,
                                    double target_misfit, RegularizedMinimization* result,
@@ -117,7 +117,7 @@ double JumpPenalty(RegularizationKind kind, double weight, double tv_smoothing, 
   return weight * penalty;
 }
 
-RegularizedObjective::RegularizedObjective(MultiParameterObjective* data, RegularizationKind kind,
+RegularizedObjective::RegularizedObjective(FirstOrderObjective* data, RegularizationKind kind,
                                            double weight, double tv_smoothing)
     : data_(data), kind_(kind), weight_(weight), tv_smoothing_(tv_smoothing) {}
 
@@ -177,7 +177,7 @@ namespace {
 class WeightSearch {
  public:
   WeightSearch(const BoundedMinimizerOptions& options, const RegularizationOptions& regularization,
-               MultiParameterObjective* data, const std::vector<double>& lower,
+               FirstOrderObjective* data, const std::vector<double>& lower,
                const std::vector<double>& upper, double target_misfit,
                RegularizedMinimization* result)
       : options_(options),
@@ -375,7 +375,7 @@ class WeightSearch {
 
   const BoundedMinimizerOptions& options_;
   const RegularizationOptions& regularization_;
-  MultiParameterObjective* data_;
+  FirstOrderObjective* data_;
   const std::vector<double>& lower_;
   const std::vector<double>& upper_;
   const double target_misfit_;  // the caller's target
@@ -398,8 +398,8 @@ class WeightSearch {
 
 RegularizedMinimization MinimizeRegularized(
     const BoundedMinimizerOptions& options, const RegularizationOptions& regularization,
-    MultiParameterObjective* data, const std::vector<double>& lower,
-    const std::vector<double>& upper, const std::vector<double>& initial, double target_misfit) {
+    FirstOrderObjective* data, const std::vector<double>& lower, const std::vector<double>& upper,
+    const std::vector<double>& initial, double target_misfit) {
   RegularizedMinimization result;
   const bool automatic =
       regularization.kind != RegularizationKind::kNone && regularization.weight < 0.0;
@@ -425,10 +425,10 @@ namespace {
 
 // The data cost over groups of zones: zone z takes its group's parameter,
 //   p_z = q_{g(z)},  d cost / d q_g = sum_{z in g} d cost / d p_z.
-class GroupedObjective : public MultiParameterObjective {
+class GroupedObjective : public FirstOrderObjective {
  public:
   // zones must outlive this objective.
-  GroupedObjective(MultiParameterObjective* zones, std::vector<int> group_of, int groups)
+  GroupedObjective(FirstOrderObjective* zones, std::vector<int> group_of, int groups)
       : zones_(zones),
         group_of_(std::move(group_of)),
         groups_(groups),
@@ -452,7 +452,7 @@ class GroupedObjective : public MultiParameterObjective {
   std::string error_message() const override { return zones_->error_message(); }
 
  private:
-  MultiParameterObjective* zones_;
+  FirstOrderObjective* zones_;
   std::vector<int> group_of_;
   int groups_;
   std::vector<double> zone_parameters_;
@@ -461,10 +461,9 @@ class GroupedObjective : public MultiParameterObjective {
 
 }  // namespace
 
-ZoneMerge MergeNeighbouringZones(const BoundedMinimizerOptions& options,
-                                 MultiParameterObjective* data, const std::vector<double>& lower,
-                                 const std::vector<double>& upper, const std::vector<double>& x,
-                                 double target_misfit) {
+ZoneMerge MergeNeighbouringZones(const BoundedMinimizerOptions& options, FirstOrderObjective* data,
+                                 const std::vector<double>& lower, const std::vector<double>& upper,
+                                 const std::vector<double>& x, double target_misfit) {
   assert(target_misfit >= 0.0 && x.size() == lower.size() && x.size() == upper.size());
   const int zones = static_cast<int>(x.size());
   ZoneMerge merge;

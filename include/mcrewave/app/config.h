@@ -62,7 +62,7 @@
 //          density, force_gain, displacement_gain, soft_zone]], comparator_data
 //          [[raw, prefilter]]
 //          (StudyOptions, study.h; used by `identify study` only)
-//   zone_identification: algorithm [ceres_lbfgs], step_tolerance [1e-8],
+//   zone_identification: optimizer [ceres], algorithm [default], step_tolerance [1e-8],
 //          function_tolerance [1e-10], max_evaluations [2000], max_time [600 s],
 //          regularization [tikhonov | total_variation | none],
 //          regularization_weight [-1: discrepancy principle], tv_smoothing [1e-3],

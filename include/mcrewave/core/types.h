@@ -244,23 +244,6 @@ inline constexpr std::array<std::pair<TerminationType, const char*>, 4> kTermina
 const char* TerminationTypeToString(TerminationType type);
 bool StringToTerminationType(const std::string& name, TerminationType* type);
 
-enum class BoundedAlgorithm {
-  kNloptLbfgs,
-  kNloptMma,
-  kNloptSlsqp,
-  kNloptBobyqa,
-  kCeresLbfgs,
-};
-inline constexpr std::array<std::pair<BoundedAlgorithm, const char*>, 5> kBoundedAlgorithmNames{{
-    {BoundedAlgorithm::kNloptLbfgs, "nlopt_lbfgs"},
-    {BoundedAlgorithm::kNloptMma, "nlopt_mma"},
-    {BoundedAlgorithm::kNloptSlsqp, "nlopt_slsqp"},
-    {BoundedAlgorithm::kNloptBobyqa, "nlopt_bobyqa"},
-    {BoundedAlgorithm::kCeresLbfgs, "ceres_lbfgs"},
-}};
-const char* BoundedAlgorithmToString(BoundedAlgorithm algorithm);
-bool StringToBoundedAlgorithm(const std::string& name, BoundedAlgorithm* algorithm);
-
 // The functional the outer loop minimises over E. Identify minimises whatever
 // ModulusObjective it is given; identify run (app/identification_run.h) builds it
 // from this choice.
@@ -286,7 +269,8 @@ inline constexpr std::array<std::pair<OptimizerType, const char*>, 2> kOptimizer
 const char* OptimizerTypeToString(OptimizerType type);
 bool StringToOptimizerType(const std::string& name, OptimizerType* type);
 
-// The algorithm of the outer optimiser; not every one exists in both.
+// The algorithm of an optimiser (optim/algorithms.h says which offers which), for one
+// parameter (outer.algorithm) or many (zone_identification.algorithm).
 enum class OuterAlgorithm {
   kDefault,  // bobyqa for nlopt, lbfgs for ceres
   kBobyqa,   // nlopt: Powell's BOBYQA, quadratic models, derivative-free, bounded
@@ -294,16 +278,19 @@ enum class OuterAlgorithm {
   kSbplx,    // nlopt: Subplex (Nelder-Mead on subspaces), derivative-free, bounded
   kMma,      // nlopt: method of moving asymptotes, adjoint gradient, bounded
   kLbfgs,    // nlopt or ceres: limited-memory BFGS, adjoint gradient
+  kSlsqp,    // nlopt: sequential quadratic programming, adjoint gradient, bounded
   kBfgs,     // ceres: dense BFGS, adjoint gradient
-  kBrent,    // under nlopt: Brent's bounded 1-D minimiser (mcrewave's own), derivative-free
+  kBrent,    // under nlopt, one parameter: Brent's bounded minimiser (mcrewave's own),
+             // derivative-free
 };
-inline constexpr std::array<std::pair<OuterAlgorithm, const char*>, 8> kOuterAlgorithmNames{{
+inline constexpr std::array<std::pair<OuterAlgorithm, const char*>, 9> kOuterAlgorithmNames{{
     {OuterAlgorithm::kDefault, "default"},
     {OuterAlgorithm::kBobyqa, "bobyqa"},
     {OuterAlgorithm::kCobyla, "cobyla"},
     {OuterAlgorithm::kSbplx, "sbplx"},
     {OuterAlgorithm::kMma, "mma"},
     {OuterAlgorithm::kLbfgs, "lbfgs"},
+    {OuterAlgorithm::kSlsqp, "slsqp"},
     {OuterAlgorithm::kBfgs, "bfgs"},
     {OuterAlgorithm::kBrent, "brent"},
 }};

@@ -1,28 +1,29 @@
 // Minimisation of a function of several parameters within bounds: the outer loop of
 // the identification of zone moduli (identification/zone_identification.h;
-// docs/zones_and_sensors.md, "Optimisers").
+// docs/zones_and_sensors.md, "Optimisers"), on the one optimiser layer that Identify
+// (identification.h) uses for one parameter.
 //
-// The objective is a MultiParameterObjective, shaped like ceres::FirstOrderFunction:
-// a cost, an optional gradient, and false (never a made-up number) when the value
-// cannot be had. Back ends, all started from the same point within the same bounds:
+// The objective is a FirstOrderObjective (first_order_objective.h). Every algorithm of
+// algorithms.h but brent (Identify's alone), all started from the same point within the
+// same bounds:
 //
-//   nlopt_lbfgs   NLopt's low-storage BFGS (LD_LBFGS), with the gradient
-//   nlopt_mma     NLopt's method of moving asymptotes (LD_MMA), with the gradient
-//   nlopt_slsqp   NLopt's sequential quadratic programming (LD_SLSQP), with the gradient
-//   nlopt_bobyqa  Powell's BOBYQA (LN_BOBYQA), derivative-free: for a few parameters
-//                 only (its first model takes (n + 1)(n + 2) / 2 evaluations)
-//   ceres_lbfgs   ceres::GradientProblemSolver, L-BFGS with a Wolfe line search, on free
-//                 variables y_i with MINUIT's bound transform
-//                   x_i = lo_i + (hi_i - lo_i) (1 + sin y_i) / 2,
-//                 which reaches a bound at a finite y; a start on a bound (a stationary
-//                 point in y) is moved inside by 1e-6 of the width.
+//   nlopt  bobyqa, cobyla, sbplx without the gradient (BOBYQA's first model takes
+//          (n + 1)(n + 2) / 2 evaluations: a few parameters only; its first trust region
+//          a tenth of each width); mma, lbfgs, slsqp with it. Stops on xtol_abs (the
+//          step tolerance) and ftol_rel.
+//   ceres  ceres::GradientProblemSolver, lbfgs (rank 100) or bfgs with a Wolfe line
+//          search, on free variables y_i with MINUIT's bound transform
+//            x_i = lo_i + (hi_i - lo_i) (1 + sin y_i) / 2,
+//          which reaches a bound at a finite y; a start on a bound (a stationary point in
+//          y) is moved inside by 1e-6 of the width.
 //
-// Guards: every evaluation is counted, the evaluation and time limits are enforced
-// before each one, an exception or a false return of the objective stops the optimiser
-// with its message (NLopt force-stopped), a non-finite cost is a failure, and the best
-// point seen is reported, not the optimiser's last. NLopt's generic failure of a
-// gradient-based algorithm after progress (its line search found no decrease: the cost
-// is flat to the objective's precision) counts as convergence, as roundoff_limited does.
+// Guards (one for every optimiser, optim's guarded objective): every evaluation is
+// counted, the evaluation and time limits are enforced before each one, an exception or
+// a false return of the objective stops the optimiser with its message, a non-finite
+// cost is a failure, and the best point seen is reported, not the optimiser's last.
+// NLopt's generic failure of a gradient-based algorithm after progress (its line search
+// found no decrease: the cost is flat to the objective's precision) counts as
+// convergence, as roundoff_limited does.
 //
 // Scaling: the optimiser sees cost / |cost(start)| (the gradient likewise), the cost
 // being evaluated once at the start, since its internal tests assume a cost of order one.
@@ -33,28 +34,15 @@
 #include <vector>
 
 #include "mcrewave/core/types.h"
+#include "mcrewave/optim/first_order_objective.h"
 
 namespace mcrewave {
-
-// A cost of num_parameters() parameters, with an optional gradient.
-class MultiParameterObjective {
- public:
-  virtual ~MultiParameterObjective() = default;
-  virtual int num_parameters() const = 0;
-  // Writes the cost at x to *cost and, when gradient is not null, d cost / d x_i to
-  // gradient[i]. False when the value could not be computed (error_message() says
-  // why). May throw: MinimizeWithinBounds catches.
-  virtual bool Evaluate(const double* x, double* cost, double* gradient) = 0;
-  // Why the last failed Evaluate failed ("" when none failed).
-  virtual std::string error_message() const { return ""; }
-};
-
-bool UsesGradient(BoundedAlgorithm algorithm);
 
 // The `zone_identification:` options of the minimiser.
 struct BoundedMinimizerOptions {
   // Ceres' L-BFGS by default (docs/zones_and_sensors.md, "Measured on the paper's bar").
-  BoundedAlgorithm algorithm = BoundedAlgorithm::kCeresLbfgs;
+  OptimizerType optimizer = OptimizerType::kCeres;
+  OuterAlgorithm algorithm = OuterAlgorithm::kDefault;
   // Stop when a step changes every parameter by at most this much (absolute: on
   // p = log(E / E_scale) it is a relative change of E). NLopt xtol_abs; Ceres: the
   // same test on x in an iteration callback.
@@ -68,12 +56,14 @@ struct BoundedMinimizerOptions {
   double max_time = 600.0;
 
   // Valid when step_tolerance in (0, 0.1), function_tolerance in [0, 0.1),
-  // max_evaluations >= 2, max_time > 0. Messages name the zone_identification.* keys.
+  // max_evaluations >= 2, max_time > 0, the algorithm offered by the optimiser for
+  // many parameters. Messages name the zone_identification.* keys.
   bool IsValid(std::string* error) const;
 };
 
 struct BoundedMinimizerSummary {
-  BoundedAlgorithm algorithm = BoundedAlgorithm::kNloptLbfgs;
+  OptimizerType optimizer = OptimizerType::kCeres;
+  OuterAlgorithm algorithm = OuterAlgorithm::kLbfgs;  // as resolved
   TerminationType termination = TerminationType::kFailure;
   std::string message = "not run";
   std::string optimizer_message;  // the optimiser's own word on why it stopped
@@ -98,7 +88,7 @@ struct BoundedMinimizerSummary {
 // options.IsValid(); lower, upper, initial have num_parameters() entries, finite,
 // lower < upper.
 BoundedMinimizerSummary MinimizeWithinBounds(const BoundedMinimizerOptions& options,
-                                             MultiParameterObjective* objective,
+                                             FirstOrderObjective* objective,
                                              const std::vector<double>& lower,
                                              const std::vector<double>& upper,
                                              const std::vector<double>& initial);

@@ -34,16 +34,10 @@
 #include <vector>
 
 #include "mcrewave/core/types.h"
+#include "mcrewave/optim/algorithms.h"
 #include "mcrewave/optim/modulus_objective.h"
 
 namespace mcrewave {
-
-// True when the optimiser offers the algorithm (kDefault: always).
-bool IsAlgorithmAvailable(OptimizerType optimizer, OuterAlgorithm algorithm);
-// kDefault resolved for the optimiser; other values unchanged.
-OuterAlgorithm ResolveAlgorithm(OptimizerType optimizer, OuterAlgorithm algorithm);
-// Whether the algorithm uses the gradient (kDefault resolved first).
-bool UsesGradient(OptimizerType optimizer, OuterAlgorithm algorithm);
 
 // The `outer:` section of the config.
 struct IdentificationOptions {

@@ -13,11 +13,11 @@
 #include <string>
 
 #include "mcrewave/core/types.h"
-#include "mcrewave/optim/bounded_minimizer.h"
+#include "mcrewave/optim/first_order_objective.h"
 
 namespace mcrewave {
 
-class LogModuliObjective : public MultiParameterObjective {
+class LogModuliObjective : public FirstOrderObjective {
  public:
   // reference_moduli: E_z,ref [Pa], one per zone, positive and finite.
   explicit LogModuliObjective(Vector reference_moduli);

@@ -9,24 +9,17 @@
 #include <memory>
 #include <string>
 
+#include "mcrewave/optim/first_order_objective.h"
+
 namespace mcrewave {
 
 // A scalar objective of one parameter x = E / modulus_scale() (x of order 1).
-class ModulusObjective {
+class ModulusObjective : public FirstOrderObjective {
  public:
-  virtual ~ModulusObjective() = default;
+  int num_parameters() const final { return 1; }
 
   // E [Pa] per unit of the parameter x.
   virtual double modulus_scale() const = 0;
-
-  // Writes the cost at x = parameters[0] to *cost and, when gradient is not
-  // null, d cost / d x to gradient[0]. Returns false when the value could not be
-  // computed (error_message() then says why); *cost and *gradient are then
-  // meaningless. May throw: the optimisers of identification.h catch.
-  virtual bool Evaluate(const double* parameters, double* cost, double* gradient) = 0;
-
-  // Why the last failed Evaluate failed ("" when none failed).
-  virtual std::string error_message() const = 0;
 
   // An independent objective of the same cost (same scale, same cost scaling),
   // its inner solves run to the relative tolerance inner_tolerance, usable on

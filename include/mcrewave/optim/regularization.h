@@ -78,10 +78,10 @@ double JumpPenalty(RegularizationKind kind, double weight, double tv_smoothing, 
 
 // The data objective plus the penalty. Keeps the two parts of its last usable
 // evaluation apart.
-class RegularizedObjective : public MultiParameterObjective {
+class RegularizedObjective : public FirstOrderObjective {
  public:
   // data must outlive this objective.
-  RegularizedObjective(MultiParameterObjective* data, RegularizationKind kind, double weight,
+  RegularizedObjective(FirstOrderObjective* data, RegularizationKind kind, double weight,
                        double tv_smoothing);
   int num_parameters() const override { return data_->num_parameters(); }
   bool Evaluate(const double* x, double* cost, double* gradient) override;
@@ -94,7 +94,7 @@ class RegularizedObjective : public MultiParameterObjective {
   double last_penalty() const { return last_penalty_; }
 
  private:
-  MultiParameterObjective* data_;
+  FirstOrderObjective* data_;
   RegularizationKind kind_;
   double weight_;
   double tv_smoothing_;
@@ -159,8 +159,8 @@ struct RegularizedMinimization {
 // not kNone.
 RegularizedMinimization MinimizeRegularized(
     const BoundedMinimizerOptions& options, const RegularizationOptions& regularization,
-    MultiParameterObjective* data, const std::vector<double>& lower,
-    const std::vector<double>& upper, const std::vector<double>& initial, double target_misfit);
+    FirstOrderObjective* data, const std::vector<double>& lower, const std::vector<double>& upper,
+    const std::vector<double>& initial, double target_misfit);
 
 // Merging of neighbouring zones after the regularised minimisation, a debiasing refit
 // (docs/zones_and_sensors.md, "Merging neighbouring zones"): from the regularised
@@ -184,9 +184,8 @@ struct ZoneMerge {
 
 // Preconditions: options valid; lower, upper and x with data->num_parameters()
 // entries, lower < upper; target_misfit >= 0 (scaled like the data cost).
-ZoneMerge MergeNeighbouringZones(const BoundedMinimizerOptions& options,
-                                 MultiParameterObjective* data, const std::vector<double>& lower,
-                                 const std::vector<double>& upper, const std::vector<double>& x,
-                                 double target_misfit);
+ZoneMerge MergeNeighbouringZones(const BoundedMinimizerOptions& options, FirstOrderObjective* data,
+                                 const std::vector<double>& lower, const std::vector<double>& upper,
+                                 const std::vector<double>& x, double target_misfit);
 
 }  // namespace mcrewave

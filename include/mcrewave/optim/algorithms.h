@@ -1,0 +1,28 @@
+// Which optimiser offers which algorithm (core/types.h: OptimizerType, OuterAlgorithm),
+// for every caller of the one optimiser layer: Identify (identification.h, one
+// parameter, the `outer:` keys) and MinimizeWithinBounds (bounded_minimizer.h, any
+// number, the `zone_identification:` keys).
+//
+//   nlopt  bobyqa (the default), cobyla and sbplx without the gradient; mma, lbfgs and
+//          slsqp with it; brent (mcrewave's own Brent minimiser) for one parameter only
+//   ceres  lbfgs (the default) and bfgs, with the gradient
+#pragma once
+
+#include <string>
+
+#include "mcrewave/core/types.h"
+
+namespace mcrewave {
+
+// True when the optimiser offers the algorithm for that many parameters (kDefault:
+// always; kBrent: NLopt's list, one parameter only).
+bool IsAlgorithmAvailable(OptimizerType optimizer, OuterAlgorithm algorithm, int parameters = 1);
+// kDefault resolved for the optimiser (bobyqa for NLopt, lbfgs for Ceres); other
+// values unchanged.
+OuterAlgorithm ResolveAlgorithm(OptimizerType optimizer, OuterAlgorithm algorithm);
+// Whether the algorithm uses the gradient (kDefault resolved first).
+bool UsesGradient(OptimizerType optimizer, OuterAlgorithm algorithm);
+// "a, b or c": the algorithms the optimiser offers for that many parameters, for messages.
+std::string AvailableAlgorithms(OptimizerType optimizer, int parameters = 1);
+
+}  // namespace mcrewave

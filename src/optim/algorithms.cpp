@@ -1,0 +1,57 @@
+#include "mcrewave/optim/algorithms.h"
+
+#include <vector>
+
+#include "core/enum_names.h"
+
+namespace mcrewave {
+
+bool IsAlgorithmAvailable(OptimizerType optimizer, OuterAlgorithm algorithm, int parameters) {
+  switch (algorithm) {
+    case OuterAlgorithm::kDefault:
+    case OuterAlgorithm::kLbfgs:
+      return true;
+    case OuterAlgorithm::kBobyqa:
+    case OuterAlgorithm::kCobyla:
+    case OuterAlgorithm::kSbplx:
+    case OuterAlgorithm::kMma:
+    case OuterAlgorithm::kSlsqp:
+      return optimizer == OptimizerType::kNlopt;
+    case OuterAlgorithm::kBrent:
+      return optimizer == OptimizerType::kNlopt && parameters == 1;
+    case OuterAlgorithm::kBfgs:
+      return optimizer == OptimizerType::kCeres;
+  }
+  return false;
+}
+
+OuterAlgorithm ResolveAlgorithm(OptimizerType optimizer, OuterAlgorithm algorithm) {
+  if (algorithm != OuterAlgorithm::kDefault) return algorithm;
+  return optimizer == OptimizerType::kNlopt ? OuterAlgorithm::kBobyqa : OuterAlgorithm::kLbfgs;
+}
+
+bool UsesGradient(OptimizerType optimizer, OuterAlgorithm algorithm) {
+  switch (ResolveAlgorithm(optimizer, algorithm)) {
+    case OuterAlgorithm::kMma:
+    case OuterAlgorithm::kLbfgs:
+    case OuterAlgorithm::kSlsqp:
+    case OuterAlgorithm::kBfgs:
+      return true;
+    default:
+      return false;
+  }
+}
+
+std::string AvailableAlgorithms(OptimizerType optimizer, int parameters) {
+  std::vector<std::string> names;
+  for (const auto& [algorithm, name] : kOuterAlgorithmNames) {
+    if (IsAlgorithmAvailable(optimizer, algorithm, parameters)) names.push_back(name);
+  }
+  std::string text;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    text += (i == 0 ? "" : (i + 1 == names.size() ? " or " : ", ")) + names[i];
+  }
+  return text;
+}
+
+}  // namespace mcrewave
