@@ -362,22 +362,26 @@ int RunStudy(const StudyArguments& arguments) {
     throw mcrewave::InputError(arguments.config_path +
                                ": data.source: the studies need synthetic data, got 'csv'");
   }
-  if (config.structure.kind != mcrewave::ModelKind::kBar) {
-    throw mcrewave::InputError(arguments.config_path +
-                               ": model.kind: the studies run on the bar, got 'matrix' (the "
-                               "plate's study: scripts/plate_study.sh)");
-  }
   const mcrewave::StudyKind kind = config.study.kind;
+  if (config.structure.kind != mcrewave::ModelKind::kBar &&
+      kind != mcrewave::StudyKind::kRobustness && kind != mcrewave::StudyKind::kReadme) {
+    throw mcrewave::InputError(
+        arguments.config_path + ": study.kind '" + mcrewave::StudyKindToString(kind) +
+        "' runs on the bar only; with model.kind 'matrix' use study.kind: robustness (the "
+        "plate's own study: scripts/plate_study.sh)");
+  }
   if (mcrewave::StudySelected(kind, mcrewave::StudyKind::kDamage)) {
     mcrewave::CheckDamageStudyConfig(config, arguments.config_path);
   }
   CheckOutputFolder(config.study.folder);
   const std::string& folder = config.study.folder;
   const bool figures = config.study.figures;
+  const std::string structure = config.structure.kind == mcrewave::ModelKind::kBar
+                                    ? std::to_string(config.model.elements) + " elements"
+                                    : "matrix model " + config.structure.manifest;
   mcrewave::StudyProgressLogger()->info(
-      "config {}: {} elements, {} steps of {:.4g} s; study {} into {}", arguments.config_path,
-      config.model.elements, config.time.NumSteps(), config.time.step,
-      mcrewave::StudyKindToString(kind), folder);
+      "config {}: {}, {} steps of {:.4g} s; study {} into {}", arguments.config_path, structure,
+      config.time.NumSteps(), config.time.step, mcrewave::StudyKindToString(kind), folder);
 
   // 2. Each selected study: compute, then write its folder.
   if (mcrewave::StudySelected(kind, mcrewave::StudyKind::kRobustness)) {

@@ -252,15 +252,44 @@ TEST(MatrixIdentificationRunTest, BadInputsExitWithOneLineAndWriteNothing) {
     }
     EXPECT_FALSE(std::filesystem::exists(out)) << overrides;
   }
-  // simulate writes nothing either, and study refuses matrices.
+  // simulate writes nothing either, and study refuses every study but robustness.
   const RunResult simulate = RunIdentify("simulate " + base +
                                          " --set 'model.channel_map={uX: tip}' -o " + dir + "/x.csv");
   EXPECT_EQ(simulate.exit_code, 2) << simulate.output;
   EXPECT_FALSE(std::filesystem::exists(dir + "/x.csv"));
   const RunResult study = RunIdentify("study " + base + " -o " + dir + "/study");
   EXPECT_EQ(study.exit_code, 2) << study.output;
-  EXPECT_NE(study.output.find("model.kind: the studies run on the bar"), std::string::npos)
+  EXPECT_NE(study.output.find("study.kind 'all' runs on the bar only; with model.kind 'matrix' "
+                              "use study.kind: robustness"),
+            std::string::npos)
       << study.output;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/study"));
+}
+
+// identify study with study.kind robustness on a matrix model: its folder and the README.
+TEST(MatrixIdentificationRunTest, TheRobustnessStudyRunsOnAMatrixModel) {
+  const std::string dir = FreshDirectory("matrix_run_study");
+  WriteQuickBarMatrices(dir + "/bar_matrices");
+  const std::string config = dir + "/matrix.yaml";
+  std::ofstream(config) << "model:\n  kind: matrix\n  manifest: bar_matrices/model.yaml\n"
+                           "data:\n  truth_moduli: [200e9]\n"
+                           "time:\n  window: 0.432e-3\n  step: 1.44e-6\n"
+                           "study:\n  kind: robustness\n  robustness_snr: [.inf, 20]\n"
+                           "  robustness_seeds: 2\n  threads: 2\n";
+  const RunResult study = RunIdentify("study " + config + " -o " + dir + "/study");
+  ASSERT_EQ(study.exit_code, 0) << study.output;
+  EXPECT_NE(study.output.find("matrix model " + dir + "/bar_matrices/model.yaml"),
+            std::string::npos)
+      << study.output;
+  EXPECT_NE(study.output.find("robustness: 3 / 3 runs"), std::string::npos) << study.output;
+  const std::string runs = ReadText(dir + "/study/robustness/runs.csv");
+  // One zone: the bar's layout, one row per run.
+  EXPECT_EQ(runs.substr(0, runs.find('\n')),
+            "snr,snr_index,seed,converged,identified_modulus,relative_error,evaluations,"
+            "scan_evaluations,sweeps,local_minima");
+  EXPECT_EQ(std::count(runs.begin(), runs.end(), '\n'), 4);
+  EXPECT_NE(ReadText(dir + "/study/README.md").find("## Robustness (`robustness/`)"),
+            std::string::npos);
 }
 
 // Fields above inner.max_field_bytes are refused before the data are simulated when a

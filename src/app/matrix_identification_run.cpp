@@ -344,6 +344,7 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
   run.outer = MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper,
                                    std::vector<double>(lower.size(), 0.0));
   TakeZoneOutcome(objective, lower, upper, &run);
+  run.sweeps = objective.sweeps();
   if (run.identified_moduli.size() > 0) {
     run.cost = objective.Cost(run.identified_moduli, nullptr);
     run.model_outputs = objective.outputs();
@@ -580,9 +581,9 @@ ChannelSet MatrixMeasurementTable(const Config& config, const MatrixModelData& m
   return table;
 }
 
-MatrixIdentificationRun RunMatrixIdentification(const Config& config,
-                                                const MatrixModelData& model,
-                                                const MatrixMeasurements& measurements) {
+MatrixIdentificationRun RunMatrixIdentification(const Config& config, const MatrixModelData& model,
+                                                const MatrixMeasurements& measurements,
+                                                bool maps_and_uncertainty) {
   const auto start = std::chrono::steady_clock::now();
   MatrixIdentificationRun run;
   run.manifest = config.structure.manifest;
@@ -655,6 +656,12 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config,
   run.outer = MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper,
                                    std::vector<double>(zones, 0.0));
   TakeZoneOutcome(objective, lower, upper, &run);
+  run.sweeps = problem.sweep_count();
+  if (!maps_and_uncertainty) {
+    run.wall_time_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return run;
+  }
 
   // 3. The error maps and the model's outputs at the identified moduli, then the maps
   //    at the nominal moduli; 4. the uncertainty of the identified moduli.

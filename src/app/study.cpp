@@ -21,6 +21,7 @@
 #include "mcrewave/app/comparator_study.h"
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
+#include "mcrewave/app/matrix_identification_run.h"
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/core/format.h"
 #include "mcrewave/data/noise.h"
@@ -298,12 +299,15 @@ double Quantile(std::vector<double> values, double q) {
 // ---------------------------------------------------------------------------
 // Robustness.
 
-RobustnessStudy RunRobustnessStudy(const Config& config) {
-  const auto start = Clock::now();
-  const StudyOptions& options = config.study;
-  RobustnessStudy study;
-  study.reference_modulus = config.model.modulus;
-  study.threads = ResolveThreads(options.threads);
+namespace {
+
+// Fills one run (its seed and SNR set) from the identification on its data.
+using RobustnessIdentification = std::function<void(RobustnessRun* run)>;
+
+// The runs of every (SNR, seed) of the study's lists, each identified on one thread,
+// then the statistics of each SNR and parameter.
+void RunRobustness(const StudyOptions& options, const RobustnessIdentification& identify,
+                   RobustnessStudy* study) {
   for (int k = 0; k < static_cast<int>(options.robustness_snr.size()); ++k) {
     const double snr = options.robustness_snr[k];
     for (const std::uint64_t seed : SeedsOf(snr, options.robustness_seeds)) {
@@ -311,64 +315,138 @@ RobustnessStudy RunRobustnessStudy(const Config& config) {
       run.snr = snr;
       run.snr_index = k;
       run.seed = seed;
-      study.runs.push_back(run);
+      study->runs.push_back(run);
     }
   }
-  // The noise-free truth once; each run adds its own noise.
-  const ChannelSet truth = SimulateStudyTruth(config);
   StudyProgressLogger()->info(
       "robustness: {} identifications ({} SNRs, {} seeds per finite SNR) on {} threads",
-      study.runs.size(), options.robustness_snr.size(), options.robustness_seeds, study.threads);
-  Progress progress("robustness", static_cast<int>(study.runs.size()));
+      study->runs.size(), options.robustness_snr.size(), options.robustness_seeds, study->threads);
+  Progress progress("robustness", static_cast<int>(study->runs.size()));
+  const auto parameters = study->parameters.size();
   ParallelFor(
-      static_cast<int>(study.runs.size()), study.threads,
+      static_cast<int>(study->runs.size()), study->threads,
       [&](int i) {
-        RobustnessRun& run = study.runs[i];
-        const ChannelSet measured = NoisyMeasurements(truth, run.snr, run.seed);
-        const IdentificationRun identification =
-            IdentifyOnOneThread(config, measured, run.snr, run.seed, &run.converged, &run.message);
-        const IdentificationSummary& outer = identification.outer;
-        run.evaluations = outer.evaluations + outer.scan_evaluations;
-        run.scan_evaluations = outer.scan_evaluations;
-        run.sweeps = identification.sweeps + outer.scan_sweeps;
-        run.local_minima = outer.local_minima;
-        if (run.converged) {
-          run.identified_modulus = identification.identified_modulus();
+        RobustnessRun& run = study->runs[i];
+        identify(&run);
+        run.identified_moduli.resize(parameters, std::numeric_limits<double>::quiet_NaN());
+        run.relative_errors.assign(parameters, std::numeric_limits<double>::quiet_NaN());
+        for (std::size_t p = 0; run.converged && p < parameters; ++p) {
           // relative error = (E* - E_ref) / E_ref
-          run.relative_error =
-              (run.identified_modulus - study.reference_modulus) / study.reference_modulus;
+          run.relative_errors[p] =
+              (run.identified_moduli[p] - study->reference_moduli[p]) / study->reference_moduli[p];
         }
       },
       &progress);
 
   for (int k = 0; k < static_cast<int>(options.robustness_snr.size()); ++k) {
-    RobustnessStatistics statistics;
-    statistics.snr = options.robustness_snr[k];
-    std::vector<double> errors;
-    for (const RobustnessRun& run : study.runs) {
-      if (run.snr_index != k) continue;
-      ++statistics.runs;
-      statistics.mean_evaluations += run.evaluations;
-      statistics.mean_sweeps += static_cast<double>(run.sweeps);
-      if (run.converged) errors.push_back(run.relative_error);
+    for (std::size_t p = 0; p < parameters; ++p) {
+      RobustnessStatistics statistics;
+      statistics.snr = options.robustness_snr[k];
+      statistics.snr_index = k;
+      statistics.parameter = static_cast<int>(p);
+      std::vector<double> errors;
+      for (const RobustnessRun& run : study->runs) {
+        if (run.snr_index != k) continue;
+        ++statistics.runs;
+        statistics.mean_evaluations += run.evaluations;
+        statistics.mean_sweeps += static_cast<double>(run.sweeps);
+        if (run.converged) errors.push_back(run.relative_errors[p]);
+      }
+      statistics.converged = static_cast<int>(errors.size());
+      statistics.converged_share = static_cast<double>(errors.size()) / statistics.runs;
+      statistics.mean_evaluations /= statistics.runs;
+      statistics.mean_sweeps /= statistics.runs;
+      if (!errors.empty()) {
+        double sum = 0.0;
+        for (const double e : errors) sum += e;
+        statistics.mean_error = sum / errors.size();
+        // sample standard deviation: sqrt(sum (e - mean)^2 / (n - 1)); 0 for one run
+        double squares = 0.0;
+        for (const double e : errors)
+          squares += (e - statistics.mean_error) * (e - statistics.mean_error);
+        statistics.std_error = errors.size() > 1 ? std::sqrt(squares / (errors.size() - 1.0)) : 0.0;
+        statistics.quantile_025 = Quantile(errors, 0.025);
+        statistics.quantile_975 = Quantile(errors, 0.975);
+      }
+      study->statistics.push_back(statistics);
     }
-    statistics.converged = static_cast<int>(errors.size());
-    statistics.converged_share = static_cast<double>(errors.size()) / statistics.runs;
-    statistics.mean_evaluations /= statistics.runs;
-    statistics.mean_sweeps /= statistics.runs;
-    if (!errors.empty()) {
-      double sum = 0.0;
-      for (const double e : errors) sum += e;
-      statistics.mean_error = sum / errors.size();
-      // sample standard deviation: sqrt(sum (e - mean)^2 / (n - 1)); 0 for one run
-      double squares = 0.0;
-      for (const double e : errors)
-        squares += (e - statistics.mean_error) * (e - statistics.mean_error);
-      statistics.std_error = errors.size() > 1 ? std::sqrt(squares / (errors.size() - 1.0)) : 0.0;
-      statistics.quantile_025 = Quantile(errors, 0.025);
-      statistics.quantile_975 = Quantile(errors, 0.975);
-    }
-    study.statistics.push_back(statistics);
+  }
+}
+
+// The bar: E from the measurements of the finer truth plus each run's noise.
+void RunBarRobustness(const Config& config, RobustnessStudy* study) {
+  study->parameters = {"E"};
+  study->reference_moduli = {config.model.modulus};
+  // The noise-free truth once; each run adds its own noise.
+  const ChannelSet truth = SimulateStudyTruth(config);
+  RunRobustness(
+      config.study,
+      [&](RobustnessRun* run) {
+        const ChannelSet measured = NoisyMeasurements(truth, run->snr, run->seed);
+        const IdentificationRun identification = IdentifyOnOneThread(
+            config, measured, run->snr, run->seed, &run->converged, &run->message);
+        const IdentificationSummary& outer = identification.outer;
+        run->evaluations = outer.evaluations + outer.scan_evaluations;
+        run->scan_evaluations = outer.scan_evaluations;
+        run->sweeps = identification.sweeps + outer.scan_sweeps;
+        run->local_minima = outer.local_minima;
+        if (run->converged) run->identified_moduli = {identification.identified_modulus()};
+      },
+      study);
+}
+
+// A matrix model: every zone modulus, without the error maps and the uncertainty, from
+// the truth's outputs (data.truth_manifest at data.truth_moduli) plus each run's noise.
+void RunMatrixRobustness(const Config& config, RobustnessStudy* study) {
+  const MatrixModelData model = LoadMatrixModel(config);
+  Config noise_free = config;
+  noise_free.data.snr = std::numeric_limits<double>::infinity();
+  const MatrixMeasurements truth = LoadMatrixMeasurements(noise_free, model);
+  if (truth.truth_moduli.size() != static_cast<int>(model.zones.size())) {
+    throw InputError((config.source_path.empty() ? std::string("config") : config.source_path) +
+                     ": the robustness study needs the truth's modulus of "
+                     "every zone of " +
+                     config.structure.manifest + ", and the truth (" +
+                     (config.data.truth_manifest.empty() ? config.structure.manifest
+                                                         : config.data.truth_manifest) +
+                     ") lacks a zone of the same name");
+  }
+  for (std::size_t z = 0; z < model.zones.size(); ++z) {
+    study->parameters.push_back(model.zones[z].name);
+    study->reference_moduli.push_back(truth.truth_moduli[static_cast<int>(z)]);
+  }
+  RunRobustness(
+      config.study,
+      [&](RobustnessRun* run) {
+        Config run_config = config;
+        run_config.data.snr = run->snr;
+        run_config.data.seed = run->seed;
+        MatrixMeasurements measured = truth;
+        AddMatrixModelNoise(model, run->snr, run->seed, &measured.histories, &measured.noise);
+        const MatrixIdentificationRun identification =
+            RunMatrixIdentification(run_config, model, measured, /*maps_and_uncertainty=*/false);
+        run->converged = identification.IsUsable();
+        run->message = identification.failure;
+        run->evaluations = identification.outer.evaluations;
+        run->sweeps = identification.sweeps;
+        if (run->converged) {
+          const Vector& moduli = identification.identified_moduli;
+          run->identified_moduli.assign(moduli.data(), moduli.data() + moduli.size());
+        }
+      },
+      study);
+}
+
+}  // namespace
+
+RobustnessStudy RunRobustnessStudy(const Config& config) {
+  const auto start = Clock::now();
+  RobustnessStudy study;
+  study.threads = ResolveThreads(config.study.threads);
+  if (config.structure.kind == ModelKind::kMatrix) {
+    RunMatrixRobustness(config, &study);
+  } else {
+    RunBarRobustness(config, &study);
   }
   study.wall_time_s = SecondsSince(start);
   return study;
@@ -376,29 +454,47 @@ RobustnessStudy RunRobustnessStudy(const Config& config) {
 
 namespace {
 
+// With more than one parameter, every row of the runs and statistics names its
+// parameter in a zone_index and a zone column (after snr_index and seed).
+bool ManyParameters(const RobustnessStudy& study) { return study.parameters.size() > 1; }
+
+// "a, b, c": the parameters' names.
+std::string ZoneList(const RobustnessStudy& study) {
+  std::string list;
+  for (const std::string& name : study.parameters) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
 std::string RobustnessRunsCsv(const RobustnessStudy& study) {
+  const bool many = ManyParameters(study);
   std::ostringstream csv;
-  csv << "snr,snr_index,seed,converged,identified_modulus,relative_error,evaluations,"
-         "scan_evaluations,sweeps,local_minima\n";
+  csv << "snr,snr_index,seed,converged," << (many ? "zone_index,zone," : "")
+      << "identified_modulus,relative_error,evaluations,scan_evaluations,sweeps,local_minima\n";
   for (const RobustnessRun& run : study.runs) {
-    csv << Csv(run.snr) << "," << run.snr_index << "," << run.seed << "," << (run.converged ? 1 : 0)
-        << "," << Csv(run.identified_modulus) << "," << Csv(run.relative_error) << ","
-        << run.evaluations << "," << run.scan_evaluations << "," << run.sweeps << ","
-        << run.local_minima << "\n";
+    for (std::size_t p = 0; p < study.parameters.size(); ++p) {
+      csv << Csv(run.snr) << "," << run.snr_index << "," << run.seed << ","
+          << (run.converged ? 1 : 0) << ",";
+      if (many) csv << p << "," << study.parameters[p] << ",";
+      csv << Csv(run.identified_moduli[p]) << "," << Csv(run.relative_errors[p]) << ","
+          << run.evaluations << "," << run.scan_evaluations << "," << run.sweeps << ","
+          << run.local_minima << "\n";
+    }
   }
   return csv.str();
 }
 
 std::string RobustnessStatisticsCsv(const RobustnessStudy& study) {
+  const bool many = ManyParameters(study);
   std::ostringstream csv;
-  csv << "snr,snr_index,runs,converged_share,mean_error,std_error,q2.5_error,q97.5_error,"
+  csv << "snr,snr_index," << (many ? "zone_index,zone," : "")
+      << "runs,converged_share,mean_error,std_error,q2.5_error,q97.5_error,"
          "mean_evaluations,mean_sweeps\n";
-  for (std::size_t k = 0; k < study.statistics.size(); ++k) {
-    const RobustnessStatistics& s = study.statistics[k];
-    csv << Csv(s.snr) << "," << k << "," << s.runs << "," << Csv(s.converged_share) << ","
-        << Csv(s.mean_error) << "," << Csv(s.std_error) << "," << Csv(s.quantile_025) << ","
-        << Csv(s.quantile_975) << "," << Csv(s.mean_evaluations) << "," << Csv(s.mean_sweeps)
-        << "\n";
+  for (const RobustnessStatistics& s : study.statistics) {
+    csv << Csv(s.snr) << "," << s.snr_index << ",";
+    if (many) csv << s.parameter << "," << study.parameters[s.parameter] << ",";
+    csv << s.runs << "," << Csv(s.converged_share) << "," << Csv(s.mean_error) << ","
+        << Csv(s.std_error) << "," << Csv(s.quantile_025) << "," << Csv(s.quantile_975) << ","
+        << Csv(s.mean_evaluations) << "," << Csv(s.mean_sweeps) << "\n";
   }
   return csv.str();
 }
@@ -406,62 +502,118 @@ std::string RobustnessStatisticsCsv(const RobustnessStudy& study) {
 std::string RobustnessScript(const RobustnessStudy& study, const std::string& folder) {
   const std::string runs = GnuplotString(folder + "/runs.csv");
   const std::string statistics = GnuplotString(folder + "/statistics.csv");
+  const int zones = static_cast<int>(study.parameters.size());
+  const int snrs = static_cast<int>(study.statistics.size()) / zones;
   std::ostringstream script;
-  script << GnuplotPngTerminal()
-         << "set title 'Relative error of the identified E against SNR (data from the finer "
-            "truth)'\n"
-         << "set xlabel 'SNR'\nset ylabel '(E^* - E_{ref}) / E_{ref} [%]'\n"
-         << "set xrange [-0.5:" << study.statistics.size() - 0.5 << "]\n"
+  script << GnuplotPngTerminal();
+  if (!ManyParameters(study)) {
+    script << "set title 'Relative error of the identified E against SNR (data from the finer "
+              "truth)'\n";
+  } else {
+    script << "set title 'Relative error of each zone modulus against SNR (each run a dot)'\n";
+  }
+  script << "set xlabel 'SNR'\nset ylabel '(E^* - E_{ref}) / E_{ref} [%]'\n"
+         << "set xrange [-0.5:" << snrs - 0.5 << "]\n"
          << "set key top left\n"
          // every run, spread sideways by its seed (golden-ratio jitter in [-0.2, 0.2])
-         << "jitter(s) = 0.4 * (s * 0.6180339887 - floor(s * 0.6180339887) - 0.5)\n"
-         << "plot " << runs
-         << " skip 1 using ($2 + jitter($3)):($4 > 0 ? 100 * $6 : 1/0) with points pt 7 ps 0.6 "
-            "lc rgb '#7f9fcf' title 'each run', "
-         << statistics
-         << " skip 1 using 2:(100 * $5):(100 * $7):(100 * $8):xtic(1) with yerrorbars pt 5 ps 1.2 "
-            "lw 2 lc rgb '#d62728' title 'mean and 2.5-97.5 % quantiles'\n";
+         << "jitter(s) = 0.4 * (s * 0.6180339887 - floor(s * 0.6180339887) - 0.5)\n";
+  if (!ManyParameters(study)) {
+    script << "plot " << runs
+           << " skip 1 using ($2 + jitter($3)):($4 > 0 ? 100 * $6 : 1/0) with points pt 7 ps 0.6 "
+              "lc rgb '#7f9fcf' title 'each run', "
+           << statistics
+           << " skip 1 using 2:(100 * $5):(100 * $7):(100 * $8):xtic(1) with yerrorbars pt 5 ps "
+              "1.2 lw 2 lc rgb '#d62728' title 'mean and 2.5-97.5 % quantiles'\n";
+    return script.str();
+  }
+  // Zone z of Z shifted sideways by 0.6 (z - (Z - 1) / 2) / Z, in a colour of its own;
+  // runs.csv and statistics.csv carry zone_index and zone after seed / snr_index.
+  script << "set key below\noffset(z) = 0.6 * (z - " << zones - 1 << " / 2.0) / " << zones << "\n"
+         << "set xtics (";
+  for (int k = 0; k < snrs; ++k) {
+    script << (k == 0 ? "" : ", ") << "'" << SnrText(study.statistics[k * zones].snr) << "' " << k;
+  }
+  script << ")\nplot ";
+  for (int z = 0; z < zones; ++z) {
+    script << (z == 0 ? "" : ", ") << runs << " skip 1 using ($5 == " << z << " ? $2 + offset(" << z
+           << ") + jitter($3) / " << zones << " : 1/0):($4 > 0 ? 100 * $8 : 1/0) with points "
+           << "pt 7 ps 0.5 lc rgb '" << Colour(z) << "' notitle, " << statistics
+           << " skip 1 using ($3 == " << z << " ? $2 + offset(" << z
+           << ") : 1/0):(100 * $7):(100 * $9):(100 * $10) with yerrorbars pt 5 ps 1.2 lw 2 lc rgb '"
+           << Colour(z) << "' title " << GnuplotString(study.parameters[z] + ": mean, 2.5-97.5 %");
+  }
+  script << "\n";
   return script.str();
 }
 
-std::string RobustnessSummary(const RobustnessStudy& study) {
+// The summary's table: one row per SNR (and zone, with zones).
+std::string RobustnessTable(const RobustnessStudy& study) {
+  const bool many = ManyParameters(study);
   std::ostringstream md;
-  md << "## Robustness (`robustness/`)\n\n"
-     << "`robustness.png`: the relative error (E* - E_ref) / E_ref of the identified modulus "
-        "against the SNR, every run as a point and, per SNR, the mean with the 2.5-97.5 % "
-        "quantile band of the converged runs. Each run is the identification of `identify run` "
-        "(pre-filter, global scan, local refinement) on data from the finer truth plus white "
-        "noise of one seed; at SNR inf there is one run (no noise), whose error is the "
-        "discretisation bias only (model against the finer truth). `runs.csv`: one row per "
-        "identification; `statistics.csv`: one row per SNR. E_ref = "
-     << Brief(study.reference_modulus / 1e9, 6) << " GPa.\n\n"
-     << "| SNR | runs | converged | mean error | std | 2.5 % | 97.5 % | evaluations | sweeps |\n"
-     << "|---|---|---|---|---|---|---|---|---|\n";
+  md << "| SNR | " << (many ? "zone | " : "")
+     << "runs | converged | mean error | std | 2.5 % | 97.5 % | evaluations | sweeps |\n"
+     << "|---|" << (many ? "---|" : "") << "---|---|---|---|---|---|---|---|\n";
   for (const RobustnessStatistics& s : study.statistics) {
-    md << "| " << SnrText(s.snr) << " | " << s.runs << " | " << Brief(100.0 * s.converged_share, 4)
-       << " % | " << Percent(s.mean_error) << " | " << Brief(100.0 * s.std_error, 3) << " % | "
-       << Percent(s.quantile_025) << " | " << Percent(s.quantile_975) << " | "
-       << Brief(s.mean_evaluations, 4) << " | " << Brief(s.mean_sweeps, 5) << " |\n";
+    md << "| " << SnrText(s.snr) << " | ";
+    if (many) md << study.parameters[s.parameter] << " | ";
+    md << s.runs << " | " << Brief(100.0 * s.converged_share, 4) << " % | " << Percent(s.mean_error)
+       << " | " << Brief(100.0 * s.std_error, 3) << " % | " << Percent(s.quantile_025) << " | "
+       << Percent(s.quantile_975) << " | " << Brief(s.mean_evaluations, 4) << " | "
+       << Brief(s.mean_sweeps, 5) << " |\n";
   }
+  return md.str();
+}
+
+std::string RobustnessSummary(const RobustnessStudy& study) {
+  const bool many = ManyParameters(study);
+  std::ostringstream md;
+  md << "## Robustness (`robustness/`)\n\n";
+  if (!many) {
+    md << "`robustness.png`: the relative error (E* - E_ref) / E_ref of the identified modulus "
+          "against the SNR, every run as a point and, per SNR, the mean with the 2.5-97.5 % "
+          "quantile band of the converged runs. Each run is the identification of `identify "
+          "run` (pre-filter, global scan, local refinement) on data from the finer truth plus "
+          "white noise of one seed; at SNR inf there is one run (no noise), whose error is the "
+          "discretisation bias only (model against the finer truth). `runs.csv`: one row per "
+          "identification; `statistics.csv`: one row per SNR. E_ref = "
+       << Brief(study.reference_moduli[0] / 1e9, 6) << " GPa.\n\n";
+  } else {
+    md << "`robustness.png`: the relative error (E* - E_ref) / E_ref of each zone modulus "
+          "against the SNR, every run as a point and, per SNR and zone, the mean with the "
+          "2.5-97.5 % quantile band of the converged runs (zones left to right: "
+       << ZoneList(study)
+       << "). Each run is the identification of `identify run` on the matrix model (pre-filter, "
+          "every zone at once from the nominal moduli; no error map or uncertainty) on data of "
+          "the truth plus white noise of one seed; at SNR inf there is one run (no noise), "
+          "whose error is the model's bias against the truth. `runs.csv`: one row per "
+          "identification and zone; `statistics.csv`: one row per SNR and zone. E_ref:";
+    for (std::size_t p = 0; p < study.parameters.size(); ++p) {
+      md << (p == 0 ? " " : ", ") << study.parameters[p] << " "
+         << Brief(study.reference_moduli[p] / 1e9, 6) << " GPa";
+    }
+    md << ".\n\n";
+  }
+  md << RobustnessTable(study);
   md << "\nEvaluations: outer evaluations of the functionals scanned and refined (the "
         "search functional's and e^2's, the scans' included), means over all runs; "
         "sweeps: inner sweeps of those evaluations.\n\n";
   for (const RobustnessStatistics& s : study.statistics) {
     if (std::isinf(s.snr)) {
-      md << "- SNR inf: error " << Percent(s.mean_error)
-         << ", the discretisation bias (no noise).\n";
+      md << "- SNR inf" << (many ? ", " + study.parameters[s.parameter] : std::string())
+         << ": error " << Percent(s.mean_error) << ", the "
+         << (many ? "model's bias" : "discretisation bias") << " (no noise).\n";
     }
   }
   // The lowest finite SNR: the paper's claim.
-  const RobustnessStatistics* lowest = nullptr;
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const RobustnessStatistics& s : study.statistics) lowest = std::min(lowest, s.snr);
   for (const RobustnessStatistics& s : study.statistics) {
-    if (std::isfinite(s.snr) && (lowest == nullptr || s.snr < lowest->snr)) lowest = &s;
-  }
-  if (lowest != nullptr) {
-    md << "- SNR " << SnrText(lowest->snr) << ": " << lowest->converged << " of " << lowest->runs
-       << " runs converged; mean error " << Percent(lowest->mean_error) << ", 95 % of the runs "
-       << "within [" << Percent(lowest->quantile_025) << ", " << Percent(lowest->quantile_975)
-       << "].\n";
+    if (std::isinf(s.snr) || s.snr != lowest) continue;
+    md << "- SNR " << SnrText(s.snr)
+       << (many ? ", " + study.parameters[s.parameter] : std::string()) << ": " << s.converged
+       << " of " << s.runs << " runs converged; mean error " << Percent(s.mean_error)
+       << ", 95 % of the runs within [" << Percent(s.quantile_025) << ", "
+       << Percent(s.quantile_975) << "].\n";
   }
   md << "- " << study.runs.size() << " identifications in " << Duration(study.wall_time_s) << " on "
      << study.threads << " threads.\n\n";

@@ -157,6 +157,7 @@ struct MatrixIdentificationRun {
   Vector truth_moduli;                   // [Pa]; empty when unknown
   BoundedMinimizerSummary outer;
   std::vector<MatrixEvaluation> evaluations;
+  long sweeps = 0;            // inner sweeps of the identification (the maps' excluded)
   double rest_cost = 0.0;     // J_rest [J s] (least squares: [s])
   double nominal_cost = 0.0;  // e^2 at the nominal moduli [J s] (J [s])
   double cost = 0.0;          // e^2 at the identified moduli [J s] (J [s])
@@ -178,10 +179,12 @@ struct MatrixIdentificationRun {
   bool IsUsable() const { return failure.empty(); }
 };
 
-// Step 3 above. Never throws for the optimiser or the inner solver: their failures
-// are in run.failure (and run.outer). Progress: one info line per evaluation.
-MatrixIdentificationRun RunMatrixIdentification(const Config& config,
-                                                const MatrixModelData& model,
-                                                const MatrixMeasurements& measurements);
+// Step 3 above; without maps_and_uncertainty, the moduli alone (no error map, model
+// outputs or uncertainty: what a study needs of each run). Never throws for the
+// optimiser or the inner solver: their failures are in run.failure (and run.outer).
+// Progress: one info line per evaluation.
+MatrixIdentificationRun RunMatrixIdentification(const Config& config, const MatrixModelData& model,
+                                                const MatrixMeasurements& measurements,
+                                                bool maps_and_uncertainty = true);
 
 }  // namespace mcrewave

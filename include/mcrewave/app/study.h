@@ -2,10 +2,12 @@
 // section of a config (README, "Studies"), each into a folder of its own:
 //
 //   robustness   for every SNR of robustness_snr and noise seeds 1..robustness_seeds
-//                (one run at SNR inf), the identification of `identify run`
-//                (identification_run.h) on data from the finer truth of `data:`; per
-//                SNR the statistics of the relative error of E, the converged share,
-//                mean outer evaluations and inner sweeps.
+//                (one run at SNR inf), the identification of `identify run` on data
+//                from the truth of `data:` (the bar: identification_run.h, E against
+//                E_ref = model.modulus; a matrix model: matrix_identification_run.h
+//                without its error maps and uncertainty, every zone modulus against the
+//                truth's); per SNR and parameter the statistics of the relative error,
+//                the converged share, mean outer evaluations and inner sweeps.
 //   relaxation   for every SNR of relaxation_snr (noise seed data.seed) and E = f E_ref,
 //                f in relaxation_moduli: the sweeps of the fixed-omega relaxation to
 //                relaxation_tolerance on a grid of omega (the paper's Fig. 3) beside what
@@ -20,7 +22,10 @@
 //
 // E_ref is model.modulus. Every study uses the config's model, load, time grid, data
 // truth, weights, inner solver, pre-filter and outer loop; the measurements of one
-// (SNR, seed) are the truth plus AddMeasurementNoise(snr, seed), then the pre-filter.
+// (SNR, seed) are the truth plus AddMeasurementNoise(snr, seed) (a matrix model:
+// AddMatrixModelNoise), then the pre-filter: the data of `identify run` with data.snr
+// and data.seed set to them. The robustness study runs on both model kinds, the others
+// on the bar.
 // Runs are spread over `threads` threads (0: every core), each run on one thread, and
 // stored by index: the numbers do not depend on the number of threads. Progress lines
 // go to StudyProgressLogger().
@@ -106,11 +111,13 @@ struct RobustnessRun {
   double snr = 0.0;
   int snr_index = 0;       // position of snr in robustness_snr
   std::uint64_t seed = 0;  // noise seed (0 at SNR inf: no noise drawn)
-  // The outer loop converged and E* lies strictly inside the bounds.
+  // The outer loop converged and every modulus lies strictly inside the bounds.
   bool converged = false;
   std::string message;  // why not, when not converged
-  double identified_modulus = std::numeric_limits<double>::quiet_NaN();  // [Pa]
-  double relative_error = std::numeric_limits<double>::quiet_NaN();      // (E* - E_ref) / E_ref
+  // One per parameter of the study (RobustnessStudy::parameters), NaN when not converged:
+  // the identified modulus E* [Pa] and its relative error (E* - E_ref) / E_ref.
+  std::vector<double> identified_moduli;
+  std::vector<double> relative_errors;
   int evaluations = 0;       // outer evaluations, scan included
   int scan_evaluations = 0;  // of which in the global scan
   long sweeps = 0;           // inner sweeps of the scan and the local refinements
@@ -119,10 +126,12 @@ struct RobustnessRun {
 
 struct RobustnessStatistics {
   double snr = 0.0;
+  int snr_index = 0;  // position of snr in robustness_snr
+  int parameter = 0;  // its index in RobustnessStudy::parameters
   int runs = 0;
   int converged = 0;
   double converged_share = 0.0;
-  // Over the converged runs (NaN when none): relative error of E.
+  // Over the converged runs (NaN when none): relative error of the parameter.
   double mean_error = std::numeric_limits<double>::quiet_NaN();
   double std_error = std::numeric_limits<double>::quiet_NaN();  // sample std (0 for one run)
   double quantile_025 = std::numeric_limits<double>::quiet_NaN();
@@ -132,13 +141,20 @@ struct RobustnessStatistics {
 };
 
 struct RobustnessStudy {
-  double reference_modulus = 0.0;                // E_ref [Pa]
-  std::vector<RobustnessRun> runs;               // SNR by SNR, seeds ascending
-  std::vector<RobustnessStatistics> statistics;  // one per SNR, in robustness_snr order
+  // The moduli identified, by name (the bar: "E"; a matrix model: its zones), and the
+  // reference of each, E_ref [Pa] (the bar: model.modulus; a matrix model: the truth's
+  // modulus of the zone).
+  std::vector<std::string> parameters;
+  std::vector<double> reference_moduli;
+  std::vector<RobustnessRun> runs;  // SNR by SNR, seeds ascending
+  // One per SNR and parameter: SNR by SNR in robustness_snr order, the parameters in
+  // order within each.
+  std::vector<RobustnessStatistics> statistics;
   int threads = 0;
   double wall_time_s = 0.0;
 };
 
+// Throws InputError when a matrix model's truth lacks one of its zones (no reference).
 // Precondition: config valid (as LoadConfig returns it), synthetic data.
 RobustnessStudy RunRobustnessStudy(const Config& config);
 
@@ -231,7 +247,8 @@ CostCurveStudy RunCostCurveStudy(const Config& config);
 //
 //   robustness/   runs.csv (one row per identification), statistics.csv (one
 //                 per SNR), robustness.png (mean and 95 % band of the error per
-//                 SNR, every run as a point)
+//                 SNR, every run as a point); with more than one parameter, a row per
+//                 parameter of each, named in a zone_index and a zone column
 //   relaxation/   cases.csv (spectrum, omegas, reference sweeps per case),
 //                 sweeps.csv (the omega grid), residuals.csv (the histories),
 //                 sweeps_vs_omega.png, residuals.png
