@@ -279,6 +279,52 @@ TEST(MatrixOutputErrorObjectiveTest, WithoutInertiaCouplingTheReactionIsTheTrust
   EXPECT_LE((objective.support_forces() - forces).norm(), 1e-14 * forces.norm());
 }
 
+// MatrixLeastSquaresMisfitLevels with a support (the lattice: load F, sensors u_tip,
+// u_mid (displacement), e_top (strain), support force R and displacement uR): s_f from
+// the load's synthetic noise, from the differences of F and R, or from F's RMS on
+// noise-free data; s_u's differences take uR in; without the support s_f is 0.
+TEST(MatrixOutputErrorObjectiveTest, TheMisfitLevelsOfASupportedModelGiveTheForceLevel) {
+  const MatrixModelData model = testing::SupportedLattice();
+  const ChannelSet data = testing::SupportedLatticeHistories(model);
+  MatrixMeasurements measurements;
+  measurements.histories = data;
+  Config config;
+  config.data.source = DataSource::kSynthetic;
+  config.data.snr = 20.0;
+  measurements.noise.displacement_std = 1e-3;
+  measurements.noise.strain_std = 2e-3;
+  measurements.noise.force_std = 3.0;
+  std::string source;
+  NoiseLevels levels = MatrixLeastSquaresMisfitLevels(config, model, measurements, data, &source);
+  EXPECT_EQ(source, "synthetic_snr");
+  EXPECT_EQ(levels.force_std, 3.0);
+  EXPECT_EQ(levels.displacement_std, 1e-3);
+  MatrixModelData unsupported = model;
+  unsupported.supports.clear();
+  EXPECT_EQ(
+      MatrixLeastSquaresMisfitLevels(config, unsupported, measurements, data, &source).force_std,
+      0.0);
+  // CSV data: s^2 of the second differences averaged per kind, over F and R for s_f and
+  // with uR among the displacements.
+  config.data.source = DataSource::kCsv;
+  levels = MatrixLeastSquaresMisfitLevels(config, model, measurements, data, &source);
+  EXPECT_EQ(source, "data_differences");
+  auto variance = [&](const char* channel) {
+    return std::pow(DifferenceNoiseStd(data.Values(channel)), 2);
+  };
+  EXPECT_EQ(levels.force_std, std::sqrt((variance("F") + variance("R")) / 2));
+  EXPECT_EQ(levels.displacement_std,
+            std::sqrt((variance("u_tip") + variance("u_mid") + variance("uR")) / 3));
+  EXPECT_EQ(levels.strain_std, std::sqrt(variance("e_top") / 1));
+  // Noise-free data (a level 0): the RMS of the load F for s_f.
+  ChannelSet quiet = data;
+  for (Channel& channel : quiet.channels) channel.values.setZero();
+  measurements.histories = quiet;
+  levels = MatrixLeastSquaresMisfitLevels(config, model, measurements, data, &source);
+  EXPECT_EQ(source, "channel_rms");
+  EXPECT_EQ(levels.force_std, std::sqrt(data.Values("F").squaredNorm() / data.num_samples() / 1));
+}
+
 TEST(MatrixOutputErrorObjectiveTest, EveryZoneGradientOfThePlateMatchesACentralDifference) {
   const MatrixModelData coarse = ReadMatrixModel(kLsPlate + "coarse/model_axial.yaml");
   const MatrixModelData fine = ReadMatrixModel(kLsPlate + "fine/model_axial.yaml");
