@@ -570,6 +570,34 @@ TEST(MatrixOutputErrorAllocationTest, TheTimeLoopAllocatesNothing) {
   EXPECT_EQ(calls[0].deallocations, calls[1].deallocations);
 }
 
+// The same with a support (the supported lattice: its reaction an output, the held
+// dofs decoupled): the same heap calls for 20 and 80 steps.
+TEST(MatrixOutputErrorAllocationTest, WithASupportTheTimeLoopAllocatesNothing) {
+  SKIP_WITHOUT_ALLOCATION_COUNTING();
+  const MatrixModelData lattice = testing::SupportedLattice();
+  HeapCalls calls[2];
+  for (int i = 0; i < 2; ++i) {
+    const int samples = 1 + 20 * (1 + 3 * i);
+    Matrix loads = Matrix::Zero(1, samples);
+    loads(0, 3) = 1e3;
+    ChannelSet data =
+        MatrixChannelSet(lattice, 2e-3, loads,
+                         Matrix::Constant(static_cast<int>(lattice.sensors.size()), samples, 1e-7));
+    data.Add("R", ChannelKind::kForce, Vector::Constant(samples, 1.0));
+    NoiseLevels levels;
+    levels.displacement_std = 1e-7;
+    levels.strain_std = 1e-7;
+    levels.force_std = 1.0;
+    MatrixOutputErrorObjective objective(lattice, data, levels, 0.5);
+    const Vector moduli = (Vector(2) << 1.9e11, 1.5e11).finished();
+    Vector gradient(2);
+    objective.Cost(moduli, &gradient);
+    calls[i] = CountHeapCalls([&] { objective.Cost(moduli, &gradient); });
+  }
+  EXPECT_EQ(calls[0].allocations, calls[1].allocations);
+  EXPECT_EQ(calls[0].deallocations, calls[1].deallocations);
+}
+
 // The heap calls of parsing `text` as a Matrix Market matrix (InputError or not).
 HeapCalls MatrixMarketHeapCalls(const std::string& text) {
   std::istringstream stream(text);

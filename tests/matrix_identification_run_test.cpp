@@ -152,6 +152,51 @@ TEST(MatrixIdentificationRunTest, TheBarWithItsClampAsASupportIdentifiesTheBuilt
             bar_cutoff);
 }
 
+// The same manifest by least squares (outer.functional: least_squares): the support
+// held, its force f0 an output weighted by 1 / s_f^2, as the built-in bar's least
+// squares holds its clamp and compares f0; both identify the same modulus from the CSV.
+TEST(MatrixIdentificationRunTest,
+     TheBarWithItsClampAsASupportIdentifiesTheBarsLeastSquaresModulus) {
+  const std::string dir = FreshDirectory("matrix_run_support_ls");
+  const std::string quick = SourcePath("configs/quick.yaml");
+  ASSERT_EQ(RunIdentify("simulate " + quick + " -q -o " + dir + "/data.csv").exit_code, 0);
+  const Config config = LoadConfig(quick);
+  std::filesystem::create_directories(dir + "/support");
+  const std::string manifest =
+      WriteMatrixModel(dir + "/support",
+                       BarMatrixModel(BarModel(config.model), 160e9, {}, BarClampExport::kSupport));
+  const std::string data = " --set data.source=csv --set data.path=" + dir +
+                           "/data.csv --set prefilter.enabled=false" +
+                           " --set outer.functional=least_squares";
+  const RunResult bar = RunIdentify("run " + quick + data + " -q -o " + dir + "/bar");
+  ASSERT_EQ(bar.exit_code, 0) << bar.output;
+  // quick.yaml's mcre.clamp (measured) is ignored by both: least squares holds the clamp.
+  const RunResult matrices = RunIdentify(
+      "run " + quick + data + " --set model.kind=matrix --set model.manifest=" + manifest +
+      " --set search.functional=pinned -q -o " + dir + "/matrices");
+  ASSERT_EQ(matrices.exit_code, 0) << matrices.output;
+  const YAML::Node bar_summary = YAML::LoadFile(dir + "/bar/summary.yaml");
+  const double bar_modulus = bar_summary["identified_modulus"].as<double>();
+  const double matrix_modulus = ZoneModulus(dir + "/matrices/zones.csv", 0);
+  // The same J(E) (matrix_output_error_objective_test.cpp: to 1e-13), different
+  // optimisers (the bar's scan and BOBYQA to relative_tolerance 1e-7, NLopt L-BFGS on
+  // log E to 1e-8): measured 2.0e-9 apart, relative.
+  EXPECT_NEAR(matrix_modulus / bar_modulus - 1.0, 0.0, 1e-8)
+      << std::setprecision(17) << "bar " << bar_modulus << " Pa, matrices " << matrix_modulus
+      << " Pa";
+  const YAML::Node summary = YAML::LoadFile(dir + "/matrices/summary.yaml");
+  EXPECT_EQ(summary["functional"].as<std::string>(), "least_squares");
+  EXPECT_EQ(summary["model"]["supports"].as<int>(), 1);
+  EXPECT_EQ(summary["misfit_levels"]["source"].as<std::string>(), "data_differences");
+  // The levels of the bar's DifferenceNoiseLevels: s_u over u0 and uL, s_f over f0 and fL.
+  const YAML::Node bar_levels = bar_summary["uncertainty"];
+  EXPECT_EQ(summary["misfit_levels"]["displacement"].as<double>(),
+            bar_levels["noise_std_displacement"].as<double>());
+  EXPECT_EQ(summary["misfit_levels"]["force"].as<double>(),
+            bar_levels["noise_std_force"].as<double>());
+  EXPECT_LT(summary["cost"].as<double>(), summary["nominal_cost"].as<double>());
+}
+
 TEST(MatrixIdentificationRunTest, ASimulatedCsvReadBackGivesTheSyntheticRunsModuli) {
   const std::string dir = FreshDirectory("matrix_run_simulate");
   const std::string manifest = WriteQuickBarMatrices(dir + "/bar_matrices");

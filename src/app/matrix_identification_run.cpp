@@ -341,6 +341,13 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
       run.manifest, run.dofs, lower.size(), model.loads.size(), model.sensors.size(), run.steps,
       run.time_step, run.misfit_levels.displacement_std, run.misfit_levels.strain_std,
       run.misfit_source);
+  if (!model.supports.empty()) {
+    // The bar's least squares keeps its clamp rigid whatever mcre.clamp says.
+    spdlog::info(
+        "{} supports held (least squares ignores mcre.clamp: {}), their forces outputs of "
+        "misfit level {:.4g} N",
+        model.supports.size(), ClampModelToString(config.mcre.clamp), run.misfit_levels.force_std);
+  }
   run.outer = MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper,
                                    std::vector<double>(lower.size(), 0.0));
   TakeZoneOutcome(objective, lower, upper, &run);
@@ -531,36 +538,64 @@ NoiseLevels MatrixLeastSquaresMisfitLevels(const Config& config, const MatrixMod
                                            const MatrixMeasurements& measurements,
                                            const ChannelSet& used, std::string* source) {
   NoiseLevels levels;
+  const bool supports = !model.supports.empty();
   if (config.data.source == DataSource::kSynthetic && std::isfinite(config.data.snr)) {
-    // std = RMS(signal) / SNR of the sensors of each kind (AddMatrixModelNoise)
+    // std = RMS(signal) / SNR of the sensors of each kind, of the loads for the forces
+    // (AddMatrixModelNoise)
     levels = measurements.noise;
     *source = "synthetic_snr";
   } else {
-    // s^2 averaged over the sensors of each kind (DifferenceNoiseStd)
-    double sums[2] = {0.0, 0.0};
-    int counts[2] = {0, 0};
-    for (const MatrixModelSensor& sensor : model.sensors) {
-      const int kind = sensor.kind == SensorKind::kStrain ? 1 : 0;
-      sums[kind] += std::pow(DifferenceNoiseStd(measurements.histories.Values(sensor.channel)), 2);
+    // s^2 averaged over the channels of each kind (DifferenceNoiseStd): the sensors', and
+    // with supports the loads' and supports' forces and the supports' displacements (the
+    // bar's f0, fL and u0 with uL and its sensors: DifferenceNoiseLevels).
+    double sums[3] = {0.0, 0.0, 0.0};
+    int counts[3] = {0, 0, 0};
+    auto add = [&](int kind, const std::string& channel) {
+      sums[kind] += std::pow(DifferenceNoiseStd(measurements.histories.Values(channel)), 2);
       ++counts[kind];
+    };
+    for (const MatrixModelSensor& sensor : model.sensors) {
+      add(sensor.kind == SensorKind::kStrain ? 1 : 0, sensor.channel);
+    }
+    if (supports) {
+      for (const MatrixModelLoad& load : model.loads) add(2, load.channel);
+      for (const MatrixModelSupport& support : model.supports) {
+        add(2, support.force_channel);
+        if (!support.displacement_channel.empty()) add(0, support.displacement_channel);
+      }
     }
     if (counts[0] > 0) levels.displacement_std = std::sqrt(sums[0] / counts[0]);
     if (counts[1] > 0) levels.strain_std = std::sqrt(sums[1] / counts[1]);
+    if (counts[2] > 0) levels.force_std = std::sqrt(sums[2] / counts[2]);
     *source = "data_differences";
   }
-  levels.force_std = 0.0;
+  // s_f weighs the supports' forces only (the loads are inputs).
+  if (!supports) levels.force_std = 0.0;
   // Noise-free data have no level to normalise by: the RMS of the kind's channels in use
-  // instead (only the ratio of the weights matters then).
-  for (const bool strain : {false, true}) {
-    double& level = strain ? levels.strain_std : levels.displacement_std;
-    double sum = 0.0;
-    int count = 0;
-    for (const MatrixModelSensor& sensor : model.sensors) {
-      if ((sensor.kind == SensorKind::kStrain) != strain) continue;
-      sum += used.Values(sensor.channel).squaredNorm() / used.num_samples();
-      ++count;
+  // instead (only the ratio of the weights matters then); for the forces the loads' (the
+  // bar's fL), or the supports' without a load.
+  for (const int kind : {0, 1, 2}) {
+    double& level = kind == 2   ? levels.force_std
+                    : kind == 1 ? levels.strain_std
+                                : levels.displacement_std;
+    std::vector<std::string> channels;
+    if (kind < 2) {
+      for (const MatrixModelSensor& sensor : model.sensors) {
+        if ((sensor.kind == SensorKind::kStrain) == (kind == 1)) channels.push_back(sensor.channel);
+      }
+    } else if (supports) {
+      for (const MatrixModelLoad& load : model.loads) channels.push_back(load.channel);
+      if (channels.empty()) {
+        for (const MatrixModelSupport& support : model.supports) {
+          channels.push_back(support.force_channel);
+        }
+      }
     }
-    const double rms = count > 0 ? std::sqrt(sum / count) : 0.0;
+    double sum = 0.0;
+    for (const std::string& channel : channels) {
+      sum += used.Values(channel).squaredNorm() / used.num_samples();
+    }
+    const double rms = channels.empty() ? 0.0 : std::sqrt(sum / channels.size());
     if (!(level > 0.0) && rms > 0.0) {
       level = rms;
       *source = "channel_rms";
@@ -623,14 +658,9 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
 
   // 2. Every zone modulus at once, p_z = log(E_z / E_z,nom), from p = 0 (by least
   //    squares with outer.functional: least_squares, without error maps). The supports
-  //    (if any) treated as mcre.clamp says (docs/matrix_models.md, "Supports").
+  //    (if any) treated as mcre.clamp says (docs/matrix_models.md, "Supports"); held by
+  //    least squares whatever it says, as the bar's least squares holds its clamp.
   if (config.outer.functional == OuterFunctional::kLeastSquares) {
-    if (!model.supports.empty()) {
-      throw InputError(ConfigName(config) +
-                       ": outer.functional least_squares does not treat the supports of " +
-                       run.manifest +
-                       " yet; use outer.functional mcre, or a manifest without supports");
-    }
     IdentifyMatrixZonesByLeastSquares(config, model, measurements, &run);
     run.wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

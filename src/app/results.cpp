@@ -1039,6 +1039,9 @@ std::string MatrixLeastSquaresSummaryYaml(const MatrixIdentificationRun& run,
   yaml.Line(0, "misfit_levels", "", "each sensor kind's misfit divided by its level");
   yaml.Number(1, "displacement", run.misfit_levels.displacement_std, "[m] s_u (0: no such sensor)");
   yaml.Number(1, "strain", run.misfit_levels.strain_std, "[-] s_e (0: no such sensor)");
+  if (run.supports > 0) {
+    yaml.Number(1, "force", run.misfit_levels.force_std, "[N] s_f of the supports' forces");
+  }
   yaml.Text(1, "source", run.misfit_source);
   MatrixOptimizerYaml(run, "J", &yaml);
   yaml.Line(0, "prefilter", "");

@@ -1,7 +1,11 @@
 #include "mcrewave/least_squares/matrix_output_error_objective.h"
 
+#include <Eigen/SparseCholesky>
 #include <cassert>
 #include <cmath>
+#include <stdexcept>
+
+#include "mcrewave/mcre/matrix_mcre_problem.h"
 
 namespace mcrewave {
 
@@ -19,6 +23,16 @@ MatrixOutputErrorObjective::MatrixOutputErrorObjective(const MatrixModelData& mo
   const int num_loads = static_cast<int>(model.loads.size());
   const int num_sensors = static_cast<int>(model.sensors.size());
   const int samples = data.num_samples();
+  // The supports' held dofs (docs/matrix_models.md section 11): none without supports.
+  if (!model.supports.empty()) {
+    held_.assign(static_cast<std::size_t>(n), 0);
+    for (const MatrixModelSupport& support : model.supports) {
+      for (const int dof : support.dofs) held_[static_cast<std::size_t>(dof)] = 1;
+    }
+  }
+  auto kept = [&](Eigen::Index i) {
+    return held_.empty() || held_[static_cast<std::size_t>(i)] == 0;
+  };
   // The data's channels of the model, gathered once into rows (columns t_j).
   measured_loads_.resize(num_loads, samples);
   for (int c = 0; c < num_loads; ++c) {
@@ -30,14 +44,16 @@ MatrixOutputErrorObjective::MatrixOutputErrorObjective(const MatrixModelData& mo
   }
   assert(samples >= 2 && theta >= 0.0 && theta <= 1.0);
   for (int z = 0; z < zones; ++z) {
-    // dK/dE_z = K_z / E_z,nom (docs/formulation.md section 6).
+    // dK/dE_z = K_z / E_z,nom (docs/formulation.md section 6), the held dofs decoupled.
     zone_stiffness_.push_back(model.zones[z].stiffness / model.zones[z].nominal_modulus);
+    if (!held_.empty()) zone_stiffness_.back() = WithHeldDofs(zone_stiffness_.back(), held_);
   }
   std::vector<Eigen::Triplet<double>> entries;
   for (int c = 0; c < num_loads; ++c) {
     const Vector& g = model.loads[c].vector;
     for (int i = 0; i < n; ++i) {
-      if (g[i] != 0.0) entries.emplace_back(i, c, g[i]);
+      // A load on a held dof goes into the support (as the trusted MCRE's).
+      if (g[i] != 0.0 && kept(i)) entries.emplace_back(i, c, g[i]);
     }
   }
   loads_.resize(n, num_loads);
@@ -53,12 +69,14 @@ MatrixOutputErrorObjective::MatrixOutputErrorObjective(const MatrixModelData& mo
     weights_[k] = 1.0 / (level * level);
     for (int outer = 0; outer < sensor.row.outerSize(); ++outer) {
       for (SparseMatrix::InnerIterator it(sensor.row, outer); it; ++it) {
-        entries.emplace_back(k, static_cast<int>(it.col()), it.value());
+        // U = 0 on a held dof: the row's entry there observes nothing.
+        if (kept(it.col())) entries.emplace_back(k, static_cast<int>(it.col()), it.value());
       }
     }
   }
   observation_.resize(num_sensors, n);
   observation_.setFromTriplets(entries.begin(), entries.end());
+  BuildReactions(data, misfit_levels);
   for (int b = 0; b < 2; ++b) {
     velocity_[b] = Vector::Zero(n);
     displacement_[b] = Vector::Zero(n);
@@ -71,11 +89,96 @@ MatrixOutputErrorObjective::MatrixOutputErrorObjective(const MatrixModelData& mo
   residual_ = Vector::Zero(num_sensors);
   trace_ = Vector::Zero(num_sensors);
   outputs_ = Matrix::Zero(num_sensors, samples);
-  // J_rest = 1/2 sum_j c_j h sum_k w_k d~_kj^2
+  // J_rest = 1/2 sum_j c_j h [sum_k w_k d~_kj^2 + w_f sum_s f~_sj^2]
   for (int j = 0; j < samples; ++j) {
     const double c = (j == 0 || j == samples - 1) ? 0.5 : 1.0;
     rest_cost_ += 0.5 * c * time_step_ * measured_outputs_.col(j).cwiseAbs2().dot(weights_);
+    if (!held_.empty()) {
+      rest_cost_ += 0.5 * c * time_step_ * force_weight_ * measured_forces_.col(j).squaredNorm();
+    }
   }
+}
+
+void MatrixOutputErrorObjective::BuildReactions(const ChannelSet& data,
+                                                const NoiseLevels& misfit_levels) {
+  const int n = model_.dofs();
+  const auto supports = static_cast<int>(model_.supports.size());
+  const auto samples = data.num_samples();
+  measured_forces_.resize(supports, samples);
+  support_forces_ = Matrix::Zero(supports, samples);
+  force_residual_ = Vector::Zero(supports);
+  force_trace_ = Vector::Zero(supports);
+  reaction_rows_ = Matrix::Zero(supports, n);
+  reaction_loads_ = Matrix::Zero(supports, loads_.cols());
+  if (supports == 0) return;
+  // w_f = 1 / s_f^2, the bar's clamp reaction's weight.
+  assert(misfit_levels.force_std > 0.0);
+  force_weight_ = 1.0 / (misfit_levels.force_std * misfit_levels.force_std);
+  held_mass_ = WithHeldDofs(model_.mass, held_);
+  Eigen::SimplicialLDLT<SparseMatrix> mass_factor(held_mass_);
+  if (mass_factor.info() != Eigen::Success) {
+    throw std::runtime_error(
+        "output-error model with supports: the mass matrix of the free dofs is not positive "
+        "definite");
+  }
+  Matrix rows(supports, n);  // (g_s - m_s)^T
+  for (int s = 0; s < supports; ++s) {
+    const MatrixModelSupport& support = model_.supports[s];
+    measured_forces_.row(s) = data.Values(support.force_channel).transpose();
+    // m_s = M_ff^-1 (M g_s)_f, 0 on D (the held rows of M decoupled; docs/matrix_models.md
+    // section 10).
+    Vector coupling = model_.mass * support.reaction;
+    for (int i = 0; i < n; ++i) {
+      if (held_[static_cast<std::size_t>(i)] != 0) coupling[i] = 0.0;
+    }
+    const Vector inertia = mass_factor.solve(coupling);
+    // p_s = G_f^T m_s (G's held rows dropped)
+    reaction_loads_.row(s) = (loads_.transpose() * inertia).transpose();
+    rows.row(s) = (support.reaction - inertia).transpose();
+  }
+  for (const MatrixModelZone& zone : model_.zones) {
+    // v_sz = [K_z (g_s - m_s)]_f / E_z,nom (K_z symmetric)
+    Matrix zone_rows = (rows * zone.stiffness) * (1.0 / zone.nominal_modulus);
+    for (int i = 0; i < n; ++i) {
+      if (held_[static_cast<std::size_t>(i)] != 0) zone_rows.col(i).setZero();
+    }
+    reaction_zone_rows_.push_back(std::move(zone_rows));
+  }
+}
+
+double MatrixOutputErrorObjective::SampleCost(int j, const Vector& displacement,
+                                              const Matrix& sensitivity, Vector* gradient) {
+  const int zones = num_parameters();
+  const int samples = static_cast<int>(measured_outputs_.cols());
+  const double h = time_step_;
+  // r_j = H U_j - d~_j
+  trace_.noalias() = observation_ * displacement;
+  outputs_.col(j) = trace_;
+  residual_ = trace_ - measured_outputs_.col(j);
+  const double c = (j == 0 || j == samples - 1) ? 0.5 : 1.0;
+  // c_j h / 2 sum_k w_k r_kj^2
+  double cost = 0.5 * c * h * residual_.cwiseAbs2().dot(weights_);
+  const bool supports = !held_.empty();
+  if (supports) {
+    // r_s,j = q_s^T U_j + p_s^T F~_j against f~_sj: c_j h / 2 w_f sum_s (r_s,j - f~_sj)^2
+    force_trace_.noalias() = reaction_rows_ * displacement;
+    force_trace_.noalias() += reaction_loads_ * measured_loads_.col(j);
+    support_forces_.col(j) = force_trace_;
+    force_residual_ = force_trace_ - measured_forces_.col(j);
+    cost += 0.5 * c * h * force_weight_ * force_residual_.squaredNorm();
+  }
+  if (gradient == nullptr) return cost;
+  for (int z = 0; z < zones; ++z) {
+    // c_j h sum_k w_k r_kj (H S_z,j)_k
+    trace_.noalias() = observation_ * sensitivity.col(z);
+    (*gradient)[z] += c * h * residual_.cwiseProduct(weights_).dot(trace_);
+    if (!supports) continue;
+    // dr_s,j/dE_z = q_s^T S_z,j + v_sz^T U_j;  c_j h w_f sum_s (r_s,j - f~_sj) dr_s,j/dE_z
+    force_trace_.noalias() = reaction_rows_ * sensitivity.col(z);
+    force_trace_.noalias() += reaction_zone_rows_[static_cast<std::size_t>(z)] * displacement;
+    (*gradient)[z] += c * h * force_weight_ * force_residual_.dot(force_trace_);
+  }
+  return cost;
 }
 
 double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradient) {
@@ -85,13 +188,22 @@ double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradi
   options.time_step = time_step_;
   options.theta = theta_;
   options.factorization = factorization_;
-  // K = sum_z (E_z / E_z,nom) K_z, factorised once for the state and every sensitivity.
-  integrator_.Init(model_.mass, model_.Stiffness(zone_moduli), options);
+  // K = sum_z (E_z / E_z,nom) K_z, factorised once for the state and every sensitivity;
+  // with supports, the held dofs decoupled in M and K.
+  if (held_.empty()) {
+    integrator_.Init(model_.mass, model_.Stiffness(zone_moduli), options);
+  } else {
+    integrator_.Init(held_mass_, WithHeldDofs(model_.Stiffness(zone_moduli), held_), options);
+    // q_s(E) = sum_z E_z v_sz
+    reaction_rows_.setZero();
+    for (int z = 0; z < zones; ++z) {
+      reaction_rows_ += zone_moduli[z] * reaction_zone_rows_[static_cast<std::size_t>(z)];
+    }
+  }
 
   const bool gradient_requested = gradient != nullptr;
   if (gradient_requested) gradient->setZero(zones);
   const int samples = static_cast<int>(measured_outputs_.cols());
-  const double h = time_step_;
   int current = 0;
   // From rest: U_0 = V_0 = 0, S_z,0 = S_z,0' = 0.
   velocity_[0].setZero();
@@ -120,19 +232,7 @@ double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradi
       }
       current = next;
     }
-    // r_j = H U_j - d~_j
-    trace_.noalias() = observation_ * displacement_[current];
-    outputs_.col(j) = trace_;
-    residual_ = trace_ - measured_outputs_.col(j);
-    const double c = (j == 0 || j == samples - 1) ? 0.5 : 1.0;
-    // c_j h / 2 sum_k w_k r_kj^2
-    cost += 0.5 * c * h * residual_.cwiseAbs2().dot(weights_);
-    if (!gradient_requested) continue;
-    for (int z = 0; z < zones; ++z) {
-      // c_j h sum_k w_k r_kj (H S_z,j)_k
-      trace_.noalias() = observation_ * sensitivity_[current].col(z);
-      (*gradient)[z] += c * h * residual_.cwiseProduct(weights_).dot(trace_);
-    }
+    cost += SampleCost(j, displacement_[current], sensitivity_[current], gradient);
   }
   sweeps_ += gradient_requested ? 1 + zones : 1;
   return cost;

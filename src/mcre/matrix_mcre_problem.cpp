@@ -26,11 +26,6 @@ ChannelSet MatrixChannelSet(const MatrixModelData& model, double time_step, cons
   return set;
 }
 
-namespace {
-
-// The matrix with the rows and columns of the held dofs decoupled from the others
-// (diagonals kept): a held dof stays at rest while its load is zero
-// (docs/formulation.md section 7, the bar's node 0).
 SparseMatrix WithHeldDofs(SparseMatrix matrix, const std::vector<char>& held) {
   for (int column = 0; column < matrix.outerSize(); ++column) {
     for (SparseMatrix::InnerIterator entry(matrix, column); entry; ++entry) {
@@ -42,6 +37,8 @@ SparseMatrix WithHeldDofs(SparseMatrix matrix, const std::vector<char>& held) {
   matrix.prune(0.0);
   return matrix;
 }
+
+namespace {
 
 // One load channel or one row of H as the constructor gathers them: the spatial vector
 // or row, its weight and the data's channel ("" for the datum 0).

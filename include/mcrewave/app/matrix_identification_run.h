@@ -20,7 +20,8 @@
 //      With outer.functional: least_squares, the same minimiser, bounds and start on
 //      the output-error misfit J instead (least_squares/matrix_output_error_objective.h),
 //      each sensor kind normalised by its misfit level (MatrixLeastSquaresMisfitLevels);
-//      no error map.
+//      no error map. The supports are held whatever mcre.clamp says (the bar's least
+//      squares keeps its clamp rigid), their forces outputs weighted by 1 / s_f^2.
 //
 // Results: WriteMatrixIdentificationResults (app/results.h).
 #pragma once
@@ -103,7 +104,12 @@ void AddMatrixModelNoise(const MatrixModelData& model, double snr, std::uint64_t
 // second differences of the measurements (DifferenceNoiseStd, s^2 averaged over the
 // sensors of the kind, *source "data_differences"); a kind with a level 0 (noise-free
 // data) takes the RMS of its channels in `used` instead (*source "channel_rms").
-// force_std is 0: the loads are inputs.
+// force_std (s_f) weighs the supports' forces: 0 without supports (the loads are
+// inputs); with supports the forces' level as the bar's clamp reaction f0 gets it: the
+// synthetic noise of the loads, else s^2 averaged over the loads' and supports' force
+// channels (the supports' displacement channels then join the displacement sensors, as
+// the bar's u0 does), else the RMS of the loads' channels in `used` (of the supports'
+// force channels without a load).
 NoiseLevels MatrixLeastSquaresMisfitLevels(const Config& config, const MatrixModelData& model,
                                            const MatrixMeasurements& measurements,
                                            const ChannelSet& used, std::string* source);
@@ -135,7 +141,7 @@ struct MatrixIdentificationRun {
   // outer.functional: least_squares: the costs are J [s] and there is no error map
   // (the maps and gaps below are empty).
   bool least_squares = false;
-  NoiseLevels misfit_levels;  // least squares: s_u, s_e of the normalisation
+  NoiseLevels misfit_levels;  // least squares: s_u, s_e (and s_f with supports)
   std::string misfit_source;  // as MatrixLeastSquaresMisfitLevels says
   int dofs = 0;
   int supports = 0;  // the manifest's supports (mcre.clamp treats them)

@@ -1,16 +1,31 @@
 // Output-error least squares on a structure given by matrices (docs/formulation.md
 // section 8, docs/matrix_models.md section 10), the comparator of MatrixZoneObjective:
 // the model M U'' + K(E) U = G F~, K(E) = sum_z (E_z / E_z,nom) K_z, driven from rest
-// by the measured loads alone, its outputs H U against the measured sensor channels,
+// by the measured loads alone, its outputs H U against the measured sensor channels and
+// (with supports) the supports' reactions r_s against their measured forces,
 //
-//   J(E_1..E_Z) = 1/2 sum_j c_j h sum_k w_k (h_k U_j - d~_kj)^2      [s],
+//   J(E_1..E_Z) = 1/2 sum_j c_j h [sum_k w_k (h_k U_j - d~_kj)^2
+//                                  + w_f sum_s (r_s,j - f~_sj)^2]      [s],
 //
 // c_j the trapezoidal weights (c_0 = c_m = 1/2, else 1). Each sensor is normalised by
 // the misfit level of its kind, the bar's convention (ZoneOutputErrorObjective):
-// w_k = 1 / s_u^2 for a displacement row, 1 / s_e^2 for a strain row (NoiseLevels; the
-// loads are inputs, taken as exact, so s_f does not enter). The bar's clamp reaction
-// f0, an output of its clamped model with inertia, has no counterpart here: a matrix
-// model's outputs are rows of U.
+// w_k = 1 / s_u^2 for a displacement row, 1 / s_e^2 for a strain row, and a support's
+// force by w_f = 1 / s_f^2 (NoiseLevels; the loads are inputs, taken as exact).
+//
+// Supports (docs/matrix_models.md section 11) are held, the bar's least squares' rigid
+// clamp (the trusted treatment whatever mcre.clamp says): the rows and columns of their
+// dofs D decoupled in M and K (diagonals kept), so U = 0 on D; a load's and a sensor
+// row's entries on D dropped. A support's displacement channel is no output (U = 0
+// there). Its reaction at t_j, with the inertia of the free dofs f as the bar's clamp
+// reaction f0 = M_01 a_1 + K_01 u_1, is
+//   r_s,j = g_s^T (K U_j + M a_j),   M_ff a_j = (G F~_j)_f - K_ff U_j,  a = 0 on D,
+//         = q_s(E)^T U_j + p_s^T F~_j,
+//   m_s = M_ff^-1 (M g_s)_f,  q_s(E) = [K(E) (g_s - m_s)]_f = sum_z E_z v_sz,
+//   v_sz = [K_z (g_s - m_s)]_f / E_z,nom,  p_s = G_f^T m_s,
+// (one solve with M per support, in the constructor), and its derivative
+//   dr_s,j/dE_z = q_s^T S_z,j + v_sz^T U_j.
+// Without mass coupling between D and the free dofs (m_s = 0) r_s is the trusted MCRE's
+// g_s^T K U (MatrixMcreProblem::ModelSupportForces).
 //
 // Scheme: the theta method of linalg/theta_integrator.h with f_theta = G F~_theta,
 // X_theta = theta X_{k+1} + (1 - theta) X_k, one factorisation of
@@ -18,7 +33,8 @@
 // S_z = dU/dE_z, each the same scheme from rest with the same factorisation and
 //   f_theta = -(1/E_z,nom) K_z U_theta        (M S_z'' + K S_z = -(1/E_z,nom) K_z U),
 // the exact derivative of the discrete J:
-//   dJ/dE_z = sum_j c_j h sum_k w_k (h_k U_j - d~_kj) h_k S_z,j      [s / Pa].
+//   dJ/dE_z = sum_j c_j h [sum_k w_k (h_k U_j - d~_kj) h_k S_z,j
+//                          + w_f sum_s (r_s,j - f~_sj) dr_s,j/dE_z]      [s / Pa].
 // One sweep per evaluation without the gradient, 1 + Z with it; no allocation in the
 // time loop (every scratch is sized in the constructor).
 //
@@ -42,26 +58,33 @@ namespace mcrewave {
 class MatrixOutputErrorObjective : public LogModuliObjective {
  public:
   // Keeps a reference to model, which must outlive the objective; copies the histories
-  // of data's channels named as the model's loads and sensors (data may go).
-  // misfit_levels: s_u (> 0 when the model has a displacement sensor) and s_e (> 0 when
-  // it has a strain sensor). Preconditions: data has a channel of each of the model's
-  // loads and sensors (else throws std::logic_error) on t_j = j h and m >= 1 steps,
-  // theta in [0, 1].
+  // of data's channels named as the model's loads, sensors and supports' forces (data
+  // may go). misfit_levels: s_u (> 0 when the model has a displacement sensor), s_e
+  // (> 0 when it has a strain sensor) and s_f (> 0 when it has a support).
+  // Preconditions: data has a channel of each of the model's loads, sensors and
+  // supports' forces (else throws std::logic_error) on t_j = j h and m >= 1 steps, theta
+  // in [0, 1]. Throws std::runtime_error when the mass matrix of the free dofs cannot be
+  // factorised (a model with supports).
   MatrixOutputErrorObjective(const MatrixModelData& model, const ChannelSet& data,
                              const NoiseLevels& misfit_levels, double theta,
                              Factorization factorization = Factorization::kAutomatic);
 
   // J at the zone moduli [s] (num_parameters() entries [Pa], positive), and dJ/dE_z
   // [s / Pa] into *gradient when it is not null (resized to num_parameters()). Leaves
-  // the outputs H U_j in outputs(). Re-initialises the integrator (the moduli change K).
+  // the outputs H U_j in outputs() and the reactions r_s,j in support_forces().
+  // Re-initialises the integrator (the moduli change K).
   double Cost(const Vector& zone_moduli, Vector* gradient);
 
   // The outputs H U_j of the last Cost, one row per sensor in the model's order, one
   // column per sample [m] or [-].
   const Matrix& outputs() const { return outputs_; }
+  // The supports' reactions r_s,j of the last Cost, one row per support in the model's
+  // order, one column per sample [N] (no row without supports).
+  const Matrix& support_forces() const { return support_forces_; }
   // w_k [1/m^2 or 1], per sensor in the model's order.
   const Vector& sensor_weights() const { return weights_; }
-  // J_rest = 1/2 sum_j c_j h sum_k w_k d~_kj^2 [s]; the cost scale (1 when J_rest = 0).
+  // J_rest = 1/2 sum_j c_j h [sum_k w_k d~_kj^2 + w_f sum_s f~_sj^2] [s]; the cost scale
+  // (1 when J_rest = 0).
   double rest_cost() const { return rest_cost_; }
   double cost_scale() const override { return rest_cost_ > 0.0 ? rest_cost_ : 1.0; }
   // Simulations run: 1 per Cost, plus one per zone with the gradient.
@@ -72,6 +95,13 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
   bool ModuliCost(const Vector& moduli, double* cost, Vector* gradient, std::string* why) override;
 
  private:
+  // The supports' reaction rows v_sz and p_s (the header's formula), with held_ set.
+  void BuildReactions(const ChannelSet& data, const NoiseLevels& misfit_levels);
+  // The misfit of sample j (c_j h / 2 times the bracket of J) with the reactions into
+  // support_forces_ and their residuals into force_residual_; adds its gradient term
+  // into *gradient when it is not null.
+  double SampleCost(int j, const Vector& displacement, const Matrix& sensitivity, Vector* gradient);
+
   const MatrixModelData& model_;
   double time_step_;  // h [s]
   double theta_;
@@ -79,17 +109,29 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
   Matrix measured_loads_;                     // F~ [N], C x (m + 1), rows in the model's order
   Matrix measured_outputs_;                   // d~ [m] or [-], S x (m + 1)
   Vector weights_;                            // w_k
-  SparseMatrix loads_;                        // G, n x C
-  SparseMatrix observation_;                  // H, S x n
-  std::vector<SparseMatrix> zone_stiffness_;  // K_z / E_z,nom [N/(m Pa)]
+  SparseMatrix loads_;                        // G, n x C (held rows dropped)
+  SparseMatrix observation_;                  // H, S x n (held columns dropped)
+  std::vector<SparseMatrix> zone_stiffness_;  // K_z / E_z,nom [N/(m Pa)] (held decoupled)
   ThetaIntegrator integrator_;
+
+  // Supports (none: every member below empty): the held dofs (1 on D), M with them
+  // decoupled, the measured forces f~ [N] (R x (m + 1)), w_f [1/N^2], the rows v_sz
+  // (R x n per zone [N/(m Pa)]), q_s(E) (R x n [N/m]) and p_s^T (R x C [-]).
+  std::vector<char> held_;
+  SparseMatrix held_mass_;
+  Matrix measured_forces_;
+  double force_weight_ = 0.0;
+  std::vector<Matrix> reaction_zone_rows_;
+  Matrix reaction_rows_, reaction_loads_;
 
   // Scratch of Cost, sized in the constructor: double buffers of the state, the
   // sensitivities (one column per zone, double buffered), the theta-weighted
-  // displacement and loads of a step, a force vector, the residuals and the outputs.
+  // displacement and loads of a step, a force vector, the residuals and the outputs;
+  // the reactions' residuals and derivatives.
   Vector velocity_[2], displacement_[2], weighted_, channel_, force_, residual_, trace_;
+  Vector force_residual_, force_trace_;
   Matrix sensitivity_velocity_[2], sensitivity_[2];
-  Matrix outputs_;
+  Matrix outputs_, support_forces_;
 
   double rest_cost_ = 0.0;
   long sweeps_ = 0;

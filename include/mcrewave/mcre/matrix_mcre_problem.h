@@ -66,6 +66,12 @@ namespace mcrewave {
 ChannelSet MatrixChannelSet(const MatrixModelData& model, double time_step, const Matrix& loads,
                             const Matrix& outputs);
 
+// The matrix with the rows and columns of the held dofs (held[i] != 0; held has one
+// entry per row) decoupled from the others, diagonals kept: a held dof stays at rest
+// while its load is zero (docs/formulation.md section 7, the bar's node 0; the trusted
+// supports of docs/matrix_models.md section 11).
+SparseMatrix WithHeldDofs(SparseMatrix matrix, const std::vector<char>& held);
+
 class MatrixMcreProblem : public StreamingCoupledProblem {
  public:
   // Keeps a reference to model, which must outlive the problem; copies the histories
