@@ -364,11 +364,12 @@ int RunStudy(const StudyArguments& arguments) {
   }
   const mcrewave::StudyKind kind = config.study.kind;
   if (config.structure.kind != mcrewave::ModelKind::kBar &&
-      kind != mcrewave::StudyKind::kRobustness && kind != mcrewave::StudyKind::kReadme) {
+      kind != mcrewave::StudyKind::kRobustness && kind != mcrewave::StudyKind::kComparator &&
+      kind != mcrewave::StudyKind::kReadme) {
     throw mcrewave::InputError(
         arguments.config_path + ": study.kind '" + mcrewave::StudyKindToString(kind) +
-        "' runs on the bar only; with model.kind 'matrix' use study.kind: robustness (the "
-        "plate's own study: scripts/plate_study.sh)");
+        "' runs on the bar only; with model.kind 'matrix' use study.kind: robustness or "
+        "comparator (the plate's own study: scripts/plate_study.sh)");
   }
   if (mcrewave::StudySelected(kind, mcrewave::StudyKind::kDamage)) {
     mcrewave::CheckDamageStudyConfig(config, arguments.config_path);

@@ -305,7 +305,7 @@ TEST(MatrixIdentificationRunTest, BadInputsExitWithOneLineAndWriteNothing) {
   const RunResult study = RunIdentify("study " + base + " -o " + dir + "/study");
   EXPECT_EQ(study.exit_code, 2) << study.output;
   EXPECT_NE(study.output.find("study.kind 'all' runs on the bar only; with model.kind 'matrix' "
-                              "use study.kind: robustness"),
+                              "use study.kind: robustness or comparator"),
             std::string::npos)
       << study.output;
   EXPECT_FALSE(std::filesystem::exists(dir + "/study"));

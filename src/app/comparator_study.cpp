@@ -8,6 +8,7 @@
 #include "app/study_internal.h"
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
+#include "mcrewave/app/matrix_identification_run.h"
 #include "mcrewave/app/study.h"
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/data/noise.h"
@@ -112,55 +113,122 @@ void RunDataSet(const Config& config, const DataSet& set, const std::vector<bool
   }
 }
 
+// A matrix model's measurements of one data set: the noise-free truth plus the noise of
+// (snr, seed) (AddMatrixModelNoise, as identify run adds it), then the sensor gains.
+MatrixMeasurements MatrixDataSet(const MatrixModelData& model, const MatrixMeasurements& truth,
+                                 const DataSet& set) {
+  MatrixMeasurements measured = truth;
+  AddMatrixModelNoise(model, set.snr, set.seed, &measured.histories, &measured.noise);
+  for (const MatrixModelLoad& load : model.loads) {
+    if (set.model_error == "force_gain") measured.histories.Values(load.channel) *= kForceGain;
+  }
+  for (const MatrixModelSensor& sensor : model.sensors) {
+    if (set.model_error == "displacement_gain" && sensor.kind == SensorKind::kDisplacement) {
+      measured.histories.Values(sensor.channel) *= kDisplacementGain;
+    }
+  }
+  return measured;
+}
+
+// The runs of one data set on a matrix model, {MCRE, least squares} x `prefilters` x
+// zones in that order: each functional as identify run identifies the zones (without
+// maps or uncertainty), the model `density` times denser under that error.
+void RunMatrixDataSet(const Config& config, const MatrixModelData& model,
+                      const MatrixMeasurements& truth, const std::vector<double>& reference,
+                      const DataSet& set, const std::vector<bool>& prefilters,
+                      ComparatorRun* runs) {
+  const MatrixMeasurements measured = MatrixDataSet(model, truth, set);
+  MatrixModelData identified = model;
+  if (set.model_error == "density") identified.mass *= kDensityError;
+  const int filters = static_cast<int>(prefilters.size());
+  const int zones = static_cast<int>(reference.size());
+  for (int k = 0; k < 2 * filters; ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    Config run_config = config;
+    run_config.data.snr = set.snr;
+    run_config.data.seed = set.seed;
+    run_config.outer.functional =
+        k >= filters ? OuterFunctional::kLeastSquares : OuterFunctional::kMcre;
+    run_config.prefilter.enabled = prefilters[k % filters];
+    const MatrixIdentificationRun run =
+        RunMatrixIdentification(run_config, identified, measured, /*maps_and_uncertainty=*/false);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    for (int z = 0; z < zones; ++z) {
+      ComparatorRun& out = runs[k * zones + z];
+      out.model_error = set.model_error;
+      out.zone = z;
+      out.snr = set.snr;
+      out.seed = set.seed;
+      out.least_squares = k >= filters;
+      out.prefilter = prefilters[k % filters];
+      out.converged = run.IsUsable();
+      out.message = run.failure;
+      out.evaluations = run.outer.evaluations;
+      out.wall_time_s = seconds;
+      if (run.identified_moduli.size() == zones) {
+        out.modulus = run.identified_moduli[z];
+        // E_z / E_z,ref - 1
+        out.error = out.modulus / reference[z] - 1.0;
+      }
+    }
+  }
+}
+
 std::vector<ComparatorStatistics> Statistics(const ComparatorStudy& study) {
   std::vector<ComparatorStatistics> table;
   for (const std::string& error : study.model_errors) {
     for (const bool least_squares : {false, true}) {
       for (const bool prefilter : study.prefilters) {
         for (const double snr : study.snrs) {
-          ComparatorStatistics row;
-          row.model_error = error;
-          row.least_squares = least_squares;
-          row.prefilter = prefilter;
-          row.snr = snr;
-          std::vector<double> errors;
-          double minima = 0.0, one_valley = 0.0, evaluations = 0.0, time = 0.0, within = 0.0;
-          for (const ComparatorRun& run : study.runs) {
-            if (run.model_error != error || run.least_squares != least_squares ||
-                run.prefilter != prefilter ||
-                !(run.snr == snr || (std::isinf(run.snr) && std::isinf(snr)))) {
-              continue;
+          for (int zone = 0; zone < static_cast<int>(study.zones.size()); ++zone) {
+            ComparatorStatistics row;
+            row.model_error = error;
+            row.zone = zone;
+            row.least_squares = least_squares;
+            row.prefilter = prefilter;
+            row.snr = snr;
+            std::vector<double> errors;
+            double minima = 0.0, one_valley = 0.0, evaluations = 0.0, time = 0.0, within = 0.0;
+            for (const ComparatorRun& run : study.runs) {
+              if (run.model_error != error || run.zone != zone ||
+                  run.least_squares != least_squares || run.prefilter != prefilter ||
+                  !(run.snr == snr || (std::isinf(run.snr) && std::isinf(snr)))) {
+                continue;
+              }
+              ++row.runs;
+              if (!run.converged) continue;
+              errors.push_back(run.error);
+              minima += run.local_minima;
+              one_valley += run.local_minima == 1 ? 1.0 : 0.0;
+              evaluations += run.evaluations;
+              time += run.wall_time_s;
+              within += std::abs(run.error) <= 0.02 ? 1.0 : 0.0;
             }
-            ++row.runs;
-            if (!run.converged) continue;
-            errors.push_back(run.error);
-            minima += run.local_minima;
-            one_valley += run.local_minima == 1 ? 1.0 : 0.0;
-            evaluations += run.evaluations;
-            time += run.wall_time_s;
-            within += std::abs(run.error) <= 0.02 ? 1.0 : 0.0;
+            const double n = static_cast<double>(errors.size());
+            row.converged_share = row.runs > 0 ? n / row.runs : 0.0;
+            if (n > 0) {
+              double mean = 0.0, squares = 0.0;
+              for (const double e : errors) mean += e / n;
+              for (const double e : errors) squares += e * e / n;
+              double variance = 0.0;
+              for (const double e : errors) variance += (e - mean) * (e - mean);
+              row.mean_error = mean;
+              row.std_error = n > 1 ? std::sqrt(variance / (n - 1.0)) : 0.0;
+              row.rms_error = std::sqrt(squares);
+              row.quantile_025 = Quantile(errors, 0.025);
+              row.quantile_975 = Quantile(errors, 0.975);
+              // Shares over every run: a run that did not converge is not within 2 %.
+              row.within_2_percent = within / row.runs;
+              if (!study.matrix_model) {
+                row.one_valley = one_valley / n;
+                row.mean_local_minima = minima / n;
+              }
+              row.mean_evaluations = evaluations / n;
+              row.mean_wall_time_s = time / n;
+            }
+            table.push_back(row);
           }
-          const double n = static_cast<double>(errors.size());
-          row.converged_share = row.runs > 0 ? n / row.runs : 0.0;
-          if (n > 0) {
-            double mean = 0.0, squares = 0.0;
-            for (const double e : errors) mean += e / n;
-            for (const double e : errors) squares += e * e / n;
-            double variance = 0.0;
-            for (const double e : errors) variance += (e - mean) * (e - mean);
-            row.mean_error = mean;
-            row.std_error = n > 1 ? std::sqrt(variance / (n - 1.0)) : 0.0;
-            row.rms_error = std::sqrt(squares);
-            row.quantile_025 = Quantile(errors, 0.025);
-            row.quantile_975 = Quantile(errors, 0.975);
-            // Shares over every run: a run that did not converge is not within 2 %.
-            row.within_2_percent = within / row.runs;
-            row.one_valley = one_valley / n;
-            row.mean_local_minima = minima / n;
-            row.mean_evaluations = evaluations / n;
-            row.mean_wall_time_s = time / n;
-          }
-          table.push_back(row);
         }
       }
     }
@@ -171,14 +239,20 @@ std::vector<ComparatorStatistics> Statistics(const ComparatorStudy& study) {
 std::string FunctionalText(bool least_squares) { return least_squares ? "least_squares" : "mcre"; }
 std::string FilterText(bool prefilter) { return prefilter ? "prefilter" : "raw"; }
 
+// With more than one zone the CSV files and tables name each row's zone.
+bool ManyZones(const ComparatorStudy& study) { return study.zones.size() > 1; }
+
 std::string RunsCsv(const ComparatorStudy& study) {
+  const bool many = ManyZones(study);
   std::ostringstream csv;
-  csv << "model_error,snr,seed,functional,data,converged,modulus_pa,relative_error,local_minima,"
-         "evaluations,wall_time_s,search_modulus_pa,message\n";
+  csv << "model_error,snr,seed,functional,data," << (many ? "zone," : "")
+      << "converged,modulus_pa,relative_error,local_minima,evaluations,wall_time_s,"
+         "search_modulus_pa,message\n";
   for (const ComparatorRun& run : study.runs) {
     csv << run.model_error << "," << SnrText(run.snr) << "," << run.seed << ","
-        << FunctionalText(run.least_squares) << "," << FilterText(run.prefilter) << ","
-        << (run.converged ? 1 : 0) << "," << Csv(run.modulus) << "," << Csv(run.error) << ","
+        << FunctionalText(run.least_squares) << "," << FilterText(run.prefilter) << ",";
+    if (many) csv << study.zones[run.zone] << ",";
+    csv << (run.converged ? 1 : 0) << "," << Csv(run.modulus) << "," << Csv(run.error) << ","
         << run.local_minima << "," << run.evaluations << "," << Csv(run.wall_time_s) << ","
         << Csv(run.search_modulus) << ",\"" << run.message << "\"\n";
   }
@@ -186,18 +260,20 @@ std::string RunsCsv(const ComparatorStudy& study) {
 }
 
 std::string StatisticsCsv(const ComparatorStudy& study) {
+  const bool many = ManyZones(study);
   std::ostringstream csv;
-  csv << "model_error,functional,data,snr,runs,converged_share,mean_error,std_error,rms_error,"
-         "q2.5_error,q97.5_error,within_2_percent,one_valley,mean_local_minima,"
-         "mean_evaluations,mean_wall_time_s\n";
+  csv << "model_error,functional,data," << (many ? "zone," : "")
+      << "snr,runs,converged_share,mean_error,std_error,rms_error,q2.5_error,q97.5_error,"
+         "within_2_percent,one_valley,mean_local_minima,mean_evaluations,mean_wall_time_s\n";
   for (const ComparatorStatistics& row : study.statistics) {
     csv << row.model_error << "," << FunctionalText(row.least_squares) << ","
-        << FilterText(row.prefilter) << "," << SnrText(row.snr) << "," << row.runs << ","
-        << Csv(row.converged_share) << "," << Csv(row.mean_error) << "," << Csv(row.std_error)
-        << "," << Csv(row.rms_error) << "," << Csv(row.quantile_025) << "," << Csv(row.quantile_975)
-        << "," << Csv(row.within_2_percent) << "," << Csv(row.one_valley) << ","
-        << Csv(row.mean_local_minima) << "," << Csv(row.mean_evaluations) << ","
-        << Csv(row.mean_wall_time_s) << "\n";
+        << FilterText(row.prefilter) << ",";
+    if (many) csv << study.zones[row.zone] << ",";
+    csv << SnrText(row.snr) << "," << row.runs << "," << Csv(row.converged_share) << ","
+        << Csv(row.mean_error) << "," << Csv(row.std_error) << "," << Csv(row.rms_error) << ","
+        << Csv(row.quantile_025) << "," << Csv(row.quantile_975) << "," << Csv(row.within_2_percent)
+        << "," << Csv(row.one_valley) << "," << Csv(row.mean_local_minima) << ","
+        << Csv(row.mean_evaluations) << "," << Csv(row.mean_wall_time_s) << "\n";
   }
   return csv.str();
 }
@@ -206,10 +282,15 @@ std::string StatisticsCsv(const ComparatorStudy& study) {
 // data) combination, for the figure (finite SNRs only: log axis).
 std::string CurvesCsv(const ComparatorStudy& study) {
   std::ostringstream csv;
+  const bool many = ManyZones(study);
+  const int zones = static_cast<int>(study.zones.size());
   csv << "model_error_index,snr";
   for (const bool least_squares : {false, true}) {
     for (const bool prefilter : study.prefilters) {
-      csv << "," << FunctionalText(least_squares) << "_" << FilterText(prefilter);
+      for (int zone = 0; zone < zones; ++zone) {
+        csv << "," << FunctionalText(least_squares) << "_" << FilterText(prefilter)
+            << (many ? "_" + study.zones[zone] : std::string());
+      }
     }
   }
   csv << "\n";
@@ -219,10 +300,13 @@ std::string CurvesCsv(const ComparatorStudy& study) {
       csv << e << "," << Csv(snr);
       for (const bool least_squares : {false, true}) {
         for (const bool prefilter : study.prefilters) {
-          for (const ComparatorStatistics& row : study.statistics) {
-            if (row.model_error == study.model_errors[e] && row.least_squares == least_squares &&
-                row.prefilter == prefilter && row.snr == snr) {
-              csv << "," << Csv(100.0 * row.rms_error);
+          for (int zone = 0; zone < zones; ++zone) {
+            for (const ComparatorStatistics& row : study.statistics) {
+              if (row.model_error == study.model_errors[e] && row.zone == zone &&
+                  row.least_squares == least_squares && row.prefilter == prefilter &&
+                  row.snr == snr) {
+                csv << "," << Csv(100.0 * row.rms_error);
+              }
             }
           }
         }
@@ -238,17 +322,23 @@ std::string CurvesScript(const std::string& folder, const ComparatorStudy& study
   const int columns = std::min(panels, 3);
   const int rows = (panels + columns - 1) / columns;
   const std::string csv = GnuplotString(folder + "/curves.csv");
+  const bool many = ManyZones(study);
+  const int zones = static_cast<int>(study.zones.size());
   std::ostringstream script;
   script << GnuplotPngTerminal() << "set terminal pngcairo size " << 520 * columns << ","
          << 420 * rows << "\nset datafile separator comma\nset logscale xy\nset grid\n"
-         << "set xlabel 'SNR'\nset ylabel 'rms error of E [%]'\nset key top right\n"
+         << "set xlabel 'SNR'\nset ylabel 'rms error of " << (many ? "E_z" : "E")
+         << " [%]'\nset key top right\n"
          << "set multiplot layout " << rows << "," << columns
          << " title 'MCRE against output-error least squares'\n";
   std::vector<std::string> titles;  // the columns of curves.csv after model_error_index, snr
   for (const bool least_squares : {false, true}) {
     for (const bool prefilter : study.prefilters) {
-      titles.push_back(std::string(least_squares ? "least squares" : "MCRE") +
-                       (prefilter ? ", pre-filtered" : ", raw"));
+      for (int zone = 0; zone < zones; ++zone) {
+        titles.push_back(std::string(least_squares ? "least squares" : "MCRE") +
+                         (prefilter ? ", pre-filtered" : ", raw") +
+                         (many ? ", " + study.zones[zone] : std::string()));
+      }
     }
   }
   for (int e = 0; e < panels; ++e) {
@@ -256,9 +346,13 @@ std::string CurvesScript(const std::string& folder, const ComparatorStudy& study
     std::replace(title.begin(), title.end(), '_', ' ');
     script << "set title '" << title << "'\nplot ";
     for (int c = 0; c < static_cast<int>(titles.size()); ++c) {
-      // The colours of the four combinations stay the same whichever are drawn.
-      const int colour = 2 * (c / static_cast<int>(study.prefilters.size())) +
-                         (study.prefilters[c % study.prefilters.size()] ? 1 : 0);
+      // The colours of the four combinations stay the same whichever are drawn; with
+      // zones, each combination and zone its own.
+      const int combination = c / zones;
+      const int colour =
+          many ? c
+               : 2 * (combination / static_cast<int>(study.prefilters.size())) +
+                     (study.prefilters[combination % study.prefilters.size()] ? 1 : 0);
       script << (c > 0 ? ", " : "") << csv << " skip 1 using ($1 == " << e
              << " ? $2 : NaN):" << c + 3 << " with linespoints lw 2 pt 7 lc rgb '"
              << internal::Colour(colour) << "' title '" << titles[c] << "'";
@@ -269,13 +363,26 @@ std::string CurvesScript(const std::string& folder, const ComparatorStudy& study
   return script.str();
 }
 
-std::string Summary(const ComparatorStudy& study) {
+// What was compared, how: the bar's text, or a matrix model's.
+std::string SummaryIntroduction(const ComparatorStudy& study) {
   std::ostringstream md;
-  md << "# MCRE against output-error least squares\n\n"
-     << study.runs.size() << " identifications on " << study.threads << " threads in "
-     << internal::Duration(study.wall_time_s)
-     << ". The same data for both functionals, the same optimiser and bounds; "
-        "least squares: the clamped model driven by the measured fL, misfit of uL and f0 "
+  md << study.runs.size() / study.zones.size() << " identifications on " << study.threads
+     << " threads in " << internal::Duration(study.wall_time_s)
+     << ". The same data for both functionals, the same optimiser and bounds; ";
+  if (study.matrix_model) {
+    md << "on the matrix model, every zone at once from the nominal moduli as identify run "
+          "does it (no global scan), least squares' misfit normalised by the noise of each "
+          "sensor kind. Model errors: `density` the model's M 3 % larger, `force_gain` every "
+          "load measured 5 % high, `displacement_gain` every displacement sensor measured 3 % "
+          "high. Errors of each zone modulus relative to the truth's (E_ref: ";
+    for (std::size_t z = 0; z < study.zones.size(); ++z) {
+      md << (z == 0 ? "" : ", ") << study.zones[z] << " "
+         << Brief(study.reference_moduli[z] / 1e9, 6) << " GPa";
+    }
+    md << "); `within 2 %` as a share of the runs.\n\n";
+    return md.str();
+  }
+  md << "least squares: the clamped model driven by the measured fL, misfit of uL and f0 "
         "normalised by RMS(channel) / SNR, its global scan on J. "
      << (study.mcre_scans_search
              ? "The MCRE's global scan runs on the search functional (search:, the pinned "
@@ -287,28 +394,41 @@ std::string Summary(const ComparatorStudy& study) {
         "`force_gain` fL measured 5 % high, `displacement_gain` uL measured 3 % high, "
         "`soft_zone` the bar 10 % softer over the 10 % of its length by the clamp. Errors "
         "of E relative to the bar's modulus; `within 2 %` and `one valley` as shares of "
-        "the runs.\n\n"
-     << "| model error | functional | data | SNR | runs | mean | std | rms | 95 % band | "
+        "the runs.\n\n";
+  return md.str();
+}
+
+std::string Summary(const ComparatorStudy& study) {
+  const bool many = ManyZones(study);
+  std::ostringstream md;
+  md << "# MCRE against output-error least squares\n\n"
+     << SummaryIntroduction(study) << "| model error | functional | data | "
+     << (many ? "zone | " : "")
+     << "SNR | runs | mean | std | rms | 95 % band | "
         "within 2 % | one valley | valleys | evaluations | time [s] |\n"
-     << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+     << "|---|---|---|" << (many ? "---|" : "") << "---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const ComparatorStatistics& row : study.statistics) {
     md << "| " << row.model_error << " | " << FunctionalText(row.least_squares) << " | "
-       << FilterText(row.prefilter) << " | " << SnrText(row.snr) << " | " << row.runs << " | "
-       << Percent(row.mean_error) << " | " << Percent(row.std_error) << " | "
-       << Percent(row.rms_error) << " | [" << Percent(row.quantile_025) << ", "
-       << Percent(row.quantile_975) << "] | " << Brief(100.0 * row.within_2_percent, 3) << " % | "
-       << Brief(100.0 * row.one_valley, 3) << " % | " << Brief(row.mean_local_minima, 3) << " | "
-       << Brief(row.mean_evaluations, 3) << " | " << Brief(row.mean_wall_time_s, 3) << " |\n";
+       << FilterText(row.prefilter) << " | ";
+    if (many) md << study.zones[row.zone] << " | ";
+    md << SnrText(row.snr) << " | " << row.runs << " | " << Percent(row.mean_error) << " | "
+       << Percent(row.std_error) << " | " << Percent(row.rms_error) << " | ["
+       << Percent(row.quantile_025) << ", " << Percent(row.quantile_975) << "] | "
+       << Brief(100.0 * row.within_2_percent, 3) << " % | "
+       << (std::isnan(row.one_valley) ? std::string("-") : Brief(100.0 * row.one_valley, 3) + " %")
+       << " | " << Brief(row.mean_local_minima, 3) << " | " << Brief(row.mean_evaluations, 3)
+       << " | " << Brief(row.mean_wall_time_s, 3) << " |\n";
   }
   md << "\nRatio of the rms errors, MCRE / least squares (1 or less: MCRE as accurate):\n\n"
-     << "| model error | data |";
+     << "| model error | data |" << (many ? " zone |" : "");
   for (const double snr : study.snrs) md << " SNR " << SnrText(snr) << " |";
-  md << "\n|---|---|";
+  md << "\n|---|---|" << (many ? "---|" : "");
   for (std::size_t i = 0; i < study.snrs.size(); ++i) md << "---|";
   md << "\n";
-  auto rms = [&](const std::string& error, bool least_squares, bool prefilter, double snr) {
+  auto rms = [&](const std::string& error, bool least_squares, bool prefilter, double snr,
+                 int zone) {
     for (const ComparatorStatistics& row : study.statistics) {
-      if (row.model_error == error && row.least_squares == least_squares &&
+      if (row.model_error == error && row.zone == zone && row.least_squares == least_squares &&
           row.prefilter == prefilter &&
           (row.snr == snr || (std::isinf(row.snr) && std::isinf(snr)))) {
         return row.rms_error;
@@ -318,15 +438,22 @@ std::string Summary(const ComparatorStudy& study) {
   };
   for (const std::string& error : study.model_errors) {
     for (const bool prefilter : study.prefilters) {
-      md << "| " << error << " | " << FilterText(prefilter) << " |";
-      for (const double snr : study.snrs) {
-        md << " " << Brief(rms(error, false, prefilter, snr) / rms(error, true, prefilter, snr), 3)
-           << " |";
+      for (int zone = 0; zone < static_cast<int>(study.zones.size()); ++zone) {
+        md << "| " << error << " | " << FilterText(prefilter) << " |";
+        if (many) md << " " << study.zones[zone] << " |";
+        for (const double snr : study.snrs) {
+          md << " "
+             << Brief(rms(error, false, prefilter, snr, zone) /
+                          rms(error, true, prefilter, snr, zone),
+                      3)
+             << " |";
+        }
+        md << "\n";
       }
-      md << "\n";
     }
   }
-  md << "\nFigure: comparator.png (rms error of E against the SNR, one panel per model error).\n";
+  md << "\nFigure: comparator.png (rms error of " << (many ? "each zone modulus" : "E")
+     << " against the SNR, one panel per model error).\n";
   return md.str();
 }
 
@@ -338,25 +465,80 @@ const std::vector<std::string>& ComparatorModelErrors() {
   return errors;
 }
 
+namespace {
+
+// The bar's runs of every data set, four per set (run_data_set's order).
+void RunBarComparator(const Config& config, const std::vector<DataSet>& sets,
+                      ComparatorStudy* study, internal::Progress* progress) {
+  study->zones = {"E"};
+  study->reference_moduli = {config.model.modulus};
+  const int runs_per_set = 2 * static_cast<int>(study->prefilters.size());
+  study->runs.resize(runs_per_set * sets.size());
+  internal::ParallelFor(
+      static_cast<int>(sets.size()), study->threads,
+      [&](int i) {
+        RunDataSet(config, sets[i], study->prefilters, &study->runs[runs_per_set * i]);
+      },
+      progress);
+}
+
+// A matrix model's runs: its zones, their truth (simulated once, noise-free), and the
+// runs of every data set.
+void RunMatrixComparator(const Config& config, const std::vector<DataSet>& sets,
+                         ComparatorStudy* study, internal::Progress* progress) {
+  const std::string name = config.source_path.empty() ? "config" : config.source_path;
+  for (const DataSet& set : sets) {
+    if (set.model_error == "soft_zone") {
+      throw InputError(name +
+                       ": study.comparator_errors: soft_zone (the bar softer by its "
+                       "clamp) applies to the bar only; with model.kind 'matrix' choose among "
+                       "none, density, force_gain and displacement_gain");
+    }
+  }
+  const MatrixModelData model = LoadMatrixModel(config);
+  Config noise_free = config;
+  noise_free.data.snr = std::numeric_limits<double>::infinity();
+  const MatrixMeasurements truth = LoadMatrixMeasurements(noise_free, model);
+  if (truth.truth_moduli.size() != static_cast<int>(model.zones.size())) {
+    throw InputError(name + ": the comparator study needs the truth's modulus of every zone of " +
+                     config.structure.manifest + ", and the truth lacks a zone of the same name");
+  }
+  study->matrix_model = true;
+  for (std::size_t z = 0; z < model.zones.size(); ++z) {
+    study->zones.push_back(model.zones[z].name);
+    study->reference_moduli.push_back(truth.truth_moduli[static_cast<int>(z)]);
+  }
+  const int runs_per_set =
+      2 * static_cast<int>(study->prefilters.size()) * static_cast<int>(study->zones.size());
+  study->runs.resize(runs_per_set * sets.size());
+  internal::ParallelFor(
+      static_cast<int>(sets.size()), study->threads,
+      [&](int i) {
+        RunMatrixDataSet(config, model, truth, study->reference_moduli, sets[i], study->prefilters,
+                         &study->runs[runs_per_set * i]);
+      },
+      progress);
+}
+
+}  // namespace
+
 ComparatorStudy RunComparatorStudy(const Config& config) {
   const auto start = std::chrono::steady_clock::now();
   const std::vector<DataSet> sets = DataSets(config.study);
   ComparatorStudy study;
-  study.reference_modulus = config.model.modulus;
   study.model_errors = config.study.comparator_errors;
   study.snrs = config.study.comparator_snr;
   study.mcre_scans_search = ScansTheSearchFunctional(config);
   for (const std::string& data : config.study.comparator_data) {
     study.prefilters.push_back(data == "prefilter");
   }
-  const int runs_per_set = 2 * static_cast<int>(study.prefilters.size());
-  study.runs.resize(runs_per_set * sets.size());
   study.threads = internal::ResolveThreads(config.study.threads);
   internal::Progress progress("comparator", static_cast<int>(sets.size()));
-  internal::ParallelFor(
-      static_cast<int>(sets.size()), study.threads,
-      [&](int i) { RunDataSet(config, sets[i], study.prefilters, &study.runs[runs_per_set * i]); },
-      &progress);
+  if (config.structure.kind == ModelKind::kMatrix) {
+    RunMatrixComparator(config, sets, &study, &progress);
+  } else {
+    RunBarComparator(config, sets, &study, &progress);
+  }
   study.statistics = Statistics(study);
   study.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

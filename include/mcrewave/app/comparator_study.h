@@ -15,6 +15,14 @@
 // (at SNR inf the RMS alone: only the ratio of the weights matters). Every run
 // is seeded, its scans on one thread: the study's numbers do not depend on
 // study.threads.
+//
+// On a matrix model (model.kind: matrix) every zone modulus is identified at once, by
+// each functional as identify run does it (app/matrix_identification_run.h: least
+// squares normalised by MatrixLeastSquaresMisfitLevels; no error maps or uncertainty),
+// from the truth of data: (data.truth_manifest at data.truth_moduli) plus the noise of
+// AddMatrixModelNoise, each zone against the truth's modulus. The model errors there:
+// density (the model's M 3 % larger), force_gain (every load channel 5 % high),
+// displacement_gain (every displacement sensor 3 % high); soft_zone is the bar's only.
 #pragma once
 
 #include <cstdint>
@@ -29,8 +37,10 @@ struct Config;
 // The names of the model errors above, in this order.
 const std::vector<std::string>& ComparatorModelErrors();
 
+// One modulus of one identification (the bar: E; a matrix model: one per zone).
 struct ComparatorRun {
   std::string model_error;  // one of ComparatorModelErrors()
+  int zone = 0;             // index in ComparatorStudy::zones
   double snr = 0.0;
   std::uint64_t seed = 0;  // 0 at SNR inf
   bool prefilter = false;
@@ -39,16 +49,17 @@ struct ComparatorRun {
   std::string message;  // the outer loop's, when not converged
   double modulus = std::numeric_limits<double>::quiet_NaN();  // identified E [Pa]
   double error = std::numeric_limits<double>::quiet_NaN();    // E / E_ref - 1
-  int local_minima = 0;  // valleys of the functional the global scan ran on
+  int local_minima = 0;  // valleys of the functional the global scan ran on (0: no scan)
   // The search functional's minimiser E_search [Pa] (two stages), NaN otherwise.
   double search_modulus = std::numeric_limits<double>::quiet_NaN();
   int evaluations = 0;   // of every functional: scans and refinements
   double wall_time_s = std::numeric_limits<double>::quiet_NaN();
 };
 
-// Over the converged runs of one (model error, functional, pre-filter, SNR).
+// Over the converged runs of one (model error, functional, pre-filter, SNR, zone).
 struct ComparatorStatistics {
   std::string model_error;
+  int zone = 0;
   bool least_squares = false;
   bool prefilter = false;
   double snr = 0.0;
@@ -60,14 +71,19 @@ struct ComparatorStatistics {
   double quantile_025 = std::numeric_limits<double>::quiet_NaN();
   double quantile_975 = std::numeric_limits<double>::quiet_NaN();
   double within_2_percent = std::numeric_limits<double>::quiet_NaN();  // share of the runs
-  double one_valley = std::numeric_limits<double>::quiet_NaN();        // share with 1 minimum
+  // Share with 1 minimum and mean minima of the global scans (NaN without a scan).
+  double one_valley = std::numeric_limits<double>::quiet_NaN();
   double mean_local_minima = std::numeric_limits<double>::quiet_NaN();
   double mean_evaluations = std::numeric_limits<double>::quiet_NaN();
   double mean_wall_time_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct ComparatorStudy {
-  double reference_modulus = 0.0;         // E_ref [Pa]
+  // The moduli identified (the bar: "E"; a matrix model: its zones) and their E_ref
+  // [Pa] (model.modulus; the truth's zone moduli).
+  std::vector<std::string> zones;
+  std::vector<double> reference_moduli;
+  bool matrix_model = false;              // no global scan: a local search from the nominal moduli
   std::vector<std::string> model_errors;  // study.comparator_errors
   std::vector<double> snrs;               // study.comparator_snr
   std::vector<bool> prefilters;           // study.comparator_data: false raw, true prefilter
@@ -83,11 +99,14 @@ struct ComparatorStudy {
 // Runs study.comparator_errors x study.comparator_snr x seeds (1..comparator_seeds
 // per finite SNR, one run at SNR inf) x study.comparator_data (raw, pre-filtered) x
 // {MCRE, least squares} on the config's case, on study.threads threads, with a progress line per
-// data set. Precondition: config valid.
+// data set; runs holds them data set by data set, {MCRE, least squares} x data x zones
+// within each. Throws InputError for soft_zone or a truth without one of the zones on a
+// matrix model. Precondition: config valid.
 ComparatorStudy RunComparatorStudy(const Config& config);
 
 // Writes runs.csv, statistics.csv, comparator.png (rms error of E against the SNR,
-// one panel per model error) and summary.md into `folder`; returns the paths.
+// one panel per model error) and summary.md into `folder`; returns the paths. With more
+// than one zone, a zone column in the CSV files and the tables, and a curve per zone.
 std::vector<std::string> WriteComparatorResults(const ComparatorStudy& study,
                                                 const std::string& folder, bool figures);
 
