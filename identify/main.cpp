@@ -386,9 +386,11 @@ int RunStudy(const StudyArguments& arguments) {
 
   // 2. Each selected study: compute, then write its folder.
   if (mcrewave::StudySelected(kind, mcrewave::StudyKind::kRobustness)) {
-    const mcrewave::RobustnessStudy study = mcrewave::RunRobustnessStudy(config);
+    const std::string journal = mcrewave::StudyJournalPath(config, "robustness");
+    const mcrewave::RobustnessStudy study = mcrewave::RunRobustnessStudy(config, journal);
     const ResultsBeingWritten held;
     mcrewave::WriteRobustnessResults(study, folder + "/robustness", figures);
+    mcrewave::RemoveStudyJournal(journal);
   }
   if (mcrewave::StudySelected(kind, mcrewave::StudyKind::kRelaxation)) {
     const mcrewave::RelaxationStudy study = mcrewave::RunRelaxationStudy(config);
@@ -402,14 +404,18 @@ int RunStudy(const StudyArguments& arguments) {
   }
 
   if (mcrewave::StudySelected(kind, mcrewave::StudyKind::kDamage)) {
-    const mcrewave::DamageStudy study = mcrewave::RunDamageStudy(config);
+    const std::string journal = mcrewave::StudyJournalPath(config, "damage");
+    const mcrewave::DamageStudy study = mcrewave::RunDamageStudy(config, journal);
     const ResultsBeingWritten held;
     mcrewave::WriteDamageResults(study, folder + "/damage", figures);
+    mcrewave::RemoveStudyJournal(journal);
   }
   if (mcrewave::StudySelected(kind, mcrewave::StudyKind::kComparator)) {
-    const mcrewave::ComparatorStudy study = mcrewave::RunComparatorStudy(config);
+    const std::string journal = mcrewave::StudyJournalPath(config, "comparator");
+    const mcrewave::ComparatorStudy study = mcrewave::RunComparatorStudy(config, journal);
     const ResultsBeingWritten held;
     mcrewave::WriteComparatorResults(study, folder + "/comparator", figures);
+    mcrewave::RemoveStudyJournal(journal);
   }
 
   // 3. The README gathering the studies' summaries.

@@ -126,6 +126,32 @@ TEST(ComparatorStudyTest, OnAMatrixModelEachRunIsIdentifyRunsIdentificationOfThe
   EXPECT_NE(summary.str().find("| density | raw | zone1 |"), std::string::npos) << summary.str();
 }
 
+TEST(ComparatorStudyTest, AKilledStudyResumesFromItsJournalToTheSameModuli) {
+  const std::string path = WriteComparatorCase("comparator_matrix_journal");
+  const Config config = LoadConfig(path);
+  const std::string journal =
+      (std::filesystem::path(path).parent_path() / ".comparator.journal").string();
+  const ComparatorStudy full = RunComparatorStudy(config, journal);
+  // 8 data sets: keep 3 and half of the fourth.
+  std::ifstream in(journal);
+  std::string line, kept;
+  for (int k = 0; k <= 3 && std::getline(in, line); ++k) kept += line + "\n";
+  std::getline(in, line);
+  kept += line.substr(0, line.size() / 2);
+  in.close();
+  std::ofstream(journal, std::ios::trunc) << kept;
+  const ComparatorStudy resumed = RunComparatorStudy(config, journal);
+  ASSERT_EQ(resumed.runs.size(), full.runs.size());
+  for (std::size_t i = 0; i < full.runs.size(); ++i) {
+    EXPECT_EQ(resumed.runs[i].modulus, full.runs[i].modulus) << i;
+    EXPECT_EQ(resumed.runs[i].zone, full.runs[i].zone) << i;
+    EXPECT_EQ(resumed.runs[i].least_squares, full.runs[i].least_squares) << i;
+    EXPECT_EQ(resumed.runs[i].model_error, full.runs[i].model_error) << i;
+    EXPECT_EQ(resumed.runs[i].evaluations, full.runs[i].evaluations) << i;
+  }
+  EXPECT_EQ(Moduli(resumed), Moduli(full));
+}
+
 TEST(ComparatorStudyTest, TheSoftZoneErrorIsTheBarsAlone) {
   const std::string path = WriteComparatorCase("comparator_matrix_soft_zone");
   const Config config = LoadConfig(path, {"study.comparator_errors=[none, soft_zone]"});

@@ -254,6 +254,48 @@ TEST(StudyTest, TheRobustnessStudyOfAMatrixModelNeedsTheTruthOfEveryZone) {
   }
 }
 
+// Keeps the journal's first line and its first `records` lines, then half of the next
+// line without its line end: a study killed while writing it.
+void CutJournal(const std::string& path, int records) {
+  std::ifstream in(path);
+  std::string line, kept;
+  for (int k = 0; k <= records && std::getline(in, line); ++k) kept += line + "\n";
+  if (std::getline(in, line)) kept += line.substr(0, line.size() / 2);
+  in.close();
+  std::ofstream(path, std::ios::trunc) << kept;
+}
+
+TEST(StudyTest, AKilledRobustnessStudyResumesFromItsJournalToTheSameBits) {
+  Config config = TinyConfig();
+  config.study.threads = 2;
+  const std::string folder = FreshFolder("study_robustness_journal");
+  const std::string journal = folder + "/.robustness.journal";
+  const RobustnessStudy full = RunRobustnessStudy(config, journal);
+  ASSERT_TRUE(std::filesystem::exists(journal));
+  WriteRobustnessResults(full, folder + "/full", /*figures=*/false);
+  // 4 runs: the journal keeps 2 and half of the third.
+  CutJournal(journal, 2);
+  const RobustnessStudy resumed = RunRobustnessStudy(config, journal);
+  WriteRobustnessResults(resumed, folder + "/resumed", /*figures=*/false);
+  for (const char* name : {"runs.csv", "statistics.csv"}) {
+    EXPECT_EQ(ReadStudyText(folder + "/full/" + name), ReadStudyText(folder + "/resumed/" + name))
+        << name;
+  }
+  // Every run journaled again, one line each: a third start restores all four.
+  std::ifstream lines(journal);
+  int count = 0;
+  for (std::string line; std::getline(lines, line);) ++count;
+  EXPECT_EQ(count, 5);
+  // A journal of another config is not used: its runs are run (SNR 20 is not 10).
+  config.study.robustness_snr = {kInf, 20.0};
+  const RobustnessStudy other = RunRobustnessStudy(config, journal);
+  ASSERT_EQ(other.runs.size(), 4u);
+  EXPECT_EQ(other.runs[0].identified_moduli, full.runs[0].identified_moduli);
+  EXPECT_NE(other.runs[1].identified_moduli, full.runs[1].identified_moduli);
+  RemoveStudyJournal(journal);
+  EXPECT_FALSE(std::filesystem::exists(journal));
+}
+
 TEST(StudyTest, RelaxationDivergesBeyondThePredictedLimitAndFollowsTheSpectrum) {
   Config config = TinyConfig();
   config.study.threads = 2;

@@ -3,8 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <memory>
 #include <sstream>
+#include <stdexcept>
 
+#include "app/run_journal.h"
 #include "app/study_internal.h"
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
@@ -467,25 +471,90 @@ const std::vector<std::string>& ComparatorModelErrors() {
 
 namespace {
 
-// The bar's runs of every data set, four per set (run_data_set's order).
+// The runs of one data set (runs_per_set of them from `first`) as a journal record
+// (app/run_journal.h), and back; their case fields are the study's own.
+std::string EncodeDataSet(const ComparatorRun* first, int runs_per_set) {
+  internal::RecordWriter record;
+  for (int k = 0; k < runs_per_set; ++k) {
+    const ComparatorRun& run = first[k];
+    record.Add(run.converged)
+        .Add(run.message)
+        .Add(run.modulus)
+        .Add(run.error)
+        .Add(run.local_minima)
+        .Add(run.search_modulus)
+        .Add(run.evaluations)
+        .Add(run.wall_time_s);
+  }
+  return record.text();
+}
+
+void DecodeDataSet(const std::string& text, int runs_per_set, ComparatorRun* first) {
+  internal::RecordReader record(text);
+  std::vector<ComparatorRun> runs(first, first + runs_per_set);
+  for (ComparatorRun& run : runs) {
+    run.converged = record.Bool();
+    run.message = record.Text();
+    run.modulus = record.Double();
+    run.error = record.Double();
+    run.local_minima = static_cast<int>(record.Integer());
+    run.search_modulus = record.Double();
+    run.evaluations = static_cast<int>(record.Integer());
+    run.wall_time_s = record.Double();
+  }
+  if (!record.AtEnd()) throw std::runtime_error("the record has more fields");
+  std::copy(runs.begin(), runs.end(), first);
+}
+
+// Every data set's runs, runs_per_set of them from study->runs[runs_per_set i] in the
+// order {MCRE, least squares} x data x zones: run_set(i) for the sets the journal does
+// not hold.
+void RunDataSets(const DataSet* sets, int count, int runs_per_set,
+                 const std::function<void(int)>& run_set, internal::RunJournal* journal,
+                 ComparatorStudy* study, internal::Progress* progress) {
+  study->runs.resize(static_cast<std::size_t>(runs_per_set) * count);
+  const int filters = static_cast<int>(study->prefilters.size());
+  const int zones = static_cast<int>(study->zones.size());
+  for (int i = 0; i < count; ++i) {
+    // The case fields, for the runs the journal restores.
+    for (int k = 0; k < runs_per_set; ++k) {
+      ComparatorRun& run = study->runs[static_cast<std::size_t>(runs_per_set) * i + k];
+      run.model_error = sets[i].model_error;
+      run.snr = sets[i].snr;
+      run.seed = sets[i].seed;
+      run.zone = k % zones;
+      run.least_squares = k / zones >= filters;
+      run.prefilter = study->prefilters[(k / zones) % filters];
+    }
+  }
+  internal::ResumableParallelFor(
+      count, study->threads, run_set, progress, journal,
+      [&](int i) { return EncodeDataSet(&study->runs[runs_per_set * i], runs_per_set); },
+      [&](int i, const std::string& record) {
+        DecodeDataSet(record, runs_per_set, &study->runs[runs_per_set * i]);
+      });
+}
+
+// The bar's runs of every data set, four per set (RunDataSet's order).
 void RunBarComparator(const Config& config, const std::vector<DataSet>& sets,
-                      ComparatorStudy* study, internal::Progress* progress) {
+                      internal::RunJournal* journal, ComparatorStudy* study,
+                      internal::Progress* progress) {
   study->zones = {"E"};
   study->reference_moduli = {config.model.modulus};
   const int runs_per_set = 2 * static_cast<int>(study->prefilters.size());
-  study->runs.resize(runs_per_set * sets.size());
-  internal::ParallelFor(
-      static_cast<int>(sets.size()), study->threads,
+  RunDataSets(
+      sets.data(), static_cast<int>(sets.size()), runs_per_set,
       [&](int i) {
         RunDataSet(config, sets[i], study->prefilters, &study->runs[runs_per_set * i]);
       },
-      progress);
+      journal, study, progress);
 }
 
 // A matrix model's runs: its zones, their truth (simulated once, noise-free), and the
 // runs of every data set.
 void RunMatrixComparator(const Config& config, const std::vector<DataSet>& sets,
-                         ComparatorStudy* study, internal::Progress* progress) {
+                         internal::RunJournal* journal, ComparatorStudy* study,
+                         internal::Progress* progress) {
   const std::string name = config.source_path.empty() ? "config" : config.source_path;
   for (const DataSet& set : sets) {
     if (set.model_error == "soft_zone") {
@@ -510,19 +579,18 @@ void RunMatrixComparator(const Config& config, const std::vector<DataSet>& sets,
   }
   const int runs_per_set =
       2 * static_cast<int>(study->prefilters.size()) * static_cast<int>(study->zones.size());
-  study->runs.resize(runs_per_set * sets.size());
-  internal::ParallelFor(
-      static_cast<int>(sets.size()), study->threads,
+  RunDataSets(
+      sets.data(), static_cast<int>(sets.size()), runs_per_set,
       [&](int i) {
         RunMatrixDataSet(config, model, truth, study->reference_moduli, sets[i], study->prefilters,
                          &study->runs[runs_per_set * i]);
       },
-      progress);
+      journal, study, progress);
 }
 
 }  // namespace
 
-ComparatorStudy RunComparatorStudy(const Config& config) {
+ComparatorStudy RunComparatorStudy(const Config& config, const std::string& journal_path) {
   const auto start = std::chrono::steady_clock::now();
   const std::vector<DataSet> sets = DataSets(config.study);
   ComparatorStudy study;
@@ -534,10 +602,16 @@ ComparatorStudy RunComparatorStudy(const Config& config) {
   }
   study.threads = internal::ResolveThreads(config.study.threads);
   internal::Progress progress("comparator", static_cast<int>(sets.size()));
+  std::unique_ptr<internal::RunJournal> journal;
+  if (!journal_path.empty()) {
+    journal = std::make_unique<internal::RunJournal>(
+        journal_path,
+        "mcrewave comparator study " + internal::StudyFingerprint(config, "comparator"));
+  }
   if (config.structure.kind == ModelKind::kMatrix) {
-    RunMatrixComparator(config, sets, &study, &progress);
+    RunMatrixComparator(config, sets, journal.get(), &study, &progress);
   } else {
-    RunBarComparator(config, sets, &study, &progress);
+    RunBarComparator(config, sets, journal.get(), &study, &progress);
   }
   study.statistics = Statistics(study);
   study.wall_time_s =

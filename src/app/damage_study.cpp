@@ -7,8 +7,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <sstream>
 
+#include "app/run_journal.h"
 #include "app/study_internal.h"
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
@@ -123,13 +125,18 @@ void FitLeastSquaresZones(const Config& config, const ChannelSet& measured,
   fit->converged = true;
 }
 
-void RunOne(const Config& config, const DamageCase& damage, DamageRun* run) {
-  const auto start = std::chrono::steady_clock::now();
+// The run's case: its truth, sensors, SNR, seed and zoning.
+void AssignCase(const DamageCase& damage, DamageRun* run) {
   run->truth = damage.truth;
   run->interior_sensors = damage.interior_sensors;
   run->snr = damage.snr;
   run->seed = damage.seed;
   run->per_element = damage.per_element;
+}
+
+void RunOne(const Config& config, const DamageCase& damage, DamageRun* run) {
+  const auto start = std::chrono::steady_clock::now();
+  AssignCase(damage, run);
   const Config run_config = RunConfig(config, damage);
   assert(ConfigProblem(run_config).empty());  // CheckDamageStudyConfig
 
@@ -543,7 +550,77 @@ void CheckDamageStudyConfig(const Config& config, const std::string& name) {
   }
 }
 
-DamageStudy RunDamageStudy(const Config& config) {
+namespace {
+
+// A run's outcome as a journal record (app/run_journal.h), and back (its case fields
+// are the study's own).
+std::string EncodeDamageRun(const DamageRun& run) {
+  const DamageLeastSquaresFit& fit = run.least_squares;
+  return internal::RecordWriter()
+      .Add(run.converged)
+      .Add(run.message)
+      .Add(run.homogeneous_modulus)
+      .Add(run.error_map_peak)
+      .Add(run.zone_start)
+      .Add(run.zone_end)
+      .Add(run.moduli)
+      .Add(run.truth_moduli)
+      .Add(run.weakest_zone)
+      .Add(run.max_zone_error)
+      .Add(run.regularization_weight)
+      .Add(run.groups)
+      .Add(run.reference_cost_ratio)
+      .Add(run.evaluations)
+      .Add(run.wall_time_s)
+      .Add(fit.ran)
+      .Add(fit.converged)
+      .Add(fit.message)
+      .Add(fit.moduli)
+      .Add(fit.weakest_zone)
+      .Add(fit.max_zone_error)
+      .Add(fit.groups)
+      .Add(fit.reference_cost_ratio)
+      .Add(fit.evaluations)
+      .Add(fit.wall_time_s)
+      .text();
+}
+
+void DecodeDamageRun(const std::string& record, DamageRun* run) {
+  internal::RecordReader in(record);
+  DamageRun out = *run;
+  DamageLeastSquaresFit& fit = out.least_squares;
+  out.converged = in.Bool();
+  out.message = in.Text();
+  out.homogeneous_modulus = in.Double();
+  out.error_map_peak = in.Double();
+  out.zone_start = in.Doubles();
+  out.zone_end = in.Doubles();
+  out.moduli = in.Doubles();
+  out.truth_moduli = in.Doubles();
+  out.weakest_zone = static_cast<int>(in.Integer());
+  out.max_zone_error = in.Double();
+  out.regularization_weight = in.Double();
+  out.groups = static_cast<int>(in.Integer());
+  out.reference_cost_ratio = in.Double();
+  out.evaluations = static_cast<int>(in.Integer());
+  out.wall_time_s = in.Double();
+  fit.ran = in.Bool();
+  fit.converged = in.Bool();
+  fit.message = in.Text();
+  fit.moduli = in.Doubles();
+  fit.weakest_zone = static_cast<int>(in.Integer());
+  fit.max_zone_error = in.Double();
+  fit.groups = static_cast<int>(in.Integer());
+  fit.reference_cost_ratio = in.Double();
+  fit.evaluations = static_cast<int>(in.Integer());
+  fit.wall_time_s = in.Double();
+  if (!in.AtEnd()) throw std::runtime_error("the record has more fields");
+  *run = out;
+}
+
+}  // namespace
+
+DamageStudy RunDamageStudy(const Config& config, const std::string& journal_path) {
   const auto start = std::chrono::steady_clock::now();
   const std::vector<DamageCase> cases = Cases(config.study);
   DamageStudy study;
@@ -564,9 +641,17 @@ DamageStudy RunDamageStudy(const Config& config) {
                    : "");
   study.settings = settings.str();
   internal::Progress progress("damage", static_cast<int>(cases.size()));
-  internal::ParallelFor(
+  std::unique_ptr<internal::RunJournal> journal;
+  if (!journal_path.empty()) {
+    journal = std::make_unique<internal::RunJournal>(
+        journal_path, "mcrewave damage study " + internal::StudyFingerprint(config, "damage"));
+  }
+  for (std::size_t i = 0; i < cases.size(); ++i) AssignCase(cases[i], &study.runs[i]);
+  internal::ResumableParallelFor(
       static_cast<int>(cases.size()), study.threads,
-      [&](int i) { RunOne(config, cases[i], &study.runs[i]); }, &progress);
+      [&](int i) { RunOne(config, cases[i], &study.runs[i]); }, &progress, journal.get(),
+      [&](int i) { return EncodeDamageRun(study.runs[i]); },
+      [&](int i, const std::string& record) { DecodeDamageRun(record, &study.runs[i]); });
   study.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return study;

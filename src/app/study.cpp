@@ -11,12 +11,15 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
+#include <memory>
 #include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
 #include <utility>
 
+#include "app/run_journal.h"
 #include "app/study_internal.h"
 #include "mcrewave/app/comparator_study.h"
 #include "mcrewave/app/config.h"
@@ -52,6 +55,11 @@ std::string Duration(double seconds) {
   return text;
 }
 
+void Progress::Restored(int runs) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  total_ -= runs;
+}
+
 void Progress::RunDone() {
   std::lock_guard<std::mutex> lock(mutex_);
   ++done_;
@@ -85,6 +93,42 @@ void ParallelFor(int count, int threads, const std::function<void(int)>& task, P
   worker();
   for (std::thread& thread : pool) thread.join();
   if (first_error) std::rethrow_exception(first_error);
+}
+
+void ResumableParallelFor(int count, int threads, const std::function<void(int)>& task,
+                          Progress* progress, RunJournal* journal,
+                          const std::function<std::string(int)>& encode,
+                          const std::function<void(int, const std::string&)>& decode) {
+  std::vector<int> todo;
+  int restored = 0;
+  for (int i = 0; i < count; ++i) {
+    if (journal == nullptr) {
+      todo.push_back(i);
+      continue;
+    }
+    const auto found = journal->restored().find(i);
+    if (found != journal->restored().end()) {
+      try {
+        decode(i, found->second);
+        ++restored;
+        continue;
+      } catch (const std::exception&) {
+        // An unreadable record: the run is run again.
+      }
+    }
+    todo.push_back(i);
+  }
+  if (restored > 0) {
+    StudyProgressLogger()->info("resumed {} of {} runs from {}", restored, count, journal->path());
+  }
+  if (progress != nullptr) progress->Restored(restored);
+  ParallelFor(
+      static_cast<int>(todo.size()), threads,
+      [&](int k) {
+        task(todo[k]);
+        if (journal != nullptr) journal->Record(todo[k], encode(todo[k]));
+      },
+      progress);
 }
 
 // The measurements of one (SNR, seed): the noise-free truth plus white noise
@@ -278,6 +322,15 @@ bool StudyOptions::IsValid(std::string* error) const {
   return false;
 }
 
+std::string StudyJournalPath(const Config& config, const std::string& study) {
+  return (std::filesystem::path(config.study.folder) / ("." + study + ".journal")).string();
+}
+
+void RemoveStudyJournal(const std::string& path) {
+  std::error_code error;
+  std::filesystem::remove(path, error);
+}
+
 std::shared_ptr<spdlog::logger> StudyProgressLogger() {
   static const std::shared_ptr<spdlog::logger> logger = [] {
     std::shared_ptr<spdlog::logger> clone = spdlog::default_logger()->clone("study");
@@ -306,8 +359,37 @@ using RobustnessIdentification = std::function<void(RobustnessRun* run)>;
 
 // The runs of every (SNR, seed) of the study's lists, each identified on one thread,
 // then the statistics of each SNR and parameter.
+// A run's outcome as a journal record (run_journal.h), and back.
+std::string EncodeRobustnessRun(const RobustnessRun& run) {
+  return RecordWriter()
+      .Add(run.converged)
+      .Add(run.message)
+      .Add(run.identified_moduli)
+      .Add(run.relative_errors)
+      .Add(run.evaluations)
+      .Add(run.scan_evaluations)
+      .Add(static_cast<std::int64_t>(run.sweeps))
+      .Add(run.local_minima)
+      .text();
+}
+
+void DecodeRobustnessRun(const std::string& record, RobustnessRun* run) {
+  RecordReader reader(record);
+  RobustnessRun decoded = *run;
+  decoded.converged = reader.Bool();
+  decoded.message = reader.Text();
+  decoded.identified_moduli = reader.Doubles();
+  decoded.relative_errors = reader.Doubles();
+  decoded.evaluations = static_cast<int>(reader.Integer());
+  decoded.scan_evaluations = static_cast<int>(reader.Integer());
+  decoded.sweeps = reader.Integer();
+  decoded.local_minima = static_cast<int>(reader.Integer());
+  if (!reader.AtEnd()) throw std::runtime_error("the record has more fields");
+  *run = decoded;
+}
+
 void RunRobustness(const StudyOptions& options, const RobustnessIdentification& identify,
-                   RobustnessStudy* study) {
+                   RunJournal* journal, RobustnessStudy* study) {
   for (int k = 0; k < static_cast<int>(options.robustness_snr.size()); ++k) {
     const double snr = options.robustness_snr[k];
     for (const std::uint64_t seed : SeedsOf(snr, options.robustness_seeds)) {
@@ -323,7 +405,7 @@ void RunRobustness(const StudyOptions& options, const RobustnessIdentification& 
       study->runs.size(), options.robustness_snr.size(), options.robustness_seeds, study->threads);
   Progress progress("robustness", static_cast<int>(study->runs.size()));
   const auto parameters = study->parameters.size();
-  ParallelFor(
+  ResumableParallelFor(
       static_cast<int>(study->runs.size()), study->threads,
       [&](int i) {
         RobustnessRun& run = study->runs[i];
@@ -336,7 +418,8 @@ void RunRobustness(const StudyOptions& options, const RobustnessIdentification& 
               (run.identified_moduli[p] - study->reference_moduli[p]) / study->reference_moduli[p];
         }
       },
-      &progress);
+      &progress, journal, [&](int i) { return EncodeRobustnessRun(study->runs[i]); },
+      [&](int i, const std::string& record) { DecodeRobustnessRun(record, &study->runs[i]); });
 
   for (int k = 0; k < static_cast<int>(options.robustness_snr.size()); ++k) {
     for (std::size_t p = 0; p < parameters; ++p) {
@@ -374,7 +457,7 @@ void RunRobustness(const StudyOptions& options, const RobustnessIdentification& 
 }
 
 // The bar: E from the measurements of the finer truth plus each run's noise.
-void RunBarRobustness(const Config& config, RobustnessStudy* study) {
+void RunBarRobustness(const Config& config, RunJournal* journal, RobustnessStudy* study) {
   study->parameters = {"E"};
   study->reference_moduli = {config.model.modulus};
   // The noise-free truth once; each run adds its own noise.
@@ -392,12 +475,12 @@ void RunBarRobustness(const Config& config, RobustnessStudy* study) {
         run->local_minima = outer.local_minima;
         if (run->converged) run->identified_moduli = {identification.identified_modulus()};
       },
-      study);
+      journal, study);
 }
 
 // A matrix model: every zone modulus, without the error maps and the uncertainty, from
 // the truth's outputs (data.truth_manifest at data.truth_moduli) plus each run's noise.
-void RunMatrixRobustness(const Config& config, RobustnessStudy* study) {
+void RunMatrixRobustness(const Config& config, RunJournal* journal, RobustnessStudy* study) {
   const MatrixModelData model = LoadMatrixModel(config);
   Config noise_free = config;
   noise_free.data.snr = std::numeric_limits<double>::infinity();
@@ -434,19 +517,24 @@ void RunMatrixRobustness(const Config& config, RobustnessStudy* study) {
           run->identified_moduli.assign(moduli.data(), moduli.data() + moduli.size());
         }
       },
-      study);
+      journal, study);
 }
 
 }  // namespace
 
-RobustnessStudy RunRobustnessStudy(const Config& config) {
+RobustnessStudy RunRobustnessStudy(const Config& config, const std::string& journal_path) {
   const auto start = Clock::now();
   RobustnessStudy study;
   study.threads = ResolveThreads(config.study.threads);
+  std::unique_ptr<RunJournal> journal;
+  if (!journal_path.empty()) {
+    journal = std::make_unique<RunJournal>(
+        journal_path, "mcrewave robustness study " + StudyFingerprint(config, "robustness"));
+  }
   if (config.structure.kind == ModelKind::kMatrix) {
-    RunMatrixRobustness(config, &study);
+    RunMatrixRobustness(config, journal.get(), &study);
   } else {
-    RunBarRobustness(config, &study);
+    RunBarRobustness(config, journal.get(), &study);
   }
   study.wall_time_s = SecondsSince(start);
   return study;

@@ -25,6 +25,8 @@ std::string Duration(double seconds);
 class Progress {
  public:
   Progress(std::string what, int total) : what_(std::move(what)), total_(total) {}
+  // `runs` of the total were restored from a journal: the lines count the others.
+  void Restored(int runs);
   void RunDone();
 
  private:
@@ -40,6 +42,17 @@ class Progress {
 // their own results (by index). The first exception a task throws is rethrown once
 // every thread has stopped (the others stop taking new indices).
 void ParallelFor(int count, int threads, const std::function<void(int)>& task, Progress* progress);
+
+class RunJournal;
+
+// ParallelFor over the runs a journal does not hold (null: every run): task(i), then
+// journal->Record(i, encode(i)); each run the journal holds is decode(i, record)
+// instead, and run again when its record does not decode (decode throws). Progress
+// counts every run.
+void ResumableParallelFor(int count, int threads, const std::function<void(int)>& task,
+                          Progress* progress, RunJournal* journal,
+                          const std::function<std::string(int)>& encode,
+                          const std::function<void(int, const std::string&)>& decode);
 
 // Number as CSV text: 10 significant digits, "nan", "inf".
 std::string Csv(double value);

@@ -102,7 +102,8 @@ struct ComparatorStudy {
 // data set; runs holds them data set by data set, {MCRE, least squares} x data x zones
 // within each. Throws InputError for soft_zone or a truth without one of the zones on a
 // matrix model. Precondition: config valid.
-ComparatorStudy RunComparatorStudy(const Config& config);
+// journal_path: as RunRobustnessStudy (study.h), the runs journaled and resumed there.
+ComparatorStudy RunComparatorStudy(const Config& config, const std::string& journal_path = "");
 
 // Writes runs.csv, statistics.csv, comparator.png (rms error of E against the SNR,
 // one panel per model error) and summary.md into `folder`; returns the paths. With more

@@ -101,7 +101,8 @@ void CheckDamageStudyConfig(const Config& config, const std::string& name);
 
 // Precondition: config valid (as LoadConfig returns it), synthetic finite-element
 // truth, and CheckDamageStudyConfig passed.
-DamageStudy RunDamageStudy(const Config& config);
+// journal_path: as RunRobustnessStudy (study.h), the runs journaled and resumed there.
+DamageStudy RunDamageStudy(const Config& config, const std::string& journal_path = "");
 
 // damage/: runs.csv (one row per run), zones.csv (one row per run and zone),
 // profiles.png (identified E(x) against the truth, per truth), error_map_peaks.png

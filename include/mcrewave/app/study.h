@@ -154,9 +154,14 @@ struct RobustnessStudy {
   double wall_time_s = 0.0;
 };
 
-// Throws InputError when a matrix model's truth lacks one of its zones (no reference).
-// Precondition: config valid (as LoadConfig returns it), synthetic data.
-RobustnessStudy RunRobustnessStudy(const Config& config);
+// With a journal_path, every finished run is journaled there, and the runs of a journal
+// left by a study of the same config killed part way are taken from it instead of being
+// run again (the same bits; docs/robustness.md, "Resuming a study"); the caller removes
+// it (RemoveStudyJournal) once the results are written. Throws InputError when a matrix
+// model's truth lacks one of its zones (no reference), std::runtime_error when the
+// journal cannot be written. Precondition: config valid (as LoadConfig returns it),
+// synthetic data.
+RobustnessStudy RunRobustnessStudy(const Config& config, const std::string& journal_path = "");
 
 // ---------------------------------------------------------------------------
 // Relaxation coefficient.
@@ -260,6 +265,12 @@ std::vector<std::string> WriteRelaxationResults(const RelaxationStudy& study,
                                                 const std::string& folder, bool figures);
 std::vector<std::string> WriteCostCurveResults(const CostCurveStudy& study,
                                                const std::string& folder, bool figures);
+
+// Where `identify study` journals the runs of `study` (robustness, comparator, damage):
+// study.folder/.<study>.journal.
+std::string StudyJournalPath(const Config& config, const std::string& study);
+// Deletes that journal (nothing when there is none): the study's results are written.
+void RemoveStudyJournal(const std::string& path);
 
 // Writes folder/README.md: the summary.md of each study subfolder present
 // (robustness, relaxation, cost_curves, damage, comparator, robustness_settings,
