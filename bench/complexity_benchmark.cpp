@@ -337,98 +337,32 @@ std::string ShootingBreakdownScan() {
   return csv.str();
 }
 
-int Run(const std::string& output_dir, int max_dofs) {
-  std::vector<Measurement> measurements;
-  std::ostringstream table1;
-  table1 << "dofs,steps,relaxation_iterations,paper_riccati_macs,paper_shooting_macs,"
-            "paper_relaxation_macs\n";
-  std::printf("%-22s %5s %11s %10s %10s %6s %7s %-14s\n", "method", "n", "steps", "MACs", "seconds",
-              "iter", "sweeps", "termination");
-  for (int dofs : kDofs) {
-    if (dofs > max_dofs) break;
-    const PaperCase paper(dofs);
-    double adaptive_omega = kNaN;
-    int relaxation_iterations = -1;
-    for (const MethodSpec& method : kMethods) {
-      CoupledSolverOptions options;
-      options.type = method.type;
-      options.max_iterations = 20000;
-      Measurement measurement;
-      measurement.method = method.name;
-      measurement.dofs = dofs;
-      const long all_at_once_unknowns = 5L * dofs * (kPaperSteps + 1);
-      if (method.type == CoupledSolverType::kRelaxation) {
-        // The paper's method with a fixed omega: 0.9 times the adaptive choice, from
-        // an adaptive solve run first.
-        CoupledSolverOptions adaptive = options;
-        adaptive.type = CoupledSolverType::kAdaptiveRelaxation;
-        adaptive_omega = RunOnce(adaptive, paper.model, paper.data, paper.bar.modulus)
-                             .summary.relaxation_coefficient;
-        options.relaxation_coefficient = 0.9 * adaptive_omega;
-        measurement = Measure(method, options, paper);
-        relaxation_iterations = measurement.summary.iterations;
-        measurement.note = "omega = 0.9 x adaptive = " + Number(0.9 * adaptive_omega);
-      } else if (method.type == CoupledSolverType::kAllAtOnce &&
-                 (all_at_once_unknowns > options.max_all_at_once_unknowns ||
-                  dofs > kMaxAllAtOnceDofs)) {
-        measurement.note = "not run: " + std::to_string(all_at_once_unknowns) +
-                           " unknowns, beyond the time budget of the sparse LU";
-      } else if (method.type == CoupledSolverType::kMultipleShooting &&
-                 dofs > kMaxMultipleShootingDofs) {
-        measurement.note = "not run: 4n-column march and 4n x 4n QR per segment beyond budget";
-      } else {
-        options.max_dense_solver_bytes = 8L << 30;
-        options.max_all_at_once_bytes = 8L << 30;
-        measurement = Measure(method, options, paper);
-      }
-      if (measurement.second_steps > 0) {
-        measurement.note = "extrapolated from " + std::to_string(measurement.first_steps) +
-                           " and " + std::to_string(measurement.second_steps) + " steps";
-      }
-      if (method.type == CoupledSolverType::kAllAtOnce) {
-        measurement.note += measurement.note.empty() ? "" : "; ";
-        measurement.note += "MACs not counted (Eigen SparseLU)";
-      }
-      const bool ran = measurement.first_steps > 0;
-      std::printf(
-          "%-22s %5d %11s %10.3g %10.3g %6d %7ld %-14s %s\n", method.name.c_str(), dofs,
-          ran ? (measurement.second_steps > 0 ? (std::to_string(measurement.first_steps) + "+" +
-                                                 std::to_string(measurement.second_steps))
-                                                    .c_str()
-                                              : "1750")
-              : "-",
-          measurement.macs, measurement.seconds, measurement.summary.iterations,
-          measurement.summary.sweeps,
-          ran ? TerminationTypeToString(measurement.summary.termination) : "not_run",
-          measurement.note.c_str());
-      std::fflush(stdout);
-      measurements.push_back(measurement);
-    }
-    table1 << dofs << ',' << kPaperSteps << ',' << relaxation_iterations << ','
-           << Number(PaperRiccati(dofs, kPaperSteps)) << ','
-           << Number(PaperShooting(dofs, kPaperSteps)) << ','
-           << Number(PaperRelaxation(dofs, kPaperSteps, relaxation_iterations)) << '\n';
-  }
-
+// methods.csv: one row per measurement that ran.
+std::string MethodsCsv(const std::vector<Measurement>& measurements) {
   std::ostringstream methods_csv;
   methods_csv << "method,dofs,steps_run,second_steps_run,macs_at_1750,seconds_at_1750,"
                  "iterations,sweeps,termination,relative_residual,segments,condition_number,"
                  "note\n";
-  std::map<std::string, std::vector<std::pair<double, double>>> macs_points, seconds_points;
-  std::map<std::pair<std::string, int>, const Measurement*> by_key;
   for (const Measurement& m : measurements) {
-    by_key[{m.method, m.dofs}] = &m;
     if (m.first_steps == 0) continue;
-    macs_points[m.method].push_back({m.dofs, m.macs});
-    seconds_points[m.method].push_back({m.dofs, m.seconds});
     methods_csv << m.method << ',' << m.dofs << ',' << m.first_steps << ',' << m.second_steps << ','
                 << Number(m.macs) << ',' << Number(m.seconds) << ',' << m.summary.iterations << ','
                 << m.summary.sweeps << ',' << TerminationTypeToString(m.summary.termination) << ','
                 << Number(m.summary.relative_residual) << ',' << m.summary.shooting_segments << ','
                 << Number(m.summary.shooting_condition_number) << ",\"" << m.note << "\"\n";
   }
+  return methods_csv.str();
+}
 
-  // Fitted growth exponents in n, over n >= 50 (asymptotic) and over all n.
+// Fitted growth exponents in n, over n >= 50 (asymptotic) and over all n, printed
+// with the paper's Table 1's; returns exponents.csv.
+std::string FittedExponentsCsv(const std::vector<Measurement>& measurements) {
+  std::map<std::string, std::vector<std::pair<double, double>>> macs_points, seconds_points;
+  for (const Measurement& m : measurements) {
+    if (m.first_steps == 0) continue;
+    macs_points[m.method].push_back({m.dofs, m.macs});
+    seconds_points[m.method].push_back({m.dofs, m.seconds});
+  }
   std::ostringstream exponents_csv;
   exponents_csv << "method,points,macs_exponent_n_ge_50,seconds_exponent_n_ge_50,"
                    "macs_exponent_all,seconds_exponent_all\n";
@@ -449,8 +383,14 @@ int Run(const std::string& output_dir, int max_dofs) {
               FittedExponent({{50, PaperShooting(50, 1750)}, {1000, PaperShooting(1000, 1750)}}, 0),
               FittedExponent(
                   {{50, PaperRelaxation(50, 1750, 1)}, {1000, PaperRelaxation(1000, 1750, 1)}}, 0));
+  return exponents_csv.str();
+}
 
-  // Ratios at the paper's size.
+// The ratios to conjugate gradients at the paper's size n = 101, and the paper's
+// Table 1 ratios beside ours, on stdout.
+void PrintRatiosAtPaperSize(const std::vector<Measurement>& measurements) {
+  std::map<std::pair<std::string, int>, const Measurement*> by_key;
+  for (const Measurement& m : measurements) by_key[{m.method, m.dofs}] = &m;
   auto at_paper = [&](const std::string& name) -> const Measurement* {
     auto it = by_key.find({name, kPaperDofs});
     return it == by_key.end() || it->second->first_steps == 0 ? nullptr : it->second;
@@ -484,11 +424,100 @@ int Run(const std::string& output_dir, int max_dofs) {
                                       : kNaN);
     }
   }
+}
+
+// One method at n = dofs on the paper's case: measured, or not run beyond its budget;
+// the fixed-omega relaxation (0.9 times the omega of an adaptive solve run first) sets
+// relaxation_iterations.
+Measurement MeasureMethodAt(const MethodSpec& method, const PaperCase& paper, int dofs,
+                            int* relaxation_iterations) {
+  CoupledSolverOptions options;
+  options.type = method.type;
+  options.max_iterations = 20000;
+  Measurement measurement;
+  measurement.method = method.name;
+  measurement.dofs = dofs;
+  const long all_at_once_unknowns = 5L * dofs * (kPaperSteps + 1);
+  if (method.type == CoupledSolverType::kRelaxation) {
+    // The paper's method with a fixed omega: 0.9 times the adaptive choice, from
+    // an adaptive solve run first.
+    CoupledSolverOptions adaptive = options;
+    adaptive.type = CoupledSolverType::kAdaptiveRelaxation;
+    const double adaptive_omega = RunOnce(adaptive, paper.model, paper.data, paper.bar.modulus)
+                                      .summary.relaxation_coefficient;
+    options.relaxation_coefficient = 0.9 * adaptive_omega;
+    measurement = Measure(method, options, paper);
+    *relaxation_iterations = measurement.summary.iterations;
+    measurement.note = "omega = 0.9 x adaptive = " + Number(0.9 * adaptive_omega);
+  } else if (method.type == CoupledSolverType::kAllAtOnce &&
+             (all_at_once_unknowns > options.max_all_at_once_unknowns ||
+              dofs > kMaxAllAtOnceDofs)) {
+    measurement.note = "not run: " + std::to_string(all_at_once_unknowns) +
+                       " unknowns, beyond the time budget of the sparse LU";
+  } else if (method.type == CoupledSolverType::kMultipleShooting &&
+             dofs > kMaxMultipleShootingDofs) {
+    measurement.note = "not run: 4n-column march and 4n x 4n QR per segment beyond budget";
+  } else {
+    options.max_dense_solver_bytes = 8L << 30;
+    options.max_all_at_once_bytes = 8L << 30;
+    measurement = Measure(method, options, paper);
+  }
+  if (measurement.second_steps > 0) {
+    measurement.note = "extrapolated from " + std::to_string(measurement.first_steps) + " and " +
+                       std::to_string(measurement.second_steps) + " steps";
+  }
+  if (method.type == CoupledSolverType::kAllAtOnce) {
+    measurement.note += measurement.note.empty() ? "" : "; ";
+    measurement.note += "MACs not counted (Eigen SparseLU)";
+  }
+  return measurement;
+}
+
+// One measurement's line of the table on stdout.
+void PrintMeasurement(const MethodSpec& method, int dofs, const Measurement& measurement) {
+  const bool ran = measurement.first_steps > 0;
+  std::printf("%-22s %5d %11s %10.3g %10.3g %6d %7ld %-14s %s\n", method.name.c_str(), dofs,
+              ran ? (measurement.second_steps > 0 ? (std::to_string(measurement.first_steps) + "+" +
+                                                     std::to_string(measurement.second_steps))
+                                                        .c_str()
+                                                  : "1750")
+                  : "-",
+              measurement.macs, measurement.seconds, measurement.summary.iterations,
+              measurement.summary.sweeps,
+              ran ? TerminationTypeToString(measurement.summary.termination) : "not_run",
+              measurement.note.c_str());
+  std::fflush(stdout);
+}
+
+int Run(const std::string& output_dir, int max_dofs) {
+  std::vector<Measurement> measurements;
+  std::ostringstream table1;
+  table1 << "dofs,steps,relaxation_iterations,paper_riccati_macs,paper_shooting_macs,"
+            "paper_relaxation_macs\n";
+  std::printf("%-22s %5s %11s %10s %10s %6s %7s %-14s\n", "method", "n", "steps", "MACs", "seconds",
+              "iter", "sweeps", "termination");
+  for (int dofs : kDofs) {
+    if (dofs > max_dofs) break;
+    const PaperCase paper(dofs);
+    int relaxation_iterations = -1;
+    for (const MethodSpec& method : kMethods) {
+      const Measurement measurement = MeasureMethodAt(method, paper, dofs, &relaxation_iterations);
+      PrintMeasurement(method, dofs, measurement);
+      measurements.push_back(measurement);
+    }
+    table1 << dofs << ',' << kPaperSteps << ',' << relaxation_iterations << ','
+           << Number(PaperRiccati(dofs, kPaperSteps)) << ','
+           << Number(PaperShooting(dofs, kPaperSteps)) << ','
+           << Number(PaperRelaxation(dofs, kPaperSteps, relaxation_iterations)) << '\n';
+  }
+  const std::string methods_csv = MethodsCsv(measurements);
+  const std::string exponents_csv = FittedExponentsCsv(measurements);
+  PrintRatiosAtPaperSize(measurements);
 
   const std::string breakdown = ShootingBreakdownScan();
-  WriteFileAtomically(output_dir + "/methods.csv", methods_csv.str());
+  WriteFileAtomically(output_dir + "/methods.csv", methods_csv);
   WriteFileAtomically(output_dir + "/paper_table1.csv", table1.str());
-  WriteFileAtomically(output_dir + "/exponents.csv", exponents_csv.str());
+  WriteFileAtomically(output_dir + "/exponents.csv", exponents_csv);
   WriteFileAtomically(output_dir + "/shooting_breakdown.csv", breakdown);
   return 0;
 }

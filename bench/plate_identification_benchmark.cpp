@@ -206,51 +206,53 @@ void WriteErrorMap(const MatrixModelData& coarse, const std::string& coarse_fold
   if (!why.empty()) std::fprintf(stderr, "error_map.png skipped: %s\n", why.c_str());
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  // OUTPUT_DIR, then --key=value options.
+// The benchmark's command line: OUTPUT_DIR, then --key=value options.
+struct PlateArguments {
   std::string folder, load = "transverse", model_folder = kPlate + "coarse",
                       truth_folder = kPlate + "fine";
   int seeds = 20, threads = 2;
+};
+
+// Reads the command line into arguments; 0, or the exit status 2 after an error or the
+// usage on stderr.
+int ParsePlateArguments(int argc, char** argv, PlateArguments* arguments) {
   for (int a = 1; a < argc; ++a) {
     const std::string argument = argv[a];
     const std::size_t equals = argument.find('=');
     const std::string key = argument.substr(0, equals);
     const std::string value = equals == std::string::npos ? "" : argument.substr(equals + 1);
     if (argument.rfind("--", 0) != 0) {
-      folder = argument;
+      arguments->folder = argument;
     } else if (key == "--seeds") {
-      seeds = std::atoi(value.c_str());
+      arguments->seeds = std::atoi(value.c_str());
     } else if (key == "--threads") {
-      threads = std::atoi(value.c_str());
+      arguments->threads = std::atoi(value.c_str());
     } else if (key == "--load") {
-      load = value;
+      arguments->load = value;
     } else if (key == "--model") {
-      model_folder = value;
+      arguments->model_folder = value;
     } else if (key == "--truth") {
-      truth_folder = value;
+      arguments->truth_folder = value;
     } else {
       std::fprintf(stderr, "error: unknown option %s\n", argument.c_str());
       return 2;
     }
   }
-  if (folder.empty() || seeds < 1 || threads < 1 || (load != "transverse" && load != "axial")) {
+  if (arguments->folder.empty() || arguments->seeds < 1 || arguments->threads < 1 ||
+      (arguments->load != "transverse" && arguments->load != "axial")) {
     std::fprintf(stderr,
                  "usage: %s OUTPUT_DIR [--seeds=20] [--threads=2] [--load=transverse|axial] "
                  "[--model=FOLDER] [--truth=FOLDER]\n",
                  argv[0]);
     return 2;
   }
-  MatrixModelData coarse = ReadMatrixModel(model_folder + "/model.yaml");
-  MatrixModelData fine = ReadMatrixModel(truth_folder + "/model.yaml");
-  if (load == "axial") {
-    coarse.loads[0].vector = AxialEdgeLoad(model_folder + "/nodes.csv", coarse.dofs());
-    fine.loads[0].vector = AxialEdgeLoad(truth_folder + "/nodes.csv", fine.dofs());
-  }
-  const ChannelSet truth = FineTruth(fine);
-  WriteErrorMap(coarse, model_folder, truth, folder);
+  return 0;
+}
 
+// The runs at SNR inf (once), 20 and 10 (seeds 1..seeds each), identified from the
+// truth on threads threads.
+std::vector<Run> PlateRuns(const MatrixModelData& coarse, const ChannelSet& truth, int seeds,
+                           int threads) {
   std::vector<Run> runs;
   for (const double snr : {std::numeric_limits<double>::infinity(), 20.0, 10.0}) {
     for (int seed = 1; seed <= (std::isinf(snr) ? 1 : seeds); ++seed) {
@@ -270,8 +272,11 @@ int main(int argc, char** argv) {
   std::vector<std::thread> pool;
   for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
   for (std::thread& thread : pool) thread.join();
+  return runs;
+}
 
-  const Vector truth_moduli = TruthModuli();
+// runs.csv: one row per identification, the errors against the truth's moduli.
+std::string PlateRunsCsv(const std::vector<Run>& runs, const Vector& truth_moduli) {
   std::ostringstream csv;
   csv.precision(17);
   csv << "snr,seed,converged,matrix_modulus,inclusion_modulus,matrix_error,inclusion_error,"
@@ -282,8 +287,14 @@ int main(int argc, char** argv) {
         << run.moduli[1] / truth_moduli[1] - 1.0 << ',' << run.evaluations << ',' << run.wall_time_s
         << '\n';
   }
-  WriteFileAtomically(folder + "/runs.csv", csv.str());
+  return csv.str();
+}
 
+// summary.md: per SNR the statistics of the converged runs (also on stdout), and the
+// issue's goals.
+void WritePlateSummary(const std::string& folder, const MatrixModelData& coarse,
+                       const MatrixModelData& fine, const std::string& load, int seeds,
+                       const std::vector<Run>& runs, const Vector& truth_moduli) {
   std::ostringstream summary;
   summary << "# The plate example: both zone moduli from the fine plate's data\n\n"
           << "`plate_identification_benchmark` (bench/; docs/matrix_models.md): the model "
@@ -332,7 +343,10 @@ int main(int argc, char** argv) {
           << "error_map.png: the MCRE error map at the homogeneous 200 GPa from the noise-free "
              "data (the inclusion outlined); runs.csv: every identification.\n";
   WriteFileAtomically(folder + "/summary.md", summary.str());
+}
 
+// moduli.png: the identified zone moduli at SNR 20 and 10 around the truth.
+void DrawModuliFigure(const std::string& folder) {
   std::ostringstream script;
   script << GnuplotPngTerminal()
          << "set title 'Identified zone moduli of the plate (truth: 200 / 140 GPa)'\n"
@@ -346,5 +360,29 @@ int main(int argc, char** argv) {
   bool gnuplot_missing = false;
   const std::string why = DrawGnuplotFigure(folder, "moduli", script.str(), &gnuplot_missing);
   if (!why.empty()) std::fprintf(stderr, "moduli.png skipped: %s\n", why.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  PlateArguments arguments;
+  const int status = ParsePlateArguments(argc, argv, &arguments);
+  if (status != 0) return status;
+  const std::string& folder = arguments.folder;
+  const std::string& model_folder = arguments.model_folder;
+  const std::string& truth_folder = arguments.truth_folder;
+  MatrixModelData coarse = ReadMatrixModel(model_folder + "/model.yaml");
+  MatrixModelData fine = ReadMatrixModel(truth_folder + "/model.yaml");
+  if (arguments.load == "axial") {
+    coarse.loads[0].vector = AxialEdgeLoad(model_folder + "/nodes.csv", coarse.dofs());
+    fine.loads[0].vector = AxialEdgeLoad(truth_folder + "/nodes.csv", fine.dofs());
+  }
+  const ChannelSet truth = FineTruth(fine);
+  WriteErrorMap(coarse, model_folder, truth, folder);
+  const std::vector<Run> runs = PlateRuns(coarse, truth, arguments.seeds, arguments.threads);
+  const Vector truth_moduli = TruthModuli();
+  WriteFileAtomically(folder + "/runs.csv", PlateRunsCsv(runs, truth_moduli));
+  WritePlateSummary(folder, coarse, fine, arguments.load, arguments.seeds, runs, truth_moduli);
+  DrawModuliFigure(folder);
   return 0;
 }

@@ -92,49 +92,33 @@ Outcome IdentifyOnce(const mcrewave::BarModel& model, const mcrewave::ChannelSet
   return outcome;
 }
 
-}  // namespace
+// One identification to run: a setting, an SNR (indices) and a noise seed.
+struct RobustnessJob {
+  int setting;
+  int snr;
+  int seed;
+};
 
-int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: %s OUTPUT_DIR [seeds]\n", argv[0]);
-    return 2;
-  }
-  spdlog::set_level(spdlog::level::warn);
-  const std::string output_dir = argv[1];
-  const int seeds = argc > 2 ? std::atoi(argv[2]) : 50;
-  const mcrewave::BarProperties bar;
-  const mcrewave::LoadOptions load;
-  const mcrewave::TimeOptions time;
-  const mcrewave::DataOptions truth_options;  // finite-element truth, refinement 4
-  const mcrewave::BarModel model(bar);
-  const double reference = bar.modulus;
-  const mcrewave::ChannelSet truth = mcrewave::SimulateTruth(bar, load, time, truth_options);
-
-  const std::vector<Setting> settings = {
-      {"local_only_w0.01", 0.01, 1.0, false, 0},
-      {"scan_w0.01", 0.01, 1.0, false, 41},
-      {"scan_w0.01_prefilter", 0.01, 1.0, true, 41},
-      {"scan121_w0.01_prefilter", 0.01, 1.0, true, 121},
-      {"scan_w0.003_prefilter", 0.003, 1.0, true, 41},
-      {"scan_w0.03_prefilter", 0.03, 1.0, true, 41},
-      {"scan_w0.01_wf0.1_prefilter", 0.01, 0.1, true, 41},
-      {"scan_w0.01_wf10_prefilter", 0.01, 10.0, true, 41},
-  };
-  const std::vector<double> snrs = {std::numeric_limits<double>::infinity(), 2.5, 5.0};
-
-  // Jobs: (setting, snr, seed); the noise-free case once per setting.
-  struct Job {
-    int setting;
-    int snr;
-    int seed;
-  };
-  std::vector<Job> jobs;
-  for (int s = 0; s < static_cast<int>(settings.size()); ++s) {
+// Jobs: (setting, snr, seed) for seeds 1..seeds; the noise-free case once per setting.
+std::vector<RobustnessJob> RobustnessJobs(int num_settings, const std::vector<double>& snrs,
+                                          int seeds) {
+  std::vector<RobustnessJob> jobs;
+  for (int s = 0; s < num_settings; ++s) {
     for (int k = 0; k < static_cast<int>(snrs.size()); ++k) {
       const int count = std::isinf(snrs[k]) ? 1 : seeds;
       for (int seed = 1; seed <= count; ++seed) jobs.push_back({s, k, seed});
     }
   }
+  return jobs;
+}
+
+// Runs every job on two threads, the truth plus the job's noise, reporting progress on
+// stderr; the outcomes in the jobs' order.
+std::vector<Outcome> RunRobustnessJobs(const mcrewave::BarModel& model,
+                                       const mcrewave::ChannelSet& truth,
+                                       const std::vector<Setting>& settings,
+                                       const std::vector<double>& snrs,
+                                       const std::vector<RobustnessJob>& jobs, double reference) {
   std::vector<Outcome> outcomes(jobs.size());
   std::atomic<int> next{0};
   std::mutex progress_mutex;
@@ -142,7 +126,7 @@ int main(int argc, char** argv) {
   const auto start = std::chrono::steady_clock::now();
   auto worker = [&]() {
     for (int j = next++; j < static_cast<int>(jobs.size()); j = next++) {
-      const Job& job = jobs[j];
+      const RobustnessJob& job = jobs[j];
       mcrewave::ChannelSet measured = truth;
       mcrewave::AddMeasurementNoise(snrs[job.snr], static_cast<std::uint64_t>(job.seed), &measured);
       outcomes[j] = IdentifyOnce(model, measured, settings[job.setting], reference);
@@ -158,7 +142,14 @@ int main(int argc, char** argv) {
   worker();
   second.join();
   std::fprintf(stderr, "\n");
+  return outcomes;
+}
 
+// identifications.csv: one row per identification.
+std::string IdentificationRows(const std::vector<Setting>& settings,
+                               const std::vector<double>& snrs,
+                               const std::vector<RobustnessJob>& jobs,
+                               const std::vector<Outcome>& outcomes) {
   std::ostringstream rows;
   rows << "setting,w_u,w_f,prefilter,scan_points,snr,seed,relative_error,local_minima,"
           "evaluations,cutoff_hz,wall_time_s\n";
@@ -170,8 +161,15 @@ int main(int argc, char** argv) {
          << "," << jobs[j].seed << "," << o.relative_error << "," << o.local_minima << ","
          << o.evaluations << "," << o.cutoff << "," << o.wall_time_s << "\n";
   }
-  mcrewave::WriteFileAtomically(output_dir + "/identifications.csv", rows.str());
+  return rows.str();
+}
 
+// Per setting and noisy SNR the statistics over the seeds into settings.csv and
+// summary.md (and a table on stdout).
+void WriteSettingsTables(const std::string& output_dir, int seeds,
+                         const std::vector<Setting>& settings, const std::vector<double>& snrs,
+                         const std::vector<RobustnessJob>& jobs,
+                         const std::vector<Outcome>& outcomes) {
   std::ostringstream table;
   table << "setting,snr,seeds,noise_free_error,mean_error,q2.5_error,q97.5_error,"
            "share_within_2pct,mean_local_minima,mean_evaluations,mean_time_s,failures\n";
@@ -235,5 +233,46 @@ int main(int argc, char** argv) {
   }
   mcrewave::WriteFileAtomically(output_dir + "/settings.csv", table.str());
   mcrewave::WriteFileAtomically(output_dir + "/summary.md", md.str() + "\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: %s OUTPUT_DIR [seeds]\n", argv[0]);
+    return 2;
+  }
+  spdlog::set_level(spdlog::level::warn);
+  const std::string output_dir = argv[1];
+  const int seeds = argc > 2 ? std::atoi(argv[2]) : 50;
+  const mcrewave::BarProperties bar;
+  const mcrewave::LoadOptions load;
+  const mcrewave::TimeOptions time;
+  const mcrewave::DataOptions truth_options;  // finite-element truth, refinement 4
+  const mcrewave::BarModel model(bar);
+  const double reference = bar.modulus;
+  const mcrewave::ChannelSet truth = mcrewave::SimulateTruth(bar, load, time, truth_options);
+
+  const std::vector<Setting> settings = {
+      {"local_only_w0.01", 0.01, 1.0, false, 0},
+      {"scan_w0.01", 0.01, 1.0, false, 41},
+      {"scan_w0.01_prefilter", 0.01, 1.0, true, 41},
+      {"scan121_w0.01_prefilter", 0.01, 1.0, true, 121},
+      {"scan_w0.003_prefilter", 0.003, 1.0, true, 41},
+      {"scan_w0.03_prefilter", 0.03, 1.0, true, 41},
+      {"scan_w0.01_wf0.1_prefilter", 0.01, 0.1, true, 41},
+      {"scan_w0.01_wf10_prefilter", 0.01, 10.0, true, 41},
+  };
+  const std::vector<double> snrs = {std::numeric_limits<double>::infinity(), 2.5, 5.0};
+
+  // Jobs: (setting, snr, seed); the noise-free case once per setting.
+  const std::vector<RobustnessJob> jobs =
+      RobustnessJobs(static_cast<int>(settings.size()), snrs, seeds);
+  const std::vector<Outcome> outcomes =
+      RunRobustnessJobs(model, truth, settings, snrs, jobs, reference);
+
+  mcrewave::WriteFileAtomically(output_dir + "/identifications.csv",
+                                IdentificationRows(settings, snrs, jobs, outcomes));
+  WriteSettingsTables(output_dir, seeds, settings, snrs, jobs, outcomes);
   return 0;
 }

@@ -20,8 +20,8 @@
 namespace mcrewave {
 namespace {
 
-// Every key of the two configs is equal (NaN never occurs in a valid config).
-void ExpectSameConfig(const Config& expected, const Config& actual) {
+// The keys model.*, load.*, time.* and data.* up to data.seed.
+void ExpectSameConfigModelToData(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.model.length, actual.model.length);
   EXPECT_EQ(expected.model.section, actual.model.section);
   EXPECT_EQ(expected.model.density, actual.model.density);
@@ -40,6 +40,10 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.data.truth_refinement, actual.data.truth_refinement);
   EXPECT_EQ(expected.data.snr, actual.data.snr);
   EXPECT_EQ(expected.data.seed, actual.data.seed);
+}
+
+// The weights w_u and w_f, mcre.reference_modulus and inner.*.
+void ExpectSameConfigMcreAndInner(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.mcre.weights.displacement_weight, actual.mcre.weights.displacement_weight);
   EXPECT_EQ(expected.mcre.weights.force_weight, actual.mcre.weights.force_weight);
   EXPECT_EQ(expected.mcre.reference_modulus, actual.mcre.reference_modulus);
@@ -56,6 +60,10 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.inner.max_field_bytes, actual.inner.max_field_bytes);
   EXPECT_EQ(expected.inner.shooting_condition_limit, actual.inner.shooting_condition_limit);
   EXPECT_EQ(expected.inner.shooting_segment_growth, actual.inner.shooting_segment_growth);
+}
+
+// The keys outer.*, prefilter.*, uncertainty.* and output.*.
+void ExpectSameConfigOuterToOutput(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.outer.optimizer, actual.outer.optimizer);
   EXPECT_EQ(expected.outer.algorithm, actual.outer.algorithm);
   EXPECT_EQ(expected.outer.lower_bound, actual.outer.lower_bound);
@@ -81,6 +89,10 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.output.folder, actual.output.folder);
   EXPECT_EQ(expected.output.figures, actual.output.figures);
   EXPECT_EQ(expected.output.curve_points, actual.output.curve_points);
+}
+
+// The keys study.* up to study.comparator_errors.
+void ExpectSameConfigStudy(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.study.kind, actual.study.kind);
   EXPECT_EQ(expected.study.folder, actual.study.folder);
   EXPECT_EQ(expected.study.threads, actual.study.threads);
@@ -103,6 +115,10 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.study.comparator_snr, actual.study.comparator_snr);
   EXPECT_EQ(expected.study.comparator_seeds, actual.study.comparator_seeds);
   EXPECT_EQ(expected.study.comparator_errors, actual.study.comparator_errors);
+}
+
+// The keys zones.*, data.sensors, data.channels and data.truth_zones.
+void ExpectSameConfigZonesAndSensors(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.zones.zoning, actual.zones.zoning);
   EXPECT_EQ(expected.zones.zone_count, actual.zones.zone_count);
   EXPECT_EQ(expected.zones.zone_boundaries, actual.zones.zone_boundaries);
@@ -114,6 +130,11 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
     EXPECT_EQ(expected.data.truth_zones[i].end, actual.data.truth_zones[i].end);
     EXPECT_EQ(expected.data.truth_zones[i].modulus, actual.data.truth_zones[i].modulus);
   }
+}
+
+// The keys added later: the other mcre weights, mcre.clamp, search.*,
+// study.comparator_data, structure.*, data.truth_manifest and data.truth_moduli.
+void ExpectSameConfigLaterKeys(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.mcre.weights.strain_weight, actual.mcre.weights.strain_weight);
   EXPECT_EQ(expected.mcre.weights.reaction_weight, actual.mcre.weights.reaction_weight);
   EXPECT_EQ(expected.mcre.weights.clamp_displacement_weight,
@@ -133,6 +154,10 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.structure.channel_map, actual.structure.channel_map);
   EXPECT_EQ(expected.data.truth_manifest, actual.data.truth_manifest);
   EXPECT_EQ(expected.data.truth_moduli, actual.data.truth_moduli);
+}
+
+// The keys zone_identification.*.
+void ExpectSameConfigZoneIdentification(const Config& expected, const Config& actual) {
   const ZoneIdentificationOptions& zones = expected.zone_identification;
   const ZoneIdentificationOptions& zones_again = actual.zone_identification;
   EXPECT_EQ(zones.minimizer.optimizer, zones_again.minimizer.optimizer);
@@ -154,6 +179,17 @@ void ExpectSameConfig(const Config& expected, const Config& actual) {
   EXPECT_EQ(zones.noise_samples, zones_again.noise_samples);
   EXPECT_EQ(zones.noise_seed, zones_again.noise_seed);
   EXPECT_EQ(zones.merge_zones, zones_again.merge_zones);
+}
+
+// Every key of the two configs is equal (NaN never occurs in a valid config).
+void ExpectSameConfig(const Config& expected, const Config& actual) {
+  ExpectSameConfigModelToData(expected, actual);
+  ExpectSameConfigMcreAndInner(expected, actual);
+  ExpectSameConfigOuterToOutput(expected, actual);
+  ExpectSameConfigStudy(expected, actual);
+  ExpectSameConfigZonesAndSensors(expected, actual);
+  ExpectSameConfigLaterKeys(expected, actual);
+  ExpectSameConfigZoneIdentification(expected, actual);
 }
 
 // Runs `action`, which must throw InputError whose message contains every one of

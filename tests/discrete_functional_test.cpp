@@ -35,71 +35,87 @@ struct KktSolution {
   double cost = 0.0;             // J at the minimum [J s]
 };
 
-KktSolution MinimiseDenseFunctional(const BarModel& model, const ChannelSet& data, double modulus,
-                                    double alpha, double beta, double theta) {
-  const Eigen::MatrixXd mass = Eigen::MatrixXd(model.mass());
-  const Eigen::MatrixXd stiffness = modulus * Eigen::MatrixXd(model.unit_stiffness());
-  const int n = model.num_nodes(), m = data.num_steps();
+// Offsets of the unknowns in z = (U_1..U_m, V_1..V_m, W_0..W_m, F_0..F_m).
+struct KktOffsets {
+  int n, m;
+  int u(int k) const { return (k - 1) * n; }  // k = 1..m
+  int v(int k) const { return n * m + (k - 1) * n; }
+  int w(int j) const { return 2 * n * m + j * n; }  // j = 0..m
+  int f(int j) const { return 2 * n * m + n * (m + 1) + 2 * j; }
+  int unknowns() const { return 2 * n * m + n * (m + 1) + 2 * (m + 1); }
+  int constraints() const { return 2 * n * m; }
+};
+
+// J = 1/2 z^T H z - g^T z + constant: the hessian H, the linear term g and the constant.
+void DenseFunctionalTerms(const ChannelSet& data, const Eigen::MatrixXd& stiffness,
+                          const KktOffsets& at, double alpha, double beta, Eigen::MatrixXd* hessian,
+                          Eigen::VectorXd* linear, double* constant) {
+  const int n = at.n, m = at.m;
   const double h = data.time_step;
   auto c = [m](int j) { return (j == 0 || j == m) ? 0.5 : 1.0; };
-  // Offsets of the unknowns in z.
-  auto u = [n](int k) { return (k - 1) * n; };  // k = 1..m
-  auto v = [n, m](int k) { return n * m + (k - 1) * n; };
-  auto w = [n, m](int j) { return 2 * n * m + j * n; };  // j = 0..m
-  auto f = [n, m](int j) { return 2 * n * m + n * (m + 1) + 2 * j; };
-  const int unknowns = 2 * n * m + n * (m + 1) + 2 * (m + 1);
-  const int constraints = 2 * n * m;
-
-  // J = 1/2 z^T H z - g^T z + constant.
-  Eigen::MatrixXd hessian = Eigen::MatrixXd::Zero(unknowns, unknowns);
-  Eigen::VectorXd linear = Eigen::VectorXd::Zero(unknowns);
-  double constant = 0.0;
+  *hessian = Eigen::MatrixXd::Zero(at.unknowns(), at.unknowns());
+  *linear = Eigen::VectorXd::Zero(at.unknowns());
+  *constant = 0.0;
   const int ends[2] = {0, n - 1};
   for (int j = 0; j <= m; ++j) {
     const double weight = c(j) * h;
-    hessian.block(w(j), w(j), n, n) += weight * stiffness;
+    hessian->block(at.w(j), at.w(j), n, n) += weight * stiffness;
     const double measured_force[2] = {data.Values("f0")[j], data.Values("fL")[j]};
     const double measured_displacement[2] = {data.Values("u0")[j], data.Values("uL")[j]};
     for (int e = 0; e < 2; ++e) {
-      hessian(f(j) + e, f(j) + e) += weight * alpha;
-      linear[f(j) + e] += weight * alpha * measured_force[e];
-      constant += 0.5 * weight * alpha * measured_force[e] * measured_force[e];
-      constant += 0.5 * weight * beta * measured_displacement[e] * measured_displacement[e];
+      (*hessian)(at.f(j) + e, at.f(j) + e) += weight * alpha;
+      (*linear)[at.f(j) + e] += weight * alpha * measured_force[e];
+      *constant += 0.5 * weight * alpha * measured_force[e] * measured_force[e];
+      *constant += 0.5 * weight * beta * measured_displacement[e] * measured_displacement[e];
       if (j > 0) {
-        hessian(u(j) + ends[e], u(j) + ends[e]) += weight * beta;
-        linear[u(j) + ends[e]] += weight * beta * measured_displacement[e];
+        (*hessian)(at.u(j) + ends[e], at.u(j) + ends[e]) += weight * beta;
+        (*linear)[at.u(j) + ends[e]] += weight * beta * measured_displacement[e];
       }
     }
   }
+}
 
-  // (D1) M (V_{k+1} - V_k) + h K [theta (U + W)_{k+1} + (1 - theta)(U + W)_k]
-  //        - h [theta F_{k+1} + (1 - theta) F_k] = 0,
-  // (D2) U_{k+1} - U_k - h [theta V_{k+1} + (1 - theta) V_k] = 0, k = 0..m-1.
-  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(constraints, unknowns);
+// The theta scheme's constraints A z = 0:
+// (D1) M (V_{k+1} - V_k) + h K [theta (U + W)_{k+1} + (1 - theta)(U + W)_k]
+//        - h [theta F_{k+1} + (1 - theta) F_k] = 0,
+// (D2) U_{k+1} - U_k - h [theta V_{k+1} + (1 - theta) V_k] = 0, k = 0..m-1.
+Eigen::MatrixXd DenseSchemeConstraints(const Eigen::MatrixXd& mass,
+                                       const Eigen::MatrixXd& stiffness, const KktOffsets& at,
+                                       double h, double theta) {
+  const int n = at.n, m = at.m;
+  const int ends[2] = {0, n - 1};
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(at.constraints(), at.unknowns());
   const Eigen::MatrixXd identity = Eigen::MatrixXd::Identity(n, n);
   for (int k = 0; k < m; ++k) {
     const int d1 = 2 * n * k, d2 = d1 + n;
-    a.block(d1, v(k + 1), n, n) += mass;
-    if (k > 0) a.block(d1, v(k), n, n) -= mass;
-    a.block(d1, u(k + 1), n, n) += h * theta * stiffness;
-    if (k > 0) a.block(d1, u(k), n, n) += h * (1.0 - theta) * stiffness;
-    a.block(d1, w(k + 1), n, n) += h * theta * stiffness;
-    a.block(d1, w(k), n, n) += h * (1.0 - theta) * stiffness;
+    a.block(d1, at.v(k + 1), n, n) += mass;
+    if (k > 0) a.block(d1, at.v(k), n, n) -= mass;
+    a.block(d1, at.u(k + 1), n, n) += h * theta * stiffness;
+    if (k > 0) a.block(d1, at.u(k), n, n) += h * (1.0 - theta) * stiffness;
+    a.block(d1, at.w(k + 1), n, n) += h * theta * stiffness;
+    a.block(d1, at.w(k), n, n) += h * (1.0 - theta) * stiffness;
     for (int e = 0; e < 2; ++e) {
-      a(d1 + ends[e], f(k + 1) + e) -= h * theta;
-      a(d1 + ends[e], f(k) + e) -= h * (1.0 - theta);
+      a(d1 + ends[e], at.f(k + 1) + e) -= h * theta;
+      a(d1 + ends[e], at.f(k) + e) -= h * (1.0 - theta);
     }
-    a.block(d2, u(k + 1), n, n) += identity;
-    if (k > 0) a.block(d2, u(k), n, n) -= identity;
-    a.block(d2, v(k + 1), n, n) -= h * theta * identity;
-    if (k > 0) a.block(d2, v(k), n, n) -= h * (1.0 - theta) * identity;
+    a.block(d2, at.u(k + 1), n, n) += identity;
+    if (k > 0) a.block(d2, at.u(k), n, n) -= identity;
+    a.block(d2, at.v(k + 1), n, n) -= h * theta * identity;
+    if (k > 0) a.block(d2, at.v(k), n, n) -= h * (1.0 - theta) * identity;
   }
+  return a;
+}
 
-  // W is fixed to zero mean at every j (its rigid translation is seen by neither J
-  // nor the constraints): m + 1 more rows, so that the KKT matrix is regular.
+// z minimising 1/2 z^T H z - g^T z subject to A z = 0, with W fixed to zero mean at
+// every j (its rigid translation is seen by neither J nor the constraints): m + 1 more
+// rows, so that the KKT matrix is regular.
+Eigen::VectorXd SolveGaugedKkt(const Eigen::MatrixXd& hessian, const Eigen::VectorXd& linear,
+                               const Eigen::MatrixXd& a, const KktOffsets& at) {
+  const int n = at.n, m = at.m;
+  const int unknowns = at.unknowns(), constraints = at.constraints();
   const int gauges = m + 1;
   Eigen::MatrixXd gauge = Eigen::MatrixXd::Zero(gauges, unknowns);
-  for (int j = 0; j <= m; ++j) gauge.block(j, w(j), 1, n).setOnes();
+  for (int j = 0; j <= m; ++j) gauge.block(j, at.w(j), 1, n).setOnes();
   const int size = unknowns + constraints + gauges;
   Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(size, size);
   kkt.topLeftCorner(unknowns, unknowns) = hessian;
@@ -118,8 +134,21 @@ KktSolution MinimiseDenseFunctional(const BarModel& model, const ChannelSet& dat
     scaled = row.asDiagonal() * scaled * row.asDiagonal();
     scale = scale.cwiseProduct(row);
   }
-  const Eigen::VectorXd z =
-      scale.cwiseProduct(scaled.fullPivLu().solve(scale.cwiseProduct(rhs))).head(unknowns);
+  return scale.cwiseProduct(scaled.fullPivLu().solve(scale.cwiseProduct(rhs))).head(unknowns);
+}
+
+KktSolution MinimiseDenseFunctional(const BarModel& model, const ChannelSet& data, double modulus,
+                                    double alpha, double beta, double theta) {
+  const Eigen::MatrixXd mass = Eigen::MatrixXd(model.mass());
+  const Eigen::MatrixXd stiffness = modulus * Eigen::MatrixXd(model.unit_stiffness());
+  const int n = model.num_nodes(), m = data.num_steps();
+  const KktOffsets at{n, m};
+  Eigen::MatrixXd hessian;
+  Eigen::VectorXd linear;
+  double constant = 0.0;
+  DenseFunctionalTerms(data, stiffness, at, alpha, beta, &hessian, &linear, &constant);
+  const Eigen::MatrixXd a = DenseSchemeConstraints(mass, stiffness, at, data.time_step, theta);
+  const Eigen::VectorXd z = SolveGaugedKkt(hessian, linear, a, at);
 
   KktSolution solution;
   solution.displacement = Eigen::MatrixXd::Zero(n, m + 1);
@@ -127,12 +156,12 @@ KktSolution MinimiseDenseFunctional(const BarModel& model, const ChannelSet& dat
   solution.retrograde = Eigen::MatrixXd::Zero(n, m + 1);
   solution.end_forces = Eigen::MatrixXd::Zero(2, m + 1);
   for (int k = 1; k <= m; ++k) {
-    solution.displacement.col(k) = z.segment(u(k), n);
-    solution.velocity.col(k) = z.segment(v(k), n);
+    solution.displacement.col(k) = z.segment(at.u(k), n);
+    solution.velocity.col(k) = z.segment(at.v(k), n);
   }
   for (int j = 0; j <= m; ++j) {
-    solution.retrograde.col(j) = z.segment(w(j), n);
-    solution.end_forces.col(j) = z.segment(f(j), 2);
+    solution.retrograde.col(j) = z.segment(at.w(j), n);
+    solution.end_forces.col(j) = z.segment(at.f(j), 2);
   }
   solution.cost = 0.5 * z.dot(hessian * z) - linear.dot(z) + constant;
   return solution;

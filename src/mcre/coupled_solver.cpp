@@ -113,6 +113,101 @@ bool NeedsThePapersDataTerm(CoupledSolverType type) {
          type == CoupledSolverType::kMultipleShooting;
 }
 
+namespace {
+
+// Why the solver name, holding fields of field_bytes, refuses to run above the limit
+// inner.max_field_bytes, with the ways around it for this kind of problem.
+std::string FieldLimitRefusal(const std::string& name, double field_bytes,
+                              const CoupledSolverOptions& options, CoupledProblem* problem,
+                              bool is_bar, bool is_streaming) {
+  std::ostringstream refusal;
+  refusal << name << " needs " << static_cast<long long>(field_bytes) << " bytes ("
+          << kIterativeSolverFields
+          << " fields of n x (m + 1) doubles, n = " << problem->num_nodes()
+          << " nodes, m = " << problem->num_steps() << " steps), above the limit of "
+          << options.max_field_bytes << " bytes (inner.max_field_bytes); ";
+  if (is_bar) {
+    refusal << "use inner.method: streaming_conjugate_gradient (or auto), which stores no "
+               "space-time field, raise inner.max_field_bytes, or use fewer elements or a "
+               "shorter window";
+  } else if (is_streaming) {
+    refusal << "use inner.method: streaming_conjugate_gradient (or auto), which stores no "
+               "space-time field, raise inner.max_field_bytes, or use a coarser mesh (fewer "
+               "dofs), a shorter window or a larger time step";
+  } else {
+    refusal << "raise inner.max_field_bytes, or use a coarser mesh (fewer dofs), a shorter "
+               "window or a larger time step";
+  }
+  return refusal.str();
+}
+
+// Why the resolved method type cannot solve this problem, "" when it can: Riccati and
+// shooting handle the built-in bar (bar) with the paper's end sensors only, the
+// streaming solver a problem on sensor traces (streaming).
+std::string UnsupportedProblemMessage(CoupledSolverType type, const McreProblem* bar,
+                                      const StreamingCoupledProblem* streaming) {
+  const bool comparator = NeedsThePapersDataTerm(type);
+  if (comparator && bar == nullptr) {
+    return std::string(CoupledSolverTypeToString(type)) +
+           " handles the built-in bar only; for a structure given by matrices use "
+           "inner.method: auto, conjugate_gradient, streaming_conjugate_gradient, "
+           "adaptive_relaxation, relaxation or all_at_once";
+  }
+  if (type == CoupledSolverType::kStreamingConjugateGradient && streaming == nullptr) {
+    return "streaming_conjugate_gradient needs a problem on sensor traces "
+           "(StreamingCoupledProblem); "
+           "use inner.method: conjugate_gradient, adaptive_relaxation, relaxation or all_at_once";
+  }
+  if (comparator && !bar->observes_ends_only()) {
+    // Their transfer operators are written for H = B (the two end displacements).
+    return std::string(CoupledSolverTypeToString(type)) +
+           " handles the paper's end sensors only (u0 and uL, no interior sensor, "
+           "mcre.clamp: measured); with interior sensors, an end channel left out or "
+           "a trusted or pinned clamp use inner.method: "
+           "conjugate_gradient, adaptive_relaxation, relaxation or all_at_once";
+  }
+  return "";
+}
+
+// Runs the solver of resolved.type (resolved, never auto); false, with the message in
+// summary, if it was left auto.
+bool RunResolvedSolver(const CoupledSolverOptions& resolved, CoupledProblem* problem,
+                       McreProblem* bar, StreamingCoupledProblem* streaming,
+                       const Matrix* initial_guess, CoupledSolution* solution,
+                       CoupledSolverSummary* summary) {
+  switch (resolved.type) {
+    case CoupledSolverType::kAllAtOnce:
+      internal::SolveAllAtOnce(resolved, problem, solution, summary);
+      break;
+    case CoupledSolverType::kRelaxation:
+    case CoupledSolverType::kAdaptiveRelaxation:
+      internal::SolveByRelaxation(resolved, problem, initial_guess, solution, summary);
+      break;
+    case CoupledSolverType::kConjugateGradient:
+      internal::SolveByConjugateGradient(resolved, problem, initial_guess, solution, summary);
+      break;
+    case CoupledSolverType::kRiccati:
+      internal::SolveByRiccati(resolved, bar, solution, summary);
+      break;
+    case CoupledSolverType::kSingleShooting:
+    case CoupledSolverType::kMultipleShooting:
+      internal::SolveByShooting(resolved, bar, solution, summary);
+      break;
+    case CoupledSolverType::kStreamingConjugateGradient:
+      // Fills the cost and the gradients itself, from its final streaming pass.
+      internal::SolveByStreamingConjugateGradient(resolved, streaming, initial_guess, solution,
+                                                  summary);
+      break;
+    case CoupledSolverType::kAuto:
+      // ResolveCoupledSolverType never returns it.
+      summary->message = "inner.method auto was not resolved";
+      return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledProblem* problem,
                                   const Matrix* initial_guess, CoupledSolution* solution) {
   using Clock = std::chrono::steady_clock;
@@ -136,80 +231,20 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
   const double field_bytes = IterativeSolverFieldBytes(problem->num_nodes(), problem->num_steps());
   if (HoldsIterativeSolverFields(type) &&
       field_bytes > static_cast<double>(options.max_field_bytes)) {
-    std::ostringstream refusal;
-    refusal << name << " needs " << static_cast<long long>(field_bytes) << " bytes ("
-            << kIterativeSolverFields
-            << " fields of n x (m + 1) doubles, n = " << problem->num_nodes()
-            << " nodes, m = " << problem->num_steps() << " steps), above the limit of "
-            << options.max_field_bytes << " bytes (inner.max_field_bytes); ";
-    if (bar != nullptr) {
-      refusal << "use inner.method: streaming_conjugate_gradient (or auto), which stores no "
-                 "space-time field, raise inner.max_field_bytes, or use fewer elements or a "
-                 "shorter window";
-    } else if (streaming != nullptr) {
-      refusal << "use inner.method: streaming_conjugate_gradient (or auto), which stores no "
-                 "space-time field, raise inner.max_field_bytes, or use a coarser mesh (fewer "
-                 "dofs), a shorter window or a larger time step";
-    } else {
-      refusal << "raise inner.max_field_bytes, or use a coarser mesh (fewer dofs), a shorter "
-                 "window or a larger time step";
-    }
-    summary.message = refusal.str();
+    summary.message = FieldLimitRefusal(name, field_bytes, options, problem, bar != nullptr,
+                                        streaming != nullptr);
     return summary;
   }
-  const bool comparator = NeedsThePapersDataTerm(type);
-  if (comparator && bar == nullptr) {
-    summary.message = std::string(CoupledSolverTypeToString(type)) +
-                      " handles the built-in bar only; for a structure given by matrices use "
-                      "inner.method: auto, conjugate_gradient, streaming_conjugate_gradient, "
-                      "adaptive_relaxation, relaxation or all_at_once";
-    return summary;
-  }
-  if (type == CoupledSolverType::kStreamingConjugateGradient && streaming == nullptr) {
-    summary.message =
-        "streaming_conjugate_gradient needs a problem on sensor traces (StreamingCoupledProblem); "
-        "use inner.method: conjugate_gradient, adaptive_relaxation, relaxation or all_at_once";
-    return summary;
-  }
-  if (comparator && !bar->observes_ends_only()) {
-    // Their transfer operators are written for H = B (the two end displacements).
-    summary.message = std::string(CoupledSolverTypeToString(type)) +
-                      " handles the paper's end sensors only (u0 and uL, no interior sensor, "
-                      "mcre.clamp: measured); with interior sensors, an end channel left out or "
-                      "a trusted or pinned clamp use inner.method: "
-                      "conjugate_gradient, adaptive_relaxation, relaxation or all_at_once";
+  const std::string unsupported = UnsupportedProblemMessage(type, bar, streaming);
+  if (!unsupported.empty()) {
+    summary.message = unsupported;
     return summary;
   }
   // The solvers below see the resolved method.
   CoupledSolverOptions resolved = options;
   resolved.type = type;
-  switch (type) {
-    case CoupledSolverType::kAllAtOnce:
-      internal::SolveAllAtOnce(resolved, problem, solution, &summary);
-      break;
-    case CoupledSolverType::kRelaxation:
-    case CoupledSolverType::kAdaptiveRelaxation:
-      internal::SolveByRelaxation(resolved, problem, initial_guess, solution, &summary);
-      break;
-    case CoupledSolverType::kConjugateGradient:
-      internal::SolveByConjugateGradient(resolved, problem, initial_guess, solution, &summary);
-      break;
-    case CoupledSolverType::kRiccati:
-      internal::SolveByRiccati(resolved, bar, solution, &summary);
-      break;
-    case CoupledSolverType::kSingleShooting:
-    case CoupledSolverType::kMultipleShooting:
-      internal::SolveByShooting(resolved, bar, solution, &summary);
-      break;
-    case CoupledSolverType::kStreamingConjugateGradient:
-      // Fills the cost and the gradients itself, from its final streaming pass.
-      internal::SolveByStreamingConjugateGradient(resolved, streaming, initial_guess, solution,
-                                                  &summary);
-      break;
-    case CoupledSolverType::kAuto:
-      // ResolveCoupledSolverType never returns it.
-      summary.message = "inner.method auto was not resolved";
-      return summary;
+  if (!RunResolvedSolver(resolved, problem, bar, streaming, initial_guess, solution, &summary)) {
+    return summary;
   }
   if (summary.IsSolutionUsable() && type != CoupledSolverType::kStreamingConjugateGradient) {
     solution->cost = problem->Cost(solution->displacement, solution->retrograde);

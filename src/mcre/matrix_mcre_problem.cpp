@@ -64,6 +64,131 @@ SparseMatrix RowOf(const Vector& vector) {
   return row;
 }
 
+// The dofs of the model's supports, flagged 1 in an n-vector (trusted: held).
+std::vector<char> HeldDofs(const MatrixModelData& model) {
+  std::vector<char> held(static_cast<std::size_t>(model.dofs()), 0);
+  for (const MatrixModelSupport& support : model.supports) {
+    for (const int dof : support.dofs) held[static_cast<std::size_t>(dof)] = 1;
+  }
+  return held;
+}
+
+// G: the model's loads, then the supports' forces (measured: alpha; pinned: alpha_0).
+std::vector<LoadColumn> LoadColumns(const MatrixModelData& model, double force_alpha,
+                                    double reaction_weight, bool measured, bool pinned) {
+  std::vector<LoadColumn> columns;
+  for (const MatrixModelLoad& load : model.loads) {
+    columns.push_back({&load.vector, force_alpha, load.channel});
+  }
+  if (measured || pinned) {
+    for (const MatrixModelSupport& support : model.supports) {
+      columns.push_back(
+          {&support.reaction, measured ? force_alpha : reaction_weight, support.force_channel});
+    }
+  }
+  return columns;
+}
+
+// H: the model's sensors, then the supports' displacement rows g^T / (g^T g)
+// (measured, with a displacement channel) or the data 0 of e_i^T (pinned).
+std::vector<ObservedRow> ObservedRows(const MatrixModelData& model, const McreWeights& weights,
+                                      double stiffness_scale, bool measured, bool pinned) {
+  const int n = model.dofs();
+  std::vector<ObservedRow> rows;
+  for (const MatrixModelSensor& sensor : model.sensors) {
+    rows.push_back({sensor.row,
+                    sensor.kind == SensorKind::kStrain
+                        ? weights.strain_weight * stiffness_scale * model.length * model.length
+                        : weights.displacement_weight * stiffness_scale,
+                    sensor.channel});
+  }
+  for (const MatrixModelSupport& support : model.supports) {
+    if (measured && !support.displacement_channel.empty()) {
+      rows.push_back({RowOf(support.reaction / support.reaction.squaredNorm()),
+                      weights.displacement_weight * stiffness_scale, support.displacement_channel});
+    }
+    if (pinned) {
+      for (const int dof : support.dofs) {
+        rows.push_back(
+            {RowOf(Vector::Unit(n, dof)), weights.clamp_displacement_weight * stiffness_scale, ""});
+      }
+    }
+  }
+  return rows;
+}
+
+// G's channels gathered once into rows (columns t_j for the sweeps): F~ into
+// measured_loads, alpha_c into alphas, and G (n x C), a load on a held dof dropped.
+void GatherLoads(const std::vector<LoadColumn>& columns, const ChannelSet& data,
+                 const std::vector<char>& held, int n, Matrix* measured_loads, Vector* alphas,
+                 SparseMatrix* loads) {
+  const int num_loads = static_cast<int>(columns.size());
+  measured_loads->resize(num_loads, data.num_samples());
+  alphas->resize(num_loads);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int c = 0; c < num_loads; ++c) {
+    measured_loads->row(c) = data.Values(columns[c].channel).transpose();
+    (*alphas)[c] = columns[c].alpha;
+    const Vector& g = *columns[c].vector;
+    for (int i = 0; i < n; ++i) {
+      // A load on a held dof goes into the support.
+      if (g[i] != 0.0 && (held.empty() || held[i] == 0)) entries.emplace_back(i, c, g[i]);
+    }
+  }
+  loads->resize(n, num_loads);
+  loads->setFromTriplets(entries.begin(), entries.end());
+}
+
+// H's fixed rows gathered once: d~ into the first rows of measured_outputs (0 for the
+// datum 0), beta_k into betas, and the rows (num_fixed x n), held columns dropped.
+void GatherFixedRows(const std::vector<ObservedRow>& rows, const ChannelSet& data,
+                     const std::vector<char>& held, int n, Matrix* measured_outputs, Vector* betas,
+                     SparseMatrix* fixed_observation) {
+  const int num_fixed = static_cast<int>(rows.size());
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int k = 0; k < num_fixed; ++k) {
+    if (rows[k].channel.empty()) {
+      measured_outputs->row(k).setZero();
+    } else {
+      measured_outputs->row(k) = data.Values(rows[k].channel).transpose();
+    }
+    (*betas)[k] = rows[k].beta;
+    for (int outer = 0; outer < rows[k].row.outerSize(); ++outer) {
+      for (SparseMatrix::InnerIterator it(rows[k].row, outer); it; ++it) {
+        // U = 0 on a held dof: the row's entry there observes nothing and would load it.
+        if (!held.empty() && held[it.col()] != 0) continue;
+        entries.emplace_back(k, static_cast<int>(it.col()), it.value());
+      }
+    }
+  }
+  fixed_observation->resize(num_fixed, n);
+  fixed_observation->setFromTriplets(entries.begin(), entries.end());
+}
+
+// The reactions r_s(U) = g_s^T K(E) U = sum_z E_z (g_s^T K_z / E_z,nom) U: per zone the
+// rows g_s^T K_z / E_z,nom, held columns dropped (U = 0 there).
+std::vector<SparseMatrix> ReactionZoneRows(const MatrixModelData& model,
+                                           const std::vector<char>& held) {
+  const int n = model.dofs();
+  const int num_reactions = static_cast<int>(model.supports.size());
+  std::vector<SparseMatrix> zone_rows_by_zone;
+  std::vector<Eigen::Triplet<double>> entries;
+  for (const MatrixModelZone& zone : model.zones) {
+    entries.clear();
+    for (int s = 0; s < num_reactions; ++s) {
+      const Vector row =
+          (zone.stiffness.transpose() * model.supports[s].reaction) * (1.0 / zone.nominal_modulus);
+      for (int i = 0; i < n; ++i) {
+        if (row[i] != 0.0 && held[i] == 0) entries.emplace_back(s, i, row[i]);
+      }
+    }
+    SparseMatrix zone_rows(num_reactions, n);
+    zone_rows.setFromTriplets(entries.begin(), entries.end());
+    zone_rows_by_zone.push_back(std::move(zone_rows));
+  }
+  return zone_rows_by_zone;
+}
+
 }  // namespace
 
 MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const ChannelSet& data,
@@ -87,102 +212,23 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
   const bool trusted = has_supports && supports == ClampModel::kTrusted;
   const bool pinned = has_supports && supports == ClampModel::kPinned;
   const bool measured = has_supports && supports == ClampModel::kMeasured;
-  if (trusted) {
-    held_.assign(static_cast<std::size_t>(n), 0);
-    for (const MatrixModelSupport& support : model.supports) {
-      for (const int dof : support.dofs) held_[static_cast<std::size_t>(dof)] = 1;
-    }
-  }
-  // G: the model's loads, then the supports' forces (measured: alpha; pinned: alpha_0).
-  std::vector<LoadColumn> columns;
-  for (const MatrixModelLoad& load : model.loads) {
-    columns.push_back({&load.vector, force_alpha, load.channel});
-  }
-  if (measured || pinned) {
-    for (const MatrixModelSupport& support : model.supports) {
-      columns.push_back(
-          {&support.reaction, measured ? force_alpha : reaction_weight_, support.force_channel});
-    }
-  }
-  // H: the model's sensors, then the supports' displacement rows g^T / (g^T g)
-  // (measured, with a displacement channel) or the data 0 of e_i^T (pinned).
-  std::vector<ObservedRow> rows;
-  for (const MatrixModelSensor& sensor : model.sensors) {
-    rows.push_back({sensor.row,
-                    sensor.kind == SensorKind::kStrain
-                        ? weights.strain_weight * stiffness_scale * model.length * model.length
-                        : weights.displacement_weight * stiffness_scale,
-                    sensor.channel});
-  }
-  for (const MatrixModelSupport& support : model.supports) {
-    if (measured && !support.displacement_channel.empty()) {
-      rows.push_back({RowOf(support.reaction / support.reaction.squaredNorm()),
-                      weights.displacement_weight * stiffness_scale, support.displacement_channel});
-    }
-    if (pinned) {
-      for (const int dof : support.dofs) {
-        rows.push_back(
-            {RowOf(Vector::Unit(n, dof)), weights.clamp_displacement_weight * stiffness_scale, ""});
-      }
-    }
-  }
+  if (trusted) held_ = HeldDofs(model);
+  const std::vector<LoadColumn> columns =
+      LoadColumns(model, force_alpha, reaction_weight_, measured, pinned);
+  const std::vector<ObservedRow> rows =
+      ObservedRows(model, weights, stiffness_scale, measured, pinned);
   if (trusted) num_reactions_ = static_cast<int>(model.supports.size());
   const int num_loads = static_cast<int>(columns.size());
   const int num_fixed = static_cast<int>(rows.size());
   const int num_rows = num_fixed + num_reactions_;
-  // The data's channels, gathered once into rows (columns t_j for the sweeps).
-  const int samples = data.num_samples();
-  measured_loads_.resize(num_loads, samples);
-  alphas_.resize(num_loads);
-  std::vector<Eigen::Triplet<double>> entries;
-  for (int c = 0; c < num_loads; ++c) {
-    measured_loads_.row(c) = data.Values(columns[c].channel).transpose();
-    alphas_[c] = columns[c].alpha;
-    const Vector& g = *columns[c].vector;
-    for (int i = 0; i < n; ++i) {
-      // A load on a held dof goes into the support.
-      if (g[i] != 0.0 && (held_.empty() || held_[i] == 0)) entries.emplace_back(i, c, g[i]);
-    }
-  }
-  loads_.resize(n, num_loads);
-  loads_.setFromTriplets(entries.begin(), entries.end());
+  GatherLoads(columns, data, held_, n, &measured_loads_, &alphas_, &loads_);
   loads_transposed_ = loads_.transpose();
-  measured_outputs_.resize(num_rows, samples);
+  measured_outputs_.resize(num_rows, data.num_samples());
   betas_.resize(num_rows);
-  entries.clear();
-  for (int k = 0; k < num_fixed; ++k) {
-    if (rows[k].channel.empty()) {
-      measured_outputs_.row(k).setZero();
-    } else {
-      measured_outputs_.row(k) = data.Values(rows[k].channel).transpose();
-    }
-    betas_[k] = rows[k].beta;
-    for (int outer = 0; outer < rows[k].row.outerSize(); ++outer) {
-      for (SparseMatrix::InnerIterator it(rows[k].row, outer); it; ++it) {
-        // U = 0 on a held dof: the row's entry there observes nothing and would load it.
-        if (!held_.empty() && held_[it.col()] != 0) continue;
-        entries.emplace_back(k, static_cast<int>(it.col()), it.value());
-      }
-    }
-  }
-  fixed_observation_.resize(num_fixed, n);
-  fixed_observation_.setFromTriplets(entries.begin(), entries.end());
+  GatherFixedRows(rows, data, held_, n, &measured_outputs_, &betas_, &fixed_observation_);
   if (trusted) {
-    // The reactions r_s(U) = g_s^T K(E) U = sum_z E_z (g_s^T K_z / E_z,nom) U, held columns
-    // dropped (U = 0 there), against the force channels with alpha_r.
-    for (const MatrixModelZone& zone : model.zones) {
-      entries.clear();
-      for (int s = 0; s < num_reactions_; ++s) {
-        const Vector row = (zone.stiffness.transpose() * model.supports[s].reaction) *
-                           (1.0 / zone.nominal_modulus);
-        for (int i = 0; i < n; ++i) {
-          if (row[i] != 0.0 && held_[i] == 0) entries.emplace_back(s, i, row[i]);
-        }
-      }
-      SparseMatrix zone_rows(num_reactions_, n);
-      zone_rows.setFromTriplets(entries.begin(), entries.end());
-      reaction_zone_rows_.push_back(std::move(zone_rows));
-    }
+    // The reactions' rows per zone, against the force channels with alpha_r.
+    reaction_zone_rows_ = ReactionZoneRows(model, held_);
     for (int s = 0; s < num_reactions_; ++s) {
       measured_outputs_.row(num_fixed + s) =
           data.Values(model.supports[s].force_channel).transpose();

@@ -104,6 +104,38 @@ void MatrixMcreProblem::AddStreamingSample(int j, const Vector& displacement,
   }
 }
 
+void MatrixMcreProblem::ResetStreamingTotals(StreamingTotals* totals) const {
+  const int zones = num_zones();
+  totals->cost = 0.0;
+  totals->cost_gradients.setZero(zones);
+  totals->error_map.setZero(num_nodes());
+  totals->zone_error_map.setZero(zones);
+  totals->zone_strain_energy.setZero(zones);
+  totals->gap_density.resize(0, 0);
+  totals->end_retrograde.resize(0, 0);
+  totals->rebuild_error = 0.0;  // W from checkpoints: the stored sweep's
+}
+
+void MatrixMcreProblem::CheckpointRetrogradeSweep(const Matrix& traces, bool include_data) {
+  const int n = num_nodes(), m = num_steps();
+  const int stride = checkpoint_stride_;
+  // The retrograde sweep from rest at T keeping its state (v_j, omega_j) at the
+  // checkpoints j = m - i s (column i: v over omega).
+  velocity_[0].setZero();
+  state_[0].setZero();
+  checkpoints_.col(0).setZero();
+  for (int j = m, s = 0; j > 0; --j, ++s) {
+    const int current = s & 1, next = current ^ 1;
+    RetrogradeTraceStep(j, traces, include_data, velocity_[current], state_[current],
+                        velocity_[next], state_[next]);
+    if ((m - (j - 1)) % stride == 0) {
+      const int column = (m - (j - 1)) / stride;
+      checkpoints_.col(column).head(n) = velocity_[next];
+      checkpoints_.col(column).tail(n) = state_[next];
+    }
+  }
+}
+
 void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
                                      StreamingTotals* totals) {
   assert(traces.rows() == num_traces() && traces.cols() == num_steps() + 1 && image != &traces);
@@ -116,17 +148,7 @@ void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Ma
   }
   const int stride = checkpoint_stride_;
   image->resize(num_traces(), m + 1);
-  if (totals != nullptr) {
-    const int zones = num_zones();
-    totals->cost = 0.0;
-    totals->cost_gradients.setZero(zones);
-    totals->error_map.setZero(n);
-    totals->zone_error_map.setZero(zones);
-    totals->zone_strain_energy.setZero(zones);
-    totals->gap_density.resize(0, 0);
-    totals->end_retrograde.resize(0, 0);
-    totals->rebuild_error = 0.0;  // W from checkpoints: the stored sweep's
-  }
+  if (totals != nullptr) ResetStreamingTotals(totals);
   // y_j = H U_j into the image, and sample j into the totals.
   auto observe = [&](int j, const Vector& displacement, const Vector& retrograde) {
     trace_.noalias() = observation_ * displacement;
@@ -152,21 +174,8 @@ void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Ma
     observe(j, stream_displacement_[next], retrograde);
   };
 
-  // 1. The retrograde sweep from rest at T keeping its state (v_j, omega_j) at the
-  // checkpoints j = m - i s (column i: v over omega).
-  velocity_[0].setZero();
-  state_[0].setZero();
-  checkpoints_.col(0).setZero();
-  for (int j = m, s = 0; j > 0; --j, ++s) {
-    const int current = s & 1, next = current ^ 1;
-    RetrogradeTraceStep(j, traces, include_data, velocity_[current], state_[current],
-                        velocity_[next], state_[next]);
-    if ((m - (j - 1)) % stride == 0) {
-      const int column = (m - (j - 1)) / stride;
-      checkpoints_.col(column).head(n) = velocity_[next];
-      checkpoints_.col(column).tail(n) = state_[next];
-    }
-  }
+  // 1. The retrograde sweep from rest at T keeping its state at the checkpoints.
+  CheckpointRetrogradeSweep(traces, include_data);
 
   // 2. Forward over the segments [a, b] between checkpoints, earliest first: from the
   // checkpoint at b the retrograde steps b -> a again (the same steps, so the same bits

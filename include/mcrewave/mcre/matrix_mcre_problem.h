@@ -182,6 +182,12 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // Adds sample j (U_j, W_j) of a streaming application to the totals. No allocation.
   void AddStreamingSample(int j, const Vector& displacement, const Vector& retrograde,
                           StreamingTotals* totals);
+  // Zeroes the totals of a streaming application, sized for the dofs and the zones.
+  void ResetStreamingTotals(StreamingTotals* totals) const;
+  // Step 1 of StreamingMap: the retrograde sweep from rest at T driven by the traces,
+  // keeping its state (v_j, omega_j) at the checkpoints j = m - i s (column i of
+  // checkpoints_: v over omega). No allocation.
+  void CheckpointRetrogradeSweep(const Matrix& traces, bool include_data);
 
   const MatrixModelData& model_;
   double time_step_;         // h [s]
