@@ -2,9 +2,9 @@
 // model/matrix_export.h): the model.yaml that names a structure's Matrix Market files.
 //
 // ReadMatrixModel takes a path, so the input is written as model.yaml into a
-// temporary folder made once per process, next to small Matrix Market files it may
-// name (a 3-dof model: kFiles below, valid ones and some that fail a check). The
-// input is the manifest's text. InputError is the expected answer to bad input;
+// temporary folder made once per process, next to small Matrix Market and channel
+// names files it may name (a 3-dof model: kFiles below, valid ones and some that fail
+// a check). The input is the manifest's text. InputError is the expected answer to bad input;
 // anything else escaping (another exception, a crash, a sanitizer report, a hang)
 // is a defect. An accepted manifest must give a checked 3-dof model.
 #include <stdlib.h>
@@ -41,6 +41,11 @@ constexpr File kFiles[] = {
     {"load_row.mtx", "%%MatrixMarket matrix coordinate integer general\n1 3 1\n1 1 -1\n"},
     {"sensor_u.mtx", "%%MatrixMarket matrix coordinate real general\n1 3 1\n1 3 1\n"},
     {"sensor_e.mtx", "%%MatrixMarket matrix coordinate real general\n3 1 2\n2 1 -10\n3 1 10\n"},
+    // A load matrix (3 x 2) and an observation matrix (2 x 3) with their channel names.
+    {"G.mtx", "%%MatrixMarket matrix coordinate real general\n3 2 2\n1 1 1\n3 2 -1\n"},
+    {"load_channels.txt", "# loads\nfa\n\n  fb \n"},
+    {"H.mtx", "%%MatrixMarket matrix coordinate real general\n2 3 3\n1 1 1\n2 2 -10\n2 3 10\n"},
+    {"sensor_channels.txt", "ua\r\neb\r\n"},
     // Each fails one check of ReadMatrixModel.
     {"K_4.mtx", "%%MatrixMarket matrix coordinate pattern symmetric\n4 4 1\n4 4\n"},
     {"K_skew.mtx", "%%MatrixMarket matrix coordinate real general\n3 3 2\n1 2 1\n2 1 -1\n"},
@@ -48,6 +53,9 @@ constexpr File kFiles[] = {
     {"sensor_zero.mtx", "%%MatrixMarket matrix coordinate real general\n1 3 1\n1 2 0\n"},
     {"sensor_past.mtx", "%%MatrixMarket matrix coordinate real general\n1 5 1\n1 5 1\n"},
     {"not_mtx.txt", "mass: M.mtx\n"},
+    {"channels_twice.txt", "fa\nfa\n"},
+    {"channels_none.txt", "# none\n\n"},
+    {"channels_three.txt", "x\ny\nz\n"},
 };
 
 std::string folder;

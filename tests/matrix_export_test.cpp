@@ -2,13 +2,16 @@
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "identify_binary.h"
@@ -243,6 +246,299 @@ TEST(MatrixExportTest, AbsolutePathsInAManifestAreUsedAsTheyAre) {
   for (std::size_t i = 0; i < data.sensors.size(); ++i) {
     EXPECT_EQ(MaxDifference(back.sensors[i].row, data.sensors[i].row), 0.0) << i;
   }
+}
+
+// Expects `read` to be `expected` in its loads and sensors: the same channels in the same
+// order, the same load vectors, sensor rows (stored entries and values) and kinds.
+void ExpectSameChannels(const MatrixModelData& read, const MatrixModelData& expected) {
+  ASSERT_EQ(read.loads.size(), expected.loads.size());
+  for (std::size_t i = 0; i < expected.loads.size(); ++i) {
+    EXPECT_EQ(read.loads[i].channel, expected.loads[i].channel) << i;
+    EXPECT_EQ(read.loads[i].vector, expected.loads[i].vector) << i;
+  }
+  ASSERT_EQ(read.sensors.size(), expected.sensors.size());
+  for (std::size_t i = 0; i < expected.sensors.size(); ++i) {
+    const MatrixModelSensor& sensor = read.sensors[i];
+    EXPECT_EQ(sensor.channel, expected.sensors[i].channel) << i;
+    EXPECT_EQ(sensor.kind, expected.sensors[i].kind) << i;
+    ASSERT_EQ(sensor.row.rows(), 1) << i;
+    ASSERT_EQ(sensor.row.cols(), expected.sensors[i].row.cols()) << i;
+    EXPECT_EQ(sensor.row.nonZeros(), expected.sensors[i].row.nonZeros()) << i;
+    EXPECT_EQ(MaxDifference(sensor.row, expected.sensors[i].row), 0.0) << i;
+  }
+}
+
+// Writes the loads first..last-1 of `data` as the load matrix `matrix` (n x C, general
+// storage) and their names, with comments, blank lines and blanks around the names, as
+// `channels`.
+void WriteLoadMatrixByHand(const std::string& folder, const MatrixModelData& data,
+                           std::size_t first, std::size_t last, const std::string& matrix,
+                           const std::string& channels) {
+  Matrix dense(data.dofs(), static_cast<Eigen::Index>(last - first));
+  std::string names = "# load channels, a column each\n\n";
+  for (std::size_t c = first; c < last; ++c) {
+    dense.col(static_cast<Eigen::Index>(c - first)) = data.loads[c].vector;
+    names += "  " + data.loads[c].channel + "\t\n";
+  }
+  WriteMatrixMarketMatrix(folder + "/" + matrix, SparseMatrix(dense.sparseView()));
+  WriteText(folder, channels, names);
+}
+
+// Writes the sensors first..last-1 of `data` as the observation matrix `matrix` (S x n)
+// and their names as `channels` (CRLF line ends).
+void WriteSensorMatrixByHand(const std::string& folder, const MatrixModelData& data,
+                             std::size_t first, std::size_t last, const std::string& matrix,
+                             const std::string& channels) {
+  std::vector<Eigen::Triplet<double>> entries;
+  std::string names;
+  for (std::size_t k = first; k < last; ++k) {
+    const SparseMatrix& row = data.sensors[k].row;
+    for (int j = 0; j < row.outerSize(); ++j) {
+      for (SparseMatrix::InnerIterator it(row, j); it; ++it) {
+        entries.emplace_back(static_cast<int>(k - first), static_cast<int>(it.col()), it.value());
+      }
+    }
+    names += data.sensors[k].channel + "\r\n";
+  }
+  SparseMatrix rows(static_cast<Eigen::Index>(last - first), data.dofs());
+  rows.setFromTriplets(entries.begin(), entries.end());
+  WriteMatrixMarketMatrix(folder + "/" + matrix, rows);
+  WriteText(folder, channels, names);
+}
+
+// The manifest `folder`/model.yaml (as WriteMatrixModel wrote it) with its keys of loads
+// and sensors (loads, sensors, loads_matrix, sensors_matrix) replaced by `channels`, YAML
+// text of the new keys.
+void ReplaceChannelKeys(const std::string& folder, const std::string& channels) {
+  YAML::Node root = YAML::LoadFile(folder + "/model.yaml");
+  for (const char* key : {"loads", "sensors", "loads_matrix", "sensors_matrix"}) root.remove(key);
+  YAML::Emitter out;
+  out << root;
+  WriteText(folder, "model.yaml", std::string(out.c_str()) + "\n" + channels);
+}
+
+// The bar with two interior sensors, its loads as one matrix and its sensors as two (the
+// displacement rows, then the strain row), files written here, reads to the model of the
+// per-file manifest: the same load vectors, sensor rows, kinds and names.
+TEST(MatrixExportTest, LoadAndObservationMatricesReadToThePerFileModel) {
+  const MatrixModelData data = BarMatrixModel(ThreeZoneBar(), 200e9, kSensors);
+  ASSERT_EQ(data.sensors.size(), 4u);  // u0, uL, u@0.25, e@0.65
+  const MatrixModelData files =
+      ReadMatrixModel(WriteMatrixModel(MakeFolder("channels_files"), data));
+  const std::string folder = MakeFolder("channels_matrices");
+  WriteMatrixModel(folder, data);
+  WriteLoadMatrixByHand(folder, data, 0, 2, "G.mtx", "load_channels.txt");
+  WriteSensorMatrixByHand(folder, data, 0, 3, "H_u.mtx", "sensor_channels_u.txt");
+  WriteSensorMatrixByHand(folder, data, 3, 4, "H_e.mtx", "sensor_channels_e.txt");
+  ReplaceChannelKeys(folder,
+                     "loads_matrix: {matrix: G.mtx, channels: load_channels.txt}\n"
+                     "sensors_matrix:\n"
+                     "  - {matrix: H_u.mtx, channels: sensor_channels_u.txt, kind: displacement}\n"
+                     "  - {matrix: H_e.mtx, channels: sensor_channels_e.txt, kind: strain}\n");
+  const MatrixModelData matrices = ReadMatrixModel(folder + "/model.yaml");
+  EXPECT_EQ(matrices.sensors[3].kind, SensorKind::kStrain);
+  ExpectSameChannels(matrices, files);
+  EXPECT_EQ(MaxDifference(matrices.mass, files.mass), 0.0);
+  ASSERT_EQ(matrices.zones.size(), files.zones.size());
+
+  // One map for the sensors (a single kind): the strain sensor dropped on both sides.
+  WriteSensorMatrixByHand(folder, data, 0, 3, "H_u.mtx", "sensor_channels_u.txt");
+  ReplaceChannelKeys(folder,
+                     "loads_matrix: [{matrix: G.mtx, channels: load_channels.txt}]\n"
+                     "sensors_matrix: {matrix: H_u.mtx, channels: sensor_channels_u.txt}\n");
+  MatrixModelData without_strain = files;
+  without_strain.sensors.pop_back();
+  ExpectSameChannels(ReadMatrixModel(folder + "/model.yaml"), without_strain);
+}
+
+// Files and matrices combine: the channels of `loads` (`sensors`) first, then the
+// matrices'; the channel names stay distinct across both forms.
+TEST(MatrixExportTest, ChannelFilesAndMatricesCombineInTheManifestsOrder) {
+  const MatrixModelData data = BarMatrixModel(ThreeZoneBar(), 200e9, kSensors);
+  const std::string folder = MakeFolder("channels_combined");
+  WriteMatrixModel(folder, data);
+  WriteLoadMatrixByHand(folder, data, 1, 2, "G.mtx", "load_channels.txt");
+  WriteSensorMatrixByHand(folder, data, 2, 4, "H.mtx", "sensor_channels.txt");
+  const std::string channels =
+      "loads:\n  - {channel: f0, vector: load_f0.mtx}\n"
+      "loads_matrix: {matrix: G.mtx, channels: load_channels.txt}\n"
+      "sensors_matrix:\n  - {matrix: H.mtx, channels: sensor_channels.txt}\n"
+      "sensors:\n  - {channel: u0, row: sensor_u0.mtx}\n  - {channel: uL, row: sensor_uL.mtx}\n";
+  ReplaceChannelKeys(folder, channels);
+  MatrixModelData expected = data;
+  expected.sensors[3].kind = SensorKind::kDisplacement;  // H.mtx's kind: the default
+  ExpectSameChannels(ReadMatrixModel(folder + "/model.yaml"), expected);
+
+  // uL in a per-file entry and on the matrix's names file: refused on the names file.
+  WriteText(folder, "sensor_channels.txt", "u@0.25\nuL\n");
+  ReplaceChannelKeys(folder, channels);
+  std::string why;
+  try {
+    ReadMatrixModel(folder + "/model.yaml");
+  } catch (const InputError& error) {
+    why = error.what();
+  }
+  EXPECT_TRUE(Contains(why, "sensor_channels.txt:2: channel 'uL' given twice: already a channel"))
+      << why;
+}
+
+// WriteMatrixModel with MatrixModelLayout::kMatrices writes G, one H per run of a kind
+// and their names files; they read back to the model.
+TEST(MatrixExportTest, TheMatricesLayoutReadsBackExactly) {
+  const MatrixModelData data = BarMatrixModel(ThreeZoneBar(), 200e9, kSensors);
+  const std::string folder = MakeFolder("channels_layout");
+  const MatrixModelData back =
+      ReadMatrixModel(WriteMatrixModel(folder, data, MatrixModelLayout::kMatrices));
+  for (const char* file : {"G.mtx", "load_channels.txt", "H_1.mtx", "sensor_channels_1.txt",
+                           "H_2.mtx", "sensor_channels_2.txt"}) {
+    EXPECT_TRUE(std::filesystem::exists(folder + "/" + file)) << file;
+  }
+  EXPECT_FALSE(std::filesystem::exists(folder + "/H_3.mtx"));
+  EXPECT_FALSE(std::filesystem::exists(folder + "/load_fL.mtx"));
+  ExpectSameChannels(back, data);
+  // A channel name a names file cannot hold.
+  MatrixModelData blank = data;
+  blank.loads[0].channel = "f0 ";
+  EXPECT_THROW(
+      WriteMatrixModel(MakeFolder("channels_layout_blank"), blank, MatrixModelLayout::kMatrices),
+      std::runtime_error);
+}
+
+// The message of ReadMatrixModel on the 6-element bar written with its loads and sensors
+// as matrices (G.mtx: 7 x 2, f0 and fL; H_1.mtx: 2 x 7, u0 and uL) after `spoil` edits
+// its files, given the folder and the manifest's text.
+template <typename Spoil>
+std::string SpoiledMatricesError(const std::string& name, Spoil&& spoil) {
+  const std::string folder = MakeFolder(name);
+  BarProperties bar;
+  bar.elements = 6;
+  const std::string manifest =
+      WriteMatrixModel(folder, BarMatrixModel(BarModel(bar), 1.0), MatrixModelLayout::kMatrices);
+  std::ifstream written(manifest);
+  std::stringstream text;
+  text << written.rdbuf();
+  spoil(folder, text.str());
+  try {
+    ReadMatrixModel(manifest);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+// `text` with `from` replaced by `to` (once, where it must be), and the 1-based line it is on.
+std::pair<std::string, int> ReplacedOnLine(std::string text, const std::string& from,
+                                           const std::string& to) {
+  const std::size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from << " in\n" << text;
+  if (at == std::string::npos) return {text, 0};
+  const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+  return {text.replace(at, from.size(), to), line};
+}
+
+TEST(MatrixExportTest, BadChannelMatricesGiveOneClearError) {
+  std::string why =
+      SpoiledMatricesError("matrices_count", [](const std::string& folder, const std::string&) {
+        WriteText(folder, "load_channels.txt", "f0\nfL\n# a third\nf2\n");
+      });
+  EXPECT_TRUE(Contains(why, "load_channels.txt: 3 channel names, but ") &&
+              Contains(why, "G.mtx has 2 columns, expected one name per column"))
+      << why;
+  why = SpoiledMatricesError("matrices_rows_count",
+                             [](const std::string& folder, const std::string&) {
+                               WriteText(folder, "sensor_channels_1.txt", "uL\n");
+                             });
+  EXPECT_TRUE(Contains(why, "sensor_channels_1.txt: 1 channel names, but ") &&
+              Contains(why, "H_1.mtx has 2 rows, expected one name per row"))
+      << why;
+  why =
+      SpoiledMatricesError("matrices_duplicate", [](const std::string& folder, const std::string&) {
+        WriteText(folder, "sensor_channels_1.txt", "u0\n\n  u0\n");
+      });
+  EXPECT_TRUE(Contains(why, "sensor_channels_1.txt:3: channel 'u0' given twice (first on line 1)"))
+      << why;
+  why = SpoiledMatricesError("matrices_duplicate_load",
+                             [](const std::string& folder, const std::string&) {
+                               WriteText(folder, "load_channels.txt", "f0\nuL\n");
+                             });
+  // Line 3: the written names file starts with a comment line.
+  EXPECT_TRUE(Contains(why,
+                       "sensor_channels_1.txt:3: channel 'uL' given twice: already a "
+                       "channel of the model"))
+      << why;
+  why = SpoiledMatricesError("matrices_empty", [](const std::string& folder, const std::string&) {
+    WriteText(folder, "load_channels.txt", "# no names\n\n   \n");
+  });
+  EXPECT_TRUE(Contains(why, "load_channels.txt: no channel names, expected one a line")) << why;
+  why = SpoiledMatricesError("matrices_g_rows", [](const std::string& folder, const std::string&) {
+    SparseMatrix g(5, 2);
+    g.insert(0, 0) = 1.0;
+    WriteMatrixMarketMatrix(folder + "/G.mtx", g);
+  });
+  EXPECT_TRUE(Contains(why, "G.mtx: 5 x 2, but ") &&
+              Contains(why, "M.mtx has 7 dofs, expected 7 rows (a column per load channel)"))
+      << why;
+  why =
+      SpoiledMatricesError("matrices_h_columns", [](const std::string& folder, const std::string&) {
+        SparseMatrix h(2, 9);
+        h.insert(0, 0) = 1.0;
+        h.insert(1, 6) = 1.0;
+        WriteMatrixMarketMatrix(folder + "/H_1.mtx", h);
+      });
+  EXPECT_TRUE(Contains(why, "H_1.mtx: 2 x 9, but ") &&
+              Contains(why, "M.mtx has 7 dofs, expected 7 columns (a row per sensor channel)"))
+      << why;
+  why = SpoiledMatricesError("matrices_h_zero_row",
+                             [](const std::string& folder, const std::string&) {
+                               SparseMatrix h(2, 7);
+                               h.insert(0, 0) = 1.0;
+                               WriteMatrixMarketMatrix(folder + "/H_1.mtx", h);
+                             });
+  EXPECT_TRUE(Contains(why, "sensor 'uL' (") &&
+              Contains(why, "H_1.mtx row 2): every coefficient is zero"))
+      << why;
+  int line = 0;
+  why = SpoiledMatricesError(
+      "matrices_key", [&line](const std::string& folder, const std::string& text) {
+        const auto spoiled = ReplacedOnLine(text, "channels: load_channels.txt}",
+                                            "channels: load_channels.txt, "
+                                            "columns: 2}");
+        line = spoiled.second;
+        WriteText(folder, "model.yaml", spoiled.first);
+      });
+  EXPECT_TRUE(Contains(why, "model.yaml:" + std::to_string(line) +
+                                ": unknown key 'columns' (expected matrix, channels)"))
+      << why;
+  why = SpoiledMatricesError(
+      "matrices_kind", [&line](const std::string& folder, const std::string& text) {
+        const auto spoiled = ReplacedOnLine(text, "channels: sensor_channels_1.txt}",
+                                            "channels: sensor_channels_1.txt, kind: force}");
+        line = spoiled.second;
+        WriteText(folder, "model.yaml", spoiled.first);
+      });
+  EXPECT_TRUE(Contains(why, "model.yaml:" + std::to_string(line) +
+                                ": kind must be displacement or strain, got 'force'"))
+      << why;
+  why = SpoiledMatricesError("matrices_missing_names",
+                             [](const std::string& folder, const std::string&) {
+                               std::remove((folder + "/load_channels.txt").c_str());
+                             });
+  EXPECT_TRUE(Contains(why, "cannot read channel names file ") &&
+              Contains(why, "load_channels.txt: No such file"))
+      << why;
+  why = SpoiledMatricesError("matrices_missing_matrix",
+                             [](const std::string& folder, const std::string&) {
+                               std::remove((folder + "/H_1.mtx").c_str());
+                             });
+  EXPECT_TRUE(Contains(why, "cannot read Matrix Market file ") && Contains(why, "H_1.mtx")) << why;
+  why = SpoiledMatricesError("matrices_no_loads_at_all",
+                             [](const std::string& folder, const std::string&) {
+                               ReplaceChannelKeys(folder,
+                                                  "sensors_matrix: {matrix: H_1.mtx, channels: "
+                                                  "sensor_channels_1.txt}\n");
+                             });
+  EXPECT_TRUE(Contains(why, "model.yaml: expected 'loads', a non-empty list, or 'loads_matrix'"))
+      << why;
 }
 
 }  // namespace

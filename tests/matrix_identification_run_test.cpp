@@ -197,6 +197,38 @@ TEST(MatrixIdentificationRunTest,
   EXPECT_LT(summary["cost"].as<double>(), summary["nominal_cost"].as<double>());
 }
 
+// The quick bar's manifest with its loads and sensors as matrices (G.mtx with its channel
+// names, H_1.mtx with theirs: MatrixModelLayout::kMatrices) runs as its per-file manifest
+// does: zones.csv, fit.csv and evaluations.csv byte for byte.
+TEST(MatrixIdentificationRunTest, LoadAndObservationMatricesRunAsThePerFileManifest) {
+  const std::string dir = FreshDirectory("matrix_run_channel_matrices");
+  const std::string quick = SourcePath("configs/quick.yaml");
+  ASSERT_EQ(RunIdentify("simulate " + quick + " -q -o " + dir + "/data.csv").exit_code, 0);
+  const Config config = LoadConfig(quick);
+  const MatrixModelData bar = BarMatrixModel(BarModel(config.model), 160e9);
+  std::filesystem::create_directories(dir + "/files");
+  std::filesystem::create_directories(dir + "/matrices");
+  const std::string per_file = WriteMatrixModel(dir + "/files", bar);
+  const std::string matrices =
+      WriteMatrixModel(dir + "/matrices", bar, MatrixModelLayout::kMatrices);
+  ASSERT_NE(ReadText(matrices).find("loads_matrix"), std::string::npos);
+  ASSERT_EQ(ReadText(matrices).find("load_f0.mtx"), std::string::npos);
+  const std::string run = "run " + quick + " --set data.source=csv --set data.path=" + dir +
+                          "/data.csv --set model.kind=matrix --set search.functional=pinned" +
+                          " --set mcre.clamp=trusted -q";
+  const RunResult files_run =
+      RunIdentify(run + " --set model.manifest=" + per_file + " -o " + dir + "/run_files");
+  ASSERT_EQ(files_run.exit_code, 0) << files_run.output;
+  const RunResult matrices_run =
+      RunIdentify(run + " --set model.manifest=" + matrices + " -o " + dir + "/run_matrices");
+  ASSERT_EQ(matrices_run.exit_code, 0) << matrices_run.output;
+  for (const char* file : {"zones.csv", "fit.csv", "evaluations.csv"}) {
+    const std::string expected = ReadText(dir + "/run_files/" + file);
+    EXPECT_FALSE(expected.empty()) << file;
+    EXPECT_EQ(ReadText(dir + "/run_matrices/" + file), expected) << file;
+  }
+}
+
 TEST(MatrixIdentificationRunTest, ASimulatedCsvReadBackGivesTheSyntheticRunsModuli) {
   const std::string dir = FreshDirectory("matrix_run_simulate");
   const std::string manifest = WriteQuickBarMatrices(dir + "/bar_matrices");

@@ -2,10 +2,15 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -163,7 +168,114 @@ MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
   return data;
 }
 
-std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& data) {
+namespace {
+
+// Writes a file per load vector and per sensor row and their manifest lists `loads` and
+// `sensors`.
+void WriteChannelFiles(const std::string& folder, const MatrixModelData& data,
+                       YAML::Emitter* manifest) {
+  *manifest << YAML::Key << "loads" << YAML::Value << YAML::BeginSeq;
+  for (const MatrixModelLoad& load : data.loads) {
+    const std::string file = "load_" + FileSafe(load.channel) + ".mtx";
+    WriteMatrixMarketVector(folder + "/" + file, load.vector,
+                            "spatial vector of load channel " + load.channel);
+    *manifest << YAML::Flow << YAML::BeginMap << YAML::Key << "channel" << YAML::Value
+              << load.channel << YAML::Key << "vector" << YAML::Value << file << YAML::EndMap;
+  }
+  *manifest << YAML::EndSeq;
+  *manifest << YAML::Key << "sensors" << YAML::Value << YAML::BeginSeq;
+  for (const MatrixModelSensor& sensor : data.sensors) {
+    const std::string file = "sensor_" + FileSafe(sensor.channel) + ".mtx";
+    WriteMatrixMarketMatrix(folder + "/" + file, sensor.row, MatrixMarketStorage::kGeneral,
+                            "observation row of sensor channel " + sensor.channel);
+    *manifest << YAML::Flow << YAML::BeginMap << YAML::Key << "channel" << YAML::Value
+              << sensor.channel << YAML::Key << "row" << YAML::Value << file;
+    if (sensor.kind == SensorKind::kStrain) {
+      *manifest << YAML::Key << "kind" << YAML::Value << "strain";
+    }
+    *manifest << YAML::EndMap;
+  }
+  *manifest << YAML::EndSeq;
+}
+
+// The text of a channels file naming `channels`, one a line. Throws std::runtime_error
+// naming `path` when a name would not read back as it is.
+std::string ChannelsText(const std::string& path, const std::vector<std::string>& channels) {
+  std::string text = "# mcrewave channel names, one a line (docs/matrix_models.md)\n";
+  for (const std::string& channel : channels) {
+    if (channel.empty() || channel[0] == '#' || channel.find('\n') != std::string::npos ||
+        channel.find_first_of(" \t\r\f\v") == 0 ||
+        channel.find_last_of(" \t\r\f\v") == channel.size() - 1) {
+      throw std::runtime_error("cannot write " + path + ": channel '" + channel +
+                               "' is empty, starts with '#', holds a line break or starts or "
+                               "ends with a blank, so a channels file cannot name it");
+    }
+    text += channel + "\n";
+  }
+  return text;
+}
+
+// Writes the load matrix G.mtx (n x C, column c the vector of load c) with
+// load_channels.txt, and an observation matrix H_<i>.mtx (S_i x n) with
+// sensor_channels_<i>.txt per run of consecutive sensors of one kind, and their manifest
+// keys `loads_matrix` and `sensors_matrix`.
+void WriteChannelMatrices(const std::string& folder, const MatrixModelData& data,
+                          YAML::Emitter* manifest) {
+  const int n = data.dofs();
+  std::vector<Eigen::Triplet<double>> entries;
+  std::vector<std::string> channels;
+  for (const MatrixModelLoad& load : data.loads) {
+    for (Eigen::Index i = 0; i < load.vector.size(); ++i) {
+      if (load.vector[i] != 0.0) {
+        entries.emplace_back(static_cast<int>(i), static_cast<int>(channels.size()),
+                             load.vector[i]);
+      }
+    }
+    channels.push_back(load.channel);
+  }
+  SparseMatrix loads(n, static_cast<Eigen::Index>(channels.size()));
+  loads.setFromTriplets(entries.begin(), entries.end());
+  WriteFileAtomically(folder + "/load_channels.txt",
+                      ChannelsText(folder + "/load_channels.txt", channels));
+  WriteMatrixMarketMatrix(folder + "/G.mtx", loads, MatrixMarketStorage::kGeneral,
+                          "load matrix G: column c is the spatial vector of load channel c");
+  *manifest << YAML::Key << "loads_matrix" << YAML::Value << YAML::Flow << YAML::BeginMap
+            << YAML::Key << "matrix" << YAML::Value << "G.mtx" << YAML::Key << "channels"
+            << YAML::Value << "load_channels.txt" << YAML::EndMap;
+  *manifest << YAML::Key << "sensors_matrix" << YAML::Value << YAML::BeginSeq;
+  for (std::size_t first = 0, run = 1; first < data.sensors.size(); ++run) {
+    const SensorKind kind = data.sensors[first].kind;
+    entries.clear();
+    channels.clear();
+    for (; first < data.sensors.size() && data.sensors[first].kind == kind; ++first) {
+      const SparseMatrix& row = data.sensors[first].row;
+      for (int j = 0; j < row.outerSize(); ++j) {
+        for (SparseMatrix::InnerIterator it(row, j); it; ++it) {
+          entries.emplace_back(static_cast<int>(channels.size()), static_cast<int>(it.col()),
+                               it.value());
+        }
+      }
+      channels.push_back(data.sensors[first].channel);
+    }
+    SparseMatrix rows(static_cast<Eigen::Index>(channels.size()), n);
+    rows.setFromTriplets(entries.begin(), entries.end());
+    const std::string matrix = "H_" + std::to_string(run) + ".mtx";
+    const std::string names = "sensor_channels_" + std::to_string(run) + ".txt";
+    WriteFileAtomically(folder + "/" + names, ChannelsText(folder + "/" + names, channels));
+    WriteMatrixMarketMatrix(folder + "/" + matrix, rows, MatrixMarketStorage::kGeneral,
+                            "observation matrix H: row k is the row of sensor channel k");
+    *manifest << YAML::Flow << YAML::BeginMap << YAML::Key << "matrix" << YAML::Value << matrix
+              << YAML::Key << "channels" << YAML::Value << names;
+    if (kind == SensorKind::kStrain) *manifest << YAML::Key << "kind" << YAML::Value << "strain";
+    *manifest << YAML::EndMap;
+  }
+  *manifest << YAML::EndSeq;
+}
+
+}  // namespace
+
+std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& data,
+                             MatrixModelLayout layout) {
   YAML::Emitter manifest;
   manifest.SetDoublePrecision(17);
   manifest << YAML::BeginMap;
@@ -182,28 +294,11 @@ std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& d
              << YAML::Value << zone.nominal_modulus << YAML::EndMap;
   }
   manifest << YAML::EndSeq;
-  manifest << YAML::Key << "loads" << YAML::Value << YAML::BeginSeq;
-  for (const MatrixModelLoad& load : data.loads) {
-    const std::string file = "load_" + FileSafe(load.channel) + ".mtx";
-    WriteMatrixMarketVector(folder + "/" + file, load.vector,
-                            "spatial vector of load channel " + load.channel);
-    manifest << YAML::Flow << YAML::BeginMap << YAML::Key << "channel" << YAML::Value
-             << load.channel << YAML::Key << "vector" << YAML::Value << file << YAML::EndMap;
+  if (layout == MatrixModelLayout::kMatrices) {
+    WriteChannelMatrices(folder, data, &manifest);
+  } else {
+    WriteChannelFiles(folder, data, &manifest);
   }
-  manifest << YAML::EndSeq;
-  manifest << YAML::Key << "sensors" << YAML::Value << YAML::BeginSeq;
-  for (const MatrixModelSensor& sensor : data.sensors) {
-    const std::string file = "sensor_" + FileSafe(sensor.channel) + ".mtx";
-    WriteMatrixMarketMatrix(folder + "/" + file, sensor.row, MatrixMarketStorage::kGeneral,
-                            "observation row of sensor channel " + sensor.channel);
-    manifest << YAML::Flow << YAML::BeginMap << YAML::Key << "channel" << YAML::Value
-             << sensor.channel << YAML::Key << "row" << YAML::Value << file;
-    if (sensor.kind == SensorKind::kStrain) {
-      manifest << YAML::Key << "kind" << YAML::Value << "strain";
-    }
-    manifest << YAML::EndMap;
-  }
-  manifest << YAML::EndSeq;
   if (!data.supports.empty()) {
     manifest << YAML::Key << "supports" << YAML::Value << YAML::BeginSeq;
     for (const MatrixModelSupport& support : data.supports) {
@@ -234,7 +329,8 @@ std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& d
 namespace {
 
 // The manifest at manifest_path, checked to be a map of the keys mass,
-// stiffness_length, length, zones, loads and sensors only.
+// stiffness_length, length, zones, loads, sensors, loads_matrix, sensors_matrix and
+// supports only.
 YAML::Node LoadManifest(const std::string& manifest_path) {
   YAML::Node root;
   try {
@@ -248,10 +344,11 @@ YAML::Node LoadManifest(const std::string& manifest_path) {
   for (const auto& key : root) {
     const std::string name = key.first.Scalar();
     if (name != "mass" && name != "stiffness_length" && name != "length" && name != "zones" &&
-        name != "loads" && name != "sensors" && name != "supports") {
+        name != "loads" && name != "sensors" && name != "loads_matrix" &&
+        name != "sensors_matrix" && name != "supports") {
       throw InputError(Where(manifest_path, key.first) + ": unknown key '" + name +
                        "' (expected mass, stiffness_length, length, zones, loads, sensors, "
-                       "supports)");
+                       "loads_matrix, sensors_matrix, supports)");
     }
   }
   return root;
@@ -298,14 +395,32 @@ void ReadZones(const std::string& manifest_path, const YAML::Node& root, const s
   }
 }
 
-// Appends the manifest's loads to data->loads: each channel not already in
-// *channels (then added), its vector file (relative to `folder`) of the mass
+// The value of top-level key `key` when given: a list (a map, where `map_allowed`,
+// stands for the list of that one entry); an empty sequence when absent.
+YAML::Node OptionalList(const std::string& manifest_path, const YAML::Node& root, const char* key,
+                        const std::string& expected, bool map_allowed = false) {
+  const YAML::Node node = root[key];
+  if (!node) return YAML::Node(YAML::NodeType::Sequence);
+  if (map_allowed && node.IsMap()) {
+    YAML::Node list(YAML::NodeType::Sequence);
+    list.push_back(node);
+    return list;
+  }
+  if (!node.IsSequence()) {
+    throw InputError(Where(manifest_path, node) + ": expected '" + key + "', " + expected);
+  }
+  return node;
+}
+
+// Appends the manifest's loads (an optional list) to data->loads: each channel not
+// already in *channels (then added), its vector file (relative to `folder`) of the mass
 // matrix's size (mass_file).
 void ReadLoads(const std::string& manifest_path, const YAML::Node& root, const std::string& folder,
                const std::string& mass_file, std::set<std::string>* channels,
                MatrixModelData* data) {
   const int n = data->dofs();
-  for (const YAML::Node& entry : RequiredList(manifest_path, root, "loads")) {
+  for (const YAML::Node& entry :
+       OptionalList(manifest_path, root, "loads", "a list of {channel, vector}")) {
     CheckEntryKeys(manifest_path, entry, {"channel", "vector"}, "channel, vector");
     MatrixModelLoad load;
     load.channel = RequiredString(manifest_path, entry, "channel");
@@ -320,29 +435,33 @@ void ReadLoads(const std::string& manifest_path, const YAML::Node& root, const s
   }
 }
 
-// Appends the manifest's sensors to data->sensors: each of kind displacement
-// (the default) or strain, its channel not already in *channels (then added),
-// its observation row file (relative to `folder`) checked against the mass
+// The sensor kind of a map entry's optional key `kind`: displacement (the default) or
+// strain.
+SensorKind KindOf(const std::string& manifest_path, const YAML::Node& entry) {
+  if (!entry["kind"]) return SensorKind::kDisplacement;
+  const std::string kind = RequiredString(manifest_path, entry, "kind");
+  if (kind == "strain") return SensorKind::kStrain;
+  if (kind != "displacement") {
+    throw InputError(Where(manifest_path, entry["kind"]) +
+                     ": kind must be displacement or strain, got '" + kind + "'");
+  }
+  return SensorKind::kDisplacement;
+}
+
+// Appends the manifest's sensors (an optional list) to data->sensors: each of kind
+// displacement (the default) or strain, its channel not already in *channels (then
+// added), its observation row file (relative to `folder`) checked against the mass
 // matrix (mass_file) and stored as a row.
 void ReadSensors(const std::string& manifest_path, const YAML::Node& root,
                  const std::string& folder, const std::string& mass_file,
                  std::set<std::string>* channels, MatrixModelData* data) {
   const int n = data->dofs();
-  for (const YAML::Node& entry : RequiredList(manifest_path, root, "sensors")) {
+  for (const YAML::Node& entry :
+       OptionalList(manifest_path, root, "sensors", "a list of {channel, row, kind}")) {
     CheckEntryKeys(manifest_path, entry, {"channel", "row", "kind"}, "channel, row, kind");
     MatrixModelSensor sensor;
     sensor.channel = RequiredString(manifest_path, entry, "channel");
-    if (entry["kind"]) {
-      const std::string kind = RequiredString(manifest_path, entry, "kind");
-      if (kind == "strain") {
-        sensor.kind = SensorKind::kStrain;
-      } else if (kind != "displacement") {
-        throw InputError(Where(manifest_path, entry["kind"]) +
-                         ": kind must be displacement or "
-                         "strain, got '" +
-                         kind + "'");
-      }
-    }
+    sensor.kind = KindOf(manifest_path, entry);
     if (!channels->insert(sensor.channel).second) {
       throw InputError(Where(manifest_path, entry) + ": channel '" + sensor.channel +
                        "' given twice");
@@ -353,6 +472,143 @@ void ReadSensors(const std::string& manifest_path, const YAML::Node& root,
     if (row.rows() != 1) row = SparseMatrix(row.transpose());
     sensor.row = std::move(row);
     data->sensors.push_back(std::move(sensor));
+  }
+}
+
+// A channel name of a channels file and the file's line it is on (1-based).
+struct ListedChannel {
+  std::string name;
+  int line = 0;
+};
+
+// The channel names of the file at `path`: one a line, trimmed; blank lines and lines
+// starting with '#' skipped. Refuses a file that cannot be read, holds no name, or names a
+// channel twice ("FILE:LINE: ...").
+std::vector<ListedChannel> ReadChannelNames(const std::string& path) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) {
+    throw InputError("cannot read channel names file " + path + ": it is a directory");
+  }
+  std::ifstream file(path, std::ios::binary);
+  if (!file) {
+    throw InputError("cannot read channel names file " + path + ": " + std::strerror(errno));
+  }
+  std::vector<ListedChannel> names;
+  std::map<std::string, int> lines;
+  std::string text;
+  for (int line = 1; std::getline(file, text); ++line) {
+    const std::size_t begin = text.find_first_not_of(" \t\r\f\v");
+    if (begin == std::string::npos || text[begin] == '#') continue;
+    const std::size_t end = text.find_last_not_of(" \t\r\f\v");
+    ListedChannel name{text.substr(begin, end - begin + 1), line};
+    const auto first = lines.emplace(name.name, line);
+    if (!first.second) {
+      throw InputError(path + ":" + std::to_string(line) + ": channel '" + name.name +
+                       "' given twice (first on line " + std::to_string(first.first->second) +
+                       "), expected each channel once");
+    }
+    names.push_back(std::move(name));
+  }
+  if (file.bad()) throw InputError("cannot read channel names file " + path);
+  if (names.empty()) {
+    throw InputError(path +
+                     ": no channel names, expected one a line (blank lines and lines starting "
+                     "with '#' are skipped)");
+  }
+  return names;
+}
+
+// The channel names of a matrix entry (key `channels`, a file relative to `folder`),
+// `count` of them (the matrix `matrix_file`'s `what`, columns or rows), each not already in
+// *channels (then added).
+std::vector<ListedChannel> ReadMatrixChannels(const std::string& manifest_path,
+                                              const YAML::Node& entry, const std::string& folder,
+                                              Eigen::Index count, const std::string& matrix_file,
+                                              const std::string& what,
+                                              std::set<std::string>* channels) {
+  const std::string file = ManifestFile(folder, RequiredString(manifest_path, entry, "channels"));
+  std::vector<ListedChannel> names = ReadChannelNames(file);
+  if (static_cast<Eigen::Index>(names.size()) != count) {
+    throw InputError(file + ": " + std::to_string(names.size()) + " channel names, but " +
+                     matrix_file + " has " + std::to_string(count) + " " + what +
+                     ", expected one name per " + what.substr(0, what.size() - 1));
+  }
+  for (const ListedChannel& name : names) {
+    if (!channels->insert(name.name).second) {
+      throw InputError(file + ":" + std::to_string(name.line) + ": channel '" + name.name +
+                       "' given twice: already a channel of the model (a load's or a "
+                       "sensor's), expected a channel of its own");
+    }
+  }
+  return names;
+}
+
+// Appends the channels of the manifest's load matrices (key loads_matrix: a map
+// {matrix, channels} or a list of them) to data->loads, in their order: column c of the
+// n x C matrix (a file relative to `folder`, n the dofs of mass_file) is the vector of the
+// channels file's c-th name.
+void ReadLoadMatrices(const std::string& manifest_path, const YAML::Node& root,
+                      const std::string& folder, const std::string& mass_file,
+                      std::set<std::string>* channels, MatrixModelData* data) {
+  const int n = data->dofs();
+  for (const YAML::Node& entry : OptionalList(manifest_path, root, "loads_matrix",
+                                              "a map {matrix, channels} or a list of them", true)) {
+    CheckEntryKeys(manifest_path, entry, {"matrix", "channels"}, "matrix, channels");
+    const std::string file = ManifestFile(folder, RequiredString(manifest_path, entry, "matrix"));
+    const SparseMatrix matrix = ReadMatrixMarketMatrix(file);
+    if (matrix.rows() != n) {
+      throw InputError(file + ": " + std::to_string(matrix.rows()) + " x " +
+                       std::to_string(matrix.cols()) + ", but " + mass_file + " has " +
+                       std::to_string(n) + " dofs, expected " + std::to_string(n) +
+                       " rows (a column per load channel)");
+    }
+    const std::vector<ListedChannel> names =
+        ReadMatrixChannels(manifest_path, entry, folder, matrix.cols(), file, "columns", channels);
+    for (std::size_t c = 0; c < names.size(); ++c) {
+      data->loads.push_back({names[c].name, Vector(matrix.col(static_cast<Eigen::Index>(c)))});
+    }
+  }
+}
+
+// Appends the channels of the manifest's observation matrices (key sensors_matrix: a map
+// {matrix, channels, kind} or a list of them) to data->sensors, in their order: row k of
+// the S x n matrix (a file relative to `folder`, n the dofs of mass_file) is the
+// observation row of the channels file's k-th name, every row of the entry's kind
+// (displacement by default, or strain). Each row is built from its own entries: no dense
+// S x n work.
+void ReadSensorMatrices(const std::string& manifest_path, const YAML::Node& root,
+                        const std::string& folder, const std::string& mass_file,
+                        std::set<std::string>* channels, MatrixModelData* data) {
+  const int n = data->dofs();
+  for (const YAML::Node& entry :
+       OptionalList(manifest_path, root, "sensors_matrix",
+                    "a map {matrix, channels, kind} or a list of them", true)) {
+    CheckEntryKeys(manifest_path, entry, {"matrix", "channels", "kind"}, "matrix, channels, kind");
+    const SensorKind kind = KindOf(manifest_path, entry);
+    const std::string file = ManifestFile(folder, RequiredString(manifest_path, entry, "matrix"));
+    const Eigen::SparseMatrix<double, Eigen::RowMajor> matrix = ReadMatrixMarketMatrix(file);
+    if (matrix.cols() != n) {
+      throw InputError(file + ": " + std::to_string(matrix.rows()) + " x " +
+                       std::to_string(matrix.cols()) + ", but " + mass_file + " has " +
+                       std::to_string(n) + " dofs, expected " + std::to_string(n) +
+                       " columns (a row per sensor channel)");
+    }
+    const std::vector<ListedChannel> names =
+        ReadMatrixChannels(manifest_path, entry, folder, matrix.rows(), file, "rows", channels);
+    for (Eigen::Index k = 0; k < matrix.rows(); ++k) {
+      std::vector<Eigen::Triplet<double>> entries;
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(matrix, k); it; ++it) {
+        entries.emplace_back(0, static_cast<int>(it.col()), it.value());
+      }
+      MatrixModelSensor sensor;
+      sensor.channel = names[static_cast<std::size_t>(k)].name;
+      sensor.kind = kind;
+      sensor.row = SparseMatrix(1, n);
+      sensor.row.setFromTriplets(entries.begin(), entries.end());
+      Refuse(CheckSensorRow(sensor.row, sensor.channel, file + " row " + std::to_string(k + 1), n,
+                            mass_file));
+      data->sensors.push_back(std::move(sensor));
+    }
   }
 }
 
@@ -461,10 +717,22 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
   Refuse(CheckSymmetric(data.mass, mass_file));
   Refuse(CheckPositiveDefinite(data.mass, mass_file));
   ReadZones(manifest_path, root, folder, mass_file, &data);
-  // Load and sensor channels share one namespace.
+  // Load and sensor channels share one namespace; each list's files, then its matrices.
   std::set<std::string> channels;
   ReadLoads(manifest_path, root, folder, mass_file, &channels, &data);
+  ReadLoadMatrices(manifest_path, root, folder, mass_file, &channels, &data);
+  if (data.loads.empty()) {
+    throw InputError(manifest_path +
+                     ": expected 'loads', a non-empty list, or 'loads_matrix', a load matrix "
+                     "and its channel names");
+  }
   ReadSensors(manifest_path, root, folder, mass_file, &channels, &data);
+  ReadSensorMatrices(manifest_path, root, folder, mass_file, &channels, &data);
+  if (data.sensors.empty()) {
+    throw InputError(manifest_path +
+                     ": expected 'sensors', a non-empty list, or 'sensors_matrix', an "
+                     "observation matrix and its channel names");
+  }
   ReadSupports(manifest_path, root, folder, mass_file, &channels, &data);
   return data;
 }

@@ -20,8 +20,25 @@
 //     - {name: clamp, dofs: [0], force_channel: f0, displacement_channel: u0}
 //
 // (a relative file name is relative to the manifest's folder, an absolute one is used
-// as it is). WriteBarMatrixModel exports the built-in bar this way, so that the general
-// path can be tested against it.
+// as it is). The loads and the sensors may instead, or as well, come as one matrix each,
+// as a finite-element code assembles them, with a file of their channel names:
+//
+//   loads_matrix: {matrix: G.mtx, channels: load_channels.txt}     # n x C
+//   sensors_matrix:                                                # S x n
+//     - {matrix: H_u.mtx, channels: sensor_channels_u.txt}         # kind displacement
+//     - {matrix: H_e.mtx, channels: sensor_channels_e.txt, kind: strain}
+//
+// Column c of G is the spatial vector of the load channel on the c-th name of its
+// channels file; row k of H is the observation row of the sensor channel on the k-th
+// name, of the entry's `kind` (displacement by default, or strain). Each key takes one
+// map or a list of them. A channels file holds one name a line, trimmed of blanks; blank
+// lines and lines starting with '#' are skipped; as many names as G has columns (H rows).
+// The channels are appended to MatrixModelData::loads (sensors) in the manifest's
+// order: those of `loads` (`sensors`) first, then each matrix's in its list's order.
+// `loads` and `sensors` become optional: the model needs at least one load channel and
+// one sensor channel from either form. WriteMatrixModel writes either form
+// (MatrixModelLayout); with BarMatrixModel it exports the built-in bar, so that the
+// general path can be tested against it.
 #pragma once
 
 #include <string>
@@ -98,23 +115,37 @@ MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
                                const std::vector<BarSensor>& sensors = {},
                                BarClampExport clamp = BarClampExport::kLoadAndSensor);
 
-// Writes `data` into `folder` (which must exist): M.mtx, K_<zone>.mtx,
-// load_<channel>.mtx, sensor_<channel>.mtx ('@' of a channel becomes '_at_'),
-// support_<name>.mtx (a support's reaction g, only when it is not the default) and the
-// manifest model.yaml, each atomically, matrices in symmetric storage, 17 digits.
-// Returns the manifest's path. Throws std::runtime_error when a file cannot be
-// written.
-std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& data);
+// How WriteMatrixModel writes the loads and sensors.
+enum class MatrixModelLayout {
+  kFilePerChannel,  // load_<channel>.mtx and sensor_<channel>.mtx (keys loads, sensors)
+  // G.mtx with load_channels.txt (key loads_matrix), and H_<i>.mtx with
+  // sensor_channels_<i>.txt (key sensors_matrix) for the i-th run of consecutive sensors of
+  // one kind, i = 1, 2, ...: the same channels in the same order.
+  kMatrices,
+};
+
+// Writes `data` into `folder` (which must exist): M.mtx, K_<zone>.mtx, the loads and
+// sensors as `layout` says (per channel, '@' of a channel becomes '_at_' in its file
+// name), support_<name>.mtx (a support's reaction g, only when it is not the default)
+// and the manifest model.yaml, each atomically, M and K_z in symmetric storage, 17
+// digits. Returns the manifest's path. Throws std::runtime_error when a file cannot be
+// written, or, with kMatrices, when a channel name cannot stand on a line of a channels
+// file (empty, a line break, a leading '#', leading or trailing blanks).
+std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& data,
+                             MatrixModelLayout layout = MatrixModelLayout::kFilePerChannel);
 
 // Reads a manifest and its files, and checks them (model/matrix_model_check.h): M
 // square, symmetric, positive definite; every K_z symmetric and of M's size; the
-// load vectors of M's size; the sensor rows within M's dofs; zone names and channels
-// distinct; nominal moduli and the scales stiffness_length and length finite and
-// positive; a sensor's kind displacement or strain; every support named once, its dofs
-// distinct, in range and held by no other support, its reaction of M's size and
-// nonzero on its dofs only, its channels distinct from every other channel (loads',
-// sensors', supports'). Throws InputError naming the file
-// (and line, for the manifest and the Matrix Market files) on the first problem.
+// load vectors of M's size; the sensor rows within M's dofs and not all zero; a load
+// matrix with M's dofs as rows, an observation matrix with them as columns, each with a
+// channels file of one distinct name per column (row), not empty; at least one load and
+// one sensor; zone names and channels (of files and matrices alike) distinct; nominal moduli and
+// the scales stiffness_length and length finite and positive; a sensor's kind displacement or
+// strain; every support named once, its dofs distinct, in range and held by no other support, its
+// reaction of M's size and nonzero on its dofs only, its channels distinct from every other channel
+// (loads', sensors', supports'). Throws InputError naming the file (and line, for the manifest, the
+// Matrix Market files and a channels file's bad name; both counts for a channels file that does not
+// match its matrix) on the first problem.
 MatrixModelData ReadMatrixModel(const std::string& manifest_path);
 
 }  // namespace mcrewave
