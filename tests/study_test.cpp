@@ -234,6 +234,10 @@ TEST(StudyTest, RobustnessRunsOnAMatrixModelEachRunBeingIdentifyRunsIdentificati
   const std::string summary = ReadStudyText(folder + "/one/summary.md");
   EXPECT_NE(summary.find("| 20 | zone1 | 2 | 100 % |"), std::string::npos) << summary;
   EXPECT_NE(summary.find("E_ref: zone0 210 GPa, zone1 190 GPa."), std::string::npos) << summary;
+  EXPECT_NE(summary.find("- SNR inf, zone1: error "), std::string::npos) << summary;
+  EXPECT_NE(summary.find("the model's bias against the truth (no noise)"), std::string::npos)
+      << summary;
+  EXPECT_EQ(summary.find("global scan"), std::string::npos) << summary;
 }
 
 TEST(StudyTest, TheRobustnessStudyOfAMatrixModelNeedsTheTruthOfEveryZone) {

@@ -494,6 +494,7 @@ void RunMatrixRobustness(const Config& config, RunJournal* journal, RobustnessSt
                                                          : config.data.truth_manifest) +
                      ") lacks a zone of the same name");
   }
+  study->matrix_model = true;
   for (std::size_t z = 0; z < model.zones.size(); ++z) {
     study->parameters.push_back(model.zones[z].name);
     study->reference_moduli.push_back(truth.truth_moduli[static_cast<int>(z)]);
@@ -656,7 +657,7 @@ std::string RobustnessSummary(const RobustnessStudy& study) {
   const bool many = ManyParameters(study);
   std::ostringstream md;
   md << "## Robustness (`robustness/`)\n\n";
-  if (!many) {
+  if (!study.matrix_model) {
     md << "`robustness.png`: the relative error (E* - E_ref) / E_ref of the identified modulus "
           "against the SNR, every run as a point and, per SNR, the mean with the 2.5-97.5 % "
           "quantile band of the converged runs. Each run is the identification of `identify "
@@ -668,7 +669,7 @@ std::string RobustnessSummary(const RobustnessStudy& study) {
   } else {
     md << "`robustness.png`: the relative error (E* - E_ref) / E_ref of each zone modulus "
           "against the SNR, every run as a point and, per SNR and zone, the mean with the "
-          "2.5-97.5 % quantile band of the converged runs (zones left to right: "
+          "2.5-97.5 % quantile band of the converged runs (zones: "
        << ZoneList(study)
        << "). Each run is the identification of `identify run` on the matrix model (pre-filter, "
           "every zone at once from the nominal moduli; no error map or uncertainty) on data of "
@@ -682,14 +683,19 @@ std::string RobustnessSummary(const RobustnessStudy& study) {
     md << ".\n\n";
   }
   md << RobustnessTable(study);
-  md << "\nEvaluations: outer evaluations of the functionals scanned and refined (the "
-        "search functional's and e^2's, the scans' included), means over all runs; "
-        "sweeps: inner sweeps of those evaluations.\n\n";
+  md << (study.matrix_model
+             ? "\nEvaluations: evaluations of e^2 (least squares: J) by the optimiser of "
+               "zone_identification:, means over all runs; sweeps: inner sweeps of those "
+               "evaluations.\n\n"
+             : "\nEvaluations: outer evaluations of the functionals scanned and refined (the "
+               "search functional's and e^2's, the scans' included), means over all runs; "
+               "sweeps: inner sweeps of those evaluations.\n\n");
   for (const RobustnessStatistics& s : study.statistics) {
     if (std::isinf(s.snr)) {
       md << "- SNR inf" << (many ? ", " + study.parameters[s.parameter] : std::string())
          << ": error " << Percent(s.mean_error) << ", the "
-         << (many ? "model's bias" : "discretisation bias") << " (no noise).\n";
+         << (study.matrix_model ? "model's bias against the truth" : "discretisation bias")
+         << " (no noise).\n";
     }
   }
   // The lowest finite SNR: the paper's claim.

@@ -146,6 +146,7 @@ struct RobustnessStudy {
   // modulus of the zone).
   std::vector<std::string> parameters;
   std::vector<double> reference_moduli;
+  bool matrix_model = false;        // a matrix model's zones: no global scan
   std::vector<RobustnessRun> runs;  // SNR by SNR, seeds ascending
   // One per SNR and parameter: SNR by SNR in robustness_snr order, the parameters in
   // order within each.
