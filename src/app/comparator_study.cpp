@@ -104,12 +104,8 @@ void RunDataSet(const Config& config, const DataSet& set, const std::vector<bool
   const BarModel model(identified);
   const int filters = static_cast<int>(prefilters.size());
   for (int k = 0; k < 2 * filters; ++k) {
+    // Its case fields (functional, data, ...) are RunDataSets'.
     ComparatorRun& run = runs[k];
-    run.model_error = set.model_error;
-    run.snr = set.snr;
-    run.seed = set.seed;
-    run.least_squares = k >= filters;
-    run.prefilter = prefilters[k % filters];
     PrefilterOptions prefilter = config.prefilter;
     prefilter.enabled = run.prefilter;
     const ChannelSet data = PrefilterMeasurements(measured, prefilter, nullptr);
@@ -135,8 +131,8 @@ MatrixMeasurements MatrixDataSet(const MatrixModelData& model, const MatrixMeasu
 }
 
 // The runs of one data set on a matrix model, {MCRE, least squares} x `prefilters` x
-// zones in that order: each functional as identify run identifies the zones (without
-// maps or uncertainty), the model `density` times denser under that error.
+// zones in that order (their case fields RunDataSets'): each functional as identify run identifies
+// the zones (without maps or uncertainty), the model `density` times denser under that error.
 void RunMatrixDataSet(const Config& config, const MatrixModelData& model,
                       const MatrixMeasurements& truth, const std::vector<double>& reference,
                       const DataSet& set, const std::vector<bool>& prefilters,
@@ -160,12 +156,6 @@ void RunMatrixDataSet(const Config& config, const MatrixModelData& model,
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     for (int z = 0; z < zones; ++z) {
       ComparatorRun& out = runs[k * zones + z];
-      out.model_error = set.model_error;
-      out.zone = z;
-      out.snr = set.snr;
-      out.seed = set.seed;
-      out.least_squares = k >= filters;
-      out.prefilter = prefilters[k % filters];
       out.converged = run.IsUsable();
       out.message = run.failure;
       out.evaluations = run.outer.evaluations;
@@ -516,7 +506,7 @@ void RunDataSets(const DataSet* sets, int count, int runs_per_set,
   const int filters = static_cast<int>(study->prefilters.size());
   const int zones = static_cast<int>(study->zones.size());
   for (int i = 0; i < count; ++i) {
-    // The case fields, for the runs the journal restores.
+    // The case fields, for every run (the journal restores the outcomes only).
     for (int k = 0; k < runs_per_set; ++k) {
       ComparatorRun& run = study->runs[static_cast<std::size_t>(runs_per_set) * i + k];
       run.model_error = sets[i].model_error;
@@ -564,26 +554,18 @@ void RunMatrixComparator(const Config& config, const std::vector<DataSet>& sets,
                        "none, density, force_gain and displacement_gain");
     }
   }
-  const MatrixModelData model = LoadMatrixModel(config);
-  Config noise_free = config;
-  noise_free.data.snr = std::numeric_limits<double>::infinity();
-  const MatrixMeasurements truth = LoadMatrixMeasurements(noise_free, model);
-  if (truth.truth_moduli.size() != static_cast<int>(model.zones.size())) {
-    throw InputError(name + ": the comparator study needs the truth's modulus of every zone of " +
-                     config.structure.manifest + ", and the truth lacks a zone of the same name");
-  }
+  const internal::MatrixStudyTruth truth(config, "comparator");
+  const MatrixModelData& model = truth.model;
   study->matrix_model = true;
-  for (std::size_t z = 0; z < model.zones.size(); ++z) {
-    study->zones.push_back(model.zones[z].name);
-    study->reference_moduli.push_back(truth.truth_moduli[static_cast<int>(z)]);
-  }
+  study->zones = truth.zone_names;
+  study->reference_moduli = truth.reference_moduli;
   const int runs_per_set =
       2 * static_cast<int>(study->prefilters.size()) * static_cast<int>(study->zones.size());
   RunDataSets(
       sets.data(), static_cast<int>(sets.size()), runs_per_set,
       [&](int i) {
-        RunMatrixDataSet(config, model, truth, study->reference_moduli, sets[i], study->prefilters,
-                         &study->runs[runs_per_set * i]);
+        RunMatrixDataSet(config, model, truth.measurements, study->reference_moduli, sets[i],
+                         study->prefilters, &study->runs[runs_per_set * i]);
       },
       journal, study, progress);
 }
@@ -602,12 +584,8 @@ ComparatorStudy RunComparatorStudy(const Config& config, const std::string& jour
   }
   study.threads = internal::ResolveThreads(config.study.threads);
   internal::Progress progress("comparator", static_cast<int>(sets.size()));
-  std::unique_ptr<internal::RunJournal> journal;
-  if (!journal_path.empty()) {
-    journal = std::make_unique<internal::RunJournal>(
-        journal_path,
-        "mcrewave comparator study " + internal::StudyFingerprint(config, "comparator"));
-  }
+  const std::unique_ptr<internal::RunJournal> journal =
+      internal::OpenStudyJournal(journal_path, config, "comparator");
   if (config.structure.kind == ModelKind::kMatrix) {
     RunMatrixComparator(config, sets, journal.get(), &study, &progress);
   } else {

@@ -641,11 +641,8 @@ DamageStudy RunDamageStudy(const Config& config, const std::string& journal_path
                    : "");
   study.settings = settings.str();
   internal::Progress progress("damage", static_cast<int>(cases.size()));
-  std::unique_ptr<internal::RunJournal> journal;
-  if (!journal_path.empty()) {
-    journal = std::make_unique<internal::RunJournal>(
-        journal_path, "mcrewave damage study " + internal::StudyFingerprint(config, "damage"));
-  }
+  const std::unique_ptr<internal::RunJournal> journal =
+      internal::OpenStudyJournal(journal_path, config, "damage");
   for (std::size_t i = 0; i < cases.size(); ++i) AssignCase(cases[i], &study.runs[i]);
   internal::ResumableParallelFor(
       static_cast<int>(cases.size()), study.threads,

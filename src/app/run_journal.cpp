@@ -73,6 +73,13 @@ std::string StudyFingerprint(const Config& config, const std::string& study) {
   return hex;
 }
 
+std::unique_ptr<RunJournal> OpenStudyJournal(const std::string& path, const Config& config,
+                                             const std::string& study) {
+  if (path.empty()) return nullptr;
+  return std::make_unique<RunJournal>(
+      path, "mcrewave " + study + " study " + StudyFingerprint(config, study));
+}
+
 RunJournal::RunJournal(std::string path, std::string header) : path_(std::move(path)) {
   namespace fs = std::filesystem;
   std::error_code error;

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -29,6 +30,13 @@ namespace mcrewave::internal {
 // the config as YAML without study.threads, study.folder, study.figures and
 // output.* (FNV-1a, 64 bits, as 16 hex digits).
 std::string StudyFingerprint(const Config& config, const std::string& study);
+
+class RunJournal;
+
+// The journal of `study` at path, its header naming the study and its fingerprint; null
+// when path is empty (no journal).
+std::unique_ptr<RunJournal> OpenStudyJournal(const std::string& path, const Config& config,
+                                             const std::string& study);
 
 class RunJournal {
  public:

@@ -139,6 +139,25 @@ ChannelSet NoisyMeasurements(const ChannelSet& truth, double snr, std::uint64_t 
   return measured;
 }
 
+MatrixStudyTruth::MatrixStudyTruth(const Config& config, const std::string& study)
+    : model(LoadMatrixModel(config)) {
+  Config noise_free = config;
+  noise_free.data.snr = std::numeric_limits<double>::infinity();
+  measurements = LoadMatrixMeasurements(noise_free, model);
+  if (measurements.truth_moduli.size() != static_cast<int>(model.zones.size())) {
+    throw InputError((config.source_path.empty() ? std::string("config") : config.source_path) +
+                     ": the " + study + " study needs the truth's modulus of every zone of " +
+                     config.structure.manifest + ", and the truth (" +
+                     (config.data.truth_manifest.empty() ? config.structure.manifest
+                                                         : config.data.truth_manifest) +
+                     ") lacks a zone of the same name");
+  }
+  for (std::size_t z = 0; z < model.zones.size(); ++z) {
+    zone_names.push_back(model.zones[z].name);
+    reference_moduli.push_back(measurements.truth_moduli[static_cast<int>(z)]);
+  }
+}
+
 ChannelSet SimulateStudyTruth(const Config& config) {
   return SimulateTruth(config.model, config.load, config.time, config.data);
 }
@@ -481,31 +500,18 @@ void RunBarRobustness(const Config& config, RunJournal* journal, RobustnessStudy
 // A matrix model: every zone modulus, without the error maps and the uncertainty, from
 // the truth's outputs (data.truth_manifest at data.truth_moduli) plus each run's noise.
 void RunMatrixRobustness(const Config& config, RunJournal* journal, RobustnessStudy* study) {
-  const MatrixModelData model = LoadMatrixModel(config);
-  Config noise_free = config;
-  noise_free.data.snr = std::numeric_limits<double>::infinity();
-  const MatrixMeasurements truth = LoadMatrixMeasurements(noise_free, model);
-  if (truth.truth_moduli.size() != static_cast<int>(model.zones.size())) {
-    throw InputError((config.source_path.empty() ? std::string("config") : config.source_path) +
-                     ": the robustness study needs the truth's modulus of "
-                     "every zone of " +
-                     config.structure.manifest + ", and the truth (" +
-                     (config.data.truth_manifest.empty() ? config.structure.manifest
-                                                         : config.data.truth_manifest) +
-                     ") lacks a zone of the same name");
-  }
+  const MatrixStudyTruth truth(config, "robustness");
+  const MatrixModelData& model = truth.model;
   study->matrix_model = true;
-  for (std::size_t z = 0; z < model.zones.size(); ++z) {
-    study->parameters.push_back(model.zones[z].name);
-    study->reference_moduli.push_back(truth.truth_moduli[static_cast<int>(z)]);
-  }
+  study->parameters = truth.zone_names;
+  study->reference_moduli = truth.reference_moduli;
   RunRobustness(
       config.study,
       [&](RobustnessRun* run) {
         Config run_config = config;
         run_config.data.snr = run->snr;
         run_config.data.seed = run->seed;
-        MatrixMeasurements measured = truth;
+        MatrixMeasurements measured = truth.measurements;
         AddMatrixModelNoise(model, run->snr, run->seed, &measured.histories, &measured.noise);
         const MatrixIdentificationRun identification =
             RunMatrixIdentification(run_config, model, measured, /*maps_and_uncertainty=*/false);
@@ -527,11 +533,7 @@ RobustnessStudy RunRobustnessStudy(const Config& config, const std::string& jour
   const auto start = Clock::now();
   RobustnessStudy study;
   study.threads = ResolveThreads(config.study.threads);
-  std::unique_ptr<RunJournal> journal;
-  if (!journal_path.empty()) {
-    journal = std::make_unique<RunJournal>(
-        journal_path, "mcrewave robustness study " + StudyFingerprint(config, "robustness"));
-  }
+  const std::unique_ptr<RunJournal> journal = OpenStudyJournal(journal_path, config, "robustness");
   if (config.structure.kind == ModelKind::kMatrix) {
     RunMatrixRobustness(config, journal.get(), &study);
   } else {

@@ -10,6 +10,12 @@
 #include <utility>
 #include <vector>
 
+#include "mcrewave/app/matrix_identification_run.h"
+
+namespace mcrewave {
+struct Config;
+}
+
 namespace mcrewave::internal {
 
 using Clock = std::chrono::steady_clock;
@@ -44,6 +50,18 @@ class Progress {
 void ParallelFor(int count, int threads, const std::function<void(int)>& task, Progress* progress);
 
 class RunJournal;
+
+// A matrix model's study truth: the model of model.manifest, its noise-free
+// measurements (the truth of data: at data.truth_moduli, data.snr ignored: each run adds
+// its own noise), and each zone's name and truth modulus E_ref [Pa]. Throws InputError
+// naming the config, the study and the truth when the truth lacks one of the zones.
+struct MatrixStudyTruth {
+  MatrixStudyTruth(const Config& config, const std::string& study);
+  MatrixModelData model;
+  MatrixMeasurements measurements;
+  std::vector<std::string> zone_names;
+  std::vector<double> reference_moduli;
+};
 
 // ParallelFor over the runs a journal does not hold (null: every run): task(i), then
 // journal->Record(i, encode(i)); each run the journal holds is decode(i, record)
