@@ -223,6 +223,7 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
   const int num_rows = num_fixed + num_reactions_;
   GatherLoads(columns, data, held_, n, &measured_loads_, &alphas_, &loads_);
   loads_transposed_ = loads_.transpose();
+  load_columns_ = SparseColumns(loads_);
   measured_outputs_.resize(num_rows, data.num_samples());
   betas_.resize(num_rows);
   GatherFixedRows(rows, data, held_, n, &measured_outputs_, &betas_, &fixed_observation_);
@@ -237,6 +238,7 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
   } else {
     observation_ = fixed_observation_;
     observation_transposed_ = observation_.transpose();
+    observation_columns_ = SparseColumns(observation_transposed_);
   }
   mass_ = trusted ? WithHeldDofs(model.mass, held_) : model.mass;
   for (int b = 0; b < 2; ++b) {
@@ -244,7 +246,6 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
     state_[b] = Vector::Zero(n);
   }
   shift_ = Vector::Zero(n);
-  force_ = Vector::Zero(n);
   product_ = Vector::Zero(n);
   channel_ = Vector::Zero(num_loads);
   other_channel_ = Vector::Zero(num_loads);
@@ -288,6 +289,7 @@ void MatrixMcreProblem::SetModuli(const Vector& zone_moduli) {
     observation_.resize(num_fixed + num_reactions_, model_.dofs());
     observation_.setFromTriplets(entries.begin(), entries.end());
     observation_transposed_ = observation_.transpose();
+    observation_columns_ = SparseColumns(observation_transposed_);
   }
   ThetaIntegratorOptions options;
   options.time_step = time_step_;
@@ -306,17 +308,10 @@ void MatrixMcreProblem::DirectSweep(const Matrix& retrograde, bool include_data,
   velocity_[0].setZero();
   for (int k = 0; k < m; ++k) {
     const int current = k & 1, next = current ^ 1;
-    // f_theta = -K W_theta + G (F~_theta - diag(1/alpha) G^T W_theta),
     // W_theta = theta W_{k+1} + (1 - theta) W_k.
     shift_ = theta_ * retrograde.col(k + 1) + (1.0 - theta_) * retrograde.col(k);
-    channel_.noalias() = loads_transposed_ * shift_;
-    channel_ = -channel_.cwiseQuotient(alphas_);
-    if (include_data) {
-      channel_ += theta_ * measured_loads_.col(k + 1) + (1.0 - theta_) * measured_loads_.col(k);
-    }
-    force_.noalias() = loads_ * channel_;
-    integrator_.StepShifted(velocity_[current], displacement->col(k), shift_, force_,
-                            velocity_[next], displacement->col(k + 1));
+    DirectStep(k, include_data, velocity_[current], displacement->col(k), velocity_[next],
+               displacement->col(k + 1));
   }
   ++sweep_count_;
 }
@@ -332,11 +327,9 @@ void MatrixMcreProblem::RetrogradeSweep(const Matrix& displacement, bool include
   for (int j = m, s = 0; j > 0; --j, ++s) {
     const int current = s & 1, next = current ^ 1;
     // Step t_j -> t_{j-1} carries c_j H^T diag(beta) (H U_j - d~_j).
-    trace_.noalias() = observation_ * displacement.col(j);
-    if (include_data) trace_ -= measured_outputs_.col(j);
-    trace_ = (QuadratureWeight(j) * betas_).cwiseProduct(trace_);
-    force_.noalias() = observation_transposed_ * trace_;
-    integrator_.Step(velocity_[current], state_[current], force_, velocity_[next], state_[next]);
+    observation_columns_.TransposeMultiply(displacement.col(j).data(), trace_.data());
+    RetrogradeStep(j, include_data, velocity_[current], state_[current], velocity_[next],
+                   state_[next]);
     // W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j, omega_m = 0.
     retrograde->col(j) =
         (theta_ * state_[next] + (1.0 - theta_) * state_[current]) * (1.0 / QuadratureWeight(j));
@@ -362,12 +355,12 @@ double MatrixMcreProblem::Cost(const Matrix& displacement, const Matrix& retrogr
   for (int j = 0; j <= num_steps(); ++j) {
     // c_j h [1/2 W^T K W + 1/2 (G^T W)^T diag(1/alpha) G^T W
     //        + 1/2 (H U - d~)^T diag(beta) (H U - d~)].
-    product_.noalias() = stiffness_ * retrograde.col(j);
-    channel_.noalias() = loads_transposed_ * retrograde.col(j);
-    trace_.noalias() = observation_ * displacement.col(j);
+    const double* w = retrograde.col(j).data();
+    const double gap = StiffnessForm(w, w);
+    load_columns_.TransposeMultiply(w, channel_.data());
+    observation_columns_.TransposeMultiply(displacement.col(j).data(), trace_.data());
     trace_ -= measured_outputs_.col(j);
-    const double integrand = 0.5 * retrograde.col(j).dot(product_) +
-                             0.5 * channel_.cwiseQuotient(alphas_).dot(channel_) +
+    const double integrand = 0.5 * gap + 0.5 * channel_.cwiseQuotient(alphas_).dot(channel_) +
                              0.5 * betas_.dot(trace_.cwiseProduct(trace_));
     sum += QuadratureWeight(j) * h * integrand;
   }
@@ -473,12 +466,8 @@ void MatrixMcreProblem::DataResponseSweep(Observe&& observe) {
     // DirectSweep's step at W = 0: f_theta = G F~_theta (the same operations, so the
     // same bits).
     shift_.setZero();
-    channel_.noalias() = loads_transposed_ * shift_;
-    channel_ = -channel_.cwiseQuotient(alphas_);
-    channel_ += theta_ * measured_loads_.col(k + 1) + (1.0 - theta_) * measured_loads_.col(k);
-    force_.noalias() = loads_ * channel_;
-    integrator_.StepShifted(stream_velocity_[current], stream_displacement_[current], shift_,
-                            force_, stream_velocity_[next], stream_displacement_[next]);
+    DirectStep(k, true, stream_velocity_[current], stream_displacement_[current],
+               stream_velocity_[next], stream_displacement_[next]);
     observe(k + 1, stream_displacement_[next]);
   }
   ++sweep_count_;
@@ -488,7 +477,7 @@ Matrix MatrixMcreProblem::ModelOutputs() {
   const auto sensors = static_cast<Eigen::Index>(model_.sensors.size());
   Matrix outputs(sensors, num_steps() + 1);
   DataResponseSweep([&](int j, const Vector& displacement) {
-    trace_.noalias() = observation_ * displacement;
+    observation_columns_.TransposeMultiply(displacement.data(), trace_.data());
     outputs.col(j) = trace_.head(sensors);
   });
   return outputs;

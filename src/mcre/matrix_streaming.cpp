@@ -24,22 +24,49 @@ double MatrixMcreProblem::TraceInnerProduct(const Matrix& a, const Matrix& b) co
 void MatrixMcreProblem::RetrogradeTraceStep(int j, const Matrix& traces, bool include_data,
                                             const Vector& velocity, const Vector& state,
                                             Vector& velocity_next, Vector& state_next) {
-  // The force of RetrogradeSweep with y_j in place of H U_j:
-  // c_j H^T diag(beta) (y_j - d~_j).
   trace_ = traces.col(j);
+  RetrogradeStep(j, include_data, velocity, state, velocity_next, state_next);
+}
+
+void MatrixMcreProblem::RetrogradeStep(int j, bool include_data, const Vector& velocity,
+                                       const Vector& state, Vector& velocity_next,
+                                       Vector& state_next) {
+  // c_j H^T diag(beta) (y_j - d~_j).
   if (include_data) trace_ -= measured_outputs_.col(j);
   trace_ = (QuadratureWeight(j) * betas_).cwiseProduct(trace_);
-  force_.noalias() = observation_transposed_ * trace_;
-  integrator_.Step(velocity, state, force_, velocity_next, state_next);
+  integrator_.StepWithEndLoads(velocity, state, 0.0, 0.0, velocity_next, state_next,
+                               observation_columns_.Scatter(trace_.data()));
+}
+
+void MatrixMcreProblem::DirectStep(int k, bool include_data, const Vector& velocity,
+                                   const Eigen::Ref<const Vector>& displacement,
+                                   Vector& velocity_next, Eigen::Ref<Vector> displacement_next) {
+  // f_theta = -K W_theta + G (F~_theta - diag(1/alpha) G^T W_theta).
+  load_columns_.TransposeMultiply(shift_.data(), channel_.data());
+  channel_ = -channel_.cwiseQuotient(alphas_);
+  if (include_data) {
+    channel_ += theta_ * measured_loads_.col(k + 1) + (1.0 - theta_) * measured_loads_.col(k);
+  }
+  integrator_.StepWithEndLoads(velocity, displacement, shift_, 0.0, 0.0, velocity_next,
+                               displacement_next, load_columns_.Scatter(channel_.data()));
+}
+
+double MatrixMcreProblem::StiffnessForm(const double* x, const double* y) {
+  if (integrator_.factorization() == Factorization::kBand) {
+    return integrator_.stiffness().BilinearForm(x, y);
+  }
+  const int n = num_nodes();
+  product_.noalias() = stiffness_ * Eigen::Map<const Vector>(y, n);
+  return Eigen::Map<const Vector>(x, n).dot(product_);
 }
 
 double MatrixMcreProblem::PenaltyForm(const Eigen::Ref<const Vector>& x,
                                       const Eigen::Ref<const Vector>& y) {
   // x^T (K + G diag(1/alpha) G^T) y, the integrand of InnerProduct.
-  product_.noalias() = stiffness_ * y;
-  channel_.noalias() = loads_transposed_ * x;
-  other_channel_.noalias() = loads_transposed_ * y;
-  return x.dot(product_) + channel_.cwiseQuotient(alphas_).dot(other_channel_);
+  const double stiffness_form = StiffnessForm(x.data(), y.data());
+  load_columns_.TransposeMultiply(x.data(), channel_.data());
+  load_columns_.TransposeMultiply(y.data(), other_channel_.data());
+  return stiffness_form + channel_.cwiseQuotient(alphas_).dot(other_channel_);
 }
 
 double MatrixMcreProblem::RetrogradeEnergy(const Matrix& traces) {
@@ -74,7 +101,7 @@ void MatrixMcreProblem::AddStreamingSample(int j, const Vector& displacement,
   // e^2: c_j h [1/2 W^T K W + 1/2 (G^T W)^T diag(1/alpha) G^T W
   //             + 1/2 (H U - d~)^T diag(beta) (H U - d~)] (Cost), trace_ = H U_j - d~_j.
   product_.noalias() = stiffness_ * retrograde;
-  channel_.noalias() = loads_transposed_ * retrograde;
+  load_columns_.TransposeMultiply(retrograde.data(), channel_.data());
   totals->cost += weight * (0.5 * retrograde.dot(product_) +
                             0.5 * channel_.cwiseQuotient(alphas_).dot(channel_) +
                             0.5 * betas_.dot(trace_.cwiseProduct(trace_)));
@@ -151,7 +178,7 @@ void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Ma
   if (totals != nullptr) ResetStreamingTotals(totals);
   // y_j = H U_j into the image, and sample j into the totals.
   auto observe = [&](int j, const Vector& displacement, const Vector& retrograde) {
-    trace_.noalias() = observation_ * displacement;
+    observation_columns_.TransposeMultiply(displacement.data(), trace_.data());
     image->col(j) = trace_;
     if (totals == nullptr) return;
     trace_ -= measured_outputs_.col(j);
@@ -163,14 +190,8 @@ void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Ma
   auto direct_step = [&](int j, const Vector& previous_retrograde, const Vector& retrograde) {
     const int current = (j - 1) & 1, next = current ^ 1;
     shift_ = theta_ * retrograde + (1.0 - theta_) * previous_retrograde;
-    channel_.noalias() = loads_transposed_ * shift_;
-    channel_ = -channel_.cwiseQuotient(alphas_);
-    if (include_data) {
-      channel_ += theta_ * measured_loads_.col(j) + (1.0 - theta_) * measured_loads_.col(j - 1);
-    }
-    force_.noalias() = loads_ * channel_;
-    integrator_.StepShifted(stream_velocity_[current], stream_displacement_[current], shift_,
-                            force_, stream_velocity_[next], stream_displacement_[next]);
+    DirectStep(j - 1, include_data, stream_velocity_[current], stream_displacement_[current],
+               stream_velocity_[next], stream_displacement_[next]);
     observe(j, stream_displacement_[next], retrograde);
   };
 

@@ -8,7 +8,8 @@
 //   DirectSweep:      W -> U, from rest, step t_k -> t_{k+1} with
 //                       f_theta = -K W_theta + G (F~_theta - diag(1/alpha) G^T W_theta),
 //                       X_theta = theta X_{k+1} + (1 - theta) X_k
-//                     (ThetaIntegrator::StepShifted: z = W_theta, force = G (...));
+//                     (ThetaIntegrator::StepWithEndLoads: z = W_theta, G (...) as point
+//                     loads on G's rows);
 //   RetrogradeSweep:  U -> W, from rest at T in reversed time, step t_j -> t_{j-1}
 //                     with the force c_j H^T diag(beta) (H U_j - d~_j), then
 //                       W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j,
@@ -51,6 +52,7 @@
 #include <vector>
 
 #include "mcrewave/data/channel_set.h"
+#include "mcrewave/linalg/sparse_columns.h"
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/coupled_problem.h"
 #include "mcrewave/mcre/mcre_problem.h"
@@ -167,9 +169,21 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   int checkpoint_stride() const { return checkpoint_stride_; }
 
  private:
-  // The retrograde step t_j -> t_{j-1} driven by the traces y_j: the force
-  // c_j H^T diag(beta) (y_j - d~_j) (without d~ when include_data is false), from
-  // (v, omega) into (v_next, omega_next). No allocation.
+  // x^T K y on either path of the integrator: from its band of K on the band path (as
+  // the bar's McreProblem::PenaltyForm), else through product_ = K y. No allocation.
+  double StiffnessForm(const double* x, const double* y);
+  // The direct step t_k -> t_{k+1} from (v, u) into (v_next, u_next), W_theta in shift_:
+  // f_theta = -K W_theta + G (F~_theta - diag(1/alpha) G^T W_theta), F~ only with
+  // include_data; G's entries as the integrator's point loads. No allocation.
+  void DirectStep(int k, bool include_data, const Vector& velocity,
+                  const Eigen::Ref<const Vector>& displacement, Vector& velocity_next,
+                  Eigen::Ref<Vector> displacement_next);
+  // The retrograde step t_j -> t_{j-1} from (v, omega) into (v_next, omega_next), y_j
+  // (H U_j or a trace) in trace_: the force c_j H^T diag(beta) (y_j - d~_j), d~ only
+  // with include_data; H's entries as point loads. Overwrites trace_. No allocation.
+  void RetrogradeStep(int j, bool include_data, const Vector& velocity, const Vector& state,
+                      Vector& velocity_next, Vector& state_next);
+  // The retrograde step driven by the traces y_j (RetrogradeStep). No allocation.
   void RetrogradeTraceStep(int j, const Matrix& traces, bool include_data, const Vector& velocity,
                            const Vector& state, Vector& velocity_next, Vector& state_next);
   // x^T P y = x^T (K + G diag(1/alpha) G^T) y of two columns; uses product_ and the
@@ -212,12 +226,15 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   SparseMatrix reactions_;
   SparseMatrix observation_;             // H, S x n
   SparseMatrix observation_transposed_;  // H^T, n x S
+  // G and H^T by columns: the sweeps' products G^T x and H x, and G c, H^T y as point
+  // loads (linalg/sparse_columns.h: the bits of the sparse products).
+  SparseColumns load_columns_, observation_columns_;
   SparseMatrix stiffness_;               // K at moduli_ (held dofs decoupled when trusted)
   ThetaIntegrator integrator_;
   // Scratch, allocated in the constructor: double buffers of the sweeps' velocity and
-  // state, W_theta, the step's force, a product K x, two vectors per load channel, one
+  // state, W_theta, a product K x, two vectors per load channel, one
   // per row of H and two per reaction.
-  Vector velocity_[2], state_[2], shift_, force_, product_, channel_, other_channel_, trace_,
+  Vector velocity_[2], state_[2], shift_, product_, channel_, other_channel_, trace_,
       reaction_trace_, reaction_zone_trace_;
   // Streaming: the checkpoints (v over omega, 2n x (m / s + 1)) and one segment's omega
   // (n x (s + 1)), allocated by the first StreamingMap; the double buffers of the

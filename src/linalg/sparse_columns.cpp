@@ -1,0 +1,60 @@
+#include "mcrewave/linalg/sparse_columns.h"
+
+namespace mcrewave {
+
+SparseColumns::SparseColumns(const SparseMatrix& a) : rows_(static_cast<int>(a.rows())) {
+  const int num_columns = static_cast<int>(a.cols());
+  column_start_.assign(1, 0);
+  std::vector<std::vector<std::pair<int, double>>> by_row(static_cast<std::size_t>(rows_));
+  for (int c = 0; c < num_columns; ++c) {
+    for (SparseMatrix::InnerIterator it(a, c); it; ++it) {
+      const int row = static_cast<int>(it.row());
+      entry_row_.push_back(row);
+      entry_value_.push_back(it.value());
+      by_row[static_cast<std::size_t>(row)].emplace_back(c, it.value());
+    }
+    column_start_.push_back(static_cast<int>(entry_row_.size()));
+  }
+  for (int row = 0; row < rows_; ++row) {
+    const auto& entries = by_row[static_cast<std::size_t>(row)];
+    if (entries.empty()) continue;
+    row_node_.push_back(row);
+    for (const auto& [column, value] : entries) {
+      row_entry_column_.push_back(column);
+      row_entry_value_.push_back(value);
+    }
+    row_start_.push_back(static_cast<int>(row_entry_column_.size()));
+  }
+  row_sum_.assign(row_node_.size(), 0.0);
+}
+
+void SparseColumns::TransposeMultiply(const double* x, double* y) const {
+  const int num_columns = cols();
+  for (int c = 0; c < num_columns; ++c) {
+    // y_c = sum_i A_ic x_i, by increasing i.
+    double sum = 0.0;
+    for (int q = column_start_[c]; q < column_start_[c + 1]; ++q) {
+      sum += entry_value_[q] * x[entry_row_[q]];
+    }
+    y[c] = sum;
+  }
+}
+
+const PointLoads* SparseColumns::Scatter(const double* c) {
+  const int num_rows = static_cast<int>(row_node_.size());
+  for (int r = 0; r < num_rows; ++r) {
+    // (A c)_i = sum_c A_ic c_c, by increasing c.
+    double sum = 0.0;
+    for (int q = row_start_[r]; q < row_start_[r + 1]; ++q) {
+      sum += row_entry_value_[q] * c[row_entry_column_[q]];
+    }
+    row_sum_[r] = sum;
+  }
+  // Set here, not in the constructor, so that a copy points at its own arrays.
+  loads_.count = num_rows;
+  loads_.nodes = row_node_.data();
+  loads_.values = row_sum_.data();
+  return &loads_;
+}
+
+}  // namespace mcrewave
