@@ -41,20 +41,24 @@ void SparseColumns::TransposeMultiply(const double* x, double* y) const {
 }
 
 const PointLoads* SparseColumns::Scatter(const double* c) {
-  const int num_rows = static_cast<int>(row_node_.size());
+  // loads_ is set here, not in the constructor, so that a copy points at its own arrays.
+  Scatter(c, row_sum_.data(), &loads_);
+  return &loads_;
+}
+
+void SparseColumns::Scatter(const double* c, double* values, PointLoads* loads) const {
+  const int num_rows = num_point_loads();
   for (int r = 0; r < num_rows; ++r) {
     // (A c)_i = sum_c A_ic c_c, by increasing c.
     double sum = 0.0;
     for (int q = row_start_[r]; q < row_start_[r + 1]; ++q) {
       sum += row_entry_value_[q] * c[row_entry_column_[q]];
     }
-    row_sum_[r] = sum;
+    values[r] = sum;
   }
-  // Set here, not in the constructor, so that a copy points at its own arrays.
-  loads_.count = num_rows;
-  loads_.nodes = row_node_.data();
-  loads_.values = row_sum_.data();
-  return &loads_;
+  loads->count = num_rows;
+  loads->nodes = row_node_.data();
+  loads->values = values;
 }
 
 }  // namespace mcrewave

@@ -1,5 +1,6 @@
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 
+#include <algorithm>
 #include <cassert>
 #include <string>
 #include <vector>
@@ -258,7 +259,16 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
     stream_retrograde_[b] = Vector::Zero(n);
   }
   stream_zone_product_ = Vector::Zero(n);
+  batch_velocity_ = Matrix::Zero(n, 2 * kMaxSweepBatch);
+  batch_state_ = Matrix::Zero(n, 2 * kMaxSweepBatch);
+  batch_shift_ = Matrix::Zero(n, kMaxSweepBatch);
+  batch_channel_ = Matrix::Zero(num_loads, kMaxSweepBatch);
+  batch_trace_ = Matrix::Zero(num_rows, kMaxSweepBatch);
   SetModuli(NominalModuli());
+  // The point loads' values of a batch, for G's rows and H^T's (built by SetModuli).
+  batch_load_values_ = Matrix::Zero(
+      std::max(load_columns_.num_point_loads(), observation_columns_.num_point_loads()),
+      kMaxSweepBatch);
 }
 
 void MatrixMcreProblem::SetModuli(const Vector& zone_moduli) {

@@ -34,6 +34,11 @@ class SparseColumns {
   // The point loads A c (c has cols() entries), valid until the next call. Every
   // distinct row of A is one load, zero when its sum is.
   const PointLoads* Scatter(const double* c);
+  // The same into the caller's arrays: values receives num_point_loads() sums, and
+  // *loads points at them (valid while values lives).
+  void Scatter(const double* c, double* values, PointLoads* loads) const;
+  // The loads of Scatter: the distinct rows of A with entries.
+  int num_point_loads() const { return static_cast<int>(row_node_.size()); }
 
  private:
   int rows_ = 0;

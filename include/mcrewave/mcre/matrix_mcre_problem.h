@@ -101,6 +101,14 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
 
   void DirectSweep(const Matrix& retrograde, bool include_data, Matrix* displacement) override;
   void RetrogradeSweep(const Matrix& displacement, bool include_data, Matrix* retrograde) override;
+  // Up to kMaxSweepBatch sweeps with the data at once (CoupledProblem): their steps run
+  // through ThetaIntegrator::StepsWithEndLoads, interleaved on the tridiagonal path;
+  // the bits of the single sweeps. No allocation once the batch scratch is sized (the
+  // constructor).
+  void DirectSweepsWithData(const std::vector<const Matrix*>& retrograde,
+                            const std::vector<Matrix*>& displacement) override;
+  void RetrogradeSweepsWithData(const std::vector<const Matrix*>& displacement,
+                                const std::vector<Matrix*>& retrograde) override;
   double InnerProduct(const Matrix& x, const Matrix& y) override;
   double Cost(const Matrix& displacement, const Matrix& retrograde) override;
   // de^2/dE_z = -(1/(2 E_z,nom)) sum_j c_j h W_j^T K_z (W_j + 2 U_j) [J s / Pa], plus
@@ -183,6 +191,11 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // with include_data; H's entries as point loads. Overwrites trace_. No allocation.
   void RetrogradeStep(int j, bool include_data, const Vector& velocity, const Vector& state,
                       Vector& velocity_next, Vector& state_next);
+  // B sweeps with the data at once, a null input the zero field (DirectSweepsWithData).
+  template <int B>
+  void DirectSweeps(const Matrix* const (&retrograde)[B], Matrix* const (&displacement)[B]);
+  template <int B>
+  void RetrogradeSweeps(const Matrix* const (&displacement)[B], Matrix* const (&retrograde)[B]);
   // The retrograde step driven by the traces y_j (RetrogradeStep). No allocation.
   void RetrogradeTraceStep(int j, const Matrix& traces, bool include_data, const Vector& velocity,
                            const Vector& state, Vector& velocity_next, Vector& state_next);
@@ -243,6 +256,12 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   int checkpoint_stride_ = 0;
   Matrix checkpoints_, segment_;
   Vector stream_velocity_[2], stream_displacement_[2], stream_retrograde_[2], stream_zone_product_;
+  // Batched sweeps, per sweep b: the double buffers of the velocity (columns 2b, 2b + 1)
+  // and of omega, W_theta, the load channels or the weighted traces, and the point
+  // loads' values; sized in the constructor.
+  Matrix batch_velocity_, batch_state_, batch_shift_, batch_channel_, batch_trace_,
+      batch_load_values_;
+  PointLoads batch_loads_[kMaxSweepBatch];
 };
 
 }  // namespace mcrewave
