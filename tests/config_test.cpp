@@ -359,6 +359,12 @@ TEST(ConfigTest, StudyKeysAreNestedPerStudy) {
   EXPECT_NE(yaml.find("\n    snr: [.inf, 20, 10, 5, 2.5]  "), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("\n    omega_min: 0.005  "), std::string::npos) << yaml;
   EXPECT_EQ(yaml.find("robustness_snr"), std::string::npos) << yaml;
+  // A run's summary.yaml echoes the blocks too, and reads back.
+  const std::string applied = AppliedConfigToYaml(Config());
+  EXPECT_NE(applied.find("\n  robustness:\n    snr: [.inf, 20, 10, 5, 2.5]\n    seeds: 100\n"),
+            std::string::npos)
+      << applied;
+  ExpectSameConfig(Config{}, ParseConfig(applied, "summary.yaml"));
 }
 
 TEST(ConfigTest, UnknownStudyKeysAreRefusedByName) {
