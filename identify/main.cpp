@@ -15,7 +15,7 @@
 //   identify simulate configs/paper_bar.yaml --set data.snr=.inf --output clean.csv
 //   identify simulate configs/paper_bar.yaml --set model.elements=400 --output fine.csv
 //   identify study configs/studies.yaml --output results
-//   identify study configs/studies.yaml --set study.kind=robustness --set study.robustness_seeds=10
+//   identify study configs/studies.yaml --set study.kind=robustness --set study.robustness.seeds=10
 //   identify study configs/paper_bar.yaml --set study.kind=comparator
 //   identify run configs/paper_bar.yaml --set outer.functional=least_squares -o /tmp/ls
 //   identify run configs/quick.yaml --set outer.functional=least_squares --set model.zone_count=10

@@ -44,9 +44,9 @@ std::string WriteComparatorCase(const std::string& name) {
   std::ofstream(config) << "model:\n  kind: matrix\n  manifest: bar/model.yaml\n"
                            "data:\n  truth_moduli: [210e9, 190e9]\n"
                            "time:\n  window: 0.432e-3\n  step: 1.44e-6\n"
-                           "study:\n  comparator_snr: [20]\n  comparator_seeds: 2\n"
-                           "  comparator_errors: [none, density, force_gain, displacement_gain]\n"
-                           "  comparator_data: [raw]\n";
+                           "study:\n  comparator:\n    snr: [20]\n    seeds: 2\n"
+                           "    errors: [none, density, force_gain, displacement_gain]\n"
+                           "    data: [raw]\n";
   return config;
 }
 
@@ -154,13 +154,13 @@ TEST(ComparatorStudyTest, AKilledStudyResumesFromItsJournalToTheSameModuli) {
 
 TEST(ComparatorStudyTest, TheSoftZoneErrorIsTheBarsAlone) {
   const std::string path = WriteComparatorCase("comparator_matrix_soft_zone");
-  const Config config = LoadConfig(path, {"study.comparator_errors=[none, soft_zone]"});
+  const Config config = LoadConfig(path, {"study.comparator.errors=[none, soft_zone]"});
   try {
     RunComparatorStudy(config);
     FAIL() << "soft_zone was accepted on a matrix model";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what())
-                  .find("study.comparator_errors: soft_zone (the bar softer by its clamp) "
+                  .find("study.comparator.errors: soft_zone (the bar softer by its clamp) "
                         "applies to the bar only"),
               std::string::npos)
         << error.what();

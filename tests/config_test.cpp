@@ -91,30 +91,30 @@ void ExpectSameConfigOuterToOutput(const Config& expected, const Config& actual)
   EXPECT_EQ(expected.output.curve_points, actual.output.curve_points);
 }
 
-// The keys study.* up to study.comparator_errors.
+// The keys study.* up to study.comparator.errors.
 void ExpectSameConfigStudy(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.study.kind, actual.study.kind);
   EXPECT_EQ(expected.study.folder, actual.study.folder);
   EXPECT_EQ(expected.study.threads, actual.study.threads);
   EXPECT_EQ(expected.study.figures, actual.study.figures);
-  EXPECT_EQ(expected.study.robustness_snr, actual.study.robustness_snr);
-  EXPECT_EQ(expected.study.robustness_seeds, actual.study.robustness_seeds);
-  EXPECT_EQ(expected.study.relaxation_snr, actual.study.relaxation_snr);
-  EXPECT_EQ(expected.study.relaxation_moduli, actual.study.relaxation_moduli);
-  EXPECT_EQ(expected.study.omega_min, actual.study.omega_min);
-  EXPECT_EQ(expected.study.omega_max, actual.study.omega_max);
-  EXPECT_EQ(expected.study.omega_points, actual.study.omega_points);
-  EXPECT_EQ(expected.study.relaxation_tolerance, actual.study.relaxation_tolerance);
-  EXPECT_EQ(expected.study.cost_curve_snr, actual.study.cost_curve_snr);
-  EXPECT_EQ(expected.study.cost_curve_seeds, actual.study.cost_curve_seeds);
-  EXPECT_EQ(expected.study.cost_curve_points, actual.study.cost_curve_points);
-  EXPECT_EQ(expected.study.cost_curve_low, actual.study.cost_curve_low);
-  EXPECT_EQ(expected.study.cost_curve_high, actual.study.cost_curve_high);
-  EXPECT_EQ(expected.study.damage_snr, actual.study.damage_snr);
-  EXPECT_EQ(expected.study.damage_seeds, actual.study.damage_seeds);
-  EXPECT_EQ(expected.study.comparator_snr, actual.study.comparator_snr);
-  EXPECT_EQ(expected.study.comparator_seeds, actual.study.comparator_seeds);
-  EXPECT_EQ(expected.study.comparator_errors, actual.study.comparator_errors);
+  EXPECT_EQ(expected.study.robustness.snr, actual.study.robustness.snr);
+  EXPECT_EQ(expected.study.robustness.seeds, actual.study.robustness.seeds);
+  EXPECT_EQ(expected.study.relaxation.snr, actual.study.relaxation.snr);
+  EXPECT_EQ(expected.study.relaxation.moduli, actual.study.relaxation.moduli);
+  EXPECT_EQ(expected.study.relaxation.omega_min, actual.study.relaxation.omega_min);
+  EXPECT_EQ(expected.study.relaxation.omega_max, actual.study.relaxation.omega_max);
+  EXPECT_EQ(expected.study.relaxation.omega_points, actual.study.relaxation.omega_points);
+  EXPECT_EQ(expected.study.relaxation.tolerance, actual.study.relaxation.tolerance);
+  EXPECT_EQ(expected.study.cost_curves.snr, actual.study.cost_curves.snr);
+  EXPECT_EQ(expected.study.cost_curves.seeds, actual.study.cost_curves.seeds);
+  EXPECT_EQ(expected.study.cost_curves.points, actual.study.cost_curves.points);
+  EXPECT_EQ(expected.study.cost_curves.low, actual.study.cost_curves.low);
+  EXPECT_EQ(expected.study.cost_curves.high, actual.study.cost_curves.high);
+  EXPECT_EQ(expected.study.damage.snr, actual.study.damage.snr);
+  EXPECT_EQ(expected.study.damage.seeds, actual.study.damage.seeds);
+  EXPECT_EQ(expected.study.comparator.snr, actual.study.comparator.snr);
+  EXPECT_EQ(expected.study.comparator.seeds, actual.study.comparator.seeds);
+  EXPECT_EQ(expected.study.comparator.errors, actual.study.comparator.errors);
 }
 
 // The keys zones.*, data.sensors, data.channels and data.truth_zones.
@@ -133,7 +133,7 @@ void ExpectSameConfigZonesAndSensors(const Config& expected, const Config& actua
 }
 
 // The keys added later: the other mcre weights, mcre.clamp, search.*,
-// study.comparator_data, structure.*, data.truth_manifest and data.truth_moduli.
+// study.comparator.data, structure.*, data.truth_manifest and data.truth_moduli.
 void ExpectSameConfigLaterKeys(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.mcre.weights.strain_weight, actual.mcre.weights.strain_weight);
   EXPECT_EQ(expected.mcre.weights.reaction_weight, actual.mcre.weights.reaction_weight);
@@ -148,7 +148,7 @@ void ExpectSameConfigLaterKeys(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.search.inner_tolerance, actual.search.inner_tolerance);
   EXPECT_EQ(expected.search.scan_points, actual.search.scan_points);
   EXPECT_EQ(expected.search.refine_window, actual.search.refine_window);
-  EXPECT_EQ(expected.study.comparator_data, actual.study.comparator_data);
+  EXPECT_EQ(expected.study.comparator.data, actual.study.comparator.data);
   EXPECT_EQ(expected.structure.kind, actual.structure.kind);
   EXPECT_EQ(expected.structure.manifest, actual.structure.manifest);
   EXPECT_EQ(expected.structure.channel_map, actual.structure.channel_map);
@@ -322,6 +322,126 @@ TEST(ConfigTest, DefaultConfigYamlParsesToTheDefaultConfig) {
   }
 }
 
+// The keys of each study lie in a block named after its study.kind, in a file and
+// on the command line alike; the default config shows the blocks with their headings.
+TEST(ConfigTest, StudyKeysAreNestedPerStudy) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const Config config = ParseConfig(
+      "study:\n  kind: robustness\n  robustness:\n    snr: [.inf, 7]\n    seeds: 3\n"
+      "  relaxation:\n  cost_curves:\n    low: 0.5\n",
+      "a.yaml");
+  const Config defaults;
+  EXPECT_EQ(config.study.kind, StudyKind::kRobustness);
+  EXPECT_EQ(config.study.robustness.snr, (std::vector<double>{inf, 7.0}));
+  EXPECT_EQ(config.study.robustness.seeds, 3);
+  EXPECT_EQ(config.study.cost_curves.low, 0.5);
+  EXPECT_EQ(config.study.cost_curves.high, defaults.study.cost_curves.high);
+  EXPECT_EQ(config.study.relaxation.omega_points, defaults.study.relaxation.omega_points);
+
+  const Config set = ParseConfig(
+      "", "a.yaml",
+      {"study.robustness.snr=[10]", "study.relaxation.omega_min=0.01", "study.cost_curves.points=5",
+       "study.damage.seeds=2", "study.comparator.data=[raw]"});
+  EXPECT_EQ(set.study.robustness.snr, (std::vector<double>{10.0}));
+  EXPECT_EQ(set.study.relaxation.omega_min, 0.01);
+  EXPECT_EQ(set.study.cost_curves.points, 5);
+  EXPECT_EQ(set.study.damage.seeds, 2);
+  EXPECT_EQ(set.study.comparator.data, (std::vector<std::string>{"raw"}));
+
+  const std::string yaml = DefaultConfigYaml();
+  for (const char* block : {"robustness", "relaxation", "cost_curves", "damage", "comparator"}) {
+    const std::size_t at = yaml.find(std::string("\n  ") + block + ":  ");
+    ASSERT_NE(at, std::string::npos) << yaml << "\nlacks the block " << block;
+    const std::string line = yaml.substr(at + 1, yaml.find('\n', at + 1) - at - 1);
+    EXPECT_NE(line.find(std::string("# study.kind ") + block + ": "), std::string::npos) << line;
+    EXPECT_EQ(yaml.compare(yaml.find('\n', at + 1) + 1, 4, "    "), 0) << yaml;
+  }
+  EXPECT_NE(yaml.find("\n    snr: [.inf, 20, 10, 5, 2.5]  "), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("\n    omega_min: 0.005  "), std::string::npos) << yaml;
+  EXPECT_EQ(yaml.find("robustness_snr"), std::string::npos) << yaml;
+  // A run's summary.yaml echoes the blocks too, and reads back.
+  const std::string applied = AppliedConfigToYaml(Config());
+  EXPECT_NE(applied.find("\n  robustness:\n    snr: [.inf, 20, 10, 5, 2.5]\n    seeds: 100\n"),
+            std::string::npos)
+      << applied;
+  ExpectSameConfig(Config{}, ParseConfig(applied, "summary.yaml"));
+}
+
+TEST(ConfigTest, UnknownStudyKeysAreRefusedByName) {
+  ExpectInputError([] { ParseConfig("study:\n  robustness:\n    snrr: [10]\n", "a.yaml"); },
+                   {"a.yaml:3: unknown key 'study.robustness.snrr'; did you mean "
+                    "'study.robustness.snr'?"});
+  ExpectInputError([] { ParseConfig("", "a.yaml", {"study.robustness.snrr=[10]"}); },
+                   {"--set study.robustness.snrr=[10]: unknown key 'study.robustness.snrr'; did "
+                    "you mean 'study.robustness.snr'?"});
+  ExpectInputError([] { ParseConfig("study:\n  robust:\n    snr: [10]\n", "a.yaml"); },
+                   {"a.yaml:2: unknown key 'study.robust'; did you mean 'study.robustness'?"});
+  // A key of another study's block is unknown in this one.
+  ExpectInputError([] { ParseConfig("study:\n  robustness:\n    omega_min: 0.01\n", "a.yaml"); },
+                   {"a.yaml:3: unknown key 'study.robustness.omega_min'"});
+}
+
+// The flat study keys of before the blocks are unknown keys, each refused with its
+// name now.
+TEST(ConfigTest, FlatStudyKeysAreRefusedNamingTheirNestedKey) {
+  const std::vector<std::pair<std::string, std::string>> renames = {
+      {"robustness_snr", "robustness.snr"},
+      {"robustness_seeds", "robustness.seeds"},
+      {"relaxation_snr", "relaxation.snr"},
+      {"relaxation_moduli", "relaxation.moduli"},
+      {"omega_min", "relaxation.omega_min"},
+      {"omega_max", "relaxation.omega_max"},
+      {"omega_points", "relaxation.omega_points"},
+      {"relaxation_tolerance", "relaxation.tolerance"},
+      {"cost_curve_snr", "cost_curves.snr"},
+      {"cost_curve_seeds", "cost_curves.seeds"},
+      {"cost_curve_points", "cost_curves.points"},
+      {"cost_curve_low", "cost_curves.low"},
+      {"cost_curve_high", "cost_curves.high"},
+      {"damage_snr", "damage.snr"},
+      {"damage_seeds", "damage.seeds"},
+      {"comparator_snr", "comparator.snr"},
+      {"comparator_seeds", "comparator.seeds"},
+      {"comparator_errors", "comparator.errors"},
+      {"comparator_data", "comparator.data"}};
+  for (const auto& [old_name, new_name] : renames) {
+    const std::string message = "unknown key 'study." + old_name +
+                                "'; the study keys are nested per study: it is now 'study." +
+                                new_name + "'";
+    ExpectInputError([&old_name] { ParseConfig("study:\n  " + old_name + ": 1\n", "a.yaml"); },
+                     {"a.yaml:2: " + message});
+    ExpectInputError([&old_name] { ParseConfig("", "a.yaml", {"study." + old_name + "=1"}); },
+                     {"--set study." + old_name + "=1: " + message});
+  }
+}
+
+// A block is a map of keys, a key of a block is written nested in a file, and
+// --set sets keys, not blocks.
+TEST(ConfigTest, StudyBlocksAreMapsOfTheirKeys) {
+  ExpectInputError([] { ParseConfig("study:\n  robustness: 5\n", "a.yaml"); },
+                   {"a.yaml:2: study.robustness: expected a map of keys (snr, seeds), got '5'"});
+  ExpectInputError([] { ParseConfig("study:\n  robustness:\n    snr:\n      x: 1\n", "a.yaml"); },
+                   {"a.yaml:3: study.robustness.snr: expected a list of numbers", "got a map"});
+  ExpectInputError([] { ParseConfig("study:\n  robustness.snr: [10]\n", "a.yaml"); },
+                   {"a.yaml:2: study.robustness.snr: expected it nested, 'robustness:' with "
+                    "'snr:' under it"});
+  ExpectInputError([] { ParseConfig("", "a.yaml", {"study.robustness=[10]"}); },
+                   {"--set study.robustness=[10]: study.robustness is a block of keys (snr, "
+                    "seeds): set one of them, e.g. study.robustness.snr=..."});
+  ExpectInputError(
+      [] {
+        ParseConfig("study:\n  robustness:\n    seeds: 2\n  robustness:\n    snr: [10]\n",
+                    "a.yaml");
+      },
+      {"a.yaml:4: duplicate key 'study.robustness' (first given on line 2)"});
+  ExpectInputError(
+      [] { ParseConfig("study:\n  robustness:\n    seeds: 2\n    seeds: 3\n", "a.yaml"); },
+      {"a.yaml:4: duplicate key 'study.robustness.seeds' (first given on line 3)"});
+  ExpectInputError([] { ParseConfig("study: 5\n", "a.yaml"); },
+                   {"a.yaml:1: study: expected a map of keys (kind, folder, threads, figures, "
+                    "robustness, relaxation, cost_curves, damage, comparator), got '5'"});
+}
+
 TEST(ConfigTest, ScanAndPrefilterKeysAreReadAndChecked) {
   const Config config = ParseConfig(
       "outer:\n  scan_points: 0\n  refine_candidates: 3\n"
@@ -446,9 +566,9 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   config.output.curve_points = 7;
   config.study.kind = StudyKind::kCostCurves;
   config.study.threads = 3;
-  config.study.robustness_snr = {std::numeric_limits<double>::infinity(), 1.0 / 3.0, 2.5};
-  config.study.relaxation_moduli = {0.1 + 0.2};
-  config.study.cost_curve_high = 1.0 / 7.0 + 1.0;
+  config.study.robustness.snr = {std::numeric_limits<double>::infinity(), 1.0 / 3.0, 2.5};
+  config.study.relaxation.moduli = {0.1 + 0.2};
+  config.study.cost_curves.high = 1.0 / 7.0 + 1.0;
   const std::string yaml = ConfigToYaml(config);
   ExpectSameConfig(config, ParseConfig(yaml, "resolved.yaml"));
   EXPECT_NE(yaml.find("mass: lumped"), std::string::npos) << yaml;
@@ -457,7 +577,7 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   EXPECT_NE(yaml.find("optimizer: ceres"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("figures: false"), std::string::npos) << yaml;
   EXPECT_NE(yaml.find("kind: cost_curves"), std::string::npos) << yaml;
-  EXPECT_NE(yaml.find("robustness_snr: [.inf, "), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("\n  robustness:\n    snr: [.inf, "), std::string::npos) << yaml;
 
   config.data.snr = std::numeric_limits<double>::infinity();
   const std::string infinite_snr = ConfigToYaml(config);
@@ -465,12 +585,13 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   ExpectSameConfig(config, ParseConfig(infinite_snr, "resolved.yaml"));
 }
 
-// Every key of a config YAML text as "section.key" -> its value as written
-// (comments and comment lines dropped; a '#' inside a quoted value kept).
+// Every key of a config YAML text as "section.key" (a key of a block:
+// "section.block.key") -> its value as written (comments and comment lines dropped;
+// a '#' inside a quoted value kept).
 std::map<std::string, std::string> FlatKeys(const std::string& yaml) {
   std::map<std::string, std::string> keys;
   std::istringstream lines(yaml);
-  std::string section;
+  std::vector<std::pair<std::size_t, std::string>> maps;  // indent and name of the open maps
   for (std::string line; std::getline(lines, line);) {
     const std::size_t first = line.find_first_not_of(' ');
     if (first == std::string::npos || line[first] == '#') continue;
@@ -487,13 +608,17 @@ std::map<std::string, std::string> FlatKeys(const std::string& yaml) {
     text.erase(text.find_last_not_of(' ') + 1);
     const std::size_t colon = text.find(':');
     if (colon == std::string::npos) continue;
-    if (first == 0) {
-      section = text.substr(0, colon);
-      continue;
-    }
+    while (!maps.empty() && maps.back().first >= first) maps.pop_back();
+    const std::string name = text.substr(first, colon - first);
     std::string value = text.substr(colon + 1);
     value.erase(0, value.find_first_not_of(' '));
-    keys[section + "." + text.substr(first, colon - first)] = value;
+    if (value.empty()) {  // a section or a block: its keys follow, further indented
+      maps.emplace_back(first, name);
+      continue;
+    }
+    std::string path;
+    for (const auto& [indent, map] : maps) path += map + ".";
+    keys[path + name] = value;
   }
   return keys;
 }
@@ -591,25 +716,30 @@ study:
   folder: "studies/x"
   threads: 3
   figures: false
-  robustness_snr: [.inf, 0.3333333333333333, 2.5]
-  robustness_seeds: 7
-  relaxation_snr: [5]
-  relaxation_moduli: [0.30000000000000004]
-  omega_min: 0.01
-  omega_max: 0.2
-  omega_points: 5
-  relaxation_tolerance: 1e-6
-  cost_curve_snr: [20]
-  cost_curve_seeds: 2
-  cost_curve_points: 9
-  cost_curve_low: 0.7
-  cost_curve_high: 1.1428571428571428
-  damage_snr: [.inf, 15]
-  damage_seeds: 3
-  comparator_snr: [.inf, 7]
-  comparator_seeds: 4
-  comparator_errors: [density, soft_zone]
-  comparator_data: [prefilter]
+  robustness:
+    snr: [.inf, 0.3333333333333333, 2.5]
+    seeds: 7
+  relaxation:
+    snr: [5]
+    moduli: [0.30000000000000004]
+    omega_min: 0.01
+    omega_max: 0.2
+    omega_points: 5
+    tolerance: 1e-6
+  cost_curves:
+    snr: [20]
+    seeds: 2
+    points: 9
+    low: 0.7
+    high: 1.1428571428571428
+  damage:
+    snr: [.inf, 15]
+    seeds: 3
+  comparator:
+    snr: [.inf, 7]
+    seeds: 4
+    errors: [density, soft_zone]
+    data: [prefilter]
 zone_identification:
   optimizer: nlopt
   algorithm: slsqp
@@ -1060,8 +1190,8 @@ TEST_F(ConfigFileTest, UnknownClampModelAndComparatorDataAreRefused) {
                   {"mcre.clamp: expected one of 'measured', 'trusted', 'pinned', got 'rigid'"});
   ExpectLoadError("mcre:\n  w_r: 0\n", 2, {"mcre.w_r must be a finite positive number"});
   ExpectLoadError("mcre:\n  w_u0: -1\n", 2, {"mcre.w_u0 must be a finite positive number"});
-  ExpectLoadError("study:\n  comparator_data: [raw, raw]\n", 2,
-                  {"study.comparator_data must hold raw, prefilter or both, once each"});
+  ExpectLoadError("study:\n  comparator:\n    data: [raw, raw]\n", 3,
+                  {"study.comparator.data must hold raw, prefilter or both, once each"});
 }
 
 TEST_F(ConfigFileTest, SearchKeysAreCheckedAndBelongToThePinnedSearchFunctional) {

@@ -27,18 +27,21 @@ time: {window: 0.45e-3, step: 3e-6}
 outer: {scan_points: 15, relative_tolerance: 1e-6}
 study:
   threads: 2
-  robustness_snr: [.inf, 10]
-  robustness_seeds: 2
-  relaxation_snr: [.inf, 10]
-  relaxation_moduli: [1]
-  omega_min: 0.05
-  omega_max: 0.4
-  omega_points: 4
-  cost_curve_snr: [.inf, 10]
-  cost_curve_seeds: 2
-  cost_curve_points: 11
-  cost_curve_low: 0.9
-  cost_curve_high: 1.1
+  robustness:
+    snr: [.inf, 10]
+    seeds: 2
+  relaxation:
+    snr: [.inf, 10]
+    moduli: [1]
+    omega_min: 0.05
+    omega_max: 0.4
+    omega_points: 4
+  cost_curves:
+    snr: [.inf, 10]
+    seeds: 2
+    points: 11
+    low: 0.9
+    high: 1.1
 )";
 
 std::string WriteConfig(const std::string& directory, const std::string& text) {
@@ -208,11 +211,11 @@ TEST(IdentifyStudyTest, DamageAndComparatorStudiesWriteTheSameBitsOnOneTwoOrFour
   const std::string quick = testing::SourcePath("configs/quick.yaml");
   const std::vector<std::pair<std::string, std::string>> studies = {
       {"damage",
-       " --set study.kind=damage --set study.damage_snr=[.inf] --set study.damage_seeds=1"
+       " --set study.kind=damage --set study.damage.snr=[.inf] --set study.damage.seeds=1"
        " --set model.elements=10"},
       {"comparator",
-       " --set study.kind=comparator --set study.comparator_snr=[20]"
-       " --set study.comparator_seeds=1 --set study.comparator_errors=[none,soft_zone]"}};
+       " --set study.kind=comparator --set study.comparator.snr=[20]"
+       " --set study.comparator.seeds=1 --set study.comparator.errors=[none,soft_zone]"}};
   for (const auto& [study, settings] : studies) {
     std::vector<std::string> folders;
     for (const int threads : {1, 2, 4}) {
@@ -252,17 +255,19 @@ TEST(IdentifyStudyTest, BadStudyValuesStopBeforeAnyComputation) {
   const std::string folder = directory + "/results";
   RunResult result = RunIdentify("study " + config + " --output " + folder);
   EXPECT_EQ(result.exit_code, 2) << result.output;
-  EXPECT_NE(result.output.find(config + ":12: study.omega_points must lie in [2, 1000], got 1"),
+  EXPECT_NE(result.output.find(config +
+                               ":14: study.relaxation.omega_points must lie in [2, 1000], got 1"),
             std::string::npos)
       << result.output;
-  result = RunIdentify("study " + config + " --set study.omega_points=4 --set " +
-                       "'study.robustness_snr=[20, 0]' --output " + folder);
+  result = RunIdentify("study " + config + " --set study.relaxation.omega_points=4 --set " +
+                       "'study.robustness.snr=[20, 0]' --output " + folder);
   EXPECT_EQ(result.exit_code, 2) << result.output;
-  EXPECT_NE(result.output.find("--set study.robustness_snr=[20, 0]: study.robustness_snr must "
+  EXPECT_NE(result.output.find("--set study.robustness.snr=[20, 0]: study.robustness.snr must "
                                "hold SNRs > 0"),
             std::string::npos)
       << result.output;
-  result = RunIdentify("study " + config + " --set study.omega_points=4 --set study.kind=every " +
+  result = RunIdentify("study " + config +
+                       " --set study.relaxation.omega_points=4 --set study.kind=every " +
                        "--output " + folder);
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(
@@ -310,7 +315,7 @@ TEST(IdentifyStudyDamageTest, TheDamageStudyRunsOnTheQuickCaseAndLocalisesWithIn
   const std::string folder = testing::FreshDirectory("identify_study_damage") + "/results";
   const testing::RunResult result = testing::RunIdentify(
       "study " + testing::SourcePath("configs/quick.yaml") + " -o " + folder +
-      " --set study.kind=damage --set study.damage_snr=[.inf] --set study.damage_seeds=1"
+      " --set study.kind=damage --set study.damage.snr=[.inf] --set study.damage.seeds=1"
       " --set zone_identification.merge_zones=true");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   std::istringstream runs(testing::ReadText(folder + "/damage/runs.csv"));
@@ -378,8 +383,8 @@ TEST(IdentifyStudyComparatorTest, BothFunctionalsOnTheSameDataWithEveryModelErro
   const std::string folder = testing::FreshDirectory("identify_study_comparator") + "/results";
   const testing::RunResult result = testing::RunIdentify(
       "study " + testing::SourcePath("configs/quick.yaml") + " -o " + folder +
-      " --set study.kind=comparator --set study.comparator_snr=[.inf,20] --set "
-      "study.comparator_seeds=2 --set study.threads=2");
+      " --set study.kind=comparator --set study.comparator.snr=[.inf,20] --set "
+      "study.comparator.seeds=2 --set study.threads=2");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   for (const char* file : {"runs.csv", "statistics.csv", "curves.csv", "summary.md"}) {
     EXPECT_TRUE(fs::exists(folder + "/comparator/" + file)) << file;
@@ -415,7 +420,7 @@ TEST(IdentifyStudyComparatorTest, BothFunctionalsOnTheSameDataWithEveryModelErro
 }
 
 TEST(IdentifyStudyComparatorTest, PreFilteredDataOnlyWithATrustedOrPinnedClamp) {
-  // study.comparator_data [prefilter]: two identifications per data set; the MCRE with
+  // study.comparator.data [prefilter]: two identifications per data set; the MCRE with
   // the clamp trusted (f0 an output), then pinned (u0's datum the known 0, f0 a load),
   // on noise-free data of the quick case. The discretisation bias of 25 elements
   // against the 4x finer truth, measured: MCRE trusted -2.8e-4, pinned -1.5e-4 (one
@@ -439,8 +444,8 @@ TEST(IdentifyStudyComparatorTest, PreFilteredDataOnlyWithATrustedOrPinnedClamp) 
         testing::FreshDirectory("identify_study_comparator_clamp") + "/results";
     const testing::RunResult result = testing::RunIdentify(
         "study " + testing::SourcePath("configs/quick.yaml") + " -o " + folder +
-        " --set study.kind=comparator --set study.comparator_snr=[.inf] --set "
-        "study.comparator_errors=[none] --set study.comparator_data=[prefilter] --set " +
+        " --set study.kind=comparator --set study.comparator.snr=[.inf] --set "
+        "study.comparator.errors=[none] --set study.comparator.data=[prefilter] --set " +
         settings);
     ASSERT_EQ(result.exit_code, 0) << result.output;
     std::istringstream runs(testing::ReadText(folder + "/comparator/runs.csv"));

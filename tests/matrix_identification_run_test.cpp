@@ -351,8 +351,8 @@ TEST(MatrixIdentificationRunTest, TheRobustnessStudyRunsOnAMatrixModel) {
   std::ofstream(config) << "model:\n  kind: matrix\n  manifest: bar_matrices/model.yaml\n"
                            "data:\n  truth_moduli: [200e9]\n"
                            "time:\n  window: 0.432e-3\n  step: 1.44e-6\n"
-                           "study:\n  kind: robustness\n  robustness_snr: [.inf, 20]\n"
-                           "  robustness_seeds: 2\n  threads: 2\n";
+                           "study:\n  kind: robustness\n  robustness:\n    snr: [.inf, 20]\n"
+                           "    seeds: 2\n  threads: 2\n";
   const RunResult study = RunIdentify("study " + config + " -o " + dir + "/study");
   ASSERT_EQ(study.exit_code, 0) << study.output;
   EXPECT_NE(study.output.find("matrix model " + dir + "/bar_matrices/model.yaml"),

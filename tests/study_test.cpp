@@ -40,18 +40,21 @@ time: {window: 0.45e-3, step: 3e-6}
 outer: {scan_points: 15, relative_tolerance: 1e-6}
 search: {functional: same}
 study:
-  robustness_snr: [.inf, 10]
-  robustness_seeds: 3
-  relaxation_snr: [10]
-  relaxation_moduli: [0.9, 1.1]
-  omega_min: 0.02
-  omega_max: 0.5
-  omega_points: 7
-  cost_curve_snr: [.inf, 10]
-  cost_curve_seeds: 2
-  cost_curve_points: 21
-  cost_curve_low: 0.9
-  cost_curve_high: 1.1
+  robustness:
+    snr: [.inf, 10]
+    seeds: 3
+  relaxation:
+    snr: [10]
+    moduli: [0.9, 1.1]
+    omega_min: 0.02
+    omega_max: 0.5
+    omega_points: 7
+  cost_curves:
+    snr: [.inf, 10]
+    seeds: 2
+    points: 21
+    low: 0.9
+    high: 1.1
 )",
                               "tiny.yaml");
   return config;
@@ -178,7 +181,7 @@ std::string WriteTwoZoneBarManifest(const std::string& folder) {
   std::ofstream(config) << "model:\n  kind: matrix\n  manifest: bar/model.yaml\n"
                            "data:\n  truth_moduli: [210e9, 190e9]\n"
                            "time:\n  window: 0.432e-3\n  step: 1.44e-6\n"
-                           "study:\n  robustness_snr: [.inf, 20]\n  robustness_seeds: 2\n";
+                           "study:\n  robustness:\n    snr: [.inf, 20]\n    seeds: 2\n";
   return config;
 }
 
@@ -292,7 +295,7 @@ TEST(StudyTest, AKilledRobustnessStudyResumesFromItsJournalToTheSameBits) {
   for (std::string line; std::getline(lines, line);) ++count;
   EXPECT_EQ(count, 5);
   // A journal of another config is not used: its runs are run (SNR 20 is not 10).
-  config.study.robustness_snr = {kInf, 20.0};
+  config.study.robustness.snr = {kInf, 20.0};
   const RobustnessStudy other = RunRobustnessStudy(config, journal);
   ASSERT_EQ(other.runs.size(), 4u);
   EXPECT_EQ(other.runs[0].identified_moduli, full.runs[0].identified_moduli);
@@ -418,18 +421,19 @@ TEST(StudyTest, BadStudyValuesAreRefusedNamingTheKey) {
       {"study.kind=robust", "--set study.kind=robust: expected one of 'robustness'"},
       {"study.threads=-1", "--set study.threads=-1: expected an integer >= 0"},
       {"study.threads=1000", "study.threads must lie in [0, 256]"},
-      {"study.robustness_snr=[.inf, 0]", "study.robustness_snr must hold SNRs > 0"},
-      {"study.robustness_snr=[]", "study.robustness_snr must hold 1 to 100 SNRs"},
-      {"study.robustness_snr=[a, 2]",
-       "--set study.robustness_snr=[a, 2]: expected a list of numbers"},
-      {"study.robustness_seeds=0", "--set study.robustness_seeds=0: expected a positive integer"},
-      {"study.relaxation_moduli=[1, -1]", "study.relaxation_moduli must hold"},
-      {"study.omega_max=2.5", "study.omega_min and study.omega_max must satisfy"},
-      {"study.omega_points=1", "study.omega_points must lie in [2, 1000]"},
-      {"study.relaxation_tolerance=1", "study.relaxation_tolerance must lie in (0, 1)"},
-      {"study.cost_curve_snr=-1", "study.cost_curve_snr must hold SNRs > 0"},
-      {"study.cost_curve_points=2", "study.cost_curve_points must lie in [3, 10000]"},
-      {"study.cost_curve_high=0.5", "study.cost_curve_low and study.cost_curve_high must"},
+      {"study.robustness.snr=[.inf, 0]", "study.robustness.snr must hold SNRs > 0"},
+      {"study.robustness.snr=[]", "study.robustness.snr must hold 1 to 100 SNRs"},
+      {"study.robustness.snr=[a, 2]",
+       "--set study.robustness.snr=[a, 2]: expected a list of numbers"},
+      {"study.robustness.seeds=0", "--set study.robustness.seeds=0: expected a positive integer"},
+      {"study.relaxation.moduli=[1, -1]", "study.relaxation.moduli must hold"},
+      {"study.relaxation.omega_max=2.5",
+       "study.relaxation.omega_min and study.relaxation.omega_max must satisfy"},
+      {"study.relaxation.omega_points=1", "study.relaxation.omega_points must lie in [2, 1000]"},
+      {"study.relaxation.tolerance=1", "study.relaxation.tolerance must lie in (0, 1)"},
+      {"study.cost_curves.snr=-1", "study.cost_curves.snr must hold SNRs > 0"},
+      {"study.cost_curves.points=2", "study.cost_curves.points must lie in [3, 10000]"},
+      {"study.cost_curves.high=0.5", "study.cost_curves.low and study.cost_curves.high must"},
       {"study.folder=", "study.folder must name a folder"},
   };
   for (const auto& [override_text, fragment] : cases) {

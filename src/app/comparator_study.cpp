@@ -44,9 +44,9 @@ struct DataSet {
 
 std::vector<DataSet> DataSets(const StudyOptions& options) {
   std::vector<DataSet> sets;
-  for (const std::string& error : options.comparator_errors) {
-    for (const double snr : options.comparator_snr) {
-      const int seeds = std::isinf(snr) ? 1 : options.comparator_seeds;
+  for (const std::string& error : options.comparator.errors) {
+    for (const double snr : options.comparator.snr) {
+      const int seeds = std::isinf(snr) ? 1 : options.comparator.seeds;
       for (int seed = 1; seed <= seeds; ++seed) {
         sets.push_back({error, snr, std::isinf(snr) ? 0u : static_cast<std::uint64_t>(seed)});
       }
@@ -549,7 +549,7 @@ void RunMatrixComparator(const Config& config, const std::vector<DataSet>& sets,
   for (const DataSet& set : sets) {
     if (set.model_error == "soft_zone") {
       throw InputError(name +
-                       ": study.comparator_errors: soft_zone (the bar softer by its "
+                       ": study.comparator.errors: soft_zone (the bar softer by its "
                        "clamp) applies to the bar only; with model.kind 'matrix' choose among "
                        "none, density, force_gain and displacement_gain");
     }
@@ -576,10 +576,10 @@ ComparatorStudy RunComparatorStudy(const Config& config, const std::string& jour
   const auto start = std::chrono::steady_clock::now();
   const std::vector<DataSet> sets = DataSets(config.study);
   ComparatorStudy study;
-  study.model_errors = config.study.comparator_errors;
-  study.snrs = config.study.comparator_snr;
+  study.model_errors = config.study.comparator.errors;
+  study.snrs = config.study.comparator.snr;
   study.mcre_scans_search = ScansTheSearchFunctional(config);
-  for (const std::string& data : config.study.comparator_data) {
+  for (const std::string& data : config.study.comparator.data) {
     study.prefilters.push_back(data == "prefilter");
   }
   study.threads = internal::ResolveThreads(config.study.threads);

@@ -320,7 +320,8 @@ ValueType<Enum> EnumByName(std::vector<Enum> values, const char* (*to_string)(En
 // One key of the config: its dotted path, documentation, and how its value is
 // read from YAML into a Config and written back.
 struct Key {
-  std::string path;         // "section.name"
+  std::string path;         // "section.name", or "section.block.name" in a block
+                            // of a section (study.robustness.snr)
   std::string unit;         // SI unit, "" for dimensionless values
   std::string description;  // one line, for the commented default config
   std::string choices;      // "a | b" for enums, "" otherwise
@@ -329,7 +330,10 @@ struct Key {
   std::function<std::string(const Config& config)> write;
 
   std::string section() const { return path.substr(0, path.find('.')); }
-  std::string name() const { return path.substr(path.find('.') + 1); }
+  // The map the key is written in: its section or its block ("study.robustness").
+  std::string parent() const { return path.substr(0, path.rfind('.')); }
+  // Its name in that map ("snr").
+  std::string leaf() const { return path.substr(path.rfind('.') + 1); }
 };
 
 // The row of key `path` stored in config.*section.*field.
@@ -637,48 +641,55 @@ const std::vector<Key>& KeyTable() {
               "threads running the studies' runs, in [0, 256]; 0: every core"),
       MakeKey("study.figures", &Config::study, &StudyOptions::figures, Boolean(), "",
               "also draw the studies' PNG figures with gnuplot"),
-      MakeKey("study.robustness_snr", &Config::study, &StudyOptions::robustness_snr, NumberList(),
-              "", "robustness: SNRs of the noise (.inf: none), each > 0"),
-      MakeKey("study.robustness_seeds", &Config::study, &StudyOptions::robustness_seeds,
-              PositiveInteger<int>(), "", "robustness: noise seeds 1..N per finite SNR"),
-      MakeKey("study.relaxation_snr", &Config::study, &StudyOptions::relaxation_snr, NumberList(),
-              "", "relaxation: SNRs of the data (noise seed data.seed)"),
-      MakeKey("study.relaxation_moduli", &Config::study, &StudyOptions::relaxation_moduli,
-              NumberList(), "", "relaxation: trial moduli E / model.modulus, in (0, 10]"),
-      MakeKey("study.omega_min", &Config::study, &StudyOptions::omega_min, Number(), "",
-              "relaxation: least omega of the grid, > 0"),
-      MakeKey("study.omega_max", &Config::study, &StudyOptions::omega_max, Number(), "",
-              "relaxation: largest omega of the grid, < 2"),
-      MakeKey("study.omega_points", &Config::study, &StudyOptions::omega_points,
-              PositiveInteger<int>(), "", "relaxation: omegas of the grid, in [2, 1000]"),
-      MakeKey("study.relaxation_tolerance", &Config::study, &StudyOptions::relaxation_tolerance,
-              Number(), "", "relaxation: relative residual the grid's solves reach, in (0, 1)"),
-      MakeKey("study.cost_curve_snr", &Config::study, &StudyOptions::cost_curve_snr, NumberList(),
-              "", "cost curves: SNRs of the data"),
-      MakeKey("study.cost_curve_seeds", &Config::study, &StudyOptions::cost_curve_seeds,
-              PositiveInteger<int>(), "", "cost curves: noise seeds 1..N per finite SNR"),
-      MakeKey("study.cost_curve_points", &Config::study, &StudyOptions::cost_curve_points,
-              PositiveInteger<int>(), "", "cost curves: moduli of each curve, in [3, 10000]"),
-      MakeKey("study.cost_curve_low", &Config::study, &StudyOptions::cost_curve_low, Number(), "",
-              "cost curves: least E / model.modulus, > 0"),
-      MakeKey("study.cost_curve_high", &Config::study, &StudyOptions::cost_curve_high, Number(), "",
-              "cost curves: largest E / model.modulus"),
-      MakeKey("study.damage_snr", &Config::study, &StudyOptions::damage_snr, NumberList(), "",
-              "damage localisation: SNRs of the grid (.inf: no noise)"),
-      MakeKey("study.damage_seeds", &Config::study, &StudyOptions::damage_seeds,
-              PositiveInteger<int>(), "",
-              "damage localisation: noise seeds of the soft zone at SNR 10 (interior sensors, "
-              "10 zones)"),
-      MakeKey("study.comparator_snr", &Config::study, &StudyOptions::comparator_snr, NumberList(),
-              "", "MCRE against least squares: SNRs (.inf: no noise)"),
-      MakeKey("study.comparator_seeds", &Config::study, &StudyOptions::comparator_seeds,
-              PositiveInteger<int>(), "", "MCRE against least squares: noise seeds per SNR"),
-      MakeKey("study.comparator_errors", &Config::study, &StudyOptions::comparator_errors,
-              TextList(), "",
-              "MCRE against least squares: model errors (none, density, force_gain, "
-              "displacement_gain, soft_zone)"),
-      MakeKey("study.comparator_data", &Config::study, &StudyOptions::comparator_data, TextList(),
-              "", "MCRE against least squares: the data identified from (raw, prefilter)"),
+      MakeKey("study.robustness.snr", &Config::study, &StudyOptions::robustness,
+              &StudyOptions::Robustness::snr, NumberList(), "",
+              "SNRs of the noise (.inf: none), each > 0"),
+      MakeKey("study.robustness.seeds", &Config::study, &StudyOptions::robustness,
+              &StudyOptions::Robustness::seeds, PositiveInteger<int>(), "",
+              "noise seeds 1..N per finite SNR"),
+      MakeKey("study.relaxation.snr", &Config::study, &StudyOptions::relaxation,
+              &StudyOptions::Relaxation::snr, NumberList(), "",
+              "SNRs of the data (noise seed data.seed)"),
+      MakeKey("study.relaxation.moduli", &Config::study, &StudyOptions::relaxation,
+              &StudyOptions::Relaxation::moduli, NumberList(), "",
+              "trial moduli E / model.modulus, in (0, 10]"),
+      MakeKey("study.relaxation.omega_min", &Config::study, &StudyOptions::relaxation,
+              &StudyOptions::Relaxation::omega_min, Number(), "", "least omega of the grid, > 0"),
+      MakeKey("study.relaxation.omega_max", &Config::study, &StudyOptions::relaxation,
+              &StudyOptions::Relaxation::omega_max, Number(), "", "largest omega of the grid, < 2"),
+      MakeKey("study.relaxation.omega_points", &Config::study, &StudyOptions::relaxation,
+              &StudyOptions::Relaxation::omega_points, PositiveInteger<int>(), "",
+              "omegas of the grid, in [2, 1000]"),
+      MakeKey("study.relaxation.tolerance", &Config::study, &StudyOptions::relaxation,
+              &StudyOptions::Relaxation::tolerance, Number(), "",
+              "relative residual the grid's solves reach, in (0, 1)"),
+      MakeKey("study.cost_curves.snr", &Config::study, &StudyOptions::cost_curves,
+              &StudyOptions::CostCurves::snr, NumberList(), "", "SNRs of the data"),
+      MakeKey("study.cost_curves.seeds", &Config::study, &StudyOptions::cost_curves,
+              &StudyOptions::CostCurves::seeds, PositiveInteger<int>(), "",
+              "noise seeds 1..N per finite SNR"),
+      MakeKey("study.cost_curves.points", &Config::study, &StudyOptions::cost_curves,
+              &StudyOptions::CostCurves::points, PositiveInteger<int>(), "",
+              "moduli of each curve, in [3, 10000]"),
+      MakeKey("study.cost_curves.low", &Config::study, &StudyOptions::cost_curves,
+              &StudyOptions::CostCurves::low, Number(), "", "least E / model.modulus, > 0"),
+      MakeKey("study.cost_curves.high", &Config::study, &StudyOptions::cost_curves,
+              &StudyOptions::CostCurves::high, Number(), "", "largest E / model.modulus"),
+      MakeKey("study.damage.snr", &Config::study, &StudyOptions::damage, &StudyOptions::Damage::snr,
+              NumberList(), "", "SNRs of the grid (.inf: no noise)"),
+      MakeKey("study.damage.seeds", &Config::study, &StudyOptions::damage,
+              &StudyOptions::Damage::seeds, PositiveInteger<int>(), "",
+              "noise seeds of the soft zone at SNR 10 (interior sensors, 10 zones)"),
+      MakeKey("study.comparator.snr", &Config::study, &StudyOptions::comparator,
+              &StudyOptions::Comparator::snr, NumberList(), "", "SNRs (.inf: no noise)"),
+      MakeKey("study.comparator.seeds", &Config::study, &StudyOptions::comparator,
+              &StudyOptions::Comparator::seeds, PositiveInteger<int>(), "", "noise seeds per SNR"),
+      MakeKey("study.comparator.errors", &Config::study, &StudyOptions::comparator,
+              &StudyOptions::Comparator::errors, TextList(), "",
+              "model errors (none, density, force_gain, displacement_gain, soft_zone)"),
+      MakeKey("study.comparator.data", &Config::study, &StudyOptions::comparator,
+              &StudyOptions::Comparator::data, TextList(), "",
+              "the data identified from (raw, prefilter)"),
       MakeKey("zone_identification.optimizer", &Config::zone_identification,
               &ZoneIdentificationOptions::minimizer, &BoundedMinimizerOptions::optimizer,
               EnumByName<OptimizerType>({OptimizerType::kNlopt, OptimizerType::kCeres},
@@ -1074,6 +1085,65 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
   return validators;
 }
 
+// The blocks of keys inside a section, each with the line that heads it in the
+// commented default config. A block is named after the study kind whose keys it
+// holds; a key "section.block.name" of KeyTable() lies in one of these.
+const std::vector<std::pair<std::string, std::string>>& BlockTable() {
+  static const std::vector<std::pair<std::string, std::string>> table = {
+      {"study.robustness", "study.kind robustness: identifications on noisy data per SNR"},
+      {"study.relaxation", "study.kind relaxation: sweeps of the fixed-omega relaxation"},
+      {"study.cost_curves", "study.kind cost_curves: e^2(E) around model.modulus"},
+      {"study.damage", "study.kind damage: localisation of a soft zone (damage_study.h)"},
+      {"study.comparator", "study.kind comparator: MCRE against least squares"},
+  };
+  return table;
+}
+
+// The study keys as they were before the study blocks, by their names now.
+const std::map<std::string, std::string>& FlatStudyKeyRenames() {
+  static const std::map<std::string, std::string> renames = {
+      {"study.robustness_snr", "study.robustness.snr"},
+      {"study.robustness_seeds", "study.robustness.seeds"},
+      {"study.relaxation_snr", "study.relaxation.snr"},
+      {"study.relaxation_moduli", "study.relaxation.moduli"},
+      {"study.omega_min", "study.relaxation.omega_min"},
+      {"study.omega_max", "study.relaxation.omega_max"},
+      {"study.omega_points", "study.relaxation.omega_points"},
+      {"study.relaxation_tolerance", "study.relaxation.tolerance"},
+      {"study.cost_curve_snr", "study.cost_curves.snr"},
+      {"study.cost_curve_seeds", "study.cost_curves.seeds"},
+      {"study.cost_curve_points", "study.cost_curves.points"},
+      {"study.cost_curve_low", "study.cost_curves.low"},
+      {"study.cost_curve_high", "study.cost_curves.high"},
+      {"study.damage_snr", "study.damage.snr"},
+      {"study.damage_seeds", "study.damage.seeds"},
+      {"study.comparator_snr", "study.comparator.snr"},
+      {"study.comparator_seeds", "study.comparator.seeds"},
+      {"study.comparator_errors", "study.comparator.errors"},
+      {"study.comparator_data", "study.comparator.data"},
+  };
+  return renames;
+}
+
+bool IsBlock(const std::string& path) {
+  const auto& blocks = BlockTable();
+  return std::any_of(blocks.begin(), blocks.end(),
+                     [&path](const auto& block) { return block.first == path; });
+}
+
+// The names of the map `path` (a section or a block) in table order, each once:
+// its keys and its blocks ("kind, folder, ..., robustness, relaxation, ...").
+std::vector<std::string> NamesIn(const std::string& path) {
+  std::vector<std::string> names;
+  for (const Key& key : KeyTable()) {
+    if (key.path.rfind(path + ".", 0) != 0) continue;
+    const std::string rest = key.path.substr(path.size() + 1);
+    const std::string name = rest.substr(0, rest.find('.'));
+    if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+  }
+  return names;
+}
+
 // The section names in table order, each once.
 std::vector<std::string> SectionNames() {
   std::vector<std::string> sections;
@@ -1124,9 +1194,17 @@ std::string Suggestion(const std::string& word, const std::vector<std::string>& 
   return nearest == nullptr ? "" : "; did you mean '" + *nearest + "'?";
 }
 
+// "unknown key '<path>'" with the nearest key or block, or with the name now of a
+// flat study key of before the study blocks.
 std::string UnknownKeyMessage(const std::string& path) {
+  const auto renamed = FlatStudyKeyRenames().find(path);
+  if (renamed != FlatStudyKeyRenames().end()) {
+    return "unknown key '" + path + "'; the study keys are nested per study: it is now '" +
+           renamed->second + "'";
+  }
   std::vector<std::string> paths;
   for (const Key& key : KeyTable()) paths.push_back(key.path);
+  for (const auto& [block, heading] : BlockTable()) paths.push_back(block);
   return "unknown key '" + path + "'" + Suggestion(path, paths);
 }
 
@@ -1166,29 +1244,59 @@ struct ParsedConfig {
   std::map<std::string, std::string> origins;
 };
 
-// Reads the keys of one section map into parsed->config.
-void ReadSection(const std::string& section, const YAML::Node& keys, const std::string& name,
-                 ParsedConfig* parsed) {
+void ReadMap(const std::string& path, const YAML::Node& keys, const std::string& name,
+             ParsedConfig* parsed);
+
+// Reads the value of the section or block `path` (given at `where`): nothing when
+// empty ("study:" alone: every key of it at its default), else a map of its keys.
+void ReadMapValue(const std::string& path, const YAML::Node& keys, const std::string& where,
+                  const std::string& name, ParsedConfig* parsed) {
+  if (keys.IsNull()) return;
+  if (!keys.IsMap()) {
+    throw InputError(where + ": " + path + ": expected a map of keys (" +
+                     Join(NamesIn(path), ", ") + "), got " + Describe(keys));
+  }
+  ReadMap(path, keys, name, parsed);
+}
+
+// Reads the keys and blocks of the map of section or block `path` into
+// parsed->config.
+void ReadMap(const std::string& path, const YAML::Node& keys, const std::string& name,
+             ParsedConfig* parsed) {
   std::map<std::string, int> first_lines;
   for (const auto& entry : keys) {
     const YAML::Node& key_node = entry.first;
     const std::string where = Where(name, key_node.Mark());
     if (!key_node.IsScalar()) {
-      throw InputError(where + ": " + section + ": expected a key name, got " + Describe(key_node));
+      throw InputError(where + ": " + path + ": expected a key name, got " + Describe(key_node));
     }
-    const std::string path = section + "." + key_node.Scalar();
-    const Key* key = FindKey(path);
-    if (key == nullptr) throw InputError(where + ": " + UnknownKeyMessage(path));
+    const std::string& key_name = key_node.Scalar();
+    const std::string key_path = path + "." + key_name;
+    const Key* key = FindKey(key_path);
+    const std::size_t dot = key_name.find('.');
+    if (dot != std::string::npos && (key != nullptr || IsBlock(key_path))) {
+      // "robustness.snr:" under study: a file spells a block's key one way, nested.
+      throw InputError(where + ": " + key_path + ": expected it nested, '" +
+                       key_name.substr(0, dot) + ":' with '" + key_name.substr(dot + 1) +
+                       ":' under it");
+    }
+    if (key == nullptr && !IsBlock(key_path)) {
+      throw InputError(where + ": " + UnknownKeyMessage(key_path));
+    }
     const int line = key_node.Mark().line + 1;
-    if (!first_lines.emplace(path, line).second) {
-      throw InputError(where + ": duplicate key '" + path + "' (first given on line " +
-                       std::to_string(first_lines[path]) + ")");
+    if (!first_lines.emplace(key_path, line).second) {
+      throw InputError(where + ": duplicate key '" + key_path + "' (first given on line " +
+                       std::to_string(first_lines[key_path]) + ")");
+    }
+    if (key == nullptr) {
+      ReadMapValue(key_path, entry.second, where, name, parsed);
+      continue;
     }
     if (!key->read(entry.second, &parsed->config)) {
-      throw InputError(where + ": " + path + ": expected " + key->expected + ", got " +
+      throw InputError(where + ": " + key_path + ": expected " + key->expected + ", got " +
                        Describe(entry.second));
     }
-    parsed->origins[path] = where;
+    parsed->origins[key_path] = where;
   }
 }
 
@@ -1217,17 +1325,7 @@ void ReadDocument(const YAML::Node& root, const std::string& name, ParsedConfig*
       throw InputError(where + ": duplicate section '" + section + "' (first given on line " +
                        std::to_string(first_lines[section]) + ")");
     }
-    const YAML::Node& keys = entry.second;
-    if (keys.IsNull()) continue;  // "section:" alone: every key of it at its default
-    if (!keys.IsMap()) {
-      std::vector<std::string> names;
-      for (const Key& key : KeyTable()) {
-        if (key.section() == section) names.push_back(key.name());
-      }
-      throw InputError(where + ": " + section + ": expected a map of keys (" + Join(names, ", ") +
-                       "), got " + Describe(keys));
-    }
-    ReadSection(section, keys, name, parsed);
+    ReadMapValue(section, entry.second, where, name, parsed);
   }
 }
 
@@ -1247,6 +1345,10 @@ void ApplyOverride(const std::string& override_text, ParsedConfig* parsed) {
   }
   const std::string path = Trim(override_text.substr(0, equals));
   const Key* key = FindKey(path);
+  if (key == nullptr && IsBlock(path)) {
+    throw InputError(where + ": " + path + " is a block of keys (" + Join(NamesIn(path), ", ") +
+                     "): set one of them, e.g. " + path + "." + NamesIn(path).front() + "=...");
+  }
   if (key == nullptr) throw InputError(where + ": " + UnknownKeyMessage(path));
   YAML::Node value;
   try {
@@ -1376,21 +1478,39 @@ std::string WhyUnreadable(const std::string& path) {
 // ---------------------------------------------------------------------------
 // Writing.
 
-// The config as YAML, one section per table section; with comments, each key
-// line ends with "# [unit] description (choices)".
+// The heading line of the commented default config of block `path`, or "".
+std::string BlockHeading(const std::string& path) {
+  for (const auto& [block, heading] : BlockTable()) {
+    if (block == path) return heading;
+  }
+  return "";
+}
+
+// The config as YAML, one map per table section and, inside it, one nested map
+// per block (study.robustness: "study:" then "  robustness:" then "    snr: ...");
+// with comments, each key line ends with "# [unit] description (choices)" and
+// each block line with its heading.
 std::string WriteYaml(const Config& config, bool with_comments, bool applied_only = false) {
   std::vector<std::pair<std::string, std::string>> lines;  // text, comment
-  std::string section;
+  std::string parent;                                      // the map of the last key
   for (const Key& key : KeyTable()) {
     if (applied_only && !KeyApplies(key.path, config.structure.kind)) continue;
-    if (key.section() != section) {
-      section = key.section();
-      lines.emplace_back(section + ":", "");
+    if (key.parent() != parent) {
+      // Open the maps of key.parent() that the last key was not in: its section
+      // and/or its block (every block lies in a section, one level deep).
+      const bool same_section = parent.substr(0, parent.find('.')) == key.section();
+      if (!same_section) lines.emplace_back(key.section() + ":", "");
+      if (key.parent() != key.section()) {
+        lines.emplace_back("  " + key.parent().substr(key.section().size() + 1) + ":",
+                           BlockHeading(key.parent()));
+      }
+      parent = key.parent();
     }
     std::string comment = key.unit.empty() ? "" : "[" + key.unit + "] ";
     comment += key.description;
     if (!key.choices.empty()) comment += " (" + key.choices + ")";
-    lines.emplace_back("  " + key.name() + ": " + key.write(config), comment);
+    const std::string indent(2 * std::count(key.path.begin(), key.path.end(), '.'), ' ');
+    lines.emplace_back(indent + key.leaf() + ": " + key.write(config), comment);
   }
   std::size_t width = 0;
   for (const auto& [text, comment] : lines) width = std::max(width, text.size());

@@ -41,21 +41,21 @@ struct DamageCase {
   bool per_element;
 };
 
-// The grid (truth, sensors, SNR, zoning), then the seeds 2..damage_seeds of the soft
+// The grid (truth, sensors, SNR, zoning), then the seeds 2..study.damage.seeds of the soft
 // truth with the interior sensors at SNR 10 and 10 zones (seed 1 is in the grid when
 // 10 is one of the SNRs).
 std::vector<DamageCase> Cases(const StudyOptions& options) {
   std::vector<DamageCase> cases;
   for (int truth = 0; truth < static_cast<int>(DamageTruths().size()); ++truth) {
     for (bool interior : {false, true}) {
-      for (double snr : options.damage_snr) {
+      for (double snr : options.damage.snr) {
         for (bool per_element : {false, true}) {
           cases.push_back({truth, interior, snr, std::isinf(snr) ? 0u : 1u, per_element});
         }
       }
     }
   }
-  for (int seed = 2; seed <= options.damage_seeds; ++seed) {
+  for (int seed = 2; seed <= options.damage.seeds; ++seed) {
     cases.push_back({0, true, 10.0, static_cast<std::uint64_t>(seed), false});
   }
   return cases;

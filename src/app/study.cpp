@@ -288,52 +288,53 @@ bool StudyOptions::IsValid(std::string* error) const {
     why << "study.folder must name a folder";
   } else if (!(threads >= 0 && threads <= 256)) {
     why << "study.threads must lie in [0, 256] (0: every core), got " << threads;
-  } else if (!check_snr(robustness_snr, "study.robustness_snr")) {
-  } else if (!(robustness_seeds >= 1 && robustness_seeds <= 100000)) {
-    why << "study.robustness_seeds must lie in [1, 100000], got " << robustness_seeds;
-  } else if (!check_snr(relaxation_snr, "study.relaxation_snr")) {
-  } else if (relaxation_moduli.empty() || relaxation_moduli.size() > 100 ||
-             std::any_of(relaxation_moduli.begin(), relaxation_moduli.end(),
+  } else if (!check_snr(robustness.snr, "study.robustness.snr")) {
+  } else if (!(robustness.seeds >= 1 && robustness.seeds <= 100000)) {
+    why << "study.robustness.seeds must lie in [1, 100000], got " << robustness.seeds;
+  } else if (!check_snr(relaxation.snr, "study.relaxation.snr")) {
+  } else if (relaxation.moduli.empty() || relaxation.moduli.size() > 100 ||
+             std::any_of(relaxation.moduli.begin(), relaxation.moduli.end(),
                          [](double f) { return !(f > 0.0 && f <= 10.0); })) {
-    why << "study.relaxation_moduli must hold 1 to 100 factors of model.modulus in (0, 10]";
-  } else if (!(omega_min > 0.0 && omega_min < omega_max && omega_max < 2.0)) {
-    why << "study.omega_min and study.omega_max must satisfy 0 < omega_min < omega_max < 2, got "
-        << omega_min << " and " << omega_max;
-  } else if (!(omega_points >= 2 && omega_points <= 1000)) {
-    why << "study.omega_points must lie in [2, 1000], got " << omega_points;
-  } else if (!(relaxation_tolerance > 0.0 && relaxation_tolerance < 1.0)) {
-    why << "study.relaxation_tolerance must lie in (0, 1), got " << relaxation_tolerance;
-  } else if (!check_snr(cost_curve_snr, "study.cost_curve_snr")) {
-  } else if (!(cost_curve_seeds >= 1 && cost_curve_seeds <= 100000)) {
-    why << "study.cost_curve_seeds must lie in [1, 100000], got " << cost_curve_seeds;
-  } else if (!(cost_curve_points >= 3 && cost_curve_points <= 10000)) {
-    why << "study.cost_curve_points must lie in [3, 10000], got " << cost_curve_points;
-  } else if (!(cost_curve_low > 0.0 && cost_curve_low < cost_curve_high &&
-               std::isfinite(cost_curve_high))) {
-    why << "study.cost_curve_low and study.cost_curve_high must satisfy 0 < cost_curve_low < "
-           "cost_curve_high (finite), got "
-        << cost_curve_low << " and " << cost_curve_high;
-  } else if (!check_snr(damage_snr, "study.damage_snr")) {
-  } else if (!(damage_seeds >= 1 && damage_seeds <= 1000)) {
-    why << "study.damage_seeds must lie in [1, 1000], got " << damage_seeds;
-  } else if (!check_snr(comparator_snr, "study.comparator_snr")) {
-  } else if (!(comparator_seeds >= 1 && comparator_seeds <= 100000)) {
-    why << "study.comparator_seeds must lie in [1, 100000], got " << comparator_seeds;
-  } else if (comparator_errors.empty() ||
-             std::any_of(comparator_errors.begin(), comparator_errors.end(),
+    why << "study.relaxation.moduli must hold 1 to 100 factors of model.modulus in (0, 10]";
+  } else if (!(relaxation.omega_min > 0.0 && relaxation.omega_min < relaxation.omega_max &&
+               relaxation.omega_max < 2.0)) {
+    why << "study.relaxation.omega_min and study.relaxation.omega_max must satisfy 0 < omega_min < "
+           "omega_max < 2, got "
+        << relaxation.omega_min << " and " << relaxation.omega_max;
+  } else if (!(relaxation.omega_points >= 2 && relaxation.omega_points <= 1000)) {
+    why << "study.relaxation.omega_points must lie in [2, 1000], got " << relaxation.omega_points;
+  } else if (!(relaxation.tolerance > 0.0 && relaxation.tolerance < 1.0)) {
+    why << "study.relaxation.tolerance must lie in (0, 1), got " << relaxation.tolerance;
+  } else if (!check_snr(cost_curves.snr, "study.cost_curves.snr")) {
+  } else if (!(cost_curves.seeds >= 1 && cost_curves.seeds <= 100000)) {
+    why << "study.cost_curves.seeds must lie in [1, 100000], got " << cost_curves.seeds;
+  } else if (!(cost_curves.points >= 3 && cost_curves.points <= 10000)) {
+    why << "study.cost_curves.points must lie in [3, 10000], got " << cost_curves.points;
+  } else if (!(cost_curves.low > 0.0 && cost_curves.low < cost_curves.high &&
+               std::isfinite(cost_curves.high))) {
+    why << "study.cost_curves.low and study.cost_curves.high must satisfy 0 < low < high "
+           "(finite), got "
+        << cost_curves.low << " and " << cost_curves.high;
+  } else if (!check_snr(damage.snr, "study.damage.snr")) {
+  } else if (!(damage.seeds >= 1 && damage.seeds <= 1000)) {
+    why << "study.damage.seeds must lie in [1, 1000], got " << damage.seeds;
+  } else if (!check_snr(comparator.snr, "study.comparator.snr")) {
+  } else if (!(comparator.seeds >= 1 && comparator.seeds <= 100000)) {
+    why << "study.comparator.seeds must lie in [1, 100000], got " << comparator.seeds;
+  } else if (comparator.errors.empty() ||
+             std::any_of(comparator.errors.begin(), comparator.errors.end(),
                          [](const std::string& name) {
                            const std::vector<std::string>& known = ComparatorModelErrors();
                            return std::find(known.begin(), known.end(), name) == known.end();
                          })) {
-    why << "study.comparator_errors must hold model errors among none, density, force_gain, "
+    why << "study.comparator.errors must hold model errors among none, density, force_gain, "
            "displacement_gain, soft_zone";
-  } else if (comparator_data.empty() || comparator_data.size() > 2 ||
-             std::any_of(comparator_data.begin(), comparator_data.end(),
-                         [](const std::string& name) {
-                           return name != "raw" && name != "prefilter";
-                         }) ||
-             (comparator_data.size() == 2 && comparator_data[0] == comparator_data[1])) {
-    why << "study.comparator_data must hold raw, prefilter or both, once each";
+  } else if (comparator.data.empty() || comparator.data.size() > 2 ||
+             std::any_of(
+                 comparator.data.begin(), comparator.data.end(),
+                 [](const std::string& name) { return name != "raw" && name != "prefilter"; }) ||
+             (comparator.data.size() == 2 && comparator.data[0] == comparator.data[1])) {
+    why << "study.comparator.data must hold raw, prefilter or both, once each";
   } else {
     return true;
   }
@@ -409,9 +410,9 @@ void DecodeRobustnessRun(const std::string& record, RobustnessRun* run) {
 
 void RunRobustness(const StudyOptions& options, const RobustnessIdentification& identify,
                    RunJournal* journal, RobustnessStudy* study) {
-  for (int k = 0; k < static_cast<int>(options.robustness_snr.size()); ++k) {
-    const double snr = options.robustness_snr[k];
-    for (const std::uint64_t seed : SeedsOf(snr, options.robustness_seeds)) {
+  for (int k = 0; k < static_cast<int>(options.robustness.snr.size()); ++k) {
+    const double snr = options.robustness.snr[k];
+    for (const std::uint64_t seed : SeedsOf(snr, options.robustness.seeds)) {
       RobustnessRun run;
       run.snr = snr;
       run.snr_index = k;
@@ -421,7 +422,7 @@ void RunRobustness(const StudyOptions& options, const RobustnessIdentification& 
   }
   StudyProgressLogger()->info(
       "robustness: {} identifications ({} SNRs, {} seeds per finite SNR) on {} threads",
-      study->runs.size(), options.robustness_snr.size(), options.robustness_seeds, study->threads);
+      study->runs.size(), options.robustness.snr.size(), options.robustness.seeds, study->threads);
   Progress progress("robustness", static_cast<int>(study->runs.size()));
   const auto parameters = study->parameters.size();
   ResumableParallelFor(
@@ -440,10 +441,10 @@ void RunRobustness(const StudyOptions& options, const RobustnessIdentification& 
       &progress, journal, [&](int i) { return EncodeRobustnessRun(study->runs[i]); },
       [&](int i, const std::string& record) { DecodeRobustnessRun(record, &study->runs[i]); });
 
-  for (int k = 0; k < static_cast<int>(options.robustness_snr.size()); ++k) {
+  for (int k = 0; k < static_cast<int>(options.robustness.snr.size()); ++k) {
     for (std::size_t p = 0; p < parameters; ++p) {
       RobustnessStatistics statistics;
-      statistics.snr = options.robustness_snr[k];
+      statistics.snr = options.robustness.snr[k];
       statistics.snr_index = k;
       statistics.parameter = static_cast<int>(p);
       std::vector<double> errors;
@@ -757,7 +758,7 @@ int PredictedIterations(double omega, double a_min, double a_max, double toleran
 }
 
 // One case of the relaxation study: its spectrum estimate and omegas, the grid's
-// fixed-omega solves to study.relaxation_tolerance (into *points), and the reference
+// fixed-omega solves to study.relaxation.tolerance (into *points), and the reference
 // solves to inner.tolerance with their residual histories (into *histories).
 void RunRelaxationCase(const Config& config, const BarModel& model, const ChannelSet& truth,
                        const std::vector<double>& omegas, int c, RelaxationCase* case_out,
@@ -790,7 +791,7 @@ void RunRelaxationCase(const Config& config, const BarModel& model, const Channe
   relaxation_case.omega_fastest = std::numeric_limits<double>::quiet_NaN();
   for (const double omega : omegas) {
     const CoupledSolverSummary summary =
-        solve(CoupledSolverType::kRelaxation, omega, options.relaxation_tolerance);
+        solve(CoupledSolverType::kRelaxation, omega, options.relaxation.tolerance);
     RelaxationPoint point;
     point.case_index = c;
     point.omega = omega;
@@ -799,7 +800,7 @@ void RunRelaxationCase(const Config& config, const BarModel& model, const Channe
     point.sweeps = summary.sweeps;
     point.relative_residual = summary.relative_residual;
     point.predicted_iterations =
-        PredictedIterations(omega, a_min, a_max, options.relaxation_tolerance);
+        PredictedIterations(omega, a_min, a_max, options.relaxation.tolerance);
     points->push_back(point);
     if (summary.IsSolutionUsable() && (fewest_sweeps < 0 || summary.sweeps < fewest_sweeps)) {
       fewest_sweeps = summary.sweeps;
@@ -840,10 +841,10 @@ RelaxationStudy RunRelaxationStudy(const Config& config) {
   const auto start = Clock::now();
   const StudyOptions& options = config.study;
   RelaxationStudy study;
-  study.tolerance = options.relaxation_tolerance;
+  study.tolerance = options.relaxation.tolerance;
   study.threads = ResolveThreads(options.threads);
-  for (const double snr : options.relaxation_snr) {
-    for (const double factor : options.relaxation_moduli) {
+  for (const double snr : options.relaxation.snr) {
+    for (const double factor : options.relaxation.moduli) {
       RelaxationCase relaxation_case;
       relaxation_case.snr = snr;
       relaxation_case.modulus_factor = factor;
@@ -852,9 +853,10 @@ RelaxationStudy RunRelaxationStudy(const Config& config) {
     }
   }
   std::vector<double> omegas;
-  for (int i = 0; i < options.omega_points; ++i) {
-    omegas.push_back(options.omega_min +
-                     (options.omega_max - options.omega_min) * i / (options.omega_points - 1.0));
+  for (int i = 0; i < options.relaxation.omega_points; ++i) {
+    omegas.push_back(options.relaxation.omega_min +
+                     (options.relaxation.omega_max - options.relaxation.omega_min) * i /
+                         (options.relaxation.omega_points - 1.0));
   }
   const int cases = static_cast<int>(study.cases.size());
   std::vector<std::vector<RelaxationPoint>> points(cases);
@@ -864,7 +866,7 @@ RelaxationStudy RunRelaxationStudy(const Config& config) {
   const BarModel model(config.model);
   StudyProgressLogger()->info(
       "relaxation: {} cases ({} SNRs x {} moduli), {} omegas each, on {} threads", cases,
-      options.relaxation_snr.size(), options.relaxation_moduli.size(), omegas.size(),
+      options.relaxation.snr.size(), options.relaxation.moduli.size(), omegas.size(),
       study.threads);
   Progress progress("relaxation", cases);
   ParallelFor(
@@ -1103,8 +1105,8 @@ CostCurveStudy RunCostCurveStudy(const Config& config) {
   CostCurveStudy study;
   study.reference_modulus = config.model.modulus;
   study.threads = ResolveThreads(options.threads);
-  for (const double snr : options.cost_curve_snr) {
-    for (const std::uint64_t seed : SeedsOf(snr, options.cost_curve_seeds)) {
+  for (const double snr : options.cost_curves.snr) {
+    for (const std::uint64_t seed : SeedsOf(snr, options.cost_curves.seeds)) {
       CostCurveRun curve;
       curve.snr = snr;
       curve.seed = seed;
@@ -1116,7 +1118,7 @@ CostCurveStudy RunCostCurveStudy(const Config& config) {
   StudyProgressLogger()->info(
       "cost curves: {} curves of {} points, each with an identification, "
       "on {} threads",
-      study.curves.size(), options.cost_curve_points, study.threads);
+      study.curves.size(), options.cost_curves.points, study.threads);
   Progress progress("cost curves", static_cast<int>(study.curves.size()));
   ParallelFor(
       static_cast<int>(study.curves.size()), study.threads,
@@ -1136,10 +1138,10 @@ CostCurveStudy RunCostCurveStudy(const Config& config) {
         // warm-started point to point.
         McreObjective objective(model, identification.data, config.mcre, config.time.theta,
                                 config.inner, study.reference_modulus, identification.ends);
-        for (int k = 0; k < options.cost_curve_points; ++k) {
+        for (int k = 0; k < options.cost_curves.points; ++k) {
           const double factor =
-              options.cost_curve_low + (options.cost_curve_high - options.cost_curve_low) * k /
-                                           (options.cost_curve_points - 1.0);
+              options.cost_curves.low + (options.cost_curves.high - options.cost_curves.low) * k /
+                                            (options.cost_curves.points - 1.0);
           const ObjectiveEvaluation& evaluation =
               objective.EvaluateModulus(factor * study.reference_modulus, false);
           curve.moduli.push_back(factor * study.reference_modulus);

@@ -84,9 +84,9 @@ struct ComparatorStudy {
   std::vector<std::string> zones;
   std::vector<double> reference_moduli;
   bool matrix_model = false;              // no global scan: a local search from the nominal moduli
-  std::vector<std::string> model_errors;  // study.comparator_errors
-  std::vector<double> snrs;               // study.comparator_snr
-  std::vector<bool> prefilters;           // study.comparator_data: false raw, true prefilter
+  std::vector<std::string> model_errors;  // study.comparator.errors
+  std::vector<double> snrs;               // study.comparator.snr
+  std::vector<bool> prefilters;           // study.comparator.data: false raw, true prefilter
   // The MCRE's global scan ran on the pinned search functional (search.functional
   // pinned), not on e^2 itself: its valleys are the search functional's.
   bool mcre_scans_search = false;
@@ -96,8 +96,8 @@ struct ComparatorStudy {
   double wall_time_s = 0.0;
 };
 
-// Runs study.comparator_errors x study.comparator_snr x seeds (1..comparator_seeds
-// per finite SNR, one run at SNR inf) x study.comparator_data (raw, pre-filtered) x
+// Runs study.comparator.errors x study.comparator.snr x seeds (1..study.comparator.seeds
+// per finite SNR, one run at SNR inf) x study.comparator.data (raw, pre-filtered) x
 // {MCRE, least squares} on the config's case, on study.threads threads, with a progress line per
 // data set; runs holds them data set by data set, {MCRE, least squares} x data x zones
 // within each. Throws InputError for soft_zone or a truth without one of the zones on a

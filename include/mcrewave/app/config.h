@@ -50,17 +50,17 @@
 //   uncertainty: samples [16], seed [1] (modulus_uncertainty.h)
 //   output: folder ["results/identify"], figures [true], curve_points [41]
 //   study: kind [all | robustness | relaxation | cost_curves | damage | comparator],
-//          folder ["results"],
-//          threads [0: every core], figures [true], robustness_snr
-//          [[.inf, 20, 10, 5, 2.5]], robustness_seeds [100], relaxation_snr
-//          [[.inf, 10, 2.5]], relaxation_moduli [[0.8, 1, 1.2]], omega_min [0.005],
-//          omega_max [0.1], omega_points [20], relaxation_tolerance [1e-4],
-//          cost_curve_snr [[.inf, 10, 2.5]], cost_curve_seeds [3],
-//          cost_curve_points [41], cost_curve_low [0.8], cost_curve_high [1.2],
-//          damage_snr [[.inf, 20, 10, 5]], damage_seeds [20], comparator_snr
-//          [[20, 10, 5, 2.5]], comparator_seeds [100], comparator_errors [[none,
-//          density, force_gain, displacement_gain, soft_zone]], comparator_data
-//          [[raw, prefilter]]
+//          folder ["results"], threads [0: every core], figures [true], and one
+//          block of keys per study, named after its kind:
+//          robustness: snr [[.inf, 20, 10, 5, 2.5]], seeds [100];
+//          relaxation: snr [[.inf, 10, 2.5]], moduli [[0.8, 1, 1.2]],
+//            omega_min [0.005], omega_max [0.1], omega_points [20], tolerance [1e-4];
+//          cost_curves: snr [[.inf, 10, 2.5]], seeds [3], points [41], low [0.8],
+//            high [1.2];
+//          damage: snr [[.inf, 20, 10, 5]], seeds [20];
+//          comparator: snr [[20, 10, 5, 2.5]], seeds [100], errors [[none, density,
+//            force_gain, displacement_gain, soft_zone]], data [[raw, prefilter]]
+//          (a key of a block is study.<block>.<key>, e.g. study.robustness.snr)
 //          (StudyOptions, study.h; used by `identify study` only)
 //   zone_identification: optimizer [ceres], algorithm [default], step_tolerance [1e-8],
 //          function_tolerance [1e-10], max_evaluations [2000], max_time [600 s],
@@ -145,7 +145,10 @@ struct Config {
 // everything before any computation. A relative data.path is resolved against
 // the config file's folder. Throws InputError with one message naming the file,
 // the line (for keys from the file) or the override, the key, and what was
-// expected: unknown keys (with the nearest valid key suggested), wrong types,
+// expected: unknown keys (with the nearest valid key suggested; a study key of
+// the flat form before the study blocks, e.g. study.robustness_snr, with its
+// name now), a block of keys (e.g. study.robustness) where a key belongs or a
+// key where a block belongs, wrong types,
 // out-of-range values, a missing or unreadable file, malformed YAML.
 Config LoadConfig(const std::string& path, const std::vector<std::string>& overrides = {});
 

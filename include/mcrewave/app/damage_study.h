@@ -7,9 +7,9 @@
 //   non_aligned   0.75 E_ref over [0.63, 0.71] m (no model zone matches it),
 //   two_zones     0.8 E_ref over [0.15, 0.25] m and 1.15 E_ref over [0.55, 0.65] m;
 // two sensor sets: the ends only (u0, uL, f0, fL), and the ends with u@0.25, 0.5,
-// 0.75 and e@0.2, 0.45, 0.65, 0.9; every SNR of study.damage_snr (noise seed 1, none at
+// 0.75 and e@0.2, 0.45, 0.65, 0.9; every SNR of study.damage.snr (noise seed 1, none at
 // SNR inf); two zonings of the identification: 10 equal zones and one zone per
-// element. Then study.damage_seeds seeds of the soft truth with the interior sensors at
+// element. Then study.damage.seeds seeds of the soft truth with the interior sensors at
 // SNR 10 and 10 zones. Each run: the scalar identification (E*), the error map at E*
 // (its peak), the zone identification from E* (every zone's modulus), against the
 // truth's modulus of each zone (its elements in series). With 10 equal zones also the

@@ -1,23 +1,23 @@
 // Studies of the identification, run by `identify study CONFIG` from the `study:`
 // section of a config (README, "Studies"), each into a folder of its own:
 //
-//   robustness   for every SNR of robustness_snr and noise seeds 1..robustness_seeds
+//   robustness   for every SNR of robustness.snr and noise seeds 1..robustness.seeds
 //                (one run at SNR inf), the identification of `identify run` on data
 //                from the truth of `data:` (the bar: identification_run.h, E against
 //                E_ref = model.modulus; a matrix model: matrix_identification_run.h
 //                without its error maps and uncertainty, every zone modulus against the
 //                truth's); per SNR and parameter the statistics of the relative error,
 //                the converged share, mean outer evaluations and inner sweeps.
-//   relaxation   for every SNR of relaxation_snr (noise seed data.seed) and E = f E_ref,
-//                f in relaxation_moduli: the sweeps of the fixed-omega relaxation to
-//                relaxation_tolerance on a grid of omega (the paper's Fig. 3) beside what
+//   relaxation   for every SNR of relaxation.snr (noise seed data.seed) and E = f E_ref,
+//                f in relaxation.moduli: the sweeps of the fixed-omega relaxation to
+//                relaxation.tolerance on a grid of omega (the paper's Fig. 3) beside what
 //                the Lanczos estimate of the spectrum of A = I - G predicts (limit
 //                2 / a_max, optimum 2 / (a_min + a_max), the adaptive omega, iterations
 //                ln(tol) / ln(rho(omega)), rho = max |1 - omega a|), and the residual
 //                histories of the fixed, adaptive and CG solves (Fig. 4 extended).
-//   cost_curves  for every SNR of cost_curve_snr and seeds 1..cost_curve_seeds (one at
-//                SNR inf): e^2(E) on cost_curve_points moduli evenly spaced over
-//                [cost_curve_low, cost_curve_high] E_ref, and the identified E on the
+//   cost_curves  for every SNR of cost_curves.snr and seeds 1..cost_curves.seeds (one at
+//                SNR inf): e^2(E) on cost_curves.points moduli evenly spaced over
+//                [cost_curves.low, cost_curves.high] E_ref, and the identified E on the
 //                same data (the paper's Fig. 6).
 //
 // E_ref is model.modulus. Every study uses the config's model, load, time grid, data
@@ -56,47 +56,66 @@ struct StudyOptions {
   // Figures (gnuplot) beside the CSV files.
   bool figures = true;
 
-  // Robustness: signal-to-noise ratios (.inf: no noise) and seeds per finite SNR.
-  std::vector<double> robustness_snr = {std::numeric_limits<double>::infinity(), 20.0, 10.0, 5.0,
-                                        2.5};
-  int robustness_seeds = 100;
+  // Robustness (study.robustness.*): signal-to-noise ratios (.inf: no noise) and
+  // seeds per finite SNR.
+  struct Robustness {
+    std::vector<double> snr = {std::numeric_limits<double>::infinity(), 20.0, 10.0, 5.0, 2.5};
+    int seeds = 100;
+  };
+  Robustness robustness;
 
-  // Relaxation: SNRs, moduli as factors of E_ref, the omega grid (evenly
-  // spaced, ends included) and the relative residual the grid's solves reach
-  // (the paper used 1e-4).
-  std::vector<double> relaxation_snr = {std::numeric_limits<double>::infinity(), 10.0, 2.5};
-  std::vector<double> relaxation_moduli = {0.8, 1.0, 1.2};
-  double omega_min = 0.005;
-  double omega_max = 0.1;
-  int omega_points = 20;
-  double relaxation_tolerance = 1e-4;
+  // Relaxation (study.relaxation.*): SNRs, moduli as factors of E_ref, the omega
+  // grid (evenly spaced, ends included) and the relative residual the grid's
+  // solves reach (the paper used 1e-4).
+  struct Relaxation {
+    std::vector<double> snr = {std::numeric_limits<double>::infinity(), 10.0, 2.5};
+    std::vector<double> moduli = {0.8, 1.0, 1.2};
+    double omega_min = 0.005;
+    double omega_max = 0.1;
+    int omega_points = 20;
+    double tolerance = 1e-4;
+  };
+  Relaxation relaxation;
 
-  // Cost curves: SNRs, seeds per finite SNR, and the grid of E as factors of E_ref.
-  std::vector<double> cost_curve_snr = {std::numeric_limits<double>::infinity(), 10.0, 2.5};
-  int cost_curve_seeds = 3;
-  int cost_curve_points = 41;
-  double cost_curve_low = 0.8;
-  double cost_curve_high = 1.2;
+  // Cost curves (study.cost_curves.*): SNRs, seeds per finite SNR, and the grid of
+  // E as factors of E_ref.
+  struct CostCurves {
+    std::vector<double> snr = {std::numeric_limits<double>::infinity(), 10.0, 2.5};
+    int seeds = 3;
+    int points = 41;
+    double low = 0.8;
+    double high = 1.2;
+  };
+  CostCurves cost_curves;
 
-  // Damage localisation (damage_study.h): SNRs of the grid and seeds of the SNR-10 runs.
-  std::vector<double> damage_snr = {std::numeric_limits<double>::infinity(), 20.0, 10.0, 5.0};
-  int damage_seeds = 20;
+  // Damage localisation (study.damage.*, damage_study.h): SNRs of the grid and
+  // seeds of the SNR-10 runs.
+  struct Damage {
+    std::vector<double> snr = {std::numeric_limits<double>::infinity(), 20.0, 10.0, 5.0};
+    int seeds = 20;
+  };
+  Damage damage;
 
-  // MCRE against least squares (comparator_study.h): SNRs, seeds per finite SNR and
-  // the model errors (ComparatorModelErrors()).
-  std::vector<double> comparator_snr = {20.0, 10.0, 5.0, 2.5};
-  int comparator_seeds = 100;
-  std::vector<std::string> comparator_errors = {"none", "density", "force_gain",
-                                                "displacement_gain", "soft_zone"};
-  // The data each functional identifies from: raw and/or prefilter (pre-filtered).
-  std::vector<std::string> comparator_data = {"raw", "prefilter"};
+  // MCRE against least squares (study.comparator.*, comparator_study.h): SNRs,
+  // seeds per finite SNR, the model errors (ComparatorModelErrors()) and the data
+  // each functional identifies from: raw and/or prefilter (pre-filtered).
+  struct Comparator {
+    std::vector<double> snr = {20.0, 10.0, 5.0, 2.5};
+    int seeds = 100;
+    std::vector<std::string> errors = {"none", "density", "force_gain", "displacement_gain",
+                                       "soft_zone"};
+    std::vector<std::string> data = {"raw", "prefilter"};
+  };
+  Comparator comparator;
 
   // Valid when folder is not empty, threads in [0, 256], every SNR > 0 (.inf
-  // allowed), lists not empty (at most 100 values), seeds in [1, 100000],
-  // relaxation_moduli in (0, 10], 0 < omega_min < omega_max < 2, omega_points
-  // in [2, 1000], relaxation_tolerance in (0, 1), cost_curve_points in
-  // [3, 10000], 0 < cost_curve_low < cost_curve_high. Messages name the
-  // study.* keys.
+  // allowed), lists not empty (at most 100 values), seeds in [1, 100000] (damage:
+  // [1, 1000]), relaxation.moduli in (0, 10], 0 < relaxation.omega_min <
+  // relaxation.omega_max < 2, relaxation.omega_points in [2, 1000],
+  // relaxation.tolerance in (0, 1), cost_curves.points in [3, 10000],
+  // 0 < cost_curves.low < cost_curves.high (finite), comparator.errors among
+  // ComparatorModelErrors(), comparator.data raw and/or prefilter once each.
+  // Messages name the study.* keys (study.robustness.snr, ...).
   bool IsValid(std::string* error) const;
 };
 
@@ -109,7 +128,7 @@ bool StudySelected(StudyKind kind, StudyKind part);
 
 struct RobustnessRun {
   double snr = 0.0;
-  int snr_index = 0;       // position of snr in robustness_snr
+  int snr_index = 0;       // position of snr in robustness.snr
   std::uint64_t seed = 0;  // noise seed (0 at SNR inf: no noise drawn)
   // The outer loop converged and every modulus lies strictly inside the bounds.
   bool converged = false;
@@ -126,7 +145,7 @@ struct RobustnessRun {
 
 struct RobustnessStatistics {
   double snr = 0.0;
-  int snr_index = 0;  // position of snr in robustness_snr
+  int snr_index = 0;  // position of snr in robustness.snr
   int parameter = 0;  // its index in RobustnessStudy::parameters
   int runs = 0;
   int converged = 0;
@@ -148,7 +167,7 @@ struct RobustnessStudy {
   std::vector<double> reference_moduli;
   bool matrix_model = false;        // a matrix model's zones: no global scan
   std::vector<RobustnessRun> runs;  // SNR by SNR, seeds ascending
-  // One per SNR and parameter: SNR by SNR in robustness_snr order, the parameters in
+  // One per SNR and parameter: SNR by SNR in robustness.snr order, the parameters in
   // order within each.
   std::vector<RobustnessStatistics> statistics;
   int threads = 0;
