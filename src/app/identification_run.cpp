@@ -234,8 +234,10 @@ IdentificationRun IdentifyModulus(const Config& config, const ChannelSet& data) 
                                          : "mcre:'s e^2");
   McreIdentification identification = IdentifyWithMcre(config, model, run.data, run.ends);
   McreObjective& objective = *identification.objective;
-  run.alpha = objective.problem().alpha();
-  run.beta = objective.problem().beta();
+  // The bar's weights alpha and beta, for its summary and the model's end forces.
+  const auto& bar_problem = dynamic_cast<const McreProblem&>(objective.problem());
+  run.alpha = bar_problem.alpha();
+  run.beta = bar_problem.beta();
   run.rest_cost = objective.rest_cost();
   run.scan_cost_scale = identification.scan_cost_scale;
   run.outer = identification.outer;
@@ -295,7 +297,7 @@ IdentificationRun RunIdentification(const Config& config, const ChannelSet& data
   run.cold_solve = cold.EvaluateModulus(run.identified_modulus()).inner;
 
   // The model's force at x = 0 and the RMS misfits at E*.
-  const McreProblem& problem = cold.problem();
+  const auto& problem = dynamic_cast<const McreProblem&>(cold.problem());
   const Vector& measured_f0 = run.data.Values("f0");
   run.clamp_force.resize(run.data.num_samples());
   for (int j = 0; j < run.data.num_samples(); ++j) {

@@ -266,7 +266,7 @@ ZoneIdentificationSummary IdentifyZoneModuli(
   return IdentifyZones(
       model, homogeneous_modulus, noise, false, [&](ZoneIdentificationSummary* summary) {
         McreObjective objective(model, data, mcre, theta, inner, homogeneous_modulus, ends);
-        const McreProblem& problem = objective.problem();
+        const StreamingCoupledProblem& problem = objective.problem();
         if (warm_start != nullptr && warm_start->cols() == problem.num_steps() + 1 &&
             (warm_start->rows() == problem.num_nodes() ||
              warm_start->rows() == problem.num_traces())) {

@@ -451,7 +451,7 @@ void MatrixMcreProblem::MeasuredForce(int j, Eigen::Ref<Vector> load) const {
   load.noalias() = loads_ * measured_loads_.col(j);
 }
 
-double MatrixMcreProblem::RestCost() const {
+double MatrixMcreProblem::RestCost() {
   double sum = 0.0;
   for (int j = 0; j <= num_steps(); ++j) {
     // c_j h [1/2 F~^T diag(alpha) F~ + 1/2 d~^T diag(beta) d~].
@@ -491,6 +491,13 @@ Matrix MatrixMcreProblem::ModelOutputs() {
     outputs.col(j) = trace_.head(sensors);
   });
   return outputs;
+}
+
+void MatrixMcreProblem::DataResponseTraces(Matrix* traces) {
+  traces->resize(num_traces(), num_steps() + 1);
+  DataResponseSweep([&](int j, const Vector& displacement) {
+    observation_columns_.TransposeMultiply(displacement.data(), traces->col(j).data());
+  });
 }
 
 Matrix MatrixMcreProblem::ModelSupportForces() {

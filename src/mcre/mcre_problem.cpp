@@ -60,6 +60,8 @@ McreProblem::McreProblem(const BarModel& model, const ChannelSet& data, const Mc
   inverse_alpha0_ = trusted ? 0.0 : 1.0 / alpha_;
   force0_gain_ = trusted ? 0.0 : 1.0;
   force0_penalty_gain_ = force0_gain_;
+  // alpha_0 / alpha of the rest cost's f0 term: 0 trusted, w_r / w_f pinned, 1 measured.
+  rest_force0_gain_ = trusted ? 0.0 : pinned ? weights.reaction_weight / weights.force_weight : 1.0;
   if (pinned) {
     // beta_0 = w_u0 S E0 / L on the datum u0~ = 0; alpha_0 = w_r L / (S E0) on f0.
     beta_u0_ = weights.clamp_displacement_weight * bar.section * reference_modulus / bar.length;
@@ -393,6 +395,22 @@ double McreProblem::PenaltyForm(const double* x, const double* y) const {
   // 0 trusted, 1 / alpha_0 pinned).
   return integrator_.stiffness().BilinearForm(x, y) +
          (force0_penalty_gain_ * x[0] * y[0] + x[last] * y[last]) / alpha_;
+}
+
+double McreProblem::RestCost() {
+  // The output part 1/2 (H U - d~)^T diag(beta_k) (H U - d~) of J at U = W = 0 is
+  // Cost(0, 0); the load part is alpha/2 |F - F~|^2 with F = 0 (a trusted clamp's f0
+  // is an output, in Cost(0, 0); a pinned clamp's has alpha_0 = w_r L / (S E0)).
+  const Matrix zero = ZeroField();
+  const Vector& f0 = data_.Values("f0");
+  const Vector& fL = data_.Values("fL");
+  double force_part = 0.0;
+  for (int j = 0; j <= data_.num_steps(); ++j) {
+    // c_j h [alpha_0/2 f~0_j^2 + alpha/2 f~L_j^2], alpha_0 = rest_force0_gain_ alpha
+    force_part += QuadratureWeight(j) * data_.time_step * 0.5 * alpha_ *
+                  (rest_force0_gain_ * f0[j] * f0[j] + fL[j] * fL[j]);
+  }
+  return Cost(zero, zero) + force_part;
 }
 
 double McreProblem::InnerProduct(const Matrix& x, const Matrix& y) {

@@ -60,53 +60,42 @@ McreOptions SearchMcreOptions(const McreOptions& mcre, const SearchOptions& sear
   return options;
 }
 
+McreObjective::McreObjective(ProblemFactory make_problem, const CoupledSolverOptions& inner,
+                             double modulus_scale)
+    : make_problem_(std::move(make_problem)),
+      problem_(make_problem_()),
+      inner_(inner),
+      modulus_scale_(modulus_scale) {
+  assert(problem_ != nullptr && inner.IsValid(nullptr) && modulus_scale > 0.0);
+  rest_cost_ = problem_->RestCost();
+}
+
 McreObjective::McreObjective(const BarModel& model, const ChannelSet& data, const McreOptions& mcre,
                              double theta, const CoupledSolverOptions& inner, double modulus_scale,
                              EndDisplacementChannels ends)
-    : model_(model),
-      data_(data),
-      mcre_(mcre),
-      theta_(theta),
-      ends_(ends),
-      problem_(model, data, mcre.weights, mcre.reference_modulus, theta, ends, mcre.clamp),
-      inner_(inner),
-      modulus_scale_(modulus_scale) {
-  assert(mcre.IsValid(nullptr) && inner.IsValid(nullptr) && modulus_scale > 0.0);
-  // The output part 1/2 (H U - d~)^T diag(beta_k) (H U - d~) of J at U = W = 0 is
-  // Cost(0, 0); the load part is alpha/2 |F - F~|^2 with F = 0 (a trusted clamp's f0
-  // is an output, in Cost(0, 0); a pinned clamp's has alpha_0 = w_r L / (S E0)).
-  const Matrix zero = problem_.ZeroField();
-  const double f0_gain = mcre.clamp == ClampModel::kTrusted ? 0.0
-                         : mcre.clamp == ClampModel::kPinned
-                             ? mcre.weights.reaction_weight / mcre.weights.force_weight
-                             : 1.0;
-  const Vector& f0 = data.Values("f0");
-  const Vector& fL = data.Values("fL");
-  double force_part = 0.0;
-  for (int j = 0; j <= data.num_steps(); ++j) {
-    // c_j h [alpha_0/2 f~0_j^2 + alpha/2 f~L_j^2], alpha_0 = f0_gain alpha
-    force_part += problem_.QuadratureWeight(j) * data.time_step * 0.5 * problem_.alpha() *
-                  (f0_gain * f0[j] * f0[j] + fL[j] * fL[j]);
-  }
-  rest_cost_ = problem_.Cost(zero, zero) + force_part;
-}
+    : McreObjective(
+          [&model, &data, mcre, theta, ends]() -> std::unique_ptr<StreamingCoupledProblem> {
+            assert(mcre.IsValid(nullptr));
+            return std::make_unique<McreProblem>(model, data, mcre.weights, mcre.reference_modulus,
+                                                 theta, ends, mcre.clamp);
+          },
+          inner, modulus_scale) {}
 
 std::unique_ptr<ModulusObjective> McreObjective::CloneForScan(double inner_tolerance) const {
   CoupledSolverOptions inner = inner_;
   inner.tolerance = inner_tolerance;
-  return std::make_unique<McreObjective>(model_, data_, mcre_, theta_, inner, modulus_scale_,
-                                         ends_);
+  return std::make_unique<McreObjective>(make_problem_, inner, modulus_scale_);
 }
 
 double McreObjective::ValleySpacing() {
   Matrix traces;
-  problem_.DataResponseTraces(&traces);
-  return PredictedValleySpacing(traces, problem_.TraceWeights(), problem_.time_step());
+  problem_->DataResponseTraces(&traces);
+  return PredictedValleySpacing(traces, problem_->TraceWeights(), problem_->time_step());
 }
 
 void McreObjective::SetWarmStart(const Matrix& start) {
-  assert((start.rows() == problem_.num_nodes() || start.rows() == problem_.num_traces()) &&
-         start.cols() == problem_.num_steps() + 1);
+  assert((start.rows() == problem_->num_nodes() || start.rows() == problem_->num_traces()) &&
+         start.cols() == problem_->num_steps() + 1);
   warm_start_ = start;
   warm_start_modulus_ = 0.0;
   previous_start_.resize(0, 0);
@@ -115,7 +104,7 @@ void McreObjective::SetWarmStart(const Matrix& start) {
 
 const ObjectiveEvaluation& McreObjective::EvaluateModulus(double modulus, bool gradient_requested) {
   assert(modulus > 0.0 && std::isfinite(modulus));
-  problem_.SetModulus(modulus);
+  problem_->SetModuli(Vector::Constant(problem_->num_zones(), modulus));
   const Matrix* initial = warm_start_.size() > 0 ? &warm_start_ : nullptr;
   if (initial != nullptr && previous_start_.size() > 0 &&
       previous_start_modulus_ != warm_start_modulus_) {
@@ -132,12 +121,12 @@ const ObjectiveEvaluation& McreObjective::EvaluateModulus(double modulus, bool g
 
 const ObjectiveEvaluation& McreObjective::EvaluateModuli(const Vector& zone_moduli,
                                                          bool gradient_requested) {
-  assert(zone_moduli.size() == problem_.num_zones() && zone_moduli.allFinite() &&
+  assert(zone_moduli.size() == problem_->num_zones() && zone_moduli.allFinite() &&
          zone_moduli.minCoeff() > 0.0);
   if (zone_moduli.minCoeff() == zone_moduli.maxCoeff()) {
     return EvaluateModulus(zone_moduli[0], gradient_requested);
   }
-  problem_.SetModuli(zone_moduli);
+  problem_->SetModuli(zone_moduli);
   // From the last usable solution: no line to extrapolate along in several dimensions.
   return Solve(-1.0, gradient_requested, warm_start_.size() > 0 ? &warm_start_ : nullptr);
 }
@@ -146,9 +135,9 @@ const ObjectiveEvaluation& McreObjective::Solve(double modulus, bool gradient_re
                                                 const Matrix* initial) {
   ObjectiveEvaluation record;
   record.modulus = modulus;
-  record.moduli = problem_.moduli();
+  record.moduli = problem_->moduli();
   record.gradient_requested = gradient_requested;
-  record.inner = SolveCoupled(inner_, &problem_, initial, &solution_);
+  record.inner = SolveCoupled(inner_, problem_.get(), initial, &solution_);
   record.usable = record.inner.IsSolutionUsable();
   if (record.usable) {
     record.cost = solution_.cost;

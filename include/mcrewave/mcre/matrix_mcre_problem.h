@@ -145,7 +145,10 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // J_rest = sum_j c_j h [1/2 F~_j^T diag(alpha) F~_j + 1/2 d~_j^T diag(beta) d~_j]
   // [J s]: the functional of the structure left at rest (U = W = 0, zero loads), which
   // satisfies the state equation at any moduli, so 0 <= e^2 <= J_rest.
-  double RestCost() const;
+  double RestCost() override;
+  // beta_k of H's rows (betas()), and H U of the data response (StreamingCoupledProblem).
+  Vector TraceWeights() const override { return betas_; }
+  void DataResponseTraces(Matrix* traces) override;
   // E_z,nom of every zone [Pa].
   Vector NominalModuli() const;
 

@@ -240,13 +240,13 @@ class McreProblem : public StreamingCoupledProblem {
   void StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
                     StreamingTotals* totals = nullptr) override;
 
-  // The weight beta_k [N/m or N m] of each trace row (0 for an end channel left out).
-  Vector TraceWeights() const;
-  // traces = H U of the direct sweep with W = 0 and the measured forces (the model
-  // driven by the data alone, at the current moduli), num_traces() x (m + 1): the
-  // predicted outputs whose valleys the global scan must resolve (valley_spacing.h).
-  // One direct sweep, O(n) memory (no field stored); resizes traces.
-  void DataResponseTraces(Matrix* traces);
+  // beta_k [N/m or N m] of the trace rows u0, uL and the interior sensors (0 for an end
+  // channel left out), and their data response (StreamingCoupledProblem).
+  Vector TraceWeights() const override;
+  void DataResponseTraces(Matrix* traces) override;
+  // J_rest = Cost(0, 0) + sum_j c_j h [alpha_0/2 f~0_j^2 + alpha/2 f~L_j^2] [J s], alpha_0
+  // of the clamp (0 trusted: f0 is an output, in Cost(0, 0)). Allocates one zero field.
+  double RestCost() override;
 
   // Number of factorisations of the integrator's iteration matrix since construction
   // (the constructor's SetModulus included): one per change of modulus.
@@ -323,6 +323,7 @@ class McreProblem : public StreamingCoupledProblem {
   // when the clamp is trusted, 1/alpha_0 and 1 when it is pinned; and alpha / alpha_0
   // of the node-0 force term of the cost and of P (1, 0, alpha / alpha_0).
   double inverse_alpha0_, force0_gain_, force0_penalty_gain_;
+  double rest_force0_gain_;  // alpha_0 / alpha of RestCost's f0 term
   // Trusted clamp: the index of the reaction row in sensor_rows_, else -1.
   int reaction_row_ = -1;
   Vector moduli_;             // E_z [Pa]

@@ -12,6 +12,7 @@
 // (CoupledSolution::WarmStart()), extrapolated the same way.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -98,11 +99,20 @@ struct ObjectiveEvaluation {
 
 class McreObjective : public ModulusObjective {
  public:
+  // Makes the coupled problem the objective solves: a new one per call (the objective's
+  // and each CloneForScan's own).
+  using ProblemFactory = std::function<std::unique_ptr<StreamingCoupledProblem>()>;
+
+  // The objective over the problems make_problem makes, whatever the structure.
+  // modulus_scale [Pa] is E per unit of x. Preconditions: make_problem gives a problem,
+  // inner.IsValid(), modulus_scale > 0.
+  McreObjective(ProblemFactory make_problem, const CoupledSolverOptions& inner,
+                double modulus_scale);
+  // The built-in bar: an McreProblem on model and data with mcre's weights and clamp.
   // Keeps references to model and data: both must outlive the objective.
-  // modulus_scale [Pa] is E per unit of x. Preconditions: mcre.IsValid(),
-  // inner.IsValid(), theta in [0, 1], modulus_scale > 0, data.num_steps() >= 1.
-  // ends: the end displacement channels in use (data.channels); the interior sensors
-  // are those of data.
+  // Preconditions: mcre.IsValid(), inner.IsValid(), theta in [0, 1], modulus_scale > 0,
+  // data.num_steps() >= 1. ends: the end displacement channels in use (data.channels);
+  // the interior sensors are those of data.
   McreObjective(const BarModel& model, const ChannelSet& data, const McreOptions& mcre,
                 double theta, const CoupledSolverOptions& inner, double modulus_scale,
                 EndDisplacementChannels ends = {});
@@ -145,7 +155,7 @@ class McreObjective : public ModulusObjective {
   // The coupled solution of the last evaluation (valid when it was usable).
   const CoupledSolution& last_solution() const { return solution_; }
   // Sweeps (direct + retrograde) of every evaluation.
-  long sweeps() const override { return problem_.sweep_count(); }
+  long sweeps() const override { return problem_->sweep_count(); }
   // From the traces of the model driven by the measured forces at the problem's
   // current moduli (McreProblem::DataResponseTraces), weighted by beta_k: one sweep.
   double ValleySpacing() override;
@@ -159,19 +169,15 @@ class McreObjective : public ModulusObjective {
   // Largest |t| of the extrapolated warm start (above: the last solution alone).
   static constexpr double kMaxExtrapolation = 2.0;
 
-  McreProblem& problem() { return problem_; }
+  StreamingCoupledProblem& problem() { return *problem_; }
 
  private:
   // Solves at the problem's moduli from `initial` (nullable) and records the evaluation;
   // modulus is the common modulus, or -1 when the zones differ.
   const ObjectiveEvaluation& Solve(double modulus, bool gradient_requested, const Matrix* initial);
 
-  const BarModel& model_;
-  const ChannelSet& data_;
-  McreOptions mcre_;
-  double theta_;
-  EndDisplacementChannels ends_;
-  McreProblem problem_;
+  ProblemFactory make_problem_;
+  std::unique_ptr<StreamingCoupledProblem> problem_;
   CoupledSolverOptions inner_;
   double modulus_scale_;
   double rest_cost_ = 0.0;

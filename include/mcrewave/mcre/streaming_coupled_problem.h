@@ -65,6 +65,18 @@ class StreamingCoupledProblem : public CoupledProblem {
   // rather than from a reversed recursion whose round-off drifted; nothing to do for a
   // problem that always uses them.
   virtual void UseCheckpoints() = 0;
+
+  // --- What the outer objective needs beside the solves (mcre/objective.h) ---
+  // J_rest [J s]: the functional of the structure left at rest (U = W = 0, zero loads),
+  // which satisfies the state equation at any moduli, so 0 <= e^2 <= J_rest.
+  virtual double RestCost() = 0;
+  // The weight beta_k of each trace row (0 for a row left out).
+  virtual Vector TraceWeights() const = 0;
+  // traces = H U of the direct sweep with W = 0 and the measured loads (the structure
+  // driven by the data alone, at the current moduli), num_traces() x (m + 1): the
+  // predicted outputs whose valleys a global scan must resolve (optim/valley_spacing.h).
+  // One direct sweep, its state only (no field stored); resizes traces.
+  virtual void DataResponseTraces(Matrix* traces) = 0;
 };
 
 }  // namespace mcrewave
