@@ -14,7 +14,7 @@
 // over the displacement channels / SNR, over the strain channels / SNR, and RMS(F) /
 // SNR for the load.
 //
-// Identification: MatrixZoneObjective (p_z = log(E_z / 200 GPa)) minimised by NLopt
+// Identification: ZoneMcreObjective (p_z = log(E_z / 200 GPa)) minimised by NLopt
 // L-BFGS within [100, 400] GPa from the nominal 200 GPa in both zones, CG inner solves
 // to 1e-8 warm-started, the default weights (w_u = 0.01, w_f = 1, w_e = 0.01).
 //
@@ -44,7 +44,7 @@
 #include "mcrewave/app/matrix_identification_run.h"
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
-#include "mcrewave/mcre/matrix_zone_objective.h"
+#include "mcrewave/mcre/objective.h"
 
 namespace {
 
@@ -85,10 +85,13 @@ void Identify(const MatrixModelData& coarse, const ChannelSet& truth, Run* run) 
   const auto start = std::chrono::steady_clock::now();
   ChannelSet data = truth;
   AddMatrixModelNoise(coarse, run->snr, run->seed, &data);
-  MatrixMcreProblem problem(coarse, data, McreWeights(), kNominal, 0.5);
+  McreOptions mcre;
+  mcre.weights = McreWeights();
+  mcre.reference_modulus = kNominal;
   CoupledSolverOptions inner;
   inner.tolerance = 1e-8;
-  MatrixZoneObjective objective(&problem, inner);
+  McreObjective mcre_objective = MatrixMcreObjective(coarse, data, mcre, 0.5, inner);
+  ZoneMcreObjective objective(&mcre_objective, coarse.NominalModuli());
   BoundedMinimizerOptions options;
   const double low = std::log(0.5), high = std::log(2.0);
   const BoundedMinimizerSummary summary =

@@ -11,7 +11,7 @@
 
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
-#include "mcrewave/mcre/matrix_zone_objective.h"
+#include "mcrewave/mcre/objective.h"
 #include "test_problems.h"
 
 namespace mcrewave {
@@ -165,19 +165,25 @@ TEST(MatrixStreamingTest, AutoStreamsWhenTheFieldsDoNotFit) {
   EXPECT_NEAR(streamed.cost, stored.cost, 3e-14 * stored.cost);
 }
 
-// MatrixZoneObjective evaluates e^2 / J_rest and its gradient in p = log(E / E_nom)
-// alike with either solver, the streaming one warm-started from its traces.
+// ZoneMcreObjective on a matrix model evaluates e^2 / J_rest and its gradient in
+// p = log(E / E_nom) alike with either solver, the streaming one warm-started from its
+// traces.
 TEST(MatrixStreamingTest, TheZoneObjectiveEvaluatesAlikeWithEitherSolver) {
   const MatrixModelData lattice = SupportedLattice();
   const ChannelSet data = SupportedLatticeHistories(lattice);
-  MatrixMcreProblem stored_problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5,
-                                   Factorization::kSparse, ClampModel::kTrusted);
-  MatrixMcreProblem streamed_problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5,
-                                     Factorization::kSparse, ClampModel::kTrusted);
-  MatrixZoneObjective stored(&stored_problem,
-                             MatrixStreamingOptions(CoupledSolverType::kConjugateGradient));
-  MatrixZoneObjective streamed(
-      &streamed_problem, MatrixStreamingOptions(CoupledSolverType::kStreamingConjugateGradient));
+  McreOptions mcre;
+  mcre.weights = Weights(0.01, 1.0);
+  mcre.reference_modulus = 2e11;
+  mcre.clamp = ClampModel::kTrusted;
+  McreObjective stored_mcre = MatrixMcreObjective(
+      lattice, data, mcre, 0.5, MatrixStreamingOptions(CoupledSolverType::kConjugateGradient),
+      Factorization::kSparse);
+  McreObjective streamed_mcre =
+      MatrixMcreObjective(lattice, data, mcre, 0.5,
+                          MatrixStreamingOptions(CoupledSolverType::kStreamingConjugateGradient),
+                          Factorization::kSparse);
+  ZoneMcreObjective stored(&stored_mcre, lattice.NominalModuli());
+  ZoneMcreObjective streamed(&streamed_mcre, lattice.NominalModuli());
   for (const double scale : {-0.1, -0.08}) {
     const double p[2] = {scale, 0.5 * scale};
     double stored_cost = 0.0, streamed_cost = 0.0, stored_gradient[2], streamed_gradient[2];
@@ -190,8 +196,8 @@ TEST(MatrixStreamingTest, TheZoneObjectiveEvaluatesAlikeWithEitherSolver) {
       EXPECT_NEAR(streamed_gradient[z], stored_gradient[z], 5e-9 * std::abs(stored_gradient[z]));
     }
   }
-  EXPECT_FALSE(streamed.last_solution().has_fields());
-  EXPECT_GT(streamed.last_solution().traces.size(), 0);
+  EXPECT_FALSE(streamed_mcre.last_solution().has_fields());
+  EXPECT_GT(streamed_mcre.last_solution().traces.size(), 0);
 }
 
 // The model's outputs and its supports' forces come from one direct sweep keeping its

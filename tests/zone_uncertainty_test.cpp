@@ -13,7 +13,7 @@
 
 #include "mcrewave/core/random.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
-#include "mcrewave/mcre/matrix_zone_objective.h"
+#include "mcrewave/mcre/objective.h"
 #include "test_problems.h"
 
 namespace mcrewave {
@@ -35,9 +35,8 @@ struct TwoZoneBarAsMatrices {
   }
   // The moduli minimising e^2 of `set`, from p = 0.
   Vector Identify(const ChannelSet& set) const {
-    MatrixMcreProblem problem(matrices, set, mcre.weights, mcre.reference_modulus, 0.5,
-                              Factorization::kAutomatic, mcre.clamp);
-    MatrixZoneObjective objective(&problem, inner);
+    McreObjective mcre_objective = MatrixMcreObjective(matrices, set, mcre, 0.5, inner);
+    ZoneMcreObjective objective(&mcre_objective, matrices.NominalModuli());
     BoundedMinimizerOptions options;
     options.step_tolerance = 1e-12;
     options.function_tolerance = 0.0;

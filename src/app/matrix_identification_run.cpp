@@ -14,7 +14,7 @@
 #include "mcrewave/data/resample.h"
 #include "mcrewave/least_squares/matrix_output_error_objective.h"
 #include "mcrewave/mcre/coupled_solver.h"
-#include "mcrewave/mcre/matrix_zone_objective.h"
+#include "mcrewave/mcre/objective.h"
 
 namespace mcrewave {
 namespace {
@@ -181,13 +181,17 @@ double RootMeanSquareOfRows(const Matrix& rows) {
   return rows.size() > 0 ? std::sqrt(rows.squaredNorm() / static_cast<double>(rows.size())) : 0.0;
 }
 
-// Records every evaluation of a zone objective (MatrixZoneObjective,
-// MatrixOutputErrorObjective) and logs a progress line naming its cost.
+// Records every evaluation of a zone objective (ZoneMcreObjective,
+// MatrixOutputErrorObjective) and logs a progress line naming its cost; with
+// failures_only, only the failed ones (ZoneMcreObjective logs its usable evaluations).
 class RecordingObjective : public FirstOrderObjective {
  public:
   RecordingObjective(LogModuliObjective* objective, std::vector<MatrixEvaluation>* records,
-                     const char* cost_name)
-      : objective_(objective), records_(records), cost_name_(cost_name) {}
+                     const char* cost_name, bool failures_only = false)
+      : objective_(objective),
+        records_(records),
+        cost_name_(cost_name),
+        failures_only_(failures_only) {}
   int num_parameters() const override { return objective_->num_parameters(); }
   bool Evaluate(const double* p, double* cost, double* gradient) override {
     MatrixEvaluation record;
@@ -198,6 +202,7 @@ class RecordingObjective : public FirstOrderObjective {
       record.gradient_norm = Eigen::Map<const Vector>(gradient, num_parameters()).norm();
     }
     records_->push_back(record);
+    if (record.usable && failures_only_) return true;
     std::string moduli;
     for (int z = 0; z < record.moduli.size(); ++z) {
       moduli += (z == 0 ? "" : ", ") + fmt::format("{:.6g}", record.moduli[z] * 1e-9);
@@ -213,6 +218,7 @@ class RecordingObjective : public FirstOrderObjective {
   LogModuliObjective* objective_;
   std::vector<MatrixEvaluation>* records_;
   const char* cost_name_;
+  bool failures_only_;
 };
 
 // e^2 and the zone and dof maps of a usable coupled solution at the problem's moduli:
@@ -251,7 +257,7 @@ bool SolveAt(const Vector& moduli, const CoupledSolverOptions& inner, MatrixMcre
 // identified moduli, the objective's or one solved into *storage (null when there is
 // none usable: a failure goes to run->failure).
 const CoupledSolution* MapsAtIdentifiedAndNominal(const Config& config,
-                                                  const MatrixZoneObjective& objective,
+                                                  const McreObjective& objective,
                                                   MatrixMcreProblem* problem,
                                                   CoupledSolution* storage,
                                                   MatrixIdentificationRun* run) {
@@ -666,12 +672,13 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return run;
   }
-  MatrixMcreProblem problem(model, run.data, config.mcre.weights, config.mcre.reference_modulus,
-                            config.time.theta, Factorization::kAutomatic, config.mcre.clamp);
+  McreObjective mcre_objective =
+      MatrixMcreObjective(model, run.data, config.mcre, config.time.theta, config.inner);
+  auto& problem = static_cast<MatrixMcreProblem&>(mcre_objective.problem());
   run.nominal_moduli = problem.NominalModuli();
-  run.rest_cost = problem.RestCost();
-  MatrixZoneObjective objective(&problem, config.inner);
-  RecordingObjective recorder(&objective, &run.evaluations, "e^2");
+  run.rest_cost = mcre_objective.rest_cost();
+  ZoneMcreObjective objective(&mcre_objective, run.nominal_moduli);
+  RecordingObjective recorder(&objective, &run.evaluations, "e^2", true);
   const auto zones = static_cast<std::size_t>(model.zones.size());
   std::vector<double> lower, upper;
   ZoneParameterBounds(config, run.nominal_moduli, &lower, &upper);
@@ -697,7 +704,7 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
   //    at the nominal moduli; 4. the uncertainty of the identified moduli.
   CoupledSolution storage;
   const CoupledSolution* identified =
-      MapsAtIdentifiedAndNominal(config, objective, &problem, &storage, &run);
+      MapsAtIdentifiedAndNominal(config, mcre_objective, &problem, &storage, &run);
   if (identified != nullptr) {
     run.noise = MatrixNoiseLevels(config, measurements, &run.noise_source);
     run.uncertainty =

@@ -13,34 +13,6 @@
 
 namespace mcrewave {
 
-ZoneMcreObjective::ZoneMcreObjective(McreObjective* objective, double modulus_scale)
-    : LogModuliObjective(Vector::Constant(objective->problem().num_zones(), modulus_scale)),
-      objective_(objective) {}
-
-double ZoneMcreObjective::cost_scale() const { return objective_->cost_scale(); }
-
-bool ZoneMcreObjective::ModuliCost(const Vector& moduli, double* cost, Vector* gradient,
-                                   std::string* why) {
-  const ObjectiveEvaluation& record = objective_->EvaluateModuli(moduli, gradient != nullptr);
-  if (!record.usable) {
-    *why = "the coupled solve at the zone moduli of evaluation " + std::to_string(evaluations()) +
-           " is not usable: " + record.inner.BriefReport() + " (" + record.inner.message + ")";
-    return false;
-  }
-  *cost = record.cost;
-  if (gradient != nullptr) *gradient = record.cost_gradients;
-  inner_report_ = record.inner.BriefReport();
-  return true;
-}
-
-void ZoneMcreObjective::OnEvaluated(const Vector& moduli, double cost, double gradient_norm) {
-  spdlog::info(
-      "zones evaluation {}: e^2 / J_rest = {:.10g}, |grad|_inf = {:.3g}, E in [{:.6g}, "
-      "{:.6g}] GPa; inner {}",
-      evaluations(), cost, gradient_norm, moduli.minCoeff() * 1e-9, moduli.maxCoeff() * 1e-9,
-      inner_report_);
-}
-
 bool ZoneIdentificationOptions::IsValid(std::string* error) const {
   if (!minimizer.IsValid(error) || !regularization.IsValid(error)) return false;
   if (noise_samples < 1 || noise_samples > 1000) {

@@ -81,6 +81,18 @@ McreObjective::McreObjective(const BarModel& model, const ChannelSet& data, cons
           },
           inner, modulus_scale) {}
 
+McreObjective MatrixMcreObjective(const MatrixModelData& model, const ChannelSet& data,
+                                  const McreOptions& mcre, double theta,
+                                  const CoupledSolverOptions& inner, Factorization factorization) {
+  assert(mcre.IsValid(nullptr));
+  return McreObjective(
+      [&model, &data, mcre, theta, factorization]() -> std::unique_ptr<StreamingCoupledProblem> {
+        return std::make_unique<MatrixMcreProblem>(
+            model, data, mcre.weights, mcre.reference_modulus, theta, factorization, mcre.clamp);
+      },
+      inner, mcre.reference_modulus);
+}
+
 std::unique_ptr<ModulusObjective> McreObjective::CloneForScan(double inner_tolerance) const {
   CoupledSolverOptions inner = inner_;
   inner.tolerance = inner_tolerance;
@@ -185,6 +197,39 @@ bool McreObjective::Evaluate(const double* parameters, double* cost, double* gra
     gradient[0] = record.cost_gradient * modulus_scale_ / cost_scale();
   }
   return true;
+}
+
+ZoneMcreObjective::ZoneMcreObjective(McreObjective* objective, const Vector& reference_moduli)
+    : LogModuliObjective(reference_moduli), objective_(objective) {
+  assert(reference_moduli.size() == objective->problem().num_zones());
+}
+
+ZoneMcreObjective::ZoneMcreObjective(McreObjective* objective, double modulus_scale)
+    : ZoneMcreObjective(objective,
+                        Vector::Constant(objective->problem().num_zones(), modulus_scale)) {}
+
+double ZoneMcreObjective::cost_scale() const { return objective_->cost_scale(); }
+
+bool ZoneMcreObjective::ModuliCost(const Vector& moduli, double* cost, Vector* gradient,
+                                   std::string* why) {
+  const ObjectiveEvaluation& record = objective_->EvaluateModuli(moduli, gradient != nullptr);
+  if (!record.usable) {
+    *why = "the coupled solve at the zone moduli of evaluation " + std::to_string(evaluations()) +
+           " is not usable: " + record.inner.BriefReport() + " (" + record.inner.message + ")";
+    return false;
+  }
+  *cost = record.cost;
+  if (gradient != nullptr) *gradient = record.cost_gradients;
+  inner_report_ = record.inner.BriefReport();
+  return true;
+}
+
+void ZoneMcreObjective::OnEvaluated(const Vector& moduli, double cost, double gradient_norm) {
+  spdlog::info(
+      "zones evaluation {}: e^2 / J_rest = {:.10g}, |grad|_inf = {:.3g}, E in [{:.6g}, "
+      "{:.6g}] GPa; inner {}",
+      evaluations(), cost, gradient_norm, moduli.minCoeff() * 1e-9, moduli.maxCoeff() * 1e-9,
+      inner_report_);
 }
 
 }  // namespace mcrewave

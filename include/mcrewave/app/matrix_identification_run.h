@@ -11,7 +11,7 @@
 //      its nominal moduli), every load channel driven by the load: history, on the
 //      same grid and theta, white noise per quantity at data.snr (AddMatrixModelNoise);
 //   3. RunMatrixIdentification: the pre-filter of prefilter: on every channel, then
-//      every zone modulus at once, p_z = log(E_z / E_z,nom) (MatrixZoneObjective), by
+//      every zone modulus at once, p_z = log(E_z / E_z,nom) (ZoneMcreObjective), by
 //      the optimiser of zone_identification: from the nominal moduli within
 //      [outer.lower_bound, outer.upper_bound] Pa in every zone, inner solves by
 //      inner:; no jump penalty (matrices do not say which zones are neighbours).

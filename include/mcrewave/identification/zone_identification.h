@@ -31,25 +31,6 @@
 
 namespace mcrewave {
 
-// McreObjective::EvaluateModuli seen as a function of p_z = log(E_z / modulus_scale)
-// (optim/log_moduli_objective.h), J_scale = McreObjective::cost_scale(). Logs one line
-// per usable evaluation.
-class ZoneMcreObjective : public LogModuliObjective {
- public:
-  // objective must outlive this adapter; its model has the identification's zones.
-  ZoneMcreObjective(McreObjective* objective, double modulus_scale);
-
-  double cost_scale() const override;
-
- protected:
-  bool ModuliCost(const Vector& moduli, double* cost, Vector* gradient, std::string* why) override;
-  void OnEvaluated(const Vector& moduli, double cost, double gradient_norm) override;
-
- private:
-  McreObjective* objective_;
-  std::string inner_report_;  // the last usable solve's BriefReport()
-};
-
 // The `zone_identification:` section.
 struct ZoneIdentificationOptions {
   BoundedMinimizerOptions minimizer;

@@ -1,5 +1,5 @@
 // Output-error least squares on a structure given by matrices (docs/formulation.md
-// section 8, docs/matrix_models.md section 10), the comparator of MatrixZoneObjective:
+// section 8, docs/matrix_models.md section 10), the comparator of ZoneMcreObjective:
 // the model M U'' + K(E) U = G F~, K(E) = sum_z (E_z / E_z,nom) K_z, driven from rest
 // by the measured loads alone, its outputs H U against the measured sensor channels and
 // (with supports) the supports' reactions r_s against their measured forces,
@@ -38,7 +38,7 @@
 // One sweep per evaluation without the gradient, 1 + Z with it; no allocation in the
 // time loop (every scratch is sized in the constructor).
 //
-// Seen by the optimisers as MatrixZoneObjective is (optim/log_moduli_objective.h): as a
+// Seen by the optimisers as ZoneMcreObjective is (optim/log_moduli_objective.h): as a
 // function of p_z = log(E_z / E_z,nom), with J_scale = J_rest (J with every prediction
 // 0).
 #pragma once

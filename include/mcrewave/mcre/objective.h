@@ -19,8 +19,10 @@
 
 #include "mcrewave/data/measurement.h"
 #include "mcrewave/mcre/coupled_solver.h"
+#include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/mcre/mcre_problem.h"
 #include "mcrewave/model/bar_model.h"
+#include "mcrewave/optim/log_moduli_objective.h"
 #include "mcrewave/optim/modulus_objective.h"
 
 namespace mcrewave {
@@ -191,6 +193,38 @@ class McreObjective : public ModulusObjective {
   double previous_start_modulus_ = 0.0;  // E0 [Pa]
   Matrix initial_;                       // the extrapolated W^(0)
   std::string error_message_;
+};
+
+// The objective of a structure given by matrices: a MatrixMcreProblem on model and data
+// with mcre's weights and E0, its supports treated as mcre.clamp says, E per unit of x
+// mcre.reference_modulus. Keeps references to model and data: both must outlive it.
+// Preconditions: those of MatrixMcreProblem and McreObjective.
+McreObjective MatrixMcreObjective(const MatrixModelData& model, const ChannelSet& data,
+                                  const McreOptions& mcre, double theta,
+                                  const CoupledSolverOptions& inner,
+                                  Factorization factorization = Factorization::kAutomatic);
+
+// McreObjective::EvaluateModuli seen as a function of p_z = log(E_z / E_z,ref)
+// (optim/log_moduli_objective.h), J_scale = McreObjective::cost_scale(), whatever the
+// structure: the bar's zones from the homogeneous E* (E_z,ref = E*), a structure given
+// by matrices from its nominal moduli. Logs one line per usable evaluation.
+class ZoneMcreObjective : public LogModuliObjective {
+ public:
+  // objective must outlive this adapter; its problem has the identification's zones,
+  // one reference modulus E_z,ref [Pa] each (positive).
+  ZoneMcreObjective(McreObjective* objective, const Vector& reference_moduli);
+  // Every zone from the same E_ref = modulus_scale [Pa].
+  ZoneMcreObjective(McreObjective* objective, double modulus_scale);
+
+  double cost_scale() const override;
+
+ protected:
+  bool ModuliCost(const Vector& moduli, double* cost, Vector* gradient, std::string* why) override;
+  void OnEvaluated(const Vector& moduli, double cost, double gradient_norm) override;
+
+ private:
+  McreObjective* objective_;
+  std::string inner_report_;  // the last usable solve's BriefReport()
 };
 
 }  // namespace mcrewave
