@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "identify_binary.h"
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/matrix_identification_run.h"
 #include "mcrewave/core/file_util.h"
@@ -404,7 +405,7 @@ TEST(StudyTest, CostCurvesHaveTheirMinimaWhereTheIdentificationFindsThem) {
   std::filesystem::create_directories(parent + "/plate");
   WriteFileAtomically(parent + "/plate/summary.md",
                       "# The plate\n\ntext\n\n## Runs\n\n```\n# not a heading\n```\n");
-  const std::string gathered = ReadText(WriteStudiesReadme(parent));
+  const std::string gathered = testing::ReadText(WriteStudiesReadme(parent));
   EXPECT_NE(gathered.find("\n## The plate (`plate/`)\n"), std::string::npos) << gathered;
   EXPECT_NE(gathered.find("\n### Runs\n"), std::string::npos) << gathered;
   EXPECT_NE(gathered.find("\n# not a heading\n"), std::string::npos) << gathered;
