@@ -131,6 +131,9 @@ TEST(MatrixIdentificationRunTest, TheBarAsMatricesIdentifiesTheBuiltInBarsModulu
   EXPECT_LT(summary["cost"].as<double>(), summary["nominal_cost"].as<double>());
   EXPECT_LT(summary["nominal_cost"].as<double>(), summary["cost_scale"].as<double>());
   ExpectTheBarsElementMap(dir + "/bar/error_map.csv", dir + "/matrices/error_map.csv");
+  EXPECT_EQ(summary["error_map"]["peak_element"].as<int>(),
+            YAML::LoadFile(dir + "/bar/summary.yaml")["error_map"]["peak_element"].as<int>());
+  EXPECT_GT(summary["error_map"]["nominal_peak_fraction"].as<double>(), 0.0);
 }
 
 // The quick bar exported with its clamp as a support (dof 0, channels f0 and u0) under

@@ -1039,6 +1039,20 @@ void MatrixOptimizerYaml(const MatrixIdentificationRun& run, const std::string& 
   yaml->Number(1, "scaled_cost", run.outer.cost, cost + " / cost_scale at the identified moduli");
 }
 
+// The error_map: block of a matrix run with an element map (error_map.csv): the element
+// of the largest share at the identified and at the nominal moduli.
+void MatrixElementMapYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) {
+  if (run.element_map.share.size() == 0 || run.nominal_element_map.share.size() == 0) return;
+  const int peak = run.element_map.PeakElement();
+  const int nominal_peak = run.nominal_element_map.PeakElement();
+  yaml->Line(0, "error_map", "", "the constitutive gap by element (error_map.csv)");
+  yaml->Integer(1, "peak_element", peak, "element of the largest share at the identified moduli");
+  yaml->Number(1, "peak_fraction", run.element_map.Fractions()[peak],
+               "its share of the constitutive gap");
+  yaml->Integer(1, "nominal_peak_element", nominal_peak, "the same at the nominal moduli");
+  yaml->Number(1, "nominal_peak_fraction", run.nominal_element_map.Fractions()[nominal_peak]);
+}
+
 // summary.yaml of a matrix run by least squares: MatrixSummaryYaml's layout with J [s]
 // for e^2, the misfit levels for the error map, and no inner solver.
 std::string MatrixLeastSquaresSummaryYaml(const MatrixIdentificationRun& run,
@@ -1105,6 +1119,7 @@ std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& 
   yaml.Number(0, "nominal_cost", run.nominal_cost, "[J s] e^2 at the nominal moduli");
   yaml.Number(0, "cost_scale", run.rest_cost,
               "[J s] J_rest, e^2 of the structure left at rest (0 <= e^2 <= J_rest)");
+  MatrixElementMapYaml(run, &yaml);
   MatrixOptimizerYaml(run, "e^2", &yaml);
   yaml.Line(0, "inner", "");
   std::string inner_comment;

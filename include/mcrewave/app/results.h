@@ -67,7 +67,8 @@ std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
 //   summary.yaml        the model (manifest, dofs, zones, channels), the data, every
 //                       zone's nominal, identified and (synthetic data) truth modulus
 //                       and its share of the constitutive gap at the nominal and the
-//                       identified moduli, e^2 and J_rest [J s], the optimiser, the
+//                       identified moduli, e^2 and J_rest [J s], with an element map
+//                       its peak element and fraction at both (error_map:), the optimiser, the
 //                       inner solver that ran (inner.method), the pre-filter, the
 //                       resolved config
 //   zones.csv           the same per zone
