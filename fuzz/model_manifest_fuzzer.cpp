@@ -4,9 +4,9 @@
 // ReadMatrixModel takes a path, so the input is written as model.yaml into a
 // temporary folder made once per process, next to small Matrix Market and channel
 // names files it may name (a 3-dof model: kFiles below, valid ones and some that fail
-// a check). The input is the manifest's text. InputError is the expected answer to bad input;
-// anything else escaping (another exception, a crash, a sanitizer report, a hang)
-// is a defect. An accepted manifest must give a checked 3-dof model.
+// a check, element files among them). The input is the manifest's text. InputError is the expected
+// answer to bad input; anything else escaping (another exception, a crash, a sanitizer report, a
+// hang) is a defect. An accepted manifest must give a checked 3-dof model.
 #include <stdlib.h>
 #include <unistd.h>
 
@@ -46,7 +46,14 @@ constexpr File kFiles[] = {
     {"load_channels.txt", "# loads\nfa\n\n  fb \n"},
     {"H.mtx", "%%MatrixMarket matrix coordinate real general\n2 3 3\n1 1 1\n2 2 -10\n2 3 10\n"},
     {"sensor_channels.txt", "ua\r\neb\r\n"},
+    // Element blocks of zones a and b (they sum to K_a and K_b) and their positions.
+    {"element_dofs.csv", "# zone, dofs\na, 0\na, 0, 1\n\na, 1, 2\nb, 0\n"},
+    {"element_stiffness.csv", "1\n1, -1, -1, 1\n 1 , -1, -1, 1\n1\n"},
+    {"element_positions.csv", "0, 0\n0.5, 0\n1.5, 0\n0, 1\n"},
     // Each fails one check of ReadMatrixModel.
+    {"element_dofs_bad.csv", "a, 0\na, 0, 3\na, 1, 2\nb, 0\n"},
+    {"element_stiffness_asymmetric.csv", "1\n1, -1, -2, 1\n1, -1, -1, 1\n1\n"},
+    {"element_stiffness_misfit.csv", "2\n1, -1, -1, 1\n1, -1, -1, 1\n1\n"},
     {"K_4.mtx", "%%MatrixMarket matrix coordinate pattern symmetric\n4 4 1\n4 4\n"},
     {"K_skew.mtx", "%%MatrixMarket matrix coordinate real general\n3 3 2\n1 2 1\n2 1 -1\n"},
     {"M_singular.mtx", "%%MatrixMarket matrix coordinate real symmetric\n3 3 2\n1 1 1\n2 2 1\n"},
@@ -81,6 +88,13 @@ bool Usable(const mcrewave::MatrixModelData& model) {
   }
   for (const mcrewave::MatrixModelSensor& sensor : model.sensors) {
     usable = usable && !sensor.channel.empty() && sensor.row.rows() == 1 && sensor.row.cols() == n;
+  }
+  for (const mcrewave::MatrixModelElement& element : model.elements) {
+    const auto k = static_cast<Eigen::Index>(element.dofs.size());
+    usable = usable && k > 0 && element.stiffness.rows() == k && element.stiffness.cols() == k &&
+             element.stiffness.allFinite() && element.zone >= 0 &&
+             element.zone < static_cast<int>(model.zones.size()) && element.position.size() <= 3;
+    for (const int dof : element.dofs) usable = usable && dof >= 0 && dof < n;
   }
   return usable;
 }

@@ -218,10 +218,14 @@ TEST(MatrixExportTest, AbsolutePathsInAManifestAreUsedAsTheyAre) {
   std::ifstream written(WriteMatrixModel(files, data));
   std::stringstream text;
   text << written.rdbuf();
-  // The manifest in another folder: the zones', loads' and sensors' files named by their
-  // absolute paths, the mass by a name relative to that folder (a copy of M.mtx there).
+  // The manifest in another folder: the zones', loads', sensors' and elements' files named
+  // by their absolute paths, the mass by a name relative to that folder (a copy of M.mtx
+  // there).
   const std::string manifest_text = std::regex_replace(
-      text.str(), std::regex("(K_|load_|sensor_)([A-Za-z0-9_.]+\\.mtx)"), files + "/$1$2");
+      text.str(), std::regex("(K_|load_|sensor_|element_)([A-Za-z0-9_.]+\\.(mtx|csv))"),
+      files + "/$1$2");
+  ASSERT_NE(manifest_text.find("dofs: " + files + "/element_dofs.csv"), std::string::npos)
+      << manifest_text;
   ASSERT_NE(manifest_text.find("stiffness: " + files + "/K_zone0.mtx"), std::string::npos)
       << manifest_text;
   ASSERT_NE(manifest_text.find("row: " + files + "/sensor_e_at_0.65.mtx"), std::string::npos)
@@ -245,6 +249,10 @@ TEST(MatrixExportTest, AbsolutePathsInAManifestAreUsedAsTheyAre) {
   ASSERT_EQ(back.sensors.size(), data.sensors.size());
   for (std::size_t i = 0; i < data.sensors.size(); ++i) {
     EXPECT_EQ(MaxDifference(back.sensors[i].row, data.sensors[i].row), 0.0) << i;
+  }
+  ASSERT_EQ(back.elements.size(), data.elements.size());
+  for (std::size_t e = 0; e < data.elements.size(); ++e) {
+    EXPECT_EQ(back.elements[e].stiffness, data.elements[e].stiffness) << e;
   }
 }
 

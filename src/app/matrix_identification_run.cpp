@@ -14,6 +14,7 @@
 #include "mcrewave/data/resample.h"
 #include "mcrewave/least_squares/matrix_output_error_objective.h"
 #include "mcrewave/mcre/coupled_solver.h"
+#include "mcrewave/mcre/element_error_map.h"
 #include "mcrewave/mcre/objective.h"
 
 namespace mcrewave {
@@ -251,16 +252,22 @@ bool SolveAt(const Vector& moduli, const CoupledSolverOptions& inner, MatrixMcre
   return true;
 }
 
+// The element map of a usable coupled solution at `moduli` (mcre/element_error_map.h):
+// empty when the model has no element blocks or the solution no fields (streaming).
+ErrorMap ElementMapOf(const MatrixModelData& model, const Vector& moduli,
+                      const CoupledSolution& solution, double time_step) {
+  if (model.elements.empty() || !solution.has_fields()) return ErrorMap();
+  return ComputeElementErrorMap(model, moduli, solution.retrograde, time_step);
+}
+
 // Step 3 of RunMatrixIdentification: the error maps and the model's outputs at the
 // identified moduli (from the last evaluation's solve when it was there, as it usually
 // is), then the maps at the nominal moduli. Returns the coupled solution at the
 // identified moduli, the objective's or one solved into *storage (null when there is
 // none usable: a failure goes to run->failure).
-const CoupledSolution* MapsAtIdentifiedAndNominal(const Config& config,
-                                                  const McreObjective& objective,
-                                                  MatrixMcreProblem* problem,
-                                                  CoupledSolution* storage,
-                                                  MatrixIdentificationRun* run) {
+const CoupledSolution* MapsAtIdentifiedAndNominal(
+    const Config& config, const MatrixModelData& model, const McreObjective& objective,
+    MatrixMcreProblem* problem, CoupledSolution* storage, MatrixIdentificationRun* run) {
   const CoupledSolution* identified = nullptr;
   std::string why;
   if (run->identified_moduli.size() > 0) {
@@ -274,12 +281,18 @@ const CoupledSolution* MapsAtIdentifiedAndNominal(const Config& config,
     } else if (run->failure.empty()) {
       run->failure = "at the identified moduli, " + why;
     }
+    if (identified != nullptr) {
+      run->element_map =
+          ElementMapOf(model, run->identified_moduli, *identified, problem->time_step());
+    }
     run->model_outputs = problem->ModelOutputs();
   }
   CoupledSolution nominal;
-  if (!SolveAt(run->nominal_moduli, config.inner, problem, &nominal, &run->nominal_cost,
-               &run->nominal_zone_map, &run->nominal_zone_gap, &run->nominal_dof_map, &why) &&
-      run->failure.empty()) {
+  if (SolveAt(run->nominal_moduli, config.inner, problem, &nominal, &run->nominal_cost,
+              &run->nominal_zone_map, &run->nominal_zone_gap, &run->nominal_dof_map, &why)) {
+    run->nominal_element_map =
+        ElementMapOf(model, run->nominal_moduli, nominal, problem->time_step());
+  } else if (run->failure.empty()) {
     run->failure = "at the nominal moduli, " + why;
   }
   return identified;
@@ -704,7 +717,7 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
   //    at the nominal moduli; 4. the uncertainty of the identified moduli.
   CoupledSolution storage;
   const CoupledSolution* identified =
-      MapsAtIdentifiedAndNominal(config, mcre_objective, &problem, &storage, &run);
+      MapsAtIdentifiedAndNominal(config, model, mcre_objective, &problem, &storage, &run);
   if (identified != nullptr) {
     run.noise = MatrixNoiseLevels(config, measurements, &run.noise_source);
     run.uncertainty =

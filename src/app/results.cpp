@@ -343,8 +343,7 @@ std::string ErrorMapCsv(const IdentificationRun& run) {
 
 // gnuplot's nonuniform matrix: first row the count and the x of each column, then
 // one row per time: t, then the densities.
-std::string ErrorMapSpaceTimeData(const IdentificationRun& run) {
-  const ErrorMap& map = run.error_map;
+std::string SpaceTimeDataOf(const ErrorMap& map) {
   std::string text = std::to_string(map.density_position.size());
   for (Eigen::Index c = 0; c < map.density_position.size(); ++c) {
     text += " " + Format(map.density_position[c]);
@@ -356,6 +355,10 @@ std::string ErrorMapSpaceTimeData(const IdentificationRun& run) {
     text += "\n";
   }
   return text;
+}
+
+std::string ErrorMapSpaceTimeData(const IdentificationRun& run) {
+  return SpaceTimeDataOf(run.error_map);
 }
 
 std::string ErrorMapScript(const IdentificationRun& run, const std::string& folder) {
@@ -891,6 +894,29 @@ std::string MatrixDofMapCsv(const MatrixIdentificationRun& run) {
   return csv;
 }
 
+// error_map.csv of a matrix model with element blocks: the bar's columns (element, its
+// position's coordinates x, y, z as it has them, share [J s] and fraction at the
+// identified moduli), then the same at the nominal moduli, then the element's zone (its
+// index in the manifest, as zones.csv's column zone).
+std::string MatrixElementMapCsv(const MatrixIdentificationRun& run, const MatrixModelData& model) {
+  const Vector fractions = run.element_map.Fractions();
+  const Vector nominal_fractions = run.nominal_element_map.Fractions();
+  const Eigen::Index dimension = model.elements.front().position.size();
+  std::string csv = "element";
+  for (Eigen::Index i = 0; i < dimension; ++i) csv += std::string(",") + "xyz"[i];
+  csv += ",share,fraction,nominal_share,nominal_fraction,zone\n";
+  for (std::size_t el = 0; el < model.elements.size(); ++el) {
+    const MatrixModelElement& element = model.elements[el];
+    const auto e = static_cast<Eigen::Index>(el);
+    csv += std::to_string(el);
+    for (Eigen::Index i = 0; i < dimension; ++i) csv += "," + Format(element.position[i]);
+    csv += "," + Format(run.element_map.share[e]) + "," + Format(fractions[e]) + "," +
+           Format(run.nominal_element_map.share[e]) + "," + Format(nominal_fractions[e]) + "," +
+           std::to_string(element.zone) + "\n";
+  }
+  return csv;
+}
+
 std::string MatrixEvaluationsCsv(const MatrixIdentificationRun& run) {
   std::string csv = "evaluation";
   for (const std::string& zone : run.zone_names) csv += "," + zone + "_pa";
@@ -1013,6 +1039,20 @@ void MatrixOptimizerYaml(const MatrixIdentificationRun& run, const std::string& 
   yaml->Number(1, "scaled_cost", run.outer.cost, cost + " / cost_scale at the identified moduli");
 }
 
+// The error_map: block of a matrix run with an element map (error_map.csv): the element
+// of the largest share at the identified and at the nominal moduli.
+void MatrixElementMapYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) {
+  if (run.element_map.share.size() == 0 || run.nominal_element_map.share.size() == 0) return;
+  const int peak = run.element_map.PeakElement();
+  const int nominal_peak = run.nominal_element_map.PeakElement();
+  yaml->Line(0, "error_map", "", "the constitutive gap by element (error_map.csv)");
+  yaml->Integer(1, "peak_element", peak, "element of the largest share at the identified moduli");
+  yaml->Number(1, "peak_fraction", run.element_map.Fractions()[peak],
+               "its share of the constitutive gap");
+  yaml->Integer(1, "nominal_peak_element", nominal_peak, "the same at the nominal moduli");
+  yaml->Number(1, "nominal_peak_fraction", run.nominal_element_map.Fractions()[nominal_peak]);
+}
+
 // summary.yaml of a matrix run by least squares: MatrixSummaryYaml's layout with J [s]
 // for e^2, the misfit levels for the error map, and no inner solver.
 std::string MatrixLeastSquaresSummaryYaml(const MatrixIdentificationRun& run,
@@ -1079,6 +1119,7 @@ std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& 
   yaml.Number(0, "nominal_cost", run.nominal_cost, "[J s] e^2 at the nominal moduli");
   yaml.Number(0, "cost_scale", run.rest_cost,
               "[J s] J_rest, e^2 of the structure left at rest (0 <= e^2 <= J_rest)");
+  MatrixElementMapYaml(run, &yaml);
   MatrixOptimizerYaml(run, "e^2", &yaml);
   yaml.Line(0, "inner", "");
   std::string inner_comment;
@@ -1112,6 +1153,10 @@ std::vector<std::string> WriteMatrixIdentificationResults(const MatrixIdentifica
   results.Write("evaluations.csv", MatrixEvaluationsCsv(run));
   results.Write("fit.csv", MatrixFitCsv(run));
   if (!run.least_squares) results.Write("error_map_dofs.csv", MatrixDofMapCsv(run));
+  if (run.element_map.share.size() > 0 && run.nominal_element_map.share.size() > 0) {
+    results.Write("error_map.csv", MatrixElementMapCsv(run, model));
+    results.Write("error_map_spacetime.dat", SpaceTimeDataOf(run.element_map));
+  }
   if (figures) {
     std::vector<SensorKind> kinds;
     for (const MatrixModelSensor& sensor : model.sensors) kinds.push_back(sensor.kind);

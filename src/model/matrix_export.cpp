@@ -143,6 +143,17 @@ MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
     zone.stiffness = model.Stiffness(Vector::Unit(model.num_zones(), z) * nominal_modulus);
     data.zones.push_back(std::move(zone));
   }
+  for (int e = 0; e < model.num_elements(); ++e) {
+    // nominal_modulus K1_e = nominal_modulus k1_e [1 -1; -1 1] on nodes (e, e + 1), as
+    // BarModel::StiffnessOfElements assembles it.
+    const double k = nominal_modulus * model.element_unit_stiffness(e);
+    MatrixModelElement element;
+    element.dofs = {e, e + 1};
+    element.zone = model.element_zone(e);
+    element.stiffness = (Matrix(2, 2) << k, -k, -k, k).finished();
+    element.position = Vector::Constant(1, model.element_midpoint(e));
+    data.elements.push_back(std::move(element));
+  }
   const bool support = clamp == BarClampExport::kSupport;
   if (!support) data.loads.push_back({"f0", Vector::Unit(n, model.left_node())});
   data.loads.push_back({"fL", Vector::Unit(n, model.right_node())});
@@ -319,6 +330,16 @@ std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& d
     }
     manifest << YAML::EndSeq;
   }
+  if (!data.elements.empty()) {
+    const MatrixModelElementFiles files = WriteMatrixModelElements(folder, data);
+    manifest << YAML::Key << "elements" << YAML::Value << YAML::Flow << YAML::BeginMap << YAML::Key
+             << "dofs" << YAML::Value << files.dofs << YAML::Key << "stiffness" << YAML::Value
+             << files.stiffness;
+    if (!files.positions.empty()) {
+      manifest << YAML::Key << "positions" << YAML::Value << files.positions;
+    }
+    manifest << YAML::EndMap;
+  }
   manifest << YAML::EndMap;
   const std::string path = folder + "/model.yaml";
   WriteFileAtomically(path, std::string("# mcrewave matrix model (docs/matrix_models.md)\n") +
@@ -329,8 +350,8 @@ std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& d
 namespace {
 
 // The manifest at manifest_path, checked to be a map of the keys mass,
-// stiffness_length, length, zones, loads, sensors, loads_matrix, sensors_matrix and
-// supports only.
+// stiffness_length, length, zones, loads, sensors, loads_matrix, sensors_matrix,
+// supports and elements only.
 YAML::Node LoadManifest(const std::string& manifest_path) {
   YAML::Node root;
   try {
@@ -345,10 +366,10 @@ YAML::Node LoadManifest(const std::string& manifest_path) {
     const std::string name = key.first.Scalar();
     if (name != "mass" && name != "stiffness_length" && name != "length" && name != "zones" &&
         name != "loads" && name != "sensors" && name != "loads_matrix" &&
-        name != "sensors_matrix" && name != "supports") {
+        name != "sensors_matrix" && name != "supports" && name != "elements") {
       throw InputError(Where(manifest_path, key.first) + ": unknown key '" + name +
                        "' (expected mass, stiffness_length, length, zones, loads, sensors, "
-                       "loads_matrix, sensors_matrix, supports)");
+                       "loads_matrix, sensors_matrix, supports, elements)");
     }
   }
   return root;
@@ -703,6 +724,27 @@ void ReadSupports(const std::string& manifest_path, const YAML::Node& root,
   }
 }
 
+// Reads the manifest's optional element blocks (key elements: a map {dofs, stiffness,
+// positions}, files relative to `folder`) into data->elements and checks that each zone's
+// blocks sum to its K_z.
+void ReadElements(const std::string& manifest_path, const YAML::Node& root,
+                  const std::string& folder, const std::string& mass_file, MatrixModelData* data) {
+  const YAML::Node entry = root["elements"];
+  if (!entry) return;
+  CheckEntryKeys(manifest_path, entry, {"dofs", "stiffness", "positions"},
+                 "dofs, stiffness, positions");
+  MatrixModelElementFiles files;
+  files.dofs = ManifestFile(folder, RequiredString(manifest_path, entry, "dofs"));
+  files.stiffness = ManifestFile(folder, RequiredString(manifest_path, entry, "stiffness"));
+  if (entry["positions"]) {
+    files.positions = ManifestFile(folder, RequiredString(manifest_path, entry, "positions"));
+  }
+  std::vector<std::string> zone_names;
+  for (const MatrixModelZone& zone : data->zones) zone_names.push_back(zone.name);
+  data->elements = ReadMatrixModelElements(files, zone_names, data->dofs(), mass_file);
+  Refuse(CheckElementBlockSums(*data, Where(manifest_path, entry) + " (" + files.stiffness + ")"));
+}
+
 }  // namespace
 
 MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
@@ -734,6 +776,7 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
                      "observation matrix and its channel names");
   }
   ReadSupports(manifest_path, root, folder, mass_file, &channels, &data);
+  ReadElements(manifest_path, root, folder, mass_file, &data);
   return data;
 }
 

@@ -15,8 +15,9 @@
 //      the optimiser of zone_identification: from the nominal moduli within
 //      [outer.lower_bound, outer.upper_bound] Pa in every zone, inner solves by
 //      inner:; no jump penalty (matrices do not say which zones are neighbours).
-//      Then the error maps (zone and dof) at the nominal and the identified moduli
-//      and the model's outputs at the identified moduli.
+//      Then the error maps (zone and dof, and element when the model has element
+//      blocks and the inner solver keeps its fields) at the nominal and the identified
+//      moduli and the model's outputs at the identified moduli.
 //      With outer.functional: least_squares, the same minimiser, bounds and start on
 //      the output-error misfit J instead (least_squares/matrix_output_error_objective.h),
 //      each sensor kind normalised by its misfit level (MatrixLeastSquaresMisfitLevels);
@@ -32,6 +33,7 @@
 
 #include "mcrewave/app/config.h"
 #include "mcrewave/data/channel_set.h"
+#include "mcrewave/mcre/error_map.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/mcre/zone_uncertainty.h"
@@ -174,6 +176,11 @@ struct MatrixIdentificationRun {
   // same sum of U, (E_z / E_z,nom) sum_j c_j h 1/2 U_j^T K_z U_j. Independent of the
   // zone's size, it is the map that points at a wrong zone.
   Vector nominal_zone_gap, zone_gap;
+  // Constitutive part of e^2 per element [J s] with its space-time picture
+  // (mcre/element_error_map.h), at the nominal and the identified moduli: when the model
+  // has element blocks and the coupled solution kept its fields (a streaming solve keeps
+  // no retrograde field: then, as without element blocks, the maps are empty).
+  ErrorMap nominal_element_map, element_map;
   // Channels and names, as used (pre-filtered), and the model's outputs H U at the
   // identified moduli.
   ChannelSet data;  // the model's channels, in its order (loads, then sensors)

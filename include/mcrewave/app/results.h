@@ -67,7 +67,8 @@ std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
 //   summary.yaml        the model (manifest, dofs, zones, channels), the data, every
 //                       zone's nominal, identified and (synthetic data) truth modulus
 //                       and its share of the constitutive gap at the nominal and the
-//                       identified moduli, e^2 and J_rest [J s], the optimiser, the
+//                       identified moduli, e^2 and J_rest [J s], with an element map
+//                       its peak element and fraction at both (error_map:), the optimiser, the
 //                       inner solver that ran (inner.method), the pre-filter, the
 //                       resolved config
 //   zones.csv           the same per zone
@@ -77,6 +78,14 @@ std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
 //                       sensor as the identified model driven by the loads gives it
 //   error_map_dofs.csv  the constitutive gap per dof [J s] at the nominal and the
 //                       identified moduli (MatrixMcreProblem::DofErrorMap)
+//   error_map.csv       with element blocks (and an inner solver that keeps its fields,
+//                       not streaming): the gap per element (mcre/element_error_map.h):
+//                       element, its position's coordinates x[, y[, z]] [m] when it has
+//                       them, share [J s] and fraction at the identified moduli,
+//                       nominal_share and nominal_fraction, zone (index); and
+//                       error_map_spacetime.dat its space-time picture at the identified
+//                       moduli (gnuplot's nonuniform matrix over the first coordinate,
+//                       densities in J per element)
 //   zones.png, fit.png  moduli and error shares per zone; the first six sensors
 // written as WriteIdentificationResults writes (atomically, summary last). By least
 // squares (run.least_squares): summary.yaml says `functional: least_squares`, with J,

@@ -39,6 +39,18 @@
 // one sensor channel from either form. WriteMatrixModel writes either form
 // (MatrixModelLayout); with BarMatrixModel it exports the built-in bar, so that the
 // general path can be tested against it.
+//
+// Optionally, the element blocks that split every zone's K_z by element, for the error
+// map per element (model/matrix_model_elements.h, docs/matrix_models.md section 4):
+//
+//   elements: {dofs: element_dofs.csv, stiffness: element_stiffness.csv,
+//              positions: element_positions.csv}          # positions optional
+//
+// element_dofs.csv: a line per element, its zone's name then its dofs (0-based):
+// `zone0, 3, 4`; element_stiffness.csv: the same lines' blocks K_el [N/m] at the zone's
+// nominal modulus, row by row: `2e9, -2e9, -2e9, 2e9`; element_positions.csv: 1 to 3
+// coordinates [m] of a point of each element (its centroid, say): `0.025`. Blank lines
+// and lines starting with '#' are skipped. The blocks of each zone must sum to its K_z.
 #pragma once
 
 #include <string>
@@ -47,6 +59,7 @@
 #include "mcrewave/core/types.h"
 #include "mcrewave/data/measurement.h"
 #include "mcrewave/model/bar_model.h"
+#include "mcrewave/model/matrix_model_elements.h"
 
 namespace mcrewave {
 
@@ -95,6 +108,9 @@ struct MatrixModelData {
   std::vector<MatrixModelLoad> loads;
   std::vector<MatrixModelSensor> sensors;
   std::vector<MatrixModelSupport> supports;  // none: a structure held by nothing but its data
+  // The element blocks (none: the zone is the finest unit of the error maps): those of
+  // zone z sum to K_z; every element has a position or none has, all of one dimension.
+  std::vector<MatrixModelElement> elements;
 
   int dofs() const { return static_cast<int>(mass.rows()); }
   // K = sum_z (E_z / E_z,nominal) K_z; zone_moduli has zones.size() entries [Pa].
@@ -107,10 +123,12 @@ struct MatrixModelData {
 SparseMatrix ObservationRowMatrix(const ObservationRow& row, int dofs);
 
 // The bar as matrices (scales a* = S / L, l* = L): M, K1_z times nominal_modulus per zone (zone z
-// named "zone<z>"), the end loads (channels f0: e_0, fL: e_N), the end displacement rows (u0, uL)
-// and the rows of `sensors` (channels u@X / e@X, as the measurement CSV names them; their
-// index is not used). With clamp kSupport, f0 and u0 are the channels of the support
-// "clamp" at dof 0 instead: the loads are fL alone, the sensors uL and `sensors`.
+// named "zone<z>"), its elements (element e: dofs e and e + 1, its zone, the block
+// nominal_modulus K1_e = nominal_modulus k1_e [1 -1; -1 1], its midpoint [m]), the end loads
+// (channels f0: e_0, fL: e_N), the end displacement rows (u0, uL) and the rows of `sensors`
+// (channels u@X / e@X, as the measurement CSV names them; their index is not used). With clamp
+// kSupport, f0 and u0 are the channels of the support "clamp" at dof 0 instead: the loads are fL
+// alone, the sensors uL and `sensors`.
 MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
                                const std::vector<BarSensor>& sensors = {},
                                BarClampExport clamp = BarClampExport::kLoadAndSensor);
@@ -126,7 +144,8 @@ enum class MatrixModelLayout {
 
 // Writes `data` into `folder` (which must exist): M.mtx, K_<zone>.mtx, the loads and
 // sensors as `layout` says (per channel, '@' of a channel becomes '_at_' in its file
-// name), support_<name>.mtx (a support's reaction g, only when it is not the default)
+// name), support_<name>.mtx (a support's reaction g, only when it is not the default),
+// the element files (WriteMatrixModelElements, when there are elements)
 // and the manifest model.yaml, each atomically, M and K_z in symmetric storage, 17
 // digits. Returns the manifest's path. Throws std::runtime_error when a file cannot be
 // written, or, with kMatrices, when a channel name cannot stand on a line of a channels
@@ -143,9 +162,10 @@ std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& d
 // the scales stiffness_length and length finite and positive; a sensor's kind displacement or
 // strain; every support named once, its dofs distinct, in range and held by no other support, its
 // reaction of M's size and nonzero on its dofs only, its channels distinct from every other channel
-// (loads', sensors', supports'). Throws InputError naming the file (and line, for the manifest, the
-// Matrix Market files and a channels file's bad name; both counts for a channels file that does not
-// match its matrix) on the first problem.
+// (loads', sensors', supports'); the element files' every line (ReadMatrixModelElements) and each
+// zone's blocks summing to its K_z (CheckElementBlockSums). Throws InputError naming the file (and
+// line, for the manifest, the Matrix Market files and a channels file's bad name; both counts for a
+// channels file that does not match its matrix) on the first problem.
 MatrixModelData ReadMatrixModel(const std::string& manifest_path);
 
 }  // namespace mcrewave

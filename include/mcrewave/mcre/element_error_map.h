@@ -1,0 +1,67 @@
+// The MCRE error map per element of a structure given by matrices with element blocks
+// (MatrixModelData::elements; docs/matrix_models.md section 2, "The error map"): the
+// bar's map (mcre/error_map.h) for any structure.
+//
+// At zone moduli E_z and the retrograde field W of a coupled solution, the constitutive
+// part of e^2 splits by element,
+//
+//   e_el^2 = (E_z / E_z,nom) sum_j c_j h 1/2 W_j^T K_el W_j  [J s],
+//
+// W_j restricted to the element's dofs, K_el its block at the zone's nominal modulus
+// (z its zone). The blocks of a zone sum to K_z, so the elements' shares sum to the
+// zones' (MatrixMcreProblem::ZoneErrorMap). Each quadratic form is taken about the
+// element's first dof value c = W_{d_1}: with V = W_el - c 1 and r = K_el 1,
+//
+//   W_el^T K_el W_el = V^T K_el V + 2 c r^T V + c^2 1^T r,
+//
+// the same number in exact arithmetic, without the cancellation of a smooth W where
+// K_el's rows sum to zero (r = 0: a bar or scalar-field element, whose gap is then
+// E k1 (W_b - W_a)^2 as the bar computes it).
+//
+// The space-time picture (ErrorMap::density) is the gap energy at a sample,
+// (E_z / E_z,nom) 1/2 W_j^T K_el W_j [J] (per element, not per length: a matrix model
+// has no element length; the bar's density is this over h_e), on every stride-th
+// sample (SpaceTimeStride) and averaged over columns of SpaceTimeGroupSize consecutive
+// elements (in the model's order). ErrorMap::position is each element's first
+// coordinate [m] (its index when the elements have no positions) and
+// ErrorMap::density_position each column's mean of them.
+#pragma once
+
+#include "mcrewave/core/types.h"
+#include "mcrewave/mcre/error_map.h"
+#include "mcrewave/model/matrix_export.h"
+
+namespace mcrewave {
+
+// 1/2 W_el^T K_el W_el of one element at its zone's nominal modulus [J], from W_j (the
+// model's n entries), by the shifted form above. No allocation.
+double ElementGapEnergy(const MatrixModelElement& element, const double* retrograde);
+
+// shares[el] += weight (E_z / E_z,nom) 1/2 W_j^T K_el W_j for every element, from W_j.
+// zone_moduli has one entry per zone [Pa]; shares one per element. No allocation.
+void AddSampleElementGapShares(const MatrixModelData& model, const Vector& zone_moduli,
+                               const double* retrograde, double weight, Vector* shares);
+
+// e_el^2 for every element [J s] at the zone moduli from W (n x (m + 1)) on steps of
+// time_step [s]. Precondition: the model has elements.
+Vector MatrixElementGapShares(const MatrixModelData& model, const Vector& zone_moduli,
+                              const Matrix& retrograde, double time_step);
+
+// ErrorMap::position of the model's elements (above).
+Vector ElementMapPositions(const MatrixModelData& model);
+
+// The picture's column centres: each column's mean of ElementMapPositions.
+Vector ElementColumnPositions(const MatrixModelData& model);
+
+// row[c] = the mean over column c's elements of (E_z / E_z,nom) 1/2 W_j^T K_el W_j [J]
+// from W_j; row holds ElementColumnPositions(model).size() entries. No allocation.
+void SampleElementGapDensity(const MatrixModelData& model, const Vector& zone_moduli,
+                             const double* retrograde, double* row);
+
+// The whole map: shares, positions and the space-time picture on at most
+// max_time_columns samples. Preconditions: the model has elements, max_time_columns >= 2.
+ErrorMap ComputeElementErrorMap(const MatrixModelData& model, const Vector& zone_moduli,
+                                const Matrix& retrograde, double time_step,
+                                int max_time_columns = kSpaceTimeSamples);
+
+}  // namespace mcrewave

@@ -1,0 +1,121 @@
+#include "mcrewave/mcre/element_error_map.h"
+
+#include <algorithm>
+#include <cassert>
+
+namespace mcrewave {
+
+double ElementGapEnergy(const MatrixModelElement& element, const double* retrograde) {
+  // 1/2 W_el^T K_el W_el = 1/2 (V^T K_el V + 2 c r^T V + c^2 1^T r), V = W_el - c 1,
+  // r = K_el 1, c = W_{d_1} (element_error_map.h; docs/matrix_models.md section 2).
+  const int k = static_cast<int>(element.dofs.size());
+  const double shift = retrograde[element.dofs[0]];
+  double quadratic = 0.0, linear = 0.0, constant = 0.0;
+  for (int a = 0; a < k; ++a) {
+    const double v_a = retrograde[element.dofs[a]] - shift;
+    double row_product = 0.0, row_sum = 0.0;
+    for (int b = 0; b < k; ++b) {
+      row_product += element.stiffness(a, b) * (retrograde[element.dofs[b]] - shift);
+      row_sum += element.stiffness(a, b);
+    }
+    quadratic += v_a * row_product;
+    linear += row_sum * v_a;
+    constant += row_sum;
+  }
+  return 0.5 * (quadratic + 2.0 * shift * linear + shift * shift * constant);
+}
+
+namespace {
+
+// E_z / E_z,nom of an element's zone.
+double ZoneFactor(const MatrixModelData& model, const Vector& zone_moduli,
+                  const MatrixModelElement& element) {
+  return zone_moduli[element.zone] /
+         model.zones[static_cast<std::size_t>(element.zone)].nominal_modulus;
+}
+
+}  // namespace
+
+void AddSampleElementGapShares(const MatrixModelData& model, const Vector& zone_moduli,
+                               const double* retrograde, double weight, Vector* shares) {
+  for (std::size_t el = 0; el < model.elements.size(); ++el) {
+    const MatrixModelElement& element = model.elements[el];
+    // weight (E_z / E_z,nom) 1/2 W_j^T K_el W_j.
+    (*shares)[static_cast<Eigen::Index>(el)] +=
+        weight * ZoneFactor(model, zone_moduli, element) * ElementGapEnergy(element, retrograde);
+  }
+}
+
+Vector MatrixElementGapShares(const MatrixModelData& model, const Vector& zone_moduli,
+                              const Matrix& retrograde, double time_step) {
+  assert(!model.elements.empty() &&
+         zone_moduli.size() == static_cast<Eigen::Index>(model.zones.size()) &&
+         retrograde.rows() == model.dofs());
+  const int m = static_cast<int>(retrograde.cols()) - 1;
+  Vector shares = Vector::Zero(static_cast<Eigen::Index>(model.elements.size()));
+  for (int j = 0; j <= m; ++j) {
+    // c_j h, c_j = 1/2 at both ends of the window.
+    const double weight = (j == 0 || j == m ? 0.5 : 1.0) * time_step;
+    AddSampleElementGapShares(model, zone_moduli, retrograde.col(j).data(), weight, &shares);
+  }
+  return shares;
+}
+
+Vector ElementMapPositions(const MatrixModelData& model) {
+  Vector positions(static_cast<Eigen::Index>(model.elements.size()));
+  for (std::size_t el = 0; el < model.elements.size(); ++el) {
+    const Vector& position = model.elements[el].position;
+    positions[static_cast<Eigen::Index>(el)] =
+        position.size() > 0 ? position[0] : static_cast<double>(el);
+  }
+  return positions;
+}
+
+Vector ElementColumnPositions(const MatrixModelData& model) {
+  const Vector positions = ElementMapPositions(model);
+  const int elements = static_cast<int>(positions.size());
+  const int group = SpaceTimeGroupSize(elements), columns = (elements + group - 1) / group;
+  Vector centres(columns);
+  for (int c = 0; c < columns; ++c) {
+    const int first = c * group, end = std::min(elements, first + group);
+    centres[c] = positions.segment(first, end - first).mean();
+  }
+  return centres;
+}
+
+void SampleElementGapDensity(const MatrixModelData& model, const Vector& zone_moduli,
+                             const double* retrograde, double* row) {
+  const int elements = static_cast<int>(model.elements.size());
+  const int group = SpaceTimeGroupSize(elements);
+  for (int first = 0, c = 0; first < elements; first += group, ++c) {
+    const int end = std::min(elements, first + group);
+    double sum = 0.0;
+    for (int el = first; el < end; ++el) {
+      // (E_z / E_z,nom) 1/2 W_j^T K_el W_j [J].
+      const MatrixModelElement& element = model.elements[static_cast<std::size_t>(el)];
+      sum += ZoneFactor(model, zone_moduli, element) * ElementGapEnergy(element, retrograde);
+    }
+    row[c] = sum / (end - first);
+  }
+}
+
+ErrorMap ComputeElementErrorMap(const MatrixModelData& model, const Vector& zone_moduli,
+                                const Matrix& retrograde, double time_step, int max_time_columns) {
+  const int m = static_cast<int>(retrograde.cols()) - 1;
+  const int stride = SpaceTimeStride(m, max_time_columns);
+  ErrorMap map;
+  map.position = ElementMapPositions(model);
+  map.share = MatrixElementGapShares(model, zone_moduli, retrograde, time_step);
+  map.density_position = ElementColumnPositions(model);
+  map.density.resize(m / stride + 1, map.density_position.size());
+  map.times.resize(map.density.rows());
+  Vector row(map.density.cols());
+  for (int i = 0; i < map.density.rows(); ++i) {
+    SampleElementGapDensity(model, zone_moduli, retrograde.col(i * stride).data(), row.data());
+    map.density.row(i) = row.transpose();
+    map.times[i] = (i * stride) * time_step;
+  }
+  return map;
+}
+
+}  // namespace mcrewave

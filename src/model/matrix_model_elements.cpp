@@ -1,0 +1,323 @@
+#include "mcrewave/model/matrix_model_elements.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "mcrewave/core/file_util.h"
+#include "mcrewave/core/format.h"
+#include "mcrewave/model/matrix_export.h"
+#include "mcrewave/model/matrix_model_check.h"
+
+namespace mcrewave {
+namespace {
+
+constexpr const char* kBlanks = " \t\r\f\v";
+
+std::string ShortNumber(double value) { return FormatNumber(value, kSixDigits); }
+
+// A data line of an element file: its fields (trimmed) and its line number (1-based).
+struct ElementLine {
+  std::vector<std::string> fields;
+  int line = 0;
+};
+
+std::string Trimmed(const std::string& text) {
+  const std::size_t begin = text.find_first_not_of(kBlanks);
+  if (begin == std::string::npos) return "";
+  return text.substr(begin, text.find_last_not_of(kBlanks) - begin + 1);
+}
+
+// The data lines of the element file at `path` (`what` says which, for messages): blank
+// lines and lines starting with '#' skipped, each other line split at its commas.
+std::vector<ElementLine> ReadElementLines(const std::string& path, const std::string& what) {
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) {
+    throw InputError("cannot read element " + what + " file " + path + ": it is a directory");
+  }
+  std::ifstream file(path, std::ios::binary);
+  if (!file) {
+    throw InputError("cannot read element " + what + " file " + path + ": " + std::strerror(errno));
+  }
+  std::vector<ElementLine> lines;
+  std::string text;
+  for (int line = 1; std::getline(file, text); ++line) {
+    const std::string trimmed = Trimmed(text);
+    if (trimmed.empty() || trimmed[0] == '#') continue;
+    ElementLine entry;
+    entry.line = line;
+    for (std::size_t begin = 0;;) {
+      const std::size_t comma = trimmed.find(',', begin);
+      entry.fields.push_back(Trimmed(trimmed.substr(begin, comma - begin)));
+      if (comma == std::string::npos) break;
+      begin = comma + 1;
+    }
+    lines.push_back(std::move(entry));
+  }
+  if (file.bad()) throw InputError("cannot read element " + what + " file " + path);
+  return lines;
+}
+
+std::string FileLine(const std::string& path, const ElementLine& line) {
+  return path + ":" + std::to_string(line.line);
+}
+
+// Field `index` of `line` as a finite number; refuses anything else naming what it is.
+double FiniteField(const std::string& path, const ElementLine& line, std::size_t index,
+                   const std::string& what) {
+  const std::string& field = line.fields[index];
+  char* stop = nullptr;
+  errno = 0;
+  const double value = field.empty() ? 0.0 : std::strtod(field.c_str(), &stop);
+  if (field.empty() || *stop != '\0' || !std::isfinite(value)) {
+    throw InputError(FileLine(path, line) + ": field " + std::to_string(index + 1) + " '" + field +
+                     "' of " + what + " is not a finite number");
+  }
+  return value;
+}
+
+// Field `index` of a dofs line as a dof in [0, dofs).
+int DofField(const std::string& path, const ElementLine& line, std::size_t index, int dofs,
+             const std::string& mass_file) {
+  const std::string& field = line.fields[index];
+  char* stop = nullptr;
+  errno = 0;
+  const long value = field.empty() ? -1 : std::strtol(field.c_str(), &stop, 10);
+  if (field.empty() || *stop != '\0' || errno == ERANGE || value < 0 || value >= dofs) {
+    throw InputError(FileLine(path, line) + ": dof '" + field + "' (field " +
+                     std::to_string(index + 1) + ") is not a dof of the model, expected an " +
+                     "integer from 0 to " + std::to_string(dofs - 1) + " (0-based, the dofs of " +
+                     mass_file + ")");
+  }
+  return static_cast<int>(value);
+}
+
+// The elements of the dofs file: zone and dofs of each line.
+std::vector<MatrixModelElement> ReadElementDofs(const std::string& path,
+                                                const std::vector<std::string>& zone_names,
+                                                int dofs, const std::string& mass_file) {
+  const std::vector<ElementLine> lines = ReadElementLines(path, "dofs");
+  if (lines.empty()) {
+    throw InputError(path + ": no elements, expected one a line: its zone, then its dofs");
+  }
+  std::vector<MatrixModelElement> elements(lines.size());
+  for (std::size_t e = 0; e < lines.size(); ++e) {
+    const ElementLine& line = lines[e];
+    if (line.fields.size() < 2) {
+      throw InputError(FileLine(path, line) +
+                       ": 1 field, expected the element's zone, then its dofs");
+    }
+    const auto zone = std::find(zone_names.begin(), zone_names.end(), line.fields[0]);
+    if (zone == zone_names.end()) {
+      throw InputError(FileLine(path, line) + ": zone '" + line.fields[0] +
+                       "' is not a zone of the manifest, expected one of its zones' names");
+    }
+    MatrixModelElement& element = elements[e];
+    element.zone = static_cast<int>(zone - zone_names.begin());
+    std::set<int> seen;
+    for (std::size_t i = 1; i < line.fields.size(); ++i) {
+      element.dofs.push_back(DofField(path, line, i, dofs, mass_file));
+      if (!seen.insert(element.dofs.back()).second) {
+        throw InputError(FileLine(path, line) + ": dof " + std::to_string(element.dofs.back()) +
+                         " given twice, expected each of the element's dofs once");
+      }
+    }
+  }
+  return elements;
+}
+
+// Refuses a file with other than one data line per element.
+void CheckElementCount(const std::string& path, const std::vector<ElementLine>& lines,
+                       std::size_t elements, const std::string& dofs_path) {
+  if (lines.size() > elements) {
+    throw InputError(FileLine(path, lines[elements]) + ": a line past the last element, expected " +
+                     std::to_string(elements) + " lines, one per element of " + dofs_path);
+  }
+  if (lines.size() < elements) {
+    throw InputError(path + ": " + std::to_string(lines.size()) + " lines, expected " +
+                     std::to_string(elements) + ", one per element of " + dofs_path);
+  }
+}
+
+// Reads each element's stiffness block: k^2 finite numbers, row by row, symmetric.
+void ReadElementBlocks(const std::string& path, const std::string& dofs_path,
+                       std::vector<MatrixModelElement>* elements) {
+  const std::vector<ElementLine> lines = ReadElementLines(path, "stiffness");
+  CheckElementCount(path, lines, elements->size(), dofs_path);
+  for (std::size_t e = 0; e < lines.size(); ++e) {
+    const ElementLine& line = lines[e];
+    MatrixModelElement& element = (*elements)[e];
+    const int k = static_cast<int>(element.dofs.size());
+    if (line.fields.size() != static_cast<std::size_t>(k) * k) {
+      throw InputError(FileLine(path, line) + ": " + std::to_string(line.fields.size()) +
+                       " values, expected " + std::to_string(static_cast<std::size_t>(k) * k) +
+                       ": the " + std::to_string(k) + " x " + std::to_string(k) +
+                       " block, row by row, of element " + std::to_string(e + 1) + " of " +
+                       dofs_path + " (" + std::to_string(k) + " dofs)");
+    }
+    element.stiffness.resize(k, k);
+    for (int a = 0; a < k; ++a) {
+      for (int b = 0; b < k; ++b) {
+        element.stiffness(a, b) =
+            FiniteField(path, line, static_cast<std::size_t>(a * k + b), "the element's block");
+      }
+    }
+    const double largest = element.stiffness.cwiseAbs().maxCoeff();
+    for (int a = 0; a < k; ++a) {
+      for (int b = a + 1; b < k; ++b) {
+        const double difference = std::abs(element.stiffness(a, b) - element.stiffness(b, a));
+        if (difference > kSymmetryTolerance * largest) {
+          throw InputError(FileLine(path, line) + ": the block is not symmetric: entry (" +
+                           std::to_string(a + 1) + ", " + std::to_string(b + 1) +
+                           ") = " + ShortNumber(element.stiffness(a, b)) + " but (" +
+                           std::to_string(b + 1) + ", " + std::to_string(a + 1) +
+                           ") = " + ShortNumber(element.stiffness(b, a)) +
+                           ", expected a symmetric block (relative tolerance " +
+                           ShortNumber(kSymmetryTolerance) + ")");
+        }
+      }
+    }
+  }
+}
+
+// Reads each element's position: 1 to 3 finite numbers, as many on every line.
+void ReadElementPositions(const std::string& path, const std::string& dofs_path,
+                          std::vector<MatrixModelElement>* elements) {
+  const std::vector<ElementLine> lines = ReadElementLines(path, "positions");
+  CheckElementCount(path, lines, elements->size(), dofs_path);
+  const std::size_t dimension = lines[0].fields.size();
+  for (std::size_t e = 0; e < lines.size(); ++e) {
+    const ElementLine& line = lines[e];
+    if (line.fields.size() != dimension || dimension > 3) {
+      throw InputError(FileLine(path, line) + ": " + std::to_string(line.fields.size()) +
+                       " coordinates, expected " +
+                       (dimension > 3 ? std::string("1 to 3")
+                                      : std::to_string(dimension) + " (as on the first line)"));
+    }
+    Vector& position = (*elements)[e].position;
+    position.resize(static_cast<Eigen::Index>(dimension));
+    for (std::size_t i = 0; i < dimension; ++i) {
+      position[static_cast<Eigen::Index>(i)] =
+          FiniteField(path, line, i, "the element's position [m]");
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<MatrixModelElement> ReadMatrixModelElements(const MatrixModelElementFiles& files,
+                                                        const std::vector<std::string>& zone_names,
+                                                        int dofs, const std::string& mass_file) {
+  std::vector<MatrixModelElement> elements =
+      ReadElementDofs(files.dofs, zone_names, dofs, mass_file);
+  ReadElementBlocks(files.stiffness, files.dofs, &elements);
+  if (!files.positions.empty()) ReadElementPositions(files.positions, files.dofs, &elements);
+  return elements;
+}
+
+std::string CheckElementBlockSums(const MatrixModelData& data, const std::string& manifest_name,
+                                  double relative_tolerance) {
+  const int n = data.dofs();
+  std::vector<std::vector<Eigen::Triplet<double>>> entries(data.zones.size());
+  for (const MatrixModelElement& element : data.elements) {
+    const int k = static_cast<int>(element.dofs.size());
+    auto& zone_entries = entries[static_cast<std::size_t>(element.zone)];
+    for (int a = 0; a < k; ++a) {
+      for (int b = 0; b < k; ++b) {
+        zone_entries.emplace_back(element.dofs[a], element.dofs[b], element.stiffness(a, b));
+      }
+    }
+  }
+  for (std::size_t z = 0; z < data.zones.size(); ++z) {
+    // The blocks' sum S_z (setFromTriplets sums repeated entries) against K_z.
+    SparseMatrix sum(n, n);
+    sum.setFromTriplets(entries[z].begin(), entries[z].end());
+    const SparseMatrix& stiffness = data.zones[z].stiffness;
+    const SparseMatrix misfit = sum - stiffness;
+    const double largest =
+        stiffness.nonZeros() > 0 ? stiffness.coeffs().cwiseAbs().maxCoeff() : 0.0;
+    double worst = 0.0;
+    int row = 0, column = 0;
+    for (int j = 0; j < misfit.outerSize(); ++j) {
+      for (SparseMatrix::InnerIterator it(misfit, j); it; ++it) {
+        if (std::abs(it.value()) > worst) {
+          worst = std::abs(it.value());
+          row = static_cast<int>(it.row());
+          column = static_cast<int>(it.col());
+        }
+      }
+    }
+    if (worst <= relative_tolerance * largest) continue;
+    return manifest_name + ": the element blocks of zone '" + data.zones[z].name +
+           "' do not sum to its stiffness: entry (" + std::to_string(row + 1) + ", " +
+           std::to_string(column + 1) + ") is " + ShortNumber(stiffness.coeff(row, column)) +
+           " in K_z but " + ShortNumber(sum.coeff(row, column)) + " in the blocks' sum (misfit " +
+           ShortNumber(worst) + ", " + ShortNumber(largest > 0.0 ? worst / largest : INFINITY) +
+           " of the largest entry " + ShortNumber(largest) + ", relative tolerance " +
+           ShortNumber(relative_tolerance) + ")";
+  }
+  return "";
+}
+
+namespace {
+
+const NumberFormat kElementRoundTrip{NumberFormat::Notation::kRoundTrip};
+
+// Refuses a zone name that would not read back as a dofs file's first field.
+void CheckZoneField(const std::string& path, const std::string& zone) {
+  if (zone.empty() || zone[0] == '#' || zone.find_first_of(",\n") != std::string::npos ||
+      zone.find_first_of(kBlanks) == 0 || zone.find_last_of(kBlanks) == zone.size() - 1) {
+    throw std::runtime_error("cannot write " + path + ": zone '" + zone +
+                             "' is empty, starts with '#', holds a comma or a line break or "
+                             "starts or ends with a blank, so a dofs file cannot name it");
+  }
+}
+
+}  // namespace
+
+MatrixModelElementFiles WriteMatrixModelElements(const std::string& folder,
+                                                 const MatrixModelData& data) {
+  MatrixModelElementFiles files{"element_dofs.csv", "element_stiffness.csv", ""};
+  std::string dofs = "# mcrewave element dofs: zone, then the element's dofs (0-based)\n";
+  std::string blocks =
+      "# mcrewave element stiffness blocks [N/m] at the zone's nominal "
+      "modulus, row by row\n";
+  std::string positions = "# mcrewave element positions [m]\n";
+  const bool with_positions = data.elements.front().position.size() > 0;
+  for (const MatrixModelElement& element : data.elements) {
+    const std::string& zone = data.zones[static_cast<std::size_t>(element.zone)].name;
+    CheckZoneField(folder + "/" + files.dofs, zone);
+    dofs += zone;
+    for (const int dof : element.dofs) dofs += ", " + std::to_string(dof);
+    dofs += "\n";
+    const Eigen::Index k = element.stiffness.rows();
+    for (Eigen::Index a = 0; a < k; ++a) {
+      for (Eigen::Index b = 0; b < k; ++b) {
+        blocks +=
+            (a + b == 0 ? "" : ", ") + FormatNumber(element.stiffness(a, b), kElementRoundTrip);
+      }
+    }
+    blocks += "\n";
+    for (Eigen::Index i = 0; with_positions && i < element.position.size(); ++i) {
+      positions += (i == 0 ? "" : ", ") + FormatNumber(element.position[i], kElementRoundTrip);
+    }
+    positions += "\n";
+  }
+  WriteFileAtomically(folder + "/" + files.dofs, dofs);
+  WriteFileAtomically(folder + "/" + files.stiffness, blocks);
+  if (with_positions) {
+    files.positions = "element_positions.csv";
+    WriteFileAtomically(folder + "/" + files.positions, positions);
+  }
+  return files;
+}
+
+}  // namespace mcrewave
