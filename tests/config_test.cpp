@@ -296,7 +296,7 @@ TEST(ConfigTest, FieldsAboveTheLimitStreamWithAutoAndAreRefusedWithStoredFieldMe
             CoupledSolverType::kConjugateGradient);
 }
 
-TEST(ConfigTest, AMatrixModelTakesAutoAndIsToldOfItWhenItAsksForABarSolver) {
+TEST(ConfigTest, AMatrixModelTakesAutoAndEveryOtherInnerMethod) {
   const std::string matrix = "model:\n  kind: matrix\n  manifest: m.yaml\n";
   EXPECT_EQ(ParseConfig(matrix, "a.yaml").inner.type, CoupledSolverType::kAuto);
   EXPECT_EQ(ParseConfig(matrix + "inner:\n  method: conjugate_gradient\n", "a.yaml").inner.type,
@@ -304,11 +304,12 @@ TEST(ConfigTest, AMatrixModelTakesAutoAndIsToldOfItWhenItAsksForABarSolver) {
   EXPECT_EQ(
       ParseConfig(matrix + "inner:\n  method: streaming_conjugate_gradient\n", "a.yaml").inner.type,
       CoupledSolverType::kStreamingConjugateGradient);
-  ExpectInputError(
-      [&matrix] { ParseConfig(matrix + "inner:\n  method: riccati\n", "a.yaml"); },
-      {"a.yaml:5: inner.method 'riccati' solves the bar only; with model.kind 'matrix' use "
-       "auto, conjugate_gradient, streaming_conjugate_gradient, relaxation, adaptive_relaxation "
-       "or all_at_once"});
+  // Riccati and shooting take the matrix model's operators (docs/riccati_shooting.md).
+  for (const char* method : {"riccati", "single_shooting", "multiple_shooting"}) {
+    EXPECT_EQ(CoupledSolverTypeToString(
+                  ParseConfig(matrix + "inner:\n  method: " + method + "\n", "a.yaml").inner.type),
+              std::string(method));
+  }
 }
 
 TEST(ConfigTest, DefaultConfigYamlParsesToTheDefaultConfig) {
@@ -875,8 +876,6 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
        "search.refine_window applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  merge_zones: true\n",
        "zone_identification.merge_zones applies to the bar only"},
-      {"model:\n  kind: matrix\n  manifest: m.yaml\ninner:\n  method: riccati\n",
-       "inner.method 'riccati' solves the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  channel_map: {F: t}\n",
        "cannot map to the time column"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  channel_map: {F: a, G: a}\n",

@@ -854,17 +854,9 @@ std::string StructureKeysProblem(const Config& config) {
   }
   // outer.functional: both run on a matrix model (least squares by
   // MatrixOutputErrorObjective, app/matrix_identification_run.h).
-  // auto streams on a matrix model when its fields do not fit (ResolveCoupledSolverType).
-  const CoupledSolverType method = config.inner.type;
-  if (method != CoupledSolverType::kAuto && method != CoupledSolverType::kConjugateGradient &&
-      method != CoupledSolverType::kStreamingConjugateGradient &&
-      method != CoupledSolverType::kRelaxation &&
-      method != CoupledSolverType::kAdaptiveRelaxation && method != CoupledSolverType::kAllAtOnce) {
-    return std::string("inner.method '") + CoupledSolverTypeToString(method) +
-           "' solves the bar only; with model.kind '" + kind +
-           "' use auto, conjugate_gradient, streaming_conjugate_gradient, relaxation, "
-           "adaptive_relaxation or all_at_once";
-  }
+  // Every inner.method runs on a matrix model: auto streams when its fields do not fit
+  // (ResolveCoupledSolverType), Riccati and shooting take its operators
+  // (docs/riccati_shooting.md).
   return "";
 }
 
