@@ -296,7 +296,7 @@ TEST(ConfigTest, FieldsAboveTheLimitStreamWithAutoAndAreRefusedWithStoredFieldMe
             CoupledSolverType::kConjugateGradient);
 }
 
-TEST(ConfigTest, AMatrixModelTakesAutoAndIsToldOfItWhenItAsksForABarSolver) {
+TEST(ConfigTest, AMatrixModelTakesAutoAndEveryOtherInnerMethod) {
   const std::string matrix = "model:\n  kind: matrix\n  manifest: m.yaml\n";
   EXPECT_EQ(ParseConfig(matrix, "a.yaml").inner.type, CoupledSolverType::kAuto);
   EXPECT_EQ(ParseConfig(matrix + "inner:\n  method: conjugate_gradient\n", "a.yaml").inner.type,
@@ -304,11 +304,12 @@ TEST(ConfigTest, AMatrixModelTakesAutoAndIsToldOfItWhenItAsksForABarSolver) {
   EXPECT_EQ(
       ParseConfig(matrix + "inner:\n  method: streaming_conjugate_gradient\n", "a.yaml").inner.type,
       CoupledSolverType::kStreamingConjugateGradient);
-  ExpectInputError(
-      [&matrix] { ParseConfig(matrix + "inner:\n  method: riccati\n", "a.yaml"); },
-      {"a.yaml:5: inner.method 'riccati' solves the bar only; with model.kind 'matrix' use "
-       "auto, conjugate_gradient, streaming_conjugate_gradient, relaxation, adaptive_relaxation "
-       "or all_at_once"});
+  // Riccati and shooting take the matrix model's operators (docs/riccati_shooting.md).
+  for (const char* method : {"riccati", "single_shooting", "multiple_shooting"}) {
+    EXPECT_EQ(CoupledSolverTypeToString(
+                  ParseConfig(matrix + "inner:\n  method: " + method + "\n", "a.yaml").inner.type),
+              std::string(method));
+  }
 }
 
 TEST(ConfigTest, DefaultConfigYamlParsesToTheDefaultConfig) {
@@ -875,8 +876,6 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
        "search.refine_window applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  merge_zones: true\n",
        "zone_identification.merge_zones applies to the bar only"},
-      {"model:\n  kind: matrix\n  manifest: m.yaml\ninner:\n  method: riccati\n",
-       "inner.method 'riccati' solves the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  channel_map: {F: t}\n",
        "cannot map to the time column"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  channel_map: {F: a, G: a}\n",
@@ -998,8 +997,7 @@ TEST(ConfigTest, EveryCoupledSolverIsAnInnerMethod) {
                            "riccati", "single_shooting", "multiple_shooting"}) {
     CoupledSolverType type;
     ASSERT_TRUE(StringToCoupledSolverType(name, &type));
-    // mcre.clamp measured and its own scan: the paper's data term, which Riccati and
-    // shooting need.
+    // mcre.clamp measured and its own scan: the paper's data term.
     EXPECT_EQ(ParseConfig("", "a.yaml",
                           {std::string("inner.method=") + name, "mcre.clamp=measured",
                            "search.functional=same"})
@@ -1008,45 +1006,18 @@ TEST(ConfigTest, EveryCoupledSolverIsAnInnerMethod) {
   }
 }
 
-TEST(ConfigTest, RiccatiAndShootingWithAnotherDataTermThanThePapersAreRefused) {
+TEST(ConfigTest, RiccatiAndShootingAreAcceptedWithEveryDataTerm) {
+  // They solve any clamp and sensors (the general data term W_obs = H^T diag(beta) H,
+  // docs/riccati_shooting.md), so no data term is refused at load any more.
   for (const char* name : {"riccati", "single_shooting", "multiple_shooting"}) {
     const std::string method = std::string("inner.method=") + name;
-    const std::string prefix = std::string("inner.method '") + name +
-                               "' handles the paper's data term only (u0 and uL, no interior "
-                               "sensor, the clamp measured), but ";
-    ExpectInputError([&] { ParseConfig("", "a.yaml", {method}); },
-                     {"--set " + method + ": " + prefix + "mcre.clamp is 'trusted'"});
-    ExpectInputError(
-        [&] {
-          ParseConfig("", "a.yaml", {method, "mcre.clamp=pinned"});
-        },
-        {prefix + "mcre.clamp is 'pinned'"});
-    ExpectInputError(
-        [&] {
-          ParseConfig("", "a.yaml", {method, "mcre.clamp=measured", "data.sensors=[e@0.5]"});
-        },
-        {prefix + "the identification uses interior sensors (data.sensors, data.channels)"});
-    ExpectInputError(
-        [&] {
-          ParseConfig("", "a.yaml", {method, "mcre.clamp=measured", "data.channels=[uL, f0, fL]"});
-        },
-        {prefix + "data.channels leaves out u0"});
-    // The pinned search functional of the default global scan.
-    ExpectInputError(
-        [&] {
-          ParseConfig("", "a.yaml", {method, "mcre.clamp=measured"});
-        },
-        {prefix + "search.functional is 'pinned' (the global scan's clamp is "
-                  "pinned); use inner.method conjugate_gradient, "
-                  "adaptive_relaxation, relaxation or all_at_once, or "
-                  "search.functional: same"});
-    // Interior sensors simulated but not used: the paper's data term.
-    EXPECT_NO_THROW(ParseConfig("", "a.yaml",
-                                {method, "mcre.clamp=measured", "search.functional=same",
-                                 "data.sensors=[e@0.5]", "data.channels=[u0, uL, f0, fL]"}));
-    // No global scan: no search functional.
+    EXPECT_NO_THROW(ParseConfig("", "a.yaml", {method}));
+    EXPECT_NO_THROW(ParseConfig("", "a.yaml", {method, "mcre.clamp=pinned"}));
     EXPECT_NO_THROW(
-        ParseConfig("", "a.yaml", {method, "mcre.clamp=measured", "outer.scan_points=0"}));
+        ParseConfig("", "a.yaml", {method, "mcre.clamp=measured", "data.sensors=[e@0.5]"}));
+    EXPECT_NO_THROW(
+        ParseConfig("", "a.yaml", {method, "mcre.clamp=measured", "data.channels=[uL, f0, fL]"}));
+    EXPECT_NO_THROW(ParseConfig("", "a.yaml", {method, "mcre.clamp=measured"}));
   }
 }
 

@@ -306,6 +306,16 @@ TEST_F(BarThroughMatricesTest, BatchedSweepsAreTheSingleSweeps) {
   }
 }
 
+// The bar exported as matrices (BarMatrixModel, 3 zones, an interior displacement
+// sensor and a strain gauge): Riccati and both shootings as on any structure.
+TEST_F(BarThroughMatricesTest, RiccatiAndShootingSolveTheBarAsMatrices) {
+  MatrixMcreProblem general(matrices_, histories_, weights_, 200e9, 0.5);
+  general.SetModuli((Vector(3) << 180e9, 200e9, 230e9).finished());
+  // Measured, the largest difference in U, W or e^2 over the three solvers: 2.0e-12 to
+  // all_at_once (single shooting's W; Riccati 3.3e-13), 8.6e-12 to CG (W).
+  testing::ExpectDenseSolversAgree("bar as matrices", &general, 1e-10, 2e-11, 8e-11);
+}
+
 TEST(MatrixMcreProblemTest, AllAtOnceAndIterativeSolversAgreeOnASparseLattice) {
   const MatrixModelData lattice = Lattice();
   const Vector truth = (Vector(2) << 2e11, 1.6e11).finished();
@@ -336,12 +346,54 @@ TEST(MatrixMcreProblemTest, AllAtOnceAndIterativeSolversAgreeOnASparseLattice) {
   const Vector dofs = problem.DofErrorMap(reference.retrograde);
   EXPECT_NEAR(dofs.sum(), zones.sum(), 1e-13 * zones.sum());
   EXPECT_GT(zones.minCoeff(), 0.0);
-  // The solvers written for the bar refuse a matrix model, naming the ones that work.
-  CoupledSolution refused;
-  const CoupledSolverSummary riccati =
-      SolveCoupled(Tight(CoupledSolverType::kRiccati), &problem, nullptr, &refused);
-  EXPECT_EQ(riccati.termination, TerminationType::kFailure);
-  EXPECT_NE(riccati.message.find("handles the built-in bar only"), std::string::npos);
+}
+
+// Riccati and both shootings on structures given by matrices, against the all-at-once
+// solver and CG (docs/riccati_shooting.md section 5): the sparse lattice with two zones
+// (band 5, an observed displacement and a difference row: W_obs not diagonal), and the
+// supported lattice of test_problems.h with its support trusted (held dofs decoupled,
+// the reaction a row of H).
+TEST(MatrixMcreProblemTest, RiccatiAndShootingSolveASparseLattice) {
+  const MatrixModelData lattice = Lattice();
+  const Vector truth = (Vector(2) << 2e11, 1.6e11).finished();
+  const ChannelSet data = Histories(lattice, truth, 120, 2e-3, 0.05, 0.05);
+  MatrixMcreProblem problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5, Factorization::kSparse);
+  problem.SetModuli((Vector(2) << 1.8e11, 2.1e11).finished());
+  // Measured, the largest difference in U, W or e^2 over the three solvers: 6.2e-15 to
+  // all_at_once, 1.7e-11 to CG (W); relative residuals 4.3e-15..6.5e-15.
+  testing::ExpectDenseSolversAgree("lattice", &problem, 1e-12, 6e-14, 1.7e-10);
+}
+
+TEST(MatrixMcreProblemTest, RiccatiAndShootingSolveASupportedLatticeWithItsSupportTrusted) {
+  const MatrixModelData lattice = testing::SupportedLattice();
+  const ChannelSet data = testing::SupportedLatticeHistories(lattice);
+  MatrixMcreProblem problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5, Factorization::kSparse,
+                            ClampModel::kTrusted);
+  problem.SetModuli((Vector(2) << 1.9e11, 1.7e11).finished());
+  // Measured, the largest difference in U, W or e^2 over the three solvers: 7.5e-14 to
+  // all_at_once, 1.4e-10 to CG (W); relative residuals 8.2e-14..1.1e-13.
+  testing::ExpectDenseSolversAgree("supported lattice, trusted", &problem, 1e-12, 7e-13, 1.4e-9);
+}
+
+TEST(MatrixMcreProblemTest, RiccatiAndShootingRefuseAboveTheDenseLimitNamingTheWayOut) {
+  const MatrixModelData lattice = Lattice();
+  const ChannelSet data = Histories(lattice, Vector::Constant(2, 2e11), 120, 2e-3, 0.05, 0.05);
+  MatrixMcreProblem problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5, Factorization::kSparse);
+  for (CoupledSolverType type : testing::kDenseSolvers) {
+    CoupledSolverOptions options = Tight(type);
+    // 28 dofs: Riccati needs 8 (120 (2 * 28^2 + 28) + 32 * 28^2 + 5 * 28 * 3) bytes,
+    // a shooting segment 8 (32 * 28^2 + ...); both above 100 kB.
+    options.max_dense_solver_bytes = 100000;
+    CoupledSolution refused;
+    const CoupledSolverSummary summary = SolveCoupled(options, &problem, nullptr, &refused);
+    EXPECT_EQ(summary.termination, TerminationType::kFailure) << CoupledSolverTypeToString(type);
+    EXPECT_NE(summary.message.find("above the limit of 100000 bytes "
+                                   "(inner.max_dense_solver_bytes); use inner.method: "
+                                   "conjugate_gradient or auto"),
+              std::string::npos)
+        << summary.message;
+    EXPECT_EQ(problem.sweep_count(), 0) << "refused before any work";
+  }
 }
 
 TEST(MatrixMcreProblemTest, EveryZoneGradientOfThePlateMatchesACentralDifference) {

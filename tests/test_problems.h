@@ -1,7 +1,11 @@
 // Small MCRE problems shared by the tests of the coupled solvers.
 #pragma once
 
+#include <gtest/gtest.h>
+
+#include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -121,7 +125,7 @@ struct Solved {
   CoupledSolution solution;
 };
 
-inline Solved Solve(const CoupledSolverOptions& options, McreProblem* problem,
+inline Solved Solve(const CoupledSolverOptions& options, CoupledProblem* problem,
                     const Matrix* initial = nullptr) {
   Solved solved;
   solved.summary = SolveCoupled(options, problem, initial, &solved.solution);
@@ -137,6 +141,37 @@ inline Agreement Compare(const Solved& solved, const Solved& reference) {
   return {RelativeDifference(solved.solution.displacement, reference.solution.displacement),
           RelativeDifference(solved.solution.retrograde, reference.solution.retrograde),
           std::abs(solved.solution.cost - reference.solution.cost) / reference.solution.cost};
+}
+
+// Riccati, single and multiple shooting at `tolerance` on `problem` against the
+// all-at-once solver (1e-12) and against conjugate gradients at 1e-13, each printed
+// under `label`; expects every solve usable and, for every solver, the relative
+// differences in U, W and e^2 below lu_bound (to all_at_once) and cg_bound (to CG; CG
+// itself stops at its round-off floor, so its figures are CG's error more than theirs).
+inline constexpr CoupledSolverType kDenseSolvers[] = {CoupledSolverType::kRiccati,
+                                                      CoupledSolverType::kSingleShooting,
+                                                      CoupledSolverType::kMultipleShooting};
+inline void ExpectDenseSolversAgree(const std::string& label, CoupledProblem* problem,
+                                    double tolerance, double lu_bound, double cg_bound) {
+  const Solved lu = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-12), problem);
+  ASSERT_TRUE(lu.summary.IsSolutionUsable()) << lu.summary.FullReport();
+  const Solved krylov = Solve(Options(CoupledSolverType::kConjugateGradient, 1e-13), problem);
+  ASSERT_TRUE(krylov.summary.IsSolutionUsable()) << krylov.summary.FullReport();
+  for (CoupledSolverType type : kDenseSolvers) {
+    const Solved solved = Solve(Options(type, tolerance), problem);
+    EXPECT_TRUE(solved.summary.IsSolutionUsable()) << label << ": " << solved.summary.FullReport();
+    if (!solved.summary.IsSolutionUsable()) continue;
+    const Agreement to_lu = Compare(solved, lu), to_krylov = Compare(solved, krylov);
+    const char* name = CoupledSolverTypeToString(type);
+    std::cout << label << ", " << name << " vs all_at_once / conjugate_gradient: U "
+              << to_lu.displacement << " / " << to_krylov.displacement << ", W " << to_lu.retrograde
+              << " / " << to_krylov.retrograde << ", e^2 " << to_lu.cost << " / " << to_krylov.cost
+              << ", residual " << solved.summary.relative_residual << "\n";
+    EXPECT_LT(std::max({to_lu.displacement, to_lu.retrograde, to_lu.cost}), lu_bound)
+        << label << ", " << name;
+    EXPECT_LT(std::max({to_krylov.displacement, to_krylov.retrograde, to_krylov.cost}), cg_bound)
+        << label << ", " << name;
+  }
 }
 
 // A small structure given by matrices with a support (matrix_supports_test.cpp,

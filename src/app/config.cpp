@@ -854,17 +854,9 @@ std::string StructureKeysProblem(const Config& config) {
   }
   // outer.functional: both run on a matrix model (least squares by
   // MatrixOutputErrorObjective, app/matrix_identification_run.h).
-  // auto streams on a matrix model when its fields do not fit (ResolveCoupledSolverType).
-  const CoupledSolverType method = config.inner.type;
-  if (method != CoupledSolverType::kAuto && method != CoupledSolverType::kConjugateGradient &&
-      method != CoupledSolverType::kStreamingConjugateGradient &&
-      method != CoupledSolverType::kRelaxation &&
-      method != CoupledSolverType::kAdaptiveRelaxation && method != CoupledSolverType::kAllAtOnce) {
-    return std::string("inner.method '") + CoupledSolverTypeToString(method) +
-           "' solves the bar only; with model.kind '" + kind +
-           "' use auto, conjugate_gradient, streaming_conjugate_gradient, relaxation, "
-           "adaptive_relaxation or all_at_once";
-  }
+  // Every inner.method runs on a matrix model: auto streams when its fields do not fit
+  // (ResolveCoupledSolverType), Riccati and shooting take its operators
+  // (docs/riccati_shooting.md).
   return "";
 }
 
@@ -1005,52 +997,6 @@ bool CheckBarRunSizes(const Config& config, std::string* error) {
   return true;
 }
 
-// Riccati and the shooting solvers are written for the paper's data term (H = B,
-// the clamp measured): refused here with any other, rather than by every solve of
-// the scan. Interior columns of a CSV are known once it is read; SolveCoupled
-// refuses those.
-bool CheckPapersDataTerm(const Config& config, std::string* error) {
-  const CoupledSolverType method = config.inner.type;
-  if (config.structure.kind != ModelKind::kBar || !NeedsThePapersDataTerm(method)) {
-    return true;
-  }
-  const std::string prefix = std::string("inner.method '") + CoupledSolverTypeToString(method) +
-                             "' handles the paper's data term only (u0 and uL, no interior "
-                             "sensor, the clamp measured), ";
-  const std::string remedy =
-      "; use inner.method conjugate_gradient, adaptive_relaxation, relaxation or "
-      "all_at_once";
-  const std::vector<std::string>& channels = config.data.channels;
-  const auto uses = [&channels](const char* name) {
-    return channels.empty() || std::find(channels.begin(), channels.end(), name) != channels.end();
-  };
-  bool interior = channels.empty() && !config.data.sensors.empty();
-  for (const std::string& name : channels) {
-    ChannelName channel;
-    std::string why;
-    // The names are valid: DataOptions::IsValid ran first.
-    ParseChannelName(name, &channel, &why);
-    interior = interior || channel.kind == ChannelName::Kind::kSensor;
-  }
-  if (config.mcre.clamp != ClampModel::kMeasured) {
-    *error = prefix + "but mcre.clamp is '" + ClampModelToString(config.mcre.clamp) + "'" + remedy +
-             ", or mcre.clamp: measured";
-  } else if (interior) {
-    *error = prefix +
-             "but the identification uses interior sensors (data.sensors, "
-             "data.channels)" +
-             remedy;
-  } else if (!uses("u0") || !uses("uL")) {
-    *error = prefix + "but data.channels leaves out " + (uses("u0") ? "uL" : "u0") + remedy;
-  } else if (ScansTheSearchFunctional(config)) {
-    *error = prefix + "but search.functional is 'pinned' (the global scan's clamp is pinned)" +
-             remedy + ", or search.functional: same";
-  } else {
-    return true;
-  }
-  return false;
-}
-
 // A cut-off at or above the Nyquist frequency is not a low-pass filter of the
 // sampled data (the bilinear transform maps Nyquist to tan(pi/2)).
 bool CheckPrefilterBelowNyquist(const Config& config, std::string* error) {
@@ -1079,7 +1025,6 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
       CheckStructureKeys,           // keys of the other model.kind
       CheckLoadSpansTwoSteps,       // load.duration against time.step
       CheckBarRunSizes,             // model.elements, time.*, data.truth_refinement, inner.*
-      CheckPapersDataTerm,          // inner.method against mcre.clamp, data.*, search.*
       CheckPrefilterBelowNyquist,   // prefilter.cutoff_frequency against time.step
   };
   return validators;

@@ -108,11 +108,6 @@ std::string CoupledSolverName(CoupledSolverType requested, CoupledSolverType use
   return CoupledSolverTypeToString(used);
 }
 
-bool NeedsThePapersDataTerm(CoupledSolverType type) {
-  return type == CoupledSolverType::kRiccati || type == CoupledSolverType::kSingleShooting ||
-         type == CoupledSolverType::kMultipleShooting;
-}
-
 namespace {
 
 // Why the solver name, holding fields of field_bytes, refuses to run above the limit
@@ -141,30 +136,17 @@ std::string FieldLimitRefusal(const std::string& name, double field_bytes,
   return refusal.str();
 }
 
-// Why the resolved method type cannot solve this problem, "" when it can: Riccati and
-// shooting handle the built-in bar (bar) with the paper's end sensors only, the
-// streaming solver a problem on sensor traces (streaming).
-std::string UnsupportedProblemMessage(CoupledSolverType type, const McreProblem* bar,
+// Why the resolved method type cannot solve this problem, "" when it can: the
+// streaming solver needs a problem on sensor traces (streaming). Riccati and shooting
+// solve any CoupledProblem from its operators (docs/riccati_shooting.md); they refuse
+// themselves above inner.max_dense_solver_bytes or when M, S or P is not positive
+// definite.
+std::string UnsupportedProblemMessage(CoupledSolverType type,
                                       const StreamingCoupledProblem* streaming) {
-  const bool comparator = NeedsThePapersDataTerm(type);
-  if (comparator && bar == nullptr) {
-    return std::string(CoupledSolverTypeToString(type)) +
-           " handles the built-in bar only; for a structure given by matrices use "
-           "inner.method: auto, conjugate_gradient, streaming_conjugate_gradient, "
-           "adaptive_relaxation, relaxation or all_at_once";
-  }
   if (type == CoupledSolverType::kStreamingConjugateGradient && streaming == nullptr) {
     return "streaming_conjugate_gradient needs a problem on sensor traces "
            "(StreamingCoupledProblem); "
            "use inner.method: conjugate_gradient, adaptive_relaxation, relaxation or all_at_once";
-  }
-  if (comparator && !bar->observes_ends_only()) {
-    // Their transfer operators are written for H = B (the two end displacements).
-    return std::string(CoupledSolverTypeToString(type)) +
-           " handles the paper's end sensors only (u0 and uL, no interior sensor, "
-           "mcre.clamp: measured); with interior sensors, an end channel left out or "
-           "a trusted or pinned clamp use inner.method: "
-           "conjugate_gradient, adaptive_relaxation, relaxation or all_at_once";
   }
   return "";
 }
@@ -172,9 +154,8 @@ std::string UnsupportedProblemMessage(CoupledSolverType type, const McreProblem*
 // Runs the solver of resolved.type (resolved, never auto); false, with the message in
 // summary, if it was left auto.
 bool RunResolvedSolver(const CoupledSolverOptions& resolved, CoupledProblem* problem,
-                       McreProblem* bar, StreamingCoupledProblem* streaming,
-                       const Matrix* initial_guess, CoupledSolution* solution,
-                       CoupledSolverSummary* summary) {
+                       StreamingCoupledProblem* streaming, const Matrix* initial_guess,
+                       CoupledSolution* solution, CoupledSolverSummary* summary) {
   switch (resolved.type) {
     case CoupledSolverType::kAllAtOnce:
       internal::SolveAllAtOnce(resolved, problem, solution, summary);
@@ -187,11 +168,11 @@ bool RunResolvedSolver(const CoupledSolverOptions& resolved, CoupledProblem* pro
       internal::SolveByConjugateGradient(resolved, problem, initial_guess, solution, summary);
       break;
     case CoupledSolverType::kRiccati:
-      internal::SolveByRiccati(resolved, bar, solution, summary);
+      internal::SolveByRiccati(resolved, problem, solution, summary);
       break;
     case CoupledSolverType::kSingleShooting:
     case CoupledSolverType::kMultipleShooting:
-      internal::SolveByShooting(resolved, bar, solution, summary);
+      internal::SolveByShooting(resolved, problem, solution, summary);
       break;
     case CoupledSolverType::kStreamingConjugateGradient:
       // Fills the cost and the gradients itself, from its final streaming pass.
@@ -220,9 +201,9 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
     summary.message = "invalid options: " + why;
     return summary;
   }
-  // Riccati and shooting are written for the built-in bar; the streaming solver for
-  // any problem on sensor traces (the bar and a structure given by matrices).
-  McreProblem* bar = dynamic_cast<McreProblem*>(problem);
+  // The streaming solver needs a problem on sensor traces (the bar and a structure
+  // given by matrices); the field-limit refusal names the ways out for the bar.
+  const bool is_bar = dynamic_cast<McreProblem*>(problem) != nullptr;
   StreamingCoupledProblem* streaming = dynamic_cast<StreamingCoupledProblem*>(problem);
   const CoupledSolverType type = ResolveCoupledSolverType(
       options, problem->num_nodes(), problem->num_steps(), streaming != nullptr);
@@ -231,11 +212,11 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
   const double field_bytes = IterativeSolverFieldBytes(problem->num_nodes(), problem->num_steps());
   if (HoldsIterativeSolverFields(type) &&
       field_bytes > static_cast<double>(options.max_field_bytes)) {
-    summary.message = FieldLimitRefusal(name, field_bytes, options, problem, bar != nullptr,
-                                        streaming != nullptr);
+    summary.message =
+        FieldLimitRefusal(name, field_bytes, options, problem, is_bar, streaming != nullptr);
     return summary;
   }
-  const std::string unsupported = UnsupportedProblemMessage(type, bar, streaming);
+  const std::string unsupported = UnsupportedProblemMessage(type, streaming);
   if (!unsupported.empty()) {
     summary.message = unsupported;
     return summary;
@@ -243,7 +224,7 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
   // The solvers below see the resolved method.
   CoupledSolverOptions resolved = options;
   resolved.type = type;
-  if (!RunResolvedSolver(resolved, problem, bar, streaming, initial_guess, solution, &summary)) {
+  if (!RunResolvedSolver(resolved, problem, streaming, initial_guess, solution, &summary)) {
     return summary;
   }
   if (summary.IsSolutionUsable() && type != CoupledSolverType::kStreamingConjugateGradient) {

@@ -17,9 +17,9 @@ void SolveByRelaxation(const CoupledSolverOptions& options, CoupledProblem* prob
 void SolveByConjugateGradient(const CoupledSolverOptions& options, CoupledProblem* problem,
                               const Matrix* initial_retrograde, CoupledSolution* solution,
                               CoupledSolverSummary* summary);
-void SolveByRiccati(const CoupledSolverOptions& options, McreProblem* problem,
+void SolveByRiccati(const CoupledSolverOptions& options, CoupledProblem* problem,
                     CoupledSolution* solution, CoupledSolverSummary* summary);
-void SolveByShooting(const CoupledSolverOptions& options, McreProblem* problem,
+void SolveByShooting(const CoupledSolverOptions& options, CoupledProblem* problem,
                      CoupledSolution* solution, CoupledSolverSummary* summary);
 // Also fills the solution's cost, gradients, traces and what the problem's streaming
 // totals hold (the bar: end retrograde values, error map and its picture; a matrix

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "mcrewave/core/operation_counts.h"
 
@@ -54,17 +55,29 @@ double BandCholesky::entries() const {
   return n * (p + 1.0) - 0.5 * p * (p + 1.0);
 }
 
-DiscreteMcreOperators::DiscreteMcreOperators(const McreProblem& problem)
+std::vector<int> ObservedDofs(const SparseMatrix& weighted_observation) {
+  std::vector<int> observed;
+  const Vector diagonal = weighted_observation.diagonal();
+  for (int i = 0; i < static_cast<int>(diagonal.size()); ++i) {
+    if (diagonal[i] != 0.0) observed.push_back(i);
+  }
+  return observed;
+}
+
+DiscreteMcreOperators::DiscreteMcreOperators(const CoupledProblem& problem)
     : problem_(problem),
       num_nodes_(problem.num_nodes()),
       num_steps_(problem.num_steps()),
       time_step_(problem.time_step()),
       theta_(problem.theta()),
-      inverse_alpha_(1.0 / problem.alpha()) {
-  const BarModel& model = problem.model();
-  const SymmetricBandMatrix mass(model.mass());
-  stiffness_ = SymmetricBandMatrix(model.Stiffness(problem.moduli()));
-  bandwidth_ = std::max(mass.half_bandwidth(), stiffness_.half_bandwidth());
+      observation_(problem.WeightedObservation()),
+      observed_(ObservedDofs(observation_)),
+      load_(num_nodes_) {
+  const SymmetricBandMatrix mass(problem.MassMatrix());
+  stiffness_ = SymmetricBandMatrix(problem.StiffnessMatrix());
+  penalty_ = SymmetricBandMatrix(problem.PenaltyMatrix());
+  bandwidth_ =
+      std::max({mass.half_bandwidth(), stiffness_.half_bandwidth(), penalty_.half_bandwidth()});
   const double h = time_step_, theta = theta_;
   // R = M - h^2 theta (1 - theta) K.
   free_state_ =
@@ -74,27 +87,42 @@ DiscreteMcreOperators::DiscreteMcreOperators(const McreProblem& problem)
       SymmetricBandMatrix::LinearCombination(1.0, mass, h * h * theta * theta, stiffness_);
   const SymmetricBandMatrix reversed_step_matrix = SymmetricBandMatrix::LinearCombination(
       1.0, mass, h * h * (1.0 - theta) * (1.0 - theta), stiffness_);
-  // Kp = K + B / alpha.
-  SymmetricBandMatrix penalty = stiffness_;
-  penalty.lower(0, 0) += inverse_alpha_;
-  penalty.lower(0, last_node()) += inverse_alpha_;
-  if (!step_factor_.Compute(step_matrix) || !reversed_step_factor_.Compute(reversed_step_matrix) ||
-      !penalty_factor_.Compute(penalty) || !mass_factor_.Compute(mass)) {
-    throw std::runtime_error(
-        "discrete MCRE operators: M + h^2 theta^2 K, M or K + B / alpha is not positive definite");
+  const char* failed = nullptr;
+  if (!step_factor_.Compute(step_matrix)) {
+    failed = "M + h^2 theta^2 K";
+  } else if (!reversed_step_factor_.Compute(reversed_step_matrix)) {
+    failed = "M + h^2 (1 - theta)^2 K";
+  } else if (!penalty_factor_.Compute(penalty_)) {
+    failed = "the penalty matrix P = K + G diag(1/alpha) G^T";
+  } else if (!mass_factor_.Compute(mass)) {
+    failed = "the mass matrix M";
+  }
+  if (failed != nullptr) {
+    throw std::runtime_error(std::string("discrete MCRE operators: ") + failed +
+                             " is not positive definite");
   }
 }
 
-void DiscreteMcreOperators::AddForceData(int j, double scale, Eigen::Ref<Vector> x) const {
-  const BarEnds& data = problem_.measured();
-  x[0] += scale * data.f0[j];
-  x[last_node()] += scale * data.fL[j];
+Vector DiscreteMcreOperators::ObservationColumn(int i) const {
+  return observation_.col(observed_[i]).toDense();
 }
 
-void DiscreteMcreOperators::AddDisplacementData(int j, double scale, Eigen::Ref<Vector> x) const {
-  const BarEnds& data = problem_.measured();
-  x[0] += scale * data.u0[j];
-  x[last_node()] += scale * data.uL[j];
+void DiscreteMcreOperators::AddMeasuredForce(int j, double scale, Eigen::Ref<Vector> x) {
+  problem_.MeasuredForce(j, load_);
+  x += scale * load_;
+  macs_ += num_nodes_;
+}
+
+void DiscreteMcreOperators::AddWeightedData(int j, double scale, Eigen::Ref<Vector> x) {
+  problem_.WeightedData(j, load_);
+  x += scale * load_;
+  macs_ += num_nodes_;
+}
+
+void DiscreteMcreOperators::ObservationProduct(const Eigen::Ref<const Vector>& x,
+                                               Eigen::Ref<Vector> y) {
+  y.noalias() = observation_ * x;
+  macs_ += static_cast<double>(observation_.nonZeros());
 }
 
 void DiscreteMcreOperators::StiffnessProduct(const Eigen::Ref<const Vector>& x,
@@ -111,11 +139,8 @@ void DiscreteMcreOperators::StiffnessProductAdd(double scale, const Eigen::Ref<c
 
 void DiscreteMcreOperators::PenaltyProduct(const Eigen::Ref<const Vector>& x,
                                            Eigen::Ref<Vector> y) {
-  // Kp x = K x + B x / alpha.
-  stiffness_.Multiply(x, y);
-  y[0] += inverse_alpha_ * x[0];
-  y[last_node()] += inverse_alpha_ * x[last_node()];
-  macs_ += counts::BandProduct(num_nodes_, bandwidth_) + 2.0;
+  penalty_.Multiply(x, y);
+  macs_ += counts::BandProduct(num_nodes_, penalty_.half_bandwidth());
 }
 
 void DiscreteMcreOperators::FreeStateProduct(const Eigen::Ref<const Vector>& x,

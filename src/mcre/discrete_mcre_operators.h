@@ -1,10 +1,15 @@
 // The banded operators of the discrete MCRE system (docs/discrete_mcre.md) for the
-// solvers that do not go through McreProblem's sweeps (Riccati, shooting): they
+// solvers that do not go through the problem's sweeps (Riccati, shooting): they
 // apply single theta steps and band products to the columns of dense blocks, and
 // count every multiply-accumulate they perform (include/mcrewave/core/operation_counts.h).
+// They are built from the sparse operators of any CoupledProblem (coupled_problem.h):
+// the built-in bar and a structure given by matrices alike.
 //
-// Notation (docs/riccati_shooting.md): n nodes, M mass, K = E K1 stiffness,
-// B = e_0 e_0^T + e_N e_N^T, Kp = K + B / alpha, and for the theta method with step h
+// Notation (docs/riccati_shooting.md): n dofs, M mass, K stiffness, P = Kp = K + G
+// diag(1/alpha) G^T (the penalty matrix), the data term W_obs = H^T diag(beta) H
+// (symmetric positive semi-definite, possibly rank deficient) with the weighted data
+// b_j = H^T diag(beta) d~_j and the measured loads G F~_j, and for the theta method
+// with step h
 //
 //   S  = M + h^2 theta^2 K         (the iteration matrix of a step),
 //   S' = M + h^2 (1 - theta)^2 K   (that of the step run backwards: shooting),
@@ -14,10 +19,17 @@
 //
 //   v' = S^-1 (R v - h K u + h f),   u' = u + h (1 - theta) v + h theta v',
 //   i.e. Psi f = (h^2 theta S^-1 f, h S^-1 f).
+//
+// The observed dofs o_1..o_s are those where W_obs has a nonzero diagonal entry (a
+// zero diagonal entry of a positive semi-definite matrix has a zero row and column),
+// so W_obs = E_o W_s E_o^T with E_o the s columns of the identity at the observed
+// dofs: the paper's end sensors give s = 2 and W_obs = beta (e_0 e_0^T + e_N e_N^T).
 #pragma once
 
+#include <vector>
+
 #include "mcrewave/linalg/band_matrix.h"
-#include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/mcre/coupled_problem.h"
 
 namespace mcrewave::internal {
 
@@ -38,25 +50,37 @@ class BandCholesky {
   Matrix lower_;  // (p + 1) x n, lower_(d, i) = L(i, i - d)
 };
 
+// The observed dofs of a data term W_obs = H^T diag(beta) H: its nonzero diagonal
+// entries, ascending.
+std::vector<int> ObservedDofs(const SparseMatrix& weighted_observation);
+
 class DiscreteMcreOperators {
  public:
-  // Builds M, K, R, Kp as band matrices and factorises S and S' at the problem's
-  // current modulus. The problem must outlive this object.
-  explicit DiscreteMcreOperators(const McreProblem& problem);
+  // Builds M, K, R, P and W_obs as band matrices from the problem's sparse operators
+  // and factorises S, S', P and M at the problem's current moduli. The problem must
+  // outlive this object. Throws std::runtime_error naming the matrix when S, S', P or
+  // M is not positive definite.
+  explicit DiscreteMcreOperators(const CoupledProblem& problem);
 
   int num_nodes() const { return num_nodes_; }
   int num_steps() const { return num_steps_; }
-  int last_node() const { return num_nodes_ - 1; }
-  int half_bandwidth() const { return bandwidth_; }  // of M and K
+  // The half bandwidth of the union of the patterns of M, K and P.
+  int half_bandwidth() const { return bandwidth_; }
   double time_step() const { return time_step_; }
   double theta() const { return theta_; }
-  double beta() const { return problem_.beta(); }
   double QuadratureWeight(int j) const { return problem_.QuadratureWeight(j); }
 
-  // x += scale F~_j, the measured end forces as a nodal vector (f0_j at node 0, fL_j at N).
-  void AddForceData(int j, double scale, Eigen::Ref<Vector> x) const;
-  // x += scale U~_j, the measured end displacements as a nodal vector.
-  void AddDisplacementData(int j, double scale, Eigen::Ref<Vector> x) const;
+  // The observed dofs o_1..o_s and W_obs e_{o_i}, the column of observed dof i.
+  const std::vector<int>& observed_dofs() const { return observed_; }
+  int num_observed() const { return static_cast<int>(observed_.size()); }
+  Vector ObservationColumn(int i) const;
+
+  // x += scale G F~_j, the measured loads at sample j [N].
+  void AddMeasuredForce(int j, double scale, Eigen::Ref<Vector> x);
+  // x += scale b_j, b_j = H^T diag(beta) d~_j the weighted data at sample j [N].
+  void AddWeightedData(int j, double scale, Eigen::Ref<Vector> x);
+  // y = W_obs x. y must not alias x.
+  void ObservationProduct(const Eigen::Ref<const Vector>& x, Eigen::Ref<Vector> y);
 
   // y = K x, y += scale K x, y = Kp x, y = R x. y must not alias x.
   void StiffnessProduct(const Eigen::Ref<const Vector>& x, Eigen::Ref<Vector> y);
@@ -70,7 +94,7 @@ class DiscreteMcreOperators {
   // Energy coordinates of a state pair (displacement-like a, velocity-like b):
   // (Lp^T a, Lm^T b) with Kp = Lp Lp^T, M = Lm Lm^T, so that the squared 2-norm of the
   // coordinates is a^T Kp a + b^T M b, an energy [J]. The trapezoidal step of the
-  // uncoupled bar conserves it up to the end springs B / alpha.
+  // uncoupled structure conserves it up to the springs G diag(1/alpha) G^T.
   void ToEnergyCoordinates(const Eigen::Ref<const Vector>& displacement_like,
                            const Eigen::Ref<const Vector>& velocity_like,
                            Eigen::Ref<Vector> displacement_coordinates,
@@ -90,15 +114,19 @@ class DiscreteMcreOperators {
   void CountMacs(double macs) { macs_ += macs; }
 
  private:
-  const McreProblem& problem_;
+  const CoupledProblem& problem_;
   int num_nodes_, num_steps_, bandwidth_;
-  double time_step_, theta_, inverse_alpha_;
+  double time_step_, theta_;
   SymmetricBandMatrix stiffness_;   // K
+  SymmetricBandMatrix penalty_;     // P
   SymmetricBandMatrix free_state_;  // R
+  SparseMatrix observation_;        // W_obs
+  std::vector<int> observed_;       // o_1..o_s
   BandLdlt step_factor_;            // S = L D L^T
   BandLdlt reversed_step_factor_;   // S' = L D L^T
   BandCholesky penalty_factor_;     // Kp = Lp Lp^T
   BandCholesky mass_factor_;        // M = Lm Lm^T
+  Vector load_;                     // scratch of the data loads
   double macs_ = 0.0;
 };
 

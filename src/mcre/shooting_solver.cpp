@@ -6,19 +6,22 @@
 // k -> k+1 (notation of discrete_mcre_operators.h):
 //
 //   W_k        = (chi_k theta omega_{k-1} + (1 - theta) omega_k) / c_k,  chi_k = [k >= 1]
-//   (R) run backwards, free part: S' yhat = R y_k + h K omega_k + h c_{k+1} beta U~_{k+1}
+//   (R) run backwards, free part: S' yhat = R y_k + h K omega_k + h c_{k+1} b_{k+1}
 //              omegahat = omega_k - h theta y_k - h (1 - theta) yhat
 //   (D) with W_{k+1} taken at omegahat: (Uhat, Vhat) = Phi Y_k + Psi [F~theta_k
 //              - Kp ((theta/c_{k+1}) (theta omega_k + (1 - theta) omegahat) + (1 - theta) W_k)]
-//   the end displacements close the implicit coupling (B U_{k+1} enters (R)):
-//              (I + Gamma) B U_{k+1} = B Uhat,   Gamma_ab = gamma_b[a],
-//              gamma_i = theta^2 (1 - theta)^2 h^4 beta S^-1 Kp S'^-1 e_i,
-//   U_{k+1}    = Uhat - sum_i gamma_i U_{k+1,i},  V_{k+1} = Vhat - sum_i gamma_i U_{k+1,i} / (h
-//   theta) omega_{k+1} = omegahat + h^2 (1 - theta) c_{k+1} beta S'^-1 B U_{k+1} y_{k+1}    = yhat
-//   - h c_{k+1} beta S'^-1 B U_{k+1}
+//   the observed values x = E_o^T U_{k+1} close the implicit coupling (W_obs U_{k+1}
+//   = E_o W_s x enters (R)):
+//              (I_s + E_o^T Gamma_U) x = E_o^T Uhat,
+//              Gamma_U = theta^2 (1 - theta)^2 h^4 S^-1 Kp S'^-1 W_obs E_o   (n x s),
+//   U_{k+1}     = Uhat - Gamma_U x,   V_{k+1} = Vhat - Gamma_V x,
+//   omega_{k+1} = omegahat + h^2 (1 - theta) c_{k+1} S'^-1 W_obs E_o x,
+//   y_{k+1}     = yhat - h c_{k+1} S'^-1 W_obs E_o x,
 //
-// (V's gamma is theta (1 - theta)^2 h^3 beta S^-1 Kp S'^-1 e_i, which the code keeps
-// separately so that theta = 0 is covered.)
+// with W_obs = H^T diag(beta) H = E_o W_s E_o^T on the s observed dofs and b_j =
+// H^T diag(beta) d~_j (the paper's end sensors: s = 2, W_obs E_o = beta (e_0, e_N)).
+// (Gamma_V = theta (1 - theta)^2 h^3 S^-1 Kp S'^-1 W_obs E_o is kept separately so
+// that theta = 0 is covered.)
 //
 // Single shooting: Y_0 = 0 is known, Z_0 is not. March the particular solution
 // (Z_0 = 0, with the data) and the 2n unit columns of Z_0 (without data) to m: the
@@ -43,7 +46,9 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
+#include <stdexcept>
 #include <vector>
 
 #include "mcre/coupled_solver_internal.h"
@@ -70,52 +75,62 @@ struct CoupledColumns {
   }
 };
 
-// The coupled step k -> k+1 applied to columns, with its constant vectors.
+// The coupled step k -> k+1 applied to columns, with its constant blocks on the s
+// observed dofs (W_obs = E_o W_s E_o^T, discrete_mcre_operators.h).
 class CoupledMarch {
  public:
-  explicit CoupledMarch(DiscreteMcreOperators* ops) : ops_(*ops), n_(ops->num_nodes()) {
-    const double h = ops_.time_step(), theta = ops_.theta(), beta = ops_.beta();
-    const std::array<int, 2> end_nodes{0, n_ - 1};
-    for (int i = 0; i < 2; ++i) {
-      // S'^-1 e_i and S^-1 Kp S'^-1 e_i.
-      reversed_solved_end_[i] = Vector::Unit(n_, end_nodes[i]);
-      ops_.SolveReversedStep(reversed_solved_end_[i]);
-      Vector response(n_);
-      ops_.PenaltyProduct(reversed_solved_end_[i], response);
+  // Throws std::runtime_error when I + E_o^T Gamma_U is singular (theta != 1/2 only:
+  // at theta = 1/2 its eigenvalues are those of I + (SPD)(PSD), at least 1).
+  explicit CoupledMarch(DiscreteMcreOperators* ops)
+      : ops_(*ops), n_(ops->num_nodes()), observed_(ops->observed_dofs()) {
+    const double h = ops_.time_step(), theta = ops_.theta();
+    const int s = static_cast<int>(observed_.size());
+    reversed_solved_.resize(n_, s);
+    displacement_gamma_.resize(n_, s);
+    velocity_gamma_.resize(n_, s);
+    Vector response(n_);
+    for (int i = 0; i < s; ++i) {
+      // S'^-1 W_obs e_{o_i} and S^-1 Kp S'^-1 W_obs e_{o_i}.
+      reversed_solved_.col(i) = ops_.ObservationColumn(i);
+      ops_.SolveReversedStep(reversed_solved_.col(i));
+      ops_.PenaltyProduct(reversed_solved_.col(i), response);
       ops_.SolveStep(response);
-      // gamma_U = theta^2 (1 - theta)^2 h^4 beta (.),  gamma_V = theta (1 - theta)^2 h^3 beta (.).
-      displacement_gamma_[i] =
-          (theta * theta * std::pow(1.0 - theta, 2) * std::pow(h, 4) * beta) * response;
-      velocity_gamma_[i] = (theta * std::pow(1.0 - theta, 2) * std::pow(h, 3) * beta) * response;
+      // Gamma_U = theta^2 (1 - theta)^2 h^4 (.),  Gamma_V = theta (1 - theta)^2 h^3 (.).
+      displacement_gamma_.col(i) =
+          (theta * theta * std::pow(1.0 - theta, 2) * std::pow(h, 4)) * response;
+      velocity_gamma_.col(i) = (theta * std::pow(1.0 - theta, 2) * std::pow(h, 3)) * response;
       ops_.CountMacs(2.0 * n_);
     }
-    // (I + Gamma)^-1, Gamma_ab = gamma_U,b at end node a.
-    Eigen::Matrix2d coupling;
-    for (int a = 0; a < 2; ++a) {
-      for (int b = 0; b < 2; ++b) {
-        coupling(a, b) = (a == b ? 1.0 : 0.0) + displacement_gamma_[b][end_nodes[a]];
-      }
+    // I + E_o^T Gamma_U (s x s): (I + E_o^T Gamma_U) E_o^T U_{k+1} = E_o^T Uhat.
+    Matrix coupling = Matrix::Identity(s, s);
+    for (int a = 0; a < s; ++a) coupling.row(a) += displacement_gamma_.row(observed_[a]);
+    if (s > 0) coupling_lu_.compute(coupling);
+    if (s > 0 && !(std::abs(coupling_lu_.determinant()) > 0.0)) {
+      throw std::runtime_error(
+          "the implicit coupling of a shooting step, I + E_o^T Gamma_U on the observed dofs, "
+          "is singular");
     }
-    end_coupling_inverse_ = coupling.inverse();
+    ops_.CountMacs(counts::LuFactorization(s));
     for (Vector* v : {&y_hat_, &omega_hat_, &mixed_, &force_, &u_hat_, &v_hat_}) {
       v->resize(n_);
     }
+    observed_values_.resize(s);
   }
 
   // One step k -> k+1 of every column of x; column 0 carries the data when with_data.
   void Step(int k, bool with_data, CoupledColumns* x) {
-    const double h = ops_.time_step(), theta = ops_.theta(), beta = ops_.beta();
+    const double h = ops_.time_step(), theta = ops_.theta();
     const double c_now = ops_.QuadratureWeight(k), c_next = ops_.QuadratureWeight(k + 1);
     const double chi = k >= 1 ? 1.0 : 0.0;
-    const int last = n_ - 1;
+    const int s = static_cast<int>(observed_.size());
     for (int j = 0; j < x->displacement.cols(); ++j) {
       const bool data = with_data && j == 0;
       auto omega = x->omega.col(j);
       auto retrograde_velocity = x->retrograde_velocity.col(j);
-      // (R) backwards, free part: S' yhat = R y + h K omega (+ h c_{k+1} beta U~_{k+1}).
+      // (R) backwards, free part: S' yhat = R y + h K omega (+ h c_{k+1} b_{k+1}).
       ops_.FreeStateProduct(retrograde_velocity, y_hat_);
       ops_.StiffnessProductAdd(h, omega, y_hat_);
-      if (data) ops_.AddDisplacementData(k + 1, h * c_next * beta, y_hat_);
+      if (data) ops_.AddWeightedData(k + 1, h * c_next, y_hat_);
       ops_.SolveReversedStep(y_hat_);
       // omegahat = omega - h theta y - h (1 - theta) yhat.
       omega_hat_ = omega - (h * theta) * retrograde_velocity - (h * (1.0 - theta)) * y_hat_;
@@ -129,40 +144,42 @@ class CoupledMarch {
       ops_.PenaltyProduct(mixed_, force_);
       force_ = -force_;
       if (data) {
-        ops_.AddForceData(k + 1, theta, force_);
-        ops_.AddForceData(k, 1.0 - theta, force_);
+        ops_.AddMeasuredForce(k + 1, theta, force_);
+        ops_.AddMeasuredForce(k, 1.0 - theta, force_);
       }
       ops_.ThetaStep(x->displacement.col(j), x->velocity.col(j), &force_, u_hat_, v_hat_);
-      // (I + Gamma) B U_{k+1} = B Uhat.
-      const Eigen::Vector2d end_values =
-          end_coupling_inverse_ * Eigen::Vector2d(u_hat_[0], u_hat_[last]);
-      x->displacement.col(j) =
-          u_hat_ - end_values[0] * displacement_gamma_[0] - end_values[1] * displacement_gamma_[1];
-      x->velocity.col(j) =
-          v_hat_ - end_values[0] * velocity_gamma_[0] - end_values[1] * velocity_gamma_[1];
+      // (I + E_o^T Gamma_U) E_o^T U_{k+1} = E_o^T Uhat.
+      for (int i = 0; i < s; ++i) observed_values_[i] = u_hat_[observed_[i]];
+      if (s > 0) observed_values_ = coupling_lu_.solve(observed_values_);
+      x->displacement.col(j) = u_hat_;
+      x->velocity.col(j) = v_hat_;
       x->previous_omega.col(j) = omega;
-      // omega_{k+1} = omegahat + h^2 (1 - theta) c_{k+1} beta S'^-1 B U_{k+1},
-      // y_{k+1} = yhat - h c_{k+1} beta S'^-1 B U_{k+1}.
-      const Eigen::Vector2d response = (h * c_next * beta) * end_values;
-      omega = omega_hat_ + (h * (1.0 - theta)) * (response[0] * reversed_solved_end_[0] +
-                                                  response[1] * reversed_solved_end_[1]);
-      retrograde_velocity =
-          y_hat_ - response[0] * reversed_solved_end_[0] - response[1] * reversed_solved_end_[1];
+      // U_{k+1} = Uhat - Gamma_U x, V_{k+1} = Vhat - Gamma_V x,
+      // omega_{k+1} = omegahat + h^2 (1 - theta) c_{k+1} S'^-1 W_obs E_o x,
+      // y_{k+1} = yhat - h c_{k+1} S'^-1 W_obs E_o x,   x = E_o^T U_{k+1}.
+      omega = omega_hat_;
+      retrograde_velocity = y_hat_;
+      for (int i = 0; i < s; ++i) {
+        const double value = observed_values_[i], response = h * c_next * value;
+        x->displacement.col(j) -= value * displacement_gamma_.col(i);
+        x->velocity.col(j) -= value * velocity_gamma_.col(i);
+        omega += (h * (1.0 - theta) * response) * reversed_solved_.col(i);
+        retrograde_velocity -= response * reversed_solved_.col(i);
+      }
     }
-    // omegahat 2n, the mix 3n, the corrections of U, V, omega, y 4 x 2n, + O(1).
-    ops_.CountMacs(x->displacement.cols() * (13.0 * n_ + 12.0));
+    // omegahat 2n, the mix 3n, the corrections of U, V, omega, y 4 s n, the s x s solve.
+    ops_.CountMacs(x->displacement.cols() *
+                   (5.0 * n_ + 4.0 * s * n_ + counts::LuSolve(s, 1) + 2.0 * s));
   }
 
   // omega_{k-1} of every column from (Z_k, U_k) by one retrograde step (R) with the
-  // force c_k beta (B U_k - U~_k); the data only in column 0 when with_data. k >= 1.
+  // force c_k (W_obs U_k - b_k); the data only in column 0 when with_data. k >= 1.
   void SetPreviousOmega(int k, bool with_data, CoupledColumns* x) {
-    const double c_now = ops_.QuadratureWeight(k), beta = ops_.beta();
-    const int last = n_ - 1;
+    const double c_now = ops_.QuadratureWeight(k);
     for (int j = 0; j < x->displacement.cols(); ++j) {
-      force_.setZero();
-      force_[0] = c_now * beta * x->displacement(0, j);
-      force_[last] = c_now * beta * x->displacement(last, j);
-      if (with_data && j == 0) ops_.AddDisplacementData(k, -c_now * beta, force_);
+      ops_.ObservationProduct(x->displacement.col(j), force_);
+      force_ *= c_now;
+      if (with_data && j == 0) ops_.AddWeightedData(k, -c_now, force_);
       ops_.ThetaStep(x->omega.col(j), x->retrograde_velocity.col(j), &force_,
                      x->previous_omega.col(j), v_hat_);
     }
@@ -171,9 +188,12 @@ class CoupledMarch {
  private:
   DiscreteMcreOperators& ops_;
   int n_;
-  std::array<Vector, 2> reversed_solved_end_, displacement_gamma_, velocity_gamma_;
-  Eigen::Matrix2d end_coupling_inverse_;
-  Vector y_hat_, omega_hat_, mixed_, force_, u_hat_, v_hat_;  // scratch
+  const std::vector<int> observed_;  // o_1..o_s
+  // S'^-1 W_obs E_o, Gamma_U = theta^2 (1 - theta)^2 h^4 S^-1 Kp S'^-1 W_obs E_o and
+  // Gamma_V = theta (1 - theta)^2 h^3 S^-1 Kp S'^-1 W_obs E_o, n x s each.
+  Matrix reversed_solved_, displacement_gamma_, velocity_gamma_;
+  Eigen::PartialPivLU<Matrix> coupling_lu_;  // of I + E_o^T Gamma_U
+  Vector y_hat_, omega_hat_, mixed_, force_, u_hat_, v_hat_, observed_values_;  // scratch
 };
 
 // The unknowns of shooting are full states in energy coordinates
@@ -220,11 +240,11 @@ constexpr int kGrowthCheckInterval = 4;
 // Bytes of the shooting solver's dense storage for `segments` segments: the
 // triangular factor and coupling block of every stage (4n x 4n each), the columns
 // of one segment's march (5 fields of n x (4n + 1)) and the stage's panel (6n x (8n + 1))
-// with its transformed copy.
-double ShootingBytes(int num_nodes, int segments) {
+// with its transformed copy, and the march's three n x s blocks on the s observed dofs.
+double ShootingBytes(int num_nodes, int segments, int num_observed) {
   const double n = num_nodes;
   return 8.0 * (segments * (32.0 * n * n + 4.0 * n) + 5.0 * n * (4.0 * n + 1.0) +
-                2.0 * 6.0 * n * (8.0 * n + 1.0));
+                2.0 * 6.0 * n * (8.0 * n + 1.0) + 3.0 * n * num_observed);
 }
 
 // One stage of the staircase QR, kept for the back substitution:
@@ -259,8 +279,9 @@ std::string ShootingMemoryMessage(const char* name, double bytes, int segments, 
                                   long limit) {
   std::ostringstream why;
   why << name << " needs at least " << static_cast<long long>(bytes) << " bytes (" << segments
-      << " segments of 4n x 4n factors, n = " << num_nodes << " nodes), above the limit of "
-      << limit << " bytes (inner.max_dense_solver_bytes); use riccati or conjugate_gradient";
+      << " segments of 4n x 4n factors, n = " << num_nodes << " dofs), above the limit of " << limit
+      << " bytes (inner.max_dense_solver_bytes); use inner.method: conjugate_gradient or auto, "
+         "which hold no dense n x n block, or raise inner.max_dense_solver_bytes";
   return why.str();
 }
 
@@ -431,8 +452,9 @@ std::vector<Vector> BackSubstitute(const Staircase& staircase, DiscreteMcreOpera
 // Marches each segment once more from its start state with the data, recording U
 // and W_k = (chi theta omega_{k-1} + (1 - theta) omega_k) / c_k into the solution.
 void RecordShootingSolution(const std::vector<int>& starts, const std::vector<Vector>& start_states,
-                            McreProblem* problem, DiscreteMcreOperators* ops, CoupledMarch* march,
-                            CoupledColumns* columns, CoupledSolution* solution) {
+                            CoupledProblem* problem, DiscreteMcreOperators* ops,
+                            CoupledMarch* march, CoupledColumns* columns,
+                            CoupledSolution* solution) {
   const int n = problem->num_nodes(), m = problem->num_steps(), two_n = 2 * n, four_n = 4 * n;
   const int segments = static_cast<int>(starts.size());
   const double theta = problem->theta();
@@ -469,14 +491,34 @@ void RecordShootingSolution(const std::vector<int>& starts, const std::vector<Ve
 
 }  // namespace
 
-void SolveByShooting(const CoupledSolverOptions& options, McreProblem* problem,
+void SolveByShooting(const CoupledSolverOptions& options, CoupledProblem* problem,
                      CoupledSolution* solution, CoupledSolverSummary* summary) {
   const bool multiple = options.type == CoupledSolverType::kMultipleShooting;
   const char* name = CoupledSolverTypeToString(options.type);
   const int n = problem->num_nodes(), m = problem->num_steps(), two_n = 2 * n, four_n = 4 * n;
   summary->iterations = 0;
-  DiscreteMcreOperators ops(*problem);
-  CoupledMarch march(&ops);
+  // The dense storage of the first segment, checked before any of it is allocated.
+  const int num_observed = static_cast<int>(ObservedDofs(problem->WeightedObservation()).size());
+  const double first_bytes = ShootingBytes(n, 1, num_observed);
+  if (first_bytes > static_cast<double>(options.max_dense_solver_bytes)) {
+    summary->termination = TerminationType::kFailure;
+    summary->message =
+        ShootingMemoryMessage(name, first_bytes, 1, n, options.max_dense_solver_bytes);
+    return;
+  }
+  std::unique_ptr<DiscreteMcreOperators> operators;
+  std::unique_ptr<CoupledMarch> coupled_march;
+  try {
+    operators = std::make_unique<DiscreteMcreOperators>(*problem);
+    coupled_march = std::make_unique<CoupledMarch>(operators.get());
+  } catch (const std::runtime_error& error) {
+    summary->termination = TerminationType::kFailure;
+    summary->message = std::string(name) + " does not apply: " + error.what() +
+                       "; use inner.method: conjugate_gradient or all_at_once";
+    return;
+  }
+  DiscreteMcreOperators& ops = *operators;
+  CoupledMarch& march = *coupled_march;
   const double window = m * problem->time_step();
   auto fail = [&](const std::string& why) {
     summary->termination = TerminationType::kFailure;
@@ -494,7 +536,7 @@ void SolveByShooting(const CoupledSolverOptions& options, McreProblem* problem,
     const int s = static_cast<int>(staircase.starts.size());
     staircase.starts.push_back(first);
     summary->shooting_segments = s + 1;
-    const double bytes = ShootingBytes(n, s + 1);
+    const double bytes = ShootingBytes(n, s + 1, ops.num_observed());
     if (bytes > static_cast<double>(options.max_dense_solver_bytes)) {
       fail(ShootingMemoryMessage(name, bytes, s + 1, n, options.max_dense_solver_bytes));
       return;

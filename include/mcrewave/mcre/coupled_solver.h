@@ -22,7 +22,8 @@
 //                        would exceed max_dense_solver_bytes.
 //   single_shooting      the initial retrograde state Z_0 from the fundamental matrix
 //                        of the coupled recursion; fails (never returns garbage) when
-//                        the shooting matrix is too ill-conditioned.
+//                        the shooting matrix is too ill-conditioned, refuses like
+//                        riccati above max_dense_solver_bytes.
 //   multiple_shooting    the same on segments whose length follows the measured growth
 //                        rate of the recursion, joined by continuity (robust variant).
 //   streaming_conjugate_gradient
@@ -66,11 +67,6 @@ double IterativeSolverFieldBytes(double num_nodes, double num_steps);
 // True for the methods whose memory is the fields above (relaxation,
 // adaptive_relaxation, conjugate_gradient).
 bool HoldsIterativeSolverFields(CoupledSolverType type);
-
-// True for the comparators written for the paper's data term only (riccati,
-// single_shooting, multiple_shooting: H = B, the clamp measured, no interior sensor);
-// SolveCoupled refuses them on any other problem, and the config at load.
-bool NeedsThePapersDataTerm(CoupledSolverType type);
 
 struct CoupledSolverOptions {
   // inner.method; auto: conjugate_gradient or, when its fields do not fit
@@ -194,10 +190,13 @@ struct CoupledSolution {
   Vector cost_gradients;       // de^2/dE_z [J s / Pa], one per zone
 };
 
-// Solves the coupled problem at the problem's current moduli: the bar (McreProblem)
-// with every solver, a structure given by matrices (MatrixMcreProblem) with auto,
-// conjugate_gradient, streaming_conjugate_gradient, the relaxations and all_at_once
-// (Riccati and shooting refuse it in the summary). auto is resolved first
+// Solves the coupled problem at the problem's current moduli with every solver, the
+// bar (McreProblem, any clamp and sensors) and a structure given by matrices
+// (MatrixMcreProblem) alike; streaming_conjugate_gradient needs a
+// StreamingCoupledProblem. Riccati and shooting refuse, in the summary and naming
+// conjugate_gradient or auto, when their dense n x n blocks exceed
+// max_dense_solver_bytes, and when M, M + h^2 theta^2 K or P is not positive
+// definite (docs/riccati_shooting.md section 5). auto is resolved first
 // (ResolveCoupledSolverType), the summary's `type` the solver that ran. A method that
 // would hold fields above max_field_bytes is refused before any work, its message
 // naming the ways out.
