@@ -20,6 +20,20 @@ std::string Dimensions(Eigen::Index rows, Eigen::Index columns) {
 
 }  // namespace
 
+LargestEntry FindLargestEntry(const SparseMatrix& matrix) {
+  LargestEntry largest;
+  for (int j = 0; j < matrix.outerSize(); ++j) {
+    for (SparseMatrix::InnerIterator it(matrix, j); it; ++it) {
+      if (std::abs(it.value()) > largest.magnitude) {
+        largest.magnitude = std::abs(it.value());
+        largest.row = static_cast<int>(it.row());
+        largest.column = static_cast<int>(it.col());
+      }
+    }
+  }
+  return largest;
+}
+
 std::string CheckSquare(const SparseMatrix& matrix, const std::string& name) {
   if (matrix.rows() == matrix.cols()) return "";
   return name + ": " + Dimensions(matrix.rows(), matrix.cols()) + " matrix, expected a square one";
@@ -29,18 +43,9 @@ std::string CheckSymmetric(const SparseMatrix& matrix, const std::string& name,
                            double relative_tolerance) {
   const double largest = matrix.nonZeros() > 0 ? matrix.coeffs().cwiseAbs().maxCoeff() : 0.0;
   const SparseMatrix transpose = matrix.transpose();
-  const SparseMatrix difference = matrix - transpose;
-  double worst = 0.0;
-  int worst_row = 0, worst_column = 0;
-  for (int j = 0; j < difference.outerSize(); ++j) {
-    for (SparseMatrix::InnerIterator it(difference, j); it; ++it) {
-      if (std::abs(it.value()) > worst) {
-        worst = std::abs(it.value());
-        worst_row = static_cast<int>(it.row());
-        worst_column = static_cast<int>(it.col());
-      }
-    }
-  }
+  const LargestEntry difference = FindLargestEntry(matrix - transpose);
+  const double worst = difference.magnitude;
+  const int worst_row = difference.row, worst_column = difference.column;
   if (worst <= relative_tolerance * largest) return "";
   return name + ": not symmetric: entry (" + std::to_string(worst_row + 1) + ", " +
          std::to_string(worst_column + 1) + ") = " + Short(matrix.coeff(worst_row, worst_column)) +

@@ -241,20 +241,11 @@ std::string CheckElementBlockSums(const MatrixModelData& data, const std::string
     SparseMatrix sum(n, n);
     sum.setFromTriplets(entries[z].begin(), entries[z].end());
     const SparseMatrix& stiffness = data.zones[z].stiffness;
-    const SparseMatrix misfit = sum - stiffness;
     const double largest =
         stiffness.nonZeros() > 0 ? stiffness.coeffs().cwiseAbs().maxCoeff() : 0.0;
-    double worst = 0.0;
-    int row = 0, column = 0;
-    for (int j = 0; j < misfit.outerSize(); ++j) {
-      for (SparseMatrix::InnerIterator it(misfit, j); it; ++it) {
-        if (std::abs(it.value()) > worst) {
-          worst = std::abs(it.value());
-          row = static_cast<int>(it.row());
-          column = static_cast<int>(it.col());
-        }
-      }
-    }
+    const LargestEntry misfit = FindLargestEntry(sum - stiffness);
+    const double worst = misfit.magnitude;
+    const int row = misfit.row, column = misfit.column;
     if (worst <= relative_tolerance * largest) continue;
     return manifest_name + ": the element blocks of zone '" + data.zones[z].name +
            "' do not sum to its stiffness: entry (" + std::to_string(row + 1) + ", " +

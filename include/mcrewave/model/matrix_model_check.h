@@ -17,6 +17,14 @@ namespace mcrewave {
 // order; writing them with 17 digits keeps them equal, with %g's 6 digits not.
 constexpr double kSymmetryTolerance = 1e-10;
 
+// The stored entry of largest magnitude and where it sits (0-based); magnitude 0 and
+// (0, 0) when none is nonzero. The checks' worst misfit.
+struct LargestEntry {
+  double magnitude = 0.0;
+  int row = 0, column = 0;
+};
+LargestEntry FindLargestEntry(const SparseMatrix& matrix);
+
 // "" when `matrix` is square; otherwise "NAME: R x C matrix, expected a square one".
 std::string CheckSquare(const SparseMatrix& matrix, const std::string& name);
 
