@@ -2,7 +2,8 @@
 // by side in one run: the built-in bar (mcre/mcre_problem.h) and the same bar exported
 // as matrices with its clamp as a support (model/matrix_export.h, BarClampExport::kSupport;
 // mcre/matrix_mcre_problem.h). Both at the paper's weights and a clamp treatment
-// (trusted, measured or pinned), theta = 1/2. Per road, medians over repeats:
+// (trusted, measured or pinned), theta = 1/2. The roads run alternately (A B A B);
+// each figure is the median of its road's repeats:
 //   - one direct and one retrograde sweep with the data;
 //   - one stored-field CG solve to 1e-8 (the default inner solver), and its sweeps;
 //   - e^2 and the zone gradient of the solved fields;
@@ -11,6 +12,7 @@
 //
 // Usage: bar_as_matrices_benchmark [--clamp trusted|measured|pinned] [--repeats N]
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -28,43 +30,35 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-template <typename Work>
-double MedianSeconds(int repeats, Work&& work) {
-  std::vector<double> seconds;
-  for (int i = 0; i < repeats; ++i) {
-    const auto start = Clock::now();
-    work();
-    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-  }
-  std::nth_element(seconds.begin(), seconds.begin() + repeats / 2, seconds.end());
-  return seconds[repeats / 2];
+double Median(std::vector<double> seconds) {
+  std::nth_element(seconds.begin(), seconds.begin() + seconds.size() / 2, seconds.end());
+  return seconds[seconds.size() / 2];
 }
 
-struct RoadTimes {
-  double direct_s = 0.0, retrograde_s = 0.0, solve_s = 0.0, gradient_s = 0.0;
-  long solve_sweeps = 0;
-  double cost = 0.0;
-};
+// Runs work(0) (the built-in bar) and work(1) (the bar as matrices) alternately, A B A B,
+// `repeats` times each, and returns the two medians [s].
+template <typename Work>
+std::array<double, 2> SideBySideSeconds(int repeats, Work&& work) {
+  std::array<std::vector<double>, 2> seconds;
+  for (int i = 0; i < repeats; ++i) {
+    for (int road = 0; road < 2; ++road) {
+      const auto start = Clock::now();
+      work(road);
+      seconds[road].push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    }
+  }
+  return {Median(seconds[0]), Median(seconds[1])};
+}
 
-RoadTimes TimeRoad(CoupledProblem* problem, int repeats) {
-  RoadTimes times;
-  Matrix u, w;
-  const Matrix zero = problem->ZeroField();
-  times.direct_s = MedianSeconds(repeats, [&] { problem->DirectSweep(zero, true, &u); });
-  times.retrograde_s = MedianSeconds(repeats, [&] { problem->RetrogradeSweep(u, true, &w); });
+// One road's problem and the fields its timed work writes.
+struct RoadState {
+  CoupledProblem* problem = nullptr;
+  Matrix zero, u, w;
   CoupledSolution solution;
   CoupledSolverSummary summary;
-  times.solve_s = MedianSeconds(repeats, [&] {
-    summary = SolveCoupled(CoupledSolverOptions(), problem, nullptr, &solution);
-  });
-  times.solve_sweeps = summary.sweeps;
   Vector gradient;
-  times.gradient_s = MedianSeconds(repeats, [&] {
-    times.cost = problem->Cost(solution.displacement, solution.retrograde);
-    problem->CostGradients(solution.displacement, solution.retrograde, &gradient);
-  });
-  return times;
-}
+  double cost = 0.0;
+};
 
 int Main(int argc, char** argv) {
   ClampModel clamp = ClampModel::kTrusted;
@@ -98,21 +92,37 @@ int Main(int argc, char** argv) {
   built_in.SetModuli(moduli);
   general.SetModuli(moduli);
 
-  std::printf("paper's bar, %d dofs, %d steps, clamp %s, %d repeats (medians)\n",
+  std::printf("paper's bar, %d dofs, %d steps, clamp %s, %d repeats each, A B A B (medians)\n",
               built_in.num_nodes(), built_in.num_steps(), ClampModelToString(clamp), repeats);
-  const RoadTimes bar_times = TimeRoad(&built_in, repeats);
-  const RoadTimes matrix_times = TimeRoad(&general, repeats);
+  std::array<RoadState, 2> roads;
+  roads[0].problem = &built_in;
+  roads[1].problem = &general;
+  for (RoadState& road : roads) road.zero = road.problem->ZeroField();
+  const auto direct = SideBySideSeconds(
+      repeats, [&](int r) { roads[r].problem->DirectSweep(roads[r].zero, true, &roads[r].u); });
+  const auto retrograde = SideBySideSeconds(
+      repeats, [&](int r) { roads[r].problem->RetrogradeSweep(roads[r].u, true, &roads[r].w); });
+  const auto solve = SideBySideSeconds(repeats, [&](int r) {
+    roads[r].summary =
+        SolveCoupled(CoupledSolverOptions(), roads[r].problem, nullptr, &roads[r].solution);
+  });
+  const auto gradient = SideBySideSeconds(repeats, [&](int r) {
+    RoadState& road = roads[r];
+    road.cost = road.problem->Cost(road.solution.displacement, road.solution.retrograde);
+    road.problem->CostGradients(road.solution.displacement, road.solution.retrograde,
+                                &road.gradient);
+  });
   std::printf("%-28s %12s %12s %8s\n", "", "built-in bar", "as matrices", "ratio");
-  auto row = [](const char* name, double a, double b) {
-    std::printf("%-28s %10.3f ms %10.3f ms %8.2f\n", name, 1e3 * a, 1e3 * b, b / a);
+  auto row = [](const char* name, const std::array<double, 2>& seconds) {
+    std::printf("%-28s %10.3f ms %10.3f ms %8.2f\n", name, 1e3 * seconds[0], 1e3 * seconds[1],
+                seconds[1] / seconds[0]);
   };
-  row("direct sweep", bar_times.direct_s, matrix_times.direct_s);
-  row("retrograde sweep", bar_times.retrograde_s, matrix_times.retrograde_s);
-  row("CG solve to 1e-8", bar_times.solve_s, matrix_times.solve_s);
-  row("e^2 and its gradient", bar_times.gradient_s, matrix_times.gradient_s);
+  row("direct sweep", direct);
+  row("retrograde sweep", retrograde);
+  row("CG solve to 1e-8", solve);
+  row("e^2 and its gradient", gradient);
   std::printf("CG sweeps: %ld (bar), %ld (matrices); e^2: %.17g (bar), %.17g (matrices)\n",
-              bar_times.solve_sweeps, matrix_times.solve_sweeps, bar_times.cost,
-              matrix_times.cost);
+              roads[0].summary.sweeps, roads[1].summary.sweeps, roads[0].cost, roads[1].cost);
   return 0;
 }
 
