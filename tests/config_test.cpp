@@ -823,7 +823,8 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
        {"model.manifest", "model.channel_map", "data.truth_manifest", "data.truth_moduli",
         "mcre.w_u", "mcre.reference_modulus", "mcre.clamp", "mcre.w_r", "mcre.w_u0", "inner.method",
         "outer.lower_bound", "prefilter.cutoff_frequency", "zone_identification.algorithm",
-        "time.step", "load.amplitude", "uncertainty.samples"}) {
+        "time.step", "load.amplitude", "uncertainty.samples", "inner.max_dense_solver_bytes",
+        "inner.shooting_condition_limit"}) {
     EXPECT_EQ(matrix_keys.count(key), 1u) << key;
     EXPECT_TRUE(KeyApplies(key, ModelKind::kMatrix)) << key;
   }
@@ -834,14 +835,15 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
     EXPECT_EQ(bar_keys.count(key), 1u) << key;
   }
   // The bar reads all but the 4 matrix keys; a matrix run none of the 2 sections
-  // search:, study: and 44 single keys fewer.
+  // search:, study: and 41 single keys fewer (it reads the dense solvers' limits: Riccati
+  // and shooting run on any model).
   EXPECT_EQ(bar_keys.size(), every.size() - 4);
   std::size_t sections = 0;
   for (const auto& [key, value] : every) {
     const std::string section = key.substr(0, key.find('.'));
     sections += section == "search" || section == "study" ? 1 : 0;
   }
-  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 44);
+  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 41);
   // Values as resolved: the matrix run's own.
   EXPECT_EQ(matrix_keys.at("model.manifest"), FlatKeys(ConfigToYaml(matrix)).at("model.manifest"));
 }

@@ -5,6 +5,7 @@
 // (McreProblem::DirectSweeps). Each sweep forms its force as DirectSweep
 // (RetrogradeSweep) does, so the results are the single sweeps' bits.
 #include <cassert>
+#include <stdexcept>
 
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 
@@ -135,7 +136,7 @@ void MatrixMcreProblem::DirectSweepsWithData(const std::vector<const Matrix*>& r
                       {displacement[0], displacement[1], displacement[2]});
       return;
     default:
-      assert(false && "1 to kMaxSweepBatch sweeps at once");
+      throw std::logic_error("1 to kMaxSweepBatch sweeps at once");
   }
 }
 
@@ -155,7 +156,7 @@ void MatrixMcreProblem::RetrogradeSweepsWithData(const std::vector<const Matrix*
                           {retrograde[0], retrograde[1], retrograde[2]});
       return;
     default:
-      assert(false && "1 to kMaxSweepBatch sweeps at once");
+      throw std::logic_error("1 to kMaxSweepBatch sweeps at once");
   }
 }
 

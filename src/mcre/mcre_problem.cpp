@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 #include <vector>
 
 #include "mcrewave/mcre/error_map.h"
@@ -365,7 +366,7 @@ void McreProblem::DirectSweepsWithData(const std::vector<const Matrix*>& retrogr
                       {displacement[0], displacement[1], displacement[2]});
       return;
     default:
-      assert(false && "1 to kMaxBatch sweeps at once");
+      throw std::logic_error("1 to kMaxSweepBatch sweeps at once");
   }
 }
 
@@ -385,7 +386,7 @@ void McreProblem::RetrogradeSweepsWithData(const std::vector<const Matrix*>& dis
                           {retrograde[0], retrograde[1], retrograde[2]});
       return;
     default:
-      assert(false && "1 to kMaxBatch sweeps at once");
+      throw std::logic_error("1 to kMaxSweepBatch sweeps at once");
   }
 }
 

@@ -105,7 +105,9 @@ class CoupledMarch {
     Matrix coupling = Matrix::Identity(s, s);
     for (int a = 0; a < s; ++a) coupling.row(a) += displacement_gamma_.row(observed_[a]);
     if (s > 0) coupling_lu_.compute(coupling);
-    if (s > 0 && !(std::abs(coupling_lu_.determinant()) > 0.0)) {
+    // The reciprocal condition estimate, not the determinant (a product of s pivots that
+    // under- or overflows for many observed dofs).
+    if (s > 0 && !(coupling_lu_.rcond() > std::numeric_limits<double>::epsilon())) {
       throw std::runtime_error(
           "the implicit coupling of a shooting step, I + E_o^T Gamma_U on the observed dofs, "
           "is singular");
@@ -115,6 +117,7 @@ class CoupledMarch {
       v->resize(n_);
     }
     observed_values_.resize(s);
+    observed_solution_.resize(s);
   }
 
   // One step k -> k+1 of every column of x; column 0 carries the data when with_data.
@@ -150,7 +153,11 @@ class CoupledMarch {
       ops_.ThetaStep(x->displacement.col(j), x->velocity.col(j), &force_, u_hat_, v_hat_);
       // (I + E_o^T Gamma_U) E_o^T U_{k+1} = E_o^T Uhat.
       for (int i = 0; i < s; ++i) observed_values_[i] = u_hat_[observed_[i]];
-      if (s > 0) observed_values_ = coupling_lu_.solve(observed_values_);
+      if (s > 0) {
+        // Into a separate vector: an in-place solve permutes with a temporary mask.
+        observed_solution_.noalias() = coupling_lu_.solve(observed_values_);
+        observed_values_ = observed_solution_;
+      }
       x->displacement.col(j) = u_hat_;
       x->velocity.col(j) = v_hat_;
       x->previous_omega.col(j) = omega;
@@ -193,7 +200,8 @@ class CoupledMarch {
   // Gamma_V = theta (1 - theta)^2 h^3 S^-1 Kp S'^-1 W_obs E_o, n x s each.
   Matrix reversed_solved_, displacement_gamma_, velocity_gamma_;
   Eigen::PartialPivLU<Matrix> coupling_lu_;  // of I + E_o^T Gamma_U
-  Vector y_hat_, omega_hat_, mixed_, force_, u_hat_, v_hat_, observed_values_;  // scratch
+  Vector y_hat_, omega_hat_, mixed_, force_, u_hat_, v_hat_, observed_values_,
+      observed_solution_;  // scratch
 };
 
 // The unknowns of shooting are full states in energy coordinates

@@ -178,7 +178,7 @@ std::string ConfigToYaml(const Config& config);
 // reads every key but the matrix model's own (model.manifest, model.channel_map,
 // data.truth_manifest, data.truth_moduli). A structure given by matrices does not
 // read the bar's geometry and zoning, its truth and sensor keys (mcre.clamp, mcre.w_r and
-// mcre.w_u0 it reads: they treat the manifest's supports), the shooting solvers' limits, the scalar
+// mcre.w_u0 it reads: they treat the manifest's supports), the scalar
 // identification's outer: keys (its zones are minimised under zone_identification:), search:,
 // study:, nor the penalty and merging keys of zone_identification:
 // (docs/matrix_models.md).

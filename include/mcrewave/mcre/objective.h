@@ -1,8 +1,10 @@
 // The objective of the outer loop: the MCRE cost e^2 as a function of the
 // trial modulus E. McreObjective implements the optimisers' interface
-// (ModulusObjective, optim/modulus_objective.h) with an McreProblem and the coupled
-// solver of coupled_solver.h: each evaluation sets E, solves the coupled problem
-// warm-started from the previous usable solutions and records what it did.
+// (ModulusObjective, optim/modulus_objective.h) with a coupled problem of any structure
+// (StreamingCoupledProblem: the built-in bar's McreProblem, a matrix model's
+// MatrixMcreProblem) and the coupled solver of coupled_solver.h: each evaluation sets E,
+// solves the coupled problem warm-started from the previous usable solutions and
+// records what it did.
 //
 // Warm start: with the last two usable solutions W(E1) (last) and W(E0) at
 // E0 != E1, the next solve at E starts from the linear extrapolation
@@ -126,7 +128,7 @@ class McreObjective : public ModulusObjective {
   // coupled solve is not usable (the solver's message is kept).
   bool Evaluate(const double* parameters, double* cost, double* gradient) override;
   std::string error_message() const override { return error_message_; }
-  // A new McreObjective on the same model, data and weights with
+  // A new McreObjective on a problem of the same factory with
   // inner.tolerance = inner_tolerance (its evaluations are its own).
   std::unique_ptr<ModulusObjective> CloneForScan(double inner_tolerance) const override;
 
@@ -139,10 +141,9 @@ class McreObjective : public ModulusObjective {
   const ObjectiveEvaluation& EvaluateModuli(const Vector& zone_moduli,
                                             bool gradient_requested = true);
 
-  // J_rest = sum_j c_j h [alpha/2 |F~_j|^2 + beta/2 |U~_j|^2] [J s] (a trusted
-  // clamp: alpha/2 fL~_j^2 + alpha_r/2 f0~_j^2 + beta/2 uL~_j^2, with the sensors'
-  // terms as ever): the functional for the bar left at rest (U = W = 0, zero end
-  // forces), which satisfies the state equation for every E, so 0 <= e^2(E) <= J_rest.
+  // J_rest [J s], the problem's RestCost() at construction: the functional of the
+  // structure left at rest (U = W = 0, zero loads), which satisfies the state equation
+  // for every E, so 0 <= e^2(E) <= J_rest.
   double rest_cost() const { return rest_cost_; }
   // The cost scale [J s]: J_rest, or 1 when the data are all zero (J_rest = 0).
   double cost_scale() const { return rest_cost_ > 0.0 ? rest_cost_ : 1.0; }
@@ -159,7 +160,7 @@ class McreObjective : public ModulusObjective {
   // Sweeps (direct + retrograde) of every evaluation.
   long sweeps() const override { return problem_->sweep_count(); }
   // From the traces of the model driven by the measured forces at the problem's
-  // current moduli (McreProblem::DataResponseTraces), weighted by beta_k: one sweep.
+  // current moduli (StreamingCoupledProblem::DataResponseTraces), weighted by beta_k: one sweep.
   double ValleySpacing() override;
 
   // The next evaluation starts its inner iteration from `start` (a solution's
