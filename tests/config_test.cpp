@@ -405,10 +405,12 @@ TEST(ConfigTest, FlatStudyKeysAreRefusedNamingTheirNestedKey) {
       {"comparator_seeds", "comparator.seeds"},
       {"comparator_errors", "comparator.errors"},
       {"comparator_data", "comparator.data"}};
-  for (const auto& [old_name, new_name] : renames) {
+  for (const auto& rename : renames) {
+    // A plain variable: a lambda may not capture a structured binding in C++17.
+    const std::string& old_name = rename.first;
     const std::string message = "unknown key 'study." + old_name +
                                 "'; the study keys are nested per study: it is now 'study." +
-                                new_name + "'";
+                                rename.second + "'";
     ExpectInputError([&old_name] { ParseConfig("study:\n  " + old_name + ": 1\n", "a.yaml"); },
                      {"a.yaml:2: " + message});
     ExpectInputError([&old_name] { ParseConfig("", "a.yaml", {"study." + old_name + "=1"}); },
