@@ -39,17 +39,14 @@ void MatrixMcreProblem::DirectSweeps(const Matrix* const (&retrograde)[B],
     for (int b = 0; b < B; ++b) {
       // As DirectStep: f_theta = -K W_theta + G (F~_theta - diag(1/alpha) G^T W_theta),
       // W_theta = theta W_{k+1} + (1 - theta) W_k (none for the zero field).
-      auto channel = batch_channel_.col(b);
       z[b] = nullptr;
-      channel.setZero();
       if (retrograde[b] != nullptr) {
         batch_shift_.col(b) =
             theta_ * retrograde[b]->col(k + 1) + (1.0 - theta_) * retrograde[b]->col(k);
-        load_columns_.TransposeMultiply(batch_shift_.col(b).data(), channel.data());
-        channel = -channel.cwiseQuotient(alphas_);
         z[b] = batch_shift_.col(b).data();
       }
-      channel += theta_ * measured_loads_.col(k + 1) + (1.0 - theta_) * measured_loads_.col(k);
+      auto channel = batch_channel_.col(b);
+      DirectChannels(k, true, z[b], channel);
       load_columns_.Scatter(channel.data(), batch_load_values_.col(b).data(), &batch_loads_[b]);
       v_k[b] = batch_velocity_.col(2 * b + current).data();
       v_next[b] = batch_velocity_.col(2 * b + next).data();
@@ -95,8 +92,7 @@ void MatrixMcreProblem::RetrogradeSweeps(const Matrix* const (&displacement)[B],
       } else {
         trace.setZero();
       }
-      trace -= measured_outputs_.col(j);
-      trace = (QuadratureWeight(j) * betas_).cwiseProduct(trace);
+      WeightTraces(j, true, trace);
       observation_columns_.Scatter(trace.data(), batch_load_values_.col(b).data(),
                                    &batch_loads_[b]);
       v_k[b] = batch_velocity_.col(2 * b + current).data();

@@ -32,8 +32,7 @@ void MatrixMcreProblem::RetrogradeStep(int j, bool include_data, const Vector& v
                                        const Vector& state, Vector& velocity_next,
                                        Vector& state_next) {
   // c_j H^T diag(beta) (y_j - d~_j).
-  if (include_data) trace_ -= measured_outputs_.col(j);
-  trace_ = (QuadratureWeight(j) * betas_).cwiseProduct(trace_);
+  WeightTraces(j, include_data, trace_);
   integrator_.StepWithEndLoads(velocity, state, 0.0, 0.0, velocity_next, state_next,
                                observation_columns_.Scatter(trace_.data()));
 }
@@ -42,13 +41,27 @@ void MatrixMcreProblem::DirectStep(int k, bool include_data, const Vector& veloc
                                    const Eigen::Ref<const Vector>& displacement,
                                    Vector& velocity_next, Eigen::Ref<Vector> displacement_next) {
   // f_theta = -K W_theta + G (F~_theta - diag(1/alpha) G^T W_theta).
-  load_columns_.TransposeMultiply(shift_.data(), channel_.data());
-  channel_ = -channel_.cwiseQuotient(alphas_);
-  if (include_data) {
-    channel_ += theta_ * measured_loads_.col(k + 1) + (1.0 - theta_) * measured_loads_.col(k);
-  }
+  DirectChannels(k, include_data, shift_.data(), channel_);
   integrator_.StepWithEndLoads(velocity, displacement, shift_, 0.0, 0.0, velocity_next,
                                displacement_next, load_columns_.Scatter(channel_.data()));
+}
+
+void MatrixMcreProblem::DirectChannels(int k, bool include_data, const double* shift,
+                                       Eigen::Ref<Vector> channel) const {
+  if (shift != nullptr) {
+    load_columns_.TransposeMultiply(shift, channel.data());
+    channel = -channel.cwiseQuotient(alphas_);
+  } else {
+    channel.setZero();
+  }
+  if (include_data) {
+    channel += theta_ * measured_loads_.col(k + 1) + (1.0 - theta_) * measured_loads_.col(k);
+  }
+}
+
+void MatrixMcreProblem::WeightTraces(int j, bool include_data, Eigen::Ref<Vector> trace) const {
+  if (include_data) trace -= measured_outputs_.col(j);
+  trace = (QuadratureWeight(j) * betas_).cwiseProduct(trace);
 }
 
 double MatrixMcreProblem::StiffnessForm(const double* x, const double* y) {

@@ -183,6 +183,14 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // x^T K y on either path of the integrator: from its band of K on the band path (as
   // the bar's McreProblem::PenaltyForm), else through product_ = K y. No allocation.
   double StiffnessForm(const double* x, const double* y);
+  // The load channels of the direct step t_k -> t_{k+1},
+  //   channel = F~_theta - diag(1/alpha) G^T W_theta  (F~ only with include_data),
+  // from W_theta (null: the zero field, no G^T W term). No allocation.
+  void DirectChannels(int k, bool include_data, const double* shift,
+                      Eigen::Ref<Vector> channel) const;
+  // The weighted traces of the retrograde step t_j -> t_{j-1}: y_j (H U_j or a trace)
+  // in, c_j diag(beta) (y_j - d~_j) out (d~ only with include_data). No allocation.
+  void WeightTraces(int j, bool include_data, Eigen::Ref<Vector> trace) const;
   // The direct step t_k -> t_{k+1} from (v, u) into (v_next, u_next), W_theta in shift_:
   // f_theta = -K W_theta + G (F~_theta - diag(1/alpha) G^T W_theta), F~ only with
   // include_data; G's entries as the integrator's point loads. No allocation.
