@@ -400,18 +400,20 @@ double McreProblem::PenaltyForm(const double* x, const double* y) const {
 
 double McreProblem::RestCost() {
   // The output part 1/2 (H U - d~)^T diag(beta_k) (H U - d~) of J at U = W = 0 is
-  // Cost(0, 0); the load part is alpha/2 |F - F~|^2 with F = 0 (a trusted clamp's f0
-  // is an output, in Cost(0, 0); a pinned clamp's has alpha_0 = w_r L / (S E0)).
-  const Matrix zero = ZeroField();
+  // Cost(0, 0), summed here sample by sample from one zero column (Cost's sum, without
+  // an n x (m + 1) field); the load part is alpha/2 |F - F~|^2 with F = 0 (a trusted
+  // clamp's f0 is an output, in Cost(0, 0); a pinned clamp's has alpha_0 = w_r L / (S E0)).
+  const Vector zero = Vector::Zero(num_nodes());
   const Vector& f0 = data_.Values("f0");
   const Vector& fL = data_.Values("fL");
-  double force_part = 0.0;
+  double output_part = 0.0, force_part = 0.0;
   for (int j = 0; j <= data_.num_steps(); ++j) {
+    output_part += QuadratureWeight(j) * time_step() * SampleCost(j, zero.data(), zero.data());
     // c_j h [alpha_0/2 f~0_j^2 + alpha/2 f~L_j^2], alpha_0 = rest_force0_gain_ alpha
     force_part += QuadratureWeight(j) * data_.time_step * 0.5 * alpha_ *
                   (rest_force0_gain_ * f0[j] * f0[j] + fL[j] * fL[j]);
   }
-  return Cost(zero, zero) + force_part;
+  return output_part + force_part;
 }
 
 double McreProblem::InnerProduct(const Matrix& x, const Matrix& y) {

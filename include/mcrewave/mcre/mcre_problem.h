@@ -245,7 +245,7 @@ class McreProblem : public StreamingCoupledProblem {
   Vector TraceWeights() const override;
   void DataResponseTraces(Matrix* traces) override;
   // J_rest = Cost(0, 0) + sum_j c_j h [alpha_0/2 f~0_j^2 + alpha/2 f~L_j^2] [J s], alpha_0
-  // of the clamp (0 trusted: f0 is an output, in Cost(0, 0)). Allocates one zero field.
+  // of the clamp (0 trusted: f0 is an output, in Cost(0, 0)). O(n) memory: no field.
   double RestCost() override;
 
   // Number of factorisations of the integrator's iteration matrix since construction
