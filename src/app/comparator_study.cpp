@@ -368,12 +368,9 @@ std::string SummaryIntroduction(const ComparatorStudy& study) {
           "does it (no global scan), least squares' misfit normalised by the noise of each "
           "sensor kind. Model errors: `density` the model's M 3 % larger, `force_gain` every "
           "load measured 5 % high, `displacement_gain` every displacement sensor measured 3 % "
-          "high. Errors of each zone modulus relative to the truth's (E_ref: ";
-    for (std::size_t z = 0; z < study.zones.size(); ++z) {
-      md << (z == 0 ? "" : ", ") << study.zones[z] << " "
-         << Brief(study.reference_moduli[z] / 1e9, 6) << " GPa";
-    }
-    md << "); `within 2 %` as a share of the runs.\n\n";
+          "high. Errors of each zone modulus relative to the truth's (E_ref: "
+       << internal::NamedModuliInGpa(study.zones, study.reference_moduli)
+       << "); `within 2 %` as a share of the runs.\n\n";
     return md.str();
   }
   md << "least squares: the clamped model driven by the measured fL, misfit of uL and f0 "

@@ -197,6 +197,15 @@ std::string Brief(double value, int digits) {
   return FormatNumber(value, {NumberFormat::Notation::kSignificant, digits, false, false, "-"});
 }
 
+std::string NamedModuliInGpa(const std::vector<std::string>& names,
+                             const std::vector<double>& moduli) {
+  std::string text;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    text += (i == 0 ? "" : ", ") + names[i] + " " + Brief(moduli[i] / 1e9, 6) + " GPa";
+  }
+  return text;
+}
+
 std::string Percent(double ratio) {
   if (std::isnan(ratio)) return "-";
   return FormatNumber(100.0 * ratio, {NumberFormat::Notation::kFixed, 3, true}) + " %";
@@ -678,12 +687,8 @@ std::string RobustnessSummary(const RobustnessStudy& study) {
           "every zone at once from the nominal moduli; no error map or uncertainty) on data of "
           "the truth plus white noise of one seed; at SNR inf there is one run (no noise), "
           "whose error is the model's bias against the truth. `runs.csv`: one row per "
-          "identification and zone; `statistics.csv`: one row per SNR and zone. E_ref:";
-    for (std::size_t p = 0; p < study.parameters.size(); ++p) {
-      md << (p == 0 ? " " : ", ") << study.parameters[p] << " "
-         << Brief(study.reference_moduli[p] / 1e9, 6) << " GPa";
-    }
-    md << ".\n\n";
+          "identification and zone; `statistics.csv`: one row per SNR and zone. E_ref: "
+       << NamedModuliInGpa(study.parameters, study.reference_moduli) << ".\n\n";
   }
   md << RobustnessTable(study);
   md << (study.matrix_model

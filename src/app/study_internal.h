@@ -76,6 +76,9 @@ void ResumableParallelFor(int count, int threads, const std::function<void(int)>
 std::string Csv(double value);
 // Number for tables: `digits` significant digits.
 std::string Brief(double value, int digits = 4);
+// "zone0 210 GPa, zone1 190 GPa": each name with its modulus [Pa] in GPa, 6 digits.
+std::string NamedModuliInGpa(const std::vector<std::string>& names,
+                             const std::vector<double>& moduli);
 // A ratio as a signed percentage with 3 decimals ("+0.012 %").
 std::string Percent(double ratio);
 std::string SnrText(double snr);
