@@ -45,11 +45,15 @@ McreProblem::McreProblem(const BarModel& model, const ChannelSet& data, const Mc
       unit_stiffness_(model.unit_stiffness()) {
   assert(weights.IsValid(nullptr) && data.num_steps() >= 1 && reference_modulus > 0.0);
   const BarProperties& bar = model.properties();
-  // beta = w_u S E0 / L, alpha = w_f L / (S E0)  (docs/discrete_mcre.md);
-  // beta_e = w_e S E0 L  (docs/zones_and_sensors.md).
-  beta_ = weights.displacement_weight * bar.section * reference_modulus / bar.length;
-  alpha_ = weights.force_weight * bar.length / (bar.section * reference_modulus);
-  strain_beta_ = weights.strain_weight * bar.section * reference_modulus * bar.length;
+  // The weights from the scales of a structure given by matrices (docs/matrix_models.md
+  // section 3) with a* = S / L and l* = L, computed as MatrixMcreProblem does:
+  // k* = E0 a*, beta = w_u k* = w_u S E0 / L, alpha = w_f / k* = w_f L / (S E0)
+  // (docs/discrete_mcre.md) and beta_e = w_e k* l*^2 = w_e S E0 L
+  // (docs/zones_and_sensors.md).
+  const double stiffness_scale = reference_modulus * (bar.section / bar.length);
+  beta_ = weights.displacement_weight * stiffness_scale;
+  alpha_ = weights.force_weight / stiffness_scale;
+  strain_beta_ = weights.strain_weight * stiffness_scale * bar.length * bar.length;
   const bool trusted = clamp == ClampModel::kTrusted;
   const bool pinned = clamp == ClampModel::kPinned;
   if (trusted) ends_.u0 = false;
@@ -59,16 +63,13 @@ McreProblem::McreProblem(const BarModel& model, const ChannelSet& data, const Mc
   beta_u0_ = ends_.u0 ? beta_ : 0.0;
   beta_uL_ = ends_.uL ? beta_ : 0.0;
   inverse_alpha0_ = trusted ? 0.0 : 1.0 / alpha_;
+  alpha0_ = alpha_;
   force0_gain_ = trusted ? 0.0 : 1.0;
-  force0_penalty_gain_ = force0_gain_;
-  // alpha_0 / alpha of the rest cost's f0 term: 0 trusted, w_r / w_f pinned, 1 measured.
-  rest_force0_gain_ = trusted ? 0.0 : pinned ? weights.reaction_weight / weights.force_weight : 1.0;
   if (pinned) {
-    // beta_0 = w_u0 S E0 / L on the datum u0~ = 0; alpha_0 = w_r L / (S E0) on f0.
-    beta_u0_ = weights.clamp_displacement_weight * bar.section * reference_modulus / bar.length;
-    const double alpha0 = weights.reaction_weight * bar.length / (bar.section * reference_modulus);
-    inverse_alpha0_ = 1.0 / alpha0;
-    force0_penalty_gain_ = alpha_ / alpha0;
+    // beta_0 = w_u0 k* = w_u0 S E0 / L on the datum u0~ = 0; alpha_0 = w_r / k* on f0.
+    beta_u0_ = weights.clamp_displacement_weight * stiffness_scale;
+    alpha0_ = weights.reaction_weight / stiffness_scale;
+    inverse_alpha0_ = 1.0 / alpha0_;
   }
   std::vector<double> weights_of_rows;
   for (const BarSensor& sensor : BarSensors(data)) {
@@ -92,13 +93,37 @@ McreProblem::McreProblem(const BarModel& model, const ChannelSet& data, const Mc
     reaction.nodes[0] = 0;
     reaction.nodes[1] = 1;
     sensor_rows_.push_back(reaction);
-    // alpha_r = w_r L / (S E0).
-    weights_of_rows.push_back(weights.reaction_weight * bar.length /
-                              (bar.section * reference_modulus));
+    // alpha_r = w_r / k* = w_r L / (S E0).
+    weights_of_rows.push_back(weights.reaction_weight / stiffness_scale);
     sensor_data_.push_back(&measured_.f0);
   }
+  // The zone stiffnesses K_z = E_nom K1_z at the model's modulus, and a trusted clamp's
+  // reaction rows e_0^T K_z / E_nom without the held column 0, of CostGradients.
+  nominal_modulus_ = bar.modulus;
+  const int n = model.num_nodes();
+  for (int z = 0; z < model.num_zones(); ++z) {
+    zone_stiffness_.push_back(
+        model.Stiffness(Vector::Unit(model.num_zones(), z) * nominal_modulus_));
+    if (!trusted) continue;
+    const Vector row =
+        (zone_stiffness_.back().transpose() * Vector::Unit(n, 0)) * (1.0 / nominal_modulus_);
+    std::vector<Eigen::Triplet<double>> entries;
+    for (int i = 1; i < n; ++i) {
+      if (row[i] != 0.0) entries.emplace_back(0, i, row[i]);
+    }
+    reaction_zone_rows_.emplace_back(1, n);
+    reaction_zone_rows_.back().setFromTriplets(entries.begin(), entries.end());
+  }
+  gradient_shift_.resize(n);
+  gradient_product_.resize(n);
   const int num_sensors = static_cast<int>(sensor_rows_.size());
   sensor_weights_ = Eigen::Map<const Vector>(weights_of_rows.data(), num_sensors);
+  // The weights of Misfits' rows: uL, the interior sensors, then u0 or the reaction.
+  cost_weights_.resize(num_sensors + (trusted ? 1 : 2));
+  cost_weights_[0] = beta_uL_;
+  for (int k = 0; k < num_sensors - trusted; ++k) cost_weights_[1 + k] = sensor_weights_[k];
+  cost_weights_[cost_weights_.size() - 1] = trusted ? sensor_weights_[reaction_row_] : beta_u0_;
+  cost_misfits_.resize(cost_weights_.size());
   for (const ObservationRow& row : sensor_rows_) {
     load_nodes_.push_back(row.nodes[0]);
     load_nodes_.push_back(row.nodes[1]);
@@ -109,7 +134,6 @@ McreProblem::McreProblem(const BarModel& model, const ChannelSet& data, const Mc
     point_loads_[b].nodes = load_nodes_.data();
     point_loads_[b].values = load_values_.col(b).data();
   }
-  const int n = model.num_nodes();
   for (int b = 0; b < 2; ++b) {
     velocity_[b] = Vector::Zero(n);
     omega_[b] = Vector::Zero(n);
@@ -144,9 +168,11 @@ void McreProblem::SetModuli(const Vector& zone_moduli) {
   options.time_step = data_.time_step;
   options.theta = theta_;
   if (reaction_row_ >= 0) {
-    // r(U) = K_01 U_1 = -(E_1 S / l_1) U_1.
-    sensor_rows_[reaction_row_].coefficients[1] =
-        moduli_[model_.element_zone(0)] * model_.unit_stiffness().coeff(0, 1);
+    // r(U) = K_01 U_1 = -(E_1 S / l_1) U_1, its row sum_z E_z (e_0^T K_z / E_nom) formed as
+    // MatrixMcreProblem forms a support's reaction row.
+    reactions_ = moduli_[0] * reaction_zone_rows_[0];
+    for (int z = 1; z < num_zones(); ++z) reactions_ += moduli_[z] * reaction_zone_rows_[z];
+    sensor_rows_[reaction_row_].coefficients[1] = reactions_.coeff(0, 1);
   }
   // K = sum_z E_z K1_z (one zone: E K1); node 0 decoupled under a trusted clamp.
   integrator_.Init(MassMatrix(), StiffnessMatrix(), options);
@@ -173,7 +199,12 @@ SparseMatrix McreProblem::MassMatrix() const {
 }
 
 SparseMatrix McreProblem::StiffnessMatrix() const {
-  SparseMatrix stiffness = model_.Stiffness(moduli_);
+  // K = sum_z (E_z / E_nom) K_z, as MatrixModelData::Stiffness sums the zones of the bar
+  // exported as matrices (so that the two factorise the same K to the bit).
+  SparseMatrix stiffness(num_nodes(), num_nodes());
+  for (int z = 0; z < num_zones(); ++z) {
+    stiffness += (moduli_[z] / nominal_modulus_) * zone_stiffness_[z];
+  }
   return clamp_ == ClampModel::kTrusted ? WithFirstNodeHeld(std::move(stiffness)) : stiffness;
 }
 
@@ -194,7 +225,6 @@ void McreProblem::DirectSweep(const Matrix& retrograde, bool include_data, Matri
   const int n = num_nodes(), m = num_steps(), last = n - 1;
   assert(retrograde.rows() == n && retrograde.cols() == m + 1);
   displacement->resize(n, m + 1);
-  const double inverse_alpha = 1.0 / alpha_;
   // From rest: U_0 = V_0 = 0.
   displacement->col(0).setZero();
   velocity_[0].setZero();
@@ -205,10 +235,13 @@ void McreProblem::DirectSweep(const Matrix& retrograde, bool include_data, Matri
     //   f_theta = -K W_theta + (F~_theta - B W_theta / alpha),
     //   W_theta = theta W_{k+1} + (1 - theta) W_k.
     shift_ = theta_ * retrograde.col(k + 1) + (1.0 - theta_) * retrograde.col(k);
-    double f0 = -inverse_alpha0_ * shift_[0];
-    double fL = -inverse_alpha * shift_[last];
+    // The end forces as MatrixMcreProblem::DirectChannels forms its channels:
+    // -W_theta / alpha, then + F~_theta (a trusted clamp's f0: 0).
+    double f0 = force0_gain_ * (-shift_[0] / alpha0_);
+    double fL = -shift_[last] / alpha_;
     if (include_data) {
-      f0 += force0_gain_ * (theta_ * measured_.f0[k + 1] + (1.0 - theta_) * measured_.f0[k]);
+      f0 = force0_gain_ * (-shift_[0] / alpha0_ +
+                           (theta_ * measured_.f0[k + 1] + (1.0 - theta_) * measured_.f0[k]));
       fL += theta_ * measured_.fL[k + 1] + (1.0 - theta_) * measured_.fL[k];
     }
     integrator_.StepWithEndLoads(velocity_[current], displacement->col(k), shift_, f0, fL,
@@ -231,12 +264,9 @@ void McreProblem::RetrogradeSweep(const Matrix& displacement, bool include_data,
     // the end displacement rows as end loads, the interior sensors as point loads.
     const double weight0 = QuadratureWeight(j) * beta_u0_;
     const double weightL = QuadratureWeight(j) * beta_uL_;
-    double f0 = weight0 * displacement(0, j);
-    double fL = weightL * displacement(last, j);
-    if (include_data) {
-      f0 -= weight0 * U0Datum(j);
-      fL -= weightL * measured_.uL[j];
-    }
+    // c_j beta (U_j - d~_j), as MatrixMcreProblem::WeightTraces forms it.
+    double f0 = weight0 * (displacement(0, j) - (include_data ? U0Datum(j) : 0.0));
+    double fL = weightL * (displacement(last, j) - (include_data ? measured_.uL[j] : 0.0));
     const PointLoads* loads = nullptr;
     if (num_interior_sensors() > 0) {
       SensorLoads(j, displacement.col(j).data(), include_data, load_values_.col(0).data());
@@ -258,7 +288,6 @@ template <int B>
 void McreProblem::DirectSweeps(const Matrix* const (&retrograde)[B],
                                Matrix* const (&displacement)[B]) {
   const int n = num_nodes(), m = num_steps(), last = n - 1;
-  const double inverse_alpha = 1.0 / alpha_;
   for (int b = 0; b < B; ++b) {
     assert(retrograde[b] == nullptr ||
            (retrograde[b]->rows() == n && retrograde[b]->cols() == m + 1));
@@ -282,8 +311,9 @@ void McreProblem::DirectSweeps(const Matrix* const (&retrograde)[B],
       if (retrograde[b] != nullptr) {
         batch_shift_.col(b) =
             theta_ * retrograde[b]->col(k + 1) + (1.0 - theta_) * retrograde[b]->col(k);
-        f0[b] = -inverse_alpha0_ * batch_shift_(0, b) + f0[b];
-        fL[b] = -inverse_alpha * batch_shift_(last, b) + fL[b];
+        f0[b] = force0_gain_ * (-batch_shift_(0, b) / alpha0_ +
+                                (theta_ * measured_.f0[k + 1] + (1.0 - theta_) * measured_.f0[k]));
+        fL[b] = -batch_shift_(last, b) / alpha_ + fL[b];
         z[b] = batch_shift_.col(b).data();
       }
       v_k[b] = batch_velocity_.col(2 * b + current).data();
@@ -321,10 +351,10 @@ void McreProblem::RetrogradeSweeps(const Matrix* const (&displacement)[B],
     const double weight0 = QuadratureWeight(j) * beta_u0_;
     const double weightL = QuadratureWeight(j) * beta_uL_;
     for (int b = 0; b < B; ++b) {
-      f0[b] = displacement[b] != nullptr ? weight0 * (*displacement[b])(0, j) : 0.0;
-      fL[b] = displacement[b] != nullptr ? weightL * (*displacement[b])(last, j) : 0.0;
-      f0[b] -= weight0 * U0Datum(j);
-      fL[b] -= weightL * measured_.uL[j];
+      f0[b] =
+          weight0 * ((displacement[b] != nullptr ? (*displacement[b])(0, j) : 0.0) - U0Datum(j));
+      fL[b] = weightL *
+              ((displacement[b] != nullptr ? (*displacement[b])(last, j) : 0.0) - measured_.uL[j]);
       if (num_interior_sensors() > 0) {
         SensorLoads(j, displacement[b] != nullptr ? displacement[b]->col(j).data() : nullptr, true,
                     load_values_.col(b).data());
@@ -390,12 +420,17 @@ void McreProblem::RetrogradeSweepsWithData(const std::vector<const Matrix*>& dis
   }
 }
 
-double McreProblem::PenaltyForm(const double* x, const double* y) const {
+double McreProblem::EndForceForm(const double* x, const double* y) const {
   const int last = num_nodes() - 1;
-  // x^T K y + x_0 y_0 / alpha_0 + x_N y_N / alpha (1 / alpha_0: 1 / alpha measured,
-  // 0 trusted, 1 / alpha_0 pinned).
-  return integrator_.stiffness().BilinearForm(x, y) +
-         (force0_penalty_gain_ * x[0] * y[0] + x[last] * y[last]) / alpha_;
+  // (x_N / alpha) y_N + (x_0 / alpha_0) y_0 (a trusted clamp: no f0 term), summed as
+  // MatrixMcreProblem sums its load channels fL, f0 (the bar exported with its clamp as
+  // a support, docs/matrix_models.md section 6).
+  return (x[last] / alpha_) * y[last] + force0_gain_ * ((x[0] / alpha0_) * y[0]);
+}
+
+double McreProblem::PenaltyForm(const double* x, const double* y) const {
+  // x^T K y + x_N y_N / alpha + x_0 y_0 / alpha_0.
+  return integrator_.stiffness().BilinearForm(x, y) + EndForceForm(x, y);
 }
 
 double McreProblem::RestCost() {
@@ -406,14 +441,17 @@ double McreProblem::RestCost() {
   const Vector zero = Vector::Zero(num_nodes());
   const Vector& f0 = data_.Values("f0");
   const Vector& fL = data_.Values("fL");
-  double output_part = 0.0, force_part = 0.0;
+  double sum = 0.0;
   for (int j = 0; j <= data_.num_steps(); ++j) {
-    output_part += QuadratureWeight(j) * time_step() * SampleCost(j, zero.data(), zero.data());
-    // c_j h [alpha_0/2 f~0_j^2 + alpha/2 f~L_j^2], alpha_0 = rest_force0_gain_ alpha
-    force_part += QuadratureWeight(j) * data_.time_step * 0.5 * alpha_ *
-                  (rest_force0_gain_ * f0[j] * f0[j] + fL[j] * fL[j]);
+    // c_j h [alpha/2 f~L_j^2 + alpha_0/2 f~0_j^2 + 1/2 d~^T diag(beta_k) d~], in
+    // MatrixMcreProblem::RestCost's order (a trusted clamp's f0 is an output).
+    const double force_part = (fL[j] * fL[j]) * alpha_ + force0_gain_ * ((f0[j] * f0[j]) * alpha0_);
+    Misfits(j, zero.data());
+    cost_misfits_ = cost_misfits_.cwiseAbs2();
+    sum +=
+        QuadratureWeight(j) * time_step() * 0.5 * (force_part + cost_weights_.dot(cost_misfits_));
   }
-  return output_part + force_part;
+  return sum;
 }
 
 double McreProblem::InnerProduct(const Matrix& x, const Matrix& y) {
@@ -427,24 +465,28 @@ double McreProblem::InnerProduct(const Matrix& x, const Matrix& y) {
   return sum;
 }
 
-double McreProblem::SampleCost(int j, const double* displacement, const double* retrograde) const {
-  const int last = num_nodes() - 1;
-  const double gap = 0.5 * integrator_.stiffness().BilinearForm(retrograde, retrograde);
-  const double force_misfit =
-      (force0_penalty_gain_ * retrograde[0] * retrograde[0] + retrograde[last] * retrograde[last]) /
-      (2.0 * alpha_);
-  const double u0_misfit = displacement[0] - U0Datum(j);
-  const double uL_misfit = displacement[last] - measured_.uL[j];
-  double displacement_misfit =
-      observes_ends_only()
-          ? 0.5 * beta_ * (u0_misfit * u0_misfit + uL_misfit * uL_misfit)
-          : 0.5 * (beta_u0_ * u0_misfit * u0_misfit + beta_uL_ * uL_misfit * uL_misfit);
-  // + 1/2 beta_k (h_k . U_j - d~_kj)^2 over the interior sensors.
-  for (int k = 0; k < num_interior_sensors(); ++k) {
-    const double misfit = sensor_rows_[k].Apply(displacement) - (*sensor_data_[k])[j];
-    displacement_misfit += 0.5 * sensor_weights_[k] * misfit * misfit;
+void McreProblem::Misfits(int j, const double* displacement) {
+  const int last = num_nodes() - 1, sensors = num_interior_sensors() - (reaction_row_ >= 0);
+  // The rows uL, the interior sensors, then u0 (its datum 0 when pinned) or the trusted
+  // clamp's reaction: H's rows of the bar exported with its clamp as a support.
+  cost_misfits_[0] = displacement[last] - measured_.uL[j];
+  for (int k = 0; k < sensors; ++k) {
+    cost_misfits_[1 + k] = sensor_rows_[k].Apply(displacement) - (*sensor_data_[k])[j];
   }
-  return gap + force_misfit + displacement_misfit;
+  cost_misfits_[1 + sensors] =
+      reaction_row_ >= 0
+          ? sensor_rows_[reaction_row_].Apply(displacement) - (*sensor_data_[reaction_row_])[j]
+          : displacement[0] - U0Datum(j);
+}
+
+double McreProblem::SampleCost(int j, const double* displacement, const double* retrograde) {
+  // 1/2 W^T K W + 1/2 W^T B W / alpha + 1/2 (H U - d~)^T diag(beta_k) (H U - d~), each
+  // part summed as MatrixMcreProblem::Cost sums it.
+  const double gap = integrator_.stiffness().BilinearForm(retrograde, retrograde);
+  Misfits(j, displacement);
+  cost_misfits_ = cost_misfits_.cwiseAbs2();
+  return 0.5 * gap + 0.5 * EndForceForm(retrograde, retrograde) +
+         0.5 * cost_weights_.dot(cost_misfits_);
 }
 
 double McreProblem::Cost(const Matrix& displacement, const Matrix& retrograde) {
@@ -487,34 +529,35 @@ double McreProblem::ReactionGradient(int j, const double* displacement) const {
 }
 
 double McreProblem::CostGradient(const Matrix& displacement, const Matrix& retrograde) {
-  const int m = num_steps();
-  const double h = time_step();
-  double sum = 0.0, reaction_sum = 0.0;
-  for (int j = 0; j <= m; ++j) {
-    sum += QuadratureWeight(j) * h *
-           SampleGradient(displacement.col(j).data(), retrograde.col(j).data());
-    reaction_sum += QuadratureWeight(j) * h * ReactionGradient(j, displacement.col(j).data());
-  }
-  // The reaction's explicit term is 0 without a trusted clamp.
-  return -0.5 * sum + reaction_sum;
+  Vector gradient;
+  CostGradients(displacement, retrograde, &gradient);
+  return gradient.sum();
 }
 
 void McreProblem::CostGradients(const Matrix& displacement, const Matrix& retrograde,
                                 Vector* gradient) {
   const int zones = num_zones();
-  if (zones == 1) {
-    gradient->setConstant(1, CostGradient(displacement, retrograde));
-    return;
-  }
-  const int m = num_steps();
   const double h = time_step();
   gradient->setZero(zones);
-  for (int j = 0; j <= m; ++j) {
-    AddSampleZoneGradients(-0.5 * QuadratureWeight(j) * h, displacement.col(j).data(),
-                           retrograde.col(j).data(), gradient);
-    if (reaction_row_ >= 0) {
-      (*gradient)[model_.element_zone(0)] +=
-          QuadratureWeight(j) * h * ReactionGradient(j, displacement.col(j).data());
+  // MatrixMcreProblem::CostGradients' sums on the bar exported as matrices
+  // (BarMatrixModel with K_z = E_nom K1_z, E_nom = the model's modulus, and the clamp a
+  // support), so that the bar's and the exported bar's gradients are the same bits.
+  for (int j = 0; j <= num_steps(); ++j) {
+    gradient_shift_ = retrograde.col(j) + 2.0 * displacement.col(j);
+    for (int z = 0; z < zones; ++z) {
+      // -(1/(2 E_nom)) c_j h W_j^T K_z (W_j + 2 U_j).
+      gradient_product_.noalias() = zone_stiffness_[z] * gradient_shift_;
+      (*gradient)[z] += -0.5 * QuadratureWeight(j) * h * retrograde.col(j).dot(gradient_product_) /
+                        nominal_modulus_;
+    }
+    if (reaction_row_ < 0) continue;
+    // Trusted: c_j h alpha_r (r(U_j) - f0~_j) e_0^T K_z U_j / E_nom, the explicit term
+    // alpha_r (r(U_j) / E_1) (r(U_j) - f0~_j) of the zone of element 1.
+    const double misfit = (reactions_ * displacement.col(j))[0] - measured_.f0[j];
+    for (int z = 0; z < zones; ++z) {
+      const double zone_reaction = (reaction_zone_rows_[z] * displacement.col(j))[0];
+      (*gradient)[z] +=
+          QuadratureWeight(j) * h * sensor_weights_[reaction_row_] * (misfit * zone_reaction);
     }
   }
 }

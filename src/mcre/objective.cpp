@@ -83,14 +83,15 @@ McreObjective::McreObjective(const BarModel& model, const ChannelSet& data, cons
 
 McreObjective MatrixMcreObjective(const MatrixModelData& model, const ChannelSet& data,
                                   const McreOptions& mcre, double theta,
-                                  const CoupledSolverOptions& inner, Factorization factorization) {
-  assert(mcre.IsValid(nullptr));
+                                  const CoupledSolverOptions& inner, Factorization factorization,
+                                  double modulus_scale) {
+  assert(mcre.IsValid(nullptr) && modulus_scale >= 0.0);
   return McreObjective(
       [&model, &data, mcre, theta, factorization]() -> std::unique_ptr<StreamingCoupledProblem> {
         return std::make_unique<MatrixMcreProblem>(
             model, data, mcre.weights, mcre.reference_modulus, theta, factorization, mcre.clamp);
       },
-      inner, mcre.reference_modulus);
+      inner, modulus_scale > 0.0 ? modulus_scale : mcre.reference_modulus);
 }
 
 std::unique_ptr<ModulusObjective> McreObjective::CloneForScan(double inner_tolerance) const {

@@ -180,16 +180,16 @@ void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* 
   // The direct step t_{j-1} -> t_j from (V, U)[current] into [next], given W_{j-1} and
   // W_j, with f_theta = -K W_theta + (F~_theta - B W_theta / alpha),
   // W_theta = theta W_j + (1 - theta) W_{j-1} (as DirectSweep); then observe(j).
-  const double inverse_alpha = 1.0 / alpha_;
   auto direct_step = [&](int j, const Vector& previous_retrograde, const Vector& retrograde) {
     const int current = (j - 1) & 1, next = current ^ 1;
     stream_shift_ = theta_ * retrograde + (1.0 - theta_) * previous_retrograde;
-    double direct_f0 = -inverse_alpha0_ * stream_shift_[0];
-    double direct_fL = -inverse_alpha * stream_shift_[last];
+    double direct_f0 = -stream_shift_[0] / alpha0_;
+    double direct_fL = -stream_shift_[last] / alpha_;
     if (include_data) {
-      direct_f0 += force0_gain_ * (theta_ * measured_.f0[j] + (1.0 - theta_) * measured_.f0[j - 1]);
+      direct_f0 += theta_ * measured_.f0[j] + (1.0 - theta_) * measured_.f0[j - 1];
       direct_fL += theta_ * measured_.fL[j] + (1.0 - theta_) * measured_.fL[j - 1];
     }
+    direct_f0 *= force0_gain_;
     integrator_.StepWithEndLoads(stream_direct_velocity_[current], stream_displacement_[current],
                                  stream_shift_, direct_f0, direct_fL, stream_direct_velocity_[next],
                                  stream_displacement_[next]);

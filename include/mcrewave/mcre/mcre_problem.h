@@ -172,13 +172,14 @@ class McreProblem : public StreamingCoupledProblem {
   // e^2 = sum_j c_j h [1/2 W^T K W + W^T B W / (2 alpha)
   //                    + 1/2 (H U - d~)^T diag(beta_k) (H U - d~)]  [J s].
   double Cost(const Matrix& displacement, const Matrix& retrograde) override;
-  // de^2/dE = -(1/(2E)) sum_j c_j h W_j^T K (W_j + 2 U_j)  [J s / Pa], the derivative
-  // along a common change of every zone's modulus (one zone: the modulus).
-  // Precondition: every zone at the same modulus.
+  // de^2/dE = sum_z de^2/dE_z [J s / Pa], the derivative along a common change of every
+  // zone's modulus (one zone: the modulus). Precondition: every zone at the same modulus.
   double CostGradient(const Matrix& displacement, const Matrix& retrograde);
-  // de^2/dE_z = -(1/(2 E_z)) sum_j c_j h W_j^T K_z (W_j + 2 U_j) = -(1/2) sum_j c_j h
-  // W_j^T K1_z (W_j + 2 U_j) [J s / Pa], every zone from the one pair of fields;
-  // gradient is resized to num_zones(). One zone: CostGradient.
+  // de^2/dE_z = -(1/(2 E_nom)) sum_j c_j h W_j^T K_z (W_j + 2 U_j) [J s / Pa] with
+  // K_z = E_nom K1_z (E_nom the model's modulus), plus under a trusted clamp the
+  // reaction's explicit term sum_j c_j h alpha_r (r(U_j) - f0~_j) e_0^T K_z U_j / E_nom,
+  // every zone from the one pair of fields, summed as MatrixMcreProblem::CostGradients
+  // sums them (the same bits); gradient is resized to num_zones().
   void CostGradients(const Matrix& displacement, const Matrix& retrograde,
                      Vector* gradient) override;
   // The error map: the share of each element in the constitutive part of e^2,
@@ -261,7 +262,13 @@ class McreProblem : public StreamingCoupledProblem {
   // The integrand of e^2 at sample j without c_j h:
   // 1/2 W^T K W + W_0^2 / (2 alpha_0) + W_N^2 / (2 alpha)
   //   + 1/2 (H U - d~_j)^T diag(beta) (H U - d~_j), 1 / alpha_0 = inverse_alpha0().
-  double SampleCost(int j, const double* displacement, const double* retrograde) const;
+  double SampleCost(int j, const double* displacement, const double* retrograde);
+  // cost_misfits_ = H U_j - d~_j of the displacement U_j in the rows uL, the interior
+  // sensors, then u0 (its datum 0 when pinned) or a trusted clamp's reaction. No
+  // allocation.
+  void Misfits(int j, const double* displacement);
+  // (x_N / alpha) y_N + (x_0 / alpha_0) y_0 (no f0 term when the clamp is trusted).
+  double EndForceForm(const double* x, const double* y) const;
   // x^T (K + e_0 e_0^T / alpha_0 + e_N e_N^T / alpha) y of two nodal vectors (n
   // entries each).
   double PenaltyForm(const double* x, const double* y) const;
@@ -319,17 +326,26 @@ class McreProblem : public StreamingCoupledProblem {
   EndDisplacementChannels ends_;
   ClampModel clamp_;
   double beta_u0_, beta_uL_;  // beta_u for an end displacement channel in use, else 0
-  // The node-0 terms of the direct sweep: 1/alpha and the gain of f0~ (1), or 0 and 0
-  // when the clamp is trusted, 1/alpha_0 and 1 when it is pinned; and alpha / alpha_0
-  // of the node-0 force term of the cost and of P (1, 0, alpha / alpha_0).
-  double inverse_alpha0_, force0_gain_, force0_penalty_gain_;
-  double rest_force0_gain_;  // alpha_0 / alpha of RestCost's f0 term
+  // f0 as a load: its weight alpha_0 (alpha when measured, alpha_0 when pinned), 1 /
+  // alpha_0, and the gain 1 of its terms; when the clamp is trusted, alpha, 0 and the
+  // gain 0 that cancels them.
+  double alpha0_, inverse_alpha0_, force0_gain_;
   // Trusted clamp: the index of the reaction row in sensor_rows_, else -1.
   int reaction_row_ = -1;
   Vector moduli_;             // E_z [Pa]
   // Interior sensors: H's rows, their weights beta_k and data d~_k (one per sample).
   std::vector<ObservationRow> sensor_rows_;
   Vector sensor_weights_;
+  // The weights of the rows of Misfits and their misfits (scratch, sized in the
+  // constructor).
+  Vector cost_weights_, cost_misfits_;
+  // CostGradients' operators (those of the bar exported as matrices): E_nom [Pa], the
+  // model's modulus; K_z = E_nom K1_z; a trusted clamp's rows e_0^T K_z / E_nom (held
+  // column dropped) and their sum at moduli_; and scratch of n entries.
+  double nominal_modulus_ = 0.0;
+  std::vector<SparseMatrix> zone_stiffness_, reaction_zone_rows_;
+  SparseMatrix reactions_;
+  Vector gradient_shift_, gradient_product_;
   std::vector<const Vector*> sensor_data_;
   // Point loads of the retrograde sweeps at the sensors' nodes, values per sweep
   // of a batch (column b), allocated in the constructor.
