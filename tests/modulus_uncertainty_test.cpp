@@ -8,12 +8,12 @@
 
 #include <cmath>
 #include <limits>
-#include <random>
 #include <vector>
 
 #include "identify_binary.h"
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
+#include "mcrewave/core/random.h"
 #include "mcrewave/data/noise.h"
 #include "test_problems.h"
 
@@ -134,16 +134,15 @@ TEST(ModulusUncertaintyTrustedClampTest, TheFirstOrderChangeIsTheDifferenceOverD
   ASSERT_TRUE(figure.available) << figure.message;
 
   // The same draws, in the same order (u0, uL, then f0, fL).
-  std::mt19937_64 engine(options.seed);
-  std::normal_distribution<double> normal(0.0, 1.0);
+  StandardNormal normal(options.seed);
   double sum_of_squares = 0.0;
   for (int sample = 0; sample < options.samples; ++sample) {
     ChannelSet drawn = data;
     for (Vector* channel : {&drawn.Values("u0"), &drawn.Values("uL")}) {
-      for (double& value : *channel) value = noise.displacement_std * normal(engine);
+      for (double& value : *channel) value = noise.displacement_std * normal();
     }
     for (Vector* channel : {&drawn.Values("f0"), &drawn.Values("fL")}) {
-      for (double& value : *channel) value = noise.force_std * normal(engine);
+      for (double& value : *channel) value = noise.force_std * normal();
     }
     double gradient[2];
     for (int sign = 0; sign < 2; ++sign) {

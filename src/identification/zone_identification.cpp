@@ -6,9 +6,9 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
-#include <random>
 #include <sstream>
 
+#include "mcrewave/core/random.h"
 #include "mcrewave/least_squares/zone_output_error_objective.h"
 
 namespace mcrewave {
@@ -67,19 +67,18 @@ namespace {
 // `drawn` (a copy of the data) with every channel replaced by white noise at `noise`'s
 // levels, then pre-filtered as `prefilter` says.
 ChannelSet DrawNoiseAlone(const PrefilterOptions& prefilter, const NoiseLevels& noise,
-                          std::mt19937_64* engine, ChannelSet* drawn) {
-  std::normal_distribution<double> normal(0.0, 1.0);
+                          StandardNormal* normal, ChannelSet* drawn) {
   for (const char* name : {"u0", "uL"}) {
-    for (double& value : drawn->Values(name)) value = noise.displacement_std * normal(*engine);
+    for (double& value : drawn->Values(name)) value = noise.displacement_std * (*normal)();
   }
   for (const char* name : {"f0", "fL"}) {
-    for (double& value : drawn->Values(name)) value = noise.force_std * normal(*engine);
+    for (double& value : drawn->Values(name)) value = noise.force_std * (*normal)();
   }
   for (const BarSensor& sensor : BarSensors(*drawn)) {
     const double level =
         sensor.kind == SensorKind::kStrain ? noise.strain_std : noise.displacement_std;
     for (double& value : drawn->channels[static_cast<std::size_t>(sensor.index)].values) {
-      value = level * normal(*engine);
+      value = level * (*normal)();
     }
   }
   return prefilter.enabled ? PrefilterMeasurements(*drawn, prefilter) : *drawn;
@@ -168,11 +167,11 @@ double ExpectedNoiseCost(const BarModel& model, const ChannelSet& data, const Mc
                          EndDisplacementChannels ends, const Vector& moduli,
                          const NoiseLevels& noise, const PrefilterOptions& prefilter, int samples,
                          std::uint64_t seed, double cost_scale) {
-  std::mt19937_64 engine(seed);
+  StandardNormal normal(seed);
   ChannelSet drawn = data;
   double sum = 0.0;
   for (int sample = 0; sample < samples; ++sample) {
-    const ChannelSet noise_data = DrawNoiseAlone(prefilter, noise, &engine, &drawn);
+    const ChannelSet noise_data = DrawNoiseAlone(prefilter, noise, &normal, &drawn);
     McreObjective objective(model, noise_data, mcre, theta, inner, moduli[0], ends);
     const ObjectiveEvaluation& record = objective.EvaluateModuli(moduli, false);
     if (!record.usable) return -1.0;
@@ -186,11 +185,11 @@ double ExpectedLeastSquaresNoiseCost(const BarModel& model, const ChannelSet& da
                                      EndDisplacementChannels ends, const Vector& moduli,
                                      const NoiseLevels& noise, const PrefilterOptions& prefilter,
                                      int samples, std::uint64_t seed, double cost_scale) {
-  std::mt19937_64 engine(seed);
+  StandardNormal normal(seed);
   ChannelSet drawn = data;
   double sum = 0.0;
   for (int sample = 0; sample < samples; ++sample) {
-    const ChannelSet noise_data = DrawNoiseAlone(prefilter, noise, &engine, &drawn);
+    const ChannelSet noise_data = DrawNoiseAlone(prefilter, noise, &normal, &drawn);
     ZoneOutputErrorObjective objective(model, noise_data, misfit_levels, theta, moduli[0], ends);
     sum += objective.Cost(moduli, nullptr);
   }

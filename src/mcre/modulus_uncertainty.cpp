@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
-#include <random>
 #include <sstream>
 
+#include "mcrewave/core/random.h"
 #include "mcrewave/mcre/mcre_problem.h"
 
 namespace mcrewave {
@@ -162,22 +162,21 @@ ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
   Vector& noise_fL = noise_data.Values("fL");
   const std::vector<BarSensor> noise_sensors = BarSensors(noise_data);
   const Vector& data_f0 = data.Values("f0");
-  std::mt19937_64 engine(options.seed);
-  std::normal_distribution<double> normal(0.0, 1.0);
+  StandardNormal normal(options.seed);
   Matrix plus_displacement, plus_retrograde, minus_displacement, minus_retrograde;
   double sum_of_squares = 0.0;
   for (int sample = 0; sample < options.samples; ++sample) {
     for (Vector* channel : {&noise_u0, &noise_uL}) {
-      for (double& value : *channel) value = noise.displacement_std * normal(engine);
+      for (double& value : *channel) value = noise.displacement_std * normal();
     }
     for (Vector* channel : {&noise_f0, &noise_fL}) {
-      for (double& value : *channel) value = noise.force_std * normal(engine);
+      for (double& value : *channel) value = noise.force_std * normal();
     }
     for (const BarSensor& sensor : noise_sensors) {
       const double level =
           sensor.kind == SensorKind::kStrain ? noise.strain_std : noise.displacement_std;
       for (double& value : noise_data.channels[static_cast<std::size_t>(sensor.index)].values) {
-        value = level * normal(engine);
+        value = level * normal();
       }
     }
     McreProblem problem(model, noise_data, mcre.weights, mcre.reference_modulus, theta, ends,
