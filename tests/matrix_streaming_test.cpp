@@ -10,8 +10,10 @@
 #include <string>
 
 #include "mcrewave/mcre/coupled_solver.h"
+#include "mcrewave/mcre/element_error_map.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/mcre/objective.h"
+#include "mcrewave/model/simulation.h"
 #include "test_problems.h"
 
 namespace mcrewave {
@@ -82,6 +84,9 @@ TEST(MatrixStreamingTest, OneApplicationIsTheStoredSweeps) {
     EXPECT_LT(RelativeDifference(totals.zone_error_map, problem.ZoneErrorMap(w)), 4e-16);
     EXPECT_LT(RelativeDifference(totals.zone_strain_energy, problem.ZoneErrorMap(u)), 4e-16);
     EXPECT_LT(RelativeDifference(totals.error_map, problem.DofErrorMap(w)), 4e-16);
+    // No element blocks: no element map, no picture.
+    EXPECT_EQ(totals.element_error_map.size(), 0);
+    EXPECT_EQ(totals.gap_density.size(), 0);
     // The linear part, and the retrograde energy of traces without data: the P-norm of
     // the retrograde sweep they drive (RetrogradeSweep of a U with H U = traces).
     Matrix linear_w;
@@ -93,6 +98,42 @@ TEST(MatrixStreamingTest, OneApplicationIsTheStoredSweeps) {
     problem.StreamingMap(traces, false, &linear_image);
     problem.DirectSweep(linear_w, false, &linear_u);
     EXPECT_EQ(linear_image, problem.ObservedTraces(linear_u));
+  }
+}
+
+// With element blocks (the bar exported, 2 zones), one application sums the element
+// map's shares and picture rows of the W it passes through: ComputeElementErrorMap's of
+// the stored W to the bit (the same W from the checkpoints, the same sums in the same
+// order), under a trusted and a measured support.
+TEST(MatrixStreamingTest, OneApplicationGivesTheStoredFieldsElementMap) {
+  const testing::SmallCase c = testing::MakeSmallCase(20, 300, 20.0, 2);
+  std::vector<int> zones(20);
+  for (int e = 0; e < 20; ++e) zones[e] = e < 12 ? 0 : 1;
+  const BarModel bar(c.bar, zones);
+  const ChannelSet data = MakeSyntheticMeasurements(c.bar, c.load, c.time, c.data);
+  const MatrixModelData model = BarMatrixModel(bar, c.bar.modulus, {}, BarClampExport::kSupport);
+  for (const ClampModel treatment : {ClampModel::kTrusted, ClampModel::kMeasured}) {
+    SCOPED_TRACE(ClampModelToString(treatment));
+    MatrixMcreProblem problem(model, data, Weights(0.01, 1.0), 2e11, 0.5, Factorization::kAutomatic,
+                              treatment);
+    problem.SetModuli((Vector(2) << 1.9e11, 1.7e11).finished());
+    Matrix u0, w;
+    problem.DirectSweep(problem.ZeroField(), true, &u0);
+    problem.RetrogradeSweep(u0, true, &w);
+    Matrix image;
+    StreamingCoupledProblem::StreamingTotals totals;
+    problem.StreamingMap(problem.ObservedTraces(u0), true, &image, &totals);
+    const ErrorMap stored = ComputeElementErrorMap(model, problem.moduli(), w, problem.time_step());
+    const ErrorMap streamed =
+        AssembleElementErrorMap(model, totals.element_error_map, totals.gap_density,
+                                problem.num_steps(), problem.time_step());
+    ASSERT_EQ(streamed.share.size(), 20);
+    EXPECT_TRUE(streamed.share == stored.share);
+    EXPECT_TRUE(streamed.density == stored.density);
+    EXPECT_TRUE(streamed.times == stored.times);
+    EXPECT_TRUE(streamed.position == stored.position);
+    EXPECT_TRUE(streamed.density_position == stored.density_position);
+    EXPECT_GT(streamed.share.maxCoeff(), 0.0);
   }
 }
 

@@ -253,10 +253,15 @@ bool SolveAt(const Vector& moduli, const CoupledSolverOptions& inner, MatrixMcre
 }
 
 // The element map of a usable coupled solution at `moduli` (mcre/element_error_map.h):
-// empty when the model has no element blocks or the solution no fields (streaming).
+// from the stored W, or from the sums of a streaming solve; empty when the model has no
+// element blocks.
 ErrorMap ElementMapOf(const MatrixModelData& model, const Vector& moduli,
                       const CoupledSolution& solution, double time_step) {
-  if (model.elements.empty() || !solution.has_fields()) return ErrorMap();
+  if (model.elements.empty()) return ErrorMap();
+  if (!solution.has_fields()) {
+    return AssembleElementErrorMap(model, solution.element_error_map, solution.gap_density,
+                                   static_cast<int>(solution.traces.cols()) - 1, time_step);
+  }
   return ComputeElementErrorMap(model, moduli, solution.retrograde, time_step);
 }
 

@@ -118,4 +118,19 @@ ErrorMap ComputeElementErrorMap(const MatrixModelData& model, const Vector& zone
   return map;
 }
 
+ErrorMap AssembleElementErrorMap(const MatrixModelData& model, const Vector& shares,
+                                 const Matrix& density, int num_steps, double time_step) {
+  const int stride = SpaceTimeStride(num_steps);
+  ErrorMap map;
+  map.position = ElementMapPositions(model);
+  map.share = shares;
+  map.density_position = ElementColumnPositions(model);
+  assert(shares.size() == map.position.size() && density.rows() == num_steps / stride + 1 &&
+         density.cols() == map.density_position.size());
+  map.density = density;
+  map.times.resize(density.rows());
+  for (int i = 0; i < density.rows(); ++i) map.times[i] = (i * stride) * time_step;
+  return map;
+}
+
 }  // namespace mcrewave

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "mcrewave/mcre/element_error_map.h"
+
 namespace mcrewave {
 
 ChannelSet MatrixChannelSet(const MatrixModelData& model, double time_step, const Matrix& loads,
@@ -259,6 +261,8 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
     stream_retrograde_[b] = Vector::Zero(n);
   }
   stream_zone_product_ = Vector::Zero(n);
+  if (!model.elements.empty())
+    stream_density_row_ = Vector::Zero(ElementColumnPositions(model).size());
   batch_velocity_ = Matrix::Zero(n, 2 * kMaxSweepBatch);
   batch_state_ = Matrix::Zero(n, 2 * kMaxSweepBatch);
   batch_shift_ = Matrix::Zero(n, kMaxSweepBatch);

@@ -7,6 +7,8 @@
 #include <cassert>
 #include <cmath>
 
+#include "mcrewave/mcre/element_error_map.h"
+#include "mcrewave/mcre/error_map.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 
 namespace mcrewave {
@@ -108,18 +110,34 @@ double MatrixMcreProblem::RetrogradeEnergy(const Matrix& traces) {
 }
 
 void MatrixMcreProblem::AddStreamingSample(int j, const Vector& displacement,
-                                           const Vector& retrograde, StreamingTotals* totals) {
+                                           const Vector& retrograde, int picture_stride,
+                                           StreamingTotals* totals) {
   const int zones = static_cast<int>(model_.zones.size());
   const double weight = QuadratureWeight(j) * time_step();
   // e^2: c_j h [1/2 W^T K W + 1/2 (G^T W)^T diag(1/alpha) G^T W
-  //             + 1/2 (H U - d~)^T diag(beta) (H U - d~)] (Cost), trace_ = H U_j - d~_j.
+  //             + 1/2 (H U - d~)^T diag(beta) (H U - d~)] (Cost), trace_ = H U_j - d~_j,
+  // W^T K W as StiffnessForm takes it (from the band of K on the band path).
   product_.noalias() = stiffness_ * retrograde;
+  const double stiffness_form =
+      integrator_.factorization() == Factorization::kBand
+          ? integrator_.stiffness().BilinearForm(retrograde.data(), retrograde.data())
+          : retrograde.dot(product_);
   load_columns_.TransposeMultiply(retrograde.data(), channel_.data());
-  totals->cost += weight * (0.5 * retrograde.dot(product_) +
-                            0.5 * channel_.cwiseQuotient(alphas_).dot(channel_) +
-                            0.5 * betas_.dot(trace_.cwiseProduct(trace_)));
+  totals->cost +=
+      weight * (0.5 * stiffness_form + 0.5 * channel_.cwiseQuotient(alphas_).dot(channel_) +
+                0.5 * betas_.dot(trace_.cwiseProduct(trace_)));
   // The dof map c_j h 1/2 W_ij (K W_j)_i (DofErrorMap).
   totals->error_map += (0.5 * weight) * retrograde.cwiseProduct(product_);
+  if (!model_.elements.empty()) {
+    // The element map's shares and, on every picture_stride-th sample, its picture's
+    // row (mcre/element_error_map.h, as ComputeElementErrorMap takes them from W).
+    AddSampleElementGapShares(model_, moduli_, retrograde.data(), weight,
+                              &totals->element_error_map);
+    if (j % picture_stride == 0) {
+      SampleElementGapDensity(model_, moduli_, retrograde.data(), stream_density_row_.data());
+      totals->gap_density.row(j / picture_stride) = stream_density_row_.transpose();
+    }
+  }
   for (int z = 0; z < zones; ++z) {
     const MatrixModelZone& zone = model_.zones[z];
     product_.noalias() = zone.stiffness * retrograde;
@@ -144,14 +162,16 @@ void MatrixMcreProblem::AddStreamingSample(int j, const Vector& displacement,
   }
 }
 
-void MatrixMcreProblem::ResetStreamingTotals(StreamingTotals* totals) const {
+void MatrixMcreProblem::ResetStreamingTotals(int picture_stride, StreamingTotals* totals) const {
   const int zones = num_zones();
   totals->cost = 0.0;
   totals->cost_gradients.setZero(zones);
   totals->error_map.setZero(num_nodes());
   totals->zone_error_map.setZero(zones);
   totals->zone_strain_energy.setZero(zones);
-  totals->gap_density.resize(0, 0);
+  totals->element_error_map.setZero(static_cast<Eigen::Index>(model_.elements.size()));
+  totals->gap_density.resize(model_.elements.empty() ? 0 : num_steps() / picture_stride + 1,
+                             stream_density_row_.size());
   totals->end_retrograde.resize(0, 0);
   totals->rebuild_error = 0.0;  // W from checkpoints: the stored sweep's
 }
@@ -188,14 +208,16 @@ void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Ma
   }
   const int stride = checkpoint_stride_;
   image->resize(num_traces(), m + 1);
-  if (totals != nullptr) ResetStreamingTotals(totals);
+  // The element map's picture takes every picture_stride-th sample.
+  const int picture_stride = SpaceTimeStride(m);
+  if (totals != nullptr) ResetStreamingTotals(picture_stride, totals);
   // y_j = H U_j into the image, and sample j into the totals.
   auto observe = [&](int j, const Vector& displacement, const Vector& retrograde) {
     observation_columns_.TransposeMultiply(displacement.data(), trace_.data());
     image->col(j) = trace_;
     if (totals == nullptr) return;
     trace_ -= measured_outputs_.col(j);
-    AddStreamingSample(j, displacement, retrograde, totals);
+    AddStreamingSample(j, displacement, retrograde, picture_stride, totals);
   };
   // The direct step t_{j-1} -> t_j of DirectSweep from (V, U)[current] into [next],
   // f_theta = -K W_theta + G (F~_theta - diag(1/alpha) G^T W_theta),

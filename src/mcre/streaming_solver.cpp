@@ -175,6 +175,7 @@ void StreamingConjugateGradient::Accept(const std::string& message) {
   solution_->traces = traces_;
   solution_->end_retrograde = totals_.end_retrograde;
   solution_->error_map = totals_.error_map;
+  solution_->element_error_map = totals_.element_error_map;
   solution_->zone_error_map = totals_.zone_error_map;
   solution_->zone_strain_energy = totals_.zone_strain_energy;
   solution_->gap_density = totals_.gap_density;

@@ -167,7 +167,10 @@ struct CoupledSolution {
   // Streaming only: on the bar e_el^2 per element, on a matrix model the dof map
   // (MatrixMcreProblem::DofErrorMap) [J s].
   Vector error_map;
-  Matrix gap_density;  // the error map's space-time picture (streaming on the bar) [J/m]
+  // Streaming on a matrix model with element blocks: e_el^2 per element [J s].
+  Vector element_error_map;
+  // Streaming: the error map's space-time picture (StreamingTotals::gap_density).
+  Matrix gap_density;
   // Streaming on a matrix model: MatrixMcreProblem::ZoneErrorMap of W and of U [J s].
   Vector zone_error_map, zone_strain_energy;
 

@@ -217,11 +217,13 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // with its state only: observe(j, U_j) for j = 0..m.
   template <typename Observe>
   void DataResponseSweep(Observe&& observe);
-  // Adds sample j (U_j, W_j) of a streaming application to the totals. No allocation.
+  // Adds sample j (U_j, W_j) of a streaming application to the totals, and the element
+  // map's picture row when j is a multiple of picture_stride. No allocation.
   void AddStreamingSample(int j, const Vector& displacement, const Vector& retrograde,
-                          StreamingTotals* totals);
-  // Zeroes the totals of a streaming application, sized for the dofs and the zones.
-  void ResetStreamingTotals(StreamingTotals* totals) const;
+                          int picture_stride, StreamingTotals* totals);
+  // Zeroes the totals of a streaming application, sized for the dofs, the zones and the
+  // elements (the picture: every picture_stride-th sample).
+  void ResetStreamingTotals(int picture_stride, StreamingTotals* totals) const;
   // Step 1 of StreamingMap: the retrograde sweep from rest at T driven by the traces,
   // keeping its state (v_j, omega_j) at the checkpoints j = m - i s (column i of
   // checkpoints_: v over omega). No allocation.
@@ -267,6 +269,9 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   int checkpoint_stride_ = 0;
   Matrix checkpoints_, segment_;
   Vector stream_velocity_[2], stream_displacement_[2], stream_retrograde_[2], stream_zone_product_;
+  // One row of the element map's picture (ElementColumnPositions entries; empty without
+  // elements), allocated in the constructor.
+  Vector stream_density_row_;
   // Batched sweeps, per sweep b: the double buffers of the velocity (columns 2b, 2b + 1)
   // and of omega, W_theta, the load channels or the weighted traces, and the point
   // loads' values; sized in the constructor.

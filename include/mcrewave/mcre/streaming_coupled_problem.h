@@ -23,8 +23,9 @@ class StreamingCoupledProblem : public CoupledProblem {
  public:
   // What a streaming application gathers at each sample when asked: the cost,
   // gradients and error maps of the fields it passes through, never stored. Entries a
-  // structure has no use for stay empty (the bar: the zone maps; a matrix model: the
-  // picture and the end values).
+  // structure has no use for stay empty (the bar: the zone maps and the element map; a
+  // matrix model: the end values, and the element map and picture without element
+  // blocks).
   struct StreamingTotals {
     double cost = 0.0;      // e^2 [J s]
     Vector cost_gradients;  // de^2/dE_z [J s / Pa]
@@ -35,9 +36,13 @@ class StreamingCoupledProblem : public CoupledProblem {
     // [J s] (MatrixMcreProblem::ZoneErrorMap of W), and the same sum over U, the zone's
     // own strain energy (ZoneErrorMap of U).
     Vector zone_error_map, zone_strain_energy;
-    // The bar: the error map's space-time picture (error_map.h), the gap energy
-    // density [J/m] at every SpaceTimeStride(m)-th sample (rows) on
-    // SpaceTimeColumnPositions (columns).
+    // A matrix model with element blocks: e_el^2 per element [J s]
+    // (mcre/element_error_map.h).
+    Vector element_error_map;
+    // The error map's space-time picture at every SpaceTimeStride(m)-th sample (rows):
+    // the bar's gap energy density [J/m] on SpaceTimeColumnPositions (error_map.h); a
+    // matrix model's element gap energy [J] on ElementColumnPositions
+    // (element_error_map.h; empty without element blocks).
     Matrix gap_density;
     Matrix end_retrograde;  // the bar: W at nodes 0 and N, 2 x (m + 1) [m]
     // ||omega_m|| / max_j ||omega_j|| of a retrograde state rebuilt by the reversed
