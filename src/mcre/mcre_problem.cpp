@@ -41,8 +41,7 @@ McreProblem::McreProblem(const BarModel& model, const ChannelSet& data, const Mc
       measured_(BarEndChannels(data)),
       theta_(theta),
       ends_(ends),
-      clamp_(clamp),
-      unit_stiffness_(model.unit_stiffness()) {
+      clamp_(clamp) {
   assert(weights.IsValid(nullptr) && data.num_steps() >= 1 && reference_modulus > 0.0);
   const BarProperties& bar = model.properties();
   // The weights from the scales of a structure given by matrices (docs/matrix_models.md
@@ -116,6 +115,8 @@ McreProblem::McreProblem(const BarModel& model, const ChannelSet& data, const Mc
   }
   gradient_shift_.resize(n);
   gradient_product_.resize(n);
+  reaction_trace_.resize(1);
+  reaction_zone_trace_.resize(1);
   const int num_sensors = static_cast<int>(sensor_rows_.size());
   sensor_weights_ = Eigen::Map<const Vector>(weights_of_rows.data(), num_sensors);
   // The weights of Misfits' rows: uL, the interior sensors, then u0 or the reaction.
@@ -174,7 +175,7 @@ void McreProblem::SetModuli(const Vector& zone_moduli) {
     for (int z = 1; z < num_zones(); ++z) reactions_ += moduli_[z] * reaction_zone_rows_[z];
     sensor_rows_[reaction_row_].coefficients[1] = reactions_.coeff(0, 1);
   }
-  // K = sum_z E_z K1_z (one zone: E K1); node 0 decoupled under a trusted clamp.
+  // K = sum_z (E_z / E_nom) K_z (StiffnessMatrix); node 0 decoupled under a trusted clamp.
   integrator_.Init(MassMatrix(), StiffnessMatrix(), options);
 }
 
@@ -501,31 +502,30 @@ double McreProblem::Cost(const Matrix& displacement, const Matrix& retrograde) {
   return sum;
 }
 
-double McreProblem::SampleGradient(const double* displacement, const double* retrograde) const {
-  // W_j^T K1 (W_j + 2 U_j), with K = E K1 so that -(1/(2E)) W^T K (.) = -(1/2) W^T K1 (.).
-  return unit_stiffness_.BilinearForm(retrograde, retrograde) +
-         2.0 * unit_stiffness_.BilinearForm(retrograde, displacement);
-}
-
-void McreProblem::AddSampleZoneGradients(double weight, const double* displacement,
-                                         const double* retrograde, Vector* gradient) const {
-  for (int e = 0; e < model_.num_elements(); ++e) {
-    // weight W_j^T K1_e (W_j + 2 U_j) = weight k1_e dW (dW + 2 dU), dX = X_{e+1} - X_e,
-    // summed by zone.
-    const double dw = retrograde[e + 1] - retrograde[e];
-    const double du = displacement[e + 1] - displacement[e];
-    (*gradient)[model_.element_zone(e)] +=
-        weight * model_.element_unit_stiffness(e) * dw * (dw + 2.0 * du);
+void McreProblem::AddSampleCostGradients(int j, const double* displacement,
+                                         const double* retrograde, Vector* gradient) {
+  const int n = num_nodes();
+  const double h = time_step();
+  const Eigen::Map<const Vector> u(displacement, n), w(retrograde, n);
+  // MatrixMcreProblem::CostGradients' sums on the bar exported as matrices
+  // (BarMatrixModel with K_z = E_nom K1_z, E_nom = the model's modulus, and the clamp a
+  // support), so that the bar's and the exported bar's gradients are the same bits.
+  gradient_shift_ = w + 2.0 * u;
+  for (int z = 0; z < num_zones(); ++z) {
+    // -(1/(2 E_nom)) c_j h W_j^T K_z (W_j + 2 U_j).
+    gradient_product_.noalias() = zone_stiffness_[z] * gradient_shift_;
+    (*gradient)[z] += -0.5 * QuadratureWeight(j) * h * w.dot(gradient_product_) / nominal_modulus_;
   }
-}
-
-double McreProblem::ReactionGradient(int j, const double* displacement) const {
-  if (reaction_row_ < 0) return 0.0;
-  // alpha_r (r(U_j) / E_1) (r(U_j) - f0~_j): d/dE_1 of alpha_r/2 (r(U_j) - f0~_j)^2 with
-  // r = E_1 K1_01 U_1.
-  const double reaction = ClampReaction(displacement);
-  return sensor_weights_[reaction_row_] * (reaction / moduli_[model_.element_zone(0)]) *
-         (reaction - measured_.f0[j]);
+  if (reaction_row_ < 0) return;
+  // Trusted: c_j h alpha_r (r(U_j) - f0~_j) e_0^T K_z U_j / E_nom, the explicit term
+  // alpha_r (r(U_j) / E_1) (r(U_j) - f0~_j) of the zone of element 1.
+  reaction_trace_.noalias() = reactions_ * u;
+  reaction_trace_[0] -= measured_.f0[j];
+  for (int z = 0; z < num_zones(); ++z) {
+    reaction_zone_trace_.noalias() = reaction_zone_rows_[z] * u;
+    (*gradient)[z] += QuadratureWeight(j) * h * sensor_weights_[reaction_row_] *
+                      reaction_trace_.dot(reaction_zone_trace_);
+  }
 }
 
 double McreProblem::CostGradient(const Matrix& displacement, const Matrix& retrograde) {
@@ -536,29 +536,9 @@ double McreProblem::CostGradient(const Matrix& displacement, const Matrix& retro
 
 void McreProblem::CostGradients(const Matrix& displacement, const Matrix& retrograde,
                                 Vector* gradient) {
-  const int zones = num_zones();
-  const double h = time_step();
-  gradient->setZero(zones);
-  // MatrixMcreProblem::CostGradients' sums on the bar exported as matrices
-  // (BarMatrixModel with K_z = E_nom K1_z, E_nom = the model's modulus, and the clamp a
-  // support), so that the bar's and the exported bar's gradients are the same bits.
+  gradient->setZero(num_zones());
   for (int j = 0; j <= num_steps(); ++j) {
-    gradient_shift_ = retrograde.col(j) + 2.0 * displacement.col(j);
-    for (int z = 0; z < zones; ++z) {
-      // -(1/(2 E_nom)) c_j h W_j^T K_z (W_j + 2 U_j).
-      gradient_product_.noalias() = zone_stiffness_[z] * gradient_shift_;
-      (*gradient)[z] += -0.5 * QuadratureWeight(j) * h * retrograde.col(j).dot(gradient_product_) /
-                        nominal_modulus_;
-    }
-    if (reaction_row_ < 0) continue;
-    // Trusted: c_j h alpha_r (r(U_j) - f0~_j) e_0^T K_z U_j / E_nom, the explicit term
-    // alpha_r (r(U_j) / E_1) (r(U_j) - f0~_j) of the zone of element 1.
-    const double misfit = (reactions_ * displacement.col(j))[0] - measured_.f0[j];
-    for (int z = 0; z < zones; ++z) {
-      const double zone_reaction = (reaction_zone_rows_[z] * displacement.col(j))[0];
-      (*gradient)[z] +=
-          QuadratureWeight(j) * h * sensor_weights_[reaction_row_] * (misfit * zone_reaction);
-    }
+    AddSampleCostGradients(j, displacement.col(j).data(), retrograde.col(j).data(), gradient);
   }
 }
 

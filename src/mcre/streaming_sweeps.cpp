@@ -144,17 +144,7 @@ void McreProblem::AddStreamingSample(int j, const Vector& displacement, const Ve
   const int last = num_nodes() - 1;
   const double weight = QuadratureWeight(j) * time_step();
   totals->cost += weight * SampleCost(j, displacement.data(), retrograde.data());
-  if (num_zones() == 1) {
-    totals->cost_gradients[0] +=
-        -0.5 * weight * SampleGradient(displacement.data(), retrograde.data());
-  } else {
-    AddSampleZoneGradients(-0.5 * weight, displacement.data(), retrograde.data(),
-                           &totals->cost_gradients);
-  }
-  if (reaction_row_ >= 0) {
-    totals->cost_gradients[model_.element_zone(0)] +=
-        weight * ReactionGradient(j, displacement.data());
-  }
+  AddSampleCostGradients(j, displacement.data(), retrograde.data(), &totals->cost_gradients);
   AddSampleGapShares(model_, moduli_, retrograde.data(), weight, &totals->error_map);
   if (j % picture_stride == 0) {
     SampleGapDensity(model_, moduli_, retrograde.data(), stream_density_row_.data());

@@ -111,7 +111,8 @@ class McreProblem : public StreamingCoupledProblem {
   // Sets every zone's modulus to E [Pa] and refactorises the integrator (once per change).
   void SetModulus(double modulus);
   // Sets the zone moduli E_z [Pa] (model().num_zones() entries) and refactorises the
-  // integrator when they changed: K = sum_z E_z K1_z.
+  // integrator when they changed: K = sum_z (E_z / E_nom) K_z, K_z = E_nom K1_z (E_nom
+  // the model's modulus).
   void SetModuli(const Vector& zone_moduli) override;
   // The modulus of a one-zone model, else the first zone's [Pa].
   double modulus() const { return moduli_.size() > 0 ? moduli_[0] : 0.0; }
@@ -173,7 +174,7 @@ class McreProblem : public StreamingCoupledProblem {
   //                    + 1/2 (H U - d~)^T diag(beta_k) (H U - d~)]  [J s].
   double Cost(const Matrix& displacement, const Matrix& retrograde) override;
   // de^2/dE = sum_z de^2/dE_z [J s / Pa], the derivative along a common change of every
-  // zone's modulus (one zone: the modulus). Precondition: every zone at the same modulus.
+  // zone's modulus (one zone: the modulus).
   double CostGradient(const Matrix& displacement, const Matrix& retrograde);
   // de^2/dE_z = -(1/(2 E_nom)) sum_j c_j h W_j^T K_z (W_j + 2 U_j) [J s / Pa] with
   // K_z = E_nom K1_z (E_nom the model's modulus), plus under a trusted clamp the
@@ -187,7 +188,7 @@ class McreProblem : public StreamingCoupledProblem {
   // one entry per element; their sum is sum_j c_j h 1/2 W_j^T K W_j.
   Vector ErrorMap(const Matrix& retrograde) const;
 
-  // The operators of the space-time system: M, K = sum_z E_z K1_z, P = K + B/alpha,
+  // The operators of the space-time system: M, K = sum_z (E_z / E_nom) K_z, P = K + B/alpha,
   // H^T diag(beta_k) H (the paper's case: beta B), H^T diag(beta_k) d~_j and the
   // measured end forces f0~_j e_0 + fL~_j e_N. Trusted clamp: M and K with row and
   // column 0 decoupled, B = e_N e_N^T, the load fL~_j e_N alone.
@@ -261,7 +262,7 @@ class McreProblem : public StreamingCoupledProblem {
 
   // The integrand of e^2 at sample j without c_j h:
   // 1/2 W^T K W + W_0^2 / (2 alpha_0) + W_N^2 / (2 alpha)
-  //   + 1/2 (H U - d~_j)^T diag(beta) (H U - d~_j), 1 / alpha_0 = inverse_alpha0().
+  //   + 1/2 (H U - d~_j)^T diag(beta) (H U - d~_j) (the force terms: EndForceForm).
   double SampleCost(int j, const double* displacement, const double* retrograde);
   // cost_misfits_ = H U_j - d~_j of the displacement U_j in the rows uL, the interior
   // sensors, then u0 (its datum 0 when pinned) or a trusted clamp's reaction. No
@@ -272,14 +273,10 @@ class McreProblem : public StreamingCoupledProblem {
   // x^T (K + e_0 e_0^T / alpha_0 + e_N e_N^T / alpha) y of two nodal vectors (n
   // entries each).
   double PenaltyForm(const double* x, const double* y) const;
-  // W_j^T K1 (W_j + 2 U_j) (one zone's gradient integrand, without -(1/2) c_j h).
-  double SampleGradient(const double* displacement, const double* retrograde) const;
-  // The explicit term of a trusted clamp's reaction row at sample j, without c_j h:
-  // alpha_r (r(U_j) / E_1) (r(U_j) - f0~_j), for the zone of element 1 (0 without it).
-  double ReactionGradient(int j, const double* displacement) const;
-  // gradient[z] += weight W_j^T K1_z (W_j + 2 U_j) for every zone.
-  void AddSampleZoneGradients(double weight, const double* displacement, const double* retrograde,
-                              Vector* gradient) const;
+  // gradient[z] += sample j's term of de^2/dE_z (CostGradients) from U_j and W_j (n
+  // entries each), for every zone. No allocation.
+  void AddSampleCostGradients(int j, const double* displacement, const double* retrograde,
+                              Vector* gradient);
 
   // Sets the totals of a streaming application to zero and sizes them (the error
   // map's picture takes every picture_stride-th sample).
@@ -345,7 +342,7 @@ class McreProblem : public StreamingCoupledProblem {
   double nominal_modulus_ = 0.0;
   std::vector<SparseMatrix> zone_stiffness_, reaction_zone_rows_;
   SparseMatrix reactions_;
-  Vector gradient_shift_, gradient_product_;
+  Vector gradient_shift_, gradient_product_, reaction_trace_, reaction_zone_trace_;
   std::vector<const Vector*> sensor_data_;
   // Point loads of the retrograde sweeps at the sensors' nodes, values per sweep
   // of a batch (column b), allocated in the constructor.
@@ -353,7 +350,6 @@ class McreProblem : public StreamingCoupledProblem {
   Matrix load_values_;
   PointLoads point_loads_[ThetaIntegrator::kMaxBatch];
   ThetaIntegrator integrator_;
-  SymmetricBandMatrix unit_stiffness_;  // K1 = sum_z K1_z
   // Streaming scratch (double buffers of the three sweeps' states, W_{j-1}, W_j, the
   // direct step's shift), allocated in the constructor: O(n).
   Vector stream_velocity_[2], stream_omega_[2], stream_rebuilt_velocity_[2],
