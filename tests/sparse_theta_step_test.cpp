@@ -235,13 +235,13 @@ TEST(SparseThetaStepTest, RefusesAnIterationMatrixThatIsNotPositiveDefinite) {
 // displacement under a smooth force, to T = 4 s, against the same scheme at h / 64.
 TEST(SparseThetaStepTest, ConvergesAtOrderTwoOnALattice) {
   const Lattice lattice = MakeLattice(12, 9, 1.0, 1.0);
-  const int n = 12 * 9;
+  constexpr int n = 12 * 9;
   constexpr double kEnd = 4.0;
   Vector u0(n);
   for (int j = 0; j < 9; ++j) {
     for (int i = 0; i < 12; ++i) u0[j * 12 + i] = std::sin(M_PI * i / 11.0) * std::cos(0.3 * j);
   }
-  auto force = [n](double t) {
+  auto force = [](double t) {
     Vector f = Vector::Zero(n);
     f[n - 1] = std::sin(2.0 * t);
     f[n / 2] = 0.5 * std::cos(t);
