@@ -103,24 +103,21 @@ ErrorMap ComputeElementErrorMap(const MatrixModelData& model, const Vector& zone
                                 const Matrix& retrograde, double time_step, int max_time_columns) {
   const int m = static_cast<int>(retrograde.cols()) - 1;
   const int stride = SpaceTimeStride(m, max_time_columns);
-  ErrorMap map;
-  map.position = ElementMapPositions(model);
-  map.share = MatrixElementGapShares(model, zone_moduli, retrograde, time_step);
-  map.density_position = ElementColumnPositions(model);
-  map.density.resize(m / stride + 1, map.density_position.size());
-  map.times.resize(map.density.rows());
-  Vector row(map.density.cols());
-  for (int i = 0; i < map.density.rows(); ++i) {
+  Matrix density(m / stride + 1, ElementColumnPositions(model).size());
+  Vector row(density.cols());
+  for (int i = 0; i < density.rows(); ++i) {
     SampleElementGapDensity(model, zone_moduli, retrograde.col(i * stride).data(), row.data());
-    map.density.row(i) = row.transpose();
-    map.times[i] = (i * stride) * time_step;
+    density.row(i) = row.transpose();
   }
-  return map;
+  return AssembleElementErrorMap(model,
+                                 MatrixElementGapShares(model, zone_moduli, retrograde, time_step),
+                                 density, m, time_step, max_time_columns);
 }
 
 ErrorMap AssembleElementErrorMap(const MatrixModelData& model, const Vector& shares,
-                                 const Matrix& density, int num_steps, double time_step) {
-  const int stride = SpaceTimeStride(num_steps);
+                                 const Matrix& density, int num_steps, double time_step,
+                                 int max_time_columns) {
+  const int stride = SpaceTimeStride(num_steps, max_time_columns);
   ErrorMap map;
   map.position = ElementMapPositions(model);
   map.share = shares;

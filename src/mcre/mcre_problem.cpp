@@ -61,14 +61,12 @@ McreProblem::McreProblem(const BarModel& model, const ChannelSet& data, const Mc
   if (pinned) ends_.u0 = true;
   beta_u0_ = ends_.u0 ? beta_ : 0.0;
   beta_uL_ = ends_.uL ? beta_ : 0.0;
-  inverse_alpha0_ = trusted ? 0.0 : 1.0 / alpha_;
   alpha0_ = alpha_;
   force0_gain_ = trusted ? 0.0 : 1.0;
   if (pinned) {
     // beta_0 = w_u0 k* = w_u0 S E0 / L on the datum u0~ = 0; alpha_0 = w_r / k* on f0.
     beta_u0_ = weights.clamp_displacement_weight * stiffness_scale;
     alpha0_ = weights.reaction_weight / stiffness_scale;
-    inverse_alpha0_ = 1.0 / alpha0_;
   }
   std::vector<double> weights_of_rows;
   for (const BarSensor& sensor : BarSensors(data)) {
@@ -543,11 +541,11 @@ void McreProblem::CostGradients(const Matrix& displacement, const Matrix& retrog
 }
 
 SparseMatrix McreProblem::PenaltyMatrix() const {
-  // P = K + e_0 e_0^T / alpha_0 + e_N e_N^T / alpha with 1 / alpha_0 = inverse_alpha0_:
+  // P = K + e_0 e_0^T / alpha_0 + e_N e_N^T / alpha with 1 / alpha_0 = inverse_alpha0():
   // the paper's K + B / alpha (measured clamp), K + e_N e_N^T / alpha (trusted: 0, on the
   // held node's kept diagonal) or the pinned clamp's alpha_0.
   SparseMatrix penalty = StiffnessMatrix();
-  penalty.coeffRef(0, 0) += inverse_alpha0_;
+  penalty.coeffRef(0, 0) += inverse_alpha0();
   penalty.coeffRef(num_nodes() - 1, num_nodes() - 1) += 1.0 / alpha_;
   return penalty;
 }

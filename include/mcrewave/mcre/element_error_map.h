@@ -66,9 +66,11 @@ ErrorMap ComputeElementErrorMap(const MatrixModelData& model, const Vector& zone
 
 // The same map from the element shares and the picture's rows a streaming solve summed
 // (StreamingCoupledProblem::StreamingTotals: element_error_map, gap_density on every
-// stride-th sample, stride = SpaceTimeStride(num_steps)). Preconditions: the model has
+// stride-th sample, stride = SpaceTimeStride(num_steps, max_time_columns));
+// ComputeElementErrorMap assembles its map here too. Preconditions: the model has
 // elements, shares one per element, density of the picture's shape.
 ErrorMap AssembleElementErrorMap(const MatrixModelData& model, const Vector& shares,
-                                 const Matrix& density, int num_steps, double time_step);
+                                 const Matrix& density, int num_steps, double time_step,
+                                 int max_time_columns = kSpaceTimeSamples);
 
 }  // namespace mcrewave

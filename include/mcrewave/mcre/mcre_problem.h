@@ -124,7 +124,7 @@ class McreProblem : public StreamingCoupledProblem {
   double theta() const override { return theta_; }
   double alpha() const { return alpha_; }              // force weight [m/N]
   // 1 / alpha of f0: 1 / alpha (measured), 0 (trusted), 1 / alpha_0 (pinned) [N/m].
-  double inverse_alpha0() const { return inverse_alpha0_; }
+  double inverse_alpha0() const { return force0_gain_ / alpha0_; }
   double beta() const { return beta_; }                // displacement weight beta_u [N/m]
   double strain_beta() const { return strain_beta_; }  // strain weight beta_e [N m]
   const EndDisplacementChannels& end_channels() const { return ends_; }
@@ -323,10 +323,10 @@ class McreProblem : public StreamingCoupledProblem {
   EndDisplacementChannels ends_;
   ClampModel clamp_;
   double beta_u0_, beta_uL_;  // beta_u for an end displacement channel in use, else 0
-  // f0 as a load: its weight alpha_0 (alpha when measured, alpha_0 when pinned), 1 /
-  // alpha_0, and the gain 1 of its terms; when the clamp is trusted, alpha, 0 and the
-  // gain 0 that cancels them.
-  double alpha0_, inverse_alpha0_, force0_gain_;
+  // f0 as a load: its weight alpha_0 (alpha when measured, alpha_0 when pinned) and the
+  // gain 1 of its terms; when the clamp is trusted, alpha and the gain 0 that cancels
+  // them.
+  double alpha0_, force0_gain_;
   // Trusted clamp: the index of the reaction row in sensor_rows_, else -1.
   int reaction_row_ = -1;
   Vector moduli_;             // E_z [Pa]
