@@ -70,10 +70,11 @@ struct IdentifyFigures {
 
 IdentifyFigures IdentifyOnce(const mcrewave::Config& config, const mcrewave::ChannelSet& data) {
   IdentifyFigures figures;
-  const mcrewave::BarModel model(config.model);
+  const mcrewave::MatrixModelData model = mcrewave::BarRunModel(
+      mcrewave::BarModel(config.model), data, mcrewave::EndDisplacementChannels());
   const double start = ProcessCpuSeconds();
   const mcrewave::McreIdentification identification =
-      mcrewave::IdentifyWithMcre(config, model, data, mcrewave::EndDisplacementChannels());
+      mcrewave::IdentifyWithMcre(config, model, data);
   figures.cpu_s = ProcessCpuSeconds() - start;
   const mcrewave::IdentificationSummary& summary = identification.outer;
   figures.modulus = summary.modulus;

@@ -35,6 +35,51 @@ CoupledSolverOptions SupportsTightSolver(CoupledSolverType type) {
   return options;
 }
 
+// MatrixMcreProblem::ModelChannels of a solution of the exported bar (30 elements,
+// sensors u@0.25 and e@0.65, maybe u@0.02) against the built-in bar's own reading of the
+// same fields: U at the ends and at the sensors (interpolated between nodes), the end
+// loads F = F~ - W / alpha (alpha_0 at a pinned clamp), a trusted clamp's reaction.
+void ExpectTheBarsModelChannels(const ChannelSet& channels, McreProblem& bar,
+                                const CoupledSolution& solution, const ChannelSet& data,
+                                ClampModel clamp) {
+  const Matrix& u = solution.displacement;
+  const Matrix& w = solution.retrograde;
+  const int last = static_cast<int>(u.rows()) - 1;
+  const double h = 1.0 / last;  // the bar's element length [m] (L = 1 m)
+  // The exact reads: unit rows and the loads' one coefficient 1.
+  EXPECT_TRUE(channels.Values("u0") == u.row(0).transpose());
+  EXPECT_TRUE(channels.Values("uL") == u.row(last).transpose());
+  EXPECT_TRUE(channels.Values("fL") == data.Values("fL") - w.row(last).transpose() / bar.alpha());
+  Vector f0(u.cols());
+  for (int j = 0; j < u.cols(); ++j) {
+    switch (clamp) {
+      case ClampModel::kMeasured:
+        f0[j] = data.Values("f0")[j] - w(0, j) / bar.alpha();
+        break;
+      case ClampModel::kPinned:
+        f0[j] = data.Values("f0")[j] - bar.inverse_alpha0() * w(0, j);
+        break;
+      case ClampModel::kTrusted:
+        f0[j] = bar.ClampReaction(u.col(j).data());
+        break;
+    }
+  }
+  // Measured at most 3.2e-17 apart, relative (1 / alpha_0 and the bar's f0 gain over
+  // alpha_0; the reaction row's sums).
+  EXPECT_LT(RelativeDifference(channels.Values("f0"), f0), 3e-16);
+  // u@0.25 midway between nodes 7 and 8 and u@0.02 in element 0 (the same products: the
+  // same bits), e@0.65 in element 19 (the row's 1 / h against a division by h: measured
+  // 1.2e-15 apart).
+  const Vector displacement = 0.5 * (u.row(7) + u.row(8)).transpose();
+  EXPECT_TRUE(channels.Values("u@0.25") == displacement);
+  const Vector strain = (u.row(20) - u.row(19)).transpose() / h;
+  EXPECT_LT(RelativeDifference(channels.Values("e@0.65"), strain), 1.2e-14);
+  if (channels.Find("u@0.02") >= 0) {
+    const Vector first = (0.4 * u.row(0) + 0.6 * u.row(1)).transpose();
+    EXPECT_TRUE(channels.Values("u@0.02") == first);
+  }
+}
+
 // The built-in bar with the clamp `clamp` against the bar exported with its clamp as
 // a support (dof 0, channels f0, u0; through Matrix Market) and the same treatment: 30
 // elements in `num_zones` zones, interior sensors u@0.25 and e@0.65, and with
@@ -135,6 +180,8 @@ void ExpectBarSupportIsTheBuiltInClamp(int num_zones, ClampModel clamp, bool fir
     EXPECT_TRUE(general_solution.cost_gradients == bar_solution.cost_gradients);
     // J_rest bounds e^2.
     EXPECT_GT(general.RestCost(), general_solution.cost);
+    ExpectTheBarsModelChannels(general.ModelChannels(general_solution), bar, bar_solution, data,
+                               clamp);
   }
 }
 

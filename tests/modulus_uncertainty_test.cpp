@@ -69,15 +69,18 @@ class ModulusUncertaintyTest : public ::testing::Test {
         model_(case_.bar),
         data_(MakeSyntheticMeasurements(case_.bar, case_.load, case_.time, case_.data)),
         problem_(model_, data_, mcre_.weights, mcre_.reference_modulus, case_.time.theta, {},
-                 mcre_.clamp) {
+                 mcre_.clamp),
+        matrices_(BarMatrixModel(model_, case_.bar.modulus, {}, BarClampExport::kSupport)) {
     problem_.SetModulus(kModulus);
     SolveCoupled(CoupledSolverOptions(), &problem_, nullptr, &solution_);
   }
 
+  // The figure on the bar exported as matrices, from the built-in bar's solution (the
+  // same bits as the exported bar's: matrix_supports_test.cpp).
   ModulusUncertainty Estimate(const NoiseLevels& noise, double curvature) {
     UncertaintyOptions options;
     options.samples = 4;
-    return EstimateModulusUncertainty(options, model_, data_, mcre_, case_.time.theta,
+    return EstimateModulusUncertainty(options, matrices_, data_, mcre_, case_.time.theta,
                                       CoupledSolverOptions(), kModulus, solution_, noise, curvature,
                                       5);
   }
@@ -89,6 +92,7 @@ class ModulusUncertaintyTest : public ::testing::Test {
   BarModel model_;
   ChannelSet data_;
   McreProblem problem_;
+  MatrixModelData matrices_;
   CoupledSolution solution_;
 };
 
@@ -130,7 +134,8 @@ TEST(ModulusUncertaintyTrustedClampTest, TheFirstOrderChangeIsTheDifferenceOverD
   options.samples = 2;
   const NoiseLevels noise{1e-7, 1.0};
   const ModulusUncertainty figure = EstimateModulusUncertainty(
-      options, model, data, mcre, 0.5, inner, kModulus, solution, noise, kCurvature, 5);
+      options, BarMatrixModel(model, small.bar.modulus, {}, BarClampExport::kSupport), data, mcre,
+      0.5, inner, kModulus, solution, noise, kCurvature, 5);
   ASSERT_TRUE(figure.available) << figure.message;
 
   // The same draws, in the same order (u0, uL, then f0, fL).
@@ -165,9 +170,9 @@ TEST(ModulusUncertaintyTrustedClampTest, TheFirstOrderChangeIsTheDifferenceOverD
     sum_of_squares += modulus_change * modulus_change;
   }
   const double expected = std::sqrt(sum_of_squares / options.samples);
-  // Measured 7.3e-10 relative (the solves' tolerance 1e-12); a first version of the
-  // added term that missed two of its three parts was 12 % off.
-  EXPECT_NEAR(figure.std_dev, expected, 7e-9 * expected);
+  // Measured 3.8e-10 relative (the solves' tolerance 1e-12); an earlier figure whose
+  // explicit data term missed two of its three parts was 12 % off.
+  EXPECT_NEAR(figure.std_dev, expected, 4e-9 * expected);
 }
 
 TEST_F(ModulusUncertaintyTest, NotAvailableWithoutCurvatureOrNoise) {
@@ -179,27 +184,38 @@ TEST_F(ModulusUncertaintyTest, NotAvailableWithoutCurvatureOrNoise) {
   EXPECT_NE(quiet.message.find("no noise"), std::string::npos) << quiet.message;
 }
 
-TEST_F(ModulusUncertaintyTest, MisfitLevelsAreTheRmsEndMisfits) {
-  const NoiseLevels misfit = MisfitLevels(data_, solution_, problem_.alpha());
+TEST_F(ModulusUncertaintyTest, EndMisfitLevelsAreTheRmsEndMisfits) {
+  // The model's end channels of the solution: U at both ends, F = F~ - W / alpha.
   const int last = model_.right_node();
-  double sum = 0.0;
+  ChannelSet model;
+  model.Add("u0", ChannelKind::kDisplacement, solution_.displacement.row(0).transpose());
+  model.Add("uL", ChannelKind::kDisplacement, solution_.displacement.row(last).transpose());
+  model.Add("f0", ChannelKind::kForce,
+            data_.Values("f0") - solution_.retrograde.row(0).transpose() / problem_.alpha());
+  model.Add("fL", ChannelKind::kForce,
+            data_.Values("fL") - solution_.retrograde.row(last).transpose() / problem_.alpha());
+  const NoiseLevels misfit = EndMisfitLevels(data_, model);
+  double sum = 0.0, force_sum = 0.0;
   for (int j = 0; j < data_.num_samples(); ++j) {
     sum += std::pow(solution_.displacement(0, j) - data_.Values("u0")[j], 2) +
            std::pow(solution_.displacement(last, j) - data_.Values("uL")[j], 2);
+    force_sum += std::pow(solution_.retrograde(0, j) / problem_.alpha(), 2) +
+                 std::pow(solution_.retrograde(last, j) / problem_.alpha(), 2);
   }
-  EXPECT_NEAR(misfit.displacement_std, std::sqrt(sum / (2.0 * data_.num_samples())),
-              1e-12 * misfit.displacement_std);
+  const double samples = 2.0 * data_.num_samples();
+  EXPECT_NEAR(misfit.displacement_std, std::sqrt(sum / samples), 1e-12 * misfit.displacement_std);
+  // F - F~ = -W / alpha, up to the round-off of F~ - W / alpha: measured 9.9e-15 apart.
+  EXPECT_NEAR(misfit.force_std, std::sqrt(force_sum / samples), 1e-13 * misfit.force_std);
   EXPECT_GT(misfit.force_std, 0.0);
-  // A trusted clamp's misfit at x = 0 is r(U) - f0~: a reaction 3 N above the data.
-  const Vector reaction = data_.Values("f0").array() + 3.0;
-  const NoiseLevels trusted = MisfitLevels(data_, solution_, problem_.alpha(), &reaction);
-  double force_sum = 0.0;
+  // Without uL, the mean is over u0 alone.
+  ChannelSet u0_only = model;
+  u0_only.channels.erase(u0_only.channels.begin() + u0_only.Find("uL"));
+  double u0_sum = 0.0;
   for (int j = 0; j < data_.num_samples(); ++j) {
-    force_sum += 9.0 + std::pow(solution_.retrograde(last, j) / problem_.alpha(), 2);
+    u0_sum += std::pow(solution_.displacement(0, j) - data_.Values("u0")[j], 2);
   }
-  EXPECT_NEAR(trusted.force_std, std::sqrt(force_sum / (2.0 * data_.num_samples())),
-              1e-12 * trusted.force_std);
-  EXPECT_EQ(trusted.displacement_std, misfit.displacement_std);
+  EXPECT_NEAR(EndMisfitLevels(data_, u0_only).displacement_std,
+              std::sqrt(u0_sum / data_.num_samples()), 1e-12 * misfit.displacement_std);
 }
 
 }  // namespace

@@ -72,7 +72,8 @@ void Identify(const Config& config, const BarModel& model, const ChannelSet& dat
     summary = mcrewave::Identify(one_thread.outer, &objective);
   } else {
     // As identify run: the search functional's scan, then mcre:'s e^2 (search:).
-    summary = IdentifyWithMcre(one_thread, model, data, EndDisplacementChannels()).outer;
+    const MatrixModelData matrices = BarRunModel(model, data, EndDisplacementChannels());
+    summary = IdentifyWithMcre(one_thread, matrices, data).outer;
   }
   run->converged = summary.IsSolutionUsable();
   if (!run->converged) run->message = summary.message;

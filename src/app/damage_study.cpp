@@ -157,7 +157,7 @@ void RunOne(const Config& config, const DamageCase& damage, DamageRun* run) {
       scalar.solution.has_fields()
           ? ElementGapShares(uniform, Vector::Constant(1, run->homogeneous_modulus),
                              scalar.solution.retrograde, run_config.time.step)
-          : scalar.solution.error_map;
+          : scalar.solution.element_error_map;  // a streaming solve's, per element
   Eigen::Index peak = 0;
   shares.maxCoeff(&peak);
   run->error_map_peak = uniform.element_midpoint(static_cast<int>(peak));

@@ -86,7 +86,7 @@ std::vector<double> CostCurveModuli(const Config& config, const IdentificationRu
 
 // The cost curve at CostCurveModuli, each solve warm-started from the previous
 // point's (the first from the solution at E*).
-std::vector<CostCurvePoint> ComputeCostCurve(const Config& config, const BarModel& model,
+std::vector<CostCurvePoint> ComputeCostCurve(const Config& config, const MatrixModelData& model,
                                              const ChannelSet& data, const IdentificationRun& run,
                                              long* sweeps) {
   const double center = run.identified_modulus();
@@ -94,8 +94,8 @@ std::vector<CostCurvePoint> ComputeCostCurve(const Config& config, const BarMode
   spdlog::info("cost curve: {} points over [{:.6g}, {:.6g}] Pa", moduli.size(), moduli.front(),
                moduli.back());
 
-  McreObjective objective(model, data, config.mcre, config.time.theta, config.inner, center,
-                          run.ends);
+  McreObjective objective = MatrixMcreObjective(model, data, config.mcre, config.time.theta,
+                                                config.inner, Factorization::kAutomatic, center);
   if (run.solution.WarmStart().size() > 0) objective.SetWarmStart(run.solution.WarmStart());
   std::vector<CostCurvePoint> curve;
   for (const double modulus : moduli) {
@@ -190,11 +190,25 @@ ChannelSet LoadMeasurements(const Config& config) {
   return data;
 }
 
-McreIdentification IdentifyWithMcre(const Config& config, const BarModel& model,
-                                    const ChannelSet& data, EndDisplacementChannels ends) {
+MatrixModelData BarRunModel(const BarModel& model, const ChannelSet& data,
+                            EndDisplacementChannels ends) {
+  MatrixModelData matrices =
+      BarMatrixModel(model, model.properties().modulus, BarSensors(data), BarClampExport::kSupport);
+  if (!ends.uL) {
+    matrices.sensors.erase(
+        std::find_if(matrices.sensors.begin(), matrices.sensors.end(),
+                     [](const MatrixModelSensor& sensor) { return sensor.channel == "uL"; }));
+  }
+  if (!ends.u0) matrices.supports.front().displacement_channel.clear();
+  return matrices;
+}
+
+McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData& model,
+                                    const ChannelSet& data) {
   McreIdentification result;
-  result.objective = std::make_unique<McreObjective>(model, data, config.mcre, config.time.theta,
-                                                     config.inner, config.outer.initial, ends);
+  result.objective = std::make_unique<McreObjective>(
+      MatrixMcreObjective(model, data, config.mcre, config.time.theta, config.inner,
+                          Factorization::kAutomatic, config.outer.initial));
   result.scan_cost_scale = result.objective->cost_scale();
   if (!ScansTheSearchFunctional(config)) {
     result.outer = Identify(config.outer, result.objective.get());
@@ -202,8 +216,9 @@ McreIdentification IdentifyWithMcre(const Config& config, const BarModel& model,
   }
   CoupledSolverOptions search_inner = config.inner;
   search_inner.tolerance = config.search.inner_tolerance;
-  McreObjective search(model, data, SearchMcreOptions(config.mcre, config.search),
-                       config.time.theta, search_inner, config.outer.initial, ends);
+  McreObjective search = MatrixMcreObjective(
+      model, data, SearchMcreOptions(config.mcre, config.search), config.time.theta, search_inner,
+      Factorization::kAutomatic, config.outer.initial);
   result.outer = IdentifyInTwoStages(config.outer, &search, config.search.scan_points,
                                      config.search.refine_window, result.objective.get());
   result.search_sweeps = search.sweeps();
@@ -232,12 +247,14 @@ IdentificationRun IdentifyModulus(const Config& config, const ChannelSet& data) 
       config.outer.scan_points == 0      ? "none (outer.scan_points 0)"
       : ScansTheSearchFunctional(config) ? "the pinned search functional (search:)"
                                          : "mcre:'s e^2");
-  McreIdentification identification = IdentifyWithMcre(config, model, run.data, run.ends);
+  const MatrixModelData matrices = BarRunModel(model, run.data, run.ends);
+  McreIdentification identification = IdentifyWithMcre(config, matrices, run.data);
   McreObjective& objective = *identification.objective;
-  // The bar's weights alpha and beta, for its summary and the model's end forces.
-  const auto& bar_problem = dynamic_cast<const McreProblem&>(objective.problem());
-  run.alpha = bar_problem.alpha();
-  run.beta = bar_problem.beta();
+  // The bar's weights from k* = E0 S / L (mcre/matrix_mcre_problem.h): alpha = w_f / k*
+  // of its loads, beta = w_u k* of its end displacement, for the summary.
+  const double stiffness_scale = config.mcre.reference_modulus * matrices.stiffness_length;
+  run.alpha = config.mcre.weights.force_weight / stiffness_scale;
+  run.beta = config.mcre.weights.displacement_weight * stiffness_scale;
   run.rest_cost = objective.rest_cost();
   run.scan_cost_scale = identification.scan_cost_scale;
   run.outer = identification.outer;
@@ -274,56 +291,37 @@ IdentificationRun RunIdentification(const Config& config, const ChannelSet& data
   IdentificationRun run = IdentifyModulus(config, data);
   if (!run.IsUsable()) return run;
   const BarModel model(config.model);
+  const MatrixModelData matrices = BarRunModel(model, run.data, run.ends);
 
   // The cost curve around E*.
-  run.cost_curve = ComputeCostCurve(config, model, run.data, run, &run.cost_curve_sweeps);
+  run.cost_curve = ComputeCostCurve(config, matrices, run.data, run, &run.cost_curve_sweeps);
 
   // The error map of the constitutive gap at the homogeneous E* (error_map.h).
-  if (run.solution.has_fields()) {
-    run.error_map = ComputeErrorMap(model, Vector::Constant(1, run.identified_modulus()),
-                                    run.solution.retrograde, config.time.step);
-  } else {
-    // The streaming solver summed the shares and sampled the picture as W passed.
-    run.error_map = AssembleErrorMap(model, run.solution.error_map, run.solution.gap_density,
-                                     SpaceTimeStride(run.data.num_steps()), config.time.step);
-  }
+  run.error_map = BarErrorMap(config, run);
   const int peak = run.error_map.PeakElement();
   spdlog::info("error map: largest share {:.3g} of the constitutive gap at x = {:.4g} m",
                run.error_map.Fractions()[peak], run.error_map.position[peak]);
 
   // The inner solver's convergence at E* from W = 0.
-  McreObjective cold(model, run.data, config.mcre, config.time.theta, config.inner,
-                     run.identified_modulus(), run.ends);
+  McreObjective cold =
+      MatrixMcreObjective(matrices, run.data, config.mcre, config.time.theta, config.inner,
+                          Factorization::kAutomatic, run.identified_modulus());
   run.cold_solve = cold.EvaluateModulus(run.identified_modulus()).inner;
 
-  // The model's force at x = 0 and the RMS misfits at E*.
-  const auto& problem = dynamic_cast<const McreProblem&>(cold.problem());
-  const Vector& measured_f0 = run.data.Values("f0");
-  run.clamp_force.resize(run.data.num_samples());
-  for (int j = 0; j < run.data.num_samples(); ++j) {
-    switch (config.mcre.clamp) {
-      case ClampModel::kMeasured:
-        // F_0 = f0~ - W_0 / alpha (docs/discrete_mcre.md section 2).
-        run.clamp_force[j] = measured_f0[j] - run.solution.EndRetrograde(0, j) / run.alpha;
-        break;
-      case ClampModel::kPinned:
-        // F_0 = f0~ - W_0 / alpha_0 (docs/trusted_clamp.md section 9).
-        run.clamp_force[j] =
-            measured_f0[j] - problem.inverse_alpha0() * run.solution.EndRetrograde(0, j);
-        break;
-      case ClampModel::kTrusted:
-        // r(U_j): the reaction row of the stored fields, or the last trace row of a
-        // streaming solve.
-        run.clamp_force[j] = run.solution.has_fields()
-                                 ? problem.ClampReaction(run.solution.displacement.col(j).data())
-                                 : run.solution.traces(problem.num_traces() - 1, j);
-        break;
+  // The model's channels and the RMS misfits at E*; an end displacement the run does
+  // not use is no channel of the problem: from the stored field.
+  run.model_channels =
+      dynamic_cast<const MatrixMcreProblem&>(cold.problem()).ModelChannels(run.solution);
+  if (run.solution.has_fields()) {
+    const auto last = run.solution.displacement.rows() - 1;
+    for (const auto& [name, row] : {std::pair<const char*, Eigen::Index>{"u0", 0}, {"uL", last}}) {
+      if (run.model_channels.Find(name) < 0) {
+        run.model_channels.Add(name, ChannelKind::kDisplacement,
+                               run.solution.displacement.row(row).transpose());
+      }
     }
   }
-  // The measured clamp's f0 misfit is W_0 / alpha itself (MisfitLevels).
-  const bool measured = config.mcre.clamp == ClampModel::kMeasured;
-  run.misfit =
-      MisfitLevels(run.data, run.solution, run.alpha, measured ? nullptr : &run.clamp_force);
+  run.misfit = EndMisfitLevels(run.data, run.model_channels);
   // The uncertainty figure: noise levels known for synthetic data with noise,
   // estimated from the data's second differences otherwise.
   run.estimated_noise = DifferenceNoiseLevels(data);
@@ -332,8 +330,8 @@ IdentificationRun RunIdentification(const Config& config, const ChannelSet& data
   const double curvature = CostGradientSlope(run.cost_curve, run.identified_modulus(),
                                              kCurvatureWindow, &curvature_points);
   run.uncertainty = EstimateModulusUncertainty(
-      config.uncertainty, model, run.data, config.mcre, config.time.theta, config.inner,
-      run.identified_modulus(), run.solution, run.noise, curvature, curvature_points, run.ends);
+      config.uncertainty, matrices, run.data, config.mcre, config.time.theta, config.inner,
+      run.identified_modulus(), run.solution, run.noise, curvature, curvature_points);
   if (run.uncertainty.available) {
     spdlog::info("uncertainty: std(E) = {:.4g} Pa ({:.3g} %) over {} noise draws",
                  run.uncertainty.std_dev, 100.0 * run.uncertainty.relative_std_dev,
@@ -347,6 +345,20 @@ IdentificationRun RunIdentification(const Config& config, const ChannelSet& data
       RunZoneIdentification(config, IdentificationZoneLayout(config), run, TruthZones(config));
   run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return run;
+}
+
+ErrorMap BarErrorMap(const Config& config, const IdentificationRun& run) {
+  const BarModel model(config.model);
+  if (run.solution.has_fields()) {
+    return ComputeErrorMap(model, Vector::Constant(1, run.identified_modulus()),
+                           run.solution.retrograde, config.time.step);
+  }
+  // The streaming solver summed the shares and sampled the picture as W passed, on the
+  // exported bar's elements, which are the bar's: its picture is the gap energy of an
+  // element [J], the bar's per length [J/m].
+  return AssembleErrorMap(model, run.solution.element_error_map,
+                          run.solution.gap_density / model.element_length(),
+                          SpaceTimeStride(run.data.num_steps()), config.time.step);
 }
 
 NoiseLevels MeasurementNoiseLevels(const Config& config, const ChannelSet& data,

@@ -115,26 +115,33 @@ std::string CostCurveCsv(const std::vector<CostCurvePoint>& curve) {
   return csv;
 }
 
-// Measured and model channels at both ends; the model force at x = L is
-// F_L = fL~ - W_L / alpha, at x = 0 the run's clamp_force (the load or the reaction
-// of the clamp model).
+// Measured and model channels at both ends (run.model_channels: F_L = fL~ - W_L / alpha,
+// at x = 0 the clamp's load or reaction); a model column the run has not (an end
+// displacement not in use, after a streaming solve) is left empty.
 std::string EndsCsv(const IdentificationRun& run) {
   const ChannelSet& data = run.data;
-  const CoupledSolution& solution = run.solution;
-  assert(run.clamp_force.size() == data.num_samples());
   std::string csv =
       "t,u0_measured,u0_model,uL_measured,uL_model,f0_measured,f0_model,fL_measured,fL_model\n";
   const BarEnds measured = BarEndChannels(data);
-  char row[512];
+  const Vector* measured_columns[] = {&measured.u0, &measured.uL, &measured.f0, &measured.fL};
+  const Vector* model_columns[4] = {};
+  const char* names[] = {"u0", "uL", "f0", "fL"};
+  for (int c = 0; c < 4; ++c) {
+    const int found = run.model_channels.Find(names[c]);
+    if (found >= 0) model_columns[c] = &run.model_channels.channels[found].values;
+  }
+  char number[32];
   for (int j = 0; j < data.num_samples(); ++j) {
-    const double f0_model = run.clamp_force[j];
-    // F_L = fL~ - W_L / alpha
-    const double fL_model = measured.fL[j] - solution.EndRetrograde(1, j) / run.alpha;
-    std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
-                  data.Time(j), measured.u0[j], solution.EndDisplacement(0, j), measured.uL[j],
-                  solution.EndDisplacement(1, j), measured.f0[j], f0_model, measured.fL[j],
-                  fL_model);
-    csv += row;
+    std::snprintf(number, sizeof(number), "%.17g", data.Time(j));
+    csv += number;
+    for (int c = 0; c < 4; ++c) {
+      std::snprintf(number, sizeof(number), ",%.17g,", (*measured_columns[c])[j]);
+      csv += number;
+      if (model_columns[c] == nullptr) continue;
+      std::snprintf(number, sizeof(number), "%.17g", (*model_columns[c])[j]);
+      csv += number;
+    }
+    csv += '\n';
   }
   return csv;
 }

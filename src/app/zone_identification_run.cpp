@@ -91,7 +91,9 @@ ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayo
             config.zone_identification, model, scalar.data, config.mcre, config.time.theta,
             config.inner, scalar.ends, scalar.identified_modulus(), config.outer.lower_bound,
             config.outer.upper_bound, scalar.estimated_noise, prefilter,
-            scalar.solution.WarmStart().size() > 0 ? &scalar.solution.WarmStart() : nullptr);
+            // W of the scalar run's stored fields (its streaming traces are the exported
+            // bar's, in another row order than the built-in bar's the zones solve).
+            scalar.solution.has_fields() ? &scalar.solution.retrograde : nullptr);
       });
 }
 

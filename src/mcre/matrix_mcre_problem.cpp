@@ -224,6 +224,19 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
   const int num_loads = static_cast<int>(columns.size());
   const int num_fixed = static_cast<int>(rows.size());
   const int num_rows = num_fixed + num_reactions_;
+  for (const LoadColumn& column : columns) load_channels_.push_back(column.channel);
+  for (const ObservedRow& row : rows) output_channels_.push_back(row.channel);
+  for (const MatrixModelSensor& sensor : model.sensors) {
+    output_kinds_.push_back(sensor.kind == SensorKind::kStrain ? ChannelKind::kStrain
+                                                               : ChannelKind::kDisplacement);
+  }
+  output_kinds_.resize(rows.size(), ChannelKind::kDisplacement);  // the supports' rows
+  if (trusted) {
+    for (const MatrixModelSupport& support : model.supports) {
+      output_channels_.push_back(support.force_channel);
+      output_kinds_.push_back(ChannelKind::kForce);
+    }
+  }
   GatherLoads(columns, data, held_, n, &measured_loads_, &alphas_, &loads_);
   loads_transposed_ = loads_.transpose();
   load_columns_ = SparseColumns(loads_);
@@ -485,6 +498,57 @@ void MatrixMcreProblem::DataResponseSweep(Observe&& observe) {
     observe(k + 1, stream_displacement_[next]);
   }
   ++sweep_count_;
+}
+
+ChannelSet MatrixMcreProblem::ModelChannels(const CoupledSolution& solution) const {
+  const int m = num_steps();
+  // G^T W and H U from the stored fields, or as the streaming solve kept them.
+  const Matrix load_retrograde = solution.has_fields()
+                                     ? Matrix(loads_transposed_ * solution.retrograde)
+                                     : solution.load_retrograde;
+  const Matrix outputs =
+      solution.has_fields() ? Matrix(observation_ * solution.displacement) : solution.traces;
+  assert(load_retrograde.rows() == alphas_.size() && load_retrograde.cols() == m + 1 &&
+         outputs.rows() == num_traces() && outputs.cols() == m + 1);
+  ChannelSet set;
+  set.time_step = time_step_;
+  for (std::size_t c = 0; c < load_channels_.size(); ++c) {
+    const auto row = static_cast<Eigen::Index>(c);
+    // F_c = F~_c - (G^T W)_c / alpha_c, the direct sweep's load (docs/matrix_models.md
+    // section 2).
+    set.Add(load_channels_[c], ChannelKind::kForce,
+            (measured_loads_.row(row) - load_retrograde.row(row) / alphas_[row]).transpose());
+  }
+  for (std::size_t k = 0; k < output_channels_.size(); ++k) {
+    if (output_channels_[k].empty()) continue;  // a datum 0
+    set.Add(output_channels_[k], output_kinds_[k],
+            outputs.row(static_cast<Eigen::Index>(k)).transpose());
+  }
+  // The supports' displacement channels that are not rows of H. Their rows, after the
+  // sensors' in the supports' order: measured, the displacement channel's; pinned, the
+  // data 0 of its dofs (ObservedRows).
+  auto row = static_cast<Eigen::Index>(model_.sensors.size());
+  for (const MatrixModelSupport& support : model_.supports) {
+    const bool has_channel = !support.displacement_channel.empty();
+    if (treatment_ == ClampModel::kMeasured) {
+      if (has_channel) ++row;
+      continue;
+    }
+    const Eigen::Index first_datum = row;
+    if (treatment_ == ClampModel::kPinned) row += static_cast<Eigen::Index>(support.dofs.size());
+    if (!has_channel) continue;
+    Vector displacement = Vector::Zero(m + 1);  // trusted: held at rest
+    if (treatment_ == ClampModel::kPinned) {
+      // g^T U / (g^T g), U_i of each dof i from its datum row e_i^T U.
+      for (std::size_t d = 0; d < support.dofs.size(); ++d) {
+        displacement += support.reaction[support.dofs[d]] *
+                        outputs.row(first_datum + static_cast<Eigen::Index>(d)).transpose();
+      }
+      displacement /= support.reaction.squaredNorm();
+    }
+    set.Add(support.displacement_channel, ChannelKind::kDisplacement, displacement);
+  }
+  return set;
 }
 
 Matrix MatrixMcreProblem::ModelOutputs() {

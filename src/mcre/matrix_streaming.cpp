@@ -123,6 +123,7 @@ void MatrixMcreProblem::AddStreamingSample(int j, const Vector& displacement,
           ? integrator_.stiffness().BilinearForm(retrograde.data(), retrograde.data())
           : retrograde.dot(product_);
   load_columns_.TransposeMultiply(retrograde.data(), channel_.data());
+  totals->load_retrograde.col(j) = channel_;
   totals->cost +=
       weight * (0.5 * stiffness_form + 0.5 * channel_.cwiseQuotient(alphas_).dot(channel_) +
                 0.5 * betas_.dot(trace_.cwiseProduct(trace_)));
@@ -173,6 +174,7 @@ void MatrixMcreProblem::ResetStreamingTotals(int picture_stride, StreamingTotals
   totals->gap_density.resize(model_.elements.empty() ? 0 : num_steps() / picture_stride + 1,
                              stream_density_row_.size());
   totals->end_retrograde.resize(0, 0);
+  totals->load_retrograde.resize(channel_.size(), num_steps() + 1);
   totals->rebuild_error = 0.0;  // W from checkpoints: the stored sweep's
 }
 

@@ -68,7 +68,8 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
                                         const MatrixModelData& model, const ChannelSet& data,
                                         const McreOptions& mcre, double theta,
                                         const CoupledSolverOptions& inner, const Vector& moduli,
-                                        const CoupledSolution& solution, const NoiseLevels& noise) {
+                                        const CoupledSolution& solution, const NoiseLevels& noise,
+                                        const Matrix* curvature) {
   assert(options.samples >= 1 && moduli.size() == static_cast<Eigen::Index>(model.zones.size()));
   ZoneUncertainty result;
   result.noise = noise;
@@ -86,18 +87,25 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
     return MatrixMcreProblem(model, set, mcre.weights, mcre.reference_modulus, theta,
                              Factorization::kAutomatic, mcre.clamp);
   };
-  MatrixMcreProblem problem = make_problem(data);
   std::string why;
-  if (!SecantCurvature(inner, moduli, solution, &problem, &result.curvature, &result.sweeps,
-                       &why)) {
-    result.message = why;
-    return result;
+  if (curvature != nullptr) {
+    assert(curvature->rows() == moduli.size() && curvature->cols() == moduli.size());
+    result.curvature = *curvature;
+  } else {
+    MatrixMcreProblem problem = make_problem(data);
+    if (!SecantCurvature(inner, moduli, solution, &problem, &result.curvature, &result.sweeps,
+                         &why)) {
+      result.message = why;
+      return result;
+    }
   }
   const Eigen::LLT<Matrix> factor(result.curvature);
   if (factor.info() != Eigen::Success) {
-    result.message =
-        "the cost is not convex around the identified moduli (the secant curvature over +- 5 % "
-        "is not positive definite)";
+    result.message = curvature != nullptr
+                         ? "the cost is not convex around the identified moduli (the curvature "
+                           "given is not positive definite)"
+                         : "the cost is not convex around the identified moduli (the secant "
+                           "curvature over +- 5 % is not positive definite)";
     return result;
   }
   const int zones = static_cast<int>(moduli.size());

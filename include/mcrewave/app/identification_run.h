@@ -5,7 +5,8 @@
 //      checked against the model's time grid.
 //   2. The pre-filter (prefilter.h) of the measurements when prefilter.enabled.
 //   3. IdentifyWithMcre: the global scan and local refinements of e^2 (objective.h,
-//      identification.h) with x = E / outer.initial; by default the scan runs on the
+//      identification.h) with x = E / outer.initial, on the bar as a structure given by
+//      matrices (BarRunModel, the one road of every MCRE solve); by default the scan runs on the
 //      search functional (search:, the pinned clamp's e^2) and mcre:'s e^2 is refined
 //      near its minimum (IdentifyInTwoStages).
 //   4. At the identified E*: the cost curve e^2(E) on output.curve_points points
@@ -25,6 +26,7 @@
 #include "mcrewave/mcre/error_map.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/mcre/objective.h"
+#include "mcrewave/model/matrix_export.h"
 #include "mcrewave/optim/identification.h"
 
 namespace mcrewave {
@@ -66,11 +68,13 @@ struct IdentificationRun {
   // The uncertainty draws white noise of `noise` on the channels, unfiltered:
   // with the pre-filter on, it overstates the spread (conservative).
   NoiseLevels estimated_noise;
-  NoiseLevels misfit;  // RMS misfits at the optimum (MisfitLevels)
-  // The model's force at x = 0 at the identified E, per sample [N]: the load
-  // f0~ - W_0 / alpha (clamp measured) or f0~ - W_0 / alpha_0 (pinned), the reaction
-  // r(U_j) (trusted). ends.csv's f0_model.
-  Vector clamp_force;
+  NoiseLevels misfit;  // RMS misfits at the optimum (EndMisfitLevels of model_channels)
+  // The model's channels at the identified E (MatrixMcreProblem::ModelChannels of
+  // BarRunModel): fL = fL~ - W_L / alpha; f0, the clamp's force, the load f0~ - W_0 / alpha
+  // (clamp measured) or f0~ - W_0 / alpha_0 (pinned), the reaction r(U_j) (trusted);
+  // uL, u0 and the sensors, H U. An end displacement the run does not use (data.channels)
+  // is read from the stored field, and is missing after a streaming solve.
+  ChannelSet model_channels;
 
   // The coupled solver that ran: config.inner.type, or what auto resolved to on this
   // bar and time grid (ResolveCoupledSolverType).
@@ -112,6 +116,13 @@ struct IdentificationRun {
   double cost() const { return best_index >= 0 ? evaluations[best_index].cost : -1.0; }
 };
 
+// The run's bar as a structure given by matrices (model/matrix_export.h), which every
+// MCRE solve of a bar's run takes: BarMatrixModel of `model` at its modulus with the
+// clamp the support "clamp" at node 0 (its channels f0 and u0), the sensors uL and those
+// of `data` (BarSensors); without uL (u0) when ends.uL (ends.u0) is false.
+MatrixModelData BarRunModel(const BarModel& model, const ChannelSet& data,
+                            EndDisplacementChannels ends);
+
 // Step 3 on mcre:'s e^2.
 struct McreIdentification {
   std::unique_ptr<McreObjective> objective;  // mcre:'s e^2, with every evaluation of it
@@ -121,13 +132,14 @@ struct McreIdentification {
 };
 
 // The outer loop of config.outer on mcre:'s e^2 of `data` (the identification's
-// measurements: selected and pre-filtered) with the model `model` and the end channels
-// `ends`; both must outlive the result's objective. With outer.scan_points > 0 and
-// search.functional pinned: IdentifyInTwoStages with the search functional
-// (SearchMcreOptions, its inner solves to search.inner_tolerance); else Identify.
-// Precondition: config valid.
-McreIdentification IdentifyWithMcre(const Config& config, const BarModel& model,
-                                    const ChannelSet& data, EndDisplacementChannels ends);
+// measurements: selected and pre-filtered) with the model `model` (BarRunModel, or any
+// structure given by matrices), its supports treated as mcre.clamp says and
+// x = E / outer.initial; model and data must outlive the result's objective. With
+// outer.scan_points > 0 and search.functional pinned: IdentifyInTwoStages with the
+// search functional (SearchMcreOptions, its inner solves to search.inner_tolerance); else
+// Identify. Precondition: config valid.
+McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData& model,
+                                    const ChannelSet& data);
 
 // Runs steps 2 and 3 on measurements made by LoadMeasurements(config): the
 // fields up to `solution` (and wall_time_s); no cost curve, no uncertainty.
@@ -149,6 +161,11 @@ std::string ModulusOnBoundMessage(double modulus, const IdentificationOptions& o
 // (run.misfit is set).
 constexpr double kImplausibleMisfitFactor = 10.0;
 std::string ImplausibleMisfitMessage(const IdentificationRun& run);
+
+// The run's error map at E* (error_map.h): from the stored retrograde field, or from
+// the element shares and picture a streaming solve summed on BarRunModel's elements
+// (mcre/element_error_map.h). Precondition: run.IsUsable().
+ErrorMap BarErrorMap(const Config& config, const IdentificationRun& run);
 
 // Runs steps 2 to 4 on measurements made by LoadMeasurements(config).
 // Precondition: config valid (as LoadConfig returns it). Never throws for a

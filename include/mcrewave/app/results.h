@@ -15,8 +15,8 @@
 //                       e^2 or the search functional (summary.yaml scan.functional)
 //   valleys.csv         every valley the scan saw (docs/global_search.md)
 //   ends.csv            measured and model end displacements and forces at the
-//                       identified E (model force F_L = fL~ - W_L / alpha; at x = 0 the
-//                       run's clamp_force)
+//                       identified E (the run's model_channels: F_L = fL~ - W_L / alpha;
+//                       at x = 0 the clamp's load or reaction)
 //   inner_residual.csv  relative residual per inner iteration of a solve from W = 0 at
 //                       the identified E (direct solvers: their final residual)
 //   error_map.csv       each element's share of the constitutive gap at the identified

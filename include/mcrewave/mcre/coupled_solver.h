@@ -164,6 +164,8 @@ struct CoupledSolution {
   // H U (streaming only), StreamingCoupledProblem::num_traces() x (m + 1).
   Matrix traces;
   Matrix end_retrograde;  // W at nodes 0 and N (streaming on the bar), 2 x (m + 1) [m]
+  // Streaming on a matrix model: G^T W, one row per load channel, C x (m + 1) [m].
+  Matrix load_retrograde;
   // Streaming only: on the bar e_el^2 per element, on a matrix model the dof map
   // (MatrixMcreProblem::DofErrorMap) [J s].
   Vector error_map;

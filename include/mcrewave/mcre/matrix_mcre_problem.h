@@ -49,12 +49,14 @@
 // zone maps of W and U and the dof map, summed as the fields pass.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "mcrewave/data/channel_set.h"
 #include "mcrewave/linalg/sparse_columns.h"
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/coupled_problem.h"
+#include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/mcre_problem.h"
 #include "mcrewave/mcre/streaming_coupled_problem.h"
 #include "mcrewave/model/matrix_export.h"
@@ -141,6 +143,16 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // the model's order [N], by the same sweep. Precondition: the treatment is trusted
   // (the supports held).
   Matrix ModelSupportForces();
+
+  // The model's channels at a coupled solution of this problem at its current moduli
+  // (stored fields, or a streaming solve's traces and load_retrograde), named as the
+  // data's: each load channel's force F = F~ - diag(1/alpha) G^T W, the direct sweep's
+  // load [N] (the model's loads, then each support's force channel when measured or
+  // pinned); each sensor's H U; each support's displacement channel, H U (measured),
+  // held at rest (trusted) or g^T U / (g^T g) from the data 0 of its dofs (pinned);
+  // and, trusted, each support's reaction r(U) = g^T K(E) U on its force channel [N].
+  // Precondition: the solution is this problem's, of m + 1 samples.
+  ChannelSet ModelChannels(const CoupledSolution& solution) const;
 
   // J_rest = sum_j c_j h [1/2 F~_j^T diag(alpha) F~_j + 1/2 d~_j^T diag(beta) d~_j]
   // [J s]: the functional of the structure left at rest (U = W = 0, zero loads), which
@@ -233,6 +245,10 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   double time_step_;         // h [s]
   Matrix measured_loads_;    // F~ [N], C x (m + 1), rows in G's order
   Matrix measured_outputs_;  // d~ [m], [-] or [N], S x (m + 1), rows in H's order
+  // The data's channel of each column of G and each row of H ("" for a datum 0), and
+  // the kind of each row.
+  std::vector<std::string> load_channels_, output_channels_;
+  std::vector<ChannelKind> output_kinds_;
   double theta_;
   Factorization factorization_;
   ClampModel treatment_;

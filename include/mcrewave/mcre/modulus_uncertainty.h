@@ -1,13 +1,14 @@
 // An uncertainty figure for the identified modulus: the first-order standard deviation
 // of E* under white measurement noise (README, "Uncertainty figure").
 //
-// E* is where g(E) = de^2/dE vanishes. The coupled solution s = (U, W) is linear in the
-// data d and g a quadratic form Q(s) of it, so noise n added to the data moves the
+// E* is where g(E) = de^2/dE vanishes. The coupled solution s = (U, W) is affine in the
+// data d and g a quadratic form of (s, d), so noise n added to the data moves the
 // minimum, to first order in n, by dE = -dg_1 / k with
-//   dg_1 = 2 Q(s_d, s_n) = (Q(s_d + s_n) - Q(s_d - s_n)) / 2   (polarisation),
+//   dg_1 = (g(s_d + s_n; d + n) - g(s_d - s_n; d - n)) / 2   (polarisation),
 //   k    = d^2 e^2 / dE^2,
-// s_n one coupled solve with the noise alone as data, at E*. Over `samples` seeded
-// draws, std(E*) = sqrt(mean_i dE_i^2) (dE is linear in n: zero mean).
+// s_n one coupled solve with the noise alone as data, at E*: the one-zone case of
+// zone_uncertainty.h. Over `samples` seeded draws, std(E*) = sqrt(mean_i dE_i^2) (dE is
+// linear in n: zero mean).
 //
 // k is the least-squares slope of g over the cost-curve points within
 // +- kCurvatureWindow E* of E*, not the local second derivative: at low SNR the cost has
@@ -22,7 +23,7 @@
 #include "mcrewave/data/measurement.h"
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/objective.h"
-#include "mcrewave/model/bar_model.h"
+#include "mcrewave/model/matrix_export.h"
 
 namespace mcrewave {
 
@@ -54,14 +55,13 @@ NoiseLevels DifferenceNoiseLevels(const ChannelSet& data);
 // samples).
 double DifferenceNoiseStd(const Vector& channel);
 
-// RMS misfits of the coupled solution at the optimum: displacement
-// sqrt(mean_{ends, j} (U_end,j - u~_end,j)^2) and force
-// sqrt(mean_{ends, j} (W_end,j / alpha)^2) (F - F~ = -B W / alpha). With a trusted
-// clamp, clamp_reaction holds the model's reaction r(U_j) [N], j = 0..m, and the
-// misfit at x = 0 is r(U_j) - f0~_j instead (f0 is an output; mcre_problem.h); with a
-// pinned clamp it holds the model's load F_0 = f0~ - W_0 / alpha_0.
-NoiseLevels MisfitLevels(const ChannelSet& data, const CoupledSolution& solution, double alpha,
-                         const Vector* clamp_reaction = nullptr);
+// RMS misfits at the optimum of the model's end channels (`model`: u0, uL, f0, fL at
+// the optimum, as MatrixMcreProblem::ModelChannels gives them) against the measured
+// ones (`data`): displacement sqrt(mean_{ends, j} (u_end,j - u~_end,j)^2) and force
+// sqrt(mean_{ends, j} (f_end,j - f~_end,j)^2), where f - f~ = -G^T W / alpha for a load
+// and r(U) - f0~ for a trusted clamp's reaction (f0 an output). An end channel `model`
+// does not hold is left out of its mean.
+NoiseLevels EndMisfitLevels(const ChannelSet& data, const ChannelSet& model);
 
 // A point of the cost curve e^2(E).
 struct CostCurvePoint {
@@ -93,17 +93,20 @@ struct ModulusUncertainty {
   long sweeps = 0;                       // of the noise solves
 };
 
-// The figure at the identified modulus (see the top of this file). `solution`
-// is the coupled solution of `data` at `modulus`; noise the levels to draw.
-// The noise drawn: displacement_std on u0, uL and every u@X, force_std on f0 and fL,
-// strain_std on every e@X (after the end channels, so that the paper's case keeps its
-// draws); `ends` as in McreProblem.
-// Not available (with a message) when curvature <= 0, both noise levels are 0,
-// or a noise solve is not usable. Precondition: options.IsValid().
-ModulusUncertainty EstimateModulusUncertainty(
-    const UncertaintyOptions& options, const BarModel& model, const ChannelSet& data,
-    const McreOptions& mcre, double theta, const CoupledSolverOptions& inner, double modulus,
-    const CoupledSolution& solution, const NoiseLevels& noise, double curvature,
-    int curvature_points, EndDisplacementChannels ends = {});
+// The figure at the identified modulus (see the top of this file) of a model of one
+// zone given by matrices (the bar's run: BarRunModel), EstimateZoneUncertainty with the
+// curvature k: `solution` is the coupled solution of `data` at `modulus` with mcre's
+// weights and treatment of the supports; noise the levels to draw on every channel of
+// data, by its kind, in the set's order (the bar's: u0 and uL, f0 and fL, then the
+// interior sensors). Not available (with a message) when curvature <= 0, no noise level
+// is positive, the solution holds no fields (a streaming solve) or a noise solve is not
+// usable. Preconditions: options.IsValid(), the model has one zone.
+ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
+                                              const MatrixModelData& model, const ChannelSet& data,
+                                              const McreOptions& mcre, double theta,
+                                              const CoupledSolverOptions& inner, double modulus,
+                                              const CoupledSolution& solution,
+                                              const NoiseLevels& noise, double curvature,
+                                              int curvature_points);
 
 }  // namespace mcrewave

@@ -45,6 +45,9 @@ class StreamingCoupledProblem : public CoupledProblem {
     // (element_error_map.h; empty without element blocks).
     Matrix gap_density;
     Matrix end_retrograde;  // the bar: W at nodes 0 and N, 2 x (m + 1) [m]
+    // A matrix model: G^T W_j of every load channel (G's columns), C x (m + 1) [m], from
+    // which its forces F = F~ - diag(1/alpha) G^T W follow (MatrixMcreProblem::ModelChannels).
+    Matrix load_retrograde;
     // ||omega_m|| / max_j ||omega_j|| of a retrograde state rebuilt by the reversed
     // recursion: 0 in exact arithmetic, the rebuild's round-off; 0 from checkpoints.
     double rebuild_error = 0.0;

@@ -10,7 +10,8 @@
 // (polarisation: exact for a quadratic form) with H the curvature of e^2, taken as the
 // secant of g over the bar's window (kCurvatureWindow, +- 5 % of each E*_z):
 //   H_{:,z} = (g(E* + w E*_z e_z) - g(E* - w E*_z e_z)) / (2 w E*_z),
-// symmetrised. Over `samples` seeded draws, Cov(E*) = mean_i dE_i dE_i^T (dE is linear
+// symmetrised, or H as the caller gives it (the bar's run: the slope of its cost curve,
+// modulus_uncertainty.h). Over `samples` seeded draws, Cov(E*) = mean_i dE_i dE_i^T (dE is linear
 // in n: zero mean). Each draw costs one coupled solve; H costs 2Z.
 #pragma once
 
@@ -41,14 +42,16 @@ struct ZoneUncertainty {
 // supports; noise holds the levels to draw: displacement_std on every displacement
 // channel of data, strain_std on every strain channel, force_std on every force channel
 // (in the set's order, a channel's samples, then the next; StandardNormal seeded with
-// options.seed). Not available (with a message) when no level is positive, the solution
-// holds no fields (a streaming solve), a solve is not usable, or H is not positive
-// definite. Precondition: options.samples >= 1 (one draw is the covariance of that draw;
-// the config asks for 2 to 1000, UncertaintyOptions::IsValid).
+// options.seed). curvature: H [J s / Pa^2] (zones x zones), or nullptr for the secants.
+// Not available (with a message) when no level is positive, the solution holds no fields
+// (a streaming solve), a solve is not usable, or H is not positive definite.
+// Precondition: options.samples >= 1 (one draw is the covariance of that draw; the config
+// asks for 2 to 1000, UncertaintyOptions::IsValid).
 ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
                                         const MatrixModelData& model, const ChannelSet& data,
                                         const McreOptions& mcre, double theta,
                                         const CoupledSolverOptions& inner, const Vector& moduli,
-                                        const CoupledSolution& solution, const NoiseLevels& noise);
+                                        const CoupledSolution& solution, const NoiseLevels& noise,
+                                        const Matrix* curvature = nullptr);
 
 }  // namespace mcrewave
