@@ -246,6 +246,7 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
   if (trusted) {
     // The reactions' rows per zone, against the force channels with alpha_r.
     reaction_zone_rows_ = ReactionZoneRows(model, held_);
+    for (const SparseMatrix& rows : reaction_zone_rows_) reaction_zone_forms_.emplace_back(rows);
     for (int s = 0; s < num_reactions_; ++s) {
       measured_outputs_.row(num_fixed + s) =
           data.Values(model.supports[s].force_channel).transpose();
@@ -256,6 +257,7 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
     observation_transposed_ = observation_.transpose();
     observation_columns_ = SparseColumns(observation_transposed_);
   }
+  for (const MatrixModelZone& zone : model.zones) zone_forms_.emplace_back(zone.stiffness);
   mass_ = trusted ? WithHeldDofs(model.mass, held_) : model.mass;
   for (int b = 0; b < 2; ++b) {
     velocity_[b] = Vector::Zero(n);
@@ -267,13 +269,11 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
   other_channel_ = Vector::Zero(num_loads);
   trace_ = Vector::Zero(num_rows);
   reaction_trace_ = Vector::Zero(num_reactions_);
-  reaction_zone_trace_ = Vector::Zero(num_reactions_);
   for (int b = 0; b < 2; ++b) {
     stream_velocity_[b] = Vector::Zero(n);
     stream_displacement_[b] = Vector::Zero(n);
     stream_retrograde_[b] = Vector::Zero(n);
   }
-  stream_zone_product_ = Vector::Zero(n);
   if (!model.elements.empty())
     stream_density_row_ = Vector::Zero(ElementColumnPositions(model).size());
   batch_velocity_ = Matrix::Zero(n, 2 * kMaxSweepBatch);
@@ -403,8 +403,8 @@ void MatrixMcreProblem::CostGradients(const Matrix& displacement, const Matrix& 
     shift_ = retrograde.col(j) + 2.0 * displacement.col(j);
     for (int z = 0; z < zones; ++z) {
       // -(1/(2 E_z,nom)) c_j h W_j^T K_z (W_j + 2 U_j).
-      product_.noalias() = model_.zones[z].stiffness * shift_;
-      (*gradient)[z] += -0.5 * QuadratureWeight(j) * h * retrograde.col(j).dot(product_) /
+      (*gradient)[z] += -0.5 * QuadratureWeight(j) * h *
+                        zone_forms_[z](retrograde.col(j).data(), shift_.data()) /
                         model_.zones[z].nominal_modulus;
     }
     if (num_reactions_ == 0) continue;
@@ -413,9 +413,8 @@ void MatrixMcreProblem::CostGradients(const Matrix& displacement, const Matrix& 
     reaction_trace_.noalias() = reactions_ * displacement.col(j);
     reaction_trace_ -= measured_outputs_.col(j).tail(num_reactions_);
     for (int z = 0; z < zones; ++z) {
-      reaction_zone_trace_.noalias() = reaction_zone_rows_[z] * displacement.col(j);
-      (*gradient)[z] +=
-          QuadratureWeight(j) * h * reaction_weight_ * reaction_trace_.dot(reaction_zone_trace_);
+      (*gradient)[z] += QuadratureWeight(j) * h * reaction_weight_ *
+                        reaction_zone_forms_[z](reaction_trace_.data(), displacement.col(j).data());
     }
   }
 }
@@ -427,9 +426,8 @@ Vector MatrixMcreProblem::ZoneErrorMap(const Matrix& retrograde) {
   for (int j = 0; j <= num_steps(); ++j) {
     for (int z = 0; z < zones; ++z) {
       // (E_z / E_z,nom) c_j h 1/2 W_j^T K_z W_j.
-      product_.noalias() = model_.zones[z].stiffness * retrograde.col(j);
       map[z] += (moduli_[z] / model_.zones[z].nominal_modulus) * QuadratureWeight(j) * h * 0.5 *
-                retrograde.col(j).dot(product_);
+                zone_forms_[z](retrograde.col(j).data(), retrograde.col(j).data());
     }
   }
   return map;

@@ -141,25 +141,24 @@ void MatrixMcreProblem::AddStreamingSample(int j, const Vector& displacement,
   }
   for (int z = 0; z < zones; ++z) {
     const MatrixModelZone& zone = model_.zones[z];
-    product_.noalias() = zone.stiffness * retrograde;
-    stream_zone_product_.noalias() = zone.stiffness * displacement;
-    const double gap = retrograde.dot(product_);
+    // W^T K_z W, W^T K_z U and U^T K_z U.
+    double gap = 0.0, cross = 0.0, strain = 0.0;
+    zone_forms_[z].Forms(retrograde.data(), displacement.data(), &gap, &cross, &strain);
     // -(1/(2 E_z,nom)) c_j h W_j^T K_z (W_j + 2 U_j) (CostGradients).
-    totals->cost_gradients[z] +=
-        -0.5 * weight * (gap + 2.0 * retrograde.dot(stream_zone_product_)) / zone.nominal_modulus;
+    totals->cost_gradients[z] += -0.5 * weight * (gap + 2.0 * cross) / zone.nominal_modulus;
     // (E_z / E_z,nom) c_j h 1/2 X_j^T K_z X_j of W and U (ZoneErrorMap).
     const double scale = moduli_[z] / zone.nominal_modulus;
     totals->zone_error_map[z] += scale * weight * 0.5 * gap;
-    totals->zone_strain_energy[z] += scale * weight * 0.5 * displacement.dot(stream_zone_product_);
+    totals->zone_strain_energy[z] += scale * weight * 0.5 * strain;
   }
   if (num_reactions_ == 0) return;
   // Trusted: c_j h alpha_r sum_s (r_s(U_j) - f~_sj) g_s^T K_z U_j / E_z,nom.
   reaction_trace_.noalias() = reactions_ * displacement;
   reaction_trace_ -= measured_outputs_.col(j).tail(num_reactions_);
   for (int z = 0; z < zones; ++z) {
-    reaction_zone_trace_.noalias() = reaction_zone_rows_[z] * displacement;
     totals->cost_gradients[z] +=
-        weight * reaction_weight_ * reaction_trace_.dot(reaction_zone_trace_);
+        weight * reaction_weight_ *
+        reaction_zone_forms_[z](reaction_trace_.data(), displacement.data());
   }
 }
 

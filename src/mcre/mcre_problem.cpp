@@ -111,10 +111,10 @@ McreProblem::McreProblem(const BarModel& model, const ChannelSet& data, const Mc
     reaction_zone_rows_.emplace_back(1, n);
     reaction_zone_rows_.back().setFromTriplets(entries.begin(), entries.end());
   }
+  for (const SparseMatrix& stiffness : zone_stiffness_) zone_forms_.emplace_back(stiffness);
+  for (const SparseMatrix& rows : reaction_zone_rows_) reaction_zone_forms_.emplace_back(rows);
   gradient_shift_.resize(n);
-  gradient_product_.resize(n);
   reaction_trace_.resize(1);
-  reaction_zone_trace_.resize(1);
   const int num_sensors = static_cast<int>(sensor_rows_.size());
   sensor_weights_ = Eigen::Map<const Vector>(weights_of_rows.data(), num_sensors);
   // The weights of Misfits' rows: uL, the interior sensors, then u0 or the reaction.
@@ -511,8 +511,8 @@ void McreProblem::AddSampleCostGradients(int j, const double* displacement,
   gradient_shift_ = w + 2.0 * u;
   for (int z = 0; z < num_zones(); ++z) {
     // -(1/(2 E_nom)) c_j h W_j^T K_z (W_j + 2 U_j).
-    gradient_product_.noalias() = zone_stiffness_[z] * gradient_shift_;
-    (*gradient)[z] += -0.5 * QuadratureWeight(j) * h * w.dot(gradient_product_) / nominal_modulus_;
+    (*gradient)[z] += -0.5 * QuadratureWeight(j) * h *
+                      zone_forms_[z](retrograde, gradient_shift_.data()) / nominal_modulus_;
   }
   if (reaction_row_ < 0) return;
   // Trusted: c_j h alpha_r (r(U_j) - f0~_j) e_0^T K_z U_j / E_nom, the explicit term
@@ -520,9 +520,8 @@ void McreProblem::AddSampleCostGradients(int j, const double* displacement,
   reaction_trace_.noalias() = reactions_ * u;
   reaction_trace_[0] -= measured_.f0[j];
   for (int z = 0; z < num_zones(); ++z) {
-    reaction_zone_trace_.noalias() = reaction_zone_rows_[z] * u;
     (*gradient)[z] += QuadratureWeight(j) * h * sensor_weights_[reaction_row_] *
-                      reaction_trace_.dot(reaction_zone_trace_);
+                      reaction_zone_forms_[z](reaction_trace_.data(), displacement);
   }
 }
 

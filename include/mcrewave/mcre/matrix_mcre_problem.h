@@ -53,6 +53,7 @@
 #include <vector>
 
 #include "mcrewave/data/channel_set.h"
+#include "mcrewave/linalg/sparse_bilinear_form.h"
 #include "mcrewave/linalg/sparse_columns.h"
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/coupled_problem.h"
@@ -265,6 +266,9 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // Trusted: per zone z, the rows g_s^T K_z / E_z,nom (held columns dropped), R x n; and
   // their sum at moduli_, sum_z E_z (...) = g_s^T K(E).
   std::vector<SparseMatrix> reaction_zone_rows_;
+  // The bilinear forms of every K_z and of those rows on the dofs they touch
+  // (linalg/sparse_bilinear_form.h): the zone sums in O(n) per sample, not O(n Z).
+  std::vector<SparseBilinearForm> zone_forms_, reaction_zone_forms_;
   SparseMatrix reactions_;
   SparseMatrix observation_;             // H, S x n
   SparseMatrix observation_transposed_;  // H^T, n x S
@@ -277,14 +281,14 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // state, W_theta, a product K x, two vectors per load channel, one
   // per row of H and two per reaction.
   Vector velocity_[2], state_[2], shift_, product_, channel_, other_channel_, trace_,
-      reaction_trace_, reaction_zone_trace_;
+      reaction_trace_;
   // Streaming: the checkpoints (v over omega, 2n x (m / s + 1)) and one segment's omega
   // (n x (s + 1)), allocated by the first StreamingMap; the double buffers of the
   // direct sweep (velocity, displacement), W_{j-1} and W_j, and K_z U_j, allocated in the
   // constructor.
   int checkpoint_stride_ = 0;
   Matrix checkpoints_, segment_;
-  Vector stream_velocity_[2], stream_displacement_[2], stream_retrograde_[2], stream_zone_product_;
+  Vector stream_velocity_[2], stream_displacement_[2], stream_retrograde_[2];
   // One row of the element map's picture (ElementColumnPositions entries; empty without
   // elements), allocated in the constructor.
   Vector stream_density_row_;

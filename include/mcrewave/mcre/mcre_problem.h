@@ -47,6 +47,7 @@
 #include <vector>
 
 #include "mcrewave/data/measurement.h"
+#include "mcrewave/linalg/sparse_bilinear_form.h"
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/coupled_problem.h"
 #include "mcrewave/mcre/streaming_coupled_problem.h"
@@ -341,8 +342,10 @@ class McreProblem : public StreamingCoupledProblem {
   // column dropped) and their sum at moduli_; and scratch of n entries.
   double nominal_modulus_ = 0.0;
   std::vector<SparseMatrix> zone_stiffness_, reaction_zone_rows_;
+  // Their bilinear forms on the dofs they touch (linalg/sparse_bilinear_form.h).
+  std::vector<SparseBilinearForm> zone_forms_, reaction_zone_forms_;
   SparseMatrix reactions_;
-  Vector gradient_shift_, gradient_product_, reaction_trace_, reaction_zone_trace_;
+  Vector gradient_shift_, reaction_trace_;
   std::vector<const Vector*> sensor_data_;
   // Point loads of the retrograde sweeps at the sensors' nodes, values per sweep
   // of a batch (column b), allocated in the constructor.

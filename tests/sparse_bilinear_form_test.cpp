@@ -1,0 +1,117 @@
+// Tests of SparseBilinearForm (linalg/sparse_bilinear_form.h): on a matrix touching few
+// dofs it is the dense x^T A y, its entries stored as 0 left out; on a matrix touching
+// every dof, the same bits as Eigen's
+// x.dot(A * y); Forms gives the three forms of a square matrix; a rectangular block of
+// reaction rows.
+#include "mcrewave/linalg/sparse_bilinear_form.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace mcrewave {
+namespace {
+
+// A symmetric n x n matrix with entries on the dofs [first, first + size) only.
+SparseMatrix LocalBlock(int n, int first, int size, std::mt19937* generator) {
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int i = first; i < first + size; ++i) {
+    for (int k = i; k < first + size; ++k) {
+      const double a = value(*generator);
+      entries.emplace_back(i, k, a);
+      if (k != i) entries.emplace_back(k, i, a);
+    }
+  }
+  SparseMatrix matrix(n, n);
+  matrix.setFromTriplets(entries.begin(), entries.end());
+  return matrix;
+}
+
+Vector RandomVector(int n, std::mt19937* generator) {
+  std::normal_distribution<double> value;
+  Vector x(n);
+  for (double& entry : x) entry = value(*generator);
+  return x;
+}
+
+TEST(SparseBilinearFormTest, IsTheDenseFormOnAFewDofs) {
+  std::mt19937 generator(3);
+  const int n = 200;
+  const SparseMatrix a = LocalBlock(n, 57, 3, &generator);
+  SparseBilinearForm form(a);
+  EXPECT_EQ(form.active_rows(), 3);
+  EXPECT_EQ(form.active_columns(), 3);
+  const Vector x = RandomVector(n, &generator), y = RandomVector(n, &generator);
+  const Matrix dense(a);
+  const double expected = x.dot(dense * y);
+  // Nine products summed in another order: at most 7.9e-16 apart, relative, over 200
+  // seeds.
+  EXPECT_NEAR(form(x.data(), y.data()), expected, 1e-15 * std::abs(expected) + 1e-300);
+  double xx = 0.0, xy = 0.0, yy = 0.0;
+  form.Forms(x.data(), y.data(), &xx, &xy, &yy);
+  EXPECT_EQ(xy, form(x.data(), y.data()));
+  EXPECT_NEAR(xx, x.dot(dense * x), 1e-15 * std::abs(x.dot(dense * x)));
+  EXPECT_NEAR(yy, y.dot(dense * y), 1e-15 * std::abs(y.dot(dense * y)));
+}
+
+TEST(SparseBilinearFormTest, EntriesStoredAsZeroAreNotActive) {
+  // A zone's K_z assembled over the whole mesh: zeros stored on every other dof.
+  std::mt19937 generator(7);
+  const int n = 60;
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int i = 0; i < n; ++i) entries.emplace_back(i, i, 0.0);
+  const SparseMatrix block = LocalBlock(n, 20, 2, &generator);
+  for (int column = 0; column < n; ++column) {
+    for (SparseMatrix::InnerIterator entry(block, column); entry; ++entry) {
+      entries.emplace_back(static_cast<int>(entry.row()), column, entry.value());
+    }
+  }
+  SparseMatrix a(n, n);
+  a.setFromTriplets(entries.begin(), entries.end());
+  ASSERT_EQ(a.nonZeros(), n + 2);  // 60 diagonal entries (two of them nonzero) and two off
+  SparseBilinearForm form(a);
+  EXPECT_EQ(form.active_rows(), 2);
+  const Vector x = RandomVector(n, &generator), y = RandomVector(n, &generator);
+  const double expected = x.dot(Matrix(a) * y);
+  EXPECT_NEAR(form(x.data(), y.data()), expected, 1e-15 * std::abs(expected));
+}
+
+TEST(SparseBilinearFormTest, TouchingEveryDofItIsEigensProductToTheBit) {
+  std::mt19937 generator(5);
+  const int n = 37;
+  const SparseMatrix a = LocalBlock(n, 0, n, &generator);
+  SparseBilinearForm form(a);
+  const Vector x = RandomVector(n, &generator), y = RandomVector(n, &generator);
+  const Vector product = a * y;
+  EXPECT_EQ(form(x.data(), y.data()), x.dot(product));
+  double xx = 0.0, xy = 0.0, yy = 0.0;
+  form.Forms(x.data(), y.data(), &xx, &xy, &yy);
+  const Vector x_product = a * x;
+  EXPECT_EQ(xx, x.dot(x_product));
+  EXPECT_EQ(xy, x.dot(product));
+  EXPECT_EQ(yy, y.dot(product));
+}
+
+TEST(SparseBilinearFormTest, RectangularRowsTakeTheirActiveColumns) {
+  // Two reaction rows g_s^T K_z over 50 dofs, the second empty: r^T (A u).
+  std::vector<Eigen::Triplet<double>> entries = {{0, 10, 2.0}, {0, 11, -3.0}, {0, 40, 0.5}};
+  SparseMatrix a(2, 50);
+  a.setFromTriplets(entries.begin(), entries.end());
+  SparseBilinearForm form(a);
+  EXPECT_EQ(form.active_rows(), 1);
+  EXPECT_EQ(form.active_columns(), 3);
+  Vector u = Vector::Zero(50);
+  u[10] = 1.0;
+  u[11] = 2.0;
+  u[40] = 4.0;
+  u[12] = 100.0;  // untouched
+  const double r[2] = {3.0, 7.0};
+  // r_0 (2 - 6 + 2) = -6.
+  EXPECT_EQ(form(r, u.data()), -6.0);
+}
+
+}  // namespace
+}  // namespace mcrewave
