@@ -42,19 +42,19 @@ TEST(SparseBilinearFormTest, IsTheDenseFormOnAFewDofs) {
   const int n = 200;
   const SparseMatrix a = LocalBlock(n, 57, 3, &generator);
   SparseBilinearForm form(a);
-  EXPECT_EQ(form.active_rows(), 3);
-  EXPECT_EQ(form.active_columns(), 3);
+  EXPECT_FALSE(form.whole());
+  EXPECT_EQ(form.num_entries(), 9);
   const Vector x = RandomVector(n, &generator), y = RandomVector(n, &generator);
   const Matrix dense(a);
   const double expected = x.dot(dense * y);
-  // Nine products summed in another order: at most 7.9e-16 apart, relative, over 200
-  // seeds.
-  EXPECT_NEAR(form(x.data(), y.data()), expected, 1e-15 * std::abs(expected) + 1e-300);
+  // Nine products summed in another order: at most 5.2e-15 apart, relative, over 200
+  // seeds (cancellation in x^T A y).
+  EXPECT_NEAR(form(x.data(), y.data()), expected, 2e-14 * std::abs(expected));
   double xx = 0.0, xy = 0.0, yy = 0.0;
   form.Forms(x.data(), y.data(), &xx, &xy, &yy);
   EXPECT_EQ(xy, form(x.data(), y.data()));
-  EXPECT_NEAR(xx, x.dot(dense * x), 1e-15 * std::abs(x.dot(dense * x)));
-  EXPECT_NEAR(yy, y.dot(dense * y), 1e-15 * std::abs(y.dot(dense * y)));
+  EXPECT_NEAR(xx, x.dot(dense * x), 2e-14 * std::abs(x.dot(dense * x)));
+  EXPECT_NEAR(yy, y.dot(dense * y), 2e-14 * std::abs(y.dot(dense * y)));
 }
 
 TEST(SparseBilinearFormTest, EntriesStoredAsZeroAreNotActive) {
@@ -73,10 +73,11 @@ TEST(SparseBilinearFormTest, EntriesStoredAsZeroAreNotActive) {
   a.setFromTriplets(entries.begin(), entries.end());
   ASSERT_EQ(a.nonZeros(), n + 2);  // 60 diagonal entries (two of them nonzero) and two off
   SparseBilinearForm form(a);
-  EXPECT_EQ(form.active_rows(), 2);
+  EXPECT_FALSE(form.whole());
+  EXPECT_EQ(form.num_entries(), 4);
   const Vector x = RandomVector(n, &generator), y = RandomVector(n, &generator);
   const double expected = x.dot(Matrix(a) * y);
-  EXPECT_NEAR(form(x.data(), y.data()), expected, 1e-15 * std::abs(expected));
+  EXPECT_NEAR(form(x.data(), y.data()), expected, 2e-14 * std::abs(expected));
 }
 
 TEST(SparseBilinearFormTest, TouchingEveryDofItIsEigensProductToTheBit) {
@@ -84,6 +85,7 @@ TEST(SparseBilinearFormTest, TouchingEveryDofItIsEigensProductToTheBit) {
   const int n = 37;
   const SparseMatrix a = LocalBlock(n, 0, n, &generator);
   SparseBilinearForm form(a);
+  EXPECT_TRUE(form.whole());
   const Vector x = RandomVector(n, &generator), y = RandomVector(n, &generator);
   const Vector product = a * y;
   EXPECT_EQ(form(x.data(), y.data()), x.dot(product));
@@ -95,14 +97,14 @@ TEST(SparseBilinearFormTest, TouchingEveryDofItIsEigensProductToTheBit) {
   EXPECT_EQ(yy, y.dot(product));
 }
 
-TEST(SparseBilinearFormTest, RectangularRowsTakeTheirActiveColumns) {
+TEST(SparseBilinearFormTest, RectangularRowsTakeTheirEntries) {
   // Two reaction rows g_s^T K_z over 50 dofs, the second empty: r^T (A u).
   std::vector<Eigen::Triplet<double>> entries = {{0, 10, 2.0}, {0, 11, -3.0}, {0, 40, 0.5}};
   SparseMatrix a(2, 50);
   a.setFromTriplets(entries.begin(), entries.end());
   SparseBilinearForm form(a);
-  EXPECT_EQ(form.active_rows(), 1);
-  EXPECT_EQ(form.active_columns(), 3);
+  EXPECT_FALSE(form.whole());
+  EXPECT_EQ(form.num_entries(), 3);
   Vector u = Vector::Zero(50);
   u[10] = 1.0;
   u[11] = 2.0;

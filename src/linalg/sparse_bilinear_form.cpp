@@ -4,72 +4,72 @@
 
 namespace mcrewave {
 
-SparseBilinearForm::SparseBilinearForm(const SparseMatrix& a) {
-  std::vector<int> row_index(static_cast<std::size_t>(a.rows()), -1);
-  std::vector<int> column_index(static_cast<std::size_t>(a.cols()), -1);
+SparseBilinearForm::SparseBilinearForm(const SparseMatrix& a)
+    : rows_(static_cast<int>(a.rows())), columns_(static_cast<int>(a.cols())) {
+  std::vector<char> active_row(static_cast<std::size_t>(a.rows()), 0);
+  std::vector<char> active_column(static_cast<std::size_t>(a.cols()), 0);
   for (int column = 0; column < a.outerSize(); ++column) {
     for (SparseMatrix::InnerIterator entry(a, column); entry; ++entry) {
       if (entry.value() == 0.0) continue;
-      row_index[static_cast<std::size_t>(entry.row())] = 0;
-      column_index[static_cast<std::size_t>(entry.col())] = 0;
+      entry_row_.push_back(static_cast<int>(entry.row()));
+      entry_column_.push_back(column);
+      entry_value_.push_back(entry.value());
+      active_row[static_cast<std::size_t>(entry.row())] = 1;
+      active_column[static_cast<std::size_t>(column)] = 1;
     }
   }
-  if (a.rows() == a.cols()) {
-    // A square A keeps one set, the rows' and columns' union, for Forms.
-    for (std::size_t i = 0; i < row_index.size(); ++i) {
-      if (row_index[i] == 0 || column_index[i] == 0) row_index[i] = column_index[i] = 0;
-    }
+  int rows = 0, columns = 0;
+  for (const char active : active_row) rows += active;
+  for (const char active : active_column) columns += active;
+  whole_ = rows == a.rows() && columns == a.cols() &&
+           static_cast<Eigen::Index>(entry_value_.size()) == a.nonZeros();
+  if (whole_) {
+    // Eigen's product and dot product on the full vectors.
+    whole_matrix_ = a;
+    product_x_ = Vector::Zero(a.rows());
+    product_y_ = Vector::Zero(a.rows());
+    entry_row_.clear();
+    entry_column_.clear();
+    entry_value_.clear();
   }
-  for (std::size_t i = 0; i < row_index.size(); ++i) {
-    if (row_index[i] == 0) {
-      row_index[i] = static_cast<int>(rows_.size());
-      rows_.push_back(static_cast<int>(i));
-    }
-  }
-  for (std::size_t k = 0; k < column_index.size(); ++k) {
-    if (column_index[k] == 0) {
-      column_index[k] = static_cast<int>(columns_.size());
-      columns_.push_back(static_cast<int>(k));
-    }
-  }
-  // A_RC in the same column-major order, entries by increasing row within a column, as
-  // A's (the products' sums in the same order).
-  std::vector<Eigen::Triplet<double>> entries;
-  for (int column = 0; column < a.outerSize(); ++column) {
-    for (SparseMatrix::InnerIterator entry(a, column); entry; ++entry) {
-      if (entry.value() == 0.0) continue;
-      entries.emplace_back(row_index[static_cast<std::size_t>(entry.row())],
-                           column_index[static_cast<std::size_t>(entry.col())], entry.value());
-    }
-  }
-  block_.resize(active_rows(), active_columns());
-  block_.setFromTriplets(entries.begin(), entries.end());
-  gathered_x_ = Vector::Zero(active_rows());
-  gathered_y_ = Vector::Zero(active_columns());
-  product_x_ = Vector::Zero(active_rows());
-  product_y_ = Vector::Zero(active_rows());
 }
 
 double SparseBilinearForm::operator()(const double* x, const double* y) {
-  for (int r = 0; r < active_rows(); ++r) gathered_x_[r] = x[rows_[r]];
-  for (int c = 0; c < active_columns(); ++c) gathered_y_[c] = y[columns_[c]];
-  // x_R^T (A_RC y_C).
-  product_y_.noalias() = block_ * gathered_y_;
-  return gathered_x_.dot(product_y_);
+  if (whole_) {
+    product_y_.noalias() = whole_matrix_ * Eigen::Map<const Vector>(y, columns_);
+    return Eigen::Map<const Vector>(x, rows_).dot(product_y_);
+  }
+  // sum over the nonzero entries a_rc x_r y_c, column by column.
+  double sum = 0.0;
+  for (std::size_t q = 0; q < entry_value_.size(); ++q) {
+    sum += entry_value_[q] * x[entry_row_[q]] * y[entry_column_[q]];
+  }
+  return sum;
 }
 
 void SparseBilinearForm::Forms(const double* x, const double* y, double* xx, double* xy,
                                double* yy) {
-  assert(block_.rows() == block_.cols());
-  for (int r = 0; r < active_rows(); ++r) {
-    gathered_x_[r] = x[rows_[r]];
-    gathered_y_[r] = y[rows_[r]];
+  assert(rows_ == columns_);
+  if (whole_) {
+    const Eigen::Map<const Vector> x_vector(x, rows_), y_vector(y, rows_);
+    product_x_.noalias() = whole_matrix_ * x_vector;
+    product_y_.noalias() = whole_matrix_ * y_vector;
+    *xx = x_vector.dot(product_x_);
+    *xy = x_vector.dot(product_y_);
+    *yy = y_vector.dot(product_y_);
+    return;
   }
-  product_x_.noalias() = block_ * gathered_x_;
-  product_y_.noalias() = block_ * gathered_y_;
-  *xx = gathered_x_.dot(product_x_);
-  *xy = gathered_x_.dot(product_y_);
-  *yy = gathered_y_.dot(product_y_);
+  double sum_xx = 0.0, sum_xy = 0.0, sum_yy = 0.0;
+  for (std::size_t q = 0; q < entry_value_.size(); ++q) {
+    const double x_row = x[entry_row_[q]], y_column = y[entry_column_[q]];
+    const double value = entry_value_[q];
+    sum_xx += value * x_row * x[entry_column_[q]];
+    sum_xy += value * x_row * y_column;
+    sum_yy += value * y[entry_row_[q]] * y_column;
+  }
+  *xx = sum_xx;
+  *xy = sum_xy;
+  *yy = sum_yy;
 }
 
 }  // namespace mcrewave

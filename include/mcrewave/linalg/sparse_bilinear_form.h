@@ -1,17 +1,14 @@
 // The bilinear form x^T A y of a sparse matrix whose entries touch few of the n dofs (a
-// zone's K_z, the rows g_s^T K_z of a support's reaction), in O(nnz(A) + its active
-// rows and columns) rather than the O(n) of Eigen's sparse product, which visits every
-// column: the zone sums of the MCRE's gradients and maps (mcre/matrix_mcre_problem.h,
-// mcre/mcre_problem.h) then cost O(n) per sample over all zones, not O(n Z).
+// zone's K_z, the rows g_s^T K_z of a support's reaction), in O(nnz(A)) rather than
+// the O(n) of Eigen's sparse product, which visits every column: the zone sums of the
+// MCRE's gradients and maps (mcre/matrix_mcre_problem.h, mcre/mcre_problem.h) then cost
+// O(n) per sample over all zones, not O(n Z).
 //
-// The active rows R and columns C are those holding a nonzero entry (entries stored as
-// 0, as a zone's K_z assembled over the whole mesh has, are dropped; for a square A, R
-// and C are both the union of the two); A_RC is kept as a
-// compressed matrix of their order, and x^T A y = x_R^T (A_RC y_C) with x_R, y_C the
-// gathered entries. When every row and column is active and no entry is 0, A_RC is A
-// and the products and dot products are Eigen's on the full vectors: the same bits as
-// x.dot(A * y).
-// No call allocates but the constructor.
+// Entries stored as 0 (a zone's K_z assembled over the whole mesh has them) are
+// dropped, and x^T A y is summed over the nonzero entries, a_rc x_r y_c, column by
+// column. When every row and column holds a nonzero entry and none is stored as 0, it
+// is Eigen's x.dot(A * y) on the full vectors instead: a structure of one zone keeps
+// the bits of that product. No call allocates but the constructor.
 #pragma once
 
 #include <vector>
@@ -23,22 +20,29 @@ namespace mcrewave {
 class SparseBilinearForm {
  public:
   SparseBilinearForm() = default;
-  // Copies the entries of a (column-major); allocates the scratch.
+  // Copies the nonzero entries of a (column-major); allocates the scratch.
   explicit SparseBilinearForm(const SparseMatrix& a);
 
-  int active_rows() const { return static_cast<int>(rows_.size()); }
-  int active_columns() const { return static_cast<int>(columns_.size()); }
+  // Whether x^T A y is Eigen's product (every row and column active, no zero stored).
+  bool whole() const { return whole_; }
+  // The nonzero entries summed (0 when whole()).
+  int num_entries() const { return static_cast<int>(entry_value_.size()); }
 
   // x^T A y: x has A's rows entries, y its columns'.
   double operator()(const double* x, const double* y);
-  // For a square A (a zone's K_z): x^T A x, x^T A y and y^T A y from one product of x
-  // and one of y.
+  // For a square A (a zone's K_z): x^T A x, x^T A y and y^T A y in one pass (two
+  // products when whole()).
   void Forms(const double* x, const double* y, double* xx, double* xy, double* yy);
 
  private:
-  std::vector<int> rows_, columns_;  // the active ones, increasing
-  SparseMatrix block_;               // A_RC
-  Vector gathered_x_, gathered_y_, product_x_, product_y_;
+  int rows_ = 0, columns_ = 0;
+  bool whole_ = false;
+  // The nonzero entries, column by column (empty when whole()).
+  std::vector<int> entry_row_, entry_column_;
+  std::vector<double> entry_value_;
+  // whole(): A and the scratch of its products.
+  SparseMatrix whole_matrix_;
+  Vector product_x_, product_y_;
 };
 
 }  // namespace mcrewave
