@@ -13,7 +13,7 @@
 #                                 (MCRE against least squares, 100 seeds x 4 SNRs x 5 model
 #                                 errors on pre-filtered data; about 20 minutes on 2 cores)
 #   results/damage/               `identify study configs/studies.yaml --set study.kind=damage`
-#                                 (include/mcrewave/app/study.h; about 19 minutes on 2 cores),
+#                                 (include/mcrewave/app/study.h; about 26 minutes on 2 cores),
 #                                 which writes results/README.md
 # The first four parts take about 10 minutes on 2 cores. Arguments go to `identify study`, and with any of them
 # only the identify studies run, e.g.
@@ -52,10 +52,10 @@ else
   # other zone was within 5 % on 13 of 20 seeds against 0 of 6 ("Damage
   # localisation"). Neighbouring zones merged while a refit meets the noise's level
   # (10 equal zones; "Merging neighbouring zones"): at SNR 10 every other zone within
-  # 5 % on 20 of 20 seeds against 13. The 10 equal zones are also fitted by least
+  # 5 % on 19 of 20 seeds against 13. The 10 equal zones are also fitted by least
   # squares with the same options ("Zones: the MCRE against least squares"). About
-  # 19 min on 2 cores: the runs with interior sensors and one zone per element take 1
-  # to 2 min each.
+  # 26 min on 2 cores: the runs with interior sensors and one zone per element take 1
+  # to 4 min each.
   "$build_dir/identify/identify" study configs/studies.yaml --output results \
     --set study.kind=damage --set mcre.clamp=measured --set mcre.w_u=0.01 --set mcre.w_e=1e-4 \
     --set search.functional=same --set zone_identification.regularization=total_variation \

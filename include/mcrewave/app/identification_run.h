@@ -81,7 +81,8 @@ struct IdentificationRun {
   CoupledSolverType inner_method = CoupledSolverType::kConjugateGradient;
   IdentificationSummary outer;
   // The optimiser's evaluations, in order; evaluations[best_index] is the one
-  // at the identified E, and `solution` its coupled solution.
+  // at the identified E, and `solution` its coupled solution (of BarRunModel's
+  // problem: a streaming solve's traces in its rows' order).
   std::vector<ObjectiveEvaluation> evaluations;
   int best_index = -1;
   CoupledSolution solution;

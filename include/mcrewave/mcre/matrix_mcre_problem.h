@@ -46,7 +46,8 @@
 // n x (s + 1) buffer and consumed in forward order by the direct sweep. Three sweeps
 // per application, memory 2 n m / s + n s = O(n sqrt(m)), W the stored sweep's to the
 // bit (the same steps), no drift. Its totals are the cost, the zone gradients, the
-// zone maps of W and U and the dof map, summed as the fields pass.
+// zone maps of W and U, the dof map and the element map, summed as the fields pass, and
+// G^T W of every sample (the model's forces, ModelChannels).
 #pragma once
 
 #include <string>
