@@ -325,7 +325,7 @@ TEST(SparseIntegratorAllocationTest, StepsAndSweepsAllocateNothingAfterInit) {
   EXPECT_EQ(batched_steps.allocations, 0);
   EXPECT_EQ(batched_steps.deallocations, 0);
   const Vector zero = Vector::Zero(n);
-  auto end_force = [n](int k, Eigen::Ref<Vector> f) {
+  auto end_force = [](int k, Eigen::Ref<Vector> f) {
     f.setZero();
     f[n - 1] = 1.0 + 0.01 * k;
   };

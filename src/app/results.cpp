@@ -128,7 +128,9 @@ std::string EndsCsv(const IdentificationRun& run) {
   const char* names[] = {"u0", "uL", "f0", "fL"};
   for (int c = 0; c < 4; ++c) {
     const int found = run.model_channels.Find(names[c]);
-    if (found >= 0) model_columns[c] = &run.model_channels.channels[found].values;
+    if (found >= 0) {
+      model_columns[c] = &run.model_channels.channels[static_cast<std::size_t>(found)].values;
+    }
   }
   char number[32];
   for (int j = 0; j < data.num_samples(); ++j) {
