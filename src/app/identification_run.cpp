@@ -247,7 +247,8 @@ IdentificationRun IdentifyModulus(const Config& config, const ChannelSet& data) 
       config.outer.scan_points == 0      ? "none (outer.scan_points 0)"
       : ScansTheSearchFunctional(config) ? "the pinned search functional (search:)"
                                          : "mcre:'s e^2");
-  const MatrixModelData matrices = BarRunModel(model, run.data, run.ends);
+  run.model = std::make_shared<const MatrixModelData>(BarRunModel(model, run.data, run.ends));
+  const MatrixModelData& matrices = *run.model;
   McreIdentification identification = IdentifyWithMcre(config, matrices, run.data);
   McreObjective& objective = *identification.objective;
   // The bar's weights from k* = E0 S / L (mcre/matrix_mcre_problem.h): alpha = w_f / k*
@@ -290,8 +291,7 @@ IdentificationRun RunIdentification(const Config& config, const ChannelSet& data
   const auto start = Clock::now();
   IdentificationRun run = IdentifyModulus(config, data);
   if (!run.IsUsable()) return run;
-  const BarModel model(config.model);
-  const MatrixModelData matrices = BarRunModel(model, run.data, run.ends);
+  const MatrixModelData& matrices = *run.model;
 
   // The cost curve around E*.
   run.cost_curve = ComputeCostCurve(config, matrices, run.data, run, &run.cost_curve_sweeps);

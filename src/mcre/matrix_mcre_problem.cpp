@@ -54,6 +54,7 @@ struct ObservedRow {
   SparseMatrix row;  // 1 x n
   double beta;
   std::string channel;
+  ChannelKind kind;
 };
 
 // The sparse 1 x n row of a dense vector's nonzero entries.
@@ -99,21 +100,23 @@ std::vector<ObservedRow> ObservedRows(const MatrixModelData& model, const McreWe
   const int n = model.dofs();
   std::vector<ObservedRow> rows;
   for (const MatrixModelSensor& sensor : model.sensors) {
+    const bool strain = sensor.kind == SensorKind::kStrain;
     rows.push_back({sensor.row,
-                    sensor.kind == SensorKind::kStrain
-                        ? weights.strain_weight * stiffness_scale * model.length * model.length
-                        : weights.displacement_weight * stiffness_scale,
-                    sensor.channel});
+                    strain ? weights.strain_weight * stiffness_scale * model.length * model.length
+                           : weights.displacement_weight * stiffness_scale,
+                    sensor.channel, strain ? ChannelKind::kStrain : ChannelKind::kDisplacement});
   }
   for (const MatrixModelSupport& support : model.supports) {
     if (measured && !support.displacement_channel.empty()) {
       rows.push_back({RowOf(support.reaction / support.reaction.squaredNorm()),
-                      weights.displacement_weight * stiffness_scale, support.displacement_channel});
+                      weights.displacement_weight * stiffness_scale, support.displacement_channel,
+                      ChannelKind::kDisplacement});
     }
     if (pinned) {
       for (const int dof : support.dofs) {
-        rows.push_back(
-            {RowOf(Vector::Unit(n, dof)), weights.clamp_displacement_weight * stiffness_scale, ""});
+        rows.push_back({RowOf(Vector::Unit(n, dof)),
+                        weights.clamp_displacement_weight * stiffness_scale, "",
+                        ChannelKind::kDisplacement});
       }
     }
   }
@@ -225,12 +228,10 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
   const int num_fixed = static_cast<int>(rows.size());
   const int num_rows = num_fixed + num_reactions_;
   for (const LoadColumn& column : columns) load_channels_.push_back(column.channel);
-  for (const ObservedRow& row : rows) output_channels_.push_back(row.channel);
-  for (const MatrixModelSensor& sensor : model.sensors) {
-    output_kinds_.push_back(sensor.kind == SensorKind::kStrain ? ChannelKind::kStrain
-                                                               : ChannelKind::kDisplacement);
+  for (const ObservedRow& row : rows) {
+    output_channels_.push_back(row.channel);
+    output_kinds_.push_back(row.kind);
   }
-  output_kinds_.resize(rows.size(), ChannelKind::kDisplacement);  // the supports' rows
   if (trusted) {
     for (const MatrixModelSupport& support : model.supports) {
       output_channels_.push_back(support.force_channel);

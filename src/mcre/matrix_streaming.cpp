@@ -172,7 +172,6 @@ void MatrixMcreProblem::ResetStreamingTotals(int picture_stride, StreamingTotals
   totals->element_error_map.setZero(static_cast<Eigen::Index>(model_.elements.size()));
   totals->gap_density.resize(model_.elements.empty() ? 0 : num_steps() / picture_stride + 1,
                              stream_density_row_.size());
-  totals->end_retrograde.resize(0, 0);
   totals->load_retrograde.resize(channel_.size(), num_steps() + 1);
   totals->rebuild_error = 0.0;  // W from checkpoints: the stored sweep's
 }

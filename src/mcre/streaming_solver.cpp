@@ -173,7 +173,6 @@ void StreamingConjugateGradient::Accept(const std::string& message) {
   solution_->cost_gradients = totals_.cost_gradients;
   solution_->cost_gradient = totals_.cost_gradients.sum();
   solution_->traces = traces_;
-  solution_->end_retrograde = totals_.end_retrograde;
   solution_->load_retrograde = totals_.load_retrograde;
   solution_->error_map = totals_.error_map;
   solution_->element_error_map = totals_.element_error_map;

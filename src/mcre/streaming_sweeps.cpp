@@ -135,13 +135,11 @@ void McreProblem::ResetStreamingTotals(int picture_stride, StreamingTotals* tota
   totals->cost_gradients.setZero(num_zones());
   totals->error_map.setZero(model_.num_elements());
   totals->gap_density.resize(m / picture_stride + 1, stream_density_row_.size());
-  totals->end_retrograde.resize(2, m + 1);
   totals->rebuild_error = 0.0;
 }
 
 void McreProblem::AddStreamingSample(int j, const Vector& displacement, const Vector& retrograde,
                                      int picture_stride, StreamingTotals* totals) {
-  const int last = num_nodes() - 1;
   const double weight = QuadratureWeight(j) * time_step();
   totals->cost += weight * SampleCost(j, displacement.data(), retrograde.data());
   AddSampleCostGradients(j, displacement.data(), retrograde.data(), &totals->cost_gradients);
@@ -150,8 +148,6 @@ void McreProblem::AddStreamingSample(int j, const Vector& displacement, const Ve
     SampleGapDensity(model_, moduli_, retrograde.data(), stream_density_row_.data());
     totals->gap_density.row(j / picture_stride) = stream_density_row_.transpose();
   }
-  totals->end_retrograde(0, j) = retrograde[0];
-  totals->end_retrograde(1, j) = retrograde[last];
 }
 
 void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* image,

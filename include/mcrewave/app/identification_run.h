@@ -54,6 +54,9 @@ struct IdentificationRun {
   ChannelSet data;
   // The end displacement channels among them (data.channels).
   EndDisplacementChannels ends;
+  // BarRunModel of config.model, data and ends: the structure every MCRE solve of the run
+  // takes (set by IdentifyModulus; shared, so that a copy of the run keeps it).
+  std::shared_ptr<const MatrixModelData> model;
   // The pre-filter's cut-off frequency [Hz] (given or derived); 0 when off.
   double prefilter_cutoff = 0.0;
   // Synthetic data: they were made with E = config.model.modulus, the reference

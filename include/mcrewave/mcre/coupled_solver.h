@@ -158,12 +158,11 @@ struct CoupledSolverSummary {
 struct CoupledSolution {
   // U and W, n x (m + 1) [m]; empty (0 x 0) after a streaming solve, which stores
   // neither: its fields are summed as they pass (cost, gradients, error map) and
-  // its traces and end retrograde values are kept.
+  // its traces (and, on a matrix model, G^T W) are kept.
   Matrix displacement;    // U, n x (m + 1) [m]
   Matrix retrograde;      // W, n x (m + 1) [m]
   // H U (streaming only), StreamingCoupledProblem::num_traces() x (m + 1).
   Matrix traces;
-  Matrix end_retrograde;  // W at nodes 0 and N (streaming on the bar), 2 x (m + 1) [m]
   // Streaming on a matrix model: G^T W, one row per load channel, C x (m + 1) [m].
   Matrix load_retrograde;
   // Streaming only: on the bar e_el^2 per element, on a matrix model the dof map
@@ -181,15 +180,6 @@ struct CoupledSolution {
   // The unknown of the iterative solver that produced this solution, as SolveCoupled's
   // initial_guess: W, or the traces after a streaming solve (empty when there is none).
   const Matrix& WarmStart() const { return has_fields() ? retrograde : traces; }
-  // U and W at node 0 (end 0) or node N (end 1) at sample j [m], from the fields or,
-  // after a streaming solve, from its traces and end values.
-  double EndDisplacement(int end, int j) const {
-    return has_fields() ? displacement(end == 0 ? 0 : displacement.rows() - 1, j) : traces(end, j);
-  }
-  double EndRetrograde(int end, int j) const {
-    return has_fields() ? retrograde(end == 0 ? 0 : retrograde.rows() - 1, j)
-                        : end_retrograde(end, j);
-  }
   double cost = -1.0;          // e^2(E) [J s]
   double cost_gradient = 0.0;  // de^2/dE [J s / Pa] (several zones: sum_z de^2/dE_z)
   Vector cost_gradients;       // de^2/dE_z [J s / Pa], one per zone

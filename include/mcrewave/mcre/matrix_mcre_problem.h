@@ -280,13 +280,12 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   ThetaIntegrator integrator_;
   // Scratch, allocated in the constructor: double buffers of the sweeps' velocity and
   // state, W_theta, a product K x, two vectors per load channel, one
-  // per row of H and two per reaction.
+  // per row of H and one per reaction.
   Vector velocity_[2], state_[2], shift_, product_, channel_, other_channel_, trace_,
       reaction_trace_;
   // Streaming: the checkpoints (v over omega, 2n x (m / s + 1)) and one segment's omega
   // (n x (s + 1)), allocated by the first StreamingMap; the double buffers of the
-  // direct sweep (velocity, displacement), W_{j-1} and W_j, and K_z U_j, allocated in the
-  // constructor.
+  // direct sweep (velocity, displacement), W_{j-1} and W_j, allocated in the constructor.
   int checkpoint_stride_ = 0;
   Matrix checkpoints_, segment_;
   Vector stream_velocity_[2], stream_displacement_[2], stream_retrograde_[2];

@@ -130,11 +130,6 @@ class McreProblem : public StreamingCoupledProblem {
   double strain_beta() const { return strain_beta_; }  // strain weight beta_e [N m]
   const EndDisplacementChannels& end_channels() const { return ends_; }
   ClampModel clamp() const { return clamp_; }
-  // alpha_r [m/N], the weight of a trusted clamp's reaction; 0 when the clamp is
-  // measured or pinned (a pinned clamp's alpha_0: 1 / inverse_alpha0()).
-  double reaction_weight() const {
-    return reaction_row_ >= 0 ? sensor_weights_[reaction_row_] : 0.0;
-  }
   // The datum of the u0 row at sample j [m]: the measured u0, or 0 under a pinned clamp.
   double U0Datum(int j) const { return clamp_ == ClampModel::kPinned ? 0.0 : measured_.u0[j]; }
   // Trusted clamp: the reaction r(U_j) = K_01(E) U_1 [N] of the displacement column

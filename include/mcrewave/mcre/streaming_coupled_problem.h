@@ -23,9 +23,8 @@ class StreamingCoupledProblem : public CoupledProblem {
  public:
   // What a streaming application gathers at each sample when asked: the cost,
   // gradients and error maps of the fields it passes through, never stored. Entries a
-  // structure has no use for stay empty (the bar: the zone maps and the element map; a
-  // matrix model: the end values, and the element map and picture without element
-  // blocks).
+  // structure has no use for stay empty (the bar: the zone maps, the element map and
+  // G^T W; a matrix model: the element map and picture without element blocks).
   struct StreamingTotals {
     double cost = 0.0;      // e^2 [J s]
     Vector cost_gradients;  // de^2/dE_z [J s / Pa]
@@ -44,7 +43,6 @@ class StreamingCoupledProblem : public CoupledProblem {
     // matrix model's element gap energy [J] on ElementColumnPositions
     // (element_error_map.h; empty without element blocks).
     Matrix gap_density;
-    Matrix end_retrograde;  // the bar: W at nodes 0 and N, 2 x (m + 1) [m]
     // A matrix model: G^T W_j of every load channel (G's columns), C x (m + 1) [m], from
     // which its forces F = F~ - diag(1/alpha) G^T W follow (MatrixMcreProblem::ModelChannels).
     Matrix load_retrograde;
