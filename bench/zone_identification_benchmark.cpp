@@ -141,10 +141,10 @@ void IdentifyAndReportZones(int zones, const mcrewave::Config& config,
   options.minimizer.optimizer = arguments.optimizer;
   options.minimizer.algorithm = arguments.algorithm;
   const auto start = std::chrono::steady_clock::now();
-  const ZoneIdentificationSummary summary =
-      IdentifyZoneModuli(options, model, scalar.data, config.mcre, config.time.theta, config.inner,
-                         {}, scalar.identified_modulus(), config.outer.lower_bound,
-                         config.outer.upper_bound, noise, prefilter, &scalar.solution.retrograde);
+  const ZoneIdentificationSummary summary = IdentifyZoneModuli(
+      options, BarRunModel(model, scalar.data, scalar.ends), scalar.data, config.mcre,
+      config.time.theta, config.inner, scalar.identified_modulus(), config.outer.lower_bound,
+      config.outer.upper_bound, noise, prefilter, &scalar.solution.WarmStart());
   const double seconds = Seconds(start);
   if (summary.moduli.size() == 0) {
     std::fprintf(stderr, "%d zones: %s\n", zones, summary.message.c_str());

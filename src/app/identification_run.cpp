@@ -190,19 +190,6 @@ ChannelSet LoadMeasurements(const Config& config) {
   return data;
 }
 
-MatrixModelData BarRunModel(const BarModel& model, const ChannelSet& data,
-                            EndDisplacementChannels ends) {
-  MatrixModelData matrices =
-      BarMatrixModel(model, model.properties().modulus, BarSensors(data), BarClampExport::kSupport);
-  if (!ends.uL) {
-    matrices.sensors.erase(
-        std::find_if(matrices.sensors.begin(), matrices.sensors.end(),
-                     [](const MatrixModelSensor& sensor) { return sensor.channel == "uL"; }));
-  }
-  if (!ends.u0) matrices.supports.front().displacement_channel.clear();
-  return matrices;
-}
-
 McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData& model,
                                     const ChannelSet& data) {
   McreIdentification result;

@@ -84,17 +84,17 @@ ZoneIdentificationRun RunZones(const Config& config, const ZoneLayout& layout, c
 ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayout& layout,
                                             const IdentificationRun& scalar,
                                             const std::vector<ModulusZone>& truth_zones) {
-  return RunZones(
-      config, layout, scalar, truth_zones, "the MCRE",
-      [&](const BarModel& model, const PrefilterOptions& prefilter) {
-        return IdentifyZoneModuli(
-            config.zone_identification, model, scalar.data, config.mcre, config.time.theta,
-            config.inner, scalar.ends, scalar.identified_modulus(), config.outer.lower_bound,
-            config.outer.upper_bound, scalar.estimated_noise, prefilter,
-            // W of the scalar run's stored fields (its streaming traces are the exported
-            // bar's, in another row order than the built-in bar's the zones solve).
-            scalar.solution.has_fields() ? &scalar.solution.retrograde : nullptr);
-      });
+  return RunZones(config, layout, scalar, truth_zones, "the MCRE",
+                  [&](const BarModel& model, const PrefilterOptions& prefilter) {
+                    ZoneIdentificationSummary summary = IdentifyZoneModuli(
+                        config.zone_identification, BarRunModel(model, scalar.data, scalar.ends),
+                        scalar.data, config.mcre, config.time.theta, config.inner,
+                        scalar.identified_modulus(), config.outer.lower_bound,
+                        config.outer.upper_bound, scalar.estimated_noise, prefilter,
+                        &scalar.solution.WarmStart());
+                    SetBarZoneExtents(model, &summary);
+                    return summary;
+                  });
 }
 
 ZoneIdentificationRun RunLeastSquaresZoneIdentification(

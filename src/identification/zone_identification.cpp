@@ -55,8 +55,11 @@ std::string ZoneIdentificationSummary::FullReport() const {
   out << "  evaluations:        " << evaluations << ", sweeps " << sweeps << "\n"
       << "  wall time:          " << wall_time_s << " s\n";
   for (Eigen::Index z = 0; z < moduli.size(); ++z) {
-    out << "  zone " << z << " [" << zone_start[z] << ", " << zone_end[z] << "] m: " << moduli[z]
-        << " Pa (" << moduli[z] / homogeneous_modulus << " E*)\n";
+    out << "  zone " << z;
+    if (static_cast<std::size_t>(z) < zone_start.size()) {
+      out << " [" << zone_start[z] << ", " << zone_end[z] << "] m";
+    }
+    out << ": " << moduli[z] << " Pa (" << moduli[z] / homogeneous_modulus << " E*)\n";
   }
   out << regularized.minimizer.FullReport();
   return out.str();
@@ -68,32 +71,8 @@ namespace {
 // levels, then pre-filtered as `prefilter` says.
 ChannelSet DrawNoiseAlone(const PrefilterOptions& prefilter, const NoiseLevels& noise,
                           StandardNormal* normal, ChannelSet* drawn) {
-  for (const char* name : {"u0", "uL"}) {
-    for (double& value : drawn->Values(name)) value = noise.displacement_std * (*normal)();
-  }
-  for (const char* name : {"f0", "fL"}) {
-    for (double& value : drawn->Values(name)) value = noise.force_std * (*normal)();
-  }
-  for (const BarSensor& sensor : BarSensors(*drawn)) {
-    const double level =
-        sensor.kind == SensorKind::kStrain ? noise.strain_std : noise.displacement_std;
-    for (double& value : drawn->channels[static_cast<std::size_t>(sensor.index)].values) {
-      value = level * (*normal)();
-    }
-  }
+  DrawWhiteNoise(noise, normal, drawn);
   return prefilter.enabled ? PrefilterMeasurements(*drawn, prefilter) : *drawn;
-}
-
-// The zone extents [m] of `model`'s zones, from the elements each holds.
-void ZoneExtents(const BarModel& model, ZoneIdentificationSummary* summary) {
-  const int zones = model.num_zones();
-  summary->zone_start.assign(zones, model.properties().length);
-  summary->zone_end.assign(zones, 0.0);
-  for (int e = 0; e < model.num_elements(); ++e) {
-    const int z = model.element_zone(e);
-    summary->zone_start[z] = std::min(summary->zone_start[z], model.node_position(e));
-    summary->zone_end[z] = std::max(summary->zone_end[z], model.node_position(e + 1));
-  }
 }
 
 // The steps both functionals share, on zone_objective (a function of p_z =
@@ -162,17 +141,29 @@ void MinimizeOverZones(const ZoneIdentificationOptions& options, int zones,
 
 }  // namespace
 
-double ExpectedNoiseCost(const BarModel& model, const ChannelSet& data, const McreOptions& mcre,
-                         double theta, const CoupledSolverOptions& inner,
-                         EndDisplacementChannels ends, const Vector& moduli,
-                         const NoiseLevels& noise, const PrefilterOptions& prefilter, int samples,
-                         std::uint64_t seed, double cost_scale) {
+void SetBarZoneExtents(const BarModel& model, ZoneIdentificationSummary* summary) {
+  const int zones = model.num_zones();
+  summary->zone_start.assign(zones, model.properties().length);
+  summary->zone_end.assign(zones, 0.0);
+  for (int e = 0; e < model.num_elements(); ++e) {
+    const int z = model.element_zone(e);
+    summary->zone_start[z] = std::min(summary->zone_start[z], model.node_position(e));
+    summary->zone_end[z] = std::max(summary->zone_end[z], model.node_position(e + 1));
+  }
+}
+
+double ExpectedNoiseCost(const MatrixModelData& model, const ChannelSet& data,
+                         const McreOptions& mcre, double theta, const CoupledSolverOptions& inner,
+                         const Vector& moduli, const NoiseLevels& noise,
+                         const PrefilterOptions& prefilter, int samples, std::uint64_t seed,
+                         double cost_scale) {
   StandardNormal normal(seed);
   ChannelSet drawn = data;
   double sum = 0.0;
   for (int sample = 0; sample < samples; ++sample) {
     const ChannelSet noise_data = DrawNoiseAlone(prefilter, noise, &normal, &drawn);
-    McreObjective objective(model, noise_data, mcre, theta, inner, moduli[0], ends);
+    McreObjective objective = MatrixMcreObjective(model, noise_data, mcre, theta, inner,
+                                                  Factorization::kAutomatic, moduli[0]);
     const ObjectiveEvaluation& record = objective.EvaluateModuli(moduli, false);
     if (!record.usable) return -1.0;
     sum += record.cost;
@@ -199,19 +190,17 @@ double ExpectedLeastSquaresNoiseCost(const BarModel& model, const ChannelSet& da
 namespace {
 
 // The frame both functionals' identifications share: the summary's start (functional,
-// E*, noise levels, zone extents), then `identify` (the objective, the cost scale and
+// E*, noise levels), then `identify` (the objective, the cost scale and
 // MinimizeOverZones into the summary), its exception a failure of the summary, and the
 // wall time.
 template <typename Identify>
-ZoneIdentificationSummary IdentifyZones(const BarModel& model, double homogeneous_modulus,
-                                        const NoiseLevels& noise, bool least_squares,
-                                        Identify&& identify) {
+ZoneIdentificationSummary IdentifyZones(double homogeneous_modulus, const NoiseLevels& noise,
+                                        bool least_squares, Identify&& identify) {
   const auto start = std::chrono::steady_clock::now();
   ZoneIdentificationSummary summary;
   summary.least_squares = least_squares;
   summary.homogeneous_modulus = homogeneous_modulus;
   summary.noise = noise;
-  ZoneExtents(model, &summary);
   try {
     identify(&summary);
   } catch (const std::exception& error) {
@@ -228,38 +217,35 @@ ZoneIdentificationSummary IdentifyZones(const BarModel& model, double homogeneou
 }  // namespace
 
 ZoneIdentificationSummary IdentifyZoneModuli(
-    const ZoneIdentificationOptions& options, const BarModel& model, const ChannelSet& data,
+    const ZoneIdentificationOptions& options, const MatrixModelData& model, const ChannelSet& data,
     const McreOptions& mcre, double theta, const CoupledSolverOptions& inner,
-    EndDisplacementChannels ends, double homogeneous_modulus, double lower_bound,
-    double upper_bound, const NoiseLevels& noise, const PrefilterOptions& prefilter,
-    const Matrix* warm_start) {
-  const int zones = model.num_zones();
-  return IdentifyZones(
-      model, homogeneous_modulus, noise, false, [&](ZoneIdentificationSummary* summary) {
-        McreObjective objective(model, data, mcre, theta, inner, homogeneous_modulus, ends);
-        const StreamingCoupledProblem& problem = objective.problem();
-        if (warm_start != nullptr && warm_start->cols() == problem.num_steps() + 1 &&
-            (warm_start->rows() == problem.num_nodes() ||
-             warm_start->rows() == problem.num_traces())) {
-          objective.SetWarmStart(*warm_start);
-        }
-        summary->cost_scale = objective.cost_scale();
-        ZoneMcreObjective zone_objective(&objective, homogeneous_modulus);
-        MinimizeOverZones(
-            options, zones, &zone_objective, lower_bound, upper_bound,
-            [&] {
-              return ExpectedNoiseCost(model, data, mcre, theta, inner, ends,
-                                       Vector::Constant(zones, homogeneous_modulus), noise,
-                                       prefilter, options.noise_samples, options.noise_seed,
-                                       summary->cost_scale);
-            },
-            summary);
-        if (!objective.evaluations().empty() && objective.evaluations().front().usable) {
-          summary->homogeneous_cost = objective.evaluations().front().cost;
-        }
-        summary->evaluations = zone_objective.evaluations();
-        summary->sweeps = objective.sweeps();
-      });
+    double homogeneous_modulus, double lower_bound, double upper_bound, const NoiseLevels& noise,
+    const PrefilterOptions& prefilter, const Matrix* warm_start) {
+  const int zones = static_cast<int>(model.zones.size());
+  return IdentifyZones(homogeneous_modulus, noise, false, [&](ZoneIdentificationSummary* summary) {
+    McreObjective objective = MatrixMcreObjective(model, data, mcre, theta, inner,
+                                                  Factorization::kAutomatic, homogeneous_modulus);
+    const StreamingCoupledProblem& problem = objective.problem();
+    if (warm_start != nullptr && warm_start->cols() == problem.num_steps() + 1 &&
+        (warm_start->rows() == problem.num_nodes() || warm_start->rows() == problem.num_traces())) {
+      objective.SetWarmStart(*warm_start);
+    }
+    summary->cost_scale = objective.cost_scale();
+    ZoneMcreObjective zone_objective(&objective, homogeneous_modulus);
+    MinimizeOverZones(
+        options, zones, &zone_objective, lower_bound, upper_bound,
+        [&] {
+          return ExpectedNoiseCost(model, data, mcre, theta, inner,
+                                   Vector::Constant(zones, homogeneous_modulus), noise, prefilter,
+                                   options.noise_samples, options.noise_seed, summary->cost_scale);
+        },
+        summary);
+    if (!objective.evaluations().empty() && objective.evaluations().front().usable) {
+      summary->homogeneous_cost = objective.evaluations().front().cost;
+    }
+    summary->evaluations = zone_objective.evaluations();
+    summary->sweeps = objective.sweeps();
+  });
 }
 
 ZoneIdentificationSummary IdentifyZoneModuliByLeastSquares(
@@ -268,8 +254,8 @@ ZoneIdentificationSummary IdentifyZoneModuliByLeastSquares(
     double homogeneous_modulus, double lower_bound, double upper_bound, const NoiseLevels& noise,
     const PrefilterOptions& prefilter) {
   const int zones = model.num_zones();
-  return IdentifyZones(
-      model, homogeneous_modulus, noise, true, [&](ZoneIdentificationSummary* summary) {
+  ZoneIdentificationSummary result =
+      IdentifyZones(homogeneous_modulus, noise, true, [&](ZoneIdentificationSummary* summary) {
         ZoneOutputErrorObjective objective(model, data, misfit_levels, theta, homogeneous_modulus,
                                            ends);
         summary->cost_scale = objective.cost_scale();
@@ -287,6 +273,8 @@ ZoneIdentificationSummary IdentifyZoneModuliByLeastSquares(
         summary->evaluations = objective.evaluations();
         summary->sweeps = objective.sweeps();
       });
+  SetBarZoneExtents(model, &result);
+  return result;
 }
 
 }  // namespace mcrewave

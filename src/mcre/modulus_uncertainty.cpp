@@ -37,6 +37,25 @@ double DifferenceNoiseStd(const Vector& channel) {
   return 1.4826 * Median(second_differences) / std::sqrt(6.0);
 }
 
+double NoiseLevel(const NoiseLevels& noise, ChannelKind kind) {
+  switch (kind) {
+    case ChannelKind::kStrain:
+      return noise.strain_std;
+    case ChannelKind::kForce:
+      return noise.force_std;
+    case ChannelKind::kDisplacement:
+      break;
+  }
+  return noise.displacement_std;
+}
+
+void DrawWhiteNoise(const NoiseLevels& noise, StandardNormal* normal, ChannelSet* set) {
+  for (Channel& channel : set->channels) {
+    const double level = NoiseLevel(noise, channel.kind);
+    for (double& value : channel.values) value = level * (*normal)();
+  }
+}
+
 NoiseLevels DifferenceNoiseLevels(const ChannelSet& data) {
   const BarEnds ends = BarEndChannels(data);
   const std::vector<BarSensor> sensors = BarSensors(data);

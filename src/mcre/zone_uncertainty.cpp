@@ -12,18 +12,6 @@
 namespace mcrewave {
 namespace {
 
-// The noise level of a channel's kind.
-double KindLevel(const NoiseLevels& noise, ChannelKind kind) {
-  switch (kind) {
-    case ChannelKind::kStrain:
-      return noise.strain_std;
-    case ChannelKind::kForce:
-      return noise.force_std;
-    default:
-      return noise.displacement_std;
-  }
-}
-
 // The coupled solve at `moduli` (warm start nullable); false with *why when not usable.
 bool SolveUsable(const CoupledSolverOptions& inner, const Vector& moduli,
                  MatrixMcreProblem* problem, const Matrix* warm_start, CoupledSolution* solution,
@@ -115,12 +103,10 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
   CoupledSolution noise_solution;
   Vector plus_gradient, minus_gradient;
   for (int sample = 0; sample < options.samples; ++sample) {
+    DrawWhiteNoise(noise, &normal, &noise_data);
     for (std::size_t c = 0; c < data.channels.size(); ++c) {
-      const double level = KindLevel(noise, data.channels[c].kind);
-      Vector& values = noise_data.channels[c].values;
-      for (double& value : values) value = level * normal();
-      plus_data.channels[c].values = data.channels[c].values + values;
-      minus_data.channels[c].values = data.channels[c].values - values;
+      plus_data.channels[c].values = data.channels[c].values + noise_data.channels[c].values;
+      minus_data.channels[c].values = data.channels[c].values - noise_data.channels[c].values;
     }
     MatrixMcreProblem noise_problem = make_problem(noise_data);
     if (!SolveUsable(inner, moduli, &noise_problem, nullptr, &noise_solution, &result.sweeps,

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -778,6 +779,19 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
   ReadSupports(manifest_path, root, folder, mass_file, &channels, &data);
   ReadElements(manifest_path, root, folder, mass_file, &data);
   return data;
+}
+
+MatrixModelData BarRunModel(const BarModel& model, const ChannelSet& data,
+                            EndDisplacementChannels ends) {
+  MatrixModelData matrices =
+      BarMatrixModel(model, model.properties().modulus, BarSensors(data), BarClampExport::kSupport);
+  if (!ends.uL) {
+    matrices.sensors.erase(
+        std::find_if(matrices.sensors.begin(), matrices.sensors.end(),
+                     [](const MatrixModelSensor& sensor) { return sensor.channel == "uL"; }));
+  }
+  if (!ends.u0) matrices.supports.front().displacement_channel.clear();
+  return matrices;
 }
 
 }  // namespace mcrewave

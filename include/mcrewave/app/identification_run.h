@@ -120,13 +120,6 @@ struct IdentificationRun {
   double cost() const { return best_index >= 0 ? evaluations[best_index].cost : -1.0; }
 };
 
-// The run's bar as a structure given by matrices (model/matrix_export.h), which every
-// MCRE solve of a bar's run takes: BarMatrixModel of `model` at its modulus with the
-// clamp the support "clamp" at node 0 (its channels f0 and u0), the sensors uL and those
-// of `data` (BarSensors); without uL (u0) when ends.uL (ends.u0) is false.
-MatrixModelData BarRunModel(const BarModel& model, const ChannelSet& data,
-                            EndDisplacementChannels ends);
-
 // Step 3 on mcre:'s e^2.
 struct McreIdentification {
   std::unique_ptr<McreObjective> objective;  // mcre:'s e^2, with every evaluation of it

@@ -55,8 +55,9 @@ struct ZoneIdentificationSummary {
   bool least_squares = false;           // the cost is least squares' J [s], not e^2 [J s]
   double homogeneous_modulus = -1.0;    // E*, the start and the scale [Pa]
   Vector moduli;                        // E_z [Pa], one per zone (empty: none usable)
-  std::vector<double> zone_start;       // [m], per zone: the first element's left node
-  std::vector<double> zone_end;         // [m], per zone: the last element's right node
+  std::vector<double> zone_start;       // [m], per zone of a bar: the first element's left
+                                        // node (SetBarZoneExtents; empty: not a bar's)
+  std::vector<double> zone_end;         // [m], per zone of a bar: the last element's right node
   double cost = -1.0;                   // e^2 at moduli [J s] (least squares: J [s])
   double homogeneous_cost = -1.0;       // e^2 at E* in every zone [J s] (J [s])
   double cost_scale = -1.0;             // J_rest [J s] (least squares: [s])
@@ -77,15 +78,15 @@ struct ZoneIdentificationSummary {
   std::string FullReport() const;
 };
 
-// Mean over `samples` draws of e^2(noise alone) / cost_scale at the zone moduli,
-// the noise white at `noise`'s levels on every channel the data have, then pre-filtered
-// as `prefilter` says (enabled with its cutoff; disabled: as drawn). -1 when a solve is
-// not usable.
-double ExpectedNoiseCost(const BarModel& model, const ChannelSet& data, const McreOptions& mcre,
-                         double theta, const CoupledSolverOptions& inner,
-                         EndDisplacementChannels ends, const Vector& moduli,
-                         const NoiseLevels& noise, const PrefilterOptions& prefilter, int samples,
-                         std::uint64_t seed, double cost_scale);
+// Mean over `samples` draws of e^2(noise alone) / cost_scale at the zone moduli of
+// `model`, the noise white at `noise`'s levels on every channel the data have
+// (DrawWhiteNoise), then pre-filtered as `prefilter` says (enabled with its cutoff;
+// disabled: as drawn). -1 when a solve is not usable.
+double ExpectedNoiseCost(const MatrixModelData& model, const ChannelSet& data,
+                         const McreOptions& mcre, double theta, const CoupledSolverOptions& inner,
+                         const Vector& moduli, const NoiseLevels& noise,
+                         const PrefilterOptions& prefilter, int samples, std::uint64_t seed,
+                         double cost_scale);
 
 // ExpectedNoiseCost for the output-error misfit (ZoneOutputErrorObjective with the
 // normalisation misfit_levels): the mean over `samples` draws of J(noise alone) /
@@ -98,20 +99,24 @@ double ExpectedLeastSquaresNoiseCost(const BarModel& model, const ChannelSet& da
                                      const NoiseLevels& noise, const PrefilterOptions& prefilter,
                                      int samples, std::uint64_t seed, double cost_scale);
 
-// Identifies the zone moduli of `model` (its zones) from `data` (as the objective sees
-// them: pre-filtered when the pre-filter is on), from the homogeneous E* within
-// [lower_bound, upper_bound] on every zone. noise: the estimated noise levels of the
-// measurements (for the discrepancy target); prefilter: the pre-filter the data went
-// through, its cutoff_frequency the one used. warm_start: the scalar identification's
-// solution at E* (CoupledSolution::WarmStart(), nullable). Never throws for a failed
-// identification.
+// Identifies the zone moduli of `model` (its zones; the bar's: BarRunModel of the zoned
+// bar) from `data` (as the objective sees them: pre-filtered when the pre-filter is on),
+// from the homogeneous E* within [lower_bound, upper_bound] on every zone. noise: the
+// estimated noise levels of the measurements (for the discrepancy target); prefilter:
+// the pre-filter the data went through, its cutoff_frequency the one used. warm_start:
+// the scalar identification's solution at E* (CoupledSolution::WarmStart() of the same
+// model's problem, nullable). The summary's zone extents are left empty (the bar's:
+// SetBarZoneExtents). Never throws for a failed identification.
 // Preconditions: options valid, 0 < lower_bound < E* < upper_bound.
 ZoneIdentificationSummary IdentifyZoneModuli(
-    const ZoneIdentificationOptions& options, const BarModel& model, const ChannelSet& data,
+    const ZoneIdentificationOptions& options, const MatrixModelData& model, const ChannelSet& data,
     const McreOptions& mcre, double theta, const CoupledSolverOptions& inner,
-    EndDisplacementChannels ends, double homogeneous_modulus, double lower_bound,
-    double upper_bound, const NoiseLevels& noise, const PrefilterOptions& prefilter,
-    const Matrix* warm_start = nullptr);
+    double homogeneous_modulus, double lower_bound, double upper_bound, const NoiseLevels& noise,
+    const PrefilterOptions& prefilter, const Matrix* warm_start = nullptr);
+
+// The extents [m] of the bar's zones (summary->zone_start, zone_end): each zone's first
+// element's left node and last element's right node.
+void SetBarZoneExtents(const BarModel& model, ZoneIdentificationSummary* summary);
 
 // The same identification on the output-error misfit J of least squares
 // (ZoneOutputErrorObjective, normalised by misfit_levels: > 0 for every kind the data

@@ -52,6 +52,7 @@
 #include "mcrewave/mcre/coupled_problem.h"
 #include "mcrewave/mcre/streaming_coupled_problem.h"
 #include "mcrewave/model/bar_model.h"
+#include "mcrewave/model/matrix_export.h"
 
 namespace mcrewave {
 
@@ -84,13 +85,6 @@ struct McreWeights {
   // (docs/trusted_clamp.md section 9).
   double clamp_displacement_weight = 0.1;
   bool IsValid(std::string* error) const;
-};
-
-// Which end displacement channels enter the data term (config data.channels); the
-// interior sensors are those of the data set.
-struct EndDisplacementChannels {
-  bool u0 = true;
-  bool uL = true;
 };
 
 class McreProblem : public StreamingCoupledProblem {

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "mcrewave/core/random.h"
 #include "mcrewave/data/measurement.h"
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/objective.h"
@@ -41,6 +42,12 @@ struct NoiseLevels {
   double force_std = 0.0;         // [N]
   double strain_std = 0.0;        // [-], every strain channel (e@X); 0 without any
 };
+
+// The level of a channel of `kind`: displacement_std, strain_std or force_std.
+double NoiseLevel(const NoiseLevels& noise, ChannelKind kind);
+// Replaces the values of every channel of *set, in the set's order, by white noise at
+// its kind's level: level x (*normal)() sample by sample.
+void DrawWhiteNoise(const NoiseLevels& noise, StandardNormal* normal, ChannelSet* set);
 
 // Noise levels estimated from the data alone, channel by channel, from second
 // differences d2_j = x_{j+1} - 2 x_j + x_{j-1}: for white noise of std s they have

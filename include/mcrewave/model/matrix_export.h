@@ -133,6 +133,20 @@ MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
                                const std::vector<BarSensor>& sensors = {},
                                BarClampExport clamp = BarClampExport::kLoadAndSensor);
 
+// Which end displacement channels enter the data term (config data.channels); the
+// interior sensors are those of the data set.
+struct EndDisplacementChannels {
+  bool u0 = true;
+  bool uL = true;
+};
+
+// The bar of an identification as the structure every MCRE solve of a bar's run takes:
+// BarMatrixModel of `model` (its zones) at its modulus, with the clamp the support
+// "clamp" at node 0 (its channels f0 and u0), the sensors uL and those of `data`
+// (BarSensors); without uL (u0) when ends.uL (ends.u0) is false.
+MatrixModelData BarRunModel(const BarModel& model, const ChannelSet& data,
+                            EndDisplacementChannels ends);
+
 // How WriteMatrixModel writes the loads and sensors.
 enum class MatrixModelLayout {
   kFilePerChannel,  // load_<channel>.mtx and sensor_<channel>.mtx (keys loads, sensors)
