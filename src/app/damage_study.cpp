@@ -16,7 +16,8 @@
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/app/zone_identification_run.h"
 #include "mcrewave/core/file_util.h"
-#include "mcrewave/least_squares/zone_output_error_objective.h"
+#include "mcrewave/least_squares/matrix_output_error_objective.h"
+#include "mcrewave/mcre/element_error_map.h"
 #include "mcrewave/mcre/error_map.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/mcre/objective.h"
@@ -99,8 +100,9 @@ void FitLeastSquaresZones(const Config& config, const ChannelSet& measured,
       LeastSquaresMisfitLevels(config, measured, scalar.data, &source);
   PrefilterOptions prefilter = config.prefilter;
   prefilter.cutoff_frequency = scalar.prefilter_cutoff;
+  const MatrixModelData zoned_matrices = BarRunModel(zoned, scalar.data, scalar.ends);
   const ZoneIdentificationSummary summary = IdentifyZoneModuliByLeastSquares(
-      config.zone_identification, zoned, scalar.data, misfit_levels, config.time.theta, scalar.ends,
+      config.zone_identification, zoned_matrices, scalar.data, misfit_levels, config.time.theta,
       scalar.identified_modulus(), config.outer.lower_bound, config.outer.upper_bound,
       scalar.estimated_noise, prefilter);
   fit->evaluations = summary.evaluations;
@@ -111,8 +113,9 @@ void FitLeastSquaresZones(const Config& config, const ChannelSet& measured,
     return;
   }
   fit->moduli.assign(summary.moduli.data(), summary.moduli.data() + summary.moduli.size());
-  ZoneOutputErrorObjective reference(zoned, scalar.data, misfit_levels, config.time.theta,
-                                     scalar.identified_modulus(), scalar.ends);
+  MatrixOutputErrorObjective reference(zoned_matrices, scalar.data, misfit_levels,
+                                       config.time.theta, Factorization::kAutomatic,
+                                       scalar.identified_modulus());
   const Vector truth = Eigen::Map<const Vector>(truth_moduli.data(), truth_moduli.size());
   fit->reference_cost_ratio = reference.Cost(truth, nullptr) / summary.cost;
   fit->weakest_zone = static_cast<int>(std::min_element(fit->moduli.begin(), fit->moduli.end()) -
@@ -151,12 +154,13 @@ void RunOne(const Config& config, const DamageCase& damage, DamageRun* run) {
     return;
   }
   run->homogeneous_modulus = scalar.identified_modulus();
-  // The error map at E* (error_map.h).
+  // The error map at E* (mcre/element_error_map.h), on the exported bar's elements,
+  // which are the bar's.
   const BarModel uniform(run_config.model);
   const Vector shares =
       scalar.solution.has_fields()
-          ? ElementGapShares(uniform, Vector::Constant(1, run->homogeneous_modulus),
-                             scalar.solution.retrograde, run_config.time.step)
+          ? MatrixElementGapShares(*scalar.model, Vector::Constant(1, run->homogeneous_modulus),
+                                   scalar.solution.retrograde, run_config.time.step)
           : scalar.solution.element_error_map;  // a streaming solve's, per element
   Eigen::Index peak = 0;
   shares.maxCoeff(&peak);
@@ -191,8 +195,10 @@ void RunOne(const Config& config, const DamageCase& damage, DamageRun* run) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!damage.per_element) {
     // e^2 at the truth's zone moduli in series, on the data and zones of the run.
-    McreObjective reference(zoned, scalar.data, run_config.mcre, run_config.time.theta,
-                            run_config.inner, run->homogeneous_modulus, scalar.ends);
+    const MatrixModelData zoned_matrices = BarRunModel(zoned, scalar.data, scalar.ends);
+    McreObjective reference =
+        MatrixMcreObjective(zoned_matrices, scalar.data, run_config.mcre, run_config.time.theta,
+                            run_config.inner, Factorization::kAutomatic, run->homogeneous_modulus);
     const ObjectiveEvaluation& record = reference.EvaluateModuli(
         Eigen::Map<const Vector>(run->truth_moduli.data(), run->truth_moduli.size()), false);
     if (record.usable) run->reference_cost_ratio = record.cost / summary.cost;

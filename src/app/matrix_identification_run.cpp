@@ -183,16 +183,13 @@ double RootMeanSquareOfRows(const Matrix& rows) {
 }
 
 // Records every evaluation of a zone objective (ZoneMcreObjective,
-// MatrixOutputErrorObjective) and logs a progress line naming its cost; with
-// failures_only, only the failed ones (ZoneMcreObjective logs its usable evaluations).
+// MatrixOutputErrorObjective, which log their usable evaluations) and logs a line for
+// each failed one, naming its cost and why.
 class RecordingObjective : public FirstOrderObjective {
  public:
   RecordingObjective(LogModuliObjective* objective, std::vector<MatrixEvaluation>* records,
-                     const char* cost_name, bool failures_only = false)
-      : objective_(objective),
-        records_(records),
-        cost_name_(cost_name),
-        failures_only_(failures_only) {}
+                     const char* cost_name)
+      : objective_(objective), records_(records), cost_name_(cost_name) {}
   int num_parameters() const override { return objective_->num_parameters(); }
   bool Evaluate(const double* p, double* cost, double* gradient) override {
     MatrixEvaluation record;
@@ -203,15 +200,14 @@ class RecordingObjective : public FirstOrderObjective {
       record.gradient_norm = Eigen::Map<const Vector>(gradient, num_parameters()).norm();
     }
     records_->push_back(record);
-    if (record.usable && failures_only_) return true;
+    if (record.usable) return true;
     std::string moduli;
     for (int z = 0; z < record.moduli.size(); ++z) {
       moduli += (z == 0 ? "" : ", ") + fmt::format("{:.6g}", record.moduli[z] * 1e-9);
     }
-    spdlog::info("evaluation {}: E = [{}] GPa, {} / J_rest = {:.9e}{}", records_->size(), moduli,
-                 cost_name_, record.cost,
-                 record.usable ? "" : " (" + objective_->error_message() + ")");
-    return record.usable;
+    spdlog::info("evaluation {}: E = [{}] GPa, {} not usable ({})", records_->size(), moduli,
+                 cost_name_, objective_->error_message());
+    return false;
   }
   std::string error_message() const override { return objective_->error_message(); }
 
@@ -219,7 +215,6 @@ class RecordingObjective : public FirstOrderObjective {
   LogModuliObjective* objective_;
   std::vector<MatrixEvaluation>* records_;
   const char* cost_name_;
-  bool failures_only_;
 };
 
 // e^2 and the zone and dof maps of a usable coupled solution at the problem's moduli:
@@ -696,7 +691,7 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
   run.nominal_moduli = problem.NominalModuli();
   run.rest_cost = mcre_objective.rest_cost();
   ZoneMcreObjective objective(&mcre_objective, run.nominal_moduli);
-  RecordingObjective recorder(&objective, &run.evaluations, "e^2", true);
+  RecordingObjective recorder(&objective, &run.evaluations, "e^2");
   const auto zones = static_cast<std::size_t>(model.zones.size());
   std::vector<double> lower, upper;
   ZoneParameterBounds(config, run.nominal_moduli, &lower, &upper);

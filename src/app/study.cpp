@@ -29,6 +29,7 @@
 #include "mcrewave/core/format.h"
 #include "mcrewave/data/noise.h"
 #include "mcrewave/data/prefilter.h"
+#include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/mcre/objective.h"
 #include "mcrewave/model/simulation.h"
 
@@ -742,7 +743,7 @@ namespace {
 // factor, read from the summary of an adaptive solve stopped after its first
 // iteration (the estimate precedes the iteration).
 std::pair<double, double> EstimateSpectrum(const CoupledSolverOptions& inner,
-                                           McreProblem* problem) {
+                                           StreamingCoupledProblem* problem) {
   CoupledSolverOptions options = inner;
   options.type = CoupledSolverType::kAdaptiveRelaxation;
   options.spectrum_safety_factor = 1.0;
@@ -773,9 +774,10 @@ void RunRelaxationCase(const Config& config, const BarModel& model, const Channe
   RelaxationCase& relaxation_case = *case_out;
   const ChannelSet data = PrefilterMeasurements(
       NoisyMeasurements(truth, relaxation_case.snr, config.data.seed), config.prefilter);
-  McreProblem problem(model, data, config.mcre.weights, config.mcre.reference_modulus,
-                      config.time.theta, {}, config.mcre.clamp);
-  problem.SetModulus(relaxation_case.modulus);
+  const MatrixModelData matrices = BarRunModel(model, data, EndDisplacementChannels());
+  MatrixMcreProblem problem(matrices, data, config.mcre.weights, config.mcre.reference_modulus,
+                            config.time.theta, Factorization::kAutomatic, config.mcre.clamp);
+  problem.SetModuli(Vector::Constant(1, relaxation_case.modulus));
   const auto [a_min, a_max] = EstimateSpectrum(config.inner, &problem);
   relaxation_case.spectrum_min = a_min;
   relaxation_case.spectrum_max = a_max;
@@ -1141,8 +1143,11 @@ CostCurveStudy RunCostCurveStudy(const Config& config) {
         }
         // e^2 on the grid, on the pre-filtered data the identification saw,
         // warm-started point to point.
-        McreObjective objective(model, identification.data, config.mcre, config.time.theta,
-                                config.inner, study.reference_modulus, identification.ends);
+        const MatrixModelData matrices =
+            BarRunModel(model, identification.data, identification.ends);
+        McreObjective objective =
+            MatrixMcreObjective(matrices, identification.data, config.mcre, config.time.theta,
+                                config.inner, Factorization::kAutomatic, study.reference_modulus);
         for (int k = 0; k < options.cost_curves.points; ++k) {
           const double factor =
               options.cost_curves.low + (options.cost_curves.high - options.cost_curves.low) * k /

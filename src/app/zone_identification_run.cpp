@@ -102,11 +102,13 @@ ZoneIdentificationRun RunLeastSquaresZoneIdentification(
     const std::vector<ModulusZone>& truth_zones) {
   return RunZones(config, layout, scalar, truth_zones, "output-error least squares",
                   [&](const BarModel& model, const PrefilterOptions& prefilter) {
-                    return IdentifyZoneModuliByLeastSquares(
-                        config.zone_identification, model, scalar.data, scalar.noise,
-                        config.time.theta, scalar.ends, scalar.identified_modulus(),
+                    ZoneIdentificationSummary summary = IdentifyZoneModuliByLeastSquares(
+                        config.zone_identification, BarRunModel(model, scalar.data, scalar.ends),
+                        scalar.data, scalar.noise, config.time.theta, scalar.identified_modulus(),
                         config.outer.lower_bound, config.outer.upper_bound, scalar.estimated_noise,
                         prefilter);
+                    SetBarZoneExtents(model, &summary);
+                    return summary;
                   });
 }
 

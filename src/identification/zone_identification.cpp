@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "mcrewave/core/random.h"
-#include "mcrewave/least_squares/zone_output_error_objective.h"
+#include "mcrewave/least_squares/matrix_output_error_objective.h"
 
 namespace mcrewave {
 
@@ -171,17 +171,18 @@ double ExpectedNoiseCost(const MatrixModelData& model, const ChannelSet& data,
   return sum / samples / cost_scale;
 }
 
-double ExpectedLeastSquaresNoiseCost(const BarModel& model, const ChannelSet& data,
+double ExpectedLeastSquaresNoiseCost(const MatrixModelData& model, const ChannelSet& data,
                                      const NoiseLevels& misfit_levels, double theta,
-                                     EndDisplacementChannels ends, const Vector& moduli,
-                                     const NoiseLevels& noise, const PrefilterOptions& prefilter,
-                                     int samples, std::uint64_t seed, double cost_scale) {
+                                     const Vector& moduli, const NoiseLevels& noise,
+                                     const PrefilterOptions& prefilter, int samples,
+                                     std::uint64_t seed, double cost_scale) {
   StandardNormal normal(seed);
   ChannelSet drawn = data;
   double sum = 0.0;
   for (int sample = 0; sample < samples; ++sample) {
     const ChannelSet noise_data = DrawNoiseAlone(prefilter, noise, &normal, &drawn);
-    ZoneOutputErrorObjective objective(model, noise_data, misfit_levels, theta, moduli[0], ends);
+    MatrixOutputErrorObjective objective(model, noise_data, misfit_levels, theta,
+                                         Factorization::kAutomatic, moduli[0]);
     sum += objective.Cost(moduli, nullptr);
   }
   return std::isfinite(sum) ? sum / samples / cost_scale : -1.0;
@@ -249,32 +250,27 @@ ZoneIdentificationSummary IdentifyZoneModuli(
 }
 
 ZoneIdentificationSummary IdentifyZoneModuliByLeastSquares(
-    const ZoneIdentificationOptions& options, const BarModel& model, const ChannelSet& data,
-    const NoiseLevels& misfit_levels, double theta, EndDisplacementChannels ends,
-    double homogeneous_modulus, double lower_bound, double upper_bound, const NoiseLevels& noise,
-    const PrefilterOptions& prefilter) {
-  const int zones = model.num_zones();
-  ZoneIdentificationSummary result =
-      IdentifyZones(homogeneous_modulus, noise, true, [&](ZoneIdentificationSummary* summary) {
-        ZoneOutputErrorObjective objective(model, data, misfit_levels, theta, homogeneous_modulus,
-                                           ends);
-        summary->cost_scale = objective.cost_scale();
-        summary->homogeneous_cost =
-            objective.Cost(Vector::Constant(zones, homogeneous_modulus), nullptr);
-        MinimizeOverZones(
-            options, zones, &objective, lower_bound, upper_bound,
-            [&] {
-              return ExpectedLeastSquaresNoiseCost(model, data, misfit_levels, theta, ends,
-                                                   Vector::Constant(zones, homogeneous_modulus),
-                                                   noise, prefilter, options.noise_samples,
-                                                   options.noise_seed, summary->cost_scale);
-            },
-            summary);
-        summary->evaluations = objective.evaluations();
-        summary->sweeps = objective.sweeps();
-      });
-  SetBarZoneExtents(model, &result);
-  return result;
+    const ZoneIdentificationOptions& options, const MatrixModelData& model, const ChannelSet& data,
+    const NoiseLevels& misfit_levels, double theta, double homogeneous_modulus, double lower_bound,
+    double upper_bound, const NoiseLevels& noise, const PrefilterOptions& prefilter) {
+  const int zones = static_cast<int>(model.zones.size());
+  return IdentifyZones(homogeneous_modulus, noise, true, [&](ZoneIdentificationSummary* summary) {
+    MatrixOutputErrorObjective objective(model, data, misfit_levels, theta,
+                                         Factorization::kAutomatic, homogeneous_modulus);
+    summary->cost_scale = objective.cost_scale();
+    summary->homogeneous_cost =
+        objective.Cost(Vector::Constant(zones, homogeneous_modulus), nullptr);
+    MinimizeOverZones(
+        options, zones, &objective, lower_bound, upper_bound,
+        [&] {
+          return ExpectedLeastSquaresNoiseCost(
+              model, data, misfit_levels, theta, Vector::Constant(zones, homogeneous_modulus),
+              noise, prefilter, options.noise_samples, options.noise_seed, summary->cost_scale);
+        },
+        summary);
+    summary->evaluations = objective.evaluations();
+    summary->sweeps = objective.sweeps();
+  });
 }
 
 }  // namespace mcrewave

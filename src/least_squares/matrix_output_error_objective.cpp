@@ -1,5 +1,7 @@
 #include "mcrewave/least_squares/matrix_output_error_objective.h"
 
+#include <spdlog/spdlog.h>
+
 #include <Eigen/SparseCholesky>
 #include <cassert>
 #include <cmath>
@@ -12,8 +14,12 @@ namespace mcrewave {
 MatrixOutputErrorObjective::MatrixOutputErrorObjective(const MatrixModelData& model,
                                                        const ChannelSet& data,
                                                        const NoiseLevels& misfit_levels,
-                                                       double theta, Factorization factorization)
-    : LogModuliObjective(model.NominalModuli()),
+                                                       double theta, Factorization factorization,
+                                                       double modulus_scale)
+    : LogModuliObjective(
+          modulus_scale > 0.0
+              ? Vector::Constant(static_cast<Eigen::Index>(model.zones.size()), modulus_scale)
+              : model.NominalModuli()),
       model_(model),
       time_step_(data.time_step),
       theta_(theta),
@@ -243,6 +249,14 @@ bool MatrixOutputErrorObjective::ModuliCost(const Vector& moduli, double* cost, 
   (void)why;  // the misfit is always had; Evaluate tests that it is finite
   *cost = Cost(moduli, gradient);
   return true;
+}
+
+void MatrixOutputErrorObjective::OnEvaluated(const Vector& moduli, double cost,
+                                             double gradient_norm) {
+  spdlog::info(
+      "least-squares evaluation {}: J / J_rest = {:.10g}, |grad|_inf = {:.3g}, E in "
+      "[{:.6g}, {:.6g}] GPa",
+      evaluations(), cost, gradient_norm, moduli.minCoeff() * 1e-9, moduli.maxCoeff() * 1e-9);
 }
 
 }  // namespace mcrewave

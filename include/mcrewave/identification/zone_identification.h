@@ -1,9 +1,10 @@
 // Identification of every zone modulus at once (docs/zones_and_sensors.md,
-// "Identification of zone moduli"), by the MCRE (IdentifyZoneModuli) or, as its
-// comparator, by output-error least squares (IdentifyZoneModuliByLeastSquares: the same
-// steps on J). K = sum_z E_z K1_z, and every zone's gradient comes from the one coupled
+// "Identification of zone moduli") of a structure given by matrices (the bar's:
+// BarRunModel), by the MCRE (IdentifyZoneModuli) or, as its comparator, by output-error
+// least squares (IdentifyZoneModuliByLeastSquares: the same steps on J).
+// K = sum_z (E_z / E_z,nom) K_z, and every zone's gradient comes from the one coupled
 // solve, de^2/dE_z = -(1/(2 E_z)) sum_j c_j h W_j^T K_z (W_j + 2 U_j)
-// (McreProblem::CostGradients).
+// (MatrixMcreProblem::CostGradients).
 //
 // Started from the homogeneous E* of the scalar identification, on p_z = log(E_z / E*)
 // with d cost / d p_z = (d cost / d E_z) E_z, the cost the scaled e^2 / J_rest (least
@@ -88,16 +89,16 @@ double ExpectedNoiseCost(const MatrixModelData& model, const ChannelSet& data,
                          const PrefilterOptions& prefilter, int samples, std::uint64_t seed,
                          double cost_scale);
 
-// ExpectedNoiseCost for the output-error misfit (ZoneOutputErrorObjective with the
+// ExpectedNoiseCost for the output-error misfit (MatrixOutputErrorObjective with the
 // normalisation misfit_levels): the mean over `samples` draws of J(noise alone) /
-// cost_scale at the zone moduli, the model driven by the load's noise and compared
-// with the other channels' (white at `noise`'s levels, then pre-filtered as
+// cost_scale at the zone moduli of `model`, the model driven by the loads' noise and
+// compared with the other channels' (white at `noise`'s levels, then pre-filtered as
 // `prefilter` says). -1 when J is not finite.
-double ExpectedLeastSquaresNoiseCost(const BarModel& model, const ChannelSet& data,
+double ExpectedLeastSquaresNoiseCost(const MatrixModelData& model, const ChannelSet& data,
                                      const NoiseLevels& misfit_levels, double theta,
-                                     EndDisplacementChannels ends, const Vector& moduli,
-                                     const NoiseLevels& noise, const PrefilterOptions& prefilter,
-                                     int samples, std::uint64_t seed, double cost_scale);
+                                     const Vector& moduli, const NoiseLevels& noise,
+                                     const PrefilterOptions& prefilter, int samples,
+                                     std::uint64_t seed, double cost_scale);
 
 // Identifies the zone moduli of `model` (its zones; the bar's: BarRunModel of the zoned
 // bar) from `data` (as the objective sees them: pre-filtered when the pre-filter is on),
@@ -119,16 +120,16 @@ ZoneIdentificationSummary IdentifyZoneModuli(
 void SetBarZoneExtents(const BarModel& model, ZoneIdentificationSummary* summary);
 
 // The same identification on the output-error misfit J of least squares
-// (ZoneOutputErrorObjective, normalised by misfit_levels: > 0 for every kind the data
-// hold) instead of the MCRE's e^2: the same parameters, bounds, start, regularisation,
-// weight rule (its target ExpectedLeastSquaresNoiseCost with the noise levels `noise`)
-// and merging. summary.cost and homogeneous_cost are J [s], cost_scale J_rest [s],
-// sweeps the simulations (1 + zones with the gradient). Never throws for a failed
-// identification. Preconditions as IdentifyZoneModuli's.
+// (MatrixOutputErrorObjective, normalised by misfit_levels: > 0 for every kind the
+// model observes; its supports held) instead of the MCRE's e^2: the same parameters,
+// bounds, start, regularisation, weight rule (its target ExpectedLeastSquaresNoiseCost
+// with the noise levels `noise`) and merging. summary.cost and homogeneous_cost are J
+// [s], cost_scale J_rest [s], sweeps the simulations (1 + zones with the gradient). The
+// zone extents are left empty. Never throws for a failed identification. Preconditions
+// as IdentifyZoneModuli's.
 ZoneIdentificationSummary IdentifyZoneModuliByLeastSquares(
-    const ZoneIdentificationOptions& options, const BarModel& model, const ChannelSet& data,
-    const NoiseLevels& misfit_levels, double theta, EndDisplacementChannels ends,
-    double homogeneous_modulus, double lower_bound, double upper_bound, const NoiseLevels& noise,
-    const PrefilterOptions& prefilter);
+    const ZoneIdentificationOptions& options, const MatrixModelData& model, const ChannelSet& data,
+    const NoiseLevels& misfit_levels, double theta, double homogeneous_modulus, double lower_bound,
+    double upper_bound, const NoiseLevels& noise, const PrefilterOptions& prefilter);
 
 }  // namespace mcrewave

@@ -39,8 +39,8 @@
 // time loop (every scratch is sized in the constructor).
 //
 // Seen by the optimisers as ZoneMcreObjective is (optim/log_moduli_objective.h): as a
-// function of p_z = log(E_z / E_z,nom), with J_scale = J_rest (J with every prediction
-// 0).
+// function of p_z = log(E_z / E_z,ref), E_z,ref the nominal moduli or one given scale,
+// with J_scale = J_rest (J with every prediction 0).
 #pragma once
 
 #include <string>
@@ -64,10 +64,13 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
   // Preconditions: data has a channel of each of the model's loads, sensors and
   // supports' forces (else throws std::logic_error) on t_j = j h and m >= 1 steps, theta
   // in [0, 1]. Throws std::runtime_error when the mass matrix of the free dofs cannot be
-  // factorised (a model with supports).
+  // factorised (a model with supports). modulus_scale > 0: every zone's reference
+  // E_z,ref of p_z = log(E_z / E_z,ref) [Pa] (the bar's zones: the homogeneous E*); 0:
+  // the nominal moduli.
   MatrixOutputErrorObjective(const MatrixModelData& model, const ChannelSet& data,
                              const NoiseLevels& misfit_levels, double theta,
-                             Factorization factorization = Factorization::kAutomatic);
+                             Factorization factorization = Factorization::kAutomatic,
+                             double modulus_scale = 0.0);
 
   // J at the zone moduli [s] (num_parameters() entries [Pa], positive), and dJ/dE_z
   // [s / Pa] into *gradient when it is not null (resized to num_parameters()). Leaves
@@ -93,6 +96,8 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
 
  protected:
   bool ModuliCost(const Vector& moduli, double* cost, Vector* gradient, std::string* why) override;
+  // Logs one line per usable evaluation.
+  void OnEvaluated(const Vector& moduli, double cost, double gradient_norm) override;
 
  private:
   // The supports' reaction rows v_sz and p_s (the header's formula), with held_ set.
