@@ -571,11 +571,12 @@ TEST(MatrixOutputErrorAllocationTest, TheTimeLoopAllocatesNothing) {
 }
 
 // The same with a support (the supported lattice: its reaction an output, the held
-// dofs decoupled): the same heap calls for 20 and 80 steps.
+// dofs decoupled), with and without the Fisher information: the same heap calls for
+// 20 and 80 steps.
 TEST(MatrixOutputErrorAllocationTest, WithASupportTheTimeLoopAllocatesNothing) {
   SKIP_WITHOUT_ALLOCATION_COUNTING();
   const MatrixModelData lattice = testing::SupportedLattice();
-  HeapCalls calls[2];
+  HeapCalls calls[2], fisher_calls[2];
   for (int i = 0; i < 2; ++i) {
     const int samples = 1 + 20 * (1 + 3 * i);
     Matrix loads = Matrix::Zero(1, samples);
@@ -593,9 +594,15 @@ TEST(MatrixOutputErrorAllocationTest, WithASupportTheTimeLoopAllocatesNothing) {
     Vector gradient(2);
     objective.Cost(moduli, &gradient);
     calls[i] = CountHeapCalls([&] { objective.Cost(moduli, &gradient); });
+    // With the Fisher information as well.
+    Matrix information;
+    objective.Cost(moduli, &gradient, &information);
+    fisher_calls[i] = CountHeapCalls([&] { objective.Cost(moduli, &gradient, &information); });
   }
   EXPECT_EQ(calls[0].allocations, calls[1].allocations);
   EXPECT_EQ(calls[0].deallocations, calls[1].deallocations);
+  EXPECT_EQ(fisher_calls[0].allocations, fisher_calls[1].allocations);
+  EXPECT_EQ(fisher_calls[0].deallocations, fisher_calls[1].deallocations);
 }
 
 // The heap calls of parsing `text` as a Matrix Market matrix (InputError or not).

@@ -17,7 +17,7 @@
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/data/noise.h"
 #include "mcrewave/data/prefilter.h"
-#include "mcrewave/least_squares/output_error_objective.h"
+#include "mcrewave/least_squares/output_error_modulus_objective.h"
 #include "mcrewave/mcre/objective.h"
 #include "mcrewave/model/simulation.h"
 #include "mcrewave/optim/identification.h"
@@ -68,7 +68,9 @@ void Identify(const Config& config, const BarModel& model, const ChannelSet& dat
     NoiseLevels noise;
     noise.displacement_std = RootMeanSquare(data.Values("uL")) / snr;
     noise.force_std = RootMeanSquare(data.Values("f0")) / snr;
-    OutputErrorObjective objective(model, data, noise, config.time.theta, config.outer.initial);
+    const MatrixModelData matrices = BarRunModel(model, data, EndDisplacementChannels());
+    OutputErrorModulusObjective objective(matrices, data, noise, config.time.theta,
+                                          config.outer.initial);
     summary = mcrewave::Identify(one_thread.outer, &objective);
   } else {
     // As identify run: the search functional's scan, then mcre:'s e^2 (search:).

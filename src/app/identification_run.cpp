@@ -391,9 +391,10 @@ LeastSquaresRun RunLeastSquares(const Config& config, const ChannelSet& data) {
   run.data = IdentificationData(config, data, &run.ends, &run.prefilter_cutoff);
   run.noise = LeastSquaresMisfitLevels(config, data, run.data, &run.noise_source);
   run.estimated_noise = DifferenceNoiseLevels(data);
-  const BarModel model(config.model);
-  OutputErrorObjective objective(model, run.data, run.noise, config.time.theta,
-                                 config.outer.initial, run.ends);
+  run.model = std::make_shared<const MatrixModelData>(
+      BarRunModel(BarModel(config.model), run.data, run.ends));
+  OutputErrorModulusObjective objective(*run.model, run.data, run.noise, config.time.theta,
+                                        config.outer.initial);
   run.rest_cost = objective.rest_cost();
   spdlog::info(
       "identifying E by output-error least squares with {}/{} from {:.6g} Pa in [{:.6g}, "
@@ -412,7 +413,7 @@ LeastSquaresRun RunLeastSquares(const Config& config, const ChannelSet& data) {
     for (int i = 0; i < points; ++i) {
       const double modulus =
           identified * (1.0 - kCurvatureWindow + 2.0 * kCurvatureWindow * i / (points - 1.0));
-      const OutputErrorPrediction& prediction = objective.Predict(modulus, true);
+      const OutputErrorFit& prediction = objective.Predict(modulus, true);
       CostCurvePoint point;
       point.modulus = modulus;
       point.cost = prediction.cost;
@@ -423,7 +424,7 @@ LeastSquaresRun RunLeastSquares(const Config& config, const ChannelSet& data) {
     int curvature_points = 0;
     run.curvature =
         CostGradientSlope(run.cost_curve, identified, kCurvatureWindow, &curvature_points);
-    // The Cramer-Rao bound 1 / sqrt(I), I the Fisher information at E* (OutputErrorPrediction).
+    // The Cramer-Rao bound 1 / sqrt(I), I the Fisher information at E* (OutputErrorFit).
     if (run.fit.fisher_information > 0.0) {
       run.modulus_std_bound = 1.0 / std::sqrt(run.fit.fisher_information);
     }

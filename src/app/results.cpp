@@ -698,26 +698,44 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
 namespace {
 
 // Measured and predicted channels of the least-squares fit at the identified E:
-// uL (x = L) and f0 (the clamp reaction), then each interior sensor.
+// uL (x = L) and f0 (the clamp reaction), then each interior sensor; uL_model is
+// empty when uL is no output of the fit (data.channels leaves it out).
 std::string FitCsv(const LeastSquaresRun& run) {
   const ChannelSet& data = run.data;
-  const OutputErrorPrediction& fit = run.fit;
+  const OutputErrorFit& fit = run.fit;
+  const std::vector<MatrixModelSensor>& model_sensors = run.model->sensors;
+  // The row of the fit's outputs of each channel, by name (-1: none).
+  auto output_row = [&](const std::string& name) {
+    for (std::size_t k = 0; k < model_sensors.size(); ++k) {
+      if (model_sensors[k].channel == name) return static_cast<Eigen::Index>(k);
+    }
+    return Eigen::Index{-1};
+  };
   std::string csv = "t,uL_measured,uL_model,f0_measured,f0_model";
   const std::vector<BarSensor> sensors = BarSensors(data);
+  std::vector<Eigen::Index> sensor_rows;
   for (const BarSensor& sensor : sensors) {
     const std::string& name = data.channels[static_cast<std::size_t>(sensor.index)].name;
     csv += "," + name + "_measured," + name + "_model";
+    sensor_rows.push_back(output_row(name));
   }
   csv += "\n";
+  const Eigen::Index uL_row = output_row("uL");
   const BarEnds measured = BarEndChannels(data);
   const std::vector<const Vector*> sensor_values = BarSensorValues(data);
   char row[128];
   for (int j = 0; j < data.num_samples(); ++j) {
-    std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g,%.17g", data.Time(j), measured.uL[j],
-                  fit.uL[j], measured.f0[j], fit.f0[j]);
+    std::snprintf(row, sizeof(row), "%.17g,%.17g,", data.Time(j), measured.uL[j]);
+    csv += row;
+    if (uL_row >= 0) {
+      std::snprintf(row, sizeof(row), "%.17g", fit.outputs(uL_row, j));
+      csv += row;
+    }
+    std::snprintf(row, sizeof(row), ",%.17g,%.17g", measured.f0[j], fit.support_forces(0, j));
     csv += row;
     for (std::size_t k = 0; k < sensor_values.size(); ++k) {
-      std::snprintf(row, sizeof(row), ",%.17g,%.17g", (*sensor_values[k])[j], fit.sensors[k][j]);
+      std::snprintf(row, sizeof(row), ",%.17g,%.17g", (*sensor_values[k])[j],
+                    fit.outputs(sensor_rows[k], j));
       csv += row;
     }
     csv += "\n";

@@ -153,7 +153,8 @@ void MatrixOutputErrorObjective::BuildReactions(const ChannelSet& data,
 }
 
 double MatrixOutputErrorObjective::SampleCost(int j, const Vector& displacement,
-                                              const Matrix& sensitivity, Vector* gradient) {
+                                              const Matrix& sensitivity, Vector* gradient,
+                                              Matrix* fisher_information) {
   const int zones = num_parameters();
   const int samples = static_cast<int>(measured_outputs_.cols());
   const double h = time_step_;
@@ -174,21 +175,40 @@ double MatrixOutputErrorObjective::SampleCost(int j, const Vector& displacement,
     cost += 0.5 * c * h * force_weight_ * force_residual_.squaredNorm();
   }
   if (gradient == nullptr) return cost;
+  const bool information = fisher_information != nullptr;
   for (int z = 0; z < zones; ++z) {
     // c_j h sum_k w_k r_kj (H S_z,j)_k
     trace_.noalias() = observation_ * sensitivity.col(z);
     (*gradient)[z] += c * h * residual_.cwiseProduct(weights_).dot(trace_);
+    if (information) output_sensitivity_.col(z) = trace_;
     if (!supports) continue;
     // dr_s,j/dE_z = q_s^T S_z,j + v_sz^T U_j;  c_j h w_f sum_s (r_s,j - f~_sj) dr_s,j/dE_z
     force_trace_.noalias() = reaction_rows_ * sensitivity.col(z);
     force_trace_.noalias() += reaction_zone_rows_[static_cast<std::size_t>(z)] * displacement;
     (*gradient)[z] += c * h * force_weight_ * force_residual_.dot(force_trace_);
+    if (information) force_sensitivity_.col(z) = force_trace_;
+  }
+  if (information) {
+    // c_j [(H S_z,j)^T W (H S_z',j) + w_f (dr_j/dE_z)^T (dr_j/dE_z')], column by column
+    // (no temporary in the time loop).
+    for (int z = 0; z < zones; ++z) {
+      trace_ = output_sensitivity_.col(z).cwiseProduct(weights_);
+      for (int y = 0; y <= z; ++y) {
+        double term = trace_.dot(output_sensitivity_.col(y));
+        if (supports)
+          term += force_weight_ * force_sensitivity_.col(z).dot(force_sensitivity_.col(y));
+        (*fisher_information)(z, y) += c * term;
+        if (y != z) (*fisher_information)(y, z) = (*fisher_information)(z, y);
+      }
+    }
   }
   return cost;
 }
 
-double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradient) {
+double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradient,
+                                        Matrix* fisher_information) {
   const int zones = num_parameters();
+  assert(fisher_information == nullptr || gradient != nullptr);
   assert(zone_moduli.size() == zones && zone_moduli.allFinite() && zone_moduli.minCoeff() > 0.0);
   ThetaIntegratorOptions options;
   options.time_step = time_step_;
@@ -209,6 +229,11 @@ double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradi
 
   const bool gradient_requested = gradient != nullptr;
   if (gradient_requested) gradient->setZero(zones);
+  if (fisher_information != nullptr) {
+    fisher_information->setZero(zones, zones);
+    output_sensitivity_.resize(observation_.rows(), zones);
+    force_sensitivity_.resize(static_cast<Eigen::Index>(model_.supports.size()), zones);
+  }
   const int samples = static_cast<int>(measured_outputs_.cols());
   int current = 0;
   // From rest: U_0 = V_0 = 0, S_z,0 = S_z,0' = 0.
@@ -238,7 +263,8 @@ double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradi
       }
       current = next;
     }
-    cost += SampleCost(j, displacement_[current], sensitivity_[current], gradient);
+    cost +=
+        SampleCost(j, displacement_[current], sensitivity_[current], gradient, fisher_information);
   }
   sweeps_ += gradient_requested ? 1 + zones : 1;
   return cost;

@@ -1,5 +1,5 @@
 // The comparator study (`identify study --set study.kind=comparator`): the MCRE and
-// output-error least squares (least_squares/output_error_objective.h) identify E from
+// output-error least squares (least_squares/output_error_modulus_objective.h) identify E from
 // the same data, with the same optimiser and bounds (outer:), each as identify run does
 // (the MCRE's global scan on the search functional of search:, least squares' on J), with
 // and without the pre-filter, over noise seeds, on the config's case as it is ("none")

@@ -22,7 +22,7 @@
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/zone_identification_run.h"
 #include "mcrewave/data/measurement.h"
-#include "mcrewave/least_squares/output_error_objective.h"
+#include "mcrewave/least_squares/output_error_modulus_objective.h"
 #include "mcrewave/mcre/error_map.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/mcre/objective.h"
@@ -184,13 +184,16 @@ NoiseLevels LeastSquaresMisfitLevels(const Config& config, const ChannelSet& dat
                                      const ChannelSet& used, std::string* source);
 
 // One identification by output-error least squares (outer.functional:
-// least_squares; least_squares/output_error_objective.h): the same data path,
+// least_squares; least_squares/output_error_modulus_objective.h): the same data path,
 // pre-filter and optimiser as the MCRE's, the global scan on J(E), the misfit of
 // the clamped model driven by the measured fL, normalised by the noise levels.
 struct LeastSquaresRun {
   Config config;
   ChannelSet data;  // the channels in use, pre-filtered as for the MCRE
   EndDisplacementChannels ends;
+  // BarRunModel of config.model, data and ends, its clamp held: the structure J
+  // simulates (shared, so that a copy of the run keeps it).
+  std::shared_ptr<const MatrixModelData> model;
   double prefilter_cutoff = 0.0;  // [Hz]; 0 when off
   bool reference_known = false;   // synthetic data: E_ref = config.model.modulus
   NoiseLevels noise;              // s_u, s_f, s_e of the misfit's normalisation
@@ -198,7 +201,7 @@ struct LeastSquaresRun {
   NoiseLevels estimated_noise;    // DifferenceNoiseLevels of the measurements (zones' target)
   IdentificationSummary outer;
   double rest_cost = 0.0;     // J_rest [s], the cost scale
-  OutputErrorPrediction fit;  // the model's outputs and J at the identified E
+  OutputErrorFit fit;         // the model's outputs and J at the identified E
   // J(E) and dJ/dE on output.curve_points moduli evenly spaced over E* +- 5 %.
   std::vector<CostCurvePoint> cost_curve;
   // d^2J/dE^2 at E* [s / Pa^2], the slope of dJ/dE over the curve (the observed

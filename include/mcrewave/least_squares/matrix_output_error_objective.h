@@ -73,10 +73,16 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
                              double modulus_scale = 0.0);
 
   // J at the zone moduli [s] (num_parameters() entries [Pa], positive), and dJ/dE_z
-  // [s / Pa] into *gradient when it is not null (resized to num_parameters()). Leaves
-  // the outputs H U_j in outputs() and the reactions r_s,j in support_forces().
+  // [s / Pa] into *gradient when it is not null (resized to num_parameters()). With
+  // fisher_information (then gradient must not be null), the Fisher information of the
+  // moduli under white noise of the misfit levels on every output, the loads taken as
+  // exact (Gauss-Newton: the expected curvature of chi^2 / 2, free of the residuals'
+  // ripple), resized to Z x Z [1/Pa^2]:
+  //   I_zz' = sum_j c_j [sum_k w_k (h_k S_z,j)(h_k S_z',j)
+  //                      + w_f sum_s (dr_s,j/dE_z)(dr_s,j/dE_z')].
+  // Leaves the outputs H U_j in outputs() and the reactions r_s,j in support_forces().
   // Re-initialises the integrator (the moduli change K).
-  double Cost(const Vector& zone_moduli, Vector* gradient);
+  double Cost(const Vector& zone_moduli, Vector* gradient, Matrix* fisher_information = nullptr);
 
   // The outputs H U_j of the last Cost, one row per sensor in the model's order, one
   // column per sample [m] or [-].
@@ -105,7 +111,9 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
   // The misfit of sample j (c_j h / 2 times the bracket of J) with the reactions into
   // support_forces_ and their residuals into force_residual_; adds its gradient term
   // into *gradient when it is not null.
-  double SampleCost(int j, const Vector& displacement, const Matrix& sensitivity, Vector* gradient);
+  // With fisher_information, adds its terms of sample j too.
+  double SampleCost(int j, const Vector& displacement, const Matrix& sensitivity, Vector* gradient,
+                    Matrix* fisher_information);
 
   const MatrixModelData& model_;
   double time_step_;  // h [s]
@@ -137,6 +145,9 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
   Vector force_residual_, force_trace_;
   Matrix sensitivity_velocity_[2], sensitivity_[2];
   Matrix outputs_, support_forces_;
+  // The outputs' and reactions' derivatives of a sample, one column per zone (the
+  // Fisher information's; sized on its first request).
+  Matrix output_sensitivity_, force_sensitivity_;
 
   double rest_cost_ = 0.0;
   long sweeps_ = 0;

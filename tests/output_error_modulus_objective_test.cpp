@@ -1,0 +1,152 @@
+// Tests of OutputErrorModulusObjective and of the Fisher information of
+// MatrixOutputErrorObjective: on the bar as matrices (BarRunModel) the one-modulus
+// objective gives the bar's own OutputErrorObjective (another code path: the clamped
+// band model, its reaction from the clamp's row) in J, dJ/dE, the Fisher information,
+// the outputs and the valley spacing; the Fisher matrix of three zones is the
+// Gauss-Newton sum of central differences of the outputs and the reaction; a clone
+// computes the same bits; a trial modulus that is not positive is refused.
+#include "mcrewave/least_squares/output_error_modulus_objective.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "mcrewave/data/noise.h"
+#include "mcrewave/least_squares/output_error_objective.h"
+#include "mcrewave/model/simulation.h"
+#include "test_problems.h"
+
+namespace mcrewave {
+namespace {
+
+// A 30-element bar with a displacement and a strain sensor, noisy data of the clamped
+// bar (SNR 20) and misfit levels of every kind.
+struct SensedBar {
+  SensedBar()
+      : small(testing::MakeSmallCase(30, 250, 20.0, 1)),
+        model(small.bar),
+        data(SimulateClampedBar(small.bar, small.load, small.time, {}, {"u@0.3", "e@0.55"})) {
+    AddMeasurementNoise(20.0, 11, &data);
+    noise.displacement_std = 1e-6;  // [m]
+    noise.force_std = 10.0;         // [N]
+    noise.strain_std = 1e-6;
+    matrices = BarRunModel(model, data, {});
+  }
+  testing::SmallCase small;
+  BarModel model;
+  ChannelSet data;
+  NoiseLevels noise;
+  MatrixModelData matrices;
+};
+
+TEST(OutputErrorModulusObjectiveTest, OnTheBarAsMatricesItIsTheBarsOwnObjective) {
+  const SensedBar bar;
+  OutputErrorModulusObjective general(bar.matrices, bar.data, bar.noise, 0.5, 200e9);
+  OutputErrorObjective own(bar.model, bar.data, bar.noise, 0.5, 200e9);
+  EXPECT_NEAR(general.rest_cost(), own.rest_cost(), 1e-14 * own.rest_cost());
+  // The rows of the outputs: uL, then the sensors in the data's order.
+  ASSERT_EQ(bar.matrices.sensors.size(), 3u);
+  ASSERT_EQ(bar.matrices.sensors[0].channel, "uL");
+  for (const double modulus : {170e9, 200e9, 236e9}) {
+    const OutputErrorFit fit = general.Predict(modulus, true);
+    const OutputErrorPrediction& prediction = own.Predict(modulus, true);
+    // Measured over the three moduli, relative: J 4.4e-14, dJ/dE 2.2e-13, I 7.6e-15
+    // apart; uL 2.4e-15, f0 1.5e-14 and the sensors 2.0e-14 of their norms.
+    EXPECT_NEAR(fit.cost, prediction.cost, 4e-13 * prediction.cost) << modulus;
+    EXPECT_NEAR(fit.cost_gradient, prediction.cost_gradient,
+                2e-12 * std::abs(prediction.cost_gradient))
+        << modulus;
+    EXPECT_NEAR(fit.fisher_information, prediction.fisher_information,
+                8e-14 * prediction.fisher_information)
+        << modulus;
+    const Vector uL = fit.outputs.row(0).transpose();
+    const Vector f0 = fit.support_forces.row(0).transpose();
+    EXPECT_LT((uL - prediction.uL).norm(), 3e-14 * prediction.uL.norm()) << modulus;
+    EXPECT_LT((f0 - prediction.f0).norm(), 2e-13 * prediction.f0.norm()) << modulus;
+    for (int k = 0; k < 2; ++k) {
+      const Vector sensor = fit.outputs.row(1 + k).transpose();
+      EXPECT_LT((sensor - prediction.sensors[k]).norm(), 2e-13 * prediction.sensors[k].norm())
+          << modulus << " sensor " << k;
+    }
+    // The optimisers' face: cost J / J_rest, d cost / dx = dJ/dE E_scale / J_rest.
+    const double x = modulus / 200e9;
+    double cost = 0.0, gradient = 0.0;
+    ASSERT_TRUE(general.Evaluate(&x, &cost, &gradient)) << general.error_message();
+    EXPECT_EQ(cost, fit.cost / general.cost_scale());
+    EXPECT_EQ(gradient, fit.cost_gradient * 200e9 / general.cost_scale());
+  }
+  // Measured 6.2e-14 relative (the channels summed in another order).
+  EXPECT_NEAR(general.ValleySpacing(), own.ValleySpacing(), 6e-13 * own.ValleySpacing());
+}
+
+TEST(OutputErrorModulusObjectiveTest, ACloneComputesTheSameBitsAndABadModulusIsRefused) {
+  const SensedBar bar;
+  OutputErrorModulusObjective objective(bar.matrices, bar.data, bar.noise, 0.5, 200e9);
+  const std::unique_ptr<ModulusObjective> clone = objective.CloneForScan(1e-8);
+  ASSERT_NE(clone, nullptr);
+  const double x = 0.93;
+  double cost = 0.0, gradient = 0.0, clone_cost = 0.0, clone_gradient = 0.0;
+  ASSERT_TRUE(objective.Evaluate(&x, &cost, &gradient));
+  ASSERT_TRUE(clone->Evaluate(&x, &clone_cost, &clone_gradient));
+  EXPECT_EQ(cost, clone_cost);
+  EXPECT_EQ(gradient, clone_gradient);
+  EXPECT_EQ(objective.sweeps(), 2);  // one simulation and one sensitivity sweep
+  const double negative = -0.5;
+  EXPECT_FALSE(objective.Evaluate(&negative, &cost, nullptr));
+  EXPECT_FALSE(objective.error_message().empty());
+}
+
+TEST(MatrixOutputErrorObjectiveTest, TheFisherMatrixIsTheGaussNewtonSumOfCentralDifferences) {
+  // Three zones of the sensed bar, its clamp held (a reaction output): I_zz' from the
+  // forward sensitivities against sum_j c_j [sum_k w_k dy_k/dE_z dy_k/dE_z'
+  // + w_f dr/dE_z dr/dE_z'] with central differences of the outputs and the reaction
+  // (step 1e-6 E_z).
+  const SensedBar bar;
+  ZoneLayout layout;
+  layout.zone_count = 3;
+  const BarModel zoned(bar.small.bar, layout.ElementZones(bar.small.bar));
+  const MatrixModelData matrices = BarRunModel(zoned, bar.data, {});
+  MatrixOutputErrorObjective objective(matrices, bar.data, bar.noise, 0.5);
+  const Vector moduli = (Vector(3) << 190e9, 214e9, 201e9).finished();
+  Vector gradient;
+  Matrix information;
+  objective.Cost(moduli, &gradient, &information);
+  ASSERT_EQ(information.rows(), 3);
+  ASSERT_EQ(information.cols(), 3);
+  const int samples = bar.data.num_samples();
+  std::vector<Matrix> output_rates, force_rates;
+  for (int z = 0; z < 3; ++z) {
+    const double step = 1e-6 * moduli[z];
+    Vector plus = moduli, minus = moduli;
+    plus[z] += step;
+    minus[z] -= step;
+    objective.Cost(plus, nullptr);
+    const Matrix outputs_plus = objective.outputs(), forces_plus = objective.support_forces();
+    objective.Cost(minus, nullptr);
+    output_rates.push_back((outputs_plus - objective.outputs()) / (2.0 * step));
+    force_rates.push_back((forces_plus - objective.support_forces()) / (2.0 * step));
+  }
+  const double force_weight = 1.0 / (bar.noise.force_std * bar.noise.force_std);
+  Matrix differences = Matrix::Zero(3, 3);
+  for (int j = 0; j < samples; ++j) {
+    const double c = (j == 0 || j == samples - 1) ? 0.5 : 1.0;
+    for (int z = 0; z < 3; ++z) {
+      for (int y = 0; y < 3; ++y) {
+        differences(z, y) += c * (output_rates[z].col(j).cwiseProduct(objective.sensor_weights()))
+                                     .dot(output_rates[y].col(j)) +
+                             c * force_weight * force_rates[z].col(j).dot(force_rates[y].col(j));
+      }
+    }
+  }
+  // Measured: 7.1e-10 relative to the largest entry.
+  EXPECT_LT((information - differences).cwiseAbs().maxCoeff(),
+            7e-9 * differences.cwiseAbs().maxCoeff())
+      << information << "\nagainst\n"
+      << differences;
+  EXPECT_LT((information - information.transpose()).norm(), 1e-14 * information.norm());
+}
+
+}  // namespace
+}  // namespace mcrewave
