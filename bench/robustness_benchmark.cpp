@@ -79,8 +79,11 @@ Outcome IdentifyOnce(const mcrewave::BarModel& model, const mcrewave::ChannelSet
   outer.scan_threads = 1;
   // E to 1e-6 relative: far below the spread measured, half the evaluations of 1e-7.
   outer.relative_tolerance = 1e-6;
-  mcrewave::McreObjective objective(model, data, mcre, 0.5, mcrewave::CoupledSolverOptions(),
-                                    outer.initial);
+  const mcrewave::MatrixModelData matrices =
+      mcrewave::BarRunModel(model, data, mcrewave::EndDisplacementChannels());
+  mcrewave::McreObjective objective =
+      mcrewave::MatrixMcreObjective(matrices, data, mcre, 0.5, mcrewave::CoupledSolverOptions(),
+                                    mcrewave::Factorization::kAutomatic, outer.initial);
   const mcrewave::IdentificationSummary summary = mcrewave::Identify(outer, &objective);
   outcome.usable = summary.IsSolutionUsable();
   // relative error = (E* - E_ref) / E_ref

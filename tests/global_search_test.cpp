@@ -38,11 +38,12 @@ McreOptions WeightsOf(double w_u) { return testing::FreeFreeMcre(w_u); }
 // tight inner tolerance, then bisection on the sign of the adjoint gradient in
 // every bracket [E_i, E_i+1] where it changes from - to +, to 1e-10 relative; the
 // lowest of those minima. Writes the minimisers of every valley (sign change) seen.
-double DenseGlobalMinimiser(const BarModel& model, const ChannelSet& data, const McreOptions& mcre,
-                            double lower, double upper, int points, std::vector<double>* valleys) {
+double DenseGlobalMinimiser(const MatrixModelData& matrices, const ChannelSet& data,
+                            const McreOptions& mcre, double lower, double upper, int points,
+                            std::vector<double>* valleys) {
   CoupledSolverOptions inner;
   inner.tolerance = 1e-10;
-  McreObjective objective(model, data, mcre, 0.5, inner, kReference);
+  McreObjective objective = testing::BarObjective(matrices, data, mcre, inner, kReference);
   std::vector<double> moduli, gradients;
   for (int i = 0; i < points; ++i) {
     moduli.push_back(lower + (upper - lower) * i / (points - 1.0));
@@ -78,14 +79,17 @@ struct RuggedCase {
       : small(MakeSmallCase(10, 400, 1.5, 2)),
         model(small.bar),
         data(PrefilterMeasurements(
-            MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data), [&] {
+            MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data),
+            [&] {
               PrefilterOptions prefilter;
               prefilter.enabled = prefilter_enabled;
               return prefilter;
-            }())) {}
+            }())),
+        matrices(BarRunModel(model, data, {})) {}
   SmallCase small;
   BarModel model;
   ChannelSet data;
+  MatrixModelData matrices;  // the bar as the identification solves it
 };
 
 struct OptimizerCase {
@@ -107,8 +111,9 @@ TEST_P(EveryOptimizerTest, ReturnsTheGlobalMinimiserOfARuggedCost) {
   const McreOptions mcre = WeightsOf(0.01);
   const IdentificationOptions defaults;
   std::vector<double> valleys;
-  const double global = DenseGlobalMinimiser(rugged.model, rugged.data, mcre, defaults.lower_bound,
-                                             defaults.upper_bound, 601, &valleys);
+  const double global =
+      DenseGlobalMinimiser(rugged.matrices, rugged.data, mcre, defaults.lower_bound,
+                           defaults.upper_bound, 601, &valleys);
   const int dense_valleys = static_cast<int>(valleys.size());
   // Unfiltered: 6 valleys, the rugged case; filtered: 1.
   ASSERT_GE(dense_valleys, filtered ? 1 : 5) << "the case is not rugged enough";
@@ -117,8 +122,8 @@ TEST_P(EveryOptimizerTest, ReturnsTheGlobalMinimiserOfARuggedCost) {
     IdentificationOptions options;
     options.optimizer = tried.optimizer;
     options.algorithm = tried.algorithm;
-    McreObjective objective(rugged.model, rugged.data, mcre, 0.5, CoupledSolverOptions(),
-                            options.initial);
+    McreObjective objective = testing::BarObjective(rugged.matrices, rugged.data, mcre,
+                                                    CoupledSolverOptions(), options.initial);
     const IdentificationSummary summary = Identify(options, &objective);
     const std::string name = std::string(OptimizerTypeToString(tried.optimizer)) + "/" +
                              OuterAlgorithmToString(tried.algorithm);
@@ -143,8 +148,8 @@ TEST_P(EveryOptimizerTest, ReturnsTheGlobalMinimiserOfARuggedCost) {
   // outer.initial alone stops in another valley.
   IdentificationOptions local_only;
   local_only.scan_points = 0;
-  McreObjective local_objective(rugged.model, rugged.data, mcre, 0.5, CoupledSolverOptions(),
-                                local_only.initial);
+  McreObjective local_objective = testing::BarObjective(rugged.matrices, rugged.data, mcre,
+                                                        CoupledSolverOptions(), local_only.initial);
   const IdentificationSummary local = Identify(local_only, &local_objective);
   EXPECT_GT(std::abs(local.modulus / global - 1.0), 1e-2) << local.FullReport();
 }
@@ -158,8 +163,9 @@ TEST_P(EveryOptimizerTest, InTwoStagesReturnsTheGlobalMinimiserOfTheTrustedCost)
   const SearchOptions search_options;
   const IdentificationOptions defaults;
   std::vector<double> valleys;
-  const double global = DenseGlobalMinimiser(rugged.model, rugged.data, mcre, defaults.lower_bound,
-                                             defaults.upper_bound, 601, &valleys);
+  const double global =
+      DenseGlobalMinimiser(rugged.matrices, rugged.data, mcre, defaults.lower_bound,
+                           defaults.upper_bound, 601, &valleys);
   // Several valleys, filtered or not (measured: 4 unfiltered, 3 filtered).
   ASSERT_GE(valleys.size(), 3u) << "the trusted cost is not rugged enough";
   CoupledSolverOptions search_inner;
@@ -168,10 +174,11 @@ TEST_P(EveryOptimizerTest, InTwoStagesReturnsTheGlobalMinimiserOfTheTrustedCost)
     IdentificationOptions options;
     options.optimizer = tried.optimizer;
     options.algorithm = tried.algorithm;
-    McreObjective search(rugged.model, rugged.data, SearchMcreOptions(mcre, search_options), 0.5,
-                         search_inner, options.initial);
-    McreObjective objective(rugged.model, rugged.data, mcre, 0.5, CoupledSolverOptions(),
-                            options.initial);
+    McreObjective search =
+        testing::BarObjective(rugged.matrices, rugged.data, SearchMcreOptions(mcre, search_options),
+                              search_inner, options.initial);
+    McreObjective objective = testing::BarObjective(rugged.matrices, rugged.data, mcre,
+                                                    CoupledSolverOptions(), options.initial);
     const IdentificationSummary summary = IdentifyInTwoStages(
         options, &search, search_options.scan_points, search_options.refine_window, &objective);
     const std::string name = std::string(OptimizerTypeToString(tried.optimizer)) + "/" +
@@ -199,10 +206,11 @@ TEST(GlobalSearchTest, PredictedValleySpacingMatchesTheDenseScan) {
   // measured spacing only makes the scan finer; the band is [0.5, 3].
   const RuggedCase rugged;
   const McreOptions mcre = WeightsOf(0.01);
-  McreObjective objective(rugged.model, rugged.data, mcre, 0.5, CoupledSolverOptions(), 200e9);
+  McreObjective objective =
+      testing::BarObjective(rugged.matrices, rugged.data, mcre, CoupledSolverOptions(), 200e9);
   const double predicted = objective.ValleySpacing();
   std::vector<double> valleys;
-  DenseGlobalMinimiser(rugged.model, rugged.data, mcre, 100e9, 400e9, 601, &valleys);
+  DenseGlobalMinimiser(rugged.matrices, rugged.data, mcre, 100e9, 400e9, 601, &valleys);
   ASSERT_GE(valleys.size(), 3u);
   const double measured = std::log(valleys.back() / valleys.front()) / (valleys.size() - 1.0);
   EXPECT_GT(predicted, 0.0);
@@ -219,8 +227,8 @@ TEST(GlobalSearchTest, CeresFirstStepFollowsTheCurvature) {
   IdentificationOptions options;
   options.optimizer = OptimizerType::kCeres;
   options.refine_candidates = 1;
-  McreObjective objective(rugged.model, rugged.data, mcre, 0.5, CoupledSolverOptions(),
-                          options.initial);
+  McreObjective objective = testing::BarObjective(rugged.matrices, rugged.data, mcre,
+                                                  CoupledSolverOptions(), options.initial);
   const IdentificationSummary summary = Identify(options, &objective);
   ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
   const std::vector<ObjectiveEvaluation>& evaluations = objective.evaluations();
@@ -243,8 +251,8 @@ TEST(GlobalSearchTest, ScanResultsDoNotDependOnTheThreads) {
     options.scan_threads = threads;
     options.scan_points = 21;
     options.scan_samples_per_valley = 0.0;  // 21 points: the chunks, not the count, are tested
-    McreObjective objective(rugged.model, rugged.data, mcre, 0.5, CoupledSolverOptions(),
-                            options.initial);
+    McreObjective objective = testing::BarObjective(rugged.matrices, rugged.data, mcre,
+                                                    CoupledSolverOptions(), options.initial);
     summaries.push_back(Identify(options, &objective));
     const IdentificationSummary& summary = summaries.back();
     ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
@@ -276,7 +284,9 @@ double NoiseFreeError(const McreOptions& mcre, bool prefilter_enabled, double* c
   const ChannelSet data = PrefilterMeasurements(
       MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data), prefilter, cutoff);
   const IdentificationOptions options;
-  McreObjective objective(model, data, mcre, 0.5, CoupledSolverOptions(), options.initial);
+  const MatrixModelData matrices = BarRunModel(model, data, {});
+  McreObjective objective =
+      testing::BarObjective(matrices, data, mcre, CoupledSolverOptions(), options.initial);
   const IdentificationSummary summary = Identify(options, &objective);
   EXPECT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
   EXPECT_EQ(summary.local_minima, 1) << summary.FullReport();

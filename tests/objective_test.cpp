@@ -26,16 +26,18 @@ class ObjectiveTest : public ::testing::Test {
   ObjectiveTest()
       : case_(MakeSmallCase(20, 120, 20.0, 2)),
         model_(case_.bar),
-        data_(MakeSyntheticMeasurements(case_.bar, case_.load, case_.time, case_.data)) {}
+        data_(MakeSyntheticMeasurements(case_.bar, case_.load, case_.time, case_.data)),
+        matrices_(BarRunModel(model_, data_, {})) {}
 
   McreObjective MakeObjective(const CoupledSolverOptions& inner = CoupledSolverOptions()) const {
-    return McreObjective(model_, data_, McreOptions(), case_.time.theta, inner, kScale);
+    return testing::BarObjective(matrices_, data_, McreOptions(), inner, kScale, case_.time.theta);
   }
 
   static constexpr double kScale = 160e9;  // E per unit of x [Pa]
   testing::SmallCase case_;
   BarModel model_;
   ChannelSet data_;
+  MatrixModelData matrices_;  // the bar as the identification solves it
 };
 
 TEST(McreOptionsTest, DefaultsAreValidAndBadValuesNameTheirKey) {
@@ -99,8 +101,8 @@ TEST_F(ObjectiveTest, RestCostIsTheCostOfTheBarAtRestForEveryClamp) {
     options.weights.reaction_weight = 0.05;
     options.reference_modulus = reference_modulus;
     options.clamp = clamp;
-    const McreObjective objective(model_, data_, options, case_.time.theta,
-                                  CoupledSolverOptions(), kScale);
+    const McreObjective objective = testing::BarObjective(
+        matrices_, data_, options, CoupledSolverOptions(), kScale, case_.time.theta);
     double expected = 0.0;
     for (int j = 0; j <= data_.num_steps(); ++j) {
       const double c = (j == 0 || j == data_.num_steps()) ? 0.5 : 1.0;

@@ -76,6 +76,15 @@ struct ProblemBundle {
   McreProblem problem;
 };
 
+// The MCRE objective of the bar exported as matrices (MatrixMcreObjective); matrices
+// and data must outlive it.
+inline McreObjective BarObjective(const MatrixModelData& matrices, const ChannelSet& data,
+                                  const McreOptions& mcre, const CoupledSolverOptions& inner,
+                                  double modulus_scale, double theta = 0.5) {
+  return MatrixMcreObjective(matrices, data, mcre, theta, inner, Factorization::kAutomatic,
+                             modulus_scale);
+}
+
 // Minimises a zone objective in p_z = log(E_z / E_z,ref) from p = 0 within
 // [log 1/2, log 2] for every zone, at the step tolerance 1e-10 and no cost tolerance
 // (the inverse crimes' setting).
