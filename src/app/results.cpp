@@ -698,8 +698,9 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
 namespace {
 
 // Measured and predicted channels of the least-squares fit at the identified E:
-// uL (x = L) and f0 (the clamp reaction), then each interior sensor; uL_model is
-// empty when uL is no output of the fit (data.channels leaves it out).
+// uL (x = L) and f0 (the clamp reaction), then each interior sensor; a model column
+// is empty when its channel is no output of the fit under that name (uL when
+// data.channels leaves it out).
 std::string FitCsv(const LeastSquaresRun& run) {
   const ChannelSet& data = run.data;
   const OutputErrorFit& fit = run.fit;
@@ -734,9 +735,12 @@ std::string FitCsv(const LeastSquaresRun& run) {
     std::snprintf(row, sizeof(row), ",%.17g,%.17g", measured.f0[j], fit.support_forces(0, j));
     csv += row;
     for (std::size_t k = 0; k < sensor_values.size(); ++k) {
-      std::snprintf(row, sizeof(row), ",%.17g,%.17g", (*sensor_values[k])[j],
-                    fit.outputs(sensor_rows[k], j));
+      std::snprintf(row, sizeof(row), ",%.17g,", (*sensor_values[k])[j]);
       csv += row;
+      if (sensor_rows[k] >= 0) {
+        std::snprintf(row, sizeof(row), "%.17g", fit.outputs(sensor_rows[k], j));
+        csv += row;
+      }
     }
     csv += "\n";
   }

@@ -249,7 +249,7 @@ bool StringToTerminationType(const std::string& name, TerminationType* type);
 // from this choice.
 enum class OuterFunctional {
   kMcre,          // the MCRE cost e^2(E) (McreObjective)
-  kLeastSquares,  // output-error least squares J(E) (OutputErrorObjective), the comparator
+  kLeastSquares,  // output-error least squares J(E) (OutputErrorModulusObjective), the comparator
 };
 inline constexpr std::array<std::pair<OuterFunctional, const char*>, 2> kOuterFunctionalNames{{
     {OuterFunctional::kMcre, "mcre"},

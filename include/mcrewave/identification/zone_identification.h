@@ -3,7 +3,7 @@
 // BarRunModel), by the MCRE (IdentifyZoneModuli) or, as its comparator, by output-error
 // least squares (IdentifyZoneModuliByLeastSquares: the same steps on J).
 // K = sum_z (E_z / E_z,nom) K_z, and every zone's gradient comes from the one coupled
-// solve, de^2/dE_z = -(1/(2 E_z)) sum_j c_j h W_j^T K_z (W_j + 2 U_j)
+// solve, de^2/dE_z = -(1/(2 E_z,nom)) sum_j c_j h W_j^T K_z (W_j + 2 U_j)
 // (MatrixMcreProblem::CostGradients).
 //
 // Started from the homogeneous E* of the scalar identification, on p_z = log(E_z / E*)

@@ -36,7 +36,7 @@
 //   dJ/dE_z = sum_j c_j h [sum_k w_k (h_k U_j - d~_kj) h_k S_z,j
 //                          + w_f sum_s (r_s,j - f~_sj) dr_s,j/dE_z]      [s / Pa].
 // One sweep per evaluation without the gradient, 1 + Z with it; no allocation in the
-// time loop (every scratch is sized in the constructor).
+// time loop (every scratch is sized before it).
 //
 // Seen by the optimisers as ZoneMcreObjective is (optim/log_moduli_objective.h): as a
 // function of p_z = log(E_z / E_z,ref), E_z,ref the nominal moduli or one given scale,
@@ -137,7 +137,8 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
   std::vector<Matrix> reaction_zone_rows_;
   Matrix reaction_rows_, reaction_loads_;
 
-  // Scratch of Cost, sized in the constructor: double buffers of the state, the
+  // Scratch of Cost, sized in the constructor (the Fisher information's below, on its
+  // first request, before the time loop): double buffers of the state, the
   // sensitivities (one column per zone, double buffered), the theta-weighted
   // displacement and loads of a step, a force vector, the residuals and the outputs;
   // the reactions' residuals and derivatives.

@@ -1,5 +1,7 @@
-// Output-error least squares (finite-element model updating, FEMU), the MCRE's
-// comparator (docs/formulation.md section 8, docs/comparator.md): the bar clamped at
+// Output-error least squares (finite-element model updating, FEMU) on the built-in bar,
+// the tests' independent reference for OutputErrorModulusObjective on the bar exported
+// as matrices, which identify run and the studies use (docs/formulation.md section 8,
+// docs/comparator.md): the bar clamped at
 // x = 0 (u_0 = 0), driven at x = L by the measured fL~ in the theta scheme of
 // linalg/theta_integrator.h, its predicted outputs against the other measured channels,
 // each kind normalised by its noise level:

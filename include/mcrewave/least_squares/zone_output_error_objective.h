@@ -1,5 +1,7 @@
-// Output-error least squares with zone moduli, the comparator of the MCRE's zone
-// identification (docs/zones_and_sensors.md, "Zones: the MCRE against least squares"):
+// Output-error least squares with zone moduli on the built-in bar, the tests'
+// independent reference for MatrixOutputErrorObjective on the bar exported as matrices,
+// which the zone identification uses (docs/zones_and_sensors.md, "Zones: the MCRE
+// against least squares"):
 // OutputErrorObjective's misfit (output_error_objective.h) with K = sum_z E_z K1_z,
 //
 //   J(E_1..E_Z) = 1/2 sum_k c_k h sum_channels (y_k - y~_k)^2 / s^2      [s].

@@ -2,8 +2,8 @@
 // identification.h through one interface (shaped like ceres::FirstOrderFunction):
 // one scaled parameter x = E / modulus_scale(), a scaled cost, an optional gradient,
 // and false (never a made-up number) when the value cannot be had. The MCRE's
-// McreObjective (mcre/objective.h) and least squares' OutputErrorObjective
-// (least_squares/output_error_objective.h) implement it.
+// McreObjective (mcre/objective.h) and least squares' OutputErrorModulusObjective
+// (least_squares/output_error_modulus_objective.h) implement it.
 #pragma once
 
 #include <memory>
