@@ -26,16 +26,22 @@ std::unique_ptr<ModulusObjective> OutputErrorModulusObjective::CloneForScan(doub
                                                        modulus_scale_);
 }
 
-const OutputErrorFit& OutputErrorModulusObjective::Predict(double modulus,
-                                                           bool gradient_requested) {
+void OutputErrorModulusObjective::Solve(double modulus, bool gradient_requested,
+                                        bool information_requested) {
   assert(modulus > 0.0 && std::isfinite(modulus));
+  assert(gradient_requested || !information_requested);
   const Vector moduli = Vector::Constant(objective_.num_parameters(), modulus);
   fit_.modulus = modulus;
   fit_.cost = objective_.Cost(moduli, gradient_requested ? &gradient_ : nullptr,
-                              gradient_requested ? &information_ : nullptr);
+                              information_requested ? &information_ : nullptr);
   // Every zone moves with E: dJ/dE = sum_z dJ/dE_z, I = 1^T I_zz' 1.
   fit_.cost_gradient = gradient_requested ? gradient_.sum() : 0.0;
-  fit_.fisher_information = gradient_requested ? information_.sum() : 0.0;
+  fit_.fisher_information = information_requested ? information_.sum() : 0.0;
+}
+
+const OutputErrorFit& OutputErrorModulusObjective::Predict(double modulus,
+                                                           bool gradient_requested) {
+  Solve(modulus, gradient_requested, gradient_requested);
   fit_.outputs = objective_.outputs();
   fit_.support_forces = objective_.support_forces();
   return fit_;
@@ -45,7 +51,8 @@ bool OutputErrorModulusObjective::Evaluate(const double* parameters, double* cos
                                            double* gradient) {
   double modulus = 0.0;
   if (!TrialModulus(parameters[0], modulus_scale_, &modulus, &error_message_)) return false;
-  const OutputErrorFit& fit = Predict(modulus, gradient != nullptr);
+  Solve(modulus, gradient != nullptr, false);
+  const OutputErrorFit& fit = fit_;
   if (!std::isfinite(fit.cost) || !std::isfinite(fit.cost_gradient)) {
     std::ostringstream why;
     why << "the output-error misfit at E = " << modulus << " Pa is not finite";
@@ -59,15 +66,17 @@ bool OutputErrorModulusObjective::Evaluate(const double* parameters, double* cos
 }
 
 double OutputErrorModulusObjective::ValleySpacing() {
-  const OutputErrorFit& fit = Predict(modulus_scale_, false);
-  const Eigen::Index sensors = fit.outputs.rows();
-  const Eigen::Index supports = fit.support_forces.rows();
-  Matrix traces(sensors + supports, fit.outputs.cols());
-  traces.topRows(sensors) = fit.outputs;
-  traces.bottomRows(supports) = fit.support_forces;
+  Solve(modulus_scale_, false, false);
+  const Matrix& outputs = objective_.outputs();
+  const Matrix& support_forces = objective_.support_forces();
+  const Eigen::Index sensors = outputs.rows();
+  const Eigen::Index supports = support_forces.rows();
+  Matrix traces(sensors + supports, outputs.cols());
+  traces.topRows(sensors) = outputs;
+  traces.bottomRows(supports) = support_forces;
   Vector weights(sensors + supports);
   weights.head(sensors) = objective_.sensor_weights();
-  weights.tail(supports).setConstant(1.0 / (misfit_levels_.force_std * misfit_levels_.force_std));
+  weights.tail(supports).setConstant(objective_.force_weight());
   return PredictedValleySpacing(traces, weights, data_.time_step);
 }
 

@@ -92,6 +92,8 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
   const Matrix& support_forces() const { return support_forces_; }
   // w_k [1/m^2 or 1], per sensor in the model's order.
   const Vector& sensor_weights() const { return weights_; }
+  // w_f = 1 / s_f^2 [1/N^2] of the supports' forces (0 without supports).
+  double force_weight() const { return force_weight_; }
   // J_rest = 1/2 sum_j c_j h [sum_k w_k d~_kj^2 + w_f sum_s f~_sj^2] [s]; the cost scale
   // (1 when J_rest = 0).
   double rest_cost() const { return rest_cost_; }

@@ -61,6 +61,11 @@ class OutputErrorModulusObjective : public ModulusObjective {
   double cost_scale() const { return objective_.cost_scale(); }
 
  private:
+  // J at E [Pa] into fit_.cost, and dJ/dE (with gradient_requested) and the Fisher
+  // information (with information_requested, which needs the gradient) into fit_; the
+  // outputs stay in objective_ (Predict copies them, an evaluation does not).
+  void Solve(double modulus, bool gradient_requested, bool information_requested);
+
   const MatrixModelData& model_;
   const ChannelSet& data_;
   NoiseLevels misfit_levels_;
