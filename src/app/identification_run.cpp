@@ -337,27 +337,19 @@ IdentificationRun RunIdentification(const Config& config, const ChannelSet& data
 
 ErrorMap BarErrorMap(const Config& config, const IdentificationRun& run) {
   const BarModel model(config.model);
-  const int stride = SpaceTimeStride(run.data.num_steps());
   // The shares and the picture on the exported bar's elements, which are the bar's: from
   // the stored W, or as the streaming solver summed and sampled them while W passed. Its
   // picture is the gap energy of an element [J], the bar's per length [J/m].
   if (run.solution.has_fields()) {
-    const MatrixModelData& matrices = *run.model;
-    const Vector moduli = Vector::Constant(1, run.identified_modulus());
-    const Matrix& retrograde = run.solution.retrograde;
-    Matrix density(run.data.num_steps() / stride + 1, ElementColumnPositions(matrices).size());
-    Vector row(density.cols());
-    for (int i = 0; i < density.rows(); ++i) {
-      SampleElementGapDensity(matrices, moduli, retrograde.col(i * stride).data(), row.data());
-      density.row(i) = row.transpose() / model.element_length();
-    }
-    return AssembleErrorMap(model,
-                            MatrixElementGapShares(matrices, moduli, retrograde, config.time.step),
-                            density, stride, config.time.step);
+    const ErrorMap elements =
+        ComputeElementErrorMap(*run.model, Vector::Constant(1, run.identified_modulus()),
+                               run.solution.retrograde, config.time.step);
+    return AssembleErrorMap(model, elements.share, elements.density / model.element_length(),
+                            SpaceTimeStride(run.data.num_steps()), config.time.step);
   }
   return AssembleErrorMap(model, run.solution.element_error_map,
-                          run.solution.gap_density / model.element_length(), stride,
-                          config.time.step);
+                          run.solution.gap_density / model.element_length(),
+                          SpaceTimeStride(run.data.num_steps()), config.time.step);
 }
 
 NoiseLevels MeasurementNoiseLevels(const Config& config, const ChannelSet& data,
