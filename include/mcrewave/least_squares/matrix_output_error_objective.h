@@ -8,7 +8,7 @@
 //                                  + w_f sum_s (r_s,j - f~_sj)^2]      [s],
 //
 // c_j the trapezoidal weights (c_0 = c_m = 1/2, else 1). Each sensor is normalised by
-// the misfit level of its kind, the bar's convention (ZoneOutputErrorObjective):
+// the misfit level of its kind, the bar's convention (docs/comparator.md):
 // w_k = 1 / s_u^2 for a displacement row, 1 / s_e^2 for a strain row, and a support's
 // force by w_f = 1 / s_f^2 (NoiseLevels; the loads are inputs, taken as exact).
 //

@@ -1,13 +1,13 @@
-#include "mcrewave/least_squares/output_error_objective.h"
+#include "reference/bar_least_squares.h"
 
 #include <cassert>
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 
 #include "mcrewave/optim/valley_spacing.h"
 
 namespace mcrewave {
+namespace testing {
 
 void OutputErrorSensorRows(const BarModel& model, const ChannelSet& data, const NoiseLevels& noise,
                            std::vector<ObservationRow>* rows, std::vector<double>* weights) {
@@ -58,9 +58,9 @@ double OutputErrorRestCost(const ChannelSet& data, const NoiseLevels& noise,
   return rest_cost;
 }
 
-OutputErrorObjective::OutputErrorObjective(const BarModel& model, const ChannelSet& data,
-                                           const NoiseLevels& noise, double theta,
-                                           double modulus_scale, EndDisplacementChannels ends)
+BarLeastSquares::BarLeastSquares(const BarModel& model, const ChannelSet& data,
+                                 const NoiseLevels& noise, double theta, double modulus_scale,
+                                 EndDisplacementChannels ends)
     : model_(model),
       data_(data),
       measured_(BarEndChannels(data)),
@@ -94,12 +94,7 @@ OutputErrorObjective::OutputErrorObjective(const BarModel& model, const ChannelS
   rest_cost_ = OutputErrorRestCost(data, noise, sensor_weights_, ends_);
 }
 
-std::unique_ptr<ModulusObjective> OutputErrorObjective::CloneForScan(double) const {
-  return std::make_unique<OutputErrorObjective>(model_, data_, noise_, theta_, modulus_scale_,
-                                                ends_);
-}
-
-double OutputErrorObjective::ValleySpacing() {
+double BarLeastSquares::ValleySpacing() {
   const OutputErrorPrediction& prediction = Predict(modulus_scale_, false);
   const int channels = 2 + static_cast<int>(prediction.sensors.size());
   Matrix traces(channels, prediction.f0.size());
@@ -115,8 +110,7 @@ double OutputErrorObjective::ValleySpacing() {
   return PredictedValleySpacing(traces, weights, data_.time_step);
 }
 
-const OutputErrorPrediction& OutputErrorObjective::Predict(double modulus,
-                                                           bool gradient_requested) {
+const OutputErrorPrediction& BarLeastSquares::Predict(double modulus, bool gradient_requested) {
   assert(modulus > 0.0 && std::isfinite(modulus));
   ThetaIntegratorOptions options;
   options.time_step = data_.time_step;
@@ -204,20 +198,5 @@ const OutputErrorPrediction& OutputErrorObjective::Predict(double modulus,
   return prediction_;
 }
 
-bool OutputErrorObjective::Evaluate(const double* parameters, double* cost, double* gradient) {
-  double modulus = 0.0;
-  if (!TrialModulus(parameters[0], modulus_scale_, &modulus, &error_message_)) return false;
-  const OutputErrorPrediction& prediction = Predict(modulus, gradient != nullptr);
-  if (!std::isfinite(prediction.cost) || !std::isfinite(prediction.cost_gradient)) {
-    std::ostringstream why;
-    why << "the output-error misfit at E = " << modulus << " Pa is not finite";
-    error_message_ = why.str();
-    return false;
-  }
-  *cost = prediction.cost / cost_scale();
-  if (gradient != nullptr) gradient[0] = prediction.cost_gradient * modulus_scale_ / cost_scale();
-  error_message_.clear();
-  return true;
-}
-
+}  // namespace testing
 }  // namespace mcrewave

@@ -1,8 +1,8 @@
-// Output-error least squares with zone moduli on the built-in bar, the tests'
-// independent reference for MatrixOutputErrorObjective on the bar exported as matrices,
-// which the zone identification uses (docs/zones_and_sensors.md, "Zones: the MCRE
-// against least squares"):
-// OutputErrorObjective's misfit (output_error_objective.h) with K = sum_z E_z K1_z,
+// Output-error least squares with zone moduli on the built-in bar's own band model: the
+// tests' independent reference for MatrixOutputErrorObjective on the bar exported as
+// matrices, which the zone identification uses (docs/zones_and_sensors.md, "Zones: the
+// MCRE against least squares"). The library held it as its bar road until issue 39.
+// BarLeastSquares' misfit (bar_least_squares.h) with K = sum_z E_z K1_z,
 //
 //   J(E_1..E_Z) = 1/2 sum_k c_k h sum_channels (y_k - y~_k)^2 / s^2      [s].
 //
@@ -10,9 +10,7 @@
 // with the input -K1_z,r (theta u_{k+1} + (1 - theta) u_k), and
 //   df0_k/dE_z = M_01 da_1 + K_01 s_z,1 + K1_z,01 u_1,   M_r da = -K_r s_z - K1_z,r u:
 // one sweep per evaluation without the gradient, 1 + Z with it (for the few zones of a
-// localisation, not one zone per element). Seen by the optimisers
-// (optim/log_moduli_objective.h) as a function of p_z = log(E_z / modulus_scale), with
-// J_scale = J_rest (OutputErrorRestCost).
+// localisation, not one zone per element). J_rest: OutputErrorRestCost.
 #pragma once
 
 #include <string>
@@ -22,37 +20,31 @@
 #include "mcrewave/data/measurement.h"
 #include "mcrewave/linalg/band_matrix.h"
 #include "mcrewave/linalg/theta_integrator.h"
-#include "mcrewave/mcre/mcre_problem.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/model/bar_model.h"
-#include "mcrewave/optim/log_moduli_objective.h"
+#include "mcrewave/model/matrix_export.h"
 
 namespace mcrewave {
+namespace testing {
 
-class ZoneOutputErrorObjective : public LogModuliObjective {
+class BarZoneLeastSquares {
  public:
-  // Keeps references to model and data: both must outlive the objective. model: the
+  // Keeps references to model and data: both must outlive the reference. model: the
   // identification's zones (one or more). noise: the levels s_u, s_f, s_e of the
   // misfit's normalisation (> 0 for every kind the data hold). ends: whether uL
-  // enters (u0 never does: it is zero in the clamped model). theta in [0, 1],
-  // modulus_scale > 0 [Pa].
-  ZoneOutputErrorObjective(const BarModel& model, const ChannelSet& data, const NoiseLevels& noise,
-                           double theta, double modulus_scale, EndDisplacementChannels ends = {});
+  // enters (u0 never does: it is zero in the clamped model). theta in [0, 1].
+  BarZoneLeastSquares(const BarModel& model, const ChannelSet& data, const NoiseLevels& noise,
+                      double theta, EndDisplacementChannels ends = {});
 
-  // J at the zone moduli [s] (num_parameters() entries [Pa], positive), and dJ/dE_z
-  // [s / Pa] into *gradient when it is not null (resized to num_parameters()). Re-initialises the
+  // J at the zone moduli [s] (one per zone [Pa], positive), and dJ/dE_z
+  // [s / Pa] into *gradient when it is not null (resized to the zone count). Re-initialises the
   // integrator (the moduli change K). No allocation in the time loop.
   double Cost(const Vector& zone_moduli, Vector* gradient);
 
   // J_rest [s]; the cost scale (1 when J_rest = 0).
   double rest_cost() const { return rest_cost_; }
-  double cost_scale() const override { return rest_cost_ > 0.0 ? rest_cost_ : 1.0; }
+  double cost_scale() const { return rest_cost_ > 0.0 ? rest_cost_ : 1.0; }
   long sweeps() const { return sweeps_; }
-
- protected:
-  // J and dJ/dE_z by Cost; logs one line per usable evaluation.
-  bool ModuliCost(const Vector& moduli, double* cost, Vector* gradient, std::string* why) override;
-  void OnEvaluated(const Vector& moduli, double cost, double gradient_norm) override;
 
  private:
   const BarModel& model_;
@@ -86,4 +78,5 @@ class ZoneOutputErrorObjective : public LogModuliObjective {
   long sweeps_ = 0;
 };
 
+}  // namespace testing
 }  // namespace mcrewave

@@ -1,22 +1,19 @@
-#include "mcrewave/least_squares/zone_output_error_objective.h"
-
-#include <spdlog/spdlog.h>
+#include "reference/bar_zone_least_squares.h"
 
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <stdexcept>
 
-#include "mcrewave/least_squares/output_error_objective.h"
+#include "reference/bar_least_squares.h"
 
 namespace mcrewave {
+namespace testing {
 
-ZoneOutputErrorObjective::ZoneOutputErrorObjective(const BarModel& model, const ChannelSet& data,
-                                                   const NoiseLevels& noise, double theta,
-                                                   double modulus_scale,
-                                                   EndDisplacementChannels ends)
-    : LogModuliObjective(Vector::Constant(model.num_zones(), modulus_scale)),
-      model_(model),
+BarZoneLeastSquares::BarZoneLeastSquares(const BarModel& model, const ChannelSet& data,
+                                         const NoiseLevels& noise, double theta,
+                                         EndDisplacementChannels ends)
+    : model_(model),
       data_(data),
       measured_(BarEndChannels(data)),
       sensor_data_(BarSensorValues(data)),
@@ -27,7 +24,7 @@ ZoneOutputErrorObjective::ZoneOutputErrorObjective(const BarModel& model, const 
       weight_f_(1.0 / (noise.force_std * noise.force_std)),
       free_mass_(BarModel::ClampedBlock(model.mass())),
       mass_01_(model.mass().coeff(0, 1)) {
-  assert(theta >= 0.0 && theta <= 1.0 && modulus_scale > 0.0);
+  assert(theta >= 0.0 && theta <= 1.0);
   assert(data.num_steps() >= 1 && noise.displacement_std > 0.0 && noise.force_std > 0.0);
   if (!mass_factor_.Compute(SymmetricBandMatrix(free_mass_))) {
     throw std::runtime_error("output-error model: the mass matrix is not positive definite");
@@ -53,7 +50,7 @@ ZoneOutputErrorObjective::ZoneOutputErrorObjective(const BarModel& model, const 
   rest_cost_ = OutputErrorRestCost(data, noise, sensor_weights_, ends_);
 }
 
-double ZoneOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradient) {
+double BarZoneLeastSquares::Cost(const Vector& zone_moduli, Vector* gradient) {
   assert(zone_moduli.size() == num_zones_ && zone_moduli.allFinite() &&
          zone_moduli.minCoeff() > 0.0);
   ThetaIntegratorOptions options;
@@ -136,19 +133,5 @@ double ZoneOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradien
   return cost;
 }
 
-bool ZoneOutputErrorObjective::ModuliCost(const Vector& moduli, double* cost, Vector* gradient,
-                                          std::string* why) {
-  (void)why;  // the misfit is always had; Evaluate tests that it is finite
-  *cost = Cost(moduli, gradient);
-  return true;
-}
-
-void ZoneOutputErrorObjective::OnEvaluated(const Vector& moduli, double cost,
-                                           double gradient_norm) {
-  spdlog::info(
-      "least-squares zones evaluation {}: J / J_rest = {:.10g}, |grad|_inf = {:.3g}, E in "
-      "[{:.6g}, {:.6g}] GPa",
-      evaluations(), cost, gradient_norm, moduli.minCoeff() * 1e-9, moduli.maxCoeff() * 1e-9);
-}
-
+}  // namespace testing
 }  // namespace mcrewave

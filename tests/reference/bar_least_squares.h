@@ -1,7 +1,9 @@
-// Output-error least squares (finite-element model updating, FEMU) on the built-in bar,
-// the tests' independent reference for OutputErrorModulusObjective on the bar exported
-// as matrices, which identify run and the studies use (docs/formulation.md section 8,
-// docs/comparator.md): the bar clamped at
+// Output-error least squares (finite-element model updating, FEMU) on the built-in bar's
+// own band model: the tests' independent reference for OutputErrorModulusObjective and
+// MatrixOutputErrorObjective on the bar exported as matrices, which identify run and the
+// studies use (docs/formulation.md section 8, docs/comparator.md). The library held it
+// as its bar road until issue 39; it lives here as the other code path the objectives
+// on the one road are checked against. The bar clamped at
 // x = 0 (u_0 = 0), driven at x = L by the measured fL~ in the theta scheme of
 // linalg/theta_integrator.h, its predicted outputs against the other measured channels,
 // each kind normalised by its noise level:
@@ -15,11 +17,10 @@
 // f0_k = row_0(M a_k + K u_k), M_r a_k = fL~_k e_N - K_r u_k (as model/simulation.h
 // makes the synthetic f0). dJ/dE comes from the forward sensitivity du_k/dE, which obeys
 // the same scheme with the input -K1 (theta u_{k+1} + (1 - theta) u_k): two sweeps per
-// evaluation with the gradient, one without, no inner iteration. The optimisers see
-// J / J_rest (J_rest: every prediction 0) and dJ/dx / J_rest, x = E / modulus_scale.
+// evaluation with the gradient, one without, no inner iteration. J_rest: J with every
+// prediction 0.
 #pragma once
 
-#include <memory>
 #include <string>
 #include <vector>
 
@@ -27,12 +28,12 @@
 #include "mcrewave/data/measurement.h"
 #include "mcrewave/linalg/band_matrix.h"
 #include "mcrewave/linalg/theta_integrator.h"
-#include "mcrewave/mcre/mcre_problem.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
-#include "mcrewave/mcre/objective.h"
 #include "mcrewave/model/bar_model.h"
+#include "mcrewave/model/matrix_export.h"
 
 namespace mcrewave {
+namespace testing {
 
 // The outputs of the clamped model at one modulus, on the data's samples.
 struct OutputErrorPrediction {
@@ -68,26 +69,19 @@ double ClampReaction(const SymmetricBandMatrix& stiffness, const BandLdlt& mass_
                      double mass_01, double stiffness_01, const Vector& displacement, double fL,
                      Vector* acceleration);
 
-class OutputErrorObjective : public ModulusObjective {
+class BarLeastSquares {
  public:
-  // Keeps references to model and data: both must outlive the objective. The
+  // Keeps references to model and data: both must outlive the reference. The
   // model must have one zone. noise: the levels s_u, s_f, s_e of the misfit's
   // normalisation (> 0 for every kind the data hold). ends: whether uL enters
   // (ends.uL; u0 never does). theta in [0, 1], modulus_scale > 0 [Pa].
-  OutputErrorObjective(const BarModel& model, const ChannelSet& data, const NoiseLevels& noise,
-                       double theta, double modulus_scale, EndDisplacementChannels ends = {});
+  BarLeastSquares(const BarModel& model, const ChannelSet& data, const NoiseLevels& noise,
+                  double theta, double modulus_scale, EndDisplacementChannels ends = {});
 
-  double modulus_scale() const override { return modulus_scale_; }
-  // cost = J(E) / cost_scale(), gradient = dJ/dE modulus_scale / cost_scale() at
-  // E = x modulus_scale. False when x is not a positive finite number or J is not
-  // finite (the reason in error_message()).
-  bool Evaluate(const double* parameters, double* cost, double* gradient) override;
-  std::string error_message() const override { return error_message_; }
-  std::unique_ptr<ModulusObjective> CloneForScan(double inner_tolerance) const override;
-  long sweeps() const override { return sweeps_; }
-  // From the predicted outputs (uL, f0, the sensors) at E = modulus_scale, weighted
-  // by 1 / s^2 of their kind: one sweep.
-  double ValleySpacing() override;
+  long sweeps() const { return sweeps_; }
+  // PredictedValleySpacing (optim/valley_spacing.h) of the predicted outputs (uL, f0,
+  // the sensors) at E = modulus_scale, weighted by 1 / s^2 of their kind: one sweep.
+  double ValleySpacing();
 
   // Simulates the clamped model at E [Pa] (> 0): predictions and J, and dJ/dE when
   // gradient_requested. Re-initialises the integrator (E changes K).
@@ -124,7 +118,7 @@ class OutputErrorObjective : public ModulusObjective {
   OutputErrorPrediction prediction_;
   double rest_cost_ = 0.0;
   long sweeps_ = 0;
-  std::string error_message_;
 };
 
+}  // namespace testing
 }  // namespace mcrewave
