@@ -307,6 +307,24 @@ TEST(IdentifyRunTest, MeasuredCsvConfigFindsTheModulusTheFileWasMadeWith) {
             std::string::npos);
 }
 
+// Sensors named with trailing zeros are the data's channels under those names: the run
+// gives the same bits as with the shortest names (it once looked for u@0.5 in data
+// holding u@0.50 and stopped).
+TEST(IdentifyRunTest, SensorNamesWithTrailingZerosGiveTheSameModulus) {
+  std::string modulus[2];
+  const std::string sensors[2] = {"[u@0.5, e@0.25]", "[u@0.50, e@0.250]"};
+  for (int i = 0; i < 2; ++i) {
+    const std::string folder =
+        FreshDirectory("identify_run_sensor_names_" + std::to_string(i)) + "/results";
+    const RunResult run = RunIdentify(
+        "run " + SourcePath("configs/quick.yaml") +
+        " --set output.figures=false --set 'data.sensors=" + sensors[i] + "' -o " + folder);
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    modulus[i] = TopLevelValues(ReadText(folder + "/summary.yaml")).at("identified_modulus");
+  }
+  EXPECT_EQ(modulus[0], modulus[1]);
+}
+
 // configs/paper_bar_pinned.yaml (the paper's case, SNR 2.5, seed 1): the pinned
 // clamp's cost has one valley, so its scan takes 4 samples per predicted spacing
 // (measured: 16 points, spacing 0.39 in ln E, one valley, E +1.54e-4 against the

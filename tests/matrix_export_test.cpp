@@ -83,6 +83,28 @@ TEST(MatrixExportTest, TheBarReadsBackExactly) {
             1e-15 * Matrix(expected).cwiseAbs().maxCoeff());
 }
 
+// BarRunModel names each interior sensor as its data channel: a name with trailing
+// zeros keeps them, and two positions that print alike in 6 digits stay two sensors.
+TEST(MatrixExportTest, TheRunsBarNamesItsSensorsAsTheDataDo) {
+  const BarModel model = ThreeZoneBar();
+  ChannelSet data;
+  data.time_step = 1e-6;
+  for (const std::string name :
+       {"u0", "uL", "f0", "fL", "u@0.50", "u@0.123456", "u@0.1234561", "e@0.650"}) {
+    data.channels.push_back({name, ChannelKind::kDisplacement, Vector::Zero(3)});
+  }
+  const MatrixModelData matrices = BarRunModel(model, data, {});
+  ASSERT_EQ(matrices.sensors.size(), 5u);
+  const std::vector<std::string> names = {"uL", "u@0.50", "u@0.123456", "u@0.1234561", "e@0.650"};
+  for (std::size_t i = 0; i < names.size(); ++i) EXPECT_EQ(matrices.sensors[i].channel, names[i]);
+  EXPECT_EQ(matrices.sensors[4].kind, SensorKind::kStrain);
+  // Each row is the bar's own at its position (the two close ones differ).
+  const ObservationRow close = model.DisplacementRow(0.1234561);
+  const SparseMatrix expected = ObservationRowMatrix(close, model.num_nodes());
+  EXPECT_EQ(MaxDifference(matrices.sensors[3].row, expected), 0.0);
+  EXPECT_GT(MaxDifference(matrices.sensors[2].row, matrices.sensors[3].row), 0.0);
+}
+
 // The bar through its files and the sparse path against the built-in bar and its
 // tridiagonal path: 1000 steps of an end load.
 TEST(MatrixExportTest, TheExportedBarIntegratesLikeTheBuiltInBar) {

@@ -783,8 +783,15 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
 
 MatrixModelData BarRunModel(const BarModel& model, const ChannelSet& data,
                             EndDisplacementChannels ends) {
+  const std::vector<BarSensor> sensors = BarSensors(data);
   MatrixModelData matrices =
-      BarMatrixModel(model, model.properties().modulus, BarSensors(data), BarClampExport::kSupport);
+      BarMatrixModel(model, model.properties().modulus, sensors, BarClampExport::kSupport);
+  // The interior sensors follow uL, in the data's order: each takes its data channel's
+  // own name (u@0.50 stays u@0.50; positions that print alike stay apart).
+  for (std::size_t i = 0; i < sensors.size(); ++i) {
+    matrices.sensors[1 + i].channel =
+        data.channels[static_cast<std::size_t>(sensors[i].index)].name;
+  }
   if (!ends.uL) {
     matrices.sensors.erase(
         std::find_if(matrices.sensors.begin(), matrices.sensors.end(),

@@ -143,8 +143,8 @@ struct EndDisplacementChannels {
 // The bar of an identification as the structure every MCRE and least-squares solve of
 // a bar's run takes (least squares holds its clamp): BarMatrixModel of `model` (its
 // zones) at its modulus, with the clamp the support "clamp" at node 0 (its channels f0
-// and u0), the sensors uL and those of `data` (BarSensors, named from their parsed
-// positions); without uL (u0) when ends.uL (ends.u0) is false.
+// and u0), the sensors uL and those of `data` (BarSensors, each named as its data
+// channel); without uL (u0) when ends.uL (ends.u0) is false.
 MatrixModelData BarRunModel(const BarModel& model, const ChannelSet& data,
                             EndDisplacementChannels ends);
 
