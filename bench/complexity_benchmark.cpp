@@ -36,6 +36,8 @@
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/core/operation_counts.h"
 #include "mcrewave/mcre/coupled_solver.h"
+#include "mcrewave/mcre/matrix_mcre_problem.h"
+#include "mcrewave/model/matrix_export.h"
 #include "mcrewave/model/simulation.h"
 
 namespace mcrewave {
@@ -151,7 +153,8 @@ struct RunResult {
 
 RunResult RunOnce(const CoupledSolverOptions& options, const BarModel& model,
                   const ChannelSet& data, double reference_modulus) {
-  McreProblem problem(model, data, McreWeights(), reference_modulus, 0.5);
+  const MatrixModelData matrices = BarRunModel(model, data, {});
+  MatrixMcreProblem problem(matrices, data, McreWeights(), reference_modulus, 0.5);
   problem.SetModulus(0.9 * reference_modulus);
   RunResult result;
   int repeats = 0;
@@ -314,7 +317,8 @@ std::string ShootingBreakdownScan() {
     const ChannelSet data = MakeSyntheticMeasurements(bar, load, time, data_options);
     McreWeights weights;
     weights.displacement_weight = window.w_u;
-    McreProblem problem(model, data, weights, bar.modulus, window.theta);
+    const MatrixModelData matrices = BarRunModel(model, data, {});
+    MatrixMcreProblem problem(matrices, data, weights, bar.modulus, window.theta);
     problem.SetModulus(0.9 * bar.modulus);
     for (CoupledSolverType type :
          {CoupledSolverType::kSingleShooting, CoupledSolverType::kMultipleShooting,

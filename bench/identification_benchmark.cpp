@@ -38,7 +38,9 @@
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/data/prefilter.h"
+#include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/mcre/objective.h"
+#include "mcrewave/model/matrix_export.h"
 #include "mcrewave/optim/identification.h"
 
 namespace {
@@ -94,8 +96,10 @@ struct SweepStepTimes {
 
 SweepStepTimes SweepStepSeconds(const mcrewave::Config& config, const mcrewave::ChannelSet& data) {
   const mcrewave::BarModel model(config.model);
-  mcrewave::McreProblem problem(model, data, config.mcre.weights, config.mcre.reference_modulus,
-                                config.time.theta, {}, config.mcre.clamp);
+  const mcrewave::MatrixModelData matrices = mcrewave::BarRunModel(model, data, {});
+  mcrewave::MatrixMcreProblem problem(matrices, data, config.mcre.weights,
+                                      config.mcre.reference_modulus, config.time.theta,
+                                      mcrewave::Factorization::kAutomatic, config.mcre.clamp);
   problem.SetModulus(config.model.modulus);
   mcrewave::Matrix retrograde = problem.ZeroField(), displacement;
   problem.DirectSweep(retrograde, true, &displacement);

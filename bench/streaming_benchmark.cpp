@@ -1,5 +1,6 @@
 // Peak memory and time of one coupled solve, stored-field conjugate gradients
-// against the streaming solver (docs/streaming.md), against the number of nodes n
+// against the streaming solver (docs/streaming.md), on the bar as every run solves it
+// (BarRunModel, MatrixMcreProblem), against the number of nodes n
 // (paper's bar scaled at its Courant number c h / h_e = 0.57, 1750 steps) and against
 // the number of steps m (101 nodes, window m h). Data: the finite-element truth on the
 // model's grid with noise at SNR 10; the solve at 0.95 E_ref from W = 0, tolerance
@@ -31,8 +32,9 @@
 #include <vector>
 
 #include "mcrewave/mcre/coupled_solver.h"
-#include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/mcre/objective.h"
+#include "mcrewave/model/matrix_export.h"
 #include "mcrewave/model/simulation.h"
 
 namespace {
@@ -90,8 +92,9 @@ Measured SolveOnce(const BarModel& model, const ChannelSet& data, CoupledSolverT
   const long before = ResidentBytes();
   Measured measured;
   {
-    McreProblem problem(model, data, formulation.weights, formulation.reference_modulus, 0.5, {},
-                        formulation.clamp);
+    const MatrixModelData matrices = BarRunModel(model, data, {});
+    MatrixMcreProblem problem(matrices, data, formulation.weights, formulation.reference_modulus,
+                              0.5, Factorization::kAutomatic, formulation.clamp);
     problem.SetModulus(0.95 * 200e9);
     const auto start = std::chrono::steady_clock::now();
     CoupledSolution solution;

@@ -27,6 +27,8 @@
 
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/mcre/coupled_solver.h"
+#include "mcrewave/mcre/matrix_mcre_problem.h"
+#include "mcrewave/model/matrix_export.h"
 #include "mcrewave/model/simulation.h"
 
 namespace {
@@ -45,7 +47,8 @@ double GridFactor(int i) { return kGridLow + (kGridHigh - kGridLow) * i / (kGrid
 
 CurveFacts CostCurve(const mcrewave::BarModel& model, const mcrewave::ChannelSet& data,
                      const mcrewave::McreWeights& weights, double reference) {
-  mcrewave::McreProblem problem(model, data, weights, reference, 0.5);
+  const mcrewave::MatrixModelData matrices = mcrewave::BarRunModel(model, data, {});
+  mcrewave::MatrixMcreProblem problem(matrices, data, weights, reference, 0.5);
   mcrewave::CoupledSolverOptions options;
   options.tolerance = 1e-10;
   CurveFacts facts;
@@ -133,7 +136,8 @@ int main(int argc, char** argv) {
     mcrewave::McreWeights weights;
     weights.displacement_weight = w_u;
     weights.force_weight = w_f;
-    mcrewave::McreProblem problem(model, data_sets[1], weights, reference, 0.5);
+    const mcrewave::MatrixModelData matrices = mcrewave::BarRunModel(model, data_sets[1], {});
+    mcrewave::MatrixMcreProblem problem(matrices, data_sets[1], weights, reference, 0.5);
     mcrewave::CoupledSolverOptions options;
     mcrewave::CoupledSolution solution;
     const auto cg = mcrewave::SolveCoupled(options, &problem, nullptr, &solution);

@@ -5,7 +5,7 @@
 // E_ref (unequal, so that the zone path runs), the CPU time of
 //   (a) one coupled solve from W = 0 with its cost and gradient (SolveCoupled: the
 //       inner solver of the config, then e^2 and every de^2/dE_z), and
-//   (b) the gradient pass alone (McreProblem::CostGradients on the solution),
+//   (b) the gradient pass alone (MatrixMcreProblem::CostGradients on the solution),
 // and the ratios to Z = 1. Goal (issue: zones): (a) at Z zones <= 1.1 x (a) at one
 // zone. Thread CPU times, the minimum over --repeats (default 5).
 //
@@ -25,7 +25,8 @@
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/data/prefilter.h"
 #include "mcrewave/mcre/coupled_solver.h"
-#include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/mcre/matrix_mcre_problem.h"
+#include "mcrewave/model/matrix_export.h"
 
 namespace {
 
@@ -47,8 +48,9 @@ Figures Measure(const mcrewave::Config& config, const mcrewave::ChannelSet& data
   ZoneLayout layout;
   layout.zone_count = zones;
   const BarModel model(config.model, layout.ElementZones(config.model));
-  McreProblem problem(model, data, config.mcre.weights, config.mcre.reference_modulus,
-                      config.time.theta, {}, config.mcre.clamp);
+  const MatrixModelData matrices = BarRunModel(model, data, {});
+  MatrixMcreProblem problem(matrices, data, config.mcre.weights, config.mcre.reference_modulus,
+                            config.time.theta, Factorization::kAutomatic, config.mcre.clamp);
   Vector moduli(zones);
   for (int z = 0; z < zones; ++z) moduli[z] = config.model.modulus * (1.0 + 1e-3 * (z % 3));
   problem.SetModuli(moduli);

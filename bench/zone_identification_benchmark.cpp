@@ -32,7 +32,7 @@
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/identification/zone_identification.h"
-#include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/mcre/matrix_mcre_problem.h"
 
 namespace {
 
@@ -98,8 +98,9 @@ mcrewave::Vector ReplaceBySoftZoneTruth(const mcrewave::Config& config,
     const double x = truth_model.element_midpoint(e) / config.model.length;
     truth[e] = (x > 0.6 && x < 0.7 ? 0.7 : 1.0) * config.model.modulus;
   }
-  McreProblem truth_problem(truth_model, *data, config.mcre.weights, config.mcre.reference_modulus,
-                            config.time.theta);
+  const MatrixModelData truth_matrices = BarRunModel(truth_model, *data, {});
+  MatrixMcreProblem truth_problem(truth_matrices, *data, config.mcre.weights,
+                                  config.mcre.reference_modulus, config.time.theta);
   truth_problem.SetModuli(truth);
   Matrix displacement;
   truth_problem.DirectSweep(truth_problem.ZeroField(), true, &displacement);

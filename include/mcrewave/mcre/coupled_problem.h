@@ -34,6 +34,9 @@ class CoupledProblem {
   int num_zones() const { return static_cast<int>(moduli().size()); }
   // Sets E_z (num_zones() entries, positive) and refactorises when they changed.
   virtual void SetModuli(const Vector& zone_moduli) = 0;
+  // Sets every zone's modulus to E [Pa] (> 0); num_zones() must be known (moduli() not
+  // empty).
+  void SetModulus(double modulus) { SetModuli(Vector::Constant(num_zones(), modulus)); }
 
   // A zero field of the problem's shape, n x (m + 1).
   Matrix ZeroField() const { return Matrix::Zero(num_nodes(), num_steps() + 1); }

@@ -103,7 +103,8 @@ class McreProblem : public StreamingCoupledProblem {
               double reference_modulus, double theta, EndDisplacementChannels ends = {},
               ClampModel clamp = ClampModel::kMeasured);
 
-  // Sets every zone's modulus to E [Pa] and refactorises the integrator (once per change).
+  // Sets every zone's modulus to E [Pa] and refactorises the integrator (once per change);
+  // hides CoupledProblem::SetModulus, since moduli() is empty until the first call.
   void SetModulus(double modulus);
   // Sets the zone moduli E_z [Pa] (model().num_zones() entries) and refactorises the
   // integrator when they changed: K = sum_z (E_z / E_nom) K_z, K_z = E_nom K1_z (E_nom
