@@ -20,11 +20,11 @@ namespace {
 
 using testing::kAddressSanitizer;
 
+using testing::BarRunProblem;
 using testing::Compare;
 using testing::kReferenceModulus;
 using testing::MakeSmallCase;
 using testing::Options;
-using testing::ProblemBundle;
 using testing::Solve;
 using testing::Solved;
 using testing::Weights;
@@ -80,8 +80,8 @@ class SolverAgreementTest : public ::testing::TestWithParam<AgreementCase> {};
 
 TEST_P(SolverAgreementTest, AgreesWithAllAtOnce) {
   const AgreementCase& param = GetParam();
-  ProblemBundle bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(param.w_u, 1.0), param.theta);
-  McreProblem& problem = bundle.problem;
+  BarRunProblem bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(param.w_u, 1.0), param.theta);
+  MatrixMcreProblem& problem = bundle.problem;
   problem.SetModulus(0.9 * kReferenceModulus);
   const Solved reference = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-8), &problem);
   ASSERT_TRUE(reference.summary.IsSolutionUsable()) << reference.summary.FullReport();
@@ -119,7 +119,7 @@ INSTANTIATE_TEST_SUITE_P(
                       AgreementCase{1.0, 0.75, CoupledSolverType::kAdaptiveRelaxation}));
 
 TEST(AllAtOnceSolverTest, RefusesAboveTheSizeLimitWithAClearMessage) {
-  ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
+  BarRunProblem bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
   CoupledSolverOptions options = Options(CoupledSolverType::kAllAtOnce, 1e-8);
   options.max_all_at_once_unknowns = 1000;
   const Solved solved = Solve(options, &bundle.problem);
@@ -132,7 +132,7 @@ TEST(AllAtOnceSolverTest, RefusesAboveTheSizeLimitWithAClearMessage) {
 }
 
 TEST(IterativeSolverTest, RefusesAboveTheFieldLimitWithTheBytesItWouldNeed) {
-  ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
+  BarRunProblem bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
   // 10 fields of 11 nodes x 51 steps' doubles: 44880 bytes.
   ASSERT_EQ(IterativeSolverFieldBytes(11, 50), 44880.0);
   for (const CoupledSolverType type :
@@ -159,7 +159,7 @@ TEST(IterativeSolverTest, RefusesAboveTheFieldLimitWithTheBytesItWouldNeed) {
 }
 
 TEST(IterativeSolverTest, ARefusalForTheFieldsNamesTheStreamingSolverAndTheLimit) {
-  ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
+  BarRunProblem bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
   CoupledSolverOptions options = Options(CoupledSolverType::kConjugateGradient, 1e-8);
   options.max_field_bytes = 44879;  // one byte below the 10 fields of 11 x 51 doubles
   const long sweeps = bundle.problem.sweep_count();
@@ -171,7 +171,8 @@ TEST(IterativeSolverTest, ARefusalForTheFieldsNamesTheStreamingSolverAndTheLimit
   // The ways out: the streaming solver (or auto, which takes it), the limit, the grid.
   EXPECT_NE(message.find("use inner.method: streaming_conjugate_gradient (or auto), which "
                          "stores no space-time field, raise inner.max_field_bytes, or use "
-                         "fewer elements or a shorter window"),
+                         "a coarser mesh (fewer dofs; the bar's model.elements), a shorter "
+                         "window or a larger time step"),
             std::string::npos)
       << message;
 }
@@ -219,8 +220,8 @@ TEST(AutoSolverTest, ResolvesToStoredFieldsWhenTheyFitAndToStreamingWhenTheyDoNo
 }
 
 TEST(AutoSolverTest, SolvesAsTheMethodItResolvesToAndReportsThatMethod) {
-  ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(0.01, 1.0));
-  McreProblem& problem = bundle.problem;
+  BarRunProblem bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(0.01, 1.0));
+  MatrixMcreProblem& problem = bundle.problem;
   problem.SetModulus(0.95 * kReferenceModulus);
   const Solved stored = Solve(Options(CoupledSolverType::kConjugateGradient, 1e-10), &problem);
   const Solved streamed =
@@ -251,7 +252,7 @@ TEST(AutoSolverTest, SolvesAsTheMethodItResolvesToAndReportsThatMethod) {
 }
 
 TEST(AllAtOnceSolverTest, RefusesAboveTheMemoryLimitWithTheBytesItWouldNeed) {
-  ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
+  BarRunProblem bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
   CoupledSolverOptions options = Options(CoupledSolverType::kAllAtOnce, 1e-8);
   options.max_all_at_once_bytes = 1000;
   const long sweeps = bundle.problem.sweep_count();
@@ -296,7 +297,7 @@ struct FixedPointResidual {
   double residual, rhs, floor;
 };
 
-FixedPointResidual Residual(McreProblem* problem, const Matrix& retrograde) {
+FixedPointResidual Residual(CoupledProblem* problem, const Matrix& retrograde) {
   Matrix scratch, rhs, image, data_response;
   problem->FixedPointMap(problem->ZeroField(), &scratch, &rhs);
   problem->FixedPointMap(retrograde, &scratch, &image);
@@ -306,8 +307,8 @@ FixedPointResidual Residual(McreProblem* problem, const Matrix& retrograde) {
 }
 
 TEST(AllAtOnceSolverTest, ReportsTheResidualOfTheOtherSolversAndClaimsNoMoreThanItMeets) {
-  ProblemBundle bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(1.0, 1.0));
-  McreProblem& problem = bundle.problem;
+  BarRunProblem bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(1.0, 1.0));
+  MatrixMcreProblem& problem = bundle.problem;
   problem.SetModulus(0.9 * kReferenceModulus);
   const Solved solved = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-8), &problem);
   ASSERT_TRUE(solved.summary.IsSolutionUsable()) << solved.summary.FullReport();
@@ -329,8 +330,8 @@ TEST(AllAtOnceSolverTest, FailsWhenItsSolutionMissesTheToleranceThoughTheLuResid
   // w_u / w_f = 1e28: the space-time system is so ill-conditioned that its LU
   // solution, with a residual at round-off, is 1e-3 from a fixed point of the
   // sweeps (10 elements, 50 steps).
-  ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 2), Weights(1e14, 1e-14));
-  McreProblem& problem = bundle.problem;
+  BarRunProblem bundle(MakeSmallCase(10, 50, 5.0, 2), Weights(1e14, 1e-14));
+  MatrixMcreProblem& problem = bundle.problem;
   problem.SetModulus(0.9 * kReferenceModulus);
   const Solved solved = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-8), &problem);
   const std::string& message = solved.summary.message;
@@ -361,7 +362,7 @@ TEST_P(AllAtOnceMemoryTest, EstimateBoundsTheFactorsAndThePeak) {
   const auto [mass, theta] = GetParam();
   testing::SmallCase small = MakeSmallCase(20, 400, 5.0, 1);
   small.bar.mass = mass;
-  ProblemBundle bundle(small, Weights(1.0, 1.0), theta);
+  BarRunProblem bundle(small, Weights(1.0, 1.0), theta);
   bundle.problem.SetModulus(0.9 * kReferenceModulus);
   CoupledSolverOptions options = Options(CoupledSolverType::kAllAtOnce, 1e-8);
   options.max_all_at_once_bytes = 1;
@@ -392,8 +393,8 @@ INSTANTIATE_TEST_SUITE_P(MassAndTheta, AllAtOnceMemoryTest,
 
 TEST(CostCurveTest, InverseCrimeDataHaveTheirMinimumAtTheReferenceModulus) {
   // Data from the model's own discretisation, noise-free.
-  ProblemBundle bundle(MakeSmallCase(20, 400, kInfinity, 1), Weights(0.01, 1.0));
-  McreProblem& problem = bundle.problem;
+  BarRunProblem bundle(MakeSmallCase(20, 400, kInfinity, 1), Weights(0.01, 1.0));
+  MatrixMcreProblem& problem = bundle.problem;
   const CoupledSolverOptions options = Options(CoupledSolverType::kConjugateGradient, 1e-10);
   auto cost = [&](double factor) {
     problem.SetModulus(factor * kReferenceModulus);
@@ -422,8 +423,8 @@ TEST(CostCurveTest, ExactSolutionDataIdentifyTheModulusToItsDiscretisationBias) 
   // discretisation bias only.
   testing::SmallCase paper = MakeSmallCase(100, 1750, kInfinity, 1);
   paper.data.truth = TruthModel::kExact;
-  ProblemBundle bundle(paper, Weights(0.01, 1.0));
-  McreProblem& problem = bundle.problem;
+  BarRunProblem bundle(paper, Weights(0.01, 1.0));
+  MatrixMcreProblem& problem = bundle.problem;
   const CoupledSolverOptions options = Options(CoupledSolverType::kConjugateGradient, 1e-8);
   auto cost = [&](double factor) {
     problem.SetModulus(factor * kReferenceModulus);
@@ -452,11 +453,11 @@ class GradientTest : public ::testing::TestWithParam<double> {};
 
 TEST_P(GradientTest, AdjointGradientMatchesCentralDifference) {
   const double factor = GetParam();
-  ProblemBundle bundle(MakeSmallCase(16, 160, 5.0, 2), Weights(1.0, 1.0));
-  McreProblem& problem = bundle.problem;
+  BarRunProblem bundle(MakeSmallCase(16, 160, 5.0, 2), Weights(1.0, 1.0));
+  MatrixMcreProblem& problem = bundle.problem;
   // The all-at-once solver is exact to round-off, so the difference quotient
   // measures the discrete derivative only. This checks the formula de^2/dE =
-  // -(1/2) sum_j c_j h W_j^T K1 (W_j + 2 U_j) (McreProblem::CostGradient) against
+  // -(1/2) sum_j c_j h W_j^T K1 (W_j + 2 U_j) (MatrixMcreProblem::CostGradients) against
   // e^2 itself. Step 1e-6 E: measured 7e-12 to 3.5e-10 relative (with step 1e-4 E
   // the truncation error reached 6.3e-7).
   const CoupledSolverOptions options = Options(CoupledSolverType::kAllAtOnce, 1e-8);
@@ -480,8 +481,8 @@ TEST_P(GradientTest, AdjointGradientMatchesCentralDifference) {
 INSTANTIATE_TEST_SUITE_P(Moduli, GradientTest, ::testing::Values(0.7, 0.95, 1.05, 1.4));
 
 TEST(WarmStartTest, ASolveAfterAOnePercentChangeNeedsFewerSweeps) {
-  ProblemBundle bundle(MakeSmallCase(20, 300, 5.0, 2), Weights(1.0, 1.0));
-  McreProblem& problem = bundle.problem;
+  BarRunProblem bundle(MakeSmallCase(20, 300, 5.0, 2), Weights(1.0, 1.0));
+  MatrixMcreProblem& problem = bundle.problem;
   const CoupledSolverOptions options = Options(CoupledSolverType::kConjugateGradient, 1e-8);
   problem.SetModulus(kReferenceModulus);
   const Solved previous = Solve(options, &problem);
@@ -495,8 +496,8 @@ TEST(WarmStartTest, ASolveAfterAOnePercentChangeNeedsFewerSweeps) {
 
 TEST(DivergenceTest, PaperCaseWithOmegaOneIsReportedAsDivergingAndAdaptiveConverges) {
   // The paper's case (100 elements, 1750 steps), data from a finer truth with noise.
-  ProblemBundle bundle(MakeSmallCase(100, 1750, 10.0, 2), Weights(0.01, 1.0));
-  McreProblem& problem = bundle.problem;
+  BarRunProblem bundle(MakeSmallCase(100, 1750, 10.0, 2), Weights(0.01, 1.0));
+  MatrixMcreProblem& problem = bundle.problem;
   problem.SetModulus(0.9 * kReferenceModulus);
   CoupledSolverOptions options = Options(CoupledSolverType::kRelaxation, 1e-8);
   options.relaxation_coefficient = 1.0;
@@ -515,7 +516,7 @@ TEST(DivergenceTest, PaperCaseWithOmegaOneIsReportedAsDivergingAndAdaptiveConver
 }
 
 // A = I - G applied to x: 2 sweeps.
-Matrix ApplyReducedOperator(McreProblem* problem, const Matrix& x) {
+Matrix ApplyReducedOperator(CoupledProblem* problem, const Matrix& x) {
   Matrix scratch, image;
   problem->ApplyIterationMap(x, &scratch, &image);
   return x - image;
@@ -535,8 +536,8 @@ Matrix ApplyReducedOperator(McreProblem* problem, const Matrix& x) {
 // the component that round-off puts back grows until the safeguard re-chooses omega
 // (measured: 1 restart, a_max re-estimated at 342.6).
 TEST(AdaptiveRelaxationTest, SafeguardRestartsAfterAnUnderestimatedSpectrumAndConverges) {
-  ProblemBundle bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(1.0, 1.0));
-  McreProblem& problem = bundle.problem;
+  BarRunProblem bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(1.0, 1.0));
+  MatrixMcreProblem& problem = bundle.problem;
   problem.SetModulus(0.9 * kReferenceModulus);
   const Solved reference = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-8), &problem);
   ASSERT_TRUE(reference.summary.IsSolutionUsable()) << reference.summary.FullReport();
@@ -586,8 +587,8 @@ TEST(AdaptiveRelaxationTest, SafeguardRestartsAfterAnUnderestimatedSpectrumAndCo
 // The same accounting from a cold start: 3 sweeps (Direct(0); T(0) = c and W_u
 // batched), 2 per Lanczos step, 2 per iteration.
 TEST(AdaptiveRelaxationTest, SweepsAreStartLanczosAndTwoPerIteration) {
-  ProblemBundle bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(0.01, 1.0));
-  McreProblem& problem = bundle.problem;
+  BarRunProblem bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(0.01, 1.0));
+  MatrixMcreProblem& problem = bundle.problem;
   problem.SetModulus(0.9 * kReferenceModulus);
   CoupledSolverOptions options = Options(CoupledSolverType::kAdaptiveRelaxation, 1e-10);
   options.spectrum_estimation_steps = 5;
@@ -603,8 +604,8 @@ TEST(AdaptiveRelaxationTest, SweepsAreStartLanczosAndTwoPerIteration) {
 
 // The integrator is factorised once per (E, h): by SetModulus, never by a solve.
 TEST(FactorisationCountTest, OnePerModulusWhateverTheSolvesAtThatModulus) {
-  ProblemBundle bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(0.01, 1.0));
-  McreProblem& problem = bundle.problem;
+  BarRunProblem bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(0.01, 1.0));
+  MatrixMcreProblem& problem = bundle.problem;
   const int after_construction = problem.factorization_count();
   EXPECT_EQ(after_construction, 1);  // the constructor sets the reference modulus
 

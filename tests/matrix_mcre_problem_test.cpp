@@ -166,7 +166,8 @@ TEST_F(BarThroughMatricesTest, AutoStreamsTheBarAndTheMatricesWhenTheirFieldsDoN
             "conjugate_gradient needs 597680 bytes (10 fields of n x (m + 1) doubles, n "
             "= 31 nodes, m = 240 steps), above the limit of 597679 bytes (inner.max_field_bytes); "
             "use inner.method: streaming_conjugate_gradient (or auto), which stores no "
-            "space-time field, raise inner.max_field_bytes, or use a coarser mesh (fewer dofs), "
+            "space-time field, raise inner.max_field_bytes, or use a coarser mesh (fewer dofs; the "
+            "bar's model.elements), "
             "a shorter window or a larger time step");
 }
 

@@ -14,11 +14,11 @@
 namespace mcrewave {
 namespace {
 
+using testing::BarRunProblem;
 using testing::Compare;
 using testing::kReferenceModulus;
 using testing::MakeSmallCase;
 using testing::Options;
-using testing::ProblemBundle;
 using testing::RelativeDifference;
 using testing::SmallCase;
 using testing::Solve;
@@ -63,8 +63,8 @@ class RiccatiAgreementTest : public ::testing::TestWithParam<RiccatiCase> {};
 
 TEST_P(RiccatiAgreementTest, AgreesWithAllAtOnceToOneInOneHundredMillion) {
   const RiccatiCase& param = GetParam();
-  ProblemBundle bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(param.w_u, 1.0), param.theta);
-  McreProblem& problem = bundle.problem;
+  BarRunProblem bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(param.w_u, 1.0), param.theta);
+  MatrixMcreProblem& problem = bundle.problem;
   problem.SetModulus(0.9 * kReferenceModulus);
   const Solved reference = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-8), &problem);
   ASSERT_TRUE(reference.summary.IsSolutionUsable()) << reference.summary.FullReport();
@@ -90,8 +90,8 @@ INSTANTIATE_TEST_SUITE_P(WeightsAndTheta, RiccatiAgreementTest,
 
 TEST(RiccatiSolverTest, AgreesWithConjugateGradientsOnThePapersCase) {
   // 100 elements, 1750 steps (the paper's window), noisy data, default weights.
-  ProblemBundle bundle(MakeSmallCase(100, 1750, 10.0, 2), McreWeights());
-  McreProblem& problem = bundle.problem;
+  BarRunProblem bundle(MakeSmallCase(100, 1750, 10.0, 2), McreWeights());
+  MatrixMcreProblem& problem = bundle.problem;
   problem.SetModulus(0.9 * kReferenceModulus);
   const Solved krylov = Solve(Options(CoupledSolverType::kConjugateGradient, 1e-12), &problem);
   ASSERT_TRUE(krylov.summary.IsSolutionUsable()) << krylov.summary.FullReport();
@@ -129,8 +129,10 @@ TEST_P(DenseSolversOnTheBarTest, AgreeWithAllAtOnceAndConjugateGradients) {
   McreWeights weights = Weights(0.01, 1.0);
   weights.strain_weight = 0.003;
   weights.clamp_displacement_weight = 0.1;  // the pinned clamp's alpha_0
-  McreProblem problem(model, data, weights, kReferenceModulus, 0.5, {}, param.clamp);
-  ASSERT_GT(problem.num_interior_sensors(), 0);
+  const MatrixModelData matrices = BarRunModel(model, data, {});
+  MatrixMcreProblem problem(matrices, data, weights, kReferenceModulus, 0.5,
+                            Factorization::kAutomatic, param.clamp);
+  ASSERT_GT(matrices.sensors.size(), 1u);  // uL and the interior sensors
   problem.SetModuli((Vector(3) << 180e9, 210e9, 230e9).finished());
   testing::ExpectDenseSolversAgree(std::string("bar, clamp ") + ClampModelToString(param.clamp),
                                    &problem, param.tolerance, param.lu_bound, param.cg_bound);
@@ -146,7 +148,7 @@ INSTANTIATE_TEST_SUITE_P(
                       BarClampCase{ClampModel::kPinned, 60, 1e-10, 3e-11, 3e-9}));
 
 TEST(RiccatiSolverTest, RefusesAboveTheMemoryLimitWithTheBytesItNeeds) {
-  ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
+  BarRunProblem bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
   CoupledSolverOptions options = Options(CoupledSolverType::kRiccati, 1e-8);
   options.max_dense_solver_bytes = 100000;
   const Solved solved = Solve(options, &bundle.problem);

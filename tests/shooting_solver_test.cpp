@@ -13,11 +13,11 @@
 namespace mcrewave {
 namespace {
 
+using testing::BarRunProblem;
 using testing::Compare;
 using testing::kReferenceModulus;
 using testing::MakeSmallCase;
 using testing::Options;
-using testing::ProblemBundle;
 using testing::Solve;
 using testing::Solved;
 using testing::Weights;
@@ -33,9 +33,9 @@ class ShootingAgreementTest : public ::testing::TestWithParam<ShootingCase> {};
 
 TEST_P(ShootingAgreementTest, AgreesWithAllAtOnceToOneInOneHundredMillion) {
   const ShootingCase& param = GetParam();
-  ProblemBundle bundle(MakeSmallCase(20, param.steps, 5.0, 2), Weights(param.w_u, 1.0),
+  BarRunProblem bundle(MakeSmallCase(20, param.steps, 5.0, 2), Weights(param.w_u, 1.0),
                        param.theta);
-  McreProblem& problem = bundle.problem;
+  MatrixMcreProblem& problem = bundle.problem;
   problem.SetModulus(0.9 * kReferenceModulus);
   const Solved reference = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-8), &problem);
   ASSERT_TRUE(reference.summary.IsSolutionUsable()) << reference.summary.FullReport();
@@ -72,8 +72,8 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(ShootingBreakdownTest, LongWindowFailsSingleShootingWhileMultipleShootingAndRiccatiAgree) {
   // 20 elements, 1600 steps: 4.6 times the paper's window, w_u = 1.
-  ProblemBundle bundle(MakeSmallCase(20, 1600, 5.0, 2), Weights(1.0, 1.0));
-  McreProblem& problem = bundle.problem;
+  BarRunProblem bundle(MakeSmallCase(20, 1600, 5.0, 2), Weights(1.0, 1.0));
+  MatrixMcreProblem& problem = bundle.problem;
   problem.SetModulus(0.9 * kReferenceModulus);
   const Solved single = Solve(Options(CoupledSolverType::kSingleShooting, 1e-8), &problem);
   std::cout << "single shooting on 1600 steps: " << single.summary.message << "\n";
@@ -100,7 +100,7 @@ TEST(ShootingBreakdownTest, LongWindowFailsSingleShootingWhileMultipleShootingAn
 }
 
 TEST(ShootingBreakdownTest, SingleShootingAtThetaThreeQuartersOverflowsAndSaysSo) {
-  ProblemBundle bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(1.0, 1.0), 0.75);
+  BarRunProblem bundle(MakeSmallCase(20, 200, 5.0, 2), Weights(1.0, 1.0), 0.75);
   const Solved single = Solve(Options(CoupledSolverType::kSingleShooting, 1e-8), &bundle.problem);
   EXPECT_EQ(single.summary.termination, TerminationType::kFailure);
   EXPECT_NE(single.summary.message.find("breaks down"), std::string::npos)
@@ -110,7 +110,7 @@ TEST(ShootingBreakdownTest, SingleShootingAtThetaThreeQuartersOverflowsAndSaysSo
 }
 
 TEST(ShootingSolverTest, MultipleShootingRefusesAboveTheMemoryLimit) {
-  ProblemBundle bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
+  BarRunProblem bundle(MakeSmallCase(10, 50, 5.0, 1), Weights(1.0, 1.0));
   CoupledSolverOptions options = Options(CoupledSolverType::kMultipleShooting, 1e-8);
   options.max_dense_solver_bytes = 10000;
   const Solved solved = Solve(options, &bundle.problem);

@@ -15,6 +15,7 @@
 #include "mcrewave/mcre/mcre_problem.h"
 #include "mcrewave/mcre/objective.h"
 #include "mcrewave/model/bar_model.h"
+#include "mcrewave/model/matrix_export.h"
 #include "mcrewave/model/simulation.h"
 #include "mcrewave/optim/bounded_minimizer.h"
 
@@ -74,6 +75,29 @@ struct ProblemBundle {
   BarModel model;
   ChannelSet data;
   McreProblem problem;
+};
+
+// The same bar and data as every run solves them: the bar exported as matrices
+// (BarRunModel; its clamp a support, measured by default as ProblemBundle's McreProblem
+// has it: the paper's free-free formulation) and its MatrixMcreProblem at the bar's
+// modulus.
+struct BarRunProblem {
+  BarRunProblem(const SmallCase& c, const McreWeights& weights, double theta = 0.5)
+      : model(c.bar),
+        data(MakeSyntheticMeasurements(
+            c.bar, c.load,
+            [&] {
+              TimeOptions t = c.time;
+              t.theta = theta;
+              return t;
+            }(),
+            c.data)),
+        matrices(BarRunModel(model, data, {})),
+        problem(matrices, data, weights, c.bar.modulus, theta) {}
+  BarModel model;
+  ChannelSet data;
+  MatrixModelData matrices;
+  MatrixMcreProblem problem;
 };
 
 // The MCRE objective of the bar exported as matrices (MatrixMcreObjective); matrices

@@ -114,25 +114,19 @@ namespace {
 // inner.max_field_bytes, with the ways around it for this kind of problem.
 std::string FieldLimitRefusal(const std::string& name, double field_bytes,
                               const CoupledSolverOptions& options, CoupledProblem* problem,
-                              bool is_bar, bool is_streaming) {
+                              bool is_streaming) {
   std::ostringstream refusal;
   refusal << name << " needs " << static_cast<long long>(field_bytes) << " bytes ("
           << kIterativeSolverFields
           << " fields of n x (m + 1) doubles, n = " << problem->num_nodes()
           << " nodes, m = " << problem->num_steps() << " steps), above the limit of "
           << options.max_field_bytes << " bytes (inner.max_field_bytes); ";
-  if (is_bar) {
+  if (is_streaming) {
     refusal << "use inner.method: streaming_conjugate_gradient (or auto), which stores no "
-               "space-time field, raise inner.max_field_bytes, or use fewer elements or a "
-               "shorter window";
-  } else if (is_streaming) {
-    refusal << "use inner.method: streaming_conjugate_gradient (or auto), which stores no "
-               "space-time field, raise inner.max_field_bytes, or use a coarser mesh (fewer "
-               "dofs), a shorter window or a larger time step";
-  } else {
-    refusal << "raise inner.max_field_bytes, or use a coarser mesh (fewer dofs), a shorter "
-               "window or a larger time step";
+               "space-time field, ";
   }
+  refusal << "raise inner.max_field_bytes, or use a coarser mesh (fewer dofs; the bar's "
+             "model.elements), a shorter window or a larger time step";
   return refusal.str();
 }
 
@@ -201,9 +195,8 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
     summary.message = "invalid options: " + why;
     return summary;
   }
-  // The streaming solver needs a problem on sensor traces (the bar and a structure
-  // given by matrices); the field-limit refusal names the ways out for the bar.
-  const bool is_bar = dynamic_cast<McreProblem*>(problem) != nullptr;
+  // The streaming solver needs a problem on sensor traces (a structure given by
+  // matrices, the bar's among them); the field-limit refusal names the ways out.
   StreamingCoupledProblem* streaming = dynamic_cast<StreamingCoupledProblem*>(problem);
   const CoupledSolverType type = ResolveCoupledSolverType(
       options, problem->num_nodes(), problem->num_steps(), streaming != nullptr);
@@ -212,8 +205,7 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
   const double field_bytes = IterativeSolverFieldBytes(problem->num_nodes(), problem->num_steps());
   if (HoldsIterativeSolverFields(type) &&
       field_bytes > static_cast<double>(options.max_field_bytes)) {
-    summary.message =
-        FieldLimitRefusal(name, field_bytes, options, problem, is_bar, streaming != nullptr);
+    summary.message = FieldLimitRefusal(name, field_bytes, options, problem, streaming != nullptr);
     return summary;
   }
   const std::string unsupported = UnsupportedProblemMessage(type, streaming);
