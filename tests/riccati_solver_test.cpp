@@ -102,8 +102,8 @@ TEST(RiccatiSolverTest, AgreesWithConjugateGradientsOnThePapersCase) {
   EXPECT_NEAR(riccati.solution.cost, krylov.solution.cost, 1e-8 * krylov.solution.cost);
 }
 
-// The built-in bar with interior sensors (u@0.3, e@0.7) under a trusted and a pinned
-// clamp, which the comparators refused before they took the general data term
+// The bar as every run solves it (BarRunModel), with interior sensors (u@0.3, e@0.7)
+// under a trusted and a pinned clamp, which the comparators refused before they took the general data term
 // W_obs = H^T diag(beta) H: 20 elements, SNR 10, three zones; the pinned clamp's stiff
 // spring 1 / alpha_0 (clamp_displacement_weight 0.1) on a shorter window, where single
 // shooting's condition number stays moderate (1.4e10 on 200 steps, where it fails its
