@@ -12,7 +12,7 @@
 // fully pivoted LU. W is defined up to a rigid translation (K W and the constraints
 // do not see it), so it is fixed to zero mean there and U, F, K W and J, which are
 // unique, are compared with the conjugate-gradient and all-at-once solvers' (F =
-// F~ - B W / alpha from their W).
+// F~ - B W / alpha from their W), which solve the bar as every run does (BarRunModel).
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -25,7 +25,6 @@ namespace mcrewave {
 namespace {
 
 using testing::MakeSmallCase;
-using testing::ProblemBundle;
 
 struct KktSolution {
   Eigen::MatrixXd displacement;  // n x (m + 1), U_0 = 0
@@ -175,15 +174,22 @@ TEST_P(DiscreteFunctionalTest, CoupledSolutionIsTheMinimumOfTheConstrainedFuncti
   const auto [mass, theta] = GetParam();
   testing::SmallCase tiny = MakeSmallCase(4, 8, 5.0, 2);
   tiny.bar.mass = mass;
-  ProblemBundle bundle(tiny, testing::Weights(0.3, 1.0), theta);
+  testing::BarRunProblem bundle(tiny, testing::Weights(0.3, 1.0), theta);
   const double modulus = 0.9 * testing::kReferenceModulus;
   bundle.problem.SetModulus(modulus);
-  const KktSolution kkt = MinimiseDenseFunctional(
-      bundle.model, bundle.data, modulus, bundle.problem.alpha(), bundle.problem.beta(), theta);
+  // One alpha for every load channel and one beta for every displacement row (the
+  // weights' w_f and w_u).
+  const double alpha = bundle.problem.alphas()[0];
+  const double beta = bundle.problem.betas()[0];
+  ASSERT_EQ(bundle.problem.alphas().minCoeff(), bundle.problem.alphas().maxCoeff());
+  ASSERT_EQ(bundle.problem.betas().minCoeff(), bundle.problem.betas().maxCoeff());
+  const KktSolution kkt =
+      MinimiseDenseFunctional(bundle.model, bundle.data, modulus, alpha, beta, theta);
   const Eigen::MatrixXd stiffness = modulus * Eigen::MatrixXd(bundle.model.unit_stiffness());
   const int last = bundle.model.num_nodes() - 1;
   // Relative tolerances on U, K W, F and e^2, within 10x of the largest figure
-  // measured over both masses and thetas: all-at-once (a direct solve of the
+  // measured over both masses and thetas (the same figures on the built-in bar's own
+  // problem before the bar was solved as matrices): all-at-once (a direct solve of the
   // stationarity system) U 1.3e-15, K W 5.9e-14, F 4.5e-16, e^2 6e-14; conjugate
   // gradients at the tolerance 1e-13 U 4.9e-13, K W 8e-11, F 3.2e-13, e^2 6e-14.
   struct Tolerances {
@@ -208,10 +214,8 @@ TEST_P(DiscreteFunctionalTest, CoupledSolutionIsTheMinimumOfTheConstrainedFuncti
     Eigen::MatrixXd forces(2, solution.retrograde.cols());
     for (int j = 0; j < forces.cols(); ++j) {
       // F = F~ - B W / alpha (docs/discrete_mcre.md section 2).
-      forces(0, j) =
-          bundle.data.Values("f0")[j] - solution.retrograde(0, j) / bundle.problem.alpha();
-      forces(1, j) =
-          bundle.data.Values("fL")[j] - solution.retrograde(last, j) / bundle.problem.alpha();
+      forces(0, j) = bundle.data.Values("f0")[j] - solution.retrograde(0, j) / alpha;
+      forces(1, j) = bundle.data.Values("fL")[j] - solution.retrograde(last, j) / alpha;
     }
     EXPECT_LT(testing::RelativeDifference(forces, kkt.end_forces), tolerance.end_force) << name;
     EXPECT_NEAR(solution.cost, kkt.cost, tolerance.cost * kkt.cost) << name;
