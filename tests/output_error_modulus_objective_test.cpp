@@ -27,14 +27,22 @@
 namespace mcrewave {
 namespace {
 
-// A 30-element bar with a displacement and a strain sensor, noisy data of the clamped
-// bar (SNR 20) and misfit levels of every kind.
+// A 30-element bar of modulus E [Pa] with interior sensors, its clamped simulation on
+// its own mesh and step with noise at snr (seed 11), misfit levels of every kind, and
+// the bar as matrices of the run. The default: 200 GPa, a displacement and a strain
+// sensor, SNR 20.
 struct SensedBar {
-  SensedBar()
-      : small(testing::MakeSmallCase(30, 250, 20.0, 1)),
+  explicit SensedBar(double modulus = 200e9,
+                     const std::vector<std::string>& sensors = {"u@0.3", "e@0.55"},
+                     double snr = 20.0)
+      : small([modulus] {
+          testing::SmallCase small = testing::MakeSmallCase(30, 250, INFINITY, 1);
+          small.bar.modulus = modulus;
+          return small;
+        }()),
         model(small.bar),
-        data(SimulateClampedBar(small.bar, small.load, small.time, {}, {"u@0.3", "e@0.55"})) {
-    AddMeasurementNoise(20.0, 11, &data);
+        data(SimulateClampedBar(small.bar, small.load, small.time, {}, sensors)) {
+    AddMeasurementNoise(snr, 11, &data);
     noise.displacement_std = 1e-6;  // [m]
     noise.force_std = 10.0;         // [N]
     noise.strain_std = 1e-6;
@@ -89,32 +97,8 @@ TEST(OutputErrorModulusObjectiveTest, OnTheBarAsMatricesItIsTheBarsOwnObjective)
 
 constexpr double kCrimeModulus = 187.3e9;  // [Pa] of the simulated data (off the scan's grid)
 
-// Data of the clamped 30-element bar at kCrimeModulus on its own mesh and step, with
-// the given interior sensors and noise at snr, and the bar as matrices of the run.
-struct InverseCrime {
-  explicit InverseCrime(const std::vector<std::string>& sensors = {}, double snr = INFINITY)
-      : small([] {
-          testing::SmallCase small = testing::MakeSmallCase(30, 250, INFINITY, 1);
-          small.bar.modulus = kCrimeModulus;
-          return small;
-        }()),
-        model(small.bar),
-        data(SimulateClampedBar(small.bar, small.load, small.time, {}, sensors)) {
-    AddMeasurementNoise(snr, 11, &data);
-    noise.displacement_std = 1e-6;  // [m]
-    noise.force_std = 10.0;         // [N]
-    noise.strain_std = 1e-6;
-    matrices = BarRunModel(model, data, {});
-  }
-  testing::SmallCase small;
-  BarModel model;
-  ChannelSet data;
-  NoiseLevels noise;
-  MatrixModelData matrices;
-};
-
 TEST(OutputErrorModulusObjectiveTest, DataOfTheSameModelGiveZeroMisfitAtTheirModulus) {
-  const InverseCrime crime({"u@0.3", "e@0.55"});
+  const SensedBar crime(kCrimeModulus, {"u@0.3", "e@0.55"}, INFINITY);
   OutputErrorModulusObjective objective(crime.matrices, crime.data, crime.noise, 0.5,
                                         kCrimeModulus);
   const OutputErrorFit fit = objective.Predict(kCrimeModulus, true);
@@ -154,14 +138,14 @@ double ModulusGradientError(OutputErrorModulusObjective* objective, double modul
 }
 
 TEST(OutputErrorModulusObjectiveTest, GradientMatchesCentralDifferences) {
-  const InverseCrime ends_only({}, 10.0);
+  const SensedBar ends_only(kCrimeModulus, {}, 10.0);
   OutputErrorModulusObjective objective(ends_only.matrices, ends_only.data, ends_only.noise, 0.5,
                                         kCrimeModulus);
   // Measured 9.7e-11 to 1.2e-9 (the difference's truncation and round-off).
   for (const double factor : {0.8, 0.97, 1.1}) {
     EXPECT_LT(ModulusGradientError(&objective, factor * kCrimeModulus), 1e-8) << factor;
   }
-  const InverseCrime sensors({"u@0.3", "e@0.55", "u@0.9"}, 10.0);
+  const SensedBar sensors(kCrimeModulus, {"u@0.3", "e@0.55", "u@0.9"}, 10.0);
   OutputErrorModulusObjective with_sensors(sensors.matrices, sensors.data, sensors.noise, 0.5,
                                            kCrimeModulus);
   for (const double factor : {0.8, 1.1}) {
@@ -174,7 +158,7 @@ TEST(OutputErrorModulusObjectiveTest, GradientMatchesCentralDifferences) {
 }
 
 TEST(OutputErrorModulusObjectiveTest, NloptAndCeresFindTheModulusOfNoiseFreeData) {
-  const InverseCrime crime;
+  const SensedBar crime(kCrimeModulus, {}, INFINITY);
   for (const OptimizerType optimizer : {OptimizerType::kNlopt, OptimizerType::kCeres}) {
     IdentificationOptions options;
     options.optimizer = optimizer;
@@ -192,7 +176,7 @@ TEST(OutputErrorModulusObjectiveTest, FisherInformationIsTheGaussNewtonSumOfCent
   // I = sum_k c_k sum (dy_k/dE)^2 / s^2 from the forward sensitivity against the same
   // sum of central differences of the predicted outputs and reaction (step 1e-6 E):
   // measured 6.0e-10 relative.
-  const InverseCrime crime({"u@0.3", "e@0.55"}, 20.0);
+  const SensedBar crime(kCrimeModulus, {"u@0.3", "e@0.55"}, 20.0);
   OutputErrorModulusObjective objective(crime.matrices, crime.data, crime.noise, 0.5,
                                         kCrimeModulus);
   const double modulus = 1.03 * kCrimeModulus;

@@ -60,17 +60,17 @@ inline SmallCase MakeSmallCase(int elements, int steps, double snr, int truth_re
 }
 
 // Owns the model, the data and the problem built on them.
+// The synthetic measurements of a small case at theta.
+inline ChannelSet SmallCaseData(const SmallCase& c, double theta) {
+  TimeOptions time = c.time;
+  time.theta = theta;
+  return MakeSyntheticMeasurements(c.bar, c.load, time, c.data);
+}
+
 struct ProblemBundle {
   ProblemBundle(const SmallCase& c, const McreWeights& weights, double theta = 0.5)
       : model(c.bar),
-        data(MakeSyntheticMeasurements(
-            c.bar, c.load,
-            [&] {
-              TimeOptions t = c.time;
-              t.theta = theta;
-              return t;
-            }(),
-            c.data)),
+        data(SmallCaseData(c, theta)),
         problem(model, data, weights, c.bar.modulus, theta) {}
   BarModel model;
   ChannelSet data;
@@ -84,14 +84,7 @@ struct ProblemBundle {
 struct BarRunProblem {
   BarRunProblem(const SmallCase& c, const McreWeights& weights, double theta = 0.5)
       : model(c.bar),
-        data(MakeSyntheticMeasurements(
-            c.bar, c.load,
-            [&] {
-              TimeOptions t = c.time;
-              t.theta = theta;
-              return t;
-            }(),
-            c.data)),
+        data(SmallCaseData(c, theta)),
         matrices(BarRunModel(model, data, {})),
         problem(matrices, data, weights, c.bar.modulus, theta) {}
   BarModel model;
