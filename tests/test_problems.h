@@ -59,7 +59,6 @@ inline SmallCase MakeSmallCase(int elements, int steps, double snr, int truth_re
   return c;
 }
 
-// Owns the model, the data and the problem built on them.
 // The synthetic measurements of a small case at theta.
 inline ChannelSet SmallCaseData(const SmallCase& c, double theta) {
   TimeOptions time = c.time;
@@ -67,6 +66,7 @@ inline ChannelSet SmallCaseData(const SmallCase& c, double theta) {
   return MakeSyntheticMeasurements(c.bar, c.load, time, c.data);
 }
 
+// Owns the model, the data and the built-in bar's own problem built on them.
 struct ProblemBundle {
   ProblemBundle(const SmallCase& c, const McreWeights& weights, double theta = 0.5)
       : model(c.bar),
