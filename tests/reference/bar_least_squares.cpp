@@ -58,27 +58,33 @@ double OutputErrorRestCost(const ChannelSet& data, const NoiseLevels& noise,
   return rest_cost;
 }
 
+ClampedBarData::ClampedBarData(const BarModel& model, const ChannelSet& data,
+                               const NoiseLevels& noise, EndDisplacementChannels ends)
+    : measured(BarEndChannels(data)),
+      sensor_data(BarSensorValues(data)),
+      free_mass(BarModel::ClampedBlock(model.mass())),
+      mass_01(model.mass().coeff(0, 1)) {
+  assert(data.num_steps() >= 1 && noise.displacement_std > 0.0 && noise.force_std > 0.0);
+  if (!mass_factor.Compute(SymmetricBandMatrix(free_mass))) {
+    throw std::runtime_error("output-error model: the mass matrix is not positive definite");
+  }
+  OutputErrorSensorRows(model, data, noise, &sensor_rows, &sensor_weights);
+  rest_cost = OutputErrorRestCost(data, noise, sensor_weights, ends);
+}
+
 BarLeastSquares::BarLeastSquares(const BarModel& model, const ChannelSet& data,
                                  const NoiseLevels& noise, double theta, double modulus_scale,
                                  EndDisplacementChannels ends)
     : model_(model),
       data_(data),
-      measured_(BarEndChannels(data)),
-      sensor_data_(BarSensorValues(data)),
+      bar_(model, data, noise, ends),
       noise_(noise),
       theta_(theta),
       modulus_scale_(modulus_scale),
       ends_(ends),
-      free_mass_(BarModel::ClampedBlock(model.mass())),
       free_stiffness_one_(BarModel::ClampedBlock(model.unit_stiffness())),
-      mass_01_(model.mass().coeff(0, 1)),
       stiffness_one_01_(model.unit_stiffness().coeff(0, 1)) {
   assert(model.num_zones() == 1 && theta >= 0.0 && theta <= 1.0 && modulus_scale > 0.0);
-  assert(data.num_steps() >= 1 && noise.displacement_std > 0.0 && noise.force_std > 0.0);
-  if (!mass_factor_.Compute(SymmetricBandMatrix(free_mass_))) {
-    throw std::runtime_error("output-error model: the mass matrix is not positive definite");
-  }
-  OutputErrorSensorRows(model, data, noise, &sensor_rows_, &sensor_weights_);
   const int free = model.num_nodes() - 1;
   for (Vector* scratch :
        {&velocity_, &displacement_, &next_velocity_, &next_displacement_, &sensitivity_velocity_,
@@ -90,8 +96,7 @@ BarLeastSquares::BarLeastSquares(const BarModel& model, const ChannelSet& data,
   const int samples = data.num_samples();
   prediction_.uL.setZero(samples);
   prediction_.f0.setZero(samples);
-  prediction_.sensors.assign(sensor_data_.size(), Vector::Zero(samples));
-  rest_cost_ = OutputErrorRestCost(data, noise, sensor_weights_, ends_);
+  prediction_.sensors.assign(bar_.sensor_data.size(), Vector::Zero(samples));
 }
 
 double BarLeastSquares::ValleySpacing() {
@@ -105,7 +110,7 @@ double BarLeastSquares::ValleySpacing() {
   weights[1] = 1.0 / (noise_.force_std * noise_.force_std);
   for (int i = 0; i + 2 < channels; ++i) {
     traces.row(2 + i) = prediction.sensors[i].transpose();
-    weights[2 + i] = sensor_weights_[i];
+    weights[2 + i] = bar_.sensor_weights[i];
   }
   return PredictedValleySpacing(traces, weights, data_.time_step);
 }
@@ -116,7 +121,7 @@ const OutputErrorPrediction& BarLeastSquares::Predict(double modulus, bool gradi
   options.time_step = data_.time_step;
   options.theta = theta_;
   const SparseMatrix free_stiffness = modulus * free_stiffness_one_;
-  integrator_.Init(free_mass_, free_stiffness, options);
+  integrator_.Init(bar_.free_mass, free_stiffness, options);
 
   const int samples = data_.num_samples();
   const int loaded = static_cast<int>(velocity_.size()) - 1;  // node N, free numbering
@@ -132,7 +137,7 @@ const OutputErrorPrediction& BarLeastSquares::Predict(double modulus, bool gradi
   for (int k = 0; k < samples; ++k) {
     if (k > 0) {
       // f_theta = (theta fL~_k + (1 - theta) fL~_{k-1}) e_N on the step t_{k-1} -> t_k.
-      const double load = theta_ * measured_.fL[k] + (1.0 - theta_) * measured_.fL[k - 1];
+      const double load = theta_ * bar_.measured.fL[k] + (1.0 - theta_) * bar_.measured.fL[k - 1];
       integrator_.StepWithEndLoads(velocity_, displacement_, 0.0, load, next_velocity_,
                                    next_displacement_);
       if (gradient_requested) {
@@ -146,22 +151,23 @@ const OutputErrorPrediction& BarLeastSquares::Predict(double modulus, bool gradi
       velocity_.swap(next_velocity_);
       displacement_.swap(next_displacement_);
     }
-    const double f0 = ClampReaction(integrator_.stiffness(), mass_factor_, mass_01_, stiffness_01,
-                                    displacement_, measured_.fL[k], &acceleration_);
+    const double f0 =
+        ClampReaction(integrator_.stiffness(), bar_.mass_factor, bar_.mass_01, stiffness_01,
+                      displacement_, bar_.measured.fL[k], &acceleration_);
     prediction_.uL[k] = displacement_[loaded];
     prediction_.f0[k] = f0;
     const double c = (k == 0 || k == samples - 1) ? 0.5 : 1.0;
-    const double residual_f = f0 - measured_.f0[k];
-    const double residual_u = displacement_[loaded] - measured_.uL[k];
+    const double residual_f = f0 - bar_.measured.f0[k];
+    const double residual_u = displacement_[loaded] - bar_.measured.uL[k];
     // c_k h / 2 [(uL - uL~)^2 / s_u^2 + (f0 - f0~)^2 / s_f^2 + sensors]
     double sum = weight_f * residual_f * residual_f;
     if (ends_.uL) sum += weight_u * residual_u * residual_u;
-    if (!sensor_rows_.empty()) nodal_.tail(nodal_.size() - 1) = displacement_;
-    for (std::size_t i = 0; i < sensor_rows_.size(); ++i) {
-      const double predicted = sensor_rows_[i].Apply(nodal_.data());
+    if (!bar_.sensor_rows.empty()) nodal_.tail(nodal_.size() - 1) = displacement_;
+    for (std::size_t i = 0; i < bar_.sensor_rows.size(); ++i) {
+      const double predicted = bar_.sensor_rows[i].Apply(nodal_.data());
       prediction_.sensors[i][k] = predicted;
-      const double residual = predicted - (*sensor_data_[i])[k];
-      sum += sensor_weights_[i] * residual * residual;
+      const double residual = predicted - (*bar_.sensor_data[i])[k];
+      sum += bar_.sensor_weights[i] * residual * residual;
     }
     cost += 0.5 * c * h * sum;
     if (gradient_requested) {
@@ -169,8 +175,8 @@ const OutputErrorPrediction& BarLeastSquares::Predict(double modulus, bool gradi
       shift_ = sensitivity_ + displacement_ / modulus;
       integrator_.stiffness().Multiply(shift_, acceleration_sensitivity_);
       acceleration_sensitivity_ = -acceleration_sensitivity_;
-      mass_factor_.SolveInPlace(acceleration_sensitivity_);
-      const double df0 = mass_01_ * acceleration_sensitivity_[0] + stiffness_01 * shift_[0];
+      bar_.mass_factor.SolveInPlace(acceleration_sensitivity_);
+      const double df0 = bar_.mass_01 * acceleration_sensitivity_[0] + stiffness_01 * shift_[0];
       // d/dE of the bracket above, times c_k h / 2.
       double dsum = 2.0 * weight_f * residual_f * df0;
       // c_k sum (dy/dE)^2 / s^2, the Fisher information's terms.
@@ -179,12 +185,12 @@ const OutputErrorPrediction& BarLeastSquares::Predict(double modulus, bool gradi
         dsum += 2.0 * weight_u * residual_u * sensitivity_[loaded];
         isum += weight_u * sensitivity_[loaded] * sensitivity_[loaded];
       }
-      if (!sensor_rows_.empty()) nodal_.tail(nodal_.size() - 1) = sensitivity_;
-      for (std::size_t i = 0; i < sensor_rows_.size(); ++i) {
-        const double residual = prediction_.sensors[i][k] - (*sensor_data_[i])[k];
-        const double derivative = sensor_rows_[i].Apply(nodal_.data());
-        dsum += 2.0 * sensor_weights_[i] * residual * derivative;
-        isum += sensor_weights_[i] * derivative * derivative;
+      if (!bar_.sensor_rows.empty()) nodal_.tail(nodal_.size() - 1) = sensitivity_;
+      for (std::size_t i = 0; i < bar_.sensor_rows.size(); ++i) {
+        const double residual = prediction_.sensors[i][k] - (*bar_.sensor_data[i])[k];
+        const double derivative = bar_.sensor_rows[i].Apply(nodal_.data());
+        dsum += 2.0 * bar_.sensor_weights[i] * residual * derivative;
+        isum += bar_.sensor_weights[i] * derivative * derivative;
       }
       gradient += 0.5 * c * h * dsum;
       information += c * isum;

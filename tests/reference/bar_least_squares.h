@@ -69,6 +69,23 @@ double ClampReaction(const SymmetricBandMatrix& stiffness, const BandLdlt& mass_
                      double mass_01, double stiffness_01, const Vector& displacement, double fL,
                      Vector* acceleration);
 
+// What both band-model references take from the bar and the data: the data's end
+// channels and interior sensors, M's free block M_r, M(0, 1) and the factor of M_r, the
+// interior sensors' rows on the bar's mesh with the weight 1 / s^2 of each one's kind,
+// and J_rest. Keeps pointers into data, which must outlive it.
+struct ClampedBarData {
+  ClampedBarData(const BarModel& model, const ChannelSet& data, const NoiseLevels& noise,
+                 EndDisplacementChannels ends);
+  BarEnds measured;                        // data's end channels
+  std::vector<const Vector*> sensor_data;  // data's interior sensors (BarSensorValues)
+  SparseMatrix free_mass;                  // M_r
+  double mass_01 = 0.0;                    // M(0, 1)
+  BandLdlt mass_factor;                    // of M_r
+  std::vector<ObservationRow> sensor_rows;
+  std::vector<double> sensor_weights;
+  double rest_cost = 0.0;  // J_rest [s] (OutputErrorRestCost)
+};
+
 class BarLeastSquares {
  public:
   // Keeps references to model and data: both must outlive the reference. The
@@ -88,26 +105,20 @@ class BarLeastSquares {
   const OutputErrorPrediction& Predict(double modulus, bool gradient_requested);
 
   // J_rest [s]: J with every prediction 0; the cost scale (1 when J_rest = 0).
-  double rest_cost() const { return rest_cost_; }
-  double cost_scale() const { return rest_cost_ > 0.0 ? rest_cost_ : 1.0; }
+  double rest_cost() const { return bar_.rest_cost; }
+  double cost_scale() const { return bar_.rest_cost > 0.0 ? bar_.rest_cost : 1.0; }
 
  private:
   const BarModel& model_;
   const ChannelSet& data_;
-  BarEnds measured_;                        // data_'s end channels
-  std::vector<const Vector*> sensor_data_;  // data_'s interior sensors (BarSensorValues)
+  ClampedBarData bar_;
   NoiseLevels noise_;
   double theta_;
   double modulus_scale_;
   EndDisplacementChannels ends_;
 
-  SparseMatrix free_mass_;
-  SparseMatrix free_stiffness_one_;          // K1 on the free nodes (K_r = E K1_r)
-  double mass_01_ = 0.0;                     // M(0, 1)
-  double stiffness_one_01_ = 0.0;            // K1(0, 1)
-  BandLdlt mass_factor_;                     // of M_r
-  std::vector<ObservationRow> sensor_rows_;  // the data's interior sensors on this mesh
-  std::vector<double> sensor_weights_;       // 1 / s^2 of each sensor's kind
+  SparseMatrix free_stiffness_one_;  // K1 on the free nodes (K_r = E K1_r)
+  double stiffness_one_01_ = 0.0;    // K1(0, 1)
   ThetaIntegrator integrator_;
 
   // Scratch of Predict, sized in the constructor.
@@ -116,7 +127,6 @@ class BarLeastSquares {
   Vector shift_, acceleration_, acceleration_sensitivity_, nodal_;
 
   OutputErrorPrediction prediction_;
-  double rest_cost_ = 0.0;
   long sweeps_ = 0;
 };
 

@@ -15,27 +15,19 @@ BarZoneLeastSquares::BarZoneLeastSquares(const BarModel& model, const ChannelSet
                                          EndDisplacementChannels ends)
     : model_(model),
       data_(data),
-      measured_(BarEndChannels(data)),
-      sensor_data_(BarSensorValues(data)),
+      bar_(model, data, noise, ends),
       theta_(theta),
       ends_(ends),
       num_zones_(model.num_zones()),
       weight_u_(1.0 / (noise.displacement_std * noise.displacement_std)),
-      weight_f_(1.0 / (noise.force_std * noise.force_std)),
-      free_mass_(BarModel::ClampedBlock(model.mass())),
-      mass_01_(model.mass().coeff(0, 1)) {
+      weight_f_(1.0 / (noise.force_std * noise.force_std)) {
   assert(theta >= 0.0 && theta <= 1.0);
-  assert(data.num_steps() >= 1 && noise.displacement_std > 0.0 && noise.force_std > 0.0);
-  if (!mass_factor_.Compute(SymmetricBandMatrix(free_mass_))) {
-    throw std::runtime_error("output-error model: the mass matrix is not positive definite");
-  }
   for (int z = 0; z < num_zones_; ++z) {
     // K1_z = K(E = 1 Pa in zone z, 0 elsewhere).
     const SparseMatrix unit_zone = model.Stiffness(Vector::Unit(num_zones_, z));
     zone_stiffness_.emplace_back(BarModel::ClampedBlock(unit_zone));
     zone_stiffness_01_.push_back(unit_zone.coeff(0, 1));
   }
-  OutputErrorSensorRows(model, data, noise, &sensor_rows_, &sensor_weights_);
   const int free = model.num_nodes() - 1;
   for (Vector* scratch : {&velocity_, &displacement_, &next_velocity_, &next_displacement_,
                           &weighted_, &force_, &acceleration_, &acceleration_sensitivity_}) {
@@ -46,8 +38,7 @@ BarZoneLeastSquares::BarZoneLeastSquares(const BarModel& model, const ChannelSet
     scratch->setZero(free, num_zones_);
   }
   nodal_.setZero(model.num_nodes());
-  residuals_.setZero(static_cast<Eigen::Index>(sensor_rows_.size()));
-  rest_cost_ = OutputErrorRestCost(data, noise, sensor_weights_, ends_);
+  residuals_.setZero(static_cast<Eigen::Index>(bar_.sensor_rows.size()));
 }
 
 double BarZoneLeastSquares::Cost(const Vector& zone_moduli, Vector* gradient) {
@@ -56,7 +47,7 @@ double BarZoneLeastSquares::Cost(const Vector& zone_moduli, Vector* gradient) {
   ThetaIntegratorOptions options;
   options.time_step = data_.time_step;
   options.theta = theta_;
-  integrator_.Init(free_mass_, BarModel::ClampedBlock(model_.Stiffness(zone_moduli)), options);
+  integrator_.Init(bar_.free_mass, BarModel::ClampedBlock(model_.Stiffness(zone_moduli)), options);
   assert(integrator_.factorization() == Factorization::kBand);
   // K_01 = sum_z E_z K1_z(0, 1).
   double stiffness_01 = 0.0;
@@ -75,7 +66,7 @@ double BarZoneLeastSquares::Cost(const Vector& zone_moduli, Vector* gradient) {
   for (int k = 0; k < samples; ++k) {
     if (k > 0) {
       // f_theta = (theta fL~_k + (1 - theta) fL~_{k-1}) e_N on the step t_{k-1} -> t_k.
-      const double load = theta_ * measured_.fL[k] + (1.0 - theta_) * measured_.fL[k - 1];
+      const double load = theta_ * bar_.measured.fL[k] + (1.0 - theta_) * bar_.measured.fL[k - 1];
       integrator_.StepWithEndLoads(velocity_, displacement_, 0.0, load, next_velocity_,
                                    next_displacement_);
       if (gradient_requested) {
@@ -95,17 +86,17 @@ double BarZoneLeastSquares::Cost(const Vector& zone_moduli, Vector* gradient) {
       displacement_.swap(next_displacement_);
     }
     const double residual_f =
-        ClampReaction(integrator_.stiffness(), mass_factor_, mass_01_, stiffness_01, displacement_,
-                      measured_.fL[k], &acceleration_) -
-        measured_.f0[k];
-    const double residual_u = displacement_[loaded] - measured_.uL[k];
+        ClampReaction(integrator_.stiffness(), bar_.mass_factor, bar_.mass_01, stiffness_01,
+                      displacement_, bar_.measured.fL[k], &acceleration_) -
+        bar_.measured.f0[k];
+    const double residual_u = displacement_[loaded] - bar_.measured.uL[k];
     // c_k h / 2 [(uL - uL~)^2 / s_u^2 + (f0 - f0~)^2 / s_f^2 + sensors]
     double sum = weight_f_ * residual_f * residual_f;
     if (ends_.uL) sum += weight_u_ * residual_u * residual_u;
-    if (!sensor_rows_.empty()) nodal_.tail(nodal_.size() - 1) = displacement_;
-    for (std::size_t i = 0; i < sensor_rows_.size(); ++i) {
-      residuals_[i] = sensor_rows_[i].Apply(nodal_.data()) - (*sensor_data_[i])[k];
-      sum += sensor_weights_[i] * residuals_[i] * residuals_[i];
+    if (!bar_.sensor_rows.empty()) nodal_.tail(nodal_.size() - 1) = displacement_;
+    for (std::size_t i = 0; i < bar_.sensor_rows.size(); ++i) {
+      residuals_[i] = bar_.sensor_rows[i].Apply(nodal_.data()) - (*bar_.sensor_data[i])[k];
+      sum += bar_.sensor_weights[i] * residuals_[i] * residuals_[i];
     }
     const double c = (k == 0 || k == samples - 1) ? 0.5 : 1.0;
     cost += 0.5 * c * h * sum;
@@ -116,15 +107,16 @@ double BarZoneLeastSquares::Cost(const Vector& zone_moduli, Vector* gradient) {
       integrator_.stiffness().Multiply(s, acceleration_sensitivity_);
       zone_stiffness_[z].MultiplyAdd(1.0, displacement_, acceleration_sensitivity_);
       acceleration_sensitivity_ = -acceleration_sensitivity_;
-      mass_factor_.SolveInPlace(acceleration_sensitivity_);
-      const double df0 = mass_01_ * acceleration_sensitivity_[0] + stiffness_01 * s[0] +
+      bar_.mass_factor.SolveInPlace(acceleration_sensitivity_);
+      const double df0 = bar_.mass_01 * acceleration_sensitivity_[0] + stiffness_01 * s[0] +
                          zone_stiffness_01_[z] * displacement_[0];
       // d/dE_z of the bracket above, times c_k h / 2.
       double dsum = 2.0 * weight_f_ * residual_f * df0;
       if (ends_.uL) dsum += 2.0 * weight_u_ * residual_u * s[loaded];
-      if (!sensor_rows_.empty()) nodal_.tail(nodal_.size() - 1) = s;
-      for (std::size_t i = 0; i < sensor_rows_.size(); ++i) {
-        dsum += 2.0 * sensor_weights_[i] * residuals_[i] * sensor_rows_[i].Apply(nodal_.data());
+      if (!bar_.sensor_rows.empty()) nodal_.tail(nodal_.size() - 1) = s;
+      for (std::size_t i = 0; i < bar_.sensor_rows.size(); ++i) {
+        dsum +=
+            2.0 * bar_.sensor_weights[i] * residuals_[i] * bar_.sensor_rows[i].Apply(nodal_.data());
       }
       (*gradient)[z] += 0.5 * c * h * dsum;
     }

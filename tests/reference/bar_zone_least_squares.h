@@ -23,6 +23,7 @@
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/model/bar_model.h"
 #include "mcrewave/model/matrix_export.h"
+#include "reference/bar_least_squares.h"
 
 namespace mcrewave {
 namespace testing {
@@ -42,28 +43,22 @@ class BarZoneLeastSquares {
   double Cost(const Vector& zone_moduli, Vector* gradient);
 
   // J_rest [s]; the cost scale (1 when J_rest = 0).
-  double rest_cost() const { return rest_cost_; }
-  double cost_scale() const { return rest_cost_ > 0.0 ? rest_cost_ : 1.0; }
+  double rest_cost() const { return bar_.rest_cost; }
+  double cost_scale() const { return bar_.rest_cost > 0.0 ? bar_.rest_cost : 1.0; }
   long sweeps() const { return sweeps_; }
 
  private:
   const BarModel& model_;
   const ChannelSet& data_;
-  BarEnds measured_;                        // data_'s end channels
-  std::vector<const Vector*> sensor_data_;  // data_'s interior sensors (BarSensorValues)
+  ClampedBarData bar_;
   double theta_;
   EndDisplacementChannels ends_;
   int num_zones_;
   double weight_u_;  // 1 / s_u^2
   double weight_f_;  // 1 / s_f^2
 
-  SparseMatrix free_mass_;
-  double mass_01_ = 0.0;                             // M(0, 1)
-  BandLdlt mass_factor_;                             // of M_r
   std::vector<SymmetricBandMatrix> zone_stiffness_;  // K1_z,r on the free nodes [m]
   std::vector<double> zone_stiffness_01_;            // K1_z(0, 1) [m]
-  std::vector<ObservationRow> sensor_rows_;          // the data's interior sensors
-  std::vector<double> sensor_weights_;               // 1 / s^2 of each sensor's kind
   ThetaIntegrator integrator_;
 
   // Scratch of Cost, sized in the constructor: the state, the theta-weighted
@@ -74,7 +69,6 @@ class BarZoneLeastSquares {
   Matrix sensitivity_velocity_, sensitivity_, next_sensitivity_velocity_, next_sensitivity_;
   Vector acceleration_, acceleration_sensitivity_, nodal_, residuals_;
 
-  double rest_cost_ = 0.0;
   long sweeps_ = 0;
 };
 
