@@ -1,5 +1,6 @@
 // The paper's bar (100 elements, 1750 steps, SNR 2.5, seed 1) on the two roads, side
-// by side in one run: the built-in bar (mcre/mcre_problem.h) and the same bar exported
+// by side in one run: the built-in bar's own band-model road (tests/reference/
+// bar_mcre_problem.h, the tests' reference) and the same bar exported
 // as matrices with its clamp as a support (model/matrix_export.h, BarClampExport::kSupport;
 // mcre/matrix_mcre_problem.h). Both at the paper's weights and a clamp treatment
 // (trusted, measured or pinned), theta = 1/2. The roads run alternately (A B A B);
@@ -24,6 +25,7 @@
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/model/matrix_export.h"
 #include "mcrewave/model/simulation.h"
+#include "reference/bar_mcre_problem.h"
 
 namespace mcrewave {
 namespace {
@@ -85,7 +87,8 @@ int Main(int argc, char** argv) {
   const MatrixModelData matrices =
       BarMatrixModel(model, bar.modulus, {}, BarClampExport::kSupport);
 
-  McreProblem built_in(model, measurements, weights, bar.modulus, time.theta, {}, clamp);
+  testing::BarMcreProblem built_in(model, measurements, weights, bar.modulus, time.theta, {},
+                                   clamp);
   MatrixMcreProblem general(matrices, measurements, weights, bar.modulus, time.theta,
                             Factorization::kAutomatic, clamp);
   const Vector moduli = Vector::Constant(1, 0.9 * bar.modulus);

@@ -1,5 +1,5 @@
 // No heap allocation in the time loops: once initialised, ThetaIntegrator's steps
-// and sweeps and McreProblem's sweeps (outputs preallocated) neither allocate nor
+// and sweeps and BarMcreProblem's sweeps (outputs preallocated) neither allocate nor
 // free memory; the least-squares zone objective's time loop neither (its heap calls
 // do not grow with the number of steps); the Matrix Market reader allocates for the
 // entries a file holds, not for what its size line declares.
@@ -27,10 +27,10 @@
 #include "mcrewave/least_squares/matrix_output_error_objective.h"
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
-#include "mcrewave/mcre/mcre_problem.h"
 #include "mcrewave/model/bar_model.h"
 #include "mcrewave/model/matrix_export.h"
 #include "mcrewave/model/simulation.h"
+#include "reference/bar_mcre_problem.h"
 #include "test_problems.h"
 
 #if defined(__GLIBC__) && !defined(MCREWAVE_ADDRESS_SANITIZER)
@@ -344,7 +344,7 @@ TEST(SparseIntegratorAllocationTest, StepsAndSweepsAllocateNothingAfterInit) {
 TEST(McreProblemAllocationTest, SweepsIntoPreallocatedFieldsAllocateNothing) {
   SKIP_WITHOUT_ALLOCATION_COUNTING();
   ProblemBundle bundle(MakeSmallCase(kElements, kSteps, 5.0, 2), Weights(0.01, 1.0));
-  McreProblem& problem = bundle.problem;
+  testing::BarMcreProblem& problem = bundle.problem;
   problem.SetModulus(0.9 * testing::kReferenceModulus);
   // Preallocated fields, n x (m + 1); the solvers' workspace (its zero field) too.
   Matrix displacement = problem.ZeroField(), retrograde = problem.ZeroField();
@@ -410,7 +410,8 @@ TEST(McreProblemAllocationTest, RetrogradeSweepsWithInteriorSensorsAllocateNothi
   ChannelSet data = bundle.data;
   data.Add("u@0.4", ChannelKind::kDisplacement, 1e-6 * data.Values("uL"));
   data.Add("e@0.7", ChannelKind::kStrain, 1e-3 * data.Values("uL"));
-  McreProblem problem(bundle.model, data, Weights(0.01, 1.0), testing::kReferenceModulus, 0.5);
+  testing::BarMcreProblem problem(bundle.model, data, Weights(0.01, 1.0),
+                                  testing::kReferenceModulus, 0.5);
   problem.SetModulus(0.9 * testing::kReferenceModulus);
   Matrix displacement = problem.ZeroField(), retrograde = problem.ZeroField();
   Matrix retrograde_2 = problem.ZeroField(), retrograde_3 = problem.ZeroField();
@@ -468,11 +469,12 @@ TEST(McreProblemAllocationTest, StreamingMapAllocatesNothingAfterItsFirstCall) {
   ProblemBundle bundle(MakeSmallCase(kElements, kSteps, 5.0, 2), Weights(0.01, 1.0));
   ChannelSet data = bundle.data;
   data.Add("e@0.7", ChannelKind::kStrain, 1e-3 * data.Values("uL"));
-  McreProblem problem(bundle.model, data, Weights(0.01, 1.0), testing::kReferenceModulus, 0.5);
+  testing::BarMcreProblem problem(bundle.model, data, Weights(0.01, 1.0),
+                                  testing::kReferenceModulus, 0.5);
   problem.SetModulus(0.9 * testing::kReferenceModulus);
   const Matrix traces = Matrix::Constant(problem.num_traces(), problem.num_steps() + 1, 1e-7);
   Matrix image;
-  McreProblem::StreamingTotals totals;
+  testing::BarMcreProblem::StreamingTotals totals;
   // The first calls size the image and the totals.
   problem.StreamingMap(traces, true, &image, &totals);
   const HeapCalls calls = CountHeapCalls([&] {

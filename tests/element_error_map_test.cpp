@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mcrewave/model/matrix_export.h"
+#include "reference/bar_error_map.h"
 #include "test_problems.h"
 
 namespace mcrewave {
@@ -30,7 +31,8 @@ BarField SolvedThreeZoneBar() {
   layout.zone_count = 3;
   BarField field{BarModel(c.bar, layout.ElementZones(c.bar)), Vector(3), c.time.step, Matrix()};
   const ChannelSet data = MakeSyntheticMeasurements(c.bar, c.load, c.time, c.data);
-  McreProblem problem(field.model, data, testing::Weights(0.01, 1.0), c.bar.modulus, 0.5);
+  testing::BarMcreProblem problem(field.model, data, testing::Weights(0.01, 1.0), c.bar.modulus,
+                                  0.5);
   field.moduli << 0.8 * c.bar.modulus, 1.1 * c.bar.modulus, 1.3 * c.bar.modulus;
   problem.SetModuli(field.moduli);
   const testing::Solved solved =
@@ -43,7 +45,8 @@ BarField SolvedThreeZoneBar() {
 
 TEST(ElementErrorMapTest, TheExportedBarGivesTheBarsErrorMap) {
   const BarField bar = SolvedThreeZoneBar();
-  const ErrorMap expected = ComputeErrorMap(bar.model, bar.moduli, bar.retrograde, bar.time_step);
+  const ErrorMap expected =
+      testing::ComputeErrorMap(bar.model, bar.moduli, bar.retrograde, bar.time_step);
   // The elements exported at a nominal modulus of their own: E_z / E_z,nom rescales.
   const MatrixModelData exported = BarMatrixModel(bar.model, 2.1e11);
   const ErrorMap map = ComputeElementErrorMap(exported, bar.moduli, bar.retrograde, bar.time_step);

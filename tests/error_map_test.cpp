@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "identify_binary.h"
+#include "reference/bar_error_map.h"
 
 namespace mcrewave {
 namespace {
@@ -33,7 +34,7 @@ TEST(ErrorMapTest, SharesAreTheElementEnergiesOfTheGapSummedOverTheWindow) {
   for (Eigen::Index i = 0; i < retrograde.size(); ++i)
     retrograde.data()[i] = 1e-6 * uniform(engine);
 
-  const ErrorMap map = ComputeErrorMap(model, moduli, retrograde, h, 4);
+  const ErrorMap map = testing::ComputeErrorMap(model, moduli, retrograde, h, 4);
   // Independently: W^T K_el W with the element's assembled stiffness matrix.
   const SparseMatrix stiffness = model.Stiffness(moduli);
   Vector total_by_time = Vector::Zero(steps + 1);
@@ -82,7 +83,7 @@ TEST(ErrorMapTest, FineMeshesAverageTheirElementsIntoAtMost2000Columns) {
   for (Eigen::Index i = 0; i < retrograde.size(); ++i)
     retrograde.data()[i] = 1e-6 * uniform(engine);
   const Vector moduli = Vector::Constant(1, 200e9);
-  const ErrorMap map = ComputeErrorMap(model, moduli, retrograde, 1e-6, 3);
+  const ErrorMap map = testing::ComputeErrorMap(model, moduli, retrograde, 1e-6, 3);
   ASSERT_EQ(map.density.rows(), 3);
   ASSERT_EQ(map.density.cols(), 1334);
   double worst = 0.0;

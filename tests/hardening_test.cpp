@@ -27,9 +27,9 @@
 #include "mcrewave/app/config.h"
 #include "mcrewave/data/measurement.h"
 #include "mcrewave/mcre/coupled_solver.h"
-#include "mcrewave/mcre/mcre_problem.h"
 #include "mcrewave/model/bar_model.h"
 #include "mcrewave/model/simulation.h"
+#include "reference/bar_mcre_problem.h"
 #include "test_problems.h"
 
 namespace mcrewave {
@@ -263,7 +263,7 @@ struct WindowCase {
   Config config;
   BarModel model;
   ChannelSet data;
-  McreProblem problem;
+  testing::BarMcreProblem problem;
 };
 
 // The fixed-omega relaxation converges iff omega < 2 / a_max, a_max the largest

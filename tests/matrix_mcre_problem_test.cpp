@@ -71,7 +71,7 @@ class BarThroughMatricesTest : public ::testing::Test {
 };
 
 TEST_F(BarThroughMatricesTest, SweepsWeightsCostAndZoneGradientsAreTheBuiltInBars) {
-  McreProblem bar(*model_, data_, weights_, 200e9, 0.5);
+  testing::BarMcreProblem bar(*model_, data_, weights_, 200e9, 0.5);
   MatrixMcreProblem general(matrices_, histories_, weights_, 200e9, 0.5);
   // The weights from a* = S / L and l* = L are the bar's (the same formulas, the same
   // operations: docs/matrix_models.md section 6).
@@ -86,7 +86,7 @@ TEST_F(BarThroughMatricesTest, SweepsWeightsCostAndZoneGradientsAreTheBuiltInBar
 
   // One sweep of each kind from the same input (the general point loads against the
   // bar's end and point loads), the inner products and the cost on the same fields: the
-  // same bits (McreProblem computes as MatrixMcreProblem does).
+  // same bits (BarMcreProblem computes as MatrixMcreProblem does).
   Matrix w = bar.ZeroField(), u_bar, u_general, w_bar, w_general;
   bar.RetrogradeSweep(bar.ZeroField(), true, &w);
   bar.DirectSweep(w, true, &u_bar);
@@ -120,7 +120,7 @@ TEST_F(BarThroughMatricesTest, SweepsWeightsCostAndZoneGradientsAreTheBuiltInBar
 // while its fields fit and streams when they do not; a stored-field method named is
 // then refused, naming what fits.
 TEST_F(BarThroughMatricesTest, AutoStreamsTheBarAndTheMatricesWhenTheirFieldsDoNotFit) {
-  McreProblem bar(*model_, data_, weights_, 200e9, 0.5);
+  testing::BarMcreProblem bar(*model_, data_, weights_, 200e9, 0.5);
   MatrixMcreProblem general(matrices_, histories_, weights_, 200e9, 0.5);
   const Vector moduli = (Vector(3) << 180e9, 200e9, 230e9).finished();
   bar.SetModuli(moduli);

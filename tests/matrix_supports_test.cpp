@@ -39,7 +39,7 @@ CoupledSolverOptions SupportsTightSolver(CoupledSolverType type) {
 // sensors u@0.25 and e@0.65, maybe u@0.02) against the built-in bar's own reading of the
 // same fields: U at the ends and at the sensors (interpolated between nodes), the end
 // loads F = F~ - W / alpha (alpha_0 at a pinned clamp), a trusted clamp's reaction.
-void ExpectTheBarsModelChannels(const ChannelSet& channels, McreProblem& bar,
+void ExpectTheBarsModelChannels(const ChannelSet& channels, testing::BarMcreProblem& bar,
                                 const CoupledSolution& solution, const ChannelSet& data,
                                 ClampModel clamp) {
   const Matrix& u = solution.displacement;
@@ -84,7 +84,7 @@ void ExpectTheBarsModelChannels(const ChannelSet& channels, McreProblem& bar,
 // a support (dof 0, channels f0, u0; through Matrix Market) and the same treatment: 30
 // elements in `num_zones` zones, interior sensors u@0.25 and e@0.65, and with
 // `first_element_sensor` u@0.02 too (in the first element: its node-0 coefficient is
-// dropped under a trusted clamp). McreProblem computes as MatrixMcreProblem does
+// dropped under a trusted clamp). BarMcreProblem computes as MatrixMcreProblem does
 // (docs/matrix_models.md section 6): the same bits, but for W when u@0.02 is there, whose
 // retrograde loads share dofs 0 and 1 with u0 or the reaction (the bar adds them one by
 // one, the matrix problem as one sum per dof). Measured at most (the three treatments,
@@ -111,7 +111,7 @@ void ExpectBarSupportIsTheBuiltInClamp(int num_zones, ClampModel clamp, bool fir
   ASSERT_EQ(matrices.supports.size(), 1u);
   McreWeights weights = Weights(0.01, 1.0);
   weights.strain_weight = 0.003;
-  McreProblem bar(model, data, weights, 200e9, 0.5, {}, clamp);
+  testing::BarMcreProblem bar(model, data, weights, 200e9, 0.5, {}, clamp);
   MatrixMcreProblem general(matrices, data, weights, 200e9, 0.5, Factorization::kAutomatic, clamp);
   Vector moduli = Vector::Constant(num_zones, 187.3e9);
   if (num_zones == 3) moduli << 181.7e9, 203.1e9, 229.9e9;

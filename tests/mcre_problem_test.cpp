@@ -1,8 +1,6 @@
 // Tests of the discrete MCRE problem: weights, the adjoint structure of the two
 // sweeps, the cost at consistent data, the trusted clamp (ClampModel::kTrusted) and the
 // pinned clamp (ClampModel::kPinned).
-#include "mcrewave/mcre/mcre_problem.h"
-
 #include <gtest/gtest.h>
 
 #include <limits>
@@ -10,7 +8,7 @@
 #include <vector>
 
 #include "mcrewave/model/simulation.h"
-
+#include "reference/bar_mcre_problem.h"
 #include "test_problems.h"
 
 namespace mcrewave {
@@ -24,7 +22,7 @@ using testing::Solve;
 using testing::Solved;
 using testing::Weights;
 
-Matrix RandomField(const McreProblem& problem, unsigned seed) {
+Matrix RandomField(const testing::BarMcreProblem& problem, unsigned seed) {
   std::mt19937 engine(seed);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   Matrix field = problem.ZeroField();
@@ -34,8 +32,8 @@ Matrix RandomField(const McreProblem& problem, unsigned seed) {
 
 // <x, G y> = <G x, y> to `tolerance` of ||x||_P ||G y||_P, and <x, G x>, <y, G y> < 0;
 // returns G x.
-Matrix ExpectSelfAdjointAndNegative(McreProblem& problem, const Matrix& x, const Matrix& y,
-                                    double tolerance) {
+Matrix ExpectSelfAdjointAndNegative(testing::BarMcreProblem& problem, const Matrix& x,
+                                    const Matrix& y, double tolerance) {
   Matrix gx, gy, scratch;
   problem.ApplyIterationMap(x, &scratch, &gx);
   problem.ApplyIterationMap(y, &scratch, &gy);
@@ -71,7 +69,7 @@ class IterationMapTest : public ::testing::TestWithParam<double> {};
 TEST_P(IterationMapTest, IsSelfAdjointAndNegativeInPInnerProduct) {
   const double theta = GetParam();
   ProblemBundle bundle(MakeSmallCase(12, 60, 5.0, 2), Weights(1.0, 1.0), theta);
-  McreProblem& problem = bundle.problem;
+  testing::BarMcreProblem& problem = bundle.problem;
   problem.SetModulus(0.9 * 200e9);
   ExpectSelfAdjointAndNegative(problem, RandomField(problem, 1), RandomField(problem, 2), 1e-11);
 }
@@ -84,7 +82,7 @@ class BatchedSweepsTest : public ::testing::TestWithParam<int> {};
 
 TEST_P(BatchedSweepsTest, MatchTheSingleSweepsExactly) {
   ProblemBundle bundle(MakeSmallCase(GetParam(), 40, 5.0, 2), Weights(0.3, 1.0));
-  McreProblem& problem = bundle.problem;
+  testing::BarMcreProblem& problem = bundle.problem;
   problem.SetModulus(1.1 * 200e9);
   const Matrix zero = problem.ZeroField();
   const Matrix w1 = RandomField(problem, 3), w2 = RandomField(problem, 4);
@@ -122,7 +120,7 @@ TEST(McreProblemTest, ConsistentDataGiveZeroCostAtZeroRetrogradeField) {
   // Inverse crime: data from the model's own discretisation, no noise.
   ProblemBundle bundle(MakeSmallCase(16, 120, std::numeric_limits<double>::infinity(), 1),
                        Weights(1.0, 1.0));
-  McreProblem& problem = bundle.problem;
+  testing::BarMcreProblem& problem = bundle.problem;
   const Matrix zero = problem.ZeroField();
   Matrix displacement, image;
   problem.FixedPointMap(zero, &displacement, &image);
@@ -153,7 +151,8 @@ TEST(TrustedClampTest, HoldsTheClampAndDrivesTheBarByFLAlone) {
   const testing::SmallCase small = MakeSmallCase(16, 120, std::numeric_limits<double>::infinity(), 1);
   const BarModel model(small.bar);
   const ChannelSet data = MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
-  McreProblem problem(model, data, Weights(0.01, 1.0), 200e9, 0.5, {}, ClampModel::kTrusted);
+  testing::BarMcreProblem problem(model, data, Weights(0.01, 1.0), 200e9, 0.5, {},
+                                  ClampModel::kTrusted);
   EXPECT_FALSE(problem.end_channels().u0);
   EXPECT_EQ(problem.num_interior_sensors(), 1);  // the reaction
   const Matrix zero = problem.ZeroField();
@@ -187,7 +186,8 @@ TEST_P(TrustedClampMapTest, IsSelfAdjointAndNegativeInPInnerProduct) {
   const ChannelSet data = WithClampSideSensors(bundle.data);
   McreWeights weights = Weights(1.0, 1.0);
   weights.reaction_weight = 0.1;
-  McreProblem problem(bundle.model, data, weights, 200e9, theta, {}, ClampModel::kTrusted);
+  testing::BarMcreProblem problem(bundle.model, data, weights, 200e9, theta, {},
+                                  ClampModel::kTrusted);
   problem.SetModulus(0.9 * 200e9);
   Matrix x = RandomField(problem, 1), y = RandomField(problem, 2);
   // Fields of the clamped problem: W_0 = 0.
@@ -203,7 +203,7 @@ INSTANTIATE_TEST_SUITE_P(Theta, TrustedClampMapTest, ::testing::Values(0.5, 1.0)
 // Solves `problem` by CG (tolerance 1e-12) and by the all-at-once sparse LU, expects
 // them to agree within `bounds` (relative differences of U, W and e^2) and returns
 // the all-at-once solution.
-Solved ExpectConjugateGradientsAgreeWithAllAtOnce(McreProblem* problem,
+Solved ExpectConjugateGradientsAgreeWithAllAtOnce(testing::BarMcreProblem* problem,
                                                   const testing::Agreement& bounds) {
   Solved reference = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-8), problem);
   const Solved solved = Solve(Options(CoupledSolverType::kConjugateGradient, 1e-12), problem);
@@ -224,7 +224,8 @@ TEST(TrustedClampTest, ConjugateGradientsAgreeWithTheAllAtOnceSolve) {
   const ChannelSet data = WithClampSideSensors(bundle.data);
   McreWeights weights = Weights(0.01, 1.0);
   weights.reaction_weight = 0.01;
-  McreProblem problem(bundle.model, data, weights, 200e9, 0.5, {}, ClampModel::kTrusted);
+  testing::BarMcreProblem problem(bundle.model, data, weights, 200e9, 0.5, {},
+                                  ClampModel::kTrusted);
   problem.SetModulus(0.95 * 200e9);
   // Measured 1.5e-13 (U), 2.6e-12 (W), 1.7e-15 (e^2).
   ExpectConjugateGradientsAgreeWithAllAtOnce(&problem, {1e-12, 2e-11, 1e-14});
@@ -238,7 +239,7 @@ std::vector<double> ZoneGradientErrors(const McreWeights& weights, ClampModel cl
   layout.zone_count = 2;
   const BarModel model(small.bar, layout.ElementZones(small.bar));
   const ChannelSet data = MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
-  McreProblem problem(model, data, weights, 200e9, 0.5, {}, clamp);
+  testing::BarMcreProblem problem(model, data, weights, 200e9, 0.5, {}, clamp);
   const CoupledSolverOptions options = Options(CoupledSolverType::kConjugateGradient, 1e-13);
   Vector moduli(2);
   moduli << 0.93 * 200e9, 1.04 * 200e9;
@@ -288,7 +289,8 @@ TEST(PinnedClampTest, WeighsTheKnownZeroAndTheReactionLoadWithTheirOwnWeights) {
   McreWeights weights = PinnedWeights();
   weights.clamp_displacement_weight = 0.3;
   weights.reaction_weight = 0.05;
-  McreProblem problem(bundle.model, bundle.data, weights, 200e9, 0.5, {}, ClampModel::kPinned);
+  testing::BarMcreProblem problem(bundle.model, bundle.data, weights, 200e9, 0.5, {},
+                                  ClampModel::kPinned);
   problem.SetModulus(0.9 * 200e9);
   // alpha_0 = w_r L / (S E0), beta_0 = w_u0 S E0 / L (S = 1e-4, L = 1, E0 = 200 GPa).
   const double alpha0 = 0.05 / (1e-4 * 200e9), beta0 = 0.3 * 1e-4 * 200e9;
@@ -319,7 +321,8 @@ TEST_P(PinnedClampMapTest, IsSelfAdjointAndNegativeInPInnerProduct) {
   const double theta = GetParam();
   ProblemBundle bundle(MakeSmallCase(12, 60, 5.0, 2), Weights(1.0, 1.0), theta);
   const ChannelSet data = WithClampSideSensors(bundle.data);
-  McreProblem problem(bundle.model, data, PinnedWeights(), 200e9, theta, {}, ClampModel::kPinned);
+  testing::BarMcreProblem problem(bundle.model, data, PinnedWeights(), 200e9, theta, {},
+                                  ClampModel::kPinned);
   problem.SetModulus(0.9 * 200e9);
   // Measured 8.9e-17 (theta 1/2) and 4.4e-17 (theta 1) of the scale.
   ExpectSelfAdjointAndNegative(problem, RandomField(problem, 1), RandomField(problem, 2), 5e-16);
@@ -330,7 +333,8 @@ INSTANTIATE_TEST_SUITE_P(Theta, PinnedClampMapTest, ::testing::Values(0.5, 1.0))
 TEST(PinnedClampTest, ConjugateGradientsAgreeWithTheAllAtOnceSolve) {
   ProblemBundle bundle(MakeSmallCase(12, 80, 5.0, 2), Weights(0.01, 1.0));
   const ChannelSet data = WithClampSideSensors(bundle.data);
-  McreProblem problem(bundle.model, data, PinnedWeights(), 200e9, 0.5, {}, ClampModel::kPinned);
+  testing::BarMcreProblem problem(bundle.model, data, PinnedWeights(), 200e9, 0.5, {},
+                                  ClampModel::kPinned);
   problem.SetModulus(0.95 * 200e9);
   // Measured 1.8e-13 (U), 3.6e-12 (W), 6.8e-16 (e^2).
   const Solved reference =
@@ -347,10 +351,10 @@ TEST(PinnedClampTest, TheMeasuredU0DoesNotEnter) {
   ProblemBundle bundle(MakeSmallCase(12, 80, 5.0, 2), Weights(0.01, 1.0));
   ChannelSet other = bundle.data;
   other.Values("u0") *= -3.0;
-  McreProblem problem(bundle.model, bundle.data, PinnedWeights(), 200e9, 0.5, {},
-                      ClampModel::kPinned);
-  McreProblem other_problem(bundle.model, other, PinnedWeights(), 200e9, 0.5, {},
-                            ClampModel::kPinned);
+  testing::BarMcreProblem problem(bundle.model, bundle.data, PinnedWeights(), 200e9, 0.5, {},
+                                  ClampModel::kPinned);
+  testing::BarMcreProblem other_problem(bundle.model, other, PinnedWeights(), 200e9, 0.5, {},
+                                        ClampModel::kPinned);
   const CoupledSolverOptions options = Options(CoupledSolverType::kConjugateGradient, 1e-10);
   const Solved solved = Solve(options, &problem);
   const Solved other_solved = Solve(options, &other_problem);
@@ -372,8 +376,8 @@ TEST(PinnedClampTest, RiccatiAndShootingSolveIt) {
   // refused it before. Measured against the space-time LU: U 8.2e-16, W 1.6e-14, e^2
   // 2.7e-15 (Riccati; both shootings 5.4e-16, 5.5e-15, 2.5e-15).
   ProblemBundle bundle(MakeSmallCase(8, 40, 5.0, 2), Weights(0.01, 1.0));
-  McreProblem problem(bundle.model, bundle.data, PinnedWeights(), 200e9, 0.5, {},
-                      ClampModel::kPinned);
+  testing::BarMcreProblem problem(bundle.model, bundle.data, PinnedWeights(), 200e9, 0.5, {},
+                                  ClampModel::kPinned);
   problem.SetModulus(180e9);
   const Solved reference = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-12), &problem);
   ASSERT_TRUE(reference.summary.IsSolutionUsable()) << reference.summary.FullReport();

@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "mcrewave/mcre/coupled_solver.h"
-#include "mcrewave/mcre/mcre_problem.h"
 #include "mcrewave/model/bar_model.h"
 #include "mcrewave/model/simulation.h"
+#include "reference/bar_mcre_problem.h"
 #include "test_problems.h"
 
 namespace mcrewave {
@@ -84,17 +84,18 @@ struct ZonedCase {
         data(MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data)) {
     AddSensorsAlong(model, data.num_samples(), &data);
     // The response of the truth to the measured forces: the direct sweep at W = 0.
-    McreProblem truth(model, data, Weights(0.01, 1.0), 200e9, 0.5, ends);
+    testing::BarMcreProblem truth(model, data, Weights(0.01, 1.0), 200e9, 0.5, ends);
     truth.SetModuli(truth_moduli);
     Matrix displacement;
     truth.DirectSweep(truth.ZeroField(), true, &displacement);
     ObserveField(model, displacement, noise, &data);
-    problem = std::make_unique<McreProblem>(model, data, Weights(0.01, 1.0), 200e9, 0.5, ends);
+    problem = std::make_unique<testing::BarMcreProblem>(model, data, Weights(0.01, 1.0), 200e9, 0.5,
+                                                        ends);
   }
   testing::SmallCase small;
   BarModel model;
   ChannelSet data;
-  std::unique_ptr<McreProblem> problem;
+  std::unique_ptr<testing::BarMcreProblem> problem;
 };
 
 ZoneLayout EqualZones(int count) {
@@ -117,7 +118,7 @@ TEST(McreZonesTest, DataResponseTracesAreTheDirectSweepAtZeroObservedByH) {
   // The streaming traces of the model driven by the data alone (one sweep, no field)
   // against H applied to the stored direct sweep at W = 0: measured the same bits.
   const ZonedCase zoned(20, 120, EqualZones(2), SoftZoneModuli(2), 0.01);
-  McreProblem& problem = *zoned.problem;
+  testing::BarMcreProblem& problem = *zoned.problem;
   Matrix traces, displacement;
   problem.DataResponseTraces(&traces);
   problem.DirectSweep(problem.ZeroField(), true, &displacement);
@@ -150,7 +151,7 @@ TEST(McreZonesTest, EqualZoneModuliGiveTheOneZoneProblem) {
   // gradient summed by element instead of as a band form).
   ZonedCase zoned(40, 120, EqualZones(10), SoftZoneModuli(10), 0.05);
   const BarModel one_zone(zoned.small.bar);
-  McreProblem reference(one_zone, zoned.data, Weights(0.01, 1.0), 200e9, 0.5);
+  testing::BarMcreProblem reference(one_zone, zoned.data, Weights(0.01, 1.0), 200e9, 0.5);
   const CoupledSolverOptions options = Options(CoupledSolverType::kConjugateGradient, 1e-12);
   for (double modulus : {180e9, 215e9}) {
     zoned.problem->SetModulus(modulus);
@@ -176,7 +177,7 @@ TEST_P(ZoneGradientTest, EveryZoneMatchesACentralDifference) {
   if (elements == 100) layout.zoning = Zoning::kPerElement;
   const int zones = elements == 100 ? elements : 10;
   const ZonedCase zoned(elements, 2 * elements, layout, SoftZoneModuli(zones), 0.05);
-  McreProblem& problem = *zoned.problem;
+  testing::BarMcreProblem& problem = *zoned.problem;
   ASSERT_EQ(problem.num_zones(), zones);
   Vector trial(zones);
   for (int z = 0; z < zones; ++z) trial[z] = 200e9 * (0.9 + 0.2 * std::sin(1.0 + 3.0 * z));
@@ -230,14 +231,14 @@ TEST(McreZonesTest, ErrorMapSharesTheConstitutivePartAndPointsAtTheSoftZone) {
   ZoneLayout per_element;
   per_element.zoning = Zoning::kPerElement;
   const BarModel truth_model(zoned.small.bar, per_element.ElementZones(zoned.small.bar));
-  McreProblem truth(truth_model, zoned.data, Weights(0.01, 1.0), 200e9, 0.5);
+  testing::BarMcreProblem truth(truth_model, zoned.data, Weights(0.01, 1.0), 200e9, 0.5);
   Vector truth_moduli = Vector::Constant(50, 200e9);
   truth_moduli.segment(30, 5).setConstant(140e9);
   truth.SetModuli(truth_moduli);
   Matrix displacement;
   truth.DirectSweep(truth.ZeroField(), true, &displacement);
   ObserveField(truth_model, displacement, 0.0, &zoned.data);
-  McreProblem problem(zoned.model, zoned.data, Weights(0.01, 1.0), 200e9, 0.5);
+  testing::BarMcreProblem problem(zoned.model, zoned.data, Weights(0.01, 1.0), 200e9, 0.5);
   problem.SetModulus(200e9);
   const Solved solved = Solve(Options(CoupledSolverType::kConjugateGradient, 1e-10), &problem);
   ASSERT_TRUE(solved.summary.IsSolutionUsable());
@@ -273,7 +274,7 @@ TEST_P(SensorSolverTest, AgreesWithAllAtOnce) {
   // 4.4e-15 in e^2 and 7.2e-11 in the zone gradients (adaptive relaxation the largest).
   const SensorCase& param = GetParam();
   ZonedCase zoned(16, 60, EqualZones(4), Vector::Constant(4, 200e9), 0.05, param.ends);
-  McreProblem& problem = *zoned.problem;
+  testing::BarMcreProblem& problem = *zoned.problem;
   Vector trial(4);
   trial << 190e9, 230e9, 150e9, 210e9;
   problem.SetModuli(trial);
@@ -303,7 +304,7 @@ TEST(McreZonesTest, BatchedRetrogradeSweepsWithSensorsMatchTheSingleSweepsExactl
   // The coupled solvers start with batched sweeps: with interior sensors their point
   // loads must be those of the single sweeps, bit for bit, zero inputs included.
   ZonedCase zoned(17, 50, EqualZones(3), Vector::Constant(3, 200e9), 0.05);
-  McreProblem& problem = *zoned.problem;
+  testing::BarMcreProblem& problem = *zoned.problem;
   Vector trial(3);
   trial << 190e9, 230e9, 150e9;
   problem.SetModuli(trial);
@@ -332,7 +333,7 @@ TEST(McreZonesTest, RiccatiAndShootingSolveZonedBarsWithEndSensors) {
       std::remove_if(channels.begin(), channels.end(),
                      [](const Channel& c) { return c.name.find('@') != std::string::npos; }),
       channels.end());
-  McreProblem problem(zoned.model, zoned.data, Weights(0.01, 1.0), 200e9, 0.5);
+  testing::BarMcreProblem problem(zoned.model, zoned.data, Weights(0.01, 1.0), 200e9, 0.5);
   Vector trial(3);
   trial << 190e9, 230e9, 150e9;
   problem.SetModuli(trial);
@@ -353,7 +354,7 @@ TEST(McreZonesTest, RiccatiAndShootingSolveBarsWithInteriorSensors) {
   // H^T diag(beta) H (docs/riccati_shooting.md). Measured against the space-time LU:
   // e^2 1.8e-15, W 1.1e-14 (Riccati), e^2 3.1e-15, W 4.0e-14 (both shootings).
   ZonedCase zoned(10, 30, EqualZones(1), Vector::Constant(1, 200e9), 0.0);
-  McreProblem& problem = *zoned.problem;
+  testing::BarMcreProblem& problem = *zoned.problem;
   ASSERT_GT(problem.num_interior_sensors(), 0);
   problem.SetModulus(180e9);
   const Solved reference = Solve(Options(CoupledSolverType::kAllAtOnce, 1e-10), &problem);

@@ -91,7 +91,7 @@ class ModulusUncertaintyTest : public ::testing::Test {
   testing::SmallCase case_;
   BarModel model_;
   ChannelSet data_;
-  McreProblem problem_;
+  testing::BarMcreProblem problem_;
   MatrixModelData matrices_;
   CoupledSolution solution_;
 };
@@ -126,7 +126,8 @@ TEST(ModulusUncertaintyTrustedClampTest, TheFirstOrderChangeIsTheDifferenceOverD
   CoupledSolverOptions inner;
   inner.tolerance = 1e-12;
   constexpr double kModulus = 200e9, kCurvature = 1e-30;
-  McreProblem problem(model, data, mcre.weights, mcre.reference_modulus, 0.5, {}, mcre.clamp);
+  testing::BarMcreProblem problem(model, data, mcre.weights, mcre.reference_modulus, 0.5, {},
+                                  mcre.clamp);
   problem.SetModulus(kModulus);
   CoupledSolution solution;
   ASSERT_TRUE(SolveCoupled(inner, &problem, nullptr, &solution).IsSolutionUsable());
@@ -157,8 +158,8 @@ TEST(ModulusUncertaintyTrustedClampTest, TheFirstOrderChangeIsTheDifferenceOverD
       shifted.Values("uL") += s * drawn.Values("uL");
       shifted.Values("f0") += s * drawn.Values("f0");
       shifted.Values("fL") += s * drawn.Values("fL");
-      McreProblem shifted_problem(model, shifted, mcre.weights, mcre.reference_modulus, 0.5, {},
-                                  mcre.clamp);
+      testing::BarMcreProblem shifted_problem(model, shifted, mcre.weights, mcre.reference_modulus,
+                                              0.5, {}, mcre.clamp);
       shifted_problem.SetModulus(kModulus);
       CoupledSolution shifted_solution;
       ASSERT_TRUE(

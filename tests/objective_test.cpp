@@ -12,6 +12,7 @@
 #include "mcrewave/model/matrix_export.h"
 #include "mcrewave/model/simulation.h"
 #include "mcrewave/optim/identification.h"
+#include "reference/bar_mcre_problem.h"
 #include "test_problems.h"
 
 namespace mcrewave {
@@ -258,7 +259,7 @@ TEST(ZoneMcreObjectiveTest, AFailedSolveIsReportedNotThrown) {
 // (the pinned clamp's e^2 scanned and refined, then the trusted clamp's e^2 refined
 // within 3 % of it) run once on the built-in bar and once on the same bar exported as
 // matrices with its clamp as a support, from the same data, E per unit of x the same:
-// the same evaluations and the same modulus, to the bit (McreProblem computes as
+// the same evaluations and the same modulus, to the bit (BarMcreProblem computes as
 // MatrixMcreProblem does, docs/matrix_models.md section 6).
 TEST(McreObjectiveTest, TheBarAsMatricesIdentifiesTheBuiltInBarsModulus) {
   const testing::SmallCase c = MakeSmallCase(20, 350, 10.0, 2);
@@ -276,14 +277,15 @@ TEST(McreObjectiveTest, TheBarAsMatricesIdentifiesTheBuiltInBarsModulus) {
   std::vector<IdentificationSummary> summaries;
   std::vector<std::vector<ObjectiveEvaluation>> evaluations;
   for (const bool as_matrices : {false, true}) {
-    McreObjective objective = as_matrices
-                                  ? MatrixMcreObjective(matrices, data, mcre, 0.5, inner,
-                                                        Factorization::kAutomatic, options.initial)
-                                  : McreObjective(model, data, mcre, 0.5, inner, options.initial);
-    McreObjective search_objective =
-        as_matrices ? MatrixMcreObjective(matrices, data, search, 0.5, search_inner,
+    McreObjective objective =
+        as_matrices ? MatrixMcreObjective(matrices, data, mcre, 0.5, inner,
                                           Factorization::kAutomatic, options.initial)
-                    : McreObjective(model, data, search, 0.5, search_inner, options.initial);
+                    : testing::BarMcreObjective(model, data, mcre, 0.5, inner, options.initial);
+    McreObjective search_objective =
+        as_matrices
+            ? MatrixMcreObjective(matrices, data, search, 0.5, search_inner,
+                                  Factorization::kAutomatic, options.initial)
+            : testing::BarMcreObjective(model, data, search, 0.5, search_inner, options.initial);
     summaries.push_back(IdentifyInTwoStages(options, &search_objective, SearchOptions().scan_points,
                                             SearchOptions().refine_window, &objective));
     ASSERT_TRUE(summaries.back().IsSolutionUsable()) << summaries.back().FullReport();

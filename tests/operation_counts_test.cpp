@@ -236,7 +236,8 @@ TEST(OperationCountsTest, DenseKernelsCountedOnRealFactorisations) {
 // the retrograde sweep's end forces per step and W_j per level). They compute what the
 // library's sweeps compute (checked on a tiny bar) and count what they execute.
 struct CountedSweeps {
-  CountedSweeps(const McreProblem& problem, const ChannelSet& data) : problem(problem), data(data) {
+  CountedSweeps(const testing::BarMcreProblem& problem, const ChannelSet& data)
+      : problem(problem), data(data) {
     const Eigen::MatrixXd mass(problem.MassMatrix()), stiffness(problem.StiffnessMatrix());
     h = problem.time_step();
     theta = problem.theta();
@@ -322,7 +323,7 @@ struct CountedSweeps {
     return sum;
   }
 
-  const McreProblem& problem;
+  const testing::BarMcreProblem& problem;
   const ChannelSet& data;
   double h = 0.0, theta = 0.0;
   Eigen::MatrixXd k, r, s;
@@ -333,7 +334,7 @@ TEST(OperationCountsTest, SweepsCountedOnRealSweepsOfATinyBar) {
     // 6 elements (7 nodes, half bandwidth 1), 5 steps, noise-free data.
     testing::ProblemBundle bundle(testing::MakeSmallCase(6, 5, INFINITY, 1),
                                   testing::Weights(0.01, 1.0), theta);
-    McreProblem& problem = bundle.problem;
+    testing::BarMcreProblem& problem = bundle.problem;
     problem.SetModulus(0.9 * bundle.model.properties().modulus);
     const CountedSweeps counted(problem, bundle.data);
     const int n = problem.num_nodes(), m = problem.num_steps();

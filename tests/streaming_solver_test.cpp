@@ -12,8 +12,9 @@
 #include "identify_binary.h"
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/error_map.h"
-#include "mcrewave/mcre/mcre_problem.h"
 #include "mcrewave/model/simulation.h"
+#include "reference/bar_error_map.h"
+#include "reference/bar_mcre_problem.h"
 #include "test_problems.h"
 
 namespace mcrewave {
@@ -26,7 +27,7 @@ using testing::Solve;
 using testing::Solved;
 using testing::Weights;
 
-Matrix RandomTraces(const McreProblem& problem, unsigned seed) {
+Matrix RandomTraces(const testing::BarMcreProblem& problem, unsigned seed) {
   std::mt19937 engine(seed);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   Matrix traces = problem.ZeroTraces();
@@ -46,7 +47,7 @@ ChannelSet WithSensors(const ChannelSet& data) {
 TEST(StreamingMapTest, TheTraceOperatorIsSelfAdjointAndPositive) {
   ProblemBundle bundle(MakeSmallCase(12, 60, 5.0, 2), Weights(1.0, 1.0));
   const ChannelSet data = WithSensors(bundle.data);
-  McreProblem problem(bundle.model, data, Weights(1.0, 1.0), 200e9, 0.5);
+  testing::BarMcreProblem problem(bundle.model, data, Weights(1.0, 1.0), 200e9, 0.5);
   problem.SetModulus(0.9 * 200e9);
   const Matrix x = RandomTraces(problem, 1), y = RandomTraces(problem, 2);
   Matrix lx, ly;
@@ -85,7 +86,7 @@ TEST_P(StreamingAgreementTest, MatchesStoredFieldConjugateGradients) {
   ends.u0 = param.use_u0;
   McreWeights weights = Weights(0.01, 1.0);
   weights.reaction_weight = 0.01;
-  McreProblem problem(model, data, weights, 200e9, 0.5, ends, param.clamp);
+  testing::BarMcreProblem problem(model, data, weights, 200e9, 0.5, ends, param.clamp);
   Vector moduli(param.zones);
   for (int z = 0; z < param.zones; ++z) moduli[z] = 200e9 * (0.85 + 0.1 * z);
   problem.SetModuli(moduli);
@@ -103,9 +104,8 @@ TEST_P(StreamingAgreementTest, MatchesStoredFieldConjugateGradients) {
       stored.solution.cost_gradients.norm();
   const Vector map = problem.ErrorMap(stored.solution.retrograde);
   const double error_map = (streamed.solution.error_map - map).norm() / map.norm();
-  const Matrix picture = ComputeErrorMap(model, moduli, stored.solution.retrograde,
-                                         small.time.step)
-                             .density;
+  const Matrix picture =
+      testing::ComputeErrorMap(model, moduli, stored.solution.retrograde, small.time.step).density;
   ASSERT_EQ(streamed.solution.gap_density.rows(), picture.rows());
   ASSERT_EQ(streamed.solution.gap_density.cols(), picture.cols());
   const double space_time = (streamed.solution.gap_density - picture).norm() / picture.norm();
@@ -164,7 +164,7 @@ TEST(StreamingSolverTest, AWarmStartFromANearbyModulusGivesTheSameSolutionInFewe
   // Measured: the same e^2 to the bit; iterations cold / warm 206 / 152.
   ProblemBundle bundle(MakeSmallCase(30, 400, 10.0, 2), Weights(0.01, 1.0));
   const ChannelSet data = WithSensors(bundle.data);
-  McreProblem problem(bundle.model, data, Weights(0.01, 1.0), 200e9, 0.5);
+  testing::BarMcreProblem problem(bundle.model, data, Weights(0.01, 1.0), 200e9, 0.5);
   const CoupledSolverOptions options =
       Options(CoupledSolverType::kStreamingConjugateGradient, 1e-10);
   problem.SetModulus(0.9 * 200e9);
@@ -249,9 +249,9 @@ TEST(StreamingSolverTest, RebuiltRetrogradeStateReturnsToRestOverTenThousandStep
   // The rebuild runs the recursion 1e4 steps the other way; omega at T must come back
   // to 0. Measured 4.8e-12 of max ||omega|| (1e4 steps, 20 elements).
   ProblemBundle bundle(MakeSmallCase(20, 10000, 5.0, 1), Weights(0.01, 1.0));
-  McreProblem& problem = bundle.problem;
+  testing::BarMcreProblem& problem = bundle.problem;
   Matrix image;
-  McreProblem::StreamingTotals totals;
+  testing::BarMcreProblem::StreamingTotals totals;
   problem.StreamingMap(RandomTraces(problem, 5), true, &image, &totals);
   EXPECT_LT(totals.rebuild_error, 5e-11);
 }
@@ -280,7 +280,7 @@ TEST(StreamingMemoryTest, PeakResidentMemoryStaysFarBelowOneSpaceTimeField) {
   const testing::SmallCase small = MakeSmallCase(2000, 4000, 10.0, 1);
   const BarModel model(small.bar);
   const ChannelSet data = MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data);
-  McreProblem problem(model, data, Weights(0.01, 1.0), 200e9, 0.5);
+  testing::BarMcreProblem problem(model, data, Weights(0.01, 1.0), 200e9, 0.5);
   problem.SetModulus(190e9);
   const double field_bytes = 8.0 * problem.num_nodes() * (problem.num_steps() + 1.0);
   if (!ResetPeakResidentMemory() || PeakResidentBytes() < 0) {

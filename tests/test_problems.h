@@ -12,12 +12,12 @@
 
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
-#include "mcrewave/mcre/mcre_problem.h"
 #include "mcrewave/mcre/objective.h"
 #include "mcrewave/model/bar_model.h"
 #include "mcrewave/model/matrix_export.h"
 #include "mcrewave/model/simulation.h"
 #include "mcrewave/optim/bounded_minimizer.h"
+#include "reference/bar_mcre_problem.h"
 
 // MCREWAVE_ADDRESS_SANITIZER: defined when this build runs under AddressSanitizer
 // (gcc's macro or clang's feature test), whose allocator and memory overhead some
@@ -74,11 +74,11 @@ struct ProblemBundle {
         problem(model, data, weights, c.bar.modulus, theta) {}
   BarModel model;
   ChannelSet data;
-  McreProblem problem;
+  testing::BarMcreProblem problem;
 };
 
 // The same bar and data as every run solves them: the bar exported as matrices
-// (BarRunModel; its clamp a support, measured by default as ProblemBundle's McreProblem
+// (BarRunModel; its clamp a support, measured by default as ProblemBundle's BarMcreProblem
 // has it: the paper's free-free formulation) and its MatrixMcreProblem at the bar's
 // modulus.
 struct BarRunProblem {

@@ -55,7 +55,7 @@ struct InverseCrime {
       : small(MakeSmallCase(elements, steps, std::numeric_limits<double>::infinity(), 1)),
         model(small.bar, EqualZones(zones).ElementZones(small.bar)),
         data(MakeSyntheticMeasurements(small.bar, small.load, small.time, small.data)) {
-    McreProblem problem(model, data, testing::Weights(0.01, 1.0), 200e9, 0.5);
+    testing::BarMcreProblem problem(model, data, testing::Weights(0.01, 1.0), 200e9, 0.5);
     problem.SetModuli(truth);
     Matrix displacement;
     problem.DirectSweep(problem.ZeroField(), true, &displacement);

@@ -1,8 +1,7 @@
 // Batched sweeps of a structure given by matrices (matrix_mcre_problem.h): up to
 // kMaxSweepBatch direct (retrograde) sweeps with the data at once, each step of the
 // batch one ThetaIntegrator::StepsWithEndLoads call, so that the tridiagonal solves of
-// the bar exported as matrices run interleaved as the built-in bar's do
-// (McreProblem::DirectSweeps). Each sweep forms its force as DirectSweep
+// the bar exported as matrices run interleaved. Each sweep forms its force as DirectSweep
 // (RetrogradeSweep) does, so the results are the single sweeps' bits.
 #include <cassert>
 #include <stdexcept>

@@ -70,17 +70,6 @@ McreObjective::McreObjective(ProblemFactory make_problem, const CoupledSolverOpt
   rest_cost_ = problem_->RestCost();
 }
 
-McreObjective::McreObjective(const BarModel& model, const ChannelSet& data, const McreOptions& mcre,
-                             double theta, const CoupledSolverOptions& inner, double modulus_scale,
-                             EndDisplacementChannels ends)
-    : McreObjective(
-          [&model, &data, mcre, theta, ends]() -> std::unique_ptr<StreamingCoupledProblem> {
-            assert(mcre.IsValid(nullptr));
-            return std::make_unique<McreProblem>(model, data, mcre.weights, mcre.reference_modulus,
-                                                 theta, ends, mcre.clamp);
-          },
-          inner, modulus_scale) {}
-
 McreObjective MatrixMcreObjective(const MatrixModelData& model, const ChannelSet& data,
                                   const McreOptions& mcre, double theta,
                                   const CoupledSolverOptions& inner, Factorization factorization,

@@ -24,12 +24,13 @@ double BandProductAdd(int n, int p);
 // K u (n), the solve and the update (2n). with_force adds the n MACs of h f.
 double ThetaStep(int n, int p, bool with_force);
 
-// One direct sweep of McreProblem (m steps, n nodes): per time level the force
+// One direct sweep of the paper's bar as a band model loaded at its two end nodes
+// (m steps, n nodes): per time level the force
 // g_j = F~_j - (K + B/alpha) W_j (a band product and 2 end entries), per step the
 // theta weighting of the force (2n) and one theta step with force.
 double DirectSweep(int n, int p, int m);
 
-// One retrograde sweep of McreProblem: per step the 2 end-node forces and a theta
+// One retrograde sweep of that band model: per step the 2 end-node forces and a theta
 // step with force, per time level W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j
 // (3n, the division by c_j included).
 double RetrogradeSweep(int n, int p, int m);

@@ -1,7 +1,7 @@
 // The coupled direct / retrograde MCRE problem as the coupled solvers see it
-// (coupled_solver.h), whatever the structure: the built-in bar (McreProblem,
-// mcre_problem.h) or a structure given by matrices (MatrixMcreProblem,
-// matrix_mcre_problem.h). docs/discrete_mcre.md states the problem; for a general
+// (coupled_solver.h), whatever the structure (MatrixMcreProblem, matrix_mcre_problem.h,
+// for a structure given by matrices, the built-in bar exported as matrices among them).
+// docs/discrete_mcre.md states the problem; for a general
 // structure docs/matrix_models.md gives the same equations with the load vectors G
 // and the observation rows H:
 //

@@ -50,7 +50,7 @@
 #include <string>
 #include <vector>
 
-#include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/mcre/streaming_coupled_problem.h"
 
 namespace mcrewave {
 
@@ -100,7 +100,7 @@ struct CoupledSolverOptions {
   // the reversed recursion drifts by more than this (||omega_0 rebuilt to omega_m|| /
   // max_j ||omega_j||, 0 in exact arithmetic, growing with the Courant number:
   // docs/streaming.md gives the measured values), the solver switches
-  // the problem to checkpoints (McreProblem::UseCheckpoints) and goes on from its
+  // the problem to checkpoints (StreamingCoupledProblem::UseCheckpoints) and goes on from its
   // traces. Library option, no config key.
   double max_rebuild_error = 1e-7;
   // Shooting fails when the 2-norm condition number of its (equilibrated) shooting
@@ -185,9 +185,8 @@ struct CoupledSolution {
   Vector cost_gradients;       // de^2/dE_z [J s / Pa], one per zone
 };
 
-// Solves the coupled problem at the problem's current moduli with every solver, the
-// bar (McreProblem, any clamp and sensors) and a structure given by matrices
-// (MatrixMcreProblem) alike; streaming_conjugate_gradient needs a
+// Solves the coupled problem at the problem's current moduli with every solver, for any
+// structure, supports and sensors; streaming_conjugate_gradient needs a
 // StreamingCoupledProblem. Riccati and shooting refuse, in the summary and naming
 // conjugate_gradient or auto, when their dense n x n blocks exceed
 // max_dense_solver_bytes, and when M, M + h^2 theta^2 K or P is not positive

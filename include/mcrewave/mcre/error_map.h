@@ -43,15 +43,6 @@ struct ErrorMap {
 // constitutive gap in each part (element, zone, dof).
 Vector GapFractions(const Vector& shares);
 
-// shares[el] += weight 1/2 W_j^T K_el W_j for every element, from W_j (n entries).
-void AddSampleGapShares(const BarModel& model, const Vector& zone_moduli, const double* retrograde,
-                        double weight, Vector* shares);
-
-// e_el^2 for every element (ErrorMap.share) of `model` at the zone moduli (one per
-// zone) from the retrograde field W (n x (m + 1)) on steps of time_step [s].
-Vector ElementGapShares(const BarModel& model, const Vector& zone_moduli, const Matrix& retrograde,
-                        double time_step);
-
 // The space-time picture's layout: every SpaceTimeStride-th of the m + 1 samples
 // (at most max_time_columns >= 2 of them), and columns of SpaceTimeGroupSize
 // consecutive elements (the last column may hold fewer), centred at
@@ -60,20 +51,10 @@ int SpaceTimeStride(int num_steps, int max_time_columns = kSpaceTimeSamples);
 int SpaceTimeGroupSize(int num_elements);
 Vector SpaceTimeColumnPositions(const BarModel& model);
 
-// row[c] = the mean over column c's elements of 1/2 W_j^T K_el W_j / h_e [J/m], from
-// W_j (n entries); row holds SpaceTimeColumnPositions(model).size() entries.
-void SampleGapDensity(const BarModel& model, const Vector& zone_moduli, const double* retrograde,
-                      double* row);
-
 // The map from its sums: the shares e_el^2 (one per element) and the picture's
 // density (rows at every stride-th sample of steps time_step [s], columns on
 // SpaceTimeColumnPositions), as a streaming solve gathers them.
 ErrorMap AssembleErrorMap(const BarModel& model, const Vector& shares, const Matrix& density,
                           int stride, double time_step);
-
-// The whole map, with the space-time picture on at most max_time_columns samples.
-// Precondition: max_time_columns >= 2.
-ErrorMap ComputeErrorMap(const BarModel& model, const Vector& zone_moduli, const Matrix& retrograde,
-                         double time_step, int max_time_columns = kSpaceTimeSamples);
 
 }  // namespace mcrewave

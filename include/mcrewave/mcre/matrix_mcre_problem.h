@@ -59,7 +59,7 @@
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/coupled_problem.h"
 #include "mcrewave/mcre/coupled_solver.h"
-#include "mcrewave/mcre/mcre_problem.h"
+#include "mcrewave/mcre/mcre_weights.h"
 #include "mcrewave/mcre/streaming_coupled_problem.h"
 #include "mcrewave/model/matrix_export.h"
 

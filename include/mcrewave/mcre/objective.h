@@ -1,8 +1,8 @@
 // The objective of the outer loop: the MCRE cost e^2 as a function of the
 // trial modulus E. McreObjective implements the optimisers' interface
 // (ModulusObjective, optim/modulus_objective.h) with a coupled problem of any structure
-// (StreamingCoupledProblem: the built-in bar's McreProblem, a matrix model's
-// MatrixMcreProblem) and the coupled solver of coupled_solver.h: each evaluation sets E,
+// (StreamingCoupledProblem: MatrixMcreProblem, whose model may be the built-in bar
+// exported as matrices) and the coupled solver of coupled_solver.h: each evaluation sets E,
 // solves the coupled problem warm-started from the previous usable solutions and
 // records what it did.
 //
@@ -22,8 +22,7 @@
 #include "mcrewave/data/measurement.h"
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
-#include "mcrewave/mcre/mcre_problem.h"
-#include "mcrewave/model/bar_model.h"
+#include "mcrewave/mcre/mcre_weights.h"
 #include "mcrewave/optim/log_moduli_objective.h"
 #include "mcrewave/optim/modulus_objective.h"
 
@@ -40,8 +39,8 @@ inline McreWeights TrustedClampWeights() {
 }
 
 // The `mcre:` section of the config: the weights of the data terms and the
-// modulus E0 they are built with (mcre_problem.h):
-//   beta = w_u S E0 / L,  alpha = w_f L / (S E0).
+// modulus E0 they are built with (mcre_weights.h):
+//   beta = w_u k*,  alpha = w_f / k*,  k* = E0 a* (the bar: a* = S / L).
 // E0 is a fixed nominal modulus, not the unknown: the same functional is then
 // minimised whatever the start or the bounds of the outer loop.
 struct McreOptions {
@@ -49,7 +48,7 @@ struct McreOptions {
   double reference_modulus = 200e9;  // E0 [Pa]
   // The clamp at x = 0: trusted (u(0) = 0, f0 a measured output), measured (the
   // paper's free-free model) or pinned (free-free, u0's datum the known 0 with w_u0,
-  // f0 a load with w_r); mcre_problem.h.
+  // f0 a load with w_r); matrix_mcre_problem.h, docs/trusted_clamp.md.
   ClampModel clamp = ClampModel::kTrusted;
 
   bool IsValid(std::string* error) const;
@@ -112,14 +111,6 @@ class McreObjective : public ModulusObjective {
   // inner.IsValid(), modulus_scale > 0.
   McreObjective(ProblemFactory make_problem, const CoupledSolverOptions& inner,
                 double modulus_scale);
-  // The built-in bar: an McreProblem on model and data with mcre's weights and clamp.
-  // Keeps references to model and data: both must outlive the objective.
-  // Preconditions: mcre.IsValid(), inner.IsValid(), theta in [0, 1], modulus_scale > 0,
-  // data.num_steps() >= 1. ends: the end displacement channels in use (data.channels);
-  // the interior sensors are those of data.
-  McreObjective(const BarModel& model, const ChannelSet& data, const McreOptions& mcre,
-                double theta, const CoupledSolverOptions& inner, double modulus_scale,
-                EndDisplacementChannels ends = {});
 
   double modulus_scale() const override { return modulus_scale_; }
 

@@ -1,8 +1,8 @@
 // The coupled problem on the sensor traces, as the streaming conjugate-gradient solver
 // sees it (docs/streaming.md): what a coupled problem offers so that it is solved with
-// O(n) states (or O(n sqrt(m)) checkpoints) instead of stored n x (m + 1) fields. The
-// built-in bar (McreProblem, mcre_problem.h) and a structure given by matrices
-// (MatrixMcreProblem, matrix_mcre_problem.h) implement it.
+// O(n) states (or O(n sqrt(m)) checkpoints) instead of stored n x (m + 1) fields. A
+// structure given by matrices (MatrixMcreProblem, matrix_mcre_problem.h), the built-in
+// bar exported as matrices among them, implements it.
 //
 // A trace field y holds one row per observation row of H and one column per sample:
 // num_traces() x (m + 1). The retrograde field depends on U only through y = H U, so

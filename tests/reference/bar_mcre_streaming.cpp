@@ -1,4 +1,4 @@
-// The streaming application of the coupled map on sensor traces (mcre_problem.h,
+// The streaming application of the coupled map on sensor traces (bar_mcre_problem.h,
 // docs/streaming.md): the retrograde sweep backward keeping only its state, then one
 // forward pass that rebuilds W_j by the reversed trapezoidal recursion and runs the
 // direct sweep beside it.
@@ -6,12 +6,13 @@
 #include <cassert>
 #include <cmath>
 
-#include "mcrewave/mcre/error_map.h"
-#include "mcrewave/mcre/mcre_problem.h"
+#include "reference/bar_error_map.h"
+#include "reference/bar_mcre_problem.h"
 
 namespace mcrewave {
+namespace testing {
 
-double McreProblem::TraceInnerProduct(const Matrix& a, const Matrix& b) const {
+double BarMcreProblem::TraceInnerProduct(const Matrix& a, const Matrix& b) const {
   const int m = num_steps();
   double sum = 0.0;
   for (int j = 0; j <= m; ++j) {
@@ -25,7 +26,7 @@ double McreProblem::TraceInnerProduct(const Matrix& a, const Matrix& b) const {
   return sum;
 }
 
-double McreProblem::RetrogradeEnergy(const Matrix& traces) {
+double BarMcreProblem::RetrogradeEnergy(const Matrix& traces) {
   assert(traces.rows() == num_traces() && traces.cols() == num_steps() + 1);
   const int m = num_steps();
   const double h = time_step();
@@ -38,8 +39,9 @@ double McreProblem::RetrogradeEnergy(const Matrix& traces) {
     const int current = s & 1, next = current ^ 1;
     RetrogradeTraceStep(j, traces, false, stream_velocity_[current], stream_omega_[current],
                         stream_velocity_[next], stream_omega_[next]);
-    stream_retrograde_[0] = (theta_ * stream_omega_[next] + (1.0 - theta_) * stream_omega_[current]) *
-                            (1.0 / QuadratureWeight(j));
+    stream_retrograde_[0] =
+        (theta_ * stream_omega_[next] + (1.0 - theta_) * stream_omega_[current]) *
+        (1.0 / QuadratureWeight(j));
     // + c_j h W_j^T (K + B/alpha) W_j.
     energy += QuadratureWeight(j) * h *
               PenaltyForm(stream_retrograde_[0].data(), stream_retrograde_[0].data());
@@ -52,7 +54,7 @@ double McreProblem::RetrogradeEnergy(const Matrix& traces) {
   return energy;
 }
 
-Vector McreProblem::TraceWeights() const {
+Vector BarMcreProblem::TraceWeights() const {
   Vector weights(num_traces());
   weights[0] = beta_u0_;
   weights[1] = beta_uL_;
@@ -60,7 +62,7 @@ Vector McreProblem::TraceWeights() const {
   return weights;
 }
 
-void McreProblem::UseCheckpoints() {
+void BarMcreProblem::UseCheckpoints() {
   if (uses_checkpoints()) return;
   const int n = num_nodes(), m = num_steps();
   // stride = ceil(sqrt(2 m)): memory 2 n m / stride + n stride, about 2 n sqrt(2 m).
@@ -69,7 +71,7 @@ void McreProblem::UseCheckpoints() {
   segment_ = Matrix::Zero(n, checkpoint_stride_ + 1);
 }
 
-Matrix McreProblem::DataTraces() const {
+Matrix BarMcreProblem::DataTraces() const {
   Matrix traces(num_traces(), num_steps() + 1);
   for (int j = 0; j < data_.num_samples(); ++j) traces(0, j) = U0Datum(j);
   traces.row(1) = measured_.uL.transpose();
@@ -77,7 +79,7 @@ Matrix McreProblem::DataTraces() const {
   return traces;
 }
 
-void McreProblem::DataResponseTraces(Matrix* traces) {
+void BarMcreProblem::DataResponseTraces(Matrix* traces) {
   const int m = num_steps();
   traces->resize(num_traces(), m + 1);
   // From rest: U_0 = V_0 = 0; the force of step t_k -> t_{k+1} is F~_theta alone (W = 0).
@@ -97,7 +99,7 @@ void McreProblem::DataResponseTraces(Matrix* traces) {
   ++sweep_count_;
 }
 
-void McreProblem::ObserveTraces(const Vector& displacement, double* column) const {
+void BarMcreProblem::ObserveTraces(const Vector& displacement, double* column) const {
   column[0] = displacement[0];
   column[1] = displacement[num_nodes() - 1];
   for (int k = 0; k < num_interior_sensors(); ++k) {
@@ -105,8 +107,8 @@ void McreProblem::ObserveTraces(const Vector& displacement, double* column) cons
   }
 }
 
-void McreProblem::TraceLoads(int j, const Matrix& traces, bool include_data, double* f0,
-                             double* fL) {
+void BarMcreProblem::TraceLoads(int j, const Matrix& traces, bool include_data, double* f0,
+                                double* fL) {
   const double quadrature = QuadratureWeight(j);
   // c_j beta (y_j - d~_j) at the ends; the sensors' c_j beta_k (y_kj - d~_kj) h_k.
   *f0 = quadrature * beta_u0_ * (traces(0, j) - (include_data ? U0Datum(j) : 0.0));
@@ -120,16 +122,16 @@ void McreProblem::TraceLoads(int j, const Matrix& traces, bool include_data, dou
   }
 }
 
-void McreProblem::RetrogradeTraceStep(int j, const Matrix& traces, bool include_data,
-                                      const Vector& velocity, const Vector& state,
-                                      Vector& velocity_next, Vector& state_next) {
+void BarMcreProblem::RetrogradeTraceStep(int j, const Matrix& traces, bool include_data,
+                                         const Vector& velocity, const Vector& state,
+                                         Vector& velocity_next, Vector& state_next) {
   double f0 = 0.0, fL = 0.0;
   TraceLoads(j, traces, include_data, &f0, &fL);
   integrator_.StepWithEndLoads(velocity, state, f0, fL, velocity_next, state_next,
                                num_interior_sensors() > 0 ? &point_loads_[0] : nullptr);
 }
 
-void McreProblem::ResetStreamingTotals(int picture_stride, StreamingTotals* totals) {
+void BarMcreProblem::ResetStreamingTotals(int picture_stride, StreamingTotals* totals) {
   const int m = num_steps();
   totals->cost = 0.0;
   totals->cost_gradients.setZero(num_zones());
@@ -138,8 +140,8 @@ void McreProblem::ResetStreamingTotals(int picture_stride, StreamingTotals* tota
   totals->rebuild_error = 0.0;
 }
 
-void McreProblem::AddStreamingSample(int j, const Vector& displacement, const Vector& retrograde,
-                                     int picture_stride, StreamingTotals* totals) {
+void BarMcreProblem::AddStreamingSample(int j, const Vector& displacement, const Vector& retrograde,
+                                        int picture_stride, StreamingTotals* totals) {
   const double weight = QuadratureWeight(j) * time_step();
   totals->cost += weight * SampleCost(j, displacement.data(), retrograde.data());
   AddSampleCostGradients(j, displacement.data(), retrograde.data(), &totals->cost_gradients);
@@ -150,8 +152,8 @@ void McreProblem::AddStreamingSample(int j, const Vector& displacement, const Ve
   }
 }
 
-void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
-                               StreamingTotals* totals) {
+void BarMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
+                                  StreamingTotals* totals) {
   assert(traces.rows() == num_traces() && traces.cols() == num_steps() + 1 && image != &traces);
   const int m = num_steps(), last = num_nodes() - 1;
   image->resize(num_traces(), m + 1);
@@ -231,8 +233,8 @@ void McreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* 
 }
 
 template <typename Observe, typename DirectStep>
-void McreProblem::CheckpointedStreamingMap(const Matrix& traces, bool include_data,
-                                           Observe& observe, DirectStep& direct_step) {
+void BarMcreProblem::CheckpointedStreamingMap(const Matrix& traces, bool include_data,
+                                              Observe& observe, DirectStep& direct_step) {
   const int m = num_steps(), stride = checkpoint_stride_;
   const int n = num_nodes();
   // 1. The retrograde sweep from rest at T keeping its state (v_j, omega_j) at the
@@ -287,4 +289,5 @@ void McreProblem::CheckpointedStreamingMap(const Matrix& traces, bool include_da
   }
 }
 
+}  // namespace testing
 }  // namespace mcrewave

@@ -1,7 +1,10 @@
-// The time-discrete coupled direct / retrograde MCRE problem of the built-in bar for
-// one set of trial zone moduli (docs/discrete_mcre.md; zones and sensors:
-// docs/zones_and_sensors.md); a CoupledProblem (coupled_problem.h), as is the
-// problem of a structure given by matrices (matrix_mcre_problem.h).
+// The time-discrete coupled direct / retrograde MCRE problem of the built-in bar on its
+// own band model, for one set of trial zone moduli (docs/discrete_mcre.md; zones and
+// sensors: docs/zones_and_sensors.md): the tests' independent reference for
+// MatrixMcreProblem on the bar exported as matrices (model/matrix_export.h), which
+// identify run and the studies solve. The library held it as its bar road until
+// issue 39; it lives here as the other code path the one road is checked against. It
+// is a StreamingCoupledProblem, so every coupled solver runs on it.
 //
 // Fields are stored as n x (m + 1) matrices, column j = time t_j = j h:
 // U (displacement), W (retrograde field, the constitutive gap). The problem owns
@@ -50,44 +53,16 @@
 #include "mcrewave/linalg/sparse_bilinear_form.h"
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/coupled_problem.h"
+#include "mcrewave/mcre/mcre_weights.h"
+#include "mcrewave/mcre/objective.h"
 #include "mcrewave/mcre/streaming_coupled_problem.h"
 #include "mcrewave/model/bar_model.h"
 #include "mcrewave/model/matrix_export.h"
 
 namespace mcrewave {
+namespace testing {
 
-// Dimensionless weights of the data terms (formulation.md section 2):
-//   beta = w_u S E0 / L [N/m],  alpha = w_f L / (S E0) [m/N],
-// so that every term of J is an energy [J] and e^2 is in [J s].
-//
-// Defaults w_u = 0.01, w_f = 1, the weights of the paper's free-free formulation
-// (the config's defaults are TrustedClampWeights() of objective.h): the extreme
-// eigenvalue of the iteration map, due to the rigid-body mode of the unclamped model,
-// scales with w_u / w_f (about -35 at these defaults on the paper's case against
-// -3.4e3 at w_u = 1), so relaxation and CG converge in tens to hundreds of sweeps
-// instead of thousands; the evidence for the identification itself is in
-// docs/weights.md.
-//
-// Strain gauges (docs/zones_and_sensors.md): beta_e = w_e S E0 L [N m]; a uniform
-// strain e over the bar moves its end by e L, so w_e = w_u weighs a gauge like an end
-// displacement sensor of the same information; the default follows w_u.
-struct McreWeights {
-  double displacement_weight = 0.01;  // w_u
-  double force_weight = 1.0;          // w_f
-  double strain_weight = 0.01;        // w_e
-  // w_r: the measured clamp reaction f0 under a trusted or pinned clamp,
-  // alpha_r = w_r L / (S E0) [m/N]. Trusted: the weight of f0 as an output; it counts
-  // against uL in the ratio w_r / w_u: with w_u = 1e-5 the default weighs the two about
-  // as their noise does on the paper's case (docs/trusted_clamp.md). Pinned: the weight
-  // of f0 as a load, in place of alpha (docs/trusted_clamp.md section 9).
-  double reaction_weight = 1e-4;
-  // w_u0: a pinned clamp's displacement datum u(0) = 0, beta_0 = w_u0 S E0 / L [N/m]
-  // (docs/trusted_clamp.md section 9).
-  double clamp_displacement_weight = 0.1;
-  bool IsValid(std::string* error) const;
-};
-
-class McreProblem : public StreamingCoupledProblem {
+class BarMcreProblem : public StreamingCoupledProblem {
  public:
   // Keeps references to model and data: both must outlive the problem.
   // reference_modulus is E0 of the weights [Pa]; theta of the time scheme. The zones
@@ -99,9 +74,9 @@ class McreProblem : public StreamingCoupledProblem {
   // (ends.u0 = false is overridden) against the known 0 with
   // weights.clamp_displacement_weight and loads node 0 with f0 weighed by
   // weights.reaction_weight in place of alpha.
-  McreProblem(const BarModel& model, const ChannelSet& data, const McreWeights& weights,
-              double reference_modulus, double theta, EndDisplacementChannels ends = {},
-              ClampModel clamp = ClampModel::kMeasured);
+  BarMcreProblem(const BarModel& model, const ChannelSet& data, const McreWeights& weights,
+                 double reference_modulus, double theta, EndDisplacementChannels ends = {},
+                 ClampModel clamp = ClampModel::kMeasured);
 
   // Sets every zone's modulus to E [Pa] and refactorises the integrator (once per change);
   // hides CoupledProblem::SetModulus, since moduli() is empty until the first call.
@@ -118,7 +93,7 @@ class McreProblem : public StreamingCoupledProblem {
   int num_steps() const override { return data_.num_steps(); }
   double time_step() const override { return data_.time_step; }
   double theta() const override { return theta_; }
-  double alpha() const { return alpha_; }              // force weight [m/N]
+  double alpha() const { return alpha_; }  // force weight [m/N]
   // 1 / alpha of f0: 1 / alpha (measured), 0 (trusted), 1 / alpha_0 (pinned) [N/m].
   double inverse_alpha0() const { return force0_gain_ / alpha0_; }
   double beta() const { return beta_; }                // displacement weight beta_u [N/m]
@@ -320,7 +295,7 @@ class McreProblem : public StreamingCoupledProblem {
   double alpha0_, force0_gain_;
   // Trusted clamp: the index of the reaction row in sensor_rows_, else -1.
   int reaction_row_ = -1;
-  Vector moduli_;             // E_z [Pa]
+  Vector moduli_;  // E_z [Pa]
   // Interior sensors: H's rows, their weights beta_k and data d~_k (one per sample).
   std::vector<ObservationRow> sensor_rows_;
   Vector sensor_weights_;
@@ -361,4 +336,16 @@ class McreProblem : public StreamingCoupledProblem {
   Matrix batch_velocity_, batch_state_, batch_shift_;
 };
 
+// The MCRE objective of the built-in bar on its own band model: an McreObjective over
+// BarMcreProblems on model and data with mcre's weights and clamp, as the library made
+// it before the bar was exported as matrices. Keeps references to model and data: both
+// must outlive the objective. Preconditions: mcre.IsValid(), inner.IsValid(), theta in
+// [0, 1], modulus_scale > 0, data.num_steps() >= 1. ends: the end displacement channels
+// in use; the interior sensors are those of data.
+McreObjective BarMcreObjective(const BarModel& model, const ChannelSet& data,
+                               const McreOptions& mcre, double theta,
+                               const CoupledSolverOptions& inner, double modulus_scale,
+                               EndDisplacementChannels ends = {});
+
+}  // namespace testing
 }  // namespace mcrewave

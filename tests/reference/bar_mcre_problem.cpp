@@ -1,4 +1,4 @@
-#include "mcrewave/mcre/mcre_problem.h"
+#include "reference/bar_mcre_problem.h"
 
 #include <algorithm>
 #include <cassert>
@@ -7,35 +7,17 @@
 #include <stdexcept>
 #include <vector>
 
-#include "mcrewave/mcre/error_map.h"
+#include "reference/bar_error_map.h"
 
 namespace mcrewave {
+namespace testing {
 
 static_assert(CoupledProblem::kMaxSweepBatch == ThetaIntegrator::kMaxBatch,
               "the batched sweeps interleave the integrator's batch");
 
-bool McreWeights::IsValid(std::string* error) const {
-  std::ostringstream why;
-  if (!(std::isfinite(displacement_weight) && displacement_weight > 0.0)) {
-    why << "mcre.w_u must be a finite positive number, got " << displacement_weight;
-  } else if (!(std::isfinite(force_weight) && force_weight > 0.0)) {
-    why << "mcre.w_f must be a finite positive number, got " << force_weight;
-  } else if (!(std::isfinite(strain_weight) && strain_weight > 0.0)) {
-    why << "mcre.w_e must be a finite positive number, got " << strain_weight;
-  } else if (!(std::isfinite(reaction_weight) && reaction_weight > 0.0)) {
-    why << "mcre.w_r must be a finite positive number, got " << reaction_weight;
-  } else if (!(std::isfinite(clamp_displacement_weight) && clamp_displacement_weight > 0.0)) {
-    why << "mcre.w_u0 must be a finite positive number, got " << clamp_displacement_weight;
-  } else {
-    return true;
-  }
-  if (error != nullptr) *error = why.str();
-  return false;
-}
-
-McreProblem::McreProblem(const BarModel& model, const ChannelSet& data, const McreWeights& weights,
-                         double reference_modulus, double theta, EndDisplacementChannels ends,
-                         ClampModel clamp)
+BarMcreProblem::BarMcreProblem(const BarModel& model, const ChannelSet& data,
+                               const McreWeights& weights, double reference_modulus, double theta,
+                               EndDisplacementChannels ends, ClampModel clamp)
     : model_(model),
       data_(data),
       measured_(BarEndChannels(data)),
@@ -154,12 +136,12 @@ McreProblem::McreProblem(const BarModel& model, const ChannelSet& data, const Mc
   SetModulus(bar.modulus);
 }
 
-void McreProblem::SetModulus(double modulus) {
+void BarMcreProblem::SetModulus(double modulus) {
   assert(modulus > 0.0);
   SetModuli(Vector::Constant(model_.num_zones(), modulus));
 }
 
-void McreProblem::SetModuli(const Vector& zone_moduli) {
+void BarMcreProblem::SetModuli(const Vector& zone_moduli) {
   assert(zone_moduli.size() == model_.num_zones() && zone_moduli.minCoeff() > 0.0);
   if (moduli_.size() == zone_moduli.size() && moduli_ == zone_moduli) return;
   moduli_ = zone_moduli;
@@ -193,11 +175,11 @@ SparseMatrix WithFirstNodeHeld(SparseMatrix matrix) {
 
 }  // namespace
 
-SparseMatrix McreProblem::MassMatrix() const {
+SparseMatrix BarMcreProblem::MassMatrix() const {
   return clamp_ == ClampModel::kTrusted ? WithFirstNodeHeld(model_.mass()) : model_.mass();
 }
 
-SparseMatrix McreProblem::StiffnessMatrix() const {
+SparseMatrix BarMcreProblem::StiffnessMatrix() const {
   // K = sum_z (E_z / E_nom) K_z, as MatrixModelData::Stiffness sums the zones of the bar
   // exported as matrices (so that the two factorise the same K to the bit).
   SparseMatrix stiffness(num_nodes(), num_nodes());
@@ -207,8 +189,8 @@ SparseMatrix McreProblem::StiffnessMatrix() const {
   return clamp_ == ClampModel::kTrusted ? WithFirstNodeHeld(std::move(stiffness)) : stiffness;
 }
 
-void McreProblem::SensorLoads(int j, const double* displacement_j, bool include_data,
-                              double* values) const {
+void BarMcreProblem::SensorLoads(int j, const double* displacement_j, bool include_data,
+                                 double* values) const {
   const double quadrature = QuadratureWeight(j);
   for (int k = 0; k < num_interior_sensors(); ++k) {
     // r_k = c_j beta_k (h_k . U_j - d~_kj), applied as r_k h_k.
@@ -220,7 +202,8 @@ void McreProblem::SensorLoads(int j, const double* displacement_j, bool include_
   }
 }
 
-void McreProblem::DirectSweep(const Matrix& retrograde, bool include_data, Matrix* displacement) {
+void BarMcreProblem::DirectSweep(const Matrix& retrograde, bool include_data,
+                                 Matrix* displacement) {
   const int n = num_nodes(), m = num_steps(), last = n - 1;
   assert(retrograde.rows() == n && retrograde.cols() == m + 1);
   displacement->resize(n, m + 1);
@@ -249,8 +232,8 @@ void McreProblem::DirectSweep(const Matrix& retrograde, bool include_data, Matri
   ++sweep_count_;
 }
 
-void McreProblem::RetrogradeSweep(const Matrix& displacement, bool include_data,
-                                  Matrix* retrograde) {
+void BarMcreProblem::RetrogradeSweep(const Matrix& displacement, bool include_data,
+                                     Matrix* retrograde) {
   const int n = num_nodes(), m = num_steps(), last = n - 1;
   assert(displacement.rows() == n && displacement.cols() == m + 1);
   retrograde->resize(n, m + 1);
@@ -284,8 +267,8 @@ void McreProblem::RetrogradeSweep(const Matrix& displacement, bool include_data,
 }
 
 template <int B>
-void McreProblem::DirectSweeps(const Matrix* const (&retrograde)[B],
-                               Matrix* const (&displacement)[B]) {
+void BarMcreProblem::DirectSweeps(const Matrix* const (&retrograde)[B],
+                                  Matrix* const (&displacement)[B]) {
   const int n = num_nodes(), m = num_steps(), last = n - 1;
   for (int b = 0; b < B; ++b) {
     assert(retrograde[b] == nullptr ||
@@ -326,8 +309,8 @@ void McreProblem::DirectSweeps(const Matrix* const (&retrograde)[B],
 }
 
 template <int B>
-void McreProblem::RetrogradeSweeps(const Matrix* const (&displacement)[B],
-                                   Matrix* const (&retrograde)[B]) {
+void BarMcreProblem::RetrogradeSweeps(const Matrix* const (&displacement)[B],
+                                      Matrix* const (&retrograde)[B]) {
   const int n = num_nodes(), m = num_steps(), last = n - 1;
   for (int b = 0; b < B; ++b) {
     assert(displacement[b] == nullptr ||
@@ -379,8 +362,8 @@ void McreProblem::RetrogradeSweeps(const Matrix* const (&displacement)[B],
   sweep_count_ += B;
 }
 
-void McreProblem::DirectSweepsWithData(const std::vector<const Matrix*>& retrograde,
-                                       const std::vector<Matrix*>& displacement) {
+void BarMcreProblem::DirectSweepsWithData(const std::vector<const Matrix*>& retrograde,
+                                          const std::vector<Matrix*>& displacement) {
   assert(retrograde.size() == displacement.size());
   switch (retrograde.size()) {
     case 1:
@@ -399,8 +382,8 @@ void McreProblem::DirectSweepsWithData(const std::vector<const Matrix*>& retrogr
   }
 }
 
-void McreProblem::RetrogradeSweepsWithData(const std::vector<const Matrix*>& displacement,
-                                           const std::vector<Matrix*>& retrograde) {
+void BarMcreProblem::RetrogradeSweepsWithData(const std::vector<const Matrix*>& displacement,
+                                              const std::vector<Matrix*>& retrograde) {
   assert(retrograde.size() == displacement.size());
   switch (displacement.size()) {
     case 1:
@@ -419,7 +402,7 @@ void McreProblem::RetrogradeSweepsWithData(const std::vector<const Matrix*>& dis
   }
 }
 
-double McreProblem::EndForceForm(const double* x, const double* y) const {
+double BarMcreProblem::EndForceForm(const double* x, const double* y) const {
   const int last = num_nodes() - 1;
   // (x_N / alpha) y_N + (x_0 / alpha_0) y_0 (a trusted clamp: no f0 term), summed as
   // MatrixMcreProblem sums its load channels fL, f0 (the bar exported with its clamp as
@@ -427,12 +410,12 @@ double McreProblem::EndForceForm(const double* x, const double* y) const {
   return (x[last] / alpha_) * y[last] + force0_gain_ * ((x[0] / alpha0_) * y[0]);
 }
 
-double McreProblem::PenaltyForm(const double* x, const double* y) const {
+double BarMcreProblem::PenaltyForm(const double* x, const double* y) const {
   // x^T K y + x_N y_N / alpha + x_0 y_0 / alpha_0.
   return integrator_.stiffness().BilinearForm(x, y) + EndForceForm(x, y);
 }
 
-double McreProblem::RestCost() {
+double BarMcreProblem::RestCost() {
   // The output part 1/2 (H U - d~)^T diag(beta_k) (H U - d~) of J at U = W = 0 is
   // Cost(0, 0), summed here sample by sample from one zero column (Cost's sum, without
   // an n x (m + 1) field); the load part is alpha/2 |F - F~|^2 with F = 0 (a trusted
@@ -453,7 +436,7 @@ double McreProblem::RestCost() {
   return sum;
 }
 
-double McreProblem::InnerProduct(const Matrix& x, const Matrix& y) {
+double BarMcreProblem::InnerProduct(const Matrix& x, const Matrix& y) {
   const int m = num_steps();
   const double h = time_step();
   double sum = 0.0;
@@ -464,7 +447,7 @@ double McreProblem::InnerProduct(const Matrix& x, const Matrix& y) {
   return sum;
 }
 
-void McreProblem::Misfits(int j, const double* displacement) {
+void BarMcreProblem::Misfits(int j, const double* displacement) {
   const int last = num_nodes() - 1, sensors = num_interior_sensors() - (reaction_row_ >= 0);
   // The rows uL, the interior sensors, then u0 (its datum 0 when pinned) or the trusted
   // clamp's reaction: H's rows of the bar exported with its clamp as a support.
@@ -478,7 +461,7 @@ void McreProblem::Misfits(int j, const double* displacement) {
           : displacement[0] - U0Datum(j);
 }
 
-double McreProblem::SampleCost(int j, const double* displacement, const double* retrograde) {
+double BarMcreProblem::SampleCost(int j, const double* displacement, const double* retrograde) {
   // 1/2 W^T K W + 1/2 W^T B W / alpha + 1/2 (H U - d~)^T diag(beta_k) (H U - d~), each
   // part summed as MatrixMcreProblem::Cost sums it.
   const double gap = integrator_.stiffness().BilinearForm(retrograde, retrograde);
@@ -488,7 +471,7 @@ double McreProblem::SampleCost(int j, const double* displacement, const double* 
          0.5 * cost_weights_.dot(cost_misfits_);
 }
 
-double McreProblem::Cost(const Matrix& displacement, const Matrix& retrograde) {
+double BarMcreProblem::Cost(const Matrix& displacement, const Matrix& retrograde) {
   const int m = num_steps();
   const double h = time_step();
   double sum = 0.0;
@@ -500,8 +483,8 @@ double McreProblem::Cost(const Matrix& displacement, const Matrix& retrograde) {
   return sum;
 }
 
-void McreProblem::AddSampleCostGradients(int j, const double* displacement,
-                                         const double* retrograde, Vector* gradient) {
+void BarMcreProblem::AddSampleCostGradients(int j, const double* displacement,
+                                            const double* retrograde, Vector* gradient) {
   const int n = num_nodes();
   const double h = time_step();
   const Eigen::Map<const Vector> u(displacement, n), w(retrograde, n);
@@ -525,21 +508,21 @@ void McreProblem::AddSampleCostGradients(int j, const double* displacement,
   }
 }
 
-double McreProblem::CostGradient(const Matrix& displacement, const Matrix& retrograde) {
+double BarMcreProblem::CostGradient(const Matrix& displacement, const Matrix& retrograde) {
   Vector gradient;
   CostGradients(displacement, retrograde, &gradient);
   return gradient.sum();
 }
 
-void McreProblem::CostGradients(const Matrix& displacement, const Matrix& retrograde,
-                                Vector* gradient) {
+void BarMcreProblem::CostGradients(const Matrix& displacement, const Matrix& retrograde,
+                                   Vector* gradient) {
   gradient->setZero(num_zones());
   for (int j = 0; j <= num_steps(); ++j) {
     AddSampleCostGradients(j, displacement.col(j).data(), retrograde.col(j).data(), gradient);
   }
 }
 
-SparseMatrix McreProblem::PenaltyMatrix() const {
+SparseMatrix BarMcreProblem::PenaltyMatrix() const {
   // P = K + e_0 e_0^T / alpha_0 + e_N e_N^T / alpha with 1 / alpha_0 = inverse_alpha0():
   // the paper's K + B / alpha (measured clamp), K + e_N e_N^T / alpha (trusted: 0, on the
   // held node's kept diagonal) or the pinned clamp's alpha_0.
@@ -549,13 +532,13 @@ SparseMatrix McreProblem::PenaltyMatrix() const {
   return penalty;
 }
 
-void McreProblem::MeasuredForce(int j, Eigen::Ref<Vector> load) const {
+void BarMcreProblem::MeasuredForce(int j, Eigen::Ref<Vector> load) const {
   load.setZero();
   load[0] = force0_gain_ * measured_.f0[j];
   load[num_nodes() - 1] = measured_.fL[j];
 }
 
-SparseMatrix McreProblem::WeightedObservation() const {
+SparseMatrix BarMcreProblem::WeightedObservation() const {
   const int n = num_nodes();
   std::vector<Eigen::Triplet<double>> entries{{0, 0, beta_u0_}, {n - 1, n - 1, beta_uL_}};
   for (int k = 0; k < num_interior_sensors(); ++k) {
@@ -574,7 +557,7 @@ SparseMatrix McreProblem::WeightedObservation() const {
   return weighted;
 }
 
-void McreProblem::WeightedData(int j, Eigen::Ref<Vector> load) const {
+void BarMcreProblem::WeightedData(int j, Eigen::Ref<Vector> load) const {
   load.setZero();
   load[0] += beta_u0_ * U0Datum(j);
   load[num_nodes() - 1] += beta_uL_ * measured_.uL[j];
@@ -587,8 +570,22 @@ void McreProblem::WeightedData(int j, Eigen::Ref<Vector> load) const {
   }
 }
 
-Vector McreProblem::ErrorMap(const Matrix& retrograde) const {
+Vector BarMcreProblem::ErrorMap(const Matrix& retrograde) const {
   return ElementGapShares(model_, moduli_, retrograde, time_step());
 }
 
+McreObjective BarMcreObjective(const BarModel& model, const ChannelSet& data,
+                               const McreOptions& mcre, double theta,
+                               const CoupledSolverOptions& inner, double modulus_scale,
+                               EndDisplacementChannels ends) {
+  assert(mcre.IsValid(nullptr));
+  return McreObjective(
+      [&model, &data, mcre, theta, ends]() -> std::unique_ptr<StreamingCoupledProblem> {
+        return std::make_unique<BarMcreProblem>(model, data, mcre.weights, mcre.reference_modulus,
+                                                theta, ends, mcre.clamp);
+      },
+      inner, modulus_scale);
+}
+
+}  // namespace testing
 }  // namespace mcrewave
