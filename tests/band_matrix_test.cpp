@@ -179,6 +179,44 @@ TEST(TwistedTridiagonalLdltTest, BatchedSolvesMatchSingleSolvesExactly) {
   }
 }
 
+// The solve with the theta step's update fused into its back-substitutions gives the
+// bits of the plain solve followed by the update's own loop, single and batched.
+TEST(TwistedTridiagonalLdltTest, TheFusedUpdateIsTheSolveThenTheUpdate) {
+  std::mt19937_64 engine(8);
+  const double a = 0.18e-6, b = 0.18e-6;
+  for (int n : {1, 2, 3, 4, 7, 50, 101}) {
+    TwistedTridiagonalLdlt factor;
+    ASSERT_TRUE(factor.Compute(SymmetricBandMatrix(RandomBandMatrix(n, 1, true, &engine))));
+    Vector rhs[3], u[3], v[3], x[3], u_next[3];
+    for (int r = 0; r < 3; ++r) {
+      rhs[r] = Vector::Random(n);
+      u[r] = Vector::Random(n);
+      v[r] = Vector::Random(n);
+      x[r] = rhs[r];
+      u_next[r] = Vector::Zero(n);
+    }
+    auto update = [&](int r) {
+      return TwistedTridiagonalLdlt::Update{u[r].data(), v[r].data(), a, b, u_next[r].data()};
+    };
+    auto expect_solve_then_update = [&](int r, const char* what) {
+      Vector solved = rhs[r];
+      factor.SolveInPlace(solved);
+      const Vector updated = u[r] + a * v[r] + b * solved;
+      EXPECT_EQ((x[r] - solved).cwiseAbs().maxCoeff(), 0.0) << what << ", n = " << n;
+      EXPECT_EQ((u_next[r] - updated).cwiseAbs().maxCoeff(), 0.0) << what << ", n = " << n;
+    };
+    factor.SolveInPlace(x[0].data(), update(0));
+    expect_solve_then_update(0, "single");
+    for (int r = 0; r < 3; ++r) x[r] = rhs[r];
+    factor.SolveInPlace<3>({x[0].data(), x[1].data(), x[2].data()},
+                           {update(0), update(1), update(2)});
+    for (int r = 0; r < 3; ++r) expect_solve_then_update(r, "batch of 3");
+    for (int r = 0; r < 2; ++r) x[r] = rhs[r];
+    factor.SolveInPlace<2>({x[0].data(), x[1].data()}, {update(0), update(1)});
+    for (int r = 0; r < 2; ++r) expect_solve_then_update(r, "batch of 2");
+  }
+}
+
 TEST(TwistedTridiagonalLdltTest, AgreesWithBandLdltOnTheThetaIterationMatrixOfTheBar) {
   const BarModel model{BarProperties{}};
   const double h_theta = 0.36e-6 * 0.5;

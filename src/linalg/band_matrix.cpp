@@ -235,7 +235,8 @@ bool TwistedTridiagonalLdlt::Compute(const SymmetricBandMatrix& matrix) {
   return true;
 }
 
-void TwistedTridiagonalLdlt::SolveInPlace(double* x) const {
+template <typename OnSolved>
+void TwistedTridiagonalLdlt::Solve(double* x, OnSolved&& on_solved) const {
   assert(ok_);
   const int n = size();
   const int k = middle_;
@@ -264,6 +265,7 @@ void TwistedTridiagonalLdlt::SolveInPlace(double* x) const {
   if (k < n - 1) middle -= m[k] * down;
   middle *= inverse_pivot[k];
   x[k] = middle;
+  on_solved(0, k);
   // Back-substitutions outward, side by side:
   //   x_i = y_i / d_i - l_{i+1} x_{i+1} (i = k-1..0),  x_j = z_j / e_j - m_{j-1} x_{j-1} (j =
   //   k+1..n-1).
@@ -276,15 +278,18 @@ void TwistedTridiagonalLdlt::SolveInPlace(double* x) const {
     down = x[j] * inverse_pivot[j] - m[j - 1] * down;
     x[i] = up;
     x[j] = down;
+    on_solved(0, i);
+    on_solved(0, j);
   }
   for (; j < n; ++j) {
     down = x[j] * inverse_pivot[j] - m[j - 1] * down;
     x[j] = down;
+    on_solved(0, j);
   }
 }
 
-template <int B>
-void TwistedTridiagonalLdlt::SolveInPlace(double* const (&x)[B]) const {
+template <int B, typename OnSolved>
+void TwistedTridiagonalLdlt::Solve(double* const (&x)[B], OnSolved&& on_solved) const {
   assert(ok_);
   const int n = size();
   const int k = middle_;
@@ -318,6 +323,7 @@ void TwistedTridiagonalLdlt::SolveInPlace(double* const (&x)[B]) const {
     if (k < n - 1) middle[b] -= m[k] * down[b];
     middle[b] *= inverse_pivot[k];
     x[b][k] = middle[b];
+    on_solved(b, k);
     up[b] = middle[b];
     down[b] = middle[b];
   }
@@ -329,17 +335,50 @@ void TwistedTridiagonalLdlt::SolveInPlace(double* const (&x)[B]) const {
       down[b] = x[b][j] * inverse_pivot[j] - m[j - 1] * down[b];
       x[b][i] = up[b];
       x[b][j] = down[b];
+      on_solved(b, i);
+      on_solved(b, j);
     }
   }
   for (; j < n; ++j) {
     for (int b = 0; b < B; ++b) {
       down[b] = x[b][j] * inverse_pivot[j] - m[j - 1] * down[b];
       x[b][j] = down[b];
+      on_solved(b, j);
     }
   }
 }
 
+void TwistedTridiagonalLdlt::SolveInPlace(double* x) const {
+  Solve(x, [](int, int) {});
+}
+
+void TwistedTridiagonalLdlt::SolveInPlace(double* x, const Update& update) const {
+  const double *u = update.u, *v = update.v;
+  const double a = update.a, b = update.b;
+  double* u_next = update.u_next;
+  // u_next_i = u_i + a v_i + b x_i, as the theta step's own loop writes it.
+  Solve(x, [&](int, int i) { u_next[i] = u[i] + a * v[i] + b * x[i]; });
+}
+
+template <int B>
+void TwistedTridiagonalLdlt::SolveInPlace(double* const (&x)[B]) const {
+  Solve(x, [](int, int) {});
+}
+
+template <int B>
+void TwistedTridiagonalLdlt::SolveInPlace(double* const (&x)[B], const Update (&update)[B]) const {
+  // u_next_i = u_i + a v_i + b x_i for each right-hand side.
+  Solve(x, [&](int r, int i) {
+    const Update& w = update[r];
+    w.u_next[i] = w.u[i] + w.a * w.v[i] + w.b * x[r][i];
+  });
+}
+
 template void TwistedTridiagonalLdlt::SolveInPlace<2>(double* const (&x)[2]) const;
 template void TwistedTridiagonalLdlt::SolveInPlace<3>(double* const (&x)[3]) const;
+template void TwistedTridiagonalLdlt::SolveInPlace<2>(double* const (&x)[2],
+                                                      const Update (&update)[2]) const;
+template void TwistedTridiagonalLdlt::SolveInPlace<3>(double* const (&x)[3],
+                                                      const Update (&update)[3]) const;
 
 }  // namespace mcrewave

@@ -28,37 +28,10 @@ SparseColumns::SparseColumns(const SparseMatrix& a) : rows_(static_cast<int>(a.r
   row_sum_.assign(row_node_.size(), 0.0);
 }
 
-void SparseColumns::TransposeMultiply(const double* x, double* y) const {
-  const int num_columns = cols();
-  for (int c = 0; c < num_columns; ++c) {
-    // y_c = sum_i A_ic x_i, by increasing i.
-    double sum = 0.0;
-    for (int q = column_start_[c]; q < column_start_[c + 1]; ++q) {
-      sum += entry_value_[q] * x[entry_row_[q]];
-    }
-    y[c] = sum;
-  }
-}
-
 const PointLoads* SparseColumns::Scatter(const double* c) {
   // loads_ is set here, not in the constructor, so that a copy points at its own arrays.
   Scatter(c, row_sum_.data(), &loads_);
   return &loads_;
-}
-
-void SparseColumns::Scatter(const double* c, double* values, PointLoads* loads) const {
-  const int num_rows = num_point_loads();
-  for (int r = 0; r < num_rows; ++r) {
-    // (A c)_i = sum_c A_ic c_c, by increasing c.
-    double sum = 0.0;
-    for (int q = row_start_[r]; q < row_start_[r + 1]; ++q) {
-      sum += row_entry_value_[q] * c[row_entry_column_[q]];
-    }
-    values[r] = sum;
-  }
-  loads->count = num_rows;
-  loads->nodes = row_node_.data();
-  loads->values = values;
 }
 
 }  // namespace mcrewave

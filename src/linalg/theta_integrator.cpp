@@ -153,13 +153,12 @@ void ThetaIntegrator::TridiagonalRightHandSide(const double* v_k, const double* 
   }
 }
 
-void ThetaIntegrator::UpdateDisplacement(const double* u_k, const double* v_k, const double* v_next,
-                                         double* u_next) const {
+TwistedTridiagonalLdlt::Update ThetaIntegrator::DisplacementUpdate(const double* u_k,
+                                                                   const double* v_k,
+                                                                   double* u_next) const {
   // u_{k+1} = u_k + h (1 - theta) v_k + h theta v_{k+1}.
-  const int n = size();
-  const double a = options_.time_step * (1.0 - options_.theta);
-  const double b = options_.time_step * options_.theta;
-  for (int i = 0; i < n; ++i) u_next[i] = u_k[i] + a * v_k[i] + b * v_next[i];
+  return {u_k, v_k, options_.time_step * (1.0 - options_.theta),
+          options_.time_step * options_.theta, u_next};
 }
 
 template <bool kForceVector>
@@ -168,9 +167,9 @@ void ThetaIntegrator::TridiagonalStep(const double* v_k, const double* u_k, cons
                                       double* u_next, const PointLoads* point_loads) {
   TridiagonalRightHandSide<kForceVector>(v_k, u_k, z, force, f0, fL, shifted_.data(), v_next,
                                          point_loads);
-  // S v_{k+1} = rhs.
-  tridiagonal_factor_.SolveInPlace(v_next);
-  UpdateDisplacement(u_k, v_k, v_next, u_next);
+  // S v_{k+1} = rhs, and u_{k+1} = u_k + h (1 - theta) v_k + h theta v_{k+1} row by row
+  // as the solve finishes each v_{k+1, i}.
+  tridiagonal_factor_.SolveInPlace(v_next, DisplacementUpdate(u_k, v_k, u_next));
 }
 
 template <int B>
@@ -201,8 +200,9 @@ void ThetaIntegrator::StepsWithEndLoads(const double* const (&v_k)[B],
                                     shifted_batch_.col(b).data(), v_next[b],
                                     point_loads != nullptr ? point_loads[b] : nullptr);
   }
-  tridiagonal_factor_.SolveInPlace<B>(v_next);
-  for (int b = 0; b < B; ++b) UpdateDisplacement(u_k[b], v_k[b], v_next[b], u_next[b]);
+  TwistedTridiagonalLdlt::Update updates[B];
+  for (int b = 0; b < B; ++b) updates[b] = DisplacementUpdate(u_k[b], v_k[b], u_next[b]);
+  tridiagonal_factor_.SolveInPlace<B>(v_next, updates);
 }
 
 template void ThetaIntegrator::StepsWithEndLoads<2>(const double* const (&)[2],

@@ -50,20 +50,37 @@ void MatrixMcreProblem::DirectStep(int k, bool include_data, const Vector& veloc
 
 void MatrixMcreProblem::DirectChannels(int k, bool include_data, const double* shift,
                                        Eigen::Ref<Vector> channel) const {
+  // Loops over the few channels rather than Eigen expressions, whose set-up costs more
+  // than their work at this size; the same operations, so the same bits.
+  const int channels = static_cast<int>(channel.size());
+  double* out = channel.data();
   if (shift != nullptr) {
-    load_columns_.TransposeMultiply(shift, channel.data());
-    channel = -channel.cwiseQuotient(alphas_);
+    load_columns_.TransposeMultiply(shift, out);
+    // -diag(1/alpha) G^T W_theta.
+    for (int c = 0; c < channels; ++c) out[c] = -(out[c] / alphas_[c]);
   } else {
     channel.setZero();
   }
   if (include_data) {
-    channel += theta_ * measured_loads_.col(k + 1) + (1.0 - theta_) * measured_loads_.col(k);
+    // + F~_theta = theta F~_{k+1} + (1 - theta) F~_k.
+    const double* next = measured_loads_.col(k + 1).data();
+    const double* now = measured_loads_.col(k).data();
+    for (int c = 0; c < channels; ++c) {
+      out[c] += theta_ * next[c] + (1.0 - theta_) * now[c];
+    }
   }
 }
 
 void MatrixMcreProblem::WeightTraces(int j, bool include_data, Eigen::Ref<Vector> trace) const {
-  if (include_data) trace -= measured_outputs_.col(j);
-  trace = (QuadratureWeight(j) * betas_).cwiseProduct(trace);
+  // c_j beta_k (y_k - d~_k), channel by channel (as DirectChannels, a loop).
+  const int rows = static_cast<int>(trace.size());
+  const double weight = QuadratureWeight(j);
+  double* y = trace.data();
+  if (include_data) {
+    const double* data = measured_outputs_.col(j).data();
+    for (int k = 0; k < rows; ++k) y[k] -= data[k];
+  }
+  for (int k = 0; k < rows; ++k) y[k] = (weight * betas_[k]) * y[k];
 }
 
 double MatrixMcreProblem::StiffnessForm(const double* x, const double* y) {

@@ -100,7 +100,29 @@ class TwistedTridiagonalLdlt {
   template <int B>
   void SolveInPlace(double* const (&x)[B]) const;
 
+  // u_next = u + a v + b x, entry by entry, the theta step's displacement update
+  // (theta_integrator.h) from the solution x of its iteration matrix.
+  struct Update {
+    const double* u;
+    const double* v;
+    double a, b;
+    double* u_next;
+  };
+  // SolveInPlace, then the update of each solution, computed as each x_i is final
+  // inside the back-substitutions: their dependency chains leave the arithmetic units
+  // idle, so the update costs almost nothing there. The same bits as SolveInPlace
+  // followed by the update's own loop. update's arrays distinct from x.
+  void SolveInPlace(double* x, const Update& update) const;
+  template <int B>
+  void SolveInPlace(double* const (&x)[B], const Update (&update)[B]) const;
+
  private:
+  // The solves, with on_solved(b, i) called once x_b[i] is final.
+  template <typename OnSolved>
+  void Solve(double* x, OnSolved&& on_solved) const;
+  template <int B, typename OnSolved>
+  void Solve(double* const (&x)[B], OnSolved&& on_solved) const;
+
   int middle_ = 0;        // k
   Vector top_;            // l_i at i = 1..k (entry 0 unused)
   Vector bottom_;         // m_i at i = k..n-2 (entry n-1 unused)

@@ -153,8 +153,10 @@ class ThetaIntegrator {
                                 double* v_next, const PointLoads* point_loads) const;
   // f_theta's end and point loads added into force_ (the banded path).
   void AddEndAndPointLoads(double f0, double fL, const PointLoads* point_loads);
-  void UpdateDisplacement(const double* u_k, const double* v_k, const double* v_next,
-                          double* u_next) const;
+  // The tridiagonal solve's fused update u_{k+1} = u_k + h (1 - theta) v_k
+  // + h theta v_{k+1} into u_next.
+  TwistedTridiagonalLdlt::Update DisplacementUpdate(const double* u_k, const double* v_k,
+                                                    double* u_next) const;
 
   ThetaIntegratorOptions options_;
   bool sparse_path_ = false;
