@@ -1,6 +1,8 @@
-// Tests of the discrete MCRE problem: weights, the adjoint structure of the two
-// sweeps, the cost at consistent data, the trusted clamp (ClampModel::kTrusted) and the
-// pinned clamp (ClampModel::kPinned).
+// Tests of the built-in bar's own band-model MCRE problem (testing::BarMcreProblem,
+// tests/reference/bar_mcre_problem.h), the reference the one road's MatrixMcreProblem is
+// checked against: weights, the adjoint structure of the two sweeps, the cost at
+// consistent data, the trusted clamp (ClampModel::kTrusted) and the pinned clamp
+// (ClampModel::kPinned).
 #include <gtest/gtest.h>
 
 #include <limits>

@@ -1,4 +1,6 @@
-// Tests of the streaming coupled solver (docs/streaming.md): the trace operator's
+// Tests of the streaming coupled solver (docs/streaming.md) on the bar's own band-model
+// problem (testing::BarMcreProblem, whose reversed-recursion rebuild lives there; the
+// one road's checkpointed map: matrix_streaming_test.cpp): the trace operator's
 // symmetry, agreement with the stored-field conjugate gradients (cost, every zone's
 // gradient, error map, traces) with and without interior sensors, the round-off of
 // the rebuilt retrograde field over long windows, checkpoints for theta != 1/2, memory.
