@@ -598,6 +598,14 @@ void InnerSolvesYaml(const IdentificationRun& run, YamlWriter* yaml) {
                 "of a solve from W = 0 at the identified modulus (inner_residual.csv)");
 }
 
+// The cost_curve: section's points and range, as the MCRE and least squares write it.
+void CostCurveYaml(const std::vector<CostCurvePoint>& curve, YamlWriter* yaml) {
+  yaml->Line(0, "cost_curve", "");
+  yaml->Integer(1, "points", static_cast<long>(curve.size()));
+  yaml->Number(1, "lowest_modulus", curve.empty() ? NAN : curve.front().modulus, "[Pa]");
+  yaml->Number(1, "highest_modulus", curve.empty() ? NAN : curve.back().modulus, "[Pa]");
+}
+
 }  // namespace
 
 std::string SummaryYaml(const IdentificationRun& run) {
@@ -642,12 +650,7 @@ std::string SummaryYaml(const IdentificationRun& run) {
   yaml.Number(1, "alpha", run.alpha, "[m/N] force weight w_f L / (S E0)");
   yaml.Number(1, "beta", run.beta, "[N/m] displacement weight w_u S E0 / L");
 
-  yaml.Line(0, "cost_curve", "");
-  yaml.Integer(1, "points", static_cast<long>(run.cost_curve.size()));
-  yaml.Number(1, "lowest_modulus", run.cost_curve.empty() ? NAN : run.cost_curve.front().modulus,
-              "[Pa]");
-  yaml.Number(1, "highest_modulus", run.cost_curve.empty() ? NAN : run.cost_curve.back().modulus,
-              "[Pa]");
+  CostCurveYaml(run.cost_curve, &yaml);
   yaml.Integer(1, "sweeps", run.cost_curve_sweeps);
   yaml.Integer(0, "total_sweeps",
                run.outer.scan_sweeps + run.sweeps + run.cost_curve_sweeps + run.uncertainty.sweeps,
@@ -836,12 +839,7 @@ std::string LeastSquaresSummaryYaml(const LeastSquaresRun& run) {
   OptimizerScanAndPrefilterYaml(outer, run.rest_cost, run.rest_cost, run.config,
                                 run.prefilter_cutoff, "J", "s", &yaml);
 
-  yaml.Line(0, "cost_curve", "");
-  yaml.Integer(1, "points", static_cast<long>(run.cost_curve.size()));
-  yaml.Number(1, "lowest_modulus", run.cost_curve.empty() ? NAN : run.cost_curve.front().modulus,
-              "[Pa]");
-  yaml.Number(1, "highest_modulus", run.cost_curve.empty() ? NAN : run.cost_curve.back().modulus,
-              "[Pa]");
+  CostCurveYaml(run.cost_curve, &yaml);
   if (run.zones.ran) {
     for (const std::string& line : ZonesYamlLines(run.zones)) yaml.Raw(line);
   }
