@@ -447,12 +447,10 @@ std::string ModulusOnBoundMessage(double modulus, const IdentificationOptions& o
                                                    {outer.upper_bound, "outer.upper_bound"}};
   for (const auto& [bound, key] : bounds) {
     if (std::abs(modulus - bound) <= kOnBoundTolerance * bound) {
-      char message[512];
-      std::snprintf(message, sizeof(message),
-                    "E = %.6g Pa lies on %s (%.6g Pa): e^2 has no minimum inside the bounds; "
-                    "widen them, or check the units of the data (SI: m and N)",
-                    modulus, key, bound);
-      return message;
+      return "E = " + FormatNumber(modulus, kSixDigits) + " Pa lies on " + key + " (" +
+             FormatNumber(bound, kSixDigits) +
+             " Pa): e^2 has no minimum inside the bounds; widen them, or check the units of the "
+             "data (SI: m and N)";
     }
   }
   return "";
@@ -476,14 +474,15 @@ std::string ImplausibleMisfitMessage(const IdentificationRun& run) {
       {"forces", "N", run.misfit.force_std, both_ends_rms(data.Values("f0"), data.Values("fL"))}};
   for (const QuantityType& type : types) {
     if (!(type.misfit <= kImplausibleMisfitFactor * type.measured)) {
-      char message[512];
-      std::snprintf(message, sizeof(message),
-                    "at E = %.6g Pa the model misses the measured end %s by an RMS of %.4g %s, "
-                    "%.3g times their own RMS (%.4g %s): it explains nothing of them; check the "
-                    "units of the data (SI: m and N) and the model's geometry and density",
-                    run.identified_modulus(), type.name, type.misfit, type.unit,
-                    type.misfit / type.measured, type.measured, type.unit);
-      return message;
+      constexpr NumberFormat kFourDigits{NumberFormat::Notation::kSignificant, 4};
+      constexpr NumberFormat kThreeDigits{NumberFormat::Notation::kSignificant, 3};
+      return "at E = " + FormatNumber(run.identified_modulus(), kSixDigits) +
+             " Pa the model misses the measured end " + type.name + " by an RMS of " +
+             FormatNumber(type.misfit, kFourDigits) + " " + type.unit + ", " +
+             FormatNumber(type.misfit / type.measured, kThreeDigits) + " times their own RMS (" +
+             FormatNumber(type.measured, kFourDigits) + " " + type.unit +
+             "): it explains nothing of them; check the units of the data (SI: m and N) and the "
+             "model's geometry and density";
     }
   }
   return "";

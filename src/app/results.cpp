@@ -34,6 +34,8 @@ constexpr const char* kUncertaintyMeaning =
 // The shortest decimal text that reads back as exactly `value` ("null" for NaN,
 // ".inf" for infinities, YAML spelling).
 std::string Format(double value) { return FormatNumber(value, kYamlRoundTrip); }
+// A CSV value of the bar's results: every digit a double needs (%.17g).
+std::string CsvNumber(double value) { return FormatNumber(value, kSeventeenDigits); }
 
 std::string Quoted(const std::string& text) {
   YAML::Emitter emitter;
@@ -91,26 +93,22 @@ std::string EvaluationsCsv(const IdentificationRun& run) {
   std::string csv =
       "evaluation,modulus,cost,cost_gradient,gradient_requested,usable,inner_iterations,sweeps,"
       "relative_residual\n";
-  char row[512];
   for (std::size_t i = 0; i < run.evaluations.size(); ++i) {
     const ObjectiveEvaluation& e = run.evaluations[i];
-    std::snprintf(row, sizeof(row), "%zu,%.17g,%.17g,%.17g,%d,%d,%d,%ld,%.6g\n", i + 1, e.modulus,
-                  e.usable ? e.cost : NAN, e.usable ? e.cost_gradient : NAN,
-                  e.gradient_requested ? 1 : 0, e.usable ? 1 : 0, e.inner.iterations,
-                  e.inner.sweeps, e.inner.relative_residual);
-    csv += row;
+    csv += std::to_string(i + 1) + ',' + CsvNumber(e.modulus) + ',' +
+           CsvNumber(e.usable ? e.cost : NAN) + ',' + CsvNumber(e.usable ? e.cost_gradient : NAN) +
+           ',' + (e.gradient_requested ? "1," : "0,") + (e.usable ? "1," : "0,") +
+           std::to_string(e.inner.iterations) + ',' + std::to_string(e.inner.sweeps) + ',' +
+           FormatNumber(e.inner.relative_residual, kSixDigits) + '\n';
   }
   return csv;
 }
 
 std::string CostCurveCsv(const std::vector<CostCurvePoint>& curve) {
   std::string csv = "modulus,cost,cost_gradient,usable\n";
-  char row[256];
   for (const CostCurvePoint& point : curve) {
-    std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%d\n", point.modulus,
-                  point.usable ? point.cost : NAN, point.usable ? point.cost_gradient : NAN,
-                  point.usable ? 1 : 0);
-    csv += row;
+    csv += CsvNumber(point.modulus) + ',' + CsvNumber(point.usable ? point.cost : NAN) + ',' +
+           CsvNumber(point.usable ? point.cost_gradient : NAN) + (point.usable ? ",1\n" : ",0\n");
   }
   return csv;
 }
@@ -132,16 +130,11 @@ std::string EndsCsv(const IdentificationRun& run) {
       model_columns[c] = &run.model_channels.channels[static_cast<std::size_t>(found)].values;
     }
   }
-  char number[32];
   for (int j = 0; j < data.num_samples(); ++j) {
-    std::snprintf(number, sizeof(number), "%.17g", data.Time(j));
-    csv += number;
+    csv += CsvNumber(data.Time(j));
     for (int c = 0; c < 4; ++c) {
-      std::snprintf(number, sizeof(number), ",%.17g,", (*measured_columns[c])[j]);
-      csv += number;
-      if (model_columns[c] == nullptr) continue;
-      std::snprintf(number, sizeof(number), "%.17g", (*model_columns[c])[j]);
-      csv += number;
+      csv += ',' + CsvNumber((*measured_columns[c])[j]) + ',';
+      if (model_columns[c] != nullptr) csv += CsvNumber((*model_columns[c])[j]);
     }
     csv += '\n';
   }
@@ -159,11 +152,9 @@ std::vector<double> InnerResidualHistory(const IdentificationRun& run) {
 
 std::string InnerResidualCsv(const IdentificationRun& run) {
   std::string csv = "iteration,relative_residual\n";
-  char row[128];
   const std::vector<double> history = InnerResidualHistory(run);
   for (std::size_t i = 0; i < history.size(); ++i) {
-    std::snprintf(row, sizeof(row), "%zu,%.17g\n", i + 1, history[i]);
-    csv += row;
+    csv += std::to_string(i + 1) + ',' + CsvNumber(history[i]) + '\n';
   }
   return csv;
 }
@@ -174,15 +165,14 @@ std::string InnerResidualCsv(const IdentificationRun& run) {
 // modulus_scale: its E_scale (outer.initial).
 std::string ScanCsv(const IdentificationSummary& outer, double cost_scale, double modulus_scale) {
   std::string csv = "modulus,cost,cost_gradient,usable\n";
-  char row[160];
   // de^2/dE = (d cost/dx) J_rest / E_scale.
   const double gradient_scale = cost_scale / modulus_scale;
   for (std::size_t i = 0; i < outer.scan_moduli.size(); ++i) {
     const bool usable = std::isfinite(outer.scan_costs[i]);
-    std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%d\n", outer.scan_moduli[i],
-                  usable ? outer.scan_costs[i] * cost_scale : 0.0,
-                  usable ? outer.scan_gradients[i] * gradient_scale : 0.0, usable ? 1 : 0);
-    csv += row;
+    csv += CsvNumber(outer.scan_moduli[i]) + ',' +
+           CsvNumber(usable ? outer.scan_costs[i] * cost_scale : 0.0) + ',' +
+           CsvNumber(usable ? outer.scan_gradients[i] * gradient_scale : 0.0) +
+           (usable ? ",1\n" : ",0\n");
   }
   return csv;
 }
@@ -193,20 +183,17 @@ std::string ValleysCsv(const IdentificationSummary& outer, double cost_scale) {
   std::string csv =
       "valley,lower_modulus,upper_modulus,estimated_modulus,estimated_cost,refined,modulus,cost,"
       "evaluations\n";
-  char row[320];
   int index = 0;
   for (const ScanValley& valley : outer.valleys) {
-    std::snprintf(row, sizeof(row), "%d,%.17g,%.17g,%.17g,%.17g,%d,", ++index, valley.lower_modulus,
-                  valley.upper_modulus, valley.estimated_modulus,
-                  valley.estimated_cost * cost_scale, valley.refined ? 1 : 0);
-    csv += row;
+    csv += std::to_string(++index) + ',' + CsvNumber(valley.lower_modulus) + ',' +
+           CsvNumber(valley.upper_modulus) + ',' + CsvNumber(valley.estimated_modulus) + ',' +
+           CsvNumber(valley.estimated_cost * cost_scale) + (valley.refined ? ",1," : ",0,");
     if (valley.refined) {
-      std::snprintf(row, sizeof(row), "%.17g,%.17g,%d\n", valley.modulus, valley.cost * cost_scale,
-                    valley.evaluations);
+      csv += CsvNumber(valley.modulus) + ',' + CsvNumber(valley.cost * cost_scale) + ',' +
+             std::to_string(valley.evaluations) + '\n';
     } else {
-      std::snprintf(row, sizeof(row), ",,0\n");
+      csv += ",,0\n";
     }
-    csv += row;
   }
   return csv;
 }
@@ -727,23 +714,13 @@ std::string FitCsv(const LeastSquaresRun& run) {
   const Eigen::Index uL_row = output_row("uL");
   const BarEnds measured = BarEndChannels(data);
   const std::vector<const Vector*> sensor_values = BarSensorValues(data);
-  char row[128];
   for (int j = 0; j < data.num_samples(); ++j) {
-    std::snprintf(row, sizeof(row), "%.17g,%.17g,", data.Time(j), measured.uL[j]);
-    csv += row;
-    if (uL_row >= 0) {
-      std::snprintf(row, sizeof(row), "%.17g", fit.outputs(uL_row, j));
-      csv += row;
-    }
-    std::snprintf(row, sizeof(row), ",%.17g,%.17g", measured.f0[j], fit.support_forces(0, j));
-    csv += row;
+    csv += CsvNumber(data.Time(j)) + ',' + CsvNumber(measured.uL[j]) + ',';
+    if (uL_row >= 0) csv += CsvNumber(fit.outputs(uL_row, j));
+    csv += ',' + CsvNumber(measured.f0[j]) + ',' + CsvNumber(fit.support_forces(0, j));
     for (std::size_t k = 0; k < sensor_values.size(); ++k) {
-      std::snprintf(row, sizeof(row), ",%.17g,", (*sensor_values[k])[j]);
-      csv += row;
-      if (sensor_rows[k] >= 0) {
-        std::snprintf(row, sizeof(row), "%.17g", fit.outputs(sensor_rows[k], j));
-        csv += row;
-      }
+      csv += ',' + CsvNumber((*sensor_values[k])[j]) + ',';
+      if (sensor_rows[k] >= 0) csv += CsvNumber(fit.outputs(sensor_rows[k], j));
     }
     csv += "\n";
   }

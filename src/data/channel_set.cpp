@@ -17,6 +17,7 @@
 
 #include "data/csv_fields.h"
 #include "mcrewave/core/file_util.h"
+#include "mcrewave/core/format.h"
 
 namespace mcrewave {
 namespace {
@@ -271,13 +272,11 @@ void WriteChannelCsv(const ChannelSet& set, const std::string& path) {
   content += "\n";
   content.reserve(content.size() +
                   static_cast<std::size_t>(samples) * (1 + set.channels.size()) * 25);
-  char field[32];
   for (int k = 0; k < samples; ++k) {
-    int length = std::snprintf(field, sizeof(field), "%.17g", set.Time(k));
-    content.append(field, static_cast<std::size_t>(length));
+    content += FormatNumber(set.Time(k), kSeventeenDigits);
     for (const Channel& channel : set.channels) {
-      length = std::snprintf(field, sizeof(field), ",%.17g", channel.values[k]);
-      content.append(field, static_cast<std::size_t>(length));
+      content += ',';
+      content += FormatNumber(channel.values[k], kSeventeenDigits);
     }
     content += '\n';
   }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "mcrewave/core/file_util.h"
+#include "mcrewave/core/format.h"
 
 namespace mcrewave {
 namespace {
@@ -495,14 +496,11 @@ std::string FormatMatrixMarketMatrix(const SparseMatrix& matrix, MatrixMarketSto
                      std::to_string(matrix.rows()) + " " + std::to_string(matrix.cols()) + " " +
                      std::to_string(count) + "\n";
   text.reserve(text.size() + static_cast<std::size_t>(count) * 40);
-  char line[96];
   for (int j = 0; j < matrix.outerSize(); ++j) {
     for (SparseMatrix::InnerIterator it(matrix, j); it; ++it) {
       if (symmetric && it.row() < it.col()) continue;
-      const int length =
-          std::snprintf(line, sizeof(line), "%ld %ld %.17g\n", static_cast<long>(it.row()) + 1,
-                        static_cast<long>(it.col()) + 1, it.value());
-      text.append(line, static_cast<std::size_t>(length));
+      text += std::to_string(it.row() + 1) + ' ' + std::to_string(it.col() + 1) + ' ' +
+              FormatNumber(it.value(), kSeventeenDigits) + '\n';
     }
   }
   return text;
@@ -511,10 +509,9 @@ std::string FormatMatrixMarketMatrix(const SparseMatrix& matrix, MatrixMarketSto
 std::string FormatMatrixMarketVector(const Vector& vector, const std::string& comment) {
   std::string text = "%%MatrixMarket matrix array real general\n" + CommentLines(comment) +
                      std::to_string(vector.size()) + " 1\n";
-  char line[40];
   for (Eigen::Index i = 0; i < vector.size(); ++i) {
-    const int length = std::snprintf(line, sizeof(line), "%.17g\n", vector[i]);
-    text.append(line, static_cast<std::size_t>(length));
+    text += FormatNumber(vector[i], kSeventeenDigits);
+    text += '\n';
   }
   return text;
 }

@@ -18,6 +18,7 @@
 
 #include "data/csv_fields.h"
 #include "mcrewave/core/file_util.h"
+#include "mcrewave/core/format.h"
 
 namespace mcrewave {
 namespace {
@@ -271,17 +272,17 @@ void WriteMeasurementCsv(const ChannelSet& measurements, const std::string& path
   }
   content += "\n";
   content.reserve(content.size() + static_cast<std::size_t>(samples) * (5 + sensors.size()) * 25);
-  char row[5 * 32];
   for (int k = 0; k < samples; ++k) {
-    int length =
-        std::snprintf(row, sizeof(row), "%.17g,%.17g,%.17g,%.17g,%.17g", measurements.Time(k),
-                      ends.u0[k], ends.uL[k], ends.f0[k], ends.fL[k]);
-    content.append(row, static_cast<std::size_t>(length));
+    content += FormatNumber(measurements.Time(k), kSeventeenDigits);
+    for (const double value : {ends.u0[k], ends.uL[k], ends.f0[k], ends.fL[k]}) {
+      content += ',';
+      content += FormatNumber(value, kSeventeenDigits);
+    }
     for (const BarSensor& sensor : sensors) {
-      length =
-          std::snprintf(row, sizeof(row), ",%.17g",
-                        measurements.channels[static_cast<std::size_t>(sensor.index)].values[k]);
-      content.append(row, static_cast<std::size_t>(length));
+      content += ',';
+      content +=
+          FormatNumber(measurements.channels[static_cast<std::size_t>(sensor.index)].values[k],
+                       kSeventeenDigits);
     }
     content += '\n';
   }

@@ -32,6 +32,9 @@ inline constexpr NumberFormat kYamlRoundTrip{
 // the integer digits of numbers below 1e6 written out.
 inline constexpr NumberFormat kConfigRoundTrip{
     NumberFormat::Notation::kRoundTrip, 6, false, true, "nan", ".inf"};
+// Seventeen significant digits (printf's %.17g), enough for any double to read back
+// exactly: the values of CSV data, results and Matrix Market files (NaN as nan).
+inline constexpr NumberFormat kSeventeenDigits{NumberFormat::Notation::kSignificant, 17};
 // Ten significant digits: CSV tables and YAML of the zone runs (NaN as null).
 inline constexpr NumberFormat kTenDigitsYaml{
     NumberFormat::Notation::kSignificant, 10, false, false, "null", "inf"};
