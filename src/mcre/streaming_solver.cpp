@@ -1,6 +1,6 @@
 // Conjugate gradients on the sensor traces (docs/streaming.md). With
-// Phi(y) = H Direct(Retrograde(y)) (StreamingCoupledProblem::StreamingMap: the bar's
-// McreProblem or a matrix model's MatrixMcreProblem), b = Phi(0) and
+// Phi(y) = H Direct(Retrograde(y)) (StreamingCoupledProblem::StreamingMap of
+// MatrixMcreProblem, or of the tests' band-model bar), b = Phi(0) and
 // L y = Phi(y) - Phi(0), the coupled solution's traces solve
 //
 //   (I - L) y = b,

@@ -33,7 +33,8 @@ inline constexpr NumberFormat kYamlRoundTrip{
 inline constexpr NumberFormat kConfigRoundTrip{
     NumberFormat::Notation::kRoundTrip, 6, false, true, "nan", ".inf"};
 // Seventeen significant digits (printf's %.17g), enough for any double to read back
-// exactly: the values of CSV data, results and Matrix Market files (NaN as nan).
+// exactly: the values of CSV data, results and Matrix Market files. NaN is nan whatever
+// its sign bit (printf writes -nan for a NaN with the sign bit set).
 inline constexpr NumberFormat kSeventeenDigits{NumberFormat::Notation::kSignificant, 17};
 // Ten significant digits: CSV tables and YAML of the zone runs (NaN as null).
 inline constexpr NumberFormat kTenDigitsYaml{

@@ -204,13 +204,12 @@ enum class CoupledSolverType {
   kRiccati,
   kSingleShooting,
   kMultipleShooting,
-  // Conjugate gradients on the sensor traces with O(n) memory (docs/streaming.md):
-  // no space-time field is stored (theta = 1/2: O(n) memory; other theta: checkpoints,
-  // O(n sqrt(m))).
+  // Conjugate gradients on the sensor traces (docs/streaming.md): no space-time field
+  // is stored, the states at checkpoints, O(n sqrt(m)) memory.
   kStreamingConjugateGradient,
   // Not a solver of its own: conjugate_gradient when its stored fields fit
   // CoupledSolverOptions::max_field_bytes, streaming_conjugate_gradient when they do not
-  // (the built-in bar; a structure given by matrices keeps conjugate_gradient). Resolved
+  // (on a StreamingCoupledProblem, every model). Resolved
   // by ResolveCoupledSolverType (mcre/coupled_solver.h). Last, so that the solvers keep
   // their order in the lists of names.
   kAuto,

@@ -111,7 +111,8 @@ class TwistedTridiagonalLdlt {
   // SolveInPlace, then the update of each solution, computed as each x_i is final
   // inside the back-substitutions: their dependency chains leave the arithmetic units
   // idle, so the update costs almost nothing there. The same bits as SolveInPlace
-  // followed by the update's own loop. update's arrays distinct from x.
+  // followed by the update's own loop. update's arrays distinct from every x; the
+  // batched form instantiated for B = 2 and 3.
   void SolveInPlace(double* x, const Update& update) const;
   template <int B>
   void SolveInPlace(double* const (&x)[B], const Update (&update)[B]) const;

@@ -1,7 +1,7 @@
 // The bilinear form x^T A y of a sparse matrix whose entries touch few of the n dofs (a
 // zone's K_z, the rows g_s^T K_z of a support's reaction), in O(nnz(A)) rather than
 // the O(n) of Eigen's sparse product, which visits every column: the zone sums of the
-// MCRE's gradients and maps (mcre/matrix_mcre_problem.h, mcre/mcre_problem.h) then cost
+// MCRE's gradients and maps (mcre/matrix_mcre_problem.h) then cost
 // O(n) per sample over all zones, not O(n Z).
 //
 // Entries stored as 0 (a zone's K_z assembled over the whole mesh has them) are

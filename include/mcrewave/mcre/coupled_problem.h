@@ -52,7 +52,7 @@ class CoupledProblem {
   // Up to kMaxSweepBatch sweeps with the data at once, sweep b from inputs[b] (null:
   // the zero field) into outputs[b] (resized), outputs distinct from every input; the
   // results of the single sweeps, counted as that many sweeps. This default runs them
-  // one after the other; McreProblem and MatrixMcreProblem interleave them.
+  // one after the other; MatrixMcreProblem interleaves them.
   static constexpr int kMaxSweepBatch = 3;
   virtual void DirectSweepsWithData(const std::vector<const Matrix*>& retrograde,
                                     const std::vector<Matrix*>& displacement);

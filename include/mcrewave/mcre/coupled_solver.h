@@ -96,8 +96,10 @@ struct CoupledSolverOptions {
   // refuse when the fields they hold at once (kIterativeSolverFields fields of
   // n x (m + 1) doubles) would exceed this many bytes; auto then streams.
   long max_field_bytes = 2L << 30;
-  // streaming_conjugate_gradient at theta = 1/2: when the retrograde state rebuilt by
-  // the reversed recursion drifts by more than this (||omega_0 rebuilt to omega_m|| /
+  // streaming_conjugate_gradient on a problem that rebuilds the retrograde field by the
+  // reversed recursion at theta = 1/2 (the tests' band-model bar; MatrixMcreProblem
+  // takes it from checkpoints, rebuild error 0): when the rebuilt state drifts by more
+  // than this (||omega_0 rebuilt to omega_m|| /
   // max_j ||omega_j||, 0 in exact arithmetic, growing with the Courant number:
   // docs/streaming.md gives the measured values), the solver switches
   // the problem to checkpoints (StreamingCoupledProblem::UseCheckpoints) and goes on from its
@@ -117,7 +119,7 @@ struct CoupledSolverOptions {
 // steps: options.type itself, unless it is kAuto, which takes conjugate_gradient when
 // its fields (IterativeSolverFieldBytes) fit options.max_field_bytes, and
 // streaming_conjugate_gradient when they do not and `streaming_available` (a
-// StreamingCoupledProblem: the built-in bar and a structure given by matrices); without
+// StreamingCoupledProblem: MatrixMcreProblem, any structure); without
 // it conjugate_gradient, which SolveCoupled then refuses. The one place where auto is
 // resolved: SolveCoupled, the configs' load-time checks and the reports call it.
 CoupledSolverType ResolveCoupledSolverType(const CoupledSolverOptions& options, double num_nodes,
@@ -142,7 +144,7 @@ struct CoupledSolverSummary {
   int safeguard_restarts = 0;            // adaptive only: omega re-chosen after growth
   double wall_time_s = -1.0;
   // Riccati and shooting only: multiply-accumulates of the method itself (the
-  // residual check excluded), counted as include/mcrewave/operation_counts.h says.
+  // residual check excluded), counted as include/mcrewave/core/operation_counts.h says.
   double multiply_accumulates = -1.0;
   // Single shooting: 2-norm condition number of the equilibrated shooting matrix.
   // Multiple shooting: max |r_ii| / min |r_ii| of the QR factor of the global
