@@ -74,7 +74,7 @@ MatrixOutputErrorObjective::MatrixOutputErrorObjective(const MatrixModelData& mo
     assert(level > 0.0);
     weights_[k] = 1.0 / (level * level);
     for (int outer = 0; outer < sensor.row.outerSize(); ++outer) {
-      for (SparseMatrix::InnerIterator it(sensor.row, outer); it; ++it) {
+      for (SparseRow::InnerIterator it(sensor.row, outer); it; ++it) {
         // U = 0 on a held dof: the row's entry there observes nothing.
         if (kept(it.col())) entries.emplace_back(k, static_cast<int>(it.col()), it.value());
       }

@@ -51,19 +51,19 @@ struct LoadColumn {
   std::string channel;
 };
 struct ObservedRow {
-  SparseMatrix row;  // 1 x n
+  SparseRow row;  // 1 x n
   double beta;
   std::string channel;
   ChannelKind kind;
 };
 
 // The sparse 1 x n row of a dense vector's nonzero entries.
-SparseMatrix RowOf(const Vector& vector) {
+SparseRow RowOf(const Vector& vector) {
   std::vector<Eigen::Triplet<double>> entries;
   for (int i = 0; i < vector.size(); ++i) {
     if (vector[i] != 0.0) entries.emplace_back(0, i, vector[i]);
   }
-  SparseMatrix row(1, vector.size());
+  SparseRow row(1, vector.size());
   row.setFromTriplets(entries.begin(), entries.end());
   return row;
 }
@@ -160,7 +160,7 @@ void GatherFixedRows(const std::vector<ObservedRow>& rows, const ChannelSet& dat
     }
     (*betas)[k] = rows[k].beta;
     for (int outer = 0; outer < rows[k].row.outerSize(); ++outer) {
-      for (SparseMatrix::InnerIterator it(rows[k].row, outer); it; ++it) {
+      for (SparseRow::InnerIterator it(rows[k].row, outer); it; ++it) {
         // U = 0 on a held dof: the row's entry there observes nothing and would load it.
         if (!held.empty() && held[it.col()] != 0) continue;
         entries.emplace_back(k, static_cast<int>(it.col()), it.value());

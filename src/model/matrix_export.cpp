@@ -161,16 +161,16 @@ MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
   ObservationRow end;
   end.coefficients[0] = 1.0;
   end.nodes[0] = end.nodes[1] = model.left_node();
-  if (!support) data.sensors.push_back({"u0", ObservationRowMatrix(end, n)});
+  if (!support) data.sensors.push_back({"u0", SparseRow(ObservationRowMatrix(end, n))});
   end.nodes[0] = end.nodes[1] = model.right_node();
-  data.sensors.push_back({"uL", ObservationRowMatrix(end, n)});
+  data.sensors.push_back({"uL", SparseRow(ObservationRowMatrix(end, n))});
   for (const BarSensor& sensor : sensors) {
     const ObservationRow row = sensor.kind == SensorKind::kDisplacement
                                    ? model.DisplacementRow(sensor.position)
                                    : model.StrainRow(sensor.position);
     std::ostringstream name;
     name << (sensor.kind == SensorKind::kDisplacement ? "u@" : "e@") << sensor.position;
-    data.sensors.push_back({name.str(), ObservationRowMatrix(row, n), sensor.kind});
+    data.sensors.push_back({name.str(), SparseRow(ObservationRowMatrix(row, n)), sensor.kind});
   }
   if (support) {
     // The clamp: dof 0 held, g = e_0, its force f0 and displacement u0.
@@ -198,7 +198,8 @@ void WriteChannelFiles(const std::string& folder, const MatrixModelData& data,
   *manifest << YAML::Key << "sensors" << YAML::Value << YAML::BeginSeq;
   for (const MatrixModelSensor& sensor : data.sensors) {
     const std::string file = "sensor_" + FileSafe(sensor.channel) + ".mtx";
-    WriteMatrixMarketMatrix(folder + "/" + file, sensor.row, MatrixMarketStorage::kGeneral,
+    WriteMatrixMarketMatrix(folder + "/" + file, SparseMatrix(sensor.row),
+                            MatrixMarketStorage::kGeneral,
                             "observation row of sensor channel " + sensor.channel);
     *manifest << YAML::Flow << YAML::BeginMap << YAML::Key << "channel" << YAML::Value
               << sensor.channel << YAML::Key << "row" << YAML::Value << file;
@@ -260,9 +261,9 @@ void WriteChannelMatrices(const std::string& folder, const MatrixModelData& data
     entries.clear();
     channels.clear();
     for (; first < data.sensors.size() && data.sensors[first].kind == kind; ++first) {
-      const SparseMatrix& row = data.sensors[first].row;
+      const SparseRow& row = data.sensors[first].row;
       for (int j = 0; j < row.outerSize(); ++j) {
-        for (SparseMatrix::InnerIterator it(row, j); it; ++it) {
+        for (SparseRow::InnerIterator it(row, j); it; ++it) {
           entries.emplace_back(static_cast<int>(channels.size()), static_cast<int>(it.col()),
                                it.value());
         }
@@ -492,7 +493,7 @@ void ReadSensors(const std::string& manifest_path, const YAML::Node& root,
     SparseMatrix row = ReadMatrixMarketMatrix(file);
     Refuse(CheckSensorRow(row, sensor.channel, file, n, mass_file));
     if (row.rows() != 1) row = SparseMatrix(row.transpose());
-    sensor.row = std::move(row);
+    sensor.row = SparseRow(row);
     data->sensors.push_back(std::move(sensor));
   }
 }
@@ -625,10 +626,10 @@ void ReadSensorMatrices(const std::string& manifest_path, const YAML::Node& root
       MatrixModelSensor sensor;
       sensor.channel = names[static_cast<std::size_t>(k)].name;
       sensor.kind = kind;
-      sensor.row = SparseMatrix(1, n);
+      sensor.row = SparseRow(1, n);
       sensor.row.setFromTriplets(entries.begin(), entries.end());
-      Refuse(CheckSensorRow(sensor.row, sensor.channel, file + " row " + std::to_string(k + 1), n,
-                            mass_file));
+      Refuse(CheckSensorRow(SparseMatrix(sensor.row), sensor.channel,
+                            file + " row " + std::to_string(k + 1), n, mass_file));
       data->sensors.push_back(std::move(sensor));
     }
   }

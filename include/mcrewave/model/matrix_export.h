@@ -76,7 +76,7 @@ struct MatrixModelLoad {
 
 struct MatrixModelSensor {
   std::string channel;  // the CSV column it is compared with
-  SparseMatrix row;     // 1 x n observation row: channel = row U
+  SparseRow row;        // 1 x n observation row: channel = row U
   // What the row measures: a displacement [m] or a strain [-] (manifest key `kind`,
   // default displacement); it chooses the weight of the channel's data term.
   SensorKind kind = SensorKind::kDisplacement;
