@@ -81,6 +81,14 @@ TEST(MatrixModelCheckTest, SensorRows) {
             "sensor 'u' (u.mtx): every coefficient is zero, the sensor reads nothing");
   EXPECT_TRUE(Contains(CheckSensorRow(SparseMatrix(2, 10), "u", "u.mtx", 10, "M.mtx"),
                        "2 x 10, expected one row"));
+  // The same rows stored by rows (MatrixModelSensor::row) get the same answers.
+  EXPECT_EQ(CheckSensorRow(SparseRow(row), "u_3", "u_3.mtx", 10, "M.mtx"), "");
+  EXPECT_EQ(CheckSensorRow(SparseRow(long_row), "e_tip", "e_tip.mtx", 10, "M.mtx"),
+            "sensor 'e_tip' (e_tip.mtx): entry at dof 11, past the last dof 10 of M.mtx");
+  EXPECT_EQ(CheckSensorRow(SparseRow(short_row), "u", "u.mtx", 10, "M.mtx"),
+            "sensor 'u' (u.mtx): 8 entries, but M.mtx has 10 dofs");
+  EXPECT_EQ(CheckSensorRow(SparseRow(1, 10), "u", "u.mtx", 10, "M.mtx"),
+            "sensor 'u' (u.mtx): every coefficient is zero, the sensor reads nothing");
 }
 
 }  // namespace

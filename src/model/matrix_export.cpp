@@ -609,7 +609,7 @@ void ReadSensorMatrices(const std::string& manifest_path, const YAML::Node& root
     CheckEntryKeys(manifest_path, entry, {"matrix", "channels", "kind"}, "matrix, channels, kind");
     const SensorKind kind = KindOf(manifest_path, entry);
     const std::string file = ManifestFile(folder, RequiredString(manifest_path, entry, "matrix"));
-    const Eigen::SparseMatrix<double, Eigen::RowMajor> matrix = ReadMatrixMarketMatrix(file);
+    const SparseRow matrix = ReadMatrixMarketMatrix(file);
     if (matrix.cols() != n) {
       throw InputError(file + ": " + std::to_string(matrix.rows()) + " x " +
                        std::to_string(matrix.cols()) + ", but " + mass_file + " has " +
@@ -619,17 +619,13 @@ void ReadSensorMatrices(const std::string& manifest_path, const YAML::Node& root
     const std::vector<ListedChannel> names =
         ReadMatrixChannels(manifest_path, entry, folder, matrix.rows(), file, "rows", channels);
     for (Eigen::Index k = 0; k < matrix.rows(); ++k) {
-      std::vector<Eigen::Triplet<double>> entries;
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(matrix, k); it; ++it) {
-        entries.emplace_back(0, static_cast<int>(it.col()), it.value());
-      }
       MatrixModelSensor sensor;
       sensor.channel = names[static_cast<std::size_t>(k)].name;
       sensor.kind = kind;
-      sensor.row = SparseRow(1, n);
-      sensor.row.setFromTriplets(entries.begin(), entries.end());
-      Refuse(CheckSensorRow(SparseMatrix(sensor.row), sensor.channel,
-                            file + " row " + std::to_string(k + 1), n, mass_file));
+      // Row k's own entries, O(nnz): matrix is stored by rows.
+      sensor.row = matrix.row(k);
+      Refuse(CheckSensorRow(sensor.row, sensor.channel, file + " row " + std::to_string(k + 1), n,
+                            mass_file));
       data->sensors.push_back(std::move(sensor));
     }
   }

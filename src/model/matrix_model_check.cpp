@@ -102,8 +102,11 @@ std::string CheckVectorSize(const Vector& vector, const std::string& name, int d
          std::to_string(dofs) + " dofs";
 }
 
-std::string CheckSensorRow(const SparseMatrix& row, const std::string& sensor,
-                           const std::string& name, int dofs, const std::string& reference_name) {
+namespace {
+
+template <typename Row>
+std::string CheckSensorRowOf(const Row& row, const std::string& sensor, const std::string& name,
+                             int dofs, const std::string& reference_name) {
   const std::string which = "sensor '" + sensor + "' (" + name + ")";
   if (row.rows() != 1 && row.cols() != 1) {
     return which + ": " + Dimensions(row.rows(), row.cols()) +
@@ -112,7 +115,7 @@ std::string CheckSensorRow(const SparseMatrix& row, const std::string& sensor,
   // The largest dof holding a non-zero coefficient.
   int last = -1;
   for (int j = 0; j < row.outerSize(); ++j) {
-    for (SparseMatrix::InnerIterator it(row, j); it; ++it) {
+    for (typename Row::InnerIterator it(row, j); it; ++it) {
       if (it.value() != 0.0) {
         last = std::max(last, static_cast<int>(std::max(it.row(), it.col())));
       }
@@ -129,6 +132,18 @@ std::string CheckSensorRow(const SparseMatrix& row, const std::string& sensor,
   }
   if (last < 0) return which + ": every coefficient is zero, the sensor reads nothing";
   return "";
+}
+
+}  // namespace
+
+std::string CheckSensorRow(const SparseMatrix& row, const std::string& sensor,
+                           const std::string& name, int dofs, const std::string& reference_name) {
+  return CheckSensorRowOf(row, sensor, name, dofs, reference_name);
+}
+
+std::string CheckSensorRow(const SparseRow& row, const std::string& sensor, const std::string& name,
+                           int dofs, const std::string& reference_name) {
+  return CheckSensorRowOf(row, sensor, name, dofs, reference_name);
 }
 
 std::string CheckSupportDofs(const std::vector<int>& support_dofs, const std::string& support,

@@ -58,6 +58,9 @@ std::string CheckVectorSize(const Vector& vector, const std::string& name, int d
 // the size mismatch. A row of only zeros reads nothing: refused too.
 std::string CheckSensorRow(const SparseMatrix& row, const std::string& sensor,
                            const std::string& name, int dofs, const std::string& reference_name);
+// The same for a row stored by rows (MatrixModelSensor::row), in O(nnz).
+std::string CheckSensorRow(const SparseRow& row, const std::string& sensor, const std::string& name,
+                           int dofs, const std::string& reference_name);
 
 // A support's held dofs (docs/matrix_models.md section 11): "" when there is at least one,
 // each in [0, dofs) and none twice; otherwise e.g. "support 'clamp' of model.yaml: dof 812
