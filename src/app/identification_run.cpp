@@ -58,7 +58,7 @@ constexpr double kGridTolerance = 1e-6;
 // farther, half of them over the span of the evaluations instead and the other
 // half over the window, so the curve shows both the optimiser's path and the
 // neighbourhood of E*. Clipped to the bounds.
-std::vector<double> CostCurveModuli(const Config& config, const IdentificationRun& run) {
+std::vector<double> CostCurveModuli(const Config& config, const ModulusStage& run) {
   const double center = run.identified_modulus();
   const double lower = config.outer.lower_bound;
   const double upper = config.outer.upper_bound;
@@ -88,7 +88,7 @@ std::vector<double> CostCurveModuli(const Config& config, const IdentificationRu
 // The cost curve at CostCurveModuli, each solve warm-started from the previous
 // point's (the first from the solution at E*).
 std::vector<CostCurvePoint> ComputeCostCurve(const Config& config, const MatrixModelData& model,
-                                             const ChannelSet& data, const IdentificationRun& run,
+                                             const ChannelSet& data, const ModulusStage& run,
                                              long* sweeps) {
   const double center = run.identified_modulus();
   const std::vector<double> moduli = CostCurveModuli(config, run);
@@ -214,6 +214,53 @@ McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData&
   return result;
 }
 
+ModulusStage IdentifyHomogeneousModulus(const Config& config, const MatrixModelData& model,
+                                        const ChannelSet& data) {
+  ModulusStage stage;
+  stage.inner_method = ResolveCoupledSolverType(config.inner, model.dofs(), data.num_steps(),
+                                                /*streaming_available=*/true);
+  McreIdentification identification = IdentifyWithMcre(config, model, data);
+  McreObjective& objective = *identification.objective;
+  stage.rest_cost = objective.rest_cost();
+  stage.scan_cost_scale = identification.scan_cost_scale;
+  stage.outer = identification.outer;
+  stage.evaluations = objective.evaluations();
+  stage.search_sweeps = identification.search_sweeps;
+  stage.sweeps = objective.sweeps() + stage.search_sweeps;
+  spdlog::info("{}", stage.outer.BriefReport());
+  if (!stage.IsUsable()) return stage;
+  // Every field reported belongs to the identified E: the objective's best evaluation is
+  // at E* unless another evaluation went lower; then E* is solved once more
+  // (warm-started).
+  stage.best_index = objective.best_index();
+  stage.solution = objective.best_solution();
+  if (stage.evaluations[stage.best_index].modulus != stage.identified_modulus()) {
+    const ObjectiveEvaluation& at_optimum = objective.EvaluateModulus(stage.identified_modulus());
+    if (!at_optimum.usable) {
+      stage.outer.termination = TerminationType::kFailure;
+      stage.outer.message =
+          "the coupled solve at the identified E is not usable: " + at_optimum.inner.message;
+    }
+    stage.evaluations = objective.evaluations();
+    stage.sweeps = objective.sweeps() + stage.search_sweeps;
+    stage.best_index = static_cast<int>(stage.evaluations.size()) - 1;
+    stage.solution = objective.last_solution();
+  }
+  return stage;
+}
+
+McreObjective CompleteModulusStage(const Config& config, const MatrixModelData& model,
+                                   const ChannelSet& data, ModulusStage* stage) {
+  // The cost curve around E*.
+  stage->cost_curve = ComputeCostCurve(config, model, data, *stage, &stage->cost_curve_sweeps);
+  // The inner solver's convergence at E* from W = 0.
+  McreObjective cold =
+      MatrixMcreObjective(model, data, config.mcre, config.time.theta, config.inner,
+                          Factorization::kAutomatic, stage->identified_modulus());
+  stage->cold_solve = cold.EvaluateModulus(stage->identified_modulus()).inner;
+  return cold;
+}
+
 IdentificationRun IdentifyModulus(const Config& config, const ChannelSet& data) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
@@ -224,52 +271,26 @@ IdentificationRun IdentifyModulus(const Config& config, const ChannelSet& data) 
 
   const BarModel model(config.model);
   // The solver every coupled solve of this run takes (SolveCoupled resolves auto alike).
-  run.inner_method = ResolveCoupledSolverType(config.inner, model.num_nodes(), run.data.num_steps(),
-                                              /*streaming_available=*/true);
+  const CoupledSolverType inner_method = ResolveCoupledSolverType(
+      config.inner, model.num_nodes(), run.data.num_steps(), /*streaming_available=*/true);
   spdlog::info(
       "identifying E with {}/{} from {:.6g} Pa in [{:.6g}, {:.6g}] Pa; inner {}; global scan on {}",
       OptimizerTypeToString(config.outer.optimizer),
       OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
       config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
-      CoupledSolverName(config.inner.type, run.inner_method),
+      CoupledSolverName(config.inner.type, inner_method),
       config.outer.scan_points == 0      ? "none (outer.scan_points 0)"
       : ScansTheSearchFunctional(config) ? "the pinned search functional (search:)"
                                          : "mcre:'s e^2");
   run.model = std::make_shared<const MatrixModelData>(BarRunModel(model, run.data, run.ends));
   const MatrixModelData& matrices = *run.model;
-  McreIdentification identification = IdentifyWithMcre(config, matrices, run.data);
-  McreObjective& objective = *identification.objective;
+  static_cast<ModulusStage&>(run) = IdentifyHomogeneousModulus(config, matrices, run.data);
+  run.inner_method = inner_method;
   // The bar's weights from k* = E0 S / L (mcre/matrix_mcre_problem.h): alpha = w_f / k*
   // of its loads, beta = w_u k* of its end displacement, for the summary.
   const double stiffness_scale = config.mcre.reference_modulus * matrices.stiffness_length;
   run.alpha = config.mcre.weights.force_weight / stiffness_scale;
   run.beta = config.mcre.weights.displacement_weight * stiffness_scale;
-  run.rest_cost = objective.rest_cost();
-  run.scan_cost_scale = identification.scan_cost_scale;
-  run.outer = identification.outer;
-  run.evaluations = objective.evaluations();
-  run.search_sweeps = identification.search_sweeps;
-  run.sweeps = objective.sweeps() + run.search_sweeps;
-  spdlog::info("{}", run.outer.BriefReport());
-  if (run.IsUsable()) {
-    // Every field reported belongs to the identified E: the objective's best
-    // evaluation is at E* unless another evaluation went lower; then E* is
-    // solved once more (warm-started).
-    run.best_index = objective.best_index();
-    run.solution = objective.best_solution();
-    if (run.evaluations[run.best_index].modulus != run.identified_modulus()) {
-      const ObjectiveEvaluation& at_optimum = objective.EvaluateModulus(run.identified_modulus());
-      if (!at_optimum.usable) {
-        run.outer.termination = TerminationType::kFailure;
-        run.outer.message =
-            "the coupled solve at the identified E is not usable: " + at_optimum.inner.message;
-      }
-      run.evaluations = objective.evaluations();
-      run.sweeps = objective.sweeps() + run.search_sweeps;
-      run.best_index = static_cast<int>(run.evaluations.size()) - 1;
-      run.solution = objective.last_solution();
-    }
-  }
   run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return run;
 }
@@ -281,20 +302,14 @@ IdentificationRun RunIdentification(const Config& config, const ChannelSet& data
   if (!run.IsUsable()) return run;
   const MatrixModelData& matrices = *run.model;
 
-  // The cost curve around E*.
-  run.cost_curve = ComputeCostCurve(config, matrices, run.data, run, &run.cost_curve_sweeps);
+  // The cost curve around E* and the inner solver's convergence there from W = 0.
+  McreObjective cold = CompleteModulusStage(config, matrices, run.data, &run);
 
   // The error map of the constitutive gap at the homogeneous E* (error_map.h).
   run.error_map = BarErrorMap(config, run);
   const int peak = run.error_map.PeakElement();
   spdlog::info("error map: largest share {:.3g} of the constitutive gap at x = {:.4g} m",
                run.error_map.Fractions()[peak], run.error_map.position[peak]);
-
-  // The inner solver's convergence at E* from W = 0.
-  McreObjective cold =
-      MatrixMcreObjective(matrices, run.data, config.mcre, config.time.theta, config.inner,
-                          Factorization::kAutomatic, run.identified_modulus());
-  run.cold_solve = cold.EvaluateModulus(run.identified_modulus()).inner;
 
   // The model's channels and the RMS misfits at E*; an end displacement the run does
   // not use is no channel of the problem: from the stored field.

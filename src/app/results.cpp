@@ -89,7 +89,7 @@ class YamlWriter {
 // ---------------------------------------------------------------------------
 // CSV files.
 
-std::string EvaluationsCsv(const IdentificationRun& run) {
+std::string EvaluationsCsv(const ModulusStage& run) {
   std::string csv =
       "evaluation,modulus,cost,cost_gradient,gradient_requested,usable,inner_iterations,sweeps,"
       "relative_residual\n";
@@ -143,14 +143,14 @@ std::string EndsCsv(const IdentificationRun& run) {
 
 // The relative residual per iteration of the solve from W = 0 at the identified
 // E; for the direct solvers (no iteration history) their one final residual.
-std::vector<double> InnerResidualHistory(const IdentificationRun& run) {
+std::vector<double> InnerResidualHistory(const ModulusStage& run) {
   const CoupledSolverSummary& inner = run.cold_solve;
   if (!inner.residual_history.empty()) return inner.residual_history;
   if (inner.relative_residual >= 0.0) return {inner.relative_residual};
   return {};
 }
 
-std::string InnerResidualCsv(const IdentificationRun& run) {
+std::string InnerResidualCsv(const ModulusStage& run) {
   std::string csv = "iteration,relative_residual\n";
   const std::vector<double> history = InnerResidualHistory(run);
   for (std::size_t i = 0; i < history.size(); ++i) {
@@ -214,7 +214,8 @@ std::string ScanPlots(const std::string& folder, bool search) {
          " with points pt 4 ps 2 lw 2 lc rgb '#1f77b4' title 'valleys refined', ";
 }
 
-std::string CostCurveScript(const IdentificationRun& run, const std::string& folder) {
+std::string CostCurveScript(const ModulusStage& run, const Config& config,
+                            const std::string& folder) {
   const double identified = run.identified_modulus() / 1e9;
   const std::string curve = GnuplotString(folder + "/cost_curve.csv");
   const std::string evaluations = GnuplotString(folder + "/evaluations.csv");
@@ -246,7 +247,7 @@ std::string CostCurveScript(const IdentificationRun& run, const std::string& fol
       if (outer.scan_moduli.back() >= 10.0 * outer.scan_moduli.front())
         script << "set logscale x\n";
       script << "set title 'global scan over the bounds (inner tolerance "
-             << run.config.outer.scan_tolerance << "), its valleys and the local refinements'\n";
+             << config.outer.scan_tolerance << "), its valleys and the local refinements'\n";
     } else if (panel == 0) {
       script << "set title 'over the optimiser evaluations'\n";
     } else {
@@ -293,12 +294,12 @@ std::string EndsScript(const IdentificationRun& run, const std::string& folder) 
   return script.str();
 }
 
-// summary.yaml's comment on inner.method: why auto chose the solver that ran ("" when
-// the config named it).
-std::string InnerMethodComment(const IdentificationRun& run) {
-  if (run.config.inner.type != CoupledSolverType::kAuto) return "";
-  const double bytes =
-      IterativeSolverFieldBytes(run.config.model.elements + 1.0, run.data.num_steps());
+// summary.yaml's comment on inner.method: why auto chose the solver that ran on `dofs`
+// dofs and `steps` steps ("" when the config named it).
+std::string InnerMethodComment(const ModulusStage& run, const Config& config, double dofs,
+                               double steps) {
+  if (config.inner.type != CoupledSolverType::kAuto) return "";
+  const double bytes = IterativeSolverFieldBytes(dofs, steps);
   std::ostringstream comment;
   comment << "inner.method auto: the stored fields, " << static_cast<long long>(bytes) << " bytes, "
           << (run.inner_method == CoupledSolverType::kStreamingConjugateGradient ? "exceed" : "fit")
@@ -306,10 +307,11 @@ std::string InnerMethodComment(const IdentificationRun& run) {
   return comment.str();
 }
 
-std::string InnerResidualScript(const IdentificationRun& run, const std::string& folder) {
+std::string InnerResidualScript(const ModulusStage& run, const Config& config,
+                                const std::string& folder) {
   // The method's name with spaces for underscores (gnuplot's subscripts).
   std::string method = CoupledSolverTypeToString(run.inner_method);
-  if (run.config.inner.type == CoupledSolverType::kAuto) method = "auto: " + method;
+  if (config.inner.type == CoupledSolverType::kAuto) method = "auto: " + method;
   std::replace(method.begin(), method.end(), '_', ' ');
   std::ostringstream script;
   script << GnuplotPngTerminal() << "set title 'Inner solver (" << method
@@ -319,7 +321,7 @@ std::string InnerResidualScript(const IdentificationRun& run, const std::string&
             "set logscale y\nset format y '10^{%T}'\n"
          << "plot " << GnuplotString(folder + "/inner_residual.csv")
          << " skip 1 using 1:2 with linespoints pt 7 ps 0.6 lw 2 title 'relative residual', "
-         << run.config.inner.tolerance << " with lines dashtype 2 lc rgb '#555555' "
+         << config.inner.tolerance << " with lines dashtype 2 lc rgb '#555555' "
          << "title 'inner.tolerance'\n";
   return script.str();
 }
@@ -557,8 +559,10 @@ void UncertaintyYaml(const IdentificationRun& run, YamlWriter* yaml) {
 }
 
 // The inner: block of an identification's summary: the coupled solves of the
-// optimiser, their iterations, sweeps and time, and the solve at the optimum.
-void InnerSolvesYaml(const IdentificationRun& run, YamlWriter* yaml) {
+// optimiser, their iterations, sweeps and time, and the solve at the optimum, on a
+// structure of `dofs` dofs over `steps` steps.
+void InnerSolvesYaml(const ModulusStage& run, const Config& config, double dofs, double steps,
+                     YamlWriter* yaml) {
   long inner_iterations = 0;
   int max_inner_iterations = 0;
   double inner_time = 0.0;
@@ -569,7 +573,8 @@ void InnerSolvesYaml(const IdentificationRun& run, YamlWriter* yaml) {
   }
   const CoupledSolverSummary& best_inner = run.evaluations[run.best_index].inner;
   yaml->Line(0, "inner", "");
-  yaml->Text(1, "method", CoupledSolverTypeToString(run.inner_method), InnerMethodComment(run));
+  yaml->Text(1, "method", CoupledSolverTypeToString(run.inner_method),
+             InnerMethodComment(run, config, dofs, steps));
   yaml->Integer(1, "solves", static_cast<long>(run.evaluations.size()),
                 "coupled solves of the optimiser");
   yaml->Integer(1, "iterations", inner_iterations, "sweep pairs over those solves");
@@ -631,7 +636,7 @@ std::string SummaryYaml(const IdentificationRun& run) {
   OptimizerScanAndPrefilterYaml(outer, run.rest_cost, run.scan_cost_scale, run.config,
                                 run.prefilter_cutoff, "e^2", "J s", &yaml);
 
-  InnerSolvesYaml(run, &yaml);
+  InnerSolvesYaml(run, run.config, run.config.model.elements + 1.0, run.data.num_steps(), &yaml);
 
   yaml.Line(0, "weights", "");
   yaml.Number(1, "alpha", run.alpha, "[m/N] force weight w_f L / (S E0)");
@@ -669,13 +674,13 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
   }
   if (figures) {
     std::vector<std::pair<std::string, std::string>> drawings = {
-        {"cost_curve", CostCurveScript(run, folder)},
+        {"cost_curve", CostCurveScript(run, run.config, folder)},
         {"ends", EndsScript(run, folder)},
     };
     if (run.error_map.share.size() > 0)
       drawings.emplace_back("error_map", ErrorMapScript(run, folder));
     if (!InnerResidualHistory(run).empty()) {
-      drawings.emplace_back("inner_residual", InnerResidualScript(run, folder));
+      drawings.emplace_back("inner_residual", InnerResidualScript(run, run.config, folder));
     }
     results.Draw(drawings);
   }

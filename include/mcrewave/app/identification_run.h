@@ -46,8 +46,49 @@ ChannelSet LoadMeasurements(const Config& config);
 // or a noise level beyond double range).
 ChannelSet SyntheticMeasurements(const Config& config);
 
-// Everything one identification computed.
-struct IdentificationRun {
+// The homogeneous stage of an identification on any structure given by matrices: one
+// modulus E in every zone, found by the outer loop of config.outer on mcre:'s e^2
+// (IdentifyWithMcre: the global scan, on the search functional by default, then the
+// local refinements), then the cost curve around E* and a solve from W = 0 there
+// (CompleteModulusStage). The bar's scalar identification, and the start of the zones on
+// a structure whose zones share one nominal modulus.
+struct ModulusStage {
+  // The coupled solver that ran: config.inner.type, or what auto resolved to on this
+  // structure and time grid (ResolveCoupledSolverType).
+  CoupledSolverType inner_method = CoupledSolverType::kConjugateGradient;
+  IdentificationSummary outer;
+  // The optimiser's evaluations, in order; evaluations[best_index] is the one
+  // at the identified E, and `solution` its coupled solution (a streaming solve's
+  // traces in its rows' order).
+  std::vector<ObjectiveEvaluation> evaluations;
+  int best_index = -1;
+  CoupledSolution solution;
+  double rest_cost = 0.0;  // J_rest, the cost scale [J s]
+  // The cost scale of outer's scan fields [J s]: J_rest of the search functional when
+  // outer.scan_of_search, else rest_cost.
+  double scan_cost_scale = 0.0;
+  // Sweeps of the optimiser's evaluations, the search objective's own included (the
+  // scans' copies: outer.scan_sweeps).
+  long sweeps = 0;
+  long search_sweeps = 0;  // of which the search objective's own (0: one stage)
+
+  std::vector<CostCurvePoint> cost_curve;  // ascending E
+  long cost_curve_sweeps = 0;
+  // A coupled solve at the identified E from W = 0, for the inner solver's
+  // convergence history (the optimiser's solves are warm-started: the one at E*
+  // takes few iterations, often none).
+  CoupledSolverSummary cold_solve;
+
+  // The outer loop converged; only then are the fields after `outer` filled.
+  bool IsUsable() const { return outer.IsSolutionUsable(); }
+  double identified_modulus() const { return outer.modulus; }
+  // e^2 at the identified E [J s].
+  double cost() const { return best_index >= 0 ? evaluations[best_index].cost : -1.0; }
+};
+
+// Everything one identification of the bar computed: its homogeneous stage (on
+// BarRunModel) and what the bar adds to it.
+struct IdentificationRun : ModulusStage {
   Config config;
   // The measurements the MCRE compared with: the channels of data.channels,
   // pre-filtered when prefilter.enabled.
@@ -79,45 +120,15 @@ struct IdentificationRun {
   // is read from the stored field, and is missing after a streaming solve.
   ChannelSet model_channels;
 
-  // The coupled solver that ran: config.inner.type, or what auto resolved to on this
-  // bar and time grid (ResolveCoupledSolverType).
-  CoupledSolverType inner_method = CoupledSolverType::kConjugateGradient;
-  IdentificationSummary outer;
-  // The optimiser's evaluations, in order; evaluations[best_index] is the one
-  // at the identified E, and `solution` its coupled solution (of BarRunModel's
-  // problem: a streaming solve's traces in its rows' order).
-  std::vector<ObjectiveEvaluation> evaluations;
-  int best_index = -1;
-  CoupledSolution solution;
-  double alpha = 0.0;      // force weight used [m/N]
-  double beta = 0.0;       // displacement weight used [N/m]
-  double rest_cost = 0.0;  // J_rest, the cost scale [J s]
-  // The cost scale of outer's scan fields [J s]: J_rest of the search functional when
-  // outer.scan_of_search, else rest_cost.
-  double scan_cost_scale = 0.0;
-  // Sweeps of the optimiser's evaluations, the search objective's own included (the
-  // scans' copies: outer.scan_sweeps).
-  long sweeps = 0;
-  long search_sweeps = 0;  // of which the search objective's own (0: one stage)
+  double alpha = 0.0;  // force weight used [m/N]
+  double beta = 0.0;   // displacement weight used [N/m]
 
-  std::vector<CostCurvePoint> cost_curve;  // ascending E
-  long cost_curve_sweeps = 0;
-  // A coupled solve at the identified E from W = 0, for the inner solver's
-  // convergence history (the optimiser's solves are warm-started: the one at E*
-  // takes few iterations, often none).
-  CoupledSolverSummary cold_solve;
   ModulusUncertainty uncertainty;
   // The error map at the identified (homogeneous) E, from `solution`.
   ErrorMap error_map;
   // The zone moduli from E* (ran = false with one zone).
   ZoneIdentificationRun zones;
   double wall_time_s = -1.0;  // the whole of RunIdentification
-
-  // The outer loop converged; only then are the fields after `outer` filled.
-  bool IsUsable() const { return outer.IsSolutionUsable(); }
-  double identified_modulus() const { return outer.modulus; }
-  // e^2 at the identified E [J s].
-  double cost() const { return best_index >= 0 ? evaluations[best_index].cost : -1.0; }
 };
 
 // Step 3 on mcre:'s e^2.
@@ -137,6 +148,20 @@ struct McreIdentification {
 // Identify. Precondition: config valid.
 McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData& model,
                                     const ChannelSet& data);
+
+// The homogeneous stage up to `solution`: IdentifyWithMcre, then the objective's best
+// evaluation, solved once more at E* when another evaluation went lower. model and data:
+// as IdentifyWithMcre's. Precondition: config valid. Never throws for a failed
+// identification: see IsUsable() and outer.message.
+ModulusStage IdentifyHomogeneousModulus(const Config& config, const MatrixModelData& model,
+                                        const ChannelSet& data);
+
+// The rest of the stage at E*: the cost curve e^2(E) on output.curve_points points
+// around E* (and over the optimiser's evaluations when they reach farther),
+// warm-started point to point from `solution`, and cold_solve. Returns the objective of
+// the cold solve, its problem's moduli at E*. Precondition: stage->IsUsable().
+McreObjective CompleteModulusStage(const Config& config, const MatrixModelData& model,
+                                   const ChannelSet& data, ModulusStage* stage);
 
 // Runs steps 2 and 3 on measurements made by LoadMeasurements(config): the
 // fields up to `solution` (and wall_time_s); no cost curve, no uncertainty.
