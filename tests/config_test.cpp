@@ -813,7 +813,8 @@ TEST(ConfigTest, EveryKeyAtANonDefaultValueRoundTripsExactly) {
 }
 
 // A summary's config block lists the keys its model kind reads: a matrix run's no
-// search or bar geometry (its clamp keys treat the manifest's supports); the bar's no manifest.
+// bar geometry or study (its clamp keys treat the manifest's supports, its outer: and
+// search: keys the homogeneous stage); the bar's no manifest.
 // Every key named by KeyApplies' lists is a key of the table (the counts below fail on a
 // misspelling).
 TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
@@ -821,31 +822,46 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
   const Config matrix = ParseConfig(kEveryMatrixKeyNotAtItsDefault, "matrix.yaml");
   const std::map<std::string, std::string> matrix_keys = FlatKeys(AppliedConfigToYaml(matrix));
   const std::map<std::string, std::string> bar_keys = FlatKeys(AppliedConfigToYaml(Config()));
-  for (const char* key :
-       {"model.manifest", "model.channel_map", "data.truth_manifest", "data.truth_moduli",
-        "mcre.w_u", "mcre.reference_modulus", "mcre.clamp", "mcre.w_r", "mcre.w_u0", "inner.method",
-        "outer.lower_bound", "prefilter.cutoff_frequency", "zone_identification.algorithm",
-        "time.step", "load.amplitude", "uncertainty.samples", "inner.max_dense_solver_bytes",
-        "inner.shooting_condition_limit"}) {
+  for (const char* key : {"model.manifest",
+                          "model.channel_map",
+                          "data.truth_manifest",
+                          "data.truth_moduli",
+                          "mcre.w_u",
+                          "mcre.reference_modulus",
+                          "mcre.clamp",
+                          "mcre.w_r",
+                          "mcre.w_u0",
+                          "inner.method",
+                          "outer.lower_bound",
+                          "prefilter.cutoff_frequency",
+                          "zone_identification.algorithm",
+                          "time.step",
+                          "load.amplitude",
+                          "uncertainty.samples",
+                          "inner.max_dense_solver_bytes",
+                          "inner.shooting_condition_limit",
+                          "search.functional",
+                          "outer.scan_points",
+                          "outer.initial",
+                          "output.curve_points"}) {
     EXPECT_EQ(matrix_keys.count(key), 1u) << key;
     EXPECT_TRUE(KeyApplies(key, ModelKind::kMatrix)) << key;
   }
-  for (const char* key :
-       {"search.functional", "model.length", "model.zone_count", "outer.scan_points",
-        "zone_identification.merge_zones", "study.kind", "data.sensors"}) {
+  for (const char* key : {"model.length", "model.zone_count", "zone_identification.merge_zones",
+                          "study.kind", "data.sensors"}) {
     EXPECT_EQ(matrix_keys.count(key), 0u) << key;
     EXPECT_EQ(bar_keys.count(key), 1u) << key;
   }
-  // The bar reads all but the 4 matrix keys; a matrix run none of the 2 sections
-  // search:, study: and 41 single keys fewer (it reads the dense solvers' limits: Riccati
-  // and shooting run on any model).
+  // The bar reads all but the 4 matrix keys; a matrix run none of the section study:
+  // and 27 single keys fewer (it reads the dense solvers' limits: Riccati and shooting
+  // run on any model).
   EXPECT_EQ(bar_keys.size(), every.size() - 4);
   std::size_t sections = 0;
   for (const auto& [key, value] : every) {
     const std::string section = key.substr(0, key.find('.'));
-    sections += section == "search" || section == "study" ? 1 : 0;
+    sections += section == "study" ? 1 : 0;
   }
-  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 41);
+  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 27);
   // Values as resolved: the matrix run's own.
   EXPECT_EQ(matrix_keys.at("model.manifest"), FlatKeys(ConfigToYaml(matrix)).at("model.manifest"));
 }
@@ -874,10 +890,6 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
        "model.zone_count applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\ndata:\n  sensors: [u@0.5]\n",
        "data.sensors applies to the bar only"},
-      {"model:\n  kind: matrix\n  manifest: m.yaml\nsearch:\n  functional: same\n",
-       "search.functional applies to the bar only"},
-      {"model:\n  kind: matrix\n  manifest: m.yaml\nsearch:\n  refine_window: 0.1\n",
-       "search.refine_window applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  merge_zones: true\n",
        "zone_identification.merge_zones applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  channel_map: {F: t}\n",

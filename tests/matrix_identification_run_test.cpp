@@ -102,11 +102,10 @@ TEST(MatrixIdentificationRunTest, TheBarAsMatricesIdentifiesTheBuiltInBarsModulu
       " --set data.source=csv --set data.path=" + dir + "/data.csv --set prefilter.enabled=false";
   const RunResult bar = RunIdentify("run " + quick + data + " -q -o " + dir + "/bar");
   ASSERT_EQ(bar.exit_code, 0) << bar.output;
-  // mcre.clamp and search.functional back at their defaults: the bar's keys, which a
-  // matrix model refuses when set.
-  const RunResult matrices = RunIdentify(
-      "run " + quick + data + " --set model.kind=matrix" + " --set model.manifest=" + manifest +
-      " --set mcre.clamp=trusted --set search.functional=pinned -q -o " + dir + "/matrices");
+  // The same config but the model: the same search functional (quick.yaml's `same`).
+  const RunResult matrices =
+      RunIdentify("run " + quick + data + " --set model.kind=matrix" +
+                  " --set model.manifest=" + manifest + " -q -o " + dir + "/matrices");
   ASSERT_EQ(matrices.exit_code, 0) << matrices.output;
   const double bar_modulus =
       YAML::LoadFile(dir + "/bar/summary.yaml")["identified_modulus"].as<double>();
@@ -118,18 +117,38 @@ TEST(MatrixIdentificationRunTest, TheBarAsMatricesIdentifiesTheBuiltInBarsModulu
   EXPECT_NEAR(matrix_modulus / bar_modulus - 1.0, 0.0, 1e-8)
       << std::setprecision(17) << "bar " << bar_modulus << " Pa, matrices " << matrix_modulus
       << " Pa";
-  for (const char* file : {"summary.yaml", "zones.csv", "evaluations.csv", "fit.csv",
-                           "error_map_dofs.csv", "zones.png", "fit.png"}) {
+  for (const char* file :
+       {"summary.yaml", "zones.csv", "zone_evaluations.csv", "fit.csv", "error_map_dofs.csv",
+        "zones.png", "fit.png", "evaluations.csv", "scan.csv", "valleys.csv", "cost_curve.csv",
+        "cost_curve.png", "inner_residual.csv"}) {
     EXPECT_TRUE(std::filesystem::exists(dir + "/matrices/" + file)) << file;
   }
-  // The summary holds what zones.csv holds, and J_rest bounds e^2.
+  // The homogeneous stage is the bar's identification on the same e^2 (the bar's own
+  // BarRunModel against its export read back, the K at 160 GPa scaled): the same scan,
+  // an E* as near as two refinements to outer.relative_tolerance 1e-7 along paths that
+  // differ in round-off (measured 5.1e-9 apart, relative), and the bar's files.
+  const YAML::Node bar_summary = YAML::LoadFile(dir + "/bar/summary.yaml");
   const YAML::Node summary = YAML::LoadFile(dir + "/matrices/summary.yaml");
-  EXPECT_EQ(summary["zones"][0]["modulus"].as<double>(), matrix_modulus);
+  EXPECT_NEAR(summary["identified_modulus"].as<double>() / bar_modulus - 1.0, 0.0, 5e-8);
+  EXPECT_EQ(summary["scan"]["points"].as<int>(), bar_summary["scan"]["points"].as<int>());
+  for (const char* file : {"evaluations.csv", "scan.csv", "cost_curve.csv"}) {
+    std::istringstream bar_text(ReadText(dir + "/bar/" + file));
+    std::istringstream matrix_text(ReadText(dir + "/matrices/" + file));
+    std::string bar_header, matrix_header;
+    std::getline(bar_text, bar_header);
+    std::getline(matrix_text, matrix_header);
+    EXPECT_EQ(matrix_header, bar_header) << file;
+  }
+  // The zones: block holds what zones.csv holds, and J_rest bounds e^2.
+  const YAML::Node zones = summary["zones"];
+  EXPECT_EQ(zones["moduli"][0]["modulus"].as<double>(), matrix_modulus);
+  EXPECT_EQ(zones["homogeneous_modulus"].as<double>(), summary["identified_modulus"].as<double>());
   EXPECT_EQ(summary["model"]["dofs"].as<int>(), 26);
   EXPECT_EQ(summary["inner"]["method"].as<std::string>(), "conjugate_gradient");  // auto's
-  EXPECT_GT(summary["cost"].as<double>(), 0.0);
-  EXPECT_LT(summary["cost"].as<double>(), summary["nominal_cost"].as<double>());
-  EXPECT_LT(summary["nominal_cost"].as<double>(), summary["cost_scale"].as<double>());
+  EXPECT_GT(zones["cost"].as<double>(), 0.0);
+  EXPECT_GT(zones["homogeneous_cost"].as<double>(), 0.0);
+  EXPECT_LT(zones["cost"].as<double>(), zones["nominal_cost"].as<double>());
+  EXPECT_LT(zones["nominal_cost"].as<double>(), zones["cost_scale"].as<double>());
   ExpectTheBarsElementMap(dir + "/bar/error_map.csv", dir + "/matrices/error_map.csv");
   EXPECT_EQ(summary["error_map"]["peak_element"].as<int>(),
             YAML::LoadFile(dir + "/bar/summary.yaml")["error_map"]["peak_element"].as<int>());
@@ -153,15 +172,13 @@ TEST(MatrixIdentificationRunTest, TheBarWithItsClampAsASupportIdentifiesTheBuilt
   for (const char* clamp : {"measured", "trusted", "pinned"}) {
     SCOPED_TRACE(clamp);
     const std::string treatment = std::string(" --set mcre.clamp=") + clamp;
-    // The bar scans its own e^2 (quick.yaml's search.functional: same); search:
-    // is the bar's (the matrix run takes the key back to its default).
+    // Both scan their own e^2 (quick.yaml's search.functional: same).
     const RunResult bar =
         RunIdentify("run " + quick + data + treatment + " -q -o " + dir + "/bar_" + clamp);
     ASSERT_EQ(bar.exit_code, 0) << bar.output;
     const RunResult matrices =
         RunIdentify("run " + quick + data + treatment + " --set model.kind=matrix" +
-                    " --set model.manifest=" + manifest + " --set search.functional=pinned -q -o " +
-                    dir + "/matrices_" + clamp);
+                    " --set model.manifest=" + manifest + " -q -o " + dir + "/matrices_" + clamp);
     ASSERT_EQ(matrices.exit_code, 0) << matrices.output;
     const double bar_modulus =
         YAML::LoadFile(dir + "/bar_" + clamp + "/summary.yaml")["identified_modulus"].as<double>();
@@ -175,6 +192,10 @@ TEST(MatrixIdentificationRunTest, TheBarWithItsClampAsASupportIdentifiesTheBuilt
         << " Pa";
     const YAML::Node summary = YAML::LoadFile(dir + "/matrices_" + clamp + "/summary.yaml");
     EXPECT_EQ(summary["model"]["supports"].as<int>(), 1);
+    // The homogeneous stage's E*, the bar's identification on the same e^2 along paths
+    // that differ in round-off: measured 5.1e-9 (measured), 1.0e-9 (trusted) and 2.1e-9
+    // (pinned) apart, relative.
+    EXPECT_NEAR(summary["identified_modulus"].as<double>() / bar_modulus - 1.0, 0.0, 5e-8);
   }
   // With the pre-filter on, both roads take its cut-off from fL alone (the clamp's
   // force f0 is the support's channel, no load), the same frequency to the bit.
@@ -183,7 +204,7 @@ TEST(MatrixIdentificationRunTest, TheBarWithItsClampAsASupportIdentifiesTheBuilt
   ASSERT_EQ(bar.exit_code, 0) << bar.output;
   const RunResult matrices = RunIdentify(
       "run " + quick + filtered + " --set model.kind=matrix --set model.manifest=" + manifest +
-      " --set search.functional=pinned -q -o " + dir + "/matrices_filtered");
+      " -q -o " + dir + "/matrices_filtered");
   ASSERT_EQ(matrices.exit_code, 0) << matrices.output;
   const double bar_cutoff =
       YAML::LoadFile(dir + "/bar_filtered/summary.yaml")["prefilter"]["cutoff_frequency"]
@@ -215,7 +236,7 @@ TEST(MatrixIdentificationRunTest,
   // quick.yaml's mcre.clamp (measured) is ignored by both: least squares holds the clamp.
   const RunResult matrices = RunIdentify(
       "run " + quick + data + " --set model.kind=matrix --set model.manifest=" + manifest +
-      " --set search.functional=pinned -q -o " + dir + "/matrices");
+      " -q -o " + dir + "/matrices");
   ASSERT_EQ(matrices.exit_code, 0) << matrices.output;
   const YAML::Node bar_summary = YAML::LoadFile(dir + "/bar/summary.yaml");
   const double bar_modulus = bar_summary["identified_modulus"].as<double>();
@@ -256,8 +277,7 @@ TEST(MatrixIdentificationRunTest, LoadAndObservationMatricesRunAsThePerFileManif
   ASSERT_NE(ReadText(matrices).find("loads_matrix"), std::string::npos);
   ASSERT_EQ(ReadText(matrices).find("load_f0.mtx"), std::string::npos);
   const std::string run = "run " + quick + " --set data.source=csv --set data.path=" + dir +
-                          "/data.csv --set model.kind=matrix --set search.functional=pinned" +
-                          " --set mcre.clamp=trusted -q";
+                          "/data.csv --set model.kind=matrix" + " --set mcre.clamp=trusted -q";
   const RunResult files_run =
       RunIdentify(run + " --set model.manifest=" + per_file + " -o " + dir + "/run_files");
   ASSERT_EQ(files_run.exit_code, 0) << files_run.output;
@@ -298,8 +318,8 @@ TEST(MatrixIdentificationRunTest, ASimulatedCsvReadBackGivesTheSyntheticRunsModu
 
 // The quick bar as matrices identified with the streaming CG named, and with auto
 // under a field limit it exceeds, against the stored-field CG's run: the same modulus
-// (measured 1.9e-8 apart, relative, either way), e^2 at the identified and nominal moduli,
-// and the summary naming the solver.
+// (measured 8.3e-9 apart, relative, either way; the homogeneous stage's E* 7.6e-9), e^2
+// at the identified and nominal moduli, and the summary naming the solver.
 TEST(MatrixIdentificationRunTest, TheStreamingSolverIdentifiesTheStoredFieldRunsModulus) {
   const std::string dir = FreshDirectory("matrix_run_streaming");
   WriteQuickBarMatrices(dir + "/bar_matrices");
@@ -322,13 +342,18 @@ TEST(MatrixIdentificationRunTest, TheStreamingSolverIdentifiesTheStoredFieldRuns
     SCOPED_TRACE(run);
     const std::string out = dir + "/" + run;
     const double modulus = ZoneModulus(out + "/zones.csv", 0);
-    EXPECT_NEAR(modulus / reference - 1.0, 0.0, 2e-7)
+    EXPECT_NEAR(modulus / reference - 1.0, 0.0, 1e-7)
         << std::setprecision(17) << "stored " << reference << " Pa, streamed " << modulus << " Pa";
     const YAML::Node summary = YAML::LoadFile(out + "/summary.yaml");
+    EXPECT_NEAR(
+        summary["identified_modulus"].as<double>() /
+                YAML::LoadFile(dir + "/stored/summary.yaml")["identified_modulus"].as<double>() -
+            1.0,
+        0.0, 1e-7);
     EXPECT_EQ(summary["inner"]["method"].as<std::string>(), "streaming_conjugate_gradient");
     EXPECT_TRUE(std::filesystem::exists(out + "/error_map_dofs.csv"));
     // The element map from the shares and picture rows the streaming sweeps summed: the
-    // stored-field run's peak, its fraction as near as the solves are (measured 1.9e-12
+    // stored-field run's peak, its fraction as near as the moduli are (measured 8.6e-9
     // apart, relative, either way).
     EXPECT_TRUE(std::filesystem::exists(out + "/error_map.csv"));
     EXPECT_TRUE(std::filesystem::exists(out + "/error_map_spacetime.dat"));
@@ -336,17 +361,19 @@ TEST(MatrixIdentificationRunTest, TheStreamingSolverIdentifiesTheStoredFieldRuns
     EXPECT_EQ(summary["error_map"]["peak_element"].as<int>(), stored_map["peak_element"].as<int>());
     EXPECT_NEAR(summary["error_map"]["peak_fraction"].as<double>(),
                 stored_map["peak_fraction"].as<double>(),
-                2e-11 * stored_map["peak_fraction"].as<double>());
+                1e-7 * stored_map["peak_fraction"].as<double>());
   }
   EXPECT_TRUE(std::filesystem::exists(dir + "/stored/error_map.csv"));
   EXPECT_TRUE(std::filesystem::exists(dir + "/stored/error_map_spacetime.dat"));
   const YAML::Node stored_summary = YAML::LoadFile(dir + "/stored/summary.yaml");
   const YAML::Node streamed_summary = YAML::LoadFile(dir + "/named/summary.yaml");
-  EXPECT_NEAR(streamed_summary["cost"].as<double>(), stored_summary["cost"].as<double>(),
-              1e-6 * stored_summary["cost"].as<double>());
-  EXPECT_NEAR(streamed_summary["nominal_cost"].as<double>(),
-              stored_summary["nominal_cost"].as<double>(),
-              1e-9 * stored_summary["nominal_cost"].as<double>());
+  const YAML::Node streamed_zones = streamed_summary["zones"],
+                   stored_zones = stored_summary["zones"];
+  EXPECT_NEAR(streamed_zones["cost"].as<double>(), stored_zones["cost"].as<double>(),
+              1e-6 * stored_zones["cost"].as<double>());
+  EXPECT_NEAR(streamed_zones["nominal_cost"].as<double>(),
+              stored_zones["nominal_cost"].as<double>(),
+              1e-9 * stored_zones["nominal_cost"].as<double>());
 }
 
 TEST(MatrixIdentificationRunTest, BadInputsExitWithOneLineAndWriteNothing) {
@@ -513,7 +540,7 @@ TEST(MatrixIdentificationRunTest, ThePlateConfigByLeastSquaresAgreesWithTheMcre)
   EXPECT_EQ(header, ReadText(mcre + "/zones.csv").substr(0, header.size()));
   std::getline(lines, row);
   EXPECT_EQ(row.substr(row.size() - 4), ",,,,") << row;
-  EXPECT_TRUE(std::filesystem::exists(ls + "/evaluations.csv"));
+  EXPECT_TRUE(std::filesystem::exists(ls + "/zone_evaluations.csv"));
   EXPECT_TRUE(std::filesystem::exists(ls + "/fit.csv"));
   EXPECT_FALSE(std::filesystem::exists(ls + "/error_map_dofs.csv"));
 }

@@ -830,7 +830,6 @@ std::string StructureKeysProblem(const Config& config) {
     }
     return "";
   }
-  const char* search_key = SearchKeyNotAtItsDefault(config.search);
   const std::pair<const char*, bool> bar_keys[] = {
       {"model.zoning", config.zones.zoning != defaults.zones.zoning},
       {"model.zone_count", config.zones.zone_count != defaults.zones.zone_count},
@@ -838,8 +837,6 @@ std::string StructureKeysProblem(const Config& config) {
       {"data.sensors", !config.data.sensors.empty()},
       {"data.channels", !config.data.channels.empty()},
       {"data.truth_zones", !config.data.truth_zones.empty()},
-      {"search.functional", config.search.functional != defaults.search.functional},
-      {search_key, search_key != nullptr},
   };
   for (const auto& [key, set] : bar_keys) {
     if (set) {
@@ -1578,7 +1575,7 @@ bool KeyApplies(const std::string& path, ModelKind kind) {
                                                     "data.truth_manifest", "data.truth_moduli"};
   if (kind == ModelKind::kBar) return matrix_only.count(path) == 0;
   // Whole sections, then single keys, that a matrix run does not read.
-  static const std::set<std::string> bar_sections = {"search", "study"};
+  static const std::set<std::string> bar_sections = {"study"};
   static const std::set<std::string> bar_only = {"model.length",
                                                  "model.section",
                                                  "model.density",
@@ -1593,20 +1590,6 @@ bool KeyApplies(const std::string& path, ModelKind kind) {
                                                  "data.sensors",
                                                  "data.channels",
                                                  "data.truth_zones",
-                                                 "outer.optimizer",
-                                                 "outer.algorithm",
-                                                 "outer.initial",
-                                                 "outer.relative_tolerance",
-                                                 "outer.max_evaluations",
-                                                 "outer.max_time",
-                                                 "outer.scan_points",
-                                                 "outer.scan_samples_per_valley",
-                                                 "outer.scan_max_points",
-                                                 "outer.scan_tolerance",
-                                                 "outer.scan_threads",
-                                                 "outer.refine_margin",
-                                                 "outer.refine_candidates",
-                                                 "output.curve_points",
                                                  "zone_identification.regularization",
                                                  "zone_identification.regularization_weight",
                                                  "zone_identification.weight_rule",

@@ -250,9 +250,11 @@ ModulusStage IdentifyHomogeneousModulus(const Config& config, const MatrixModelD
 }
 
 McreObjective CompleteModulusStage(const Config& config, const MatrixModelData& model,
-                                   const ChannelSet& data, ModulusStage* stage) {
+                                   const ChannelSet& data, bool cost_curve, ModulusStage* stage) {
   // The cost curve around E*.
-  stage->cost_curve = ComputeCostCurve(config, model, data, *stage, &stage->cost_curve_sweeps);
+  if (cost_curve) {
+    stage->cost_curve = ComputeCostCurve(config, model, data, *stage, &stage->cost_curve_sweeps);
+  }
   // The inner solver's convergence at E* from W = 0.
   McreObjective cold =
       MatrixMcreObjective(model, data, config.mcre, config.time.theta, config.inner,
@@ -303,7 +305,7 @@ IdentificationRun RunIdentification(const Config& config, const ChannelSet& data
   const MatrixModelData& matrices = *run.model;
 
   // The cost curve around E* and the inner solver's convergence there from W = 0.
-  McreObjective cold = CompleteModulusStage(config, matrices, run.data, &run);
+  McreObjective cold = CompleteModulusStage(config, matrices, run.data, /*cost_curve=*/true, &run);
 
   // The error map of the constitutive gap at the homogeneous E* (error_map.h).
   run.error_map = BarErrorMap(config, run);

@@ -350,6 +350,7 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
       MatrixLeastSquaresMisfitLevels(config, model, measurements, run.data, &run.misfit_source);
   MatrixOutputErrorObjective objective(model, run.data, run.misfit_levels, config.time.theta);
   run.nominal_moduli = objective.reference_moduli();
+  run.start_moduli = run.nominal_moduli;
   run.rest_cost = objective.rest_cost();
   RecordingObjective recorder(&objective, &run.evaluations, "J");
   std::vector<double> lower, upper;
@@ -379,6 +380,49 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
   if (!(std::isfinite(run.cost) && std::isfinite(run.nominal_cost)) && run.failure.empty()) {
     run.failure = "the output-error misfit is not finite at the identified or nominal moduli";
   }
+}
+
+// Whether every zone of `model` has the same nominal modulus, so that one E in every
+// zone is the model at one modulus (the homogeneous stage applies).
+bool SharesOneNominalModulus(const MatrixModelData& model) {
+  return std::all_of(model.zones.begin(), model.zones.end(), [&](const MatrixModelZone& zone) {
+    return zone.nominal_modulus == model.zones[0].nominal_modulus;
+  });
+}
+
+// Step 2a of RunMatrixIdentification: the homogeneous stage on run->data, with its cost
+// curve and cold solve when `complete`. False, with run->failure set, when E* is not
+// usable or lies on a bound of the search.
+bool IdentifyHomogeneousStage(const Config& config, const MatrixModelData& model, bool complete,
+                              MatrixIdentificationRun* run) {
+  spdlog::info(
+      "homogeneous stage: one E in every zone with {}/{} from {:.6g} Pa in [{:.6g}, {:.6g}] Pa; "
+      "global scan on {}",
+      OptimizerTypeToString(config.outer.optimizer),
+      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
+      config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
+      config.outer.scan_points == 0      ? "none (outer.scan_points 0)"
+      : ScansTheSearchFunctional(config) ? "the pinned search functional (search:)"
+                                         : "mcre:'s e^2");
+  run->homogeneous_ran = true;
+  run->homogeneous = IdentifyHomogeneousModulus(config, model, run->data);
+  ModulusStage& stage = run->homogeneous;
+  if (!stage.IsUsable()) {
+    run->failure = "the homogeneous stage (one E in every zone): " + stage.outer.message;
+    return false;
+  }
+  const std::string on_bound = ModulusOnBoundMessage(stage.identified_modulus(), config.outer);
+  if (!on_bound.empty()) {
+    run->failure = "the homogeneous stage (one E in every zone): " + on_bound;
+    return false;
+  }
+  // The cost curve e^2(E) feeds the uncertainty of one modulus (the bar's); the zones'
+  // uncertainty does without it, so with several zones it is not computed.
+  if (complete) {
+    CompleteModulusStage(config, model, run->data, /*cost_curve=*/model.zones.size() == 1, &stage);
+  }
+  spdlog::info("homogeneous stage: E* = {:.9g} Pa, the zones' start", stage.identified_modulus());
+  return true;
 }
 
 }  // namespace
@@ -638,7 +682,7 @@ ChannelSet MatrixMeasurementTable(const Config& config, const MatrixModelData& m
 MatrixIdentificationRun RunMatrixIdentification(const Config& config, const MatrixModelData& model,
                                                 const MatrixMeasurements& measurements,
                                                 bool maps_and_uncertainty) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start_time = std::chrono::steady_clock::now();
   MatrixIdentificationRun run;
   run.manifest = config.structure.manifest;
   run.dofs = model.dofs();
@@ -682,7 +726,7 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
   if (config.outer.functional == OuterFunctional::kLeastSquares) {
     IdentifyMatrixZonesByLeastSquares(config, model, measurements, &run);
     run.wall_time_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
     return run;
   }
   McreObjective mcre_objective =
@@ -703,13 +747,29 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
     spdlog::info("{} supports, treated as mcre.clamp: {}", model.supports.size(),
                  ClampModelToString(config.mcre.clamp));
   }
-  run.outer = MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper,
-                                   std::vector<double>(zones, 0.0));
+  std::vector<double> start(zones, 0.0);
+  run.start_moduli = run.nominal_moduli;
+  if (SharesOneNominalModulus(model)) {
+    // 2a. One E in every zone first, by the global scan and the refinements of the
+    //     bar's identification (outer:, search:); the zones then start from E*, their
+    //     first solve warm-started from its solution.
+    if (!IdentifyHomogeneousStage(config, model, maps_and_uncertainty, &run)) {
+      run.wall_time_s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+      return run;
+    }
+    const double homogeneous_modulus = run.homogeneous.identified_modulus();
+    run.start_moduli.setConstant(homogeneous_modulus);
+    std::fill(start.begin(), start.end(), std::log(homogeneous_modulus / run.nominal_moduli[0]));
+    mcre_objective.SetWarmStart(run.homogeneous.solution.WarmStart());
+  }
+  run.outer =
+      MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper, start);
   TakeZoneOutcome(objective, lower, upper, &run);
   run.sweeps = problem.sweep_count();
   if (!maps_and_uncertainty) {
     run.wall_time_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
     return run;
   }
 
@@ -726,7 +786,7 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
     spdlog::info("uncertainty: {}", run.uncertainty.message);
   }
   run.wall_time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return run;
 }
 

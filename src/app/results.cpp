@@ -254,11 +254,14 @@ std::string CostCurveScript(const ModulusStage& run, const Config& config,
       script << "unset logscale x\nset title 'within 5 % of the identified E'\nset xrange [" << low
              << ":" << high << "]\n";
     }
-    script << "plot " << scan_plot << curve
-           << " skip 1 using ($1/1e9):($4 > 0 ? $2 : 1/0) with linespoints pt 7 ps 0.5 lw 2 lc rgb "
-              "'#8b00c9' "
-              "title 'e^2(E), cost curve', "
-           << evaluations
+    script << "plot " << scan_plot;
+    // Without a cost curve (a structure of several zones), the scan and the evaluations.
+    if (!run.cost_curve.empty()) {
+      script << curve
+             << " skip 1 using ($1/1e9):($4 > 0 ? $2 : 1/0) with linespoints pt 7 ps 0.5 lw 2 lc "
+                "rgb '#8b00c9' title 'e^2(E), cost curve', ";
+    }
+    script << evaluations
            << " skip 1 using ($2/1e9):($6 > 0 ? $3 : 1/0) with points pt 6 ps 1.5 lc rgb 'red' "
               "title 'optimiser evaluations'\n";
   }
@@ -452,6 +455,24 @@ void ConfigYaml(const Config& config, YamlWriter* yaml) {
   for (std::string line; std::getline(text, line);) yaml->Raw("  " + line);
 }
 
+namespace {
+
+// The prefilter: block of a summary: whether the measurements were low-passed, at which
+// cut-off [Hz] and where it came from.
+void PrefilterYaml(const Config& config, double prefilter_cutoff, YamlWriter* yaml) {
+  yaml->Line(0, "prefilter", "", "zero-phase low-pass of the measurements (prefilter.*)");
+  yaml->Line(1, "enabled", config.prefilter.enabled ? "true" : "false");
+  yaml->Number(1, "cutoff_frequency", config.prefilter.enabled ? prefilter_cutoff : NAN,
+               "[Hz] cut-off used (null: off)");
+  yaml->Text(1, "cutoff_source",
+             !config.prefilter.enabled                 ? "off"
+             : config.prefilter.cutoff_frequency > 0.0 ? "config"
+                                                       : "derived_from_load",
+             "config: prefilter.cutoff_frequency; derived_from_load: EstimateCutoffFrequency");
+}
+
+}  // namespace
+
 // The optimizer:, scan: and prefilter: blocks of a summary, for a cost named
 // `cost` (e^2 or J) in `unit` (J s or s) whose scale is cost_scale; the scan's costs
 // are scaled by scan_cost_scale (the search functional's, outer.scan_of_search).
@@ -472,7 +493,7 @@ void OptimizerScanAndPrefilterYaml(const IdentificationSummary& outer, double co
   yaml->Integer(1, "iterations", outer.iterations, "Ceres iterations (-1: NLopt)");
   yaml->Number(1, "scaled_cost", outer.cost, cost + " / cost_scale at the identified modulus");
   yaml->Number(1, "cost_scale", cost_scale,
-               "[" + unit + "] " + cost + " of the bar left at rest, the scale of the cost");
+               "[" + unit + "] " + cost + " of the structure left at rest, the scale of the cost");
   yaml->Number(1, "wall_time_s", outer.wall_time_s, "[s] scan and refinements");
 
   const std::string scanned = outer.scan_of_search ? cost + "_search" : cost;
@@ -514,15 +535,7 @@ void OptimizerScanAndPrefilterYaml(const IdentificationSummary& outer, double co
   yaml->Integer(1, "sweeps", outer.scan_sweeps, "sweeps of the scan");
   yaml->Number(1, "wall_time_s", outer.scan_wall_time_s, "[s] of the scan");
 
-  yaml->Line(0, "prefilter", "", "zero-phase low-pass of the measurements (prefilter.*)");
-  yaml->Line(1, "enabled", config.prefilter.enabled ? "true" : "false");
-  yaml->Number(1, "cutoff_frequency", config.prefilter.enabled ? prefilter_cutoff : NAN,
-               "[Hz] cut-off used (null: off)");
-  yaml->Text(1, "cutoff_source",
-             !config.prefilter.enabled                 ? "off"
-             : config.prefilter.cutoff_frequency > 0.0 ? "config"
-                                                       : "derived_from_load",
-             "config: prefilter.cutoff_frequency; derived_from_load: EstimateCutoffFrequency");
+  PrefilterYaml(config, prefilter_cutoff, yaml);
 }
 
 namespace {
@@ -1103,52 +1116,90 @@ std::string MatrixLeastSquaresSummaryYaml(const MatrixIdentificationRun& run,
   return yaml.str();
 }
 
+// The zones: block of a matrix run by the MCRE, in the layout of the bar's
+// (ZonesYamlLines): the zones' minimiser, its costs and every zone's modulus with its
+// share of the constitutive gap at the nominal and the identified moduli.
+void MatrixZonesYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) {
+  yaml->Line(0, "zones", "",
+             run.homogeneous_ran ? "identification of every zone modulus from the homogeneous E*"
+                                 : "identification of every zone modulus from the nominal moduli");
+  yaml->Line(1, "functional", "mcre", "outer.functional");
+  yaml->Integer(1, "count", static_cast<long>(run.zone_names.size()));
+  yaml->Line(1, "termination", TerminationTypeToString(run.outer.termination));
+  yaml->Text(1, "message", run.outer.message);
+  yaml->Number(1, "homogeneous_modulus",
+               run.homogeneous_ran ? run.homogeneous.identified_modulus() : NAN,
+               "[Pa] E*, the start (null: the zones' nominal moduli differ, they start there)");
+  yaml->Number(1, "cost", run.cost, "[J s] e^2 at the zone moduli");
+  yaml->Number(1, "homogeneous_cost", run.homogeneous_ran ? run.homogeneous.cost() : NAN,
+               "[J s] e^2 at E* in every zone");
+  yaml->Number(1, "nominal_cost", run.nominal_cost, "[J s] e^2 at the nominal moduli");
+  yaml->Number(1, "cost_scale", run.rest_cost,
+               "[J s] J_rest, e^2 of the structure left at rest (0 <= e^2 <= J_rest)");
+  yaml->Line(1, "optimizer", OptimizerTypeToString(run.outer.optimizer));
+  yaml->Line(1, "algorithm", OuterAlgorithmToString(run.outer.algorithm));
+  yaml->Text(1, "optimizer_message", run.outer.optimizer_message, "the optimiser's own words");
+  yaml->Integer(1, "evaluations", run.outer.evaluations, "zone_evaluations.csv");
+  yaml->Integer(1, "gradient_evaluations", run.outer.gradient_evaluations);
+  yaml->Number(1, "scaled_cost", run.outer.cost, "e^2 / cost_scale at the zone moduli");
+  yaml->Integer(1, "sweeps", run.sweeps);
+  yaml->Line(1, "moduli", "",
+             "per zone (zones.csv): index, name, nominal, identified and truth modulus [Pa], "
+             "share of the gap and gap / strain energy at the nominal and identified moduli");
+  const Vector nominal_share = GapFractions(run.nominal_zone_map),
+               share = GapFractions(run.zone_map);
+  for (int z = 0; z < run.nominal_moduli.size(); ++z) {
+    const bool truth = run.truth_moduli.size() > 0;
+    yaml->Raw("    - {index: " + std::to_string(z) +
+              ", name: " + Quoted(run.zone_names[static_cast<std::size_t>(z)]) + ", nominal: " +
+              Format(run.nominal_moduli[z]) + ", modulus: " + Format(run.identified_moduli[z]) +
+              ", truth: " + Format(truth ? run.truth_moduli[z] : NAN) + ", relative_error: " +
+              Format(truth ? run.identified_moduli[z] / run.truth_moduli[z] - 1.0 : NAN) +
+              ", error_share_nominal: " + Format(nominal_share[z]) + ", error_share_identified: " +
+              Format(share[z]) + ", relative_gap_nominal: " + Format(run.nominal_zone_gap[z]) +
+              ", relative_gap_identified: " + Format(run.zone_gap[z]) + "}");
+  }
+}
+
 }  // namespace
 
 std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& config) {
   if (run.least_squares) return MatrixLeastSquaresSummaryYaml(run, config);
+  const ModulusStage& stage = run.homogeneous;
   YamlWriter yaml;
   yaml.Raw("# mcrewave identify run: the zone moduli of a structure given by matrices, by the MCRE");
   if (!config.source_path.empty()) yaml.Raw("# config: " + config.source_path);
   yaml.Text(0, "version", kVersion, "mcrewave version");
   MatrixModelAndDataYaml(run, config, &yaml);
-  yaml.Line(0, "zones", "", "identified modulus per zone (zones.csv)");
-  const Vector nominal_share = GapFractions(run.nominal_zone_map), share = GapFractions(run.zone_map);
-  for (int z = 0; z < run.nominal_moduli.size(); ++z) {
-    const bool truth = run.truth_moduli.size() > 0;
-    yaml.Raw("  - {name: " + Quoted(run.zone_names[static_cast<std::size_t>(z)]) +
-             ", nominal: " + Format(run.nominal_moduli[z]) +
-             ", modulus: " + Format(run.identified_moduli[z]) +
-             ", truth: " + Format(truth ? run.truth_moduli[z] : NAN) + ", relative_error: " +
-             Format(truth ? run.identified_moduli[z] / run.truth_moduli[z] - 1.0 : NAN) +
-             ", error_share_nominal: " + Format(nominal_share[z]) +
-             ", error_share_identified: " + Format(share[z]) +
-             ", relative_gap_nominal: " + Format(run.nominal_zone_gap[z]) +
-             ", relative_gap_identified: " + Format(run.zone_gap[z]) + "}");
+  if (run.homogeneous_ran) {
+    // The bar's headline keys, of the homogeneous stage.
+    yaml.Number(0, "identified_modulus", stage.identified_modulus(),
+                "[Pa] one E in every zone minimising e^2, the zones' start");
+    yaml.Number(0, "cost", stage.cost(), "[J s] e^2 at the identified modulus");
+    yaml.Integer(0, "evaluations", stage.outer.scan_evaluations + stage.outer.evaluations,
+                 "evaluations of the homogeneous stage: the scans' and the refinements' (the "
+                 "search functional's included)");
+    yaml.Integer(0, "sweeps", stage.outer.scan_sweeps + stage.sweeps,
+                 "direct + retrograde sweeps of those evaluations");
   }
-  yaml.Number(0, "cost", run.cost, "[J s] e^2 at the identified moduli");
-  yaml.Number(0, "nominal_cost", run.nominal_cost, "[J s] e^2 at the nominal moduli");
-  yaml.Number(0, "cost_scale", run.rest_cost,
-              "[J s] J_rest, e^2 of the structure left at rest (0 <= e^2 <= J_rest)");
-  MatrixElementMapYaml(run, &yaml);
-  MatrixOptimizerYaml(run, "e^2", &yaml);
-  yaml.Line(0, "inner", "");
-  std::string inner_comment;
-  if (config.inner.type == CoupledSolverType::kAuto) {
-    // Why auto chose the solver that ran, as InnerMethodComment says it for the bar.
-    const double bytes = IterativeSolverFieldBytes(run.dofs, run.steps);
-    inner_comment =
-        "inner.method auto: the stored fields, " + std::to_string(static_cast<long long>(bytes)) +
-        " bytes, " +
-        (run.inner_method == CoupledSolverType::kStreamingConjugateGradient ? "exceed" : "fit") +
-        " inner.max_field_bytes";
-  }
-  yaml.Text(1, "method", CoupledSolverTypeToString(run.inner_method), inner_comment);
-  yaml.Line(0, "prefilter", "");
-  yaml.Line(1, "enabled", config.prefilter.enabled ? "true" : "false");
-  yaml.Number(1, "cutoff_frequency", run.prefilter_cutoff, "[Hz] the cut-off used (0: off)");
-  MatrixUncertaintyYaml(run, &yaml);
   yaml.Number(0, "wall_time_s", run.wall_time_s, "[s] identification, error maps and uncertainty");
+  MatrixElementMapYaml(run, &yaml);
+  MatrixUncertaintyYaml(run, &yaml);
+  if (run.homogeneous_ran) {
+    OptimizerScanAndPrefilterYaml(stage.outer, stage.rest_cost, stage.scan_cost_scale, config,
+                                  run.prefilter_cutoff, "e^2", "J s", &yaml);
+    InnerSolvesYaml(stage, config, run.dofs, run.steps, &yaml);
+    if (!stage.cost_curve.empty()) {
+      CostCurveYaml(stage.cost_curve, &yaml);
+      yaml.Integer(1, "sweeps", stage.cost_curve_sweeps);
+    }
+  } else {
+    PrefilterYaml(config, run.prefilter_cutoff, &yaml);
+    yaml.Line(0, "inner", "");
+    yaml.Text(1, "method", CoupledSolverTypeToString(run.inner_method),
+              InnerMethodComment(stage, config, run.dofs, run.steps));
+  }
+  MatrixZonesYaml(run, &yaml);
   ConfigYaml(config, &yaml);
   return yaml.str();
 }
@@ -1161,7 +1212,19 @@ std::vector<std::string> WriteMatrixIdentificationResults(const MatrixIdentifica
   assert(run.IsUsable());
   ResultsFolder results(folder);
   results.Write("zones.csv", MatrixZonesCsv(run));
-  results.Write("evaluations.csv", MatrixEvaluationsCsv(run));
+  results.Write("zone_evaluations.csv", MatrixEvaluationsCsv(run));
+  const ModulusStage& stage = run.homogeneous;
+  if (run.homogeneous_ran) {
+    results.Write("evaluations.csv", EvaluationsCsv(stage));
+    if (!stage.outer.scan_moduli.empty()) {
+      results.Write("scan.csv", ScanCsv(stage.outer, stage.scan_cost_scale, config.outer.initial));
+      results.Write("valleys.csv", ValleysCsv(stage.outer, stage.scan_cost_scale));
+    }
+    if (!stage.cost_curve.empty()) {
+      results.Write("cost_curve.csv", CostCurveCsv(stage.cost_curve));
+    }
+    results.Write("inner_residual.csv", InnerResidualCsv(stage));
+  }
   results.Write("fit.csv", MatrixFitCsv(run));
   if (!run.least_squares) results.Write("error_map_dofs.csv", MatrixDofMapCsv(run));
   if (run.element_map.share.size() > 0 && run.nominal_element_map.share.size() > 0) {
@@ -1171,8 +1234,16 @@ std::vector<std::string> WriteMatrixIdentificationResults(const MatrixIdentifica
   if (figures) {
     std::vector<SensorKind> kinds;
     for (const MatrixModelSensor& sensor : model.sensors) kinds.push_back(sensor.kind);
-    results.Draw({{"zones", MatrixZonesScript(run, folder)},
-                  {"fit", MatrixFitScript(run, folder, config.prefilter.enabled, kinds)}});
+    std::vector<std::pair<std::string, std::string>> drawings = {
+        {"zones", MatrixZonesScript(run, folder)},
+        {"fit", MatrixFitScript(run, folder, config.prefilter.enabled, kinds)}};
+    if (run.homogeneous_ran) {
+      drawings.emplace_back("cost_curve", CostCurveScript(stage, config, folder));
+      if (!InnerResidualHistory(stage).empty()) {
+        drawings.emplace_back("inner_residual", InnerResidualScript(stage, config, folder));
+      }
+    }
+    results.Draw(drawings);
   }
   // The summary last: its presence says the folder is complete.
   results.Write("summary.yaml", MatrixSummaryYaml(run, config));

@@ -156,12 +156,13 @@ McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData&
 ModulusStage IdentifyHomogeneousModulus(const Config& config, const MatrixModelData& model,
                                         const ChannelSet& data);
 
-// The rest of the stage at E*: the cost curve e^2(E) on output.curve_points points
-// around E* (and over the optimiser's evaluations when they reach farther),
-// warm-started point to point from `solution`, and cold_solve. Returns the objective of
-// the cold solve, its problem's moduli at E*. Precondition: stage->IsUsable().
+// The rest of the stage at E*: with cost_curve, the cost curve e^2(E) on
+// output.curve_points points around E* (and over the optimiser's evaluations when they
+// reach farther), warm-started point to point from `solution`; then cold_solve. Returns
+// the objective of the cold solve, its problem's moduli at E*.
+// Precondition: stage->IsUsable().
 McreObjective CompleteModulusStage(const Config& config, const MatrixModelData& model,
-                                   const ChannelSet& data, ModulusStage* stage);
+                                   const ChannelSet& data, bool cost_curve, ModulusStage* stage);
 
 // Runs steps 2 and 3 on measurements made by LoadMeasurements(config): the
 // fields up to `solution` (and wall_time_s); no cost curve, no uncertainty.

@@ -10,14 +10,17 @@
 //      (data.truth_manifest, default the model's own) at data.truth_moduli (default
 //      its nominal moduli), every load channel driven by the load: history, on the
 //      same grid and theta, white noise per quantity at data.snr (AddMatrixModelNoise);
-//   3. RunMatrixIdentification: the pre-filter of prefilter: on every channel, then
-//      every zone modulus at once, p_z = log(E_z / E_z,nom) (ZoneMcreObjective), by
-//      the optimiser of zone_identification: from the nominal moduli within
-//      [outer.lower_bound, outer.upper_bound] Pa in every zone, inner solves by
-//      inner:; no jump penalty (matrices do not say which zones are neighbours).
-//      Then the error maps (zone and dof, and element when the model has element
-//      blocks and the inner solver keeps its fields) at the nominal and the identified
-//      moduli and the model's outputs at the identified moduli.
+//   3. RunMatrixIdentification: the pre-filter of prefilter: on every channel; when
+//      every zone has the same nominal modulus, the homogeneous stage first
+//      (identification_run.h: one E in every zone by outer:'s global scan, on the search
+//      functional of search: by default, and its refinements, as the bar's E is
+//      identified); then every zone modulus at once, p_z = log(E_z / E_z,nom)
+//      (ZoneMcreObjective), by the optimiser of zone_identification: from E* (or from the
+//      nominal moduli when they differ) within [outer.lower_bound, outer.upper_bound] Pa
+//      in every zone, inner solves by inner:; no jump penalty (matrices do not say which
+//      zones are neighbours). Then the error maps (zone and dof, and element when the
+//      model has element blocks and the inner solver keeps its fields) at the nominal and
+//      the identified moduli and the model's outputs at the identified moduli.
 //      With outer.functional: least_squares, the same minimiser, bounds and start on
 //      the output-error misfit J instead (least_squares/matrix_output_error_objective.h),
 //      each sensor kind normalised by its misfit level (MatrixLeastSquaresMisfitLevels);
@@ -32,6 +35,7 @@
 #include <vector>
 
 #include "mcrewave/app/config.h"
+#include "mcrewave/app/identification_run.h"
 #include "mcrewave/data/channel_set.h"
 #include "mcrewave/mcre/error_map.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
@@ -160,7 +164,15 @@ struct MatrixIdentificationRun {
   std::string data_source;               // CSV path or "synthetic"
   double prefilter_cutoff = 0.0;         // [Hz]; 0: no pre-filter
   std::vector<std::string> zone_names;
-  Vector nominal_moduli;                 // E_z,nom [Pa], the start
+  Vector nominal_moduli;  // E_z,nom [Pa]
+  // The MCRE on a model whose zones share one nominal modulus: the homogeneous stage
+  // (identification_run.h), one E in every zone by config.outer's global scan and
+  // refinements, then (with maps_and_uncertainty) its cost curve and a solve from W = 0
+  // at E*; the zones start from E*. Otherwise homogeneous_ran is false and the zones
+  // start from their nominal moduli.
+  bool homogeneous_ran = false;
+  ModulusStage homogeneous;
+  Vector start_moduli;                   // E_z [Pa] the zones' minimiser started from
   Vector identified_moduli;              // [Pa]; empty when no usable point
   Vector truth_moduli;                   // [Pa]; empty when unknown
   BoundedMinimizerSummary outer;

@@ -64,16 +64,23 @@ std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
                                                   const std::string& folder, bool figures);
 
 // The results of `identify run` with model.kind: matrix (app/matrix_identification_run.h):
-//   summary.yaml        the model (manifest, dofs, zones, channels), the data, every
-//                       zone's nominal, identified and (synthetic data) truth modulus
-//                       and its share of the constitutive gap at the nominal and the
-//                       identified moduli, e^2 and J_rest [J s], with an element map
-//                       its peak element and fraction at both (error_map:), the optimiser, the
-//                       inner solver that ran (inner.method), the pre-filter, the
-//                       resolved config
+//   summary.yaml        the model (manifest, dofs, zones, channels), the data; with the
+//                       homogeneous stage (zones of one nominal modulus) the bar's
+//                       headline keys of E* (identified_modulus, cost, evaluations,
+//                       sweeps) and its optimizer:, scan:, inner: and (one zone)
+//                       cost_curve: blocks; the element map's peak at both moduli
+//                       (error_map:), the zones' uncertainty, the pre-filter, and the
+//                       zones: block in the bar's layout (the zones' minimiser, e^2 at the
+//                       zone, homogeneous and nominal moduli, J_rest, and per zone its
+//                       nominal, identified and (synthetic data) truth modulus and its
+//                       share of the constitutive gap at the nominal and the identified
+//                       moduli), the resolved config
 //   zones.csv           the same per zone
-//   evaluations.csv     every evaluation: the zone moduli [Pa], e^2 / J_rest, usable,
-//                       |gradient|
+//   zone_evaluations.csv  every evaluation of the zones' minimiser: the zone moduli [Pa],
+//                       e^2 / J_rest, usable, |gradient|
+//   evaluations.csv, scan.csv, valleys.csv, inner_residual.csv, cost_curve.png (and,
+//                       with one zone, cost_curve.csv): the homogeneous stage's, in the
+//                       bar's layout
 //   fit.csv             t, the loads and the sensors as used (pre-filtered), and each
 //                       sensor as the identified model driven by the loads gives it
 //   error_map_dofs.csv  the constitutive gap per dof [J s] at the nominal and the
