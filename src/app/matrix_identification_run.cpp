@@ -13,6 +13,7 @@
 #include "mcrewave/data/prefilter.h"
 #include "mcrewave/data/resample.h"
 #include "mcrewave/least_squares/matrix_output_error_objective.h"
+#include "mcrewave/least_squares/output_error_modulus_objective.h"
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/element_error_map.h"
 #include "mcrewave/mcre/objective.h"
@@ -338,6 +339,79 @@ void ZoneParameterBounds(const Config& config, const Vector& nominal, std::vecto
   }
 }
 
+// Whether every zone of `model` has the same nominal modulus, so that one E in every
+// zone is the model at one modulus (the homogeneous stage applies).
+bool SharesOneNominalModulus(const MatrixModelData& model) {
+  return std::all_of(model.zones.begin(), model.zones.end(), [&](const MatrixModelZone& zone) {
+    return zone.nominal_modulus == model.zones[0].nominal_modulus;
+  });
+}
+
+// Whether the homogeneous stage's E* can start the zones: false, with run->failure set,
+// when it is not usable or lies on a bound of the search, as the bar's E* fails.
+bool TakeHomogeneousOutcome(const Config& config, MatrixIdentificationRun* run) {
+  const IdentificationSummary& outer = run->homogeneous.outer;
+  std::string why =
+      outer.IsSolutionUsable() ? ModulusOnBoundMessage(outer.modulus, config.outer) : outer.message;
+  if (why.empty()) return true;
+  run->failure = "the homogeneous stage (one E in every zone): " + why;
+  return false;
+}
+
+// Step 2a of RunMatrixIdentification: the homogeneous stage on run->data, with its cost
+// curve and cold solve when `complete`. False, with run->failure set, when E* is not
+// usable or lies on a bound of the search.
+bool IdentifyHomogeneousStage(const Config& config, const MatrixModelData& model, bool complete,
+                              MatrixIdentificationRun* run) {
+  spdlog::info(
+      "homogeneous stage: one E in every zone with {}/{} from {:.6g} Pa in [{:.6g}, {:.6g}] Pa; "
+      "global scan on {}",
+      OptimizerTypeToString(config.outer.optimizer),
+      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
+      config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
+      config.outer.scan_points == 0      ? "none (outer.scan_points 0)"
+      : ScansTheSearchFunctional(config) ? "the pinned search functional (search:)"
+                                         : "mcre:'s e^2");
+  run->homogeneous_ran = true;
+  run->homogeneous = IdentifyHomogeneousModulus(config, model, run->data);
+  ModulusStage& stage = run->homogeneous;
+  if (!TakeHomogeneousOutcome(config, run)) return false;
+  run->homogeneous_cost = stage.cost();
+  // The cost curve e^2(E) feeds the uncertainty of one modulus (the bar's); the zones'
+  // uncertainty does without it, so with several zones it is not computed.
+  if (complete) {
+    CompleteModulusStage(config, model, run->data, /*cost_curve=*/model.zones.size() == 1, &stage);
+  }
+  spdlog::info("homogeneous stage: E* = {:.9g} Pa, the zones' start", stage.identified_modulus());
+  return true;
+}
+
+// Step 2a by least squares: one E in every zone by outer:'s scan and refinements on J
+// (OutputErrorModulusObjective, the bar's least squares), J at E* into
+// run->homogeneous_cost. False, with run->failure set, as TakeHomogeneousOutcome says.
+bool IdentifyHomogeneousStageByLeastSquares(const Config& config, const MatrixModelData& model,
+                                            MatrixIdentificationRun* run) {
+  spdlog::info(
+      "homogeneous stage: one E in every zone by least squares with {}/{} from {:.6g} Pa",
+      OptimizerTypeToString(config.outer.optimizer),
+      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
+      config.outer.initial);
+  OutputErrorModulusObjective objective(model, run->data, run->misfit_levels, config.time.theta,
+                                        config.outer.initial);
+  run->homogeneous_ran = true;
+  ModulusStage& stage = run->homogeneous;
+  stage.outer = Identify(config.outer, &objective);
+  spdlog::info("{}", stage.outer.BriefReport());
+  stage.rest_cost = objective.rest_cost();
+  stage.scan_cost_scale = stage.rest_cost;
+  stage.sweeps = objective.sweeps();
+  if (!TakeHomogeneousOutcome(config, run)) return false;
+  run->homogeneous_cost = objective.Predict(stage.identified_modulus(), false).cost;
+  stage.sweeps = objective.sweeps();
+  spdlog::info("homogeneous stage: E* = {:.9g} Pa, the zones' start", stage.identified_modulus());
+  return true;
+}
+
 // Step 2 with outer.functional: least_squares: every zone modulus by the output-error
 // misfit J (docs/formulation.md section 8), then J and the model's outputs at the
 // identified moduli and J at the nominal ones. run->data is the pre-filtered data.
@@ -368,8 +442,16 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
         "misfit level {:.4g} N",
         model.supports.size(), ClampModelToString(config.mcre.clamp), run.misfit_levels.force_std);
   }
-  run.outer = MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper,
-                                   std::vector<double>(lower.size(), 0.0));
+  std::vector<double> start(lower.size(), 0.0);
+  if (SharesOneNominalModulus(model)) {
+    // One E in every zone first, as the bar's least squares identifies its E.
+    if (!IdentifyHomogeneousStageByLeastSquares(config, model, &run)) return;
+    const double homogeneous_modulus = run.homogeneous.identified_modulus();
+    run.start_moduli.setConstant(homogeneous_modulus);
+    std::fill(start.begin(), start.end(), std::log(homogeneous_modulus / run.nominal_moduli[0]));
+  }
+  run.outer =
+      MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper, start);
   TakeZoneOutcome(objective, lower, upper, &run);
   run.sweeps = objective.sweeps();
   if (run.identified_moduli.size() > 0) {
@@ -380,49 +462,6 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
   if (!(std::isfinite(run.cost) && std::isfinite(run.nominal_cost)) && run.failure.empty()) {
     run.failure = "the output-error misfit is not finite at the identified or nominal moduli";
   }
-}
-
-// Whether every zone of `model` has the same nominal modulus, so that one E in every
-// zone is the model at one modulus (the homogeneous stage applies).
-bool SharesOneNominalModulus(const MatrixModelData& model) {
-  return std::all_of(model.zones.begin(), model.zones.end(), [&](const MatrixModelZone& zone) {
-    return zone.nominal_modulus == model.zones[0].nominal_modulus;
-  });
-}
-
-// Step 2a of RunMatrixIdentification: the homogeneous stage on run->data, with its cost
-// curve and cold solve when `complete`. False, with run->failure set, when E* is not
-// usable or lies on a bound of the search.
-bool IdentifyHomogeneousStage(const Config& config, const MatrixModelData& model, bool complete,
-                              MatrixIdentificationRun* run) {
-  spdlog::info(
-      "homogeneous stage: one E in every zone with {}/{} from {:.6g} Pa in [{:.6g}, {:.6g}] Pa; "
-      "global scan on {}",
-      OptimizerTypeToString(config.outer.optimizer),
-      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
-      config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
-      config.outer.scan_points == 0      ? "none (outer.scan_points 0)"
-      : ScansTheSearchFunctional(config) ? "the pinned search functional (search:)"
-                                         : "mcre:'s e^2");
-  run->homogeneous_ran = true;
-  run->homogeneous = IdentifyHomogeneousModulus(config, model, run->data);
-  ModulusStage& stage = run->homogeneous;
-  if (!stage.IsUsable()) {
-    run->failure = "the homogeneous stage (one E in every zone): " + stage.outer.message;
-    return false;
-  }
-  const std::string on_bound = ModulusOnBoundMessage(stage.identified_modulus(), config.outer);
-  if (!on_bound.empty()) {
-    run->failure = "the homogeneous stage (one E in every zone): " + on_bound;
-    return false;
-  }
-  // The cost curve e^2(E) feeds the uncertainty of one modulus (the bar's); the zones'
-  // uncertainty does without it, so with several zones it is not computed.
-  if (complete) {
-    CompleteModulusStage(config, model, run->data, /*cost_curve=*/model.zones.size() == 1, &stage);
-  }
-  spdlog::info("homogeneous stage: E* = {:.9g} Pa, the zones' start", stage.identified_modulus());
-  return true;
 }
 
 }  // namespace

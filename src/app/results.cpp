@@ -1077,10 +1077,71 @@ void MatrixElementMapYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) 
   yaml->Number(1, "nominal_peak_fraction", run.nominal_element_map.Fractions()[nominal_peak]);
 }
 
-// summary.yaml of a matrix run by least squares: MatrixSummaryYaml's layout with J [s]
-// for e^2, the misfit levels for the error map, and no inner solver.
+// The zones: block of a matrix run, in the layout of the bar's (ZonesYamlLines): the
+// zones' minimiser, its costs (e^2 [J s], or J [s] by least squares) and every zone's
+// modulus, with its share of the constitutive gap at the nominal and the identified
+// moduli by the MCRE.
+void MatrixZonesYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) {
+  const std::string cost = run.least_squares ? "J" : "e^2";
+  const std::string unit = run.least_squares ? "[s] " : "[J s] ";
+  yaml->Line(0, "zones", "",
+             run.homogeneous_ran ? "identification of every zone modulus from the homogeneous E*"
+                                 : "identification of every zone modulus from the nominal moduli");
+  yaml->Line(1, "functional", run.least_squares ? "least_squares" : "mcre", "outer.functional");
+  yaml->Integer(1, "count", static_cast<long>(run.zone_names.size()));
+  yaml->Line(1, "termination", TerminationTypeToString(run.outer.termination));
+  yaml->Text(1, "message", run.outer.message);
+  yaml->Number(1, "homogeneous_modulus",
+               run.homogeneous_ran ? run.homogeneous.identified_modulus() : NAN,
+               "[Pa] E*, the start (null: the zones' nominal moduli differ, they start there)");
+  yaml->Number(1, "cost", run.cost, unit + cost + " at the zone moduli");
+  yaml->Number(1, "homogeneous_cost", run.homogeneous_ran ? run.homogeneous_cost : NAN,
+               unit + cost + " at E* in every zone");
+  yaml->Number(1, "nominal_cost", run.nominal_cost, unit + cost + " at the nominal moduli");
+  yaml->Number(1, "cost_scale", run.rest_cost,
+               run.least_squares ? "[s] J_rest, J with every prediction 0"
+                                 : "[J s] J_rest, e^2 of the structure left at rest "
+                                   "(0 <= e^2 <= J_rest)");
+  yaml->Line(1, "optimizer", OptimizerTypeToString(run.outer.optimizer));
+  yaml->Line(1, "algorithm", OuterAlgorithmToString(run.outer.algorithm));
+  yaml->Text(1, "optimizer_message", run.outer.optimizer_message, "the optimiser's own words");
+  yaml->Integer(1, "evaluations", run.outer.evaluations, "zone_evaluations.csv");
+  yaml->Integer(1, "gradient_evaluations", run.outer.gradient_evaluations);
+  yaml->Number(1, "scaled_cost", run.outer.cost, cost + " / cost_scale at the zone moduli");
+  yaml->Integer(1, "sweeps", run.sweeps);
+  yaml->Line(1, "moduli", "",
+             run.least_squares
+                 ? "per zone (zones.csv): index, name, nominal, identified and truth modulus [Pa]"
+                 : "per zone (zones.csv): index, name, nominal, identified and truth modulus "
+                   "[Pa], share of the gap and gap / strain energy at the nominal and "
+                   "identified moduli");
+  const Vector nominal_share = GapFractions(run.nominal_zone_map),
+               share = GapFractions(run.zone_map);
+  for (int z = 0; z < run.nominal_moduli.size(); ++z) {
+    const bool truth = run.truth_moduli.size() > 0;
+    std::string entry = "    - {index: " + std::to_string(z) +
+                        ", name: " + Quoted(run.zone_names[static_cast<std::size_t>(z)]) +
+                        ", nominal: " + Format(run.nominal_moduli[z]) +
+                        ", modulus: " + Format(run.identified_moduli[z]) +
+                        ", truth: " + Format(truth ? run.truth_moduli[z] : NAN) +
+                        ", relative_error: " +
+                        Format(truth ? run.identified_moduli[z] / run.truth_moduli[z] - 1.0 : NAN);
+    if (!run.least_squares) {
+      entry += ", error_share_nominal: " + Format(nominal_share[z]) +
+               ", error_share_identified: " + Format(share[z]) +
+               ", relative_gap_nominal: " + Format(run.nominal_zone_gap[z]) +
+               ", relative_gap_identified: " + Format(run.zone_gap[z]);
+    }
+    yaml->Raw(entry + "}");
+  }
+}
+
+// summary.yaml of a matrix run by least squares: the bar's least-squares layout (J [s]
+// for e^2, the misfit levels, no error map and no inner solver) with the model, the data
+// and the zones: block.
 std::string MatrixLeastSquaresSummaryYaml(const MatrixIdentificationRun& run,
                                           const Config& config) {
+  const ModulusStage& stage = run.homogeneous;
   YamlWriter yaml;
   yaml.Raw(
       "# mcrewave identify run: the zone moduli of a structure given by matrices, by output-error "
@@ -1089,17 +1150,17 @@ std::string MatrixLeastSquaresSummaryYaml(const MatrixIdentificationRun& run,
   yaml.Text(0, "version", kVersion, "mcrewave version");
   yaml.Text(0, "functional", "least_squares", "outer.functional (docs/formulation.md section 8)");
   MatrixModelAndDataYaml(run, config, &yaml);
-  yaml.Line(0, "zones", "", "identified modulus per zone (zones.csv)");
-  for (int z = 0; z < run.nominal_moduli.size(); ++z) {
-    const bool truth = run.truth_moduli.size() > 0;
-    yaml.Raw("  - {name: " + Quoted(run.zone_names[static_cast<std::size_t>(z)]) + ", nominal: " +
-             Format(run.nominal_moduli[z]) + ", modulus: " + Format(run.identified_moduli[z]) +
-             ", truth: " + Format(truth ? run.truth_moduli[z] : NAN) + ", relative_error: " +
-             Format(truth ? run.identified_moduli[z] / run.truth_moduli[z] - 1.0 : NAN) + "}");
+  if (run.homogeneous_ran) {
+    yaml.Number(0, "identified_modulus", stage.identified_modulus(),
+                "[Pa] one E in every zone minimising J, the zones' start");
+    yaml.Number(0, "cost", run.homogeneous_cost,
+                "[s] J = 1/2 sum_k c_k h (misfit / noise level)^2 at the identified modulus");
+    yaml.Integer(0, "evaluations", stage.outer.scan_evaluations + stage.outer.evaluations,
+                 "J evaluations of the homogeneous stage: the scan's and the refinements'");
+    yaml.Integer(0, "sweeps", stage.outer.scan_sweeps + stage.sweeps,
+                 "simulations and sensitivity sweeps of those evaluations");
   }
-  yaml.Number(0, "cost", run.cost, "[s] J at the identified moduli");
-  yaml.Number(0, "nominal_cost", run.nominal_cost, "[s] J at the nominal moduli");
-  yaml.Number(0, "cost_scale", run.rest_cost, "[s] J_rest, J with every prediction 0");
+  yaml.Number(0, "wall_time_s", run.wall_time_s, "[s] identification and fit");
   yaml.Line(0, "misfit_levels", "", "each sensor kind's misfit divided by its level");
   yaml.Number(1, "displacement", run.misfit_levels.displacement_std, "[m] s_u (0: no such sensor)");
   yaml.Number(1, "strain", run.misfit_levels.strain_std, "[-] s_e (0: no such sensor)");
@@ -1107,58 +1168,15 @@ std::string MatrixLeastSquaresSummaryYaml(const MatrixIdentificationRun& run,
     yaml.Number(1, "force", run.misfit_levels.force_std, "[N] s_f of the supports' forces");
   }
   yaml.Text(1, "source", run.misfit_source);
-  MatrixOptimizerYaml(run, "J", &yaml);
-  yaml.Line(0, "prefilter", "");
-  yaml.Line(1, "enabled", config.prefilter.enabled ? "true" : "false");
-  yaml.Number(1, "cutoff_frequency", run.prefilter_cutoff, "[Hz] the cut-off used (0: off)");
-  yaml.Number(0, "wall_time_s", run.wall_time_s, "[s] identification and fit");
+  if (run.homogeneous_ran) {
+    OptimizerScanAndPrefilterYaml(stage.outer, stage.rest_cost, stage.rest_cost, config,
+                                  run.prefilter_cutoff, "J", "s", &yaml);
+  } else {
+    PrefilterYaml(config, run.prefilter_cutoff, &yaml);
+  }
+  MatrixZonesYaml(run, &yaml);
   ConfigYaml(config, &yaml);
   return yaml.str();
-}
-
-// The zones: block of a matrix run by the MCRE, in the layout of the bar's
-// (ZonesYamlLines): the zones' minimiser, its costs and every zone's modulus with its
-// share of the constitutive gap at the nominal and the identified moduli.
-void MatrixZonesYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) {
-  yaml->Line(0, "zones", "",
-             run.homogeneous_ran ? "identification of every zone modulus from the homogeneous E*"
-                                 : "identification of every zone modulus from the nominal moduli");
-  yaml->Line(1, "functional", "mcre", "outer.functional");
-  yaml->Integer(1, "count", static_cast<long>(run.zone_names.size()));
-  yaml->Line(1, "termination", TerminationTypeToString(run.outer.termination));
-  yaml->Text(1, "message", run.outer.message);
-  yaml->Number(1, "homogeneous_modulus",
-               run.homogeneous_ran ? run.homogeneous.identified_modulus() : NAN,
-               "[Pa] E*, the start (null: the zones' nominal moduli differ, they start there)");
-  yaml->Number(1, "cost", run.cost, "[J s] e^2 at the zone moduli");
-  yaml->Number(1, "homogeneous_cost", run.homogeneous_ran ? run.homogeneous.cost() : NAN,
-               "[J s] e^2 at E* in every zone");
-  yaml->Number(1, "nominal_cost", run.nominal_cost, "[J s] e^2 at the nominal moduli");
-  yaml->Number(1, "cost_scale", run.rest_cost,
-               "[J s] J_rest, e^2 of the structure left at rest (0 <= e^2 <= J_rest)");
-  yaml->Line(1, "optimizer", OptimizerTypeToString(run.outer.optimizer));
-  yaml->Line(1, "algorithm", OuterAlgorithmToString(run.outer.algorithm));
-  yaml->Text(1, "optimizer_message", run.outer.optimizer_message, "the optimiser's own words");
-  yaml->Integer(1, "evaluations", run.outer.evaluations, "zone_evaluations.csv");
-  yaml->Integer(1, "gradient_evaluations", run.outer.gradient_evaluations);
-  yaml->Number(1, "scaled_cost", run.outer.cost, "e^2 / cost_scale at the zone moduli");
-  yaml->Integer(1, "sweeps", run.sweeps);
-  yaml->Line(1, "moduli", "",
-             "per zone (zones.csv): index, name, nominal, identified and truth modulus [Pa], "
-             "share of the gap and gap / strain energy at the nominal and identified moduli");
-  const Vector nominal_share = GapFractions(run.nominal_zone_map),
-               share = GapFractions(run.zone_map);
-  for (int z = 0; z < run.nominal_moduli.size(); ++z) {
-    const bool truth = run.truth_moduli.size() > 0;
-    yaml->Raw("    - {index: " + std::to_string(z) +
-              ", name: " + Quoted(run.zone_names[static_cast<std::size_t>(z)]) + ", nominal: " +
-              Format(run.nominal_moduli[z]) + ", modulus: " + Format(run.identified_moduli[z]) +
-              ", truth: " + Format(truth ? run.truth_moduli[z] : NAN) + ", relative_error: " +
-              Format(truth ? run.identified_moduli[z] / run.truth_moduli[z] - 1.0 : NAN) +
-              ", error_share_nominal: " + Format(nominal_share[z]) + ", error_share_identified: " +
-              Format(share[z]) + ", relative_gap_nominal: " + Format(run.nominal_zone_gap[z]) +
-              ", relative_gap_identified: " + Format(run.zone_gap[z]) + "}");
-  }
 }
 
 }  // namespace
@@ -1175,7 +1193,7 @@ std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& 
     // The bar's headline keys, of the homogeneous stage.
     yaml.Number(0, "identified_modulus", stage.identified_modulus(),
                 "[Pa] one E in every zone minimising e^2, the zones' start");
-    yaml.Number(0, "cost", stage.cost(), "[J s] e^2 at the identified modulus");
+    yaml.Number(0, "cost", run.homogeneous_cost, "[J s] e^2 at the identified modulus");
     yaml.Integer(0, "evaluations", stage.outer.scan_evaluations + stage.outer.evaluations,
                  "evaluations of the homogeneous stage: the scans' and the refinements' (the "
                  "search functional's included)");
@@ -1215,15 +1233,18 @@ std::vector<std::string> WriteMatrixIdentificationResults(const MatrixIdentifica
   results.Write("zone_evaluations.csv", MatrixEvaluationsCsv(run));
   const ModulusStage& stage = run.homogeneous;
   if (run.homogeneous_ran) {
-    results.Write("evaluations.csv", EvaluationsCsv(stage));
     if (!stage.outer.scan_moduli.empty()) {
       results.Write("scan.csv", ScanCsv(stage.outer, stage.scan_cost_scale, config.outer.initial));
       results.Write("valleys.csv", ValleysCsv(stage.outer, stage.scan_cost_scale));
     }
-    if (!stage.cost_curve.empty()) {
-      results.Write("cost_curve.csv", CostCurveCsv(stage.cost_curve));
+    // The MCRE's evaluations and solves (least squares keeps none, as the bar's).
+    if (!run.least_squares) {
+      results.Write("evaluations.csv", EvaluationsCsv(stage));
+      if (!stage.cost_curve.empty()) {
+        results.Write("cost_curve.csv", CostCurveCsv(stage.cost_curve));
+      }
+      results.Write("inner_residual.csv", InnerResidualCsv(stage));
     }
-    results.Write("inner_residual.csv", InnerResidualCsv(stage));
   }
   results.Write("fit.csv", MatrixFitCsv(run));
   if (!run.least_squares) results.Write("error_map_dofs.csv", MatrixDofMapCsv(run));
@@ -1237,7 +1258,7 @@ std::vector<std::string> WriteMatrixIdentificationResults(const MatrixIdentifica
     std::vector<std::pair<std::string, std::string>> drawings = {
         {"zones", MatrixZonesScript(run, folder)},
         {"fit", MatrixFitScript(run, folder, config.prefilter.enabled, kinds)}};
-    if (run.homogeneous_ran) {
+    if (run.homogeneous_ran && !run.least_squares) {
       drawings.emplace_back("cost_curve", CostCurveScript(stage, config, folder));
       if (!InnerResidualHistory(stage).empty()) {
         drawings.emplace_back("inner_residual", InnerResidualScript(stage, config, folder));

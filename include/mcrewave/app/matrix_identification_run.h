@@ -170,8 +170,11 @@ struct MatrixIdentificationRun {
   // refinements, then (with maps_and_uncertainty) its cost curve and a solve from W = 0
   // at E*; the zones start from E*. Otherwise homogeneous_ran is false and the zones
   // start from their nominal moduli.
+  // By least squares, the same stage on J (OutputErrorModulusObjective): its outer,
+  // rest_cost and sweeps; no evaluations, solution or cost curve.
   bool homogeneous_ran = false;
   ModulusStage homogeneous;
+  double homogeneous_cost = 0.0;         // e^2 [J s] (least squares: J [s]) at E* in every zone
   Vector start_moduli;                   // E_z [Pa] the zones' minimiser started from
   Vector identified_moduli;              // [Pa]; empty when no usable point
   Vector truth_moduli;                   // [Pa]; empty when unknown
