@@ -239,7 +239,7 @@ int IdentifyMatrixModel(const mcrewave::Config& config) {
     }
   }
   spdlog::info("identified {} zone moduli in {} evaluations, {:.2f} s", run.zone_names.size(),
-               run.outer.evaluations, run.wall_time_s);
+               run.TotalEvaluations(), run.wall_time_s);
   spdlog::info("wrote {} files to {}", files.size(), config.output.folder);
   return 0;
 }

@@ -528,8 +528,8 @@ void RunMatrixRobustness(const Config& config, RunJournal* journal, RobustnessSt
             RunMatrixIdentification(run_config, model, measured, /*maps_and_uncertainty=*/false);
         run->converged = identification.IsUsable();
         run->message = identification.failure;
-        run->evaluations = identification.outer.evaluations;
-        run->sweeps = identification.sweeps;
+        run->evaluations = identification.TotalEvaluations();
+        run->sweeps = identification.TotalSweeps();
         if (run->converged) {
           const Vector& moduli = identification.identified_moduli;
           run->identified_moduli.assign(moduli.data(), moduli.data() + moduli.size());

@@ -49,7 +49,9 @@ struct ComparatorRun {
   std::string message;  // the outer loop's, when not converged
   double modulus = std::numeric_limits<double>::quiet_NaN();  // identified E [Pa]
   double error = std::numeric_limits<double>::quiet_NaN();    // E / E_ref - 1
-  int local_minima = 0;  // valleys of the functional the global scan ran on (0: no scan)
+  // Valleys of the functional the global scan ran on (0: no scan; -1: a matrix model
+  // without the homogeneous stage, whose zones start from their nominal moduli).
+  int local_minima = 0;
   // The search functional's minimiser E_search [Pa] (two stages), NaN otherwise.
   double search_modulus = std::numeric_limits<double>::quiet_NaN();
   int evaluations = 0;   // of every functional: scans and refinements

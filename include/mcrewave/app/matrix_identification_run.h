@@ -205,6 +205,17 @@ struct MatrixIdentificationRun {
   double wall_time_s = 0.0;
 
   bool IsUsable() const { return failure.empty(); }
+  // Evaluations and sweeps of the identification: the homogeneous stage's (its scan's
+  // and refinements') and the zones' minimiser's.
+  long TotalEvaluations() const {
+    const long stage =
+        homogeneous_ran ? homogeneous.outer.scan_evaluations + homogeneous.outer.evaluations : 0;
+    return stage + outer.evaluations;
+  }
+  long TotalSweeps() const {
+    const long stage = homogeneous_ran ? homogeneous.outer.scan_sweeps + homogeneous.sweeps : 0;
+    return stage + sweeps;
+  }
 };
 
 // Step 3 above; without maps_and_uncertainty, the moduli alone (no error map, model
