@@ -892,6 +892,14 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
        "data.sensors applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  merge_zones: true\n",
        "zone_identification.merge_zones applies to the bar only"},
+      // Every key of the bar's structure away from its default, where it was set.
+      {"model:\n  kind: matrix\n  manifest: m.yaml\n  elements: 50\n",
+       "kinds.yaml:4: model.elements applies to the bar only"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\ndata:\n  truth: exact\n",
+       "kinds.yaml:5: data.truth applies to the bar only"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  weight_rule: "
+       "discrepancy\n",
+       "kinds.yaml:5: zone_identification.weight_rule applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  channel_map: {F: t}\n",
        "cannot map to the time column"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  channel_map: {F: a, G: a}\n",
@@ -909,6 +917,16 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
       EXPECT_EQ(std::string(error.what()).rfind("kinds.yaml:", 0), 0u) << error.what();
     }
   }
+  // An override names itself; at its default a key of the bar says nothing and passes.
+  try {
+    ParseConfig("model:\n  kind: matrix\n  manifest: m.yaml\n", "kinds.yaml", {"model.length=2"});
+    ADD_FAILURE() << "model.length=2 accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("--set model.length=2: model.length applies", 0), 0u)
+        << error.what();
+  }
+  EXPECT_NO_THROW(
+      ParseConfig("model:\n  kind: matrix\n  manifest: m.yaml\n  length: 1\n", "kinds.yaml"));
 }
 
 // Least squares is the MCRE's comparator on matrix models too

@@ -40,6 +40,18 @@ std::string WriteQuickBarMatrices(const std::string& folder) {
   return WriteMatrixModel(folder, BarMatrixModel(BarModel(quick.model), 160e9));
 }
 
+// configs/quick.yaml for the structure of `manifest`: the keys a matrix run reads
+// (AppliedConfigToYaml; the bar's geometry, which a matrix model refuses, left out),
+// written into `folder`. Returns its path.
+std::string WriteQuickMatrixConfig(const std::string& folder, const std::string& manifest) {
+  Config config = LoadConfig(SourcePath("configs/quick.yaml"));
+  config.structure.kind = ModelKind::kMatrix;
+  config.structure.manifest = manifest;
+  const std::string path = folder + "/quick_matrix.yaml";
+  std::ofstream(path) << AppliedConfigToYaml(config);
+  return path;
+}
+
 // The identified modulus of zone `zone` in a matrix run's zones.csv.
 double ZoneModulus(const std::string& zones_csv, int zone) {
   std::istringstream lines(ReadText(zones_csv));
@@ -103,9 +115,8 @@ TEST(MatrixIdentificationRunTest, TheBarAsMatricesIdentifiesTheBuiltInBarsModulu
   const RunResult bar = RunIdentify("run " + quick + data + " -q -o " + dir + "/bar");
   ASSERT_EQ(bar.exit_code, 0) << bar.output;
   // The same config but the model: the same search functional (quick.yaml's `same`).
-  const RunResult matrices =
-      RunIdentify("run " + quick + data + " --set model.kind=matrix" +
-                  " --set model.manifest=" + manifest + " -q -o " + dir + "/matrices");
+  const RunResult matrices = RunIdentify("run " + WriteQuickMatrixConfig(dir, manifest) + data +
+                                         " -q -o " + dir + "/matrices");
   ASSERT_EQ(matrices.exit_code, 0) << matrices.output;
   const double bar_modulus =
       YAML::LoadFile(dir + "/bar/summary.yaml")["identified_modulus"].as<double>();
@@ -176,9 +187,8 @@ TEST(MatrixIdentificationRunTest, TheBarWithItsClampAsASupportIdentifiesTheBuilt
     const RunResult bar =
         RunIdentify("run " + quick + data + treatment + " -q -o " + dir + "/bar_" + clamp);
     ASSERT_EQ(bar.exit_code, 0) << bar.output;
-    const RunResult matrices =
-        RunIdentify("run " + quick + data + treatment + " --set model.kind=matrix" +
-                    " --set model.manifest=" + manifest + " -q -o " + dir + "/matrices_" + clamp);
+    const RunResult matrices = RunIdentify("run " + WriteQuickMatrixConfig(dir, manifest) + data +
+                                           treatment + " -q -o " + dir + "/matrices_" + clamp);
     ASSERT_EQ(matrices.exit_code, 0) << matrices.output;
     const double bar_modulus =
         YAML::LoadFile(dir + "/bar_" + clamp + "/summary.yaml")["identified_modulus"].as<double>();
@@ -202,9 +212,8 @@ TEST(MatrixIdentificationRunTest, TheBarWithItsClampAsASupportIdentifiesTheBuilt
   const std::string filtered = " --set data.source=csv --set data.path=" + dir + "/data.csv";
   const RunResult bar = RunIdentify("run " + quick + filtered + " -q -o " + dir + "/bar_filtered");
   ASSERT_EQ(bar.exit_code, 0) << bar.output;
-  const RunResult matrices = RunIdentify(
-      "run " + quick + filtered + " --set model.kind=matrix --set model.manifest=" + manifest +
-      " -q -o " + dir + "/matrices_filtered");
+  const RunResult matrices = RunIdentify("run " + WriteQuickMatrixConfig(dir, manifest) + filtered +
+                                         " -q -o " + dir + "/matrices_filtered");
   ASSERT_EQ(matrices.exit_code, 0) << matrices.output;
   const double bar_cutoff =
       YAML::LoadFile(dir + "/bar_filtered/summary.yaml")["prefilter"]["cutoff_frequency"]
@@ -234,9 +243,8 @@ TEST(MatrixIdentificationRunTest,
   const RunResult bar = RunIdentify("run " + quick + data + " -q -o " + dir + "/bar");
   ASSERT_EQ(bar.exit_code, 0) << bar.output;
   // quick.yaml's mcre.clamp (measured) is ignored by both: least squares holds the clamp.
-  const RunResult matrices = RunIdentify(
-      "run " + quick + data + " --set model.kind=matrix --set model.manifest=" + manifest +
-      " -q -o " + dir + "/matrices");
+  const RunResult matrices = RunIdentify("run " + WriteQuickMatrixConfig(dir, manifest) + data +
+                                         " -q -o " + dir + "/matrices");
   ASSERT_EQ(matrices.exit_code, 0) << matrices.output;
   const YAML::Node bar_summary = YAML::LoadFile(dir + "/bar/summary.yaml");
   const double bar_modulus = bar_summary["identified_modulus"].as<double>();
@@ -280,8 +288,9 @@ TEST(MatrixIdentificationRunTest, LoadAndObservationMatricesRunAsThePerFileManif
       WriteMatrixModel(dir + "/matrices", bar, MatrixModelLayout::kMatrices);
   ASSERT_NE(ReadText(matrices).find("loads_matrix"), std::string::npos);
   ASSERT_EQ(ReadText(matrices).find("load_f0.mtx"), std::string::npos);
-  const std::string run = "run " + quick + " --set data.source=csv --set data.path=" + dir +
-                          "/data.csv --set model.kind=matrix" + " --set mcre.clamp=trusted -q";
+  const std::string run = "run " + WriteQuickMatrixConfig(dir, per_file) +
+                          " --set data.source=csv --set data.path=" + dir +
+                          "/data.csv --set mcre.clamp=trusted -q";
   const RunResult files_run =
       RunIdentify(run + " --set model.manifest=" + per_file + " -o " + dir + "/run_files");
   ASSERT_EQ(files_run.exit_code, 0) << files_run.output;

@@ -1350,9 +1350,61 @@ std::string FirstProblem(const Config& config) {
   return "";
 }
 
+// The single keys of the bar's structure, its zones, its sensors and its zones'
+// regularisation, which a structure given by matrices does not read: refused there when
+// set (RefuseKeysOfTheBar).
+bool BarOnlyKey(const std::string& path) {
+  static const std::set<std::string> bar_only = {"model.length",
+                                                 "model.section",
+                                                 "model.density",
+                                                 "model.modulus",
+                                                 "model.elements",
+                                                 "model.mass",
+                                                 "model.zoning",
+                                                 "model.zone_count",
+                                                 "model.zone_boundaries",
+                                                 "data.truth",
+                                                 "data.truth_refinement",
+                                                 "data.sensors",
+                                                 "data.channels",
+                                                 "data.truth_zones",
+                                                 "zone_identification.regularization",
+                                                 "zone_identification.regularization_weight",
+                                                 "zone_identification.weight_rule",
+                                                 "zone_identification.tv_smoothing",
+                                                 "zone_identification.max_weight",
+                                                 "zone_identification.min_weight",
+                                                 "zone_identification.grid_factor",
+                                                 "zone_identification.refinement_steps",
+                                                 "zone_identification.weight_tolerance",
+                                                 "zone_identification.discrepancy_factor",
+                                                 "zone_identification.noise_samples",
+                                                 "zone_identification.noise_seed",
+                                                 "zone_identification.merge_zones"};
+  return bar_only.count(path) > 0;
+}
+
+// A key of the bar set away from its default in a config of a structure given by
+// matrices: refused where it was set, naming it (every key is read by the model kind or
+// refused, never ignored; at its default, as a resolved config writes it, it says
+// nothing).
+void RefuseKeysOfTheBar(const ParsedConfig& parsed) {
+  if (parsed.config.structure.kind != ModelKind::kMatrix) return;
+  const Config defaults;
+  for (const auto& [path, origin] : parsed.origins) {
+    const Key* key = FindKey(path);
+    if (BarOnlyKey(path) && key != nullptr && key->write(parsed.config) != key->write(defaults)) {
+      throw InputError(origin + ": " + path +
+                       " applies to the bar only; with model.kind 'matrix' the zones, loads and "
+                       "sensors are those of the manifest (model.manifest): leave it out");
+    }
+  }
+}
+
 void Validate(const ParsedConfig& parsed, const std::string& name) {
   const std::string error = FirstProblem(parsed.config);
   if (!error.empty()) throw InputError(Locate(error, parsed, name));
+  RefuseKeysOfTheBar(parsed);
 }
 
 ParsedConfig Parse(const std::string& yaml_text, const std::string& name,
@@ -1576,34 +1628,7 @@ bool KeyApplies(const std::string& path, ModelKind kind) {
   if (kind == ModelKind::kBar) return matrix_only.count(path) == 0;
   // Whole sections, then single keys, that a matrix run does not read.
   static const std::set<std::string> bar_sections = {"study"};
-  static const std::set<std::string> bar_only = {"model.length",
-                                                 "model.section",
-                                                 "model.density",
-                                                 "model.modulus",
-                                                 "model.elements",
-                                                 "model.mass",
-                                                 "model.zoning",
-                                                 "model.zone_count",
-                                                 "model.zone_boundaries",
-                                                 "data.truth",
-                                                 "data.truth_refinement",
-                                                 "data.sensors",
-                                                 "data.channels",
-                                                 "data.truth_zones",
-                                                 "zone_identification.regularization",
-                                                 "zone_identification.regularization_weight",
-                                                 "zone_identification.weight_rule",
-                                                 "zone_identification.tv_smoothing",
-                                                 "zone_identification.max_weight",
-                                                 "zone_identification.min_weight",
-                                                 "zone_identification.grid_factor",
-                                                 "zone_identification.refinement_steps",
-                                                 "zone_identification.weight_tolerance",
-                                                 "zone_identification.discrepancy_factor",
-                                                 "zone_identification.noise_samples",
-                                                 "zone_identification.noise_seed",
-                                                 "zone_identification.merge_zones"};
-  return bar_sections.count(path.substr(0, path.find('.'))) == 0 && bar_only.count(path) == 0;
+  return bar_sections.count(path.substr(0, path.find('.'))) == 0 && !BarOnlyKey(path);
 }
 
 std::string AppliedConfigToYaml(const Config& config) {
