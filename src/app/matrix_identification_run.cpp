@@ -424,7 +424,6 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
       MatrixLeastSquaresMisfitLevels(config, model, measurements, run.data, &run.misfit_source);
   MatrixOutputErrorObjective objective(model, run.data, run.misfit_levels, config.time.theta);
   run.nominal_moduli = objective.reference_moduli();
-  run.start_moduli = run.nominal_moduli;
   run.rest_cost = objective.rest_cost();
   RecordingObjective recorder(&objective, &run.evaluations, "J");
   std::vector<double> lower, upper;
@@ -447,7 +446,6 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
     // One E in every zone first, as the bar's least squares identifies its E.
     if (!IdentifyHomogeneousStageByLeastSquares(config, model, &run)) return;
     const double homogeneous_modulus = run.homogeneous.identified_modulus();
-    run.start_moduli.setConstant(homogeneous_modulus);
     std::fill(start.begin(), start.end(), std::log(homogeneous_modulus / run.nominal_moduli[0]));
   }
   run.outer =
@@ -787,7 +785,6 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
                  ClampModelToString(config.mcre.clamp));
   }
   std::vector<double> start(zones, 0.0);
-  run.start_moduli = run.nominal_moduli;
   if (SharesOneNominalModulus(model)) {
     // 2a. One E in every zone first, by the global scan and the refinements of the
     //     bar's identification (outer:, search:); the zones then start from E*, their
@@ -798,7 +795,6 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
       return run;
     }
     const double homogeneous_modulus = run.homogeneous.identified_modulus();
-    run.start_moduli.setConstant(homogeneous_modulus);
     std::fill(start.begin(), start.end(), std::log(homogeneous_modulus / run.nominal_moduli[0]));
     mcre_objective.SetWarmStart(run.homogeneous.solution.WarmStart());
   }

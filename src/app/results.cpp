@@ -1049,20 +1049,6 @@ void MatrixUncertaintyYaml(const MatrixIdentificationRun& run, YamlWriter* yaml)
   yaml->Integer(1, "sweeps", uncertainty.sweeps, "of the curvature's and the noise's solves");
 }
 
-// The optimizer: block of a matrix run's summary.yaml; `cost` names its cost (J, e^2).
-void MatrixOptimizerYaml(const MatrixIdentificationRun& run, const std::string& cost,
-                         YamlWriter* yaml) {
-  yaml->Line(0, "optimizer", "", "zone_identification: (the zone moduli in log E)");
-  yaml->Text(1, "optimizer", OptimizerTypeToString(run.outer.optimizer));
-  yaml->Text(1, "algorithm", OuterAlgorithmToString(run.outer.algorithm));
-  yaml->Text(1, "termination", TerminationTypeToString(run.outer.termination));
-  yaml->Text(1, "message", run.outer.message);
-  yaml->Text(1, "optimizer_message", run.outer.optimizer_message, "the optimiser's own words");
-  yaml->Integer(1, "evaluations", run.outer.evaluations);
-  yaml->Integer(1, "gradient_evaluations", run.outer.gradient_evaluations);
-  yaml->Number(1, "scaled_cost", run.outer.cost, cost + " / cost_scale at the identified moduli");
-}
-
 // The error_map: block of a matrix run with an element map (error_map.csv): the element
 // of the largest share at the identified and at the nominal moduli.
 void MatrixElementMapYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) {

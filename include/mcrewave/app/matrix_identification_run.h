@@ -175,7 +175,6 @@ struct MatrixIdentificationRun {
   bool homogeneous_ran = false;
   ModulusStage homogeneous;
   double homogeneous_cost = 0.0;         // e^2 [J s] (least squares: J [s]) at E* in every zone
-  Vector start_moduli;                   // E_z [Pa] the zones' minimiser started from
   Vector identified_moduli;              // [Pa]; empty when no usable point
   Vector truth_moduli;                   // [Pa]; empty when unknown
   BoundedMinimizerSummary outer;
