@@ -219,6 +219,15 @@ ModulusStage IdentifyHomogeneousModulus(const Config& config, const MatrixModelD
   ModulusStage stage;
   stage.inner_method = ResolveCoupledSolverType(config.inner, model.dofs(), data.num_steps(),
                                                 /*streaming_available=*/true);
+  spdlog::info(
+      "identifying E with {}/{} from {:.6g} Pa in [{:.6g}, {:.6g}] Pa; inner {}; global scan on {}",
+      OptimizerTypeToString(config.outer.optimizer),
+      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
+      config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
+      CoupledSolverName(config.inner.type, stage.inner_method),
+      config.outer.scan_points == 0      ? "none (outer.scan_points 0)"
+      : ScansTheSearchFunctional(config) ? "the pinned search functional (search:)"
+                                         : "mcre:'s e^2");
   McreIdentification identification = IdentifyWithMcre(config, model, data);
   McreObjective& objective = *identification.objective;
   stage.rest_cost = objective.rest_cost();
@@ -275,15 +284,6 @@ IdentificationRun IdentifyModulus(const Config& config, const ChannelSet& data) 
   // The solver every coupled solve of this run takes (SolveCoupled resolves auto alike).
   const CoupledSolverType inner_method = ResolveCoupledSolverType(
       config.inner, model.num_nodes(), run.data.num_steps(), /*streaming_available=*/true);
-  spdlog::info(
-      "identifying E with {}/{} from {:.6g} Pa in [{:.6g}, {:.6g}] Pa; inner {}; global scan on {}",
-      OptimizerTypeToString(config.outer.optimizer),
-      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
-      config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
-      CoupledSolverName(config.inner.type, inner_method),
-      config.outer.scan_points == 0      ? "none (outer.scan_points 0)"
-      : ScansTheSearchFunctional(config) ? "the pinned search functional (search:)"
-                                         : "mcre:'s e^2");
   run.model = std::make_shared<const MatrixModelData>(BarRunModel(model, run.data, run.ends));
   const MatrixModelData& matrices = *run.model;
   static_cast<ModulusStage&>(run) = IdentifyHomogeneousModulus(config, matrices, run.data);

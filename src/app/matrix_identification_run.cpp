@@ -363,15 +363,7 @@ bool TakeHomogeneousOutcome(const Config& config, MatrixIdentificationRun* run) 
 // usable or lies on a bound of the search.
 bool IdentifyHomogeneousStage(const Config& config, const MatrixModelData& model, bool complete,
                               MatrixIdentificationRun* run) {
-  spdlog::info(
-      "homogeneous stage: one E in every zone with {}/{} from {:.6g} Pa in [{:.6g}, {:.6g}] Pa; "
-      "global scan on {}",
-      OptimizerTypeToString(config.outer.optimizer),
-      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
-      config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
-      config.outer.scan_points == 0      ? "none (outer.scan_points 0)"
-      : ScansTheSearchFunctional(config) ? "the pinned search functional (search:)"
-                                         : "mcre:'s e^2");
+  spdlog::info("homogeneous stage: one E in every zone");
   run->homogeneous_ran = true;
   run->homogeneous = IdentifyHomogeneousModulus(config, model, run->data);
   ModulusStage& stage = run->homogeneous;
