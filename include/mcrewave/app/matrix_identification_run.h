@@ -21,10 +21,10 @@
 //      zones are neighbours). Then the error maps (zone and dof, and element when the
 //      model has element blocks and the inner solver keeps its fields) at the nominal and
 //      the identified moduli and the model's outputs at the identified moduli.
-//      With outer.functional: least_squares, the same minimiser, bounds and start on
-//      the output-error misfit J instead (least_squares/matrix_output_error_objective.h),
-//      each sensor kind normalised by its misfit level (MatrixLeastSquaresMisfitLevels);
-//      no error map. The supports are held whatever mcre.clamp says (the bar's least
+//      With outer.functional: least_squares, the same stages on the output-error misfit
+//      J instead (the homogeneous one by OutputErrorModulusObjective, the zones by
+//      least_squares/matrix_output_error_objective.h), each sensor kind normalised by its
+//      misfit level (MatrixLeastSquaresMisfitLevels); no error map. The supports are held whatever mcre.clamp says (the bar's least
 //      squares keeps its clamp rigid), their forces outputs weighted by 1 / s_f^2.
 //
 // Results: WriteMatrixIdentificationResults (app/results.h).
