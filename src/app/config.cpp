@@ -813,11 +813,10 @@ const char* SearchKeyNotAtItsDefault(const SearchOptions& search) {
   return nullptr;
 }
 
-// "" when the keys that apply to one kind of structure only are at their defaults
-// with the other kind; else the message, naming the key first.
+// "" when the keys of a structure given by matrices are at their defaults with the bar;
+// else the message, naming the key first. (The bar's keys with model.kind matrix are
+// refused where they were set: RefuseKeysOfTheBar.)
 std::string StructureKeysProblem(const Config& config) {
-  const Config defaults;
-  const std::string kind = ModelKindToString(config.structure.kind);
   if (config.structure.kind == ModelKind::kBar) {
     const std::pair<const char*, bool> matrix_keys[] = {
         {"model.manifest", !config.structure.manifest.empty()},
@@ -828,26 +827,6 @@ std::string StructureKeysProblem(const Config& config) {
     for (const auto& [key, set] : matrix_keys) {
       if (set) return std::string(key) + " applies to model.kind 'matrix' only (model.kind is 'bar')";
     }
-    return "";
-  }
-  const std::pair<const char*, bool> bar_keys[] = {
-      {"model.zoning", config.zones.zoning != defaults.zones.zoning},
-      {"model.zone_count", config.zones.zone_count != defaults.zones.zone_count},
-      {"model.zone_boundaries", !config.zones.zone_boundaries.empty()},
-      {"data.sensors", !config.data.sensors.empty()},
-      {"data.channels", !config.data.channels.empty()},
-      {"data.truth_zones", !config.data.truth_zones.empty()},
-  };
-  for (const auto& [key, set] : bar_keys) {
-    if (set) {
-      return std::string(key) + " applies to the bar only; with model.kind '" + kind +
-             "' the zones, loads and sensors are those of the manifest (model.manifest)";
-    }
-  }
-  if (config.zone_identification.merge_zones) {
-    return "zone_identification.merge_zones applies to the bar only; with model.kind '" + kind +
-           "' the manifest's zones are identified without a penalty, so there is no "
-           "discrepancy target to merge them by";
   }
   // outer.functional: both run on a matrix model (least squares by
   // MatrixOutputErrorObjective, app/matrix_identification_run.h).
@@ -1402,9 +1381,10 @@ void RefuseKeysOfTheBar(const ParsedConfig& parsed) {
 }
 
 void Validate(const ParsedConfig& parsed, const std::string& name) {
+  // A key of the other structure first: the bar's checks of it would mislead.
+  RefuseKeysOfTheBar(parsed);
   const std::string error = FirstProblem(parsed.config);
   if (!error.empty()) throw InputError(Locate(error, parsed, name));
-  RefuseKeysOfTheBar(parsed);
 }
 
 ParsedConfig Parse(const std::string& yaml_text, const std::string& name,

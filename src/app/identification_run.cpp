@@ -280,14 +280,10 @@ IdentificationRun IdentifyModulus(const Config& config, const ChannelSet& data) 
   run.reference_known = config.data.source == DataSource::kSynthetic;
   run.data = IdentificationData(config, data, &run.ends, &run.prefilter_cutoff);
 
-  const BarModel model(config.model);
-  // The solver every coupled solve of this run takes (SolveCoupled resolves auto alike).
-  const CoupledSolverType inner_method = ResolveCoupledSolverType(
-      config.inner, model.num_nodes(), run.data.num_steps(), /*streaming_available=*/true);
-  run.model = std::make_shared<const MatrixModelData>(BarRunModel(model, run.data, run.ends));
+  run.model = std::make_shared<const MatrixModelData>(
+      BarRunModel(BarModel(config.model), run.data, run.ends));
   const MatrixModelData& matrices = *run.model;
   static_cast<ModulusStage&>(run) = IdentifyHomogeneousModulus(config, matrices, run.data);
-  run.inner_method = inner_method;
   // The bar's weights from k* = E0 S / L (mcre/matrix_mcre_problem.h): alpha = w_f / k*
   // of its loads, beta = w_u k* of its end displacement, for the summary.
   const double stiffness_scale = config.mcre.reference_modulus * matrices.stiffness_length;

@@ -396,12 +396,21 @@ bool IdentifyHomogeneousStageByLeastSquares(const Config& config, const MatrixMo
   spdlog::info("{}", stage.outer.BriefReport());
   stage.rest_cost = objective.rest_cost();
   stage.scan_cost_scale = stage.rest_cost;
+  const bool usable = TakeHomogeneousOutcome(config, run);
+  if (usable) run->homogeneous_cost = objective.Predict(stage.identified_modulus(), false).cost;
   stage.sweeps = objective.sweeps();
-  if (!TakeHomogeneousOutcome(config, run)) return false;
-  run->homogeneous_cost = objective.Predict(stage.identified_modulus(), false).cost;
-  stage.sweeps = objective.sweeps();
+  if (!usable) return false;
   spdlog::info("homogeneous stage: E* = {:.9g} Pa, the zones' start", stage.identified_modulus());
   return true;
+}
+
+// The zones' minimiser's start, p_z = log(E_z / E_z,nom): E* in every zone after the
+// homogeneous stage (the zones share E_z,nom), else the nominal moduli (p = 0).
+std::vector<double> ZoneStart(const MatrixIdentificationRun& run) {
+  const auto zones = static_cast<std::size_t>(run.nominal_moduli.size());
+  if (!run.homogeneous_ran) return std::vector<double>(zones, 0.0);
+  return std::vector<double>(
+      zones, std::log(run.homogeneous.identified_modulus() / run.nominal_moduli[0]));
 }
 
 // Step 2 with outer.functional: least_squares: every zone modulus by the output-error
@@ -433,15 +442,13 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
         "misfit level {:.4g} N",
         model.supports.size(), ClampModelToString(config.mcre.clamp), run.misfit_levels.force_std);
   }
-  std::vector<double> start(lower.size(), 0.0);
-  if (SharesOneNominalModulus(model)) {
-    // One E in every zone first, as the bar's least squares identifies its E.
-    if (!IdentifyHomogeneousStageByLeastSquares(config, model, &run)) return;
-    const double homogeneous_modulus = run.homogeneous.identified_modulus();
-    std::fill(start.begin(), start.end(), std::log(homogeneous_modulus / run.nominal_moduli[0]));
+  // One E in every zone first, as the bar's least squares identifies its E.
+  if (SharesOneNominalModulus(model) &&
+      !IdentifyHomogeneousStageByLeastSquares(config, model, &run)) {
+    return;
   }
-  run.outer =
-      MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper, start);
+  run.outer = MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper,
+                                   ZoneStart(run));
   TakeZoneOutcome(objective, lower, upper, &run);
   run.sweeps = objective.sweeps();
   if (run.identified_moduli.size() > 0) {
@@ -776,7 +783,6 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
     spdlog::info("{} supports, treated as mcre.clamp: {}", model.supports.size(),
                  ClampModelToString(config.mcre.clamp));
   }
-  std::vector<double> start(zones, 0.0);
   if (SharesOneNominalModulus(model)) {
     // 2a. One E in every zone first, by the global scan and the refinements of the
     //     bar's identification (outer:, search:); the zones then start from E*, their
@@ -786,12 +792,10 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
       return run;
     }
-    const double homogeneous_modulus = run.homogeneous.identified_modulus();
-    std::fill(start.begin(), start.end(), std::log(homogeneous_modulus / run.nominal_moduli[0]));
     mcre_objective.SetWarmStart(run.homogeneous.solution.WarmStart());
   }
-  run.outer =
-      MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper, start);
+  run.outer = MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper,
+                                   ZoneStart(run));
   TakeZoneOutcome(objective, lower, upper, &run);
   run.sweeps = problem.sweep_count();
   if (!maps_and_uncertainty) {

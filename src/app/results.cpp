@@ -299,13 +299,13 @@ std::string EndsScript(const IdentificationRun& run, const std::string& folder) 
 
 // summary.yaml's comment on inner.method: why auto chose the solver that ran on `dofs`
 // dofs and `steps` steps ("" when the config named it).
-std::string InnerMethodComment(const ModulusStage& run, const Config& config, double dofs,
+std::string InnerMethodComment(CoupledSolverType method, const Config& config, double dofs,
                                double steps) {
   if (config.inner.type != CoupledSolverType::kAuto) return "";
   const double bytes = IterativeSolverFieldBytes(dofs, steps);
   std::ostringstream comment;
   comment << "inner.method auto: the stored fields, " << static_cast<long long>(bytes) << " bytes, "
-          << (run.inner_method == CoupledSolverType::kStreamingConjugateGradient ? "exceed" : "fit")
+          << (method == CoupledSolverType::kStreamingConjugateGradient ? "exceed" : "fit")
           << " inner.max_field_bytes";
   return comment.str();
 }
@@ -587,7 +587,7 @@ void InnerSolvesYaml(const ModulusStage& run, const Config& config, double dofs,
   const CoupledSolverSummary& best_inner = run.evaluations[run.best_index].inner;
   yaml->Line(0, "inner", "");
   yaml->Text(1, "method", CoupledSolverTypeToString(run.inner_method),
-             InnerMethodComment(run, config, dofs, steps));
+             InnerMethodComment(run.inner_method, config, dofs, steps));
   yaml->Integer(1, "solves", static_cast<long>(run.evaluations.size()),
                 "coupled solves of the optimiser");
   yaml->Integer(1, "iterations", inner_iterations, "sweep pairs over those solves");
@@ -1201,7 +1201,7 @@ std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& 
     PrefilterYaml(config, run.prefilter_cutoff, &yaml);
     yaml.Line(0, "inner", "");
     yaml.Text(1, "method", CoupledSolverTypeToString(run.inner_method),
-              InnerMethodComment(stage, config, run.dofs, run.steps));
+              InnerMethodComment(run.inner_method, config, run.dofs, run.steps));
   }
   MatrixZonesYaml(run, &yaml);
   ConfigYaml(config, &yaml);

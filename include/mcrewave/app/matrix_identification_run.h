@@ -24,8 +24,9 @@
 //      With outer.functional: least_squares, the same stages on the output-error misfit
 //      J instead (the homogeneous one by OutputErrorModulusObjective, the zones by
 //      least_squares/matrix_output_error_objective.h), each sensor kind normalised by its
-//      misfit level (MatrixLeastSquaresMisfitLevels); no error map. The supports are held whatever mcre.clamp says (the bar's least
-//      squares keeps its clamp rigid), their forces outputs weighted by 1 / s_f^2.
+//      misfit level (MatrixLeastSquaresMisfitLevels); no error map. The supports are
+//      held whatever mcre.clamp says (the bar's least squares keeps its clamp rigid),
+//      their forces outputs weighted by 1 / s_f^2.
 //
 // Results: WriteMatrixIdentificationResults (app/results.h).
 #pragma once
