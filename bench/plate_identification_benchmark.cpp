@@ -23,8 +23,8 @@
 //   (model and truth: folders of make_plate_example.py; default configs/plate/coarse
 //   and configs/plate/fine; scripts/plate_study.sh runs the study of results/plate).
 //   Writes OUTPUT_DIR/runs.csv (one row per identification), summary.md (statistics
-//   per SNR and the goals), error_map.csv and error_map.png (the dof map of
-//   MatrixMcreProblem::DofErrorMap summed per node, averaged per element), moduli.png.
+//   per SNR and the goals), error_map.csv and error_map.png (the element map of
+//   the model's element blocks), moduli.png.
 // Runs are independent and each is seeded: the numbers do not depend on threads.
 
 #include <algorithm>
@@ -43,6 +43,7 @@
 
 #include "mcrewave/app/matrix_identification_run.h"
 #include "mcrewave/core/file_util.h"
+#include "mcrewave/mcre/element_error_map.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/mcre/objective.h"
 
@@ -146,11 +147,19 @@ Vector AxialEdgeLoad(const std::string& nodes_csv, int dofs) {
 }
 
 // The error map of the noise-free data at the nominal model (200 GPa in both zones),
-// per element: the dof map summed per node, the element's the mean of its 4 nodes',
-// as shares of the total. Writes error_map.csv (element, x_centre, y_centre, half
-// width, half height, zone, share) and draws error_map.png.
+// per element: e_el^2 of the model's element blocks (MatrixElementGapShares,
+// docs/matrix_models.md section 2) as shares of the total. Writes error_map.csv
+// (element, x_centre, y_centre, half width, half height, zone index, share) and draws
+// error_map.png.
 void WriteErrorMap(const MatrixModelData& coarse, const std::string& coarse_folder,
                    const ChannelSet& truth, const std::string& folder) {
+  if (coarse.elements.empty()) {
+    std::fprintf(stderr,
+                 "error: %s/model.yaml has no element blocks (elements:), which the error "
+                 "map needs: regenerate it with scripts/make_plate_example.py\n",
+                 coarse_folder.c_str());
+    std::exit(1);
+  }
   MatrixMcreProblem problem(coarse, truth, McreWeights(), kNominal, 0.5);
   CoupledSolverOptions inner;
   inner.tolerance = 1e-10;
@@ -160,23 +169,16 @@ void WriteErrorMap(const MatrixModelData& coarse, const std::string& coarse_fold
     std::fprintf(stderr, "error: the error map's solve failed: %s\n", summary.FullReport().c_str());
     std::exit(1);
   }
-  const Vector dofs = problem.DofErrorMap(solution.retrograde);
+  const Vector element_energy =
+      MatrixElementGapShares(coarse, coarse.NominalModuli(), solution.retrograde, kTimeStep);
   const std::vector<std::vector<double>> nodes = ReadCsv(coarse_folder + "/nodes.csv");
   const std::vector<std::vector<double>> elements = ReadCsv(coarse_folder + "/elements.csv");
-  std::vector<double> node_energy(nodes.size(), 0.0);
-  for (std::size_t i = 0; i < nodes.size(); ++i) {
-    for (int c = 3; c <= 4; ++c) {
-      if (nodes[i][c] >= 0) node_energy[i] += dofs[static_cast<int>(nodes[i][c])];
-    }
+  if (elements.size() != coarse.elements.size()) {
+    std::fprintf(stderr, "error: %s/elements.csv has %zu elements, the manifest's blocks %zu\n",
+                 coarse_folder.c_str(), elements.size(), coarse.elements.size());
+    std::exit(1);
   }
-  std::vector<double> element_energy;
-  for (const std::vector<double>& element : elements) {
-    double sum = 0.0;
-    for (int a = 1; a <= 4; ++a) sum += 0.25 * node_energy[static_cast<std::size_t>(element[a])];
-    element_energy.push_back(sum);
-  }
-  double total = 0.0;
-  for (double e : element_energy) total += e;
+  const double total = element_energy.sum();
   std::ostringstream csv;
   csv.precision(17);
   csv << "element,x,y,half_width,half_height,zone,share\n";
@@ -190,8 +192,8 @@ void WriteErrorMap(const MatrixModelData& coarse, const std::string& coarse_fold
       y_max = std::max(y_max, node[2]);
     }
     csv << e << ',' << 0.5 * (x_min + x_max) << ',' << 0.5 * (y_min + y_max) << ','
-        << 0.5 * (x_max - x_min) << ',' << 0.5 * (y_max - y_min) << ','
-        << static_cast<int>(elements[e][5]) << ',' << element_energy[e] / total << '\n';
+        << 0.5 * (x_max - x_min) << ',' << 0.5 * (y_max - y_min) << ',' << coarse.elements[e].zone
+        << ',' << element_energy[static_cast<int>(e)] / total << '\n';
   }
   WriteFileAtomically(folder + "/error_map.csv", csv.str());
   std::ostringstream script;

@@ -15,9 +15,11 @@ meshes of the same plate are written:
 Each folder holds M.mtx, one K_<zone>.mtx per zone at the nominal modulus, the load
 vectors load_F.mtx and load_Fx.mtx (a unit transverse or axial traction resultant on
 the free edge x = L; its time history is the CSV channel F), one sensor_<channel>.mtx
-row per sensor, the manifests model.yaml (transverse impact) and model_axial.yaml
-(axial impact) read by mcrewave (model/matrix_export.h) and the mesh
-(nodes.csv, elements.csv) for drawing the error map. The clamped dofs are eliminated.
+row per sensor, the element blocks of the error map per element (element_dofs.csv,
+element_stiffness.csv, element_positions.csv), the manifests model.yaml (transverse
+impact) and model_axial.yaml (axial impact) read by mcrewave (model/matrix_export.h) and
+the mesh (nodes.csv, elements.csv) for drawing the error map. The clamped dofs are
+eliminated.
 
 Usage: python3 scripts/make_plate_example.py [--output configs/plate] [--nx 24 --ny 6]
        [--refine 2]
@@ -124,6 +126,7 @@ def assemble(mesh):
     n = mesh.dofs
     entries = {"matrix": {}, "inclusion": {}, "mass": {}}
     zones = []
+    blocks = []  # per element: its kept dofs and its block of k_element on them
     for j in range(mesh.ny):
         for i in range(mesh.nx):
             zone = "inclusion" if mesh.in_inclusion(i, j) else "matrix"
@@ -132,6 +135,8 @@ def assemble(mesh):
             for (nj, ni) in mesh.element_nodes(i, j):
                 base = mesh.dof[nj, ni]
                 dofs += [base, base + 1] if base >= 0 else [-1, -1]
+            kept = [a for a in range(8) if dofs[a] >= 0]
+            blocks.append(([dofs[a] for a in kept], k_element[np.ix_(kept, kept)]))
             for a in range(8):
                 for b in range(8):
                     if dofs[a] < 0 or dofs[b] < 0:
@@ -139,7 +144,7 @@ def assemble(mesh):
                     key = (dofs[a], dofs[b])
                     entries[zone][key] = entries[zone].get(key, 0.0) + k_element[a, b]
                     entries["mass"][key] = entries["mass"].get(key, 0.0) + m_element[a, b]
-    return n, entries, zones
+    return n, entries, zones, blocks
 
 
 def write_symmetric(path, n, entries, comment):
@@ -176,7 +181,7 @@ def write_vector(path, vector, comment):
 def write_mesh(folder, refine):
     mesh = Mesh(args.nx * refine, args.ny * refine)
     os.makedirs(folder, exist_ok=True)
-    n, entries, zones = assemble(mesh)
+    n, entries, zones, blocks = assemble(mesh)
     write_symmetric(os.path.join(folder, "M.mtx"), n, entries["mass"],
                     f"consistent mass [kg], Q4 plane stress {mesh.nx} x {mesh.ny}")
     for zone in ("matrix", "inclusion"):
@@ -230,6 +235,24 @@ def write_mesh(folder, refine):
             for sensor in SENSORS:
                 kind = ", kind: strain" if sensor[1] == "exx" else ""
                 f.write(f"  - {{channel: {sensor[0]}, row: sensor_{sensor[0]}.mtx{kind}}}\n")
+            f.write("elements: {dofs: element_dofs.csv, stiffness: element_stiffness.csv, "
+                    "positions: element_positions.csv}\n")
+    # The element blocks of the error map per element (docs/matrix_models.md section 4):
+    # each element's zone and kept dofs (the clamped ones eliminated), its block of
+    # K_<zone> at the nominal modulus, and its centroid.
+    with open(os.path.join(folder, "element_dofs.csv"), "w") as f:
+        f.write("# zone, then the element's dofs (0-based), elements as in elements.csv\n")
+        for zone, (dofs, _) in zip(zones, blocks):
+            f.write(f"{zone},{','.join(map(str, dofs))}\n")
+    with open(os.path.join(folder, "element_stiffness.csv"), "w") as f:
+        f.write(f"# the element's block of K [N/m] at E = {NOMINAL_MODULUS:g} Pa, row by row\n")
+        for _, block in blocks:
+            f.write(",".join(f"{value:.17g}" for value in block.ravel()) + "\n")
+    with open(os.path.join(folder, "element_positions.csv"), "w") as f:
+        f.write("# the element's centroid x, y [m]\n")
+        for j in range(mesh.ny):
+            for i in range(mesh.nx):
+                f.write(f"{(i + 0.5) * mesh.dx:.17g},{(j + 0.5) * mesh.dy:.17g}\n")
     with open(os.path.join(folder, "nodes.csv"), "w") as f:
         f.write("node,x,y,dof_x,dof_y\n")
         for j in range(mesh.ny + 1):
