@@ -7,9 +7,9 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <random>
 #include <utility>
 
+#include "mcrewave/core/random.h"
 #include "mcrewave/data/prefilter.h"
 #include "mcrewave/data/resample.h"
 #include "mcrewave/least_squares/matrix_output_error_objective.h"
@@ -585,12 +585,7 @@ void AddMatrixModelNoise(const MatrixModelData& model, double snr, std::uint64_t
     levels->strain_std = std_e;
     levels->force_std = std_f;
   }
-  std::mt19937_64 generator(seed);
-  // Uniform in (0, 1) from 53 random bits; a standard normal draw by Box-Muller.
-  auto uniform = [&] { return (static_cast<double>(generator() >> 11) + 0.5) * 0x1.0p-53; };
-  auto normal = [&] {
-    return std::sqrt(-2.0 * std::log(uniform())) * std::cos(2.0 * M_PI * uniform());
-  };
+  StandardNormal normal(seed);
   for (int c = 0; c < num_loads; ++c) {
     for (int j = 0; j < samples; ++j) (*load_values[c])[j] += std_f * normal();
   }

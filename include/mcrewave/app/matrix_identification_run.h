@@ -96,8 +96,8 @@ Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_modu
 
 // Adds white Gaussian noise to every channel: standard deviation RMS / snr of the
 // channels of the same quantity (the displacement sensors together, the strain
-// sensors together, the loads together), drawn by a 64-bit Mersenne twister seeded
-// with `seed` (Box-Muller), the loads first, then the sensors in order, sample by
+// sensors together, the loads together), drawn by the project's StandardNormal
+// (core/random.h) seeded with `seed`, the loads first, then the sensors in order, sample by
 // sample, then each support's force (the loads' deviation) and displacement channel
 // (the displacement sensors'). Nothing when snr is infinite. levels (nullable): the
 // standard deviations drawn (displacement_std, strain_std, force_std; all 0 when snr is
