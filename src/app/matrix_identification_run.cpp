@@ -543,8 +543,18 @@ Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_modu
   MatrixMcreProblem simulation(truth, data, McreWeights(), truth.zones[0].nominal_modulus, theta,
                                Factorization::kAutomatic, ClampModel::kTrusted);
   simulation.SetModuli(zone_moduli);
-  if (support_forces != nullptr) {
-    *support_forces = truth.supports.empty() ? Matrix() : simulation.ModelSupportForces();
+  if (support_forces != nullptr && truth.supports.empty()) {
+    *support_forces = Matrix();
+  } else if (support_forces != nullptr) {
+    // A support measures its reaction with the inertia of the free dofs,
+    // r_s = g_s^T (K U + M a) (docs/matrix_models.md section 11), as the bar's clamp
+    // reaction f0 = row_0(M a + K u) (model/simulation.h): least squares' prediction of
+    // the same held structure from the same loads. The misfit levels only weigh its cost.
+    NoiseLevels unit_levels;
+    unit_levels.displacement_std = unit_levels.strain_std = unit_levels.force_std = 1.0;
+    MatrixOutputErrorObjective held(truth, data, unit_levels, theta);
+    held.Cost(zone_moduli, nullptr);
+    *support_forces = held.support_forces();
   }
   return simulation.ModelOutputs();
 }

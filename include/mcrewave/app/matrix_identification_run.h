@@ -88,8 +88,9 @@ void CheckMatrixModelFieldBytes(const Config& config, const MatrixModelData& mod
 // per load channel [N], sampled at t_j = j time_step) with the theta method: the
 // noise-free data of that structure (sensor rows, model order). A truth with supports
 // is held by them (their dofs at rest, docs/matrix_models.md section 11); with
-// support_forces not null, it receives their reactions g^T K U [N] (one row per support,
-// model order; no row without supports).
+// support_forces not null, it receives their reactions with the inertia of the free
+// dofs, g^T (K U + M a) [N], as the bar's clamp reaction (one row per support, model
+// order; no row without supports).
 Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_moduli,
                            const Matrix& loads, double time_step, double theta,
                            Matrix* support_forces = nullptr);
