@@ -685,7 +685,8 @@ std::string RobustnessSummary(const RobustnessStudy& study) {
           "2.5-97.5 % quantile band of the converged runs (zones: "
        << ZoneList(study)
        << "). Each run is the identification of `identify run` on the matrix model (pre-filter, "
-          "every zone at once from the nominal moduli; no error map or uncertainty) on data of "
+          "the homogeneous stage when the zones' nominal moduli agree, then every zone at once "
+          "from its E*, else from the nominal moduli; no error map or uncertainty) on data of "
           "the truth plus white noise of one seed; at SNR inf there is one run (no noise), "
           "whose error is the model's bias against the truth. `runs.csv`: one row per "
           "identification and zone; `statistics.csv`: one row per SNR and zone. E_ref: "
