@@ -498,8 +498,8 @@ TEST(MatrixIdentificationRunTest, FieldsAboveTheLimitAreRefusedAtLoadNamingWhatF
 }
 
 // The plate example's config (configs/plate.yaml) on half its window: both zones from
-// the finer mesh's data at SNR 20 (seed 1). Measured on the full window: -2.58 %
-// (matrix) and -1.48 % (inclusion), mostly the coarse mesh's discretisation error; on
+// the finer mesh's data at SNR 20 (seed 1). Measured on the full window: -2.40 %
+// (matrix) and -1.16 % (inclusion), mostly the coarse mesh's discretisation error; on
 // the half window -2.16 % and -7.69 %, checked to half a percentage point (the run is
 // seeded: a change of these figures is a change of the code).
 TEST(MatrixIdentificationRunTest, ThePlateConfigIdentifiesBothZones) {
