@@ -6,7 +6,7 @@
 # made here by scripts/make_plate_example.py into a temporary folder (Debian's
 # python3-numpy: `apt-get install python3-numpy`; the build and the tests never need
 # it); an axial impact on the free edge; then results/README.md is gathered again.
-# About 35 minutes on 2 cores with 20 seeds.
+# About 20 minutes on 2 idle cores with 20 seeds.
 # Usage: scripts/plate_study.sh [seeds]     (default 20)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
