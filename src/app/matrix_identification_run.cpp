@@ -547,9 +547,10 @@ Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_modu
     *support_forces = Matrix();
   } else if (support_forces != nullptr) {
     // A support measures its reaction with the inertia of the free dofs,
-    // r_s = g_s^T (K U + M a) (docs/matrix_models.md section 11), as the bar's clamp
+    // r_s = g_s^T (K U + M a) (docs/matrix_models.md section 10), as the bar's clamp
     // reaction f0 = row_0(M a + K u) (model/simulation.h): least squares' prediction of
-    // the same held structure from the same loads. The misfit levels only weigh its cost.
+    // the same held structure from the same loads. The misfit levels only weigh its cost;
+    // M is positive definite (checked when the manifest is read), so is its free block.
     NoiseLevels unit_levels;
     unit_levels.displacement_std = unit_levels.strain_std = unit_levels.force_std = 1.0;
     MatrixOutputErrorObjective held(truth, data, unit_levels, theta);
