@@ -601,6 +601,12 @@ void InnerSolvesYaml(const ModulusStage& run, const Config& config, double dofs,
   yaml->Number(1, "relative_residual_at_optimum", best_inner.relative_residual);
   yaml->Integer(1, "iterations_from_zero_at_optimum", run.cold_solve.iterations,
                 "of a solve from W = 0 at the identified modulus (inner_residual.csv)");
+  // The spectrum of I - G that sets the CG's iterations (docs/formulation.md section 4).
+  auto estimate = [](double a) { return a > 0.0 ? a : NAN; };
+  yaml->Number(1, "spectrum_min_from_zero", estimate(run.cold_solve.spectrum_min),
+               "least eigenvalue of I - G, the Ritz estimate of that solve (null: not a CG)");
+  yaml->Number(1, "spectrum_max_from_zero", estimate(run.cold_solve.spectrum_max),
+               "largest: CG needs about sqrt(max / min) iterations a decade of residual");
 }
 
 // The cost_curve: section's points and range, as the MCRE and least squares write it.

@@ -68,8 +68,10 @@ std::string CoupledSolverSummary::FullReport() const {
     out << "  relaxation coefficient " << relaxation_coefficient << "\n";
   }
   if (spectrum_max > 0.0) {
-    out << "  spectrum of I - G      [" << spectrum_min << ", " << spectrum_max << "]\n"
-        << "  safeguard restarts     " << safeguard_restarts << "\n";
+    out << "  spectrum of I - G      [" << spectrum_min << ", " << spectrum_max << "]\n";
+  }
+  if (type == CoupledSolverType::kAdaptiveRelaxation) {
+    out << "  safeguard restarts     " << safeguard_restarts << "\n";
   }
   if (shooting_segments > 0) {
     out << "  shooting segments      " << shooting_segments << "\n"

@@ -8,6 +8,9 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 #include "mcre/coupled_solver_internal.h"
 #include "mcre/direct_solution_check.h"
@@ -109,6 +112,26 @@ std::pair<double, double> EstimateSpectrum(CoupledProblem* problem, const Matrix
   Eigen::SelfAdjointEigenSolver<Matrix> ritz;
   Vector sub = off_diagonal.head(std::max(done - 1, 0));
   ritz.computeFromTridiagonal(diagonal.head(done), sub, Eigen::EigenvaluesOnly);
+  return {ritz.eigenvalues().minCoeff(), ritz.eigenvalues().maxCoeff()};
+}
+
+// The extreme Ritz values {a_min, a_max} of the Lanczos process that conjugate
+// gradients run on A = I - G, from their coefficients: step_k = rho_k / <p_k, A p_k>_P
+// and ratio_k = rho_{k+1} / rho_k give the tridiagonal (Saad, Iterative Methods for
+// Sparse Linear Systems, 2nd ed., section 6.7.3)
+//   T_kk = 1 / step_k + ratio_{k-1} / step_{k-1},   T_k,k+1 = sqrt(ratio_k) / step_k.
+// Precondition: at least one step.
+std::pair<double, double> ConjugateGradientRitzExtremes(const std::vector<double>& steps,
+                                                        const std::vector<double>& ratios) {
+  const auto k = static_cast<Eigen::Index>(steps.size());
+  Vector diagonal(k), off_diagonal(std::max<Eigen::Index>(k - 1, 0));
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const auto at = static_cast<std::size_t>(i);
+    diagonal[i] = 1.0 / steps[at] + (i > 0 ? ratios[at - 1] / steps[at - 1] : 0.0);
+    if (i + 1 < k) off_diagonal[i] = std::sqrt(ratios[at]) / steps[at];
+  }
+  Eigen::SelfAdjointEigenSolver<Matrix> ritz;
+  ritz.computeFromTridiagonal(diagonal, off_diagonal, Eigen::EigenvaluesOnly);
   return {ritz.eigenvalues().minCoeff(), ritz.eigenvalues().maxCoeff()};
 }
 
@@ -272,6 +295,16 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, CoupledProble
   // Whether `residual` is the true residual T(W) - W with U = Direct(W): after the
   // start and after a verification, not after a CG step (recursive residual).
   bool residual_is_true = true;
+  // The Lanczos coefficients of the first CG run (a verified restart starts another
+  // Krylov space), for the summary's Ritz extremes of A.
+  std::vector<double> lanczos_steps, lanczos_ratios;
+  lanczos_steps.reserve(static_cast<std::size_t>(std::min(options.max_iterations, 1000)));
+  lanczos_ratios.reserve(lanczos_steps.capacity());
+  auto record_spectrum = [&] {
+    if (lanczos_steps.empty()) return;
+    std::tie(summary->spectrum_min, summary->spectrum_max) =
+        ConjugateGradientRitzExtremes(lanczos_steps, lanczos_ratios);
+  };
   for (int iteration = 0;; ++iteration) {
     double relative = std::sqrt(std::max(rho, 0.0)) / start.rhs_norm;
     if (!std::isfinite(relative)) {
@@ -296,12 +329,14 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, CoupledProble
         summary->iterations = iteration;  // CG steps taken
         summary->termination = TerminationType::kConvergence;
         summary->message = ConvergenceMessage(start, relative, options.tolerance);
+        record_spectrum();
         return;
       }
       if (++restarts > kMaxVerifiedRestarts) {
         summary->termination = TerminationType::kNoConvergence;
         summary->message = "the true residual " + ScientificString(relative) +
                            " stays above the tolerance (round-off limit reached)";
+        record_spectrum();
         return;
       }
       direction = residual;
@@ -314,6 +349,7 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, CoupledProble
       summary->message = "no convergence in " + std::to_string(iteration) +
                          " iterations: relative residual " + ScientificString(relative) +
                          " > tolerance " + ScientificString(options.tolerance);
+      record_spectrum();
       return;
     }
     // q = A p = p - G p.
@@ -331,6 +367,10 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, CoupledProble
     residual -= step * image;
     residual_is_true = false;
     const double rho_next = problem->InnerProduct(residual, residual);
+    if (restarts == 0) {
+      lanczos_steps.push_back(step);
+      lanczos_ratios.push_back(rho_next / rho);
+    }
     direction = residual + (rho_next / rho) * direction;
     rho = rho_next;
   }

@@ -139,8 +139,12 @@ struct CoupledSolverSummary {
   double relative_residual = -1.0;       // final ||c - A W||_P / ||c||_P
   std::vector<double> residual_history;  // relative residual per iteration
   double relaxation_coefficient = -1.0;  // omega used by the relaxation solvers
-  double spectrum_min = -1.0;            // estimated a_min of A = I - G (adaptive only)
-  double spectrum_max = -1.0;            // estimated a_max of A = I - G (adaptive only)
+  // Estimates of the extreme eigenvalues a_min, a_max of A = I - G: adaptive relaxation,
+  // the Lanczos estimate its omega comes from; conjugate_gradient, the extreme Ritz
+  // values of its own Lanczos process (from its coefficients, no extra sweep; a_max from
+  // below, a_min from above), once it took a step; -1 otherwise.
+  double spectrum_min = -1.0;
+  double spectrum_max = -1.0;
   int safeguard_restarts = 0;            // adaptive only: omega re-chosen after growth
   double wall_time_s = -1.0;
   // Riccati and shooting only: multiply-accumulates of the method itself (the
