@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs the Debian packages mcrewave needs, only those that are missing.
+# Installs the Debian packages mcrewave needs, only those that are missing, and the
+# packages named as arguments (a study script's own, e.g. python3-numpy).
 # Runs as root (or through sudo when available); never prompts.
 set -euo pipefail
 
@@ -8,6 +9,7 @@ packages=(
   libeigen3-dev libnlopt-cxx-dev libceres-dev libyaml-cpp-dev libspdlog-dev
   libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox
   clang libclang-rt-14-dev
+  "$@"
 )
 
 missing=()
