@@ -5,6 +5,9 @@
 // sweeps and time.
 #pragma once
 
+#include <utility>
+#include <vector>
+
 #include "mcrewave/mcre/coupled_solver.h"
 
 namespace mcrewave::internal {
@@ -29,5 +32,15 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options,
                                        StreamingCoupledProblem* problem,
                                        const Matrix* initial_traces, CoupledSolution* solution,
                                        CoupledSolverSummary* summary);
+
+// The extreme Ritz values {a_min, a_max} of the Lanczos process that conjugate
+// gradients run on A = I - G in <.,.>_P (or on I - L over the traces, whose spectrum
+// is A's but for eigenvalues 1), from their coefficients: step_k = rho_k / <p_k, A p_k>
+// and ratio_k = rho_{k+1} / rho_k give the tridiagonal (Saad, Iterative Methods for
+// Sparse Linear Systems, 2nd ed., section 6.7.3)
+//   T_kk = 1 / step_k + ratio_{k-1} / step_{k-1},   T_k,k+1 = sqrt(ratio_k) / step_k.
+// Precondition: at least one step.
+std::pair<double, double> ConjugateGradientRitzExtremes(const std::vector<double>& steps,
+                                                        const std::vector<double>& ratios);
 
 }  // namespace mcrewave::internal

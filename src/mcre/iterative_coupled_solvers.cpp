@@ -115,26 +115,6 @@ std::pair<double, double> EstimateSpectrum(CoupledProblem* problem, const Matrix
   return {ritz.eigenvalues().minCoeff(), ritz.eigenvalues().maxCoeff()};
 }
 
-// The extreme Ritz values {a_min, a_max} of the Lanczos process that conjugate
-// gradients run on A = I - G, from their coefficients: step_k = rho_k / <p_k, A p_k>_P
-// and ratio_k = rho_{k+1} / rho_k give the tridiagonal (Saad, Iterative Methods for
-// Sparse Linear Systems, 2nd ed., section 6.7.3)
-//   T_kk = 1 / step_k + ratio_{k-1} / step_{k-1},   T_k,k+1 = sqrt(ratio_k) / step_k.
-// Precondition: at least one step.
-std::pair<double, double> ConjugateGradientRitzExtremes(const std::vector<double>& steps,
-                                                        const std::vector<double>& ratios) {
-  const auto k = static_cast<Eigen::Index>(steps.size());
-  Vector diagonal(k), off_diagonal(std::max<Eigen::Index>(k - 1, 0));
-  for (Eigen::Index i = 0; i < k; ++i) {
-    const auto at = static_cast<std::size_t>(i);
-    diagonal[i] = 1.0 / steps[at] + (i > 0 ? ratios[at - 1] / steps[at - 1] : 0.0);
-    if (i + 1 < k) off_diagonal[i] = std::sqrt(ratios[at]) / steps[at];
-  }
-  Eigen::SelfAdjointEigenSolver<Matrix> ritz;
-  ritz.computeFromTridiagonal(diagonal, off_diagonal, Eigen::EigenvaluesOnly);
-  return {ritz.eigenvalues().minCoeff(), ritz.eigenvalues().maxCoeff()};
-}
-
 // The message of a converged solve.
 std::string ConvergenceMessage(const StartingPoint& start, double relative, double tolerance) {
   if (relative <= tolerance) {
@@ -199,6 +179,20 @@ std::string RelaxationDivergenceMessage(double best, double relative, int iterat
 }
 
 }  // namespace
+
+std::pair<double, double> ConjugateGradientRitzExtremes(const std::vector<double>& steps,
+                                                        const std::vector<double>& ratios) {
+  const auto k = static_cast<Eigen::Index>(steps.size());
+  Vector diagonal(k), off_diagonal(std::max<Eigen::Index>(k - 1, 0));
+  for (Eigen::Index i = 0; i < k; ++i) {
+    const auto at = static_cast<std::size_t>(i);
+    diagonal[i] = 1.0 / steps[at] + (i > 0 ? ratios[at - 1] / steps[at - 1] : 0.0);
+    if (i + 1 < k) off_diagonal[i] = std::sqrt(ratios[at]) / steps[at];
+  }
+  Eigen::SelfAdjointEigenSolver<Matrix> ritz;
+  ritz.computeFromTridiagonal(diagonal, off_diagonal, Eigen::EigenvaluesOnly);
+  return {ritz.eigenvalues().minCoeff(), ritz.eigenvalues().maxCoeff()};
+}
 
 void SolveByRelaxation(const CoupledSolverOptions& options, CoupledProblem* problem,
                        const Matrix* initial_retrograde, CoupledSolution* solution,

@@ -140,9 +140,10 @@ struct CoupledSolverSummary {
   std::vector<double> residual_history;  // relative residual per iteration
   double relaxation_coefficient = -1.0;  // omega used by the relaxation solvers
   // Estimates of the extreme eigenvalues a_min, a_max of A = I - G: adaptive relaxation,
-  // the Lanczos estimate its omega comes from; conjugate_gradient, the extreme Ritz
-  // values of its own Lanczos process (from its coefficients, no extra sweep; a_max from
-  // below, a_min from above), once it took a step; -1 otherwise.
+  // the Lanczos estimate its omega comes from; conjugate_gradient and
+  // streaming_conjugate_gradient, the extreme Ritz values of their own Lanczos process
+  // (from their coefficients, no extra sweep; a_max from below, a_min from above), once
+  // they took a step; -1 otherwise.
   double spectrum_min = -1.0;
   double spectrum_max = -1.0;
   int safeguard_restarts = 0;            // adaptive only: omega re-chosen after growth
