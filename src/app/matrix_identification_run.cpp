@@ -461,6 +461,20 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
   }
 }
 
+// A held truth's support forces as a support measures them, with the inertia of the
+// free dofs, r_s = g_s^T (K U + M a) (docs/matrix_models.md section 10), as the bar's
+// clamp reaction f0 = row_0(M a + K u) (model/simulation.h): least squares' prediction
+// of the same held structure from the loads of `data`. The misfit levels only weigh its
+// cost; M is positive definite (checked when the manifest is read), so is its free block.
+Matrix HeldSupportForces(const MatrixModelData& truth, const ChannelSet& data,
+                         const Vector& zone_moduli, double theta) {
+  NoiseLevels unit_levels;
+  unit_levels.displacement_std = unit_levels.strain_std = unit_levels.force_std = 1.0;
+  MatrixOutputErrorObjective held(truth, data, unit_levels, theta);
+  held.Cost(zone_moduli, nullptr);
+  return held.support_forces();
+}
+
 }  // namespace
 
 MatrixModelData LoadMatrixModel(const Config& config) {
@@ -543,19 +557,9 @@ Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_modu
   MatrixMcreProblem simulation(truth, data, McreWeights(), truth.zones[0].nominal_modulus, theta,
                                Factorization::kAutomatic, ClampModel::kTrusted);
   simulation.SetModuli(zone_moduli);
-  if (support_forces != nullptr && truth.supports.empty()) {
-    *support_forces = Matrix();
-  } else if (support_forces != nullptr) {
-    // A support measures its reaction with the inertia of the free dofs,
-    // r_s = g_s^T (K U + M a) (docs/matrix_models.md section 10), as the bar's clamp
-    // reaction f0 = row_0(M a + K u) (model/simulation.h): least squares' prediction of
-    // the same held structure from the same loads. The misfit levels only weigh its cost;
-    // M is positive definite (checked when the manifest is read), so is its free block.
-    NoiseLevels unit_levels;
-    unit_levels.displacement_std = unit_levels.strain_std = unit_levels.force_std = 1.0;
-    MatrixOutputErrorObjective held(truth, data, unit_levels, theta);
-    held.Cost(zone_moduli, nullptr);
-    *support_forces = held.support_forces();
+  if (support_forces != nullptr) {
+    *support_forces =
+        truth.supports.empty() ? Matrix() : HeldSupportForces(truth, data, zone_moduli, theta);
   }
   return simulation.ModelOutputs();
 }

@@ -33,14 +33,25 @@ void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options,
                                        const Matrix* initial_traces, CoupledSolution* solution,
                                        CoupledSolverSummary* summary);
 
-// The extreme Ritz values {a_min, a_max} of the Lanczos process that conjugate
-// gradients run on A = I - G in <.,.>_P (or on I - L over the traces, whose spectrum
-// is A's but for eigenvalues 1), from their coefficients: step_k = rho_k / <p_k, A p_k>
-// and ratio_k = rho_{k+1} / rho_k give the tridiagonal (Saad, Iterative Methods for
-// Sparse Linear Systems, 2nd ed., section 6.7.3)
+// {min, max} of the eigenvalues of the symmetric tridiagonal matrix with this diagonal
+// and sub-diagonal (one entry fewer): the Ritz extremes of a Lanczos process.
+std::pair<double, double> TridiagonalEigenvalueExtremes(const Vector& diagonal,
+                                                        const Vector& sub_diagonal);
+
+// The Lanczos coefficients of a conjugate-gradient run on A = I - G in <.,.>_P (or on
+// I - L over the traces, whose spectrum is A's but for eigenvalues 1): step_k =
+// rho_k / <p_k, A p_k> and ratio_k = rho_{k+1} / rho_k give the tridiagonal (Saad,
+// Iterative Methods for Sparse Linear Systems, 2nd ed., section 6.7.3)
 //   T_kk = 1 / step_k + ratio_{k-1} / step_{k-1},   T_k,k+1 = sqrt(ratio_k) / step_k.
-// Precondition: at least one step.
-std::pair<double, double> ConjugateGradientRitzExtremes(const std::vector<double>& steps,
-                                                        const std::vector<double>& ratios);
+struct ConjugateGradientLanczos {
+  std::vector<double> steps, ratios;
+  void Add(double step, double ratio) {
+    steps.push_back(step);
+    ratios.push_back(ratio);
+  }
+  // The extreme Ritz values of T into summary->spectrum_min / spectrum_max; nothing
+  // before the first step.
+  void ReportTo(CoupledSolverSummary* summary) const;
+};
 
 }  // namespace mcrewave::internal

@@ -109,10 +109,8 @@ std::pair<double, double> EstimateSpectrum(CoupledProblem* problem, const Matrix
     q = w / beta;
     beta_previous = beta;
   }
-  Eigen::SelfAdjointEigenSolver<Matrix> ritz;
-  Vector sub = off_diagonal.head(std::max(done - 1, 0));
-  ritz.computeFromTridiagonal(diagonal.head(done), sub, Eigen::EigenvaluesOnly);
-  return {ritz.eigenvalues().minCoeff(), ritz.eigenvalues().maxCoeff()};
+  return TridiagonalEigenvalueExtremes(diagonal.head(done),
+                                       off_diagonal.head(std::max(done - 1, 0)));
 }
 
 // The message of a converged solve.
@@ -180,18 +178,25 @@ std::string RelaxationDivergenceMessage(double best, double relative, int iterat
 
 }  // namespace
 
-std::pair<double, double> ConjugateGradientRitzExtremes(const std::vector<double>& steps,
-                                                        const std::vector<double>& ratios) {
+std::pair<double, double> TridiagonalEigenvalueExtremes(const Vector& diagonal,
+                                                        const Vector& sub_diagonal) {
+  Eigen::SelfAdjointEigenSolver<Matrix> ritz;
+  ritz.computeFromTridiagonal(diagonal, sub_diagonal, Eigen::EigenvaluesOnly);
+  return {ritz.eigenvalues().minCoeff(), ritz.eigenvalues().maxCoeff()};
+}
+
+void ConjugateGradientLanczos::ReportTo(CoupledSolverSummary* summary) const {
   const auto k = static_cast<Eigen::Index>(steps.size());
-  Vector diagonal(k), off_diagonal(std::max<Eigen::Index>(k - 1, 0));
+  if (k == 0) return;
+  Vector diagonal(k), sub_diagonal(k - 1);
   for (Eigen::Index i = 0; i < k; ++i) {
     const auto at = static_cast<std::size_t>(i);
+    // T_kk = 1 / step_k + ratio_{k-1} / step_{k-1},  T_k,k+1 = sqrt(ratio_k) / step_k
     diagonal[i] = 1.0 / steps[at] + (i > 0 ? ratios[at - 1] / steps[at - 1] : 0.0);
-    if (i + 1 < k) off_diagonal[i] = std::sqrt(ratios[at]) / steps[at];
+    if (i + 1 < k) sub_diagonal[i] = std::sqrt(ratios[at]) / steps[at];
   }
-  Eigen::SelfAdjointEigenSolver<Matrix> ritz;
-  ritz.computeFromTridiagonal(diagonal, off_diagonal, Eigen::EigenvaluesOnly);
-  return {ritz.eigenvalues().minCoeff(), ritz.eigenvalues().maxCoeff()};
+  std::tie(summary->spectrum_min, summary->spectrum_max) =
+      TridiagonalEigenvalueExtremes(diagonal, sub_diagonal);
 }
 
 void SolveByRelaxation(const CoupledSolverOptions& options, CoupledProblem* problem,
@@ -291,14 +296,7 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, CoupledProble
   bool residual_is_true = true;
   // The Lanczos coefficients of the first CG run (a verified restart starts another
   // Krylov space), for the summary's Ritz extremes of A.
-  std::vector<double> lanczos_steps, lanczos_ratios;
-  lanczos_steps.reserve(static_cast<std::size_t>(std::min(options.max_iterations, 1000)));
-  lanczos_ratios.reserve(lanczos_steps.capacity());
-  auto record_spectrum = [&] {
-    if (lanczos_steps.empty()) return;
-    std::tie(summary->spectrum_min, summary->spectrum_max) =
-        ConjugateGradientRitzExtremes(lanczos_steps, lanczos_ratios);
-  };
+  ConjugateGradientLanczos lanczos;
   for (int iteration = 0;; ++iteration) {
     double relative = std::sqrt(std::max(rho, 0.0)) / start.rhs_norm;
     if (!std::isfinite(relative)) {
@@ -323,14 +321,14 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, CoupledProble
         summary->iterations = iteration;  // CG steps taken
         summary->termination = TerminationType::kConvergence;
         summary->message = ConvergenceMessage(start, relative, options.tolerance);
-        record_spectrum();
+        lanczos.ReportTo(summary);
         return;
       }
       if (++restarts > kMaxVerifiedRestarts) {
         summary->termination = TerminationType::kNoConvergence;
         summary->message = "the true residual " + ScientificString(relative) +
                            " stays above the tolerance (round-off limit reached)";
-        record_spectrum();
+        lanczos.ReportTo(summary);
         return;
       }
       direction = residual;
@@ -343,7 +341,7 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, CoupledProble
       summary->message = "no convergence in " + std::to_string(iteration) +
                          " iterations: relative residual " + ScientificString(relative) +
                          " > tolerance " + ScientificString(options.tolerance);
-      record_spectrum();
+      lanczos.ReportTo(summary);
       return;
     }
     // q = A p = p - G p.
@@ -361,10 +359,7 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, CoupledProble
     residual -= step * image;
     residual_is_true = false;
     const double rho_next = problem->InnerProduct(residual, residual);
-    if (restarts == 0) {
-      lanczos_steps.push_back(step);
-      lanczos_ratios.push_back(rho_next / rho);
-    }
+    if (restarts == 0) lanczos.Add(step, rho_next / rho);
     direction = residual + (rho_next / rho) * direction;
     rho = rho_next;
   }

@@ -40,8 +40,6 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
-#include <tuple>
-#include <vector>
 
 #include "mcre/coupled_solver_internal.h"
 #include "mcre/direct_solution_check.h"
@@ -77,7 +75,7 @@ class StreamingConjugateGradient {
   void Solve(const Matrix* initial_traces);
   // The summary's spectrum_min / spectrum_max: the Ritz extremes of the CG run before
   // the first restart, once it took a step.
-  void ReportSpectrum() const;
+  void ReportSpectrum() const { lanczos_.ReportTo(summary_); }
 
  private:
   // The final pass at y: the true residual Phi(y) - y = b - (I - L) y into `image`,
@@ -124,14 +122,8 @@ class StreamingConjugateGradient {
   // The true residual of the previous final pass (none yet: infinite).
   double previous_true_relative_ = std::numeric_limits<double>::infinity();
   // The Lanczos coefficients (step_k, rho_{k+1} / rho_k) before the first restart.
-  std::vector<double> lanczos_steps_, lanczos_ratios_;
+  ConjugateGradientLanczos lanczos_;
 };
-
-void StreamingConjugateGradient::ReportSpectrum() const {
-  if (lanczos_steps_.empty()) return;
-  std::tie(summary_->spectrum_min, summary_->spectrum_max) =
-      ConjugateGradientRitzExtremes(lanczos_steps_, lanczos_ratios_);
-}
 
 void StreamingConjugateGradient::Solve(const Matrix* initial_traces) {
   solution_->displacement.resize(0, 0);
@@ -254,10 +246,7 @@ void StreamingConjugateGradient::Step(double direction_energy, double curvature)
   residual_ -= step * image_;
   const double rho_next = problem_->TraceInnerProduct(residual_, residual_);
   direction_coefficient_ = rho_next / rho_;
-  if (restarts_ == 0) {
-    lanczos_steps_.push_back(step);
-    lanczos_ratios_.push_back(direction_coefficient_);
-  }
+  if (restarts_ == 0) lanczos_.Add(step, direction_coefficient_);
   // <p_{k+1}, p_k> = <r_{k+1}, p_k> + beta_{k+1} <p_k, p_k>.
   consecutive_directions_ =
       problem_->TraceInnerProduct(residual_, direction_) +
