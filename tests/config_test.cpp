@@ -60,6 +60,10 @@ void ExpectSameConfigMcreAndInner(const Config& expected, const Config& actual) 
   EXPECT_EQ(expected.inner.max_field_bytes, actual.inner.max_field_bytes);
   EXPECT_EQ(expected.inner.shooting_condition_limit, actual.inner.shooting_condition_limit);
   EXPECT_EQ(expected.inner.shooting_segment_growth, actual.inner.shooting_segment_growth);
+  EXPECT_EQ(expected.inner.preconditioner, actual.inner.preconditioner);
+  EXPECT_EQ(expected.inner.preconditioner_rebuild_change,
+            actual.inner.preconditioner_rebuild_change);
+  EXPECT_EQ(expected.inner.max_preconditioner_traces, actual.inner.max_preconditioner_traces);
 }
 
 // The keys outer.*, prefilter.*, uncertainty.* and output.*.
@@ -776,11 +780,18 @@ data:
   truth_moduli: [2e11, 1.4000000000000001e11]
 )";
 
-// The key of equal zones, refused with the zoning of kEveryKeyNotAtItsDefault.
+// The key of equal zones, refused with the zoning of kEveryKeyNotAtItsDefault; the
+// streaming CG's preconditioner, which kEveryKeyNotAtItsDefault's adaptive_relaxation
+// does not take.
 constexpr const char* kEqualZonesKeyNotAtItsDefault = R"(model:
   zone_count: 3
 search:
   functional: same
+inner:
+  method: streaming_conjugate_gradient
+  preconditioner: dense_traces
+  preconditioner_rebuild_change: 0.035
+  max_preconditioner_traces: 777
 )";
 
 TEST(ConfigTest, EveryKeyAtANonDefaultValueRoundTripsExactly) {

@@ -500,6 +500,20 @@ const std::vector<Key>& KeyTable() {
               "solver of the coupled direct/retrograde problem for one E; auto: "
               "conjugate_gradient when its fields fit inner.max_field_bytes, else "
               "streaming_conjugate_gradient, which stores none"),
+      MakeKey("inner.preconditioner", &Config::inner, &CoupledSolverOptions::preconditioner,
+              EnumByName<TracePreconditioner>(
+                  {TracePreconditioner::kNone, TracePreconditioner::kDenseTraces},
+                  TracePreconditionerToString, StringToTracePreconditioner),
+              "",
+              "streaming_conjugate_gradient's preconditioner: none, or dense_traces (I - L at "
+              "nearby moduli, dense over the traces; a structure given by matrices)"),
+      MakeKey("inner.preconditioner_rebuild_change", &Config::inner,
+              &CoupledSolverOptions::preconditioner_rebuild_change, Number(), "",
+              "dense_traces is rebuilt when a modulus moved by more than this (relative)"),
+      MakeKey("inner.max_preconditioner_traces", &Config::inner,
+              &CoupledSolverOptions::max_preconditioner_traces, PositiveInteger<long>(), "",
+              "dense_traces only up to this many traces x samples (its factor: their square "
+              "in doubles)"),
       MakeKey("inner.tolerance", &Config::inner, &CoupledSolverOptions::tolerance, Number(), "",
               "stop when ||c - A W||_P / ||c||_P falls below this, in (0, 1)"),
       MakeKey("inner.max_iterations", &Config::inner, &CoupledSolverOptions::max_iterations,

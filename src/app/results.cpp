@@ -604,8 +604,8 @@ void InnerSolvesYaml(const ModulusStage& run, const Config& config, double dofs,
   // The spectrum of I - G that sets the CG's iterations (docs/formulation.md section 4).
   auto estimate = [](double a) { return a > 0.0 ? a : NAN; };
   yaml->Number(1, "spectrum_min_from_zero", estimate(run.cold_solve.spectrum_min),
-               "least eigenvalue of I - G, that solve's Ritz estimate (null: not estimated, "
-               "another solver or no step)");
+               "least eigenvalue of I - G (preconditioned: of M^-1 (I - L)), that solve's Ritz "
+               "estimate (null: not estimated, another solver or no step)");
   yaml->Number(1, "spectrum_max_from_zero", estimate(run.cold_solve.spectrum_max),
                "largest: CG needs about sqrt(max / min) iterations a decade of residual");
 }

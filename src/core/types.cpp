@@ -81,6 +81,13 @@ bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type)
   return internal::FromName(kCoupledSolverTypeNames, name, type);
 }
 
+const char* TracePreconditionerToString(TracePreconditioner preconditioner) {
+  return internal::ToName(kTracePreconditionerNames, preconditioner);
+}
+bool StringToTracePreconditioner(const std::string& name, TracePreconditioner* preconditioner) {
+  return internal::FromName(kTracePreconditionerNames, name, preconditioner);
+}
+
 const char* TerminationTypeToString(TerminationType type) { return internal::ToName(kTerminationTypeNames, type); }
 bool StringToTerminationType(const std::string& name, TerminationType* type) {
   return internal::FromName(kTerminationTypeNames, name, type);

@@ -35,6 +35,17 @@ bool CoupledSolverOptions::IsValid(std::string* error) const {
     why << "max_rebuild_error must lie in (0, 1), got " << max_rebuild_error;
   } else if (max_field_bytes < 1) {
     why << "inner.max_field_bytes must be positive, got " << max_field_bytes;
+  } else if (!(preconditioner_rebuild_change >= 0.0 && preconditioner_rebuild_change < 1.0)) {
+    why << "inner.preconditioner_rebuild_change must lie in [0, 1), got "
+        << preconditioner_rebuild_change;
+  } else if (max_preconditioner_traces < 1) {
+    why << "inner.max_preconditioner_traces must be positive, got " << max_preconditioner_traces;
+  } else if (preconditioner != TracePreconditioner::kNone &&
+             type != CoupledSolverType::kStreamingConjugateGradient) {
+    why << "inner.preconditioner " << TracePreconditionerToString(preconditioner)
+        << " preconditions inner.method streaming_conjugate_gradient only, got inner.method "
+        << CoupledSolverTypeToString(type)
+        << "; set inner.method: streaming_conjugate_gradient, or inner.preconditioner: none";
   } else if (!(shooting_condition_limit > 1.0)) {
     why << "inner.shooting_condition_limit must be above 1, got " << shooting_condition_limit;
   } else if (!(shooting_segment_growth > 1.0 && std::isfinite(shooting_segment_growth))) {

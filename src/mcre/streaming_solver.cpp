@@ -35,6 +35,15 @@
 // backward sweep (StreamingCoupledProblem::RetrogradeEnergy). (A first version stopped on
 // ||r||_beta / ||Phi(0)||_beta, which grows with the window: at the tolerance 1e-8 on
 // 101 nodes, e^2 was 2.2e-3 off the stored-field CG's at 1e5 steps.)
+//
+// Preconditioned (options.preconditioner, docs/streaming.md section 6): with M = I - L
+// at moduli near the solve's (StreamingCoupledProblem::PrepareTracePreconditioner),
+// z_k = M^-1 r_k, rho_k = <r_k, z_k>, p_k = z_k + (rho_k / rho_{k-1}) p_{k-1}, the same
+// step; M is self-adjoint in <.,.>_beta. The recursion above for ||r_k||_W needs
+// r_k = p_k - beta_k p_{k-1}, which PCG does not have: ||r_k||_W is estimated by
+// ||r_start||_W (rho_k / rho_start)^1/2 and measured by RetrogradeEnergy once that
+// estimate is within kMeasuredResidualFactor of the tolerance; r_k is tested before
+// p_k is applied, then the final pass as above.
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -60,6 +69,11 @@ constexpr double kRoundOffFloorFactor = 10.0;
 // restarts, a true residual that the last restart did not reduce tenfold is accepted
 // at that floor when it is within this factor of the tolerance.
 constexpr double kStalledResidualFactor = 100.0;
+
+// Preconditioned, the residual's W-norm is estimated from the decrease of its
+// M^-1-norm, and measured (one backward sweep) once the estimate is within this factor
+// of the tolerance: the two norms weigh the spectrum of -L differently.
+constexpr double kMeasuredResidualFactor = 10.0;
 
 // One solve by conjugate gradients on the traces (the scheme at the top of this
 // file): its trace fields, the scalars of the recursion and of the stopping test,
@@ -89,6 +103,14 @@ class StreamingConjugateGradient {
   // L p into image, then q = (I - L) p; <p, -L p> and <p, q> returned through the
   // pointers. False (the summary says why) when <p, q> is not positive.
   bool ApplyToDirection(int iteration, double* direction_energy, double* curvature);
+  // Preconditioned: z = M^-1 r, p = z and rho = <r, z> of the residual r now in
+  // residual_, whose ||r||_W / ||r_0||_W is `relative`.
+  void StartPreconditionedRecursion(double relative);
+  // Preconditioned: ||r_k||_W / ||r_0||_W into relative_ and the history, estimated
+  // by start_relative_ (rho_k / start_rho_)^1/2 (the M^-1-norm's decrease), measured
+  // by one backward sweep once that estimate is within kMeasuredResidualFactor of the
+  // tolerance.
+  void UpdatePreconditionedResidual();
   // ||r_k||_W / ||r_0||_W from the recursion into relative_ and the history; false
   // (the summary says why) when it is not finite.
   bool UpdateRecursiveResidual(int iteration, double direction_energy);
@@ -106,6 +128,11 @@ class StreamingConjugateGradient {
   CoupledSolution* solution_;
   CoupledSolverSummary* summary_;
   Matrix traces_, residual_, direction_, image_;
+  // With a preconditioner M (options.preconditioner): z = M^-1 r, and rho = <r, z>
+  // and ||r||_W / ||r_0||_W where the recursion (re)started.
+  bool preconditioned_ = false;
+  Matrix preconditioned_residual_;
+  double start_rho_ = 0.0, start_relative_ = 1.0;
   double rhs_norm_ = 0.0;
   StreamingCoupledProblem::StreamingTotals totals_;
   // Said in the message when the solve started from the warm start or switched to
@@ -140,8 +167,17 @@ void StreamingConjugateGradient::Solve(const Matrix* initial_traces) {
     return;
   }
   if (initial_traces != nullptr && TryWarmStart(*initial_traces)) return;
-  direction_ = residual_;
-  rho_ = problem_->TraceInnerProduct(residual_, residual_);
+  preconditioned_ = options_.preconditioner == TracePreconditioner::kDenseTraces &&
+                    problem_->PrepareTracePreconditioner(options_.preconditioner_rebuild_change,
+                                                         options_.max_preconditioner_traces);
+  if (preconditioned_) {
+    start_note_ += "; preconditioned by I - L at moduli within " +
+                   ScientificString(options_.preconditioner_rebuild_change);
+    StartPreconditionedRecursion(relative_);
+  } else {
+    direction_ = residual_;
+    rho_ = problem_->TraceInnerProduct(residual_, residual_);
+  }
   summary_->residual_history.push_back(relative_);
   summary_->relative_residual = relative_;
   for (int iteration = 0;; ++iteration, ++since_restart_) {
@@ -152,9 +188,17 @@ void StreamingConjugateGradient::Solve(const Matrix* initial_traces) {
                           " iterations: relative residual " + ScientificString(relative_);
       return;
     }
+    // Preconditioned, ||r_k||_W is known before p_k is applied: y_k is checked first.
+    if (preconditioned_ && relative_ <= options_.tolerance) {
+      if (CheckTrueResidual()) return;
+      continue;
+    }
     double direction_energy = 0.0, curvature = 0.0;
     if (!ApplyToDirection(iteration, &direction_energy, &curvature)) return;
-    if (since_restart_ > 0 && !UpdateRecursiveResidual(iteration, direction_energy)) return;
+    if (!preconditioned_ && since_restart_ > 0 &&
+        !UpdateRecursiveResidual(iteration, direction_energy)) {
+      return;
+    }
     if (relative_ > options_.tolerance) {
       Step(direction_energy, curvature);
       continue;
@@ -221,6 +265,26 @@ bool StreamingConjugateGradient::ApplyToDirection(int iteration, double* directi
   return true;
 }
 
+void StreamingConjugateGradient::StartPreconditionedRecursion(double relative) {
+  problem_->PreconditionTraces(residual_, &preconditioned_residual_);
+  direction_ = preconditioned_residual_;
+  rho_ = problem_->TraceInnerProduct(residual_, preconditioned_residual_);
+  start_rho_ = rho_;
+  start_relative_ = relative;
+  relative_ = relative;
+}
+
+void StreamingConjugateGradient::UpdatePreconditionedResidual() {
+  relative_ =
+      start_rho_ > 0.0 ? start_relative_ * std::sqrt(std::max(rho_, 0.0) / start_rho_) : 0.0;
+  if (relative_ <= kMeasuredResidualFactor * options_.tolerance) {
+    // ||r||_W^2 = ||R r||_P^2, R r the retrograde field driven by r.
+    relative_ = std::sqrt(std::max(problem_->RetrogradeEnergy(residual_), 0.0)) / rhs_norm_;
+  }
+  summary_->residual_history.push_back(relative_);
+  summary_->relative_residual = relative_;
+}
+
 bool StreamingConjugateGradient::UpdateRecursiveResidual(int iteration, double direction_energy) {
   // ||r_k||_W^2 = <p_k, -L p_k> + 2 beta_k <p_k, p_{k-1}> + beta_k^2 <p_{k-1}, -L p_{k-1}>.
   const double energy =
@@ -244,6 +308,17 @@ void StreamingConjugateGradient::Step(double direction_energy, double curvature)
   const double step = rho_ / curvature;
   traces_ += step * direction_;
   residual_ -= step * image_;
+  if (preconditioned_) {
+    // PCG: z_{k+1} = M^-1 r_{k+1}, rho = <r, z>, p_{k+1} = z_{k+1} + beta p_k.
+    problem_->PreconditionTraces(residual_, &preconditioned_residual_);
+    const double rho_next = problem_->TraceInnerProduct(residual_, preconditioned_residual_);
+    direction_coefficient_ = rho_next / rho_;
+    if (restarts_ == 0) lanczos_.Add(step, direction_coefficient_);
+    direction_ = preconditioned_residual_ + direction_coefficient_ * direction_;
+    rho_ = rho_next;
+    UpdatePreconditionedResidual();
+    return;
+  }
   const double rho_next = problem_->TraceInnerProduct(residual_, residual_);
   direction_coefficient_ = rho_next / rho_;
   if (restarts_ == 0) lanczos_.Add(step, direction_coefficient_);
@@ -286,9 +361,13 @@ bool StreamingConjugateGradient::CheckTrueResidual() {
   ++restarts_;
   since_restart_ = -1;
   residual_ = image_;
-  direction_ = residual_;
-  rho_ = problem_->TraceInnerProduct(residual_, residual_);
   relative_ = true_relative;
+  if (preconditioned_) {
+    StartPreconditionedRecursion(relative_);
+  } else {
+    direction_ = residual_;
+    rho_ = problem_->TraceInnerProduct(residual_, residual_);
+  }
   summary_->residual_history.push_back(relative_);
   return false;
 }

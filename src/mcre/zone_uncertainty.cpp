@@ -37,7 +37,8 @@ bool SecantCurvature(const CoupledSolverOptions& inner, const Vector& moduli,
     for (int side = 0; side < 2; ++side) {
       Vector shifted = moduli;
       shifted[z] *= side == 0 ? 1.0 + kCurvatureWindow : 1.0 - kCurvatureWindow;
-      if (!SolveUsable(inner, shifted, problem, &solution.retrograde, &trial, sweeps, why)) {
+      const Matrix* warm_start = solution.has_fields() ? &solution.retrograde : &solution.traces;
+      if (!SolveUsable(inner, shifted, problem, warm_start, &trial, sweeps, why)) {
         *why = "the curvature's solve at zone " + std::to_string(z) + " is not usable: " + *why;
         return false;
       }
@@ -65,10 +66,8 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
     result.message = "no noise to propagate (every noise level is 0)";
     return result;
   }
-  if (!solution.has_fields()) {
-    result.message =
-        "the figure needs the coupled solution's fields, which the streaming solver does not "
-        "store: use inner.method conjugate_gradient when the fields fit inner.max_field_bytes";
+  if (!solution.has_fields() && solution.traces.size() == 0) {
+    result.message = "the figure needs the coupled solution's fields or traces";
     return result;
   }
   auto make_problem = [&](const ChannelSet& set) {
@@ -101,7 +100,10 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
   StandardNormal normal(options.seed);
   Matrix sum = Matrix::Zero(zones, zones);
   CoupledSolution noise_solution;
+  std::shared_ptr<const MatrixMcreProblem::TraceFactor> shared_factor;
   Vector plus_gradient, minus_gradient;
+  Matrix image;
+  StreamingCoupledProblem::StreamingTotals totals;
   for (int sample = 0; sample < options.samples; ++sample) {
     DrawWhiteNoise(noise, &normal, &noise_data);
     for (std::size_t c = 0; c < data.channels.size(); ++c) {
@@ -109,19 +111,32 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
       minus_data.channels[c].values = data.channels[c].values - noise_data.channels[c].values;
     }
     MatrixMcreProblem noise_problem = make_problem(noise_data);
+    // Every draw at the same moduli: the first draw's preconditioner serves them all.
+    noise_problem.ShareTraceFactor(shared_factor);
     if (!SolveUsable(inner, moduli, &noise_problem, nullptr, &noise_solution, &result.sweeps,
                      &why)) {
       result.message = "a noise solve is not usable: " + why;
       return result;
     }
+    shared_factor = noise_problem.trace_factor();
     // dg = (g(s_d + s_n; d + n) - g(s_d - s_n; d - n)) / 2
     MatrixMcreProblem plus = make_problem(plus_data), minus = make_problem(minus_data);
     plus.SetModuli(moduli);
     minus.SetModuli(moduli);
-    plus.CostGradients(solution.displacement + noise_solution.displacement,
-                       solution.retrograde + noise_solution.retrograde, &plus_gradient);
-    minus.CostGradients(solution.displacement - noise_solution.displacement,
-                        solution.retrograde - noise_solution.retrograde, &minus_gradient);
+    if (solution.has_fields()) {
+      plus.CostGradients(solution.displacement + noise_solution.displacement,
+                         solution.retrograde + noise_solution.retrograde, &plus_gradient);
+      minus.CostGradients(solution.displacement - noise_solution.displacement,
+                          solution.retrograde - noise_solution.retrograde, &minus_gradient);
+    } else {
+      // A streaming solution: s_d +- s_n are the fixed points y_d +- y_n on the traces,
+      // whose fields one application of each problem's map passes through (3 sweeps).
+      plus.StreamingMap(solution.traces + noise_solution.traces, true, &image, &totals);
+      plus_gradient = totals.cost_gradients;
+      minus.StreamingMap(solution.traces - noise_solution.traces, true, &image, &totals);
+      minus_gradient = totals.cost_gradients;
+      result.sweeps += 6;
+    }
     // dE = -H^-1 dg
     const Vector change = -factor.solve(0.5 * (plus_gradient - minus_gradient));
     sum += change * change.transpose();

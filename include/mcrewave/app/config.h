@@ -23,7 +23,10 @@
 //          | pinned] (McreOptions, objective.h)
 //   inner: method [auto: conjugate_gradient, or streaming_conjugate_gradient when the
 //          fields exceed max_field_bytes | conjugate_gradient | all_at_once | relaxation
-//          | adaptive_relaxation | any other CoupledSolverType], tolerance [1e-8],
+//          | adaptive_relaxation | any other CoupledSolverType], preconditioner [none |
+//          dense_traces: streaming_conjugate_gradient only],
+//          preconditioner_rebuild_change [0.02], max_preconditioner_traces [4096],
+//          tolerance [1e-8],
 //          max_iterations [5000], omega [0.5], spectrum_steps [12],
 //          spectrum_safety_factor [1.05],
 //          divergence_factor [1e3], max_all_at_once_unknowns [1500000],

@@ -231,6 +231,23 @@ inline constexpr std::array<std::pair<CoupledSolverType, const char*>, 9> kCoupl
 const char* CoupledSolverTypeToString(CoupledSolverType type);
 bool StringToCoupledSolverType(const std::string& name, CoupledSolverType* type);
 
+// The preconditioner of the streaming CG (inner.preconditioner; docs/streaming.md
+// section 6).
+enum class TracePreconditioner {
+  kNone,  // CG on the traces as it is
+  // M = I - L at moduli near the current ones, as a dense Cholesky factor over the
+  // traces (MatrixMcreProblem::SymmetricTraceOperator), rebuilt when a modulus moved
+  // more than CoupledSolverOptions::preconditioner_rebuild_change.
+  kDenseTraces,
+};
+inline constexpr std::array<std::pair<TracePreconditioner, const char*>, 2>
+    kTracePreconditionerNames{{
+        {TracePreconditioner::kNone, "none"},
+        {TracePreconditioner::kDenseTraces, "dense_traces"},
+    }};
+const char* TracePreconditionerToString(TracePreconditioner preconditioner);
+bool StringToTracePreconditioner(const std::string& name, TracePreconditioner* preconditioner);
+
 enum class TerminationType {
   kConvergence,    // the residual reached the tolerance
   kNoConvergence,  // the iteration limit was reached first

@@ -105,6 +105,14 @@ struct CoupledSolverOptions {
   // the problem to checkpoints (StreamingCoupledProblem::UseCheckpoints) and goes on from its
   // traces. Library option, no config key.
   double max_rebuild_error = 1e-7;
+  // streaming_conjugate_gradient's preconditioner (docs/streaming.md section 6): with
+  // kDenseTraces, on a problem that offers it (MatrixMcreProblem, any structure given
+  // by matrices), M = I - L built at moduli within preconditioner_rebuild_change
+  // (relative) of the solve's, as a dense factor of num_traces (m + 1) rows when they
+  // are at most max_preconditioner_traces (else CG runs without, and says so).
+  TracePreconditioner preconditioner = TracePreconditioner::kNone;
+  double preconditioner_rebuild_change = 0.02;
+  long max_preconditioner_traces = 4096;
   // Shooting fails when the 2-norm condition number of its (equilibrated) shooting
   // matrix exceeds this, or is not finite.
   double shooting_condition_limit = 1e14;
@@ -143,7 +151,7 @@ struct CoupledSolverSummary {
   // the Lanczos estimate its omega comes from; conjugate_gradient and
   // streaming_conjugate_gradient, the extreme Ritz values of their own Lanczos process
   // (from their coefficients, no extra sweep; a_max from below, a_min from above), once
-  // they took a step; -1 otherwise.
+  // they took a step; -1 otherwise. With inner.preconditioner, those of M^-1 (I - L).
   double spectrum_min = -1.0;
   double spectrum_max = -1.0;
   int safeguard_restarts = 0;            // adaptive only: omega re-chosen after growth

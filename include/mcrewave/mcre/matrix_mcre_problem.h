@@ -50,6 +50,7 @@
 // G^T W of every sample (the model's forces, ModelChannels).
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -190,6 +191,39 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   void UseCheckpoints() override {}
   // H U of a displacement field, num_traces() x (m + 1): the traces of stored fields.
   Matrix ObservedTraces(const Matrix& displacement) const { return observation_ * displacement; }
+  // The trace operator -L at the current moduli as a dense symmetric matrix
+  // (docs/streaming.md section 6),
+  //   S = (C beta)^1/2 Z P C^-1 Z^T (C beta)^1/2,  C = diag(c_j h),  Z = H D,
+  // num_traces() (m + 1) square, row k at sample j at index j num_traces() + k (a trace
+  // field's column-major order): -L y = (C beta)^-1/2 S (C beta)^1/2 y. From one
+  // retrograde sweep per trace row (the impulse responses, by time invariance) and one
+  // product of n x R m matrices. Preconditions: m >= 2, theta >= 1/2 (the recursion
+  // from the responses to Z's blocks divides by theta), every beta_k > 0.
+  Matrix SymmetricTraceOperator();
+  // The Cholesky factor of I + S (above) at the current moduli, rebuilt when a modulus
+  // moved by more than rebuild_change since it was built; (C beta)^-1/2 (I + S)^-1
+  // (C beta)^1/2 applied by PreconditionTraces.
+  bool PrepareTracePreconditioner(double rebuild_change, long max_traces) override;
+  void PreconditionTraces(const Matrix& residual, Matrix* result) override;
+  // The factor of I + S with the weights and moduli it was built at (null before the
+  // first build): it depends on the model, the weights, theta, the time grid and the
+  // moduli, not on the data, so problems of the same model and options at the same
+  // moduli share it (the uncertainty's noise problems).
+  struct TraceFactor {
+    Matrix factor;   // L of I + S = L L^T in its lower triangle
+    Vector weights;  // (c_j h beta_k)^1/2 in a trace field's order
+    Vector moduli;   // E_z [Pa] it was built at
+  };
+  std::shared_ptr<const TraceFactor> trace_factor() const { return trace_factor_; }
+  // Takes `factor` (of a problem of the same model, weights, theta and time grid) as
+  // this problem's preconditioner; PrepareTracePreconditioner keeps it while the moduli
+  // stay within its rebuild_change.
+  void ShareTraceFactor(std::shared_ptr<const TraceFactor> factor) {
+    trace_factor_ = std::move(factor);
+  }
+  // Factorisations of I + S by this problem so far.
+  int trace_preconditioner_builds() const { return trace_preconditioner_builds_; }
+
   // The checkpoints' stride s (0 before the first StreamingMap).
   int checkpoint_stride() const { return checkpoint_stride_; }
 
@@ -289,6 +323,11 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   int checkpoint_stride_ = 0;
   Matrix checkpoints_, segment_;
   Vector stream_velocity_[2], stream_displacement_[2], stream_retrograde_[2];
+  // The streaming CG's preconditioner (null: none yet), a scratch vector of a trace
+  // field's size, and the builds so far.
+  std::shared_ptr<const TraceFactor> trace_factor_;
+  Vector trace_scratch_;
+  int trace_preconditioner_builds_ = 0;
   // One row of the element map's picture (ElementColumnPositions entries; empty without
   // elements), allocated in the constructor.
   Vector stream_density_row_;

@@ -67,6 +67,23 @@ class StreamingCoupledProblem : public CoupledProblem {
   // traces and image of shape ZeroTraces(), distinct.
   virtual void StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
                             StreamingTotals* totals = nullptr) = 0;
+  // The streaming CG's preconditioner (inner.preconditioner: dense_traces,
+  // docs/streaming.md section 6): makes M = I - L at moduli near the current ones
+  // available, building it at the current moduli unless the one held was built where
+  // every modulus was within rebuild_change (relative) of its value now. False when the
+  // problem offers none (the default) or cannot build it (a row of weight 0, or
+  // max_traces below num_traces() (m + 1)): CG then runs without.
+  virtual bool PrepareTracePreconditioner(double rebuild_change, long max_traces) {
+    (void)rebuild_change;
+    (void)max_traces;
+    return false;
+  }
+  // result = M^-1 residual, of shape ZeroTraces(). Precondition: the last
+  // PrepareTracePreconditioner returned true.
+  virtual void PreconditionTraces(const Matrix& residual, Matrix* result) {
+    (void)residual;
+    (void)result;
+  }
   // From now on, StreamingMap takes the retrograde field from checkpoints (exact)
   // rather than from a reversed recursion whose round-off drifted; nothing to do for a
   // problem that always uses them.

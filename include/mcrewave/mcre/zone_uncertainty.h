@@ -43,10 +43,11 @@ struct ZoneUncertainty {
 // channel of data, strain_std on every strain channel, force_std on every force channel
 // (in the set's order, a channel's samples, then the next; StandardNormal seeded with
 // options.seed). curvature: H [J s / Pa^2] (zones x zones), or nullptr for the secants.
-// Not available (with a message) when no level is positive, the solution holds no fields
-// (a streaming solve), a solve is not usable, or H is not positive definite.
-// Precondition: options.samples >= 1 (one draw is the covariance of that draw; the config
-// asks for 2 to 1000, UncertaintyOptions::IsValid).
+// A streaming solution (its traces, no fields) gives dg from one application of the
+// plus and minus problems' maps at y_d +- y_n. Not available (with a message) when no
+// level is positive, the solution holds neither fields nor traces, a solve is not usable, or H is
+// not positive definite. Precondition: options.samples >= 1 (one draw is the covariance of that
+// draw; the config asks for 2 to 1000, UncertaintyOptions::IsValid).
 ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
                                         const MatrixModelData& model, const ChannelSet& data,
                                         const McreOptions& mcre, double theta,

@@ -1,0 +1,143 @@
+// The trace operator -L of a structure given by matrices as a dense symmetric matrix,
+// from one retrograde sweep per trace row (docs/streaming.md section 6), and the
+// preconditioner of the streaming CG built from it.
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include "mcrewave/mcre/matrix_mcre_problem.h"
+
+namespace mcrewave {
+
+Matrix MatrixMcreProblem::SymmetricTraceOperator() {
+  const int n = num_nodes(), m = num_steps(), rows = num_traces();
+  assert(m >= 2 && theta_ > 0.0);
+  const double h = time_step();
+  // a(j), j = 1..m: the traces' response at t_j to a unit force over the step
+  // t_0 -> t_1 alone, one R x n block per sample, stored transposed (n x R m, column
+  // (j - 1) R + k for row k). By the adjointness of the two sweeps,
+  //   Z(i, l) = H D(i, l) = (c_l / c_i) [D* (h_k at t_i)]_l^T,
+  // so the retrograde field driven by h_k at t_m alone gives every interior block
+  // z(j) = Z(l + j, l) = (c_{m-j} / c_m) W_{m-j}^T, and z(j) = theta a(j + 1) +
+  // (1 - theta) a(j) with a(0) = 0 gives a(j).
+  Matrix responses(n, rows * m);
+  Matrix traces = ZeroTraces();
+  Vector field(n), previous_response(n);
+  for (int k = 0; k < rows; ++k) {
+    // y = e_k / beta_k at t_m: the retrograde load c_m h_k.
+    traces.setZero();
+    traces(k, m) = 1.0 / betas_[k];
+    velocity_[0].setZero();
+    state_[0].setZero();
+    previous_response.setZero();
+    for (int j = m, s = 0; j > 0; --j, ++s) {
+      const int current = s & 1, next = current ^ 1;
+      RetrogradeTraceStep(j, traces, false, velocity_[current], state_[current], velocity_[next],
+                          state_[next]);
+      // W_j = (theta omega_{j-1} + (1 - theta) omega_j) / c_j; z(m - j) = (c_j / c_m) W_j.
+      field =
+          (theta_ * state_[next] + (1.0 - theta_) * state_[current]) * (1.0 / QuadratureWeight(m));
+      // a(m - j + 1) = (z(m - j) - (1 - theta) a(m - j)) / theta.
+      auto response = responses.col((m - j) * rows + k);
+      response = (field - (1.0 - theta_) * previous_response) / theta_;
+      previous_response = response;
+    }
+    ++sweep_count_;
+  }
+  // A(i, k) = a(i) P a(k)^T / h, R x R blocks, in a matrix over the samples 0..m
+  // whose block row and column 0 stay zero (a(0) = 0): its lower triangle by one
+  // product (P symmetric), the upper by symmetry.
+  const int size = rows * (m + 1);
+  const SparseMatrix penalty = PenaltyMatrix();
+  const Matrix weighted = penalty * responses;
+  Matrix gram = Matrix::Zero(size, size);
+  auto inner = gram.bottomRightCorner(rows * m, rows * m);
+  inner.triangularView<Eigen::Lower>() = responses.transpose() * weighted;
+  inner *= 1.0 / h;
+  inner.triangularView<Eigen::StrictlyUpper>() = inner.transpose();
+  // Q = Z P C^-1 Z^T over the samples i, k = 0..m, Z(i, 0) = (1 - theta) a(i) and
+  // Z(i, l) = theta a(i - l + 1) + (1 - theta) a(i - l) for l >= 1:
+  //   Q(i, k) = Q(i - 1, k - 1) + D(i, k),
+  //   D(i, k) = theta^2 A(i, k) + theta (1 - theta) (A(i, k - 1) + A(i - 1, k))
+  //             + (1 - theta)^2 A(i - 1, k - 1) + (1 - theta)^2 / c_0 [A(i, k) - A(i - 1, k - 1)],
+  // the term l = m counted twice at (m, m) (c_m = 1/2), and Q(0, .) = 0 (U_0 = 0).
+  const double t = theta_, u = 1.0 - theta_, start = u * u / QuadratureWeight(0);
+  const int rest = size - rows;
+  Matrix q = (t * t + start) * gram;
+  q.bottomRightCorner(rest, rest) += (u * u - start) * gram.topLeftCorner(rest, rest);
+  q.rightCols(rest) += t * u * gram.leftCols(rest);
+  q.bottomRows(rest) += t * u * gram.topRows(rest);
+  // The cumulative sums along the block diagonals, block row by block row.
+  for (int i = 1; i <= m; ++i) {
+    q.block(i * rows, rows, rows, rest) += q.block((i - 1) * rows, 0, rows, rest);
+  }
+  q.block(m * rows, m * rows, rows, rows) +=
+      (t * t * (1.0 / QuadratureWeight(m) - 1.0)) * gram.block(rows, rows, rows, rows);
+  // S = (C beta)^1/2 Q (C beta)^1/2, C = diag(c_j h).
+  Vector weights(size);
+  for (int j = 0; j <= m; ++j) {
+    for (int k = 0; k < rows; ++k) {
+      weights[j * rows + k] = std::sqrt(QuadratureWeight(j) * h * betas_[k]);
+    }
+  }
+  q.array().colwise() *= weights.array();
+  q.array().rowwise() *= weights.transpose().array();
+  // Symmetric to round-off: the mean of the two triangles, in place.
+  for (int c = 0; c < size; ++c) {
+    for (int r = c + 1; r < size; ++r) {
+      const double mean = 0.5 * (q(r, c) + q(c, r));
+      q(r, c) = mean;
+      q(c, r) = mean;
+    }
+  }
+  return q;
+}
+
+bool MatrixMcreProblem::PrepareTracePreconditioner(double rebuild_change, long max_traces) {
+  const int rows = num_traces(), m = num_steps();
+  const long size = static_cast<long>(rows) * (m + 1);
+  if (rows == 0 || m < 2 || theta_ < 0.5 || size > max_traces || !(betas_.minCoeff() > 0.0)) {
+    return false;
+  }
+  trace_scratch_.resize(size);
+  if (trace_factor_ != nullptr && trace_factor_->moduli.size() == moduli_.size()) {
+    const double change = (moduli_.array() / trace_factor_->moduli.array() - 1.0).abs().maxCoeff();
+    if (change <= rebuild_change) return true;
+  }
+  trace_factor_.reset();
+  auto built = std::make_shared<TraceFactor>();
+  // I + S = L L^T, factorised in place (its lower triangle becomes L).
+  built->factor = SymmetricTraceOperator();
+  built->factor.diagonal().array() += 1.0;
+  {
+    Eigen::LLT<Eigen::Ref<Matrix>> in_place(built->factor);
+    if (in_place.info() != Eigen::Success) return false;
+  }
+  built->weights.resize(size);
+  for (int j = 0; j <= m; ++j) {
+    for (int k = 0; k < rows; ++k) {
+      built->weights[j * rows + k] = std::sqrt(QuadratureWeight(j) * time_step() * betas_[k]);
+    }
+  }
+  built->moduli = moduli_;
+  trace_factor_ = std::move(built);
+  ++trace_preconditioner_builds_;
+  return true;
+}
+
+void MatrixMcreProblem::PreconditionTraces(const Matrix& residual, Matrix* result) {
+  assert(trace_factor_ != nullptr && residual.rows() == num_traces() &&
+         residual.cols() == num_steps() + 1 && trace_scratch_.size() == residual.size());
+  // z = (C beta)^-1/2 (I + S)^-1 (C beta)^1/2 r, the trace field as one column.
+  const Eigen::Map<const Vector> r(residual.data(), residual.size());
+  trace_scratch_ = trace_factor_->weights.cwiseProduct(r);
+  const auto lower = trace_factor_->factor.triangularView<Eigen::Lower>();
+  lower.solveInPlace(trace_scratch_);
+  lower.transpose().solveInPlace(trace_scratch_);
+  result->resize(residual.rows(), residual.cols());
+  Eigen::Map<Vector>(result->data(), result->size()) =
+      trace_scratch_.cwiseQuotient(trace_factor_->weights);
+}
+
+}  // namespace mcrewave
