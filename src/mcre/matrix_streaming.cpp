@@ -218,8 +218,10 @@ void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Ma
   assert(traces.rows() == num_traces() && traces.cols() == num_steps() + 1 && image != &traces);
   const int n = num_nodes(), m = num_steps();
   if (checkpoint_stride_ == 0) {
-    // s = ceil(sqrt(2 m)): memory 2 n m / s + n s, about 2 n sqrt(2 m) doubles.
-    checkpoint_stride_ = std::max(1, static_cast<int>(std::ceil(std::sqrt(2.0 * m))));
+    // s = ceil(sqrt(2 m)): memory 2 n m / s + n s, about 2 n sqrt(2 m) doubles; or s = m
+    // when omega's whole history fits.
+    const bool whole = 8.0 * n * (m + 1.0) <= static_cast<double>(whole_history_bytes_);
+    checkpoint_stride_ = whole ? m : std::max(1, static_cast<int>(std::ceil(std::sqrt(2.0 * m))));
     checkpoints_ = Matrix::Zero(2 * n, m / checkpoint_stride_ + 1);
     segment_ = Matrix::Zero(n, checkpoint_stride_ + 1);
   }
@@ -247,8 +249,14 @@ void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Ma
     observe(j, stream_displacement_[next], retrograde);
   };
 
-  // 1. The retrograde sweep from rest at T keeping its state at the checkpoints.
-  CheckpointRetrogradeSweep(traces, include_data);
+  // 1. The retrograde sweep from rest at T keeping its state at the checkpoints; with
+  //    one segment (s = m) its only checkpoint is that rest state, and step 2 is the
+  //    one backward sweep.
+  if (stride < m) {
+    CheckpointRetrogradeSweep(traces, include_data);
+  } else {
+    checkpoints_.col(0).setZero();
+  }
 
   // 2. Forward over the segments [a, b] between checkpoints, earliest first: from the
   // checkpoint at b the retrograde steps b -> a again (the same steps, so the same bits
@@ -287,7 +295,7 @@ void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Ma
     a = b;
     b = std::min(b + stride, m);
   }
-  sweep_count_ += 3;
+  sweep_count_ += stride < m ? 3 : 2;
 }
 
 }  // namespace mcrewave

@@ -45,7 +45,9 @@
 // from t = 0, the segment's omega is swept again from its upper checkpoint into an
 // n x (s + 1) buffer and consumed in forward order by the direct sweep. Three sweeps
 // per application, memory 2 n m / s + n s = O(n sqrt(m)), W the stored sweep's to the
-// bit (the same steps), no drift. Its totals are the cost, the zone gradients, the
+// bit (the same steps), no drift. When omega's whole history fits
+// set_whole_history_bytes (64 MB by default), s = m: one segment, swept once, two
+// sweeps per application. Its totals are the cost, the zone gradients, the
 // zone maps of W and U, the dof map and the element map, summed as the fields pass, and
 // G^T W of every sample (the model's forces, ModelChannels).
 #pragma once
@@ -189,6 +191,12 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
                     StreamingTotals* totals = nullptr) override;
   // The checkpoints are always used: nothing to switch.
   void UseCheckpoints() override {}
+  // StreamingMap keeps the whole history of omega, n x (m + 1) doubles, from its one
+  // backward sweep when it holds at most this many bytes: two sweeps per application
+  // instead of three, the same steps, so the same bits. 0: checkpoints always. Takes
+  // effect at the first StreamingMap.
+  static constexpr long kDefaultWholeHistoryBytes = 1L << 26;
+  void set_whole_history_bytes(long bytes) { whole_history_bytes_ = bytes; }
   // H U of a displacement field, num_traces() x (m + 1): the traces of stored fields.
   Matrix ObservedTraces(const Matrix& displacement) const { return observation_ * displacement; }
   // The trace operator -L at the current moduli as a dense symmetric matrix
@@ -321,6 +329,7 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // (n x (s + 1)), allocated by the first StreamingMap; the double buffers of the
   // direct sweep (velocity, displacement), W_{j-1} and W_j, allocated in the constructor.
   int checkpoint_stride_ = 0;
+  long whole_history_bytes_ = kDefaultWholeHistoryBytes;
   Matrix checkpoints_, segment_;
   Vector stream_velocity_[2], stream_displacement_[2], stream_retrograde_[2];
   // The streaming CG's preconditioner (null: none yet), a scratch vector of a trace
