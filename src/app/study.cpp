@@ -747,6 +747,7 @@ std::pair<double, double> EstimateSpectrum(const CoupledSolverOptions& inner,
                                            StreamingCoupledProblem* problem) {
   CoupledSolverOptions options = inner;
   options.type = CoupledSolverType::kAdaptiveRelaxation;
+  options.preconditioner = TracePreconditioner::kNone;  // the streaming CG's only
   options.spectrum_safety_factor = 1.0;
   options.max_iterations = 1;
   CoupledSolution solution;
@@ -790,6 +791,7 @@ void RunRelaxationCase(const Config& config, const BarModel& model, const Channe
   auto solve = [&](CoupledSolverType type, double omega, double tolerance) {
     CoupledSolverOptions solver = config.inner;
     solver.type = type;
+    solver.preconditioner = TracePreconditioner::kNone;  // the streaming CG's only
     if (type == CoupledSolverType::kRelaxation) solver.relaxation_coefficient = omega;
     solver.tolerance = tolerance;
     CoupledSolution solution;
