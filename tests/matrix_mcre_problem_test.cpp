@@ -234,11 +234,7 @@ MatrixModelData Lattice() {
 // relative size `spoil` (so that the data are not the model's).
 ChannelSet Histories(const MatrixModelData& truth, const Vector& truth_moduli, int steps,
                      double time_step, double duration, double spoil) {
-  Matrix loads = Matrix::Zero(1, steps + 1);
-  for (int j = 0; j <= steps; ++j) {
-    const double t = j * time_step;
-    if (t < duration) loads(0, j) = 1e3 * std::sin(M_PI * t / duration);
-  }
+  const Matrix loads = testing::HalfSineLoadRow(steps, time_step, duration);
   const ChannelSet at_rest = MatrixChannelSet(
       truth, time_step, loads, Matrix::Zero(static_cast<int>(truth.sensors.size()), steps + 1));
   MatrixMcreProblem simulation(truth, at_rest, Weights(0.01, 1.0), 2e11, 0.5);

@@ -71,11 +71,7 @@ class PreconditionedPlateTest : public ::testing::Test {
     fine_ = ReadMatrixModel(kTraceOperatorPlate + "fine/model.yaml");
     const int steps = 150;
     const double time_step = 1e-6, duration = 2e-5;
-    Matrix loads = Matrix::Zero(1, steps + 1);
-    for (int j = 0; j <= steps; ++j) {
-      const double t = j * time_step;
-      if (t < duration) loads(0, j) = 1e3 * std::sin(M_PI * t / duration);
-    }
+    const Matrix loads = testing::HalfSineLoadRow(steps, time_step, duration);
     const ChannelSet at_rest = MatrixChannelSet(
         fine_, time_step, loads, Matrix::Zero(static_cast<int>(fine_.sensors.size()), steps + 1));
     MatrixMcreProblem truth(fine_, at_rest, Weights(0.01, 1.0), 2e11, 0.5);

@@ -279,17 +279,24 @@ inline MatrixModelData SupportedLattice() {
   return model;
 }
 
+// One load channel's row, 1 x (steps + 1): a half sine of 1 kN over `duration` [s],
+// sampled at t_j = j time_step, then zero.
+inline Matrix HalfSineLoadRow(int steps, double time_step, double duration) {
+  Matrix loads = Matrix::Zero(1, steps + 1);
+  for (int j = 0; j <= steps; ++j) {
+    const double t = j * time_step;
+    if (t < duration) loads(0, j) = 1e3 * std::sin(M_PI * t / duration);
+  }
+  return loads;
+}
+
 // The lattice's histories: a half sine on F; the sensors and the support force of the
 // held lattice (trusted) at truth moduli, with a deterministic wiggle of 5 % so that the
 // data are not the model's; a support displacement of a few % of the tip's.
 inline ChannelSet SupportedLatticeHistories(const MatrixModelData& model) {
   const int steps = 120;
   const double time_step = 2e-3, duration = 0.05;
-  Matrix loads = Matrix::Zero(1, steps + 1);
-  for (int j = 0; j <= steps; ++j) {
-    const double t = j * time_step;
-    if (t < duration) loads(0, j) = 1e3 * std::sin(M_PI * t / duration);
-  }
+  const Matrix loads = HalfSineLoadRow(steps, time_step, duration);
   ChannelSet at_rest = MatrixChannelSet(
       model, time_step, loads, Matrix::Zero(static_cast<int>(model.sensors.size()), steps + 1));
   at_rest.Add("R", ChannelKind::kForce, Vector::Zero(steps + 1));
