@@ -12,7 +12,7 @@ namespace mcrewave {
 
 Matrix MatrixMcreProblem::SymmetricTraceOperator() {
   const int n = num_nodes(), m = num_steps(), rows = num_traces();
-  assert(m >= 2 && theta_ > 0.0);
+  assert(m >= 2 && theta_ >= 0.5 && betas_.minCoeff() > 0.0);
   const double h = time_step();
   // a(j), j = 1..m: the traces' response at t_j to a unit force over the step
   // t_0 -> t_1 alone, one R x n block per sample, stored transposed (n x R m, column
@@ -75,12 +75,7 @@ Matrix MatrixMcreProblem::SymmetricTraceOperator() {
   q.block(m * rows, m * rows, rows, rows) +=
       (t * t * (1.0 / QuadratureWeight(m) - 1.0)) * gram.block(rows, rows, rows, rows);
   // S = (C beta)^1/2 Q (C beta)^1/2, C = diag(c_j h).
-  Vector weights(size);
-  for (int j = 0; j <= m; ++j) {
-    for (int k = 0; k < rows; ++k) {
-      weights[j * rows + k] = std::sqrt(QuadratureWeight(j) * h * betas_[k]);
-    }
-  }
+  const Vector weights = TraceWeightRoots();
   q.array().colwise() *= weights.array();
   q.array().rowwise() *= weights.transpose().array();
   // Symmetric to round-off: the mean of the two triangles, in place.
@@ -92,6 +87,17 @@ Matrix MatrixMcreProblem::SymmetricTraceOperator() {
     }
   }
   return q;
+}
+
+Vector MatrixMcreProblem::TraceWeightRoots() const {
+  const int rows = num_traces(), m = num_steps();
+  Vector roots(static_cast<Eigen::Index>(rows) * (m + 1));
+  for (int j = 0; j <= m; ++j) {
+    for (int k = 0; k < rows; ++k) {
+      roots[j * rows + k] = std::sqrt(QuadratureWeight(j) * time_step() * betas_[k]);
+    }
+  }
+  return roots;
 }
 
 bool MatrixMcreProblem::PrepareTracePreconditioner(double rebuild_change, long max_traces) {
@@ -114,12 +120,7 @@ bool MatrixMcreProblem::PrepareTracePreconditioner(double rebuild_change, long m
     Eigen::LLT<Eigen::Ref<Matrix>> in_place(built->factor);
     if (in_place.info() != Eigen::Success) return false;
   }
-  built->weights.resize(size);
-  for (int j = 0; j <= m; ++j) {
-    for (int k = 0; k < rows; ++k) {
-      built->weights[j * rows + k] = std::sqrt(QuadratureWeight(j) * time_step() * betas_[k]);
-    }
-  }
+  built->weights = TraceWeightRoots();
   built->moduli = moduli_;
   trace_factor_ = std::move(built);
   ++trace_preconditioner_builds_;

@@ -236,6 +236,8 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   int checkpoint_stride() const { return checkpoint_stride_; }
 
  private:
+  // (c_j h beta_k)^1/2 of every trace entry, in a trace field's (column-major) order.
+  Vector TraceWeightRoots() const;
   // x^T K y on either path of the integrator: from its band of K on the band path (as
   // the bar's McreProblem::PenaltyForm), else through product_ = K y. No allocation.
   double StiffnessForm(const double* x, const double* y);
