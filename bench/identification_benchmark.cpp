@@ -35,6 +35,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/data/prefilter.h"
@@ -51,13 +52,6 @@ double ProcessCpuSeconds() {
   getrusage(RUSAGE_SELF, &usage);
   auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
   return seconds(usage.ru_utime) + seconds(usage.ru_stime);
-}
-
-// CPU time of the calling thread [s].
-double ThreadCpuSeconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec + 1e-9 * t.tv_nsec;
 }
 
 struct IdentifyFigures {
@@ -110,17 +104,18 @@ SweepStepTimes SweepStepSeconds(const mcrewave::Config& config, const mcrewave::
   double batched = std::numeric_limits<double>::infinity();
   mcrewave::Matrix u1, u2;
   for (int round = 0; round < 3; ++round) {
-    double start = ThreadCpuSeconds();
+    double start = mcrewave::bench::ThreadCpuSeconds();
     for (int i = 0; i < repeats; ++i) problem.DirectSweep(retrograde, true, &displacement);
-    direct = std::min(direct, (ThreadCpuSeconds() - start) / repeats);
-    start = ThreadCpuSeconds();
+    direct = std::min(direct, (mcrewave::bench::ThreadCpuSeconds() - start) / repeats);
+    start = mcrewave::bench::ThreadCpuSeconds();
     for (int i = 0; i < repeats; ++i) problem.RetrogradeSweep(displacement, true, &retrograde);
-    backward = std::min(backward, (ThreadCpuSeconds() - start) / repeats);
-    start = ThreadCpuSeconds();
+    backward = std::min(backward, (mcrewave::bench::ThreadCpuSeconds() - start) / repeats);
+    start = mcrewave::bench::ThreadCpuSeconds();
     for (int i = 0; i < repeats; i += 3) {
       problem.DirectSweepsWithData({&retrograde, nullptr, &retrograde}, {&displacement, &u1, &u2});
     }
-    batched = std::min(batched, (ThreadCpuSeconds() - start) / (3 * ((repeats + 2) / 3)));
+    batched = std::min(batched,
+                       (mcrewave::bench::ThreadCpuSeconds() - start) / (3 * ((repeats + 2) / 3)));
   }
   const double steps = problem.num_steps();
   return {direct / steps, backward / steps, batched / steps};

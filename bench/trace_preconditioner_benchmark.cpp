@@ -24,6 +24,7 @@
 #include <limits>
 #include <string>
 
+#include "bench_util.h"
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/matrix_identification_run.h"
 #include "mcrewave/mcre/coupled_solver.h"
@@ -32,12 +33,7 @@
 namespace {
 
 using namespace mcrewave;
-
-double ThreadCpuSeconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec + 1e-9 * t.tv_nsec;
-}
+using bench::ThreadCpuSeconds;
 
 struct Figures {
   double seconds = std::numeric_limits<double>::infinity();
@@ -68,13 +64,7 @@ void TimeSolve(const CoupledSolverOptions& options, const Vector& moduli,
 int main(int argc, char** argv) {
   int repeats = 5;
   std::string path = std::string(MCREWAVE_SOURCE_DIR) + "/configs/plate.yaml";
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--repeats") == 0 && i + 1 < argc) {
-      repeats = std::max(1, std::atoi(argv[++i]));
-    } else {
-      path = argv[i];
-    }
-  }
+  bench::ParseRepeatsAndConfig(argc, argv, &repeats, &path);
   spdlog::set_level(spdlog::level::warn);
   try {
     const Config config = LoadConfig(path);

@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/data/prefilter.h"
@@ -29,12 +30,6 @@
 #include "mcrewave/model/matrix_export.h"
 
 namespace {
-
-double ThreadCpuSeconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec + 1e-9 * t.tv_nsec;
-}
 
 struct Figures {
   double solve_s = std::numeric_limits<double>::infinity();
@@ -58,18 +53,18 @@ Figures Measure(const mcrewave::Config& config, const mcrewave::ChannelSet& data
   for (int r = 0; r < repeats; ++r) {
     CoupledSolution solution;
     const long sweeps_before = problem.sweep_count();
-    const double start = ThreadCpuSeconds();
+    const double start = bench::ThreadCpuSeconds();
     const CoupledSolverSummary summary = SolveCoupled(config.inner, &problem, nullptr, &solution);
-    figures.solve_s = std::min(figures.solve_s, ThreadCpuSeconds() - start);
+    figures.solve_s = std::min(figures.solve_s, bench::ThreadCpuSeconds() - start);
     figures.sweeps = problem.sweep_count() - sweeps_before;
     if (!summary.IsSolutionUsable()) {
       std::fprintf(stderr, "solve failed at %d zones: %s\n", zones, summary.message.c_str());
       std::exit(1);
     }
     Vector gradient;
-    const double gradient_start = ThreadCpuSeconds();
+    const double gradient_start = bench::ThreadCpuSeconds();
     problem.CostGradients(solution.displacement, solution.retrograde, &gradient);
-    figures.gradient_s = std::min(figures.gradient_s, ThreadCpuSeconds() - gradient_start);
+    figures.gradient_s = std::min(figures.gradient_s, bench::ThreadCpuSeconds() - gradient_start);
   }
   return figures;
 }
@@ -79,13 +74,7 @@ Figures Measure(const mcrewave::Config& config, const mcrewave::ChannelSet& data
 int main(int argc, char** argv) {
   int repeats = 5;
   std::string path = "configs/paper_bar.yaml";
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--repeats") == 0 && i + 1 < argc) {
-      repeats = std::max(1, std::atoi(argv[++i]));
-    } else {
-      path = argv[i];
-    }
-  }
+  mcrewave::bench::ParseRepeatsAndConfig(argc, argv, &repeats, &path);
   spdlog::set_level(spdlog::level::warn);
   try {
     const mcrewave::Config config = mcrewave::LoadConfig(path);

@@ -1,0 +1,32 @@
+// What the benchmark programs share: the calling thread's CPU clock, and the command
+// line of those that take `[--repeats N] [CONFIG.yaml]`.
+#pragma once
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <string>
+
+namespace mcrewave::bench {
+
+// CPU time of the calling thread [s].
+inline double ThreadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+// `[--repeats N] [CONFIG.yaml]`: *repeats (at least 1) and *path keep their values
+// when not given.
+inline void ParseRepeatsAndConfig(int argc, char** argv, int* repeats, std::string* path) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--repeats") == 0 && i + 1 < argc) {
+      *repeats = std::max(1, std::atoi(argv[++i]));
+    } else {
+      *path = argv[i];
+    }
+  }
+}
+
+}  // namespace mcrewave::bench
