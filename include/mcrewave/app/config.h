@@ -25,7 +25,7 @@
 //          fields exceed max_field_bytes | conjugate_gradient | all_at_once | relaxation
 //          | adaptive_relaxation | any other CoupledSolverType], preconditioner [none |
 //          dense_traces: streaming_conjugate_gradient only],
-//          preconditioner_rebuild_change [0.02], max_preconditioner_traces [4096],
+//          preconditioner_rebuild_change [0.02], max_preconditioner_traces [2048],
 //          tolerance [1e-8],
 //          max_iterations [5000], omega [0.5], spectrum_steps [12],
 //          spectrum_safety_factor [1.05],

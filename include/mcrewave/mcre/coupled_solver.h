@@ -112,7 +112,7 @@ struct CoupledSolverOptions {
   // are at most max_preconditioner_traces (else CG runs without, and says so).
   TracePreconditioner preconditioner = TracePreconditioner::kNone;
   double preconditioner_rebuild_change = 0.02;
-  long max_preconditioner_traces = 4096;
+  long max_preconditioner_traces = 2048;
   // Shooting fails when the 2-norm condition number of its (equilibrated) shooting
   // matrix exceeds this, or is not finite.
   double shooting_condition_limit = 1e14;
