@@ -103,9 +103,10 @@ class StreamingConjugateGradient {
   // L p into image, then q = (I - L) p; <p, -L p> and <p, q> returned through the
   // pointers. False (the summary says why) when <p, q> is not positive.
   bool ApplyToDirection(int iteration, double* direction_energy, double* curvature);
-  // Preconditioned: z = M^-1 r, p = z and rho = <r, z> of the residual r now in
-  // residual_, whose ||r||_W / ||r_0||_W is `relative`.
-  void StartPreconditionedRecursion(double relative);
+  // z = M^-1 r (z = r without a preconditioner), p = z and rho = <r, z> of the residual
+  // r now in residual_, whose ||r||_W / ||r_0||_W is relative_ (preconditioned: the
+  // start of its estimate).
+  void StartRecursion();
   // Preconditioned: ||r_k||_W / ||r_0||_W into relative_ and the history, estimated
   // by start_relative_ (rho_k / start_rho_)^1/2 (the M^-1-norm's decrease), measured
   // by one backward sweep once that estimate is within kMeasuredResidualFactor of the
@@ -173,11 +174,8 @@ void StreamingConjugateGradient::Solve(const Matrix* initial_traces) {
   if (preconditioned_) {
     start_note_ += "; preconditioned by I - L at moduli within " +
                    ScientificString(options_.preconditioner_rebuild_change);
-    StartPreconditionedRecursion(relative_);
-  } else {
-    direction_ = residual_;
-    rho_ = problem_->TraceInnerProduct(residual_, residual_);
   }
+  StartRecursion();
   summary_->residual_history.push_back(relative_);
   summary_->relative_residual = relative_;
   for (int iteration = 0;; ++iteration, ++since_restart_) {
@@ -265,13 +263,13 @@ bool StreamingConjugateGradient::ApplyToDirection(int iteration, double* directi
   return true;
 }
 
-void StreamingConjugateGradient::StartPreconditionedRecursion(double relative) {
-  problem_->PreconditionTraces(residual_, &preconditioned_residual_);
-  direction_ = preconditioned_residual_;
-  rho_ = problem_->TraceInnerProduct(residual_, preconditioned_residual_);
+void StreamingConjugateGradient::StartRecursion() {
+  if (preconditioned_) problem_->PreconditionTraces(residual_, &preconditioned_residual_);
+  const Matrix& preconditioned = preconditioned_ ? preconditioned_residual_ : residual_;
+  direction_ = preconditioned;
+  rho_ = problem_->TraceInnerProduct(residual_, preconditioned);
   start_rho_ = rho_;
-  start_relative_ = relative;
-  relative_ = relative;
+  start_relative_ = relative_;
 }
 
 void StreamingConjugateGradient::UpdatePreconditionedResidual() {
@@ -308,27 +306,23 @@ void StreamingConjugateGradient::Step(double direction_energy, double curvature)
   const double step = rho_ / curvature;
   traces_ += step * direction_;
   residual_ -= step * image_;
-  if (preconditioned_) {
-    // PCG: z_{k+1} = M^-1 r_{k+1}, rho = <r, z>, p_{k+1} = z_{k+1} + beta p_k.
-    problem_->PreconditionTraces(residual_, &preconditioned_residual_);
-    const double rho_next = problem_->TraceInnerProduct(residual_, preconditioned_residual_);
-    direction_coefficient_ = rho_next / rho_;
-    if (restarts_ == 0) lanczos_.Add(step, direction_coefficient_);
-    direction_ = preconditioned_residual_ + direction_coefficient_ * direction_;
-    rho_ = rho_next;
-    UpdatePreconditionedResidual();
-    return;
-  }
-  const double rho_next = problem_->TraceInnerProduct(residual_, residual_);
+  // z_{k+1} = M^-1 r_{k+1} (r_{k+1} without a preconditioner), rho = <r, z>,
+  // p_{k+1} = z_{k+1} + beta p_k.
+  if (preconditioned_) problem_->PreconditionTraces(residual_, &preconditioned_residual_);
+  const Matrix& preconditioned = preconditioned_ ? preconditioned_residual_ : residual_;
+  const double rho_next = problem_->TraceInnerProduct(residual_, preconditioned);
   direction_coefficient_ = rho_next / rho_;
   if (restarts_ == 0) lanczos_.Add(step, direction_coefficient_);
-  // <p_{k+1}, p_k> = <r_{k+1}, p_k> + beta_{k+1} <p_k, p_k>.
-  consecutive_directions_ =
-      problem_->TraceInnerProduct(residual_, direction_) +
-      direction_coefficient_ * problem_->TraceInnerProduct(direction_, direction_);
-  direction_ = residual_ + direction_coefficient_ * direction_;
-  previous_direction_energy_ = direction_energy;
+  if (!preconditioned_) {
+    // <p_{k+1}, p_k> = <r_{k+1}, p_k> + beta_{k+1} <p_k, p_k>, for ||r||_W's recursion.
+    consecutive_directions_ =
+        problem_->TraceInnerProduct(residual_, direction_) +
+        direction_coefficient_ * problem_->TraceInnerProduct(direction_, direction_);
+    previous_direction_energy_ = direction_energy;
+  }
+  direction_ = preconditioned + direction_coefficient_ * direction_;
   rho_ = rho_next;
+  if (preconditioned_) UpdatePreconditionedResidual();
 }
 
 bool StreamingConjugateGradient::CheckTrueResidual() {
@@ -362,12 +356,7 @@ bool StreamingConjugateGradient::CheckTrueResidual() {
   since_restart_ = -1;
   residual_ = image_;
   relative_ = true_relative;
-  if (preconditioned_) {
-    StartPreconditionedRecursion(relative_);
-  } else {
-    direction_ = residual_;
-    rho_ = problem_->TraceInnerProduct(residual_, residual_);
-  }
+  StartRecursion();
   summary_->residual_history.push_back(relative_);
   return false;
 }
