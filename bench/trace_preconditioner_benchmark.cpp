@@ -85,12 +85,14 @@ int main(int argc, char** argv) {
     preconditioned.type = CoupledSolverType::kStreamingConjugateGradient;
     preconditioned.preconditioner = TracePreconditioner::kDenseTraces;
     Figures fields, built, kept, build;
+    int traces = 0;
     for (int r = 0; r < repeats; ++r) {
       MatrixMcreProblem reference = make_problem();
       TimeSolve(stored, near, &reference, &fields);
       MatrixMcreProblem problem = make_problem();
       TimeSolve(preconditioned, near, &problem, &built);
       TimeSolve(preconditioned, moved, &problem, &kept);
+      traces = problem.num_traces();
       MatrixMcreProblem fresh = make_problem();
       fresh.SetModuli(near);
       const double start = ThreadCpuSeconds();
@@ -102,7 +104,7 @@ int main(int argc, char** argv) {
       build.seconds = std::min(build.seconds, ThreadCpuSeconds() - start);
     }
     std::printf("%s: %d dofs, %d traces x %d samples, tolerance %g, %d repeats (minimum CPU)\n",
-                path.c_str(), model.dofs(), make_problem().num_traces(), data.num_steps() + 1,
+                path.c_str(), model.dofs(), traces, data.num_steps() + 1,
                 config.inner.tolerance, repeats);
     std::printf("%-44s %10s %10s %8s %12s\n", "solve", "CPU [s]", "iterations", "sweeps",
                 "ratio to (a)");

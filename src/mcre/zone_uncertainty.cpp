@@ -130,12 +130,12 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
                           solution.retrograde - noise_solution.retrograde, &minus_gradient);
     } else {
       // A streaming solution: s_d +- s_n are the fixed points y_d +- y_n on the traces,
-      // whose fields one application of each problem's map passes through (3 sweeps).
+      // whose fields one application of each problem's map passes through.
       plus.StreamingMap(solution.traces + noise_solution.traces, true, &image, &totals);
       plus_gradient = totals.cost_gradients;
       minus.StreamingMap(solution.traces - noise_solution.traces, true, &image, &totals);
       minus_gradient = totals.cost_gradients;
-      result.sweeps += 6;
+      result.sweeps += plus.sweep_count() + minus.sweep_count();
     }
     // dE = -H^-1 dg
     const Vector change = -factor.solve(0.5 * (plus_gradient - minus_gradient));
