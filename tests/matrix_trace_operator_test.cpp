@@ -100,10 +100,10 @@ TEST_F(PreconditionedPlateTest, GivesTheStoredFieldSolutionInFewIterations) {
       CoupledSolverType::kStreamingConjugateGradient, TracePreconditioner::kDenseTraces);
   const Vector built_at = (Vector(2) << 1.9e11, 1.7e11).finished();
   // At the moduli it is built at, then 1.5 % away (kept), then 5 % away (rebuilt
-  // there: one iteration again).
+  // there: two iterations again, the factor being single precision).
   const double factors[] = {1.0, 1.015, 1.05};
   const int builds[] = {1, 1, 2};
-  const int most_iterations[] = {1, 15, 1};
+  const int most_iterations[] = {2, 15, 2};
   for (int i = 0; i < 3; ++i) {
     const Vector moduli = factors[i] * built_at;
     stored.SetModuli(moduli);
@@ -116,10 +116,10 @@ TEST_F(PreconditionedPlateTest, GivesTheStoredFieldSolutionInFewIterations) {
     ASSERT_TRUE(by_traces.IsSolutionUsable()) << by_traces.message;
     EXPECT_NE(by_traces.message.find("preconditioned"), std::string::npos) << by_traces.message;
     EXPECT_EQ(streamed.trace_preconditioner_builds(), builds[i]) << factors[i];
-    // Measured: 1, 11 and 1 iterations against 149 to 151 of the stored-field CG.
+    // Measured: 2, 11 and 2 iterations against 149 to 151 of the stored-field CG.
     EXPECT_LE(by_traces.iterations, most_iterations[i]) << factors[i];
     EXPECT_GT(by_fields.iterations, 8 * by_traces.iterations) << factors[i];
-    // The same e^2 and zone gradients to the tolerance: measured within 1.1e-15 (e^2)
+    // The same e^2 and zone gradients to the tolerance: measured within 2.9e-15 (e^2)
     // and 1.6e-10 (gradients, of the largest) relative.
     EXPECT_NEAR(solution.cost, reference.cost, 1e-14 * reference.cost) << factors[i];
     for (int z = 0; z < 2; ++z) {

@@ -10,10 +10,9 @@
 
 namespace mcrewave {
 
-Matrix MatrixMcreProblem::SymmetricTraceOperator() {
+Matrix MatrixMcreProblem::TraceImpulseResponses() {
   const int n = num_nodes(), m = num_steps(), rows = num_traces();
   assert(m >= 2 && theta_ >= 0.5 && betas_.minCoeff() > 0.0);
-  const double h = time_step();
   // a(j), j = 1..m: the traces' response at t_j to a unit force over the step
   // t_0 -> t_1 alone, one R x n block per sample, stored transposed (n x R m, column
   // (j - 1) R + k for row k). By the adjointness of the two sweeps,
@@ -45,42 +44,80 @@ Matrix MatrixMcreProblem::SymmetricTraceOperator() {
     }
     ++sweep_count_;
   }
+  return responses;
+}
+
+namespace {
+
+// The time grid's facts the trace operator's assembly needs.
+struct TraceGrid {
+  int rows = 0;   // R, trace rows
+  int steps = 0;  // m
+  double theta = 0.5;
+  double time_step = 0.0;     // h [s]
+  double first_weight = 0.5;  // c_0
+  double last_weight = 0.5;   // c_m
+};
+
+// S = (C beta)^1/2 Q (C beta)^1/2 from the impulse responses (SymmetricTraceOperator's
+// formulas), in Scalar arithmetic: double for the operator, float for the
+// preconditioner's factor, which needs I + S to a few digits only. Symmetric to
+// round-off; its lower triangle is the product's.
+template <typename Scalar>
+Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> AssembleTraceOperator(
+    const Matrix& responses, const SparseMatrix& penalty, const TraceGrid& grid,
+    const Vector& weight_roots) {
+  using Dense = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
+  const int rows = grid.rows, m = grid.steps;
   // A(i, k) = a(i) P a(k)^T / h, R x R blocks, in a matrix over the samples 0..m
   // whose block row and column 0 stay zero (a(0) = 0): its lower triangle by one
   // product (P symmetric), the upper by symmetry.
   const int size = rows * (m + 1);
-  const SparseMatrix penalty = PenaltyMatrix();
-  const Matrix weighted = penalty * responses;
-  Matrix gram = Matrix::Zero(size, size);
+  const Dense weighted = (penalty * responses).template cast<Scalar>();
+  const Dense transposed = responses.transpose().template cast<Scalar>();
+  Dense gram = Dense::Zero(size, size);
   auto inner = gram.bottomRightCorner(rows * m, rows * m);
-  inner.triangularView<Eigen::Lower>() = responses.transpose() * weighted;
-  inner *= 1.0 / h;
-  inner.triangularView<Eigen::StrictlyUpper>() = inner.transpose();
+  inner.template triangularView<Eigen::Lower>() = transposed * weighted;
+  inner *= static_cast<Scalar>(1.0 / grid.time_step);
+  inner.template triangularView<Eigen::StrictlyUpper>() = inner.transpose();
   // Q = Z P C^-1 Z^T over the samples i, k = 0..m, Z(i, 0) = (1 - theta) a(i) and
   // Z(i, l) = theta a(i - l + 1) + (1 - theta) a(i - l) for l >= 1:
   //   Q(i, k) = Q(i - 1, k - 1) + D(i, k),
   //   D(i, k) = theta^2 A(i, k) + theta (1 - theta) (A(i, k - 1) + A(i - 1, k))
   //             + (1 - theta)^2 A(i - 1, k - 1) + (1 - theta)^2 / c_0 [A(i, k) - A(i - 1, k - 1)],
   // the term l = m counted twice at (m, m) (c_m = 1/2), and Q(0, .) = 0 (U_0 = 0).
-  const double t = theta_, u = 1.0 - theta_, start = u * u / QuadratureWeight(0);
+  const double t = grid.theta, u = 1.0 - grid.theta, start = u * u / grid.first_weight;
   const int rest = size - rows;
-  Matrix q = (t * t + start) * gram;
-  q.bottomRightCorner(rest, rest) += (u * u - start) * gram.topLeftCorner(rest, rest);
-  q.rightCols(rest) += t * u * gram.leftCols(rest);
-  q.bottomRows(rest) += t * u * gram.topRows(rest);
+  Dense q = static_cast<Scalar>(t * t + start) * gram;
+  q.bottomRightCorner(rest, rest) +=
+      static_cast<Scalar>(u * u - start) * gram.topLeftCorner(rest, rest);
+  q.rightCols(rest) += static_cast<Scalar>(t * u) * gram.leftCols(rest);
+  q.bottomRows(rest) += static_cast<Scalar>(t * u) * gram.topRows(rest);
   // The cumulative sums along the block diagonals, block row by block row.
   for (int i = 1; i <= m; ++i) {
     q.block(i * rows, rows, rows, rest) += q.block((i - 1) * rows, 0, rows, rest);
   }
   q.block(m * rows, m * rows, rows, rows) +=
-      (t * t * (1.0 / QuadratureWeight(m) - 1.0)) * gram.block(rows, rows, rows, rows);
+      static_cast<Scalar>(t * t * (1.0 / grid.last_weight - 1.0)) *
+      gram.block(rows, rows, rows, rows);
   // S = (C beta)^1/2 Q (C beta)^1/2, C = diag(c_j h).
-  const Vector weights = TraceWeightRoots();
-  q.array().colwise() *= weights.array();
-  q.array().rowwise() *= weights.transpose().array();
+  const auto roots = weight_roots.template cast<Scalar>();
+  q.array().colwise() *= roots.array();
+  q.array().rowwise() *= roots.transpose().array();
+  return q;
+}
+
+}  // namespace
+
+Matrix MatrixMcreProblem::SymmetricTraceOperator() {
+  const TraceGrid grid{num_traces(), num_steps(),         theta_,
+                       time_step(),  QuadratureWeight(0), QuadratureWeight(num_steps())};
+  Matrix q = AssembleTraceOperator<double>(TraceImpulseResponses(), PenaltyMatrix(), grid,
+                                           TraceWeightRoots());
   // Symmetric to round-off: the mean of the two triangles, in place.
-  for (int c = 0; c < size; ++c) {
-    for (int r = c + 1; r < size; ++r) {
+  const auto size = q.rows();
+  for (Eigen::Index c = 0; c < size; ++c) {
+    for (Eigen::Index r = c + 1; r < size; ++r) {
       const double mean = 0.5 * (q(r, c) + q(c, r));
       q(r, c) = mean;
       q(c, r) = mean;
@@ -113,14 +150,19 @@ bool MatrixMcreProblem::PrepareTracePreconditioner(double rebuild_change, long m
   }
   trace_factor_.reset();
   auto built = std::make_shared<TraceFactor>();
-  // I + S = L L^T, factorised in place (its lower triangle becomes L).
-  built->factor = SymmetricTraceOperator();
-  built->factor.diagonal().array() += 1.0;
+  built->weights = TraceWeightRoots();
+  // I + S = L L^T in single precision, factorised in place (its lower triangle becomes
+  // L): a preconditioner needs I + S to a few digits, and float halves the two O(size^3)
+  // products. The factor is kept in double, so that PCG applies one fixed operator.
+  const TraceGrid grid{rows, m, theta_, time_step(), QuadratureWeight(0), QuadratureWeight(m)};
+  Eigen::MatrixXf operator_plus_identity =
+      AssembleTraceOperator<float>(TraceImpulseResponses(), PenaltyMatrix(), grid, built->weights);
+  operator_plus_identity.diagonal().array() += 1.0f;
   {
-    Eigen::LLT<Eigen::Ref<Matrix>> in_place(built->factor);
+    Eigen::LLT<Eigen::Ref<Eigen::MatrixXf>> in_place(operator_plus_identity);
     if (in_place.info() != Eigen::Success) return false;
   }
-  built->weights = TraceWeightRoots();
+  built->factor = operator_plus_identity.cast<double>();
   built->moduli = moduli_;
   trace_factor_ = std::move(built);
   ++trace_preconditioner_builds_;

@@ -238,6 +238,9 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
  private:
   // (c_j h beta_k)^1/2 of every trace entry, in a trace field's (column-major) order.
   Vector TraceWeightRoots() const;
+  // The traces' impulse responses a(j), j = 1..m, n x R m (column (j - 1) R + k for
+  // row k), from one retrograde sweep per trace row (matrix_trace_operator.cpp).
+  Matrix TraceImpulseResponses();
   // x^T K y on either path of the integrator: from its band of K on the band path (as
   // the bar's McreProblem::PenaltyForm), else through product_ = K y. No allocation.
   double StiffnessForm(const double* x, const double* y);
