@@ -510,9 +510,14 @@ TEST(MatrixIdentificationRunTest, ThePlateConfigIdentifiesBothZones) {
   EXPECT_NEAR(ZoneModulus(dir + "/zones.csv", 0) / 200e9 - 1.0, -0.0216, 0.005);
   EXPECT_NEAR(ZoneModulus(dir + "/zones.csv", 1) / 140e9 - 1.0, -0.0769, 0.005);
   EXPECT_TRUE(std::filesystem::exists(dir + "/zones.png"));
+  // Without supports and at the search's weights, the search functional is e^2 itself:
+  // one stage, its scan on e^2.
+  const YAML::Node summary = YAML::LoadFile(dir + "/summary.yaml");
+  EXPECT_EQ(summary["scan"]["functional"].as<std::string>(), "same");
+  EXPECT_EQ(summary["inner"]["search_sweeps"].as<int>(), 0);
   // The uncertainty of both moduli from the config's 8 noise draws at the data's SNR
   // (zone_uncertainty_test.cpp checks the figure against re-identification).
-  const YAML::Node uncertainty = YAML::LoadFile(dir + "/summary.yaml")["uncertainty"];
+  const YAML::Node uncertainty = summary["uncertainty"];
   EXPECT_EQ(uncertainty["message"].as<std::string>(), "ok");
   EXPECT_EQ(uncertainty["samples"].as<int>(), 8);
   EXPECT_EQ(uncertainty["noise_source"].as<std::string>(), "synthetic_snr");

@@ -255,6 +255,25 @@ TEST(ZoneMcreObjectiveTest, AFailedSolveIsReportedNotThrown) {
       << objective.error_message();
 }
 
+// The search functional is e^2 itself when its weights are mcre's and there are no
+// supports, or mcre's clamp is pinned at the search's w_u0 and w_r.
+TEST(McreObjectiveTest, TheSearchIsTheObjectiveOnlyWhereItPosesTheSameProblem) {
+  const SearchOptions search;
+  McreOptions mcre;  // the config's defaults: w_u = 1e-7, the clamp trusted
+  EXPECT_FALSE(SearchIsTheObjective(mcre, search, false));
+  mcre.weights.displacement_weight = search.displacement_weight;
+  mcre.weights.strain_weight = search.strain_weight;
+  EXPECT_TRUE(SearchIsTheObjective(mcre, search, false));
+  EXPECT_FALSE(SearchIsTheObjective(mcre, search, true));  // trusted, not pinned
+  mcre.clamp = ClampModel::kPinned;
+  mcre.weights.clamp_displacement_weight = search.clamp_displacement_weight;
+  mcre.weights.reaction_weight = search.reaction_weight;
+  EXPECT_TRUE(SearchIsTheObjective(mcre, search, true));
+  mcre.weights.reaction_weight = 2.0 * search.reaction_weight;
+  EXPECT_FALSE(SearchIsTheObjective(mcre, search, true));
+  EXPECT_TRUE(SearchIsTheObjective(mcre, search, false));
+}
+
 // The bar's identification on the one road: the two-stage search of configs/paper_bar.yaml
 // (the pinned clamp's e^2 scanned and refined, then the trusted clamp's e^2 refined
 // within 3 % of it) run once on the built-in bar and once on the same bar exported as

@@ -379,8 +379,10 @@ std::string SummaryIntroduction(const ComparatorStudy& study) {
   if (study.matrix_model) {
     md << "on the matrix model, as identify run does it: when the zones share one nominal "
           "modulus, one E in every zone first by the global scan and refinements (for the MCRE "
-          "on the search functional of search:, then e^2), its `one valley` and `valleys` of "
-          "that scan; then every zone at once from E* (else from the nominal moduli, without "
+          "on the search functional of search:, then e^2; on e^2 alone where the search "
+          "functional is e^2 itself: no supports, search:'s w_u and w_e), its `one valley` "
+          "and `valleys` of that scan; then every zone at once from E* (else from the nominal "
+          "moduli, without "
           "a scan); least squares' misfit normalised by the noise of each sensor kind. Model "
           "errors: `density` the model's M 3 % larger, `force_gain` every "
           "load measured 5 % high, `displacement_gain` every displacement sensor measured 3 % "

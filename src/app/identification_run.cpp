@@ -198,8 +198,11 @@ McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData&
       MatrixMcreObjective(model, data, config.mcre, config.time.theta, config.inner,
                           Factorization::kAutomatic, config.outer.initial));
   result.scan_cost_scale = result.objective->cost_scale();
-  if (!ScansTheSearchFunctional(config)) {
-    result.outer = Identify(config.outer, result.objective.get());
+  if (!IdentifiesInTwoStages(config, model)) {
+    IdentificationOptions outer = config.outer;
+    // The search functional is e^2 itself: its scan, on e^2, in one stage.
+    if (ScansTheSearchFunctional(config)) outer.scan_points = config.search.scan_points;
+    result.outer = Identify(outer, result.objective.get());
     return result;
   }
   CoupledSolverOptions search_inner = config.inner;
@@ -214,6 +217,11 @@ McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData&
   return result;
 }
 
+bool IdentifiesInTwoStages(const Config& config, const MatrixModelData& model) {
+  return ScansTheSearchFunctional(config) &&
+         !SearchIsTheObjective(config.mcre, config.search, !model.supports.empty());
+}
+
 ModulusStage IdentifyHomogeneousModulus(const Config& config, const MatrixModelData& model,
                                         const ChannelSet& data) {
   ModulusStage stage;
@@ -225,9 +233,11 @@ ModulusStage IdentifyHomogeneousModulus(const Config& config, const MatrixModelD
       OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
       config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
       CoupledSolverName(config.inner.type, stage.inner_method),
-      config.outer.scan_points == 0      ? "none (outer.scan_points 0)"
-      : ScansTheSearchFunctional(config) ? "the pinned search functional (search:)"
-                                         : "mcre:'s e^2");
+      config.outer.scan_points == 0          ? "none (outer.scan_points 0)"
+      : IdentifiesInTwoStages(config, model) ? "the pinned search functional (search:)"
+      : ScansTheSearchFunctional(config)
+          ? "mcre:'s e^2, the search functional itself on this model (search.scan_points)"
+          : "mcre:'s e^2");
   McreIdentification identification = IdentifyWithMcre(config, model, data);
   McreObjective& objective = *identification.objective;
   stage.rest_cost = objective.rest_cost();

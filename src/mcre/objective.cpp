@@ -60,6 +60,19 @@ McreOptions SearchMcreOptions(const McreOptions& mcre, const SearchOptions& sear
   return options;
 }
 
+bool SearchIsTheObjective(const McreOptions& mcre, const SearchOptions& search,
+                          bool model_has_supports) {
+  const McreWeights& weights = mcre.weights;
+  if (weights.displacement_weight != search.displacement_weight ||
+      weights.strain_weight != search.strain_weight) {
+    return false;
+  }
+  return !model_has_supports ||
+         (mcre.clamp == ClampModel::kPinned &&
+          weights.clamp_displacement_weight == search.clamp_displacement_weight &&
+          weights.reaction_weight == search.reaction_weight);
+}
+
 McreObjective::McreObjective(ProblemFactory make_problem, const CoupledSolverOptions& inner,
                              double modulus_scale)
     : make_problem_(std::move(make_problem)),

@@ -142,12 +142,18 @@ struct McreIdentification {
 // The outer loop of config.outer on mcre:'s e^2 of `data` (the identification's
 // measurements: selected and pre-filtered) with the model `model` (BarRunModel, or any
 // structure given by matrices), its supports treated as mcre.clamp says and
-// x = E / outer.initial; model and data must outlive the result's objective. With
-// outer.scan_points > 0 and search.functional pinned: IdentifyInTwoStages with the
-// search functional (SearchMcreOptions, its inner solves to search.inner_tolerance); else
-// Identify. Precondition: config valid.
+// x = E / outer.initial; model and data must outlive the result's objective. When
+// IdentifiesInTwoStages: IdentifyInTwoStages with the search functional
+// (SearchMcreOptions, its inner solves to search.inner_tolerance). Else Identify, its
+// scan of search.scan_points when the search functional is e^2 itself on this model.
+// Precondition: config valid.
 McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData& model,
                                     const ChannelSet& data);
+
+// Whether IdentifyWithMcre scans the search functional first: ScansTheSearchFunctional
+// (config.h) and the search functional is not e^2 itself on this model
+// (SearchIsTheObjective, objective.h: no supports and the same w_u and w_e, say).
+bool IdentifiesInTwoStages(const Config& config, const MatrixModelData& model);
 
 // The homogeneous stage up to `solution`: IdentifyWithMcre, then the objective's best
 // evaluation, solved once more at E* when another evaluation went lower. model and data:

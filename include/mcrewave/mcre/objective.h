@@ -88,6 +88,13 @@ struct SearchOptions {
 // the search's weights.
 McreOptions SearchMcreOptions(const McreOptions& mcre, const SearchOptions& search);
 
+// Whether SearchMcreOptions(mcre, search) poses mcre's own problem on a model with or
+// without supports: the same w_u and w_e, and either no supports (the clamp's treatment,
+// w_u0 and w_r then act on nothing) or mcre's clamp pinned at the search's w_u0 and w_r.
+// The search's scan is then e^2's own, and its second stage would refine e^2 again.
+bool SearchIsTheObjective(const McreOptions& mcre, const SearchOptions& search,
+                          bool model_has_supports);
+
 // One evaluation of e^2(E) by McreObjective.
 struct ObjectiveEvaluation {
   double modulus = -1.0;            // E [Pa] when every zone has it; -1 when they differ
