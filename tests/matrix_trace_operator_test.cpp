@@ -130,6 +130,27 @@ TEST_F(PreconditionedPlateTest, GivesTheStoredFieldSolutionInFewIterations) {
   }
 }
 
+// At data weights 1e8 times the paper's, S reaches about 6e7: float's round-off breaks
+// I + S's definiteness (from w = 1e6 on, measured), and the factor is built in double;
+// a solve at its moduli still takes a few iterations (measured 1). To 1e-6: the sweeps'
+// round-off holds the true residual near 2e-7 at such weights.
+TEST_F(PreconditionedPlateTest, BeyondSinglePrecisionTheFactorIsBuiltInDouble) {
+  const Vector moduli = (Vector(2) << 1.9e11, 1.7e11).finished();
+  CoupledSolverOptions preconditioned = TraceSolverOptions(
+      CoupledSolverType::kStreamingConjugateGradient, TracePreconditioner::kDenseTraces);
+  preconditioned.tolerance = 1e-6;
+  for (const double weight : {0.01, 1e6}) {
+    MatrixMcreProblem problem(coarse_, data_, Weights(weight, 1.0), 2e11, 0.5);
+    problem.SetModuli(moduli);
+    CoupledSolution solution;
+    const CoupledSolverSummary summary = SolveCoupled(preconditioned, &problem, nullptr, &solution);
+    ASSERT_TRUE(summary.IsSolutionUsable()) << summary.message;
+    ASSERT_NE(problem.trace_factor(), nullptr) << weight;
+    EXPECT_EQ(problem.trace_factor()->single_precision, weight < 1.0) << weight;
+    EXPECT_LE(summary.iterations, 3) << weight;
+  }
+}
+
 TEST_F(PreconditionedPlateTest, AboveItsTraceLimitCgRunsWithout) {
   MatrixMcreProblem problem(coarse_, data_, Weights(0.01, 1.0), 2e11, 0.5);
   problem.SetModuli((Vector(2) << 1.9e11, 1.7e11).finished());

@@ -155,14 +155,21 @@ bool MatrixMcreProblem::PrepareTracePreconditioner(double rebuild_change, long m
   // L): a preconditioner needs I + S to a few digits, and float halves the two O(size^3)
   // products. The factor is kept in double, so that PCG applies one fixed operator.
   const TraceGrid grid{rows, m, theta_, time_step(), QuadratureWeight(0), QuadratureWeight(m)};
-  Eigen::MatrixXf operator_plus_identity =
-      AssembleTraceOperator<float>(TraceImpulseResponses(), PenaltyMatrix(), grid, built->weights);
-  operator_plus_identity.diagonal().array() += 1.0f;
-  {
-    Eigen::LLT<Eigen::Ref<Eigen::MatrixXf>> in_place(operator_plus_identity);
-    if (in_place.info() != Eigen::Success) return false;
+  const Matrix responses = TraceImpulseResponses();
+  const SparseMatrix penalty = PenaltyMatrix();
+  Eigen::MatrixXf single = AssembleTraceOperator<float>(responses, penalty, grid, built->weights);
+  single.diagonal().array() += 1.0f;
+  const Eigen::LLT<Eigen::Ref<Eigen::MatrixXf>> single_factor(single);
+  if (single_factor.info() == Eigen::Success) {
+    built->factor = single.cast<double>();
+  } else {
+    // Float's round-off of a large S broke I + S's definiteness: in double.
+    built->factor = AssembleTraceOperator<double>(responses, penalty, grid, built->weights);
+    built->factor.diagonal().array() += 1.0;
+    const Eigen::LLT<Eigen::Ref<Matrix>> double_factor(built->factor);
+    if (double_factor.info() != Eigen::Success) return false;
+    built->single_precision = false;
   }
-  built->factor = operator_plus_identity.cast<double>();
   built->moduli = moduli_;
   trace_factor_ = std::move(built);
   ++trace_preconditioner_builds_;

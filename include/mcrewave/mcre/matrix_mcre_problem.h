@@ -208,7 +208,8 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // product of n x R m matrices. Preconditions: m >= 2, theta >= 1/2 (the recursion
   // from the responses to Z's blocks divides by theta), every beta_k > 0.
   Matrix SymmetricTraceOperator();
-  // The Cholesky factor of I + S (above) at the current moduli, rebuilt when a modulus
+  // The Cholesky factor of I + S (above) at the current moduli, in single precision
+  // where that keeps it definite (TraceFactor::single_precision), rebuilt when a modulus
   // moved by more than rebuild_change since it was built; (C beta)^-1/2 (I + S)^-1
   // (C beta)^1/2 applied by PreconditionTraces.
   bool PrepareTracePreconditioner(double rebuild_change, long max_traces) override;
@@ -221,6 +222,9 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
     Matrix factor;   // L of I + S = L L^T in its lower triangle
     Vector weights;  // (c_j h beta_k)^1/2 in a trace field's order
     Vector moduli;   // E_z [Pa] it was built at
+    // Factorised in float (false: in double, where float's round-off of a large S,
+    // about 1e7 and more, broke I + S's definiteness).
+    bool single_precision = true;
   };
   std::shared_ptr<const TraceFactor> trace_factor() const { return trace_factor_; }
   // Takes `factor` (of a problem of the same model, weights, theta and time grid) as
