@@ -144,6 +144,40 @@ TEST(MatrixStreamingTest, OneApplicationGivesTheStoredFieldsElementMap) {
   }
 }
 
+// With the element map left out (set_element_maps(false)), a streaming solve's totals
+// hold none and the same cost and gradients; StreamingElementMaps then gives, from the
+// solution's traces, the map a solve that gathered it holds, to the bit.
+TEST(MatrixStreamingTest, TheElementMapLeftOutIsGatheredFromTheTraces) {
+  const testing::SmallCase c = testing::MakeSmallCase(20, 300, 20.0, 2);
+  std::vector<int> zones(20);
+  for (int e = 0; e < 20; ++e) zones[e] = e < 12 ? 0 : 1;
+  const BarModel bar(c.bar, zones);
+  const ChannelSet data = MakeSyntheticMeasurements(c.bar, c.load, c.time, c.data);
+  const MatrixModelData model = BarMatrixModel(bar, c.bar.modulus, {}, BarClampExport::kSupport);
+  CoupledSolverOptions streaming;
+  streaming.type = CoupledSolverType::kStreamingConjugateGradient;
+  const Vector moduli = (Vector(2) << 1.9e11, 1.7e11).finished();
+  CoupledSolution with_maps, without_maps;
+  for (const bool gather : {true, false}) {
+    MatrixMcreProblem problem(model, data, Weights(0.01, 1.0), 2e11, 0.5);
+    problem.set_element_maps(gather);
+    problem.SetModuli(moduli);
+    CoupledSolution& solution = gather ? with_maps : without_maps;
+    ASSERT_TRUE(SolveCoupled(streaming, &problem, nullptr, &solution).IsSolutionUsable());
+    if (!gather) {
+      EXPECT_EQ(solution.element_error_map.size(), 0);
+      EXPECT_EQ(solution.gap_density.size(), 0);
+      problem.StreamingElementMaps(solution.traces, &solution);
+    }
+  }
+  EXPECT_EQ(without_maps.cost, with_maps.cost);
+  EXPECT_TRUE(without_maps.cost_gradients == with_maps.cost_gradients);
+  ASSERT_EQ(with_maps.element_error_map.size(), 20);
+  EXPECT_TRUE(without_maps.element_error_map == with_maps.element_error_map);
+  EXPECT_TRUE(without_maps.gap_density == with_maps.gap_density);
+  EXPECT_GT(with_maps.element_error_map.maxCoeff(), 0.0);
+}
+
 // The streaming CG against the stored-field CG, both to 1e-12, under every treatment.
 TEST(MatrixStreamingTest, StreamingAndStoredFieldConjugateGradientsAgree) {
   for (const MatrixStreamingCase& c : kMatrixStreamingCases) {

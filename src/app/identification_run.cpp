@@ -192,11 +192,11 @@ ChannelSet LoadMeasurements(const Config& config) {
 }
 
 McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData& model,
-                                    const ChannelSet& data) {
+                                    const ChannelSet& data, bool element_maps) {
   McreIdentification result;
   result.objective = std::make_unique<McreObjective>(
       MatrixMcreObjective(model, data, config.mcre, config.time.theta, config.inner,
-                          Factorization::kAutomatic, config.outer.initial));
+                          Factorization::kAutomatic, config.outer.initial, element_maps));
   result.scan_cost_scale = result.objective->cost_scale();
   if (!IdentifiesInTwoStages(config, model)) {
     IdentificationOptions outer = config.outer;
@@ -209,7 +209,7 @@ McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData&
   search_inner.tolerance = config.search.inner_tolerance;
   McreObjective search = MatrixMcreObjective(
       model, data, SearchMcreOptions(config.mcre, config.search), config.time.theta, search_inner,
-      Factorization::kAutomatic, config.outer.initial);
+      Factorization::kAutomatic, config.outer.initial, element_maps);
   result.outer = IdentifyInTwoStages(config.outer, &search, config.search.scan_points,
                                      config.search.refine_window, result.objective.get());
   result.search_sweeps = search.sweeps();
@@ -223,7 +223,7 @@ bool IdentifiesInTwoStages(const Config& config, const MatrixModelData& model) {
 }
 
 ModulusStage IdentifyHomogeneousModulus(const Config& config, const MatrixModelData& model,
-                                        const ChannelSet& data) {
+                                        const ChannelSet& data, bool element_maps) {
   ModulusStage stage;
   stage.inner_method = ResolveCoupledSolverType(config.inner, model.dofs(), data.num_steps(),
                                                 /*streaming_available=*/true);
@@ -238,7 +238,7 @@ ModulusStage IdentifyHomogeneousModulus(const Config& config, const MatrixModelD
       : ScansTheSearchFunctional(config)
           ? "mcre:'s e^2, the search functional itself on this model (search.scan_points)"
           : "mcre:'s e^2");
-  McreIdentification identification = IdentifyWithMcre(config, model, data);
+  McreIdentification identification = IdentifyWithMcre(config, model, data, element_maps);
   McreObjective& objective = *identification.objective;
   stage.rest_cost = objective.rest_cost();
   stage.scan_cost_scale = identification.scan_cost_scale;

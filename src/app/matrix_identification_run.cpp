@@ -275,6 +275,13 @@ const CoupledSolution* MapsAtIdentifiedAndNominal(
     const MatrixEvaluation& last = run->evaluations.back();
     if (last.usable && last.moduli == run->identified_moduli) {
       identified = &objective.last_solution();
+      if (!model.elements.empty() && !identified->has_fields()) {
+        // A streaming solve of the minimiser's, without the element map: gathered from
+        // its traces, as its final pass would have.
+        *storage = *identified;
+        problem->StreamingElementMaps(storage->traces, storage);
+        identified = storage;
+      }
       CostAndMaps(problem, *identified, &run->cost, &run->zone_map, &run->zone_gap, &run->dof_map);
     } else if (SolveAt(run->identified_moduli, config.inner, problem, storage, &run->cost,
                        &run->zone_map, &run->zone_gap, &run->dof_map, &why)) {
@@ -365,7 +372,8 @@ bool IdentifyHomogeneousStage(const Config& config, const MatrixModelData& model
                               MatrixIdentificationRun* run) {
   spdlog::info("homogeneous stage: one E in every zone");
   run->homogeneous_ran = true;
-  run->homogeneous = IdentifyHomogeneousModulus(config, model, run->data);
+  // Its solution warm-starts the zones: no element map.
+  run->homogeneous = IdentifyHomogeneousModulus(config, model, run->data, /*element_maps=*/false);
   ModulusStage& stage = run->homogeneous;
   if (!TakeHomogeneousOutcome(config, run)) return false;
   run->homogeneous_cost = stage.cost();
@@ -778,6 +786,8 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
   McreObjective mcre_objective =
       MatrixMcreObjective(model, run.data, config.mcre, config.time.theta, config.inner);
   auto& problem = static_cast<MatrixMcreProblem&>(mcre_objective.problem());
+  // The minimiser's solves gather no element map; step 3 gathers it where it is read.
+  problem.set_element_maps(false);
   run.nominal_moduli = problem.NominalModuli();
   run.rest_cost = mcre_objective.rest_cost();
   ZoneMcreObjective objective(&mcre_objective, run.nominal_moduli);
@@ -816,6 +826,7 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
 
   // 3. The error maps and the model's outputs at the identified moduli, then the maps
   //    at the nominal moduli; 4. the uncertainty of the identified moduli.
+  problem.set_element_maps(true);
   CoupledSolution storage;
   const CoupledSolution* identified =
       MapsAtIdentifiedAndNominal(config, model, mcre_objective, &problem, &storage, &run);

@@ -146,7 +146,7 @@ void MatrixMcreProblem::AddStreamingSample(int j, const Vector& displacement,
                 0.5 * betas_.dot(trace_.cwiseProduct(trace_)));
   // The dof map c_j h 1/2 W_ij (K W_j)_i (DofErrorMap).
   totals->error_map += (0.5 * weight) * retrograde.cwiseProduct(product_);
-  if (!model_.elements.empty()) {
+  if (element_maps_ && !model_.elements.empty()) {
     // The element map's shares and, on every picture_stride-th sample, its picture's
     // row (mcre/element_error_map.h, as ComputeElementErrorMap takes them from W).
     AddSampleElementGapShares(model_, moduli_, retrograde.data(), weight,
@@ -186,11 +186,25 @@ void MatrixMcreProblem::ResetStreamingTotals(int picture_stride, StreamingTotals
   totals->error_map.setZero(num_nodes());
   totals->zone_error_map.setZero(zones);
   totals->zone_strain_energy.setZero(zones);
-  totals->element_error_map.setZero(static_cast<Eigen::Index>(model_.elements.size()));
-  totals->gap_density.resize(model_.elements.empty() ? 0 : num_steps() / picture_stride + 1,
-                             stream_density_row_.size());
+  const bool elements = element_maps_ && !model_.elements.empty();
+  totals->element_error_map.setZero(elements ? static_cast<Eigen::Index>(model_.elements.size())
+                                             : 0);
+  totals->gap_density.resize(elements ? num_steps() / picture_stride + 1 : 0,
+                             elements ? stream_density_row_.size() : 0);
   totals->load_retrograde.resize(channel_.size(), num_steps() + 1);
   totals->rebuild_error = 0.0;  // W from checkpoints: the stored sweep's
+}
+
+void MatrixMcreProblem::StreamingElementMaps(const Matrix& traces, CoupledSolution* solution) {
+  assert(traces.rows() == num_traces() && traces.cols() == num_steps() + 1);
+  const bool gathered = element_maps_;
+  element_maps_ = true;
+  Matrix image;
+  StreamingTotals totals;
+  StreamingMap(traces, true, &image, &totals);
+  element_maps_ = gathered;
+  solution->element_error_map = std::move(totals.element_error_map);
+  solution->gap_density = std::move(totals.gap_density);
 }
 
 void MatrixMcreProblem::CheckpointRetrogradeSweep(const Matrix& traces, bool include_data) {

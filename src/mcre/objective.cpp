@@ -86,12 +86,15 @@ McreObjective::McreObjective(ProblemFactory make_problem, const CoupledSolverOpt
 McreObjective MatrixMcreObjective(const MatrixModelData& model, const ChannelSet& data,
                                   const McreOptions& mcre, double theta,
                                   const CoupledSolverOptions& inner, Factorization factorization,
-                                  double modulus_scale) {
+                                  double modulus_scale, bool element_maps) {
   assert(mcre.IsValid(nullptr) && modulus_scale >= 0.0);
   return McreObjective(
-      [&model, &data, mcre, theta, factorization]() -> std::unique_ptr<StreamingCoupledProblem> {
-        return std::make_unique<MatrixMcreProblem>(
+      [&model, &data, mcre, theta, factorization,
+       element_maps]() -> std::unique_ptr<StreamingCoupledProblem> {
+        auto problem = std::make_unique<MatrixMcreProblem>(
             model, data, mcre.weights, mcre.reference_modulus, theta, factorization, mcre.clamp);
+        problem->set_element_maps(element_maps);
+        return problem;
       },
       inner, modulus_scale > 0.0 ? modulus_scale : mcre.reference_modulus);
 }

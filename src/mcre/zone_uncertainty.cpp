@@ -70,6 +70,7 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
     result.message = "the figure needs the coupled solution's fields or traces";
     return result;
   }
+  // Its solves read costs and gradients, never the element map (set_element_maps).
   auto make_problem = [&](const ChannelSet& set) {
     return MatrixMcreProblem(model, set, mcre.weights, mcre.reference_modulus, theta,
                              Factorization::kAutomatic, mcre.clamp);
@@ -80,6 +81,7 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
     result.curvature = *curvature;
   } else {
     MatrixMcreProblem problem = make_problem(data);
+    problem.set_element_maps(false);
     if (!SecantCurvature(inner, moduli, solution, &problem, &result.curvature, &result.sweeps,
                          &why)) {
       result.message = why;
@@ -111,6 +113,7 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
       minus_data.channels[c].values = data.channels[c].values - noise_data.channels[c].values;
     }
     MatrixMcreProblem noise_problem = make_problem(noise_data);
+    noise_problem.set_element_maps(false);
     // Every draw at the same moduli: the first draw's preconditioner serves them all.
     noise_problem.ShareTraceFactor(shared_factor);
     if (!SolveUsable(inner, moduli, &noise_problem, nullptr, &noise_solution, &result.sweeps,
@@ -123,6 +126,8 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
     MatrixMcreProblem plus = make_problem(plus_data), minus = make_problem(minus_data);
     plus.SetModuli(moduli);
     minus.SetModuli(moduli);
+    plus.set_element_maps(false);
+    minus.set_element_maps(false);
     if (solution.has_fields()) {
       plus.CostGradients(solution.displacement + noise_solution.displacement,
                          solution.retrograde + noise_solution.retrograde, &plus_gradient);

@@ -146,9 +146,10 @@ struct McreIdentification {
 // IdentifiesInTwoStages: IdentifyInTwoStages with the search functional
 // (SearchMcreOptions, its inner solves to search.inner_tolerance). Else Identify, its
 // scan of search.scan_points when the search functional is e^2 itself on this model.
-// Precondition: config valid.
+// element_maps false: the streaming solves leave the element map out (a stage whose
+// solution only warm-starts another). Precondition: config valid.
 McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData& model,
-                                    const ChannelSet& data);
+                                    const ChannelSet& data, bool element_maps = true);
 
 // Whether IdentifyWithMcre scans the search functional first: ScansTheSearchFunctional
 // (config.h) and the search functional is not e^2 itself on this model
@@ -157,10 +158,10 @@ bool IdentifiesInTwoStages(const Config& config, const MatrixModelData& model);
 
 // The homogeneous stage up to `solution`: IdentifyWithMcre, then the objective's best
 // evaluation, solved once more at E* when another evaluation went lower. model and data:
-// as IdentifyWithMcre's. Precondition: config valid. Never throws for a failed
-// identification: see IsUsable() and outer.message.
+// as IdentifyWithMcre's, and element_maps. Precondition: config valid. Never throws for
+// a failed identification: see IsUsable() and outer.message.
 ModulusStage IdentifyHomogeneousModulus(const Config& config, const MatrixModelData& model,
-                                        const ChannelSet& data);
+                                        const ChannelSet& data, bool element_maps = true);
 
 // The rest of the stage at E*: with cost_curve, the cost curve e^2(E) on
 // output.curve_points points around E* (and over the optimiser's evaluations when they

@@ -197,6 +197,16 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // effect at the first StreamingMap.
   static constexpr long kDefaultWholeHistoryBytes = 1L << 26;
   void set_whole_history_bytes(long bytes) { whole_history_bytes_ = bytes; }
+  // Whether StreamingMap's totals gather the element map and its picture (true by
+  // default; with element blocks they cost about as much as a sweep's solves). Off,
+  // StreamingTotals::element_error_map and gap_density stay empty: for solves whose
+  // maps nobody reads (a minimiser's, the uncertainty's), StreamingElementMaps then
+  // gives a solution's maps from its traces.
+  void set_element_maps(bool gather) { element_maps_ = gather; }
+  // A streaming solution's element map and picture at the current moduli, from its
+  // traces: one application of the map (two or three sweeps), the same sums as a
+  // final pass that gathered them. Precondition: traces of this problem's size.
+  void StreamingElementMaps(const Matrix& traces, CoupledSolution* solution);
   // H U of a displacement field, num_traces() x (m + 1): the traces of stored fields.
   Matrix ObservedTraces(const Matrix& displacement) const { return observation_ * displacement; }
   // The trace operator -L at the current moduli as a dense symmetric matrix
@@ -339,6 +349,7 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // direct sweep (velocity, displacement), W_{j-1} and W_j, allocated in the constructor.
   int checkpoint_stride_ = 0;
   long whole_history_bytes_ = kDefaultWholeHistoryBytes;
+  bool element_maps_ = true;
   Matrix checkpoints_, segment_;
   Vector stream_velocity_[2], stream_displacement_[2], stream_retrograde_[2];
   // The streaming CG's preconditioner (null: none yet), a scratch vector of a trace

@@ -196,14 +196,16 @@ class McreObjective : public ModulusObjective {
 
 // The objective of a structure given by matrices: a MatrixMcreProblem on model and data
 // with mcre's weights and E0, its supports treated as mcre.clamp says, E per unit of x
-// modulus_scale [Pa] (0: mcre.reference_modulus; the bar's run takes outer.initial).
-// Keeps references to model and data: both must outlive it.
-// Preconditions: those of MatrixMcreProblem and McreObjective, modulus_scale >= 0.
+// modulus_scale [Pa] (0: mcre.reference_modulus; the bar's run takes outer.initial);
+// element_maps false: its streaming solves leave the element map out
+// (MatrixMcreProblem::set_element_maps). Keeps references to model and data: both must
+// outlive it. Preconditions: those of MatrixMcreProblem and McreObjective,
+// modulus_scale >= 0.
 McreObjective MatrixMcreObjective(const MatrixModelData& model, const ChannelSet& data,
                                   const McreOptions& mcre, double theta,
                                   const CoupledSolverOptions& inner,
                                   Factorization factorization = Factorization::kAutomatic,
-                                  double modulus_scale = 0.0);
+                                  double modulus_scale = 0.0, bool element_maps = true);
 
 // McreObjective::EvaluateModuli seen as a function of p_z = log(E_z / E_z,ref)
 // (optim/log_moduli_objective.h), J_scale = McreObjective::cost_scale(), whatever the
