@@ -62,11 +62,12 @@ struct TraceGrid {
 // S = (C beta)^1/2 Q (C beta)^1/2 from the impulse responses (SymmetricTraceOperator's
 // formulas), in Scalar arithmetic: double for the operator, float for the
 // preconditioner's factor, which needs I + S to a few digits only. Symmetric to
-// round-off; its lower triangle is the product's.
+// round-off; its lower triangle is the product's. lower_only: the strict upper
+// triangle is left undefined (a Cholesky factorisation reads the lower one).
 template <typename Scalar>
 Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> AssembleTraceOperator(
     const Matrix& responses, const SparseMatrix& penalty, const TraceGrid& grid,
-    const Vector& weight_roots) {
+    const Vector& weight_roots, bool lower_only) {
   using Dense = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
   const int rows = grid.rows, m = grid.steps;
   // A(i, k) = a(i) P a(k)^T / h, R x R blocks, in a matrix over the samples 0..m
@@ -74,12 +75,20 @@ Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> AssembleTraceOperator(
   // product (P symmetric), the upper by symmetry.
   const int size = rows * (m + 1);
   const Dense weighted = (penalty * responses).template cast<Scalar>();
-  const Dense transposed = responses.transpose().template cast<Scalar>();
+  const Dense cast_responses = responses.template cast<Scalar>();
   Dense gram = Dense::Zero(size, size);
   auto inner = gram.bottomRightCorner(rows * m, rows * m);
-  inner.template triangularView<Eigen::Lower>() = transposed * weighted;
+  inner.template triangularView<Eigen::Lower>() = cast_responses.transpose() * weighted;
   inner *= static_cast<Scalar>(1.0 / grid.time_step);
-  inner.template triangularView<Eigen::StrictlyUpper>() = inner.transpose();
+  if (lower_only) {
+    // Q's lower triangle reads A's lower triangle and, through A(i - 1, k), its band
+    // of R entries above the diagonal.
+    for (int c = 1; c < size; ++c) {
+      for (int r = std::max(0, c - rows); r < c; ++r) gram(r, c) = gram(c, r);
+    }
+  } else {
+    inner.template triangularView<Eigen::StrictlyUpper>() = inner.transpose();
+  }
   // Q = Z P C^-1 Z^T over the samples i, k = 0..m, Z(i, 0) = (1 - theta) a(i) and
   // Z(i, l) = theta a(i - l + 1) + (1 - theta) a(i - l) for l >= 1:
   //   Q(i, k) = Q(i - 1, k - 1) + D(i, k),
@@ -113,7 +122,7 @@ Matrix MatrixMcreProblem::SymmetricTraceOperator() {
   const TraceGrid grid{num_traces(), num_steps(),         theta_,
                        time_step(),  QuadratureWeight(0), QuadratureWeight(num_steps())};
   Matrix q = AssembleTraceOperator<double>(TraceImpulseResponses(), PenaltyMatrix(), grid,
-                                           TraceWeightRoots());
+                                           TraceWeightRoots(), /*lower_only=*/false);
   // Symmetric to round-off: the mean of the two triangles, in place.
   const auto size = q.rows();
   for (Eigen::Index c = 0; c < size; ++c) {
@@ -157,14 +166,16 @@ bool MatrixMcreProblem::PrepareTracePreconditioner(double rebuild_change, long m
   const TraceGrid grid{rows, m, theta_, time_step(), QuadratureWeight(0), QuadratureWeight(m)};
   const Matrix responses = TraceImpulseResponses();
   const SparseMatrix penalty = PenaltyMatrix();
-  Eigen::MatrixXf single = AssembleTraceOperator<float>(responses, penalty, grid, built->weights);
+  Eigen::MatrixXf single =
+      AssembleTraceOperator<float>(responses, penalty, grid, built->weights, /*lower_only=*/true);
   single.diagonal().array() += 1.0f;
   const Eigen::LLT<Eigen::Ref<Eigen::MatrixXf>> single_factor(single);
   if (single_factor.info() == Eigen::Success) {
     built->factor = single.cast<double>();
   } else {
     // Float's round-off of a large S broke I + S's definiteness: in double.
-    built->factor = AssembleTraceOperator<double>(responses, penalty, grid, built->weights);
+    built->factor = AssembleTraceOperator<double>(responses, penalty, grid, built->weights,
+                                                  /*lower_only=*/true);
     built->factor.diagonal().array() += 1.0;
     const Eigen::LLT<Eigen::Ref<Matrix>> double_factor(built->factor);
     if (double_factor.info() != Eigen::Success) return false;
