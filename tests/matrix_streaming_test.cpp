@@ -108,6 +108,43 @@ TEST(MatrixStreamingTest, OneApplicationIsTheStoredSweeps) {
   }
 }
 
+// At the data itself (y = d~, the start of every solve) the retrograde loads vanish:
+// StreamingMap skips the backward sweep and gives the direct sweep of W = 0, the same
+// bits as the stored fields of that sweep, in one sweep instead of two or three.
+TEST(MatrixStreamingTest, AtTheDataItselfOneDirectSweepGivesTheMap) {
+  for (const MatrixStreamingCase& c : kMatrixStreamingCases) {
+    for (const bool whole : {false, true}) {
+      SCOPED_TRACE(std::string(c.name) + (whole ? ", whole history" : ", checkpoints"));
+      const MatrixModelData lattice = MatrixStreamingLattice(c);
+      const ChannelSet data = SupportedLatticeHistories(SupportedLattice());
+      MatrixMcreProblem problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5,
+                                Factorization::kSparse, c.treatment);
+      if (!whole) problem.set_whole_history_bytes(0);
+      problem.SetModuli((Vector(2) << 1.8e11, 2.1e11).finished());
+      Matrix u0;
+      problem.DirectSweep(problem.ZeroField(), true, &u0);
+      Matrix image;
+      StreamingCoupledProblem::StreamingTotals totals;
+      const long sweeps = problem.sweep_count();
+      problem.StreamingMap(problem.DataTraces(), true, &image, &totals);
+      EXPECT_EQ(problem.sweep_count() - sweeps, 1);
+      EXPECT_EQ(image, problem.ObservedTraces(u0));
+      // Measured 0 apart: the same sums in the same order, W's terms zero.
+      const double cost = problem.Cost(u0, problem.ZeroField());
+      EXPECT_NEAR(totals.cost, cost, 4e-16 * cost);
+      EXPECT_EQ(totals.zone_error_map.norm(), 0.0);
+      EXPECT_EQ(totals.error_map.norm(), 0.0);
+      // Beside the data, the full map again.
+      Matrix beside = problem.DataTraces();
+      beside(0, 1) += 1e-3 * (std::abs(beside(0, 1)) + 1e-9);
+      const long before = problem.sweep_count();
+      problem.StreamingMap(beside, true, &image, &totals);
+      EXPECT_EQ(problem.sweep_count() - before, whole ? 2 : 3);
+      EXPECT_GT(totals.zone_error_map.norm(), 0.0);
+    }
+  }
+}
+
 // With element blocks (the bar exported, 2 zones), one application sums the element
 // map's shares and picture rows of the W it passes through: ComputeElementErrorMap's of
 // the stored W to the bit (the same W from the checkpoints, the same sums in the same

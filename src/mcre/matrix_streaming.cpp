@@ -263,10 +263,14 @@ void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Ma
     observe(j, stream_displacement_[next], retrograde);
   };
 
+  // At the data itself (y = d~, include_data: the start of every solve) the retrograde
+  // loads c_j H^T diag(beta) (y_j - d~_j) are zero, so omega stays at rest: no
+  // backward sweep, W = 0 (as the sweep would give it), the direct sweep alone.
+  const bool at_rest = include_data && traces == measured_outputs_;
   // 1. The retrograde sweep from rest at T keeping its state at the checkpoints; with
   //    one segment (s = m) its only checkpoint is that rest state, and step 2 is the
   //    one backward sweep.
-  if (stride < m) {
+  if (stride < m && !at_rest) {
     CheckpointRetrogradeSweep(traces, include_data);
   } else {
     checkpoints_.col(0).setZero();
@@ -286,7 +290,8 @@ void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Ma
     velocity_[0] = checkpoints_.col(column).head(n);
     state_[0] = checkpoints_.col(column).tail(n);
     segment_.col(b - a) = state_[0];
-    for (int j = b, s = 0; j > a; --j, ++s) {
+    if (at_rest) segment_.leftCols(b - a + 1).setZero();
+    for (int j = b, s = 0; j > a && !at_rest; --j, ++s) {
       const int current = s & 1, next = current ^ 1;
       RetrogradeTraceStep(j, traces, include_data, velocity_[current], state_[current],
                           velocity_[next], state_[next]);
@@ -309,7 +314,7 @@ void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Ma
     a = b;
     b = std::min(b + stride, m);
   }
-  sweep_count_ += stride < m ? 3 : 2;
+  sweep_count_ += at_rest ? 1 : stride < m ? 3 : 2;
 }
 
 }  // namespace mcrewave
