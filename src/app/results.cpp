@@ -424,17 +424,17 @@ class ResultsFolder {
   // figure fails, warns and goes on without it.
   void Draw(const std::vector<std::pair<std::string, std::string>>& drawings) {
     bool gnuplot_missing = false;
-    for (const auto& [name, script] : drawings) {
-      const std::string why = DrawGnuplotFigure(folder_, name, script, &gnuplot_missing);
-      if (gnuplot_missing) {
-        spdlog::warn("gnuplot not found on the PATH: figures skipped (the CSV files are written)");
-        return;
-      }
-      if (!why.empty()) {
-        spdlog::warn("figure {}.png skipped: {}", name, why);
+    const std::vector<std::string> why = DrawGnuplotFigures(folder_, drawings, &gnuplot_missing);
+    if (gnuplot_missing) {
+      spdlog::warn("gnuplot not found on the PATH: figures skipped (the CSV files are written)");
+      return;
+    }
+    for (std::size_t i = 0; i < drawings.size(); ++i) {
+      if (!why[i].empty()) {
+        spdlog::warn("figure {}.png skipped: {}", drawings[i].first, why[i]);
         continue;
       }
-      written_.push_back(folder_ + "/" + name + ".png");
+      written_.push_back(folder_ + "/" + drawings[i].first + ".png");
     }
   }
   void Add(const std::vector<std::string>& paths) {

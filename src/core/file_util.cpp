@@ -104,4 +104,49 @@ std::string DrawGnuplotFigure(const std::string& folder, const std::string& name
   return why;
 }
 
+std::vector<std::string> DrawGnuplotFigures(
+    const std::string& folder, const std::vector<std::pair<std::string, std::string>>& figures,
+    bool* gnuplot_missing) {
+  std::vector<std::string> why(figures.size());
+  if (figures.empty()) return why;
+  const std::string suffix = ".tmp." + std::to_string(::getpid());
+  const std::string script_path = folder + "/figures.gp" + suffix;
+  const std::string log_path = folder + "/figures.log" + suffix;
+  std::vector<std::string> temporary_pngs;
+  {
+    std::ofstream script(script_path);
+    for (const auto& [name, body] : figures) {
+      temporary_pngs.push_back(folder + "/" + name + ".png" + suffix);
+      script << "set output " << GnuplotString(temporary_pngs.back()) << "\n"
+             << body << "\nset output\nreset session\n";
+    }
+    if (!script) {
+      std::remove(script_path.c_str());
+      for (std::string& reason : why) reason = "cannot write " + script_path;
+      return why;
+    }
+  }
+  const std::string failure = RunGnuplot(script_path, log_path, gnuplot_missing);
+  std::remove(script_path.c_str());
+  std::remove(log_path.c_str());
+  bool all_drawn = failure.empty();
+  for (std::size_t i = 0; i < figures.size() && all_drawn; ++i) {
+    const std::string png = folder + "/" + figures[i].first + ".png";
+    if (std::rename(temporary_pngs[i].c_str(), png.c_str()) != 0) all_drawn = false;
+  }
+  for (const std::string& temporary : temporary_pngs) std::remove(temporary.c_str());
+  if (all_drawn || *gnuplot_missing) {
+    if (*gnuplot_missing) {
+      for (std::string& reason : why) reason = failure;
+    }
+    return why;
+  }
+  // One figure (or more) failed the shared process: each on its own, to keep the others.
+  for (std::size_t i = 0; i < figures.size(); ++i) {
+    why[i] = DrawGnuplotFigure(folder, figures[i].first, figures[i].second, gnuplot_missing);
+    if (*gnuplot_missing) break;
+  }
+  return why;
+}
+
 }  // namespace mcrewave

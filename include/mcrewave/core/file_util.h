@@ -3,6 +3,8 @@
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace mcrewave {
 
@@ -25,5 +27,13 @@ std::string GnuplotPngTerminal();
 // sets *gnuplot_missing when gnuplot is not on the PATH.
 std::string DrawGnuplotFigure(const std::string& folder, const std::string& name,
                               const std::string& script_body, bool* gnuplot_missing);
+
+// DrawGnuplotFigure for every (name, script_body), in one gnuplot process (its start-up
+// is most of a small figure's cost), each figure after `reset session`. Returns why each
+// figure was not drawn ("" when it was): when the one process fails, every figure is
+// drawn again on its own, so that only the failing ones are missing.
+std::vector<std::string> DrawGnuplotFigures(
+    const std::string& folder, const std::vector<std::pair<std::string, std::string>>& figures,
+    bool* gnuplot_missing);
 
 }  // namespace mcrewave
