@@ -10,7 +10,7 @@
 
 namespace mcrewave {
 
-Matrix MatrixMcreProblem::TraceImpulseResponses() {
+void MatrixMcreProblem::TraceImpulseResponses(Matrix* impulse_responses) {
   const int n = num_nodes(), m = num_steps(), rows = num_traces();
   assert(m >= 2 && theta_ >= 0.5 && betas_.minCoeff() > 0.0);
   // a(j), j = 1..m: the traces' response at t_j to a unit force over the step
@@ -20,7 +20,8 @@ Matrix MatrixMcreProblem::TraceImpulseResponses() {
   // so the retrograde field driven by h_k at t_m alone gives every interior block
   // z(j) = Z(l + j, l) = (c_{m-j} / c_m) W_{m-j}^T, and z(j) = theta a(j + 1) +
   // (1 - theta) a(j) with a(0) = 0 gives a(j).
-  Matrix responses(n, rows * m);
+  Matrix& responses = *impulse_responses;
+  responses.resize(n, rows * m);
   Matrix traces = ZeroTraces();
   Vector field(n), previous_response(n);
   for (int k = 0; k < rows; ++k) {
@@ -44,7 +45,6 @@ Matrix MatrixMcreProblem::TraceImpulseResponses() {
     }
     ++sweep_count_;
   }
-  return responses;
 }
 
 namespace {
@@ -64,19 +64,31 @@ struct TraceGrid {
 // preconditioner's factor, which needs I + S to a few digits only. Symmetric to
 // round-off; its lower triangle is the product's. lower_only: the strict upper
 // triangle is left undefined (a Cholesky factorisation reads the lower one).
+// The buffers it works in, kept by the caller (no fresh megabytes a build when they
+// already have their sizes).
 template <typename Scalar>
-Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> AssembleTraceOperator(
-    const Matrix& responses, const SparseMatrix& penalty, const TraceGrid& grid,
-    const Vector& weight_roots, bool lower_only) {
+struct TraceAssemblyBuffers {
+  using Dense = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
+  Dense weighted, responses, gram;
+};
+
+template <typename Scalar>
+void AssembleTraceOperator(const Matrix& responses, const SparseMatrix& penalty,
+                           const TraceGrid& grid, const Vector& weight_roots, bool lower_only,
+                           TraceAssemblyBuffers<Scalar>* buffers,
+                           Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>* result) {
   using Dense = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
   const int rows = grid.rows, m = grid.steps;
   // A(i, k) = a(i) P a(k)^T / h, R x R blocks, in a matrix over the samples 0..m
   // whose block row and column 0 stay zero (a(0) = 0): its lower triangle by one
   // product (P symmetric), the upper by symmetry.
   const int size = rows * (m + 1);
-  const Dense weighted = (penalty * responses).template cast<Scalar>();
-  const Dense cast_responses = responses.template cast<Scalar>();
-  Dense gram = Dense::Zero(size, size);
+  Dense& weighted = buffers->weighted;
+  Dense& cast_responses = buffers->responses;
+  Dense& gram = buffers->gram;
+  weighted = (penalty * responses).template cast<Scalar>();
+  cast_responses = responses.template cast<Scalar>();
+  gram.setZero(size, size);
   auto inner = gram.bottomRightCorner(rows * m, rows * m);
   inner.template triangularView<Eigen::Lower>() = cast_responses.transpose() * weighted;
   inner *= static_cast<Scalar>(1.0 / grid.time_step);
@@ -97,7 +109,8 @@ Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> AssembleTraceOperator(
   // the term l = m counted twice at (m, m) (c_m = 1/2), and Q(0, .) = 0 (U_0 = 0).
   const double t = grid.theta, u = 1.0 - grid.theta, start = u * u / grid.first_weight;
   const int rest = size - rows;
-  Dense q = static_cast<Scalar>(t * t + start) * gram;
+  Dense& q = *result;
+  q = static_cast<Scalar>(t * t + start) * gram;
   q.bottomRightCorner(rest, rest) +=
       static_cast<Scalar>(u * u - start) * gram.topLeftCorner(rest, rest);
   q.rightCols(rest) += static_cast<Scalar>(t * u) * gram.leftCols(rest);
@@ -113,7 +126,6 @@ Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> AssembleTraceOperator(
   const auto roots = weight_roots.template cast<Scalar>();
   q.array().colwise() *= roots.array();
   q.array().rowwise() *= roots.transpose().array();
-  return q;
 }
 
 }  // namespace
@@ -121,8 +133,11 @@ Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> AssembleTraceOperator(
 Matrix MatrixMcreProblem::SymmetricTraceOperator() {
   const TraceGrid grid{num_traces(), num_steps(),         theta_,
                        time_step(),  QuadratureWeight(0), QuadratureWeight(num_steps())};
-  Matrix q = AssembleTraceOperator<double>(TraceImpulseResponses(), PenaltyMatrix(), grid,
-                                           TraceWeightRoots(), /*lower_only=*/false);
+  Matrix responses, q;
+  TraceImpulseResponses(&responses);
+  TraceAssemblyBuffers<double> buffers;
+  AssembleTraceOperator<double>(responses, PenaltyMatrix(), grid, TraceWeightRoots(),
+                                /*lower_only=*/false, &buffers, &q);
   // Symmetric to round-off: the mean of the two triangles, in place.
   const auto size = q.rows();
   for (Eigen::Index c = 0; c < size; ++c) {
@@ -157,25 +172,38 @@ bool MatrixMcreProblem::PrepareTracePreconditioner(double rebuild_change, long m
     const double change = (moduli_.array() / trace_factor_->moduli.array() - 1.0).abs().maxCoeff();
     if (change <= rebuild_change) return true;
   }
+  // The previous factor's storage when this problem alone holds it (shared, a new one).
+  std::shared_ptr<TraceFactor> built = trace_factor_ != nullptr && trace_factor_.use_count() == 1
+                                           ? std::const_pointer_cast<TraceFactor>(trace_factor_)
+                                           : std::make_shared<TraceFactor>();
   trace_factor_.reset();
-  auto built = std::make_shared<TraceFactor>();
   built->weights = TraceWeightRoots();
   // I + S = L L^T in single precision, factorised in place (its lower triangle becomes
   // L): a preconditioner needs I + S to a few digits, and float halves the two O(size^3)
   // products. The factor is kept in double, so that PCG applies one fixed operator.
   const TraceGrid grid{rows, m, theta_, time_step(), QuadratureWeight(0), QuadratureWeight(m)};
-  const Matrix responses = TraceImpulseResponses();
+  Matrix& responses = trace_build_.impulse_responses;
+  TraceImpulseResponses(&responses);
   const SparseMatrix penalty = PenaltyMatrix();
-  Eigen::MatrixXf single =
-      AssembleTraceOperator<float>(responses, penalty, grid, built->weights, /*lower_only=*/true);
+  TraceAssemblyBuffers<float> buffers{std::move(trace_build_.weighted),
+                                      std::move(trace_build_.responses),
+                                      std::move(trace_build_.gram)};
+  Eigen::MatrixXf& single = trace_build_.operator_plus_identity;
+  AssembleTraceOperator<float>(responses, penalty, grid, built->weights, /*lower_only=*/true,
+                               &buffers, &single);
+  trace_build_.weighted = std::move(buffers.weighted);
+  trace_build_.responses = std::move(buffers.responses);
+  trace_build_.gram = std::move(buffers.gram);
   single.diagonal().array() += 1.0f;
   const Eigen::LLT<Eigen::Ref<Eigen::MatrixXf>> single_factor(single);
   if (single_factor.info() == Eigen::Success) {
     built->factor = single.cast<double>();
+    built->single_precision = true;
   } else {
     // Float's round-off of a large S broke I + S's definiteness: in double.
-    built->factor = AssembleTraceOperator<double>(responses, penalty, grid, built->weights,
-                                                  /*lower_only=*/true);
+    TraceAssemblyBuffers<double> double_buffers;
+    AssembleTraceOperator<double>(responses, penalty, grid, built->weights, /*lower_only=*/true,
+                                  &double_buffers, &built->factor);
     built->factor.diagonal().array() += 1.0;
     const Eigen::LLT<Eigen::Ref<Matrix>> double_factor(built->factor);
     if (double_factor.info() != Eigen::Success) return false;

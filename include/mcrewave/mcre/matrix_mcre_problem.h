@@ -254,7 +254,7 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   Vector TraceWeightRoots() const;
   // The traces' impulse responses a(j), j = 1..m, n x R m (column (j - 1) R + k for
   // row k), from one retrograde sweep per trace row (matrix_trace_operator.cpp).
-  Matrix TraceImpulseResponses();
+  void TraceImpulseResponses(Matrix* impulse_responses);
   // x^T K y on either path of the integrator: from its band of K on the band path (as
   // the bar's McreProblem::PenaltyForm), else through product_ = K y. No allocation.
   double StiffnessForm(const double* x, const double* y);
@@ -355,6 +355,13 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // The streaming CG's preconditioner (null: none yet), a scratch vector of a trace
   // field's size, and the builds so far.
   std::shared_ptr<const TraceFactor> trace_factor_;
+  // The preconditioner build's buffers, kept between builds (their megabytes are not
+  // allocated and faulted in again).
+  struct TraceBuildBuffers {
+    Matrix impulse_responses;
+    Eigen::MatrixXf weighted, responses, gram, operator_plus_identity;
+  };
+  TraceBuildBuffers trace_build_;
   Vector trace_scratch_;
   int trace_preconditioner_builds_ = 0;
   // One row of the element map's picture (ElementColumnPositions entries; empty without
