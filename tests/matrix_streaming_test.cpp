@@ -52,110 +52,122 @@ MatrixModelData MatrixStreamingLattice(const MatrixStreamingCase& c) {
   return lattice;
 }
 
+// Runs check(problem, whole) on the lattice's problem at the moduli (1.8, 2.1) x 1e11 Pa
+// under every support treatment, from checkpoints (whole false) and from omega's whole
+// history.
+template <typename Check>
+void ForEveryLatticeProblem(Check&& check) {
+  const ChannelSet data = SupportedLatticeHistories(SupportedLattice());
+  for (const MatrixStreamingCase& c : kMatrixStreamingCases) {
+    for (const bool whole : {false, true}) {
+      SCOPED_TRACE(std::string(c.name) + (whole ? ", whole history" : ", checkpoints"));
+      const MatrixModelData lattice = MatrixStreamingLattice(c);
+      MatrixMcreProblem problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5,
+                                Factorization::kSparse, c.treatment);
+      if (!whole) problem.set_whole_history_bytes(0);
+      problem.SetModuli((Vector(2) << 1.8e11, 2.1e11).finished());
+      check(problem, whole);
+    }
+  }
+}
+
 // StreamingMap at traces y = H U runs the retrograde sweep of U and the direct sweep of
 // the W it gives, and gathers the cost, gradients and maps of those fields: from
 // checkpoints (three sweeps) and from omega's whole history (two; the default at this
 // size), the same bits.
 TEST(MatrixStreamingTest, OneApplicationIsTheStoredSweeps) {
-  for (const MatrixStreamingCase& c : kMatrixStreamingCases) {
-    for (const bool whole : {false, true}) {
-      SCOPED_TRACE(std::string(c.name) + (whole ? ", whole history" : ", checkpoints"));
-      const MatrixModelData lattice = MatrixStreamingLattice(c);
-      const ChannelSet data = SupportedLatticeHistories(SupportedLattice());
-      MatrixMcreProblem problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5,
-                                Factorization::kSparse, c.treatment);
-      if (!whole) problem.set_whole_history_bytes(0);
-      problem.SetModuli((Vector(2) << 1.8e11, 2.1e11).finished());
-      Matrix u0, w, u;
-      problem.DirectSweep(problem.ZeroField(), true, &u0);
-      problem.RetrogradeSweep(u0, true, &w);
-      problem.DirectSweep(w, true, &u);
-      const Matrix traces = problem.ObservedTraces(u0);
-      ASSERT_EQ(traces.rows(), problem.num_traces());
-      Matrix image;
-      StreamingCoupledProblem::StreamingTotals totals;
-      const long sweeps = problem.sweep_count();
-      problem.StreamingMap(traces, true, &image, &totals);
-      EXPECT_EQ(problem.sweep_count() - sweeps, whole ? 2 : 3);
-      EXPECT_EQ(problem.checkpoint_stride() == problem.num_steps(), whole);
-      // The same steps from the same loads: the same bits.
-      EXPECT_EQ(image, problem.ObservedTraces(u));
-      // The sums of the stored-field path, e^2 and the maps in the same order (measured
-      // 0 apart), the gradients from K_z W and K_z U apart (measured at most 4.1e-16).
-      const double cost = problem.Cost(u, w);
-      EXPECT_NEAR(totals.cost, cost, 4e-16 * cost);
-      Vector gradients;
-      problem.CostGradients(u, w, &gradients);
-      EXPECT_LT((totals.cost_gradients - gradients).norm(), 4e-15 * gradients.norm());
-      EXPECT_LT(RelativeDifference(totals.zone_error_map, problem.ZoneErrorMap(w)), 4e-16);
-      EXPECT_LT(RelativeDifference(totals.zone_strain_energy, problem.ZoneErrorMap(u)), 4e-16);
-      EXPECT_LT(RelativeDifference(totals.error_map, problem.DofErrorMap(w)), 4e-16);
-      // No element blocks: no element map, no picture.
-      EXPECT_EQ(totals.element_error_map.size(), 0);
-      EXPECT_EQ(totals.gap_density.size(), 0);
-      // The linear part, and the retrograde energy of traces without data: the P-norm of
-      // the retrograde sweep they drive (RetrogradeSweep of a U with H U = traces).
-      Matrix linear_w;
-      problem.RetrogradeSweep(u0, false, &linear_w);
-      const double energy = problem.InnerProduct(linear_w, linear_w);
-      // Measured at most 8.5e-16 apart.
-      EXPECT_NEAR(problem.RetrogradeEnergy(traces), energy, 8e-15 * energy);
-      Matrix linear_image, linear_u;
-      problem.StreamingMap(traces, false, &linear_image);
-      problem.DirectSweep(linear_w, false, &linear_u);
-      EXPECT_EQ(linear_image, problem.ObservedTraces(linear_u));
-    }
-  }
+  ForEveryLatticeProblem([](MatrixMcreProblem& problem, bool whole) {
+    Matrix u0, w, u;
+    problem.DirectSweep(problem.ZeroField(), true, &u0);
+    problem.RetrogradeSweep(u0, true, &w);
+    problem.DirectSweep(w, true, &u);
+    const Matrix traces = problem.ObservedTraces(u0);
+    ASSERT_EQ(traces.rows(), problem.num_traces());
+    Matrix image;
+    StreamingCoupledProblem::StreamingTotals totals;
+    const long sweeps = problem.sweep_count();
+    problem.StreamingMap(traces, true, &image, &totals);
+    EXPECT_EQ(problem.sweep_count() - sweeps, whole ? 2 : 3);
+    EXPECT_EQ(problem.checkpoint_stride() == problem.num_steps(), whole);
+    // The same steps from the same loads: the same bits.
+    EXPECT_EQ(image, problem.ObservedTraces(u));
+    // The sums of the stored-field path, e^2 and the maps in the same order (measured
+    // 0 apart), the gradients from K_z W and K_z U apart (measured at most 4.1e-16).
+    const double cost = problem.Cost(u, w);
+    EXPECT_NEAR(totals.cost, cost, 4e-16 * cost);
+    Vector gradients;
+    problem.CostGradients(u, w, &gradients);
+    EXPECT_LT((totals.cost_gradients - gradients).norm(), 4e-15 * gradients.norm());
+    EXPECT_LT(RelativeDifference(totals.zone_error_map, problem.ZoneErrorMap(w)), 4e-16);
+    EXPECT_LT(RelativeDifference(totals.zone_strain_energy, problem.ZoneErrorMap(u)), 4e-16);
+    EXPECT_LT(RelativeDifference(totals.error_map, problem.DofErrorMap(w)), 4e-16);
+    // No element blocks: no element map, no picture.
+    EXPECT_EQ(totals.element_error_map.size(), 0);
+    EXPECT_EQ(totals.gap_density.size(), 0);
+    // The linear part, and the retrograde energy of traces without data: the P-norm of
+    // the retrograde sweep they drive (RetrogradeSweep of a U with H U = traces).
+    Matrix linear_w;
+    problem.RetrogradeSweep(u0, false, &linear_w);
+    const double energy = problem.InnerProduct(linear_w, linear_w);
+    // Measured at most 8.5e-16 apart.
+    EXPECT_NEAR(problem.RetrogradeEnergy(traces), energy, 8e-15 * energy);
+    Matrix linear_image, linear_u;
+    problem.StreamingMap(traces, false, &linear_image);
+    problem.DirectSweep(linear_w, false, &linear_u);
+    EXPECT_EQ(linear_image, problem.ObservedTraces(linear_u));
+  });
 }
 
 // At the data itself (y = d~, the start of every solve) the retrograde loads vanish:
 // StreamingMap skips the backward sweep and gives the direct sweep of W = 0, the same
 // bits as the stored fields of that sweep, in one sweep instead of two or three.
 TEST(MatrixStreamingTest, AtTheDataItselfOneDirectSweepGivesTheMap) {
-  for (const MatrixStreamingCase& c : kMatrixStreamingCases) {
-    for (const bool whole : {false, true}) {
-      SCOPED_TRACE(std::string(c.name) + (whole ? ", whole history" : ", checkpoints"));
-      const MatrixModelData lattice = MatrixStreamingLattice(c);
-      const ChannelSet data = SupportedLatticeHistories(SupportedLattice());
-      MatrixMcreProblem problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5,
-                                Factorization::kSparse, c.treatment);
-      if (!whole) problem.set_whole_history_bytes(0);
-      problem.SetModuli((Vector(2) << 1.8e11, 2.1e11).finished());
-      Matrix u0;
-      problem.DirectSweep(problem.ZeroField(), true, &u0);
-      Matrix image;
-      StreamingCoupledProblem::StreamingTotals totals;
-      const long sweeps = problem.sweep_count();
-      problem.StreamingMap(problem.DataTraces(), true, &image, &totals);
-      EXPECT_EQ(problem.sweep_count() - sweeps, 1);
-      EXPECT_EQ(image, problem.ObservedTraces(u0));
-      // Measured 0 apart: the same sums in the same order, W's terms zero.
-      const double cost = problem.Cost(u0, problem.ZeroField());
-      EXPECT_NEAR(totals.cost, cost, 4e-16 * cost);
-      EXPECT_EQ(totals.zone_error_map.norm(), 0.0);
-      EXPECT_EQ(totals.error_map.norm(), 0.0);
-      // Beside the data, the full map again.
-      Matrix beside = problem.DataTraces();
-      beside(0, 1) += 1e-3 * (std::abs(beside(0, 1)) + 1e-9);
-      const long before = problem.sweep_count();
-      problem.StreamingMap(beside, true, &image, &totals);
-      EXPECT_EQ(problem.sweep_count() - before, whole ? 2 : 3);
-      EXPECT_GT(totals.zone_error_map.norm(), 0.0);
-    }
-  }
+  ForEveryLatticeProblem([](MatrixMcreProblem& problem, bool whole) {
+    Matrix u0;
+    problem.DirectSweep(problem.ZeroField(), true, &u0);
+    Matrix image;
+    StreamingCoupledProblem::StreamingTotals totals;
+    const long sweeps = problem.sweep_count();
+    problem.StreamingMap(problem.DataTraces(), true, &image, &totals);
+    EXPECT_EQ(problem.sweep_count() - sweeps, 1);
+    EXPECT_EQ(image, problem.ObservedTraces(u0));
+    // Measured 0 apart: the same sums in the same order, W's terms zero.
+    const double cost = problem.Cost(u0, problem.ZeroField());
+    EXPECT_NEAR(totals.cost, cost, 4e-16 * cost);
+    EXPECT_EQ(totals.zone_error_map.norm(), 0.0);
+    EXPECT_EQ(totals.error_map.norm(), 0.0);
+    // Beside the data, the full map again.
+    Matrix beside = problem.DataTraces();
+    beside(0, 1) += 1e-3 * (std::abs(beside(0, 1)) + 1e-9);
+    const long before = problem.sweep_count();
+    problem.StreamingMap(beside, true, &image, &totals);
+    EXPECT_EQ(problem.sweep_count() - before, whole ? 2 : 3);
+    EXPECT_GT(totals.zone_error_map.norm(), 0.0);
+  });
 }
+
+// A small bar of 20 elements in two zones (12 and 8), exported with its clamp as a
+// support (element blocks, one per element), and its synthetic data.
+struct ZonedBar {
+  ZonedBar() {
+    const testing::SmallCase c = testing::MakeSmallCase(20, 300, 20.0, 2);
+    std::vector<int> zones(20);
+    for (int e = 0; e < 20; ++e) zones[e] = e < 12 ? 0 : 1;
+    data = MakeSyntheticMeasurements(c.bar, c.load, c.time, c.data);
+    model = BarMatrixModel(BarModel(c.bar, zones), c.bar.modulus, {}, BarClampExport::kSupport);
+  }
+  ChannelSet data;
+  MatrixModelData model;
+};
 
 // With element blocks (the bar exported, 2 zones), one application sums the element
 // map's shares and picture rows of the W it passes through: ComputeElementErrorMap's of
 // the stored W to the bit (the same W from the checkpoints, the same sums in the same
 // order), under a trusted and a measured support.
 TEST(MatrixStreamingTest, OneApplicationGivesTheStoredFieldsElementMap) {
-  const testing::SmallCase c = testing::MakeSmallCase(20, 300, 20.0, 2);
-  std::vector<int> zones(20);
-  for (int e = 0; e < 20; ++e) zones[e] = e < 12 ? 0 : 1;
-  const BarModel bar(c.bar, zones);
-  const ChannelSet data = MakeSyntheticMeasurements(c.bar, c.load, c.time, c.data);
-  const MatrixModelData model = BarMatrixModel(bar, c.bar.modulus, {}, BarClampExport::kSupport);
+  const ZonedBar zoned;
+  const ChannelSet& data = zoned.data;
+  const MatrixModelData& model = zoned.model;
   for (const ClampModel treatment : {ClampModel::kTrusted, ClampModel::kMeasured}) {
     SCOPED_TRACE(ClampModelToString(treatment));
     MatrixMcreProblem problem(model, data, Weights(0.01, 1.0), 2e11, 0.5, Factorization::kAutomatic,
@@ -185,12 +197,9 @@ TEST(MatrixStreamingTest, OneApplicationGivesTheStoredFieldsElementMap) {
 // hold none and the same cost and gradients; StreamingElementMaps then gives, from the
 // solution's traces, the map a solve that gathered it holds, to the bit.
 TEST(MatrixStreamingTest, TheElementMapLeftOutIsGatheredFromTheTraces) {
-  const testing::SmallCase c = testing::MakeSmallCase(20, 300, 20.0, 2);
-  std::vector<int> zones(20);
-  for (int e = 0; e < 20; ++e) zones[e] = e < 12 ? 0 : 1;
-  const BarModel bar(c.bar, zones);
-  const ChannelSet data = MakeSyntheticMeasurements(c.bar, c.load, c.time, c.data);
-  const MatrixModelData model = BarMatrixModel(bar, c.bar.modulus, {}, BarClampExport::kSupport);
+  const ZonedBar zoned;
+  const ChannelSet& data = zoned.data;
+  const MatrixModelData& model = zoned.model;
   CoupledSolverOptions streaming;
   streaming.type = CoupledSolverType::kStreamingConjugateGradient;
   const Vector moduli = (Vector(2) << 1.9e11, 1.7e11).finished();
