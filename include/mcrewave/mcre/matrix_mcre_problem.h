@@ -198,10 +198,9 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   static constexpr long kDefaultWholeHistoryBytes = 1L << 26;
   void set_whole_history_bytes(long bytes) { whole_history_bytes_ = bytes; }
   // Whether StreamingMap's totals gather the element map and its picture (true by
-  // default; with element blocks they cost about as much as a sweep's solves). Off,
-  // StreamingTotals::element_error_map and gap_density stay empty: for solves whose
-  // maps nobody reads (a minimiser's, the uncertainty's), StreamingElementMaps then
-  // gives a solution's maps from its traces.
+  // default). Off, StreamingTotals::element_error_map and gap_density stay empty: for
+  // solves whose maps nobody reads (a minimiser's, the uncertainty's);
+  // StreamingElementMaps then gives a solution's maps from its traces.
   void set_element_maps(bool gather) { element_maps_ = gather; }
   // A streaming solution's element map and picture at the current moduli, from its
   // traces: one application of the map (two or three sweeps), the same sums as a
