@@ -50,6 +50,42 @@ std::string RunGnuplot(const std::string& script_path, const std::string& log_pa
   return "gnuplot failed" + (first_line.empty() ? std::string() : ": " + first_line);
 }
 
+// Draws every (name, script_body) in one gnuplot process, each after `reset session`
+// into a temporary PNG renamed to folder/name.png once the process succeeded; the
+// script and log are named after `stem`. Returns "" on success, else why not (the
+// figures renamed before a rename failed stay).
+std::string DrawInOneProcess(const std::string& folder, const std::string& stem,
+                             const std::vector<std::pair<std::string, std::string>>& figures,
+                             bool* gnuplot_missing) {
+  const std::string suffix = ".tmp." + std::to_string(::getpid());
+  const std::string script_path = folder + "/" + stem + ".gp" + suffix;
+  const std::string log_path = folder + "/" + stem + ".log" + suffix;
+  std::vector<std::string> temporary_pngs;
+  {
+    std::ofstream script(script_path);
+    for (const auto& [name, body] : figures) {
+      temporary_pngs.push_back(folder + "/" + name + ".png" + suffix);
+      script << "set output " << GnuplotString(temporary_pngs.back()) << "\n"
+             << body << "\nset output\nreset session\n";
+    }
+    if (!script) {
+      std::remove(script_path.c_str());
+      return "cannot write " + script_path;
+    }
+  }
+  std::string why = RunGnuplot(script_path, log_path, gnuplot_missing);
+  std::remove(script_path.c_str());
+  std::remove(log_path.c_str());
+  for (std::size_t i = 0; i < figures.size() && why.empty(); ++i) {
+    const std::string png = folder + "/" + figures[i].first + ".png";
+    if (std::rename(temporary_pngs[i].c_str(), png.c_str()) != 0) {
+      why = "cannot write " + png + ": " + std::strerror(errno);
+    }
+  }
+  for (const std::string& temporary : temporary_pngs) std::remove(temporary.c_str());
+  return why;
+}
+
 }  // namespace
 
 void WriteFileAtomically(const std::string& path, const std::string& content) {
@@ -80,28 +116,9 @@ std::string GnuplotPngTerminal() {
          "set key top right\nset grid\n";
 }
 
-// Draws one figure to folder/name.png through a temporary PNG renamed at the
-// end. Returns "" on success, else why not.
 std::string DrawGnuplotFigure(const std::string& folder, const std::string& name,
                               const std::string& script_body, bool* gnuplot_missing) {
-  const std::string suffix = ".tmp." + std::to_string(::getpid());
-  const std::string png = folder + "/" + name + ".png";
-  const std::string temporary_png = png + suffix;
-  const std::string script_path = folder + "/" + name + ".gp" + suffix;
-  const std::string log_path = folder + "/" + name + ".log" + suffix;
-  {
-    std::ofstream script(script_path);
-    script << "set output " << GnuplotString(temporary_png) << "\n" << script_body;
-    if (!script) return "cannot write " + script_path;
-  }
-  std::string why = RunGnuplot(script_path, log_path, gnuplot_missing);
-  if (why.empty() && std::rename(temporary_png.c_str(), png.c_str()) != 0) {
-    why = "cannot write " + png + ": " + std::strerror(errno);
-  }
-  std::remove(script_path.c_str());
-  std::remove(log_path.c_str());
-  std::remove(temporary_png.c_str());
-  return why;
+  return DrawInOneProcess(folder, name, {{name, script_body}}, gnuplot_missing);
 }
 
 std::vector<std::string> DrawGnuplotFigures(
@@ -109,42 +126,15 @@ std::vector<std::string> DrawGnuplotFigures(
     bool* gnuplot_missing) {
   std::vector<std::string> why(figures.size());
   if (figures.empty()) return why;
-  const std::string suffix = ".tmp." + std::to_string(::getpid());
-  const std::string script_path = folder + "/figures.gp" + suffix;
-  const std::string log_path = folder + "/figures.log" + suffix;
-  std::vector<std::string> temporary_pngs;
-  {
-    std::ofstream script(script_path);
-    for (const auto& [name, body] : figures) {
-      temporary_pngs.push_back(folder + "/" + name + ".png" + suffix);
-      script << "set output " << GnuplotString(temporary_pngs.back()) << "\n"
-             << body << "\nset output\nreset session\n";
-    }
-    if (!script) {
-      std::remove(script_path.c_str());
-      for (std::string& reason : why) reason = "cannot write " + script_path;
-      return why;
-    }
-  }
-  const std::string failure = RunGnuplot(script_path, log_path, gnuplot_missing);
-  std::remove(script_path.c_str());
-  std::remove(log_path.c_str());
-  bool all_drawn = failure.empty();
-  for (std::size_t i = 0; i < figures.size() && all_drawn; ++i) {
-    const std::string png = folder + "/" + figures[i].first + ".png";
-    if (std::rename(temporary_pngs[i].c_str(), png.c_str()) != 0) all_drawn = false;
-  }
-  for (const std::string& temporary : temporary_pngs) std::remove(temporary.c_str());
-  if (all_drawn || *gnuplot_missing) {
-    if (*gnuplot_missing) {
-      for (std::string& reason : why) reason = failure;
-    }
+  const std::string failure = DrawInOneProcess(folder, "figures", figures, gnuplot_missing);
+  if (failure.empty()) return why;
+  if (*gnuplot_missing) {
+    for (std::string& reason : why) reason = failure;
     return why;
   }
   // One figure (or more) failed the shared process: each on its own, to keep the others.
-  for (std::size_t i = 0; i < figures.size(); ++i) {
+  for (std::size_t i = 0; i < figures.size() && !*gnuplot_missing; ++i) {
     why[i] = DrawGnuplotFigure(folder, figures[i].first, figures[i].second, gnuplot_missing);
-    if (*gnuplot_missing) break;
   }
   return why;
 }
