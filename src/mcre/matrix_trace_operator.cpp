@@ -60,22 +60,16 @@ struct TraceGrid {
 };
 
 // S = (C beta)^1/2 Q (C beta)^1/2 from the impulse responses (SymmetricTraceOperator's
-// formulas), in Scalar arithmetic: double for the operator, float for the
+// formulas) into *result, in Scalar arithmetic: double for the operator, float for the
 // preconditioner's factor, which needs I + S to a few digits only. Symmetric to
 // round-off; its lower triangle is the product's. lower_only: the strict upper
-// triangle is left undefined (a Cholesky factorisation reads the lower one).
-// The buffers it works in, kept by the caller (no fresh megabytes a build when they
-// already have their sizes).
-template <typename Scalar>
-struct TraceAssemblyBuffers {
-  using Dense = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
-  Dense weighted, responses, gram;
-};
-
-template <typename Scalar>
+// triangle is left undefined (a Cholesky factorisation reads the lower one). Works in
+// *buffers (MatrixMcreProblem::TraceAssemblyScratch<Scalar>: weighted, responses and
+// gram), kept by the caller: no fresh megabytes a build once they have their sizes.
+template <typename Scalar, typename Scratch>
 void AssembleTraceOperator(const Matrix& responses, const SparseMatrix& penalty,
                            const TraceGrid& grid, const Vector& weight_roots, bool lower_only,
-                           TraceAssemblyBuffers<Scalar>* buffers,
+                           Scratch* buffers,
                            Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>* result) {
   using Dense = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
   const int rows = grid.rows, m = grid.steps;
@@ -135,7 +129,7 @@ Matrix MatrixMcreProblem::SymmetricTraceOperator() {
                        time_step(),  QuadratureWeight(0), QuadratureWeight(num_steps())};
   Matrix responses, q;
   TraceImpulseResponses(&responses);
-  TraceAssemblyBuffers<double> buffers;
+  TraceAssemblyScratch<double> buffers;
   AssembleTraceOperator<double>(responses, PenaltyMatrix(), grid, TraceWeightRoots(),
                                 /*lower_only=*/false, &buffers, &q);
   // Symmetric to round-off: the mean of the two triangles, in place.
@@ -185,15 +179,9 @@ bool MatrixMcreProblem::PrepareTracePreconditioner(double rebuild_change, long m
   Matrix& responses = trace_build_.impulse_responses;
   TraceImpulseResponses(&responses);
   const SparseMatrix penalty = PenaltyMatrix();
-  TraceAssemblyBuffers<float> buffers{std::move(trace_build_.weighted),
-                                      std::move(trace_build_.responses),
-                                      std::move(trace_build_.gram)};
   Eigen::MatrixXf& single = trace_build_.operator_plus_identity;
   AssembleTraceOperator<float>(responses, penalty, grid, built->weights, /*lower_only=*/true,
-                               &buffers, &single);
-  trace_build_.weighted = std::move(buffers.weighted);
-  trace_build_.responses = std::move(buffers.responses);
-  trace_build_.gram = std::move(buffers.gram);
+                               &trace_build_.scratch, &single);
   single.diagonal().array() += 1.0f;
   const Eigen::LLT<Eigen::Ref<Eigen::MatrixXf>> single_factor(single);
   if (single_factor.info() == Eigen::Success) {
@@ -201,7 +189,7 @@ bool MatrixMcreProblem::PrepareTracePreconditioner(double rebuild_change, long m
     built->single_precision = true;
   } else {
     // Float's round-off of a large S broke I + S's definiteness: in double.
-    TraceAssemblyBuffers<double> double_buffers;
+    TraceAssemblyScratch<double> double_buffers;
     AssembleTraceOperator<double>(responses, penalty, grid, built->weights, /*lower_only=*/true,
                                   &double_buffers, &built->factor);
     built->factor.diagonal().array() += 1.0;

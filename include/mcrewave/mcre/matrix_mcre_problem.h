@@ -354,11 +354,18 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // The streaming CG's preconditioner (null: none yet), a scratch vector of a trace
   // field's size, and the builds so far.
   std::shared_ptr<const TraceFactor> trace_factor_;
+  // The trace operator's assembly scratch in Scalar arithmetic (P times the impulse
+  // responses, the responses, A), matrix_trace_operator.cpp.
+  template <typename Scalar>
+  struct TraceAssemblyScratch {
+    Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> weighted, responses, gram;
+  };
   // The preconditioner build's buffers, kept between builds (their megabytes are not
   // allocated and faulted in again).
   struct TraceBuildBuffers {
     Matrix impulse_responses;
-    Eigen::MatrixXf weighted, responses, gram, operator_plus_identity;
+    TraceAssemblyScratch<float> scratch;
+    Eigen::MatrixXf operator_plus_identity;
   };
   TraceBuildBuffers trace_build_;
   Vector trace_scratch_;
