@@ -5,6 +5,7 @@
 #include <Eigen/Cholesky>
 #include <cassert>
 #include <cmath>
+#include <memory>
 
 #include "mcrewave/core/random.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
@@ -72,17 +73,19 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
   }
   // Its solves read costs and gradients, never the element map (set_element_maps).
   auto make_problem = [&](const ChannelSet& set) {
-    return MatrixMcreProblem(model, set, mcre.weights, mcre.reference_modulus, theta,
-                             Factorization::kAutomatic, mcre.clamp);
+    auto problem =
+        std::make_unique<MatrixMcreProblem>(model, set, mcre.weights, mcre.reference_modulus, theta,
+                                            Factorization::kAutomatic, mcre.clamp);
+    problem->set_element_maps(false);
+    return problem;
   };
   std::string why;
   if (curvature != nullptr) {
     assert(curvature->rows() == moduli.size() && curvature->cols() == moduli.size());
     result.curvature = *curvature;
   } else {
-    MatrixMcreProblem problem = make_problem(data);
-    problem.set_element_maps(false);
-    if (!SecantCurvature(inner, moduli, solution, &problem, &result.curvature, &result.sweeps,
+    const std::unique_ptr<MatrixMcreProblem> problem = make_problem(data);
+    if (!SecantCurvature(inner, moduli, solution, problem.get(), &result.curvature, &result.sweeps,
                          &why)) {
       result.message = why;
       return result;
@@ -112,35 +115,33 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
       plus_data.channels[c].values = data.channels[c].values + noise_data.channels[c].values;
       minus_data.channels[c].values = data.channels[c].values - noise_data.channels[c].values;
     }
-    MatrixMcreProblem noise_problem = make_problem(noise_data);
-    noise_problem.set_element_maps(false);
+    const std::unique_ptr<MatrixMcreProblem> noise_problem = make_problem(noise_data);
     // Every draw at the same moduli: the first draw's preconditioner serves them all.
-    noise_problem.ShareTraceFactor(shared_factor);
-    if (!SolveUsable(inner, moduli, &noise_problem, nullptr, &noise_solution, &result.sweeps,
+    noise_problem->ShareTraceFactor(shared_factor);
+    if (!SolveUsable(inner, moduli, noise_problem.get(), nullptr, &noise_solution, &result.sweeps,
                      &why)) {
       result.message = "a noise solve is not usable: " + why;
       return result;
     }
-    shared_factor = noise_problem.trace_factor();
+    shared_factor = noise_problem->trace_factor();
     // dg = (g(s_d + s_n; d + n) - g(s_d - s_n; d - n)) / 2
-    MatrixMcreProblem plus = make_problem(plus_data), minus = make_problem(minus_data);
-    plus.SetModuli(moduli);
-    minus.SetModuli(moduli);
-    plus.set_element_maps(false);
-    minus.set_element_maps(false);
+    const std::unique_ptr<MatrixMcreProblem> plus = make_problem(plus_data),
+                                             minus = make_problem(minus_data);
+    plus->SetModuli(moduli);
+    minus->SetModuli(moduli);
     if (solution.has_fields()) {
-      plus.CostGradients(solution.displacement + noise_solution.displacement,
-                         solution.retrograde + noise_solution.retrograde, &plus_gradient);
-      minus.CostGradients(solution.displacement - noise_solution.displacement,
-                          solution.retrograde - noise_solution.retrograde, &minus_gradient);
+      plus->CostGradients(solution.displacement + noise_solution.displacement,
+                          solution.retrograde + noise_solution.retrograde, &plus_gradient);
+      minus->CostGradients(solution.displacement - noise_solution.displacement,
+                           solution.retrograde - noise_solution.retrograde, &minus_gradient);
     } else {
       // A streaming solution: s_d +- s_n are the fixed points y_d +- y_n on the traces,
       // whose fields one application of each problem's map passes through.
-      plus.StreamingMap(solution.traces + noise_solution.traces, true, &image, &totals);
+      plus->StreamingMap(solution.traces + noise_solution.traces, true, &image, &totals);
       plus_gradient = totals.cost_gradients;
-      minus.StreamingMap(solution.traces - noise_solution.traces, true, &image, &totals);
+      minus->StreamingMap(solution.traces - noise_solution.traces, true, &image, &totals);
       minus_gradient = totals.cost_gradients;
-      result.sweeps += plus.sweep_count() + minus.sweep_count();
+      result.sweeps += plus->sweep_count() + minus->sweep_count();
     }
     // dE = -H^-1 dg
     const Vector change = -factor.solve(0.5 * (plus_gradient - minus_gradient));
