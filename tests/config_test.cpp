@@ -854,25 +854,27 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
                           "search.functional",
                           "outer.scan_points",
                           "outer.initial",
-                          "output.curve_points"}) {
+                          "output.curve_points",
+                          "zone_identification.merge_zones",
+                          "zone_identification.regularization"}) {
     EXPECT_EQ(matrix_keys.count(key), 1u) << key;
     EXPECT_TRUE(KeyApplies(key, ModelKind::kMatrix)) << key;
   }
-  for (const char* key : {"model.length", "model.zone_count", "zone_identification.merge_zones",
-                          "study.kind", "data.sensors"}) {
+  for (const char* key :
+       {"model.length", "model.zone_count", "data.truth_zones", "study.kind", "data.sensors"}) {
     EXPECT_EQ(matrix_keys.count(key), 0u) << key;
     EXPECT_EQ(bar_keys.count(key), 1u) << key;
   }
   // The bar reads all but the 4 matrix keys; a matrix run none of the section study:
-  // and 27 single keys fewer (it reads the dense solvers' limits: Riccati and shooting
-  // run on any model).
+  // and 14 single keys fewer (it reads the dense solvers' limits, Riccati and shooting
+  // running on any model, and the zones' regularisation and merging).
   EXPECT_EQ(bar_keys.size(), every.size() - 4);
   std::size_t sections = 0;
   for (const auto& [key, value] : every) {
     const std::string section = key.substr(0, key.find('.'));
     sections += section == "study" ? 1 : 0;
   }
-  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 27);
+  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 14);
   // Values as resolved: the matrix run's own.
   EXPECT_EQ(matrix_keys.at("model.manifest"), FlatKeys(ConfigToYaml(matrix)).at("model.manifest"));
 }
@@ -901,16 +903,15 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
        "model.zone_count applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\ndata:\n  sensors: [u@0.5]\n",
        "data.sensors applies to the bar only"},
-      {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  merge_zones: true\n",
-       "zone_identification.merge_zones applies to the bar only"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\n  zoning: per_element\n",
+       "model.zoning applies to the bar only"},
       // Every key of the bar's structure away from its default, where it was set.
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  elements: 50\n",
        "kinds.yaml:4: model.elements applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\ndata:\n  truth: exact\n",
        "kinds.yaml:5: data.truth applies to the bar only"},
-      {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  weight_rule: "
-       "discrepancy\n",
-       "kinds.yaml:5: zone_identification.weight_rule applies to the bar only"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\ndata:\n  truth_refinement: 3\n",
+       "kinds.yaml:5: data.truth_refinement applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  channel_map: {F: t}\n",
        "cannot map to the time column"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  channel_map: {F: a, G: a}\n",

@@ -166,6 +166,46 @@ TEST(MatrixIdentificationRunTest, TheBarAsMatricesIdentifiesTheBuiltInBarsModulu
   EXPECT_GT(summary["error_map"]["nominal_peak_fraction"].as<double>(), 0.0);
 }
 
+// The quick bar in 4 zones of equal length, exported as matrices: the zones are
+// identified by the built-in bar's steps (the penalty on the jumps between consecutive
+// zones, its weight from the L-curve, then the merging), and from uniform data both
+// roads merge the four zones into one group at the same modulus.
+TEST(MatrixIdentificationRunTest, ZonesOfTheBarAsMatricesAreRegularisedAndMergedAsTheBarsAre) {
+  const std::string dir = FreshDirectory("matrix_run_zones_merged");
+  const std::string quick = SourcePath("configs/quick.yaml");
+  ASSERT_EQ(RunIdentify("simulate " + quick + " -q -o " + dir + "/data.csv").exit_code, 0);
+  const Config config = LoadConfig(quick, {"model.zone_count=4"});
+  std::filesystem::create_directories(dir + "/bar_matrices");
+  const std::string manifest = WriteMatrixModel(
+      dir + "/bar_matrices",
+      BarMatrixModel(BarModel(config.model, config.zones.ElementZones(config.model)), 160e9));
+  const std::string data = " --set data.source=csv --set data.path=" + dir +
+                           "/data.csv --set prefilter.enabled=false"
+                           " --set zone_identification.merge_zones=true";
+  const RunResult bar =
+      RunIdentify("run " + quick + data + " --set model.zone_count=4 -q -o " + dir + "/bar");
+  ASSERT_EQ(bar.exit_code, 0) << bar.output;
+  const RunResult matrices = RunIdentify("run " + WriteQuickMatrixConfig(dir, manifest) + data +
+                                         " -q -o " + dir + "/matrices");
+  ASSERT_EQ(matrices.exit_code, 0) << matrices.output;
+  const YAML::Node bar_zones = YAML::LoadFile(dir + "/bar/summary.yaml")["zones"];
+  const YAML::Node zones = YAML::LoadFile(dir + "/matrices/summary.yaml")["zones"];
+  // Both weights chosen for a discrepancy target (the matrix run's noise levels from its
+  // own channels: measured 1.75e-5 against the bar's 1.88e-5).
+  EXPECT_GT(zones["target_misfit"].as<double>(), 0.0);
+  EXPECT_GT(bar_zones["target_misfit"].as<double>(), 0.0);
+  EXPECT_EQ(zones["groups"].as<int>(), 1);
+  EXPECT_EQ(bar_zones["groups"].as<int>(), 1);
+  // The merged group's refit on p = log(E / E_nom) and on p = log(E / E*), J_rest at 160 GPa
+  // and at E*: measured 5e-10 apart, relative (the bar's summary prints 10 digits).
+  for (int z = 0; z < 4; ++z) {
+    const double bar_modulus = bar_zones["moduli"][z]["modulus"].as<double>();
+    EXPECT_NEAR(zones["moduli"][z]["modulus"].as<double>() / bar_modulus - 1.0, 0.0, 5e-9)
+        << std::setprecision(17) << "zone " << z << ": bar " << bar_modulus << " Pa, matrices "
+        << zones["moduli"][z]["modulus"].as<double>() << " Pa";
+  }
+}
+
 // The quick bar exported with its clamp as a support (dof 0, channels f0 and u0) under
 // each treatment of mcre.clamp: the run through the manifest identifies the built-in
 // bar's modulus from the same CSV.

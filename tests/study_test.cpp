@@ -181,6 +181,7 @@ std::string WriteTwoZoneBarManifest(const std::string& folder) {
   std::ofstream(config) << "model:\n  kind: matrix\n  manifest: bar/model.yaml\n"
                            "data:\n  truth_moduli: [210e9, 190e9]\n"
                            "time:\n  window: 0.432e-3\n  step: 1.44e-6\n"
+                           "zone_identification:\n  regularization: none\n"
                            "study:\n  robustness:\n    snr: [.inf, 20]\n    seeds: 2\n";
   return config;
 }

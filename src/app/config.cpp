@@ -1343,37 +1343,14 @@ std::string FirstProblem(const Config& config) {
   return "";
 }
 
-// The single keys of the bar's structure, its zones, its sensors and its zones'
-// regularisation, which a structure given by matrices does not read: refused there when
-// set (RefuseKeysOfTheBar).
+// The single keys of the bar's structure, its zones and its sensors, which a structure
+// given by matrices does not read: refused there when set (RefuseKeysOfTheBar).
 bool BarOnlyKey(const std::string& path) {
-  static const std::set<std::string> bar_only = {"model.length",
-                                                 "model.section",
-                                                 "model.density",
-                                                 "model.modulus",
-                                                 "model.elements",
-                                                 "model.mass",
-                                                 "model.zoning",
-                                                 "model.zone_count",
-                                                 "model.zone_boundaries",
-                                                 "data.truth",
-                                                 "data.truth_refinement",
-                                                 "data.sensors",
-                                                 "data.channels",
-                                                 "data.truth_zones",
-                                                 "zone_identification.regularization",
-                                                 "zone_identification.regularization_weight",
-                                                 "zone_identification.weight_rule",
-                                                 "zone_identification.tv_smoothing",
-                                                 "zone_identification.max_weight",
-                                                 "zone_identification.min_weight",
-                                                 "zone_identification.grid_factor",
-                                                 "zone_identification.refinement_steps",
-                                                 "zone_identification.weight_tolerance",
-                                                 "zone_identification.discrepancy_factor",
-                                                 "zone_identification.noise_samples",
-                                                 "zone_identification.noise_seed",
-                                                 "zone_identification.merge_zones"};
+  static const std::set<std::string> bar_only = {
+      "model.length",          "model.section",   "model.density",         "model.modulus",
+      "model.elements",        "model.mass",      "model.zoning",          "model.zone_count",
+      "model.zone_boundaries", "data.truth",      "data.truth_refinement", "data.sensors",
+      "data.channels",         "data.truth_zones"};
   return bar_only.count(path) > 0;
 }
 

@@ -183,41 +183,6 @@ double RootMeanSquareOfRows(const Matrix& rows) {
   return rows.size() > 0 ? std::sqrt(rows.squaredNorm() / static_cast<double>(rows.size())) : 0.0;
 }
 
-// Records every evaluation of a zone objective (ZoneMcreObjective,
-// MatrixOutputErrorObjective, which log their usable evaluations) and logs a line for
-// each failed one, naming its cost and why.
-class RecordingObjective : public FirstOrderObjective {
- public:
-  RecordingObjective(LogModuliObjective* objective, std::vector<MatrixEvaluation>* records,
-                     const char* cost_name)
-      : objective_(objective), records_(records), cost_name_(cost_name) {}
-  int num_parameters() const override { return objective_->num_parameters(); }
-  bool Evaluate(const double* p, double* cost, double* gradient) override {
-    MatrixEvaluation record;
-    record.moduli = objective_->Moduli(p);
-    record.usable = objective_->Evaluate(p, cost, gradient);
-    record.cost = record.usable ? *cost : std::nan("");
-    if (record.usable && gradient != nullptr) {
-      record.gradient_norm = Eigen::Map<const Vector>(gradient, num_parameters()).norm();
-    }
-    records_->push_back(record);
-    if (record.usable) return true;
-    std::string moduli;
-    for (int z = 0; z < record.moduli.size(); ++z) {
-      moduli += (z == 0 ? "" : ", ") + fmt::format("{:.6g}", record.moduli[z] * 1e-9);
-    }
-    spdlog::info("evaluation {}: E = [{}] GPa, {} not usable ({})", records_->size(), moduli,
-                 cost_name_, objective_->error_message());
-    return false;
-  }
-  std::string error_message() const override { return objective_->error_message(); }
-
- private:
-  LogModuliObjective* objective_;
-  std::vector<MatrixEvaluation>* records_;
-  const char* cost_name_;
-};
-
 // e^2 and the zone and dof maps of a usable coupled solution at the problem's moduli:
 // from its fields, or as a streaming solve summed them.
 void CostAndMaps(MatrixMcreProblem* problem, const CoupledSolution& solution, double* cost,
@@ -272,8 +237,9 @@ const CoupledSolution* MapsAtIdentifiedAndNominal(
   const CoupledSolution* identified = nullptr;
   std::string why;
   if (run->identified_moduli.size() > 0) {
-    const MatrixEvaluation& last = run->evaluations.back();
-    if (last.usable && last.moduli == run->identified_moduli) {
+    const std::vector<ZoneEvaluation>& history = run->zones.history;
+    if (!history.empty() && history.back().usable &&
+        history.back().moduli == run->identified_moduli) {
       identified = &objective.last_solution();
       if (!model.elements.empty() && !identified->has_fields()) {
         // A streaming solve of the minimiser's, without the element map: gathered from
@@ -306,43 +272,26 @@ const CoupledSolution* MapsAtIdentifiedAndNominal(
   return identified;
 }
 
-// After the minimiser: the identified moduli of run->outer and why the run is not
-// usable (no usable point, no tolerance met, a zone on a bound of p in [lower, upper]).
-template <typename ZoneObjective>
-void TakeZoneOutcome(const ZoneObjective& objective, const std::vector<double>& lower,
-                     const std::vector<double>& upper, MatrixIdentificationRun* out) {
+// After the zones: the identified moduli and why the run is not usable (no usable
+// point, no tolerance met, a zone on a bound of [outer.lower_bound, outer.upper_bound]).
+void TakeZoneOutcome(MatrixIdentificationRun* out) {
   MatrixIdentificationRun& run = *out;
-  const std::size_t zones = lower.size();
-  spdlog::info("zones: {}", run.outer.BriefReport());
-  if (run.outer.x.empty()) {
-    run.failure = "no usable evaluation: " + run.outer.message;
-  } else {
-    run.identified_moduli = objective.Moduli(run.outer.x.data());
-    if (!run.outer.IsSolutionUsable()) {
-      run.failure = "the optimiser stopped before a tolerance was met: " + run.outer.message;
-    }
-    for (std::size_t z = 0; z < zones && run.failure.empty(); ++z) {
-      // A modulus on a bound is where the search stopped, not where the data point.
-      const double p = run.outer.x[z];
-      if (std::abs(p - lower[z]) < 1e-6 || std::abs(p - upper[z]) < 1e-6) {
-        run.failure = fmt::format(
-            "zone '{}' ends on a bound of outer.lower_bound / outer.upper_bound ({:.6g} Pa): "
-            "widen the bounds or check the data's units",
-            run.zone_names[z], run.identified_moduli[static_cast<int>(z)]);
-      }
-    }
+  const ZoneIdentificationSummary& zones = run.zones;
+  spdlog::info("zones: {}", zones.BriefReport());
+  if (zones.moduli.size() == 0) {
+    run.failure = "no usable evaluation: " + zones.message;
+    return;
   }
-}
-
-// The bounds of p_z = log(E_z / E_z,nom): outer.lower_bound and outer.upper_bound.
-void ZoneParameterBounds(const Config& config, const Vector& nominal, std::vector<double>* lower,
-                         std::vector<double>* upper) {
-  const auto zones = static_cast<std::size_t>(nominal.size());
-  lower->resize(zones);
-  upper->resize(zones);
-  for (std::size_t z = 0; z < zones; ++z) {
-    (*lower)[z] = std::log(config.outer.lower_bound / nominal[static_cast<int>(z)]);
-    (*upper)[z] = std::log(config.outer.upper_bound / nominal[static_cast<int>(z)]);
+  run.identified_moduli = zones.moduli;
+  if (!zones.IsSolutionUsable()) {
+    run.failure = "the optimiser stopped before a tolerance was met: " + zones.message;
+  } else if (!zones.zones_on_bounds.empty()) {
+    // A modulus on a bound is where the search stopped, not where the data point.
+    const int z = zones.zones_on_bounds.front();
+    run.failure = fmt::format(
+        "zone '{}' ends on a bound of outer.lower_bound / outer.upper_bound ({:.6g} Pa): "
+        "widen the bounds or check the data's units",
+        run.zone_names[static_cast<std::size_t>(z)], run.identified_moduli[z]);
   }
 }
 
@@ -412,13 +361,18 @@ bool IdentifyHomogeneousStageByLeastSquares(const Config& config, const MatrixMo
   return true;
 }
 
-// The zones' minimiser's start, p_z = log(E_z / E_z,nom): E* in every zone after the
-// homogeneous stage (the zones share E_z,nom), else the nominal moduli (p = 0).
-std::vector<double> ZoneStart(const MatrixIdentificationRun& run) {
-  const auto zones = static_cast<std::size_t>(run.nominal_moduli.size());
-  if (!run.homogeneous_ran) return std::vector<double>(zones, 0.0);
-  return std::vector<double>(
-      zones, std::log(run.homogeneous.identified_modulus() / run.nominal_moduli[0]));
+// The zones' start: E* in every zone after the homogeneous stage (the zones share
+// E_z,nom), else the nominal moduli.
+Vector ZoneStart(const MatrixIdentificationRun& run) {
+  if (!run.homogeneous_ran) return run.nominal_moduli;
+  return Vector::Constant(run.nominal_moduli.size(), run.homogeneous.identified_modulus());
+}
+
+// The pre-filter the data went through, its cut-off the one used.
+PrefilterOptions UsedPrefilter(const Config& config, const MatrixIdentificationRun& run) {
+  PrefilterOptions prefilter = config.prefilter;
+  prefilter.cutoff_frequency = run.prefilter_cutoff;
+  return prefilter;
 }
 
 // Step 2 with outer.functional: least_squares: every zone modulus by the output-error
@@ -434,14 +388,11 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
   MatrixOutputErrorObjective objective(model, run.data, run.misfit_levels, config.time.theta);
   run.nominal_moduli = objective.reference_moduli();
   run.rest_cost = objective.rest_cost();
-  RecordingObjective recorder(&objective, &run.evaluations, "J");
-  std::vector<double> lower, upper;
-  ZoneParameterBounds(config, run.nominal_moduli, &lower, &upper);
   spdlog::info(
       "matrix model {}: {} dofs, {} zones, {} loads, {} sensors, {} steps of {:.4g} s; "
       "output-error least squares, misfit levels {:.4g} m, {:.4g} ({})",
-      run.manifest, run.dofs, lower.size(), model.loads.size(), model.sensors.size(), run.steps,
-      run.time_step, run.misfit_levels.displacement_std, run.misfit_levels.strain_std,
+      run.manifest, run.dofs, model.zones.size(), model.loads.size(), model.sensors.size(),
+      run.steps, run.time_step, run.misfit_levels.displacement_std, run.misfit_levels.strain_std,
       run.misfit_source);
   if (!model.supports.empty()) {
     // The bar's least squares keeps its clamp rigid whatever mcre.clamp says.
@@ -455,10 +406,12 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
       !IdentifyHomogeneousStageByLeastSquares(config, model, &run)) {
     return;
   }
-  run.outer = MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper,
-                                   ZoneStart(run));
-  TakeZoneOutcome(objective, lower, upper, &run);
-  run.sweeps = objective.sweeps();
+  run.noise = MatrixNoiseLevels(config, measurements, &run.noise_source);
+  run.zones = IdentifyZoneModuliByLeastSquares(
+      config.zone_identification, model, run.data, run.misfit_levels, config.time.theta, &objective,
+      ZoneStart(run), config.outer.lower_bound, config.outer.upper_bound, run.noise,
+      UsedPrefilter(config, run));
+  TakeZoneOutcome(&run);
   if (run.identified_moduli.size() > 0) {
     run.cost = objective.Cost(run.identified_moduli, nullptr);
     run.model_outputs = objective.outputs();
@@ -790,11 +743,7 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
   problem.set_element_maps(false);
   run.nominal_moduli = problem.NominalModuli();
   run.rest_cost = mcre_objective.rest_cost();
-  ZoneMcreObjective objective(&mcre_objective, run.nominal_moduli);
-  RecordingObjective recorder(&objective, &run.evaluations, "e^2");
   const auto zones = static_cast<std::size_t>(model.zones.size());
-  std::vector<double> lower, upper;
-  ZoneParameterBounds(config, run.nominal_moduli, &lower, &upper);
   spdlog::info(
       "matrix model {}: {} dofs, {} zones, {} loads, {} sensors, {} steps of {:.4g} s; inner {}",
       run.manifest, run.dofs, zones, model.loads.size(), model.sensors.size(), run.steps,
@@ -814,10 +763,13 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
     }
     mcre_objective.SetWarmStart(run.homogeneous.solution.WarmStart());
   }
-  run.outer = MinimizeWithinBounds(config.zone_identification.minimizer, &recorder, lower, upper,
-                                   ZoneStart(run));
-  TakeZoneOutcome(objective, lower, upper, &run);
-  run.sweeps = problem.sweep_count();
+  // The discrepancy target's levels (zone_identification:), and the uncertainty's.
+  run.noise = MatrixNoiseLevels(config, measurements, &run.noise_source);
+  run.zones = IdentifyZoneModuli(config.zone_identification, model, run.data, config.mcre,
+                                 config.time.theta, config.inner, &mcre_objective,
+                                 run.nominal_moduli, ZoneStart(run), config.outer.lower_bound,
+                                 config.outer.upper_bound, run.noise, UsedPrefilter(config, run));
+  TakeZoneOutcome(&run);
   if (!maps_and_uncertainty) {
     run.wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
@@ -831,7 +783,6 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
   const CoupledSolution* identified =
       MapsAtIdentifiedAndNominal(config, model, mcre_objective, &problem, &storage, &run);
   if (identified != nullptr) {
-    run.noise = MatrixNoiseLevels(config, measurements, &run.noise_source);
     run.uncertainty =
         EstimateZoneUncertainty(config.uncertainty, model, run.data, config.mcre, config.time.theta,
                                 config.inner, run.identified_moduli, *identified, run.noise);

@@ -952,8 +952,8 @@ std::string MatrixEvaluationsCsv(const MatrixIdentificationRun& run) {
   std::string csv = "evaluation";
   for (const std::string& zone : run.zone_names) csv += "," + zone + "_pa";
   csv += ",scaled_cost,usable,gradient_norm\n";
-  for (std::size_t i = 0; i < run.evaluations.size(); ++i) {
-    const MatrixEvaluation& e = run.evaluations[i];
+  for (std::size_t i = 0; i < run.zones.history.size(); ++i) {
+    const ZoneEvaluation& e = run.zones.history[i];
     csv += std::to_string(i + 1);
     for (int z = 0; z < e.moduli.size(); ++z) csv += "," + Format(e.moduli[z]);
     csv += "," + Format(e.cost) + "," + (e.usable ? "1" : "0") + "," + Format(e.gradient_norm) +
@@ -1082,8 +1082,10 @@ void MatrixZonesYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) {
                                  : "identification of every zone modulus from the nominal moduli");
   yaml->Line(1, "functional", run.least_squares ? "least_squares" : "mcre", "outer.functional");
   yaml->Integer(1, "count", static_cast<long>(run.zone_names.size()));
-  yaml->Line(1, "termination", TerminationTypeToString(run.outer.termination));
-  yaml->Text(1, "message", run.outer.message);
+  const ZoneIdentificationSummary& zones = run.zones;
+  const BoundedMinimizerSummary& minimizer = zones.regularized.minimizer;
+  yaml->Line(1, "termination", TerminationTypeToString(zones.termination));
+  yaml->Text(1, "message", zones.message);
   yaml->Number(1, "homogeneous_modulus",
                run.homogeneous_ran ? run.homogeneous.identified_modulus() : NAN,
                "[Pa] E*, the start (null: the zones' nominal moduli differ, they start there)");
@@ -1095,13 +1097,26 @@ void MatrixZonesYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) {
                run.least_squares ? "[s] J_rest, J with every prediction 0"
                                  : "[J s] J_rest, e^2 of the structure left at rest "
                                    "(0 <= e^2 <= J_rest)");
-  yaml->Line(1, "optimizer", OptimizerTypeToString(run.outer.optimizer));
-  yaml->Line(1, "algorithm", OuterAlgorithmToString(run.outer.algorithm));
-  yaml->Text(1, "optimizer_message", run.outer.optimizer_message, "the optimiser's own words");
-  yaml->Integer(1, "evaluations", run.outer.evaluations, "zone_evaluations.csv");
-  yaml->Integer(1, "gradient_evaluations", run.outer.gradient_evaluations);
-  yaml->Number(1, "scaled_cost", run.outer.cost, cost + " / cost_scale at the zone moduli");
-  yaml->Integer(1, "sweeps", run.sweeps);
+  // The penalty and merging of zone_identification:, as the bar's zones: block says them.
+  yaml->Number(1, "regularization_weight", zones.regularized.weight,
+               "lambda of the jump penalty on log E between consecutive zones");
+  yaml->Text(1, "weight_choice", zones.regularized.weight_choice);
+  yaml->Number(1, "target_misfit", zones.regularized.target_misfit,
+               cost + " / J_rest the noise explains (discrepancy principle; -1: not used)");
+  yaml->Integer(1, "weights_tried", static_cast<long>(zones.regularized.path.size()));
+  yaml->Integer(1, "groups", zones.merge.groups,
+                "zones left distinct by merging (-1: zone_identification.merge_zones off)");
+  yaml->Integer(1, "merges", zones.merge.merges);
+  yaml->Line(1, "optimizer", OptimizerTypeToString(minimizer.optimizer));
+  yaml->Line(1, "algorithm", OuterAlgorithmToString(minimizer.algorithm));
+  yaml->Text(1, "optimizer_message", minimizer.optimizer_message, "the optimiser's own words");
+  yaml->Integer(1, "evaluations", zones.evaluations,
+                "of every minimisation (zone_evaluations.csv) and the costs at its minimiser");
+  yaml->Integer(1, "gradient_evaluations", minimizer.gradient_evaluations,
+                "of the minimisation kept");
+  yaml->Number(1, "scaled_cost", minimizer.cost,
+               cost + " / cost_scale (+ the penalty) at the zone moduli");
+  yaml->Integer(1, "sweeps", zones.sweeps);
   yaml->Line(1, "moduli", "",
              run.least_squares
                  ? "per zone (zones.csv): index, name, nominal, identified and truth modulus [Pa]"

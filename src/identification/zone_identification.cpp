@@ -75,21 +75,61 @@ ChannelSet DrawNoiseAlone(const PrefilterOptions& prefilter, const NoiseLevels& 
   return prefilter.enabled ? PrefilterMeasurements(*drawn, prefilter) : *drawn;
 }
 
+// Records every evaluation of a zone objective into `history` and logs a line for each
+// one that is not usable, naming the cost and why (the objective logs the usable ones).
+class RecordingObjective : public FirstOrderObjective {
+ public:
+  RecordingObjective(LogModuliObjective* objective, const char* cost_name,
+                     std::vector<ZoneEvaluation>* history)
+      : objective_(objective), cost_name_(cost_name), history_(history) {}
+  int num_parameters() const override { return objective_->num_parameters(); }
+  bool Evaluate(const double* p, double* cost, double* gradient) override {
+    ZoneEvaluation record;
+    record.moduli = objective_->Moduli(p);
+    record.usable = objective_->Evaluate(p, cost, gradient);
+    record.cost = record.usable ? *cost : std::nan("");
+    if (record.usable && gradient != nullptr) {
+      record.gradient_norm = Eigen::Map<const Vector>(gradient, num_parameters()).norm();
+    }
+    history_->push_back(record);
+    if (record.usable) return true;
+    std::string moduli;
+    for (int z = 0; z < record.moduli.size(); ++z) {
+      moduli += (z == 0 ? "" : ", ") + fmt::format("{:.6g}", record.moduli[z] * 1e-9);
+    }
+    spdlog::info("evaluation {}: E = [{}] GPa, {} not usable ({})", history_->size(), moduli,
+                 cost_name_, objective_->error_message());
+    return false;
+  }
+  std::string error_message() const override { return objective_->error_message(); }
+
+ private:
+  LogModuliObjective* objective_;
+  const char* cost_name_;
+  std::vector<ZoneEvaluation>* history_;
+};
+
 // The steps both functionals share, on zone_objective (a function of p_z =
-// log(E_z / E*), its cost scaled by summary->cost_scale, which the caller has set):
-// the discrepancy target from expected_noise_cost() (the scaled cost of noise alone;
-// negative: not usable) when the weight rule or the merging needs it, the regularised
-// minimisation from E* in every zone, the merging, and the moduli, cost and zones on a
-// bound. When the target's noise cost is not usable the summary says so and nothing is
+// log(E_z / E_z,ref), its cost scaled by summary->cost_scale, which the caller has set)
+// from summary->start_moduli: the discrepancy target from expected_noise_cost() (the
+// scaled cost of noise alone; negative: not usable) when the weight rule or the merging
+// needs it, the regularised minimisation, the merging, and the moduli, cost and zones on
+// a bound. When the target's noise cost is not usable the summary says so and nothing is
 // minimised.
 template <typename NoiseCost>
-void MinimizeOverZones(const ZoneIdentificationOptions& options, int zones,
-                       FirstOrderObjective* zone_objective, double lower_bound, double upper_bound,
-                       NoiseCost&& expected_noise_cost, ZoneIdentificationSummary* summary) {
-  const double homogeneous_modulus = summary->homogeneous_modulus;
-  const std::vector<double> lower(zones, std::log(lower_bound / homogeneous_modulus));
-  const std::vector<double> upper(zones, std::log(upper_bound / homogeneous_modulus));
-  const std::vector<double> initial(zones, 0.0);
+void MinimizeOverZones(const ZoneIdentificationOptions& options, LogModuliObjective* zone_objective,
+                       double lower_bound, double upper_bound, NoiseCost&& expected_noise_cost,
+                       ZoneIdentificationSummary* summary) {
+  const Vector& reference = zone_objective->reference_moduli();
+  const int zones = static_cast<int>(reference.size());
+  std::vector<double> lower(zones), upper(zones), initial(zones);
+  for (int z = 0; z < zones; ++z) {
+    lower[z] = std::log(lower_bound / reference[z]);
+    upper[z] = std::log(upper_bound / reference[z]);
+    initial[z] = std::log(summary->start_moduli[z] / reference[z]);
+  }
+  RecordingObjective recorder(zone_objective, summary->least_squares ? "J" : "e^2",
+                              &summary->history);
 
   double target = -1.0;
   const bool automatic = options.regularization.kind != RegularizationKind::kNone &&
@@ -107,8 +147,8 @@ void MinimizeOverZones(const ZoneIdentificationOptions& options, int zones,
     spdlog::info("zones: discrepancy target {} / J_rest = {:.6g} (noise alone, {} draws)",
                  summary->least_squares ? "J" : "e^2", target, options.noise_samples);
   }
-  summary->regularized = MinimizeRegularized(options.minimizer, options.regularization,
-                                             zone_objective, lower, upper, initial, target);
+  summary->regularized = MinimizeRegularized(options.minimizer, options.regularization, &recorder,
+                                             lower, upper, initial, target);
   const RegularizedMinimization& result = summary->regularized;
   summary->termination = result.minimizer.termination;
   summary->message = result.minimizer.message;
@@ -116,16 +156,15 @@ void MinimizeOverZones(const ZoneIdentificationOptions& options, int zones,
     // The merges' target: the discrepancy target or, when no weight of the grid met it
     // (a draw whose noise cost lies above the mean the target is), the misfit floor's,
     // as the weight's own fallback.
-    summary->merge = MergeNeighbouringZones(options.minimizer, zone_objective, lower, upper,
-                                            result.x, result.AttainableTarget());
+    summary->merge = MergeNeighbouringZones(options.minimizer, &recorder, lower, upper, result.x,
+                                            result.AttainableTarget());
     spdlog::info("zones: {} merge(s) kept in {} refits: {} groups", summary->merge.merges,
                  summary->merge.refits, summary->merge.groups);
   }
   const bool merged = !summary->merge.x.empty();
   const std::vector<double>& x = merged ? summary->merge.x : result.x;
   if (!x.empty()) {
-    summary->moduli.resize(zones);
-    for (int z = 0; z < zones; ++z) summary->moduli[z] = homogeneous_modulus * std::exp(x[z]);
+    summary->moduli = zone_objective->Moduli(x.data());
     summary->cost = (merged ? summary->merge.misfit : result.misfit) * summary->cost_scale;
     for (int z = 0; z < zones; ++z) {
       if (std::abs(x[z] - lower[z]) < 1e-6 || std::abs(x[z] - upper[z]) < 1e-6) {
@@ -191,16 +230,19 @@ double ExpectedLeastSquaresNoiseCost(const MatrixModelData& model, const Channel
 namespace {
 
 // The frame both functionals' identifications share: the summary's start (functional,
-// E*, noise levels), then `identify` (the objective, the cost scale and
+// start moduli, noise levels), then `identify` (the objective, the cost scale and
 // MinimizeOverZones into the summary), its exception a failure of the summary, and the
 // wall time.
 template <typename Identify>
-ZoneIdentificationSummary IdentifyZones(double homogeneous_modulus, const NoiseLevels& noise,
+ZoneIdentificationSummary IdentifyZones(const Vector& start_moduli, const NoiseLevels& noise,
                                         bool least_squares, Identify&& identify) {
   const auto start = std::chrono::steady_clock::now();
   ZoneIdentificationSummary summary;
   summary.least_squares = least_squares;
-  summary.homogeneous_modulus = homogeneous_modulus;
+  summary.start_moduli = start_moduli;
+  if (start_moduli.size() > 0 && (start_moduli.array() == start_moduli[0]).all()) {
+    summary.homogeneous_modulus = start_moduli[0];
+  }
   summary.noise = noise;
   try {
     identify(&summary);
@@ -215,6 +257,54 @@ ZoneIdentificationSummary IdentifyZones(double homogeneous_modulus, const NoiseL
   return summary;
 }
 
+// IdentifyZoneModuli's steps on `objective` into *summary (its start set).
+void IdentifyOnMcreObjective(const ZoneIdentificationOptions& options, const MatrixModelData& model,
+                             const ChannelSet& data, const McreOptions& mcre, double theta,
+                             const CoupledSolverOptions& inner, McreObjective* objective,
+                             const Vector& reference_moduli, double lower_bound, double upper_bound,
+                             const PrefilterOptions& prefilter,
+                             ZoneIdentificationSummary* summary) {
+  const std::size_t first = objective->evaluations().size();
+  const long sweeps_before = objective->sweeps();
+  summary->cost_scale = objective->cost_scale();
+  ZoneMcreObjective zone_objective(objective, reference_moduli);
+  MinimizeOverZones(
+      options, &zone_objective, lower_bound, upper_bound,
+      [&] {
+        return ExpectedNoiseCost(model, data, mcre, theta, inner, summary->start_moduli,
+                                 summary->noise, prefilter, options.noise_samples,
+                                 options.noise_seed, summary->cost_scale);
+      },
+      summary);
+  if (objective->evaluations().size() > first && objective->evaluations()[first].usable) {
+    summary->homogeneous_cost = objective->evaluations()[first].cost;
+  }
+  summary->evaluations = zone_objective.evaluations();
+  summary->sweeps = objective->sweeps() - sweeps_before;
+}
+
+// IdentifyZoneModuliByLeastSquares's steps on `objective` into *summary (its start set).
+void IdentifyOnOutputError(const ZoneIdentificationOptions& options, const MatrixModelData& model,
+                           const ChannelSet& data, const NoiseLevels& misfit_levels, double theta,
+                           MatrixOutputErrorObjective* objective, double lower_bound,
+                           double upper_bound, const PrefilterOptions& prefilter,
+                           ZoneIdentificationSummary* summary) {
+  const int evaluations_before = objective->evaluations();
+  const long sweeps_before = objective->sweeps();
+  summary->cost_scale = objective->cost_scale();
+  summary->homogeneous_cost = objective->Cost(summary->start_moduli, nullptr);
+  MinimizeOverZones(
+      options, objective, lower_bound, upper_bound,
+      [&] {
+        return ExpectedLeastSquaresNoiseCost(
+            model, data, misfit_levels, theta, summary->start_moduli, summary->noise, prefilter,
+            options.noise_samples, options.noise_seed, summary->cost_scale);
+      },
+      summary);
+  summary->evaluations = objective->evaluations() - evaluations_before;
+  summary->sweeps = objective->sweeps() - sweeps_before;
+}
+
 }  // namespace
 
 ZoneIdentificationSummary IdentifyZoneModuli(
@@ -222,8 +312,8 @@ ZoneIdentificationSummary IdentifyZoneModuli(
     const McreOptions& mcre, double theta, const CoupledSolverOptions& inner,
     double homogeneous_modulus, double lower_bound, double upper_bound, const NoiseLevels& noise,
     const PrefilterOptions& prefilter, const Matrix* warm_start) {
-  const int zones = static_cast<int>(model.zones.size());
-  return IdentifyZones(homogeneous_modulus, noise, false, [&](ZoneIdentificationSummary* summary) {
+  const Vector start = Vector::Constant(static_cast<int>(model.zones.size()), homogeneous_modulus);
+  return IdentifyZones(start, noise, false, [&](ZoneIdentificationSummary* summary) {
     McreObjective objective = MatrixMcreObjective(model, data, mcre, theta, inner,
                                                   Factorization::kAutomatic, homogeneous_modulus);
     const StreamingCoupledProblem& problem = objective.problem();
@@ -231,21 +321,20 @@ ZoneIdentificationSummary IdentifyZoneModuli(
         (warm_start->rows() == problem.num_nodes() || warm_start->rows() == problem.num_traces())) {
       objective.SetWarmStart(*warm_start);
     }
-    summary->cost_scale = objective.cost_scale();
-    ZoneMcreObjective zone_objective(&objective, homogeneous_modulus);
-    MinimizeOverZones(
-        options, zones, &zone_objective, lower_bound, upper_bound,
-        [&] {
-          return ExpectedNoiseCost(model, data, mcre, theta, inner,
-                                   Vector::Constant(zones, homogeneous_modulus), noise, prefilter,
-                                   options.noise_samples, options.noise_seed, summary->cost_scale);
-        },
-        summary);
-    if (!objective.evaluations().empty() && objective.evaluations().front().usable) {
-      summary->homogeneous_cost = objective.evaluations().front().cost;
-    }
-    summary->evaluations = zone_objective.evaluations();
-    summary->sweeps = objective.sweeps();
+    IdentifyOnMcreObjective(options, model, data, mcre, theta, inner, &objective, start,
+                            lower_bound, upper_bound, prefilter, summary);
+  });
+}
+
+ZoneIdentificationSummary IdentifyZoneModuli(
+    const ZoneIdentificationOptions& options, const MatrixModelData& model, const ChannelSet& data,
+    const McreOptions& mcre, double theta, const CoupledSolverOptions& inner,
+    McreObjective* objective, const Vector& reference_moduli, const Vector& start_moduli,
+    double lower_bound, double upper_bound, const NoiseLevels& noise,
+    const PrefilterOptions& prefilter) {
+  return IdentifyZones(start_moduli, noise, false, [&](ZoneIdentificationSummary* summary) {
+    IdentifyOnMcreObjective(options, model, data, mcre, theta, inner, objective, reference_moduli,
+                            lower_bound, upper_bound, prefilter, summary);
   });
 }
 
@@ -253,23 +342,23 @@ ZoneIdentificationSummary IdentifyZoneModuliByLeastSquares(
     const ZoneIdentificationOptions& options, const MatrixModelData& model, const ChannelSet& data,
     const NoiseLevels& misfit_levels, double theta, double homogeneous_modulus, double lower_bound,
     double upper_bound, const NoiseLevels& noise, const PrefilterOptions& prefilter) {
-  const int zones = static_cast<int>(model.zones.size());
-  return IdentifyZones(homogeneous_modulus, noise, true, [&](ZoneIdentificationSummary* summary) {
+  const Vector start = Vector::Constant(static_cast<int>(model.zones.size()), homogeneous_modulus);
+  return IdentifyZones(start, noise, true, [&](ZoneIdentificationSummary* summary) {
     MatrixOutputErrorObjective objective(model, data, misfit_levels, theta,
                                          Factorization::kAutomatic, homogeneous_modulus);
-    summary->cost_scale = objective.cost_scale();
-    summary->homogeneous_cost =
-        objective.Cost(Vector::Constant(zones, homogeneous_modulus), nullptr);
-    MinimizeOverZones(
-        options, zones, &objective, lower_bound, upper_bound,
-        [&] {
-          return ExpectedLeastSquaresNoiseCost(
-              model, data, misfit_levels, theta, Vector::Constant(zones, homogeneous_modulus),
-              noise, prefilter, options.noise_samples, options.noise_seed, summary->cost_scale);
-        },
-        summary);
-    summary->evaluations = objective.evaluations();
-    summary->sweeps = objective.sweeps();
+    IdentifyOnOutputError(options, model, data, misfit_levels, theta, &objective, lower_bound,
+                          upper_bound, prefilter, summary);
+  });
+}
+
+ZoneIdentificationSummary IdentifyZoneModuliByLeastSquares(
+    const ZoneIdentificationOptions& options, const MatrixModelData& model, const ChannelSet& data,
+    const NoiseLevels& misfit_levels, double theta, MatrixOutputErrorObjective* objective,
+    const Vector& start_moduli, double lower_bound, double upper_bound, const NoiseLevels& noise,
+    const PrefilterOptions& prefilter) {
+  return IdentifyZones(start_moduli, noise, true, [&](ZoneIdentificationSummary* summary) {
+    IdentifyOnOutputError(options, model, data, misfit_levels, theta, objective, lower_bound,
+                          upper_bound, prefilter, summary);
   });
 }
 

@@ -30,7 +30,12 @@ BoundedMinimizerSummary MinimizeAt(const BoundedMinimizerOptions& options,
   point->weight = weight;
   point->evaluations = summary.evaluations;
   point->termination = summary.termination;
-  if (!summary.x.empty()) {
+  if (!summary.x.empty() && weight == 0.0) {
+    // Without a penalty the minimiser's cost is the data cost at its minimiser.
+    point->misfit = summary.cost;
+    point->roughness = JumpPenalty(regularization.kind, 1.0, regularization.tv_smoothing,
+                                   summary.x.data(), static_cast<int>(summary.x.size()), nullptr);
+  } else if (!summary.x.empty()) {
     // The parts at the best point: evaluate once more without the gradient (the
     // objective's last evaluation need not be the best one).
     double cost = 0.0;

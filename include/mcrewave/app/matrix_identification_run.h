@@ -14,11 +14,12 @@
 //      every zone has the same nominal modulus, the homogeneous stage first
 //      (identification_run.h: one E in every zone by outer:'s global scan, on the search
 //      functional of search: by default, and its refinements, as the bar's E is
-//      identified); then every zone modulus at once, p_z = log(E_z / E_z,nom)
-//      (ZoneMcreObjective), by the optimiser of zone_identification: from E* (or from the
-//      nominal moduli when they differ) within [outer.lower_bound, outer.upper_bound] Pa
-//      in every zone, inner solves by inner:; no jump penalty (matrices do not say which
-//      zones are neighbours). Then the error maps (zone and dof, and element when the
+//      identified); then every zone modulus at once, p_z = log(E_z / E_z,nom), by the
+//      bar's zone steps (identification/zone_identification.h: the minimiser of
+//      zone_identification:, its penalty on the jumps between consecutive zones of the
+//      manifest, its weight and the merging) from E* (or from the nominal moduli when
+//      they differ) within [outer.lower_bound, outer.upper_bound] Pa in every zone, inner
+//      solves by inner:. Then the error maps (zone and dof, and element when the
 //      model has element blocks and the inner solver keeps its fields) at the nominal and
 //      the identified moduli and the model's outputs at the identified moduli.
 //      With outer.functional: least_squares, the same stages on the output-error misfit
@@ -38,6 +39,7 @@
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/data/channel_set.h"
+#include "mcrewave/identification/zone_identification.h"
 #include "mcrewave/mcre/error_map.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
@@ -122,7 +124,8 @@ NoiseLevels MatrixLeastSquaresMisfitLevels(const Config& config, const MatrixMod
                                            const MatrixMeasurements& measurements,
                                            const ChannelSet& used, std::string* source);
 
-// The noise levels the uncertainty of a matrix run draws (EstimateZoneUncertainty): the
+// The noise levels the uncertainty of a matrix run draws (EstimateZoneUncertainty) and
+// its zones' discrepancy target (IdentifyZoneModuli): the
 // noise of synthetic data at a finite data.snr (measurements.noise, *source
 // "synthetic_snr"), else per channel kind (displacement, strain, force) the estimate
 // from the second differences of the measurements (DifferenceNoiseStd, s^2 averaged
@@ -136,14 +139,6 @@ NoiseLevels MatrixNoiseLevels(const Config& config, const MatrixMeasurements& me
 ChannelSet MatrixMeasurementTable(const Config& config, const MatrixModelData& model,
                                   const ChannelSet& histories);
 
-// One evaluation of the identification's cost.
-struct MatrixEvaluation {
-  Vector moduli;                      // E_z [Pa]
-  double cost = 0.0;                  // e^2 / J_rest (least squares: J / J_rest)
-  bool usable = false;                // the inner solve was usable (least squares: J finite)
-  double gradient_norm = -1.0;        // |d cost / d p|; -1 without gradient
-};
-
 struct MatrixIdentificationRun {
   std::string manifest;  // the model's manifest path
   // outer.functional: least_squares: the costs are J [s] and there is no error map
@@ -153,8 +148,9 @@ struct MatrixIdentificationRun {
   std::string misfit_source;  // as MatrixLeastSquaresMisfitLevels says
   int dofs = 0;
   int supports = 0;  // the manifest's supports (mcre.clamp treats them)
-  // The MCRE: the first-order uncertainty of the identified moduli (uncertainty:), drawn
-  // at `noise`, whose origin noise_source names (MatrixNoiseLevels).
+  // The noise levels of the zones' discrepancy target and of the MCRE's first-order
+  // uncertainty of the identified moduli (uncertainty:), whose origin noise_source names
+  // (MatrixNoiseLevels).
   ZoneUncertainty uncertainty;
   NoiseLevels noise;
   std::string noise_source;
@@ -179,9 +175,10 @@ struct MatrixIdentificationRun {
   double homogeneous_cost = 0.0;         // e^2 [J s] (least squares: J [s]) at E* in every zone
   Vector identified_moduli;              // [Pa]; empty when no usable point
   Vector truth_moduli;                   // [Pa]; empty when unknown
-  BoundedMinimizerSummary outer;
-  std::vector<MatrixEvaluation> evaluations;
-  long sweeps = 0;            // inner sweeps of the identification (the maps' excluded)
+  // Every zone at once (identification/zone_identification.h, the bar's zones' steps:
+  // the regularised minimisation and the merging of zone_identification:), on
+  // p_z = log(E_z / E_z,nom) from E* in every zone or the nominal moduli.
+  ZoneIdentificationSummary zones;
   double rest_cost = 0.0;     // J_rest [J s] (least squares: [s])
   double nominal_cost = 0.0;  // e^2 at the nominal moduli [J s] (J [s])
   double cost = 0.0;          // e^2 at the identified moduli [J s] (J [s])
@@ -207,15 +204,15 @@ struct MatrixIdentificationRun {
 
   bool IsUsable() const { return failure.empty(); }
   // Evaluations and sweeps of the identification: the homogeneous stage's (its scan's
-  // and refinements') and the zones' minimiser's.
+  // and refinements') and the zones'.
   long TotalEvaluations() const {
     const long stage =
         homogeneous_ran ? homogeneous.outer.scan_evaluations + homogeneous.outer.evaluations : 0;
-    return stage + outer.evaluations;
+    return stage + zones.evaluations;
   }
   long TotalSweeps() const {
     const long stage = homogeneous_ran ? homogeneous.outer.scan_sweeps + homogeneous.sweeps : 0;
-    return stage + sweeps;
+    return stage + zones.sweeps;
   }
 };
 

@@ -70,13 +70,15 @@ std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
 //                       sweeps) and its optimizer:, scan:, inner: and (one zone)
 //                       cost_curve: blocks; the element map's peak at both moduli
 //                       (error_map:), the zones' uncertainty, the pre-filter, and the
-//                       zones: block in the bar's layout (the zones' minimiser, e^2 at the
+//                       zones: block in the bar's layout (the zones' minimiser, the
+//                       penalty's weight and its choice, the merging, e^2 at the
 //                       zone, homogeneous and nominal moduli, J_rest, and per zone its
 //                       nominal, identified and (synthetic data) truth modulus and its
 //                       share of the constitutive gap at the nominal and the identified
 //                       moduli), the resolved config
 //   zones.csv           the same per zone
-//   zone_evaluations.csv  every evaluation of the zones' minimiser: the zone moduli [Pa],
+//   zone_evaluations.csv  every evaluation of the zones' minimisations (each weight of the
+//                       penalty's and the merges' refits): the zone moduli [Pa],
 //                       e^2 / J_rest, usable, |gradient|
 //   evaluations.csv, scan.csv, valleys.csv, inner_residual.csv, cost_curve.png (and,
 //                       with one zone, cost_curve.csv): the homogeneous stage's, in the

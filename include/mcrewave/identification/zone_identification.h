@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "mcrewave/data/prefilter.h"
+#include "mcrewave/least_squares/matrix_output_error_objective.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/mcre/objective.h"
 #include "mcrewave/optim/bounded_minimizer.h"
@@ -50,17 +51,26 @@ struct ZoneIdentificationOptions {
   bool IsValid(std::string* error) const;
 };
 
+// One evaluation of the zones' data cost, as a minimiser asked for it.
+struct ZoneEvaluation {
+  Vector moduli;                // E_z [Pa]
+  double cost = 0.0;            // e^2 / J_rest (least squares: J / J_rest); NaN when not usable
+  bool usable = false;          // the inner solve was usable (least squares: J finite)
+  double gradient_norm = -1.0;  // |d cost / d p|; -1 without gradient
+};
+
 struct ZoneIdentificationSummary {
   TerminationType termination = TerminationType::kFailure;
   std::string message = "not run";
   bool least_squares = false;           // the cost is least squares' J [s], not e^2 [J s]
-  double homogeneous_modulus = -1.0;    // E*, the start and the scale [Pa]
+  double homogeneous_modulus = -1.0;    // E* when every zone started from it [Pa]; else -1
+  Vector start_moduli;                  // E_z at the start [Pa]
   Vector moduli;                        // E_z [Pa], one per zone (empty: none usable)
   std::vector<double> zone_start;       // [m], per zone of a bar: the first element's left
                                         // node (SetBarZoneExtents; empty: not a bar's)
   std::vector<double> zone_end;         // [m], per zone of a bar: the last element's right node
   double cost = -1.0;                   // e^2 at moduli [J s] (least squares: J [s])
-  double homogeneous_cost = -1.0;       // e^2 at E* in every zone [J s] (J [s])
+  double homogeneous_cost = -1.0;       // e^2 at the start moduli [J s] (J [s])
   double cost_scale = -1.0;             // J_rest [J s] (least squares: [s])
   NoiseLevels noise;                    // levels of the discrepancy target's draws
   double noise_cost = -1.0;             // ExpectedNoiseCost or ExpectedLeastSquaresNoiseCost
@@ -71,6 +81,9 @@ struct ZoneIdentificationSummary {
   std::vector<int> zones_on_bounds;     // zones whose modulus lies on a bound
   int evaluations = 0;                  // cost evaluations of the zone identification (MCRE:
                                         // coupled solves)
+  // Every evaluation of the data cost by the minimisations (the regularised ones and the
+  // merges' refits), in order.
+  std::vector<ZoneEvaluation> history;
   long sweeps = 0;
   double wall_time_s = -1.0;
 
@@ -115,6 +128,20 @@ ZoneIdentificationSummary IdentifyZoneModuli(
     double homogeneous_modulus, double lower_bound, double upper_bound, const NoiseLevels& noise,
     const PrefilterOptions& prefilter, const Matrix* warm_start = nullptr);
 
+// The same on the caller's objective: a McreObjective of model and data with mcre's
+// weights, theta and inner (its warm start, cost scale and element-map switch as the
+// caller made them; its last solution is then the minimiser's last evaluation's), on
+// p_z = log(E_z / E_z,ref) with E_z,ref = reference_moduli [Pa], from start_moduli [Pa]
+// (E* in every zone, or a structure's nominal moduli). The discrepancy target's noise
+// draws are solved at start_moduli, and homogeneous_cost is e^2 there. Preconditions:
+// options valid, lower_bound < every start modulus < upper_bound.
+ZoneIdentificationSummary IdentifyZoneModuli(
+    const ZoneIdentificationOptions& options, const MatrixModelData& model, const ChannelSet& data,
+    const McreOptions& mcre, double theta, const CoupledSolverOptions& inner,
+    McreObjective* objective, const Vector& reference_moduli, const Vector& start_moduli,
+    double lower_bound, double upper_bound, const NoiseLevels& noise,
+    const PrefilterOptions& prefilter);
+
 // The extents [m] of the bar's zones (summary->zone_start, zone_end): each zone's first
 // element's left node and last element's right node.
 void SetBarZoneExtents(const BarModel& model, ZoneIdentificationSummary* summary);
@@ -131,5 +158,14 @@ ZoneIdentificationSummary IdentifyZoneModuliByLeastSquares(
     const ZoneIdentificationOptions& options, const MatrixModelData& model, const ChannelSet& data,
     const NoiseLevels& misfit_levels, double theta, double homogeneous_modulus, double lower_bound,
     double upper_bound, const NoiseLevels& noise, const PrefilterOptions& prefilter);
+
+// The same on the caller's objective (MatrixOutputErrorObjective of model, data,
+// misfit_levels and theta), on p_z = log(E_z / E_z,ref) with its reference moduli, from
+// start_moduli [Pa]; homogeneous_cost is J there. Preconditions as the MCRE's.
+ZoneIdentificationSummary IdentifyZoneModuliByLeastSquares(
+    const ZoneIdentificationOptions& options, const MatrixModelData& model, const ChannelSet& data,
+    const NoiseLevels& misfit_levels, double theta, MatrixOutputErrorObjective* zones,
+    const Vector& start_moduli, double lower_bound, double upper_bound, const NoiseLevels& noise,
+    const PrefilterOptions& prefilter);
 
 }  // namespace mcrewave
