@@ -186,30 +186,6 @@ void CheckOutputFolder(const std::string& folder) {
   RequireWritableFolder(existing, "output folder " + folder);
 }
 
-// Steps 3 to 5 of RunIdentify with outer.functional: least_squares: the
-// comparator's estimate of E, its fit and cost curve, and its zone moduli when the
-// identification has zones.
-int IdentifyByLeastSquares(const mcrewave::Config& config, const mcrewave::ChannelSet& data) {
-  const mcrewave::LeastSquaresRun run = mcrewave::RunLeastSquares(config, data);
-  const std::string on_bound =
-      run.IsUsable() ? mcrewave::ModulusOnBoundMessage(run.identified_modulus(), config.outer)
-                     : run.outer.message;
-  if (!on_bound.empty()) {
-    std::fprintf(stderr, "error: identification failed: %s\n", on_bound.c_str());
-    return 1;
-  }
-  std::vector<std::string> files;
-  {
-    const ResultsBeingWritten held;
-    files = mcrewave::WriteLeastSquaresResults(run, config.output.folder, config.output.figures);
-  }
-  spdlog::info("identified E = {:.9g} Pa by least squares in {} evaluations, {:.2f} s",
-               run.identified_modulus(), run.outer.scan_evaluations + run.outer.evaluations,
-               run.wall_time_s);
-  spdlog::info("wrote {} files to {}", files.size(), config.output.folder);
-  return 0;
-}
-
 // Steps 2 to 5 of RunIdentify with model.kind: matrix: every zone modulus of a
 // structure given by matrices (app/matrix_identification_run.h).
 int IdentifyMatrixModel(const mcrewave::Config& config) {
@@ -262,10 +238,8 @@ int RunIdentify(const RunArguments& arguments) {
                data.num_samples());
 
   // 3. Identify E, then the cost curve and the uncertainty figure (by output-error
-  //    least squares instead of the MCRE with outer.functional: least_squares).
-  if (config.outer.functional == mcrewave::OuterFunctional::kLeastSquares) {
-    return IdentifyByLeastSquares(config, data);
-  }
+  //    least squares instead of the MCRE with outer.functional: least_squares: its fit,
+  //    cost curve and Cramer-Rao bound).
   const mcrewave::IdentificationRun run = mcrewave::RunIdentification(config, data);
   if (!run.IsUsable()) {
     std::fprintf(stderr, "error: identification failed: %s\n", run.outer.message.c_str());
@@ -273,7 +247,7 @@ int RunIdentify(const RunArguments& arguments) {
   }
   for (const std::string& unusable :
        {mcrewave::ModulusOnBoundMessage(run.identified_modulus(), config.outer),
-        mcrewave::ImplausibleMisfitMessage(run)}) {
+        run.least_squares ? std::string() : mcrewave::ImplausibleMisfitMessage(run)}) {
     if (!unusable.empty()) {
       std::fprintf(stderr, "error: identification failed: %s\n", unusable.c_str());
       return 1;
@@ -288,16 +262,17 @@ int RunIdentify(const RunArguments& arguments) {
   }
 
   // 5. Brief report.
+  const char* functional = run.least_squares ? " by least squares" : "";
   if (run.reference_known) {
     spdlog::info(
-        "identified E = {:.9g} Pa (reference {:.9g} Pa, relative error {:.3e}) in {} "
+        "identified E = {:.9g} Pa{} (reference {:.9g} Pa, relative error {:.3e}) in {} "
         "evaluations, {:.2f} s",
-        run.identified_modulus(), config.model.modulus,
+        run.identified_modulus(), functional, config.model.modulus,
         (run.identified_modulus() - config.model.modulus) / config.model.modulus,
         run.outer.scan_evaluations + run.outer.evaluations, run.wall_time_s);
   } else {
-    spdlog::info("identified E = {:.9g} Pa in {} evaluations, {:.2f} s", run.identified_modulus(),
-                 run.outer.scan_evaluations + run.outer.evaluations, run.wall_time_s);
+    spdlog::info("identified E = {:.9g} Pa{} in {} evaluations, {:.2f} s", run.identified_modulus(),
+                 functional, run.outer.scan_evaluations + run.outer.evaluations, run.wall_time_s);
   }
   spdlog::info("wrote {} files to {}", files.size(), config.output.folder);
   return 0;

@@ -304,6 +304,9 @@ IdentificationRun IdentifyModulus(const Config& config, const ChannelSet& data) 
 }
 
 IdentificationRun RunIdentification(const Config& config, const ChannelSet& data) {
+  if (config.outer.functional == OuterFunctional::kLeastSquares) {
+    return RunLeastSquares(config, data);
+  }
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   IdentificationRun run = IdentifyModulus(config, data);
@@ -409,11 +412,12 @@ NoiseLevels LeastSquaresMisfitLevels(const Config& config, const ChannelSet& dat
   return levels;
 }
 
-LeastSquaresRun RunLeastSquares(const Config& config, const ChannelSet& data) {
+IdentificationRun RunLeastSquares(const Config& config, const ChannelSet& data) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  LeastSquaresRun run;
+  IdentificationRun run;
   run.config = config;
+  run.least_squares = true;
   run.reference_known = config.data.source == DataSource::kSynthetic;
   run.data = IdentificationData(config, data, &run.ends, &run.prefilter_cutoff);
   run.noise = LeastSquaresMisfitLevels(config, data, run.data, &run.noise_source);

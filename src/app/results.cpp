@@ -618,9 +618,164 @@ void CostCurveYaml(const std::vector<CostCurvePoint>& curve, YamlWriter* yaml) {
   yaml->Number(1, "highest_modulus", curve.empty() ? NAN : curve.back().modulus, "[Pa]");
 }
 
+// Measured and predicted channels of the least-squares fit at the identified E:
+// uL (x = L) and f0 (the clamp reaction), then each interior sensor; a model column
+// is empty when its channel is no output of the fit under that name (uL when
+// data.channels leaves it out).
+std::string FitCsv(const IdentificationRun& run) {
+  const ChannelSet& data = run.data;
+  const OutputErrorFit& fit = run.fit;
+  const std::vector<MatrixModelSensor>& model_sensors = run.model->sensors;
+  // The row of the fit's outputs of each channel, by name (-1: none).
+  auto output_row = [&](const std::string& name) {
+    for (std::size_t k = 0; k < model_sensors.size(); ++k) {
+      if (model_sensors[k].channel == name) return static_cast<Eigen::Index>(k);
+    }
+    return Eigen::Index{-1};
+  };
+  std::string csv = "t,uL_measured,uL_model,f0_measured,f0_model";
+  const std::vector<BarSensor> sensors = BarSensors(data);
+  std::vector<Eigen::Index> sensor_rows;
+  for (const BarSensor& sensor : sensors) {
+    const std::string& name = data.channels[static_cast<std::size_t>(sensor.index)].name;
+    csv += "," + name + "_measured," + name + "_model";
+    sensor_rows.push_back(output_row(name));
+  }
+  csv += "\n";
+  const Eigen::Index uL_row = output_row("uL");
+  const BarEnds measured = BarEndChannels(data);
+  const std::vector<const Vector*> sensor_values = BarSensorValues(data);
+  for (int j = 0; j < data.num_samples(); ++j) {
+    csv += CsvNumber(data.Time(j)) + ',' + CsvNumber(measured.uL[j]) + ',';
+    if (uL_row >= 0) csv += CsvNumber(fit.outputs(uL_row, j));
+    csv += ',' + CsvNumber(measured.f0[j]) + ',' + CsvNumber(fit.support_forces(0, j));
+    for (std::size_t k = 0; k < sensor_values.size(); ++k) {
+      csv += ',' + CsvNumber((*sensor_values[k])[j]) + ',';
+      if (sensor_rows[k] >= 0) csv += CsvNumber(fit.outputs(sensor_rows[k], j));
+    }
+    csv += "\n";
+  }
+  return csv;
+}
+
+std::string LeastSquaresCostCurveScript(const IdentificationRun& run, const std::string& folder) {
+  const double identified = run.identified_modulus() / 1e9;
+  const bool scanned = !run.outer.scan_moduli.empty();
+  std::ostringstream script;
+  script << GnuplotPngTerminal() << "set terminal pngcairo size 1000,1000\n"
+         << "set multiplot layout 2,1 title 'Output-error least squares J(E); identified E = "
+         << identified << " GPa (dashed)'\n"
+         << "set xlabel 'E [GPa]'\nset ylabel 'J [s]'\nset format y '%.5g'\nset key top center\n"
+         << "set arrow 1 from " << identified << ", graph 0 to " << identified
+         << ", graph 1 nohead dashtype 2 lc rgb '#555555'\n";
+  const std::string curve = GnuplotString(folder + "/cost_curve.csv") +
+                            " skip 1 using ($1/1e9):($4 > 0 ? $2 : 1/0) with linespoints pt 7 "
+                            "ps 0.5 lw 2 lc rgb '#8b00c9' title 'J(E), cost curve'";
+  if (scanned) {
+    if (run.outer.scan_moduli.back() >= 10.0 * run.outer.scan_moduli.front())
+      script << "set logscale x\n";
+    script << "set title 'global scan over the bounds, its valleys and the local refinements'\n"
+           << "plot " << ScanPlots(folder, false) << curve << "\nunset logscale x\n";
+  }
+  script << "set title 'within 5 % of the identified E'\nset xrange ["
+         << identified * (1.0 - kCurvatureWindow) << ":" << identified * (1.0 + kCurvatureWindow)
+         << "]\nplot " << (scanned ? ScanPlots(folder, false) : std::string()) << curve
+         << "\nunset multiplot\n";
+  return script.str();
+}
+
+std::string FitScript(const IdentificationRun& run, const std::string& folder) {
+  const std::string csv = GnuplotString(folder + "/fit.csv");
+  const char* measured = run.config.prefilter.enabled ? "measured, pre-filtered" : "measured";
+  std::ostringstream script;
+  script << GnuplotPngTerminal() << "set terminal pngcairo size 1200,500\nset multiplot layout 1,2 "
+         << "title 'Least-squares fit at the identified modulus: the clamped model driven by the "
+            "measured f_L'\n"
+         << "set xlabel 't [ms]'\n"
+         << "set title 'u_L (x = L)'\nset ylabel 'u [um]'\nplot " << csv
+         << " skip 1 using ($1*1e3):($2*1e6) with lines lc rgb '#aaaaaa' title '" << measured
+         << "', " << csv
+         << " skip 1 using ($1*1e3):($3*1e6) with lines lw 2 lc rgb '#1f4e9c' title 'model'\n"
+         << "set title 'f_0 (x = 0, clamp reaction)'\nset ylabel 'f [N]'\nplot " << csv
+         << " skip 1 using ($1*1e3):4 with lines lc rgb '#aaaaaa' title '" << measured << "', "
+         << csv << " skip 1 using ($1*1e3):5 with lines lw 2 lc rgb '#1f4e9c' title 'model'\n"
+         << "unset multiplot\n";
+  return script.str();
+}
+
+std::string LeastSquaresSummaryYaml(const IdentificationRun& run) {
+  const IdentificationSummary& outer = run.outer;
+  const double identified = run.identified_modulus();
+  const double reference = run.reference_known ? run.config.model.modulus : NAN;
+  YamlWriter yaml;
+  yaml.Raw("# mcrewave identify run: the modulus E identified by output-error least squares J(E)");
+  if (!run.config.source_path.empty()) yaml.Raw("# config: " + run.config.source_path);
+  yaml.Text(0, "version", kVersion, "mcrewave version");
+  yaml.Text(0, "functional", OuterFunctionalToString(run.config.outer.functional),
+            "outer.functional");
+  yaml.Number(0, "identified_modulus", identified, "[Pa] E minimising J");
+  yaml.Number(0, "reference_modulus", reference,
+              "[Pa] E the synthetic data were made with (null: unknown, CSV data)");
+  yaml.Number(0, "relative_error", run.reference_known ? (identified - reference) / reference : NAN,
+              "(identified - reference) / reference (null when unknown)");
+  yaml.Number(0, "cost", run.fit.cost,
+              "[s] J = 1/2 sum_k c_k h (misfit / noise level)^2 at the identified modulus");
+  yaml.Integer(0, "evaluations", outer.scan_evaluations + outer.evaluations,
+               "J evaluations of the identification: the scan's and the refinements'");
+  yaml.Integer(0, "sweeps", run.sweeps, "simulations and sensitivity sweeps, curve included");
+  yaml.Number(0, "wall_time_s", run.wall_time_s, "[s] identification and cost curve");
+
+  yaml.Line(0, "uncertainty", "");
+  yaml.Number(1, "modulus_std_bound", run.modulus_std_bound,
+              "[Pa] 1 / sqrt(I): Cramer-Rao bound with the measured load taken as exact");
+  yaml.Number(1, "relative_std_bound", run.modulus_std_bound / identified,
+              "modulus_std_bound / identified_modulus; the load's noise is not counted");
+  yaml.Number(1, "fisher_information", run.fit.fisher_information,
+              "[1/Pa^2] sum_k c_k sum (dy/dE)^2 / s^2 at the identified modulus");
+  yaml.Number(1, "curvature", run.curvature,
+              "[s/Pa^2] d^2J/dE^2 observed, least-squares slope of dJ/dE over E +- 5 %");
+  yaml.Number(1, "noise_std_displacement", run.noise.displacement_std,
+              "[m] s_u, the normalisation of the displacement misfit");
+  yaml.Number(1, "noise_std_force", run.noise.force_std, "[N] s_f, of the force misfit");
+  yaml.Number(1, "noise_std_strain", run.noise.strain_std, "[-] s_e, of the strain misfit");
+  yaml.Text(1, "noise_source", run.noise_source,
+            "synthetic_snr: the data's own noise; data_differences: estimated from the data; "
+            "channel_rms: noise-free data, the channels' RMS");
+
+  OptimizerScanAndPrefilterYaml(outer, run.rest_cost, run.rest_cost, run.config,
+                                run.prefilter_cutoff, "J", "s", &yaml);
+
+  CostCurveYaml(run.cost_curve, &yaml);
+  if (run.zones.ran) {
+    for (const std::string& line : ZonesYamlLines(run.zones)) yaml.Raw(line);
+  }
+  ConfigYaml(run.config, &yaml);
+  return yaml.str();
+}
+
+std::vector<std::string> WriteLeastSquaresResults(const IdentificationRun& run,
+                                                  const std::string& folder, bool figures) {
+  ResultsFolder results(folder);
+  results.Write("cost_curve.csv", CostCurveCsv(run.cost_curve));
+  results.Write("fit.csv", FitCsv(run));
+  if (!run.outer.scan_moduli.empty()) {
+    results.Write("scan.csv", ScanCsv(run.outer, run.rest_cost, run.config.outer.initial));
+    results.Write("valleys.csv", ValleysCsv(run.outer, run.rest_cost));
+  }
+  if (figures) {
+    results.Draw({{"cost_curve", LeastSquaresCostCurveScript(run, folder)},
+                  {"fit", FitScript(run, folder)}});
+  }
+  results.Add(WriteZoneResults(run.zones, run.config.model, folder, figures));
+  // The summary last: its presence says the folder is complete.
+  results.Write("summary.yaml", LeastSquaresSummaryYaml(run));
+  return results.written();
+}
+
 }  // namespace
 
 std::string SummaryYaml(const IdentificationRun& run) {
+  if (run.least_squares) return LeastSquaresSummaryYaml(run);
   const IdentificationSummary& outer = run.outer;
   const double identified = run.identified_modulus();
   const double reference = run.reference_known ? run.config.model.modulus : NAN;
@@ -677,6 +832,7 @@ std::string SummaryYaml(const IdentificationRun& run) {
 
 std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run,
                                                     const std::string& folder, bool figures) {
+  if (run.least_squares) return WriteLeastSquaresResults(run, folder, figures);
   ResultsFolder results(folder);
   results.Write("evaluations.csv", EvaluationsCsv(run));
   results.Write("cost_curve.csv", CostCurveCsv(run.cost_curve));
@@ -707,164 +863,6 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
   results.Add(WriteZoneResults(run.zones, run.config.model, folder, figures));
   // The summary last: its presence says the folder is complete.
   results.Write("summary.yaml", SummaryYaml(run));
-  return results.written();
-}
-
-namespace {
-
-// Measured and predicted channels of the least-squares fit at the identified E:
-// uL (x = L) and f0 (the clamp reaction), then each interior sensor; a model column
-// is empty when its channel is no output of the fit under that name (uL when
-// data.channels leaves it out).
-std::string FitCsv(const LeastSquaresRun& run) {
-  const ChannelSet& data = run.data;
-  const OutputErrorFit& fit = run.fit;
-  const std::vector<MatrixModelSensor>& model_sensors = run.model->sensors;
-  // The row of the fit's outputs of each channel, by name (-1: none).
-  auto output_row = [&](const std::string& name) {
-    for (std::size_t k = 0; k < model_sensors.size(); ++k) {
-      if (model_sensors[k].channel == name) return static_cast<Eigen::Index>(k);
-    }
-    return Eigen::Index{-1};
-  };
-  std::string csv = "t,uL_measured,uL_model,f0_measured,f0_model";
-  const std::vector<BarSensor> sensors = BarSensors(data);
-  std::vector<Eigen::Index> sensor_rows;
-  for (const BarSensor& sensor : sensors) {
-    const std::string& name = data.channels[static_cast<std::size_t>(sensor.index)].name;
-    csv += "," + name + "_measured," + name + "_model";
-    sensor_rows.push_back(output_row(name));
-  }
-  csv += "\n";
-  const Eigen::Index uL_row = output_row("uL");
-  const BarEnds measured = BarEndChannels(data);
-  const std::vector<const Vector*> sensor_values = BarSensorValues(data);
-  for (int j = 0; j < data.num_samples(); ++j) {
-    csv += CsvNumber(data.Time(j)) + ',' + CsvNumber(measured.uL[j]) + ',';
-    if (uL_row >= 0) csv += CsvNumber(fit.outputs(uL_row, j));
-    csv += ',' + CsvNumber(measured.f0[j]) + ',' + CsvNumber(fit.support_forces(0, j));
-    for (std::size_t k = 0; k < sensor_values.size(); ++k) {
-      csv += ',' + CsvNumber((*sensor_values[k])[j]) + ',';
-      if (sensor_rows[k] >= 0) csv += CsvNumber(fit.outputs(sensor_rows[k], j));
-    }
-    csv += "\n";
-  }
-  return csv;
-}
-
-std::string LeastSquaresCostCurveScript(const LeastSquaresRun& run, const std::string& folder) {
-  const double identified = run.identified_modulus() / 1e9;
-  const bool scanned = !run.outer.scan_moduli.empty();
-  std::ostringstream script;
-  script << GnuplotPngTerminal() << "set terminal pngcairo size 1000,1000\n"
-         << "set multiplot layout 2,1 title 'Output-error least squares J(E); identified E = "
-         << identified << " GPa (dashed)'\n"
-         << "set xlabel 'E [GPa]'\nset ylabel 'J [s]'\nset format y '%.5g'\nset key top center\n"
-         << "set arrow 1 from " << identified << ", graph 0 to " << identified
-         << ", graph 1 nohead dashtype 2 lc rgb '#555555'\n";
-  const std::string curve = GnuplotString(folder + "/cost_curve.csv") +
-                            " skip 1 using ($1/1e9):($4 > 0 ? $2 : 1/0) with linespoints pt 7 "
-                            "ps 0.5 lw 2 lc rgb '#8b00c9' title 'J(E), cost curve'";
-  if (scanned) {
-    if (run.outer.scan_moduli.back() >= 10.0 * run.outer.scan_moduli.front())
-      script << "set logscale x\n";
-    script << "set title 'global scan over the bounds, its valleys and the local refinements'\n"
-           << "plot " << ScanPlots(folder, false) << curve << "\nunset logscale x\n";
-  }
-  script << "set title 'within 5 % of the identified E'\nset xrange ["
-         << identified * (1.0 - kCurvatureWindow) << ":" << identified * (1.0 + kCurvatureWindow)
-         << "]\nplot " << (scanned ? ScanPlots(folder, false) : std::string()) << curve
-         << "\nunset multiplot\n";
-  return script.str();
-}
-
-std::string FitScript(const LeastSquaresRun& run, const std::string& folder) {
-  const std::string csv = GnuplotString(folder + "/fit.csv");
-  const char* measured = run.config.prefilter.enabled ? "measured, pre-filtered" : "measured";
-  std::ostringstream script;
-  script << GnuplotPngTerminal() << "set terminal pngcairo size 1200,500\nset multiplot layout 1,2 "
-         << "title 'Least-squares fit at the identified modulus: the clamped model driven by the "
-            "measured f_L'\n"
-         << "set xlabel 't [ms]'\n"
-         << "set title 'u_L (x = L)'\nset ylabel 'u [um]'\nplot " << csv
-         << " skip 1 using ($1*1e3):($2*1e6) with lines lc rgb '#aaaaaa' title '" << measured
-         << "', " << csv
-         << " skip 1 using ($1*1e3):($3*1e6) with lines lw 2 lc rgb '#1f4e9c' title 'model'\n"
-         << "set title 'f_0 (x = 0, clamp reaction)'\nset ylabel 'f [N]'\nplot " << csv
-         << " skip 1 using ($1*1e3):4 with lines lc rgb '#aaaaaa' title '" << measured << "', "
-         << csv << " skip 1 using ($1*1e3):5 with lines lw 2 lc rgb '#1f4e9c' title 'model'\n"
-         << "unset multiplot\n";
-  return script.str();
-}
-
-}  // namespace
-
-std::string LeastSquaresSummaryYaml(const LeastSquaresRun& run) {
-  const IdentificationSummary& outer = run.outer;
-  const double identified = run.identified_modulus();
-  const double reference = run.reference_known ? run.config.model.modulus : NAN;
-  YamlWriter yaml;
-  yaml.Raw("# mcrewave identify run: the modulus E identified by output-error least squares J(E)");
-  if (!run.config.source_path.empty()) yaml.Raw("# config: " + run.config.source_path);
-  yaml.Text(0, "version", kVersion, "mcrewave version");
-  yaml.Text(0, "functional", OuterFunctionalToString(run.config.outer.functional),
-            "outer.functional");
-  yaml.Number(0, "identified_modulus", identified, "[Pa] E minimising J");
-  yaml.Number(0, "reference_modulus", reference,
-              "[Pa] E the synthetic data were made with (null: unknown, CSV data)");
-  yaml.Number(0, "relative_error", run.reference_known ? (identified - reference) / reference : NAN,
-              "(identified - reference) / reference (null when unknown)");
-  yaml.Number(0, "cost", run.fit.cost,
-              "[s] J = 1/2 sum_k c_k h (misfit / noise level)^2 at the identified modulus");
-  yaml.Integer(0, "evaluations", outer.scan_evaluations + outer.evaluations,
-               "J evaluations of the identification: the scan's and the refinements'");
-  yaml.Integer(0, "sweeps", run.sweeps, "simulations and sensitivity sweeps, curve included");
-  yaml.Number(0, "wall_time_s", run.wall_time_s, "[s] identification and cost curve");
-
-  yaml.Line(0, "uncertainty", "");
-  yaml.Number(1, "modulus_std_bound", run.modulus_std_bound,
-              "[Pa] 1 / sqrt(I): Cramer-Rao bound with the measured load taken as exact");
-  yaml.Number(1, "relative_std_bound", run.modulus_std_bound / identified,
-              "modulus_std_bound / identified_modulus; the load's noise is not counted");
-  yaml.Number(1, "fisher_information", run.fit.fisher_information,
-              "[1/Pa^2] sum_k c_k sum (dy/dE)^2 / s^2 at the identified modulus");
-  yaml.Number(1, "curvature", run.curvature,
-              "[s/Pa^2] d^2J/dE^2 observed, least-squares slope of dJ/dE over E +- 5 %");
-  yaml.Number(1, "noise_std_displacement", run.noise.displacement_std,
-              "[m] s_u, the normalisation of the displacement misfit");
-  yaml.Number(1, "noise_std_force", run.noise.force_std, "[N] s_f, of the force misfit");
-  yaml.Number(1, "noise_std_strain", run.noise.strain_std, "[-] s_e, of the strain misfit");
-  yaml.Text(1, "noise_source", run.noise_source,
-            "synthetic_snr: the data's own noise; data_differences: estimated from the data; "
-            "channel_rms: noise-free data, the channels' RMS");
-
-  OptimizerScanAndPrefilterYaml(outer, run.rest_cost, run.rest_cost, run.config,
-                                run.prefilter_cutoff, "J", "s", &yaml);
-
-  CostCurveYaml(run.cost_curve, &yaml);
-  if (run.zones.ran) {
-    for (const std::string& line : ZonesYamlLines(run.zones)) yaml.Raw(line);
-  }
-  ConfigYaml(run.config, &yaml);
-  return yaml.str();
-}
-
-std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
-                                                  const std::string& folder, bool figures) {
-  ResultsFolder results(folder);
-  results.Write("cost_curve.csv", CostCurveCsv(run.cost_curve));
-  results.Write("fit.csv", FitCsv(run));
-  if (!run.outer.scan_moduli.empty()) {
-    results.Write("scan.csv", ScanCsv(run.outer, run.rest_cost, run.config.outer.initial));
-    results.Write("valleys.csv", ValleysCsv(run.outer, run.rest_cost));
-  }
-  if (figures) {
-    results.Draw({{"cost_curve", LeastSquaresCostCurveScript(run, folder)},
-                  {"fit", FitScript(run, folder)}});
-  }
-  results.Add(WriteZoneResults(run.zones, run.config.model, folder, figures));
-  // The summary last: its presence says the folder is complete.
-  results.Write("summary.yaml", LeastSquaresSummaryYaml(run));
   return results.written();
 }
 

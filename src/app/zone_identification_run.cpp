@@ -98,7 +98,7 @@ ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayo
 }
 
 ZoneIdentificationRun RunLeastSquaresZoneIdentification(
-    const Config& config, const ZoneLayout& layout, const LeastSquaresRun& scalar,
+    const Config& config, const ZoneLayout& layout, const IdentificationRun& scalar,
     const std::vector<ModulusZone>& truth_zones) {
   return RunZones(config, layout, scalar, truth_zones, "output-error least squares",
                   [&](const BarModel& model, const PrefilterOptions& prefilter) {

@@ -87,9 +87,17 @@ struct ModulusStage {
 };
 
 // Everything one identification of the bar computed: its homogeneous stage (on
-// BarRunModel) and what the bar adds to it.
+// BarRunModel) and what the bar adds to it. By the MCRE (RunIdentification), or by
+// output-error least squares (outer.functional: least_squares, RunLeastSquares): the same
+// data path, pre-filter and optimiser, the global scan on J(E), the misfit of the clamped
+// model driven by the measured fL normalised by the noise levels; then the stage's
+// evaluations, solution, cold solve, uncertainty, error map and model channels are left
+// empty, rest_cost is J_rest [s], `noise` holds the misfit levels s_u, s_f, s_e (as
+// LeastSquaresMisfitLevels says) and `sweeps` counts every simulation (scan, refinement,
+// fit, curve).
 struct IdentificationRun : ModulusStage {
   Config config;
+  bool least_squares = false;  // outer.functional: least_squares
   // The measurements the MCRE compared with: the channels of data.channels,
   // pre-filtered when prefilter.enabled.
   ChannelSet data;
@@ -129,6 +137,17 @@ struct IdentificationRun : ModulusStage {
   // The zone moduli from E* (ran = false with one zone).
   ZoneIdentificationRun zones;
   double wall_time_s = -1.0;  // the whole of RunIdentification
+
+  // Least squares only: the model's outputs and J at the identified E, and on the cost
+  // curve J(E) and dJ/dE over E* +- 5 %, the curvature d^2J/dE^2 at E* [s / Pa^2] (the
+  // slope of dJ/dE over the curve, ripple included).
+  OutputErrorFit fit;
+  double curvature = 0.0;
+  // 1 / sqrt(fit.fisher_information) [Pa]: the Cramer-Rao bound of E under white noise of
+  // the levels `noise` on the outputs with the measured load taken as exact. The noise of
+  // the load that drives the model is not counted, so the spread of E over noise draws is
+  // larger (docs/comparator.md). NaN when the information is not positive.
+  double modulus_std_bound = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Step 3 on mcre:'s e^2.
@@ -197,9 +216,10 @@ std::string ImplausibleMisfitMessage(const IdentificationRun& run);
 // (mcre/element_error_map.h). Precondition: run.IsUsable().
 ErrorMap BarErrorMap(const Config& config, const IdentificationRun& run);
 
-// Runs steps 2 to 4 on measurements made by LoadMeasurements(config).
-// Precondition: config valid (as LoadConfig returns it). Never throws for a
-// failed identification: see IsUsable() and outer.message.
+// Runs steps 2 to 4 on measurements made by LoadMeasurements(config); RunLeastSquares
+// with outer.functional: least_squares. Precondition: config valid (as LoadConfig
+// returns it). Never throws for a failed identification: see IsUsable() and
+// outer.message.
 IdentificationRun RunIdentification(const Config& config, const ChannelSet& data);
 
 // The noise levels of the measurements `data` (as LoadMeasurements made them):
@@ -216,51 +236,11 @@ NoiseLevels MeasurementNoiseLevels(const Config& config, const ChannelSet& data,
 NoiseLevels LeastSquaresMisfitLevels(const Config& config, const ChannelSet& data,
                                      const ChannelSet& used, std::string* source);
 
-// One identification by output-error least squares (outer.functional:
-// least_squares; least_squares/output_error_modulus_objective.h): the same data path,
-// pre-filter and optimiser as the MCRE's, the global scan on J(E), the misfit of
-// the clamped model driven by the measured fL, normalised by the noise levels.
-struct LeastSquaresRun {
-  Config config;
-  ChannelSet data;  // the channels in use, pre-filtered as for the MCRE
-  EndDisplacementChannels ends;
-  // BarRunModel of config.model, data and ends, its clamp held: the structure J
-  // simulates (shared, so that a copy of the run keeps it).
-  std::shared_ptr<const MatrixModelData> model;
-  double prefilter_cutoff = 0.0;  // [Hz]; 0 when off
-  bool reference_known = false;   // synthetic data: E_ref = config.model.modulus
-  NoiseLevels noise;              // s_u, s_f, s_e of the misfit's normalisation
-  std::string noise_source;       // as LeastSquaresMisfitLevels says
-  NoiseLevels estimated_noise;    // DifferenceNoiseLevels of the measurements (zones' target)
-  IdentificationSummary outer;
-  double rest_cost = 0.0;     // J_rest [s], the cost scale
-  OutputErrorFit fit;         // the model's outputs and J at the identified E
-  // J(E) and dJ/dE on output.curve_points moduli evenly spaced over E* +- 5 %.
-  std::vector<CostCurvePoint> cost_curve;
-  // d^2J/dE^2 at E* [s / Pa^2], the slope of dJ/dE over the curve (the observed
-  // curvature, ripple included).
-  double curvature = 0.0;
-  // 1 / sqrt(fit.fisher_information) [Pa]: the Cramer-Rao bound of E under white
-  // noise of the levels `noise` on the outputs with the measured load taken as
-  // exact. The noise of the load that drives the model is not counted, so the
-  // spread of E over noise draws is larger (docs/comparator.md). NaN when the
-  // information is not positive.
-  double modulus_std_bound = std::numeric_limits<double>::quiet_NaN();
-  long sweeps = 0;  // of every simulation (scan, refinement, fit, curve)
-  // Every zone's modulus from E* by least squares when the identification has zones
-  // (RunLeastSquaresZoneIdentification; ran = false with one zone).
-  ZoneIdentificationRun zones;
-  double wall_time_s = -1.0;
-
-  bool IsUsable() const { return outer.IsSolutionUsable(); }
-  double identified_modulus() const { return outer.modulus; }
-};
-
 // Runs the least-squares identification on measurements made by
 // LoadMeasurements(config), then its fit and cost curve at E* and, with zones, every
 // zone from E* (RunLeastSquaresZoneIdentification). Precondition:
 // config valid with outer.functional = least_squares. Never throws for a failed
 // identification: see IsUsable() and outer.message.
-LeastSquaresRun RunLeastSquares(const Config& config, const ChannelSet& data);
+IdentificationRun RunLeastSquares(const Config& config, const ChannelSet& data);
 
 }  // namespace mcrewave

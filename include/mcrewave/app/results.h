@@ -46,7 +46,8 @@ std::string SummaryYaml(const IdentificationRun& run);
 std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run,
                                                     const std::string& folder, bool figures);
 
-// The results of `identify run` with outer.functional: least_squares:
+// With outer.functional: least_squares (run.least_squares), SummaryYaml and
+// WriteIdentificationResults write instead:
 //   summary.yaml     identified_modulus, reference and relative error, J [s], the
 //                    uncertainty 1 / sqrt(d^2J/dE^2) and the noise levels, the
 //                    optimizer, scan and prefilter blocks as above, the config
@@ -57,11 +58,7 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
 //   zones.csv, moduli.csv, moduli.png and summary.yaml's `zones:` block (functional
 //                    least_squares, costs J [s]) when the identification has zones
 //                    (zone_identification_run.h)
-// written as WriteIdentificationResults writes (atomically, summary last).
-// Precondition: run.IsUsable().
-std::string LeastSquaresSummaryYaml(const LeastSquaresRun& run);
-std::vector<std::string> WriteLeastSquaresResults(const LeastSquaresRun& run,
-                                                  const std::string& folder, bool figures);
+// written in the same way (atomically, summary last).
 
 // The results of `identify run` with model.kind: matrix (app/matrix_identification_run.h):
 //   summary.yaml        the model (manifest, dofs, zones, channels), the data; with the

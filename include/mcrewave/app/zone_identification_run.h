@@ -16,7 +16,6 @@
 namespace mcrewave {
 
 struct IdentificationRun;
-struct LeastSquaresRun;
 
 struct ZoneIdentificationRun {
   bool ran = false;  // false: one zone, nothing done (the scalar result stands alone)
@@ -50,7 +49,7 @@ ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayo
 // scalar.data with its misfit levels scalar.noise, the discrepancy target from
 // scalar.estimated_noise. Precondition: scalar.IsUsable(), the layout valid.
 ZoneIdentificationRun RunLeastSquaresZoneIdentification(
-    const Config& config, const ZoneLayout& layout, const LeastSquaresRun& scalar,
+    const Config& config, const ZoneLayout& layout, const IdentificationRun& scalar,
     const std::vector<ModulusZone>& truth_zones);
 
 // The lines of summary.yaml's `zones:` block (indented, no trailing newline per line).
