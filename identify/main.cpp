@@ -186,82 +186,50 @@ void CheckOutputFolder(const std::string& folder) {
   RequireWritableFolder(existing, "output folder " + folder);
 }
 
-// Steps 2 to 5 of RunIdentify with model.kind: matrix: every zone modulus of a
-// structure given by matrices (app/matrix_identification_run.h).
-int IdentifyMatrixModel(const mcrewave::Config& config) {
+// Steps 2 and 3 of RunIdentify with model.kind: matrix: the manifest's model and the
+// measurements of its channels, then every zone modulus of the structure
+// (app/matrix_identification_run.h).
+mcrewave::IdentificationRun IdentifyMatrixModel(const mcrewave::Config& config) {
   const mcrewave::MatrixModelData model = mcrewave::LoadMatrixModel(config);
   mcrewave::CheckMatrixModelFieldBytes(config, model);
   const mcrewave::MatrixMeasurements data = mcrewave::LoadMatrixMeasurements(config, model);
-  const mcrewave::MatrixIdentificationRun run =
-      mcrewave::RunMatrixIdentification(config, model, data);
-  if (!run.IsUsable()) {
-    std::fprintf(stderr, "error: identification failed: %s\n", run.failure.c_str());
-    return 1;
-  }
-  std::vector<std::string> files;
-  {
-    const ResultsBeingWritten held;
-    files = mcrewave::WriteMatrixIdentificationResults(run, config, model, config.output.folder,
-                                                       config.output.figures);
-  }
-  for (std::size_t z = 0; z < run.zone_names.size(); ++z) {
-    const auto index = static_cast<Eigen::Index>(z);
-    if (run.truth_moduli.size() > 0) {
-      spdlog::info("zone {}: E = {:.9g} Pa (truth {:.9g} Pa, relative error {:.3e})",
-                   run.zone_names[z], run.identified_moduli[index], run.truth_moduli[index],
-                   run.identified_moduli[index] / run.truth_moduli[index] - 1.0);
-    } else {
-      spdlog::info("zone {}: E = {:.9g} Pa", run.zone_names[z], run.identified_moduli[index]);
-    }
-  }
-  spdlog::info("identified {} zone moduli in {} evaluations, {:.2f} s", run.zone_names.size(),
-               run.TotalEvaluations(), run.wall_time_s);
-  spdlog::info("wrote {} files to {}", files.size(), config.output.folder);
-  return 0;
+  return mcrewave::RunMatrixIdentification(config, model, data);
 }
 
-int RunIdentify(const RunArguments& arguments) {
-  // 1. Read and validate the config and the output folder (nothing is computed
-  //    or written if either is invalid).
-  mcrewave::Config config = mcrewave::LoadConfig(arguments.config_path, arguments.overrides);
-  if (!arguments.output_folder.empty()) config.output.folder = arguments.output_folder;
-  CheckOutputFolder(config.output.folder);
-  if (config.structure.kind == mcrewave::ModelKind::kMatrix) return IdentifyMatrixModel(config);
-
-  // 2. The measurements, checked against the model's time grid.
+// Steps 2 and 3 of RunIdentify on the bar: its measurements, checked against the model's
+// time grid, then E, the cost curve and the uncertainty figure (by output-error least
+// squares instead of the MCRE with outer.functional: least_squares: its fit, cost curve
+// and Cramer-Rao bound), and the zones when it has any.
+mcrewave::IdentificationRun IdentifyBar(const mcrewave::Config& config,
+                                        const std::string& config_path) {
   const mcrewave::ChannelSet data = mcrewave::LoadMeasurements(config);
-  spdlog::info("config {}: {} elements, {} steps of {:.4g} s; data {} ({} samples)",
-               arguments.config_path, config.model.elements, config.time.NumSteps(),
-               config.time.step,
+  spdlog::info("config {}: {} elements, {} steps of {:.4g} s; data {} ({} samples)", config_path,
+               config.model.elements, config.time.NumSteps(), config.time.step,
                config.data.source == mcrewave::DataSource::kCsv ? config.data.path
                                                                 : std::string("synthetic"),
                data.num_samples());
+  return mcrewave::RunIdentification(config, data);
+}
 
-  // 3. Identify E, then the cost curve and the uncertainty figure (by output-error
-  //    least squares instead of the MCRE with outer.functional: least_squares: its fit,
-  //    cost curve and Cramer-Rao bound).
-  const mcrewave::IdentificationRun run = mcrewave::RunIdentification(config, data);
-  if (!run.IsUsable()) {
-    std::fprintf(stderr, "error: identification failed: %s\n", run.outer.message.c_str());
-    return 1;
-  }
-  for (const std::string& unusable :
-       {mcrewave::ModulusOnBoundMessage(run.identified_modulus(), config.outer),
-        run.least_squares ? std::string() : mcrewave::ImplausibleMisfitMessage(run)}) {
-    if (!unusable.empty()) {
-      std::fprintf(stderr, "error: identification failed: %s\n", unusable.c_str());
-      return 1;
+// Step 5 of RunIdentify: the identified moduli, against the truth's when it is known.
+void ReportModuli(const mcrewave::IdentificationRun& run) {
+  const mcrewave::Config& config = run.config;
+  if (config.structure.kind == mcrewave::ModelKind::kMatrix) {
+    for (std::size_t z = 0; z < run.model->zones.size(); ++z) {
+      const auto index = static_cast<Eigen::Index>(z);
+      const std::string& name = run.model->zones[z].name;
+      if (run.truth_moduli.size() > 0) {
+        spdlog::info("zone {}: E = {:.9g} Pa (truth {:.9g} Pa, relative error {:.3e})", name,
+                     run.identified_moduli[index], run.truth_moduli[index],
+                     run.identified_moduli[index] / run.truth_moduli[index] - 1.0);
+      } else {
+        spdlog::info("zone {}: E = {:.9g} Pa", name, run.identified_moduli[index]);
+      }
     }
+    spdlog::info("identified {} zone moduli in {} evaluations, {:.2f} s", run.model->zones.size(),
+                 run.TotalEvaluations(), run.wall_time_s);
+    return;
   }
-
-  // 4. Write the results, each file atomically.
-  std::vector<std::string> files;
-  {
-    const ResultsBeingWritten held;
-    files = mcrewave::WriteIdentificationResults(run, config.output.folder, config.output.figures);
-  }
-
-  // 5. Brief report.
   const char* functional = run.least_squares ? " by least squares" : "";
   if (run.reference_known) {
     spdlog::info(
@@ -274,6 +242,36 @@ int RunIdentify(const RunArguments& arguments) {
     spdlog::info("identified E = {:.9g} Pa{} in {} evaluations, {:.2f} s", run.identified_modulus(),
                  functional, run.outer.scan_evaluations + run.outer.evaluations, run.wall_time_s);
   }
+}
+
+int RunIdentify(const RunArguments& arguments) {
+  // 1. Read and validate the config and the output folder (nothing is computed
+  //    or written if either is invalid).
+  mcrewave::Config config = mcrewave::LoadConfig(arguments.config_path, arguments.overrides);
+  if (!arguments.output_folder.empty()) config.output.folder = arguments.output_folder;
+  CheckOutputFolder(config.output.folder);
+
+  // 2. The measurements, and 3. the identification: E (or on a structure given by
+  //    matrices its zones' common E*), then every zone modulus, the error maps and the
+  //    uncertainty.
+  const mcrewave::IdentificationRun run = config.structure.kind == mcrewave::ModelKind::kMatrix
+                                              ? IdentifyMatrixModel(config)
+                                              : IdentifyBar(config, arguments.config_path);
+  const std::string unreportable = mcrewave::UnreportableMessage(run);
+  if (!unreportable.empty()) {
+    std::fprintf(stderr, "error: identification failed: %s\n", unreportable.c_str());
+    return 1;
+  }
+
+  // 4. Write the results, each file atomically.
+  std::vector<std::string> files;
+  {
+    const ResultsBeingWritten held;
+    files = mcrewave::WriteIdentificationResults(run, config.output.folder, config.output.figures);
+  }
+
+  // 5. Brief report.
+  ReportModuli(run);
   spdlog::info("wrote {} files to {}", files.size(), config.output.folder);
   return 0;
 }

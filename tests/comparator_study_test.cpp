@@ -80,7 +80,7 @@ TEST(ComparatorStudyTest, OnAMatrixModelEachRunIsIdentifyRunsIdentificationOfThe
         path, {"data.snr=20", "data.seed=1", std::string("outer.functional=") + functional,
                "prefilter.enabled=false"});
     const MatrixModelData model = LoadMatrixModel(run_config);
-    const MatrixIdentificationRun reference =
+    const IdentificationRun reference =
         RunMatrixIdentification(run_config, model, LoadMatrixMeasurements(run_config, model),
                                 /*maps_and_uncertainty=*/false);
     ASSERT_TRUE(reference.IsUsable()) << reference.failure;

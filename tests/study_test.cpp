@@ -207,7 +207,7 @@ TEST(StudyTest, RobustnessRunsOnAMatrixModelEachRunBeingIdentifyRunsIdentificati
   // own: the same moduli to the bit.
   const Config seed_two = LoadConfig(config_path, {"data.snr=20", "data.seed=2"});
   const MatrixModelData model = LoadMatrixModel(seed_two);
-  const MatrixIdentificationRun reference = RunMatrixIdentification(
+  const IdentificationRun reference = RunMatrixIdentification(
       seed_two, model, LoadMatrixMeasurements(seed_two, model), /*maps_and_uncertainty=*/false);
   ASSERT_TRUE(reference.IsUsable()) << reference.failure;
   EXPECT_EQ(one.runs[2].identified_moduli[0], reference.identified_moduli[0]);

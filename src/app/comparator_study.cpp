@@ -153,7 +153,7 @@ void RunMatrixDataSet(const Config& config, const MatrixModelData& model,
     run_config.outer.functional =
         k >= filters ? OuterFunctional::kLeastSquares : OuterFunctional::kMcre;
     run_config.prefilter.enabled = prefilters[k % filters];
-    const MatrixIdentificationRun run =
+    const IdentificationRun run =
         RunMatrixIdentification(run_config, identified, measured, /*maps_and_uncertainty=*/false);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -163,9 +163,9 @@ void RunMatrixDataSet(const Config& config, const MatrixModelData& model,
       out.message = run.failure;
       out.evaluations = run.TotalEvaluations();
       // The valleys of the homogeneous stage's scan (-1 without the stage: no scan).
-      out.local_minima = run.homogeneous_ran ? run.homogeneous.outer.local_minima : -1;
-      if (run.homogeneous_ran && run.homogeneous.outer.search_modulus > 0.0) {
-        out.search_modulus = run.homogeneous.outer.search_modulus;
+      out.local_minima = run.homogeneous_ran ? run.outer.local_minima : -1;
+      if (run.homogeneous_ran && run.outer.search_modulus > 0.0) {
+        out.search_modulus = run.outer.search_modulus;
       }
       out.wall_time_s = seconds;
       if (run.identified_moduli.size() == zones) {

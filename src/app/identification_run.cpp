@@ -420,20 +420,20 @@ IdentificationRun RunLeastSquares(const Config& config, const ChannelSet& data) 
   run.least_squares = true;
   run.reference_known = config.data.source == DataSource::kSynthetic;
   run.data = IdentificationData(config, data, &run.ends, &run.prefilter_cutoff);
-  run.noise = LeastSquaresMisfitLevels(config, data, run.data, &run.noise_source);
+  run.misfit_levels = LeastSquaresMisfitLevels(config, data, run.data, &run.misfit_source);
   run.estimated_noise = DifferenceNoiseLevels(data);
   run.model = std::make_shared<const MatrixModelData>(
       BarRunModel(BarModel(config.model), run.data, run.ends));
-  OutputErrorModulusObjective objective(*run.model, run.data, run.noise, config.time.theta,
+  OutputErrorModulusObjective objective(*run.model, run.data, run.misfit_levels, config.time.theta,
                                         config.outer.initial);
   run.rest_cost = objective.rest_cost();
   spdlog::info(
       "identifying E by output-error least squares with {}/{} from {:.6g} Pa in [{:.6g}, "
-      "{:.6g}] Pa; noise levels {:.4g} m, {:.4g} N ({})",
+      "{:.6g}] Pa; misfit levels {:.4g} m, {:.4g} N ({})",
       OptimizerTypeToString(config.outer.optimizer),
       OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
       config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
-      run.noise.displacement_std, run.noise.force_std, run.noise_source);
+      run.misfit_levels.displacement_std, run.misfit_levels.force_std, run.misfit_source);
   run.outer = Identify(config.outer, &objective);
   spdlog::info("{}", run.outer.BriefReport());
   if (run.IsUsable()) {
@@ -481,6 +481,15 @@ std::string ModulusOnBoundMessage(double modulus, const IdentificationOptions& o
     }
   }
   return "";
+}
+
+std::string UnreportableMessage(const IdentificationRun& run) {
+  if (!run.failure.empty()) return run.failure;
+  if (!run.IsUsable()) return run.outer.message;
+  if (run.config.structure.kind == ModelKind::kMatrix) return "";
+  const std::string on_bound = ModulusOnBoundMessage(run.identified_modulus(), run.config.outer);
+  if (!on_bound.empty() || run.least_squares) return on_bound;
+  return ImplausibleMisfitMessage(run);
 }
 
 std::string ImplausibleMisfitMessage(const IdentificationRun& run) {

@@ -233,11 +233,11 @@ ErrorMap ElementMapOf(const MatrixModelData& model, const Vector& moduli,
 // none usable: a failure goes to run->failure).
 const CoupledSolution* MapsAtIdentifiedAndNominal(
     const Config& config, const MatrixModelData& model, const McreObjective& objective,
-    MatrixMcreProblem* problem, CoupledSolution* storage, MatrixIdentificationRun* run) {
+    MatrixMcreProblem* problem, CoupledSolution* storage, IdentificationRun* run) {
   const CoupledSolution* identified = nullptr;
   std::string why;
   if (run->identified_moduli.size() > 0) {
-    const std::vector<ZoneEvaluation>& history = run->zones.history;
+    const std::vector<ZoneEvaluation>& history = run->zones.summary.history;
     if (!history.empty() && history.back().usable &&
         history.back().moduli == run->identified_moduli) {
       identified = &objective.last_solution();
@@ -248,8 +248,9 @@ const CoupledSolution* MapsAtIdentifiedAndNominal(
         problem->StreamingElementMaps(storage->traces, storage);
         identified = storage;
       }
-      CostAndMaps(problem, *identified, &run->cost, &run->zone_map, &run->zone_gap, &run->dof_map);
-    } else if (SolveAt(run->identified_moduli, config.inner, problem, storage, &run->cost,
+      CostAndMaps(problem, *identified, &run->zone_cost, &run->zone_map, &run->zone_gap,
+                  &run->dof_map);
+    } else if (SolveAt(run->identified_moduli, config.inner, problem, storage, &run->zone_cost,
                        &run->zone_map, &run->zone_gap, &run->dof_map, &why)) {
       identified = storage;
     } else if (run->failure.empty()) {
@@ -274,9 +275,9 @@ const CoupledSolution* MapsAtIdentifiedAndNominal(
 
 // After the zones: the identified moduli and why the run is not usable (no usable
 // point, no tolerance met, a zone on a bound of [outer.lower_bound, outer.upper_bound]).
-void TakeZoneOutcome(MatrixIdentificationRun* out) {
-  MatrixIdentificationRun& run = *out;
-  const ZoneIdentificationSummary& zones = run.zones;
+void TakeZoneOutcome(const MatrixModelData& model, IdentificationRun* out) {
+  IdentificationRun& run = *out;
+  const ZoneIdentificationSummary& zones = run.zones.summary;
   spdlog::info("zones: {}", zones.BriefReport());
   if (zones.moduli.size() == 0) {
     run.failure = "no usable evaluation: " + zones.message;
@@ -291,7 +292,7 @@ void TakeZoneOutcome(MatrixIdentificationRun* out) {
     run.failure = fmt::format(
         "zone '{}' ends on a bound of outer.lower_bound / outer.upper_bound ({:.6g} Pa): "
         "widen the bounds or check the data's units",
-        run.zone_names[static_cast<std::size_t>(z)], run.identified_moduli[z]);
+        model.zones[static_cast<std::size_t>(z)].name, run.identified_moduli[z]);
   }
 }
 
@@ -305,8 +306,8 @@ bool SharesOneNominalModulus(const MatrixModelData& model) {
 
 // Whether the homogeneous stage's E* can start the zones: false, with run->failure set,
 // when it is not usable or lies on a bound of the search, as the bar's E* fails.
-bool TakeHomogeneousOutcome(const Config& config, MatrixIdentificationRun* run) {
-  const IdentificationSummary& outer = run->homogeneous.outer;
+bool TakeHomogeneousOutcome(const Config& config, IdentificationRun* run) {
+  const IdentificationSummary& outer = run->outer;
   std::string why =
       outer.IsSolutionUsable() ? ModulusOnBoundMessage(outer.modulus, config.outer) : outer.message;
   if (why.empty()) return true;
@@ -318,12 +319,12 @@ bool TakeHomogeneousOutcome(const Config& config, MatrixIdentificationRun* run) 
 // curve and cold solve when `complete`. False, with run->failure set, when E* is not
 // usable or lies on a bound of the search.
 bool IdentifyHomogeneousStage(const Config& config, const MatrixModelData& model, bool complete,
-                              MatrixIdentificationRun* run) {
+                              IdentificationRun* run) {
   spdlog::info("homogeneous stage: one E in every zone");
   run->homogeneous_ran = true;
+  ModulusStage& stage = *run;
   // Its solution warm-starts the zones: no element map.
-  run->homogeneous = IdentifyHomogeneousModulus(config, model, run->data, /*element_maps=*/false);
-  ModulusStage& stage = run->homogeneous;
+  stage = IdentifyHomogeneousModulus(config, model, run->data, /*element_maps=*/false);
   if (!TakeHomogeneousOutcome(config, run)) return false;
   run->homogeneous_cost = stage.cost();
   // The cost curve e^2(E) feeds the uncertainty of one modulus (the bar's); the zones'
@@ -339,7 +340,7 @@ bool IdentifyHomogeneousStage(const Config& config, const MatrixModelData& model
 // (OutputErrorModulusObjective, the bar's least squares), J at E* into
 // run->homogeneous_cost. False, with run->failure set, as TakeHomogeneousOutcome says.
 bool IdentifyHomogeneousStageByLeastSquares(const Config& config, const MatrixModelData& model,
-                                            MatrixIdentificationRun* run) {
+                                            IdentificationRun* run) {
   spdlog::info(
       "homogeneous stage: one E in every zone by least squares with {}/{} from {:.6g} Pa",
       OptimizerTypeToString(config.outer.optimizer),
@@ -348,7 +349,7 @@ bool IdentifyHomogeneousStageByLeastSquares(const Config& config, const MatrixMo
   OutputErrorModulusObjective objective(model, run->data, run->misfit_levels, config.time.theta,
                                         config.outer.initial);
   run->homogeneous_ran = true;
-  ModulusStage& stage = run->homogeneous;
+  ModulusStage& stage = *run;
   stage.outer = Identify(config.outer, &objective);
   spdlog::info("{}", stage.outer.BriefReport());
   stage.rest_cost = objective.rest_cost();
@@ -363,13 +364,13 @@ bool IdentifyHomogeneousStageByLeastSquares(const Config& config, const MatrixMo
 
 // The zones' start: E* in every zone after the homogeneous stage (the zones share
 // E_z,nom), else the nominal moduli.
-Vector ZoneStart(const MatrixIdentificationRun& run) {
+Vector ZoneStart(const IdentificationRun& run) {
   if (!run.homogeneous_ran) return run.nominal_moduli;
-  return Vector::Constant(run.nominal_moduli.size(), run.homogeneous.identified_modulus());
+  return Vector::Constant(run.nominal_moduli.size(), run.identified_modulus());
 }
 
 // The pre-filter the data went through, its cut-off the one used.
-PrefilterOptions UsedPrefilter(const Config& config, const MatrixIdentificationRun& run) {
+PrefilterOptions UsedPrefilter(const Config& config, const IdentificationRun& run) {
   PrefilterOptions prefilter = config.prefilter;
   prefilter.cutoff_frequency = run.prefilter_cutoff;
   return prefilter;
@@ -380,20 +381,20 @@ PrefilterOptions UsedPrefilter(const Config& config, const MatrixIdentificationR
 // identified moduli and J at the nominal ones. run->data is the pre-filtered data.
 void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelData& model,
                                        const MatrixMeasurements& measurements,
-                                       MatrixIdentificationRun* out) {
-  MatrixIdentificationRun& run = *out;
+                                       IdentificationRun* out) {
+  IdentificationRun& run = *out;
   run.least_squares = true;
   run.misfit_levels =
       MatrixLeastSquaresMisfitLevels(config, model, measurements, run.data, &run.misfit_source);
   MatrixOutputErrorObjective objective(model, run.data, run.misfit_levels, config.time.theta);
   run.nominal_moduli = objective.reference_moduli();
-  run.rest_cost = objective.rest_cost();
+  run.zone_rest_cost = objective.rest_cost();
   spdlog::info(
       "matrix model {}: {} dofs, {} zones, {} loads, {} sensors, {} steps of {:.4g} s; "
       "output-error least squares, misfit levels {:.4g} m, {:.4g} ({})",
-      run.manifest, run.dofs, model.zones.size(), model.loads.size(), model.sensors.size(),
-      run.steps, run.time_step, run.misfit_levels.displacement_std, run.misfit_levels.strain_std,
-      run.misfit_source);
+      config.structure.manifest, model.dofs(), model.zones.size(), model.loads.size(),
+      model.sensors.size(), run.data.num_steps(), run.data.time_step,
+      run.misfit_levels.displacement_std, run.misfit_levels.strain_std, run.misfit_source);
   if (!model.supports.empty()) {
     // The bar's least squares keeps its clamp rigid whatever mcre.clamp says.
     spdlog::info(
@@ -407,17 +408,18 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
     return;
   }
   run.noise = MatrixNoiseLevels(config, measurements, &run.noise_source);
-  run.zones = IdentifyZoneModuliByLeastSquares(
+  run.zones.ran = true;
+  run.zones.summary = IdentifyZoneModuliByLeastSquares(
       config.zone_identification, model, run.data, run.misfit_levels, config.time.theta, &objective,
       ZoneStart(run), config.outer.lower_bound, config.outer.upper_bound, run.noise,
       UsedPrefilter(config, run));
-  TakeZoneOutcome(&run);
+  TakeZoneOutcome(model, &run);
   if (run.identified_moduli.size() > 0) {
-    run.cost = objective.Cost(run.identified_moduli, nullptr);
+    run.zone_cost = objective.Cost(run.identified_moduli, nullptr);
     run.model_outputs = objective.outputs();
   }
   run.nominal_cost = objective.Cost(run.nominal_moduli, nullptr);
-  if (!(std::isfinite(run.cost) && std::isfinite(run.nominal_cost)) && run.failure.empty()) {
+  if (!(std::isfinite(run.zone_cost) && std::isfinite(run.nominal_cost)) && run.failure.empty()) {
     run.failure = "the output-error misfit is not finite at the identified or nominal moduli";
   }
 }
@@ -686,23 +688,22 @@ ChannelSet MatrixMeasurementTable(const Config& config, const MatrixModelData& m
   return table;
 }
 
-MatrixIdentificationRun RunMatrixIdentification(const Config& config, const MatrixModelData& model,
-                                                const MatrixMeasurements& measurements,
-                                                bool maps_and_uncertainty) {
+IdentificationRun RunMatrixIdentification(const Config& config, const MatrixModelData& model,
+                                          const MatrixMeasurements& measurements,
+                                          bool maps_and_uncertainty) {
   const auto start_time = std::chrono::steady_clock::now();
-  MatrixIdentificationRun run;
-  run.manifest = config.structure.manifest;
-  run.dofs = model.dofs();
-  run.supports = static_cast<int>(model.supports.size());
-  run.steps = measurements.histories.num_steps();
-  run.inner_method = ResolveCoupledSolverType(config.inner, run.dofs, run.steps,
+  IdentificationRun run;
+  run.config = config;
+  run.homogeneous_ran = false;
+  const int dofs = model.dofs();
+  const int steps = measurements.histories.num_steps();
+  const double time_step = measurements.histories.time_step;
+  run.inner_method = ResolveCoupledSolverType(config.inner, dofs, steps,
                                               /*streaming_available=*/true);
-  run.time_step = measurements.histories.time_step;
   run.data_source = measurements.source;
   run.truth_moduli = measurements.truth_moduli;
-  for (const MatrixModelZone& zone : model.zones) run.zone_names.push_back(zone.name);
-  for (const MatrixModelLoad& load : model.loads) run.load_names.push_back(load.channel);
-  for (const MatrixModelSensor& sensor : model.sensors) run.sensor_names.push_back(sensor.channel);
+  run.reference_known = run.truth_moduli.size() > 0;
+  if (maps_and_uncertainty) run.model = std::make_shared<const MatrixModelData>(model);
   run.data = measurements.histories;
 
   // 1. The pre-filter, the same on every channel (the structure is linear and
@@ -712,13 +713,16 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
     double cutoff = config.prefilter.cutoff_frequency;
     if (cutoff <= 0.0) {
       // From the loads, or the sensors when there is no load.
-      const std::vector<std::string>& source =
-          run.load_names.empty() ? run.sensor_names : run.load_names;
+      std::vector<std::string> source;
+      for (const MatrixModelLoad& load : model.loads) source.push_back(load.channel);
+      if (source.empty()) {
+        for (const MatrixModelSensor& sensor : model.sensors) source.push_back(sensor.channel);
+      }
       for (const std::string& channel : source) {
-        cutoff = std::max(cutoff, EstimateCutoffFrequency(run.data.Values(channel), run.time_step));
+        cutoff = std::max(cutoff, EstimateCutoffFrequency(run.data.Values(channel), time_step));
       }
     }
-    const ZeroPhaseLowPass filter(cutoff, 1.0 / run.time_step, config.prefilter.order);
+    const ZeroPhaseLowPass filter(cutoff, 1.0 / time_step, config.prefilter.order);
     for (Channel& channel : run.data.channels) {
       channel.values = filter.Apply(channel.values, config.prefilter.at_rest_before_start);
     }
@@ -742,12 +746,12 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
   // The minimiser's solves gather no element map; step 3 gathers it where it is read.
   problem.set_element_maps(false);
   run.nominal_moduli = problem.NominalModuli();
-  run.rest_cost = mcre_objective.rest_cost();
+  run.zone_rest_cost = mcre_objective.rest_cost();
   const auto zones = static_cast<std::size_t>(model.zones.size());
   spdlog::info(
       "matrix model {}: {} dofs, {} zones, {} loads, {} sensors, {} steps of {:.4g} s; inner {}",
-      run.manifest, run.dofs, zones, model.loads.size(), model.sensors.size(), run.steps,
-      run.time_step, CoupledSolverName(config.inner.type, run.inner_method));
+      config.structure.manifest, dofs, zones, model.loads.size(), model.sensors.size(), steps,
+      time_step, CoupledSolverName(config.inner.type, run.inner_method));
   if (!model.supports.empty()) {
     spdlog::info("{} supports, treated as mcre.clamp: {}", model.supports.size(),
                  ClampModelToString(config.mcre.clamp));
@@ -761,15 +765,16 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
       return run;
     }
-    mcre_objective.SetWarmStart(run.homogeneous.solution.WarmStart());
+    mcre_objective.SetWarmStart(run.solution.WarmStart());
   }
   // The discrepancy target's levels (zone_identification:), and the uncertainty's.
   run.noise = MatrixNoiseLevels(config, measurements, &run.noise_source);
-  run.zones = IdentifyZoneModuli(config.zone_identification, model, run.data, config.mcre,
-                                 config.time.theta, config.inner, &mcre_objective,
-                                 run.nominal_moduli, ZoneStart(run), config.outer.lower_bound,
-                                 config.outer.upper_bound, run.noise, UsedPrefilter(config, run));
-  TakeZoneOutcome(&run);
+  run.zones.ran = true;
+  run.zones.summary = IdentifyZoneModuli(
+      config.zone_identification, model, run.data, config.mcre, config.time.theta, config.inner,
+      &mcre_objective, run.nominal_moduli, ZoneStart(run), config.outer.lower_bound,
+      config.outer.upper_bound, run.noise, UsedPrefilter(config, run));
+  TakeZoneOutcome(model, &run);
   if (!maps_and_uncertainty) {
     run.wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
@@ -783,10 +788,10 @@ MatrixIdentificationRun RunMatrixIdentification(const Config& config, const Matr
   const CoupledSolution* identified =
       MapsAtIdentifiedAndNominal(config, model, mcre_objective, &problem, &storage, &run);
   if (identified != nullptr) {
-    run.uncertainty =
+    run.zone_uncertainty =
         EstimateZoneUncertainty(config.uncertainty, model, run.data, config.mcre, config.time.theta,
                                 config.inner, run.identified_moduli, *identified, run.noise);
-    spdlog::info("uncertainty: {}", run.uncertainty.message);
+    spdlog::info("uncertainty: {}", run.zone_uncertainty.message);
   }
   run.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();

@@ -734,11 +734,11 @@ std::string LeastSquaresSummaryYaml(const IdentificationRun& run) {
               "[1/Pa^2] sum_k c_k sum (dy/dE)^2 / s^2 at the identified modulus");
   yaml.Number(1, "curvature", run.curvature,
               "[s/Pa^2] d^2J/dE^2 observed, least-squares slope of dJ/dE over E +- 5 %");
-  yaml.Number(1, "noise_std_displacement", run.noise.displacement_std,
+  yaml.Number(1, "noise_std_displacement", run.misfit_levels.displacement_std,
               "[m] s_u, the normalisation of the displacement misfit");
-  yaml.Number(1, "noise_std_force", run.noise.force_std, "[N] s_f, of the force misfit");
-  yaml.Number(1, "noise_std_strain", run.noise.strain_std, "[-] s_e, of the strain misfit");
-  yaml.Text(1, "noise_source", run.noise_source,
+  yaml.Number(1, "noise_std_force", run.misfit_levels.force_std, "[N] s_f, of the force misfit");
+  yaml.Number(1, "noise_std_strain", run.misfit_levels.strain_std, "[-] s_e, of the strain misfit");
+  yaml.Text(1, "noise_source", run.misfit_source,
             "synthetic_snr: the data's own noise; data_differences: estimated from the data; "
             "channel_rms: noise-free data, the channels' RMS");
 
@@ -774,7 +774,15 @@ std::vector<std::string> WriteLeastSquaresResults(const IdentificationRun& run,
 
 }  // namespace
 
+namespace {
+// A structure given by matrices (model.kind: matrix): its summary and files (results.h).
+std::string MatrixSummaryYaml(const IdentificationRun& run);
+std::vector<std::string> WriteMatrixIdentificationResults(const IdentificationRun& run,
+                                                          const std::string& folder, bool figures);
+}  // namespace
+
 std::string SummaryYaml(const IdentificationRun& run) {
+  if (run.config.structure.kind == ModelKind::kMatrix) return MatrixSummaryYaml(run);
   if (run.least_squares) return LeastSquaresSummaryYaml(run);
   const IdentificationSummary& outer = run.outer;
   const double identified = run.identified_modulus();
@@ -832,6 +840,10 @@ std::string SummaryYaml(const IdentificationRun& run) {
 
 std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run,
                                                     const std::string& folder, bool figures) {
+  assert(run.IsUsable());
+  if (run.config.structure.kind == ModelKind::kMatrix) {
+    return WriteMatrixIdentificationResults(run, folder, figures);
+  }
   if (run.least_squares) return WriteLeastSquaresResults(run, folder, figures);
   ResultsFolder results(folder);
   results.Write("evaluations.csv", EvaluationsCsv(run));
@@ -868,12 +880,29 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
 
 namespace {
 
+// The names of the zones, loads and sensors of a structure given by matrices, in its order.
+std::vector<std::string> ZoneNames(const MatrixModelData& model) {
+  std::vector<std::string> names;
+  for (const MatrixModelZone& zone : model.zones) names.push_back(zone.name);
+  return names;
+}
+std::vector<std::string> LoadNames(const MatrixModelData& model) {
+  std::vector<std::string> names;
+  for (const MatrixModelLoad& load : model.loads) names.push_back(load.channel);
+  return names;
+}
+std::vector<std::string> SensorNames(const MatrixModelData& model) {
+  std::vector<std::string> names;
+  for (const MatrixModelSensor& sensor : model.sensors) names.push_back(sensor.channel);
+  return names;
+}
+
 // Least squares has no error map: its columns are left empty.
-std::string MatrixZonesCsv(const MatrixIdentificationRun& run) {
+std::string MatrixZonesCsv(const IdentificationRun& run) {
   std::vector<ZoneRow> rows(static_cast<std::size_t>(run.nominal_moduli.size()));
   for (int z = 0; z < run.nominal_moduli.size(); ++z) {
     ZoneRow& row = rows[static_cast<std::size_t>(z)];
-    row.name = run.zone_names[static_cast<std::size_t>(z)];
+    row.name = ZoneNames(*run.model)[static_cast<std::size_t>(z)];
     row.nominal_modulus = run.nominal_moduli[z];
     row.modulus = run.identified_moduli[z];
     if (run.truth_moduli.size() > 0) row.truth_modulus = run.truth_moduli[z];
@@ -892,18 +921,19 @@ std::string MatrixZonesCsv(const MatrixIdentificationRun& run) {
 }
 
 // t, each load as used, each sensor as used and as the identified model gives it.
-std::string MatrixFitCsv(const MatrixIdentificationRun& run) {
+std::string MatrixFitCsv(const IdentificationRun& run) {
   std::string csv = "t";
-  for (const std::string& load : run.load_names) csv += "," + load;
-  for (const std::string& sensor : run.sensor_names) {
+  for (const std::string& load : LoadNames(*run.model)) csv += "," + load;
+  for (const std::string& sensor : SensorNames(*run.model)) {
     csv += "," + sensor + "_measured," + sensor + "_model";
   }
   csv += "\n";
   std::vector<const Vector*> loads, sensors;
-  for (const std::string& load : run.load_names) loads.push_back(&run.data.Values(load));
-  for (const std::string& sensor : run.sensor_names) sensors.push_back(&run.data.Values(sensor));
-  for (int j = 0; j <= run.steps; ++j) {
-    csv += Format(j * run.time_step);
+  for (const std::string& load : LoadNames(*run.model)) loads.push_back(&run.data.Values(load));
+  for (const std::string& sensor : SensorNames(*run.model))
+    sensors.push_back(&run.data.Values(sensor));
+  for (int j = 0; j <= run.data.num_steps(); ++j) {
+    csv += Format(j * run.data.time_step);
     for (const Vector* load : loads) csv += "," + Format((*load)[j]);
     for (std::size_t k = 0; k < sensors.size(); ++k) {
       csv +=
@@ -914,9 +944,9 @@ std::string MatrixFitCsv(const MatrixIdentificationRun& run) {
   return csv;
 }
 
-std::string MatrixDofMapCsv(const MatrixIdentificationRun& run) {
+std::string MatrixDofMapCsv(const IdentificationRun& run) {
   std::string csv = "dof,nominal_j_s,identified_j_s\n";
-  for (int i = 0; i < run.dofs; ++i) {
+  for (int i = 0; i < run.model->dofs(); ++i) {
     csv += std::to_string(i) + "," + Format(run.nominal_dof_map[i]) + "," +
            Format(run.dof_map[i]) + "\n";
   }
@@ -927,7 +957,7 @@ std::string MatrixDofMapCsv(const MatrixIdentificationRun& run) {
 // position's coordinates x, y, z as it has them, share [J s] and fraction at the
 // identified moduli), then the same at the nominal moduli, then the element's zone (its
 // index in the manifest, as zones.csv's column zone).
-std::string MatrixElementMapCsv(const MatrixIdentificationRun& run, const MatrixModelData& model) {
+std::string MatrixElementMapCsv(const IdentificationRun& run, const MatrixModelData& model) {
   const Vector fractions = run.element_map.Fractions();
   const Vector nominal_fractions = run.nominal_element_map.Fractions();
   const Eigen::Index dimension = model.elements.front().position.size();
@@ -946,12 +976,12 @@ std::string MatrixElementMapCsv(const MatrixIdentificationRun& run, const Matrix
   return csv;
 }
 
-std::string MatrixEvaluationsCsv(const MatrixIdentificationRun& run) {
+std::string MatrixEvaluationsCsv(const IdentificationRun& run) {
   std::string csv = "evaluation";
-  for (const std::string& zone : run.zone_names) csv += "," + zone + "_pa";
+  for (const std::string& zone : ZoneNames(*run.model)) csv += "," + zone + "_pa";
   csv += ",scaled_cost,usable,gradient_norm\n";
-  for (std::size_t i = 0; i < run.zones.history.size(); ++i) {
-    const ZoneEvaluation& e = run.zones.history[i];
+  for (std::size_t i = 0; i < run.zones.summary.history.size(); ++i) {
+    const ZoneEvaluation& e = run.zones.summary.history[i];
     csv += std::to_string(i + 1);
     for (int z = 0; z < e.moduli.size(); ++z) csv += "," + Format(e.moduli[z]);
     csv += "," + Format(e.cost) + "," + (e.usable ? "1" : "0") + "," + Format(e.gradient_norm) +
@@ -960,13 +990,13 @@ std::string MatrixEvaluationsCsv(const MatrixIdentificationRun& run) {
   return csv;
 }
 
-std::string MatrixZonesScript(const MatrixIdentificationRun& run, const std::string& folder) {
+std::string MatrixZonesScript(const IdentificationRun& run, const std::string& folder) {
   const std::string csv = GnuplotString(folder + "/zones.csv");
   std::ostringstream script;
   script << GnuplotPngTerminal() << "set terminal pngcairo size 1200,500\n"
          << "set termoption noenhanced\nset datafile separator ','\n"
             "set multiplot layout 1,2 title "
-         << GnuplotString("Zones of " + run.manifest) << "\n"
+         << GnuplotString("Zones of " + run.config.structure.manifest) << "\n"
          << "set style data histograms\nset style histogram clustered gap 1\n"
             "set style fill solid 0.8 border -1\nset xtics rotate by -30\n"
             "set key top right\nset yrange [0:*]\nset offsets 0, 0, graph 0.25, 0\n"
@@ -992,11 +1022,11 @@ std::string MatrixZonesScript(const MatrixIdentificationRun& run, const std::str
 }
 
 // The first sensors (at most 6 panels), measured and model, in um or microstrain.
-std::string MatrixFitScript(const MatrixIdentificationRun& run, const std::string& folder,
+std::string MatrixFitScript(const IdentificationRun& run, const std::string& folder,
                             bool prefiltered, const std::vector<SensorKind>& kinds) {
   const std::string csv = GnuplotString(folder + "/fit.csv");
-  const int panels = std::min<int>(6, static_cast<int>(run.sensor_names.size()));
-  const int loads = static_cast<int>(run.load_names.size());
+  const int panels = std::min<int>(6, static_cast<int>(SensorNames(*run.model).size()));
+  const int loads = static_cast<int>(LoadNames(*run.model).size());
   std::ostringstream script;
   script << GnuplotPngTerminal() << "set terminal pngcairo size 1000," << 220 * std::max(panels, 1)
          << "\nset termoption noenhanced\nset datafile separator ','\nset multiplot layout " << std::max(panels, 1)
@@ -1006,7 +1036,7 @@ std::string MatrixFitScript(const MatrixIdentificationRun& run, const std::strin
   for (int k = 0; k < panels; ++k) {
     const bool strain = kinds[static_cast<std::size_t>(k)] == SensorKind::kStrain;
     const int column = 2 + loads + 2 * k;
-    script << "set title " << GnuplotString(run.sensor_names[static_cast<std::size_t>(k)])
+    script << "set title " << GnuplotString(SensorNames(*run.model)[static_cast<std::size_t>(k)])
            << "\nset ylabel '" << (strain ? "strain [1e-6]" : "u [um]") << "'\nplot " << csv
            << " skip 1 using ($1*1e3):($" << column << "*1e6) with lines lc rgb '#aaaaaa' notitle, "
            << csv << " skip 1 using ($1*1e3):($" << column + 1
@@ -1017,32 +1047,31 @@ std::string MatrixFitScript(const MatrixIdentificationRun& run, const std::strin
 }
 
 // The model: and data: blocks of a matrix run's summary.yaml.
-void MatrixModelAndDataYaml(const MatrixIdentificationRun& run, const Config& config,
-                            YamlWriter* yaml) {
+void MatrixModelAndDataYaml(const IdentificationRun& run, const Config& config, YamlWriter* yaml) {
   yaml->Line(0, "model", "");
   yaml->Text(1, "kind", ModelKindToString(config.structure.kind));
-  yaml->Text(1, "manifest", run.manifest);
-  yaml->Integer(1, "dofs", run.dofs);
-  yaml->Integer(1, "zones", static_cast<long>(run.zone_names.size()));
-  yaml->Integer(1, "loads", static_cast<long>(run.load_names.size()));
-  yaml->Integer(1, "sensors", static_cast<long>(run.sensor_names.size()));
-  yaml->Integer(1, "supports", run.supports);
+  yaml->Text(1, "manifest", run.config.structure.manifest);
+  yaml->Integer(1, "dofs", run.model->dofs());
+  yaml->Integer(1, "zones", static_cast<long>(ZoneNames(*run.model).size()));
+  yaml->Integer(1, "loads", static_cast<long>(LoadNames(*run.model).size()));
+  yaml->Integer(1, "sensors", static_cast<long>(SensorNames(*run.model).size()));
+  yaml->Integer(1, "supports", static_cast<int>(run.model->supports.size()));
   yaml->Line(0, "data", "");
   yaml->Text(1, "source", run.data_source);
-  yaml->Integer(1, "steps", run.steps);
-  yaml->Number(1, "time_step", run.time_step, "[s]");
+  yaml->Integer(1, "steps", run.data.num_steps());
+  yaml->Number(1, "time_step", run.data.time_step, "[s]");
 }
 
 // The uncertainty: block of a matrix run's summary.yaml (EstimateZoneUncertainty).
-void MatrixUncertaintyYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) {
-  const ZoneUncertainty& uncertainty = run.uncertainty;
+void MatrixUncertaintyYaml(const IdentificationRun& run, YamlWriter* yaml) {
+  const ZoneUncertainty& uncertainty = run.zone_uncertainty;
   yaml->Line(0, "uncertainty", "", "first order, from the noise drawn (uncertainty:)");
   yaml->Text(1, "message", uncertainty.message);
   yaml->Line(1, "zones", "", "std_dev [Pa] null when not available");
-  for (std::size_t z = 0; z < run.zone_names.size(); ++z) {
+  for (std::size_t z = 0; z < ZoneNames(*run.model).size(); ++z) {
     const auto index = static_cast<Eigen::Index>(z);
     const double std_dev = uncertainty.available ? uncertainty.std_dev[index] : NAN;
-    yaml->Raw("    - {name: " + Quoted(run.zone_names[z]) + ", std_dev: " + Format(std_dev) +
+    yaml->Raw("    - {name: " + Quoted(ZoneNames(*run.model)[z]) + ", std_dev: " + Format(std_dev) +
               ", relative_std_dev: " + Format(std_dev / run.identified_moduli[index]) + "}");
   }
   yaml->Integer(1, "samples", uncertainty.samples, "noise draws");
@@ -1056,7 +1085,7 @@ void MatrixUncertaintyYaml(const MatrixIdentificationRun& run, YamlWriter* yaml)
 
 // The error_map: block of a matrix run with an element map (error_map.csv): the element
 // of the largest share at the identified and at the nominal moduli.
-void MatrixElementMapYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) {
+void MatrixElementMapYaml(const IdentificationRun& run, YamlWriter* yaml) {
   if (run.element_map.share.size() == 0 || run.nominal_element_map.share.size() == 0) return;
   const int peak = run.element_map.PeakElement();
   const int nominal_peak = run.nominal_element_map.PeakElement();
@@ -1072,26 +1101,25 @@ void MatrixElementMapYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) 
 // zones' minimiser, its costs (e^2 [J s], or J [s] by least squares) and every zone's
 // modulus, with its share of the constitutive gap at the nominal and the identified
 // moduli by the MCRE.
-void MatrixZonesYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) {
+void MatrixZonesYaml(const IdentificationRun& run, YamlWriter* yaml) {
   const std::string cost = run.least_squares ? "J" : "e^2";
   const std::string unit = run.least_squares ? "[s] " : "[J s] ";
   yaml->Line(0, "zones", "",
              run.homogeneous_ran ? "identification of every zone modulus from the homogeneous E*"
                                  : "identification of every zone modulus from the nominal moduli");
   yaml->Line(1, "functional", run.least_squares ? "least_squares" : "mcre", "outer.functional");
-  yaml->Integer(1, "count", static_cast<long>(run.zone_names.size()));
-  const ZoneIdentificationSummary& zones = run.zones;
+  yaml->Integer(1, "count", static_cast<long>(ZoneNames(*run.model).size()));
+  const ZoneIdentificationSummary& zones = run.zones.summary;
   const BoundedMinimizerSummary& minimizer = zones.regularized.minimizer;
   yaml->Line(1, "termination", TerminationTypeToString(zones.termination));
   yaml->Text(1, "message", zones.message);
-  yaml->Number(1, "homogeneous_modulus",
-               run.homogeneous_ran ? run.homogeneous.identified_modulus() : NAN,
+  yaml->Number(1, "homogeneous_modulus", run.homogeneous_ran ? run.identified_modulus() : NAN,
                "[Pa] E*, the start (null: the zones' nominal moduli differ, they start there)");
-  yaml->Number(1, "cost", run.cost, unit + cost + " at the zone moduli");
+  yaml->Number(1, "cost", run.zone_cost, unit + cost + " at the zone moduli");
   yaml->Number(1, "homogeneous_cost", run.homogeneous_ran ? run.homogeneous_cost : NAN,
                unit + cost + " at E* in every zone");
   yaml->Number(1, "nominal_cost", run.nominal_cost, unit + cost + " at the nominal moduli");
-  yaml->Number(1, "cost_scale", run.rest_cost,
+  yaml->Number(1, "cost_scale", run.zone_rest_cost,
                run.least_squares ? "[s] J_rest, J with every prediction 0"
                                  : "[J s] J_rest, e^2 of the structure left at rest "
                                    "(0 <= e^2 <= J_rest)");
@@ -1126,7 +1154,7 @@ void MatrixZonesYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) {
   for (int z = 0; z < run.nominal_moduli.size(); ++z) {
     const bool truth = run.truth_moduli.size() > 0;
     std::string entry = "    - {index: " + std::to_string(z) +
-                        ", name: " + Quoted(run.zone_names[static_cast<std::size_t>(z)]) +
+                        ", name: " + Quoted(ZoneNames(*run.model)[static_cast<std::size_t>(z)]) +
                         ", nominal: " + Format(run.nominal_moduli[z]) +
                         ", modulus: " + Format(run.identified_moduli[z]) +
                         ", truth: " + Format(truth ? run.truth_moduli[z] : NAN) +
@@ -1145,9 +1173,8 @@ void MatrixZonesYaml(const MatrixIdentificationRun& run, YamlWriter* yaml) {
 // summary.yaml of a matrix run by least squares: the bar's least-squares layout (J [s]
 // for e^2, the misfit levels, no error map and no inner solver) with the model, the data
 // and the zones: block.
-std::string MatrixLeastSquaresSummaryYaml(const MatrixIdentificationRun& run,
-                                          const Config& config) {
-  const ModulusStage& stage = run.homogeneous;
+std::string MatrixLeastSquaresSummaryYaml(const IdentificationRun& run, const Config& config) {
+  const ModulusStage& stage = run;
   YamlWriter yaml;
   yaml.Raw(
       "# mcrewave identify run: the zone moduli of a structure given by matrices, by output-error "
@@ -1170,7 +1197,7 @@ std::string MatrixLeastSquaresSummaryYaml(const MatrixIdentificationRun& run,
   yaml.Line(0, "misfit_levels", "", "each sensor kind's misfit divided by its level");
   yaml.Number(1, "displacement", run.misfit_levels.displacement_std, "[m] s_u (0: no such sensor)");
   yaml.Number(1, "strain", run.misfit_levels.strain_std, "[-] s_e (0: no such sensor)");
-  if (run.supports > 0) {
+  if (static_cast<int>(run.model->supports.size()) > 0) {
     yaml.Number(1, "force", run.misfit_levels.force_std, "[N] s_f of the supports' forces");
   }
   yaml.Text(1, "source", run.misfit_source);
@@ -1185,11 +1212,10 @@ std::string MatrixLeastSquaresSummaryYaml(const MatrixIdentificationRun& run,
   return yaml.str();
 }
 
-}  // namespace
-
-std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& config) {
+std::string MatrixSummaryYaml(const IdentificationRun& run) {
+  const Config& config = run.config;
   if (run.least_squares) return MatrixLeastSquaresSummaryYaml(run, config);
-  const ModulusStage& stage = run.homogeneous;
+  const ModulusStage& stage = run;
   YamlWriter yaml;
   yaml.Raw("# mcrewave identify run: the zone moduli of a structure given by matrices, by the MCRE");
   if (!config.source_path.empty()) yaml.Raw("# config: " + config.source_path);
@@ -1212,7 +1238,7 @@ std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& 
   if (run.homogeneous_ran) {
     OptimizerScanAndPrefilterYaml(stage.outer, stage.rest_cost, stage.scan_cost_scale, config,
                                   run.prefilter_cutoff, "e^2", "J s", &yaml);
-    InnerSolvesYaml(stage, config, run.dofs, run.steps, &yaml);
+    InnerSolvesYaml(stage, config, run.model->dofs(), run.data.num_steps(), &yaml);
     if (!stage.cost_curve.empty()) {
       CostCurveYaml(stage.cost_curve, &yaml);
       yaml.Integer(1, "sweeps", stage.cost_curve_sweeps);
@@ -1220,24 +1246,23 @@ std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& 
   } else {
     PrefilterYaml(config, run.prefilter_cutoff, &yaml);
     yaml.Line(0, "inner", "");
-    yaml.Text(1, "method", CoupledSolverTypeToString(run.inner_method),
-              InnerMethodComment(run.inner_method, config, run.dofs, run.steps));
+    yaml.Text(
+        1, "method", CoupledSolverTypeToString(run.inner_method),
+        InnerMethodComment(run.inner_method, config, run.model->dofs(), run.data.num_steps()));
   }
   MatrixZonesYaml(run, &yaml);
   ConfigYaml(config, &yaml);
   return yaml.str();
 }
 
-std::vector<std::string> WriteMatrixIdentificationResults(const MatrixIdentificationRun& run,
-                                                          const Config& config,
-                                                          const MatrixModelData& model,
-                                                          const std::string& folder,
-                                                          bool figures) {
-  assert(run.IsUsable());
+std::vector<std::string> WriteMatrixIdentificationResults(const IdentificationRun& run,
+                                                          const std::string& folder, bool figures) {
+  const Config& config = run.config;
+  const MatrixModelData& model = *run.model;
   ResultsFolder results(folder);
   results.Write("zones.csv", MatrixZonesCsv(run));
   results.Write("zone_evaluations.csv", MatrixEvaluationsCsv(run));
-  const ModulusStage& stage = run.homogeneous;
+  const ModulusStage& stage = run;
   if (run.homogeneous_ran) {
     if (!stage.outer.scan_moduli.empty()) {
       results.Write("scan.csv", ScanCsv(stage.outer, stage.scan_cost_scale, config.outer.initial));
@@ -1273,8 +1298,9 @@ std::vector<std::string> WriteMatrixIdentificationResults(const MatrixIdentifica
     results.Draw(drawings);
   }
   // The summary last: its presence says the folder is complete.
-  results.Write("summary.yaml", MatrixSummaryYaml(run, config));
+  results.Write("summary.yaml", MatrixSummaryYaml(run));
   return results.written();
 }
 
+}  // namespace
 }  // namespace mcrewave

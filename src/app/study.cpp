@@ -524,7 +524,7 @@ void RunMatrixRobustness(const Config& config, RunJournal* journal, RobustnessSt
         run_config.data.seed = run->seed;
         MatrixMeasurements measured = truth.measurements;
         AddMatrixModelNoise(model, run->snr, run->seed, &measured.histories, &measured.noise);
-        const MatrixIdentificationRun identification =
+        const IdentificationRun identification =
             RunMatrixIdentification(run_config, model, measured, /*maps_and_uncertainty=*/false);
         run->converged = identification.IsUsable();
         run->message = identification.failure;

@@ -104,9 +104,9 @@ ZoneIdentificationRun RunLeastSquaresZoneIdentification(
                   [&](const BarModel& model, const PrefilterOptions& prefilter) {
                     ZoneIdentificationSummary summary = IdentifyZoneModuliByLeastSquares(
                         config.zone_identification, BarRunModel(model, scalar.data, scalar.ends),
-                        scalar.data, scalar.noise, config.time.theta, scalar.identified_modulus(),
-                        config.outer.lower_bound, config.outer.upper_bound, scalar.estimated_noise,
-                        prefilter);
+                        scalar.data, scalar.misfit_levels, config.time.theta,
+                        scalar.identified_modulus(), config.outer.lower_bound,
+                        config.outer.upper_bound, scalar.estimated_noise, prefilter);
                     SetBarZoneExtents(model, &summary);
                     return summary;
                   });

@@ -26,6 +26,7 @@
 #include "mcrewave/mcre/error_map.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/mcre/objective.h"
+#include "mcrewave/mcre/zone_uncertainty.h"
 #include "mcrewave/model/matrix_export.h"
 #include "mcrewave/optim/identification.h"
 
@@ -86,68 +87,122 @@ struct ModulusStage {
   double cost() const { return best_index >= 0 ? evaluations[best_index].cost : -1.0; }
 };
 
-// Everything one identification of the bar computed: its homogeneous stage (on
-// BarRunModel) and what the bar adds to it. By the MCRE (RunIdentification), or by
-// output-error least squares (outer.functional: least_squares, RunLeastSquares): the same
-// data path, pre-filter and optimiser, the global scan on J(E), the misfit of the clamped
-// model driven by the measured fL normalised by the noise levels; then the stage's
-// evaluations, solution, cold solve, uncertainty, error map and model channels are left
-// empty, rest_cost is J_rest [s], `noise` holds the misfit levels s_u, s_f, s_e (as
-// LeastSquaresMisfitLevels says) and `sweeps` counts every simulation (scan, refinement,
-// fit, curve).
+// Everything one identification computed, on the bar (RunIdentification) or on a
+// structure given by matrices (RunMatrixIdentification, app/matrix_identification_run.h):
+// the homogeneous stage this run is (one E in every zone; on a structure whose zones'
+// nominal moduli differ it does not run, homogeneous_ran false), then the zones, the
+// error maps and the uncertainty. By the MCRE, or by output-error least squares
+// (outer.functional: least_squares, RunLeastSquares on the bar): the same data path,
+// pre-filter and optimiser, the global scan on J(E), the misfit of the held model driven
+// by the measured loads normalised by misfit_levels; then the stage's evaluations,
+// solution, cold solve, uncertainty, error maps and model channels are left empty,
+// rest_cost is J_rest [s] and, on the bar, `sweeps` counts every simulation (scan,
+// refinement, fit, curve).
 struct IdentificationRun : ModulusStage {
   Config config;
   bool least_squares = false;  // outer.functional: least_squares
-  // The measurements the MCRE compared with: the channels of data.channels,
-  // pre-filtered when prefilter.enabled.
+  // The homogeneous stage (this ModulusStage) ran: always on the bar; on a structure
+  // given by matrices when its zones share one nominal modulus.
+  bool homogeneous_ran = true;
+  // The measurements as compared with, pre-filtered when prefilter.enabled: on the bar
+  // the channels of data.channels; on a structure given by matrices every channel of the
+  // model, in its order (loads, then sensors).
   ChannelSet data;
-  // The end displacement channels among them (data.channels).
+  std::string data_source;  // the CSV's path, or "synthetic"
+  // The bar's end displacement channels among them (data.channels).
   EndDisplacementChannels ends;
-  // BarRunModel of config.model, data and ends: the structure every MCRE solve of the run
-  // takes (set by IdentifyModulus; shared, so that a copy of the run keeps it).
+  // The structure every solve of the run takes: BarRunModel of config.model, data and
+  // ends (set by IdentifyModulus), or the manifest's model (set when the run writes maps;
+  // shared, so that a copy of the run keeps it).
   std::shared_ptr<const MatrixModelData> model;
   // The pre-filter's cut-off frequency [Hz] (given or derived); 0 when off.
   double prefilter_cutoff = 0.0;
-  // Synthetic data: they were made with E = config.model.modulus, the reference
-  // the identified modulus is compared with. False for CSV data.
+  // Synthetic data: they were made with E = config.model.modulus (the bar), or the
+  // truth moduli (truth_moduli), the reference the identified moduli are compared with.
   bool reference_known = false;
-  // The noise levels the uncertainty draws, and where they come from:
-  // "synthetic_snr" (the levels the synthetic noise was drawn with) or
-  // "data_differences" (DifferenceNoiseLevels: CSV data, or no synthetic noise).
+  // The noise levels the uncertainty draws (and, on a structure given by matrices, the
+  // zones' discrepancy target), and where they come from: "synthetic_snr" (the levels
+  // the synthetic noise was drawn with) or "data_differences" (CSV data, or no synthetic
+  // noise; MeasurementNoiseLevels, MatrixNoiseLevels).
   NoiseLevels noise;
   std::string noise_source;
-  // DifferenceNoiseLevels of the measurements as given (before the pre-filter).
-  // The uncertainty draws white noise of `noise` on the channels, unfiltered:
-  // with the pre-filter on, it overstates the spread (conservative).
+  // The bar: DifferenceNoiseLevels of the measurements as given (before the pre-filter),
+  // the zones' discrepancy target. The uncertainty draws white noise of `noise` on the
+  // channels, unfiltered: with the pre-filter on, it overstates the spread (conservative).
   NoiseLevels estimated_noise;
-  NoiseLevels misfit;  // RMS misfits at the optimum (EndMisfitLevels of model_channels)
-  // The model's channels at the identified E (MatrixMcreProblem::ModelChannels of
+  // Least squares: the levels that normalise the misfit (s_u, s_f, s_e), and where they
+  // come from (LeastSquaresMisfitLevels, MatrixLeastSquaresMisfitLevels).
+  NoiseLevels misfit_levels;
+  std::string misfit_source;
+  NoiseLevels misfit;  // the bar: RMS misfits at the optimum (EndMisfitLevels of model_channels)
+  // The bar's channels at the identified E (MatrixMcreProblem::ModelChannels of
   // BarRunModel): fL = fL~ - W_L / alpha; f0, the clamp's force, the load f0~ - W_0 / alpha
   // (clamp measured) or f0~ - W_0 / alpha_0 (pinned), the reaction r(U_j) (trusted);
   // uL, u0 and the sensors, H U. An end displacement the run does not use (data.channels)
   // is read from the stored field, and is missing after a streaming solve.
   ChannelSet model_channels;
 
-  double alpha = 0.0;  // force weight used [m/N]
-  double beta = 0.0;   // displacement weight used [N/m]
+  double alpha = 0.0;  // the bar's force weight used [m/N]
+  double beta = 0.0;   // the bar's displacement weight used [N/m]
 
+  // The bar's uncertainty of E* (from the cost curve's curvature and the noise draws).
   ModulusUncertainty uncertainty;
-  // The error map at the identified (homogeneous) E, from `solution`.
+  // The bar's error map along x at the identified (homogeneous) E, from `solution`.
   ErrorMap error_map;
-  // The zone moduli from E* (ran = false with one zone).
+  // The zone moduli from E* (on the bar ran = false with one zone), or from the nominal
+  // moduli when they differ.
   ZoneIdentificationRun zones;
-  double wall_time_s = -1.0;  // the whole of RunIdentification
+  double wall_time_s = -1.0;  // the whole of the run
 
-  // Least squares only: the model's outputs and J at the identified E, and on the cost
-  // curve J(E) and dJ/dE over E* +- 5 %, the curvature d^2J/dE^2 at E* [s / Pa^2] (the
-  // slope of dJ/dE over the curve, ripple included).
+  // Least squares on the bar: the model's outputs and J at the identified E, and on the
+  // cost curve J(E) and dJ/dE over E* +- 5 %, the curvature d^2J/dE^2 at E* [s / Pa^2]
+  // (the slope of dJ/dE over the curve, ripple included).
   OutputErrorFit fit;
   double curvature = 0.0;
   // 1 / sqrt(fit.fisher_information) [Pa]: the Cramer-Rao bound of E under white noise of
-  // the levels `noise` on the outputs with the measured load taken as exact. The noise of
-  // the load that drives the model is not counted, so the spread of E over noise draws is
-  // larger (docs/comparator.md). NaN when the information is not positive.
+  // the levels misfit_levels on the outputs with the measured load taken as exact. The
+  // noise of the load that drives the model is not counted, so the spread of E over
+  // noise draws is larger (docs/comparator.md). NaN when the information is not positive.
   double modulus_std_bound = std::numeric_limits<double>::quiet_NaN();
+
+  // A structure given by matrices: its zones' moduli [Pa] (identified: empty when no
+  // usable point; truth: empty when unknown).
+  Vector nominal_moduli, identified_moduli, truth_moduli;
+  // e^2 [J s] (least squares: J [s]) at E* in every zone, at the identified and at the
+  // nominal moduli, and J_rest of the zones' objective.
+  double homogeneous_cost = 0.0, zone_cost = 0.0, nominal_cost = 0.0, zone_rest_cost = 0.0;
+  // Constitutive part of e^2 per zone and per dof [J s], at the nominal moduli (where
+  // the model is wrong) and at the identified ones.
+  Vector nominal_zone_map, zone_map, nominal_dof_map, dof_map;
+  // Each zone's gap relative to its strain energy over the window [-]: e_z^2 over the
+  // same sum of U, (E_z / E_z,nom) sum_j c_j h 1/2 U_j^T K_z U_j. Independent of the
+  // zone's size, it is the map that points at a wrong zone.
+  Vector nominal_zone_gap, zone_gap;
+  // Constitutive part of e^2 per element [J s] with its space-time picture
+  // (mcre/element_error_map.h), at the nominal and the identified moduli, when the model
+  // has element blocks.
+  ErrorMap nominal_element_map, element_map;
+  // The model's outputs H U at the identified moduli, a row per sensor.
+  Matrix model_outputs;
+  // The first-order uncertainty of the identified zone moduli (uncertainty:), drawn at
+  // `noise` (EstimateZoneUncertainty).
+  ZoneUncertainty zone_uncertainty;
+  // Why a run on a structure given by matrices is not usable ("" when it is).
+  std::string failure;
+
+  bool IsUsable() const {
+    return failure.empty() && (!homogeneous_ran || ModulusStage::IsUsable());
+  }
+  // Evaluations and sweeps of the identification: the homogeneous stage's (its scan's
+  // and refinements') and the zones'.
+  long TotalEvaluations() const {
+    const long stage = homogeneous_ran ? outer.scan_evaluations + outer.evaluations : 0;
+    return stage + zones.summary.evaluations;
+  }
+  long TotalSweeps() const {
+    const long stage = homogeneous_ran ? outer.scan_sweeps + sweeps : 0;
+    return stage + zones.summary.sweeps;
+  }
 };
 
 // Step 3 on mcre:'s e^2.
@@ -210,6 +265,12 @@ std::string ModulusOnBoundMessage(double modulus, const IdentificationOptions& o
 // (run.misfit is set).
 constexpr double kImplausibleMisfitFactor = 10.0;
 std::string ImplausibleMisfitMessage(const IdentificationRun& run);
+
+// Why the run's results cannot be reported, "" when they can: a structure given by
+// matrices says so in run.failure; the bar's identification did not converge
+// (outer.message), its E lies on a bound (ModulusOnBoundMessage) or, by the MCRE,
+// explains nothing of the data (ImplausibleMisfitMessage).
+std::string UnreportableMessage(const IdentificationRun& run);
 
 // The run's error map at E* (error_map.h): from the stored retrograde field, or from
 // the element shares and picture a streaming solve summed on BarRunModel's elements

@@ -29,7 +29,7 @@
 //      held whatever mcre.clamp says (the bar's least squares keeps its clamp rigid),
 //      their forces outputs weighted by 1 / s_f^2.
 //
-// Results: WriteMatrixIdentificationResults (app/results.h).
+// Results: WriteIdentificationResults (app/results.h).
 #pragma once
 
 #include <cstdint>
@@ -139,89 +139,12 @@ NoiseLevels MatrixNoiseLevels(const Config& config, const MatrixMeasurements& me
 ChannelSet MatrixMeasurementTable(const Config& config, const MatrixModelData& model,
                                   const ChannelSet& histories);
 
-struct MatrixIdentificationRun {
-  std::string manifest;  // the model's manifest path
-  // outer.functional: least_squares: the costs are J [s] and there is no error map
-  // (the maps and gaps below are empty).
-  bool least_squares = false;
-  NoiseLevels misfit_levels;  // least squares: s_u, s_e (and s_f with supports)
-  std::string misfit_source;  // as MatrixLeastSquaresMisfitLevels says
-  int dofs = 0;
-  int supports = 0;  // the manifest's supports (mcre.clamp treats them)
-  // The noise levels of the zones' discrepancy target and of the MCRE's first-order
-  // uncertainty of the identified moduli (uncertainty:), whose origin noise_source names
-  // (MatrixNoiseLevels).
-  ZoneUncertainty uncertainty;
-  NoiseLevels noise;
-  std::string noise_source;
-  int steps = 0;
-  // The coupled solver of every solve: config.inner.type, auto resolved
-  // (conjugate_gradient on a matrix model; ResolveCoupledSolverType).
-  CoupledSolverType inner_method = CoupledSolverType::kConjugateGradient;
-  double time_step = 0.0;                // h [s]
-  std::string data_source;               // CSV path or "synthetic"
-  double prefilter_cutoff = 0.0;         // [Hz]; 0: no pre-filter
-  std::vector<std::string> zone_names;
-  Vector nominal_moduli;  // E_z,nom [Pa]
-  // The MCRE on a model whose zones share one nominal modulus: the homogeneous stage
-  // (identification_run.h), one E in every zone by config.outer's global scan and
-  // refinements, then (with maps_and_uncertainty) its cost curve and a solve from W = 0
-  // at E*; the zones start from E*. Otherwise homogeneous_ran is false and the zones
-  // start from their nominal moduli.
-  // By least squares, the same stage on J (OutputErrorModulusObjective): its outer,
-  // rest_cost and sweeps; no evaluations, solution or cost curve.
-  bool homogeneous_ran = false;
-  ModulusStage homogeneous;
-  double homogeneous_cost = 0.0;         // e^2 [J s] (least squares: J [s]) at E* in every zone
-  Vector identified_moduli;              // [Pa]; empty when no usable point
-  Vector truth_moduli;                   // [Pa]; empty when unknown
-  // Every zone at once (identification/zone_identification.h, the bar's zones' steps:
-  // the regularised minimisation and the merging of zone_identification:), on
-  // p_z = log(E_z / E_z,nom) from E* in every zone or the nominal moduli.
-  ZoneIdentificationSummary zones;
-  double rest_cost = 0.0;     // J_rest [J s] (least squares: [s])
-  double nominal_cost = 0.0;  // e^2 at the nominal moduli [J s] (J [s])
-  double cost = 0.0;          // e^2 at the identified moduli [J s] (J [s])
-  // Constitutive part of e^2 per zone and per dof [J s], at the nominal moduli (where
-  // the model is wrong) and at the identified ones.
-  Vector nominal_zone_map, zone_map, nominal_dof_map, dof_map;
-  // Each zone's gap relative to its strain energy over the window [-]: e_z^2 over the
-  // same sum of U, (E_z / E_z,nom) sum_j c_j h 1/2 U_j^T K_z U_j. Independent of the
-  // zone's size, it is the map that points at a wrong zone.
-  Vector nominal_zone_gap, zone_gap;
-  // Constitutive part of e^2 per element [J s] with its space-time picture
-  // (mcre/element_error_map.h), at the nominal and the identified moduli: when the model
-  // has element blocks and the coupled solution kept its fields (a streaming solve keeps
-  // no retrograde field: then, as without element blocks, the maps are empty).
-  ErrorMap nominal_element_map, element_map;
-  // Channels and names, as used (pre-filtered), and the model's outputs H U at the
-  // identified moduli.
-  ChannelSet data;  // the model's channels, in its order (loads, then sensors)
-  std::vector<std::string> load_names, sensor_names;
-  Matrix model_outputs;
-  std::string failure;                   // why the run is not usable ("" when it is)
-  double wall_time_s = 0.0;
-
-  bool IsUsable() const { return failure.empty(); }
-  // Evaluations and sweeps of the identification: the homogeneous stage's (its scan's
-  // and refinements') and the zones'.
-  long TotalEvaluations() const {
-    const long stage =
-        homogeneous_ran ? homogeneous.outer.scan_evaluations + homogeneous.outer.evaluations : 0;
-    return stage + zones.evaluations;
-  }
-  long TotalSweeps() const {
-    const long stage = homogeneous_ran ? homogeneous.outer.scan_sweeps + homogeneous.sweeps : 0;
-    return stage + zones.sweeps;
-  }
-};
-
 // Step 3 above; without maps_and_uncertainty, the moduli alone (no error map, model
 // outputs or uncertainty: what a study needs of each run). Never throws for the
 // optimiser or the inner solver: their failures are in run.failure (and run.outer).
 // Progress: one info line per evaluation.
-MatrixIdentificationRun RunMatrixIdentification(const Config& config, const MatrixModelData& model,
-                                                const MatrixMeasurements& measurements,
-                                                bool maps_and_uncertainty = true);
+IdentificationRun RunMatrixIdentification(const Config& config, const MatrixModelData& model,
+                                          const MatrixMeasurements& measurements,
+                                          bool maps_and_uncertainty = true);
 
 }  // namespace mcrewave

@@ -60,7 +60,8 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
 //                    (zone_identification_run.h)
 // written in the same way (atomically, summary last).
 
-// The results of `identify run` with model.kind: matrix (app/matrix_identification_run.h):
+// With model.kind: matrix (app/matrix_identification_run.h), SummaryYaml and
+// WriteIdentificationResults write instead:
 //   summary.yaml        the model (manifest, dofs, zones, channels), the data; with the
 //                       homogeneous stage (zones of one nominal modulus) the bar's
 //                       headline keys of E* (identified_modulus, cost, evaluations,
@@ -84,8 +85,7 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
 //                       sensor as the identified model driven by the loads gives it
 //   error_map_dofs.csv  the constitutive gap per dof [J s] at the nominal and the
 //                       identified moduli (MatrixMcreProblem::DofErrorMap)
-//   error_map.csv       with element blocks (and an inner solver that keeps its fields,
-//                       not streaming): the gap per element (mcre/element_error_map.h):
+//   error_map.csv       with element blocks: the gap per element (mcre/element_error_map.h):
 //                       element, its position's coordinates x[, y[, z]] [m] when it has
 //                       them, share [J s] and fraction at the identified moduli,
 //                       nominal_share and nominal_fraction, zone (index); and
@@ -93,16 +93,9 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
 //                       moduli (gnuplot's nonuniform matrix over the first coordinate,
 //                       densities in J per element)
 //   zones.png, fit.png  moduli and error shares per zone; the first six sensors
-// written as WriteIdentificationResults writes (atomically, summary last). By least
-// squares (run.least_squares): summary.yaml says `functional: least_squares`, with J,
+// written in the same way (atomically, summary last). By least squares
+// (run.least_squares): summary.yaml says `functional: least_squares`, with J,
 // J_rest [s] and the misfit levels in place of e^2 and the inner solver; zones.csv
 // has its error-map columns empty; no error_map_dofs.csv; zones.png the moduli alone.
-// Precondition: run.IsUsable().
-std::string MatrixSummaryYaml(const MatrixIdentificationRun& run, const Config& config);
-std::vector<std::string> WriteMatrixIdentificationResults(const MatrixIdentificationRun& run,
-                                                          const Config& config,
-                                                          const MatrixModelData& model,
-                                                          const std::string& folder,
-                                                          bool figures);
 
 }  // namespace mcrewave

@@ -46,7 +46,7 @@ ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayo
 
 // The same with outer.functional: least_squares: the zones by output-error least
 // squares (IdentifyZoneModuliByLeastSquares) from scalar.identified_modulus(), on
-// scalar.data with its misfit levels scalar.noise, the discrepancy target from
+// scalar.data with its misfit levels scalar.misfit_levels, the discrepancy target from
 // scalar.estimated_noise. Precondition: scalar.IsUsable(), the layout valid.
 ZoneIdentificationRun RunLeastSquaresZoneIdentification(
     const Config& config, const ZoneLayout& layout, const IdentificationRun& scalar,
