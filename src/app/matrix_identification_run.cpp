@@ -424,6 +424,32 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
   }
 }
 
+// Step 1 of RunMatrixIdentification: the pre-filter of run->data, the same on every
+// channel (the structure is linear and time-invariant: the model driven by the filtered
+// loads answers with the filtered outputs), its cut-off from the loads' spectra unless
+// given (from the sensors' when there is no load) into run->prefilter_cutoff.
+void PrefilterEveryChannel(const Config& config, const MatrixModelData& model,
+                           IdentificationRun* run) {
+  const double time_step = run->data.time_step;
+  double cutoff = config.prefilter.cutoff_frequency;
+  if (cutoff <= 0.0) {
+    std::vector<std::string> source;
+    for (const MatrixModelLoad& load : model.loads) source.push_back(load.channel);
+    if (source.empty()) {
+      for (const MatrixModelSensor& sensor : model.sensors) source.push_back(sensor.channel);
+    }
+    for (const std::string& channel : source) {
+      cutoff = std::max(cutoff, EstimateCutoffFrequency(run->data.Values(channel), time_step));
+    }
+  }
+  const ZeroPhaseLowPass filter(cutoff, 1.0 / time_step, config.prefilter.order);
+  for (Channel& channel : run->data.channels) {
+    channel.values = filter.Apply(channel.values, config.prefilter.at_rest_before_start);
+  }
+  run->prefilter_cutoff = cutoff;
+  spdlog::info("pre-filter: zero-phase Butterworth, cut-off {:.6g} Hz", cutoff);
+}
+
 // A held truth's support forces as a support measures them, with the inertia of the
 // free dofs, r_s = g_s^T (K U + M a) (docs/matrix_models.md section 10), as the bar's
 // clamp reaction f0 = row_0(M a + K u) (model/simulation.h): least squares' prediction
@@ -706,29 +732,8 @@ IdentificationRun RunMatrixIdentification(const Config& config, const MatrixMode
   if (maps_and_uncertainty) run.model = std::make_shared<const MatrixModelData>(model);
   run.data = measurements.histories;
 
-  // 1. The pre-filter, the same on every channel (the structure is linear and
-  //    time-invariant: the model driven by the filtered loads answers with the filtered
-  //    outputs); the cut-off from the loads' spectra unless given.
-  if (config.prefilter.enabled) {
-    double cutoff = config.prefilter.cutoff_frequency;
-    if (cutoff <= 0.0) {
-      // From the loads, or the sensors when there is no load.
-      std::vector<std::string> source;
-      for (const MatrixModelLoad& load : model.loads) source.push_back(load.channel);
-      if (source.empty()) {
-        for (const MatrixModelSensor& sensor : model.sensors) source.push_back(sensor.channel);
-      }
-      for (const std::string& channel : source) {
-        cutoff = std::max(cutoff, EstimateCutoffFrequency(run.data.Values(channel), time_step));
-      }
-    }
-    const ZeroPhaseLowPass filter(cutoff, 1.0 / time_step, config.prefilter.order);
-    for (Channel& channel : run.data.channels) {
-      channel.values = filter.Apply(channel.values, config.prefilter.at_rest_before_start);
-    }
-    run.prefilter_cutoff = cutoff;
-    spdlog::info("pre-filter: zero-phase Butterworth, cut-off {:.6g} Hz", cutoff);
-  }
+  // 1. The pre-filter, the same on every channel.
+  if (config.prefilter.enabled) PrefilterEveryChannel(config, model, &run);
 
   // 2. Every zone modulus at once, p_z = log(E_z / E_z,nom), from p = 0 (by least
   //    squares with outer.functional: least_squares, without error maps). The supports

@@ -52,6 +52,18 @@ bool SecantCurvature(const CoupledSolverOptions& inner, const Vector& moduli,
   return true;
 }
 
+// The problem of the figure's solves on `data`: they read costs and gradients, never
+// the element map (set_element_maps).
+std::unique_ptr<MatrixMcreProblem> FigureProblem(const MatrixModelData& model,
+                                                 const ChannelSet& data, const McreOptions& mcre,
+                                                 double theta) {
+  auto problem =
+      std::make_unique<MatrixMcreProblem>(model, data, mcre.weights, mcre.reference_modulus, theta,
+                                          Factorization::kAutomatic, mcre.clamp);
+  problem->set_element_maps(false);
+  return problem;
+}
+
 }  // namespace
 
 ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
@@ -71,14 +83,7 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
     result.message = "the figure needs the coupled solution's fields or traces";
     return result;
   }
-  // Its solves read costs and gradients, never the element map (set_element_maps).
-  auto make_problem = [&](const ChannelSet& set) {
-    auto problem =
-        std::make_unique<MatrixMcreProblem>(model, set, mcre.weights, mcre.reference_modulus, theta,
-                                            Factorization::kAutomatic, mcre.clamp);
-    problem->set_element_maps(false);
-    return problem;
-  };
+  auto make_problem = [&](const ChannelSet& set) { return FigureProblem(model, set, mcre, theta); };
   std::string why;
   if (curvature != nullptr) {
     assert(curvature->rows() == moduli.size() && curvature->cols() == moduli.size());
