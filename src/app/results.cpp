@@ -703,14 +703,30 @@ std::string FitScript(const IdentificationRun& run, const std::string& folder) {
   return script.str();
 }
 
+// The first lines of a summary.yaml: what the run identified, the config's path and the
+// version.
+void SummaryHeaderYaml(const Config& config, const std::string& title, YamlWriter* yaml) {
+  yaml->Raw("# mcrewave identify run: " + title);
+  if (!config.source_path.empty()) yaml->Raw("# config: " + config.source_path);
+  yaml->Text(0, "version", kVersion, "mcrewave version");
+}
+
+// The end of the bar's summary.yaml: its zones: block when it has zones, then the
+// resolved config.
+void ZonesAndConfigYaml(const IdentificationRun& run, YamlWriter* yaml) {
+  if (run.zones.ran) {
+    for (const std::string& line : ZonesYamlLines(run.zones)) yaml->Raw(line);
+  }
+  ConfigYaml(run.config, yaml);
+}
+
 std::string LeastSquaresSummaryYaml(const IdentificationRun& run) {
   const IdentificationSummary& outer = run.outer;
   const double identified = run.identified_modulus();
   const double reference = run.reference_known ? run.config.model.modulus : NAN;
   YamlWriter yaml;
-  yaml.Raw("# mcrewave identify run: the modulus E identified by output-error least squares J(E)");
-  if (!run.config.source_path.empty()) yaml.Raw("# config: " + run.config.source_path);
-  yaml.Text(0, "version", kVersion, "mcrewave version");
+  SummaryHeaderYaml(run.config, "the modulus E identified by output-error least squares J(E)",
+                    &yaml);
   yaml.Text(0, "functional", OuterFunctionalToString(run.config.outer.functional),
             "outer.functional");
   yaml.Number(0, "identified_modulus", identified, "[Pa] E minimising J");
@@ -746,10 +762,7 @@ std::string LeastSquaresSummaryYaml(const IdentificationRun& run) {
                                 run.prefilter_cutoff, "J", "s", &yaml);
 
   CostCurveYaml(run.cost_curve, &yaml);
-  if (run.zones.ran) {
-    for (const std::string& line : ZonesYamlLines(run.zones)) yaml.Raw(line);
-  }
-  ConfigYaml(run.config, &yaml);
+  ZonesAndConfigYaml(run, &yaml);
   return yaml.str();
 }
 
@@ -788,9 +801,8 @@ std::string SummaryYaml(const IdentificationRun& run) {
   const double identified = run.identified_modulus();
   const double reference = run.reference_known ? run.config.model.modulus : NAN;
   YamlWriter yaml;
-  yaml.Raw("# mcrewave identify run: the modulus E identified by minimising the MCRE cost e^2(E)");
-  if (!run.config.source_path.empty()) yaml.Raw("# config: " + run.config.source_path);
-  yaml.Text(0, "version", kVersion, "mcrewave version");
+  SummaryHeaderYaml(run.config, "the modulus E identified by minimising the MCRE cost e^2(E)",
+                    &yaml);
   yaml.Number(0, "identified_modulus", identified, "[Pa] E minimising e^2");
   yaml.Number(0, "reference_modulus", reference,
               "[Pa] E the synthetic data were made with (null: unknown, CSV data)");
@@ -831,10 +843,7 @@ std::string SummaryYaml(const IdentificationRun& run) {
                run.outer.scan_sweeps + run.sweeps + run.cost_curve_sweeps + run.uncertainty.sweeps,
                "scan, optimiser, cost curve and uncertainty");
 
-  if (run.zones.ran) {
-    for (const std::string& line : ZonesYamlLines(run.zones)) yaml.Raw(line);
-  }
-  ConfigYaml(run.config, &yaml);
+  ZonesAndConfigYaml(run, &yaml);
   return yaml.str();
 }
 
@@ -1176,11 +1185,10 @@ void MatrixZonesYaml(const IdentificationRun& run, YamlWriter* yaml) {
 std::string MatrixLeastSquaresSummaryYaml(const IdentificationRun& run, const Config& config) {
   const ModulusStage& stage = run;
   YamlWriter yaml;
-  yaml.Raw(
-      "# mcrewave identify run: the zone moduli of a structure given by matrices, by output-error "
-      "least squares");
-  if (!config.source_path.empty()) yaml.Raw("# config: " + config.source_path);
-  yaml.Text(0, "version", kVersion, "mcrewave version");
+  SummaryHeaderYaml(config,
+                    "the zone moduli of a structure given by matrices, by output-error least "
+                    "squares",
+                    &yaml);
   yaml.Text(0, "functional", "least_squares", "outer.functional (docs/formulation.md section 8)");
   MatrixModelAndDataYaml(run, config, &yaml);
   if (run.homogeneous_ran) {
@@ -1217,9 +1225,7 @@ std::string MatrixSummaryYaml(const IdentificationRun& run) {
   if (run.least_squares) return MatrixLeastSquaresSummaryYaml(run, config);
   const ModulusStage& stage = run;
   YamlWriter yaml;
-  yaml.Raw("# mcrewave identify run: the zone moduli of a structure given by matrices, by the MCRE");
-  if (!config.source_path.empty()) yaml.Raw("# config: " + config.source_path);
-  yaml.Text(0, "version", kVersion, "mcrewave version");
+  SummaryHeaderYaml(config, "the zone moduli of a structure given by matrices, by the MCRE", &yaml);
   MatrixModelAndDataYaml(run, config, &yaml);
   if (run.homogeneous_ran) {
     // The bar's headline keys, of the homogeneous stage.
