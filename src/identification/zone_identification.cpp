@@ -41,9 +41,9 @@ std::string ZoneIdentificationSummary::FullReport() const {
   out << "Zone identification\n"
       << "  termination:        " << TerminationTypeToString(termination) << "\n"
       << "  message:            " << message << "\n"
-      << "  homogeneous E*:     " << homogeneous_modulus << " Pa\n"
+      << "  homogeneous E*:     " << homogeneous_modulus << " Pa (-1: the zones started apart)\n"
       << (least_squares ? "  J:                  " : "  e^2:                ") << cost
-      << (least_squares ? " s" : " J s") << " (at E*: " << homogeneous_cost << ")\n"
+      << (least_squares ? " s" : " J s") << " (at the start: " << homogeneous_cost << ")\n"
       << "  weight:             " << regularized.weight << " (" << regularized.weight_choice
       << ", target misfit " << regularized.target_misfit << ", noise "
       << (least_squares ? "J" : "e^2") << " / J_rest " << noise_cost << ")\n";
@@ -59,7 +59,7 @@ std::string ZoneIdentificationSummary::FullReport() const {
     if (static_cast<std::size_t>(z) < zone_start.size()) {
       out << " [" << zone_start[z] << ", " << zone_end[z] << "] m";
     }
-    out << ": " << moduli[z] << " Pa (" << moduli[z] / homogeneous_modulus << " E*)\n";
+    out << ": " << moduli[z] << " Pa (" << moduli[z] / start_moduli[z] << " of its start)\n";
   }
   out << regularized.minimizer.FullReport();
   return out.str();

@@ -6,9 +6,11 @@
 // solve, de^2/dE_z = -(1/(2 E_z,nom)) sum_j c_j h W_j^T K_z (W_j + 2 U_j)
 // (MatrixMcreProblem::CostGradients).
 //
-// Started from the homogeneous E* of the scalar identification, on p_z = log(E_z / E*)
-// with d cost / d p_z = (d cost / d E_z) E_z, the cost the scaled e^2 / J_rest (least
-// squares: J / J_rest), every zone within [outer.lower_bound, outer.upper_bound].
+// Started from the homogeneous E* of the scalar identification (or, on a structure whose
+// zones' nominal moduli differ, from those), on p_z = log(E_z / E_z,ref) with
+// d cost / d p_z = (d cost / d E_z) E_z, E_z,ref the objective's reference (E* on the bar,
+// the nominal moduli on a structure given by matrices), the cost the scaled e^2 / J_rest
+// (least squares: J / J_rest), every zone within [outer.lower_bound, outer.upper_bound].
 //
 // The regularisation's discrepancy target (optim/regularization.h) and the merging of
 // zones need the misfit the noise alone explains: ExpectedNoiseCost, the mean scaled e^2
