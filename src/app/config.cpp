@@ -737,7 +737,9 @@ const std::vector<Key>& KeyTable() {
           EnumByName<RegularizationKind>({RegularizationKind::kNone, RegularizationKind::kTikhonov,
                                           RegularizationKind::kTotalVariation},
                                          RegularizationKindToString, StringToRegularizationKind),
-          "", "penalty on the jumps of log E between neighbouring zones"),
+          "",
+          "penalty on the jumps of log E between consecutive zones (along the bar, or in the "
+          "manifest's list)"),
       MakeKey("zone_identification.regularization_weight", &Config::zone_identification,
               &ZoneIdentificationOptions::regularization, &RegularizationOptions::weight, Number(),
               "", "lambda of the penalty; < 0: by weight_rule"),
