@@ -14,6 +14,7 @@
 
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
+#include "mcrewave/app/results.h"
 
 namespace mcrewave {
 namespace {
@@ -115,6 +116,33 @@ TEST(ZoneIdentificationRunTest, InverseCrimeOfTenZonesThroughRunIdentification) 
   ASSERT_EQ(run.zones.truth_element_moduli.size(), 25);
   EXPECT_NEAR(run.zones.truth_element_moduli[15], 140e9, 1e-3);
   EXPECT_NEAR(run.zones.truth_element_moduli[17], 200e9, 1e-3);
+}
+
+// The bar's zones report their first-order covariance as a manifest's zones do
+// (EstimateZoneUncertainty on the zoned bar at the zone moduli), in summary.yaml's zones:
+// block. Two free zones of the quick case at SNR 20 each know less than the homogeneous
+// E* that pools the whole bar.
+TEST(ZoneIdentificationRunTest, TheBarsZonesReportTheirUncertainty) {
+  const Config config =
+      LoadConfig(std::string(MCREWAVE_SOURCE_DIR) + "/configs/quick.yaml",
+                 {"model.zone_count=2", "zone_identification.regularization=none"});
+  const IdentificationRun run = RunIdentification(config, LoadMeasurements(config));
+  ASSERT_TRUE(run.IsUsable()) << run.outer.message;
+  ASSERT_TRUE(run.zones.summary.IsSolutionUsable()) << run.zones.summary.FullReport();
+  ASSERT_TRUE(run.uncertainty.available) << run.uncertainty.message;
+  ASSERT_TRUE(run.zone_uncertainty.available) << run.zone_uncertainty.message;
+  ASSERT_EQ(run.zone_uncertainty.std_dev.size(), 2);
+  // std(E_z) / std(E*): measured 1.50 (the clamped half) and 2.98 (the loaded half),
+  // relative std(E_z) 0.72 % and 1.43 %.
+  for (int z = 0; z < 2; ++z) {
+    const double ratio = run.zone_uncertainty.std_dev[z] / run.uncertainty.std_dev;
+    EXPECT_GT(ratio, 1.0) << z;
+    EXPECT_LT(ratio, 30.0) << z;
+  }
+  EXPECT_EQ(run.zone_uncertainty.samples, config.uncertainty.samples);
+  const std::string yaml = SummaryYaml(run);
+  EXPECT_NE(yaml.find("\n  uncertainty:"), std::string::npos) << yaml;
+  EXPECT_NE(yaml.find("      - {index: 1, std_dev: "), std::string::npos) << yaml;
 }
 
 TEST(ZoneIdentificationRunTest, OneZoneDoesNothing) {

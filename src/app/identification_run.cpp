@@ -357,8 +357,35 @@ IdentificationRun RunIdentification(const Config& config, const ChannelSet& data
   // (zone_identification_run.h).
   run.zones =
       RunZoneIdentification(config, IdentificationZoneLayout(config), run, TruthZones(config));
+  if (run.zones.ran && run.zones.summary.moduli.size() > 0) {
+    run.zone_uncertainty = BarZoneUncertainty(config, run);
+    spdlog::info("zones: uncertainty {}", run.zone_uncertainty.message);
+  }
   run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return run;
+}
+
+ZoneUncertainty BarZoneUncertainty(const Config& config, const IdentificationRun& run) {
+  const ZoneIdentificationSummary& zones = run.zones.summary;
+  const BarModel bar(config.model, run.zones.layout.ElementZones(config.model));
+  const MatrixModelData model = BarRunModel(bar, run.data, run.ends);
+  McreObjective objective =
+      MatrixMcreObjective(model, run.data, config.mcre, config.time.theta, config.inner,
+                          Factorization::kAutomatic, zones.homogeneous_modulus);
+  const Matrix& warm_start = run.solution.WarmStart();
+  const StreamingCoupledProblem& problem = objective.problem();
+  if (warm_start.cols() == problem.num_steps() + 1 &&
+      (warm_start.rows() == problem.num_nodes() || warm_start.rows() == problem.num_traces())) {
+    objective.SetWarmStart(warm_start);
+  }
+  if (!objective.EvaluateModuli(zones.moduli, false).usable) {
+    ZoneUncertainty unavailable;
+    unavailable.message = "the coupled solve at the zone moduli is not usable";
+    return unavailable;
+  }
+  return EstimateZoneUncertainty(config.uncertainty, model, run.data, config.mcre,
+                                 config.time.theta, config.inner, zones.moduli,
+                                 objective.last_solution(), run.noise);
 }
 
 ErrorMap BarErrorMap(const Config& config, const IdentificationRun& run) {

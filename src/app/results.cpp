@@ -711,11 +711,28 @@ void SummaryHeaderYaml(const Config& config, const std::string& title, YamlWrite
   yaml->Text(0, "version", kVersion, "mcrewave version");
 }
 
+// The zones: block's uncertainty: of the bar's zone moduli (BarZoneUncertainty).
+void BarZoneUncertaintyYaml(const IdentificationRun& run, YamlWriter* yaml) {
+  const ZoneUncertainty& uncertainty = run.zone_uncertainty;
+  const Vector& moduli = run.zones.summary.moduli;
+  yaml->Line(1, "uncertainty", "", "first order, from the noise drawn (uncertainty:)");
+  yaml->Text(2, "message", uncertainty.message);
+  yaml->Line(2, "zones", "", "std_dev [Pa] null when not available");
+  for (Eigen::Index z = 0; z < moduli.size(); ++z) {
+    const double std_dev = uncertainty.available ? uncertainty.std_dev[z] : NAN;
+    yaml->Raw("      - {index: " + std::to_string(z) + ", std_dev: " + Format(std_dev) +
+              ", relative_std_dev: " + Format(std_dev / moduli[z]) + "}");
+  }
+  yaml->Integer(2, "samples", uncertainty.samples, "noise draws");
+  yaml->Integer(2, "sweeps", uncertainty.sweeps, "of the curvature's and the noise's solves");
+}
+
 // The end of the bar's summary.yaml: its zones: block when it has zones, then the
 // resolved config.
 void ZonesAndConfigYaml(const IdentificationRun& run, YamlWriter* yaml) {
   if (run.zones.ran) {
     for (const std::string& line : ZonesYamlLines(run.zones)) yaml->Raw(line);
+    if (!run.least_squares) BarZoneUncertaintyYaml(run, yaml);
   }
   ConfigYaml(run.config, yaml);
 }

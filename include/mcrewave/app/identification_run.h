@@ -185,7 +185,7 @@ struct IdentificationRun : ModulusStage {
   // The model's outputs H U at the identified moduli, a row per sensor.
   Matrix model_outputs;
   // The first-order uncertainty of the identified zone moduli (uncertainty:), drawn at
-  // `noise` (EstimateZoneUncertainty).
+  // `noise` (EstimateZoneUncertainty; on the bar BarZoneUncertainty, with zones).
   ZoneUncertainty zone_uncertainty;
   // Why a run on a structure given by matrices is not usable ("" when it is).
   std::string failure;
@@ -265,6 +265,11 @@ std::string ModulusOnBoundMessage(double modulus, const IdentificationOptions& o
 // (run.misfit is set).
 constexpr double kImplausibleMisfitFactor = 10.0;
 std::string ImplausibleMisfitMessage(const IdentificationRun& run);
+
+// The first-order uncertainty of the bar's zone moduli (EstimateZoneUncertainty on the
+// zoned bar, at run.zones' moduli, from a solve there warm-started from run.solution,
+// drawn at run.noise). Precondition: by the MCRE, run.zones ran with usable moduli.
+ZoneUncertainty BarZoneUncertainty(const Config& config, const IdentificationRun& run);
 
 // Why the run's results cannot be reported, "" when they can: a structure given by
 // matrices says so in run.failure; the bar's identification did not converge

@@ -22,7 +22,9 @@
 //   error_map.csv       each element's share of the constitutive gap at the identified
 //                       E, and error_map_spacetime.dat its space-time density
 //                       (mcre/error_map.h)
-//   zones.csv, ...      with zones, WriteZoneResults' files (zone_identification_run.h)
+//   zones.csv, ...      with zones, WriteZoneResults' files (zone_identification_run.h),
+//                       and summary.yaml's zones: block with the zones' first-order
+//                       uncertainty (BarZoneUncertainty)
 //   cost_curve.png, ends.png, error_map.png, inner_residual.png (when there is a
 //                       residual to draw): with figures (gnuplot, pngcairo)
 #pragma once
