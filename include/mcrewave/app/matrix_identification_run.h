@@ -20,8 +20,8 @@
 //      manifest, its weight and the merging) from E* (or from the nominal moduli when
 //      they differ) within [outer.lower_bound, outer.upper_bound] Pa in every zone, inner
 //      solves by inner:. Then the error maps (zone and dof, and element when the
-//      model has element blocks and the inner solver keeps its fields) at the nominal and
-//      the identified moduli and the model's outputs at the identified moduli.
+//      model has element blocks) at the nominal and the identified moduli and the model's
+//      outputs at the identified moduli.
 //      With outer.functional: least_squares, the same stages on the output-error misfit
 //      J instead (the homogeneous one by OutputErrorModulusObjective, the zones by
 //      least_squares/matrix_output_error_objective.h), each sensor kind normalised by its
@@ -139,8 +139,9 @@ NoiseLevels MatrixNoiseLevels(const Config& config, const MatrixMeasurements& me
 ChannelSet MatrixMeasurementTable(const Config& config, const MatrixModelData& model,
                                   const ChannelSet& histories);
 
-// Step 3 above; without maps_and_uncertainty, the moduli alone (no error map, model
-// outputs or uncertainty: what a study needs of each run). Never throws for the
+// Step 3 above, into the one run type; with maps_and_uncertainty, run.model holds a copy
+// of `model` for the writer (WriteIdentificationResults). Without, the moduli alone (no
+// error map, model outputs or uncertainty: what a study needs of each run). Never throws for the
 // optimiser or the inner solver: their failures are in run.failure (and run.outer).
 // Progress: one info line per evaluation.
 IdentificationRun RunMatrixIdentification(const Config& config, const MatrixModelData& model,
