@@ -727,6 +727,17 @@ void BarZoneUncertaintyYaml(const IdentificationRun& run, YamlWriter* yaml) {
   yaml->Integer(2, "sweeps", uncertainty.sweeps, "of the curvature's and the noise's solves");
 }
 
+// The bar's reference_modulus and relative_error: E of synthetic data against the
+// identified E (null for CSV data).
+void ReferenceYaml(const IdentificationRun& run, YamlWriter* yaml) {
+  const double reference = run.reference_known ? run.config.model.modulus : NAN;
+  yaml->Number(0, "reference_modulus", reference,
+               "[Pa] E the synthetic data were made with (null: unknown, CSV data)");
+  yaml->Number(0, "relative_error",
+               run.reference_known ? (run.identified_modulus() - reference) / reference : NAN,
+               "(identified - reference) / reference (null when unknown)");
+}
+
 // The end of the bar's summary.yaml: its zones: block when it has zones, then the
 // resolved config.
 void ZonesAndConfigYaml(const IdentificationRun& run, YamlWriter* yaml) {
@@ -740,17 +751,13 @@ void ZonesAndConfigYaml(const IdentificationRun& run, YamlWriter* yaml) {
 std::string LeastSquaresSummaryYaml(const IdentificationRun& run) {
   const IdentificationSummary& outer = run.outer;
   const double identified = run.identified_modulus();
-  const double reference = run.reference_known ? run.config.model.modulus : NAN;
   YamlWriter yaml;
   SummaryHeaderYaml(run.config, "the modulus E identified by output-error least squares J(E)",
                     &yaml);
   yaml.Text(0, "functional", OuterFunctionalToString(run.config.outer.functional),
             "outer.functional");
   yaml.Number(0, "identified_modulus", identified, "[Pa] E minimising J");
-  yaml.Number(0, "reference_modulus", reference,
-              "[Pa] E the synthetic data were made with (null: unknown, CSV data)");
-  yaml.Number(0, "relative_error", run.reference_known ? (identified - reference) / reference : NAN,
-              "(identified - reference) / reference (null when unknown)");
+  ReferenceYaml(run, &yaml);
   yaml.Number(0, "cost", run.fit.cost,
               "[s] J = 1/2 sum_k c_k h (misfit / noise level)^2 at the identified modulus");
   yaml.Integer(0, "evaluations", outer.scan_evaluations + outer.evaluations,
@@ -816,15 +823,11 @@ std::string SummaryYaml(const IdentificationRun& run) {
   if (run.least_squares) return LeastSquaresSummaryYaml(run);
   const IdentificationSummary& outer = run.outer;
   const double identified = run.identified_modulus();
-  const double reference = run.reference_known ? run.config.model.modulus : NAN;
   YamlWriter yaml;
   SummaryHeaderYaml(run.config, "the modulus E identified by minimising the MCRE cost e^2(E)",
                     &yaml);
   yaml.Number(0, "identified_modulus", identified, "[Pa] E minimising e^2");
-  yaml.Number(0, "reference_modulus", reference,
-              "[Pa] E the synthetic data were made with (null: unknown, CSV data)");
-  yaml.Number(0, "relative_error", run.reference_known ? (identified - reference) / reference : NAN,
-              "(identified - reference) / reference (null when unknown)");
+  ReferenceYaml(run, &yaml);
   yaml.Number(0, "cost", run.cost(), "[J s] e^2 at the identified modulus");
   yaml.Integer(0, "evaluations", outer.scan_evaluations + outer.evaluations,
                "evaluations of the identification: the scans' and the refinements' (the search "
@@ -906,29 +909,12 @@ std::vector<std::string> WriteIdentificationResults(const IdentificationRun& run
 
 namespace {
 
-// The names of the zones, loads and sensors of a structure given by matrices, in its order.
-std::vector<std::string> ZoneNames(const MatrixModelData& model) {
-  std::vector<std::string> names;
-  for (const MatrixModelZone& zone : model.zones) names.push_back(zone.name);
-  return names;
-}
-std::vector<std::string> LoadNames(const MatrixModelData& model) {
-  std::vector<std::string> names;
-  for (const MatrixModelLoad& load : model.loads) names.push_back(load.channel);
-  return names;
-}
-std::vector<std::string> SensorNames(const MatrixModelData& model) {
-  std::vector<std::string> names;
-  for (const MatrixModelSensor& sensor : model.sensors) names.push_back(sensor.channel);
-  return names;
-}
-
 // Least squares has no error map: its columns are left empty.
 std::string MatrixZonesCsv(const IdentificationRun& run) {
   std::vector<ZoneRow> rows(static_cast<std::size_t>(run.nominal_moduli.size()));
   for (int z = 0; z < run.nominal_moduli.size(); ++z) {
     ZoneRow& row = rows[static_cast<std::size_t>(z)];
-    row.name = ZoneNames(*run.model)[static_cast<std::size_t>(z)];
+    row.name = run.model->zones[static_cast<std::size_t>(z)].name;
     row.nominal_modulus = run.nominal_moduli[z];
     row.modulus = run.identified_moduli[z];
     if (run.truth_moduli.size() > 0) row.truth_modulus = run.truth_moduli[z];
@@ -949,15 +935,18 @@ std::string MatrixZonesCsv(const IdentificationRun& run) {
 // t, each load as used, each sensor as used and as the identified model gives it.
 std::string MatrixFitCsv(const IdentificationRun& run) {
   std::string csv = "t";
-  for (const std::string& load : LoadNames(*run.model)) csv += "," + load;
-  for (const std::string& sensor : SensorNames(*run.model)) {
-    csv += "," + sensor + "_measured," + sensor + "_model";
+  for (const MatrixModelLoad& load : run.model->loads) csv += "," + load.channel;
+  for (const MatrixModelSensor& sensor : run.model->sensors) {
+    csv += "," + sensor.channel + "_measured," + sensor.channel + "_model";
   }
   csv += "\n";
   std::vector<const Vector*> loads, sensors;
-  for (const std::string& load : LoadNames(*run.model)) loads.push_back(&run.data.Values(load));
-  for (const std::string& sensor : SensorNames(*run.model))
-    sensors.push_back(&run.data.Values(sensor));
+  for (const MatrixModelLoad& load : run.model->loads) {
+    loads.push_back(&run.data.Values(load.channel));
+  }
+  for (const MatrixModelSensor& sensor : run.model->sensors) {
+    sensors.push_back(&run.data.Values(sensor.channel));
+  }
   for (int j = 0; j <= run.data.num_steps(); ++j) {
     csv += Format(j * run.data.time_step);
     for (const Vector* load : loads) csv += "," + Format((*load)[j]);
@@ -1004,7 +993,7 @@ std::string MatrixElementMapCsv(const IdentificationRun& run, const MatrixModelD
 
 std::string MatrixEvaluationsCsv(const IdentificationRun& run) {
   std::string csv = "evaluation";
-  for (const std::string& zone : ZoneNames(*run.model)) csv += "," + zone + "_pa";
+  for (const MatrixModelZone& zone : run.model->zones) csv += "," + zone.name + "_pa";
   csv += ",scaled_cost,usable,gradient_norm\n";
   for (std::size_t i = 0; i < run.zones.summary.history.size(); ++i) {
     const ZoneEvaluation& e = run.zones.summary.history[i];
@@ -1051,8 +1040,8 @@ std::string MatrixZonesScript(const IdentificationRun& run, const std::string& f
 std::string MatrixFitScript(const IdentificationRun& run, const std::string& folder,
                             bool prefiltered, const std::vector<SensorKind>& kinds) {
   const std::string csv = GnuplotString(folder + "/fit.csv");
-  const int panels = std::min<int>(6, static_cast<int>(SensorNames(*run.model).size()));
-  const int loads = static_cast<int>(LoadNames(*run.model).size());
+  const int panels = std::min<int>(6, static_cast<int>(run.model->sensors.size()));
+  const int loads = static_cast<int>(run.model->loads.size());
   std::ostringstream script;
   script << GnuplotPngTerminal() << "set terminal pngcairo size 1000," << 220 * std::max(panels, 1)
          << "\nset termoption noenhanced\nset datafile separator ','\nset multiplot layout " << std::max(panels, 1)
@@ -1062,7 +1051,7 @@ std::string MatrixFitScript(const IdentificationRun& run, const std::string& fol
   for (int k = 0; k < panels; ++k) {
     const bool strain = kinds[static_cast<std::size_t>(k)] == SensorKind::kStrain;
     const int column = 2 + loads + 2 * k;
-    script << "set title " << GnuplotString(SensorNames(*run.model)[static_cast<std::size_t>(k)])
+    script << "set title " << GnuplotString(run.model->sensors[static_cast<std::size_t>(k)].channel)
            << "\nset ylabel '" << (strain ? "strain [1e-6]" : "u [um]") << "'\nplot " << csv
            << " skip 1 using ($1*1e3):($" << column << "*1e6) with lines lc rgb '#aaaaaa' notitle, "
            << csv << " skip 1 using ($1*1e3):($" << column + 1
@@ -1078,9 +1067,9 @@ void MatrixModelAndDataYaml(const IdentificationRun& run, const Config& config, 
   yaml->Text(1, "kind", ModelKindToString(config.structure.kind));
   yaml->Text(1, "manifest", run.config.structure.manifest);
   yaml->Integer(1, "dofs", run.model->dofs());
-  yaml->Integer(1, "zones", static_cast<long>(ZoneNames(*run.model).size()));
-  yaml->Integer(1, "loads", static_cast<long>(LoadNames(*run.model).size()));
-  yaml->Integer(1, "sensors", static_cast<long>(SensorNames(*run.model).size()));
+  yaml->Integer(1, "zones", static_cast<long>(run.model->zones.size()));
+  yaml->Integer(1, "loads", static_cast<long>(run.model->loads.size()));
+  yaml->Integer(1, "sensors", static_cast<long>(run.model->sensors.size()));
   yaml->Integer(1, "supports", static_cast<int>(run.model->supports.size()));
   yaml->Line(0, "data", "");
   yaml->Text(1, "source", run.data_source);
@@ -1094,10 +1083,10 @@ void MatrixUncertaintyYaml(const IdentificationRun& run, YamlWriter* yaml) {
   yaml->Line(0, "uncertainty", "", "first order, from the noise drawn (uncertainty:)");
   yaml->Text(1, "message", uncertainty.message);
   yaml->Line(1, "zones", "", "std_dev [Pa] null when not available");
-  for (std::size_t z = 0; z < ZoneNames(*run.model).size(); ++z) {
+  for (std::size_t z = 0; z < run.model->zones.size(); ++z) {
     const auto index = static_cast<Eigen::Index>(z);
     const double std_dev = uncertainty.available ? uncertainty.std_dev[index] : NAN;
-    yaml->Raw("    - {name: " + Quoted(ZoneNames(*run.model)[z]) + ", std_dev: " + Format(std_dev) +
+    yaml->Raw("    - {name: " + Quoted(run.model->zones[z].name) + ", std_dev: " + Format(std_dev) +
               ", relative_std_dev: " + Format(std_dev / run.identified_moduli[index]) + "}");
   }
   yaml->Integer(1, "samples", uncertainty.samples, "noise draws");
@@ -1134,7 +1123,7 @@ void MatrixZonesYaml(const IdentificationRun& run, YamlWriter* yaml) {
              run.homogeneous_ran ? "identification of every zone modulus from the homogeneous E*"
                                  : "identification of every zone modulus from the nominal moduli");
   yaml->Line(1, "functional", run.least_squares ? "least_squares" : "mcre", "outer.functional");
-  yaml->Integer(1, "count", static_cast<long>(ZoneNames(*run.model).size()));
+  yaml->Integer(1, "count", static_cast<long>(run.model->zones.size()));
   const ZoneIdentificationSummary& zones = run.zones.summary;
   const BoundedMinimizerSummary& minimizer = zones.regularized.minimizer;
   yaml->Line(1, "termination", TerminationTypeToString(zones.termination));
@@ -1180,7 +1169,7 @@ void MatrixZonesYaml(const IdentificationRun& run, YamlWriter* yaml) {
   for (int z = 0; z < run.nominal_moduli.size(); ++z) {
     const bool truth = run.truth_moduli.size() > 0;
     std::string entry = "    - {index: " + std::to_string(z) +
-                        ", name: " + Quoted(ZoneNames(*run.model)[static_cast<std::size_t>(z)]) +
+                        ", name: " + Quoted(run.model->zones[static_cast<std::size_t>(z)].name) +
                         ", nominal: " + Format(run.nominal_moduli[z]) +
                         ", modulus: " + Format(run.identified_moduli[z]) +
                         ", truth: " + Format(truth ? run.truth_moduli[z] : NAN) +
