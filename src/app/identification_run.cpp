@@ -372,12 +372,8 @@ ZoneUncertainty BarZoneUncertainty(const Config& config, const IdentificationRun
   McreObjective objective =
       MatrixMcreObjective(model, run.data, config.mcre, config.time.theta, config.inner,
                           Factorization::kAutomatic, zones.homogeneous_modulus);
-  const Matrix& warm_start = run.solution.WarmStart();
-  const StreamingCoupledProblem& problem = objective.problem();
-  if (warm_start.cols() == problem.num_steps() + 1 &&
-      (warm_start.rows() == problem.num_nodes() || warm_start.rows() == problem.num_traces())) {
-    objective.SetWarmStart(warm_start);
-  }
+  // E*'s solution, on the same mesh, steps and channels: its shape is the zoned problem's.
+  objective.SetWarmStart(run.solution.WarmStart());
   if (!objective.EvaluateModuli(zones.moduli, false).usable) {
     ZoneUncertainty unavailable;
     unavailable.message = "the coupled solve at the zone moduli is not usable";

@@ -108,7 +108,8 @@ struct IdentificationRun : ModulusStage {
   // the channels of data.channels; on a structure given by matrices every channel of the
   // model, in its order (loads, then sensors).
   ChannelSet data;
-  std::string data_source;  // the CSV's path, or "synthetic"
+  std::string
+      data_source;  // a manifest's run: the CSV's path, or "synthetic" (the bar's: config.data)
   // The bar's end displacement channels among them (data.channels).
   EndDisplacementChannels ends;
   // The structure every solve of the run takes: BarRunModel of config.model, data and
