@@ -133,7 +133,8 @@ TEST(ComparatorStudyTest, OnAMatrixModelEachRunIsIdentifyRunsIdentificationOfThe
   std::getline(runs, header);
   EXPECT_EQ(header,
             "model_error,snr,seed,functional,data,zone,converged,modulus_pa,relative_error,"
-            "local_minima,evaluations,wall_time_s,search_modulus_pa,message");
+            "local_minima,evaluations,wall_time_s,search_modulus_pa,support_switched,"
+            "support_statistic,message");
   std::ifstream statistics(folder + "/statistics.csv");
   std::getline(statistics, header);
   EXPECT_EQ(header.substr(0, 33), "model_error,functional,data,zone,");
@@ -178,8 +179,8 @@ TEST(ComparatorStudyTest, TheSoftZoneErrorIsTheBarsAlone) {
     FAIL() << "soft_zone was accepted on a matrix model";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what())
-                  .find("study.comparator.errors: soft_zone (the bar softer by its clamp) "
-                        "applies to the bar only"),
+                  .find("study.comparator.errors: soft_zone (the bar softer by its clamp, or "
+                        "its clamp a spring) applies to the bar only"),
               std::string::npos)
         << error.what();
   }

@@ -144,6 +144,9 @@ void ExpectSameConfigLaterKeys(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.mcre.weights.clamp_displacement_weight,
             actual.mcre.weights.clamp_displacement_weight);
   EXPECT_EQ(expected.mcre.clamp, actual.mcre.clamp);
+  EXPECT_EQ(expected.mcre.support_check, actual.mcre.support_check);
+  EXPECT_EQ(expected.mcre.support_check_threshold, actual.mcre.support_check_threshold);
+  EXPECT_EQ(expected.data.support_stiffness, actual.data.support_stiffness);
   EXPECT_EQ(expected.search.functional, actual.search.functional);
   EXPECT_EQ(expected.search.displacement_weight, actual.search.displacement_weight);
   EXPECT_EQ(expected.search.strain_weight, actual.search.strain_weight);
@@ -659,6 +662,7 @@ data:
   sensors: [u@0.1, e@0.25]
   channels: [fL, f0, uL, u@0.1, e@0.25]
   truth_zones: [{start: 0.1, end: 0.15, modulus: 1.4e11}]
+  support_stiffness: 2e8
 mcre:
   w_u: 0.3
   w_f: 0.14285714285714285
@@ -667,6 +671,8 @@ mcre:
   w_u0: 0.25
   reference_modulus: 70e9
   clamp: pinned
+  support_check: warn
+  support_check_threshold: 2.5
 inner:
   method: adaptive_relaxation
   tolerance: 1e-11
@@ -866,7 +872,7 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
     EXPECT_EQ(bar_keys.count(key), 1u) << key;
   }
   // The bar reads all but the 4 matrix keys; a matrix run none of the section study:
-  // and 14 single keys fewer (it reads the dense solvers' limits, Riccati and shooting
+  // and 15 single keys fewer (it reads the dense solvers' limits, Riccati and shooting
   // running on any model, and the zones' regularisation and merging).
   EXPECT_EQ(bar_keys.size(), every.size() - 4);
   std::size_t sections = 0;
@@ -874,7 +880,7 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
     const std::string section = key.substr(0, key.find('.'));
     sections += section == "study" ? 1 : 0;
   }
-  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 14);
+  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 15);
   // Values as resolved: the matrix run's own.
   EXPECT_EQ(matrix_keys.at("model.manifest"), FlatKeys(ConfigToYaml(matrix)).at("model.manifest"));
 }
@@ -1075,6 +1081,28 @@ TEST(ConfigTest, EmptyTextAndEmptySectionsGiveDefaults) {
 TEST(ConfigTest, InfiniteSnrIsAccepted) {
   EXPECT_EQ(ParseConfig("data:\n  snr: .inf\n", "a.yaml").data.snr,
             std::numeric_limits<double>::infinity());
+}
+
+TEST(ConfigTest, ASupportSpringIsPositiveAndTheExactTruthHasNone) {
+  EXPECT_EQ(ParseConfig("data:\n  support_stiffness: 2e8\n", "a.yaml").data.support_stiffness, 2e8);
+  ExpectInputError([] { ParseConfig("data:\n  support_stiffness: -1\n", "a.yaml"); },
+                   {"a.yaml", "data.support_stiffness must be positive in N/m"});
+  ExpectInputError(
+      [] { ParseConfig("data:\n  truth: exact\n  support_stiffness: 2e8\n", "a.yaml"); },
+      {"a.yaml", "data.support_stiffness: the exact truth"});
+}
+
+TEST(ConfigTest, TheSupportCheckIsReadAndChecked) {
+  const Config defaults;
+  EXPECT_EQ(defaults.mcre.support_check, SupportCheckAction::kSwitch);
+  const Config config =
+      ParseConfig("mcre:\n  support_check: warn\n  support_check_threshold: 2.5\n", "a.yaml");
+  EXPECT_EQ(config.mcre.support_check, SupportCheckAction::kWarn);
+  EXPECT_EQ(config.mcre.support_check_threshold, 2.5);
+  ExpectInputError([] { ParseConfig("mcre:\n  support_check: maybe\n", "a.yaml"); },
+                   {"a.yaml", "mcre.support_check", "'switch', 'warn', 'off'"});
+  ExpectInputError([] { ParseConfig("mcre:\n  support_check_threshold: 0\n", "a.yaml"); },
+                   {"a.yaml", "mcre.support_check_threshold must be a finite positive number"});
 }
 
 TEST(ConfigTest, OverridesApplyAfterTheFile) {

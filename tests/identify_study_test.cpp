@@ -379,7 +379,7 @@ namespace {
 
 TEST(IdentifyStudyComparatorTest, BothFunctionalsOnTheSameDataWithEveryModelError) {
   // The quick case (25 elements, 300 steps), SNR inf and 20 with 2 seeds, every
-  // model error: 3 data sets x 5 errors x 4 identifications.
+  // model error: 3 data sets x 8 errors x 4 identifications.
   const std::string folder = testing::FreshDirectory("identify_study_comparator") + "/results";
   const testing::RunResult result = testing::RunIdentify(
       "study " + testing::SourcePath("configs/quick.yaml") + " -o " + folder +
@@ -411,12 +411,68 @@ TEST(IdentifyStudyComparatorTest, BothFunctionalsOnTheSameDataWithEveryModelErro
     if (cells[0] == "soft_zone" && cells[1] == "inf") {
       EXPECT_LT(error, 0.0) << line;
     }
+    // A spring of 10 E S / L at the clamp: the MCRE with the paper's measured clamp
+    // (quick.yaml) does not trust it, least squares does (measured: MCRE -2.5e-4, least
+    // squares -16.6 %).
+    if (cells[0] == "support_10" && cells[1] == "inf") {
+      if (cells[3] == "mcre") {
+        EXPECT_LT(std::abs(error), 2.5e-3) << line;
+      } else {
+        EXPECT_LT(error, -0.1) << line;
+      }
+    }
   }
-  EXPECT_EQ(count, 3 * 5 * 4);
+  EXPECT_EQ(count, 3 * 8 * 4);
   EXPECT_EQ(converged, count);
   if (result.output.find("gnuplot not found") == std::string::npos) {
     EXPECT_GT(fs::file_size(folder + "/comparator/comparator.png"), 10000u);
   }
+}
+
+TEST(IdentifyStudyComparatorTest, ATrustedClampContradictedByTheDataIsTreatedAsMeasured) {
+  // The quick case with the default clamp (trusted, its weights and search), pre-filtered
+  // data at SNR inf and 20 (2 seeds) of the rigid clamp and of a spring of 10 E S / L:
+  // the MCRE tests u0 against f0 on every data set and switches on the spring's alone.
+  const std::string folder =
+      testing::FreshDirectory("identify_study_comparator_support") + "/results";
+  const testing::RunResult result = testing::RunIdentify(
+      "study " + testing::SourcePath("configs/quick.yaml") + " -o " + folder +
+      " --set study.kind=comparator --set study.comparator.snr=[.inf,20] --set "
+      "study.comparator.seeds=2 --set study.comparator.errors=[none,support_10] --set "
+      "study.comparator.data=[prefilter] --set mcre.clamp=trusted --set mcre.w_u=1e-7 --set "
+      "mcre.w_e=1e-7 --set mcre.w_r=1e-6 --set search.functional=pinned");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  std::istringstream runs(testing::ReadText(folder + "/comparator/runs.csv"));
+  std::string line;
+  std::getline(runs, line);
+  ASSERT_NE(line.find(",support_switched,support_statistic,"), std::string::npos) << line;
+  int count = 0;
+  for (; std::getline(runs, line); ++count) {
+    std::vector<std::string> cells;
+    std::istringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) cells.push_back(cell);
+    ASSERT_GE(cells.size(), 15u) << line;
+    EXPECT_EQ(cells[5], "1") << line;
+    const bool mcre = cells[3] == "mcre";
+    const bool spring = cells[0] == "support_10";
+    const double error = std::stod(cells[7]);
+    EXPECT_EQ(cells[12], mcre && spring ? "1" : "0") << line;
+    if (!mcre) {
+      EXPECT_EQ(cells[13], "nan") << line;
+      continue;
+    }
+    const double statistic = std::stod(cells[13]);
+    // Measured: t 1.0e4 (SNR inf), 47 and 50 on the spring, 0, 0.14 and -0.35 on the
+    // rigid clamp; the switched E -2.5e-4 (inf), +2.4e-3 and -2.8e-3 (SNR 20); least
+    // squares -16.6 %.
+    if (spring) {
+      EXPECT_GT(statistic, 2.0) << line;
+      EXPECT_LT(std::abs(error), cells[1] == "inf" ? 2.5e-3 : 1e-2) << line;
+    } else {
+      EXPECT_LT(statistic, 2.0) << line;
+    }
+  }
+  EXPECT_EQ(count, 2 * 3 * 2);
 }
 
 TEST(IdentifyStudyComparatorTest, PreFilteredDataOnlyWithATrustedOrPinnedClamp) {

@@ -271,6 +271,88 @@ void MeanAndStd(const Vector& values, double* mean, double* std) {
   *std = std::sqrt((values.array() - *mean).square().sum() / (values.size() - 1));
 }
 
+// The bar held at x = 0 by a spring k_s, M a + (K + k_s e_0 e_0^T) u = F(t) e_N, by the
+// trapezoidal rule written densely here (theta = 1/2 on (u, v)):
+//   (2 M / h + h/2 K_s) u_{k+1} = (2 M / h - h/2 K_s) u_k + 2 M v_k + h/2 (F_k + F_{k+1}) e_N,
+//   v_{k+1} = 2 (u_{k+1} - u_k) / h - v_k,
+// an integration independent of the theta integrator and its band factorisation.
+TEST(SimulationTest, ASpringSupportedTruthIsTheTrapezoidalRulesSolution) {
+  BarProperties bar;
+  bar.elements = 16;
+  const LoadOptions load;
+  const TimeOptions time;
+  DataOptions data;
+  data.truth_refinement = 1;
+  data.support_stiffness = 10.0 * bar.modulus * bar.section / bar.length;
+  const ChannelSet truth = SimulateTruth(bar, load, time, data);
+
+  const BarModel model(bar);
+  const int n = model.num_nodes();
+  const Matrix mass = Matrix(model.mass());
+  Matrix stiffness = Matrix(model.Stiffness(bar.modulus));
+  stiffness(0, 0) += data.support_stiffness;
+  const double h = time.step;
+  const Eigen::PartialPivLU<Matrix> lhs(2.0 * mass / h + 0.5 * h * stiffness);
+  const Matrix rhs = 2.0 * mass / h - 0.5 * h * stiffness;
+  Vector u = Vector::Zero(n), v = Vector::Zero(n);
+  double u0_error = 0.0, uL_error = 0.0, f0_error = 0.0;
+  const double uL_scale = truth.Values("uL").lpNorm<Eigen::Infinity>();
+  const double u0_scale = truth.Values("u0").lpNorm<Eigen::Infinity>();
+  for (int k = 0; k <= time.NumSteps(); ++k) {
+    u0_error = std::max(u0_error, std::abs(truth.Values("u0")[k] - u[0]) / u0_scale);
+    uL_error = std::max(uL_error, std::abs(truth.Values("uL")[k] - u[n - 1]) / uL_scale);
+    f0_error = std::max(f0_error, std::abs(truth.Values("f0")[k] + data.support_stiffness * u[0]) /
+                                      (data.support_stiffness * u0_scale));
+    if (k == time.NumSteps()) break;
+    Vector right = rhs * u + 2.0 * mass * v;
+    right[n - 1] += 0.5 * h * (load.Value(k * h) + load.Value((k + 1) * h));
+    const Vector next = lhs.solve(right);
+    v = 2.0 * (next - u) / h - v;
+    u = next;
+  }
+  RecordProperty("u0_error", Scientific(u0_error));
+  RecordProperty("uL_error", Scientific(uL_error));
+  // Measured: 7.1e-13, 7.2e-13 and 7.1e-13 of the channels' largest values over the
+  // 1750 steps; u0 reaches 0.19 of uL's largest value.
+  EXPECT_LT(u0_error, 7e-12);
+  EXPECT_LT(uL_error, 7e-12);
+  EXPECT_LT(f0_error, 7e-12);
+  EXPECT_GT(u0_scale, 0.1 * uL_scale);
+}
+
+TEST(SimulationTest, AStifferSpringTendsToTheClamp) {
+  // The spring's u0 falls as 1 / k_s and its channels tend to the clamped truth's.
+  BarProperties bar;
+  bar.elements = 16;
+  const LoadOptions load;
+  const TimeOptions time;
+  DataOptions clamped;
+  clamped.truth_refinement = 1;
+  const ChannelSet rigid = SimulateTruth(bar, load, time, clamped);
+  const double scale = bar.modulus * bar.section / bar.length;  // E S / L [N/m]
+  std::vector<double> uL_errors, f0_errors, u0_sizes;
+  for (const double factor : {1e3, 1e4}) {
+    DataOptions spring = clamped;
+    spring.support_stiffness = factor * scale;
+    const ChannelSet held = SimulateTruth(bar, load, time, spring);
+    uL_errors.push_back(RelativeMaxError(held.Values("uL"), rigid.Values("uL")));
+    f0_errors.push_back(RelativeMaxError(held.Values("f0"), rigid.Values("f0")));
+    u0_sizes.push_back(held.Values("u0").lpNorm<Eigen::Infinity>() /
+                       rigid.Values("uL").lpNorm<Eigen::Infinity>());
+  }
+  RecordProperty("uL_errors", Scientific(uL_errors[0]) + " " + Scientific(uL_errors[1]));
+  RecordProperty("f0_errors", Scientific(f0_errors[0]) + " " + Scientific(f0_errors[1]));
+  // Measured: u0 / max uL 1.9e-3 and 1.9e-4; uL 1.6e-2 and 1.6e-3, f0 1.8e-2 and 1.8e-3
+  // from the clamped channels: each tenfold for a tenfold stiffer spring.
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_LT(u0_sizes[i], 3e-3 / std::pow(10.0, i));
+    EXPECT_LT(uL_errors[i], 3e-2 / std::pow(10.0, i));
+    EXPECT_LT(f0_errors[i], 3e-2 / std::pow(10.0, i));
+  }
+  EXPECT_NEAR(uL_errors[0] / uL_errors[1], 10.0, 1.0);
+  EXPECT_NEAR(u0_sizes[0] / u0_sizes[1], 10.0, 0.5);
+}
+
 TEST(NoiseTest, NoiseLevelMatchesTheSnr) {
   // A long record (17501 samples per channel): the sample std is within ~0.6 % (1 sigma)
   // of the true one.

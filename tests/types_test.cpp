@@ -44,6 +44,8 @@ TEST(TypesTest, EveryEnumRoundTripsThroughItsNameTable) {
   ExpectTableRoundTrips(kZoningNames, ZoningToString, StringToZoning);
   ExpectTableRoundTrips(kModelKindNames, ModelKindToString, StringToModelKind);
   ExpectTableRoundTrips(kClampModelNames, ClampModelToString, StringToClampModel);
+  ExpectTableRoundTrips(kSupportCheckActionNames, SupportCheckActionToString,
+                        StringToSupportCheckAction);
   ExpectTableRoundTrips(kBarClampExportNames, BarClampExportToString, StringToBarClampExport);
   ExpectTableRoundTrips(kSearchFunctionalNames, SearchFunctionalToString, StringToSearchFunctional);
   ExpectTableRoundTrips(kFactorizationNames, FactorizationToString, StringToFactorization);

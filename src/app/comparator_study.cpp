@@ -36,6 +36,14 @@ constexpr double kDisplacementGain = 1.03;  // measured uL / true uL
 constexpr double kSoftZoneFactor = 0.9;     // E over the soft zone / E
 constexpr double kSoftZoneLength = 0.1;     // its length / L, from the clamp
 
+// The clamp's spring k_s / (E S / L) of a support_* model error; 0 for another error.
+double SupportStiffnessFactor(const std::string& model_error) {
+  if (model_error == "support_50") return 50.0;
+  if (model_error == "support_10") return 10.0;
+  if (model_error == "support_5") return 5.0;
+  return 0.0;
+}
+
 struct DataSet {
   std::string model_error;
   double snr;
@@ -99,12 +107,19 @@ void RunDataSet(const Config& config, const DataSet& set, const std::vector<bool
     truth.data.truth_zones = {
         {0.0, kSoftZoneLength * config.model.length, kSoftZoneFactor * config.model.modulus}};
   }
+  // k_s = factor E S / L
+  const double support_factor = SupportStiffnessFactor(set.model_error);
+  if (support_factor > 0.0) {
+    truth.data.support_stiffness =
+        support_factor * config.model.modulus * config.model.section / config.model.length;
+  }
   ChannelSet measured = MakeSyntheticMeasurements(truth.model, truth.load, truth.time, truth.data);
   if (set.model_error == "force_gain") measured.Values("fL") *= kForceGain;
   if (set.model_error == "displacement_gain") measured.Values("uL") *= kDisplacementGain;
   BarProperties identified = config.model;
   if (set.model_error == "density") identified.density *= kDensityError;
   const BarModel model(identified);
+  const MatrixModelData matrices = BarRunModel(model, measured, EndDisplacementChannels());
   const int filters = static_cast<int>(prefilters.size());
   for (int k = 0; k < 2 * filters; ++k) {
     // Its case fields (functional, data, ...) are RunDataSets'.
@@ -112,7 +127,14 @@ void RunDataSet(const Config& config, const DataSet& set, const std::vector<bool
     PrefilterOptions prefilter = config.prefilter;
     prefilter.enabled = run.prefilter;
     const ChannelSet data = PrefilterMeasurements(measured, prefilter, nullptr);
-    Identify(config, model, data, run.least_squares, &run);
+    // The MCRE's config: the clamp tested on the raw data, as identify run tests it.
+    std::vector<SupportCheck> checks;
+    const Config mcre_config = run.least_squares
+                                   ? config
+                                   : ConfigForTheSupports(config, matrices, measured, data, &checks,
+                                                          &run.support_switched, /*log=*/false);
+    if (!checks.empty()) run.support_statistic = checks.front().statistic;
+    Identify(mcre_config, model, data, run.least_squares, &run);
   }
 }
 
@@ -191,7 +213,8 @@ std::vector<ComparatorStatistics> Statistics(const ComparatorStudy& study) {
             row.prefilter = prefilter;
             row.snr = snr;
             std::vector<double> errors;
-            double minima = 0.0, one_valley = 0.0, evaluations = 0.0, time = 0.0, within = 0.0;
+            double minima = 0.0, one_valley = 0.0, evaluations = 0.0, time = 0.0, within = 0.0,
+                   switched = 0.0;
             int scanned = 0;  // runs with a global scan (a matrix model without the
                               // homogeneous stage has none)
             for (const ComparatorRun& run : study.runs) {
@@ -210,6 +233,7 @@ std::vector<ComparatorStatistics> Statistics(const ComparatorStudy& study) {
               }
               evaluations += run.evaluations;
               time += run.wall_time_s;
+              switched += run.support_switched ? 1.0 : 0.0;
               within += std::abs(run.error) <= 0.02 ? 1.0 : 0.0;
             }
             const double n = static_cast<double>(errors.size());
@@ -233,6 +257,7 @@ std::vector<ComparatorStatistics> Statistics(const ComparatorStudy& study) {
               }
               row.mean_evaluations = evaluations / n;
               row.mean_wall_time_s = time / n;
+              row.switched_share = switched / n;
             }
             table.push_back(row);
           }
@@ -254,14 +279,15 @@ std::string RunsCsv(const ComparatorStudy& study) {
   std::ostringstream csv;
   csv << "model_error,snr,seed,functional,data," << (many ? "zone," : "")
       << "converged,modulus_pa,relative_error,local_minima,evaluations,wall_time_s,"
-         "search_modulus_pa,message\n";
+         "search_modulus_pa,support_switched,support_statistic,message\n";
   for (const ComparatorRun& run : study.runs) {
     csv << run.model_error << "," << SnrText(run.snr) << "," << run.seed << ","
         << FunctionalText(run.least_squares) << "," << FilterText(run.prefilter) << ",";
     if (many) csv << study.zones[run.zone] << ",";
     csv << (run.converged ? 1 : 0) << "," << Csv(run.modulus) << "," << Csv(run.error) << ","
         << run.local_minima << "," << run.evaluations << "," << Csv(run.wall_time_s) << ","
-        << Csv(run.search_modulus) << ",\"" << run.message << "\"\n";
+        << Csv(run.search_modulus) << "," << (run.support_switched ? 1 : 0) << ","
+        << Csv(run.support_statistic) << ",\"" << run.message << "\"\n";
   }
   return csv.str();
 }
@@ -271,7 +297,8 @@ std::string StatisticsCsv(const ComparatorStudy& study) {
   std::ostringstream csv;
   csv << "model_error,functional,data," << (many ? "zone," : "")
       << "snr,runs,converged_share,mean_error,std_error,rms_error,q2.5_error,q97.5_error,"
-         "within_2_percent,one_valley,mean_local_minima,mean_evaluations,mean_wall_time_s\n";
+         "within_2_percent,one_valley,mean_local_minima,mean_evaluations,mean_wall_time_s,"
+         "switched_share\n";
   for (const ComparatorStatistics& row : study.statistics) {
     csv << row.model_error << "," << FunctionalText(row.least_squares) << ","
         << FilterText(row.prefilter) << ",";
@@ -280,7 +307,8 @@ std::string StatisticsCsv(const ComparatorStudy& study) {
         << Csv(row.mean_error) << "," << Csv(row.std_error) << "," << Csv(row.rms_error) << ","
         << Csv(row.quantile_025) << "," << Csv(row.quantile_975) << "," << Csv(row.within_2_percent)
         << "," << Csv(row.one_valley) << "," << Csv(row.mean_local_minima) << ","
-        << Csv(row.mean_evaluations) << "," << Csv(row.mean_wall_time_s) << "\n";
+        << Csv(row.mean_evaluations) << "," << Csv(row.mean_wall_time_s) << ","
+        << Csv(row.switched_share) << "\n";
   }
   return csv.str();
 }
@@ -401,7 +429,10 @@ std::string SummaryIntroduction(const ComparatorStudy& study) {
              : "The MCRE's global scan runs on e^2 itself. ")
      << "Model errors: `density` the model 3 % denser, "
         "`force_gain` fL measured 5 % high, `displacement_gain` uL measured 3 % high, "
-        "`soft_zone` the bar 10 % softer over the 10 % of its length by the clamp. Errors "
+        "`soft_zone` the bar 10 % softer over the 10 % of its length by the clamp, "
+        "`support_K` the clamp a spring of K E S / L (the model's rigid). The MCRE tests the "
+        "clamp on the raw data (mcre.support_check); `clamp switched` is the share of its "
+        "runs that treated it as measured. Errors "
         "of E relative to the bar's modulus; `within 2 %` and `one valley` as shares of "
         "the runs.\n\n";
   return md.str();
@@ -414,8 +445,9 @@ std::string Summary(const ComparatorStudy& study) {
      << SummaryIntroduction(study) << "| model error | functional | data | "
      << (many ? "zone | " : "")
      << "SNR | runs | mean | std | rms | 95 % band | "
-        "within 2 % | one valley | valleys | evaluations | time [s] |\n"
-     << "|---|---|---|" << (many ? "---|" : "") << "---|---|---|---|---|---|---|---|---|---|---|\n";
+        "within 2 % | one valley | valleys | evaluations | time [s] | clamp switched |\n"
+     << "|---|---|---|" << (many ? "---|" : "")
+     << "---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const ComparatorStatistics& row : study.statistics) {
     md << "| " << row.model_error << " | " << FunctionalText(row.least_squares) << " | "
        << FilterText(row.prefilter) << " | ";
@@ -426,7 +458,10 @@ std::string Summary(const ComparatorStudy& study) {
        << Brief(100.0 * row.within_2_percent, 3) << " % | "
        << (std::isnan(row.one_valley) ? std::string("-") : Brief(100.0 * row.one_valley, 3) + " %")
        << " | " << Brief(row.mean_local_minima, 3) << " | " << Brief(row.mean_evaluations, 3)
-       << " | " << Brief(row.mean_wall_time_s, 3) << " |\n";
+       << " | " << Brief(row.mean_wall_time_s, 3) << " | "
+       << (row.least_squares || many ? std::string("-")
+                                     : Brief(100.0 * row.switched_share, 3) + " %")
+       << " |\n";
   }
   md << "\nRatio of the rms errors, MCRE / least squares (1 or less: MCRE as accurate):\n\n"
      << "| model error | data |" << (many ? " zone |" : "");
@@ -469,8 +504,9 @@ std::string Summary(const ComparatorStudy& study) {
 }  // namespace
 
 const std::vector<std::string>& ComparatorModelErrors() {
-  static const std::vector<std::string> errors = {"none", "density", "force_gain",
-                                                  "displacement_gain", "soft_zone"};
+  static const std::vector<std::string> errors = {
+      "none",      "density",    "force_gain", "displacement_gain",
+      "soft_zone", "support_50", "support_10", "support_5"};
   return errors;
 }
 
@@ -489,7 +525,9 @@ std::string EncodeDataSet(const ComparatorRun* first, int runs_per_set) {
         .Add(run.local_minima)
         .Add(run.search_modulus)
         .Add(run.evaluations)
-        .Add(run.wall_time_s);
+        .Add(run.wall_time_s)
+        .Add(run.support_switched)
+        .Add(run.support_statistic);
   }
   return record.text();
 }
@@ -506,6 +544,8 @@ void DecodeDataSet(const std::string& text, int runs_per_set, ComparatorRun* fir
     run.search_modulus = record.Double();
     run.evaluations = static_cast<int>(record.Integer());
     run.wall_time_s = record.Double();
+    run.support_switched = record.Bool();
+    run.support_statistic = record.Double();
   }
   if (!record.AtEnd()) throw std::runtime_error("the record has more fields");
   std::copy(runs.begin(), runs.end(), first);
@@ -562,11 +602,11 @@ void RunMatrixComparator(const Config& config, const std::vector<DataSet>& sets,
                          internal::Progress* progress) {
   const std::string name = config.source_path.empty() ? "config" : config.source_path;
   for (const DataSet& set : sets) {
-    if (set.model_error == "soft_zone") {
-      throw InputError(name +
-                       ": study.comparator.errors: soft_zone (the bar softer by its "
-                       "clamp) applies to the bar only; with model.kind 'matrix' choose among "
-                       "none, density, force_gain and displacement_gain");
+    if (set.model_error == "soft_zone" || SupportStiffnessFactor(set.model_error) > 0.0) {
+      throw InputError(name + ": study.comparator.errors: " + set.model_error +
+                       " (the bar softer by its clamp, or its clamp a spring) applies to the "
+                       "bar only; with model.kind 'matrix' choose among none, density, "
+                       "force_gain and displacement_gain");
     }
   }
   const internal::MatrixStudyTruth truth(config, "comparator");

@@ -463,6 +463,10 @@ const std::vector<Key>& KeyTable() {
               "always)"),
       MakeKey("data.truth_zones", &Config::data, &DataOptions::truth_zones, ZoneList(), "",
               "synthetic truth: stretches of another modulus, [{start: m, end: m, modulus: Pa}]"),
+      MakeKey("data.support_stiffness", &Config::data, &DataOptions::support_stiffness, Number(),
+              "N/m",
+              "synthetic truth: a spring of this stiffness holds x = 0 (.inf: a rigid clamp); "
+              "u0 its displacement, f0 = -k_s u0"),
       MakeKey("data.truth_manifest", &Config::data, &DataOptions::truth_manifest, Text(), "",
               "model.kind matrix, synthetic: the truth's manifest (\"\": the model's own); "
               "relative to this file"),
@@ -493,6 +497,19 @@ const std::vector<Key>& KeyTable() {
           "trusted (u(0) = 0 imposed, f0 a measured output) or pinned (free-free model, "
           "u0's datum the known 0 with weight w_u0, f0 a load with weight w_r); a matrix "
           "model's supports alike (docs/matrix_models.md section 11)"),
+      MakeKey(
+          "mcre.support_check", &Config::mcre, &McreOptions::support_check,
+          EnumByName<SupportCheckAction>(
+              {SupportCheckAction::kSwitch, SupportCheckAction::kWarn, SupportCheckAction::kOff},
+              SupportCheckActionToString, StringToSupportCheckAction),
+          "",
+          "with mcre.clamp trusted, a measured support displacement tested against its "
+          "force: switch (a contradicted support is treated as measured, with the "
+          "paper's weights), warn, or off (docs/boundaries.md)"),
+      MakeKey("mcre.support_check_threshold", &Config::mcre, &McreOptions::support_check_threshold,
+              Number(), "",
+              "the support test's t above which the data contradict a rigid support (a false "
+              "alarm rate of 1 - Phi(threshold))"),
       MakeKey("inner.method", &Config::inner, &CoupledSolverOptions::type,
               EnumByName<CoupledSolverType>(AllCoupledSolverTypes(), CoupledSolverTypeToString,
                                             StringToCoupledSolverType),
@@ -700,7 +717,8 @@ const std::vector<Key>& KeyTable() {
               &StudyOptions::Comparator::seeds, PositiveInteger<int>(), "", "noise seeds per SNR"),
       MakeKey("study.comparator.errors", &Config::study, &StudyOptions::comparator,
               &StudyOptions::Comparator::errors, TextList(), "",
-              "model errors (none, density, force_gain, displacement_gain, soft_zone)"),
+              "model errors (none, density, force_gain, displacement_gain, soft_zone, support_50, "
+              "support_10, support_5)"),
       MakeKey("study.comparator.data", &Config::study, &StudyOptions::comparator,
               &StudyOptions::Comparator::data, TextList(), "",
               "the data identified from (raw, prefilter)"),
@@ -1349,10 +1367,10 @@ std::string FirstProblem(const Config& config) {
 // given by matrices does not read: refused there when set (RefuseKeysOfTheBar).
 bool BarOnlyKey(const std::string& path) {
   static const std::set<std::string> bar_only = {
-      "model.length",          "model.section",   "model.density",         "model.modulus",
-      "model.elements",        "model.mass",      "model.zoning",          "model.zone_count",
-      "model.zone_boundaries", "data.truth",      "data.truth_refinement", "data.sensors",
-      "data.channels",         "data.truth_zones"};
+      "model.length",          "model.section",    "model.density",         "model.modulus",
+      "model.elements",        "model.mass",       "model.zoning",          "model.zone_count",
+      "model.zone_boundaries", "data.truth",       "data.truth_refinement", "data.sensors",
+      "data.channels",         "data.truth_zones", "data.support_stiffness"};
   return bar_only.count(path) > 0;
 }
 

@@ -282,17 +282,67 @@ McreObjective CompleteModulusStage(const Config& config, const MatrixModelData& 
   return cold;
 }
 
-IdentificationRun IdentifyModulus(const Config& config, const ChannelSet& data) {
+Config MeasuredSupportConfig(const Config& config) {
+  Config measured = config;
+  const McreWeights paper;
+  measured.mcre.clamp = ClampModel::kMeasured;
+  measured.mcre.weights.displacement_weight = paper.displacement_weight;
+  measured.mcre.weights.strain_weight = paper.strain_weight;
+  measured.search.functional = SearchFunctional::kSame;
+  return measured;
+}
+
+Config ConfigForTheSupports(const Config& config, const MatrixModelData& model,
+                            const ChannelSet& raw, const ChannelSet& data,
+                            std::vector<SupportCheck>* checks, bool* switched, bool log) {
+  checks->clear();
+  *switched = false;
+  if (config.mcre.clamp != ClampModel::kTrusted ||
+      config.mcre.support_check == SupportCheckAction::kOff) {
+    return config;
+  }
+  *checks = CheckSupports(model, raw, data, config.mcre.support_check_threshold);
+  for (const SupportCheck& check : *checks) {
+    if (!log) break;
+    if (check.contradicted) {
+      spdlog::warn("{}", check.BriefReport());
+    } else {
+      spdlog::info("{}", check.BriefReport());
+    }
+  }
+  if (!AnySupportContradicted(*checks)) return config;
+  if (config.mcre.support_check == SupportCheckAction::kWarn) {
+    if (log) {
+      spdlog::warn(
+          "the supports stay trusted (mcre.support_check: warn): E may be biased; "
+          "mcre.support_check: switch or mcre.clamp: measured treats them as measured");
+    }
+    return config;
+  }
+  if (log) {
+    spdlog::warn(
+        "the supports are treated as measured, with the paper's weights and scan "
+        "(mcre.support_check: switch; mcre.support_check: warn keeps them trusted)");
+  }
+  *switched = true;
+  return MeasuredSupportConfig(config);
+}
+
+IdentificationRun IdentifyModulus(const Config& given, const ChannelSet& data) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   IdentificationRun run;
-  run.config = config;
-  run.reference_known = config.data.source == DataSource::kSynthetic;
-  run.data = IdentificationData(config, data, &run.ends, &run.prefilter_cutoff);
+  run.reference_known = given.data.source == DataSource::kSynthetic;
+  run.data = IdentificationData(given, data, &run.ends, &run.prefilter_cutoff);
 
   run.model = std::make_shared<const MatrixModelData>(
-      BarRunModel(BarModel(config.model), run.data, run.ends));
+      BarRunModel(BarModel(given.model), run.data, run.ends));
   const MatrixModelData& matrices = *run.model;
+  // The supports tested on the data as given, before the pre-filter, their forces
+  // pre-filtered.
+  run.config = ConfigForTheSupports(given, matrices, data, run.data, &run.support_checks,
+                                    &run.support_switched);
+  const Config& config = run.config;
   static_cast<ModulusStage&>(run) = IdentifyHomogeneousModulus(config, matrices, run.data);
   // The bar's weights from k* = E0 S / L (mcre/matrix_mcre_problem.h): alpha = w_f / k*
   // of its loads, beta = w_u k* of its end displacement, for the summary.
@@ -303,14 +353,16 @@ IdentificationRun IdentifyModulus(const Config& config, const ChannelSet& data) 
   return run;
 }
 
-IdentificationRun RunIdentification(const Config& config, const ChannelSet& data) {
-  if (config.outer.functional == OuterFunctional::kLeastSquares) {
-    return RunLeastSquares(config, data);
+IdentificationRun RunIdentification(const Config& given, const ChannelSet& data) {
+  if (given.outer.functional == OuterFunctional::kLeastSquares) {
+    return RunLeastSquares(given, data);
   }
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  IdentificationRun run = IdentifyModulus(config, data);
+  IdentificationRun run = IdentifyModulus(given, data);
   if (!run.IsUsable()) return run;
+  // Every step identifies with the config of the homogeneous stage (ConfigForTheSupports).
+  const Config config = run.config;
   const MatrixModelData& matrices = *run.model;
 
   // The cost curve around E* and the inner solver's convergence there from W = 0.

@@ -738,6 +738,33 @@ void ReferenceYaml(const IdentificationRun& run, YamlWriter* yaml) {
                "(identified - reference) / reference (null when unknown)");
 }
 
+// The supports: block: each test of a trusted support against the data
+// (ConfigForTheSupports) and whether the run switched to the measured treatment; nothing
+// when no support was tested.
+void SupportChecksYaml(const IdentificationRun& run, YamlWriter* yaml) {
+  if (run.support_checks.empty()) return;
+  yaml->Line(0, "supports", "",
+             "the trusted supports tested against the data (mcre.support_check, "
+             "docs/boundaries.md)");
+  yaml->Line(1, "switched", run.support_switched ? "true" : "false",
+             "treated as measured because the data contradict them (the config below)");
+  yaml->Line(1, "tests", "");
+  for (const SupportCheck& check : run.support_checks) {
+    yaml->Raw("    - support: " + Quoted(check.support));
+    yaml->Text(3, "displacement_channel", check.displacement_channel);
+    yaml->Text(3, "force_channel", check.force_channel);
+    yaml->Number(3, "statistic", check.statistic,
+                 "t = -<u~, z> / (s_u ||z||): standard normal on a rigid support");
+    yaml->Number(3, "threshold", check.threshold, "t above it contradicts the support");
+    yaml->Line(3, "contradicted", check.contradicted ? "true" : "false");
+    yaml->Number(3, "compliance", check.compliance, "[m/N] c = -<u~, z> / <z, z>");
+    yaml->Number(3, "compliance_std", check.compliance_std, "[m/N] s_u / ||z||");
+    yaml->Number(3, "support_stiffness", check.SupportStiffness(), "[N/m] 1 / c");
+    yaml->Number(3, "displacement_std", check.displacement_std,
+                 "[m] s_u, from the second differences of the raw displacement");
+  }
+}
+
 // The end of the bar's summary.yaml: its zones: block when it has zones, then the
 // resolved config.
 void ZonesAndConfigYaml(const IdentificationRun& run, YamlWriter* yaml) {
@@ -836,6 +863,7 @@ std::string SummaryYaml(const IdentificationRun& run) {
                "direct + retrograde sweeps of those evaluations");
   yaml.Number(0, "wall_time_s", run.wall_time_s,
               "[s] identification, cost curve and uncertainty (not the data)");
+  SupportChecksYaml(run, &yaml);
 
   if (run.error_map.share.size() > 0) {
     const int peak = run.error_map.PeakElement();

@@ -338,7 +338,7 @@ bool StudyOptions::IsValid(std::string* error) const {
                            return std::find(known.begin(), known.end(), name) == known.end();
                          })) {
     why << "study.comparator.errors must hold model errors among none, density, force_gain, "
-           "displacement_gain, soft_zone";
+           "displacement_gain, soft_zone, support_50, support_10, support_5";
   } else if (comparator.data.empty() || comparator.data.size() > 2 ||
              std::any_of(
                  comparator.data.begin(), comparator.data.end(),

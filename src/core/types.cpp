@@ -54,6 +54,13 @@ bool StringToClampModel(const std::string& name, ClampModel* model) {
   return internal::FromName(kClampModelNames, name, model);
 }
 
+const char* SupportCheckActionToString(SupportCheckAction action) {
+  return internal::ToName(kSupportCheckActionNames, action);
+}
+bool StringToSupportCheckAction(const std::string& name, SupportCheckAction* action) {
+  return internal::FromName(kSupportCheckActionNames, name, action);
+}
+
 const char* BarClampExportToString(BarClampExport clamp) {
   return internal::ToName(kBarClampExportNames, clamp);
 }

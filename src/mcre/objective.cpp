@@ -21,6 +21,13 @@ bool McreOptions::IsValid(std::string* error) const {
     if (error != nullptr) *error = why.str();
     return false;
   }
+  if (!(std::isfinite(support_check_threshold) && support_check_threshold > 0.0)) {
+    std::ostringstream why;
+    why << "mcre.support_check_threshold must be a finite positive number, got "
+        << support_check_threshold;
+    if (error != nullptr) *error = why.str();
+    return false;
+  }
   return true;
 }
 

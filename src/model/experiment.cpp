@@ -80,6 +80,11 @@ bool DataOptions::IsValid(std::string* error) const {
     why << "data.snr must be positive (.inf for no noise), got " << snr;
     return Fail(error, why.str());
   }
+  if (!(support_stiffness > 0.0)) {
+    why << "data.support_stiffness must be positive in N/m (.inf for a rigid clamp), got "
+        << support_stiffness;
+    return Fail(error, why.str());
+  }
   for (std::size_t z = 0; z < truth_moduli.size(); ++z) {
     if (!(truth_moduli[z] > 0.0) || !std::isfinite(truth_moduli[z])) {
       why << "data.truth_moduli must hold finite positive moduli (Pa), got " << truth_moduli[z]
@@ -154,10 +159,15 @@ std::string ValidateDataAgainstBar(const DataOptions& data, const BarProperties&
   std::string reason = ValidateModulusZones(bar, data.truth_zones, "data.truth_zones");
   if (!reason.empty()) return reason;
   if (data.source == DataSource::kSynthetic && data.truth == TruthModel::kExact &&
-      (!data.truth_zones.empty() || !data.sensors.empty())) {
-    return std::string("data.") + (data.truth_zones.empty() ? "sensors" : "truth_zones") +
-           ": the exact truth (data.truth: exact) is the uniform bar observed at its ends; use "
-           "data.truth: finite_element for zones and interior sensors";
+      (!data.truth_zones.empty() || !data.sensors.empty() ||
+       std::isfinite(data.support_stiffness))) {
+    return std::string("data.") +
+           (!data.truth_zones.empty() ? "truth_zones"
+            : !data.sensors.empty()   ? "sensors"
+                                      : "support_stiffness") +
+           ": the exact truth (data.truth: exact) is the uniform clamped bar observed at its "
+           "ends; use data.truth: finite_element for zones, interior sensors and a compliant "
+           "support";
   }
   return "";
 }

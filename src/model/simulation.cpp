@@ -1,6 +1,8 @@
 #include "mcrewave/model/simulation.h"
 
 #include <cassert>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -13,21 +15,26 @@
 namespace mcrewave {
 namespace {
 
-// Clamped simulation on `bar` with `steps_per_sample` steps of `time.step /
-// steps_per_sample` between two samples of the output grid t_k = k time.step.
-ChannelSet SimulateClamped(const BarProperties& bar, const LoadOptions& load,
-                           const TimeOptions& time, int steps_per_sample,
-                           const std::vector<ModulusZone>& zones,
-                           const std::vector<std::string>& sensors) {
+// Simulation on `bar` with `steps_per_sample` steps of `time.step / steps_per_sample`
+// between two samples of the output grid t_k = k time.step, node 0 clamped
+// (support_stiffness = +inf) or held by a spring of stiffness k_s = support_stiffness
+// [N/m]: K + k_s e_0 e_0^T on every node, u0 = u_0 and f0 = -k_s u_0.
+ChannelSet SimulateSupported(const BarProperties& bar, const LoadOptions& load,
+                             const TimeOptions& time, int steps_per_sample,
+                             const std::vector<ModulusZone>& zones,
+                             const std::vector<std::string>& sensors, double support_stiffness) {
   const BarModel model(bar);
   // K = sum_e E_e K1_e with the truth's element moduli (in series where a zone ends
   // inside an element); without zones, E K1 as the paper's bar.
   const SparseMatrix stiffness = zones.empty()
                                      ? model.Stiffness(bar.modulus)
                                      : model.StiffnessOfElements(ElementModuli(bar, zones));
-  const SparseMatrix free_mass = BarModel::ClampedBlock(model.mass());
-  const SparseMatrix free_stiffness = BarModel::ClampedBlock(stiffness);
-  const int num_free = model.num_nodes() - 1;
+  const bool clamped = !std::isfinite(support_stiffness);
+  SparseMatrix free_mass = clamped ? BarModel::ClampedBlock(model.mass()) : model.mass();
+  SparseMatrix free_stiffness = clamped ? BarModel::ClampedBlock(stiffness) : stiffness;
+  if (!clamped) free_stiffness.coeffRef(0, 0) += support_stiffness;
+  // The integrated dofs: nodes 1..N when clamped, else 0..N.
+  const int num_free = model.num_nodes() - (clamped ? 1 : 0);
   const int loaded = num_free - 1;  // node N in the free numbering
 
   ThetaIntegratorOptions integrator_options;
@@ -51,7 +58,7 @@ ChannelSet SimulateClamped(const BarProperties& bar, const LoadOptions& load,
   ChannelSet out =
       BarChannelSet(0.0, time.step, Vector::Zero(num_samples), Vector::Zero(num_samples),
                     Vector::Zero(num_samples), Vector::Zero(num_samples));
-  // The interior sensors' rows on this mesh (node 0 is clamped: u_0 = 0).
+  // The interior sensors' rows on this mesh (clamped: u_0 = 0).
   std::vector<ObservationRow> rows;
   for (const std::string& name : sensors) {
     ChannelName channel;
@@ -68,6 +75,7 @@ ChannelSet SimulateClamped(const BarProperties& bar, const LoadOptions& load,
             Vector::Zero(num_samples));
   }
   // The channels written in the time loop, looked up once (the set is complete).
+  Vector& out_u0 = out.Values("u0");
   Vector& out_uL = out.Values("uL");
   Vector& out_f0 = out.Values("f0");
   Vector& out_fL = out.Values("fL");
@@ -75,7 +83,7 @@ ChannelSet SimulateClamped(const BarProperties& bar, const LoadOptions& load,
   for (const BarSensor& sensor : BarSensors(out)) {
     out_sensors.push_back(&out.channels[static_cast<std::size_t>(sensor.index)].values);
   }
-  Vector nodal = Vector::Zero(model.num_nodes());  // all nodes, u_0 = 0
+  Vector nodal = Vector::Zero(model.num_nodes());  // all nodes (clamped: u_0 = 0)
 
   Vector acceleration = Vector::Zero(num_free);
   const Vector zero = Vector::Zero(num_free);
@@ -90,11 +98,13 @@ ChannelSet SimulateClamped(const BarProperties& bar, const LoadOptions& load,
         if (k % steps_per_sample != 0) return;
         const int sample = k / steps_per_sample;
         const double applied = load.Value(k * h);
-        // M_r a_k = f_k - K_r u_k, then f0_k = M_01 a_1 + K_01 u_1.
-        integrator.stiffness().Multiply(displacement, acceleration);
-        acceleration = -acceleration;
-        acceleration[loaded] += applied;
-        mass_factor.SolveInPlace(acceleration);
+        // Clamped: M_r a_k = f_k - K_r u_k, then f0_k = M_01 a_1 + K_01 u_1.
+        if (clamped) {
+          integrator.stiffness().Multiply(displacement, acceleration);
+          acceleration = -acceleration;
+          acceleration[loaded] += applied;
+          mass_factor.SolveInPlace(acceleration);
+        }
         out_uL[sample] = displacement[loaded];
         if (!rows.empty()) {
           nodal.tail(num_free) = displacement;
@@ -102,7 +112,13 @@ ChannelSet SimulateClamped(const BarProperties& bar, const LoadOptions& load,
             (*out_sensors[r])[sample] = rows[r].Apply(nodal.data());
           }
         }
-        out_f0[sample] = mass_01 * acceleration[0] + stiffness_01 * displacement[0];
+        if (clamped) {
+          out_f0[sample] = mass_01 * acceleration[0] + stiffness_01 * displacement[0];
+        } else {
+          // The spring's force on the bar, f0 = -k_s u_0.
+          out_u0[sample] = displacement[0];
+          out_f0[sample] = -support_stiffness * displacement[0];
+        }
         out_fL[sample] = applied;
       });
   return out;
@@ -113,7 +129,8 @@ ChannelSet SimulateClamped(const BarProperties& bar, const LoadOptions& load,
 ChannelSet SimulateClampedBar(const BarProperties& bar, const LoadOptions& load,
                               const TimeOptions& time, const std::vector<ModulusZone>& zones,
                               const std::vector<std::string>& sensors) {
-  return SimulateClamped(bar, load, time, 1, zones, sensors);
+  return SimulateSupported(bar, load, time, 1, zones, sensors,
+                           std::numeric_limits<double>::infinity());
 }
 
 ChannelSet SimulateTruth(const BarProperties& bar, const LoadOptions& load, const TimeOptions& time,
@@ -124,7 +141,8 @@ ChannelSet SimulateTruth(const BarProperties& bar, const LoadOptions& load, cons
   }
   BarProperties fine = bar;
   fine.elements = bar.elements * data.truth_refinement;
-  return SimulateClamped(fine, load, time, data.truth_refinement, data.truth_zones, data.sensors);
+  return SimulateSupported(fine, load, time, data.truth_refinement, data.truth_zones, data.sensors,
+                           data.support_stiffness);
 }
 
 ChannelSet MakeSyntheticMeasurements(const BarProperties& bar, const LoadOptions& load,

@@ -10,7 +10,13 @@
 //   displacement_gain  the measured uL 3 % too high (a displacement sensor's gain)
 //   soft_zone          the bar 10 % softer over [0, 0.1 L] (by the clamp), the model
 //                      uniform
+//   support_50, support_10, support_5
+//                      the clamp a spring of 50, 10 or 5 E S / L (data.support_stiffness),
+//                      the model's clamp rigid
 //
+// The MCRE runs test the clamp against the raw data as identify run does
+// (ConfigForTheSupports, identification_run.h: with the defaults a contradicted clamp is
+// treated as measured); least squares keeps it rigid.
 // Least squares weighs each channel by 1 / s^2 with s = RMS(measured channel) / SNR
 // (at SNR inf the RMS alone: only the ratio of the weights matters). Every run
 // is seeded, its scans on one thread: the study's numbers do not depend on
@@ -22,7 +28,8 @@
 // from the truth of data: (data.truth_manifest at data.truth_moduli) plus the noise of
 // AddMatrixModelNoise, each zone against the truth's modulus. The model errors there:
 // density (the model's M 3 % larger), force_gain (every load channel 5 % high),
-// displacement_gain (every displacement sensor 3 % high); soft_zone is the bar's only.
+// displacement_gain (every displacement sensor 3 % high); soft_zone and the supports are
+// the bar's only.
 #pragma once
 
 #include <cstdint>
@@ -56,6 +63,10 @@ struct ComparatorRun {
   double search_modulus = std::numeric_limits<double>::quiet_NaN();
   int evaluations = 0;   // of every functional: scans and refinements
   double wall_time_s = std::numeric_limits<double>::quiet_NaN();
+  // The MCRE's run treated the clamp as measured: its test contradicted it (the bar);
+  // and the test's t (NaN: not tested).
+  bool support_switched = false;
+  double support_statistic = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Over the converged runs of one (model error, functional, pre-filter, SNR, zone).
@@ -78,6 +89,7 @@ struct ComparatorStatistics {
   double mean_local_minima = std::numeric_limits<double>::quiet_NaN();
   double mean_evaluations = std::numeric_limits<double>::quiet_NaN();
   double mean_wall_time_s = std::numeric_limits<double>::quiet_NaN();
+  double switched_share = 0.0;  // of the runs, support_switched
 };
 
 struct ComparatorStudy {

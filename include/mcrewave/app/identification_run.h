@@ -26,6 +26,7 @@
 #include "mcrewave/mcre/error_map.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/mcre/objective.h"
+#include "mcrewave/mcre/support_check.h"
 #include "mcrewave/mcre/zone_uncertainty.h"
 #include "mcrewave/model/matrix_export.h"
 #include "mcrewave/optim/identification.h"
@@ -99,7 +100,13 @@ struct ModulusStage {
 // rest_cost is J_rest [s] and, on the bar, `sweeps` counts every simulation (scan,
 // refinement, fit, curve).
 struct IdentificationRun : ModulusStage {
+  // The config the run identified with: the one given, or ConfigForTheSupports' switch
+  // to the paper's treatment when the data contradicted a trusted support.
   Config config;
+  // The tests of the supports against the raw data (none: not tested), and whether
+  // `config` switched their treatment to measured.
+  std::vector<SupportCheck> support_checks;
+  bool support_switched = false;
   bool least_squares = false;  // outer.functional: least_squares
   // The homogeneous stage (this ModulusStage) ran: always on the bar; on a structure
   // given by matrices when its zones share one nominal modulus.
@@ -245,6 +252,23 @@ ModulusStage IdentifyHomogeneousModulus(const Config& config, const MatrixModelD
 // Precondition: stage->IsUsable().
 McreObjective CompleteModulusStage(const Config& config, const MatrixModelData& model,
                                    const ChannelSet& data, bool cost_curve, ModulusStage* stage);
+
+// config with the paper's treatment of the supports (configs/paper_bar_free_free.yaml's
+// mcre: and search: sections): mcre.clamp measured, w_u and w_e the paper's (McreWeights'
+// defaults) and the global scan on that e^2 itself (search.functional same).
+Config MeasuredSupportConfig(const Config& config);
+
+// The config an MCRE run identifies with on `raw` data (before the pre-filter) and the
+// data it compares with (`data`, pre-filtered when prefilter.enabled): with mcre.clamp
+// trusted and mcre.support_check not off, each support of `model` whose displacement the
+// raw data hold is tested (CheckSupports, its force from `data`) and the result logged, a
+// contradiction as a warning; when one is contradicted and mcre.support_check is
+// switch, MeasuredSupportConfig(config), else config. *checks gets the tests (none when
+// not tested), *switched whether the config was switched. log false: nothing logged (a
+// study's runs).
+Config ConfigForTheSupports(const Config& config, const MatrixModelData& model,
+                            const ChannelSet& raw, const ChannelSet& data,
+                            std::vector<SupportCheck>* checks, bool* switched, bool log = true);
 
 // Runs steps 2 and 3 on measurements made by LoadMeasurements(config): the
 // fields up to `solution` (and wall_time_s); no cost curve, no uncertainty.

@@ -102,8 +102,8 @@ struct StudyOptions {
   struct Comparator {
     std::vector<double> snr = {20.0, 10.0, 5.0, 2.5};
     int seeds = 100;
-    std::vector<std::string> errors = {"none", "density", "force_gain", "displacement_gain",
-                                       "soft_zone"};
+    std::vector<std::string> errors = {"none",      "density",    "force_gain", "displacement_gain",
+                                       "soft_zone", "support_50", "support_10", "support_5"};
     std::vector<std::string> data = {"raw", "prefilter"};
   };
   Comparator comparator;

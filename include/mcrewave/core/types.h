@@ -147,6 +147,23 @@ inline constexpr std::array<std::pair<ClampModel, const char*>, 3> kClampModelNa
 const char* ClampModelToString(ClampModel model);
 bool StringToClampModel(const std::string& name, ClampModel* model);
 
+// What a run does when its data contradict a trusted support (config key
+// mcre.support_check; mcre/support_check.h, docs/boundaries.md).
+enum class SupportCheckAction {
+  kSwitch,  // test; a contradicted support is treated as measured (the paper's free-free
+            // formulation, its weights and scan), with a warning
+  kWarn,    // test and warn; the support stays trusted
+  kOff,     // no test
+};
+inline constexpr std::array<std::pair<SupportCheckAction, const char*>, 3> kSupportCheckActionNames{
+    {
+        {SupportCheckAction::kSwitch, "switch"},
+        {SupportCheckAction::kWarn, "warn"},
+        {SupportCheckAction::kOff, "off"},
+    }};
+const char* SupportCheckActionToString(SupportCheckAction action);
+bool StringToSupportCheckAction(const std::string& name, SupportCheckAction* action);
+
 // How BarMatrixModel (model/matrix_export.h) exports the bar's clamp at x = 0.
 enum class BarClampExport {
   kLoadAndSensor,  // the load f0 (e_0) and the sensor u0 (e_0^T): the free-free model

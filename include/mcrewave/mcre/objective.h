@@ -50,6 +50,11 @@ struct McreOptions {
   // paper's free-free model) or pinned (free-free, u0's datum the known 0 with w_u0,
   // f0 a load with w_r); matrix_mcre_problem.h, docs/trusted_clamp.md.
   ClampModel clamp = ClampModel::kTrusted;
+  // What a run does when the clamp is trusted and its data contradict a support
+  // (support_check.h, docs/boundaries.md): switch to the paper's treatment, warn, or
+  // not test; and the threshold of its t above which they contradict it.
+  SupportCheckAction support_check = SupportCheckAction::kSwitch;
+  double support_check_threshold = 2.0;
 
   bool IsValid(std::string* error) const;
 };

@@ -56,6 +56,11 @@ struct DataOptions {
   // The truth's stretches of another modulus (synthetic only; `model.modulus`
   // elsewhere), each [start, end] m at `modulus` Pa, not overlapping.
   std::vector<ModulusZone> truth_zones;
+  // The truth's support at x = 0 (finite_element truth only): a spring of this
+  // stiffness [N/m] between node 0 and the wall, a load cell or a compliant clamp;
+  // +inf is the rigid clamp u(0) = 0. The measured u0 is then the spring's
+  // displacement and f0 = -k_s u0 the force it applies on the bar.
+  double support_stiffness = std::numeric_limits<double>::infinity();
   // Synthetic data of a structure given by matrices (model.kind: matrix): the truth's
   // manifest ("" = the model's own; relative to the config file) and its zone moduli
   // [Pa] (one per zone of the truth's manifest; [] = their nominal moduli).

@@ -26,9 +26,11 @@ ChannelSet SimulateClampedBar(const BarProperties& bar, const LoadOptions& load,
                               const TimeOptions& time, const std::vector<ModulusZone>& zones = {},
                               const std::vector<std::string>& sensors = {});
 
-// The noise-free "truth" sampled on the model's grid t_k = k h: the clamped
-// simulation on a mesh and step refined by data.truth_refinement (every r-th step
-// kept) with data.truth_zones and data.sensors, or the exact solution
+// The noise-free "truth" sampled on the model's grid t_k = k h: the simulation on a
+// mesh and step refined by data.truth_refinement (every r-th step kept) with
+// data.truth_zones and data.sensors, clamped or, with a finite
+// data.support_stiffness k_s, held at x = 0 by a spring (K + k_s e_0 e_0^T, u0 = u_0,
+// f0 = -k_s u_0), or the exact solution
 // (exact_solution.h; uniform bar, end channels only: ValidateDataAgainstBar refuses
 // the rest).
 ChannelSet SimulateTruth(const BarProperties& bar, const LoadOptions& load, const TimeOptions& time,
