@@ -11,6 +11,7 @@
 //   identify run configs/measured_csv.yaml -q
 //   identify run configs/paper_bar.yaml --set inner.method=streaming_conjugate_gradient -o /tmp/s
 //   identify run configs/paper_bar_pinned.yaml -o /tmp/pinned
+//   identify run configs/paper_bar.yaml --set data.support_stiffness=2e8 -o /tmp/spring
 //   identify simulate configs/paper_bar.yaml --output measurements.csv
 //   identify simulate configs/paper_bar.yaml --set data.snr=.inf --output clean.csv
 //   identify simulate configs/paper_bar.yaml --set model.elements=400 --output fine.csv
@@ -45,7 +46,8 @@
 //   `simulate` writes such a CSV from the truth of data.truth_manifest.
 //
 //   `simulate` reads a YAML config (see include/mcrewave/app/config.h or
-//   --print-default-config), simulates the bar clamped at x = 0 and hit by a
+//   --print-default-config), simulates the bar clamped at x = 0 (or held there by
+//   the spring data.support_stiffness) and hit by a
 //   half-sine load at x = L on the truth discretisation of `data:`, samples the
 //   four channels (u0, uL, f0, fL) on the model's time grid, adds white noise at
 //   the configured SNR and writes the measurement CSV (t,u0,uL,f0,fL).
@@ -229,6 +231,11 @@ void ReportModuli(const mcrewave::IdentificationRun& run) {
     spdlog::info("identified {} zone moduli in {} evaluations, {:.2f} s", run.model->zones.size(),
                  run.TotalEvaluations(), run.wall_time_s);
     return;
+  }
+  if (run.support_switched) {
+    spdlog::warn(
+        "the clamp was treated as measured: the data contradict a rigid clamp (summary.yaml, "
+        "supports:)");
   }
   const char* functional = run.least_squares ? " by least squares" : "";
   if (run.reference_known) {

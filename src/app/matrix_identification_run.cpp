@@ -714,17 +714,17 @@ ChannelSet MatrixMeasurementTable(const Config& config, const MatrixModelData& m
   return table;
 }
 
-IdentificationRun RunMatrixIdentification(const Config& config, const MatrixModelData& model,
+IdentificationRun RunMatrixIdentification(const Config& given, const MatrixModelData& model,
                                           const MatrixMeasurements& measurements,
                                           bool maps_and_uncertainty) {
   const auto start_time = std::chrono::steady_clock::now();
   IdentificationRun run;
-  run.config = config;
+  run.config = given;
   run.homogeneous_ran = false;
   const int dofs = model.dofs();
   const int steps = measurements.histories.num_steps();
   const double time_step = measurements.histories.time_step;
-  run.inner_method = ResolveCoupledSolverType(config.inner, dofs, steps,
+  run.inner_method = ResolveCoupledSolverType(given.inner, dofs, steps,
                                               /*streaming_available=*/true);
   run.data_source = measurements.source;
   run.truth_moduli = measurements.truth_moduli;
@@ -733,18 +733,23 @@ IdentificationRun RunMatrixIdentification(const Config& config, const MatrixMode
   run.data = measurements.histories;
 
   // 1. The pre-filter, the same on every channel.
-  if (config.prefilter.enabled) PrefilterEveryChannel(config, model, &run);
+  if (given.prefilter.enabled) PrefilterEveryChannel(given, model, &run);
 
   // 2. Every zone modulus at once, p_z = log(E_z / E_z,nom), from p = 0 (by least
   //    squares with outer.functional: least_squares, without error maps). The supports
   //    (if any) treated as mcre.clamp says (docs/matrix_models.md, "Supports"); held by
   //    least squares whatever it says, as the bar's least squares holds its clamp.
-  if (config.outer.functional == OuterFunctional::kLeastSquares) {
-    IdentifyMatrixZonesByLeastSquares(config, model, measurements, &run);
+  if (given.outer.functional == OuterFunctional::kLeastSquares) {
+    IdentifyMatrixZonesByLeastSquares(given, model, measurements, &run);
     run.wall_time_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
     return run;
   }
+  // The supports with a measured displacement tested on the raw data, their forces as
+  // compared with (ConfigForTheSupports): every later step identifies with run.config.
+  run.config = ConfigForTheSupports(given, model, measurements.histories, run.data,
+                                    &run.support_checks, &run.support_switched);
+  const Config& config = run.config;
   McreObjective mcre_objective =
       MatrixMcreObjective(model, run.data, config.mcre, config.time.theta, config.inner);
   auto& problem = static_cast<MatrixMcreProblem&>(mcre_objective.problem());

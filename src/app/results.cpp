@@ -1261,6 +1261,7 @@ std::string MatrixSummaryYaml(const IdentificationRun& run) {
   YamlWriter yaml;
   SummaryHeaderYaml(config, "the zone moduli of a structure given by matrices, by the MCRE", &yaml);
   MatrixModelAndDataYaml(run, config, &yaml);
+  SupportChecksYaml(run, &yaml);
   if (run.homogeneous_ran) {
     // The bar's headline keys, of the homogeneous stage.
     yaml.Number(0, "identified_modulus", stage.identified_modulus(),

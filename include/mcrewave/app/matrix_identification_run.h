@@ -139,7 +139,10 @@ NoiseLevels MatrixNoiseLevels(const Config& config, const MatrixMeasurements& me
 ChannelSet MatrixMeasurementTable(const Config& config, const MatrixModelData& model,
                                   const ChannelSet& histories);
 
-// Step 3 above, into the one run type; with maps_and_uncertainty, run.model holds a copy
+// Step 3 above, into the one run type; the MCRE's supports with a measured displacement
+// first tested against the data (ConfigForTheSupports: with mcre.clamp trusted and the
+// data contradicting one, run.config treats them as measured when mcre.support_check is
+// switch). With maps_and_uncertainty, run.model holds a copy
 // of `model` for the writer (WriteIdentificationResults). Without, the moduli alone (no
 // error map, model outputs or uncertainty: what a study needs of each run). Never throws for the
 // optimiser or the inner solver: their failures are in run.failure (and run.outer).
