@@ -190,6 +190,8 @@ void RunMatrixDataSet(const Config& config, const MatrixModelData& model,
         out.search_modulus = run.outer.search_modulus;
       }
       out.wall_time_s = seconds;
+      out.support_switched = run.support_switched;
+      if (!run.support_checks.empty()) out.support_statistic = run.support_checks.front().statistic;
       if (run.identified_moduli.size() == zones) {
         out.modulus = run.identified_moduli[z];
         // E_z / E_z,ref - 1

@@ -63,8 +63,8 @@ struct ComparatorRun {
   double search_modulus = std::numeric_limits<double>::quiet_NaN();
   int evaluations = 0;   // of every functional: scans and refinements
   double wall_time_s = std::numeric_limits<double>::quiet_NaN();
-  // The MCRE's run treated the clamp as measured: its test contradicted it (the bar);
-  // and the test's t (NaN: not tested).
+  // The MCRE's run treated its supports as measured: the test of the first one (the
+  // bar's clamp) contradicted one; and that test's t (NaN: not tested).
   bool support_switched = false;
   double support_statistic = std::numeric_limits<double>::quiet_NaN();
 };
@@ -89,7 +89,7 @@ struct ComparatorStatistics {
   double mean_local_minima = std::numeric_limits<double>::quiet_NaN();
   double mean_evaluations = std::numeric_limits<double>::quiet_NaN();
   double mean_wall_time_s = std::numeric_limits<double>::quiet_NaN();
-  double switched_share = 0.0;  // of the runs, support_switched
+  double switched_share = 0.0;  // of the converged runs, support_switched
 };
 
 struct ComparatorStudy {
