@@ -54,7 +54,7 @@ struct McreOptions {
   // (support_check.h, docs/boundaries.md): switch to the paper's treatment, warn, or
   // not test; and the threshold of its t above which they contradict it.
   SupportCheckAction support_check = SupportCheckAction::kSwitch;
-  double support_check_threshold = 1.645;
+  double support_check_threshold = 2.5;
 
   bool IsValid(std::string* error) const;
 };
