@@ -672,7 +672,7 @@ mcre:
   reference_modulus: 70e9
   clamp: pinned
   support_check: warn
-  support_check_threshold: 2.5
+  support_check_threshold: 3.5
 inner:
   method: adaptive_relaxation
   tolerance: 1e-11
@@ -1096,9 +1096,10 @@ TEST(ConfigTest, TheSupportCheckIsReadAndChecked) {
   const Config defaults;
   EXPECT_EQ(defaults.mcre.support_check, SupportCheckAction::kSwitch);
   const Config config =
-      ParseConfig("mcre:\n  support_check: warn\n  support_check_threshold: 2.5\n", "a.yaml");
+      ParseConfig("mcre:\n  support_check: warn\n  support_check_threshold: 3.5\n", "a.yaml");
   EXPECT_EQ(config.mcre.support_check, SupportCheckAction::kWarn);
-  EXPECT_EQ(config.mcre.support_check_threshold, 2.5);
+  EXPECT_EQ(config.mcre.support_check_threshold, 3.5);
+  EXPECT_EQ(defaults.mcre.support_check_threshold, 2.5);
   ExpectInputError([] { ParseConfig("mcre:\n  support_check: maybe\n", "a.yaml"); },
                    {"a.yaml", "mcre.support_check", "'switch', 'warn', 'off'"});
   ExpectInputError([] { ParseConfig("mcre:\n  support_check_threshold: 0\n", "a.yaml"); },
