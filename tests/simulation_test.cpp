@@ -18,6 +18,7 @@
 #include "mcrewave/data/noise.h"
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/model/exact_solution.h"
+#include "test_problems.h"
 
 namespace mcrewave {
 namespace {
@@ -282,9 +283,7 @@ TEST(SimulationTest, ASpringSupportedTruthIsTheTrapezoidalRulesSolution) {
   const LoadOptions load;
   const TimeOptions time;
   DataOptions data;
-  data.truth_refinement = 1;
-  data.support_stiffness = 10.0 * bar.modulus * bar.section / bar.length;
-  const ChannelSet truth = SimulateTruth(bar, load, time, data);
+  const ChannelSet truth = testing::SpringSupportedBarData(bar, 10.0, &data);
 
   const BarModel model(bar);
   const int n = model.num_nodes();
@@ -329,12 +328,10 @@ TEST(SimulationTest, AStifferSpringTendsToTheClamp) {
   DataOptions clamped;
   clamped.truth_refinement = 1;
   const ChannelSet rigid = SimulateTruth(bar, load, time, clamped);
-  const double scale = bar.modulus * bar.section / bar.length;  // E S / L [N/m]
   std::vector<double> uL_errors, f0_errors, u0_sizes;
   for (const double factor : {1e3, 1e4}) {
-    DataOptions spring = clamped;
-    spring.support_stiffness = factor * scale;
-    const ChannelSet held = SimulateTruth(bar, load, time, spring);
+    DataOptions spring;
+    const ChannelSet held = testing::SpringSupportedBarData(bar, factor, &spring);
     uL_errors.push_back(RelativeMaxError(held.Values("uL"), rigid.Values("uL")));
     f0_errors.push_back(RelativeMaxError(held.Values("f0"), rigid.Values("f0")));
     u0_sizes.push_back(held.Values("u0").lpNorm<Eigen::Infinity>() /

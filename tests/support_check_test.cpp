@@ -12,6 +12,7 @@
 #include "mcrewave/model/bar_model.h"
 #include "mcrewave/model/matrix_export.h"
 #include "mcrewave/model/simulation.h"
+#include "test_problems.h"
 
 namespace mcrewave {
 namespace {
@@ -104,12 +105,8 @@ TEST(SupportCheckTest, TheBarsClampIsTestedWhenItsDisplacementIsMeasured) {
   // contradict it; without u0 among the data there is nothing to test.
   BarProperties bar;
   bar.elements = 20;
-  const LoadOptions load;
-  const TimeOptions time;
   DataOptions data;
-  data.truth_refinement = 1;
-  data.support_stiffness = 10.0 * bar.modulus * bar.section / bar.length;
-  const ChannelSet measured = SimulateTruth(bar, load, time, data);
+  const ChannelSet measured = testing::SpringSupportedBarData(bar, 10.0, &data);
   const MatrixModelData model = BarRunModel(BarModel(bar), measured, EndDisplacementChannels());
   const std::vector<SupportCheck> checks = CheckSupports(model, measured, measured, 3.0);
   ASSERT_EQ(checks.size(), 1u);

@@ -132,6 +132,16 @@ inline McreOptions FreeFreeMcre(double w_u = 0.01) {
 }
 
 // ||a - b|| / ||b|| (Frobenius).
+// The noise-free truth of `bar` on its own mesh and step (data.truth_refinement 1), held
+// at x = 0 by a spring of `stiffness_factor` E S / L (data.support_stiffness), with the
+// default load and time grid.
+inline ChannelSet SpringSupportedBarData(const BarProperties& bar, double stiffness_factor,
+                                         DataOptions* data) {
+  data->truth_refinement = 1;
+  data->support_stiffness = stiffness_factor * bar.modulus * bar.section / bar.length;
+  return SimulateTruth(bar, LoadOptions(), TimeOptions(), *data);
+}
+
 inline double RelativeDifference(const Matrix& a, const Matrix& b) {
   return (a - b).norm() / b.norm();
 }
