@@ -10,8 +10,9 @@
 #                                 omega study: at the defaults' small weights every
 #                                 omega below 2 converges)
 #   results/comparator/           `identify study configs/studies.yaml --set study.kind=comparator`
-#                                 (MCRE against least squares, 100 seeds x 4 SNRs x 5 model
-#                                 errors on pre-filtered data; about 20 minutes on 2 cores)
+#                                 (MCRE against least squares, 100 seeds x 4 SNRs x 8 model
+#                                 errors, springs at the clamp among them, on pre-filtered
+#                                 data; about 35 minutes on 2 cores)
 #   results/damage/               `identify study configs/studies.yaml --set study.kind=damage`
 #                                 (include/mcrewave/app/study.h; about 26 minutes on 2 cores),
 #                                 which writes results/README.md
