@@ -43,7 +43,8 @@ ChannelSet SimulateSupported(const BarProperties& bar, const LoadOptions& load,
   ThetaIntegrator integrator;
   integrator.Init(free_mass, free_stiffness, integrator_options);
   BandLdlt mass_factor;
-  if (!mass_factor.Compute(SymmetricBandMatrix(free_mass))) {
+  // The mass factor gives the clamped reaction's accelerations; a spring's force needs none.
+  if (clamped && !mass_factor.Compute(SymmetricBandMatrix(free_mass))) {
     throw std::runtime_error("clamped simulation: the mass matrix is not positive definite");
   }
 
