@@ -302,12 +302,13 @@ Config ConfigForTheSupports(const Config& config, const MatrixModelData& model,
     return config;
   }
   *checks = CheckSupports(model, raw, data, config.mcre.support_check_threshold);
-  for (const SupportCheck& check : *checks) {
-    if (!log) break;
-    if (check.contradicted) {
-      spdlog::warn("{}", check.BriefReport());
-    } else {
-      spdlog::info("{}", check.BriefReport());
+  if (log) {
+    for (const SupportCheck& check : *checks) {
+      if (check.contradicted) {
+        spdlog::warn("{}", check.BriefReport());
+      } else {
+        spdlog::info("{}", check.BriefReport());
+      }
     }
   }
   if (!AnySupportContradicted(*checks)) return config;
