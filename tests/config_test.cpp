@@ -28,6 +28,7 @@ void ExpectSameConfigModelToData(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.model.modulus, actual.model.modulus);
   EXPECT_EQ(expected.model.elements, actual.model.elements);
   EXPECT_EQ(expected.model.mass, actual.model.mass);
+  EXPECT_EQ(expected.model.reaction_length, actual.model.reaction_length);
   EXPECT_EQ(expected.load.kind, actual.load.kind);
   EXPECT_EQ(expected.load.amplitude, actual.load.amplitude);
   EXPECT_EQ(expected.load.duration, actual.load.duration);
@@ -534,6 +535,7 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   config.model.modulus = 2.1e11;
   config.model.elements = 437;
   config.model.mass = MassType::kLumped;
+  config.model.reaction_length = 0.07;
   config.load.amplitude = -12.5;
   config.load.duration = 2.0 / 3.0 * 1e-4;
   config.time.window = 1e-3;
@@ -642,6 +644,7 @@ constexpr const char* kEveryKeyNotAtItsDefault = R"(model:
   modulus: 2.1e11
   elements: 437
   mass: lumped
+  reaction_length: 0.07
   zoning: boundaries
   zone_boundaries: [0.1, 0.2]
 load:
@@ -872,7 +875,7 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
     EXPECT_EQ(bar_keys.count(key), 1u) << key;
   }
   // The bar reads all but the 4 matrix keys; a matrix run none of the section study:
-  // and 15 single keys fewer (it reads the dense solvers' limits, Riccati and shooting
+  // and 16 single keys fewer (it reads the dense solvers' limits, Riccati and shooting
   // running on any model, and the zones' regularisation and merging).
   EXPECT_EQ(bar_keys.size(), every.size() - 4);
   std::size_t sections = 0;
@@ -880,7 +883,7 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
     const std::string section = key.substr(0, key.find('.'));
     sections += section == "study" ? 1 : 0;
   }
-  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 15);
+  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 16);
   // Values as resolved: the matrix run's own.
   EXPECT_EQ(matrix_keys.at("model.manifest"), FlatKeys(ConfigToYaml(matrix)).at("model.manifest"));
 }
@@ -1087,6 +1090,8 @@ TEST(ConfigTest, ASupportSpringIsPositiveAndTheExactTruthHasNone) {
   EXPECT_EQ(ParseConfig("data:\n  support_stiffness: 2e8\n", "a.yaml").data.support_stiffness, 2e8);
   ExpectInputError([] { ParseConfig("data:\n  support_stiffness: -1\n", "a.yaml"); },
                    {"a.yaml", "data.support_stiffness must be positive in N/m"});
+  ExpectInputError([] { ParseConfig("model:\n  reaction_length: 2\n", "a.yaml"); },
+                   {"a.yaml", "model.reaction_length must lie in [0, L = 1] m, got 2"});
   ExpectInputError(
       [] { ParseConfig("data:\n  truth: exact\n  support_stiffness: 2e8\n", "a.yaml"); },
       {"a.yaml", "data.support_stiffness: the exact truth"});

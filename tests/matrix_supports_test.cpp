@@ -3,7 +3,9 @@
 // the bar exported with its clamp as a support gives, under each treatment (measured,
 // trusted, pinned), the built-in bar's sweeps, e^2 and zone gradients to the bit; the trusted
 // gradient matches central differences on a small 2-D-like lattice; the all-at-once
-// solver agrees with CG under every treatment; the manifest round trip; each bad
+// solver agrees with CG under every treatment; the bar's trusted reaction averaged over
+// model.reaction_length is the mean axial force, its gradients match central differences,
+// and it keeps the inner iterations off the mesh; the manifest round trip; each bad
 // support refused with a message naming it.
 #include <gtest/gtest.h>
 
@@ -229,6 +231,99 @@ TEST(MatrixSupportsTest, TrustedGradientMatchesCentralDifferencesOnALattice) {
   }
 }
 
+// The bar's trusted reaction over model.reaction_length (docs/boundaries.md section 7):
+// on 60 elements of 16.7 mm, 100 mm give m = 6 and phi_i = 1 - i / 6 on nodes 0 to 5. The
+// reaction of a direct sweep is the mean axial force -(S / (m l)) sum_{e < m} E_e
+// (U_{e+1} - U_e), written out here from the field, across the boundary of zones 0
+// (elements 0 to 3) and 1; and its zone gradients match central differences.
+TEST(MatrixSupportsTest, TheBarsTrustedReactionIsTheMeanAxialForceOverTheReactionLength) {
+  SmallCase c = MakeSmallCase(60, 120, 20.0, 1);
+  c.bar.reaction_length = 0.1;
+  std::vector<int> zones(60, 1);
+  for (int e = 0; e < 4; ++e) zones[e] = 0;
+  const BarModel model(c.bar, zones);
+  const ChannelSet data = MakeSyntheticMeasurements(c.bar, c.load, c.time, c.data);
+  const MatrixModelData matrices =
+      BarMatrixModel(model, c.bar.modulus, {}, BarClampExport::kSupport);
+  const Vector& phi = matrices.supports[0].reaction_test;
+  ASSERT_EQ(phi.size(), 61);
+  for (int i = 0; i < 61; ++i) EXPECT_EQ(phi[i], i < 6 ? 1.0 - i / 6.0 : 0.0) << i;
+  EXPECT_EQ(&TrustedReactionTest(matrices.supports[0]), &phi);
+
+  McreWeights weights = Weights(0.01, 1.0);
+  weights.reaction_weight = 0.1;  // the reaction's term large enough to matter
+  MatrixMcreProblem problem(matrices, data, weights, 200e9, 0.5, Factorization::kAutomatic,
+                            ClampModel::kTrusted);
+  const Vector moduli = (Vector(2) << 1.83e11, 2.07e11).finished();
+  problem.SetModuli(moduli);
+  Matrix u;
+  problem.DirectSweep(problem.ZeroField(), true, &u);
+  const Matrix forces = problem.ModelSupportForces();
+  ASSERT_EQ(forces.rows(), 1);
+  const double l = model.element_length();
+  double largest = 0.0, worst = 0.0;
+  for (int j = 0; j < u.cols(); ++j) {
+    double mean_force = 0.0;
+    for (int e = 0; e < 6; ++e) mean_force -= moduli[zones[e]] * (u(e + 1, j) - u(e, j));
+    mean_force *= c.bar.section / (6 * l);
+    largest = std::max(largest, std::abs(mean_force));
+    worst = std::max(worst, std::abs(forces(0, j) - mean_force));
+  }
+  // Measured: 4.2e-16 of the largest force.
+  EXPECT_LT(worst, 1e-14 * largest);
+
+  auto solve = [&](const Vector& at) {
+    problem.SetModuli(at);
+    CoupledSolution solution;
+    const CoupledSolverSummary summary = SolveCoupled(
+        SupportsTightSolver(CoupledSolverType::kAllAtOnce), &problem, nullptr, &solution);
+    EXPECT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+    return solution;
+  };
+  const CoupledSolution at = solve(moduli);
+  for (int z = 0; z < 2; ++z) {
+    const double step = 1e-5 * moduli[z];
+    Vector plus = moduli, minus = moduli;
+    plus[z] += step;
+    minus[z] -= step;
+    const double difference = (solve(plus).cost - solve(minus).cost) / (2.0 * step);
+    // Measured: 1.7e-10 (zone 0) and 1.8e-9 (zone 1), relative.
+    EXPECT_NEAR(at.cost_gradients[z], difference, 1e-8 * std::abs(difference)) << "zone " << z;
+  }
+}
+
+// The inner CG's iterations from zero at the paper's defaults (w_u = 1e-7, w_r = 1e-6,
+// the clamp trusted) on 100 and 1600 elements over the same window and time step: with
+// the reaction the mean force over 10 mm they stay within 1.3 times; with the first
+// element's stress (reaction_length 0), whose gain grows as N, they grow.
+TEST(MatrixSupportsTest, ATrustedReactionOverAFixedLengthKeepsTheInnerIterationsOffTheMesh) {
+  auto iterations = [](int elements, double reaction_length) {
+    SmallCase c = MakeSmallCase(100, 1750, 20.0, 1);
+    c.bar.elements = elements;
+    c.bar.reaction_length = reaction_length;
+    const ChannelSet data = MakeSyntheticMeasurements(c.bar, c.load, c.time, c.data);
+    const MatrixModelData matrices =
+        BarMatrixModel(BarModel(c.bar), c.bar.modulus, {}, BarClampExport::kSupport);
+    McreWeights weights = Weights(1e-7, 1.0);
+    weights.reaction_weight = 1e-6;
+    MatrixMcreProblem problem(matrices, data, weights, 200e9, 0.5, Factorization::kAutomatic,
+                              ClampModel::kTrusted);
+    problem.SetModuli(Vector::Constant(1, 1.9e11));
+    CoupledSolverOptions options;
+    options.type = CoupledSolverType::kConjugateGradient;
+    CoupledSolution solution;
+    const CoupledSolverSummary summary = SolveCoupled(options, &problem, nullptr, &solution);
+    EXPECT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+    return summary.iterations;
+  };
+  const int coarse = iterations(100, 0.01);
+  const int fine = iterations(3200, 0.01);
+  const int fine_first_element = iterations(3200, 0.0);
+  // Measured: 7, 6 and 11 iterations.
+  EXPECT_LE(fine, 1.3 * coarse) << coarse << " " << fine;
+  EXPECT_GE(fine_first_element, 1.5 * fine) << fine << " " << fine_first_element;
+}
+
 TEST(MatrixSupportsTest, AllAtOnceAndConjugateGradientsAgreeUnderEveryTreatment) {
   const MatrixModelData lattice = SupportedLattice();
   const ChannelSet data = SupportedLatticeHistories(lattice);
@@ -269,6 +364,7 @@ void ExpectSameModel(const MatrixModelData& a, const MatrixModelData& b) {
     EXPECT_EQ(a.supports[s].name, b.supports[s].name);
     EXPECT_EQ(a.supports[s].dofs, b.supports[s].dofs);
     EXPECT_EQ(a.supports[s].reaction, b.supports[s].reaction);
+    EXPECT_EQ(a.supports[s].reaction_test, b.supports[s].reaction_test);
     EXPECT_EQ(a.supports[s].force_channel, b.supports[s].force_channel);
     EXPECT_EQ(a.supports[s].displacement_channel, b.supports[s].displacement_channel);
   }
@@ -294,6 +390,17 @@ TEST(MatrixSupportsTest, ManifestRoundTripKeepsTheSupports) {
             std::string::npos)
       << testing::ReadText(bar_manifest);
   ExpectSameModel(exported, ReadMatrixModel(bar_manifest));
+  // Its trusted reaction over 100 mm of 60 elements: phi in a file of its own.
+  bar.elements = 60;
+  bar.reaction_length = 0.1;
+  const MatrixModelData averaged = BarMatrixModel(BarModel(bar), 1e9, {}, BarClampExport::kSupport);
+  const std::string averaged_manifest =
+      WriteMatrixModel(testing::FreshDirectory("supports_round_trip_averaged"), averaged);
+  EXPECT_NE(
+      testing::ReadText(averaged_manifest).find("reaction_test: support_clamp_reaction_test.mtx}"),
+      std::string::npos)
+      << testing::ReadText(averaged_manifest);
+  ExpectSameModel(averaged, ReadMatrixModel(averaged_manifest));
 }
 
 // The message of ReadMatrixModel on the lattice's manifest with its supports: section
@@ -341,6 +448,10 @@ TEST(MatrixSupportsTest, EachBadSupportIsRefusedNamingIt) {
       {"supports:\n  - {name: left, dofs: [0], force_channel: R, reaction: off.mtx}\n",
        {"support 'left'", "off.mtx", "at dof 7, which the support does not hold"}},
       {"supports:\n  - {name: left, dofs: [0], force_channel: R, reaction: short.mtx}\n",
+       {"support 'left'", "short.mtx", "5 entries"}},
+      {"supports:\n  - {name: left, dofs: [0], force_channel: R, reaction_test: off.mtx}\n",
+       {"support 'left'", "off.mtx", "entry 0 at held dof 0, expected the support's reaction"}},
+      {"supports:\n  - {name: left, dofs: [0], force_channel: R, reaction_test: short.mtx}\n",
        {"support 'left'", "short.mtx", "5 entries"}},
       {"supports:\n  - {name: left, dofs: [0], force_channel: R, stiffness: 3}\n",
        {"unknown key 'stiffness'"}},

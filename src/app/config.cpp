@@ -416,6 +416,8 @@ const std::vector<Key>& KeyTable() {
               EnumByName<MassType>({MassType::kConsistent, MassType::kLumped}, MassTypeToString,
                                    StringToMassType),
               "", "element mass matrix"),
+      MakeKey("model.reaction_length", &Config::model, &BarProperties::reaction_length, Number(),
+              "m", "a trusted clamp's reaction: the axial force averaged over [0, this]"),
       MakeKey("model.zoning", &Config::zones, &ZoneLayout::zoning,
               EnumByName<Zoning>({Zoning::kEqual, Zoning::kPerElement, Zoning::kBoundaries},
                                  ZoningToString, StringToZoning),
@@ -1367,10 +1369,12 @@ std::string FirstProblem(const Config& config) {
 // given by matrices does not read: refused there when set (RefuseKeysOfTheBar).
 bool BarOnlyKey(const std::string& path) {
   static const std::set<std::string> bar_only = {
-      "model.length",          "model.section",    "model.density",         "model.modulus",
-      "model.elements",        "model.mass",       "model.zoning",          "model.zone_count",
-      "model.zone_boundaries", "data.truth",       "data.truth_refinement", "data.sensors",
-      "data.channels",         "data.truth_zones", "data.support_stiffness"};
+      "model.length",          "model.section",  "model.density",
+      "model.modulus",         "model.elements", "model.mass",
+      "model.reaction_length", "model.zoning",   "model.zone_count",
+      "model.zone_boundaries", "data.truth",     "data.truth_refinement",
+      "data.sensors",          "data.channels",  "data.truth_zones",
+      "data.support_stiffness"};
   return bar_only.count(path) > 0;
 }
 

@@ -171,8 +171,9 @@ void GatherFixedRows(const std::vector<ObservedRow>& rows, const ChannelSet& dat
   fixed_observation->setFromTriplets(entries.begin(), entries.end());
 }
 
-// The reactions r_s(U) = g_s^T K(E) U = sum_z E_z (g_s^T K_z / E_z,nom) U: per zone the
-// rows g_s^T K_z / E_z,nom, held columns dropped (U = 0 there).
+// The reactions r_s(U) = phi_s^T K(E) U = sum_z E_z (phi_s^T K_z / E_z,nom) U: per zone
+// the rows phi_s^T K_z / E_z,nom, held columns dropped (U = 0 there); phi_s the support's
+// TrustedReactionTest, g_s unless it extends over free dofs (docs/boundaries.md section 7).
 std::vector<SparseMatrix> ReactionZoneRows(const MatrixModelData& model,
                                            const std::vector<char>& held) {
   const int n = model.dofs();
@@ -182,8 +183,8 @@ std::vector<SparseMatrix> ReactionZoneRows(const MatrixModelData& model,
   for (const MatrixModelZone& zone : model.zones) {
     entries.clear();
     for (int s = 0; s < num_reactions; ++s) {
-      const Vector row =
-          (zone.stiffness.transpose() * model.supports[s].reaction) * (1.0 / zone.nominal_modulus);
+      const Vector row = (zone.stiffness.transpose() * TrustedReactionTest(model.supports[s])) *
+                         (1.0 / zone.nominal_modulus);
       for (int i = 0; i < n; ++i) {
         if (row[i] != 0.0 && held[i] == 0) entries.emplace_back(s, i, row[i]);
       }

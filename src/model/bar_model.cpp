@@ -19,6 +19,11 @@ bool BarProperties::IsValid(std::string* error) const {
   };
   bool ok = positive(length, "model.length") && positive(section, "model.section") &&
             positive(density, "model.density") && positive(modulus, "model.modulus");
+  if (ok &&
+      !(std::isfinite(reaction_length) && reaction_length >= 0.0 && reaction_length <= length)) {
+    why << "model.reaction_length must lie in [0, L = " << length << "] m, got " << reaction_length;
+    ok = false;
+  }
   // At most 1e8, so that node and entry counts stay far inside int.
   if (ok && (elements < 1 || elements > 100000000)) {
     why << "model.elements must be an integer in [1, 1e8], got " << elements;

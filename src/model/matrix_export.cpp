@@ -174,8 +174,22 @@ MatrixModelData BarMatrixModel(const BarModel& model, double nominal_modulus,
   }
   if (support) {
     // The clamp: dof 0 held, g = e_0, its force f0 and displacement u0.
-    data.supports.push_back(
-        {"clamp", {model.left_node()}, Vector::Unit(n, model.left_node()), "f0", "u0"});
+    MatrixModelSupport clamp{
+        "clamp", {model.left_node()}, Vector::Unit(n, model.left_node()), "f0", "u0", Vector()};
+    // Its trusted reaction's virtual displacement phi, linear from 1 at x = 0 to 0 at the
+    // node m nearest to model.reaction_length: phi^T K U = -(S / (m l)) sum_{e < m} E_e
+    // (U_{e+1} - U_e), the axial force averaged over [0, m l] (docs/boundaries.md
+    // section 7). m = 1 leaves g alone.
+    const BarProperties& bar = model.properties();
+    const double element_length = bar.length / bar.elements;
+    const int m =
+        std::min(bar.elements,
+                 std::max(1, static_cast<int>(std::lround(bar.reaction_length / element_length))));
+    if (m > 1) {
+      clamp.reaction_test = Vector::Zero(n);
+      for (int i = 0; i < m; ++i) clamp.reaction_test[model.left_node() + i] = 1.0 - double(i) / m;
+    }
+    data.supports.push_back(std::move(clamp));
   }
   return data;
 }
@@ -327,6 +341,13 @@ std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& d
         WriteMatrixMarketVector(folder + "/" + file, support.reaction,
                                 "reaction vector g of support " + support.name);
         manifest << YAML::Key << "reaction" << YAML::Value << file;
+      }
+      if (support.reaction_test.size() > 0) {
+        const std::string file = "support_" + FileSafe(support.name) + "_reaction_test.mtx";
+        WriteMatrixMarketVector(
+            folder + "/" + file, support.reaction_test,
+            "virtual displacement phi of support " + support.name + "'s trusted reaction");
+        manifest << YAML::Key << "reaction_test" << YAML::Value << file;
       }
       manifest << YAML::EndMap;
     }
@@ -659,10 +680,10 @@ void ReadSupports(const std::string& manifest_path, const YAML::Node& root,
     for (const auto& key : entry) {
       const std::string& name = key.first.Scalar();
       if (name != "name" && name != "dofs" && name != "force_channel" &&
-          name != "displacement_channel" && name != "reaction") {
+          name != "displacement_channel" && name != "reaction" && name != "reaction_test") {
         throw InputError(which + ": unknown key '" + name +
                          "' (expected name, dofs, force_channel, displacement_channel, "
-                         "reaction)");
+                         "reaction, reaction_test)");
       }
     }
     // The string of key `key` (a channel or file name).
@@ -705,6 +726,13 @@ void ReadSupports(const std::string& manifest_path, const YAML::Node& root,
       }
     } else {
       support.reaction = DefaultSupportReaction(support.dofs, n);
+    }
+    if (entry["reaction_test"]) {
+      const std::string file = ManifestFile(folder, string_of("reaction_test"));
+      support.reaction_test = ReadMatrixMarketVector(file);
+      const std::string bad_test = CheckSupportReactionTest(
+          support.reaction_test, support.reaction, support.dofs, support.name, file, n, mass_file);
+      if (!bad_test.empty()) throw InputError(Where(manifest_path, entry) + ": " + bad_test);
     }
     support.force_channel = string_of("force_channel");
     if (entry["displacement_channel"]) {
@@ -776,6 +804,10 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
   ReadSupports(manifest_path, root, folder, mass_file, &channels, &data);
   ReadElements(manifest_path, root, folder, mass_file, &data);
   return data;
+}
+
+const Vector& TrustedReactionTest(const MatrixModelSupport& support) {
+  return support.reaction_test.size() > 0 ? support.reaction_test : support.reaction;
 }
 
 MatrixModelData BarRunModel(const BarModel& model, const ChannelSet& data,

@@ -187,4 +187,28 @@ std::string CheckSupportReaction(const Vector& reaction, const std::vector<int>&
   return "";
 }
 
+std::string CheckSupportReactionTest(const Vector& test, const Vector& reaction,
+                                     const std::vector<int>& support_dofs,
+                                     const std::string& support, const std::string& name, int dofs,
+                                     const std::string& reference_name) {
+  const std::string which = "support '" + support + "' (" + name + ")";
+  if (test.size() != dofs) {
+    return which + ": " + std::to_string(test.size()) + " entries, but " + reference_name +
+           " has " + std::to_string(dofs) + " dofs";
+  }
+  for (int i = 0; i < dofs; ++i) {
+    if (!std::isfinite(test[i])) {
+      return which + ": entry " + Short(test[i]) + " at dof " + std::to_string(i) +
+             ", expected finite entries";
+    }
+  }
+  for (const int dof : support_dofs) {
+    if (test[dof] != reaction[dof]) {
+      return which + ": entry " + Short(test[dof]) + " at held dof " + std::to_string(dof) +
+             ", expected the support's reaction vector g there (" + Short(reaction[dof]) + ")";
+    }
+  }
+  return "";
+}
+
 }  // namespace mcrewave

@@ -34,6 +34,11 @@ struct BarProperties {
   double modulus = 200e9;  // E [Pa], the reference (or initial) modulus
   int elements = 100;      // N, number of linear elements
   MassType mass = MassType::kConsistent;
+  // a [m]: the clamp's reaction, where the clamp is trusted, is the axial force averaged
+  // over [0, a] (at least the first element; docs/boundaries.md section 7). A fixed
+  // length keeps the reaction's gain, and the inner solves' iterations, independent of
+  // the mesh. 0: the first element.
+  double reaction_length = 0.01;
 
   // True when every value is usable; otherwise writes the reason to *error.
   bool IsValid(std::string* error) const;

@@ -95,7 +95,17 @@ struct MatrixModelSupport {
   Vector reaction;
   std::string force_channel;         // the CSV column of the measured force [N]
   std::string displacement_channel;  // the CSV column of the measured displacement [m]; "" if none
+  // phi [-]: the virtual displacement of a trusted support's reaction r(U) = phi^T K(E) U
+  // (docs/boundaries.md section 7). It equals g on the support's dofs and may extend over
+  // free dofs near it, where phi^T K U adds the elastic forces, so that r is a mean force
+  // over a fixed region and its gain does not grow as the mesh is refined. Manifest key
+  // `reaction_test` (a vector file); empty: g.
+  Vector reaction_test;
 };
+
+// The virtual displacement of a support's trusted reaction: reaction_test, or g when it
+// is empty.
+const Vector& TrustedReactionTest(const MatrixModelSupport& support);
 
 struct MatrixModelData {
   SparseMatrix mass;  // M [kg], n x n

@@ -76,5 +76,12 @@ std::string CheckSupportDofs(const std::vector<int>& support_dofs, const std::st
 std::string CheckSupportReaction(const Vector& reaction, const std::vector<int>& support_dofs,
                                  const std::string& support, const std::string& name, int dofs,
                                  const std::string& reference_name);
+// A support's trusted-reaction virtual displacement phi (key reaction_test, file `name`):
+// "" when it has `dofs` entries, all finite, equal to g (`reaction`) on the support's dofs;
+// otherwise the reason.
+std::string CheckSupportReactionTest(const Vector& test, const Vector& reaction,
+                                     const std::vector<int>& support_dofs,
+                                     const std::string& support, const std::string& name, int dofs,
+                                     const std::string& reference_name);
 
 }  // namespace mcrewave
