@@ -187,6 +187,7 @@ void ExpectSameConfigZoneIdentification(const Config& expected, const Config& ac
   EXPECT_EQ(zones.noise_samples, zones_again.noise_samples);
   EXPECT_EQ(zones.noise_seed, zones_again.noise_seed);
   EXPECT_EQ(zones.merge_zones, zones_again.merge_zones);
+  EXPECT_EQ(zones.measured_clamp, zones_again.measured_clamp);
 }
 
 // Every key of the two configs is equal (NaN never occurs in a valid config).
@@ -776,6 +777,7 @@ zone_identification:
   noise_samples: 6
   noise_seed: 7
   merge_zones: true
+  measured_clamp: false
 )";
 
 // The keys of a structure given by matrices at non-default values (they are refused

@@ -206,6 +206,48 @@ TEST(MatrixIdentificationRunTest, ZonesOfTheBarAsMatricesAreRegularisedAndMerged
   }
 }
 
+// Many zones on a trusted support whose displacement the data hold are identified with
+// the support measured, as the bar's zones are (zone_identification.measured_clamp,
+// docs/boundaries.md section 8): the quick bar in 3 zones with its clamp a support, run
+// trusted, gives the zones of the run told mcre.clamp=measured to the bit (quick.yaml's
+// w_u, w_e and search are the paper's), and trusted ones with the key off.
+TEST(MatrixIdentificationRunTest, ZonesOnATrustedSupportAreIdentifiedWithTheSupportMeasured) {
+  const std::string dir = FreshDirectory("matrix_run_zones_trusted");
+  const std::string quick = SourcePath("configs/quick.yaml");
+  ASSERT_EQ(RunIdentify("simulate " + quick + " -q -o " + dir + "/data.csv").exit_code, 0);
+  const Config config = LoadConfig(quick);
+  std::vector<int> zones(config.model.elements);
+  for (int e = 0; e < config.model.elements; ++e) zones[e] = 3 * e / config.model.elements;
+  std::filesystem::create_directories(dir + "/support");
+  const std::string manifest = WriteMatrixModel(
+      dir + "/support",
+      BarMatrixModel(BarModel(config.model, zones), 160e9, {}, BarClampExport::kSupport));
+  const std::string run = "run " + WriteQuickMatrixConfig(dir, manifest) +
+                          " --set data.source=csv --set data.path=" + dir + "/data.csv -q -o " +
+                          dir;
+  for (const char* name : {"measured", "trusted", "trusted_kept"}) {
+    const std::string settings =
+        std::string(name) == "measured" ? " --set mcre.clamp=measured"
+        : std::string(name) == "trusted"
+            ? " --set mcre.clamp=trusted"
+            : " --set mcre.clamp=trusted --set zone_identification.measured_clamp=false";
+    const RunResult result = RunIdentify(run + "/" + name + settings);
+    ASSERT_EQ(result.exit_code, 0) << result.output;
+  }
+  auto clamp_of = [&](const char* name) {
+    return YAML::LoadFile(dir + "/" + name + "/summary.yaml")["zones"]["clamp"].as<std::string>();
+  };
+  EXPECT_EQ(clamp_of("measured"), "measured");
+  EXPECT_EQ(clamp_of("trusted"), "measured");
+  EXPECT_EQ(clamp_of("trusted_kept"), "trusted");
+  for (int z = 0; z < 3; ++z) {
+    EXPECT_EQ(ZoneModulus(dir + "/trusted/zones.csv", z),
+              ZoneModulus(dir + "/measured/zones.csv", z));
+    EXPECT_NE(ZoneModulus(dir + "/trusted_kept/zones.csv", z),
+              ZoneModulus(dir + "/measured/zones.csv", z));
+  }
+}
+
 // The quick bar exported with its clamp as a support (dof 0, channels f0 and u0) under
 // each treatment of mcre.clamp: the run through the manifest identifies the built-in
 // bar's modulus from the same CSV.

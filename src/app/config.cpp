@@ -801,6 +801,9 @@ const std::vector<Key>& KeyTable() {
       MakeKey("zone_identification.merge_zones", &Config::zone_identification,
               &ZoneIdentificationOptions::merge_zones, Boolean(), "",
               "merge neighbouring zones while a refit meets the discrepancy target"),
+      MakeKey("zone_identification.measured_clamp", &Config::zone_identification,
+              &ZoneIdentificationOptions::measured_clamp, Boolean(), "",
+              "the MCRE's zones on a trusted clamp with u0 in the data: the clamp measured"),
   };
   return table;
 }

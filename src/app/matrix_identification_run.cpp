@@ -749,6 +749,21 @@ IdentificationRun RunMatrixIdentification(const Config& given, const MatrixModel
   // compared with (ConfigForTheSupports): every later step identifies with run.config.
   run.config = ConfigForTheSupports(given, model, measurements.histories, run.data,
                                     &run.support_checks, &run.support_switched);
+  // Many zones on trusted supports whose displacements the data hold: the clamp measured,
+  // the paper's formulation, as the bar's zones (zone_identification.measured_clamp,
+  // docs/boundaries.md section 8). Every step of this run identifies the zones.
+  const bool every_support_measured =
+      !model.supports.empty() &&
+      std::all_of(model.supports.begin(), model.supports.end(),
+                  [](const MatrixModelSupport& s) { return !s.displacement_channel.empty(); });
+  if (run.config.zone_identification.measured_clamp &&
+      run.config.mcre.clamp == ClampModel::kTrusted && model.zones.size() > 1 &&
+      every_support_measured) {
+    run.config = MeasuredSupportConfig(run.config);
+    spdlog::info("{} zones: the supports measured (zone_identification.measured_clamp)",
+                 model.zones.size());
+  }
+  run.zones.clamp = run.config.mcre.clamp;
   const Config& config = run.config;
   McreObjective mcre_objective =
       MatrixMcreObjective(model, run.data, config.mcre, config.time.theta, config.inner);

@@ -1151,6 +1151,10 @@ void MatrixZonesYaml(const IdentificationRun& run, YamlWriter* yaml) {
              run.homogeneous_ran ? "identification of every zone modulus from the homogeneous E*"
                                  : "identification of every zone modulus from the nominal moduli");
   yaml->Line(1, "functional", run.least_squares ? "least_squares" : "mcre", "outer.functional");
+  if (!run.least_squares && !run.model->supports.empty()) {
+    yaml->Line(1, "clamp", ClampModelToString(run.zones.clamp),
+               "the supports' treatment of the zones (zone_identification.measured_clamp)");
+  }
   yaml->Integer(1, "count", static_cast<long>(run.model->zones.size()));
   const ZoneIdentificationSummary& zones = run.zones.summary;
   const BoundedMinimizerSummary& minimizer = zones.regularized.minimizer;

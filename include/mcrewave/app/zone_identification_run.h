@@ -1,7 +1,8 @@
 // The identification of zone moduli within `identify run` (docs/zones_and_sensors.md,
 // "Identification of zone moduli"): after the scalar identification, from its
 // homogeneous E*, every zone modulus at once (identification/zone_identification.h; by the
-// MCRE, or by output-error least squares with outer.functional: least_squares), and its
+// MCRE, with a trusted clamp measured when the data hold u0, or by output-error least
+// squares with outer.functional: least_squares), and its
 // outputs: the `zones:` block of summary.yaml, zones.csv and the figure moduli.png of
 // E(x) (a step plot) against the truth's E(x) when the data are synthetic.
 #pragma once
@@ -21,6 +22,9 @@ struct ZoneIdentificationRun {
   bool ran = false;  // false: one zone, nothing done (the scalar result stands alone)
   ZoneLayout layout;
   ZoneIdentificationSummary summary;
+  // The clamp's treatment the zones were identified with: mcre.clamp, or measured
+  // (zone_identification.measured_clamp).
+  ClampModel clamp = ClampModel::kMeasured;
   // Synthetic data: the truth's modulus per element of the identification's mesh
   // [Pa] (BarProperties.modulus, the truth zones over it, in series where an
   // element is cut); empty for CSV data.
@@ -35,10 +39,13 @@ ZoneLayout IdentificationZoneLayout(const Config& config);
 std::vector<ModulusZone> TruthZones(const Config& config);
 
 // Runs the zone identification when the layout has more than one zone on
-// config.model (else returns ran = false): from scalar.identified_modulus() within
+// config.model (else returns ran = false), with a trusted clamp measured
+// (MeasuredSupportConfig) when zone_identification.measured_clamp and the data hold u0:
+// from scalar.identified_modulus() within
 // [outer.lower_bound, outer.upper_bound], on scalar.data (pre-filtered as the scalar
 // run saw them), noise levels scalar.estimated_noise for the discrepancy target,
-// warm-started from scalar.solution. truth_zones: as TruthZones (synthetic data only).
+// warm-started from scalar.solution when the clamp's treatment is the scalar run's.
+// truth_zones: as TruthZones (synthetic data only).
 // Precondition: scalar.IsUsable(), layout.Validate(config.model) empty.
 ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayout& layout,
                                             const IdentificationRun& scalar,

@@ -48,6 +48,11 @@ struct ZoneIdentificationOptions {
   // default: each trial is a minimisation, O(zones^2) of them at worst
   // (docs/zones_and_sensors.md, "Merging neighbouring zones").
   bool merge_zones = false;
+  // A run whose clamp is trusted (mcre.clamp) and whose data hold u0 identifies its zones
+  // with the clamp measured, the paper's formulation (MeasuredSupportConfig; read by
+  // app/zone_identification_run.h, docs/boundaries.md section 8). false: the run's own
+  // treatment.
+  bool measured_clamp = true;
 
   // Messages name the zone_identification.* keys.
   bool IsValid(std::string* error) const;
