@@ -1249,7 +1249,7 @@ TEST_F(ConfigFileTest, UnknownClampModelAndComparatorDataAreRefused) {
 
 TEST_F(ConfigFileTest, SearchKeysAreCheckedAndBelongToThePinnedSearchFunctional) {
   ExpectLoadError("search:\n  functional: other\n", 2,
-                  {"search.functional: expected one of 'pinned', 'same', got 'other'"});
+                  {"search.functional: expected one of 'pinned', 'same', 'measured', got 'other'"});
   ExpectLoadError("search:\n  w_u: 0\n", 2, {"search.w_u must be a finite positive number, got 0"});
   ExpectLoadError("search:\n  w_r: -1\n", 2,
                   {"search.w_r must be a finite positive number, got -1"});
@@ -1270,6 +1270,15 @@ TEST_F(ConfigFileTest, SearchKeysAreCheckedAndBelongToThePinnedSearchFunctional)
   ExpectLoadError("search:\n  functional: same\n  w_u0: 0.2\n", 3,
                   {"search.w_u0 applies to search.functional 'pinned' only (search.functional "
                    "is 'same', the scan runs on mcre:'s e^2); leave it out with this functional"});
+  // The measured search functional reads w_u and w_e, not the pinned clamp's w_u0 and w_r.
+  EXPECT_NO_THROW(ParseConfig("search:\n  functional: measured\n  w_u: 0.1\n", "a.yaml"));
+  ExpectLoadError("search:\n  functional: measured\n  w_r: 0.2\n", 3,
+                  {"search.w_r applies to search.functional 'pinned' only (search.functional "
+                   "is 'measured'"});
+  ExpectLoadError(
+      "search:\n  functional: measured\nouter:\n  scan_points: 3\n  "
+      "max_evaluations: 20\n",
+      5, {"with search.functional 'measured'"});
 }
 
 TEST_F(ConfigFileTest, NegativeSeed) {

@@ -209,8 +209,9 @@ TEST(MatrixIdentificationRunTest, ZonesOfTheBarAsMatricesAreRegularisedAndMerged
 // Many zones on a trusted support whose displacement the data hold are identified with
 // the support measured, as the bar's zones are (zone_identification.measured_clamp,
 // docs/boundaries.md section 8): the quick bar in 3 zones with its clamp a support, run
-// trusted, gives the zones of the run told mcre.clamp=measured to the bit (quick.yaml's
-// w_u, w_e and search are the paper's), and trusted ones with the key off.
+// trusted, gives the zones of the run told the measured clamp and its scan
+// (MeasuredSupportConfig: quick.yaml's w_u and w_e are the paper's; the search measured
+// at 0.1) to the bit, and trusted ones with the key off.
 TEST(MatrixIdentificationRunTest, ZonesOnATrustedSupportAreIdentifiedWithTheSupportMeasured) {
   const std::string dir = FreshDirectory("matrix_run_zones_trusted");
   const std::string quick = SourcePath("configs/quick.yaml");
@@ -227,7 +228,9 @@ TEST(MatrixIdentificationRunTest, ZonesOnATrustedSupportAreIdentifiedWithTheSupp
                           dir;
   for (const char* name : {"measured", "trusted", "trusted_kept"}) {
     const std::string settings =
-        std::string(name) == "measured" ? " --set mcre.clamp=measured"
+        std::string(name) == "measured"
+            ? " --set mcre.clamp=measured --set search.functional=measured --set search.w_u=0.1 "
+              "--set search.w_e=0.1"
         : std::string(name) == "trusted"
             ? " --set mcre.clamp=trusted"
             : " --set mcre.clamp=trusted --set zone_identification.measured_clamp=false";

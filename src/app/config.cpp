@@ -618,28 +618,32 @@ const std::vector<Key>& KeyTable() {
               PositiveInteger<int>(), "",
               "most valleys of the scan refined by the local optimiser"),
       MakeKey("search.functional", &Config::search, &SearchOptions::functional,
-              EnumByName<SearchFunctional>({SearchFunctional::kPinned, SearchFunctional::kSame},
-                                           SearchFunctionalToString, StringToSearchFunctional),
+              EnumByName<SearchFunctional>(
+                  {SearchFunctional::kPinned, SearchFunctional::kSame, SearchFunctional::kMeasured},
+                  SearchFunctionalToString, StringToSearchFunctional),
               "",
               "the functional the global scan runs on: pinned (the pinned clamp's e^2 with "
-              "search.w_*, one valley; mcre:'s e^2 then refined near its minimum) or same "
+              "search.w_*, one valley; mcre:'s e^2 then refined near its minimum), measured "
+              "(the measured clamp's e^2 with search.w_u and w_e, then the same) or same "
               "(mcre:'s e^2 itself)"),
       MakeKey("search.w_u", &Config::search, &SearchOptions::displacement_weight, Number(), "",
-              "search functional pinned: displacement weight, beta = w_u S E0 / L"),
+              "search functional pinned or measured: displacement weight, beta = w_u S E0 / L"),
       MakeKey("search.w_e", &Config::search, &SearchOptions::strain_weight, Number(), "",
-              "search functional pinned: strain weight, beta_e = w_e S E0 L"),
+              "search functional pinned or measured: strain weight, beta_e = w_e S E0 L"),
       MakeKey("search.w_u0", &Config::search, &SearchOptions::clamp_displacement_weight, Number(),
               "", "search functional pinned: weight of u(0) = 0, beta_0 = w_u0 S E0 / L"),
       MakeKey("search.w_r", &Config::search, &SearchOptions::reaction_weight, Number(), "",
               "search functional pinned: weight of the load f0, alpha_0 = w_r L / (S E0)"),
-      MakeKey("search.inner_tolerance", &Config::search, &SearchOptions::inner_tolerance, Number(),
-              "", "search functional pinned: relative residual of its inner solves, in (0, 1)"),
       MakeKey(
-          "search.scan_points", &Config::search, &SearchOptions::scan_points,
-          PositiveInteger<int>(), "",
-          "search functional pinned: fewest moduli of its scan (in place of outer.scan_points)"),
+          "search.inner_tolerance", &Config::search, &SearchOptions::inner_tolerance, Number(), "",
+          "search functional pinned or measured: relative residual of its inner solves, in (0, 1)"),
+      MakeKey("search.scan_points", &Config::search, &SearchOptions::scan_points,
+              PositiveInteger<int>(), "",
+              "search functional pinned or measured: fewest moduli of its scan (in place of "
+              "outer.scan_points)"),
       MakeKey("search.refine_window", &Config::search, &SearchOptions::refine_window, Number(), "",
-              "search functional pinned: mcre:'s e^2 is refined within E_search (1 -+ this), "
+              "search functional pinned or measured: mcre:'s e^2 is refined within E_search (1 -+ "
+              "this), "
               "in (0, 0.5]"),
       MakeKey("prefilter.enabled", &Config::prefilter, &PrefilterOptions::enabled, Boolean(), "",
               "zero-phase Butterworth low-pass, the same on every channel the identification "
@@ -905,6 +909,18 @@ bool CheckZoneLayout(const Config& config, std::string* error) {
 bool CheckSearchKeysApply(const Config& config, std::string* error) {
   const char* key = SearchKeyNotAtItsDefault(config.search);
   if (config.search.functional == SearchFunctional::kPinned || key == nullptr) return true;
+  if (config.search.functional == SearchFunctional::kMeasured) {
+    const SearchOptions defaults;
+    const char* pinned_only =
+        config.search.clamp_displacement_weight != defaults.clamp_displacement_weight
+            ? "search.w_u0"
+            : (config.search.reaction_weight != defaults.reaction_weight ? "search.w_r" : nullptr);
+    if (pinned_only == nullptr) return true;
+    *error = std::string(pinned_only) +
+             " applies to search.functional 'pinned' only (search.functional is 'measured': "
+             "no datum u(0) = 0, f0 a load at mcre.w_f); leave it out with this functional";
+    return false;
+  }
   *error = std::string(key) +
            " applies to search.functional 'pinned' only (search.functional is 'same', "
            "the scan runs on mcre:'s e^2); leave it out with this functional";
@@ -927,13 +943,14 @@ bool CheckTwoStageScansFitLimits(const Config& config, std::string* error) {
         << ") must not exceed outer.scan_max_points (" << config.outer.scan_max_points << ")";
   } else if (config.outer.scan_max_points < kTwoStageWindowScanPoints) {
     why << "outer.scan_max_points (" << config.outer.scan_max_points << ") must be at least "
-        << kTwoStageWindowScanPoints
-        << " with search.functional 'pinned': e^2 is scanned over that many moduli near "
-           "the search's minimiser";
+        << kTwoStageWindowScanPoints << " with search.functional '"
+        << SearchFunctionalToString(config.search.functional)
+        << "': e^2 is scanned over that many moduli near the search's minimiser";
   } else if (config.outer.max_evaluations < least_evaluations) {
     why << "outer.max_evaluations (" << config.outer.max_evaluations
         << ") must be at least search.scan_points + " << kTwoStageWindowScanPoints + 4 << " = "
-        << least_evaluations << " with search.functional 'pinned': the search's scan, e^2's "
+        << least_evaluations << " with search.functional '"
+        << SearchFunctionalToString(config.search.functional) << "': the search's scan, e^2's "
         << kTwoStageWindowScanPoints << " near its minimiser and two evaluations of each "
         << "refinement";
   } else {
@@ -1607,7 +1624,7 @@ Config LoadConfig(const std::string& path, const std::vector<std::string>& overr
 std::string ConfigProblem(const Config& config) { return FirstProblem(config); }
 
 bool ScansTheSearchFunctional(const Config& config) {
-  return config.outer.scan_points > 0 && config.search.functional == SearchFunctional::kPinned;
+  return config.outer.scan_points > 0 && config.search.functional != SearchFunctional::kSame;
 }
 
 std::string DefaultConfigYaml() {

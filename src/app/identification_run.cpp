@@ -288,7 +288,11 @@ Config MeasuredSupportConfig(const Config& config) {
   measured.mcre.clamp = ClampModel::kMeasured;
   measured.mcre.weights.displacement_weight = paper.displacement_weight;
   measured.mcre.weights.strain_weight = paper.strain_weight;
-  measured.search.functional = SearchFunctional::kSame;
+  // The scan on the same formulation at heavier weights, which has one valley where
+  // e^2's own may have two (docs/boundaries.md section 9); e^2 refined near its minimum.
+  measured.search.functional = SearchFunctional::kMeasured;
+  measured.search.displacement_weight = 0.1;
+  measured.search.strain_weight = 0.1;
   return measured;
 }
 

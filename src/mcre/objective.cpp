@@ -59,7 +59,8 @@ bool SearchOptions::IsValid(std::string* error) const {
 
 McreOptions SearchMcreOptions(const McreOptions& mcre, const SearchOptions& search) {
   McreOptions options = mcre;
-  options.clamp = ClampModel::kPinned;
+  options.clamp = search.functional == SearchFunctional::kMeasured ? ClampModel::kMeasured
+                                                                   : ClampModel::kPinned;
   options.weights.displacement_weight = search.displacement_weight;
   options.weights.strain_weight = search.strain_weight;
   options.weights.clamp_displacement_weight = search.clamp_displacement_weight;
@@ -74,10 +75,11 @@ bool SearchIsTheObjective(const McreOptions& mcre, const SearchOptions& search,
       weights.strain_weight != search.strain_weight) {
     return false;
   }
-  return !model_has_supports ||
-         (mcre.clamp == ClampModel::kPinned &&
-          weights.clamp_displacement_weight == search.clamp_displacement_weight &&
-          weights.reaction_weight == search.reaction_weight);
+  if (!model_has_supports) return true;
+  if (search.functional == SearchFunctional::kMeasured) return mcre.clamp == ClampModel::kMeasured;
+  return mcre.clamp == ClampModel::kPinned &&
+         weights.clamp_displacement_weight == search.clamp_displacement_weight &&
+         weights.reaction_weight == search.reaction_weight;
 }
 
 McreObjective::McreObjective(ProblemFactory make_problem, const CoupledSolverOptions& inner,

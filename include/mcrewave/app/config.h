@@ -164,8 +164,8 @@ Config ParseConfig(const std::string& yaml_text, const std::string& name,
 // key first, as LoadConfig's message without the file and line.
 std::string ConfigProblem(const Config& config);
 
-// Whether the global scan runs on the pinned search functional (search.functional
-// pinned with a scan, outer.scan_points > 0): the MCRE then identifies in two stages
+// Whether the global scan runs on a search functional (search.functional pinned or
+// measured, with a scan, outer.scan_points > 0): the MCRE then identifies in two stages
 // (IdentifyInTwoStages, identification.h).
 bool ScansTheSearchFunctional(const Config& config);
 

@@ -254,8 +254,10 @@ McreObjective CompleteModulusStage(const Config& config, const MatrixModelData& 
                                    const ChannelSet& data, bool cost_curve, ModulusStage* stage);
 
 // config with the paper's treatment of the supports (configs/paper_bar_free_free.yaml's
-// mcre: and search: sections): mcre.clamp measured, w_u and w_e the paper's (McreWeights'
-// defaults) and the global scan on that e^2 itself (search.functional same).
+// mcre: section): mcre.clamp measured, w_u and w_e the paper's (McreWeights' defaults),
+// and the global scan on the same formulation at w_u = w_e = 0.1 (search.functional
+// measured), one valley where e^2's own may have two, e^2 then refined near its minimum
+// (docs/boundaries.md section 9).
 Config MeasuredSupportConfig(const Config& config);
 
 // The config an MCRE run identifies with on `raw` data (before the pre-filter) and the

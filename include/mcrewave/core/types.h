@@ -179,13 +179,17 @@ bool StringToBarClampExport(const std::string& name, BarClampExport* clamp);
 // The functional the global search of a bar's identification scans (config key
 // search.functional; docs/trusted_clamp.md section 10).
 enum class SearchFunctional {
-  kPinned,  // the pinned clamp's e^2 with the search: section's weights (one valley over
-            // the bounds), then mcre:'s e^2 refined near its minimum
-  kSame,    // mcre:'s e^2 itself, scanned and refined
+  kPinned,    // the pinned clamp's e^2 with the search: section's weights (one valley over
+              // the bounds), then mcre:'s e^2 refined near its minimum
+  kSame,      // mcre:'s e^2 itself, scanned and refined
+  kMeasured,  // the measured clamp's e^2 (the paper's free-free formulation) with the
+              // search: section's w_u and w_e, then mcre:'s e^2 refined near its minimum
+              // (docs/boundaries.md section 9)
 };
-inline constexpr std::array<std::pair<SearchFunctional, const char*>, 2> kSearchFunctionalNames{{
+inline constexpr std::array<std::pair<SearchFunctional, const char*>, 3> kSearchFunctionalNames{{
     {SearchFunctional::kPinned, "pinned"},
     {SearchFunctional::kSame, "same"},
+    {SearchFunctional::kMeasured, "measured"},
 }};
 const char* SearchFunctionalToString(SearchFunctional functional);
 bool StringToSearchFunctional(const std::string& name, SearchFunctional* functional);

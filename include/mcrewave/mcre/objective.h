@@ -89,13 +89,14 @@ struct SearchOptions {
   bool IsValid(std::string* error) const;
 };
 
-// The McreOptions of the search functional: mcre's w_f and E0, the clamp pinned and
-// the search's weights.
+// The McreOptions of the search functional: mcre's w_f and E0, the clamp pinned (or
+// measured, with functional measured) and the search's weights.
 McreOptions SearchMcreOptions(const McreOptions& mcre, const SearchOptions& search);
 
 // Whether SearchMcreOptions(mcre, search) poses mcre's own problem on a model with or
 // without supports: the same w_u and w_e, and either no supports (the clamp's treatment,
-// w_u0 and w_r then act on nothing) or mcre's clamp pinned at the search's w_u0 and w_r.
+// w_u0 and w_r then act on nothing), or mcre's clamp pinned at the search's w_u0 and w_r
+// (functional pinned), or mcre's clamp measured (functional measured).
 // The search's scan is then e^2's own, and its second stage would refine e^2 again.
 bool SearchIsTheObjective(const McreOptions& mcre, const SearchOptions& search,
                           bool model_has_supports);
