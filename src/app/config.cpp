@@ -642,9 +642,8 @@ const std::vector<Key>& KeyTable() {
               "search functional pinned or measured: fewest moduli of its scan (in place of "
               "outer.scan_points)"),
       MakeKey("search.refine_window", &Config::search, &SearchOptions::refine_window, Number(), "",
-              "search functional pinned or measured: mcre:'s e^2 is refined within E_search (1 -+ "
-              "this), "
-              "in (0, 0.5]"),
+              "search functional pinned or measured: mcre:'s e^2 is refined within E_search "
+              "(1 -+ this), in (0, 0.5]"),
       MakeKey("prefilter.enabled", &Config::prefilter, &PrefilterOptions::enabled, Boolean(), "",
               "zero-phase Butterworth low-pass, the same on every channel the identification "
               "uses (loads, displacements, strains)"),
