@@ -226,14 +226,13 @@ TEST(MatrixIdentificationRunTest, ZonesOnATrustedSupportAreIdentifiedWithTheSupp
   const std::string run = "run " + WriteQuickMatrixConfig(dir, manifest) +
                           " --set data.source=csv --set data.path=" + dir + "/data.csv -q -o " +
                           dir;
-  for (const char* name : {"measured", "trusted", "trusted_kept"}) {
-    const std::string settings =
-        std::string(name) == "measured"
-            ? " --set mcre.clamp=measured --set search.functional=measured --set search.w_u=0.1 "
-              "--set search.w_e=0.1"
-        : std::string(name) == "trusted"
-            ? " --set mcre.clamp=trusted"
-            : " --set mcre.clamp=trusted --set zone_identification.measured_clamp=false";
+  const std::pair<const char*, const char*> runs[] = {
+      {"measured",
+       " --set mcre.clamp=measured --set search.functional=measured --set search.w_u=0.1 "
+       "--set search.w_e=0.1"},
+      {"trusted", " --set mcre.clamp=trusted"},
+      {"trusted_kept", " --set mcre.clamp=trusted --set zone_identification.measured_clamp=false"}};
+  for (const auto& [name, settings] : runs) {
     const RunResult result = RunIdentify(run + "/" + name + settings);
     ASSERT_EQ(result.exit_code, 0) << result.output;
   }

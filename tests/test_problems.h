@@ -131,7 +131,6 @@ inline McreOptions FreeFreeMcre(double w_u = 0.01) {
   return mcre;
 }
 
-// ||a - b|| / ||b|| (Frobenius).
 // The noise-free truth of `bar` on its own mesh and step (data.truth_refinement 1), held
 // at x = 0 by a spring of `stiffness_factor` E S / L (data.support_stiffness), with the
 // default load and time grid.
@@ -142,6 +141,7 @@ inline ChannelSet SpringSupportedBarData(const BarProperties& bar, double stiffn
   return SimulateTruth(bar, LoadOptions(), TimeOptions(), *data);
 }
 
+// ||a - b|| / ||b|| (Frobenius).
 inline double RelativeDifference(const Matrix& a, const Matrix& b) {
   return (a - b).norm() / b.norm();
 }

@@ -296,6 +296,13 @@ Config MeasuredSupportConfig(const Config& config) {
   return measured;
 }
 
+Config ConfigForTheZones(const Config& config, bool supports_displaced) {
+  return config.zone_identification.measured_clamp && config.mcre.clamp == ClampModel::kTrusted &&
+                 supports_displaced
+             ? MeasuredSupportConfig(config)
+             : config;
+}
+
 Config ConfigForTheSupports(const Config& config, const MatrixModelData& model,
                             const ChannelSet& raw, const ChannelSet& data,
                             std::vector<SupportCheck>* checks, bool* switched, bool log) {

@@ -752,14 +752,14 @@ IdentificationRun RunMatrixIdentification(const Config& given, const MatrixModel
   // Many zones on trusted supports whose displacements the data hold: the clamp measured,
   // the paper's formulation, as the bar's zones (zone_identification.measured_clamp,
   // docs/boundaries.md section 8). Every step of this run identifies the zones.
-  const bool every_support_measured =
+  const bool supports_displaced =
       !model.supports.empty() &&
       std::all_of(model.supports.begin(), model.supports.end(),
                   [](const MatrixModelSupport& s) { return !s.displacement_channel.empty(); });
-  if (run.config.zone_identification.measured_clamp &&
-      run.config.mcre.clamp == ClampModel::kTrusted && model.zones.size() > 1 &&
-      every_support_measured) {
-    run.config = MeasuredSupportConfig(run.config);
+  const Config zone_config =
+      ConfigForTheZones(run.config, model.zones.size() > 1 && supports_displaced);
+  if (zone_config.mcre.clamp != run.config.mcre.clamp) {
+    run.config = zone_config;
     spdlog::info("{} zones: the supports measured (zone_identification.measured_clamp)",
                  model.zones.size());
   }

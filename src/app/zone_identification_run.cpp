@@ -88,9 +88,8 @@ ZoneIdentificationRun RunZoneIdentification(const Config& config, const ZoneLayo
   // own error with zones that oscillate; the paper's formulation keeps that error in the
   // constitutive gap and meets the noise's level (docs/boundaries.md section 8). Its
   // fields differ from the scalar run's: no warm start then.
-  const bool measured = config.zone_identification.measured_clamp &&
-                        config.mcre.clamp == ClampModel::kTrusted && scalar.ends.u0;
-  const Config zone_config = measured ? MeasuredSupportConfig(config) : config;
+  const Config zone_config = ConfigForTheZones(config, scalar.ends.u0);
+  const bool measured = zone_config.mcre.clamp != config.mcre.clamp;
   ZoneIdentificationRun run = RunZones(
       config, layout, scalar, truth_zones,
       measured ? "the MCRE with the clamp measured" : "the MCRE",

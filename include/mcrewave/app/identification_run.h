@@ -260,6 +260,12 @@ McreObjective CompleteModulusStage(const Config& config, const MatrixModelData& 
 // (docs/boundaries.md section 9).
 Config MeasuredSupportConfig(const Config& config);
 
+// The config a run's many zones are identified with (zone_identification.measured_clamp,
+// docs/boundaries.md section 8): MeasuredSupportConfig(config) when the key is on,
+// mcre.clamp is trusted and the data hold every support's displacement
+// (`supports_displaced`); else config.
+Config ConfigForTheZones(const Config& config, bool supports_displaced);
+
 // The config an MCRE run identifies with on `raw` data (before the pre-filter) and the
 // data it compares with (`data`, pre-filtered when prefilter.enabled): with mcre.clamp
 // trusted and mcre.support_check not off, each support of `model` whose displacement the
