@@ -232,7 +232,12 @@ void ReportModuli(const mcrewave::IdentificationRun& run) {
                  run.TotalEvaluations(), run.wall_time_s);
     return;
   }
-  if (run.support_switched) {
+  if (run.support_blend.Blends()) {
+    spdlog::warn(
+        "E weighs the clamp measured by {:.3g} and trusted by {:.3g}: the data may contradict a "
+        "rigid clamp (summary.yaml, supports:)",
+        run.support_blend.weight, 1.0 - run.support_blend.weight);
+  } else if (run.support_switched) {
     spdlog::warn(
         "the clamp was treated as measured: the data contradict a rigid clamp (summary.yaml, "
         "supports:)");

@@ -134,7 +134,7 @@ TEST(ComparatorStudyTest, OnAMatrixModelEachRunIsIdentifyRunsIdentificationOfThe
   EXPECT_EQ(header,
             "model_error,snr,seed,functional,data,zone,converged,modulus_pa,relative_error,"
             "local_minima,evaluations,wall_time_s,search_modulus_pa,support_switched,"
-            "support_statistic,message");
+            "support_statistic,support_weight,message");
   std::ifstream statistics(folder + "/statistics.csv");
   std::getline(statistics, header);
   EXPECT_EQ(header.substr(0, 33), "model_error,functional,data,zone,");

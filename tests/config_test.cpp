@@ -147,6 +147,7 @@ void ExpectSameConfigLaterKeys(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.mcre.clamp, actual.mcre.clamp);
   EXPECT_EQ(expected.mcre.support_check, actual.mcre.support_check);
   EXPECT_EQ(expected.mcre.support_check_threshold, actual.mcre.support_check_threshold);
+  EXPECT_EQ(expected.mcre.support_check_ramp_start, actual.mcre.support_check_ramp_start);
   EXPECT_EQ(expected.data.support_stiffness, actual.data.support_stiffness);
   EXPECT_EQ(expected.search.functional, actual.search.functional);
   EXPECT_EQ(expected.search.displacement_weight, actual.search.displacement_weight);
@@ -677,6 +678,7 @@ mcre:
   clamp: pinned
   support_check: warn
   support_check_threshold: 3.5
+  support_check_ramp_start: 1.5
 inner:
   method: adaptive_relaxation
   tolerance: 1e-11
@@ -1111,6 +1113,17 @@ TEST(ConfigTest, TheSupportCheckIsReadAndChecked) {
                    {"a.yaml", "mcre.support_check", "'switch', 'warn', 'off'"});
   ExpectInputError([] { ParseConfig("mcre:\n  support_check_threshold: 0\n", "a.yaml"); },
                    {"a.yaml", "mcre.support_check_threshold must be a finite positive number"});
+  // The ramp: from 1.28 by default; its start at most the threshold (equal: a hard switch).
+  EXPECT_EQ(defaults.mcre.support_check_ramp_start, 1.28);
+  EXPECT_EQ(ParseConfig("mcre:\n  support_check_ramp_start: 2.5\n", "a.yaml")
+                .mcre.support_check_ramp_start,
+            2.5);
+  ExpectInputError([] { ParseConfig("mcre:\n  support_check_ramp_start: 2.6\n", "a.yaml"); },
+                   {"a.yaml",
+                    "mcre.support_check_ramp_start must be a finite positive number no larger than "
+                    "mcre.support_check_threshold (2.5), got 2.6"});
+  ExpectInputError([] { ParseConfig("mcre:\n  support_check_ramp_start: 0\n", "a.yaml"); },
+                   {"a.yaml", "mcre.support_check_ramp_start must be"});
 }
 
 TEST(ConfigTest, OverridesApplyAfterTheFile) {

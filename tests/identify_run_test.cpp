@@ -347,7 +347,7 @@ TEST(IdentifyRunTest, PinnedClampConfigFindsOneValleyWithAShortScan) {
 
 // docs/boundaries.md section 9: the paper's case on a spring of 5 E S / L (1e8 N/m), SNR
 // 20. The default's test switches to the measured clamp, whose scan runs on the same
-// formulation at w_u = w_e = 0.1 and sees one valley over the bounds; e^2 then refined
+// formulation at w_u = w_e = 1 and sees one valley over the bounds; e^2 then refined
 // near its minimum gives the E of a scan on e^2 itself, which sees two (the second at the
 // upper bound).
 TEST(IdentifyRunTest, ASwitchedClampScansOneValleyAndFindsTheSameModulus) {
@@ -372,6 +372,49 @@ TEST(IdentifyRunTest, ASwitchedClampScansOneValleyAndFindsTheSameModulus) {
   // Measured: 8.2e-9 apart, relative (both refinements to outer.relative_tolerance 1e-7).
   EXPECT_NEAR(a["identified_modulus"].as<double>() / b["identified_modulus"].as<double>(), 1.0,
               1e-7);
+}
+
+// docs/boundaries.md section 10: the paper's case on a spring of 50 E S / L (1e9 N/m) at
+// SNR 2.5, seed 1, where the test's t = 1.89 lies in the ramp [1.28, 2.5]. E* weighs the
+// two treatments' E by a = (t - 1.28) / 1.22: each the E of a run with that treatment
+// alone (the support test off with the clamp trusted; the ramp and threshold at 1, the
+// clamp measured), to the bit; the fields are the measured one's (a >= 1/2).
+TEST(IdentifyRunTest, InTheRampEWeighsTheTrustedAndTheMeasuredClamp) {
+  const std::string folder = FreshDirectory("identify_run_ramp");
+  const std::string run = "run " + SourcePath("configs/paper_bar.yaml") +
+                          " --set data.support_stiffness=1e9"
+                          " --set output.figures=false --set output.curve_points=5"
+                          " --set uncertainty.samples=2 -o " +
+                          folder;
+  const RunResult blended = RunIdentify(run + "/blended");
+  ASSERT_EQ(blended.exit_code, 0) << blended.output;
+  const RunResult trusted = RunIdentify(run + "/trusted --set mcre.support_check=off");
+  ASSERT_EQ(trusted.exit_code, 0) << trusted.output;
+  const RunResult measured = RunIdentify(
+      run + "/measured --set mcre.support_check_ramp_start=1 --set mcre.support_check_threshold=1");
+  ASSERT_EQ(measured.exit_code, 0) << measured.output;
+  const YAML::Node a = YAML::LoadFile(folder + "/blended/summary.yaml");
+  const YAML::Node t = YAML::LoadFile(folder + "/trusted/summary.yaml");
+  const YAML::Node m = YAML::LoadFile(folder + "/measured/summary.yaml");
+  const double statistic = a["supports"]["tests"][0]["statistic"].as<double>();
+  ASSERT_GT(statistic, 1.28);
+  ASSERT_LT(statistic, 2.5);
+  const double weight = a["supports"]["measured_weight"].as<double>();
+  EXPECT_DOUBLE_EQ(weight, (statistic - 1.28) / (2.5 - 1.28));
+  EXPECT_EQ(a["supports"]["switched"].as<bool>(), weight >= 0.5);
+  EXPECT_EQ(m["supports"]["measured_weight"].as<double>(), 1.0);
+  const double e_trusted = t["identified_modulus"].as<double>();
+  const double e_measured = m["identified_modulus"].as<double>();
+  EXPECT_EQ(a["supports"]["trusted_modulus"].as<double>(), e_trusted);
+  EXPECT_EQ(a["supports"]["measured_modulus"].as<double>(), e_measured);
+  EXPECT_DOUBLE_EQ(a["identified_modulus"].as<double>(),
+                   (1.0 - weight) * e_trusted + weight * e_measured);
+  // The trusted clamp is biased by the spring (-4.1 %), the measured one much less
+  // (-1.2 % on this noise draw); the weighed E lies between (-2.6 %).
+  EXPECT_LT(e_trusted, a["identified_modulus"].as<double>());
+  EXPECT_LT(a["identified_modulus"].as<double>(), e_measured);
+  EXPECT_NE(blended.output.find("E weighs the clamp measured by"), std::string::npos)
+      << blended.output;
 }
 
 // The same config with NLopt L-BFGS: its line search finds no decrease where the cost

@@ -445,7 +445,8 @@ TEST(IdentifyStudyComparatorTest, ATrustedClampContradictedByTheDataIsTreatedAsM
   std::istringstream runs(testing::ReadText(folder + "/comparator/runs.csv"));
   std::string line;
   std::getline(runs, line);
-  ASSERT_NE(line.find(",support_switched,support_statistic,"), std::string::npos) << line;
+  ASSERT_NE(line.find(",support_switched,support_statistic,support_weight,"), std::string::npos)
+      << line;
   int count = 0;
   for (; std::getline(runs, line); ++count) {
     std::vector<std::string> cells;

@@ -228,8 +228,8 @@ TEST(MatrixIdentificationRunTest, ZonesOnATrustedSupportAreIdentifiedWithTheSupp
                           dir;
   const std::pair<const char*, const char*> runs[] = {
       {"measured",
-       " --set mcre.clamp=measured --set search.functional=measured --set search.w_u=0.1 "
-       "--set search.w_e=0.1"},
+       " --set mcre.clamp=measured --set search.functional=measured --set search.w_u=1 "
+       "--set search.w_e=1"},
       {"trusted", " --set mcre.clamp=trusted"},
       {"trusted_kept", " --set mcre.clamp=trusted --set zone_identification.measured_clamp=false"}};
   for (const auto& [name, settings] : runs) {

@@ -92,6 +92,30 @@ TEST(SupportCheckTest, ASpringIsFoundFromTheForceItApplies) {
   EXPECT_EQ(pulled.SupportStiffness(), std::numeric_limits<double>::infinity());
 }
 
+// a = (t - t1) / (t2 - t1) clipped to [0, 1], the largest over the supports;
+// t1 = t2: the hard switch at t2 (docs/boundaries.md section 10).
+TEST(SupportCheckTest, TheSwitchWeightRampsFromTheStartToTheThreshold) {
+  auto checks = [](std::vector<double> statistics) {
+    std::vector<SupportCheck> result;
+    for (const double t : statistics) {
+      SupportCheck check;
+      check.statistic = t;
+      result.push_back(check);
+    }
+    return result;
+  };
+  EXPECT_EQ(SupportSwitchWeight({}, 1.0, 3.0), 0.0);
+  EXPECT_EQ(SupportSwitchWeight(checks({-4.0}), 1.0, 3.0), 0.0);
+  EXPECT_EQ(SupportSwitchWeight(checks({1.0}), 1.0, 3.0), 0.0);
+  EXPECT_EQ(SupportSwitchWeight(checks({1.5}), 1.0, 3.0), 0.25);
+  EXPECT_EQ(SupportSwitchWeight(checks({3.0}), 1.0, 3.0), 1.0);
+  EXPECT_EQ(SupportSwitchWeight(checks({30.0}), 1.0, 3.0), 1.0);
+  EXPECT_EQ(SupportSwitchWeight(checks({1.5, 2.0, -1.0}), 1.0, 3.0), 0.5);
+  // The hard switch: contradicted (t > t2) or not.
+  EXPECT_EQ(SupportSwitchWeight(checks({2.5}), 2.5, 2.5), 0.0);
+  EXPECT_EQ(SupportSwitchWeight(checks({2.5000001}), 2.5, 2.5), 1.0);
+}
+
 TEST(SupportCheckTest, NothingToTestWithoutAForce) {
   const Vector zero = Vector::Zero(100);
   const Vector displacement = Vector::Constant(100, 1e-6);

@@ -129,12 +129,28 @@ void RunDataSet(const Config& config, const DataSet& set, const std::vector<bool
     const ChannelSet data = PrefilterMeasurements(measured, prefilter, nullptr);
     // The MCRE's config: the clamp tested on the raw data, as identify run tests it.
     std::vector<SupportCheck> checks;
-    const Config mcre_config = run.least_squares
-                                   ? config
-                                   : ConfigForTheSupports(config, matrices, measured, data, &checks,
-                                                          &run.support_switched, /*log=*/false);
+    const Config mcre_config =
+        run.least_squares
+            ? config
+            : ConfigForTheSupports(config, matrices, measured, data, &checks, &run.support_switched,
+                                   &run.support_weight, /*log=*/false);
     if (!checks.empty()) run.support_statistic = checks.front().statistic;
     Identify(mcre_config, model, data, run.least_squares, &run);
+    const double a = run.support_weight;
+    if (run.least_squares || !(a > 0.0 && a < 1.0) || !run.converged) continue;
+    // Both treatments weigh in E (as IdentifyHomogeneousModulusOfSupports weighs them):
+    // the other one's identification, then E = (1 - a) E_trusted + a E_measured.
+    ComparatorRun other = run;
+    Identify(run.support_switched ? config : MeasuredSupportConfig(config), model, data,
+             /*least_squares=*/false, &other);
+    run.evaluations += other.evaluations;
+    run.wall_time_s += other.wall_time_s;
+    run.local_minima = std::max(run.local_minima, other.local_minima);
+    if (!other.converged) continue;
+    const double trusted = run.support_switched ? other.modulus : run.modulus;
+    const double measured_modulus = run.support_switched ? run.modulus : other.modulus;
+    run.modulus = (1.0 - a) * trusted + a * measured_modulus;
+    run.error = run.modulus / config.model.modulus - 1.0;
   }
 }
 
@@ -191,6 +207,7 @@ void RunMatrixDataSet(const Config& config, const MatrixModelData& model,
       }
       out.wall_time_s = seconds;
       out.support_switched = run.support_switched;
+      out.support_weight = run.support_blend.weight;
       if (!run.support_checks.empty()) out.support_statistic = run.support_checks.front().statistic;
       if (run.identified_moduli.size() == zones) {
         out.modulus = run.identified_moduli[z];
@@ -281,7 +298,7 @@ std::string RunsCsv(const ComparatorStudy& study) {
   std::ostringstream csv;
   csv << "model_error,snr,seed,functional,data," << (many ? "zone," : "")
       << "converged,modulus_pa,relative_error,local_minima,evaluations,wall_time_s,"
-         "search_modulus_pa,support_switched,support_statistic,message\n";
+         "search_modulus_pa,support_switched,support_statistic,support_weight,message\n";
   for (const ComparatorRun& run : study.runs) {
     csv << run.model_error << "," << SnrText(run.snr) << "," << run.seed << ","
         << FunctionalText(run.least_squares) << "," << FilterText(run.prefilter) << ",";
@@ -289,7 +306,8 @@ std::string RunsCsv(const ComparatorStudy& study) {
     csv << (run.converged ? 1 : 0) << "," << Csv(run.modulus) << "," << Csv(run.error) << ","
         << run.local_minima << "," << run.evaluations << "," << Csv(run.wall_time_s) << ","
         << Csv(run.search_modulus) << "," << (run.support_switched ? 1 : 0) << ","
-        << Csv(run.support_statistic) << ",\"" << run.message << "\"\n";
+        << Csv(run.support_statistic) << "," << Csv(run.support_weight) << ",\"" << run.message
+        << "\"\n";
   }
   return csv.str();
 }
@@ -529,7 +547,8 @@ std::string EncodeDataSet(const ComparatorRun* first, int runs_per_set) {
         .Add(run.evaluations)
         .Add(run.wall_time_s)
         .Add(run.support_switched)
-        .Add(run.support_statistic);
+        .Add(run.support_statistic)
+        .Add(run.support_weight);
   }
   return record.text();
 }
@@ -548,6 +567,7 @@ void DecodeDataSet(const std::string& text, int runs_per_set, ComparatorRun* fir
     run.wall_time_s = record.Double();
     run.support_switched = record.Bool();
     run.support_statistic = record.Double();
+    run.support_weight = record.Double();
   }
   if (!record.AtEnd()) throw std::runtime_error("the record has more fields");
   std::copy(runs.begin(), runs.end(), first);

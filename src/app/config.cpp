@@ -512,6 +512,11 @@ const std::vector<Key>& KeyTable() {
               Number(), "",
               "the support test's t above which the data contradict a rigid support (a false "
               "alarm rate of 1 - Phi(threshold))"),
+      MakeKey("mcre.support_check_ramp_start", &Config::mcre,
+              &McreOptions::support_check_ramp_start, Number(), "",
+              "the support test's t from which E weighs in the paper's formulation's, "
+              "linearly up to all of it at mcre.support_check_threshold (equal to it: a hard "
+              "switch; docs/boundaries.md section 10)"),
       MakeKey("inner.method", &Config::inner, &CoupledSolverOptions::type,
               EnumByName<CoupledSolverType>(AllCoupledSolverTypes(), CoupledSolverTypeToString,
                                             StringToCoupledSolverType),

@@ -291,8 +291,8 @@ Config MeasuredSupportConfig(const Config& config) {
   // The scan on the same formulation at heavier weights, which has one valley where
   // e^2's own may have two (docs/boundaries.md section 9); e^2 refined near its minimum.
   measured.search.functional = SearchFunctional::kMeasured;
-  measured.search.displacement_weight = 0.1;
-  measured.search.strain_weight = 0.1;
+  measured.search.displacement_weight = 1.0;
+  measured.search.strain_weight = 1.0;
   return measured;
 }
 
@@ -305,9 +305,11 @@ Config ConfigForTheZones(const Config& config, bool supports_displaced) {
 
 Config ConfigForTheSupports(const Config& config, const MatrixModelData& model,
                             const ChannelSet& raw, const ChannelSet& data,
-                            std::vector<SupportCheck>* checks, bool* switched, bool log) {
+                            std::vector<SupportCheck>* checks, bool* switched, double* weight,
+                            bool log) {
   checks->clear();
   *switched = false;
+  *weight = 0.0;
   if (config.mcre.clamp != ClampModel::kTrusted ||
       config.mcre.support_check == SupportCheckAction::kOff) {
     return config;
@@ -322,22 +324,82 @@ Config ConfigForTheSupports(const Config& config, const MatrixModelData& model,
       }
     }
   }
-  if (!AnySupportContradicted(*checks)) return config;
+  const double a = SupportSwitchWeight(*checks, config.mcre.support_check_ramp_start,
+                                       config.mcre.support_check_threshold);
+  if (a == 0.0) return config;
   if (config.mcre.support_check == SupportCheckAction::kWarn) {
-    if (log) {
+    if (log && AnySupportContradicted(*checks)) {
       spdlog::warn(
           "the supports stay trusted (mcre.support_check: warn): E may be biased; "
           "mcre.support_check: switch or mcre.clamp: measured treats them as measured");
     }
     return config;
   }
+  *weight = a;
+  *switched = a >= 0.5;
   if (log) {
-    spdlog::warn(
-        "the supports are treated as measured, with the paper's weights and scan "
-        "(mcre.support_check: switch; mcre.support_check: warn keeps them trusted)");
+    if (a == 1.0) {
+      spdlog::warn(
+          "the supports are treated as measured, with the paper's weights and scan "
+          "(mcre.support_check: switch; mcre.support_check: warn keeps them trusted)");
+    } else {
+      spdlog::warn(
+          "t lies between mcre.support_check_ramp_start and mcre.support_check_threshold: E "
+          "is identified both ways and weighs the paper's formulation's by {:.3g}; the fields "
+          "are the {} treatment's (mcre.support_check: warn keeps the supports trusted)",
+          a, *switched ? "measured" : "trusted");
+    }
   }
-  *switched = true;
-  return MeasuredSupportConfig(config);
+  return *switched ? MeasuredSupportConfig(config) : config;
+}
+
+ModulusStage IdentifyHomogeneousModulusOfSupports(const Config& given, const Config& config,
+                                                  const MatrixModelData& model,
+                                                  const ChannelSet& data, bool element_maps,
+                                                  SupportBlend* blend) {
+  ModulusStage stage = IdentifyHomogeneousModulus(config, model, data, element_maps);
+  const bool measured = config.mcre.clamp != given.mcre.clamp;
+  if (!blend->Blends() || !stage.IsUsable()) return stage;
+  const Config other = measured ? given : MeasuredSupportConfig(given);
+  spdlog::info("E with the {} treatment of the supports too (weight {:.3g})",
+               measured ? "trusted" : "measured", measured ? 1.0 - blend->weight : blend->weight);
+  const ModulusStage other_stage =
+      IdentifyHomogeneousModulus(other, model, data, /*element_maps=*/false);
+  blend->other_sweeps = other_stage.sweeps;
+  stage.sweeps += other_stage.sweeps;
+  if (!other_stage.IsUsable()) {
+    spdlog::warn("the {} treatment's identification failed ({}): E* is the {} one's alone",
+                 measured ? "trusted" : "measured", other_stage.outer.message,
+                 measured ? "measured" : "trusted");
+    blend->weight = measured ? 1.0 : 0.0;
+    return stage;
+  }
+  blend->trusted_modulus = measured ? other_stage.identified_modulus() : stage.identified_modulus();
+  blend->measured_modulus =
+      measured ? stage.identified_modulus() : other_stage.identified_modulus();
+  // E* = (1 - a) E_trusted + a E_measured (docs/boundaries.md section 10).
+  const double modulus =
+      (1.0 - blend->weight) * blend->trusted_modulus + blend->weight * blend->measured_modulus;
+  spdlog::info("E* = {:.6g} Pa: {:.6g} Pa trusted, {:.6g} Pa measured, weights {:.3g} and {:.3g}",
+               modulus, blend->trusted_modulus, blend->measured_modulus, 1.0 - blend->weight,
+               blend->weight);
+  // Every field reported belongs to E*: config's solve there, from its own E*'s solution.
+  McreObjective objective =
+      MatrixMcreObjective(model, data, config.mcre, config.time.theta, config.inner,
+                          Factorization::kAutomatic, config.outer.initial, element_maps);
+  if (stage.solution.WarmStart().size() > 0) objective.SetWarmStart(stage.solution.WarmStart());
+  const ObjectiveEvaluation& at_blend = objective.EvaluateModulus(modulus);
+  stage.sweeps += objective.sweeps();
+  stage.outer.modulus = modulus;
+  stage.evaluations.push_back(at_blend);
+  stage.best_index = static_cast<int>(stage.evaluations.size()) - 1;
+  stage.solution = objective.last_solution();
+  if (!at_blend.usable) {
+    stage.outer.termination = TerminationType::kFailure;
+    stage.outer.message =
+        "the coupled solve at the weighted E* is not usable: " + at_blend.inner.message;
+  }
+  return stage;
 }
 
 IdentificationRun IdentifyModulus(const Config& given, const ChannelSet& data) {
@@ -353,9 +415,10 @@ IdentificationRun IdentifyModulus(const Config& given, const ChannelSet& data) {
   // The supports tested on the data as given, before the pre-filter, their forces
   // pre-filtered.
   run.config = ConfigForTheSupports(given, matrices, data, run.data, &run.support_checks,
-                                    &run.support_switched);
+                                    &run.support_switched, &run.support_blend.weight);
   const Config& config = run.config;
-  static_cast<ModulusStage&>(run) = IdentifyHomogeneousModulus(config, matrices, run.data);
+  static_cast<ModulusStage&>(run) = IdentifyHomogeneousModulusOfSupports(
+      given, config, matrices, run.data, /*element_maps=*/true, &run.support_blend);
   // The bar's weights from k* = E0 S / L (mcre/matrix_mcre_problem.h): alpha = w_f / k*
   // of its loads, beta = w_u k* of its end displacement, for the summary.
   const double stiffness_scale = config.mcre.reference_modulus * matrices.stiffness_length;

@@ -316,15 +316,18 @@ bool TakeHomogeneousOutcome(const Config& config, IdentificationRun* run) {
 }
 
 // Step 2a of RunMatrixIdentification: the homogeneous stage on run->data, with its cost
-// curve and cold solve when `complete`. False, with run->failure set, when E* is not
-// usable or lies on a bound of the search.
-bool IdentifyHomogeneousStage(const Config& config, const MatrixModelData& model, bool complete,
-                              IdentificationRun* run) {
+// curve and cold solve when `complete`; E* weighs both treatments of the supports when
+// run->support_blend says so (IdentifyHomogeneousModulusOfSupports, `given` the config
+// before the supports' test). False, with run->failure set, when E* is not usable or lies
+// on a bound of the search.
+bool IdentifyHomogeneousStage(const Config& given, const Config& config,
+                              const MatrixModelData& model, bool complete, IdentificationRun* run) {
   spdlog::info("homogeneous stage: one E in every zone");
   run->homogeneous_ran = true;
   ModulusStage& stage = *run;
   // Its solution warm-starts the zones: no element map.
-  stage = IdentifyHomogeneousModulus(config, model, run->data, /*element_maps=*/false);
+  stage = IdentifyHomogeneousModulusOfSupports(given, config, model, run->data,
+                                               /*element_maps=*/false, &run->support_blend);
   if (!TakeHomogeneousOutcome(config, run)) return false;
   run->homogeneous_cost = stage.cost();
   // The cost curve e^2(E) feeds the uncertainty of one modulus (the bar's); the zones'
@@ -747,8 +750,9 @@ IdentificationRun RunMatrixIdentification(const Config& given, const MatrixModel
   }
   // The supports with a measured displacement tested on the raw data, their forces as
   // compared with (ConfigForTheSupports): every later step identifies with run.config.
-  run.config = ConfigForTheSupports(given, model, measurements.histories, run.data,
-                                    &run.support_checks, &run.support_switched);
+  run.config =
+      ConfigForTheSupports(given, model, measurements.histories, run.data, &run.support_checks,
+                           &run.support_switched, &run.support_blend.weight);
   // Many zones on trusted supports whose displacements the data hold: the clamp measured,
   // the paper's formulation, as the bar's zones (zone_identification.measured_clamp,
   // docs/boundaries.md section 8). Every step of this run identifies the zones.
@@ -760,6 +764,8 @@ IdentificationRun RunMatrixIdentification(const Config& given, const MatrixModel
       ConfigForTheZones(run.config, model.zones.size() > 1 && supports_displaced);
   if (zone_config.mcre.clamp != run.config.mcre.clamp) {
     run.config = zone_config;
+    // The zones' treatment alone, whatever the test weighed.
+    run.support_blend = SupportBlend();
     spdlog::info("{} zones: the supports measured (zone_identification.measured_clamp)",
                  model.zones.size());
   }
@@ -785,7 +791,7 @@ IdentificationRun RunMatrixIdentification(const Config& given, const MatrixModel
     // 2a. One E in every zone first, by the global scan and the refinements of the
     //     bar's identification (outer:, search:); the zones then start from E*, their
     //     first solve warm-started from its solution.
-    if (!IdentifyHomogeneousStage(config, model, maps_and_uncertainty, &run)) {
+    if (!IdentifyHomogeneousStage(given, config, model, maps_and_uncertainty, &run)) {
       run.wall_time_s =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
       return run;

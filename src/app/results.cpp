@@ -748,6 +748,15 @@ void SupportChecksYaml(const IdentificationRun& run, YamlWriter* yaml) {
              "docs/boundaries.md)");
   yaml->Line(1, "switched", run.support_switched ? "true" : "false",
              "treated as measured because the data contradict them (the config below)");
+  const SupportBlend& blend = run.support_blend;
+  yaml->Number(1, "measured_weight", blend.weight,
+               "the paper's formulation's weight a in E* (0: trusted, 1: measured)");
+  if (blend.trusted_modulus > 0.0 && blend.measured_modulus > 0.0) {
+    yaml->Number(1, "trusted_modulus", blend.trusted_modulus,
+                 "[Pa] E of the trusted treatment; E* = (1 - a) this + a the next");
+    yaml->Number(1, "measured_modulus", blend.measured_modulus,
+                 "[Pa] E of the paper's treatment (docs/boundaries.md section 10)");
+  }
   yaml->Line(1, "tests", "");
   for (const SupportCheck& check : run.support_checks) {
     yaml->Raw("    - support: " + Quoted(check.support));

@@ -28,6 +28,16 @@ bool McreOptions::IsValid(std::string* error) const {
     if (error != nullptr) *error = why.str();
     return false;
   }
+  if (!(std::isfinite(support_check_ramp_start) && support_check_ramp_start > 0.0 &&
+        support_check_ramp_start <= support_check_threshold)) {
+    std::ostringstream why;
+    why << "mcre.support_check_ramp_start must be a finite positive number no larger than "
+           "mcre.support_check_threshold ("
+        << support_check_threshold << "), got " << support_check_ramp_start
+        << " (equal to it: a hard switch)";
+    if (error != nullptr) *error = why.str();
+    return false;
+  }
   return true;
 }
 

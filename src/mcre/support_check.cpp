@@ -1,5 +1,6 @@
 #include "mcrewave/mcre/support_check.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -68,6 +69,20 @@ bool AnySupportContradicted(const std::vector<SupportCheck>& checks) {
     if (check.contradicted) return true;
   }
   return false;
+}
+
+double SupportSwitchWeight(const std::vector<SupportCheck>& checks, double ramp_start,
+                           double threshold) {
+  double weight = 0.0;
+  for (const SupportCheck& check : checks) {
+    const double t = check.statistic;
+    // a = (t - t1) / (t2 - t1) in [0, 1]; t1 = t2: the step at t2.
+    const double a = t > threshold     ? 1.0
+                     : t <= ramp_start ? 0.0
+                                       : (t - ramp_start) / (threshold - ramp_start);
+    weight = std::max(weight, a);
+  }
+  return weight;
 }
 
 }  // namespace mcrewave

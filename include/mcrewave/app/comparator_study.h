@@ -67,6 +67,9 @@ struct ComparatorRun {
   // bar's clamp) contradicted one; and that test's t (NaN: not tested).
   bool support_switched = false;
   double support_statistic = std::numeric_limits<double>::quiet_NaN();
+  // The paper's formulation's weight in E (SupportBlend::weight): 0 trusted, 1 switched,
+  // between: both identified and weighed.
+  double support_weight = 0.0;
 };
 
 // Over the converged runs of one (model error, functional, pre-filter, SNR, zone).

@@ -88,6 +88,17 @@ struct ModulusStage {
   double cost() const { return best_index >= 0 ? evaluations[best_index].cost : -1.0; }
 };
 
+// How the two treatments of a run's supports weigh in its E*
+// (IdentifyHomogeneousModulusOfSupports below, docs/boundaries.md section 10).
+struct SupportBlend {
+  double weight = 0.0;             // a, the paper's formulation's weight in E*
+  double trusted_modulus = -1.0;   // E of the trusted treatment [Pa]; -1: not identified
+  double measured_modulus = -1.0;  // E of the paper's treatment [Pa]; -1: not identified
+  long other_sweeps = 0;           // sweeps of the other treatment's identification
+  // Both treatments weigh in E* (0 < a < 1).
+  bool Blends() const { return weight > 0.0 && weight < 1.0; }
+};
+
 // Everything one identification computed, on the bar (RunIdentification) or on a
 // structure given by matrices (RunMatrixIdentification, app/matrix_identification_run.h):
 // the homogeneous stage this run is (one E in every zone; on a structure whose zones'
@@ -107,6 +118,9 @@ struct IdentificationRun : ModulusStage {
   // `config` switched their treatment to measured.
   std::vector<SupportCheck> support_checks;
   bool support_switched = false;
+  // The two treatments' moduli and the paper's weight in E* (IdentifyHomogeneousModulusOf
+  // Supports); weight 0 and both moduli -1 when E* is one treatment's alone.
+  SupportBlend support_blend;
   bool least_squares = false;  // outer.functional: least_squares
   // The homogeneous stage (this ModulusStage) ran: always on the bar; on a structure
   // given by matrices when its zones share one nominal modulus.
@@ -255,7 +269,7 @@ McreObjective CompleteModulusStage(const Config& config, const MatrixModelData& 
 
 // config with the paper's treatment of the supports (configs/paper_bar_free_free.yaml's
 // mcre: section): mcre.clamp measured, w_u and w_e the paper's (McreWeights' defaults),
-// and the global scan on the same formulation at w_u = w_e = 0.1 (search.functional
+// and the global scan on the same formulation at w_u = w_e = 1 (search.functional
 // measured), one valley where e^2's own may have two, e^2 then refined near its minimum
 // (docs/boundaries.md section 9).
 Config MeasuredSupportConfig(const Config& config);
@@ -271,12 +285,28 @@ Config ConfigForTheZones(const Config& config, bool supports_displaced);
 // trusted and mcre.support_check not off, each support of `model` whose displacement the
 // raw data hold is tested (CheckSupports, its force from `data`) and the result logged, a
 // contradiction as a warning; when one is contradicted and mcre.support_check is
-// switch, MeasuredSupportConfig(config), else config. *checks gets the tests (none when
-// not tested), *switched whether the config was switched. log false: nothing logged (a
-// study's runs).
+// switch, the paper's weight a = SupportSwitchWeight of the tests (mcre.support_check_
+// ramp_start and _threshold; 0 otherwise) into *weight, and MeasuredSupportConfig(config)
+// when a >= 1/2, the treatment that weighs more, else config. *checks gets the tests
+// (none when not tested), *switched whether the config was switched. log false: nothing
+// logged (a study's runs).
 Config ConfigForTheSupports(const Config& config, const MatrixModelData& model,
                             const ChannelSet& raw, const ChannelSet& data,
-                            std::vector<SupportCheck>* checks, bool* switched, bool log = true);
+                            std::vector<SupportCheck>* checks, bool* switched, double* weight,
+                            bool log = true);
+
+// The homogeneous stage of a run whose supports were tested (ConfigForTheSupports gave
+// `config` and the paper's weight a): IdentifyHomogeneousModulus with config, and when
+// 0 < a < 1 with the other treatment too (`given`, trusted, or MeasuredSupportConfig of
+// it), then E* = (1 - a) E_trusted + a E_measured, the stage's solution solved once more
+// at that E* with config (docs/boundaries.md section 10). *blend gets both moduli (-1 for
+// one not identified). The other identification failing leaves config's stage as it
+// is, with a warning. Preconditions: those of IdentifyHomogeneousModulus, a in [0, 1]
+// (SupportBlend above IdentificationRun).
+ModulusStage IdentifyHomogeneousModulusOfSupports(const Config& given, const Config& config,
+                                                  const MatrixModelData& model,
+                                                  const ChannelSet& data, bool element_maps,
+                                                  SupportBlend* blend);
 
 // Runs steps 2 and 3 on measurements made by LoadMeasurements(config): the
 // fields up to `solution` (and wall_time_s); no cost curve, no uncertainty.

@@ -55,6 +55,11 @@ struct McreOptions {
   // not test; and the threshold of its t above which they contradict it.
   SupportCheckAction support_check = SupportCheckAction::kSwitch;
   double support_check_threshold = 2.5;
+  // With support_check switch, a run whose t lies between this and the threshold
+  // identifies E both ways and weighs the paper's E by SupportSwitchWeight
+  // (support_check.h, docs/boundaries.md section 10). Equal to the threshold: a hard
+  // switch.
+  double support_check_ramp_start = 1.28;
 
   bool IsValid(std::string* error) const;
 };

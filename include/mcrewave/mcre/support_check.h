@@ -58,4 +58,13 @@ std::vector<SupportCheck> CheckSupports(const MatrixModelData& model, const Chan
 // Whether any of the checks contradicts its support.
 bool AnySupportContradicted(const std::vector<SupportCheck>& checks);
 
+// The weight a in [0, 1] of the paper's formulation in a run's E,
+//   E = (1 - a) E_trusted + a E_measured,  a = (t - t1) / (t2 - t1) clipped to [0, 1],
+// t the largest statistic of the checks, t1 = ramp_start, t2 = threshold
+// (docs/boundaries.md section 10): 0 below t1 (or without checks), 1 above t2. With
+// t1 = t2, 1 when t > t2 and 0 otherwise: the hard switch. Precondition:
+// 0 < ramp_start <= threshold.
+double SupportSwitchWeight(const std::vector<SupportCheck>& checks, double ramp_start,
+                           double threshold);
+
 }  // namespace mcrewave
