@@ -350,13 +350,20 @@ TEST(IdentifyRunTest, PinnedClampConfigFindsOneValleyWithAShortScan) {
 // formulation at w_u = w_e = 1 and sees one valley over the bounds; e^2 then refined
 // near its minimum gives the E of a scan on e^2 itself, which sees two (the second at the
 // upper bound).
+// `identify run` of the paper's case on a spring of `settings` (data.support_stiffness
+// and the data's keys), short on figures, curve and uncertainty, into `folder`/<name>
+// as the caller appends it.
+std::string PaperBarOnASpringRun(const std::string& folder, const std::string& settings) {
+  return "run " + SourcePath("configs/paper_bar.yaml") + " " + settings +
+         " --set output.figures=false --set output.curve_points=5"
+         " --set uncertainty.samples=2 -o " +
+         folder;
+}
+
 TEST(IdentifyRunTest, ASwitchedClampScansOneValleyAndFindsTheSameModulus) {
   const std::string folder = FreshDirectory("identify_run_switched");
-  const std::string run = "run " + SourcePath("configs/paper_bar.yaml") +
-                          " --set data.support_stiffness=1e8 --set data.snr=20"
-                          " --set output.figures=false --set output.curve_points=5"
-                          " --set uncertainty.samples=2 -o " +
-                          folder;
+  const std::string run =
+      PaperBarOnASpringRun(folder, "--set data.support_stiffness=1e8 --set data.snr=20");
   const RunResult switched = RunIdentify(run + "/switched");
   ASSERT_EQ(switched.exit_code, 0) << switched.output;
   const RunResult own_scan =
@@ -381,11 +388,7 @@ TEST(IdentifyRunTest, ASwitchedClampScansOneValleyAndFindsTheSameModulus) {
 // clamp measured), to the bit; the fields are the measured one's (a >= 1/2).
 TEST(IdentifyRunTest, InTheRampEWeighsTheTrustedAndTheMeasuredClamp) {
   const std::string folder = FreshDirectory("identify_run_ramp");
-  const std::string run = "run " + SourcePath("configs/paper_bar.yaml") +
-                          " --set data.support_stiffness=1e9"
-                          " --set output.figures=false --set output.curve_points=5"
-                          " --set uncertainty.samples=2 -o " +
-                          folder;
+  const std::string run = PaperBarOnASpringRun(folder, "--set data.support_stiffness=1e9");
   const RunResult blended = RunIdentify(run + "/blended");
   ASSERT_EQ(blended.exit_code, 0) << blended.output;
   const RunResult trusted = RunIdentify(run + "/trusted --set mcre.support_check=off");

@@ -862,7 +862,10 @@ std::string SummaryYaml(const IdentificationRun& run) {
   YamlWriter yaml;
   SummaryHeaderYaml(run.config, "the modulus E identified by minimising the MCRE cost e^2(E)",
                     &yaml);
-  yaml.Number(0, "identified_modulus", identified, "[Pa] E minimising e^2");
+  yaml.Number(0, "identified_modulus", identified,
+              run.support_blend.Blends()
+                  ? "[Pa] E weighing two treatments' minimisers of e^2 (supports:)"
+                  : "[Pa] E minimising e^2");
   ReferenceYaml(run, &yaml);
   yaml.Number(0, "cost", run.cost(), "[J s] e^2 at the identified modulus");
   yaml.Integer(0, "evaluations", outer.scan_evaluations + outer.evaluations,
