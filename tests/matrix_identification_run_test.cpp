@@ -250,6 +250,50 @@ TEST(MatrixIdentificationRunTest, ZonesOnATrustedSupportAreIdentifiedWithTheSupp
   }
 }
 
+// The support test's ramp on the one road (docs/boundaries.md section 10): the quick bar
+// on a spring of 10 E S / L, exported with its clamp as a support and trusted, the ramp
+// widened to [0.5, 1000] so that its t lies inside. The matrix run weighs the trusted and the
+// measured E by the bar's run's a, and its E* is the bar's.
+TEST(MatrixIdentificationRunTest, TheRampWeighsBothTreatmentsOfTheBarAsMatrices) {
+  const std::string dir = FreshDirectory("matrix_run_ramp");
+  const std::string quick = SourcePath("configs/quick.yaml");
+  ASSERT_EQ(RunIdentify("simulate " + quick + " --set data.support_stiffness=2e8 -q -o " + dir +
+                        "/data.csv")
+                .exit_code,
+            0);
+  const Config config = LoadConfig(quick);
+  std::filesystem::create_directories(dir + "/support");
+  const std::string manifest =
+      WriteMatrixModel(dir + "/support",
+                       BarMatrixModel(BarModel(config.model), 160e9, {}, BarClampExport::kSupport));
+  const std::string settings = " --set data.source=csv --set data.path=" + dir +
+                               "/data.csv --set prefilter.enabled=false --set mcre.clamp=trusted"
+                               " --set mcre.support_check_ramp_start=0.5"
+                               " --set mcre.support_check_threshold=1000 -q -o " +
+                               dir;
+  const RunResult bar = RunIdentify("run " + quick + settings + "/bar");
+  ASSERT_EQ(bar.exit_code, 0) << bar.output;
+  const RunResult matrices =
+      RunIdentify("run " + WriteQuickMatrixConfig(dir, manifest) + settings + "/matrices");
+  ASSERT_EQ(matrices.exit_code, 0) << matrices.output;
+  const YAML::Node b = YAML::LoadFile(dir + "/bar/summary.yaml")["supports"];
+  const YAML::Node m = YAML::LoadFile(dir + "/matrices/summary.yaml");
+  const YAML::Node supports = m["supports"];
+  const double weight = supports["measured_weight"].as<double>();
+  ASSERT_GT(weight, 0.0);
+  ASSERT_LT(weight, 1.0);
+  // The same test of the same raw data on both roads (measured: the same bits).
+  EXPECT_NEAR(weight, b["measured_weight"].as<double>(), 1e-12);
+  EXPECT_DOUBLE_EQ(m["identified_modulus"].as<double>(),
+                   (1.0 - weight) * supports["trusted_modulus"].as<double>() +
+                       weight * supports["measured_modulus"].as<double>());
+  // Each treatment's E on both roads: the same e^2 along paths that differ in round-off
+  // (measured: 3.1e-9 trusted, 3.0e-9 measured apart, relative; a = 0.047).
+  for (const char* key : {"trusted_modulus", "measured_modulus"}) {
+    EXPECT_NEAR(supports[key].as<double>() / b[key].as<double>() - 1.0, 0.0, 5e-8) << key;
+  }
+}
+
 // The quick bar exported with its clamp as a support (dof 0, channels f0 and u0) under
 // each treatment of mcre.clamp: the run through the manifest identifies the built-in
 // bar's modulus from the same CSV.

@@ -284,10 +284,10 @@ Config ConfigForTheZones(const Config& config, bool supports_displaced);
 // data it compares with (`data`, pre-filtered when prefilter.enabled): with mcre.clamp
 // trusted and mcre.support_check not off, each support of `model` whose displacement the
 // raw data hold is tested (CheckSupports, its force from `data`) and the result logged, a
-// contradiction as a warning; when one is contradicted and mcre.support_check is
-// switch, the paper's weight a = SupportSwitchWeight of the tests (mcre.support_check_
-// ramp_start and _threshold; 0 otherwise) into *weight, and MeasuredSupportConfig(config)
-// when a >= 1/2, the treatment that weighs more, else config. *checks gets the tests
+// contradiction as a warning; when mcre.support_check is switch, the paper's weight
+// a = SupportSwitchWeight of the tests (mcre.support_check_ramp_start and _threshold; 0
+// otherwise) into *weight, and MeasuredSupportConfig(config) when a >= 1/2, the
+// treatment that weighs more, else config. *checks gets the tests
 // (none when not tested), *switched whether the config was switched. log false: nothing
 // logged (a study's runs).
 Config ConfigForTheSupports(const Config& config, const MatrixModelData& model,
