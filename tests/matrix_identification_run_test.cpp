@@ -52,6 +52,21 @@ std::string WriteQuickMatrixConfig(const std::string& folder, const std::string&
   return path;
 }
 
+// Simulates the quick bar with `simulate_settings` into dir/data.csv and exports the
+// quick bar with its clamp as a support (dof 0, channels f0 and u0) into dir/support:
+// the manifest's path, "" when the simulation failed (a failure recorded).
+std::string SimulateAndExportQuickBarWithSupport(const std::string& dir,
+                                                 const std::string& simulate_settings) {
+  const std::string quick = SourcePath("configs/quick.yaml");
+  const RunResult simulated =
+      RunIdentify("simulate " + quick + simulate_settings + " -q -o " + dir + "/data.csv");
+  EXPECT_EQ(simulated.exit_code, 0) << simulated.output;
+  if (simulated.exit_code != 0) return "";
+  std::filesystem::create_directories(dir + "/support");
+  return WriteMatrixModel(dir + "/support", BarMatrixModel(BarModel(LoadConfig(quick).model), 160e9,
+                                                           {}, BarClampExport::kSupport));
+}
+
 // The identified modulus of zone `zone` in a matrix run's zones.csv.
 double ZoneModulus(const std::string& zones_csv, int zone) {
   std::istringstream lines(ReadText(zones_csv));
@@ -257,15 +272,9 @@ TEST(MatrixIdentificationRunTest, ZonesOnATrustedSupportAreIdentifiedWithTheSupp
 TEST(MatrixIdentificationRunTest, TheRampWeighsBothTreatmentsOfTheBarAsMatrices) {
   const std::string dir = FreshDirectory("matrix_run_ramp");
   const std::string quick = SourcePath("configs/quick.yaml");
-  ASSERT_EQ(RunIdentify("simulate " + quick + " --set data.support_stiffness=2e8 -q -o " + dir +
-                        "/data.csv")
-                .exit_code,
-            0);
-  const Config config = LoadConfig(quick);
-  std::filesystem::create_directories(dir + "/support");
   const std::string manifest =
-      WriteMatrixModel(dir + "/support",
-                       BarMatrixModel(BarModel(config.model), 160e9, {}, BarClampExport::kSupport));
+      SimulateAndExportQuickBarWithSupport(dir, " --set data.support_stiffness=2e8");
+  ASSERT_FALSE(manifest.empty());
   const std::string settings = " --set data.source=csv --set data.path=" + dir +
                                "/data.csv --set prefilter.enabled=false --set mcre.clamp=trusted"
                                " --set mcre.support_check_ramp_start=0.5"
@@ -358,16 +367,10 @@ TEST(MatrixIdentificationRunTest, TheBarWithItsClampAsASupportIdentifiesTheBuilt
 TEST(MatrixIdentificationRunTest, ASpringAtTheSupportSwitchesTheMatrixRunAsItSwitchesTheBars) {
   const std::string dir = FreshDirectory("matrix_run_support_spring");
   const std::string quick = SourcePath("configs/quick.yaml");
-  ASSERT_EQ(
-      RunIdentify("simulate " + quick +
-                  " --set data.support_stiffness=2e8 --set data.snr=20 -q -o " + dir + "/data.csv")
-          .exit_code,
-      0);
+  const std::string manifest = SimulateAndExportQuickBarWithSupport(
+      dir, " --set data.support_stiffness=2e8 --set data.snr=20");
+  ASSERT_FALSE(manifest.empty());
   const Config config = LoadConfig(quick);
-  std::filesystem::create_directories(dir + "/support");
-  const std::string manifest =
-      WriteMatrixModel(dir + "/support",
-                       BarMatrixModel(BarModel(config.model), 160e9, {}, BarClampExport::kSupport));
   const std::string settings = " --set data.source=csv --set data.path=" + dir +
                                "/data.csv --set mcre.clamp=trusted --set mcre.w_u=1e-7 "
                                "--set mcre.w_e=1e-7 --set mcre.w_r=1e-6";
