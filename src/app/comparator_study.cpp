@@ -139,7 +139,7 @@ void RunDataSet(const Config& config, const DataSet& set, const std::vector<bool
     const double a = run.support_weight;
     if (run.least_squares || !(a > 0.0 && a < 1.0) || !run.converged) continue;
     // Both treatments weigh in E (as IdentifyHomogeneousModulusOfSupports weighs them):
-    // the other one's identification, then E = (1 - a) E_trusted + a E_measured.
+    // the other one's identification, then SupportBlend::Modulus.
     ComparatorRun other = run;
     Identify(run.support_switched ? config : MeasuredSupportConfig(config), model, data,
              /*least_squares=*/false, &other);
@@ -147,9 +147,11 @@ void RunDataSet(const Config& config, const DataSet& set, const std::vector<bool
     run.wall_time_s += other.wall_time_s;
     run.local_minima = std::max(run.local_minima, other.local_minima);
     if (!other.converged) continue;
-    const double trusted = run.support_switched ? other.modulus : run.modulus;
-    const double measured_modulus = run.support_switched ? run.modulus : other.modulus;
-    run.modulus = (1.0 - a) * trusted + a * measured_modulus;
+    SupportBlend blend;
+    blend.weight = a;
+    blend.trusted_modulus = run.support_switched ? other.modulus : run.modulus;
+    blend.measured_modulus = run.support_switched ? run.modulus : other.modulus;
+    run.modulus = blend.Modulus();
     run.error = run.modulus / config.model.modulus - 1.0;
   }
 }

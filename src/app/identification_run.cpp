@@ -118,6 +118,25 @@ std::vector<CostCurvePoint> ComputeCostCurve(const Config& config, const MatrixM
 
 std::string Number(double value) { return FormatNumber(value, kSixDigits); }
 
+// Solves `objective` at `modulus` [Pa] and makes that solve the stage's E*: its
+// evaluation the stage's last and best, its solution the stage's, its sweeps counted. A
+// solve that is not usable fails the stage: "<what> is not usable: " and the solver's
+// message.
+void SolveStageAt(double modulus, const std::string& what, McreObjective* objective,
+                  ModulusStage* stage) {
+  const long sweeps_before = objective->sweeps();
+  const ObjectiveEvaluation& solve = objective->EvaluateModulus(modulus);
+  stage->outer.modulus = modulus;
+  if (!solve.usable) {
+    stage->outer.termination = TerminationType::kFailure;
+    stage->outer.message = what + " is not usable: " + solve.inner.message;
+  }
+  stage->evaluations.push_back(solve);
+  stage->sweeps += objective->sweeps() - sweeps_before;
+  stage->best_index = static_cast<int>(stage->evaluations.size()) - 1;
+  stage->solution = objective->last_solution();
+}
+
 }  // namespace
 
 ChannelSet SyntheticMeasurements(const Config& config) {
@@ -254,16 +273,8 @@ ModulusStage IdentifyHomogeneousModulus(const Config& config, const MatrixModelD
   stage.best_index = objective.best_index();
   stage.solution = objective.best_solution();
   if (stage.evaluations[stage.best_index].modulus != stage.identified_modulus()) {
-    const ObjectiveEvaluation& at_optimum = objective.EvaluateModulus(stage.identified_modulus());
-    if (!at_optimum.usable) {
-      stage.outer.termination = TerminationType::kFailure;
-      stage.outer.message =
-          "the coupled solve at the identified E is not usable: " + at_optimum.inner.message;
-    }
-    stage.evaluations = objective.evaluations();
-    stage.sweeps = objective.sweeps() + stage.search_sweeps;
-    stage.best_index = static_cast<int>(stage.evaluations.size()) - 1;
-    stage.solution = objective.last_solution();
+    SolveStageAt(stage.identified_modulus(), "the coupled solve at the identified E", &objective,
+                 &stage);
   }
   return stage;
 }
@@ -365,7 +376,6 @@ ModulusStage IdentifyHomogeneousModulusOfSupports(const Config& given, const Con
                measured ? "trusted" : "measured", measured ? 1.0 - blend->weight : blend->weight);
   const ModulusStage other_stage =
       IdentifyHomogeneousModulus(other, model, data, /*element_maps=*/false);
-  blend->other_sweeps = other_stage.sweeps;
   stage.sweeps += other_stage.sweeps;
   if (!other_stage.IsUsable()) {
     spdlog::warn("the {} treatment's identification failed ({}): E* is the {} one's alone",
@@ -377,9 +387,7 @@ ModulusStage IdentifyHomogeneousModulusOfSupports(const Config& given, const Con
   blend->trusted_modulus = measured ? other_stage.identified_modulus() : stage.identified_modulus();
   blend->measured_modulus =
       measured ? stage.identified_modulus() : other_stage.identified_modulus();
-  // E* = (1 - a) E_trusted + a E_measured (docs/boundaries.md section 10).
-  const double modulus =
-      (1.0 - blend->weight) * blend->trusted_modulus + blend->weight * blend->measured_modulus;
+  const double modulus = blend->Modulus();
   spdlog::info("E* = {:.6g} Pa: {:.6g} Pa trusted, {:.6g} Pa measured, weights {:.3g} and {:.3g}",
                modulus, blend->trusted_modulus, blend->measured_modulus, 1.0 - blend->weight,
                blend->weight);
@@ -388,17 +396,7 @@ ModulusStage IdentifyHomogeneousModulusOfSupports(const Config& given, const Con
       MatrixMcreObjective(model, data, config.mcre, config.time.theta, config.inner,
                           Factorization::kAutomatic, config.outer.initial, element_maps);
   if (stage.solution.WarmStart().size() > 0) objective.SetWarmStart(stage.solution.WarmStart());
-  const ObjectiveEvaluation& at_blend = objective.EvaluateModulus(modulus);
-  stage.sweeps += objective.sweeps();
-  stage.outer.modulus = modulus;
-  stage.evaluations.push_back(at_blend);
-  stage.best_index = static_cast<int>(stage.evaluations.size()) - 1;
-  stage.solution = objective.last_solution();
-  if (!at_blend.usable) {
-    stage.outer.termination = TerminationType::kFailure;
-    stage.outer.message =
-        "the coupled solve at the weighted E* is not usable: " + at_blend.inner.message;
-  }
+  SolveStageAt(modulus, "the coupled solve at the weighted E*", &objective, &stage);
   return stage;
 }
 

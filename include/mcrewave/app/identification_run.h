@@ -94,9 +94,10 @@ struct SupportBlend {
   double weight = 0.0;             // a, the paper's formulation's weight in E*
   double trusted_modulus = -1.0;   // E of the trusted treatment [Pa]; -1: not identified
   double measured_modulus = -1.0;  // E of the paper's treatment [Pa]; -1: not identified
-  long other_sweeps = 0;           // sweeps of the other treatment's identification
   // Both treatments weigh in E* (0 < a < 1).
   bool Blends() const { return weight > 0.0 && weight < 1.0; }
+  // E* = (1 - a) E_trusted + a E_measured [Pa] (docs/boundaries.md section 10).
+  double Modulus() const { return (1.0 - weight) * trusted_modulus + weight * measured_modulus; }
 };
 
 // Everything one identification computed, on the bar (RunIdentification) or on a
