@@ -3,10 +3,12 @@
 #include "mcrewave/mcre/error_map.h"
 
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <string>
@@ -108,20 +110,31 @@ TEST(ErrorMapFilesTest, IdentifyRunWritesTheMapItsPeakAndTheFigure) {
   const testing::RunResult result = testing::RunIdentify(
       "run " + testing::SourcePath("configs/quick.yaml") + " --output " + folder + " -q");
   ASSERT_EQ(result.exit_code, 0) << result.output;
-  // error_map.csv: element,x,share,fraction; one row per element (25).
+  // error_map.csv: element,x,share,fraction,sensitivity,sensitivity_noise_std; one row
+  // per element (25).
   std::istringstream csv(testing::ReadText(folder + "/error_map.csv"));
   std::string line;
   std::getline(csv, line);
-  EXPECT_EQ(line, "element,x,share,fraction");
+  EXPECT_EQ(line, "element,x,share,fraction,sensitivity,sensitivity_noise_std");
   std::vector<double> fractions;
   double largest = -1.0, largest_x = -1.0;
+  double softening = -std::numeric_limits<double>::infinity(), softening_x = -1.0;
+  double softening_ratio = 0.0;
   while (std::getline(csv, line)) {
     std::istringstream row(line);
-    std::string element, x, share, fraction;
+    std::string element, x, share, fraction, sensitivity, noise_std;
     std::getline(row, element, ',');
     std::getline(row, x, ',');
     std::getline(row, share, ',');
     std::getline(row, fraction, ',');
+    std::getline(row, sensitivity, ',');
+    std::getline(row, noise_std, ',');
+    EXPECT_GT(std::stod(noise_std), 0.0);
+    if (std::stod(sensitivity) > softening) {
+      softening = std::stod(sensitivity);
+      softening_x = std::stod(x);
+      softening_ratio = softening / std::stod(noise_std);
+    }
     EXPECT_EQ(std::stoi(element), static_cast<int>(fractions.size()));
     EXPECT_NEAR(std::stod(x), (fractions.size() + 0.5) / 25.0, 1e-12);
     EXPECT_GT(std::stod(share), 0.0);
@@ -140,6 +153,13 @@ TEST(ErrorMapFilesTest, IdentifyRunWritesTheMapItsPeakAndTheFigure) {
   EXPECT_NE(summary.find("  peak_position: "), std::string::npos) << summary;
   const double summary_x = std::stod(summary.substr(summary.find("  peak_position: ") + 17, 30));
   EXPECT_DOUBLE_EQ(summary_x, largest_x);
+  // The sensitivity's largest element, as summary.yaml names it.
+  const YAML::Node map = YAML::LoadFile(folder + "/summary.yaml")["error_map"];
+  EXPECT_DOUBLE_EQ(map["softening_peak_position"].as<double>(), softening_x);
+  // The ratio from the 17 printed digits of both: measured 0 apart.
+  EXPECT_NEAR(map["softening_peak_noise_ratio"].as<double>(), softening_ratio,
+              1e-14 * std::abs(softening_ratio));
+  EXPECT_GE(map["stiffening_peak_position"].as<double>(), 0.0);
   EXPECT_TRUE(fs::exists(folder + "/error_map_spacetime.dat"));
   EXPECT_TRUE(fs::exists(folder + "/error_map.png")) << result.output;
 }

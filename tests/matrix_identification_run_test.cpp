@@ -95,27 +95,37 @@ std::vector<std::vector<std::string>> ElementMapCsvRows(const std::string& path,
   return rows;
 }
 
-// The element map of the bar's run (element,x,share,fraction at its E*) against the
-// matrix run's of the bar exported with its elements (element,x,share,fraction,
-// nominal_share,nominal_fraction,zone at its identified modulus).
+// The element map of the bar's run (element,x,share,fraction,sensitivity and its noise
+// std at its E*)
+// against the matrix run's of the bar exported with its elements (element,x,share,
+// fraction,nominal_share,nominal_fraction,zone,sensitivity,nominal_sensitivity at its
+// identified modulus).
 void ExpectTheBarsElementMap(const std::string& bar_csv, const std::string& matrix_csv) {
   std::string bar_header, matrix_header;
   const auto bar = ElementMapCsvRows(bar_csv, &bar_header);
   const auto matrix = ElementMapCsvRows(matrix_csv, &matrix_header);
-  EXPECT_EQ(bar_header, "element,x,share,fraction");
-  EXPECT_EQ(matrix_header, "element,x,share,fraction,nominal_share,nominal_fraction,zone");
+  EXPECT_EQ(bar_header, "element,x,share,fraction,sensitivity,sensitivity_noise_std");
+  EXPECT_EQ(matrix_header,
+            "element,x,share,fraction,nominal_share,nominal_fraction,zone,sensitivity,"
+            "nominal_sensitivity");
   ASSERT_EQ(matrix.size(), bar.size());
-  double worst = 0.0;
+  double worst = 0.0, worst_sensitivity = 0.0, largest_sensitivity = 0.0;
   for (std::size_t e = 0; e < bar.size(); ++e) {
-    ASSERT_EQ(matrix[e].size(), 7u);
+    ASSERT_EQ(matrix[e].size(), 9u);
     EXPECT_EQ(matrix[e][0], bar[e][0]);
     EXPECT_EQ(matrix[e][1], bar[e][1]);  // the midpoint, written alike
     EXPECT_EQ(matrix[e][6], "0");
     worst = std::max(worst, std::abs(std::stod(matrix[e][3]) - std::stod(bar[e][3])));
+    worst_sensitivity =
+        std::max(worst_sensitivity, std::abs(std::stod(matrix[e][7]) - std::stod(bar[e][4])));
+    largest_sensitivity = std::max(largest_sensitivity, std::abs(std::stod(bar[e][4])));
   }
   // The fractions at the two runs' moduli (1.1e-9 apart) from their own solves:
   // measured 5.9e-10 apart at most.
   EXPECT_LT(worst, 5e-9);
+  // The sensitivities, relative to the largest: measured 1.9e-6 apart at most (each
+  // from its own inner solve to inner.tolerance).
+  EXPECT_LT(worst_sensitivity, 2e-5 * largest_sensitivity);
 }
 
 TEST(MatrixIdentificationRunTest, TheBarAsMatricesIdentifiesTheBuiltInBarsModulus) {

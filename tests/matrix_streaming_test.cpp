@@ -161,9 +161,10 @@ struct ZonedBar {
 };
 
 // With element blocks (the bar exported, 2 zones), one application sums the element
-// map's shares and picture rows of the W it passes through: ComputeElementErrorMap's of
-// the stored W to the bit (the same W from the checkpoints, the same sums in the same
-// order), under a trusted and a measured support.
+// map's shares and picture rows of the W it passes through, and the sensitivities of W
+// and U: ComputeElementErrorMap's and ElementSensitivities' of the stored fields to the
+// bit (the same fields from the checkpoints, the same sums in the same order), under a
+// trusted and a measured support.
 TEST(MatrixStreamingTest, OneApplicationGivesTheStoredFieldsElementMap) {
   const ZonedBar zoned;
   const ChannelSet& data = zoned.data;
@@ -190,6 +191,13 @@ TEST(MatrixStreamingTest, OneApplicationGivesTheStoredFieldsElementMap) {
     EXPECT_TRUE(streamed.position == stored.position);
     EXPECT_TRUE(streamed.density_position == stored.density_position);
     EXPECT_GT(streamed.share.maxCoeff(), 0.0);
+    // The sensitivities of that application's fields, W and U = Direct(W).
+    Matrix u;
+    problem.DirectSweep(w, true, &u);
+    Vector sensitivity;
+    problem.ElementSensitivities(u, w, &sensitivity);
+    EXPECT_TRUE(totals.element_sensitivity == sensitivity);
+    EXPECT_GT(sensitivity.cwiseAbs().maxCoeff(), 0.0);
   }
 }
 

@@ -122,9 +122,11 @@ TEST(ZoneIdentificationRunTest, InverseCrimeOfTenZonesThroughRunIdentification) 
 // with 10 zones, on noise-free data of a soft zone 140 GPa over [0.6, 0.7] m (the truth
 // 4 times finer): the zones are identified with the clamp measured and every zone comes
 // within 2 %; with the clamp trusted (zone_identification.measured_clamp false) they
-// fit the model's own error, as least squares does.
+// fit the model's own error, as least squares does. Before any zone, the sensitivity map
+// at E* (docs/boundaries.md section 11) is largest inside the soft zone.
 TEST(ZoneIdentificationRunTest, TheDefaultsLocaliseASoftZoneWithTheClampMeasured) {
-  auto worst_zone_error = [](bool measured_clamp, ClampModel* clamp) {
+  double softening_peak = -1.0;
+  auto worst_zone_error = [&softening_peak](bool measured_clamp, ClampModel* clamp) {
     const Config config = LoadConfig(
         std::string(MCREWAVE_SOURCE_DIR) + "/configs/paper_bar.yaml",
         {"model.zone_count=10", "data.snr=.inf",
@@ -134,6 +136,7 @@ TEST(ZoneIdentificationRunTest, TheDefaultsLocaliseASoftZoneWithTheClampMeasured
     EXPECT_TRUE(run.IsUsable()) << run.outer.message;
     EXPECT_TRUE(run.zones.summary.IsSolutionUsable()) << run.zones.summary.FullReport();
     *clamp = run.zones.clamp;
+    softening_peak = run.error_map.position[run.error_map.SofteningPeakElement()];
     double worst = 0.0;
     for (int z = 0; z < run.zones.summary.moduli.size(); ++z) {
       const double truth = z == 6 ? 140e9 : 200e9;
@@ -144,6 +147,9 @@ TEST(ZoneIdentificationRunTest, TheDefaultsLocaliseASoftZoneWithTheClampMeasured
   ClampModel clamp;
   const double measured = worst_zone_error(true, &clamp);
   EXPECT_EQ(clamp, ClampModel::kMeasured);
+  // Measured: 0.655 m, the midpoint of element 65.
+  EXPECT_GT(softening_peak, 0.6);
+  EXPECT_LT(softening_peak, 0.7);
   const double trusted = worst_zone_error(false, &clamp);
   EXPECT_EQ(clamp, ClampModel::kTrusted);
   // Measured: 0.36 % (zone 7) and 9.8 % (the soft zone, 153.7 GPa).

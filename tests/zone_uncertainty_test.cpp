@@ -1,9 +1,9 @@
 // EstimateZoneUncertainty (mcre/zone_uncertainty.h) against re-identification: one noise
 // draw n, reproduced here, scaled down to stay in the linear regime, moves the moduli
 // identified from d + eps n by eps dE, and the estimate with that single draw has the
-// covariance dE dE^T. The bar of 30 elements in two zones as matrices, free-free (the
-// paper's formulation), SNR 20 data with an interior displacement sensor and a strain
-// gauge.
+// covariance dE dE^T; the sensitivity map's noise part against solves of the noisy data
+// themselves. The bar of 30 elements in two zones as matrices, free-free (the paper's
+// formulation), SNR 20 data with an interior displacement sensor and a strain gauge.
 #include "mcrewave/mcre/zone_uncertainty.h"
 
 #include <gtest/gtest.h>
@@ -89,6 +89,52 @@ TEST(ZoneUncertaintyTest, OneDrawPredictsTheMovementOfTheReidentifiedModuli) {
               0.1 * std::abs(change[0] * change[1]));
 }
 
+// The sensitivity map's noise part (zone_uncertainty.h) against solves of the noisy data
+// themselves: with one draw n, reproduced here at full level, std(s_el) is
+// |s_el(d + n) - s_el(d - n)| / 2, each map from a coupled solve of d + n or d - n at the
+// same moduli (the estimate: from superposition, s_d +- s_n).
+TEST(ZoneUncertaintyTest, OneDrawGivesTheSensitivityMapsChangeUnderThatNoise) {
+  TwoZoneBarAsMatrices bar;
+  ASSERT_EQ(bar.matrices.elements.size(), 30u);
+  const Vector moduli = (Vector(2) << 1.98e11, 2.03e11).finished();
+  auto sensitivity_of = [&](const ChannelSet& set, CoupledSolution* solution) {
+    MatrixMcreProblem problem(bar.matrices, set, bar.mcre.weights, bar.mcre.reference_modulus, 0.5,
+                              Factorization::kAutomatic, bar.mcre.clamp);
+    problem.SetModuli(moduli);
+    EXPECT_TRUE(SolveCoupled(bar.inner, &problem, nullptr, solution).IsSolutionUsable());
+    Vector sensitivity;
+    problem.ElementSensitivities(solution->displacement, solution->retrograde, &sensitivity);
+    return sensitivity;
+  };
+  CoupledSolution solution;
+  sensitivity_of(bar.data, &solution);
+  const NoiseLevels levels = DifferenceNoiseLevels(bar.data);
+  UncertaintyOptions options;
+  options.samples = 1;
+  options.seed = 5;
+  const ZoneUncertainty estimate = EstimateZoneUncertainty(
+      options, bar.matrices, bar.data, bar.mcre, 0.5, bar.inner, moduli, solution, levels);
+  ASSERT_TRUE(estimate.available) << estimate.message;
+  ASSERT_EQ(estimate.sensitivity_std.size(), 30);
+
+  ChannelSet plus = bar.data, minus = bar.data;
+  StandardNormal normal(options.seed);
+  for (std::size_t c = 0; c < plus.channels.size(); ++c) {
+    const double level = NoiseLevel(levels, plus.channels[c].kind);
+    for (Eigen::Index j = 0; j < plus.channels[c].values.size(); ++j) {
+      const double draw = level * normal();
+      plus.channels[c].values[j] += draw;
+      minus.channels[c].values[j] -= draw;
+    }
+  }
+  CoupledSolution scratch;
+  const Vector expected =
+      0.5 * (sensitivity_of(plus, &scratch) - sensitivity_of(minus, &scratch)).cwiseAbs();
+  // Relative to the largest: measured 3.5e-11 (the solves' tolerance 1e-12).
+  EXPECT_LT((estimate.sensitivity_std - expected).cwiseAbs().maxCoeff(),
+            4e-10 * expected.maxCoeff());
+}
+
 // A streaming solution (traces, no fields; the preconditioned CG of dense_traces) gives
 // the stored-field solution's figure: dg from the plus and minus problems' maps at
 // y_d +- y_n instead of their fields.
@@ -121,6 +167,11 @@ TEST(ZoneUncertaintyTest, AStreamingSolutionGivesTheStoredFieldFigure) {
     EXPECT_NEAR(estimates[1].std_dev[z], estimates[0].std_dev[z], 4e-10 * estimates[0].std_dev[z])
         << z;
   }
+  // The sensitivity map's std, relative to the largest: measured 2.2e-11.
+  ASSERT_EQ(estimates[1].sensitivity_std.size(), 30);
+  const Vector& stored = estimates[0].sensitivity_std;
+  EXPECT_LT((estimates[1].sensitivity_std - stored).cwiseAbs().maxCoeff(),
+            2e-10 * stored.maxCoeff());
 }
 
 TEST(ZoneUncertaintyTest, NoNoiseIsNotAFigure) {

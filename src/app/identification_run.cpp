@@ -442,10 +442,17 @@ IdentificationRun RunIdentification(const Config& given, const ChannelSet& data)
   McreObjective cold = CompleteModulusStage(config, matrices, run.data, /*cost_curve=*/true, &run);
 
   // The error map of the constitutive gap at the homogeneous E* (error_map.h).
-  run.error_map = BarErrorMap(config, run);
+  run.error_map = BarErrorMap(config, run, &dynamic_cast<MatrixMcreProblem&>(cold.problem()));
   const int peak = run.error_map.PeakElement();
   spdlog::info("error map: largest share {:.3g} of the constitutive gap at x = {:.4g} m",
                run.error_map.Fractions()[peak], run.error_map.position[peak]);
+  if (run.error_map.sensitivity.size() > 0) {
+    spdlog::info(
+        "sensitivity map: e^2 falls fastest as E is lowered at x = {:.4g} m, "
+        "as it is raised at x = {:.4g} m",
+        run.error_map.position[run.error_map.SofteningPeakElement()],
+        run.error_map.position[run.error_map.StiffeningPeakElement()]);
+  }
 
   // The model's channels and the RMS misfits at E*; an end displacement the run does
   // not use is no channel of the problem: from the stored field.
@@ -509,21 +516,30 @@ ZoneUncertainty BarZoneUncertainty(const Config& config, const IdentificationRun
                                  objective.last_solution(), run.noise);
 }
 
-ErrorMap BarErrorMap(const Config& config, const IdentificationRun& run) {
+ErrorMap BarErrorMap(const Config& config, const IdentificationRun& run,
+                     MatrixMcreProblem* problem) {
   const BarModel model(config.model);
-  // The shares and the picture on the exported bar's elements, which are the bar's: from
-  // the stored W, or as the streaming solver summed and sampled them while W passed. Its
-  // picture is the gap energy of an element [J], the bar's per length [J/m].
+  // The shares, the picture and the sensitivities on the exported bar's elements, which
+  // are the bar's: from the stored fields, or as the streaming solver summed and sampled
+  // them while the fields passed. Its picture is the gap energy of an element [J], the
+  // bar's per length [J/m].
   if (run.solution.has_fields()) {
     const ErrorMap elements =
         ComputeElementErrorMap(*run.model, Vector::Constant(1, run.identified_modulus()),
                                run.solution.retrograde, config.time.step);
-    return AssembleErrorMap(model, elements.share, elements.density / model.element_length(),
-                            SpaceTimeStride(run.data.num_steps()), config.time.step);
+    ErrorMap map =
+        AssembleErrorMap(model, elements.share, elements.density / model.element_length(),
+                         SpaceTimeStride(run.data.num_steps()), config.time.step);
+    problem->SetModuli(Vector::Constant(1, run.identified_modulus()));
+    problem->ElementSensitivities(run.solution.displacement, run.solution.retrograde,
+                                  &map.sensitivity);
+    return map;
   }
-  return AssembleErrorMap(model, run.solution.element_error_map,
-                          run.solution.gap_density / model.element_length(),
-                          SpaceTimeStride(run.data.num_steps()), config.time.step);
+  ErrorMap map = AssembleErrorMap(model, run.solution.element_error_map,
+                                  run.solution.gap_density / model.element_length(),
+                                  SpaceTimeStride(run.data.num_steps()), config.time.step);
+  map.sensitivity = run.solution.element_sensitivity;
+  return map;
 }
 
 NoiseLevels MeasurementNoiseLevels(const Config& config, const ChannelSet& data,

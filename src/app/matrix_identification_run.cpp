@@ -213,17 +213,23 @@ bool SolveAt(const Vector& moduli, const CoupledSolverOptions& inner, MatrixMcre
   return true;
 }
 
-// The element map of a usable coupled solution at `moduli` (mcre/element_error_map.h):
-// from the stored W, or from the sums of a streaming solve; empty when the model has no
-// element blocks.
-ErrorMap ElementMapOf(const MatrixModelData& model, const Vector& moduli,
-                      const CoupledSolution& solution, double time_step) {
+// The element map and sensitivities of a usable coupled solution of `problem` at its
+// current moduli (mcre/element_error_map.h): from the stored fields, or from the sums of
+// a streaming solve; empty when the model has no element blocks.
+ErrorMap ElementMapOf(const MatrixModelData& model, const CoupledSolution& solution,
+                      MatrixMcreProblem* problem) {
   if (model.elements.empty()) return ErrorMap();
   if (!solution.has_fields()) {
-    return AssembleElementErrorMap(model, solution.element_error_map, solution.gap_density,
-                                   static_cast<int>(solution.traces.cols()) - 1, time_step);
+    ErrorMap map =
+        AssembleElementErrorMap(model, solution.element_error_map, solution.gap_density,
+                                static_cast<int>(solution.traces.cols()) - 1, problem->time_step());
+    map.sensitivity = solution.element_sensitivity;
+    return map;
   }
-  return ComputeElementErrorMap(model, moduli, solution.retrograde, time_step);
+  ErrorMap map =
+      ComputeElementErrorMap(model, problem->moduli(), solution.retrograde, problem->time_step());
+  problem->ElementSensitivities(solution.displacement, solution.retrograde, &map.sensitivity);
+  return map;
 }
 
 // Step 3 of RunMatrixIdentification: the error maps and the model's outputs at the
@@ -257,16 +263,14 @@ const CoupledSolution* MapsAtIdentifiedAndNominal(
       run->failure = "at the identified moduli, " + why;
     }
     if (identified != nullptr) {
-      run->element_map =
-          ElementMapOf(model, run->identified_moduli, *identified, problem->time_step());
+      run->element_map = ElementMapOf(model, *identified, problem);
     }
     run->model_outputs = problem->ModelOutputs();
   }
   CoupledSolution nominal;
   if (SolveAt(run->nominal_moduli, config.inner, problem, &nominal, &run->nominal_cost,
               &run->nominal_zone_map, &run->nominal_zone_gap, &run->nominal_dof_map, &why)) {
-    run->nominal_element_map =
-        ElementMapOf(model, run->nominal_moduli, nominal, problem->time_step());
+    run->nominal_element_map = ElementMapOf(model, nominal, problem);
   } else if (run->failure.empty()) {
     run->failure = "at the nominal moduli, " + why;
   }

@@ -329,15 +329,52 @@ std::string InnerResidualScript(const ModulusStage& run, const Config& config,
   return script.str();
 }
 
+// The sensitivity map's two peaks (error_map.h), prefixed by `prefix` ("" or
+// "nominal_"): the element where e^2 falls fastest as its modulus is lowered, and where
+// it falls fastest as it is raised. Nothing when the map has no sensitivity.
+// With the noise's std of every element's sensitivity (`noise_std`, empty when not
+// known), each peak's value in those stds.
+void SensitivityPeaksYaml(const ErrorMap& map, const std::string& prefix, const Vector& noise_std,
+                          YamlWriter* yaml) {
+  if (map.sensitivity.size() == 0) return;
+  const bool known = noise_std.size() == map.sensitivity.size();
+  const int softening = map.SofteningPeakElement(), stiffening = map.StiffeningPeakElement();
+  yaml->Integer(1, prefix + "softening_peak_element", softening,
+                "largest de^2/d ln E_el: e^2 falls fastest as its modulus is lowered");
+  yaml->Number(1, prefix + "softening_peak_position", map.position[softening], "[m]");
+  if (known) {
+    // s_el / std(s_el): the peak in the noise's standard deviations.
+    yaml->Number(1, prefix + "softening_peak_noise_ratio",
+                 map.sensitivity[softening] / noise_std[softening],
+                 "its value over its std under the noise, E held (docs/boundaries.md "
+                 "section 11)");
+  }
+  yaml->Integer(1, prefix + "stiffening_peak_element", stiffening,
+                "smallest de^2/d ln E_el: e^2 falls fastest as its modulus is raised");
+  yaml->Number(1, prefix + "stiffening_peak_position", map.position[stiffening], "[m]");
+  if (known) {
+    yaml->Number(1, prefix + "stiffening_peak_noise_ratio",
+                 map.sensitivity[stiffening] / noise_std[stiffening], "the same");
+  }
+}
+
 }  // namespace
 
 std::string ErrorMapCsv(const IdentificationRun& run) {
   const ErrorMap& map = run.error_map;
   const Vector fractions = map.Fractions();
-  std::string csv = "element,x,share,fraction\n";
+  const bool sensitivity = map.sensitivity.size() == map.share.size();
+  const Vector& noise_std = run.uncertainty.sensitivity_std;
+  const bool known = sensitivity && noise_std.size() == map.share.size();
+  std::string csv = "element,x,share,fraction";
+  csv += sensitivity ? ",sensitivity" : "";
+  csv += known ? ",sensitivity_noise_std\n" : "\n";
   for (Eigen::Index e = 0; e < map.share.size(); ++e) {
     csv += std::to_string(e) + "," + Format(map.position[e]) + "," + Format(map.share[e]) + "," +
-           Format(fractions[e]) + "\n";
+           Format(fractions[e]);
+    if (sensitivity) csv += "," + Format(map.sensitivity[e]);
+    if (known) csv += "," + Format(noise_std[e]);
+    csv += "\n";
   }
   return csv;
 }
@@ -363,11 +400,13 @@ std::string ErrorMapSpaceTimeData(const IdentificationRun& run) {
 }
 
 std::string ErrorMapScript(const IdentificationRun& run, const std::string& folder) {
-  // The space-time panel when the map has one.
+  // The sensitivity and the space-time panels when the map has them.
   const bool space_time = run.error_map.density.size() > 0;
+  const bool sensitivity = run.error_map.sensitivity.size() > 0;
+  const int panels = 1 + (space_time ? 1 : 0) + (sensitivity ? 1 : 0);
   std::ostringstream script;
-  script << GnuplotPngTerminal() << "set terminal pngcairo size 1100," << (space_time ? 900 : 450)
-         << "\nset multiplot layout " << (space_time ? 2 : 1)
+  script << GnuplotPngTerminal() << "set terminal pngcairo size 1100," << 450 * panels
+         << "\nset multiplot layout " << panels
          << ",1 title 'MCRE error map at the identified E = " << run.identified_modulus() / 1e9
          << " GPa'\n"
          << "set xlabel 'x [m]'\nset ylabel 'share of the constitutive gap'\nset grid\n"
@@ -375,6 +414,21 @@ std::string ErrorMapScript(const IdentificationRun& run, const std::string& fold
          << "set title 'e_{el}^2 / sum e_{el}^2 per element'\n"
          << "plot " << GnuplotString(folder + "/error_map.csv")
          << " skip 1 using 2:4 with boxes fill solid 0.6 lc rgb '#1f4e9c' notitle\n";
+  if (sensitivity) {
+    script
+        << "set title 'sensitivity de^2/d ln E_{el} per element: > 0 where a softer element "
+           "lowers e^2'\n"
+        << "set ylabel 'de^2/d ln E_{el} [J s]'\n"
+        << "plot " << GnuplotString(folder + "/error_map.csv")
+        << " skip 1 using 2:5 with boxes fill solid 0.6 lc rgb '#b2182b' title 'de^2/d ln E_{el}'";
+    if (run.uncertainty.sensitivity_std.size() == run.error_map.sensitivity.size()) {
+      // +- 3 std of the noise's part, E held.
+      script << ", '' skip 1 using 2:(3*$6) with lines lc rgb '#333333' dashtype 2 "
+                "title '+- 3 std of the noise', '' skip 1 using 2:(-3*$6) with lines lc rgb "
+                "'#333333' dashtype 2 notitle";
+    }
+    script << "\n";
+  }
   if (!space_time) {
     script << "unset multiplot\n";
     return script.str();
@@ -884,6 +938,7 @@ std::string SummaryYaml(const IdentificationRun& run) {
     yaml.Number(1, "peak_position", run.error_map.position[peak], "[m] its midpoint");
     yaml.Number(1, "peak_fraction", run.error_map.Fractions()[peak],
                 "its share of the constitutive gap");
+    SensitivityPeaksYaml(run.error_map, "", run.uncertainty.sensitivity_std, &yaml);
   }
 
   UncertaintyYaml(run, &yaml);
@@ -1011,14 +1066,15 @@ std::string MatrixDofMapCsv(const IdentificationRun& run) {
 // error_map.csv of a matrix model with element blocks: the bar's columns (element, its
 // position's coordinates x, y, z as it has them, share [J s] and fraction at the
 // identified moduli), then the same at the nominal moduli, then the element's zone (its
-// index in the manifest, as zones.csv's column zone).
+// index in the manifest, as zones.csv's column zone), then the sensitivity
+// de^2/d ln E_el [J s] at the identified and at the nominal moduli.
 std::string MatrixElementMapCsv(const IdentificationRun& run, const MatrixModelData& model) {
   const Vector fractions = run.element_map.Fractions();
   const Vector nominal_fractions = run.nominal_element_map.Fractions();
   const Eigen::Index dimension = model.elements.front().position.size();
   std::string csv = "element";
   for (Eigen::Index i = 0; i < dimension; ++i) csv += std::string(",") + "xyz"[i];
-  csv += ",share,fraction,nominal_share,nominal_fraction,zone\n";
+  csv += ",share,fraction,nominal_share,nominal_fraction,zone,sensitivity,nominal_sensitivity\n";
   for (std::size_t el = 0; el < model.elements.size(); ++el) {
     const MatrixModelElement& element = model.elements[el];
     const auto e = static_cast<Eigen::Index>(el);
@@ -1026,7 +1082,8 @@ std::string MatrixElementMapCsv(const IdentificationRun& run, const MatrixModelD
     for (Eigen::Index i = 0; i < dimension; ++i) csv += "," + Format(element.position[i]);
     csv += "," + Format(run.element_map.share[e]) + "," + Format(fractions[e]) + "," +
            Format(run.nominal_element_map.share[e]) + "," + Format(nominal_fractions[e]) + "," +
-           std::to_string(element.zone) + "\n";
+           std::to_string(element.zone) + "," + Format(run.element_map.sensitivity[e]) + "," +
+           Format(run.nominal_element_map.sensitivity[e]) + "\n";
   }
   return csv;
 }
@@ -1150,6 +1207,8 @@ void MatrixElementMapYaml(const IdentificationRun& run, YamlWriter* yaml) {
                "its share of the constitutive gap");
   yaml->Integer(1, "nominal_peak_element", nominal_peak, "the same at the nominal moduli");
   yaml->Number(1, "nominal_peak_fraction", run.nominal_element_map.Fractions()[nominal_peak]);
+  SensitivityPeaksYaml(run.element_map, "", Vector(), yaml);
+  SensitivityPeaksYaml(run.nominal_element_map, "nominal_", Vector(), yaml);
 }
 
 // The zones: block of a matrix run, in the layout of the bar's (ZonesYamlLines): the

@@ -25,6 +25,26 @@ double ElementGapEnergy(const MatrixModelElement& element, const double* retrogr
   return 0.5 * (quadratic + 2.0 * shift * linear + shift * shift * constant);
 }
 
+double ElementBilinearForm(const MatrixModelElement& element, const double* a, const double* b) {
+  // a^T K_el b = V_a^T K_el V_b + c_b r^T V_a + c_a r^T V_b + c_a c_b 1^T r, V_x = x_el - c_x 1,
+  // r = K_el 1, c_x = x_{d_1} (element_error_map.h).
+  const int k = static_cast<int>(element.dofs.size());
+  const double shift_a = a[element.dofs[0]], shift_b = b[element.dofs[0]];
+  double quadratic = 0.0, linear_a = 0.0, linear_b = 0.0, constant = 0.0;
+  for (int p = 0; p < k; ++p) {
+    double row_product = 0.0, row_sum = 0.0;
+    for (int q = 0; q < k; ++q) {
+      row_product += element.stiffness(p, q) * (b[element.dofs[q]] - shift_b);
+      row_sum += element.stiffness(p, q);
+    }
+    quadratic += (a[element.dofs[p]] - shift_a) * row_product;
+    linear_a += row_sum * (a[element.dofs[p]] - shift_a);
+    linear_b += row_sum * (b[element.dofs[p]] - shift_b);
+    constant += row_sum;
+  }
+  return quadratic + shift_b * linear_a + shift_a * linear_b + shift_a * shift_b * constant;
+}
+
 namespace {
 
 // E_z / E_z,nom of an element's zone.
@@ -43,6 +63,22 @@ void AddSampleElementGapShares(const MatrixModelData& model, const Vector& zone_
     // weight (E_z / E_z,nom) 1/2 W_j^T K_el W_j.
     (*shares)[static_cast<Eigen::Index>(el)] +=
         weight * ZoneFactor(model, zone_moduli, element) * ElementGapEnergy(element, retrograde);
+  }
+}
+
+void AddSampleElementMaps(const MatrixModelData& model, const Vector& zone_moduli,
+                          const double* displacement, const double* retrograde, double weight,
+                          Vector* shares, Vector* sensitivities) {
+  for (std::size_t el = 0; el < model.elements.size(); ++el) {
+    const MatrixModelElement& element = model.elements[el];
+    const double scale = weight * ZoneFactor(model, zone_moduli, element);
+    const double gap = ElementGapEnergy(element, retrograde);
+    const auto index = static_cast<Eigen::Index>(el);
+    // weight (E_z / E_z,nom) 1/2 W_j^T K_el W_j.
+    if (shares != nullptr) (*shares)[index] += scale * gap;
+    // -weight (E_z / E_z,nom) (1/2 W_j^T K_el W_j + W_j^T K_el U_j).
+    (*sensitivities)[index] -=
+        scale * (gap + ElementBilinearForm(element, retrograde, displacement));
   }
 }
 

@@ -12,6 +12,20 @@ int ErrorMap::PeakElement() const {
   return static_cast<int>(peak);
 }
 
+int ErrorMap::SofteningPeakElement() const {
+  if (sensitivity.size() == 0) return -1;
+  Eigen::Index peak = 0;
+  sensitivity.maxCoeff(&peak);
+  return static_cast<int>(peak);
+}
+
+int ErrorMap::StiffeningPeakElement() const {
+  if (sensitivity.size() == 0) return -1;
+  Eigen::Index peak = 0;
+  sensitivity.minCoeff(&peak);
+  return static_cast<int>(peak);
+}
+
 Vector GapFractions(const Vector& shares) {
   const double total = shares.sum();
   return total > 0.0 ? Vector(shares / total) : Vector(Vector::Zero(shares.size()));

@@ -250,6 +250,17 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
     reaction_zone_rows_ = ReactionZoneRows(model, held_);
     for (const SparseMatrix& rows : reaction_zone_rows_) reaction_zone_forms_.emplace_back(rows);
     for (int s = 0; s < num_reactions_; ++s) {
+      const Vector& test = TrustedReactionTest(model.supports[s]);
+      for (std::size_t el = 0; el < model.elements.size(); ++el) {
+        for (const int dof : model.elements[el].dofs) {
+          if (test[dof] != 0.0) {
+            reaction_elements_.emplace_back(s, static_cast<int>(el));
+            break;
+          }
+        }
+      }
+    }
+    for (int s = 0; s < num_reactions_; ++s) {
       measured_outputs_.row(num_fixed + s) =
           data.Values(model.supports[s].force_channel).transpose();
       betas_[num_fixed + s] = reaction_weight_;
@@ -444,6 +455,37 @@ Vector MatrixMcreProblem::DofErrorMap(const Matrix& retrograde) {
     map += (0.5 * QuadratureWeight(j) * h) * retrograde.col(j).cwiseProduct(product_);
   }
   return map;
+}
+
+void MatrixMcreProblem::ElementSensitivities(const Matrix& displacement, const Matrix& retrograde,
+                                             Vector* sensitivity) {
+  assert(!model_.elements.empty());
+  const double h = time_step();
+  sensitivity->setZero(static_cast<Eigen::Index>(model_.elements.size()));
+  for (int j = 0; j <= num_steps(); ++j) {
+    const double weight = QuadratureWeight(j) * h;
+    // -c_j h (E_z / E_z,nom) (1/2 W_j^T K_el W_j + W_j^T K_el U_j).
+    AddSampleElementMaps(model_, moduli_, displacement.col(j).data(), retrograde.col(j).data(),
+                         weight, nullptr, sensitivity);
+    if (num_reactions_ == 0) continue;
+    reaction_trace_.noalias() = reactions_ * displacement.col(j);
+    reaction_trace_ -= measured_outputs_.col(j).tail(num_reactions_);
+    AddSampleReactionSensitivities(displacement.col(j).data(), weight, sensitivity);
+  }
+}
+
+void MatrixMcreProblem::AddSampleReactionSensitivities(const double* displacement, double weight,
+                                                       Vector* sensitivity) const {
+  for (const auto& [support, el] : reaction_elements_) {
+    const MatrixModelElement& element = model_.elements[static_cast<std::size_t>(el)];
+    const double zone_factor = moduli_[element.zone] /
+                               model_.zones[static_cast<std::size_t>(element.zone)].nominal_modulus;
+    // c_j h alpha_r (E_z / E_z,nom) (r_s(U_j) - f~_sj) phi_s^T K_el U_j (CostGradients).
+    (*sensitivity)[el] +=
+        weight * reaction_weight_ * zone_factor * reaction_trace_[support] *
+        ElementBilinearForm(element, TrustedReactionTest(model_.supports[support]).data(),
+                            displacement);
+  }
 }
 
 SparseMatrix MatrixMcreProblem::PenaltyMatrix() const {

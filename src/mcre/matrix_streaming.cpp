@@ -147,10 +147,11 @@ void MatrixMcreProblem::AddStreamingSample(int j, const Vector& displacement,
   // The dof map c_j h 1/2 W_ij (K W_j)_i (DofErrorMap).
   totals->error_map += (0.5 * weight) * retrograde.cwiseProduct(product_);
   if (element_maps_ && !model_.elements.empty()) {
-    // The element map's shares and, on every picture_stride-th sample, its picture's
-    // row (mcre/element_error_map.h, as ComputeElementErrorMap takes them from W).
-    AddSampleElementGapShares(model_, moduli_, retrograde.data(), weight,
-                              &totals->element_error_map);
+    // The element map's shares and sensitivities' field part and, on every
+    // picture_stride-th sample, its picture's row (mcre/element_error_map.h, as
+    // ComputeElementErrorMap and ElementSensitivities take them from the fields).
+    AddSampleElementMaps(model_, moduli_, displacement.data(), retrograde.data(), weight,
+                         &totals->element_error_map, &totals->element_sensitivity);
     if (j % picture_stride == 0) {
       SampleElementGapDensity(model_, moduli_, retrograde.data(), stream_density_row_.data());
       totals->gap_density.row(j / picture_stride) = stream_density_row_.transpose();
@@ -177,6 +178,9 @@ void MatrixMcreProblem::AddStreamingSample(int j, const Vector& displacement,
         weight * reaction_weight_ *
         reaction_zone_forms_[z](reaction_trace_.data(), displacement.data());
   }
+  if (element_maps_ && !model_.elements.empty()) {
+    AddSampleReactionSensitivities(displacement.data(), weight, &totals->element_sensitivity);
+  }
 }
 
 void MatrixMcreProblem::ResetStreamingTotals(int picture_stride, StreamingTotals* totals) const {
@@ -189,6 +193,7 @@ void MatrixMcreProblem::ResetStreamingTotals(int picture_stride, StreamingTotals
   const bool elements = element_maps_ && !model_.elements.empty();
   totals->element_error_map.setZero(elements ? static_cast<Eigen::Index>(model_.elements.size())
                                              : 0);
+  totals->element_sensitivity.setZero(totals->element_error_map.size());
   totals->gap_density.resize(elements ? num_steps() / picture_stride + 1 : 0,
                              elements ? stream_density_row_.size() : 0);
   totals->load_retrograde.resize(channel_.size(), num_steps() + 1);
@@ -205,6 +210,7 @@ void MatrixMcreProblem::StreamingElementMaps(const Matrix& traces, CoupledSoluti
   element_maps_ = gathered;
   solution->element_error_map = std::move(totals.element_error_map);
   solution->gap_density = std::move(totals.gap_density);
+  solution->element_sensitivity = std::move(totals.element_sensitivity);
 }
 
 void MatrixMcreProblem::CheckpointRetrogradeSweep(const Matrix& traces, bool include_data) {

@@ -175,6 +175,7 @@ ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
   }
   result.samples = zone.samples;
   result.std_dev = zone.std_dev[0];
+  result.sensitivity_std = zone.sensitivity_std;
   result.relative_std_dev = result.std_dev / modulus;
   result.available = true;
   result.message = "ok";

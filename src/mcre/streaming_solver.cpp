@@ -227,6 +227,7 @@ void StreamingConjugateGradient::Accept(const std::string& message) {
   solution_->load_retrograde = totals_.load_retrograde;
   solution_->error_map = totals_.error_map;
   solution_->element_error_map = totals_.element_error_map;
+  solution_->element_sensitivity = totals_.element_sensitivity;
   solution_->zone_error_map = totals_.zone_error_map;
   solution_->zone_strain_energy = totals_.zone_strain_energy;
   solution_->gap_density = totals_.gap_density;

@@ -112,6 +112,10 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
   CoupledSolution noise_solution;
   std::shared_ptr<const MatrixMcreProblem::TraceFactor> shared_factor;
   Vector plus_gradient, minus_gradient;
+  // The sensitivity map's draws on a model with element blocks: sum_i ds_el,i^2.
+  const bool elements = !model.elements.empty();
+  Vector plus_sensitivity, minus_sensitivity;
+  Vector sensitivity_square_sum = Vector::Zero(static_cast<Eigen::Index>(model.elements.size()));
   Matrix image;
   StreamingCoupledProblem::StreamingTotals totals;
   for (int sample = 0; sample < options.samples; ++sample) {
@@ -135,18 +139,33 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
     plus->SetModuli(moduli);
     minus->SetModuli(moduli);
     if (solution.has_fields()) {
-      plus->CostGradients(solution.displacement + noise_solution.displacement,
-                          solution.retrograde + noise_solution.retrograde, &plus_gradient);
-      minus->CostGradients(solution.displacement - noise_solution.displacement,
-                           solution.retrograde - noise_solution.retrograde, &minus_gradient);
+      const Matrix plus_displacement = solution.displacement + noise_solution.displacement;
+      const Matrix plus_retrograde = solution.retrograde + noise_solution.retrograde;
+      plus->CostGradients(plus_displacement, plus_retrograde, &plus_gradient);
+      if (elements)
+        plus->ElementSensitivities(plus_displacement, plus_retrograde, &plus_sensitivity);
+      const Matrix minus_displacement = solution.displacement - noise_solution.displacement;
+      const Matrix minus_retrograde = solution.retrograde - noise_solution.retrograde;
+      minus->CostGradients(minus_displacement, minus_retrograde, &minus_gradient);
+      if (elements) {
+        minus->ElementSensitivities(minus_displacement, minus_retrograde, &minus_sensitivity);
+      }
     } else {
       // A streaming solution: s_d +- s_n are the fixed points y_d +- y_n on the traces,
       // whose fields one application of each problem's map passes through.
+      plus->set_element_maps(elements);
+      minus->set_element_maps(elements);
       plus->StreamingMap(solution.traces + noise_solution.traces, true, &image, &totals);
       plus_gradient = totals.cost_gradients;
+      plus_sensitivity = totals.element_sensitivity;
       minus->StreamingMap(solution.traces - noise_solution.traces, true, &image, &totals);
       minus_gradient = totals.cost_gradients;
+      minus_sensitivity = totals.element_sensitivity;
       result.sweeps += plus->sweep_count() + minus->sweep_count();
+    }
+    if (elements) {
+      // ds_el = (s_el(s_d + s_n; d + n) - s_el(s_d - s_n; d - n)) / 2
+      sensitivity_square_sum += (0.5 * (plus_sensitivity - minus_sensitivity)).cwiseAbs2();
     }
     // dE = -H^-1 dg
     const Vector change = -factor.solve(0.5 * (plus_gradient - minus_gradient));
@@ -160,6 +179,8 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
   // Cov(E*) = mean_i dE_i dE_i^T
   result.covariance = sum / options.samples;
   result.std_dev = result.covariance.diagonal().cwiseSqrt();
+  // std(s_el) = sqrt(mean_i ds_el,i^2)
+  if (elements) result.sensitivity_std = (sensitivity_square_sum / options.samples).cwiseSqrt();
   result.available = true;
   result.message = "ok";
   return result;

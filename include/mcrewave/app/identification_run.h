@@ -341,10 +341,12 @@ ZoneUncertainty BarZoneUncertainty(const Config& config, const IdentificationRun
 // explains nothing of the data (ImplausibleMisfitMessage).
 std::string UnreportableMessage(const IdentificationRun& run);
 
-// The run's error map at E* (error_map.h): from the stored retrograde field, or from
-// the element shares and picture a streaming solve summed on BarRunModel's elements
+// The run's error map and sensitivity map at E* (error_map.h): from the stored fields,
+// with `problem` (run.config's, on run.model and run.data; its moduli set to E* here),
+// or from the element sums a streaming solve gathered on BarRunModel's elements
 // (mcre/element_error_map.h). Precondition: run.IsUsable().
-ErrorMap BarErrorMap(const Config& config, const IdentificationRun& run);
+ErrorMap BarErrorMap(const Config& config, const IdentificationRun& run,
+                     MatrixMcreProblem* problem);
 
 // Runs steps 2 to 4 on measurements made by LoadMeasurements(config); RunLeastSquares
 // with outer.functional: least_squares. Precondition: config valid (as LoadConfig

@@ -185,6 +185,9 @@ struct CoupledSolution {
   Vector error_map;
   // Streaming on a matrix model with element blocks: e_el^2 per element [J s].
   Vector element_error_map;
+  // Streaming on a matrix model with element blocks: de^2/d ln E_el per element [J s]
+  // (MatrixMcreProblem::ElementSensitivities).
+  Vector element_sensitivity;
   // Streaming: the error map's space-time picture (StreamingTotals::gap_density).
   Matrix gap_density;
   // Streaming on a matrix model: MatrixMcreProblem::ZoneErrorMap of W and of U [J s].

@@ -25,6 +25,20 @@
 // elements (in the model's order). ErrorMap::position is each element's first
 // coordinate [m] (its index when the elements have no positions) and
 // ErrorMap::density_position each column's mean of them.
+//
+// The sensitivity map (ErrorMap::sensitivity) is the zone gradient
+// (MatrixMcreProblem::CostGradients) split by element and taken in log E: with every
+// element its own modulus, each at its zone's E_z,
+//
+//   s_el = de^2/d ln E_el
+//        = -(E_z / E_z,nom) sum_j c_j h (1/2 W_j^T K_el W_j + W_j^T K_el U_j)  [J s],
+//
+// plus, under a trusted treatment, the reactions' part
+// (E_z / E_z,nom) sum_j c_j h alpha_r sum_s (r_s(U_j) - f~_sj) phi_s^T K_el U_j. The
+// elements of zone z sum to E_z de^2/dE_z. s_el > 0 where lowering the element's
+// modulus lowers e^2 (the model too stiff there), s_el < 0 where raising it does
+// (docs/boundaries.md section 11). The cross form W^T K_el U is shifted like the gap's,
+// each vector about its own first dof value.
 #pragma once
 
 #include "mcrewave/core/types.h"
@@ -37,10 +51,23 @@ namespace mcrewave {
 // model's n entries), by the shifted form above. No allocation.
 double ElementGapEnergy(const MatrixModelElement& element, const double* retrograde);
 
+// a_el^T K_el b_el of one element at its zone's nominal modulus [J per unit of a and b],
+// from the model's n-entry vectors a and b, by the shifted form above (a about a_{d_1},
+// b about b_{d_1}). No allocation.
+double ElementBilinearForm(const MatrixModelElement& element, const double* a, const double* b);
+
 // shares[el] += weight (E_z / E_z,nom) 1/2 W_j^T K_el W_j for every element, from W_j.
 // zone_moduli has one entry per zone [Pa]; shares one per element. No allocation.
 void AddSampleElementGapShares(const MatrixModelData& model, const Vector& zone_moduli,
                                const double* retrograde, double weight, Vector* shares);
+
+// The gap shares and the sensitivity's field part of one sample, from U_j and W_j:
+//   shares[el] += weight (E_z / E_z,nom) 1/2 W_j^T K_el W_j,
+//   sensitivities[el] -= weight (E_z / E_z,nom) (1/2 W_j^T K_el W_j + W_j^T K_el U_j).
+// shares may be null. No allocation.
+void AddSampleElementMaps(const MatrixModelData& model, const Vector& zone_moduli,
+                          const double* displacement, const double* retrograde, double weight,
+                          Vector* shares, Vector* sensitivities);
 
 // e_el^2 for every element [J s] at the zone moduli from W (n x (m + 1)) on steps of
 // time_step [s]. Precondition: the model has elements.

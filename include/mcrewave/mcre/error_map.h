@@ -32,9 +32,18 @@ struct ErrorMap {
   Vector times;             // [s]
   Vector density_position;  // column centres [m]
   Matrix density;           // times.size() x density_position.size()
+  // The sensitivity map s_el = de^2/d ln E_el [J s], one per element, at the same
+  // moduli (mcre/element_error_map.h): positive where lowering the element's modulus
+  // lowers e^2, negative where raising it does. Empty when not computed.
+  Vector sensitivity;
 
   // Index of the element with the largest share (-1 when empty).
   int PeakElement() const;
+  // Index of the element with the largest sensitivity, where e^2 falls fastest as the
+  // modulus is lowered (softening), and with the smallest, where it falls fastest as it
+  // is raised (stiffening); -1 when the sensitivity is empty.
+  int SofteningPeakElement() const;
+  int StiffeningPeakElement() const;
   // share / sum(share): the fraction of the constitutive gap in each element.
   Vector Fractions() const;
 };

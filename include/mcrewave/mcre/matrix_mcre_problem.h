@@ -131,6 +131,12 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // to the constitutive part and shows where in a zone the gap sits (a nodal
   // density for a figure over the mesh; an entry can be slightly negative).
   Vector DofErrorMap(const Matrix& retrograde);
+  // The sensitivity map s_el = de^2/d ln E_el [J s] of the model's elements at the
+  // current moduli from a coupled solution's U and W (mcre/element_error_map.h), the
+  // trusted reactions' part included: the elements of zone z sum to E_z de^2/dE_z of
+  // CostGradients. Precondition: the model has element blocks.
+  void ElementSensitivities(const Matrix& displacement, const Matrix& retrograde,
+                            Vector* sensitivity);
 
   SparseMatrix MassMatrix() const override { return mass_; }
   SparseMatrix StiffnessMatrix() const override { return stiffness_; }
@@ -302,6 +308,11 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // keeping its state (v_j, omega_j) at the checkpoints j = m - i s (column i of
   // checkpoints_: v over omega). No allocation.
   void CheckpointRetrogradeSweep(const Matrix& traces, bool include_data);
+  // The trusted reactions' part of the sensitivity map at one sample, from
+  // reaction_trace_ = r(U_j) - f~_j: sensitivity[el] += weight alpha_r (E_z / E_z,nom)
+  // sum_s (r_s(U_j) - f~_sj) phi_s^T K_el U_j over reaction_elements_. No allocation.
+  void AddSampleReactionSensitivities(const double* displacement, double weight,
+                                      Vector* sensitivity) const;
 
   const MatrixModelData& model_;
   double time_step_;         // h [s]
@@ -330,6 +341,9 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // The bilinear forms of every K_z and of those rows on the dofs they touch
   // (linalg/sparse_bilinear_form.h): the zone sums in O(n) per sample, not O(n Z).
   std::vector<SparseBilinearForm> zone_forms_, reaction_zone_forms_;
+  // Trusted, with element blocks: (support s, element el) wherever phi_s is nonzero on
+  // one of the element's dofs, the elements the reactions' sensitivity touches.
+  std::vector<std::pair<int, int>> reaction_elements_;
   SparseMatrix reactions_;
   SparseMatrix observation_;             // H, S x n
   SparseMatrix observation_transposed_;  // H^T, n x S

@@ -98,6 +98,9 @@ struct ModulusUncertainty {
   int samples = 0;                       // noise draws used
   NoiseLevels noise;                     // the levels drawn
   long sweeps = 0;                       // of the noise solves
+  // std(s_el) [J s] of the sensitivity map at E* under the same draws, E* held, one per
+  // element (zone_uncertainty.h); empty without element blocks.
+  Vector sensitivity_std;
 };
 
 // The figure at the identified modulus (see the top of this file) of a model of one

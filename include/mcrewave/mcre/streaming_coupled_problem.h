@@ -38,6 +38,9 @@ class StreamingCoupledProblem : public CoupledProblem {
     // A matrix model with element blocks: e_el^2 per element [J s]
     // (mcre/element_error_map.h).
     Vector element_error_map;
+    // The same: the sensitivity map de^2/d ln E_el per element [J s]
+    // (MatrixMcreProblem::ElementSensitivities).
+    Vector element_sensitivity;
     // The error map's space-time picture at every SpaceTimeStride(m)-th sample (rows):
     // the bar's gap energy density [J/m] on SpaceTimeColumnPositions (error_map.h); a
     // matrix model's element gap energy [J] on ElementColumnPositions

@@ -13,6 +13,12 @@
 // symmetrised, or H as the caller gives it (the bar's run: the slope of its cost curve,
 // modulus_uncertainty.h). Over `samples` seeded draws, Cov(E*) = mean_i dE_i dE_i^T (dE is linear
 // in n: zero mean). Each draw costs one coupled solve; H costs 2Z.
+//
+// On a model with element blocks the same draws give the noise's part of the
+// sensitivity map s_el = de^2/d ln E_el at the moduli (mcre/element_error_map.h), the
+// moduli held: ds_el = (s_el(s_d + s_n; d + n) - s_el(s_d - s_n; d - n)) / 2 and
+// std(s_el) = sqrt(mean_i ds_el,i^2), against which a peak of the map is significant or
+// not (docs/boundaries.md section 11).
 #pragma once
 
 #include <string>
@@ -35,6 +41,8 @@ struct ZoneUncertainty {
   int samples = 0;                       // noise draws used
   NoiseLevels noise;                     // the levels drawn
   long sweeps = 0;                       // of the curvature's and the noise's solves
+  // std(s_el) [J s], one per element (above); empty without element blocks.
+  Vector sensitivity_std;
 };
 
 // The figure at the identified moduli (see the top of this file). `solution` is the
