@@ -240,30 +240,62 @@ TEST(MatrixSupportsTest, TrustedGradientMatchesCentralDifferencesOnALattice) {
   }
 }
 
+// The bar of 60 elements of 16.7 mm in zones 0 (elements 0 to 3) and 1, its trusted
+// reaction averaged over reaction_length 100 mm, exported with its clamp as a support
+// (`zones` given per element: one zone per element for the central differences), and
+// the trusted problem at moduli (183, 207) GPa (or those of `element_moduli` when
+// given), the reaction's weight 0.1, large enough to matter.
+struct SixtyElementTrustedBar {
+  explicit SixtyElementTrustedBar(const std::vector<int>& element_zones = TwoZones())
+      : c(Case()),
+        zones(element_zones),
+        model(c.bar, zones),
+        data(MakeSyntheticMeasurements(c.bar, c.load, c.time, c.data)),
+        matrices(BarMatrixModel(model, c.bar.modulus, {}, BarClampExport::kSupport)),
+        problem(matrices, data, ReactionWeights(), 200e9, 0.5, Factorization::kAutomatic,
+                ClampModel::kTrusted) {}
+  static SmallCase Case() {
+    SmallCase small = MakeSmallCase(60, 120, 20.0, 1);
+    small.bar.reaction_length = 0.1;
+    return small;
+  }
+  static std::vector<int> TwoZones() {
+    std::vector<int> two(60, 1);
+    for (int e = 0; e < 4; ++e) two[e] = 0;
+    return two;
+  }
+  static McreWeights ReactionWeights() {
+    McreWeights weights = Weights(0.01, 1.0);
+    weights.reaction_weight = 0.1;
+    return weights;
+  }
+  static Vector TwoModuli() { return (Vector(2) << 1.83e11, 2.07e11).finished(); }
+
+  SmallCase c;
+  std::vector<int> zones;
+  BarModel model;
+  ChannelSet data;
+  MatrixModelData matrices;
+  MatrixMcreProblem problem;
+};
+
 // The bar's trusted reaction over model.reaction_length (docs/boundaries.md section 7):
 // on 60 elements of 16.7 mm, 100 mm give m = 6 and phi_i = 1 - i / 6 on nodes 0 to 5. The
 // reaction of a direct sweep is the mean axial force -(S / (m l)) sum_{e < m} E_e
 // (U_{e+1} - U_e), written out here from the field, across the boundary of zones 0
 // (elements 0 to 3) and 1; and its zone gradients match central differences.
 TEST(MatrixSupportsTest, TheBarsTrustedReactionIsTheMeanAxialForceOverTheReactionLength) {
-  SmallCase c = MakeSmallCase(60, 120, 20.0, 1);
-  c.bar.reaction_length = 0.1;
-  std::vector<int> zones(60, 1);
-  for (int e = 0; e < 4; ++e) zones[e] = 0;
-  const BarModel model(c.bar, zones);
-  const ChannelSet data = MakeSyntheticMeasurements(c.bar, c.load, c.time, c.data);
-  const MatrixModelData matrices =
-      BarMatrixModel(model, c.bar.modulus, {}, BarClampExport::kSupport);
-  const Vector& phi = matrices.supports[0].reaction_test;
+  SixtyElementTrustedBar bar;
+  const SmallCase& c = bar.c;
+  const std::vector<int>& zones = bar.zones;
+  const BarModel& model = bar.model;
+  const Vector& phi = bar.matrices.supports[0].reaction_test;
   ASSERT_EQ(phi.size(), 61);
   for (int i = 0; i < 61; ++i) EXPECT_EQ(phi[i], i < 6 ? 1.0 - i / 6.0 : 0.0) << i;
-  EXPECT_EQ(&TrustedReactionTest(matrices.supports[0]), &phi);
+  EXPECT_EQ(&TrustedReactionTest(bar.matrices.supports[0]), &phi);
 
-  McreWeights weights = Weights(0.01, 1.0);
-  weights.reaction_weight = 0.1;  // the reaction's term large enough to matter
-  MatrixMcreProblem problem(matrices, data, weights, 200e9, 0.5, Factorization::kAutomatic,
-                            ClampModel::kTrusted);
-  const Vector moduli = (Vector(2) << 1.83e11, 2.07e11).finished();
+  MatrixMcreProblem& problem = bar.problem;
+  const Vector moduli = SixtyElementTrustedBar::TwoModuli();
   problem.SetModuli(moduli);
   Matrix u;
   problem.DirectSweep(problem.ZeroField(), true, &u);
@@ -292,19 +324,10 @@ TEST(MatrixSupportsTest, TheBarsTrustedReactionIsTheMeanAxialForceOverTheReactio
 // per element), inside the reaction's region (elements 2 and 4, either side of the zone
 // boundary) and away from it (element 40).
 TEST(MatrixSupportsTest, TheSensitivityMapIsEachElementsGradientInLogE) {
-  SmallCase c = MakeSmallCase(60, 120, 20.0, 1);
-  c.bar.reaction_length = 0.1;
-  std::vector<int> zones(60, 1), own(60);
-  for (int e = 0; e < 60; ++e) own[e] = e;
-  for (int e = 0; e < 4; ++e) zones[e] = 0;
-  const ChannelSet data = MakeSyntheticMeasurements(c.bar, c.load, c.time, c.data);
-  const MatrixModelData matrices =
-      BarMatrixModel(BarModel(c.bar, zones), c.bar.modulus, {}, BarClampExport::kSupport);
-  McreWeights weights = Weights(0.01, 1.0);
-  weights.reaction_weight = 0.1;  // the reaction's term large enough to matter
-  MatrixMcreProblem problem(matrices, data, weights, 200e9, 0.5, Factorization::kAutomatic,
-                            ClampModel::kTrusted);
-  const Vector moduli = (Vector(2) << 1.83e11, 2.07e11).finished();
+  SixtyElementTrustedBar bar;
+  const std::vector<int>& zones = bar.zones;
+  MatrixMcreProblem& problem = bar.problem;
+  const Vector moduli = SixtyElementTrustedBar::TwoModuli();
   problem.SetModuli(moduli);
   CoupledSolution at;
   ASSERT_TRUE(
@@ -322,10 +345,10 @@ TEST(MatrixSupportsTest, TheSensitivityMapIsEachElementsGradientInLogE) {
         << "zone " << z;
   }
 
-  const MatrixModelData elements =
-      BarMatrixModel(BarModel(c.bar, own), c.bar.modulus, {}, BarClampExport::kSupport);
-  MatrixMcreProblem per_element(elements, data, weights, 200e9, 0.5, Factorization::kAutomatic,
-                                ClampModel::kTrusted);
+  std::vector<int> own(60);
+  for (int e = 0; e < 60; ++e) own[e] = e;
+  SixtyElementTrustedBar one_zone_per_element(own);
+  MatrixMcreProblem& per_element = one_zone_per_element.problem;
   Vector element_moduli(60);
   for (int e = 0; e < 60; ++e) element_moduli[e] = moduli[zones[e]];
   auto cost_at = [&](const Vector& at_moduli) {

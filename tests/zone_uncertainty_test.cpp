@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "mcrewave/core/random.h"
@@ -51,6 +52,20 @@ struct TwoZoneBarAsMatrices {
   CoupledSolverOptions inner;
 };
 
+// The seed of the one draw the tests reproduce.
+constexpr std::uint64_t kDrawSeed = 5;
+
+// EstimateZoneUncertainty with that one draw, at the levels DifferenceNoiseLevels
+// estimates from the bar's data.
+ZoneUncertainty OneDrawEstimate(const TwoZoneBarAsMatrices& bar, const Vector& moduli,
+                                const CoupledSolution& solution) {
+  UncertaintyOptions options;
+  options.samples = 1;
+  options.seed = kDrawSeed;
+  return EstimateZoneUncertainty(options, bar.matrices, bar.data, bar.mcre, 0.5, bar.inner, moduli,
+                                 solution, DifferenceNoiseLevels(bar.data));
+}
+
 TEST(ZoneUncertaintyTest, OneDrawPredictsTheMovementOfTheReidentifiedModuli) {
   TwoZoneBarAsMatrices bar;
   const Vector moduli = bar.Identify(bar.data);
@@ -60,18 +75,14 @@ TEST(ZoneUncertaintyTest, OneDrawPredictsTheMovementOfTheReidentifiedModuli) {
   CoupledSolution solution;
   ASSERT_TRUE(SolveCoupled(bar.inner, &problem, nullptr, &solution).IsSolutionUsable());
   const NoiseLevels levels = DifferenceNoiseLevels(bar.data);
-  UncertaintyOptions options;
-  options.samples = 1;
-  options.seed = 5;
-  const ZoneUncertainty estimate = EstimateZoneUncertainty(
-      options, bar.matrices, bar.data, bar.mcre, 0.5, bar.inner, moduli, solution, levels);
+  const ZoneUncertainty estimate = OneDrawEstimate(bar, moduli, solution);
   ASSERT_TRUE(estimate.available) << estimate.message;
   EXPECT_EQ(estimate.samples, 1);
 
   // The same draw, in the same order, scaled by eps.
   const double eps = 1e-3;
   ChannelSet noisy = bar.data;
-  StandardNormal normal(options.seed);
+  StandardNormal normal(kDrawSeed);
   for (Channel& channel : noisy.channels) {
     const double level = channel.kind == ChannelKind::kStrain  ? levels.strain_std
                          : channel.kind == ChannelKind::kForce ? levels.force_std
@@ -109,16 +120,12 @@ TEST(ZoneUncertaintyTest, OneDrawGivesTheSensitivityMapsChangeUnderThatNoise) {
   CoupledSolution solution;
   sensitivity_of(bar.data, &solution);
   const NoiseLevels levels = DifferenceNoiseLevels(bar.data);
-  UncertaintyOptions options;
-  options.samples = 1;
-  options.seed = 5;
-  const ZoneUncertainty estimate = EstimateZoneUncertainty(
-      options, bar.matrices, bar.data, bar.mcre, 0.5, bar.inner, moduli, solution, levels);
+  const ZoneUncertainty estimate = OneDrawEstimate(bar, moduli, solution);
   ASSERT_TRUE(estimate.available) << estimate.message;
   ASSERT_EQ(estimate.sensitivity_std.size(), 30);
 
   ChannelSet plus = bar.data, minus = bar.data;
-  StandardNormal normal(options.seed);
+  StandardNormal normal(kDrawSeed);
   for (std::size_t c = 0; c < plus.channels.size(); ++c) {
     const double level = NoiseLevel(levels, plus.channels[c].kind);
     for (Eigen::Index j = 0; j < plus.channels[c].values.size(); ++j) {
