@@ -96,10 +96,9 @@ std::vector<std::vector<std::string>> ElementMapCsvRows(const std::string& path,
 }
 
 // The element map of the bar's run (element,x,share,fraction,sensitivity and its noise
-// std at its E*)
-// against the matrix run's of the bar exported with its elements (element,x,share,
-// fraction,nominal_share,nominal_fraction,zone,sensitivity,nominal_sensitivity at its
-// identified modulus).
+// std at its E*) against the matrix run's of the bar exported with its elements
+// (element,x,share,fraction,nominal_share,nominal_fraction,zone,sensitivity,
+// nominal_sensitivity and the sensitivity's noise std at its identified modulus).
 void ExpectTheBarsElementMap(const std::string& bar_csv, const std::string& matrix_csv) {
   std::string bar_header, matrix_header;
   const auto bar = ElementMapCsvRows(bar_csv, &bar_header);
@@ -107,11 +106,11 @@ void ExpectTheBarsElementMap(const std::string& bar_csv, const std::string& matr
   EXPECT_EQ(bar_header, "element,x,share,fraction,sensitivity,sensitivity_noise_std");
   EXPECT_EQ(matrix_header,
             "element,x,share,fraction,nominal_share,nominal_fraction,zone,sensitivity,"
-            "nominal_sensitivity");
+            "nominal_sensitivity,sensitivity_noise_std");
   ASSERT_EQ(matrix.size(), bar.size());
   double worst = 0.0, worst_sensitivity = 0.0, largest_sensitivity = 0.0;
   for (std::size_t e = 0; e < bar.size(); ++e) {
-    ASSERT_EQ(matrix[e].size(), 9u);
+    ASSERT_EQ(matrix[e].size(), 10u);
     EXPECT_EQ(matrix[e][0], bar[e][0]);
     EXPECT_EQ(matrix[e][1], bar[e][1]);  // the midpoint, written alike
     EXPECT_EQ(matrix[e][6], "0");
@@ -119,6 +118,9 @@ void ExpectTheBarsElementMap(const std::string& bar_csv, const std::string& matr
     worst_sensitivity =
         std::max(worst_sensitivity, std::abs(std::stod(matrix[e][7]) - std::stod(bar[e][4])));
     largest_sensitivity = std::max(largest_sensitivity, std::abs(std::stod(bar[e][4])));
+    // The noise's spread from the run's own draws (the channels in another order than
+    // the bar's: other draws).
+    EXPECT_GT(std::stod(matrix[e][9]), 0.0);
   }
   // The fractions at the two runs' moduli (1.1e-9 apart) from their own solves:
   // measured 5.9e-10 apart at most.

@@ -1067,14 +1067,18 @@ std::string MatrixDofMapCsv(const IdentificationRun& run) {
 // position's coordinates x, y, z as it has them, share [J s] and fraction at the
 // identified moduli), then the same at the nominal moduli, then the element's zone (its
 // index in the manifest, as zones.csv's column zone), then the sensitivity
-// de^2/d ln E_el [J s] at the identified and at the nominal moduli.
+// de^2/d ln E_el [J s] at the identified and at the nominal moduli, and, when the
+// uncertainty is known, the sensitivity's noise std at the identified moduli.
 std::string MatrixElementMapCsv(const IdentificationRun& run, const MatrixModelData& model) {
   const Vector fractions = run.element_map.Fractions();
   const Vector nominal_fractions = run.nominal_element_map.Fractions();
   const Eigen::Index dimension = model.elements.front().position.size();
   std::string csv = "element";
   for (Eigen::Index i = 0; i < dimension; ++i) csv += std::string(",") + "xyz"[i];
-  csv += ",share,fraction,nominal_share,nominal_fraction,zone,sensitivity,nominal_sensitivity\n";
+  const Vector& noise_std = run.zone_uncertainty.sensitivity_std;
+  const bool known = noise_std.size() == static_cast<Eigen::Index>(model.elements.size());
+  csv += ",share,fraction,nominal_share,nominal_fraction,zone,sensitivity,nominal_sensitivity";
+  csv += known ? ",sensitivity_noise_std\n" : "\n";
   for (std::size_t el = 0; el < model.elements.size(); ++el) {
     const MatrixModelElement& element = model.elements[el];
     const auto e = static_cast<Eigen::Index>(el);
@@ -1083,7 +1087,9 @@ std::string MatrixElementMapCsv(const IdentificationRun& run, const MatrixModelD
     csv += "," + Format(run.element_map.share[e]) + "," + Format(fractions[e]) + "," +
            Format(run.nominal_element_map.share[e]) + "," + Format(nominal_fractions[e]) + "," +
            std::to_string(element.zone) + "," + Format(run.element_map.sensitivity[e]) + "," +
-           Format(run.nominal_element_map.sensitivity[e]) + "\n";
+           Format(run.nominal_element_map.sensitivity[e]);
+    if (known) csv += "," + Format(noise_std[e]);
+    csv += "\n";
   }
   return csv;
 }
@@ -1207,7 +1213,7 @@ void MatrixElementMapYaml(const IdentificationRun& run, YamlWriter* yaml) {
                "its share of the constitutive gap");
   yaml->Integer(1, "nominal_peak_element", nominal_peak, "the same at the nominal moduli");
   yaml->Number(1, "nominal_peak_fraction", run.nominal_element_map.Fractions()[nominal_peak]);
-  SensitivityPeaksYaml(run.element_map, "", Vector(), yaml);
+  SensitivityPeaksYaml(run.element_map, "", run.zone_uncertainty.sensitivity_std, yaml);
   SensitivityPeaksYaml(run.nominal_element_map, "nominal_", Vector(), yaml);
 }
 
