@@ -1075,9 +1075,13 @@ std::string MatrixElementMapCsv(const IdentificationRun& run, const MatrixModelD
   const Eigen::Index dimension = model.elements.front().position.size();
   std::string csv = "element";
   for (Eigen::Index i = 0; i < dimension; ++i) csv += std::string(",") + "xyz"[i];
+  const auto elements = static_cast<Eigen::Index>(model.elements.size());
+  const bool sensitivities = run.element_map.sensitivity.size() == elements &&
+                             run.nominal_element_map.sensitivity.size() == elements;
   const Vector& noise_std = run.zone_uncertainty.sensitivity_std;
-  const bool known = noise_std.size() == static_cast<Eigen::Index>(model.elements.size());
-  csv += ",share,fraction,nominal_share,nominal_fraction,zone,sensitivity,nominal_sensitivity";
+  const bool known = sensitivities && noise_std.size() == elements;
+  csv += ",share,fraction,nominal_share,nominal_fraction,zone";
+  csv += sensitivities ? ",sensitivity,nominal_sensitivity" : "";
   csv += known ? ",sensitivity_noise_std\n" : "\n";
   for (std::size_t el = 0; el < model.elements.size(); ++el) {
     const MatrixModelElement& element = model.elements[el];
@@ -1086,8 +1090,11 @@ std::string MatrixElementMapCsv(const IdentificationRun& run, const MatrixModelD
     for (Eigen::Index i = 0; i < dimension; ++i) csv += "," + Format(element.position[i]);
     csv += "," + Format(run.element_map.share[e]) + "," + Format(fractions[e]) + "," +
            Format(run.nominal_element_map.share[e]) + "," + Format(nominal_fractions[e]) + "," +
-           std::to_string(element.zone) + "," + Format(run.element_map.sensitivity[e]) + "," +
-           Format(run.nominal_element_map.sensitivity[e]);
+           std::to_string(element.zone);
+    if (sensitivities) {
+      csv += "," + Format(run.element_map.sensitivity[e]) + "," +
+             Format(run.nominal_element_map.sensitivity[e]);
+    }
     if (known) csv += "," + Format(noise_std[e]);
     csv += "\n";
   }
