@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <memory>
@@ -176,6 +177,10 @@ const ObjectiveEvaluation& McreObjective::Solve(double modulus, bool gradient_re
   record.gradient_requested = gradient_requested;
   record.inner = SolveCoupled(inner_, problem_.get(), initial, &solution_);
   record.usable = record.inner.IsSolutionUsable();
+  if (record.usable && record.inner.at_round_off_floor) {
+    // The floor this problem's sweeps reach: later solves accept within kFloorMargin of it.
+    inner_.tolerance = std::max(inner_.tolerance, kFloorMargin * record.inner.relative_residual);
+  }
   if (record.usable) {
     record.cost = solution_.cost;
     record.cost_gradient = solution_.cost_gradient;

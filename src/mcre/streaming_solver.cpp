@@ -374,6 +374,7 @@ void StreamingConjugateGradient::StopAfterRestarts(double true_relative) {
   const double floor = kRoundOffFloorFactor * totals_.rebuild_error *
                        std::sqrt(std::max(problem_->RetrogradeEnergy(traces_), 0.0)) / rhs_norm_;
   if (true_relative <= floor) {
+    summary_->at_round_off_floor = true;
     Accept("relative residual " + ScientificString(true_relative) + " at the round-off floor " +
            ScientificString(floor) + " of the rebuilt field (tolerance " +
            ScientificString(options_.tolerance) + ")");
@@ -381,6 +382,7 @@ void StreamingConjugateGradient::StopAfterRestarts(double true_relative) {
   }
   if (true_relative > 0.1 * previous_true_relative_ &&
       true_relative <= kStalledResidualFactor * options_.tolerance) {
+    summary_->at_round_off_floor = true;
     Accept("relative residual " + ScientificString(true_relative) +
            " at the round-off floor of the sweeps: the last restart left it at " +
            ScientificString(true_relative / previous_true_relative_) +

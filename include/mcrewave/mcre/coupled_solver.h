@@ -145,6 +145,9 @@ struct CoupledSolverSummary {
   int iterations = -1;                   // sweep pairs of the main iteration
   long sweeps = -1;                      // every direct or retrograde sweep, estimation included
   double relative_residual = -1.0;       // final ||c - A W||_P / ||c||_P
+  // The solve was accepted above the tolerance, at a round-off floor its restarts could
+  // not lower (the streaming CG; relative_residual is that floor).
+  bool at_round_off_floor = false;
   std::vector<double> residual_history;  // relative residual per iteration
   double relaxation_coefficient = -1.0;  // omega used by the relaxation solvers
   // Estimates of the extreme eigenvalues a_min, a_max of A = I - G: adaptive relaxation,

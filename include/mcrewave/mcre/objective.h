@@ -180,6 +180,15 @@ class McreObjective : public ModulusObjective {
 
   // Largest |t| of the extrapolated warm start (above: the last solution alone).
   static constexpr double kMaxExtrapolation = 2.0;
+  // Once a solve is accepted at a round-off floor f above inner.tolerance
+  // (CoupledSolverSummary::at_round_off_floor: the streaming CG's sweeps lose digits at
+  // a high Courant number), later solves take the tolerance kFloorMargin times the
+  // largest such f: a warm start or a first true residual within it is accepted
+  // instead of being confirmed at the floor by two restarts (docs/boundaries.md
+  // section 7). Solves that meet inner.tolerance never change it.
+  static constexpr double kFloorMargin = 2.0;
+  // inner.tolerance, or the floor's tolerance above once one was met [-].
+  double inner_tolerance() const { return inner_.tolerance; }
 
   StreamingCoupledProblem& problem() { return *problem_; }
 
