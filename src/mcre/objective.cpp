@@ -98,6 +98,7 @@ McreObjective::McreObjective(ProblemFactory make_problem, const CoupledSolverOpt
     : make_problem_(std::move(make_problem)),
       problem_(make_problem_()),
       inner_(inner),
+      given_tolerance_(inner.tolerance),
       modulus_scale_(modulus_scale) {
   assert(problem_ != nullptr && inner.IsValid(nullptr) && modulus_scale > 0.0);
   rest_cost_ = problem_->RestCost();
@@ -179,7 +180,9 @@ const ObjectiveEvaluation& McreObjective::Solve(double modulus, bool gradient_re
   record.usable = record.inner.IsSolutionUsable();
   if (record.usable && record.inner.at_round_off_floor) {
     // The floor this problem's sweeps reach: later solves accept within kFloorMargin of it.
-    inner_.tolerance = std::max(inner_.tolerance, kFloorMargin * record.inner.relative_residual);
+    inner_.tolerance =
+        std::min(kMaxFloorTolerance * given_tolerance_,
+                 std::max(inner_.tolerance, kFloorMargin * record.inner.relative_residual));
   }
   if (record.usable) {
     record.cost = solution_.cost;

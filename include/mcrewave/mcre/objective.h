@@ -185,8 +185,10 @@ class McreObjective : public ModulusObjective {
   // a high Courant number), later solves take the tolerance kFloorMargin times the
   // largest such f: a warm start or a first true residual within it is accepted
   // instead of being confirmed at the floor by two restarts (docs/boundaries.md
-  // section 7). Solves that meet inner.tolerance never change it.
+  // section 7). Solves that meet inner.tolerance never change it, and it stays within
+  // kMaxFloorTolerance times inner.tolerance (the streaming CG's own bound on a floor).
   static constexpr double kFloorMargin = 2.0;
+  static constexpr double kMaxFloorTolerance = 100.0;
   // inner.tolerance, or the floor's tolerance above once one was met [-].
   double inner_tolerance() const { return inner_.tolerance; }
 
@@ -200,6 +202,7 @@ class McreObjective : public ModulusObjective {
   ProblemFactory make_problem_;
   std::unique_ptr<StreamingCoupledProblem> problem_;
   CoupledSolverOptions inner_;
+  double given_tolerance_;  // inner.tolerance as given, before any floor
   double modulus_scale_;
   double rest_cost_ = 0.0;
   std::vector<ObjectiveEvaluation> evaluations_;
