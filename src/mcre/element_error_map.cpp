@@ -56,16 +56,6 @@ double ZoneFactor(const MatrixModelData& model, const Vector& zone_moduli,
 
 }  // namespace
 
-void AddSampleElementGapShares(const MatrixModelData& model, const Vector& zone_moduli,
-                               const double* retrograde, double weight, Vector* shares) {
-  for (std::size_t el = 0; el < model.elements.size(); ++el) {
-    const MatrixModelElement& element = model.elements[el];
-    // weight (E_z / E_z,nom) 1/2 W_j^T K_el W_j.
-    (*shares)[static_cast<Eigen::Index>(el)] +=
-        weight * ZoneFactor(model, zone_moduli, element) * ElementGapEnergy(element, retrograde);
-  }
-}
-
 void AddSampleElementMaps(const MatrixModelData& model, const Vector& zone_moduli,
                           const double* displacement, const double* retrograde, double weight,
                           Vector* shares, Vector* sensitivities) {
@@ -77,8 +67,10 @@ void AddSampleElementMaps(const MatrixModelData& model, const Vector& zone_modul
     // weight (E_z / E_z,nom) 1/2 W_j^T K_el W_j.
     if (shares != nullptr) (*shares)[index] += scale * gap;
     // -weight (E_z / E_z,nom) (1/2 W_j^T K_el W_j + W_j^T K_el U_j).
-    (*sensitivities)[index] -=
-        scale * (gap + ElementBilinearForm(element, retrograde, displacement));
+    if (sensitivities != nullptr) {
+      (*sensitivities)[index] -=
+          scale * (gap + ElementBilinearForm(element, retrograde, displacement));
+    }
   }
 }
 
@@ -92,7 +84,8 @@ Vector MatrixElementGapShares(const MatrixModelData& model, const Vector& zone_m
   for (int j = 0; j <= m; ++j) {
     // c_j h, c_j = 1/2 at both ends of the window.
     const double weight = (j == 0 || j == m ? 0.5 : 1.0) * time_step;
-    AddSampleElementGapShares(model, zone_moduli, retrograde.col(j).data(), weight, &shares);
+    AddSampleElementMaps(model, zone_moduli, nullptr, retrograde.col(j).data(), weight, &shares,
+                         nullptr);
   }
   return shares;
 }

@@ -56,15 +56,11 @@ double ElementGapEnergy(const MatrixModelElement& element, const double* retrogr
 // b about b_{d_1}). No allocation.
 double ElementBilinearForm(const MatrixModelElement& element, const double* a, const double* b);
 
-// shares[el] += weight (E_z / E_z,nom) 1/2 W_j^T K_el W_j for every element, from W_j.
-// zone_moduli has one entry per zone [Pa]; shares one per element. No allocation.
-void AddSampleElementGapShares(const MatrixModelData& model, const Vector& zone_moduli,
-                               const double* retrograde, double weight, Vector* shares);
-
 // The gap shares and the sensitivity's field part of one sample, from U_j and W_j:
 //   shares[el] += weight (E_z / E_z,nom) 1/2 W_j^T K_el W_j,
 //   sensitivities[el] -= weight (E_z / E_z,nom) (1/2 W_j^T K_el W_j + W_j^T K_el U_j).
-// shares may be null. No allocation.
+// zone_moduli has one entry per zone [Pa]; shares and sensitivities one per element.
+// Either may be null; displacement is read only for the sensitivities. No allocation.
 void AddSampleElementMaps(const MatrixModelData& model, const Vector& zone_moduli,
                           const double* displacement, const double* retrograde, double weight,
                           Vector* shares, Vector* sensitivities);
