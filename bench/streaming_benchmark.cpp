@@ -87,7 +87,11 @@ Measured SolveOnce(const BarModel& model, const ChannelSet& data, CoupledSolverT
   options.type = type;
   options.tolerance = tolerance;
   options.max_iterations = 100000;
-  options.max_field_bytes = 1L << 40;
+  // The stored-field solver unrefused; the streaming one keeps omega's whole history
+  // up to 64 MB, as docs/streaming.md's tables were measured, and uses checkpoints above.
+  options.max_field_bytes = type == CoupledSolverType::kStreamingConjugateGradient
+                                ? MatrixMcreProblem::kDefaultHistoryBytes
+                                : 1L << 40;
   ResetPeak();
   const long before = ResidentBytes();
   Measured measured;

@@ -561,7 +561,8 @@ const std::vector<Key>& KeyTable() {
       MakeKey("inner.max_field_bytes", &Config::inner, &CoupledSolverOptions::max_field_bytes,
               PositiveInteger<long>(), "bytes",
               "relaxation and conjugate_gradient refuse when their fields would need more "
-              "memory; auto then streams"),
+              "memory; auto then streams, keeping the retrograde field's history when that "
+              "one field fits"),
       MakeKey("inner.max_dense_solver_bytes", &Config::inner,
               &CoupledSolverOptions::max_dense_solver_bytes, PositiveInteger<long>(), "bytes",
               "riccati and multiple_shooting refuse to store more"),

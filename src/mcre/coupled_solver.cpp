@@ -226,9 +226,13 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
     summary.message = unsupported;
     return summary;
   }
-  // The solvers below see the resolved method.
+  // The solvers below see the resolved method; a streaming one keeps omega's whole
+  // history when it fits the same budget as the stored fields.
   CoupledSolverOptions resolved = options;
   resolved.type = type;
+  if (type == CoupledSolverType::kStreamingConjugateGradient) {
+    streaming->SetHistoryBudget(options.max_field_bytes);
+  }
   if (!RunResolvedSolver(resolved, problem, streaming, initial_guess, solution, &summary)) {
     return summary;
   }

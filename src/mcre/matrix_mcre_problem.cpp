@@ -423,8 +423,7 @@ void MatrixMcreProblem::CostGradients(const Matrix& displacement, const Matrix& 
     if (num_reactions_ == 0) continue;
     // Trusted: c_j h alpha_r sum_s (r_s(U_j) - f~_sj) g_s^T K_z U_j / E_z,nom, the bar's
     // alpha_r (r(U_j) / E_1) (r(U_j) - f0~_j) (docs/formulation.md section 7).
-    reaction_trace_.noalias() = reactions_ * displacement.col(j);
-    reaction_trace_ -= measured_outputs_.col(j).tail(num_reactions_);
+    FormReactionMisfit(j, displacement.col(j));
     for (int z = 0; z < zones; ++z) {
       (*gradient)[z] += QuadratureWeight(j) * h * reaction_weight_ *
                         reaction_zone_forms_[z](reaction_trace_.data(), displacement.col(j).data());
@@ -468,10 +467,15 @@ void MatrixMcreProblem::ElementSensitivities(const Matrix& displacement, const M
     AddSampleElementMaps(model_, moduli_, displacement.col(j).data(), retrograde.col(j).data(),
                          weight, nullptr, sensitivity);
     if (num_reactions_ == 0) continue;
-    reaction_trace_.noalias() = reactions_ * displacement.col(j);
-    reaction_trace_ -= measured_outputs_.col(j).tail(num_reactions_);
+    FormReactionMisfit(j, displacement.col(j));
     AddSampleReactionSensitivities(displacement.col(j).data(), weight, sensitivity);
   }
+}
+
+void MatrixMcreProblem::FormReactionMisfit(int j, const Eigen::Ref<const Vector>& displacement) {
+  // r(U_j) - f~_j, the trusted supports' reactions against their data.
+  reaction_trace_.noalias() = reactions_ * displacement;
+  reaction_trace_ -= measured_outputs_.col(j).tail(num_reactions_);
 }
 
 void MatrixMcreProblem::AddSampleReactionSensitivities(const double* displacement, double weight,

@@ -171,8 +171,7 @@ void MatrixMcreProblem::AddStreamingSample(int j, const Vector& displacement,
   }
   if (num_reactions_ == 0) return;
   // Trusted: c_j h alpha_r sum_s (r_s(U_j) - f~_sj) g_s^T K_z U_j / E_z,nom.
-  reaction_trace_.noalias() = reactions_ * displacement;
-  reaction_trace_ -= measured_outputs_.col(j).tail(num_reactions_);
+  FormReactionMisfit(j, displacement);
   for (int z = 0; z < zones; ++z) {
     totals->cost_gradients[z] +=
         weight * reaction_weight_ *
@@ -233,6 +232,18 @@ void MatrixMcreProblem::CheckpointRetrogradeSweep(const Matrix& traces, bool inc
   }
 }
 
+bool MatrixMcreProblem::HistoryFits(long bytes) const {
+  return 8.0 * num_nodes() * (num_steps() + 1.0) <= static_cast<double>(bytes);
+}
+
+void MatrixMcreProblem::SetHistoryBudget(long bytes) {
+  // A layout already made is kept unless the new budget changes it.
+  if (checkpoint_stride_ != 0 && HistoryFits(bytes) != HistoryFits(history_budget_bytes_)) {
+    checkpoint_stride_ = 0;
+  }
+  history_budget_bytes_ = bytes;
+}
+
 void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Matrix* image,
                                      StreamingTotals* totals) {
   assert(traces.rows() == num_traces() && traces.cols() == num_steps() + 1 && image != &traces);
@@ -240,7 +251,7 @@ void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Ma
   if (checkpoint_stride_ == 0) {
     // s = ceil(sqrt(2 m)): memory 2 n m / s + n s, about 2 n sqrt(2 m) doubles; or s = m
     // when omega's whole history fits.
-    const bool whole = 8.0 * n * (m + 1.0) <= static_cast<double>(whole_history_bytes_);
+    const bool whole = HistoryFits(history_budget_bytes_);
     checkpoint_stride_ = whole ? m : std::max(1, static_cast<int>(std::ceil(std::sqrt(2.0 * m))));
     checkpoints_ = Matrix::Zero(2 * n, m / checkpoint_stride_ + 1);
     segment_ = Matrix::Zero(n, checkpoint_stride_ + 1);

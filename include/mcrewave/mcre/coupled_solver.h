@@ -94,7 +94,10 @@ struct CoupledSolverOptions {
   long max_dense_solver_bytes = 2L << 30;
   // The iterative solvers (relaxation, adaptive_relaxation, conjugate_gradient)
   // refuse when the fields they hold at once (kIterativeSolverFields fields of
-  // n x (m + 1) doubles) would exceed this many bytes; auto then streams.
+  // n x (m + 1) doubles) would exceed this many bytes; auto then streams. The
+  // streaming solver keeps the retrograde field's whole history (one such field) when
+  // it fits this budget, and recomputes it from checkpoints when it does not
+  // (StreamingCoupledProblem::SetHistoryBudget).
   long max_field_bytes = 2L << 30;
   // streaming_conjugate_gradient on a problem that rebuilds the retrograde field by the
   // reversed recursion at theta = 1/2 (the tests' band-model bar; MatrixMcreProblem

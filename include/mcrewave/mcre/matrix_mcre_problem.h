@@ -46,8 +46,8 @@
 // n x (s + 1) buffer and consumed in forward order by the direct sweep. Three sweeps
 // per application, memory 2 n m / s + n s = O(n sqrt(m)), W the stored sweep's to the
 // bit (the same steps), no drift. When omega's whole history fits
-// set_whole_history_bytes (64 MB by default), s = m: one segment, swept once, two
-// sweeps per application. Its totals are the cost, the zone gradients, the
+// SetHistoryBudget (64 MB by default; inner.max_field_bytes in a solve), s = m: one
+// segment, swept once, two sweeps per application. Its totals are the cost, the zone gradients, the
 // zone maps of W and U, the dof map and the element map, summed as the fields pass, and
 // G^T W of every sample (the model's forces, ModelChannels).
 #pragma once
@@ -198,11 +198,12 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // The checkpoints are always used: nothing to switch.
   void UseCheckpoints() override {}
   // StreamingMap keeps the whole history of omega, n x (m + 1) doubles, from its one
-  // backward sweep when it holds at most this many bytes: two sweeps per application
-  // instead of three, the same steps, so the same bits. 0: checkpoints always. Takes
-  // effect at the first StreamingMap.
-  static constexpr long kDefaultWholeHistoryBytes = 1L << 26;
-  void set_whole_history_bytes(long bytes) { whole_history_bytes_ = bytes; }
+  // backward sweep when it holds at most `bytes`: two sweeps per application instead
+  // of three, the same steps, so the same bits. 0: checkpoints always. The default
+  // budget, until a solve or a caller sets one, is kDefaultHistoryBytes. A budget that
+  // changes the layout takes effect at the next StreamingMap (which allocates again).
+  static constexpr long kDefaultHistoryBytes = 1L << 26;
+  void SetHistoryBudget(long bytes) override;
   // Whether StreamingMap's totals gather the element map and its picture (true by
   // default). Off, StreamingTotals::element_error_map and gap_density stay empty: for
   // solves whose maps nobody reads (a minimiser's, the uncertainty's);
@@ -308,6 +309,9 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // keeping its state (v_j, omega_j) at the checkpoints j = m - i s (column i of
   // checkpoints_: v over omega). No allocation.
   void CheckpointRetrogradeSweep(const Matrix& traces, bool include_data);
+  // reaction_trace_ = r(U_j) - f~_j: the trusted supports' reactions of the kinematic
+  // field at sample j against their data. No allocation.
+  void FormReactionMisfit(int j, const Eigen::Ref<const Vector>& displacement);
   // The trusted reactions' part of the sensitivity map at one sample, from
   // reaction_trace_ = r(U_j) - f~_j: sensitivity[el] += weight alpha_r (E_z / E_z,nom)
   // sum_s (r_s(U_j) - f~_sj) phi_s^T K_el U_j over reaction_elements_. No allocation.
@@ -361,7 +365,9 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // (n x (s + 1)), allocated by the first StreamingMap; the double buffers of the
   // direct sweep (velocity, displacement), W_{j-1} and W_j, allocated in the constructor.
   int checkpoint_stride_ = 0;
-  long whole_history_bytes_ = kDefaultWholeHistoryBytes;
+  long history_budget_bytes_ = kDefaultHistoryBytes;
+  // Whether omega's whole history, n x (m + 1) doubles, fits `bytes`.
+  bool HistoryFits(long bytes) const;
   bool element_maps_ = true;
   Matrix checkpoints_, segment_;
   Vector stream_velocity_[2], stream_displacement_[2], stream_retrograde_[2];

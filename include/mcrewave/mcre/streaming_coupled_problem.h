@@ -91,6 +91,12 @@ class StreamingCoupledProblem : public CoupledProblem {
   // rather than from a reversed recursion whose round-off drifted; nothing to do for a
   // problem that always uses them.
   virtual void UseCheckpoints() = 0;
+  // The bytes a solve grants the retrograde field's history (inner.max_field_bytes,
+  // passed by SolveCoupled before every streaming solve): a problem that can keep
+  // omega's whole history within it sweeps omega once per application instead of
+  // recomputing it from checkpoints, the same steps. Ignored by a problem that has no
+  // such choice (the default).
+  virtual void SetHistoryBudget(long bytes) { (void)bytes; }
 
   // --- What the outer objective needs beside the solves (mcre/objective.h) ---
   // J_rest [J s]: the functional of the structure left at rest (U = W = 0, zero loads),
