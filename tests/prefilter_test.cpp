@@ -3,7 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -142,6 +145,33 @@ TEST(PrefilterTest, CutoffDerivedFromTheLoadLiesAboveItsSpectrum) {
     const double cutoff = EstimateCutoffFrequency(measurements);
     EXPECT_GT(cutoff, 30e3) << "SNR " << snr;
     EXPECT_LT(cutoff, 300e3) << "SNR " << snr;
+  }
+}
+
+// The cut-off is twice the edge of the load's band, not of a window of noise that stands
+// above the threshold far above it: with the noise of seed 38 one window at 230 kHz,
+// 133 bins above a band ending at 19 kHz, set the cut-off to 460 kHz before the band
+// was required to be connected (docs/robustness.md, "Measurements"). Measured over
+// seeds 1 to 100 on this data (the truth on the model's mesh): 38 to 60 kHz at SNR 2.5
+// and 98 to 187 kHz at SNR 20; 460 kHz at both before.
+TEST(PrefilterTest, ANoiseWindowFarAboveTheLoadsBandDoesNotSetTheCutoff) {
+  BarProperties bar;
+  LoadOptions load;
+  TimeOptions time;
+  DataOptions data;
+  data.truth_refinement = 1;
+  for (double snr : {20.0, 2.5}) {
+    data.snr = snr;
+    double lowest = std::numeric_limits<double>::infinity(), highest = 0.0;
+    for (std::uint64_t seed = 1; seed <= 100; ++seed) {
+      data.seed = seed;
+      const double cutoff =
+          EstimateCutoffFrequency(MakeSyntheticMeasurements(bar, load, time, data));
+      lowest = std::min(lowest, cutoff);
+      highest = std::max(highest, cutoff);
+    }
+    EXPECT_GT(lowest, snr > 10.0 ? 80e3 : 30e3) << "SNR " << snr;
+    EXPECT_LT(highest, snr > 10.0 ? 250e3 : 80e3) << "SNR " << snr;
   }
 }
 

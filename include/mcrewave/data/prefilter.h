@@ -58,10 +58,11 @@ class ZeroPhaseLowPass {
   int pad_;  // samples of odd reflection at each end
 };
 
-// A cut-off derived from the bar's measured load fL [Hz]: twice the highest frequency at
-// which its periodogram (averaged over 9 bins) stands above both 3 x the white-noise
-// level (estimated from the upper half of the band) and 1e-5 x its peak, clamped to
-// [2 / T, 0.45 x sample rate].
+// A cut-off derived from the bar's measured load fL [Hz]: twice the upper edge of the
+// load's band, clamped to [2 / T, 0.45 x sample rate]. The band is where its
+// periodogram (averaged over 9 bins) stands above both 3 x the white-noise level
+// (estimated from the upper half of the band) and 1e-5 x its peak, from the peak up,
+// across gaps no wider than the band below them (docs/robustness.md, "Measurements").
 double EstimateCutoffFrequency(const ChannelSet& measurements);
 // The same from any measured load history sampled at time_step [s].
 double EstimateCutoffFrequency(const Vector& load, double time_step);
