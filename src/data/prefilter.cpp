@@ -186,7 +186,7 @@ double EstimateCutoffFrequency(const Vector& load, double time_step) {
   // stands above the threshold, each within the band's own width of the band so far
   // (a gap of at most edge + kSmoothingBins bins): a pulse's side lobes lie closer
   // than its main lobe is wide, and a window of noise alone above the threshold far
-  // above the band (one in about 100 records of the paper's case) is left out.
+  // above the band (rare for one window, but the band has hundreds) is left out.
   int edge = peak_bin;
   bool above = false;
   double window_sum = 0.0;

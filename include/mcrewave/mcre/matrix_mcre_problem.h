@@ -47,9 +47,9 @@
 // per application, memory 2 n m / s + n s = O(n sqrt(m)), W the stored sweep's to the
 // bit (the same steps), no drift. When omega's whole history fits
 // SetHistoryBudget (64 MB by default; inner.max_field_bytes in a solve), s = m: one
-// segment, swept once, two sweeps per application. Its totals are the cost, the zone gradients, the
-// zone maps of W and U, the dof map and the element map, summed as the fields pass, and
-// G^T W of every sample (the model's forces, ModelChannels).
+// segment, swept once, two sweeps per application. Its totals are the cost, the zone
+// gradients, the zone maps of W and U, the dof map and the element map, summed as the
+// fields pass, and G^T W of every sample (the model's forces, ModelChannels).
 #pragma once
 
 #include <memory>
