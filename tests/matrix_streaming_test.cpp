@@ -32,6 +32,18 @@ CoupledSolverOptions MatrixStreamingOptions(CoupledSolverType type) {
   return options;
 }
 
+// The lattice under its trusted support, its problem at the moduli (1.8, 2.1) x 1e11 Pa.
+struct TrustedLatticeProblem {
+  TrustedLatticeProblem()
+      : problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5, Factorization::kSparse,
+                ClampModel::kTrusted) {
+    problem.SetModuli((Vector(2) << 1.8e11, 2.1e11).finished());
+  }
+  MatrixModelData lattice = SupportedLattice();
+  ChannelSet data = SupportedLatticeHistories(lattice);
+  MatrixMcreProblem problem;
+};
+
 // The support treatments the tests run through; "none" is the lattice without its
 // support.
 struct MatrixStreamingCase {
@@ -326,11 +338,8 @@ TEST(MatrixStreamingTest, AutoStreamsWhenTheFieldsDoNotFit) {
 // the same steps, so the same solution to the bit, and a problem's layout follows the
 // budget of each solve.
 TEST(MatrixStreamingTest, TheSolveKeepsOmegasWholeHistoryWhenItFitsTheFieldBudget) {
-  const MatrixModelData lattice = SupportedLattice();
-  const ChannelSet data = SupportedLatticeHistories(lattice);
-  MatrixMcreProblem problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5, Factorization::kSparse,
-                            ClampModel::kTrusted);
-  problem.SetModuli((Vector(2) << 1.8e11, 2.1e11).finished());
+  TrustedLatticeProblem trusted;
+  MatrixMcreProblem& problem = trusted.problem;
   // 18 dofs, 120 steps: omega's history is 18 x 121 doubles, 17424 bytes.
   const long history_bytes = 8L * problem.num_nodes() * (problem.num_steps() + 1);
   ASSERT_EQ(history_bytes, 17424);
@@ -398,11 +407,8 @@ TEST(MatrixStreamingTest, TheZoneObjectiveEvaluatesAlikeWithEitherSolver) {
 // The model's outputs and its supports' forces come from one direct sweep keeping its
 // state (no field: a run that streams stores none): the stored sweep's numbers.
 TEST(MatrixStreamingTest, ModelOutputsAreTheStoredSweepsWithoutItsField) {
-  const MatrixModelData lattice = SupportedLattice();
-  const ChannelSet data = SupportedLatticeHistories(lattice);
-  MatrixMcreProblem problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5, Factorization::kSparse,
-                            ClampModel::kTrusted);
-  problem.SetModuli((Vector(2) << 1.8e11, 2.1e11).finished());
+  TrustedLatticeProblem trusted;
+  MatrixMcreProblem& problem = trusted.problem;
   Matrix displacement;
   problem.DirectSweep(problem.ZeroField(), true, &displacement);
   // H's rows: the three sensors, then the support's reaction.
