@@ -157,6 +157,8 @@ void ExpectSameConfigLaterKeys(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.search.inner_tolerance, actual.search.inner_tolerance);
   EXPECT_EQ(expected.search.scan_points, actual.search.scan_points);
   EXPECT_EQ(expected.search.refine_window, actual.search.refine_window);
+  EXPECT_EQ(expected.search.algorithm, actual.search.algorithm);
+  EXPECT_EQ(expected.search.relative_tolerance, actual.search.relative_tolerance);
   EXPECT_EQ(expected.study.comparator.data, actual.study.comparator.data);
   EXPECT_EQ(expected.structure.kind, actual.structure.kind);
   EXPECT_EQ(expected.structure.manifest, actual.structure.manifest);
@@ -718,6 +720,8 @@ search:
   inner_tolerance: 1e-5
   scan_points: 9
   refine_window: 0.05
+  algorithm: secant
+  relative_tolerance: 1e-4
 prefilter:
   enabled: false
   cutoff_frequency: 12345.5
@@ -1272,6 +1276,11 @@ TEST_F(ConfigFileTest, SearchKeysAreCheckedAndBelongToThePinnedSearchFunctional)
                   {"search.scan_points must lie in [3, 100000], got 2"});
   ExpectLoadError("search:\n  refine_window: 0.6\n", 2,
                   {"search.refine_window must lie in (0, 0.5], got 0.6"});
+  ExpectLoadError("search:\n  algorithm: lbfgs\n", 2,
+                  {"search.algorithm must be bobyqa or secant, got lbfgs"});
+  ExpectLoadError("search:\n  relative_tolerance: 0.5\n", 2,
+                  {"search.relative_tolerance must be 0 (outer.relative_tolerance) or lie in "
+                   "(0, 0.1], got 0.5"});
   // The two stages' scans within outer's limits.
   ExpectLoadError("outer:\n  scan_points: 3\n  scan_max_points: 10\n", 3,
                   {"search.scan_points (12) must not exceed outer.scan_max_points (10)"});

@@ -100,6 +100,7 @@ constexpr OptimizerCase kEveryOptimizer[] = {
     {OptimizerType::kNlopt, OuterAlgorithm::kBobyqa},
     {OptimizerType::kNlopt, OuterAlgorithm::kLbfgs},
     {OptimizerType::kNlopt, OuterAlgorithm::kBrent},
+    {OptimizerType::kNlopt, OuterAlgorithm::kSecant},
     {OptimizerType::kCeres, OuterAlgorithm::kLbfgs},
 };
 

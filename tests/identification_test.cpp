@@ -110,12 +110,37 @@ INSTANTIATE_TEST_SUITE_P(NloptAndCeres, EveryAlgorithmTest,
                                            Case{OptimizerType::kNlopt, OuterAlgorithm::kLbfgs},
                                            Case{OptimizerType::kNlopt, OuterAlgorithm::kSlsqp},
                                            Case{OptimizerType::kNlopt, OuterAlgorithm::kBrent},
+                                           Case{OptimizerType::kNlopt, OuterAlgorithm::kSecant},
                                            Case{OptimizerType::kCeres, OuterAlgorithm::kDefault},
                                            Case{OptimizerType::kCeres, OuterAlgorithm::kBfgs}),
                          [](const ::testing::TestParamInfo<Case>& info) {
                            return std::string(OptimizerTypeToString(std::get<0>(info.param))) +
                                   "_" + OuterAlgorithmToString(std::get<1>(info.param));
                          });
+
+TEST(SecantTest, ConvergesFasterThanBobyqaOnASkewedValley) {
+  // exp(x - 1.3) - (x - 1.3): minimum at 1.3, curvature 1 there, skewed (its third
+  // derivative 1), from x = 1 without a curvature estimate (no scan): the first step
+  // goes halfway to the upper bound, then the secant steps. Independent check: BOBYQA
+  // on the same function and tolerance.
+  const auto cost = [](double x) { return std::exp(x - 1.3) - (x - 1.3); };
+  const auto gradient = [](double x) { return std::exp(x - 1.3) - 1.0; };
+  ScriptedObjective secant_objective(cost, gradient);
+  ScriptedObjective bobyqa_objective(cost, gradient);
+  const IdentificationSummary secant =
+      Identify(Options(OptimizerType::kNlopt, OuterAlgorithm::kSecant), &secant_objective);
+  const IdentificationSummary bobyqa =
+      Identify(Options(OptimizerType::kNlopt, OuterAlgorithm::kBobyqa), &bobyqa_objective);
+  ASSERT_TRUE(secant.IsSolutionUsable()) << secant.FullReport();
+  ASSERT_TRUE(bobyqa.IsSolutionUsable()) << bobyqa.FullReport();
+  // relative_tolerance 1e-8: measured 5.4e-10 from the minimum (secant), BOBYQA's
+  // within 1e-9 of it.
+  EXPECT_NEAR(secant.modulus, 1.3e9, 5e-9 * 1.3e9);
+  EXPECT_NEAR(secant.modulus, bobyqa.modulus, 1e-8 * 1.3e9);
+  // Measured 7 evaluations against BOBYQA's 17.
+  EXPECT_LE(secant.evaluations, 8);
+  EXPECT_LT(2 * secant.evaluations, bobyqa.evaluations);
+}
 
 TEST(IdentificationSummaryTest, ReportsSayNoSecondValleyInsteadOfANan) {
   IdentificationSummary summary;
@@ -361,6 +386,31 @@ TEST(IdentificationTest, TwoStagesRefineTheObjectiveNearTheSearchsMinimum) {
               static_cast<int>(objective.evaluated.size()));
     EXPECT_EQ(summary.scan_evaluations,
               static_cast<int>(search.evaluated.size()) + kTwoStageWindowScanPoints);
+  }
+}
+
+TEST(IdentificationTest, TheSearchsOwnRefinementOnlyPlacesTheWindow) {
+  // The search refined by BOBYQA to the options' 1e-9 (the default), against BOBYQA
+  // and the secant to 1e-3: fewer search evaluations, E_s within about 1e-3 of its
+  // minimum, and the objective's minimum as accurate.
+  IdentificationOptions options = ScanOptions(OptimizerType::kNlopt);
+  options.relative_tolerance = 1e-9;
+  ScriptedObjective tight_search = Parabola(1.31);
+  ScriptedObjective tight_objective = Rippled(1.3);
+  const IdentificationSummary tight =
+      IdentifyInTwoStages(options, &tight_search, 7, 0.03, &tight_objective);
+  ASSERT_TRUE(tight.IsSolutionUsable()) << tight.FullReport();
+  EXPECT_NEAR(tight.modulus, 1.3e9, 1e-6 * 1.3e9);
+  for (const OuterAlgorithm algorithm : {OuterAlgorithm::kBobyqa, OuterAlgorithm::kSecant}) {
+    SCOPED_TRACE(OuterAlgorithmToString(algorithm));
+    ScriptedObjective loose_search = Parabola(1.31);
+    ScriptedObjective loose_objective = Rippled(1.3);
+    const IdentificationSummary loose =
+        IdentifyInTwoStages(options, &loose_search, 7, 0.03, &loose_objective, {algorithm, 1e-3});
+    ASSERT_TRUE(loose.IsSolutionUsable()) << loose.FullReport();
+    EXPECT_LT(loose_search.evaluated.size(), tight_search.evaluated.size());
+    EXPECT_NEAR(loose.search_modulus, 1.31e9, 1e-3 * 1.31e9);
+    EXPECT_NEAR(loose.modulus, 1.3e9, 1e-6 * 1.3e9);
   }
 }
 

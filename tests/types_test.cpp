@@ -70,6 +70,7 @@ TEST(TypesTest, NamesAreTheConfigsSpelling) {
                "streaming_conjugate_gradient");
   EXPECT_STREQ(StudyKindToString(StudyKind::kCostCurves), "cost_curves");
   EXPECT_STREQ(OuterAlgorithmToString(OuterAlgorithm::kBrent), "brent");
+  EXPECT_STREQ(OuterAlgorithmToString(OuterAlgorithm::kSecant), "secant");
   EXPECT_STREQ(WeightRuleToString(WeightRule::kLCurve), "l_curve");
 }
 

@@ -586,11 +586,13 @@ const std::vector<Key>& KeyTable() {
               EnumByName<OuterAlgorithm>(
                   {OuterAlgorithm::kDefault, OuterAlgorithm::kBobyqa, OuterAlgorithm::kCobyla,
                    OuterAlgorithm::kSbplx, OuterAlgorithm::kMma, OuterAlgorithm::kLbfgs,
-                   OuterAlgorithm::kSlsqp, OuterAlgorithm::kBfgs, OuterAlgorithm::kBrent},
+                   OuterAlgorithm::kSlsqp, OuterAlgorithm::kBfgs, OuterAlgorithm::kBrent,
+                   OuterAlgorithm::kSecant},
                   OuterAlgorithmToString, StringToOuterAlgorithm),
               "",
               "default: bobyqa (nlopt) or lbfgs (ceres); nlopt: bobyqa, cobyla, sbplx, mma, "
-              "lbfgs, slsqp, brent (bounded 1-D, derivative-free); ceres: lbfgs, bfgs"),
+              "lbfgs, slsqp, brent (bounded 1-D, derivative-free), secant (bounded 1-D, on the "
+              "gradient); ceres: lbfgs, bfgs"),
       MakeKey("outer.lower_bound", &Config::outer, &IdentificationOptions::lower_bound, Number(),
               "Pa", "least modulus searched, > 0"),
       MakeKey("outer.upper_bound", &Config::outer, &IdentificationOptions::upper_bound, Number(),
@@ -650,6 +652,16 @@ const std::vector<Key>& KeyTable() {
       MakeKey("search.refine_window", &Config::search, &SearchOptions::refine_window, Number(), "",
               "search functional pinned or measured: mcre:'s e^2 is refined within E_search "
               "(1 -+ this), in (0, 0.5]"),
+      MakeKey("search.algorithm", &Config::search, &SearchOptions::algorithm,
+              EnumByName<OuterAlgorithm>({OuterAlgorithm::kBobyqa, OuterAlgorithm::kSecant},
+                                         OuterAlgorithmToString, StringToOuterAlgorithm),
+              "",
+              "search functional pinned or measured: its valley's refinement, bobyqa "
+              "(derivative-free) or secant (on its gradient), whatever outer.optimizer"),
+      MakeKey("search.relative_tolerance", &Config::search, &SearchOptions::relative_tolerance,
+              Number(), "",
+              "search functional pinned or measured: relative tolerance on E of its valley's "
+              "refinement, which places that window; 0: outer.relative_tolerance"),
       MakeKey("prefilter.enabled", &Config::prefilter, &PrefilterOptions::enabled, Boolean(), "",
               "zero-phase Butterworth low-pass, the same on every channel the identification "
               "uses (loads, displacements, strains)"),
@@ -854,6 +866,8 @@ const char* SearchKeyNotAtItsDefault(const SearchOptions& search) {
       {"search.inner_tolerance", search.inner_tolerance != defaults.inner_tolerance},
       {"search.scan_points", search.scan_points != defaults.scan_points},
       {"search.refine_window", search.refine_window != defaults.refine_window},
+      {"search.algorithm", search.algorithm != defaults.algorithm},
+      {"search.relative_tolerance", search.relative_tolerance != defaults.relative_tolerance},
   };
   for (const auto& [key, set] : keys) {
     if (set) return key;

@@ -230,7 +230,8 @@ McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData&
       model, data, SearchMcreOptions(config.mcre, config.search), config.time.theta, search_inner,
       Factorization::kAutomatic, config.outer.initial, element_maps);
   result.outer = IdentifyInTwoStages(config.outer, &search, config.search.scan_points,
-                                     config.search.refine_window, result.objective.get());
+                                     config.search.refine_window, result.objective.get(),
+                                     {config.search.algorithm, config.search.relative_tolerance});
   result.search_sweeps = search.sweeps();
   if (result.outer.scan_of_search) result.scan_cost_scale = search.cost_scale();
   return result;

@@ -61,6 +61,13 @@ bool SearchOptions::IsValid(std::string* error) const {
     why << "search.scan_points must lie in [3, 100000], got " << scan_points;
   } else if (!(refine_window > 0.0 && refine_window <= 0.5)) {
     why << "search.refine_window must lie in (0, 0.5], got " << refine_window;
+  } else if (algorithm != OuterAlgorithm::kBobyqa && algorithm != OuterAlgorithm::kSecant) {
+    why << "search.algorithm must be bobyqa or secant, got " << OuterAlgorithmToString(algorithm);
+  } else if (!(relative_tolerance == 0.0 ||
+               (relative_tolerance > 0.0 && relative_tolerance <= 0.1))) {
+    why << "search.relative_tolerance must be 0 (outer.relative_tolerance) or lie in (0, 0.1], "
+           "got "
+        << relative_tolerance;
   } else {
     return true;
   }

@@ -18,6 +18,7 @@ bool IsAlgorithmAvailable(OptimizerType optimizer, OuterAlgorithm algorithm, int
     case OuterAlgorithm::kSlsqp:
       return optimizer == OptimizerType::kNlopt;
     case OuterAlgorithm::kBrent:
+    case OuterAlgorithm::kSecant:
       return optimizer == OptimizerType::kNlopt && parameters == 1;
     case OuterAlgorithm::kBfgs:
       return optimizer == OptimizerType::kCeres;
@@ -36,6 +37,7 @@ bool UsesGradient(OptimizerType optimizer, OuterAlgorithm algorithm) {
     case OuterAlgorithm::kLbfgs:
     case OuterAlgorithm::kSlsqp:
     case OuterAlgorithm::kBfgs:
+    case OuterAlgorithm::kSecant:
       return true;
     default:
       return false;

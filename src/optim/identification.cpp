@@ -174,6 +174,8 @@ IdentificationSummary MinimizeLocally(const IdentificationOptions& options,
   });
   if (summary.algorithm == OuterAlgorithm::kBrent) {
     internal::MinimizeWithBrent(options, &guarded, scale, &summary);
+  } else if (summary.algorithm == OuterAlgorithm::kSecant) {
+    internal::MinimizeWithSecant(options, &guarded, scale, curvature, &summary);
   } else if (options.optimizer == OptimizerType::kNlopt) {
     internal::MinimizeWithNlopt(options, &guarded, scale, curvature, &summary);
   } else {
@@ -772,16 +774,20 @@ IdentificationOptions WindowOptions(const IdentificationOptions& options,
 
 IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
                                           ModulusObjective* search, int search_scan_points,
-                                          double refine_window, ModulusObjective* objective) {
+                                          double refine_window, ModulusObjective* objective,
+                                          const SearchRefinement& refinement) {
   assert(options.scan_points > 0 && search_scan_points >= 3 && refine_window > 0.0 &&
          refine_window <= 0.5);
   TwoStageRecord record;
   record.start = Clock::now();
-  // 1. The global search, its valleys refined by NLopt BOBYQA whatever the optimiser.
+  // 1. The global search, its valleys refined as `refinement` says whatever the optimiser.
   IdentificationOptions global = options;
   global.scan_points = search_scan_points;
   global.optimizer = OptimizerType::kNlopt;
-  global.algorithm = OuterAlgorithm::kBobyqa;
+  global.algorithm = refinement.algorithm;
+  if (refinement.relative_tolerance > 0.0) {
+    global.relative_tolerance = refinement.relative_tolerance;
+  }
   record.found = Identify(global, search);
   const IdentificationSummary& found = record.found;
   record.search_evaluations = found.scan_evaluations + found.evaluations;

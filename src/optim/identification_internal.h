@@ -20,5 +20,7 @@ void MinimizeWithCeres(const IdentificationOptions& options, GuardedObjective* o
                        double modulus_scale, double curvature, IdentificationSummary* summary);
 void MinimizeWithBrent(const IdentificationOptions& options, GuardedObjective* objective,
                        double modulus_scale, IdentificationSummary* summary);
+void MinimizeWithSecant(const IdentificationOptions& options, GuardedObjective* objective,
+                        double modulus_scale, double curvature, IdentificationSummary* summary);
 
 }  // namespace mcrewave::internal

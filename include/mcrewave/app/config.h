@@ -37,14 +37,15 @@
 //          (CoupledSolverOptions, coupled_solver.h)
 //   outer: functional [mcre | least_squares], optimizer [nlopt | ceres], algorithm [default |
 //   bobyqa | cobyla | sbplx |
-//          mma | lbfgs | bfgs | brent], lower_bound [100e9 Pa], upper_bound [400e9 Pa],
+//          mma | lbfgs | bfgs | brent | secant], lower_bound [100e9 Pa], upper_bound [400e9 Pa],
 //          initial [160e9 Pa], relative_tolerance [1e-7], max_evaluations [1000],
 //          max_time [600 s], scan_points [41], scan_samples_per_valley [4],
 //          scan_max_points [2000], scan_tolerance [1e-4], scan_threads [2],
 //          refine_margin [0.05], refine_candidates [10] (IdentificationOptions,
 //          identification.h)
 //   search: functional [pinned | same], w_u [0.01], w_e [0.01], w_u0 [0.1], w_r [0.1],
-//          inner_tolerance [1e-6], scan_points [12], refine_window [0.03]
+//          inner_tolerance [1e-6], scan_points [12], refine_window [0.03],
+//          algorithm [bobyqa | secant], relative_tolerance [0: outer.relative_tolerance]
 //          (SearchOptions, objective.h; the bar's global scan)
 //   prefilter: enabled [true], cutoff_frequency [0 Hz: derived from the data;
 //          else below the Nyquist frequency 0.5 / time.step], order [4],

@@ -322,8 +322,10 @@ enum class OuterAlgorithm {
   kBfgs,     // ceres: dense BFGS, adjoint gradient
   kBrent,    // under nlopt, one parameter: Brent's bounded minimiser (mcrewave's own),
              // derivative-free
+  kSecant,   // under nlopt, one parameter: a safeguarded secant iteration on the adjoint
+             // gradient (mcrewave's own)
 };
-inline constexpr std::array<std::pair<OuterAlgorithm, const char*>, 9> kOuterAlgorithmNames{{
+inline constexpr std::array<std::pair<OuterAlgorithm, const char*>, 10> kOuterAlgorithmNames{{
     {OuterAlgorithm::kDefault, "default"},
     {OuterAlgorithm::kBobyqa, "bobyqa"},
     {OuterAlgorithm::kCobyla, "cobyla"},
@@ -333,6 +335,7 @@ inline constexpr std::array<std::pair<OuterAlgorithm, const char*>, 9> kOuterAlg
     {OuterAlgorithm::kSlsqp, "slsqp"},
     {OuterAlgorithm::kBfgs, "bfgs"},
     {OuterAlgorithm::kBrent, "brent"},
+    {OuterAlgorithm::kSecant, "secant"},
 }};
 const char* OuterAlgorithmToString(OuterAlgorithm algorithm);
 bool StringToOuterAlgorithm(const std::string& name, OuterAlgorithm* algorithm);

@@ -87,9 +87,14 @@ struct SearchOptions {
   // Half width of the refinement of mcre:'s e^2 around the search's E*, relative
   // (its choice: docs/trusted_clamp.md section 10).
   double refine_window = 0.03;
+  // The refinement of its valley, which only places that window: NLopt BOBYQA or
+  // kSecant, to relative_tolerance on E (0: outer.relative_tolerance).
+  OuterAlgorithm algorithm = OuterAlgorithm::kBobyqa;
+  double relative_tolerance = 0.0;
 
   // Valid when the weights and inner_tolerance are finite and positive,
-  // inner_tolerance < 1, scan_points in [3, 100000] and refine_window in (0, 0.5].
+  // inner_tolerance < 1, scan_points in [3, 100000], refine_window in (0, 0.5],
+  // algorithm bobyqa or secant and relative_tolerance 0 or in (0, 0.1].
   // Messages name the search.* keys.
   bool IsValid(std::string* error) const;
 };

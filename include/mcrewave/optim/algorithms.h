@@ -4,7 +4,8 @@
 // number, the `zone_identification:` keys).
 //
 //   nlopt  bobyqa (the default), cobyla and sbplx without the gradient; mma, lbfgs and
-//          slsqp with it; brent (mcrewave's own Brent minimiser) for one parameter only
+//          slsqp with it; for one parameter only, mcrewave's own brent (Brent's
+//          minimiser, without the gradient) and secant (with it)
 //   ceres  lbfgs (the default) and bfgs, with the gradient
 #pragma once
 

@@ -174,10 +174,12 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
 // Two stages: a global search on another functional, a local refinement of the objective.
 //   1. Identify(options with scan_points = search_scan_points, search): the scan and its
 //      valleys' refinements on `search`, a cost of one valley over the bounds whose
-//      minimiser E_s lies near the objective's. The refinements are NLopt BOBYQA's
-//      whatever options' optimiser: derivative-free, they do not depend on the accuracy
-//      of the search's gradient, which its looser inner solves limit, and every
-//      optimiser then refines the objective around the same E_s.
+//      minimiser E_s lies near the objective's. The refinements are `refinement`'s
+//      whatever options' optimiser, so that every optimiser then refines the objective
+//      around the same E_s: by default NLopt BOBYQA, derivative-free, which does not
+//      depend on the accuracy of the search's gradient (its looser inner solves limit
+//      it), to options.relative_tolerance. E_s only places stage 2's window, so a
+//      looser refinement.relative_tolerance moves the result within that window only.
 //   2. Identify(options with scan_points = kTwoStageWindowScanPoints, objective) within
 //      E_s (1 -+ refine_window), cut to the bounds: a scan of the window (cost and
 //      gradient) that brackets the objective's valleys there and gives the local
@@ -194,8 +196,15 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
 // message. Preconditions: options.IsValid(), options.scan_points > 0,
 // search_scan_points in [3, 100000], refine_window in (0, 0.5].
 constexpr int kTwoStageWindowScanPoints = 5;
+// How stage 1 refines the search's valleys: NLopt BOBYQA or kSecant (on the search's
+// gradient), to relative_tolerance (0: options.relative_tolerance).
+struct SearchRefinement {
+  OuterAlgorithm algorithm = OuterAlgorithm::kBobyqa;
+  double relative_tolerance = 0.0;
+};
 IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
                                           ModulusObjective* search, int search_scan_points,
-                                          double refine_window, ModulusObjective* objective);
+                                          double refine_window, ModulusObjective* objective,
+                                          const SearchRefinement& refinement = {});
 
 }  // namespace mcrewave
