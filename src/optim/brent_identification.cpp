@@ -15,18 +15,6 @@
 #include "optim/identification_internal.h"
 
 namespace mcrewave::internal {
-namespace {
-
-// Absolute floor of the tolerance on x = E / E_scale (x is of order 1).
-constexpr double kAbsoluteTolerance = 1e-12;
-
-// Stops at the guard's stop, with its termination and message.
-void ReportStop(const GuardedObjective& objective, IdentificationSummary* summary) {
-  summary->termination = objective.StopTermination();
-  summary->message = objective.stop_message();
-}
-
-}  // namespace
 
 void MinimizeWithBrent(const IdentificationOptions& options, GuardedObjective* objective,
                        double modulus_scale, IdentificationSummary* summary) {

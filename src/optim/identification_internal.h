@@ -23,4 +23,14 @@ void MinimizeWithBrent(const IdentificationOptions& options, GuardedObjective* o
 void MinimizeWithSecant(const IdentificationOptions& options, GuardedObjective* objective,
                         double modulus_scale, double curvature, IdentificationSummary* summary);
 
+// mcrewave's own 1-D back ends (Brent, secant): the absolute floor of their tolerance on
+// x = E / E_scale (x is of order 1), tol = relative_tolerance |x| + kAbsoluteTolerance.
+constexpr double kAbsoluteTolerance = 1e-12;
+
+// Ends such a back end at the guard's stop, with its termination and message.
+inline void ReportStop(const GuardedObjective& objective, IdentificationSummary* summary) {
+  summary->termination = objective.StopTermination();
+  summary->message = objective.stop_message();
+}
+
 }  // namespace mcrewave::internal

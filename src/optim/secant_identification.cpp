@@ -21,12 +21,6 @@
 #include "optim/identification_internal.h"
 
 namespace mcrewave::internal {
-namespace {
-
-// Absolute floor of the tolerance on x = E / E_scale (x is of order 1).
-constexpr double kAbsoluteTolerance = 1e-12;
-
-}  // namespace
 
 void MinimizeWithSecant(const IdentificationOptions& options, GuardedObjective* objective,
                         double modulus_scale, double curvature, IdentificationSummary* summary) {
@@ -35,8 +29,7 @@ void MinimizeWithSecant(const IdentificationOptions& options, GuardedObjective* 
   double x = options.initial / modulus_scale;
   double cost = 0.0, gradient = 0.0;
   if (!objective->Evaluate(&x, &cost, &gradient)) {
-    summary->termination = objective->StopTermination();
-    summary->message = objective->stop_message();
+    ReportStop(*objective, summary);
     return;
   }
   bool has_previous = false;
@@ -71,8 +64,7 @@ void MinimizeWithSecant(const IdentificationOptions& options, GuardedObjective* 
     has_previous = true;
     x = next;
     if (!objective->Evaluate(&x, &cost, &gradient)) {
-      summary->termination = objective->StopTermination();
-      summary->message = objective->stop_message();
+      ReportStop(*objective, summary);
       return;
     }
   }
