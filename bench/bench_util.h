@@ -1,6 +1,8 @@
-// What the benchmark programs share: the calling thread's CPU clock, and the command
-// line of those that take `[--repeats N] [CONFIG.yaml]`.
+// What the benchmark programs share: the calling thread's and the process's CPU clocks,
+// and the command line of those that take `[--repeats N] [CONFIG.yaml]`.
 #pragma once
+
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -15,6 +17,14 @@ inline double ThreadCpuSeconds() {
   timespec t{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
   return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+// User + system CPU time of the process, all threads [s].
+inline double ProcessCpuSeconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
 }
 
 // `[--repeats N] [CONFIG.yaml]`: *repeats (at least 1) and *path keep their values

@@ -23,7 +23,6 @@
 //   --set: config overrides as in `identify run --set`, e.g. --set data.seed=3.
 
 #include <spdlog/spdlog.h>
-#include <sys/resource.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -46,13 +45,7 @@
 
 namespace {
 
-// User + system CPU time of the process, all threads [s].
-double ProcessCpuSeconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
-  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
-}
+using mcrewave::bench::ProcessCpuSeconds;
 
 struct IdentifyFigures {
   double cpu_s = std::numeric_limits<double>::infinity();

@@ -32,7 +32,6 @@
 //   configs/plate.yaml from the source tree); --set applies to both configs.
 
 #include <spdlog/spdlog.h>
-#include <sys/resource.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -42,6 +41,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/app/matrix_identification_run.h"
@@ -54,14 +54,7 @@
 namespace {
 
 using namespace mcrewave;
-
-// User + system CPU time of the process, all threads [s].
-double ProcessCpuSeconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
-  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
-}
+using bench::ProcessCpuSeconds;
 
 double Median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
@@ -162,8 +155,7 @@ void RunBar(const Config& config, int seeds, int repeats) {
               config.model.elements + 1, config.time.NumSteps(), seeds, repeats);
   std::printf("  %-6s %-10s %-10s %-7s %-12s %-12s %-13s %s\n", "SNR", "MCRE [s]", "LS [s]",
               "ratio", "MCRE sweeps", "LS sweeps", "MCRE valleys", "max |E_MCRE / E_LS - 1|");
-  bool stages_printed = false;
-  McreIdentification first;
+  McreIdentification first;  // of the first data set
   for (const double snr : {20.0, 10.0, 5.0, 2.5}) {
     std::vector<double> mcre_s, ls_s, mcre_sweeps, ls_sweeps;
     double largest_difference = 0.0;
@@ -187,10 +179,7 @@ void RunBar(const Config& config, int seeds, int repeats) {
       largest_difference =
           std::max(largest_difference, std::abs(mcre.modulus / least_squares.modulus - 1.0));
       most_valleys = std::max(most_valleys, mcre.valleys);
-      if (!stages_printed) {
-        first = std::move(identification);
-        stages_printed = true;
-      }
+      if (first.objective == nullptr) first = std::move(identification);
     }
     const double mcre_median = Median(mcre_s), ls_median = Median(ls_s);
     std::printf("  %-6g %-10.4f %-10.4f %-7.2f %-12.0f %-12.0f %-13d %.2e\n", snr, mcre_median,
