@@ -50,6 +50,7 @@ void ExpectSameConfigMcreAndInner(const Config& expected, const Config& actual) 
   EXPECT_EQ(expected.mcre.reference_modulus, actual.mcre.reference_modulus);
   EXPECT_EQ(expected.inner.type, actual.inner.type);
   EXPECT_EQ(expected.inner.tolerance, actual.inner.tolerance);
+  EXPECT_EQ(expected.inner.unchecked_tolerance, actual.inner.unchecked_tolerance);
   EXPECT_EQ(expected.inner.max_iterations, actual.inner.max_iterations);
   EXPECT_EQ(expected.inner.relaxation_coefficient, actual.inner.relaxation_coefficient);
   EXPECT_EQ(expected.inner.spectrum_estimation_steps, actual.inner.spectrum_estimation_steps);
@@ -156,6 +157,8 @@ void ExpectSameConfigLaterKeys(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.search.reaction_weight, actual.search.reaction_weight);
   EXPECT_EQ(expected.search.inner_tolerance, actual.search.inner_tolerance);
   EXPECT_EQ(expected.search.scan_points, actual.search.scan_points);
+  EXPECT_EQ(expected.search.samples_per_valley, actual.search.samples_per_valley);
+  EXPECT_EQ(expected.search.window_points, actual.search.window_points);
   EXPECT_EQ(expected.search.refine_window, actual.search.refine_window);
   EXPECT_EQ(expected.search.algorithm, actual.search.algorithm);
   EXPECT_EQ(expected.search.relative_tolerance, actual.search.relative_tolerance);
@@ -556,6 +559,7 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   config.mcre.reference_modulus = 70e9;
   config.inner.type = CoupledSolverType::kAdaptiveRelaxation;
   config.inner.tolerance = 1e-11;
+  config.inner.unchecked_tolerance = 1e-5;
   config.inner.max_iterations = 123;
   config.inner.relaxation_coefficient = 0.7;
   config.inner.spectrum_estimation_steps = 9;
@@ -684,6 +688,7 @@ mcre:
 inner:
   method: adaptive_relaxation
   tolerance: 1e-11
+  unchecked_tolerance: 1e-5
   max_iterations: 123
   omega: 0.7
   spectrum_steps: 9
@@ -719,6 +724,8 @@ search:
   w_r: 0.3
   inner_tolerance: 1e-5
   scan_points: 9
+  samples_per_valley: 2.5
+  window_points: 4
   refine_window: 0.05
   algorithm: secant
   relative_tolerance: 1e-4
@@ -1274,6 +1281,11 @@ TEST_F(ConfigFileTest, SearchKeysAreCheckedAndBelongToThePinnedSearchFunctional)
                   {"search.inner_tolerance must lie in (0, 1), got 1"});
   ExpectLoadError("search:\n  scan_points: 2\n", 2,
                   {"search.scan_points must lie in [3, 100000], got 2"});
+  ExpectLoadError("search:\n  samples_per_valley: 0.5\n", 2,
+                  {"search.samples_per_valley must be 0 (outer.scan_samples_per_valley) or lie in "
+                   "[1, 100], got 0.5"});
+  ExpectLoadError("search:\n  window_points: 2\n", 2,
+                  {"search.window_points must lie in [3, 100], got 2"});
   ExpectLoadError("search:\n  refine_window: 0.6\n", 2,
                   {"search.refine_window must lie in (0, 0.5], got 0.6"});
   ExpectLoadError("search:\n  algorithm: lbfgs\n", 2,
@@ -1285,8 +1297,8 @@ TEST_F(ConfigFileTest, SearchKeysAreCheckedAndBelongToThePinnedSearchFunctional)
   ExpectLoadError("outer:\n  scan_points: 3\n  scan_max_points: 10\n", 3,
                   {"search.scan_points (12) must not exceed outer.scan_max_points (10)"});
   ExpectLoadError("outer:\n  scan_points: 3\n  max_evaluations: 20\n", 3,
-                  {"outer.max_evaluations (20) must be at least search.scan_points + 9 = 21 with "
-                   "search.functional 'pinned'"});
+                  {"outer.max_evaluations (20) must be at least search.scan_points + "
+                   "search.window_points + 4 = 21 with search.functional 'pinned'"});
   EXPECT_NO_THROW(ParseConfig("outer:\n  scan_points: 3\n  max_evaluations: 21\n", "a.yaml"));
   // A key of the pinned search functional with the functional `same`: ignored, refused.
   ExpectLoadError("search:\n  functional: same\n  w_u0: 0.2\n", 3,

@@ -44,8 +44,10 @@ class ScriptedObjective : public ModulusObjective {
     return true;
   }
   std::string error_message() const override { return message_; }
+  double ValleySpacing() override { return valley_spacing; }
 
   double scale = 1e9;
+  double valley_spacing = 0.0;  // the predicted spacing in ln E (0: none)
   int throw_at = -1;
   int fail_at = -1;
   std::function<bool(int count, double x)> fails;  // also fail where this says so
@@ -382,10 +384,10 @@ TEST(IdentificationTest, TwoStagesRefineTheObjectiveNearTheSearchsMinimum) {
     }
     // The objective's window scan (on the objective itself: it has no copies) counts
     // with the search's evaluations.
-    EXPECT_EQ(summary.evaluations + kTwoStageWindowScanPoints,
+    EXPECT_EQ(summary.evaluations + SearchRefinement().window_points,
               static_cast<int>(objective.evaluated.size()));
     EXPECT_EQ(summary.scan_evaluations,
-              static_cast<int>(search.evaluated.size()) + kTwoStageWindowScanPoints);
+              static_cast<int>(search.evaluated.size()) + SearchRefinement().window_points);
   }
 }
 
@@ -414,6 +416,31 @@ TEST(IdentificationTest, TheSearchsOwnRefinementOnlyPlacesTheWindow) {
   }
 }
 
+TEST(IdentificationTest, TheSearchsSamplesPerValleyAndTheWindowsPointsAreHonoured) {
+  // A search whose predicted spacing 0.25 in ln E asks, over the bounds' ln 5 = 1.61, for
+  // ceil(1.61 / 0.25 * 4) + 1 = 27 samples at the options' 4 per spacing and
+  // ceil(1.61 / 0.25 * 2) + 1 = 14 at 2; the window then scanned on 3 points, not 5.
+  IdentificationOptions options = ScanOptions(OptimizerType::kNlopt);
+  options.scan_samples_per_valley = 4.0;
+  const int expected_points[] = {27, 14};
+  const double samples_per_valley[] = {0.0, 2.0};
+  for (int k = 0; k < 2; ++k) {
+    SCOPED_TRACE(samples_per_valley[k]);
+    ScriptedObjective search = Parabola(1.31);
+    search.valley_spacing = 0.25;
+    ScriptedObjective objective = Rippled(1.3);
+    SearchRefinement refinement;
+    refinement.samples_per_valley = samples_per_valley[k];
+    refinement.window_points = 3;
+    const IdentificationSummary summary =
+        IdentifyInTwoStages(options, &search, 7, 0.03, &objective, refinement);
+    ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+    EXPECT_EQ(static_cast<int>(summary.scan_moduli.size()), expected_points[k]);
+    EXPECT_EQ(summary.evaluations + 3, static_cast<int>(objective.evaluated.size()));
+    EXPECT_NEAR(summary.modulus, 1.3e9, 1e-6 * 1.3e9);
+  }
+}
+
 TEST(IdentificationTest, TwoStagesScanTheObjectiveWhenItsMinimumLiesBeyondTheWindow) {
   // The objective's minimum at 1.3 lies 13 % from the search's at 1.5: the refinement
   // ends on the window's lower edge, and the objective's own scan finds 1.3.
@@ -428,10 +455,10 @@ TEST(IdentificationTest, TwoStagesScanTheObjectiveWhenItsMinimumLiesBeyondTheWin
   EXPECT_EQ(summary.scan_moduli.size(), 41u);
   EXPECT_EQ(summary.local_minima, 1);
   EXPECT_NEAR(summary.modulus, 1.3e9, 1e-6 * 1.3e9);
-  EXPECT_EQ(summary.evaluations + kTwoStageWindowScanPoints + 41,
+  EXPECT_EQ(summary.evaluations + SearchRefinement().window_points + 41,
             static_cast<int>(objective.evaluated.size()));
   EXPECT_EQ(summary.scan_evaluations,
-            static_cast<int>(search.evaluated.size()) + kTwoStageWindowScanPoints + 41);
+            static_cast<int>(search.evaluated.size()) + SearchRefinement().window_points + 41);
 }
 
 TEST(IdentificationTest, TwoStagesStopWithTheSearchsFailure) {

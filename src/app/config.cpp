@@ -540,6 +540,10 @@ const std::vector<Key>& KeyTable() {
               "in doubles)"),
       MakeKey("inner.tolerance", &Config::inner, &CoupledSolverOptions::tolerance, Number(), "",
               "stop when ||c - A W||_P / ||c||_P falls below this, in (0, 1)"),
+      MakeKey("inner.unchecked_tolerance", &Config::inner,
+              &CoupledSolverOptions::unchecked_tolerance, Number(), "",
+              "conjugate_gradient solves to a tolerance at least this end on the recursive "
+              "residual, without the true residual's 2 sweeps; 1: every solve checked"),
       MakeKey("inner.max_iterations", &Config::inner, &CoupledSolverOptions::max_iterations,
               PositiveInteger<int>(), "", "sweep pairs allowed to one iterative solve"),
       MakeKey("inner.omega", &Config::inner, &CoupledSolverOptions::relaxation_coefficient,
@@ -649,6 +653,14 @@ const std::vector<Key>& KeyTable() {
               PositiveInteger<int>(), "",
               "search functional pinned or measured: fewest moduli of its scan (in place of "
               "outer.scan_points)"),
+      MakeKey("search.samples_per_valley", &Config::search, &SearchOptions::samples_per_valley,
+              Number(), "",
+              "search functional pinned or measured: its scan's samples per predicted valley "
+              "spacing; 0: outer.scan_samples_per_valley"),
+      MakeKey("search.window_points", &Config::search, &SearchOptions::window_points,
+              PositiveInteger<int>(), "",
+              "search functional pinned or measured: moduli of e^2's scan within "
+              "search.refine_window, its edges included, in [3, 100]"),
       MakeKey("search.refine_window", &Config::search, &SearchOptions::refine_window, Number(), "",
               "search functional pinned or measured: mcre:'s e^2 is refined within E_search "
               "(1 -+ this), in (0, 0.5]"),
@@ -865,6 +877,8 @@ const char* SearchKeyNotAtItsDefault(const SearchOptions& search) {
       {"search.w_r", search.reaction_weight != defaults.reaction_weight},
       {"search.inner_tolerance", search.inner_tolerance != defaults.inner_tolerance},
       {"search.scan_points", search.scan_points != defaults.scan_points},
+      {"search.samples_per_valley", search.samples_per_valley != defaults.samples_per_valley},
+      {"search.window_points", search.window_points != defaults.window_points},
       {"search.refine_window", search.refine_window != defaults.refine_window},
       {"search.algorithm", search.algorithm != defaults.algorithm},
       {"search.relative_tolerance", search.relative_tolerance != defaults.relative_tolerance},
@@ -947,7 +961,7 @@ bool CheckSearchKeysApply(const Config& config, std::string* error) {
 }
 
 // The two stages' scans fit outer's limits (IdentifyInTwoStages): the search's
-// search.scan_points and the window's kTwoStageWindowScanPoints samples within
+// search.scan_points and the window's search.window_points samples within
 // outer.scan_max_points, and both with two evaluations of a refinement each
 // within outer.max_evaluations.
 bool CheckTwoStageScansFitLimits(const Config& config, std::string* error) {
@@ -955,23 +969,23 @@ bool CheckTwoStageScansFitLimits(const Config& config, std::string* error) {
       config.outer.functional != OuterFunctional::kMcre || !ScansTheSearchFunctional(config)) {
     return true;
   }
-  const int least_evaluations = config.search.scan_points + kTwoStageWindowScanPoints + 4;
+  const int window_points = config.search.window_points;
+  const int least_evaluations = config.search.scan_points + window_points + 4;
   std::ostringstream why;
   if (config.search.scan_points > config.outer.scan_max_points) {
     why << "search.scan_points (" << config.search.scan_points
         << ") must not exceed outer.scan_max_points (" << config.outer.scan_max_points << ")";
-  } else if (config.outer.scan_max_points < kTwoStageWindowScanPoints) {
-    why << "outer.scan_max_points (" << config.outer.scan_max_points << ") must be at least "
-        << kTwoStageWindowScanPoints << " with search.functional '"
-        << SearchFunctionalToString(config.search.functional)
+  } else if (config.outer.scan_max_points < window_points) {
+    why << "outer.scan_max_points (" << config.outer.scan_max_points
+        << ") must be at least search.window_points (" << window_points
+        << ") with search.functional '" << SearchFunctionalToString(config.search.functional)
         << "': e^2 is scanned over that many moduli near the search's minimiser";
   } else if (config.outer.max_evaluations < least_evaluations) {
     why << "outer.max_evaluations (" << config.outer.max_evaluations
-        << ") must be at least search.scan_points + " << kTwoStageWindowScanPoints + 4 << " = "
+        << ") must be at least search.scan_points + search.window_points + 4 = "
         << least_evaluations << " with search.functional '"
         << SearchFunctionalToString(config.search.functional) << "': the search's scan, e^2's "
-        << kTwoStageWindowScanPoints << " near its minimiser and two evaluations of each "
-        << "refinement";
+        << window_points << " near its minimiser and two evaluations of each refinement";
   } else {
     return true;
   }

@@ -231,7 +231,7 @@ McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData&
       Factorization::kAutomatic, config.outer.initial, element_maps);
   result.outer = IdentifyInTwoStages(config.outer, &search, config.search.scan_points,
                                      config.search.refine_window, result.objective.get(),
-                                     {config.search.algorithm, config.search.relative_tolerance});
+                                     SearchRefinementOf(config.search));
   result.search_sweeps = search.sweeps();
   if (result.outer.scan_of_search) result.scan_cost_scale = search.cost_scale();
   return result;

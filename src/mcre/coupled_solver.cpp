@@ -15,6 +15,8 @@ bool CoupledSolverOptions::IsValid(std::string* error) const {
   std::ostringstream why;
   if (!(tolerance > 0.0 && tolerance < 1.0)) {
     why << "inner.tolerance must lie in (0, 1), got " << tolerance;
+  } else if (!(unchecked_tolerance > 0.0 && unchecked_tolerance <= 1.0)) {
+    why << "inner.unchecked_tolerance must lie in (0, 1], got " << unchecked_tolerance;
   } else if (max_iterations < 1) {
     why << "inner.max_iterations must be at least 1, got " << max_iterations;
   } else if (!(relaxation_coefficient > 0.0 && relaxation_coefficient < 2.0)) {

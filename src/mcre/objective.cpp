@@ -59,6 +59,13 @@ bool SearchOptions::IsValid(std::string* error) const {
     why << "search.inner_tolerance must lie in (0, 1), got " << inner_tolerance;
   } else if (scan_points < 3 || scan_points > 100000) {
     why << "search.scan_points must lie in [3, 100000], got " << scan_points;
+  } else if (!(samples_per_valley == 0.0 ||
+               (samples_per_valley >= 1.0 && samples_per_valley <= 100.0))) {
+    why << "search.samples_per_valley must be 0 (outer.scan_samples_per_valley) or lie in "
+           "[1, 100], got "
+        << samples_per_valley;
+  } else if (window_points < 3 || window_points > 100) {
+    why << "search.window_points must lie in [3, 100], got " << window_points;
   } else if (!(refine_window > 0.0 && refine_window <= 0.5)) {
     why << "search.refine_window must lie in (0, 0.5], got " << refine_window;
   } else if (algorithm != OuterAlgorithm::kBobyqa && algorithm != OuterAlgorithm::kSecant) {
@@ -73,6 +80,15 @@ bool SearchOptions::IsValid(std::string* error) const {
   }
   if (error != nullptr) *error = why.str();
   return false;
+}
+
+SearchRefinement SearchRefinementOf(const SearchOptions& search) {
+  SearchRefinement refinement;
+  refinement.algorithm = search.algorithm;
+  refinement.relative_tolerance = search.relative_tolerance;
+  refinement.samples_per_valley = search.samples_per_valley;
+  refinement.window_points = search.window_points;
+  return refinement;
 }
 
 McreOptions SearchMcreOptions(const McreOptions& mcre, const SearchOptions& search) {

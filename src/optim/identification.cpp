@@ -753,13 +753,14 @@ struct TwoStageRecord {
   }
 };
 
-// Stage 2's options: a scan of kTwoStageWindowScanPoints over the search's modulus
-// +- refine_window (within the bounds), started at that modulus, with the evaluations
-// and the time the search left.
+// Stage 2's options: a scan of window_points over the search's modulus +- refine_window
+// (within the bounds), started at that modulus, with the evaluations and the time the
+// search left.
 IdentificationOptions WindowOptions(const IdentificationOptions& options,
-                                    const TwoStageRecord& record, double refine_window) {
+                                    const TwoStageRecord& record, double refine_window,
+                                    int window_points) {
   IdentificationOptions local = options;
-  local.scan_points = kTwoStageWindowScanPoints;
+  local.scan_points = window_points;
   local.lower_bound = std::max(options.lower_bound, record.found.modulus * (1.0 - refine_window));
   local.upper_bound = std::min(options.upper_bound, record.found.modulus * (1.0 + refine_window));
   const double width = local.upper_bound - local.lower_bound;
@@ -777,12 +778,15 @@ IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
                                           double refine_window, ModulusObjective* objective,
                                           const SearchRefinement& refinement) {
   assert(options.scan_points > 0 && search_scan_points >= 3 && refine_window > 0.0 &&
-         refine_window <= 0.5);
+         refine_window <= 0.5 && refinement.window_points >= 3);
   TwoStageRecord record;
   record.start = Clock::now();
   // 1. The global search, its valleys refined as `refinement` says whatever the optimiser.
   IdentificationOptions global = options;
   global.scan_points = search_scan_points;
+  if (refinement.samples_per_valley > 0.0) {
+    global.scan_samples_per_valley = refinement.samples_per_valley;
+  }
   global.optimizer = OptimizerType::kNlopt;
   global.algorithm = refinement.algorithm;
   if (refinement.relative_tolerance > 0.0) {
@@ -796,7 +800,8 @@ IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
   }
   // 2. The objective near the search's minimiser, with what the search left: a scan of
   // the window (cost and gradient, as the global scan's), its valleys refined.
-  const IdentificationOptions local = WindowOptions(options, record, refine_window);
+  const IdentificationOptions local =
+      WindowOptions(options, record, refine_window, refinement.window_points);
   if (local.max_evaluations < local.scan_points + 2 || !(local.max_time > 0.0)) {
     return record.NotRun(options, TerminationType::kNoConvergence,
                          local.max_evaluations < local.scan_points + 2

@@ -74,6 +74,12 @@ struct CoupledSolverOptions {
   CoupledSolverType type = CoupledSolverType::kAuto;
   // Stopping test on ||c - A W||_P / ||c||_P (the paper used 1e-4).
   double tolerance = 1e-8;
+  // conjugate_gradient: a solve whose tolerance is at least this ends on CG's recursive
+  // residual, with U = Direct(W) updated along W (one more update a step), instead of
+  // checking the true residual T(W) - W at the end (2 sweeps). The recursive residual
+  // departs from the true one by round-off only (about 1e-12 of ||c||_P on the paper's
+  // case), which a loose tolerance cannot see. 1: every solve checked. In (0, 1].
+  double unchecked_tolerance = 1.0;
   // Iterations (sweep pairs) allowed to the iterative solvers.
   int max_iterations = 5000;
   // omega of the fixed-coefficient relaxation, in (0, 2).

@@ -23,6 +23,7 @@
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/mcre/mcre_weights.h"
+#include "mcrewave/optim/identification.h"
 #include "mcrewave/optim/log_moduli_objective.h"
 #include "mcrewave/optim/modulus_objective.h"
 
@@ -84,6 +85,13 @@ struct SearchOptions {
   double inner_tolerance = 1e-6;
   // Fewest moduli of its scan (outer.scan_points for the functional `same`).
   int scan_points = 12;
+  // Its scan's samples per predicted valley spacing (0: outer.scan_samples_per_valley).
+  // The search functional has one valley by design, so its scan may sample it more
+  // sparsely than e^2's, whose valleys it must not miss.
+  double samples_per_valley = 0.0;
+  // Moduli of e^2's scan within E_search (1 -+ refine_window), the window's edges
+  // included: at least 3 (an interior one and the edges).
+  int window_points = 5;
   // Half width of the refinement of mcre:'s e^2 around the search's E*, relative
   // (its choice: docs/trusted_clamp.md section 10).
   double refine_window = 0.03;
@@ -93,8 +101,9 @@ struct SearchOptions {
   double relative_tolerance = 0.0;
 
   // Valid when the weights and inner_tolerance are finite and positive,
-  // inner_tolerance < 1, scan_points in [3, 100000], refine_window in (0, 0.5],
-  // algorithm bobyqa or secant and relative_tolerance 0 or in (0, 0.1].
+  // inner_tolerance < 1, scan_points in [3, 100000], samples_per_valley 0 or in
+  // [1, 100], window_points in [3, 100], refine_window in (0, 0.5], algorithm bobyqa
+  // or secant and relative_tolerance 0 or in (0, 0.1].
   // Messages name the search.* keys.
   bool IsValid(std::string* error) const;
 };
@@ -102,6 +111,10 @@ struct SearchOptions {
 // The McreOptions of the search functional: mcre's w_f and E0, the clamp pinned (or
 // measured, with functional measured) and the search's weights.
 McreOptions SearchMcreOptions(const McreOptions& mcre, const SearchOptions& search);
+
+// How IdentifyInTwoStages samples and refines the search, and scans e^2's window, as
+// `search` says.
+SearchRefinement SearchRefinementOf(const SearchOptions& search);
 
 // Whether SearchMcreOptions(mcre, search) poses mcre's own problem on a model with or
 // without supports: the same w_u and w_e, and either no supports (the clamp's treatment,

@@ -172,15 +172,16 @@ struct IdentificationSummary {
 IdentificationSummary Identify(const IdentificationOptions& options, ModulusObjective* objective);
 
 // Two stages: a global search on another functional, a local refinement of the objective.
-//   1. Identify(options with scan_points = search_scan_points, search): the scan and its
-//      valleys' refinements on `search`, a cost of one valley over the bounds whose
+//   1. Identify(options with scan_points = search_scan_points and
+//      refinement.samples_per_valley, search): the scan and its valleys' refinements on
+//      `search`, a cost of one valley over the bounds whose
 //      minimiser E_s lies near the objective's. The refinements are `refinement`'s
 //      whatever options' optimiser, so that every optimiser then refines the objective
 //      around the same E_s: by default NLopt BOBYQA, derivative-free, which does not
 //      depend on the accuracy of the search's gradient (its looser inner solves limit
 //      it), to options.relative_tolerance. E_s only places stage 2's window, so a
 //      looser refinement.relative_tolerance moves the result within that window only.
-//   2. Identify(options with scan_points = kTwoStageWindowScanPoints, objective) within
+//   2. Identify(options with scan_points = refinement.window_points, objective) within
 //      E_s (1 -+ refine_window), cut to the bounds: a scan of the window (cost and
 //      gradient) that brackets the objective's valleys there and gives the local
 //      optimiser its curvature, then their refinements.
@@ -195,12 +196,17 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
 // search that does not converge ends the identification with its termination and
 // message. Preconditions: options.IsValid(), options.scan_points > 0,
 // search_scan_points in [3, 100000], refine_window in (0, 0.5].
-constexpr int kTwoStageWindowScanPoints = 5;
-// How stage 1 refines the search's valleys: NLopt BOBYQA or kSecant (on the search's
-// gradient), to relative_tolerance (0: options.relative_tolerance).
+// How stage 1 samples and refines the search's valleys, and how densely stage 2 scans
+// its window. Defaults: SearchOptions' (objective.h).
 struct SearchRefinement {
+  // The search's refinement: NLopt BOBYQA or kSecant (on the search's gradient), to
+  // relative_tolerance (0: options.relative_tolerance).
   OuterAlgorithm algorithm = OuterAlgorithm::kBobyqa;
   double relative_tolerance = 0.0;
+  // The search's scan samples per predicted valley spacing (0: the options').
+  double samples_per_valley = 0.0;
+  // Stage 2's scan: moduli over the window, its edges included (at least 3).
+  int window_points = 5;
 };
 IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
                                           ModulusObjective* search, int search_scan_points,
