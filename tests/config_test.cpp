@@ -727,7 +727,7 @@ search:
   samples_per_valley: 2.5
   window_points: 4
   refine_window: 0.05
-  algorithm: secant
+  algorithm: bobyqa
   relative_tolerance: 1e-4
 prefilter:
   enabled: false
@@ -1294,12 +1294,12 @@ TEST_F(ConfigFileTest, SearchKeysAreCheckedAndBelongToThePinnedSearchFunctional)
                   {"search.relative_tolerance must be 0 (outer.relative_tolerance) or lie in "
                    "(0, 0.1], got 0.5"});
   // The two stages' scans within outer's limits.
-  ExpectLoadError("outer:\n  scan_points: 3\n  scan_max_points: 10\n", 3,
-                  {"search.scan_points (12) must not exceed outer.scan_max_points (10)"});
-  ExpectLoadError("outer:\n  scan_points: 3\n  max_evaluations: 20\n", 3,
-                  {"outer.max_evaluations (20) must be at least search.scan_points + "
-                   "search.window_points + 4 = 21 with search.functional 'pinned'"});
-  EXPECT_NO_THROW(ParseConfig("outer:\n  scan_points: 3\n  max_evaluations: 21\n", "a.yaml"));
+  ExpectLoadError("outer:\n  scan_points: 3\n  scan_max_points: 5\n", 3,
+                  {"search.scan_points (6) must not exceed outer.scan_max_points (5)"});
+  ExpectLoadError("outer:\n  scan_points: 3\n  max_evaluations: 12\n", 3,
+                  {"outer.max_evaluations (12) must be at least search.scan_points + "
+                   "search.window_points + 4 = 13 with search.functional 'pinned'"});
+  EXPECT_NO_THROW(ParseConfig("outer:\n  scan_points: 3\n  max_evaluations: 13\n", "a.yaml"));
   // A key of the pinned search functional with the functional `same`: ignored, refused.
   ExpectLoadError("search:\n  functional: same\n  w_u0: 0.2\n", 3,
                   {"search.w_u0 applies to search.functional 'pinned' only (search.functional "
@@ -1311,7 +1311,7 @@ TEST_F(ConfigFileTest, SearchKeysAreCheckedAndBelongToThePinnedSearchFunctional)
                    "is 'measured'"});
   ExpectLoadError(
       "search:\n  functional: measured\nouter:\n  scan_points: 3\n  "
-      "max_evaluations: 20\n",
+      "max_evaluations: 12\n",
       5, {"with search.functional 'measured'"});
 }
 

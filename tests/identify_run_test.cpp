@@ -96,7 +96,7 @@ TEST(IdentifyRunTest, QuickConfigIdentifiesEAndWritesEveryResult) {
   EXPECT_NEAR(relative_error, (identified - 200e9) / 200e9, 1e-12);
   EXPECT_LT(std::abs(relative_error), 0.01);
   // The scan's 41 evaluations and at least 2 of the refinement.
-  EXPECT_GT(std::stoi(run.summary.at("evaluations")), 41 + 2);
+  EXPECT_GE(std::stoi(run.summary.at("evaluations")), 41 + 2);
   EXPECT_GT(std::stol(run.summary.at("sweeps")), 0);
   const std::string summary = ReadText(run.folder + "/summary.yaml");
   EXPECT_NE(summary.find("  modulus_std_dev: "), std::string::npos) << summary;
@@ -121,16 +121,21 @@ TEST(IdentifyRunTest, QuickConfigIdentifiesEAndWritesEveryResult) {
   EXPECT_EQ(std::count(ends.begin(), ends.end(), '\n'), 302);
 }
 
-TEST(IdentifyRunTest, CeresAgreesWithNloptInFewerEvaluations) {
+TEST(IdentifyRunTest, CeresAndTheSecantAgreeWithBobyqaInFewerEvaluations) {
   const QuickRun nlopt = RunQuick("identify_run_nlopt", " --set output.figures=false -q");
+  const QuickRun bobyqa = RunQuick("identify_run_bobyqa",
+                                   " --set outer.algorithm=bobyqa --set output.figures=false -q");
   const QuickRun ceres =
       RunQuick("identify_run_ceres", " --set outer.optimizer=ceres --set output.figures=false -q");
   ASSERT_EQ(nlopt.result.exit_code, 0) << nlopt.result.output;
+  ASSERT_EQ(bobyqa.result.exit_code, 0) << bobyqa.result.output;
   ASSERT_EQ(ceres.result.exit_code, 0) << ceres.result.output;
-  const double e_nlopt = std::stod(nlopt.summary.at("identified_modulus"));
-  const double e_ceres = std::stod(ceres.summary.at("identified_modulus"));
-  EXPECT_NEAR(e_ceres, e_nlopt, 1e-6 * e_nlopt);
-  EXPECT_LT(std::stoi(ceres.summary.at("evaluations")), std::stoi(nlopt.summary.at("evaluations")));
+  const double e_bobyqa = std::stod(bobyqa.summary.at("identified_modulus"));
+  for (const QuickRun* run : {&nlopt, &ceres}) {
+    EXPECT_NEAR(std::stod(run->summary.at("identified_modulus")), e_bobyqa, 1e-6 * e_bobyqa);
+    EXPECT_LT(std::stoi(run->summary.at("evaluations")),
+              std::stoi(bobyqa.summary.at("evaluations")));
+  }
   EXPECT_FALSE(fs::exists(nlopt.folder + "/cost_curve.png"));
 }
 
@@ -515,11 +520,11 @@ TEST(IdentifyRunTest, AutoTakesStoredFieldsWhenTheyFitAndStreamsWhenTheyDoNot) {
   // The same solver when the fields fit: the same modulus, bit for bit.
   const double e_named = std::stod(named.summary.at("identified_modulus"));
   EXPECT_EQ(std::stod(fits.summary.at("identified_modulus")), e_named);
-  // Streamed: measured 2.9e-9 apart (2.2e-9 and 3.3e-9 at the inner tolerances 1e-10 and
-  // 1e-12): the two solvers' e^2 differ by round-off, and BOBYQA's derivative-free stop on
-  // the flat minimum resolves E no better (with outer.optimizer ceres, on the adjoint
-  // gradient, 3.5e-10).
-  EXPECT_NEAR(std::stod(streams.summary.at("identified_modulus")), e_named, 5e-9 * e_named);
+  // Streamed: measured 3.0e-8 apart. The two solvers' e^2 differ by round-off in the
+  // refinement, but their window scans, solved to outer.scan_tolerance 1e-2, differ by
+  // more (the stored CG ends on its recursive residual, inner.unchecked_tolerance), so the
+  // secant starts elsewhere and stops on a step below outer.relative_tolerance 1e-7.
+  EXPECT_NEAR(std::stod(streams.summary.at("identified_modulus")), e_named, 1e-7 * e_named);
 }
 
 TEST(IdentifyRunTest, VerboseLogsEveryInnerSolve) {
@@ -547,9 +552,11 @@ TEST(IdentifyRunTest, DefaultConfigIsAcceptedByRun) {
 TEST(IdentifyRunTest, UnconvergedIdentificationExitsWithOneAndWritesNothing) {
   const std::string folder = FreshDirectory("identify_run_unconverged") + "/results";
   const RunResult run = RunIdentify("run " + SourcePath("configs/quick.yaml") +
-                                    " --set outer.max_evaluations=44 -q -o " + folder);
+                                    " --set outer.max_evaluations=43 "
+                                    "--set outer.relative_tolerance=1e-12 -q -o " +
+                                    folder);
   EXPECT_EQ(run.exit_code, 1) << run.output;
-  EXPECT_NE(run.output.find("error: identification failed: outer.max_evaluations (44, the "
+  EXPECT_NE(run.output.find("error: identification failed: outer.max_evaluations (43, the "
                             "scan's 41 included) reached before convergence"),
             std::string::npos)
       << run.output;

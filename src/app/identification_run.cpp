@@ -250,7 +250,7 @@ ModulusStage IdentifyHomogeneousModulus(const Config& config, const MatrixModelD
   spdlog::info(
       "identifying E with {}/{} from {:.6g} Pa in [{:.6g}, {:.6g}] Pa; inner {}; global scan on {}",
       OptimizerTypeToString(config.outer.optimizer),
-      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
+      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm, 1)),
       config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
       CoupledSolverName(config.inner.type, stage.inner_method),
       config.outer.scan_points == 0          ? "none (outer.scan_points 0)"
@@ -596,7 +596,7 @@ IdentificationRun RunLeastSquares(const Config& config, const ChannelSet& data) 
       "identifying E by output-error least squares with {}/{} from {:.6g} Pa in [{:.6g}, "
       "{:.6g}] Pa; misfit levels {:.4g} m, {:.4g} N ({})",
       OptimizerTypeToString(config.outer.optimizer),
-      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
+      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm, 1)),
       config.outer.initial, config.outer.lower_bound, config.outer.upper_bound,
       run.misfit_levels.displacement_std, run.misfit_levels.force_std, run.misfit_source);
   run.outer = Identify(config.outer, &objective);

@@ -351,7 +351,7 @@ bool IdentifyHomogeneousStageByLeastSquares(const Config& config, const MatrixMo
   spdlog::info(
       "homogeneous stage: one E in every zone by least squares with {}/{} from {:.6g} Pa",
       OptimizerTypeToString(config.outer.optimizer),
-      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm)),
+      OuterAlgorithmToString(ResolveAlgorithm(config.outer.optimizer, config.outer.algorithm, 1)),
       config.outer.initial);
   OutputErrorModulusObjective objective(model, run->data, run->misfit_levels, config.time.theta,
                                         config.outer.initial);

@@ -26,13 +26,14 @@ bool IsAlgorithmAvailable(OptimizerType optimizer, OuterAlgorithm algorithm, int
   return false;
 }
 
-OuterAlgorithm ResolveAlgorithm(OptimizerType optimizer, OuterAlgorithm algorithm) {
+OuterAlgorithm ResolveAlgorithm(OptimizerType optimizer, OuterAlgorithm algorithm, int parameters) {
   if (algorithm != OuterAlgorithm::kDefault) return algorithm;
-  return optimizer == OptimizerType::kNlopt ? OuterAlgorithm::kBobyqa : OuterAlgorithm::kLbfgs;
+  if (optimizer == OptimizerType::kCeres) return OuterAlgorithm::kLbfgs;
+  return parameters == 1 ? OuterAlgorithm::kSecant : OuterAlgorithm::kBobyqa;
 }
 
-bool UsesGradient(OptimizerType optimizer, OuterAlgorithm algorithm) {
-  switch (ResolveAlgorithm(optimizer, algorithm)) {
+bool UsesGradient(OptimizerType optimizer, OuterAlgorithm algorithm, int parameters) {
+  switch (ResolveAlgorithm(optimizer, algorithm, parameters)) {
     case OuterAlgorithm::kMma:
     case OuterAlgorithm::kLbfgs:
     case OuterAlgorithm::kSlsqp:

@@ -38,7 +38,8 @@ OptimizerOutcome RunNlopt(const BoundedMinimizerOptions& options, OuterAlgorithm
     for (unsigned i = 0; i < n; ++i) step[i] = 0.1 * (upper[i] - lower[i]);
     optimizer.set_initial_step(step);
   }
-  return internal::RunNlopt(&optimizer, guard, &x, UsesGradient(options.optimizer, algorithm));
+  return internal::RunNlopt(&optimizer, guard, &x,
+                            UsesGradient(options.optimizer, algorithm, kManyParameters));
 }
 
 // x_i = lo_i + (hi_i - lo_i) (1 + sin y_i) / 2, dx_i/dy_i = (hi_i - lo_i) cos(y_i) / 2.
@@ -145,7 +146,7 @@ BoundedMinimizerSummary MinimizeWithinBounds(const BoundedMinimizerOptions& opti
                                              const std::vector<double>& initial) {
   BoundedMinimizerSummary summary;
   summary.optimizer = options.optimizer;
-  summary.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm);
+  summary.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm, kManyParameters);
   const std::size_t n = initial.size();
   summary.initial.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -158,7 +159,7 @@ BoundedMinimizerSummary MinimizeWithinBounds(const BoundedMinimizerOptions& opti
   // one, while e^2 / J_rest of nearly consistent data starts at 1e-6 or less.
   double start_cost = 0.0;
   std::vector<double> start_gradient(n);
-  const bool gradient_based = UsesGradient(options.optimizer, summary.algorithm);
+  const bool gradient_based = UsesGradient(options.optimizer, summary.algorithm, kManyParameters);
   OptimizerOutcome outcome;
   if (!guard.Evaluate(summary.initial.data(), &start_cost,
                       gradient_based ? start_gradient.data() : nullptr)) {

@@ -162,7 +162,7 @@ IdentificationSummary MinimizeLocally(const IdentificationOptions& options,
                                       ModulusObjective* objective, double curvature = 0.0) {
   IdentificationSummary summary;
   summary.optimizer = options.optimizer;
-  summary.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm);
+  summary.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm, 1);
   summary.initial_modulus = options.initial;
   const double scale = objective->modulus_scale();
   internal::GuardedObjective guarded(objective,
@@ -655,7 +655,7 @@ void SetSecondValley(const std::vector<ScanValley>& reported, IdentificationSumm
 IdentificationSummary Identify(const IdentificationOptions& options, ModulusObjective* objective) {
   IdentificationSummary summary;
   summary.optimizer = options.optimizer;
-  summary.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm);
+  summary.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm, 1);
   summary.initial_modulus = options.initial;
   std::string why;
   if (!options.IsValid(&why)) {
@@ -744,7 +744,7 @@ struct TwoStageRecord {
                                const IdentificationSummary* refined = nullptr) const {
     IdentificationSummary not_run;
     not_run.optimizer = options.optimizer;
-    not_run.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm);
+    not_run.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm, 1);
     not_run.initial_modulus = options.initial;
     IdentificationSummary result = With(refined != nullptr ? *refined : not_run, true);
     result.termination = termination;

@@ -12,7 +12,7 @@ namespace mcrewave::internal {
 void MinimizeWithNlopt(const IdentificationOptions& options, GuardedObjective* objective,
                        double modulus_scale, double curvature, IdentificationSummary* summary) {
   nlopt::opt optimizer(NloptAlgorithm(summary->algorithm), 1);
-  const bool gradient_based = UsesGradient(options.optimizer, summary->algorithm);
+  const bool gradient_based = UsesGradient(options.optimizer, summary->algorithm, 1);
   // The gradient methods (MMA's convexity term, L-BFGS' first step) assume cost
   // changes of order one across the bounds; a flat e^2 stops MMA at its start. Their
   // cost unit is the change the curvature k predicts over the bounds' width w: k w^2.

@@ -79,7 +79,7 @@ struct CoupledSolverOptions {
   // checking the true residual T(W) - W at the end (2 sweeps). The recursive residual
   // departs from the true one by round-off only (about 1e-12 of ||c||_P on the paper's
   // case), which a loose tolerance cannot see. 1: every solve checked. In (0, 1].
-  double unchecked_tolerance = 1.0;
+  double unchecked_tolerance = 1e-6;
   // Iterations (sweep pairs) allowed to the iterative solvers.
   int max_iterations = 5000;
   // omega of the fixed-coefficient relaxation, in (0, 2).

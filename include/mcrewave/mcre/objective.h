@@ -81,24 +81,25 @@ struct SearchOptions {
   double clamp_displacement_weight = 0.1;  // search.w_u0
   double reaction_weight = 0.1;            // search.w_r
   // Relative residual of the search's inner solves (docs/trusted_clamp.md section 9,
-  // "The inner tolerance").
-  double inner_tolerance = 1e-6;
+  // "The inner tolerance"; docs/performance.md, issue 41's section: its refinement
+  // only places e^2's window).
+  double inner_tolerance = 1e-4;
   // Fewest moduli of its scan (outer.scan_points for the functional `same`).
-  int scan_points = 12;
+  int scan_points = 6;
   // Its scan's samples per predicted valley spacing (0: outer.scan_samples_per_valley).
   // The search functional has one valley by design, so its scan may sample it more
   // sparsely than e^2's, whose valleys it must not miss.
-  double samples_per_valley = 0.0;
+  double samples_per_valley = 2.0;
   // Moduli of e^2's scan within E_search (1 -+ refine_window), the window's edges
   // included: at least 3 (an interior one and the edges).
-  int window_points = 5;
+  int window_points = 3;
   // Half width of the refinement of mcre:'s e^2 around the search's E*, relative
   // (its choice: docs/trusted_clamp.md section 10).
   double refine_window = 0.03;
   // The refinement of its valley, which only places that window: NLopt BOBYQA or
   // kSecant, to relative_tolerance on E (0: outer.relative_tolerance).
-  OuterAlgorithm algorithm = OuterAlgorithm::kBobyqa;
-  double relative_tolerance = 0.0;
+  OuterAlgorithm algorithm = OuterAlgorithm::kSecant;
+  double relative_tolerance = 1e-3;
 
   // Valid when the weights and inner_tolerance are finite and positive,
   // inner_tolerance < 1, scan_points in [3, 100000], samples_per_valley 0 or in

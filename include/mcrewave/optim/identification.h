@@ -70,7 +70,9 @@ struct IdentificationOptions {
   int scan_max_points = 2000;
   // Relative residual asked of the inner solves of the scan (the refinement uses
   // the objective's own, inner.tolerance): the scan only ranks and brackets
-  // valleys.
+  // valleys. Its gradients, on whose signs the valleys are found, err in proportion
+  // to it: looser scans see valleys that are not there (docs/performance.md, issue
+  // 41's section).
   double scan_tolerance = 1e-4;
   // Threads of the scan (each its own copy of the objective).
   int scan_threads = 2;
@@ -174,13 +176,12 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
 // Two stages: a global search on another functional, a local refinement of the objective.
 //   1. Identify(options with scan_points = search_scan_points and
 //      refinement.samples_per_valley, search): the scan and its valleys' refinements on
-//      `search`, a cost of one valley over the bounds whose
-//      minimiser E_s lies near the objective's. The refinements are `refinement`'s
-//      whatever options' optimiser, so that every optimiser then refines the objective
-//      around the same E_s: by default NLopt BOBYQA, derivative-free, which does not
-//      depend on the accuracy of the search's gradient (its looser inner solves limit
-//      it), to options.relative_tolerance. E_s only places stage 2's window, so a
-//      looser refinement.relative_tolerance moves the result within that window only.
+//      `search`, a cost of one valley over the bounds whose minimiser E_s lies near
+//      the objective's. The refinements are `refinement`'s whatever options'
+//      optimiser, so that every optimiser then refines the objective around the same
+//      E_s: by default the secant on the search's gradient to 1e-3 in E. E_s only
+//      places stage 2's window, so a loose refinement moves the result within that
+//      window only.
 //   2. Identify(options with scan_points = refinement.window_points, objective) within
 //      E_s (1 -+ refine_window), cut to the bounds: a scan of the window (cost and
 //      gradient) that brackets the objective's valleys there and gives the local
@@ -201,12 +202,12 @@ IdentificationSummary Identify(const IdentificationOptions& options, ModulusObje
 struct SearchRefinement {
   // The search's refinement: NLopt BOBYQA or kSecant (on the search's gradient), to
   // relative_tolerance (0: options.relative_tolerance).
-  OuterAlgorithm algorithm = OuterAlgorithm::kBobyqa;
-  double relative_tolerance = 0.0;
+  OuterAlgorithm algorithm = OuterAlgorithm::kSecant;
+  double relative_tolerance = 1e-3;
   // The search's scan samples per predicted valley spacing (0: the options').
-  double samples_per_valley = 0.0;
+  double samples_per_valley = 2.0;
   // Stage 2's scan: moduli over the window, its edges included (at least 3).
-  int window_points = 5;
+  int window_points = 3;
 };
 IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
                                           ModulusObjective* search, int search_scan_points,
