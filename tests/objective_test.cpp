@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -352,6 +353,41 @@ TEST(McreObjectiveTest, ARoundOffFloorMetOnceIsNotConfirmedAgain) {
   const ObjectiveEvaluation nearby = objective.EvaluateModulus(2.02e11);
   ASSERT_TRUE(nearby.usable) << nearby.inner.FullReport();
   EXPECT_LT(nearby.inner.iterations, first.inner.iterations);
+}
+
+TEST(McreObjectiveTest, AScanCopyStartedAfreshEvaluatesAsAFreshCopy) {
+  // The scan reuses one CloneForScan copy for several chunks of points, StartAfresh
+  // before each: its next evaluation must be a fresh copy's to the bit, the warm starts
+  // and the trace preconditioner (kept within 2 % of the moduli it was built at)
+  // forgotten. The plate, its streaming CG preconditioned, at E 1 % apart.
+  PlateInverseCrime crime((Vector(2) << 2.1e11, 1.5e11).finished());
+  CoupledSolverOptions inner;
+  inner.type = CoupledSolverType::kStreamingConjugateGradient;
+  inner.preconditioner = TracePreconditioner::kDenseTraces;
+  const McreObjective objective =
+      MatrixMcreObjective(crime.plate, crime.data, PlateMcre(), 0.5, inner);
+  const double first = 1.0, second = 1.01;  // x = E / 2e11
+  struct Value {
+    double cost = 0.0, gradient = 0.0;
+  };
+  auto evaluate = [](ModulusObjective* copy, double x) {
+    Value value;
+    EXPECT_TRUE(copy->Evaluate(&x, &value.cost, &value.gradient)) << copy->error_message();
+    return value;
+  };
+  const std::unique_ptr<ModulusObjective> fresh = objective.CloneForScan(1e-6);
+  const Value expected = evaluate(fresh.get(), second);
+  const std::unique_ptr<ModulusObjective> reused = objective.CloneForScan(1e-6);
+  evaluate(reused.get(), first);
+  reused->StartAfresh();
+  const Value actual = evaluate(reused.get(), second);
+  EXPECT_EQ(actual.cost, expected.cost);
+  EXPECT_EQ(actual.gradient, expected.gradient);
+  // Without StartAfresh the second evaluation starts from the first's solution and
+  // factor: other bits.
+  const std::unique_ptr<ModulusObjective> warm = objective.CloneForScan(1e-6);
+  evaluate(warm.get(), first);
+  EXPECT_NE(evaluate(warm.get(), second).cost, expected.cost);
 }
 
 }  // namespace

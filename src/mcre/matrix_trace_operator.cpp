@@ -155,6 +155,15 @@ Vector MatrixMcreProblem::TraceWeightRoots() const {
   return roots;
 }
 
+void MatrixMcreProblem::ForgetTracePreconditioner() {
+  if (trace_factor_ != nullptr && trace_factor_.use_count() == 1) {
+    // No moduli: PrepareTracePreconditioner rebuilds it in the same storage.
+    std::const_pointer_cast<TraceFactor>(trace_factor_)->moduli.resize(0);
+  } else {
+    trace_factor_.reset();
+  }
+}
+
 bool MatrixMcreProblem::PrepareTracePreconditioner(double rebuild_change, long max_traces) {
   const int rows = num_traces(), m = num_steps();
   const long size = static_cast<long>(rows) * (m + 1);

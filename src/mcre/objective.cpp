@@ -149,6 +149,15 @@ std::unique_ptr<ModulusObjective> McreObjective::CloneForScan(double inner_toler
   return std::make_unique<McreObjective>(make_problem_, inner, modulus_scale_);
 }
 
+void McreObjective::StartAfresh() {
+  warm_start_.resize(0, 0);
+  warm_start_modulus_ = 0.0;
+  previous_start_.resize(0, 0);
+  previous_start_modulus_ = 0.0;
+  inner_.tolerance = given_tolerance_;
+  problem_->ForgetTracePreconditioner();
+}
+
 double McreObjective::ValleySpacing() {
   Matrix traces;
   problem_->DataResponseTraces(&traces);

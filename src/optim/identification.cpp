@@ -233,9 +233,10 @@ constexpr int kScanChunks = 8;
 
 // The scaled costs and gradients at xs. The points form min(kScanChunks, P)
 // contiguous chunks, chunk c = [c P / C, (c + 1) P / C); each chunk is evaluated in
-// order by a fresh copy of the objective (CloneForScan), warm-started point to
-// point from its own first point only, so a sample depends on its chunk and never
-// on which thread ran it. Chunk c runs on thread c mod scan_threads. Without copies
+// order by a copy of the objective (CloneForScan, one per thread, StartAfresh
+// before each chunk but its first: a copy's fields are made once), warm-started
+// point to point from its own first point only, so a sample depends on its chunk and
+// never on which thread ran it. Chunk c runs on thread c mod scan_threads. Without copies
 // (CloneForScan gives none) every point is evaluated in order on `objective`.
 // Samples not reached within options.max_time of `start` stay NaN.
 // *first_failure: why the lowest failed sample failed; *sweeps: the inner sweeps
@@ -259,17 +260,22 @@ void ScanSamples(const IdentificationOptions& options, ModulusObjective* objecti
   std::vector<long> thread_sweeps(threads, 0);
   std::vector<char> cloned(threads, 1);
   auto run_chunks = [&](int thread) {
+    std::unique_ptr<ModulusObjective> copy;
     for (int c = thread; c < chunks; c += threads) {
-      std::unique_ptr<ModulusObjective> copy = objective->CloneForScan(options.scan_tolerance);
       if (copy == nullptr) {
-        cloned[thread] = 0;
-        return;
+        copy = objective->CloneForScan(options.scan_tolerance);
+        if (copy == nullptr) {
+          cloned[thread] = 0;
+          return;
+        }
+      } else {
+        copy->StartAfresh();
       }
       for (int i = c * points / chunks; i < (c + 1) * points / chunks; ++i) {
         sample(copy.get(), i);
       }
-      thread_sweeps[thread] += copy->sweeps();
     }
+    if (copy != nullptr) thread_sweeps[thread] = copy->sweeps();
   };
   std::vector<std::thread> pool;
   for (int t = 1; t < threads; ++t) pool.emplace_back(run_chunks, t);

@@ -229,6 +229,8 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // moved by more than rebuild_change since it was built; (C beta)^-1/2 (I + S)^-1
   // (C beta)^1/2 applied by PreconditionTraces.
   bool PrepareTracePreconditioner(double rebuild_change, long max_traces) override;
+  // Keeps the factor's storage when this problem alone holds it.
+  void ForgetTracePreconditioner() override;
   void PreconditionTraces(const Matrix& residual, Matrix* result) override;
   // The factor of I + S with the weights and moduli it was built at (null before the
   // first build): it depends on the model, the weights, theta, the time grid and the

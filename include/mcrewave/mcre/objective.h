@@ -159,6 +159,9 @@ class McreObjective : public ModulusObjective {
   // A new McreObjective on a problem of the same factory with
   // inner.tolerance = inner_tolerance (its evaluations are its own).
   std::unique_ptr<ModulusObjective> CloneForScan(double inner_tolerance) const override;
+  // Drops the warm starts, the round-off floor's tolerance and the problem's trace
+  // preconditioner; the evaluations so far stay recorded.
+  void StartAfresh() override;
 
   // Evaluates e^2 and de^2/dE at modulus E [Pa] (> 0) and records it; returns the
   // record. Evaluate calls this.

@@ -81,6 +81,10 @@ class StreamingCoupledProblem : public CoupledProblem {
     (void)max_traces;
     return false;
   }
+  // The next PrepareTracePreconditioner builds its factor anew, whatever the moduli, as
+  // on a newly made problem (a problem may keep the factor's storage); nothing to do
+  // for a problem that offers none (the default).
+  virtual void ForgetTracePreconditioner() {}
   // result = M^-1 residual, of shape ZeroTraces(). Precondition: the last
   // PrepareTracePreconditioner returned true.
   virtual void PreconditionTraces(const Matrix& residual, Matrix* result) {

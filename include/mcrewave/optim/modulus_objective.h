@@ -30,6 +30,13 @@ class ModulusObjective : public FirstOrderObjective {
     return nullptr;
   }
 
+  // Forgets every earlier solution and solver state a later evaluation would start
+  // from, so that the next evaluation is the same bits as the first of a fresh
+  // CloneForScan copy's (the scan reuses one copy for several chunks of points); its
+  // sweeps() go on counting. Nothing to do for an objective without such state (the
+  // default).
+  virtual void StartAfresh() {}
+
   // Inner sweeps (direct + retrograde) of every evaluation so far; 0 when the
   // objective has no inner solver (the default).
   virtual long sweeps() const { return 0; }
