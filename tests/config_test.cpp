@@ -162,6 +162,7 @@ void ExpectSameConfigLaterKeys(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.search.refine_window, actual.search.refine_window);
   EXPECT_EQ(expected.search.algorithm, actual.search.algorithm);
   EXPECT_EQ(expected.search.relative_tolerance, actual.search.relative_tolerance);
+  EXPECT_EQ(expected.search.time_step_factor, actual.search.time_step_factor);
   EXPECT_EQ(expected.study.comparator.data, actual.study.comparator.data);
   EXPECT_EQ(expected.structure.kind, actual.structure.kind);
   EXPECT_EQ(expected.structure.manifest, actual.structure.manifest);
@@ -729,6 +730,7 @@ search:
   refine_window: 0.05
   algorithm: bobyqa
   relative_tolerance: 1e-4
+  time_step_factor: 3
 prefilter:
   enabled: false
   cutoff_frequency: 12345.5
@@ -1293,6 +1295,9 @@ TEST_F(ConfigFileTest, SearchKeysAreCheckedAndBelongToThePinnedSearchFunctional)
   ExpectLoadError("search:\n  relative_tolerance: 0.5\n", 2,
                   {"search.relative_tolerance must be 0 (outer.relative_tolerance) or lie in "
                    "(0, 0.1], got 0.5"});
+  ExpectLoadError("search:\n  time_step_factor: 65\n", 2,
+                  {"search.time_step_factor must lie in [1, 64], got 65"});
+  ExpectLoadError("search:\n  time_step_factor: 0\n", 2, {"search.time_step_factor"});
   // The two stages' scans within outer's limits.
   ExpectLoadError("outer:\n  scan_points: 3\n  scan_max_points: 5\n", 3,
                   {"search.scan_points (6) must not exceed outer.scan_max_points (5)"});

@@ -674,6 +674,10 @@ const std::vector<Key>& KeyTable() {
               Number(), "",
               "search functional pinned or measured: relative tolerance on E of its valley's "
               "refinement, which places that window; 0: outer.relative_tolerance"),
+      MakeKey("search.time_step_factor", &Config::search, &SearchOptions::time_step_factor,
+              PositiveInteger<int>(), "",
+              "search functional pinned or measured: its time step in steps of the data, in "
+              "[1, 64]; it runs on the data resampled to that step (1: the data's own)"),
       MakeKey("prefilter.enabled", &Config::prefilter, &PrefilterOptions::enabled, Boolean(), "",
               "zero-phase Butterworth low-pass, the same on every channel the identification "
               "uses (loads, displacements, strains)"),
@@ -882,6 +886,7 @@ const char* SearchKeyNotAtItsDefault(const SearchOptions& search) {
       {"search.refine_window", search.refine_window != defaults.refine_window},
       {"search.algorithm", search.algorithm != defaults.algorithm},
       {"search.relative_tolerance", search.relative_tolerance != defaults.relative_tolerance},
+      {"search.time_step_factor", search.time_step_factor != defaults.time_step_factor},
   };
   for (const auto& [key, set] : keys) {
     if (set) return key;

@@ -210,6 +210,14 @@ ChannelSet LoadMeasurements(const Config& config) {
   return data;
 }
 
+ChannelSet SearchData(const ChannelSet& data, const SearchOptions& search) {
+  const int steps = data.num_steps();
+  const int factor = std::max(1, std::min(search.time_step_factor, steps / kSearchMinimumSteps));
+  if (factor == 1) return data;
+  return ResampleMeasurements(data, factor * data.time_step, steps / factor + 1,
+                              "the search functional's data (search.time_step_factor)");
+}
+
 McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData& model,
                                     const ChannelSet& data, bool element_maps) {
   McreIdentification result;
@@ -226,9 +234,11 @@ McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData&
   }
   CoupledSolverOptions search_inner = config.inner;
   search_inner.tolerance = config.search.inner_tolerance;
+  // The search's data must outlive `search` only: its minimiser places e^2's window.
+  const ChannelSet search_data = SearchData(data, config.search);
   McreObjective search = MatrixMcreObjective(
-      model, data, SearchMcreOptions(config.mcre, config.search), config.time.theta, search_inner,
-      Factorization::kAutomatic, config.outer.initial, element_maps);
+      model, search_data, SearchMcreOptions(config.mcre, config.search), config.time.theta,
+      search_inner, Factorization::kAutomatic, config.outer.initial, element_maps);
   result.outer = IdentifyInTwoStages(config.outer, &search, config.search.scan_points,
                                      config.search.refine_window, result.objective.get(),
                                      SearchRefinementOf(config.search));

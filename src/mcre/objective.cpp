@@ -75,6 +75,8 @@ bool SearchOptions::IsValid(std::string* error) const {
     why << "search.relative_tolerance must be 0 (outer.relative_tolerance) or lie in (0, 0.1], "
            "got "
         << relative_tolerance;
+  } else if (time_step_factor < 1 || time_step_factor > 64) {
+    why << "search.time_step_factor must lie in [1, 64], got " << time_step_factor;
   } else {
     return true;
   }

@@ -236,13 +236,20 @@ struct McreIdentification {
   double scan_cost_scale = 0.0;  // [J s] J_rest of the functional outer's scan ran on
 };
 
+// The data the search functional runs on: `data` resampled to time_step_factor times
+// its step (ResampleMeasurements), on floor(m / factor) steps, so a window not a
+// multiple of the factor loses its last steps; the factor is lowered to keep at least
+// kSearchMinimumSteps steps, and at 1 the data as they are.
+ChannelSet SearchData(const ChannelSet& data, const SearchOptions& search);
+constexpr int kSearchMinimumSteps = 64;
+
 // The outer loop of config.outer on mcre:'s e^2 of `data` (the identification's
 // measurements: selected and pre-filtered) with the model `model` (BarRunModel, or any
 // structure given by matrices), its supports treated as mcre.clamp says and
 // x = E / outer.initial; model and data must outlive the result's objective. When
 // IdentifiesInTwoStages: IdentifyInTwoStages with the search functional
-// (SearchMcreOptions, its inner solves to search.inner_tolerance). Else Identify, its
-// scan of search.scan_points when the search functional is e^2 itself on this model.
+// (SearchMcreOptions, its inner solves to search.inner_tolerance, on SearchData). Else Identify,
+// its scan of search.scan_points when the search functional is e^2 itself on this model.
 // element_maps false: the streaming solves leave the element map out (a stage whose
 // solution only warm-starts another). Precondition: config valid.
 McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData& model,

@@ -100,11 +100,16 @@ struct SearchOptions {
   // kSecant, to relative_tolerance on E (0: outer.relative_tolerance).
   OuterAlgorithm algorithm = OuterAlgorithm::kSecant;
   double relative_tolerance = 1e-3;
+  // The search functional's time step, in steps of the data's grid: its scan and
+  // refinement run on the data resampled to this many times the step (SearchData,
+  // app/identification_run.h), as its minimiser only places e^2's window; 1: the
+  // data's own grid.
+  int time_step_factor = 1;
 
   // Valid when the weights and inner_tolerance are finite and positive,
   // inner_tolerance < 1, scan_points in [3, 100000], samples_per_valley 0 or in
   // [1, 100], window_points in [3, 100], refine_window in (0, 0.5], algorithm bobyqa
-  // or secant and relative_tolerance 0 or in (0, 0.1].
+  // or secant, relative_tolerance 0 or in (0, 0.1] and time_step_factor in [1, 64].
   // Messages name the search.* keys.
   bool IsValid(std::string* error) const;
 };
