@@ -401,13 +401,15 @@ TEST(MatrixIdentificationRunTest, ASpringAtTheSupportSwitchesTheMatrixRunAsItSwi
   const double bar_statistic = bar_summary["supports"]["tests"][0]["statistic"].as<double>();
   const double matrix_statistic = matrix_summary["supports"]["tests"][0]["statistic"].as<double>();
   // Measured: t = 47.29 on both roads, to the bit (the same f0 pre-filtered alike); the
-  // moduli 4.2e-9 apart, relative, and +0.24 % from the bar's 200 GPa.
+  // moduli 6.7e-8 apart, relative (both refined to outer.relative_tolerance 1e-7, from
+  // windows their searches, on a coarser grid, placed a round-off apart; 4.2e-9 with
+  // the search on the data's own grid), and +0.24 % from the bar's 200 GPa.
   EXPECT_GT(bar_statistic, 10.0);
   EXPECT_NEAR(matrix_statistic / bar_statistic - 1.0, 0.0, 1e-12);
   EXPECT_NEAR(
       ZoneModulus(dir + "/matrices/zones.csv", 0) / bar_summary["identified_modulus"].as<double>() -
           1.0,
-      0.0, 4e-8);
+      0.0, 2e-7);
   EXPECT_NEAR(bar_summary["identified_modulus"].as<double>() / config.model.modulus - 1.0, 0.0,
               1e-2);
 }

@@ -3,11 +3,14 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "mcrewave/app/zone_identification_run.h"
 #include "mcrewave/core/format.h"
@@ -210,11 +213,38 @@ ChannelSet LoadMeasurements(const Config& config) {
   return data;
 }
 
-ChannelSet SearchData(const ChannelSet& data, const SearchOptions& search) {
-  const int steps = data.num_steps();
-  const int factor = std::max(1, std::min(search.time_step_factor, steps / kSearchMinimumSteps));
+int SearchTimeStepFactor(const ChannelSet& data, const MatrixModelData& model, double theta,
+                         const SearchOptions& search, double* load_frequency) {
+  const double h = data.time_step;
+  // The forces the model is driven by or tested against: its loads' and its supports'
+  // measured forces (the same channels whichever road the bar takes).
+  std::vector<std::string> forces;
+  for (const MatrixModelLoad& load : model.loads) forces.push_back(load.channel);
+  for (const MatrixModelSupport& support : model.supports) forces.push_back(support.force_channel);
+  double largest = 0.0;  // the largest rms frequency of a force channel [Hz]
+  for (const std::string& channel : forces) {
+    const int index = data.Find(channel);
+    if (index < 0) continue;
+    const Vector& x = data.channels[index].values;
+    const double energy = x.squaredNorm();
+    if (x.size() < 2 || !(energy > 0.0)) continue;
+    // f_rms = (1 / (2 pi h)) (sum_j (x_j+1 - x_j)^2 / sum_j x_j^2)^1/2
+    const double differences = (x.tail(x.size() - 1) - x.head(x.size() - 1)).squaredNorm();
+    largest = std::max(largest, std::sqrt(differences / energy) / (2.0 * M_PI * h));
+  }
+  if (load_frequency != nullptr) *load_frequency = largest;
+  if (theta != 0.5 || !(largest > 0.0) || !std::isfinite(largest)) return 1;
+  // (omega k h)^2 / 6 <= refine_window / 10.
+  const double allowed = std::sqrt(0.6 * search.refine_window) / (2.0 * M_PI * largest * h);
+  const int by_band =
+      allowed >= search.time_step_factor ? search.time_step_factor : static_cast<int>(allowed);
+  return std::max(1, std::min(by_band, data.num_steps() / kSearchMinimumSteps));
+}
+
+ChannelSet SearchData(const ChannelSet& data, int factor) {
+  assert(factor >= 1 && data.num_steps() / factor >= 1);
   if (factor == 1) return data;
-  return ResampleMeasurements(data, factor * data.time_step, steps / factor + 1,
+  return ResampleMeasurements(data, factor * data.time_step, data.num_steps() / factor + 1,
                               "the search functional's data (search.time_step_factor)");
 }
 
@@ -235,7 +265,14 @@ McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData&
   CoupledSolverOptions search_inner = config.inner;
   search_inner.tolerance = config.search.inner_tolerance;
   // The search's data must outlive `search` only: its minimiser places e^2's window.
-  const ChannelSet search_data = SearchData(data, config.search);
+  double load_frequency = 0.0;
+  const int factor =
+      SearchTimeStepFactor(data, model, config.time.theta, config.search, &load_frequency);
+  spdlog::info(
+      "search functional on {} steps of {:.6g} s ({} times the data's; the loads' rms "
+      "frequency {:.4g} Hz)",
+      data.num_steps() / factor, factor * data.time_step, factor, load_frequency);
+  const ChannelSet search_data = SearchData(data, factor);
   McreObjective search = MatrixMcreObjective(
       model, search_data, SearchMcreOptions(config.mcre, config.search), config.time.theta,
       search_inner, Factorization::kAutomatic, config.outer.initial, element_maps);

@@ -236,19 +236,33 @@ struct McreIdentification {
   double scan_cost_scale = 0.0;  // [J s] J_rest of the functional outer's scan ran on
 };
 
-// The data the search functional runs on: `data` resampled to time_step_factor times
-// its step (ResampleMeasurements), on floor(m / factor) steps, so a window not a
-// multiple of the factor loses its last steps; the factor is lowered to keep at least
-// kSearchMinimumSteps steps, and at 1 the data as they are.
-ChannelSet SearchData(const ChannelSet& data, const SearchOptions& search);
+// The time-step factor k of the search functional (docs/performance.md, issue 41's
+// section): the largest k <= search.time_step_factor at which the theta method's
+// shift of the search's minimiser stays within search.refine_window / 10. At
+// theta = 1/2 a period of angular frequency omega is lengthened by about
+// (omega k h)^2 / 12, so a wave speed, and the E that matches it (E ~ c^2), by about
+// (omega k h)^2 / 6; omega is the largest rms angular frequency of the model's force
+// channels in `data` (its loads' and its supports' measured forces), from their first
+// differences. k = 1 at theta != 1/2 (a dissipation of first order), when no force
+// channel carries a signal, and k keeps at least kSearchMinimumSteps steps. *load_frequency
+// (nullable): that rms frequency [Hz] (0: none).
+int SearchTimeStepFactor(const ChannelSet& data, const MatrixModelData& model, double theta,
+                         const SearchOptions& search, double* load_frequency = nullptr);
 constexpr int kSearchMinimumSteps = 64;
+
+// `data` resampled to `factor` times its step (ResampleMeasurements, its low-pass at
+// 0.4 / (factor h)) on floor(m / factor) steps, so a window not a multiple of the
+// factor loses its last steps; at 1 the data as they are. Precondition: factor >= 1,
+// m / factor >= 1.
+ChannelSet SearchData(const ChannelSet& data, int factor);
 
 // The outer loop of config.outer on mcre:'s e^2 of `data` (the identification's
 // measurements: selected and pre-filtered) with the model `model` (BarRunModel, or any
 // structure given by matrices), its supports treated as mcre.clamp says and
 // x = E / outer.initial; model and data must outlive the result's objective. When
 // IdentifiesInTwoStages: IdentifyInTwoStages with the search functional
-// (SearchMcreOptions, its inner solves to search.inner_tolerance, on SearchData). Else Identify,
+// (SearchMcreOptions, its inner solves to search.inner_tolerance, on SearchData at
+// SearchTimeStepFactor). Else Identify,
 // its scan of search.scan_points when the search functional is e^2 itself on this model.
 // element_maps false: the streaming solves leave the element map out (a stage whose
 // solution only warm-starts another). Precondition: config valid.

@@ -100,11 +100,12 @@ struct SearchOptions {
   // kSecant, to relative_tolerance on E (0: outer.relative_tolerance).
   OuterAlgorithm algorithm = OuterAlgorithm::kSecant;
   double relative_tolerance = 1e-3;
-  // The search functional's time step, in steps of the data's grid: its scan and
-  // refinement run on the data resampled to this many times the step (SearchData,
+  // The largest time step of the search functional, in steps of the data's grid: its
+  // scan and refinement run on the data resampled to k times the step, k at most this
+  // and as small as the loads' band asks (SearchTimeStepFactor,
   // app/identification_run.h), as its minimiser only places e^2's window; 1: the
   // data's own grid.
-  int time_step_factor = 1;
+  int time_step_factor = 4;
 
   // Valid when the weights and inner_tolerance are finite and positive,
   // inner_tolerance < 1, scan_points in [3, 100000], samples_per_valley 0 or in
