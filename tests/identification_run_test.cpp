@@ -53,7 +53,7 @@ TEST(SearchDataTest, ResamplesToTheFactorsStep) {
   }
 }
 
-TEST(SearchDataTest, TheFactorFollowsTheLoadsBandTheSchemeAndTheSteps) {
+TEST(SearchDataTest, TheFactorFollowsTheForcesBandTheSchemeAndTheSteps) {
   // The paper's case (h = 0.36 us, the pre-filtered load's rms frequency measured
   // 5.15 kHz): the band allows k = 11 (0.134 / (2 pi 5.15 kHz 0.36 us) = 11.5), so the
   // default's 4 stands. The quick case's raw data (h = 1.44 us, its loads' rms

@@ -676,8 +676,8 @@ const std::vector<Key>& KeyTable() {
               "refinement, which places that window; 0: outer.relative_tolerance"),
       MakeKey("search.time_step_factor", &Config::search, &SearchOptions::time_step_factor,
               PositiveInteger<int>(), "",
-              "search functional pinned or measured: its time step in steps of the data, in "
-              "[1, 64]; it runs on the data resampled to that step (1: the data's own)"),
+              "search functional pinned or measured: its largest time step in steps of the data, "
+              "in [1, 64], lowered as the forces' band asks (1: the data's own grid)"),
       MakeKey("prefilter.enabled", &Config::prefilter, &PrefilterOptions::enabled, Boolean(), "",
               "zero-phase Butterworth low-pass, the same on every channel the identification "
               "uses (loads, displacements, strains)"),

@@ -214,7 +214,7 @@ ChannelSet LoadMeasurements(const Config& config) {
 }
 
 int SearchTimeStepFactor(const ChannelSet& data, const MatrixModelData& model, double theta,
-                         const SearchOptions& search, double* load_frequency) {
+                         const SearchOptions& search, double* force_frequency) {
   const double h = data.time_step;
   // The forces the model is driven by or tested against: its loads' and its supports'
   // measured forces (the same channels whichever road the bar takes).
@@ -232,7 +232,7 @@ int SearchTimeStepFactor(const ChannelSet& data, const MatrixModelData& model, d
     const double differences = (x.tail(x.size() - 1) - x.head(x.size() - 1)).squaredNorm();
     largest = std::max(largest, std::sqrt(differences / energy) / (2.0 * M_PI * h));
   }
-  if (load_frequency != nullptr) *load_frequency = largest;
+  if (force_frequency != nullptr) *force_frequency = largest;
   if (theta != 0.5 || !(largest > 0.0) || !std::isfinite(largest)) return 1;
   // (omega k h)^2 / 6 <= refine_window / 10.
   const double allowed = std::sqrt(0.6 * search.refine_window) / (2.0 * M_PI * largest * h);
@@ -265,13 +265,13 @@ McreIdentification IdentifyWithMcre(const Config& config, const MatrixModelData&
   CoupledSolverOptions search_inner = config.inner;
   search_inner.tolerance = config.search.inner_tolerance;
   // The search's data must outlive `search` only: its minimiser places e^2's window.
-  double load_frequency = 0.0;
+  double force_frequency = 0.0;
   const int factor =
-      SearchTimeStepFactor(data, model, config.time.theta, config.search, &load_frequency);
+      SearchTimeStepFactor(data, model, config.time.theta, config.search, &force_frequency);
   spdlog::info(
-      "search functional on {} steps of {:.6g} s ({} times the data's; the loads' rms "
+      "search functional on {} steps of {:.6g} s ({} times the data's; the forces' rms "
       "frequency {:.4g} Hz)",
-      data.num_steps() / factor, factor * data.time_step, factor, load_frequency);
+      data.num_steps() / factor, factor * data.time_step, factor, force_frequency);
   const ChannelSet search_data = SearchData(data, factor);
   McreObjective search = MatrixMcreObjective(
       model, search_data, SearchMcreOptions(config.mcre, config.search), config.time.theta,

@@ -244,10 +244,10 @@ struct McreIdentification {
 // (omega k h)^2 / 6; omega is the largest rms angular frequency of the model's force
 // channels in `data` (its loads' and its supports' measured forces), from their first
 // differences. k = 1 at theta != 1/2 (a dissipation of first order), when no force
-// channel carries a signal, and k keeps at least kSearchMinimumSteps steps. *load_frequency
+// channel carries a signal, and k keeps at least kSearchMinimumSteps steps. *force_frequency
 // (nullable): that rms frequency [Hz] (0: none).
 int SearchTimeStepFactor(const ChannelSet& data, const MatrixModelData& model, double theta,
-                         const SearchOptions& search, double* load_frequency = nullptr);
+                         const SearchOptions& search, double* force_frequency = nullptr);
 constexpr int kSearchMinimumSteps = 64;
 
 // `data` resampled to `factor` times its step (ResampleMeasurements, its low-pass at

@@ -102,7 +102,7 @@ struct SearchOptions {
   double relative_tolerance = 1e-3;
   // The largest time step of the search functional, in steps of the data's grid: its
   // scan and refinement run on the data resampled to k times the step, k at most this
-  // and as small as the loads' band asks (SearchTimeStepFactor,
+  // and as small as the forces' band asks (SearchTimeStepFactor,
   // app/identification_run.h), as its minimiser only places e^2's window; 1: the
   // data's own grid.
   int time_step_factor = 4;
