@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/model/matrix_export.h"
@@ -132,4 +133,4 @@ int Main(int argc, char** argv) {
 }  // namespace
 }  // namespace mcrewave
 
-int main(int argc, char** argv) { return mcrewave::Main(argc, argv); }
+int main(int argc, char** argv) { return mcrewave::bench::GuardedMain(mcrewave::Main, argc, argv); }

@@ -1,13 +1,16 @@
 // What the benchmark programs share: the calling thread's and the process's CPU clocks,
-// and the command line of those that take `[--repeats N] [CONFIG.yaml]`.
+// the command line of those that take `[--repeats N] [CONFIG.yaml]`, and a main that
+// reports a bad argument or input file on one line instead of crashing.
 #pragma once
 
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <exception>
 #include <string>
 
 namespace mcrewave::bench {
@@ -37,6 +40,19 @@ inline void ParseRepeatsAndConfig(int argc, char** argv, int* repeats, std::stri
       *path = argv[i];
     }
   }
+}
+
+// Runs a benchmark's own main; an exception (a config, CSV or manifest it cannot read,
+// an argument it cannot use) is reported as `error: <what>` on stderr with exit code 2.
+inline int GuardedMain(int (*body)(int, char**), int argc, char** argv) {
+  try {
+    return body(argc, argv);
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "error: %s\n", error.what());
+  } catch (...) {
+    std::fprintf(stderr, "error: an exception that is not a std::exception\n");
+  }
+  return 2;
 }
 
 }  // namespace mcrewave::bench

@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/core/operation_counts.h"
 #include "mcrewave/mcre/coupled_solver.h"
@@ -529,7 +530,7 @@ int Run(const std::string& output_dir, int max_dofs) {
 }  // namespace
 }  // namespace mcrewave
 
-int main(int argc, char** argv) {
+static int BenchmarkMain(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr, "usage: %s OUTPUT_DIR [max_dofs]\n", argv[0]);
     return 2;
@@ -537,3 +538,5 @@ int main(int argc, char** argv) {
   const int max_dofs = argc > 2 ? std::atoi(argv[2]) : 1000;
   return mcrewave::Run(argv[1], max_dofs);
 }
+
+int main(int argc, char** argv) { return mcrewave::bench::GuardedMain(BenchmarkMain, argc, argv); }

@@ -21,6 +21,7 @@
 #include <limits>
 #include <vector>
 
+#include "bench_util.h"
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/model/matrix_export.h"
@@ -83,7 +84,7 @@ double SecondsOfOneDirectSweep(CoupledProblem* problem) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int BenchmarkMain(int argc, char** argv) {
   const bool skip_all_at_once = argc > 1 && std::strcmp(argv[1], "--skip-all-at-once") == 0;
   mcrewave::BarProperties bar;  // the paper's bar, 100 elements
   mcrewave::LoadOptions load;
@@ -164,3 +165,5 @@ int main(int argc, char** argv) {
   std::printf("\none direct sweep of the MCRE problem: %.3f ms\n", 1e3 * sweep_seconds);
   return 0;
 }
+
+int main(int argc, char** argv) { return mcrewave::bench::GuardedMain(BenchmarkMain, argc, argv); }

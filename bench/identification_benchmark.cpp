@@ -116,7 +116,7 @@ SweepStepTimes SweepStepSeconds(const mcrewave::Config& config, const mcrewave::
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int BenchmarkMain(int argc, char** argv) {
   spdlog::set_level(spdlog::level::warn);
   int repeats = 3;
   bool identify_only = false;
@@ -175,3 +175,5 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+int main(int argc, char** argv) { return mcrewave::bench::GuardedMain(BenchmarkMain, argc, argv); }

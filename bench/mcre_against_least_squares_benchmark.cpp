@@ -231,7 +231,7 @@ void RunPlate(const std::string& path, const std::vector<std::string>& overrides
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int BenchmarkMain(int argc, char** argv) {
   spdlog::set_level(spdlog::level::warn);
   int seeds = 5;
   int repeats = 3;
@@ -257,3 +257,5 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+int main(int argc, char** argv) { return mcrewave::bench::GuardedMain(BenchmarkMain, argc, argv); }

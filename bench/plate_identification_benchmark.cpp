@@ -41,6 +41,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_util.h"
 #include "mcrewave/app/matrix_identification_run.h"
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/mcre/element_error_map.h"
@@ -369,7 +370,7 @@ void DrawModuliFigure(const std::string& folder) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int BenchmarkMain(int argc, char** argv) {
   PlateArguments arguments;
   const int status = ParsePlateArguments(argc, argv, &arguments);
   if (status != 0) return status;
@@ -391,3 +392,5 @@ int main(int argc, char** argv) {
   DrawModuliFigure(folder);
   return 0;
 }
+
+int main(int argc, char** argv) { return mcrewave::bench::GuardedMain(BenchmarkMain, argc, argv); }

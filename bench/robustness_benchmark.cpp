@@ -31,6 +31,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_util.h"
 #include "mcrewave/app/study.h"
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/data/noise.h"
@@ -240,7 +241,7 @@ void WriteSettingsTables(const std::string& output_dir, int seeds,
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int BenchmarkMain(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr, "usage: %s OUTPUT_DIR [seeds]\n", argv[0]);
     return 2;
@@ -279,3 +280,5 @@ int main(int argc, char** argv) {
   WriteSettingsTables(output_dir, seeds, settings, snrs, jobs, outcomes);
   return 0;
 }
+
+int main(int argc, char** argv) { return mcrewave::bench::GuardedMain(BenchmarkMain, argc, argv); }

@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "bench_util.h"
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/model/bar_model.h"
 #include "mcrewave/model/simulation.h"
@@ -115,7 +116,7 @@ double LogLogSlope(const std::vector<std::pair<double, double>>& points) {
 }  // namespace
 }  // namespace mcrewave
 
-int main(int argc, char** argv) {
+static int BenchmarkMain(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   mcrewave::SweepRecorder recorder;
@@ -133,3 +134,5 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+int main(int argc, char** argv) { return mcrewave::bench::GuardedMain(BenchmarkMain, argc, argv); }

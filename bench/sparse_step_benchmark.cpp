@@ -28,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
@@ -214,7 +215,7 @@ void Run(long max_dofs) {
 }  // namespace
 }  // namespace mcrewave
 
-int main(int argc, char** argv) {
+static int BenchmarkMain(int argc, char** argv) {
   long max_dofs = 250000;
   for (int i = 1; i + 1 < argc; ++i) {
     if (std::strcmp(argv[i], "--max-dofs") == 0) max_dofs = std::atol(argv[i + 1]);
@@ -222,3 +223,5 @@ int main(int argc, char** argv) {
   mcrewave::Run(max_dofs);
   return 0;
 }
+
+int main(int argc, char** argv) { return mcrewave::bench::GuardedMain(BenchmarkMain, argc, argv); }

@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/mcre/objective.h"
@@ -194,7 +195,7 @@ void Table(const std::vector<Row>& rows, bool against_nodes) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int BenchmarkMain(int argc, char** argv) {
   int max_elements = 100000;
   int max_steps = 100000;
   double max_stored_bytes = 4e9;
@@ -238,3 +239,5 @@ int main(int argc, char** argv) {
   Table(by_steps, false);
   return 0;
 }
+
+int main(int argc, char** argv) { return mcrewave::bench::GuardedMain(BenchmarkMain, argc, argv); }

@@ -61,7 +61,7 @@ void TimeSolve(const CoupledSolverOptions& options, const Vector& moduli,
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int BenchmarkMain(int argc, char** argv) {
   int repeats = 5;
   std::string path = std::string(MCREWAVE_SOURCE_DIR) + "/configs/plate.yaml";
   bench::ParseRepeatsAndConfig(argc, argv, &repeats, &path);
@@ -126,3 +126,5 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+int main(int argc, char** argv) { return mcrewave::bench::GuardedMain(BenchmarkMain, argc, argv); }

@@ -25,6 +25,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_util.h"
 #include "mcrewave/core/file_util.h"
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
@@ -78,7 +79,7 @@ CurveFacts CostCurve(const mcrewave::BarModel& model, const mcrewave::ChannelSet
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int BenchmarkMain(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr, "usage: %s OUTPUT_DIR [seeds]\n", argv[0]);
     return 2;
@@ -174,3 +175,5 @@ int main(int argc, char** argv) {
   mcrewave::WriteFileAtomically(output_dir + "/cost_curves.csv", curves_csv.str());
   return 0;
 }
+
+int main(int argc, char** argv) { return mcrewave::bench::GuardedMain(BenchmarkMain, argc, argv); }

@@ -71,7 +71,7 @@ Figures Measure(const mcrewave::Config& config, const mcrewave::ChannelSet& data
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int BenchmarkMain(int argc, char** argv) {
   int repeats = 5;
   std::string path = "configs/paper_bar.yaml";
   mcrewave::bench::ParseRepeatsAndConfig(argc, argv, &repeats, &path);
@@ -103,3 +103,5 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+int main(int argc, char** argv) { return mcrewave::bench::GuardedMain(BenchmarkMain, argc, argv); }

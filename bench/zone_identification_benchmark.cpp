@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.h"
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/identification/zone_identification.h"
@@ -172,7 +173,7 @@ void IdentifyAndReportZones(int zones, const mcrewave::Config& config,
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int BenchmarkMain(int argc, char** argv) {
   using namespace mcrewave;
   ZoneBenchArguments arguments;
   const int status = ParseZoneBenchArguments(argc, argv, &arguments);
@@ -217,3 +218,5 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+int main(int argc, char** argv) { return mcrewave::bench::GuardedMain(BenchmarkMain, argc, argv); }
