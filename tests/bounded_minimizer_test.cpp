@@ -127,6 +127,31 @@ TEST_P(BoundedMinimizerTest, OptimumOnBounds) {
   }
 }
 
+// A start at a minimum whose cost is round-off (1e-30 above the quadratic's 0, its
+// gradient 1e-16): with matched_cost the start is the answer in one evaluation, where the
+// optimisers would see a cost scaled by 1e-30 (NLopt's L-BFGS failed so on the plate's
+// noise-free data).
+TEST_P(BoundedMinimizerTest, AStartAtTheRoundOffIsTheAnswerWithAMatchedCost) {
+  const std::vector<double> a{1.0, 2.0, 0.5};
+  const std::vector<double> c{0.3, -0.7, 1.2};
+  FunctionObjective objective(3, [&](const double* x, double* g) {
+    const double f = Quadratic(a, c, x, g) + 1e-30;
+    if (g != nullptr) g[0] += 1e-16;
+    return f;
+  });
+  const std::vector<double> lower(3, -2.0), upper(3, 2.0);
+  BoundedMinimizerOptions options = OptionsFor(GetParam());
+  options.matched_cost = 1e-20;
+  const BoundedMinimizerSummary summary =
+      MinimizeWithinBounds(options, &objective, lower, upper, c);
+  EXPECT_EQ(summary.termination, TerminationType::kConvergence) << summary.FullReport();
+  EXPECT_EQ(summary.evaluations, 1);
+  EXPECT_EQ(summary.x, c);
+  EXPECT_EQ(summary.message,
+            "the start is a minimum: its cost 1.000e-30 is at most 1.000e-20 (the data matched to "
+            "round-off)");
+}
+
 TEST_P(BoundedMinimizerTest, Rosenbrock) {
   if (GetParam().algorithm == OuterAlgorithm::kMma ||
       GetParam().algorithm == OuterAlgorithm::kCobyla) {

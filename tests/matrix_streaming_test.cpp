@@ -307,6 +307,53 @@ TEST(MatrixStreamingTest, StreamingAndStoredFieldConjugateGradientsAgree) {
   }
 }
 
+// Noise-free data of the model itself, solved at moduli 1e-12 off the truth's: the
+// start's residual Phi(d~) - d~ is at the sweeps' round-off, so no decrease relative to
+// it can be measured. The streaming CG accepts the traces once their residual is within
+// the tolerance of their own norm, as the stored-field CG accepts its round-off floor;
+// both leave e^2 at the round-off. (Before, the streaming CG restarted twice and failed.)
+TEST(MatrixStreamingTest, DataTheModelMatchesAreAcceptedAtTheSweepsRoundOff) {
+  const MatrixModelData lattice = SupportedLattice();
+  const int steps = 120;
+  const double time_step = 2e-3;
+  const Matrix loads = testing::HalfSineLoadRow(steps, time_step, 0.05);
+  ChannelSet at_rest = MatrixChannelSet(
+      lattice, time_step, loads, Matrix::Zero(static_cast<int>(lattice.sensors.size()), steps + 1));
+  at_rest.Add("R", ChannelKind::kForce, Vector::Zero(steps + 1));
+  at_rest.Add("uR", ChannelKind::kDisplacement, Vector::Zero(steps + 1));
+  const Vector truth_moduli = (Vector(2) << 2e11, 1.6e11).finished();
+  MatrixMcreProblem truth(lattice, at_rest, Weights(0.01, 1.0), 2e11, 0.5, Factorization::kSparse,
+                          ClampModel::kTrusted);
+  truth.SetModuli(truth_moduli);
+  ChannelSet data = MatrixChannelSet(lattice, time_step, loads, truth.ModelOutputs());
+  data.Add("R", ChannelKind::kForce, truth.ModelSupportForces().row(0).transpose());
+  data.Add("uR", ChannelKind::kDisplacement, Vector::Zero(steps + 1));
+  MatrixMcreProblem problem(lattice, data, Weights(0.01, 1.0), 2e11, 0.5, Factorization::kSparse,
+                            ClampModel::kTrusted);
+  problem.SetModuli(truth_moduli * (1.0 + 1e-12));
+  CoupledSolverOptions options;
+  options.tolerance = 1e-8;
+  options.type = CoupledSolverType::kStreamingConjugateGradient;
+  CoupledSolution streamed, stored;
+  const CoupledSolverSummary summary = SolveCoupled(options, &problem, nullptr, &streamed);
+  ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
+  EXPECT_NE(summary.message.find("the data are matched within the tolerance"), std::string::npos)
+      << summary.message;
+  options.type = CoupledSolverType::kConjugateGradient;
+  const CoupledSolverSummary stored_summary = SolveCoupled(options, &problem, nullptr, &stored);
+  ASSERT_TRUE(stored_summary.IsSolutionUsable()) << stored_summary.FullReport();
+  // The streamed traces (the data's own) against the stored-field CG's: measured 3.4e-14.
+  EXPECT_LT(RelativeDifference(streamed.traces, problem.ObservedTraces(stored.displacement)),
+            3e-13);
+  // e^2 at the round-off: measured 4.5e-26 and 4.7e-26 J s, 1.0e-18 times the e^2 of the
+  // same data at moduli 1e-3 off (4.5e-8 J s).
+  problem.SetModuli(truth_moduli * (1.0 + 1e-3));
+  CoupledSolution off;
+  ASSERT_TRUE(SolveCoupled(options, &problem, nullptr, &off).IsSolutionUsable());
+  EXPECT_LT(streamed.cost, 1e-17 * off.cost);
+  EXPECT_LT(stored.cost, 1e-17 * off.cost);
+}
+
 // auto takes the stored-field CG while its fields fit inner.max_field_bytes and the
 // streaming CG when they do not, on a matrix model as on the bar.
 TEST(MatrixStreamingTest, AutoStreamsWhenTheFieldsDoNotFit) {

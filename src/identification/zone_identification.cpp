@@ -116,6 +116,8 @@ class RecordingObjective : public FirstOrderObjective {
 // needs it, the regularised minimisation, the merging, and the moduli, cost and zones on
 // a bound. When the target's noise cost is not usable the summary says so and nothing is
 // minimised.
+constexpr double kMatchedRelativeCost = 1e-20;
+
 template <typename NoiseCost>
 void MinimizeOverZones(const ZoneIdentificationOptions& options, LogModuliObjective* zone_objective,
                        double lower_bound, double upper_bound, NoiseCost&& expected_noise_cost,
@@ -147,8 +149,12 @@ void MinimizeOverZones(const ZoneIdentificationOptions& options, LogModuliObject
     spdlog::info("zones: discrepancy target {} / J_rest = {:.6g} (noise alone, {} draws)",
                  summary->least_squares ? "J" : "e^2", target, options.noise_samples);
   }
-  summary->regularized = MinimizeRegularized(options.minimizer, options.regularization, &recorder,
-                                             lower, upper, initial, target);
+  // e^2 / J_rest at most kMatchedRelativeCost: the admissible fields meet the data to a
+  // relative gap of 1e-10, round-off (noise-free data of the model at the start).
+  BoundedMinimizerOptions minimizer = options.minimizer;
+  if (!summary->least_squares) minimizer.matched_cost = kMatchedRelativeCost;
+  summary->regularized = MinimizeRegularized(minimizer, options.regularization, &recorder, lower,
+                                             upper, initial, target);
   const RegularizedMinimization& result = summary->regularized;
   summary->termination = result.minimizer.termination;
   summary->message = result.minimizer.message;

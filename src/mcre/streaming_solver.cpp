@@ -371,13 +371,25 @@ void StreamingConjugateGradient::StopAfterRestarts(double true_relative) {
   // The rebuild's round-off is a floor under the true residual: Phi(y) ~ y is
   // known to about rebuild_error ||y|| (1.1e-8 measured on 1e5 elements at
   // Courant number 570, where a tolerance of 1e-8 cannot be met).
-  const double floor = kRoundOffFloorFactor * totals_.rebuild_error *
-                       std::sqrt(std::max(problem_->RetrogradeEnergy(traces_), 0.0)) / rhs_norm_;
+  const double traces_norm = std::sqrt(std::max(problem_->RetrogradeEnergy(traces_), 0.0));
+  const double floor = kRoundOffFloorFactor * totals_.rebuild_error * traces_norm / rhs_norm_;
   if (true_relative <= floor) {
     summary_->at_round_off_floor = true;
     Accept("relative residual " + ScientificString(true_relative) + " at the round-off floor " +
            ScientificString(floor) + " of the rebuilt field (tolerance " +
            ScientificString(options_.tolerance) + ")");
+    return;
+  }
+  // Data the model matches to within the tolerance of their own norm (noise-free data of
+  // the model itself, at or near its moduli): the start's residual r_0 = Phi(d~) - d~ is
+  // then at the sweeps' round-off, and no decrease relative to it can be measured.
+  // Accepted when ||r_0||_W and ||r||_W are both within the tolerance of ||y||_W, y the
+  // traces (about d~).
+  if (std::max(rhs_norm_, true_relative * rhs_norm_) <= options_.tolerance * traces_norm) {
+    Accept("the data are matched within the tolerance: the residual " +
+           ScientificString(true_relative * rhs_norm_ / traces_norm) +
+           " of the traces' norm (the start's was " + ScientificString(rhs_norm_ / traces_norm) +
+           ", at the sweeps' round-off)");
     return;
   }
   if (true_relative > 0.1 * previous_true_relative_ &&

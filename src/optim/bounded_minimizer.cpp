@@ -6,6 +6,7 @@
 #include <sstream>
 #include <vector>
 
+#include "mcrewave/core/format.h"
 #include "mcrewave/optim/algorithms.h"
 #include "optim/ceres_driver.h"
 #include "optim/guarded_objective.h"
@@ -165,6 +166,13 @@ BoundedMinimizerSummary MinimizeWithinBounds(const BoundedMinimizerOptions& opti
                       gradient_based ? start_gradient.data() : nullptr)) {
     outcome.termination = guard.StopTermination();
     outcome.message = guard.stop_message();
+  } else if (options.matched_cost > 0.0 && start_cost <= options.matched_cost) {
+    // Scaled by a cost at the round-off the optimisers' steps would be noise.
+    outcome.termination = TerminationType::kConvergence;
+    outcome.message = "the start is a minimum: its cost " +
+                      FormatNumber(start_cost, kScientificThreeDecimals) + " is at most " +
+                      FormatNumber(options.matched_cost, kScientificThreeDecimals) +
+                      " (the data matched to round-off)";
   } else {
     if (std::abs(start_cost) > 0.0) guard.set_cost_scale(std::abs(start_cost));
     outcome = options.optimizer == OptimizerType::kCeres

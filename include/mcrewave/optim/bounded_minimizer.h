@@ -54,6 +54,10 @@ struct BoundedMinimizerOptions {
   int max_evaluations = 2000;
   // Wall time allowed [s]; reaching it is not convergence.
   double max_time = 600.0;
+  // A start whose cost is at most this is a minimum already (data the model matches to
+  // round-off): the optimiser does not run, the start is the answer, converged. Not a
+  // config key: set by the caller that knows the cost's scale (0: off).
+  double matched_cost = 0.0;
 
   // Valid when step_tolerance in (0, 0.1), function_tolerance in [0, 0.1),
   // max_evaluations >= 2, max_time > 0, the algorithm offered by the optimiser for
