@@ -215,6 +215,15 @@ TEST(BarZonesTest, ElementsBelongToTheZoneOfTheirMidpoint) {
   EXPECT_EQ(layout.ElementZones(bar), (std::vector<int>{0, 0, 0, 0, 0, 0, 1, 2, 2, 2}));
   layout.zoning = Zoning::kPerElement;
   EXPECT_EQ(layout.ElementZones(bar), (std::vector<int>{0, 1, 2, 3, 4, 5, 6, 7, 8, 9}));
+  // A grid of one count along the bar: equal zones.
+  layout.zoning = Zoning::kGrid;
+  layout.zone_grid = {3};
+  EXPECT_EQ(layout.Validate(bar), "");
+  EXPECT_EQ(layout.ElementZones(bar), (std::vector<int>{0, 0, 0, 1, 1, 1, 1, 2, 2, 2}));
+  layout.zone_grid = {3, 2};
+  EXPECT_NE(layout.Validate(bar).find("model.zone_grid must hold one count"), std::string::npos);
+  layout.zone_grid = {11};
+  EXPECT_NE(layout.Validate(bar).find("model.zone_grid must hold one count"), std::string::npos);
 }
 
 TEST(BarZonesTest, LayoutsWithoutAnElementInAZoneAreRefusedNamingTheKey) {

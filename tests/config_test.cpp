@@ -801,6 +801,8 @@ constexpr const char* kEveryMatrixKeyNotAtItsDefault = R"(model:
   kind: matrix
   manifest: "plate dir/model #2.yaml"
   channel_map: {F: "F [N]", uy_tip: "tip #1"}
+  zoning: grid
+  zone_grid: [16, 4]
 data:
   truth_manifest: fine/model.yaml
   truth_moduli: [2e11, 1.4000000000000001e11]
@@ -892,7 +894,7 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
     EXPECT_EQ(bar_keys.count(key), 1u) << key;
   }
   // The bar reads all but the 4 matrix keys; a matrix run none of the section study:
-  // and 16 single keys fewer (it reads the dense solvers' limits, Riccati and shooting
+  // and 15 single keys fewer (it reads the dense solvers' limits, Riccati and shooting
   // running on any model, and the zones' regularisation and merging).
   EXPECT_EQ(bar_keys.size(), every.size() - 4);
   std::size_t sections = 0;
@@ -900,7 +902,7 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
     const std::string section = key.substr(0, key.find('.'));
     sections += section == "study" ? 1 : 0;
   }
-  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 16);
+  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 15);
   // Values as resolved: the matrix run's own.
   EXPECT_EQ(matrix_keys.at("model.manifest"), FlatKeys(ConfigToYaml(matrix)).at("model.manifest"));
 }
@@ -929,8 +931,19 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
        "model.zone_count applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\ndata:\n  sensors: [u@0.5]\n",
        "data.sensors applies to the bar only"},
-      {"model:\n  kind: matrix\n  manifest: m.yaml\n  zoning: per_element\n",
-       "model.zoning applies to the bar only"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\n  zoning: boundaries\n",
+       "model.zoning 'boundaries' applies to the bar only; on a matrix model use per_element "
+       "or grid"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\n  zoning: grid\n",
+       "model.zoning 'grid' needs model.zone_grid"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\n  zone_grid: [4, 2]\n",
+       "model.zone_grid applies to model.zoning 'grid' only"},
+      {"model:\n  zoning: grid\n  zone_grid: [4, 2]\n",
+       "model.zone_grid must hold one count of zones along the bar"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\n  zoning: grid\n  zone_grid: [4, 0]\n",
+       "model.zone_grid: expected 1 to 3 positive integers"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\n  zoning: grid\n  zone_grid: [1, 2, 3, 4]\n",
+       "model.zone_grid: expected 1 to 3 positive integers"},
       // Every key of the bar's structure away from its default, where it was set.
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  elements: 50\n",
        "kinds.yaml:4: model.elements applies to the bar only"},

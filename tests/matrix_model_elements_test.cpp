@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "file_fixture.h"
+#include "identify_binary.h"
 #include "mcrewave/model/matrix_export.h"
 
 namespace mcrewave {
@@ -173,6 +174,126 @@ TEST_F(MatrixModelElementsTest, AZoneNameThatNoDofsFileCanHoldIsNotWritten) {
   MatrixModelData data = BarMatrixModel(BarModel(bar), 2e11);
   data.zones[0].name = "a, b";
   EXPECT_THROW(WriteMatrixModel(PathOf(""), data), std::runtime_error);
+}
+
+// The stiffness of `data` at every zone's nominal modulus.
+SparseMatrix NominalStiffness(const MatrixModelData& data) {
+  return data.Stiffness(data.NominalModuli());
+}
+
+// The largest entry of |a - b| relative to b's largest.
+double RelativeDifference(const SparseMatrix& a, const SparseMatrix& b) {
+  return SparseMatrix(a - b).coeffs().cwiseAbs().maxCoeff() / b.coeffs().cwiseAbs().maxCoeff();
+}
+
+TEST_F(MatrixModelElementsTest, PerElementZonesAreTheBlocksAndKeepTheNominalStiffness) {
+  const MatrixModelData data = ReadMatrixModel(WriteFourElementBar());
+  ZoneLayout layout;
+  layout.zoning = Zoning::kPerElement;
+  std::vector<std::string> names;
+  const std::vector<int> zones = RegroupedElementZones(data, layout, "m.yaml", &names);
+  EXPECT_EQ(zones, (std::vector<int>{0, 1, 2, 3}));
+  EXPECT_EQ(names, (std::vector<std::string>{"element0", "element1", "element2", "element3"}));
+  const MatrixModelData rezoned = RezonedMatrixModel(data, zones, names);
+  ASSERT_EQ(rezoned.zones.size(), 4u);
+  for (int e = 0; e < 4; ++e) {
+    const MatrixModelZone& zone = rezoned.zones[static_cast<std::size_t>(e)];
+    EXPECT_EQ(zone.name, names[static_cast<std::size_t>(e)]);
+    EXPECT_EQ(zone.nominal_modulus, 2e11);
+    // K_e = E_nom S / h_e [1 -1; -1 1] on dofs e, e + 1, and nothing else.
+    EXPECT_EQ(zone.stiffness.nonZeros(), 4);
+    EXPECT_EQ(zone.stiffness.coeff(e, e + 1), -2e11 * 1e-4 / 0.25);
+    EXPECT_EQ(rezoned.elements[static_cast<std::size_t>(e)].zone, e);
+  }
+  // The blocks sum to each K_z, and K at the nominal moduli is the manifest's.
+  EXPECT_EQ(CheckElementBlockSums(rezoned, "m.yaml"), "");
+  EXPECT_EQ(RelativeDifference(NominalStiffness(rezoned), NominalStiffness(data)), 0.0);
+  EXPECT_EQ(rezoned.loads.size(), data.loads.size());
+  EXPECT_EQ(rezoned.sensors.size(), data.sensors.size());
+}
+
+TEST_F(MatrixModelElementsTest, ARegroupedZoneScalesItsBlocksToItsFirstElementsNominalModulus) {
+  MatrixModelData data = ReadMatrixModel(WriteFourElementBar());
+  // The manifest's second zone given at a nominal 1e11 (its K and blocks halved).
+  data.zones[1].nominal_modulus = 1e11;
+  data.zones[1].stiffness *= 0.5;
+  for (MatrixModelElement& element : data.elements) {
+    if (element.zone == 1) element.stiffness *= 0.5;
+  }
+  ZoneLayout layout;
+  layout.zoning = Zoning::kGrid;
+  layout.zone_grid = {1};
+  std::vector<std::string> names;
+  const std::vector<int> zones = RegroupedElementZones(data, layout, "m.yaml", &names);
+  EXPECT_EQ(zones, (std::vector<int>{0, 0, 0, 0}));
+  EXPECT_EQ(names, (std::vector<std::string>{"grid_0"}));
+  const MatrixModelData rezoned = RezonedMatrixModel(data, zones, names);
+  ASSERT_EQ(rezoned.zones.size(), 1u);
+  EXPECT_EQ(rezoned.zones[0].nominal_modulus, 2e11);
+  EXPECT_EQ(CheckElementBlockSums(rezoned, "m.yaml"), "");
+  // One modulus for the zone: every block at 2e11, the manifest's K at [2e11, 2e11]
+  // (summed in another order: measured 0 apart on this bar).
+  EXPECT_LT(
+      RelativeDifference(NominalStiffness(rezoned), data.Stiffness(Vector::Constant(2, 2e11))),
+      1e-15);
+}
+
+TEST_F(MatrixModelElementsTest, AGridSplitsThePlatesElementsIntoEqualBoxes) {
+  // The plate example's model: 24 x 6 elements of 1/60 x 1/60 m, centroids as positions.
+  const MatrixModelData plate =
+      ReadMatrixModel(testing::SourcePath("configs/plate/coarse/model_axial.yaml"));
+  ASSERT_EQ(plate.elements.size(), 144u);
+  ZoneLayout layout;
+  layout.zoning = Zoning::kGrid;
+  layout.zone_grid = {8, 2};
+  std::vector<std::string> names;
+  const std::vector<int> zones = RegroupedElementZones(plate, layout, "plate.yaml", &names);
+  ASSERT_EQ(names.size(), 16u);
+  EXPECT_EQ(names[0], "grid_0_0");
+  EXPECT_EQ(names[1], "grid_1_0");
+  EXPECT_EQ(names[15], "grid_7_1");
+  // Every box 3 x 3 elements: the one of an element by its centroid (x, y).
+  std::vector<int> count(16, 0);
+  for (std::size_t e = 0; e < plate.elements.size(); ++e) {
+    const Vector& x = plate.elements[e].position;
+    const int column = static_cast<int>(x[0] * 60.0) / 3, row = static_cast<int>(x[1] * 60.0) / 3;
+    EXPECT_EQ(zones[e], column + 8 * row) << "element " << e;
+    ++count[static_cast<std::size_t>(zones[e])];
+  }
+  EXPECT_EQ(count, std::vector<int>(16, 9));
+  const MatrixModelData rezoned = RezonedMatrixModel(plate, zones, names);
+  EXPECT_EQ(CheckElementBlockSums(rezoned, "plate.yaml"), "");
+  // The blocks as read (17 digits) against the manifest's two K_z: measured 2.2e-16.
+  EXPECT_LT(RelativeDifference(NominalStiffness(rezoned), NominalStiffness(plate)), 2e-15);
+}
+
+TEST_F(MatrixModelElementsTest, ALayoutTheElementsCannotServeGivesOneClearError) {
+  MatrixModelData data = ReadMatrixModel(WriteFourElementBar());
+  ZoneLayout grid;
+  grid.zoning = Zoning::kGrid;
+  grid.zone_grid = {2, 2};
+  std::vector<std::string> names;
+  auto message = [&](const MatrixModelData& model, const ZoneLayout& layout) -> std::string {
+    try {
+      RegroupedElementZones(model, layout, "m.yaml", &names);
+    } catch (const InputError& error) {
+      return error.what();
+    }
+    return "";
+  };
+  EXPECT_THAT(message(data, grid),
+              HasSubstr("model.zone_grid must hold one positive count per coordinate of the "
+                        "element positions of m.yaml (1 coordinate), got 2 values"));
+  for (MatrixModelElement& element : data.elements) element.position.resize(0);
+  EXPECT_THAT(message(data, grid), AllOf(HasSubstr("the manifest m.yaml gives none"),
+                                         HasSubstr("use model.zoning: per_element")));
+  data.elements.clear();
+  ZoneLayout per_element;
+  per_element.zoning = Zoning::kPerElement;
+  EXPECT_THAT(message(data, per_element),
+              AllOf(HasSubstr("model.zoning 'per_element' regroups the element blocks of the "
+                              "manifest m.yaml, which has none"),
+                    HasSubstr("leave model.zoning out")));
 }
 
 }  // namespace

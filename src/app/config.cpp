@@ -189,6 +189,40 @@ ValueType<std::vector<double>> NumberList() {
   return type;
 }
 
+// A YAML list of 1 to 3 positive integers ([16, 4]); a single integer is a list of one.
+ValueType<std::vector<int>> GridCounts() {
+  ValueType<std::vector<int>> type;
+  type.expected = "1 to 3 positive integers, one per coordinate, e.g. [16, 4]";
+  type.read = [](const YAML::Node& node, std::vector<int>* value) {
+    const ValueType<int> count = PositiveInteger<int>();
+    std::vector<int> parsed;
+    if (node.IsScalar()) {
+      int single;
+      if (!count.read(node, &single)) return false;
+      parsed.push_back(single);
+    } else if (node.IsSequence()) {
+      for (const YAML::Node& element : node) {
+        int element_value;
+        if (!count.read(element, &element_value)) return false;
+        parsed.push_back(element_value);
+      }
+    } else {
+      return false;
+    }
+    if (parsed.size() > 3) return false;  // [] (the default): no grid
+    *value = parsed;
+    return true;
+  };
+  type.write = [](const std::vector<int>& value) {
+    std::string text = "[";
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      text += (i == 0 ? "" : ", ") + std::to_string(value[i]);
+    }
+    return text + "]";
+  };
+  return type;
+}
+
 // A YAML list of strings ([u@0.25, e@0.65]); a single string is a list of one, an
 // empty value the empty list.
 ValueType<std::vector<std::string>> TextList() {
@@ -419,13 +453,18 @@ const std::vector<Key>& KeyTable() {
       MakeKey("model.reaction_length", &Config::model, &BarProperties::reaction_length, Number(),
               "m", "a trusted clamp's reaction: the axial force averaged over [0, this]"),
       MakeKey("model.zoning", &Config::zones, &ZoneLayout::zoning,
-              EnumByName<Zoning>({Zoning::kEqual, Zoning::kPerElement, Zoning::kBoundaries},
-                                 ZoningToString, StringToZoning),
-              "", "zones of constant modulus the identification finds (docs/zones_and_sensors.md)"),
+              EnumByName<Zoning>(
+                  {Zoning::kEqual, Zoning::kPerElement, Zoning::kBoundaries, Zoning::kGrid},
+                  ZoningToString, StringToZoning),
+              "",
+              "zones of constant modulus the identification finds (docs/zones_and_sensors.md; "
+              "a matrix model: its manifest's zones, per_element or grid)"),
       MakeKey("model.zone_count", &Config::zones, &ZoneLayout::zone_count, PositiveInteger<int>(),
               "", "zones of equal length (model.zoning: equal; 1 = the uniform bar)"),
       MakeKey("model.zone_boundaries", &Config::zones, &ZoneLayout::zone_boundaries, NumberList(),
               "m", "interior zone boundaries (model.zoning: boundaries)"),
+      MakeKey("model.zone_grid", &Config::zones, &ZoneLayout::zone_grid, GridCounts(), "",
+              "zones per coordinate of the element positions (model.zoning: grid)"),
       MakeKey("load.kind", &Config::load, &LoadOptions::kind,
               EnumByName<LoadKind>({LoadKind::kHalfSine}, LoadKindToString, StringToLoadKind), "",
               "shape of the shock load applied at x = L"),
@@ -926,6 +965,26 @@ std::string StructureKeysProblem(const Config& config) {
 bool CheckZoneLayout(const Config& config, std::string* error) {
   const ZoneLayout defaults;
   const std::string zoning = ZoningToString(config.zones.zoning);
+  if (config.zones.zoning != Zoning::kGrid && !config.zones.zone_grid.empty()) {
+    *error = "model.zone_grid applies to model.zoning 'grid' only (model.zoning is '" + zoning +
+             "'); set model.zoning: grid to use it";
+    return false;
+  }
+  if (config.zones.zoning == Zoning::kGrid && config.zones.zone_grid.empty()) {
+    *error = "model.zoning 'grid' needs model.zone_grid, the zones per coordinate (e.g. [16, 4])";
+    return false;
+  }
+  if (config.structure.kind == ModelKind::kMatrix) {
+    // The manifest's zones (the default) or its element blocks regrouped; the grid's
+    // counts are checked against the positions when the manifest is read.
+    if (config.zones.zoning == Zoning::kBoundaries) {
+      *error =
+          "model.zoning 'boundaries' applies to the bar only; on a matrix model use "
+          "per_element or grid (with model.zone_grid), or leave it out for the manifest's zones";
+      return false;
+    }
+    return true;
+  }
   if (config.zones.zoning != Zoning::kBoundaries && !config.zones.zone_boundaries.empty()) {
     *error =
         "model.zone_boundaries applies to model.zoning 'boundaries' only (model.zoning "
@@ -1427,12 +1486,10 @@ std::string FirstProblem(const Config& config) {
 // given by matrices does not read: refused there when set (RefuseKeysOfTheBar).
 bool BarOnlyKey(const std::string& path) {
   static const std::set<std::string> bar_only = {
-      "model.length",          "model.section",  "model.density",
-      "model.modulus",         "model.elements", "model.mass",
-      "model.reaction_length", "model.zoning",   "model.zone_count",
-      "model.zone_boundaries", "data.truth",     "data.truth_refinement",
-      "data.sensors",          "data.channels",  "data.truth_zones",
-      "data.support_stiffness"};
+      "model.length",          "model.section",    "model.density",         "model.modulus",
+      "model.elements",        "model.mass",       "model.reaction_length", "model.zone_count",
+      "model.zone_boundaries", "data.truth",       "data.truth_refinement", "data.sensors",
+      "data.channels",         "data.truth_zones", "data.support_stiffness"};
   return bar_only.count(path) > 0;
 }
 

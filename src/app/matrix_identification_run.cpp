@@ -92,8 +92,11 @@ ChannelSet SyntheticMatrixMeasurements(const Config& config, const MatrixModelDa
                                        Vector* truth_moduli, NoiseLevels* noise) {
   const std::string manifest = config.data.truth_manifest.empty() ? config.structure.manifest
                                                                   : config.data.truth_manifest;
+  // The truth's zones are its manifest's, also when the model regroups its elements.
   const MatrixModelData truth =
-      manifest == config.structure.manifest ? model : ReadMatrixModel(manifest);
+      manifest == config.structure.manifest && !config.zones.RegroupsElements()
+          ? model
+          : ReadMatrixModel(manifest);
   const auto zones = static_cast<int>(truth.zones.size());
   Vector moduli(zones);
   if (!config.data.truth_moduli.empty()) {
@@ -476,6 +479,16 @@ Matrix HeldSupportForces(const MatrixModelData& truth, const ChannelSet& data,
 MatrixModelData LoadMatrixModel(const Config& config) {
   assert(config.structure.kind == ModelKind::kMatrix);
   MatrixModelData model = ReadMatrixModel(config.structure.manifest);
+  if (config.zones.RegroupsElements()) {
+    // model.zoning per_element or grid: the identification's zones regroup the manifest's
+    // element blocks (model/matrix_model_elements.h).
+    std::vector<std::string> names;
+    const std::vector<int> element_zones =
+        RegroupedElementZones(model, config.zones, config.structure.manifest, &names);
+    spdlog::info("{}: model.zoning {}: {} zones of {} elements", config.structure.manifest,
+                 ZoningToString(config.zones.zoning), names.size(), model.elements.size());
+    model = RezonedMatrixModel(model, element_zones, names);
+  }
   for (const auto& entry : config.structure.channel_map) {
     const std::string& channel = entry.first;
     const bool known =

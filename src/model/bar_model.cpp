@@ -127,6 +127,13 @@ std::string ZoneLayout::Validate(const BarProperties& bar) const {
       break;
     case Zoning::kPerElement:
       break;
+    case Zoning::kGrid:
+      if (zone_grid.size() != 1 || zone_grid[0] < 1 || zone_grid[0] > bar.elements) {
+        why << "model.zone_grid must hold one count of zones along the bar, between 1 and "
+               "model.elements = "
+            << bar.elements << ", with model.zoning: grid on the bar";
+      }
+      break;
     case Zoning::kBoundaries: {
       if (zone_boundaries.empty()) {
         why << "model.zone_boundaries must list at least one interior boundary [m] with "
@@ -172,10 +179,12 @@ std::vector<int> ZoneLayout::ElementZones(const BarProperties& bar) const {
     const double middle = (e + 0.5) * he;
     switch (zoning) {
       case Zoning::kEqual:
+      case Zoning::kGrid: {
         // Zone z holds [z L / Z, (z + 1) L / Z): floor(Z x / L), clamped to Z - 1.
-        zones[e] = std::min(zone_count - 1,
-                            static_cast<int>(std::floor(zone_count * middle / bar.length)));
+        const int count = zoning == Zoning::kGrid ? zone_grid[0] : zone_count;
+        zones[e] = std::min(count - 1, static_cast<int>(std::floor(count * middle / bar.length)));
         break;
+      }
       case Zoning::kPerElement:
         zones[e] = e;
         break;

@@ -1,12 +1,14 @@
 #include "mcrewave/model/matrix_model_elements.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -256,6 +258,134 @@ std::string CheckElementBlockSums(const MatrixModelData& data, const std::string
            ShortNumber(relative_tolerance) + ")";
   }
   return "";
+}
+
+std::vector<int> RegroupedElementZones(const MatrixModelData& data, const ZoneLayout& layout,
+                                       const std::string& manifest_name,
+                                       std::vector<std::string>* zone_names) {
+  assert(layout.RegroupsElements());
+  const std::string zoning = ZoningToString(layout.zoning);
+  const auto elements = static_cast<int>(data.elements.size());
+  if (elements == 0) {
+    throw InputError("model.zoning '" + zoning + "' regroups the element blocks of the manifest " +
+                     manifest_name +
+                     ", which has none: give them (key elements, docs/matrix_models.md section "
+                     "4) or leave model.zoning out to identify the manifest's zones");
+  }
+  std::vector<int> zones(static_cast<std::size_t>(elements), 0);
+  zone_names->clear();
+  if (layout.zoning == Zoning::kPerElement) {
+    for (int e = 0; e < elements; ++e) {
+      zones[static_cast<std::size_t>(e)] = e;
+      zone_names->push_back("element" + std::to_string(e));
+    }
+    return zones;
+  }
+  const Eigen::Index dimension = data.elements[0].position.size();
+  if (dimension == 0) {
+    throw InputError(
+        "model.zoning 'grid' places the elements by their positions, and the "
+        "manifest " +
+        manifest_name +
+        " gives none: add elements.positions (docs/matrix_models.md section 4) or "
+        "use model.zoning: per_element");
+  }
+  const std::vector<int>& counts = layout.zone_grid;
+  if (static_cast<Eigen::Index>(counts.size()) != dimension ||
+      std::any_of(counts.begin(), counts.end(), [](int count) { return count < 1; })) {
+    throw InputError(
+        "model.zone_grid must hold one positive count per coordinate of the "
+        "element positions of " +
+        manifest_name + " (" + std::to_string(dimension) + " coordinate" +
+        (dimension == 1 ? "" : "s") + "), got " + std::to_string(counts.size()) + " values");
+  }
+  Eigen::ArrayXd low = data.elements[0].position.array(), high = low;
+  for (const MatrixModelElement& element : data.elements) {
+    low = low.min(element.position.array());
+    high = high.max(element.position.array());
+  }
+  // Box index along d: floor((x_d - min_d) / (max_d - min_d) n_d), the last box closed;
+  // the flat index runs over the boxes with the first coordinate fastest.
+  std::vector<int> box_of(static_cast<std::size_t>(elements), 0);
+  for (int e = 0; e < elements; ++e) {
+    const Vector& x = data.elements[static_cast<std::size_t>(e)].position;
+    int flat = 0, stride = 1;
+    for (Eigen::Index d = 0; d < dimension; ++d) {
+      const int n = counts[static_cast<std::size_t>(d)];
+      const double extent = high[d] - low[d];
+      const int box =
+          extent > 0.0 ? std::min(n - 1, static_cast<int>(std::floor((x[d] - low[d]) / extent * n)))
+                       : 0;
+      flat += box * stride;
+      stride *= n;
+    }
+    box_of[static_cast<std::size_t>(e)] = flat;
+  }
+  // The boxes that hold an element, in flat order, become zones 0, 1, ...
+  std::map<int, int> zone_of_box;
+  for (int box : box_of) zone_of_box.emplace(box, 0);
+  for (auto& [box, zone] : zone_of_box) {
+    zone = static_cast<int>(zone_names->size());
+    std::string name = "grid";
+    for (std::size_t d = 0, rest = static_cast<std::size_t>(box); d < counts.size(); ++d) {
+      name += "_" + std::to_string(rest % static_cast<std::size_t>(counts[d]));
+      rest /= static_cast<std::size_t>(counts[d]);
+    }
+    zone_names->push_back(std::move(name));
+  }
+  for (int e = 0; e < elements; ++e) {
+    zones[static_cast<std::size_t>(e)] = zone_of_box.at(box_of[static_cast<std::size_t>(e)]);
+  }
+  return zones;
+}
+
+MatrixModelData RezonedMatrixModel(const MatrixModelData& data,
+                                   const std::vector<int>& element_zones,
+                                   const std::vector<std::string>& zone_names) {
+  assert(!data.elements.empty() && element_zones.size() == data.elements.size());
+  const auto zones = zone_names.size();
+  MatrixModelData rezoned;
+  rezoned.mass = data.mass;
+  rezoned.stiffness_length = data.stiffness_length;
+  rezoned.length = data.length;
+  rezoned.loads = data.loads;
+  rezoned.sensors = data.sensors;
+  rezoned.supports = data.supports;
+  rezoned.zones.resize(zones);
+  std::vector<bool> named(zones, false);
+  std::vector<std::vector<Eigen::Triplet<double>>> entries(zones);
+  rezoned.elements.reserve(data.elements.size());
+  for (std::size_t e = 0; e < data.elements.size(); ++e) {
+    const MatrixModelElement& element = data.elements[e];
+    const auto z = static_cast<std::size_t>(element_zones[e]);
+    assert(z < zones);
+    const double element_nominal =
+        data.zones[static_cast<std::size_t>(element.zone)].nominal_modulus;
+    if (!named[z]) {
+      rezoned.zones[z].name = zone_names[z];
+      rezoned.zones[z].nominal_modulus = element_nominal;
+      named[z] = true;
+    }
+    // The block at the new zone's nominal modulus: (E_z',nom / E_zone(e),nom) K_e.
+    MatrixModelElement moved = element;
+    moved.zone = static_cast<int>(z);
+    moved.stiffness *= rezoned.zones[z].nominal_modulus / element_nominal;
+    const auto k = static_cast<Eigen::Index>(moved.dofs.size());
+    for (Eigen::Index a = 0; a < k; ++a) {
+      for (Eigen::Index b = 0; b < k; ++b) {
+        entries[z].emplace_back(moved.dofs[static_cast<std::size_t>(a)],
+                                moved.dofs[static_cast<std::size_t>(b)], moved.stiffness(a, b));
+      }
+    }
+    rezoned.elements.push_back(std::move(moved));
+  }
+  const int n = data.dofs();
+  for (std::size_t z = 0; z < zones; ++z) {
+    assert(named[z]);
+    rezoned.zones[z].stiffness.resize(n, n);
+    rezoned.zones[z].stiffness.setFromTriplets(entries[z].begin(), entries[z].end());
+  }
+  return rezoned;
 }
 
 namespace {

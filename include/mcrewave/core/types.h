@@ -107,11 +107,13 @@ enum class Zoning {
   kEqual,       // model.zone_count zones of equal length
   kPerElement,  // one zone per element
   kBoundaries,  // zones between the interior boundaries model.zone_boundaries [m]
+  kGrid,        // the boxes of a regular grid over the elements' positions (model.zone_grid)
 };
-inline constexpr std::array<std::pair<Zoning, const char*>, 3> kZoningNames{{
+inline constexpr std::array<std::pair<Zoning, const char*>, 4> kZoningNames{{
     {Zoning::kEqual, "equal"},
     {Zoning::kPerElement, "per_element"},
     {Zoning::kBoundaries, "boundaries"},
+    {Zoning::kGrid, "grid"},
 }};
 const char* ZoningToString(Zoning zoning);
 bool StringToZoning(const std::string& name, Zoning* zoning);

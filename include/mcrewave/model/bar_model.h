@@ -70,20 +70,29 @@ std::vector<double> ZoneModuliInSeries(const BarModel& model, const Vector& elem
 std::string ValidateModulusZones(const BarProperties& bar, const std::vector<ModulusZone>& zones,
                                  const std::string& key);
 
-// The identification's zones: which zone each element belongs to.
+// The identification's zones: which zone each element belongs to. On the bar every
+// zoning applies; on a structure given by matrices the default (kEqual with one zone)
+// keeps the manifest's zones, and kPerElement and kGrid regroup its element blocks
+// (RezonedMatrixModel, model/matrix_model_elements.h).
 struct ZoneLayout {
   Zoning zoning = Zoning::kEqual;
   int zone_count = 1;                   // kEqual: Z zones of equal length
   std::vector<double> zone_boundaries;  // kBoundaries: interior boundaries [m], increasing
+  // kGrid: boxes per coordinate of the elements' positions (1 to 3 counts); on the bar
+  // one count Z, the same zones as kEqual with Z.
+  std::vector<int> zone_grid;
 
+  // True when the layout regroups a matrix model's elements (kPerElement, kGrid).
+  bool RegroupsElements() const { return zoning == Zoning::kPerElement || zoning == Zoning::kGrid; }
   // Empty when the layout is usable on `bar` (every zone holds at least one element,
-  // boundaries strictly inside (0, L) and increasing); otherwise the reason, naming
-  // the keys model.zoning, model.zone_count, model.zone_boundaries.
+  // boundaries strictly inside (0, L) and increasing, one grid count); otherwise the
+  // reason, naming the keys model.zoning, model.zone_count, model.zone_boundaries,
+  // model.zone_grid.
   std::string Validate(const BarProperties& bar) const;
   // The zone of each element, by its midpoint: zone z holds the elements whose
   // midpoint lies in [b_z, b_{z+1}) (the last zone up to L inclusive), b_0 = 0,
-  // b_Z = L; kEqual: b_z = z L / Z; kPerElement: zone e = element e.
-  // Precondition: Validate(bar) is empty.
+  // b_Z = L; kEqual: b_z = z L / Z (kGrid: Z = zone_grid[0]); kPerElement: zone e =
+  // element e. Precondition: Validate(bar) is empty.
   std::vector<int> ElementZones(const BarProperties& bar) const;
 };
 

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "mcrewave/core/types.h"
+#include "mcrewave/model/bar_model.h"
 
 namespace mcrewave {
 
@@ -66,6 +67,36 @@ std::vector<MatrixModelElement> ReadMatrixModelElements(const MatrixModelElement
 // Precondition: every element's dofs in range and zone valid.
 std::string CheckElementBlockSums(const MatrixModelData& data, const std::string& manifest_name,
                                   double relative_tolerance = kElementSumTolerance);
+
+// The zone of each element of data.elements under `layout` (one that RegroupsElements)
+// and the regrouped zones' names, in their order:
+//   per_element  zone e = element e, named "element<e>" (0-based, as error_map.csv counts);
+//   grid         the bounding box of the elements' positions split into zone_grid[d]
+//                equal boxes along coordinate d; an element lies in the box of its position
+//                (floor((x_d - min_d) / (max_d - min_d) zone_grid[d]), the last box closed).
+//                The boxes that hold an element are the zones, numbered with the first
+//                coordinate fastest and named "grid_<i>[_<j>[_<k>]]" (0-based box indices);
+//                empty boxes are left out (a plate with a hole, say).
+// Throws InputError naming manifest_name and the key to change when the model has no
+// element blocks, a grid has no positions to place them, or zone_grid does not hold one
+// positive count per coordinate of the positions.
+std::vector<int> RegroupedElementZones(const MatrixModelData& data, const ZoneLayout& layout,
+                                       const std::string& manifest_name,
+                                       std::vector<std::string>* zone_names);
+
+// `data` with its zones replaced by one zone per name of zone_names, zone z' holding the
+// elements e with element_zones[e] = z':
+//   K_z' = sum_{e in z'} (E_z',nom / E_zone(e),nom) P_e^T K_e P_e,
+// so that at a modulus E of z' every one of its elements is at E. E_z',nom is the
+// nominal modulus of the manifest zone of z''s first element; where the manifest's zones
+// share one nominal modulus, the stiffness at the nominal moduli is the manifest's (up to
+// the order of the sums; the blocks sum to each K_z within kElementSumTolerance when
+// read). The elements point to their new zone and their blocks are scaled the same way;
+// mass, loads, sensors and supports are kept. Precondition: data.elements not empty, element_zones
+// one entry in [0, zone_names.size()) per element, every zone holding an element.
+MatrixModelData RezonedMatrixModel(const MatrixModelData& data,
+                                   const std::vector<int>& element_zones,
+                                   const std::vector<std::string>& zone_names);
 
 // Writes data.elements into `folder` as element_dofs.csv, element_stiffness.csv and
 // (when the elements have positions) element_positions.csv, 17 significant digits,
