@@ -283,7 +283,10 @@ TEST_F(MatrixModelElementsTest, ALayoutTheElementsCannotServeGivesOneClearError)
   };
   EXPECT_THAT(message(data, grid),
               HasSubstr("model.zone_grid must hold one positive count per coordinate of the "
-                        "element positions of m.yaml (1 coordinate), got 2 values"));
+                        "element positions of m.yaml (1 coordinate), each at most its 4 "
+                        "elements, got 2 values"));
+  grid.zone_grid = {5};
+  EXPECT_THAT(message(data, grid), HasSubstr("each at most its 4 elements"));
   for (MatrixModelElement& element : data.elements) element.position.resize(0);
   EXPECT_THAT(message(data, grid), AllOf(HasSubstr("the manifest m.yaml gives none"),
                                          HasSubstr("use model.zoning: per_element")));

@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -292,12 +293,14 @@ std::vector<int> RegroupedElementZones(const MatrixModelData& data, const ZoneLa
   }
   const std::vector<int>& counts = layout.zone_grid;
   if (static_cast<Eigen::Index>(counts.size()) != dimension ||
-      std::any_of(counts.begin(), counts.end(), [](int count) { return count < 1; })) {
+      std::any_of(counts.begin(), counts.end(),
+                  [&](int count) { return count < 1 || count > elements; })) {
     throw InputError(
         "model.zone_grid must hold one positive count per coordinate of the "
         "element positions of " +
         manifest_name + " (" + std::to_string(dimension) + " coordinate" +
-        (dimension == 1 ? "" : "s") + "), got " + std::to_string(counts.size()) + " values");
+        (dimension == 1 ? "" : "s") + "), each at most its " + std::to_string(elements) +
+        " elements, got " + std::to_string(counts.size()) + " values");
   }
   Eigen::ArrayXd low = data.elements[0].position.array(), high = low;
   for (const MatrixModelElement& element : data.elements) {
@@ -306,10 +309,11 @@ std::vector<int> RegroupedElementZones(const MatrixModelData& data, const ZoneLa
   }
   // Box index along d: floor((x_d - min_d) / (max_d - min_d) n_d), the last box closed;
   // the flat index runs over the boxes with the first coordinate fastest.
-  std::vector<int> box_of(static_cast<std::size_t>(elements), 0);
+  // At most elements^3 boxes: within 64 bits for any model that fits in memory.
+  std::vector<std::int64_t> box_of(static_cast<std::size_t>(elements), 0);
   for (int e = 0; e < elements; ++e) {
     const Vector& x = data.elements[static_cast<std::size_t>(e)].position;
-    int flat = 0, stride = 1;
+    std::int64_t flat = 0, stride = 1;
     for (Eigen::Index d = 0; d < dimension; ++d) {
       const int n = counts[static_cast<std::size_t>(d)];
       const double extent = high[d] - low[d];
@@ -322,14 +326,15 @@ std::vector<int> RegroupedElementZones(const MatrixModelData& data, const ZoneLa
     box_of[static_cast<std::size_t>(e)] = flat;
   }
   // The boxes that hold an element, in flat order, become zones 0, 1, ...
-  std::map<int, int> zone_of_box;
-  for (int box : box_of) zone_of_box.emplace(box, 0);
+  std::map<std::int64_t, int> zone_of_box;
+  for (std::int64_t box : box_of) zone_of_box.emplace(box, 0);
   for (auto& [box, zone] : zone_of_box) {
     zone = static_cast<int>(zone_names->size());
     std::string name = "grid";
-    for (std::size_t d = 0, rest = static_cast<std::size_t>(box); d < counts.size(); ++d) {
-      name += "_" + std::to_string(rest % static_cast<std::size_t>(counts[d]));
-      rest /= static_cast<std::size_t>(counts[d]);
+    std::int64_t rest = box;
+    for (const int count : counts) {
+      name += "_" + std::to_string(rest % count);
+      rest /= count;
     }
     zone_names->push_back(std::move(name));
   }

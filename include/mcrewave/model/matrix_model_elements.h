@@ -79,7 +79,7 @@ std::string CheckElementBlockSums(const MatrixModelData& data, const std::string
 //                empty boxes are left out (a plate with a hole, say).
 // Throws InputError naming manifest_name and the key to change when the model has no
 // element blocks, a grid has no positions to place them, or zone_grid does not hold one
-// positive count per coordinate of the positions.
+// count per coordinate of the positions, each in [1, elements].
 std::vector<int> RegroupedElementZones(const MatrixModelData& data, const ZoneLayout& layout,
                                        const std::string& manifest_name,
                                        std::vector<std::string>* zone_names);
