@@ -164,16 +164,6 @@ def write_rows(path, rows, n, comment):
     os.replace(path + ".tmp", path)
 
 
-def write_vector(path, vector, comment):
-    with open(path + ".tmp", "w") as f:
-        f.write("%%MatrixMarket matrix array real general\n")
-        f.write("% " + comment + "\n")
-        f.write(f"{len(vector)} 1\n")
-        for value in vector:
-            f.write(f"{value:.17g}\n")
-    os.replace(path + ".tmp", path)
-
-
 def write_text(path, text):
     with open(path + ".tmp", "w") as f:
         f.write(text)
@@ -189,7 +179,7 @@ def write_channels(folder, grid):
     for j in range(grid.ny):
         for nj in (j, j + 1):
             load[grid.dof(grid.nx, nj, 0)] += 0.5 / grid.ny
-    write_vector(os.path.join(folder, "load_Fx.mtx"), load,
+    textbook.write_vector(os.path.join(folder, "load_Fx.mtx"), load,
                  "unit +x traction resultant on the edge x = L; history: channel F [N]")
     names, rows = [], []
     for j in range(model.ny + 1):

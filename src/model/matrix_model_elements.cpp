@@ -349,14 +349,9 @@ MatrixModelData RezonedMatrixModel(const MatrixModelData& data,
                                    const std::vector<std::string>& zone_names) {
   assert(!data.elements.empty() && element_zones.size() == data.elements.size());
   const auto zones = zone_names.size();
-  MatrixModelData rezoned;
-  rezoned.mass = data.mass;
-  rezoned.stiffness_length = data.stiffness_length;
-  rezoned.length = data.length;
-  rezoned.loads = data.loads;
-  rezoned.sensors = data.sensors;
-  rezoned.supports = data.supports;
-  rezoned.zones.resize(zones);
+  MatrixModelData rezoned = data;  // mass, scales, loads, sensors and supports kept
+  rezoned.zones.assign(zones, MatrixModelZone{});
+  rezoned.elements.clear();
   std::vector<bool> named(zones, false);
   std::vector<std::vector<Eigen::Triplet<double>>> entries(zones);
   rezoned.elements.reserve(data.elements.size());
