@@ -109,6 +109,11 @@ class RecordingObjective : public FirstOrderObjective {
   std::vector<ZoneEvaluation>* history_;
 };
 
+// A start of e^2 / J_rest at most this is a minimum already: the admissible fields meet
+// the data to a relative gap of 1e-10, round-off (noise-free data of the model at the
+// start; BoundedMinimizerOptions::matched_cost).
+constexpr double kMatchedRelativeCost = 1e-20;
+
 // The steps both functionals share, on zone_objective (a function of p_z =
 // log(E_z / E_z,ref), its cost scaled by summary->cost_scale, which the caller has set)
 // from summary->start_moduli: the discrepancy target from expected_noise_cost() (the
@@ -116,8 +121,6 @@ class RecordingObjective : public FirstOrderObjective {
 // needs it, the regularised minimisation, the merging, and the moduli, cost and zones on
 // a bound. When the target's noise cost is not usable the summary says so and nothing is
 // minimised.
-constexpr double kMatchedRelativeCost = 1e-20;
-
 template <typename NoiseCost>
 void MinimizeOverZones(const ZoneIdentificationOptions& options, LogModuliObjective* zone_objective,
                        double lower_bound, double upper_bound, NoiseCost&& expected_noise_cost,
@@ -149,8 +152,6 @@ void MinimizeOverZones(const ZoneIdentificationOptions& options, LogModuliObject
     spdlog::info("zones: discrepancy target {} / J_rest = {:.6g} (noise alone, {} draws)",
                  summary->least_squares ? "J" : "e^2", target, options.noise_samples);
   }
-  // e^2 / J_rest at most kMatchedRelativeCost: the admissible fields meet the data to a
-  // relative gap of 1e-10, round-off (noise-free data of the model at the start).
   BoundedMinimizerOptions minimizer = options.minimizer;
   if (!summary->least_squares) minimizer.matched_cost = kMatchedRelativeCost;
   summary->regularized = MinimizeRegularized(minimizer, options.regularization, &recorder, lower,
