@@ -1,29 +1,35 @@
 #!/usr/bin/env python3
 """Regenerates results/plate_zones/: the 64 zones of the many-zone plate
-(configs/plate_zones.yaml, configs/plate_zones/README.md) identified by the MCRE for each
-case of CASES (truth, sensor set, SNR), and each run's zones set against its truth.
+(configs/plate_zones.yaml, configs/plate_zones/README.md) identified by the MCRE and by
+output-error least squares (the same zones, data, total variation and weight rule) for
+each case of CASES (truth, sensor set, SNR), and each run's zones set against its truth.
 
-For every case, `identify run configs/plate_zones.yaml` with the case's truth, manifest
-and SNR (the cost curve at 5 points, no figures of its own) into a temporary folder; its
-zones.csv and error_map.csv are kept in results/plate_zones/<case>/. Then, per case:
+For every case and functional, `identify run configs/plate_zones.yaml` with the case's
+truth, manifest and SNR (the cost curve at 5 points, no figures of its own) into a
+temporary folder; its zones.csv (least squares: least_squares_zones.csv) and, by the
+MCRE, error_map.csv are kept in results/plate_zones/<case>/. Then, per run:
 
   - the truth of each zone: the moduli of the truth's fine elements whose model element
     lies in the zone, combined in series (1 / E = mean of 1 / E_el, the Reuss bound) and
     in parallel (mean of E_el, the Voigt bound); a zone is 'changed' when its series
     modulus differs from 200 GPa by more than 0.1 %;
   - localisation: of the k changed zones, how many are among the k zones farthest from
-    the homogeneous E* (|ln E_z / E*|), and how many among the k largest shares of the
-    error map at the nominal moduli (zones.csv error_share_nominal); whether the map's
-    peak is a changed zone;
+    the zones' geometric mean (|ln E_z / E_mean|), and, by the MCRE, how many among the k
+    largest shares of the error map at the nominal moduli (zones.csv
+    error_share_nominal); whether the map's peak is a changed zone;
   - sizing: the changed zones' worst relative error against the series truth (and
-    whether E lies between the two bounds), the other zones' worst and rms error.
+    how many lie between the two bounds), the other zones' worst and rms error.
 
-Writes cases.csv (a row per case), summary.md, and <case>/maps.png: the truth (series),
-the identified moduli and the error map's share per zone at the nominal moduli, on the
-16 x 4 grid (gnuplot). Prints progress; the files are written atomically.
+Writes cases.csv (a row per case and functional), summary.md (from cases.csv), and
+<case>/maps.png: the truth (series), the MCRE's and least squares' moduli, and the error
+map's share per zone at the nominal moduli, on the 16 x 4 grid (gnuplot). Prints
+progress; the files are written atomically.
 
-Usage: /usr/bin/python3 scripts/plate_zones_study.py BUILD_DIR RESULTS_DIR [--figures-only]
-       (--figures-only: no run; each case's maps.png drawn again from its kept zones.csv)
+Usage: /usr/bin/python3 scripts/plate_zones_study.py BUILD_DIR RESULTS_DIR
+           [--functional mcre|least_squares|both] [--figures-only]
+       --functional: the runs to make (default both); the other functional's rows of an
+           existing cases.csv are kept.
+       --figures-only: no run; maps.png and summary.md drawn again from the kept files.
 """
 
 import csv
@@ -86,9 +92,16 @@ def truth_of_zones(truth):
             for name, m in moduli.items()}
 
 
-def run_case(build_dir, work, truth, manifest, snr):
+FUNCTIONALS = ("mcre", "least_squares")
+
+
+def zones_file(functional):
+    return "zones.csv" if functional == "mcre" else "least_squares_zones.csv"
+
+
+def run_case(build_dir, work, truth, manifest, snr, functional):
     moduli = [1.0] + [modulus for _, modulus, _ in TRUTHS[truth]]
-    folder = os.path.join(work, case_name(truth, manifest, snr))
+    folder = os.path.join(work, case_name(truth, manifest, snr) + "_" + functional)
     command = [os.path.join(build_dir, "identify", "identify"), "run",
                os.path.join(ROOT, "configs", "plate_zones.yaml"),
                "--set", f"model.manifest=plate_zones/model/{manifest}.yaml",
@@ -97,6 +110,8 @@ def run_case(build_dir, work, truth, manifest, snr):
                ",".join(f"{m * NOMINAL_MODULUS:.17g}" for m in moduli) + "]",
                "--set", f"data.snr={snr:g}", "--set", "output.curve_points=5",
                "--set", "output.figures=false", "-q", "-o", folder]
+    if functional == "least_squares":
+        command[3:3] = ["--set", "outer.functional=least_squares"]
     start = time.monotonic()
     subprocess.run(command, check=True)
     return folder, time.monotonic() - start
@@ -111,14 +126,15 @@ def analyse(zones_csv, truth):
         series, parallel = truths[r["name"]]
         zones.append({"name": r["name"], "E": float(r["modulus_pa"]) / NOMINAL_MODULUS,
                       "series": series, "parallel": parallel,
-                      "share": float(r["error_share_nominal"]),
+                      "share": float(r["error_share_nominal"] or "nan"),
                       "distance": abs(math.log(float(r["modulus_pa"]) / homogeneous))})
     changed = [z for z in zones if abs(z["series"] - 1.0) > CHANGED]
     others = [z for z in zones if abs(z["series"] - 1.0) <= CHANGED]
     k = len(changed)
     names = {z["name"] for z in changed}
     by_distance = sorted(zones, key=lambda z: -z["distance"])[:k]
-    by_share = sorted(zones, key=lambda z: -z["share"])
+    mapped = not math.isnan(zones[0]["share"])  # least squares has no error map
+    by_share = sorted(zones, key=lambda z: -z["share"]) if mapped else []
     errors = [abs(z["E"] / z["series"] - 1.0) for z in changed]
     within = sum(1 for z in changed
                  if min(z["series"], z["parallel"]) * 0.999 <= z["E"]
@@ -127,8 +143,8 @@ def analyse(zones_csv, truth):
     return zones, {
         "changed_zones": k,
         "found_by_moduli": sum(1 for z in by_distance if z["name"] in names),
-        "found_by_error_map": sum(1 for z in by_share[:k] if z["name"] in names),
-        "error_map_peak_changed": by_share[0]["name"] in names,
+        "found_by_error_map": sum(1 for z in by_share[:k] if z["name"] in names) if mapped else "",
+        "error_map_peak_changed": (str(by_share[0]["name"] in names).lower() if mapped else ""),
         "changed_worst_error": max(errors),
         "changed_within_bounds": within,
         "other_worst_error": max(abs(e) for e in other_errors),
@@ -136,18 +152,25 @@ def analyse(zones_csv, truth):
     }
 
 
-def write_maps(folder, zones, title):
-    """maps.png: truth (series), identified and nominal error share on the zone grid."""
+def write_maps(folder, zones, ls_zones, title):
+    """maps.png: truth (series), the MCRE's and least squares' moduli (ls_zones: None when
+    not run) and the nominal error share on the zone grid."""
     data = os.path.join(folder, "maps.dat")
-    lines = ["# i j truth_series identified error_share_nominal"]
+    ls = {z["name"]: z["E"] for z in ls_zones} if ls_zones else {}
+    lines = ["# i j truth_series mcre error_share_nominal least_squares"]
     for z in zones:
         _, i, j = z["name"].split("_")
-        lines.append(f"{i} {j} {z['series']:.6f} {z['E']:.6f} {z['share']:.6g}")
+        lines.append(f"{i} {j} {z['series']:.6f} {z['E']:.6f} {z['share']:.6g} "
+                     f"{ls.get(z['name'], float('nan')):.6f}")
     write_atomic(data, "\n".join(lines) + "\n")
     png = os.path.join(folder, "maps.png")
-    script = f"""set terminal pngcairo size 900,760 font ",10"
+    panels = 4 if ls else 3
+    ls_panel = (f"""set title "identified by least squares / 200 GPa"
+plot "{data}" using 1:2:6 with image notitle
+""" if ls else "")
+    script = f"""set terminal pngcairo size 900,{250 * panels + 10} font ",10"
 set output "{png}.tmp"
-set multiplot layout 3,1 title "{title}" noenhanced
+set multiplot layout {panels},1 title "{title}" noenhanced
 set xrange [-0.5:{GRID[0] - 0.5}]
 set yrange [-0.5:{GRID[1] - 0.5}]
 set size ratio {GRID[1] / GRID[0] * LENGTH / HEIGHT / 4:.4f}
@@ -159,7 +182,7 @@ set title "truth: zone modulus in series / 200 GPa"
 plot "{data}" using 1:2:3 with image notitle
 set title "identified by the MCRE / 200 GPa"
 plot "{data}" using 1:2:4 with image notitle
-set autoscale cb
+{ls_panel}set autoscale cb
 set palette defined (0 "white", 1 "dark-green")
 set title "error map at the nominal moduli: share of e^2 per zone"
 plot "{data}" using 1:2:5 with image notitle
@@ -173,67 +196,128 @@ def case_title(truth, manifest, snr):
     return f"{truth.replace('_', ' ')}, {manifest.replace('_', ' ')}, SNR {snr:g}"
 
 
-def main():
-    build_dir, results = sys.argv[1], sys.argv[2]
-    if sys.argv[3:] == ["--figures-only"]:
-        for truth, manifest, snr in CASES:
-            out = os.path.join(results, case_name(truth, manifest, snr))
-            zones, _ = analyse(os.path.join(out, "zones.csv"), truth)
-            write_maps(out, zones, case_title(truth, manifest, snr))
-        print(f"drew {len(CASES)} maps.png in {results}")
-        return
-    os.makedirs(results, exist_ok=True)
-    header = ("case,truth,manifest,snr,changed_zones,found_by_moduli,found_by_error_map,"
-              "error_map_peak_changed,changed_worst_error,changed_within_bounds,"
-              "other_worst_error,other_rms_error,zone_evaluations,wall_time_s")
-    rows = [header]
-    table = []
-    with tempfile.TemporaryDirectory() as work:
-        for n, (truth, manifest, snr) in enumerate(CASES, 1):
-            name = case_name(truth, manifest, snr)
-            print(f"[{n}/{len(CASES)}] {name} ...", flush=True)
-            run, seconds = run_case(build_dir, work, truth, manifest, snr)
-            out = os.path.join(results, name)
-            os.makedirs(out, exist_ok=True)
-            for kept in ("zones.csv", "error_map.csv"):
-                shutil.copyfile(os.path.join(run, kept), os.path.join(out, kept + ".tmp"))
-                os.replace(os.path.join(out, kept + ".tmp"), os.path.join(out, kept))
-            evaluations = sum(1 for _ in open(os.path.join(run, "zone_evaluations.csv"))) - 1
-            zones, m = analyse(os.path.join(out, "zones.csv"), truth)
-            write_maps(out, zones, case_title(truth, manifest, snr))
-            print(f"    {seconds:.0f} s: {m['found_by_moduli']} / {m['changed_zones']} changed "
-                  f"zones found by the moduli, {m['found_by_error_map']} by the error map; "
-                  f"changed zones within {m['changed_worst_error']:.3f} of the series truth, "
-                  f"the others within {m['other_worst_error']:.4f}", flush=True)
-            rows.append(",".join(str(v) for v in (
-                name, truth, manifest, snr, m["changed_zones"], m["found_by_moduli"],
-                m["found_by_error_map"], str(m["error_map_peak_changed"]).lower(),
-                f"{m['changed_worst_error']:.6f}", m["changed_within_bounds"],
-                f"{m['other_worst_error']:.6f}", f"{m['other_rms_error']:.6f}", evaluations,
-                f"{seconds:.1f}")))
-            table.append((name, m, evaluations, seconds))
-    write_atomic(os.path.join(results, "cases.csv"), "\n".join(rows) + "\n")
-    md = ["# The many-zone plate: 64 zones by the MCRE (scripts/plate_zones_study.sh)", "",
+HEADER = ["case", "functional", "truth", "manifest", "snr", "changed_zones", "found_by_moduli",
+          "found_by_error_map", "error_map_peak_changed", "changed_worst_error",
+          "changed_within_bounds", "other_worst_error", "other_rms_error", "zone_evaluations",
+          "wall_time_s"]
+
+
+def case_row(name, functional, truth, manifest, snr, m, evaluations, seconds):
+    return {"case": name, "functional": functional, "truth": truth, "manifest": manifest,
+            "snr": f"{snr:g}", "changed_zones": m["changed_zones"],
+            "found_by_moduli": m["found_by_moduli"],
+            "found_by_error_map": m["found_by_error_map"],
+            "error_map_peak_changed": m["error_map_peak_changed"],
+            "changed_worst_error": f"{m['changed_worst_error']:.6f}",
+            "changed_within_bounds": m["changed_within_bounds"],
+            "other_worst_error": f"{m['other_worst_error']:.6f}",
+            "other_rms_error": f"{m['other_rms_error']:.6f}", "zone_evaluations": evaluations,
+            "wall_time_s": f"{seconds:.1f}"}
+
+
+def read_cases(results):
+    """The rows of results/cases.csv; none when it does not exist. A file written before
+    least squares joined the study holds the MCRE's rows only, without the column."""
+    path = os.path.join(results, "cases.csv")
+    if not os.path.exists(path):
+        return []
+    rows = list(csv.DictReader(open(path)))
+    for row in rows:
+        row.setdefault("functional", "mcre")
+    return rows
+
+
+def write_cases(results, rows):
+    order = {case_name(*c): i for i, c in enumerate(CASES)}
+    rows = sorted(rows, key=lambda r: (order[r["case"]], FUNCTIONALS.index(r["functional"])))
+    text = ",".join(HEADER) + "\n" + "".join(
+        ",".join(str(r[h]) for h in HEADER) + "\n" for r in rows)
+    write_atomic(os.path.join(results, "cases.csv"), text)
+
+
+def write_summary(results):
+    rows = read_cases(results)
+    md = ["# The many-zone plate: 64 zones by the MCRE and by least squares "
+          "(scripts/plate_zones_study.sh)", "",
           "configs/plate_zones.yaml (48 x 12 Q4 model, 16 x 4 grid of zones, total variation "
           "weighted by the discrepancy principle or the L-curve's corner) on the 96 x 24 "
-          "truths of configs/plate_zones/README.md. 'Changed' zones: those whose truth in "
-          "series differs from 200 GPa. Found: of the k changed zones, how many are among "
-          "the k zones farthest from the homogeneous modulus (moduli) or among the k largest "
-          "shares of the error map at the nominal moduli (map). Errors against the zone's "
-          "truth in series; 'within bounds': between the series and parallel bounds.", "",
-          "| case | changed zones | found (moduli) | found (map) | map's peak changed | "
-          "changed: worst error | within bounds | others: worst error | others: rms | "
-          "zone evaluations | time [s] |",
-          "|---|---|---|---|---|---|---|---|---|---|---|"]
-    for name, m, evaluations, seconds in table:
-        md.append(f"| {name} | {m['changed_zones']} | {m['found_by_moduli']} | "
-                  f"{m['found_by_error_map']} | {'yes' if m['error_map_peak_changed'] else 'no'} | "
-                  f"{100 * m['changed_worst_error']:.1f} % | {m['changed_within_bounds']} | "
-                  f"{100 * m['other_worst_error']:.2f} % | {100 * m['other_rms_error']:.2f} % | "
-                  f"{evaluations} | {seconds:.0f} |")
-    md += ["", "Each case's folder holds zones.csv and error_map.csv of its run and maps.png "
-           "(truth, identified, error map per zone).", ""]
+          "truths of configs/plate_zones/README.md; least squares on the same zones and data "
+          "with the same penalty and weight rule (outer.functional: least_squares). 'Changed' "
+          "zones: those whose truth in series differs from 200 GPa. Found: of the k changed "
+          "zones, how many are among the k zones farthest from the zones' geometric mean "
+          "(moduli) or among the k largest shares of the MCRE's error map at the nominal "
+          "moduli (map). Errors against the zone's truth in series; 'within bounds': between "
+          "the series and parallel bounds.", "",
+          "| case | functional | changed zones | found (moduli) | found (map) | map's peak "
+          "changed | changed: worst error | within bounds | others: worst error | others: rms "
+          "| zone evaluations | time [s] |",
+          "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        peak = {"true": "yes", "false": "no"}.get(r["error_map_peak_changed"], "-")
+        md.append(f"| {r['case']} | {r['functional'].replace('_', ' ')} | {r['changed_zones']} | "
+                  f"{r['found_by_moduli']} | {r['found_by_error_map'] or '-'} | {peak} | "
+                  f"{100 * float(r['changed_worst_error']):.1f} % | {r['changed_within_bounds']} | "
+                  f"{100 * float(r['other_worst_error']):.2f} % | "
+                  f"{100 * float(r['other_rms_error']):.2f} % | {r['zone_evaluations']} | "
+                  f"{float(r['wall_time_s']):.0f} |")
+    md += ["", "Each case's folder holds zones.csv and error_map.csv of the MCRE's run, "
+           "least_squares_zones.csv of least squares', and maps.png (truth, both functionals' "
+           "moduli, error map per zone).", ""]
     write_atomic(os.path.join(results, "summary.md"), "\n".join(md))
+
+
+def draw_case(results, truth, manifest, snr):
+    out = os.path.join(results, case_name(truth, manifest, snr))
+    zones, _ = analyse(os.path.join(out, "zones.csv"), truth)
+    ls_path = os.path.join(out, zones_file("least_squares"))
+    ls_zones = analyse(ls_path, truth)[0] if os.path.exists(ls_path) else None
+    write_maps(out, zones, ls_zones, case_title(truth, manifest, snr))
+
+
+def main():
+    build_dir, results = sys.argv[1], sys.argv[2]
+    options = sys.argv[3:]
+    if options == ["--figures-only"]:
+        for case in CASES:
+            draw_case(results, *case)
+        write_summary(results)
+        print(f"drew {len(CASES)} maps.png and summary.md in {results}")
+        return
+    functionals = FUNCTIONALS
+    if options[:1] == ["--functional"] and len(options) == 2 and options[1] != "both":
+        if options[1] not in FUNCTIONALS:
+            sys.exit(f"--functional: expected mcre, least_squares or both, got '{options[1]}'")
+        functionals = (options[1],)
+    elif options and options != ["--functional", "both"]:
+        sys.exit(f"unknown options {options}: expected [--functional mcre|least_squares|both] "
+                 "or --figures-only")
+    os.makedirs(results, exist_ok=True)
+    rows = [r for r in read_cases(results) if r["functional"] not in functionals]
+    runs = [(c, f) for c in CASES for f in functionals]
+    with tempfile.TemporaryDirectory() as work:
+        for n, ((truth, manifest, snr), functional) in enumerate(runs, 1):
+            name = case_name(truth, manifest, snr)
+            print(f"[{n}/{len(runs)}] {name}, {functional} ...", flush=True)
+            run, seconds = run_case(build_dir, work, truth, manifest, snr, functional)
+            out = os.path.join(results, name)
+            os.makedirs(out, exist_ok=True)
+            kept_files = [("zones.csv", zones_file(functional))]
+            if functional == "mcre":
+                kept_files.append(("error_map.csv", "error_map.csv"))
+            for source, target in kept_files:
+                shutil.copyfile(os.path.join(run, source), os.path.join(out, target + ".tmp"))
+                os.replace(os.path.join(out, target + ".tmp"), os.path.join(out, target))
+            evaluations = sum(1 for _ in open(os.path.join(run, "zone_evaluations.csv"))) - 1
+            _, m = analyse(os.path.join(out, zones_file(functional)), truth)
+            print(f"    {seconds:.0f} s: {m['found_by_moduli']} / {m['changed_zones']} changed "
+                  f"zones found by the moduli; changed zones within "
+                  f"{m['changed_worst_error']:.3f} of the series truth, the others within "
+                  f"{m['other_worst_error']:.4f}", flush=True)
+            rows.append(case_row(name, functional, truth, manifest, snr, m, evaluations, seconds))
+    write_cases(results, rows)
+    for case in CASES:
+        draw_case(results, *case)
+    write_summary(results)
     print(f"wrote {results}/cases.csv, summary.md and {len(CASES)} case folders")
 
 
