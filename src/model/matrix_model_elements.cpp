@@ -226,8 +226,11 @@ std::vector<MatrixModelElement> ReadMatrixModelElements(const MatrixModelElement
   return elements;
 }
 
-std::string CheckElementBlockSums(const MatrixModelData& data, const std::string& manifest_name,
-                                  double relative_tolerance) {
+namespace {
+
+// S_z = sum_{el in z} P_el^T K_el P_el for every zone of data (setFromTriplets sums
+// repeated entries), the elements in their order.
+std::vector<SparseMatrix> ElementBlockSums(const MatrixModelData& data) {
   const int n = data.dofs();
   std::vector<std::vector<Eigen::Triplet<double>>> entries(data.zones.size());
   for (const MatrixModelElement& element : data.elements) {
@@ -239,10 +242,21 @@ std::string CheckElementBlockSums(const MatrixModelData& data, const std::string
       }
     }
   }
+  std::vector<SparseMatrix> sums(data.zones.size(), SparseMatrix(n, n));
+  for (std::size_t z = 0; z < sums.size(); ++z) {
+    sums[z].setFromTriplets(entries[z].begin(), entries[z].end());
+  }
+  return sums;
+}
+
+}  // namespace
+
+std::string CheckElementBlockSums(const MatrixModelData& data, const std::string& manifest_name,
+                                  double relative_tolerance) {
+  const std::vector<SparseMatrix> sums = ElementBlockSums(data);
   for (std::size_t z = 0; z < data.zones.size(); ++z) {
-    // The blocks' sum S_z (setFromTriplets sums repeated entries) against K_z.
-    SparseMatrix sum(n, n);
-    sum.setFromTriplets(entries[z].begin(), entries[z].end());
+    // The blocks' sum S_z against K_z.
+    const SparseMatrix& sum = sums[z];
     const SparseMatrix& stiffness = data.zones[z].stiffness;
     const double largest =
         stiffness.nonZeros() > 0 ? stiffness.coeffs().cwiseAbs().maxCoeff() : 0.0;
@@ -353,7 +367,6 @@ MatrixModelData RezonedMatrixModel(const MatrixModelData& data,
   rezoned.zones.assign(zones, MatrixModelZone{});
   rezoned.elements.clear();
   std::vector<bool> named(zones, false);
-  std::vector<std::vector<Eigen::Triplet<double>>> entries(zones);
   rezoned.elements.reserve(data.elements.size());
   for (std::size_t e = 0; e < data.elements.size(); ++e) {
     const MatrixModelElement& element = data.elements[e];
@@ -370,20 +383,12 @@ MatrixModelData RezonedMatrixModel(const MatrixModelData& data,
     MatrixModelElement moved = element;
     moved.zone = static_cast<int>(z);
     moved.stiffness *= rezoned.zones[z].nominal_modulus / element_nominal;
-    const auto k = static_cast<Eigen::Index>(moved.dofs.size());
-    for (Eigen::Index a = 0; a < k; ++a) {
-      for (Eigen::Index b = 0; b < k; ++b) {
-        entries[z].emplace_back(moved.dofs[static_cast<std::size_t>(a)],
-                                moved.dofs[static_cast<std::size_t>(b)], moved.stiffness(a, b));
-      }
-    }
     rezoned.elements.push_back(std::move(moved));
   }
-  const int n = data.dofs();
+  std::vector<SparseMatrix> sums = ElementBlockSums(rezoned);
   for (std::size_t z = 0; z < zones; ++z) {
     assert(named[z]);
-    rezoned.zones[z].stiffness.resize(n, n);
-    rezoned.zones[z].stiffness.setFromTriplets(entries[z].begin(), entries[z].end());
+    rezoned.zones[z].stiffness = std::move(sums[z]);
   }
   return rezoned;
 }
