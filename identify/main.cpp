@@ -24,6 +24,7 @@
 //   identify run configs/plate.yaml --output /tmp/plate
 //   identify simulate configs/plate.yaml --output plate.csv
 //   identify run configs/plate.yaml --set data.source=csv --set data.path=$PWD/plate.csv -o /tmp/p
+//   identify sensors configs/plate_zones.yaml --count 20 --set data.snr=20 -o /tmp/sensors
 //   identify --print-default-config > my_config.yaml
 //
 // Description:
@@ -59,6 +60,12 @@
 //   summaries. Runs spread over study.threads threads; one progress line per
 //   completed run with the time left (-v: the identifications' own lines too).
 //
+//   `sensors` reads a YAML config of a matrix model and chooses --count of its sensors
+//   (say, of a full field) by greedy D-optimal design on the Fisher information of the
+//   zone moduli at their nominal values, under the load: history and the noise of
+//   data.snr (include/mcrewave/app/sensor_placement_run.h); it writes sensors.csv,
+//   cramer_rao.csv and channels.yaml, the data.channels block that runs `run` on them.
+//
 // Exit code 0 on success (for `run`: a converged identification); otherwise one
 // line on stderr saying why and exit code 2 for bad input (config, CSV, options,
 // an output folder that cannot be created) or 1 for a failed computation.
@@ -83,6 +90,7 @@
 #include "mcrewave/app/identification_run.h"
 #include "mcrewave/app/matrix_identification_run.h"
 #include "mcrewave/app/results.h"
+#include "mcrewave/app/sensor_placement_run.h"
 #include "mcrewave/app/study.h"
 #include "mcrewave/core/version.h"
 #include "mcrewave/data/measurement.h"
@@ -107,6 +115,13 @@ struct RunArguments {
   std::string config_path;
   std::vector<std::string> overrides;
   std::string output_folder;  // "" = output.folder of the config
+};
+
+struct SensorsArguments {
+  std::string config_path;
+  std::vector<std::string> overrides;
+  std::string output_folder;
+  int count = 20;
 };
 
 // Log levels of -v and -q; info (one line per outer evaluation) otherwise.
@@ -417,6 +432,27 @@ int RunStudy(const StudyArguments& arguments) {
   return 0;
 }
 
+int RunSensors(const SensorsArguments& arguments) {
+  // 1. Read and validate the config and the output folder.
+  const mcrewave::Config config = mcrewave::LoadConfig(arguments.config_path, arguments.overrides);
+  CheckOutputFolder(arguments.output_folder);
+
+  // 2. The candidates' information and the greedy choice.
+  const mcrewave::SensorPlacementRun run = mcrewave::RunSensorPlacement(config, arguments.count);
+
+  // 3. Write the results, each file atomically.
+  std::vector<std::string> files;
+  {
+    const ResultsBeingWritten held;
+    files = mcrewave::WriteSensorPlacementResults(run, arguments.output_folder);
+  }
+
+  // 4. Brief report.
+  spdlog::info("{} in {:.2f} s; wrote {} files to {}", run.placement.BriefReport(), run.wall_time_s,
+               files.size(), arguments.output_folder);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -478,6 +514,23 @@ int main(int argc, char** argv) {
   study_command->add_flag("-q,--quiet", study_verbosity.quiet, "Log warnings and errors only")
       ->excludes(study_verbose);
 
+  SensorsArguments sensors;
+  Verbosity sensors_verbosity;
+  CLI::App* sensors_command = app.add_subcommand(
+      "sensors", "Choose a few of a matrix model's sensors by D-optimal design; write them");
+  sensors_command->add_option("config", sensors.config_path, "YAML config file")->required();
+  sensors_command
+      ->add_option("--set", sensors.overrides,
+                   "Override a config key: --set key.path=value (repeatable)")
+      ->allow_extra_args(false)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  sensors_command->add_option("-n,--count", sensors.count, "Sensors to choose (default 20)");
+  sensors_command->add_option("-o,--output", sensors.output_folder, "Results folder")->required();
+  CLI::Option* sensors_verbose =
+      sensors_command->add_flag("-v,--verbose", sensors_verbosity.verbose, "Log more");
+  sensors_command->add_flag("-q,--quiet", sensors_verbosity.quiet, "Log warnings and errors only")
+      ->excludes(sensors_verbose);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& help_or_version) {
@@ -501,6 +554,10 @@ int main(int argc, char** argv) {
     if (study_command->parsed()) {
       study_verbosity.ApplyToStudy();
       return RunStudy(study);
+    }
+    if (sensors_command->parsed()) {
+      sensors_verbosity.Apply();
+      return RunSensors(sensors);
     }
     if (simulate_command->parsed()) {
       simulate_verbosity.Apply();

@@ -576,12 +576,12 @@ TEST(MatrixOutputErrorAllocationTest, TheTimeLoopAllocatesNothing) {
 }
 
 // The same with a support (the supported lattice: its reaction an output, the held
-// dofs decoupled), with and without the Fisher information: the same heap calls for
-// 20 and 80 steps.
+// dofs decoupled), with and without the Fisher information and each sensor's: the same
+// heap calls for 20 and 80 steps.
 TEST(MatrixOutputErrorAllocationTest, WithASupportTheTimeLoopAllocatesNothing) {
   SKIP_WITHOUT_ALLOCATION_COUNTING();
   const MatrixModelData lattice = testing::SupportedLattice();
-  HeapCalls calls[2], fisher_calls[2];
+  HeapCalls calls[2], fisher_calls[2], sensor_calls[2];
   for (int i = 0; i < 2; ++i) {
     const int samples = 1 + 20 * (1 + 3 * i);
     Matrix loads = Matrix::Zero(1, samples);
@@ -603,7 +603,14 @@ TEST(MatrixOutputErrorAllocationTest, WithASupportTheTimeLoopAllocatesNothing) {
     Matrix information;
     objective.Cost(moduli, &gradient, &information);
     fisher_calls[i] = CountHeapCalls([&] { objective.Cost(moduli, &gradient, &information); });
+    // And each sensor's: its matrices are sized before the time loop.
+    std::vector<Matrix> sensors;
+    objective.Cost(moduli, &gradient, &information, &sensors);
+    sensor_calls[i] =
+        CountHeapCalls([&] { objective.Cost(moduli, &gradient, &information, &sensors); });
   }
+  EXPECT_EQ(sensor_calls[0].allocations, sensor_calls[1].allocations);
+  EXPECT_EQ(sensor_calls[0].deallocations, sensor_calls[1].deallocations);
   EXPECT_EQ(calls[0].allocations, calls[1].allocations);
   EXPECT_EQ(calls[0].deallocations, calls[1].deallocations);
   EXPECT_EQ(fisher_calls[0].allocations, fisher_calls[1].allocations);

@@ -884,7 +884,8 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
                           "outer.initial",
                           "output.curve_points",
                           "zone_identification.merge_zones",
-                          "zone_identification.regularization"}) {
+                          "zone_identification.regularization",
+                          "data.channels"}) {
     EXPECT_EQ(matrix_keys.count(key), 1u) << key;
     EXPECT_TRUE(KeyApplies(key, ModelKind::kMatrix)) << key;
   }
@@ -894,15 +895,16 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
     EXPECT_EQ(bar_keys.count(key), 1u) << key;
   }
   // The bar reads all but the 4 matrix keys; a matrix run none of the section study:
-  // and 15 single keys fewer (it reads the dense solvers' limits, Riccati and shooting
-  // running on any model, and the zones' regularisation and merging).
+  // and 14 single keys fewer (it reads the dense solvers' limits, Riccati and shooting
+  // running on any model, the zones' regularisation and merging, and data.channels, the
+  // manifest's sensors it uses).
   EXPECT_EQ(bar_keys.size(), every.size() - 4);
   std::size_t sections = 0;
   for (const auto& [key, value] : every) {
     const std::string section = key.substr(0, key.find('.'));
     sections += section == "study" ? 1 : 0;
   }
-  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 15);
+  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 14);
   // Values as resolved: the matrix run's own.
   EXPECT_EQ(matrix_keys.at("model.manifest"), FlatKeys(ConfigToYaml(matrix)).at("model.manifest"));
 }

@@ -592,8 +592,7 @@ TEST(MatrixIdentificationRunTest, BadInputsExitWithOneLineAndWriteNothing) {
        {dir + "/short.csv:1", "lacks the column 'tip' of the model's channel 'uL'",
         "model.channel_map"}},
       // A channel missing under its own name.
-      {"--set data.source=csv --set data.path=short.csv",
-       {"short.csv:1", "lacks the column 'uL'"}},
+      {"--set data.source=csv --set data.path=short.csv", {"short.csv:1", "lacks the column 'uL'"}},
       {"--set 'model.channel_map={uX: tip}'",
        {"model.channel_map: 'uX' is not a channel of the manifest"}},
       {"--set model.manifest=missing.yaml", {"model.manifest: cannot read manifest"}},
@@ -601,6 +600,9 @@ TEST(MatrixIdentificationRunTest, BadInputsExitWithOneLineAndWriteNothing) {
       {"--set outer.lower_bound=170e9 --set outer.initial=180e9",
        {"outer.lower_bound and outer.upper_bound", "nominal modulus 1.6e+11 Pa of zone 'zone0'"}},
       {"--set model.zone_count=2", {"model.zone_count applies to the bar only"}},
+      {"--set 'data.channels=[uL, uX]'",
+       {"data.channels: 'uX' is not a sensor of the manifest", "loads and supports"}},
+      {"--set 'data.channels=[uL, uL]'", {"data.channels: 'uL' is listed twice"}},
   };
   for (const auto& [overrides, reasons] : cases) {
     const std::string out = dir + "/out";

@@ -501,7 +501,8 @@ const std::vector<Key>& KeyTable() {
               "at X m), e@X (strain at X m)"),
       MakeKey("data.channels", &Config::data, &DataOptions::channels, TextList(), "",
               "channels the identification uses ([] = every channel of the data; f0 and fL "
-              "always)"),
+              "always; on a matrix model: the manifest's sensors it uses, its loads and "
+              "supports always)"),
       MakeKey("data.truth_zones", &Config::data, &DataOptions::truth_zones, ZoneList(), "",
               "synthetic truth: stretches of another modulus, [{start: m, end: m, modulus: Pa}]"),
       MakeKey("data.support_stiffness", &Config::data, &DataOptions::support_stiffness, Number(),
@@ -895,16 +896,34 @@ SectionValidator ValidatorOf(Section Config::*section) {
   };
 }
 
+// data:'s IsValid, but on a matrix model data.channels names the manifest's sensors,
+// checked against the manifest when it is read (LoadMatrixModel), not the bar's.
+SectionValidator DataValidator() {
+  return [](const Config& config, std::string* error) {
+    if (config.structure.kind != ModelKind::kMatrix) return config.data.IsValid(error);
+    DataOptions data = config.data;
+    data.channels.clear();
+    return data.IsValid(error);
+  };
+}
+
 // One entry per section of Config, in the order of the checks.
 const std::vector<SectionValidator>& SectionValidators() {
   static const std::vector<SectionValidator> validators = {
-      ValidatorOf(&Config::structure),   ValidatorOf(&Config::model),
-      ValidatorOf(&Config::load),        ValidatorOf(&Config::time),
-      ValidatorOf(&Config::data),        ValidatorOf(&Config::mcre),
-      ValidatorOf(&Config::inner),       ValidatorOf(&Config::outer),
-      ValidatorOf(&Config::search),      ValidatorOf(&Config::prefilter),
-      ValidatorOf(&Config::uncertainty), ValidatorOf(&Config::output),
-      ValidatorOf(&Config::study),       ValidatorOf(&Config::zone_identification),
+      ValidatorOf(&Config::structure),
+      ValidatorOf(&Config::model),
+      ValidatorOf(&Config::load),
+      ValidatorOf(&Config::time),
+      DataValidator(),
+      ValidatorOf(&Config::mcre),
+      ValidatorOf(&Config::inner),
+      ValidatorOf(&Config::outer),
+      ValidatorOf(&Config::search),
+      ValidatorOf(&Config::prefilter),
+      ValidatorOf(&Config::uncertainty),
+      ValidatorOf(&Config::output),
+      ValidatorOf(&Config::study),
+      ValidatorOf(&Config::zone_identification),
   };
   return validators;
 }
@@ -1059,6 +1078,14 @@ bool CheckTwoStageScansFitLimits(const Config& config, std::string* error) {
 
 // Sensors on the bar, truth zones inside it and apart, a truth that can give them.
 bool CheckDataAgainstBar(const Config& config, std::string* error) {
+  if (config.structure.kind == ModelKind::kMatrix) {
+    // data.channels names the manifest's sensors (DataValidator); the bar's other keys of
+    // data: are refused on a matrix model (CheckStructureKeys).
+    DataOptions data = config.data;
+    data.channels.clear();
+    *error = ValidateDataAgainstBar(data, config.model);
+    return error->empty();
+  }
   *error = ValidateDataAgainstBar(config.data, config.model);
   return error->empty();
 }
@@ -1485,11 +1512,13 @@ std::string FirstProblem(const Config& config) {
 // The single keys of the bar's structure, its zones and its sensors, which a structure
 // given by matrices does not read: refused there when set (RefuseKeysOfTheBar).
 bool BarOnlyKey(const std::string& path) {
-  static const std::set<std::string> bar_only = {
-      "model.length",          "model.section",    "model.density",         "model.modulus",
-      "model.elements",        "model.mass",       "model.reaction_length", "model.zone_count",
-      "model.zone_boundaries", "data.truth",       "data.truth_refinement", "data.sensors",
-      "data.channels",         "data.truth_zones", "data.support_stiffness"};
+  static const std::set<std::string> bar_only = {"model.length",          "model.section",
+                                                 "model.density",         "model.modulus",
+                                                 "model.elements",        "model.mass",
+                                                 "model.reaction_length", "model.zone_count",
+                                                 "model.zone_boundaries", "data.truth",
+                                                 "data.truth_refinement", "data.sensors",
+                                                 "data.truth_zones",      "data.support_stiffness"};
   return bar_only.count(path) > 0;
 }
 

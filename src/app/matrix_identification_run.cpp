@@ -479,6 +479,33 @@ Matrix HeldSupportForces(const MatrixModelData& truth, const ChannelSet& data,
 MatrixModelData LoadMatrixModel(const Config& config) {
   assert(config.structure.kind == ModelKind::kMatrix);
   MatrixModelData model = ReadMatrixModel(config.structure.manifest);
+  if (!config.data.channels.empty()) {
+    // data.channels: the manifest's sensors the identification uses, in the manifest's
+    // order (a sensor layout chosen among many, e.g. by `identify sensors`).
+    std::vector<MatrixModelSensor> used;
+    for (const std::string& channel : config.data.channels) {
+      if (std::count(config.data.channels.begin(), config.data.channels.end(), channel) > 1) {
+        throw InputError(ConfigName(config) + ": data.channels: '" + channel + "' is listed twice");
+      }
+      const auto found =
+          std::find_if(model.sensors.begin(), model.sensors.end(),
+                       [&](const MatrixModelSensor& sensor) { return sensor.channel == channel; });
+      if (found == model.sensors.end()) {
+        throw InputError(ConfigName(config) + ": data.channels: '" + channel +
+                         "' is not a sensor of the manifest " + config.structure.manifest +
+                         " (its loads and supports are always used)");
+      }
+    }
+    for (MatrixModelSensor& sensor : model.sensors) {
+      const auto& names = config.data.channels;
+      if (std::find(names.begin(), names.end(), sensor.channel) != names.end()) {
+        used.push_back(std::move(sensor));
+      }
+    }
+    spdlog::info("{}: data.channels: {} of its {} sensors", config.structure.manifest, used.size(),
+                 model.sensors.size());
+    model.sensors = std::move(used);
+  }
   if (config.zones.RegroupsElements()) {
     // model.zoning per_element or grid: the identification's zones regroup the manifest's
     // element blocks (model/matrix_model_elements.h).

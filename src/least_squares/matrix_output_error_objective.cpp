@@ -154,7 +154,8 @@ void MatrixOutputErrorObjective::BuildReactions(const ChannelSet& data,
 
 double MatrixOutputErrorObjective::SampleCost(int j, const Vector& displacement,
                                               const Matrix& sensitivity, Vector* gradient,
-                                              Matrix* fisher_information) {
+                                              Matrix* fisher_information,
+                                              std::vector<Matrix>* sensor_information) {
   const int zones = num_parameters();
   const int samples = static_cast<int>(measured_outputs_.cols());
   const double h = time_step_;
@@ -175,7 +176,7 @@ double MatrixOutputErrorObjective::SampleCost(int j, const Vector& displacement,
     cost += 0.5 * c * h * force_weight_ * force_residual_.squaredNorm();
   }
   if (gradient == nullptr) return cost;
-  const bool information = fisher_information != nullptr;
+  const bool information = fisher_information != nullptr || sensor_information != nullptr;
   for (int z = 0; z < zones; ++z) {
     // c_j h sum_k w_k r_kj (H S_z,j)_k
     trace_.noalias() = observation_ * sensitivity.col(z);
@@ -188,7 +189,15 @@ double MatrixOutputErrorObjective::SampleCost(int j, const Vector& displacement,
     (*gradient)[z] += c * h * force_weight_ * force_residual_.dot(force_trace_);
     if (information) force_sensitivity_.col(z) = force_trace_;
   }
-  if (information) {
+  if (sensor_information != nullptr) {
+    // I_k += c_j w_k (h_k S_j)(h_k S_j)^T, its lower triangle (Cost fills the upper).
+    for (Eigen::Index k = 0; k < output_sensitivity_.rows(); ++k) {
+      sensor_sensitivity_ = output_sensitivity_.row(k).transpose();
+      (*sensor_information)[static_cast<std::size_t>(k)].selfadjointView<Eigen::Lower>().rankUpdate(
+          sensor_sensitivity_, c * weights_[k]);
+    }
+  }
+  if (fisher_information != nullptr) {
     // c_j [(H S_z,j)^T W (H S_z',j) + w_f (dr_j/dE_z)^T (dr_j/dE_z')], column by column
     // (no temporary in the time loop).
     for (int z = 0; z < zones; ++z) {
@@ -206,9 +215,10 @@ double MatrixOutputErrorObjective::SampleCost(int j, const Vector& displacement,
 }
 
 double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradient,
-                                        Matrix* fisher_information) {
+                                        Matrix* fisher_information,
+                                        std::vector<Matrix>* sensor_information) {
   const int zones = num_parameters();
-  assert(fisher_information == nullptr || gradient != nullptr);
+  assert((fisher_information == nullptr && sensor_information == nullptr) || gradient != nullptr);
   assert(zone_moduli.size() == zones && zone_moduli.allFinite() && zone_moduli.minCoeff() > 0.0);
   ThetaIntegratorOptions options;
   options.time_step = time_step_;
@@ -229,8 +239,13 @@ double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradi
 
   const bool gradient_requested = gradient != nullptr;
   if (gradient_requested) gradient->setZero(zones);
-  if (fisher_information != nullptr) {
-    fisher_information->setZero(zones, zones);
+  if (fisher_information != nullptr) fisher_information->setZero(zones, zones);
+  if (sensor_information != nullptr) {
+    sensor_information->assign(static_cast<std::size_t>(observation_.rows()),
+                               Matrix::Zero(zones, zones));
+    sensor_sensitivity_.resize(zones);
+  }
+  if (fisher_information != nullptr || sensor_information != nullptr) {
     output_sensitivity_.resize(observation_.rows(), zones);
     force_sensitivity_.resize(static_cast<Eigen::Index>(model_.supports.size()), zones);
   }
@@ -263,8 +278,15 @@ double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradi
       }
       current = next;
     }
-    cost +=
-        SampleCost(j, displacement_[current], sensitivity_[current], gradient, fisher_information);
+    cost += SampleCost(j, displacement_[current], sensitivity_[current], gradient,
+                       fisher_information, sensor_information);
+  }
+  if (sensor_information != nullptr) {
+    for (Matrix& information : *sensor_information) {
+      for (int z = 0; z < zones; ++z) {
+        for (int y = 0; y < z; ++y) information(y, z) = information(z, y);
+      }
+    }
   }
   sweeps_ += gradient_requested ? 1 + zones : 1;
   return cost;

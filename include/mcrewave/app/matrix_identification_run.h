@@ -62,10 +62,12 @@ struct MatrixMeasurements {
   NoiseLevels noise;
 };
 
-// Reads the manifest of config.structure.manifest. Throws InputError naming the file
-// and line (ReadMatrixModel), or the config and the key: a model.channel_map channel
-// that is not one of the manifest's; a zone's nominal modulus outside
-// [outer.lower_bound, outer.upper_bound] (the search starts there).
+// Reads the manifest of config.structure.manifest, its zones regrouped by model.zoning
+// and, when data.channels lists channels, only those of its sensors kept (in the
+// manifest's order). Throws InputError naming the file and line (ReadMatrixModel), or
+// the config and the key: a model.channel_map channel that is not one of the
+// manifest's; a data.channels channel that is not one of its sensors, or listed twice; a zone's
+// nominal modulus outside [outer.lower_bound, outer.upper_bound] (the search starts there).
 // Precondition: config.structure.kind is kMatrix.
 MatrixModelData LoadMatrixModel(const Config& config);
 

@@ -80,9 +80,15 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
   // ripple), resized to Z x Z [1/Pa^2]:
   //   I_zz' = sum_j c_j [sum_k w_k (h_k S_z,j)(h_k S_z',j)
   //                      + w_f sum_s (dr_s,j/dE_z)(dr_s,j/dE_z')].
+  // With sensor_information (then gradient must not be null), each sensor's own part of
+  // it, one Z x Z matrix per sensor in the model's order [1/Pa^2]:
+  //   I_k,zz' = sum_j c_j w_k (h_k S_z,j)(h_k S_z',j),
+  // whose sum over the sensors is I without the supports' forces (the information of
+  // any subset of the sensors: least_squares/sensor_placement.h).
   // Leaves the outputs H U_j in outputs() and the reactions r_s,j in support_forces().
   // Re-initialises the integrator (the moduli change K).
-  double Cost(const Vector& zone_moduli, Vector* gradient, Matrix* fisher_information = nullptr);
+  double Cost(const Vector& zone_moduli, Vector* gradient, Matrix* fisher_information = nullptr,
+              std::vector<Matrix>* sensor_information = nullptr);
 
   // The outputs H U_j of the last Cost, one row per sensor in the model's order, one
   // column per sample [m] or [-].
@@ -115,7 +121,7 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
   // into *gradient when it is not null.
   // With fisher_information, adds its terms of sample j too.
   double SampleCost(int j, const Vector& displacement, const Matrix& sensitivity, Vector* gradient,
-                    Matrix* fisher_information);
+                    Matrix* fisher_information, std::vector<Matrix>* sensor_information);
 
   const MatrixModelData& model_;
   double time_step_;  // h [s]
@@ -151,6 +157,7 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
   // The outputs' and reactions' derivatives of a sample, one column per zone (the
   // Fisher information's; sized on its first request).
   Matrix output_sensitivity_, force_sensitivity_;
+  Vector sensor_sensitivity_;  // one sensor's row of output_sensitivity_ (Z entries)
 
   double rest_cost_ = 0.0;
   long sweeps_ = 0;
