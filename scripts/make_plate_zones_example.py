@@ -11,9 +11,11 @@ eliminated. Two meshes of the same plate are written:
                                 M, one zone 'plate' (K.mtx) and the element blocks with
                                 their centroids, so that the config chooses the zones
                                 (model.zoning: grid or per_element; docs/matrix_models.md
-                                section 4). Two manifests: full-field data (ux and uy at
-                                every free node: one observation matrix and a file of
-                                channel names) and ten point sensors.
+                                section 4). Three manifests: full-field data (ux and uy
+                                at every free node: one observation matrix and a file of
+                                channel names), ten point sensors, and the candidates of
+                                `identify sensors` (the full field and a strain gauge on
+                                every horizontal element edge).
     configs/plate_zones/truth/  the truths, 96 x 24 elements (4800 dofs): each inclusion
                                 follows the finer elements (those whose centroid lies in
                                 it), one manifest per truth with the model's channels
@@ -28,7 +30,8 @@ The truths (modulus relative to 200 GPa):
 
 Channels: F, the impact's history [N] (a unit +x traction resultant on the edge x = L);
 ux_<i>_<j> and uy_<i>_<j>, the displacements of the model's node (i, j) (i = 1..48
-along x, j = 0..12 along y); the point sensors of POINT_SENSORS.
+along x, j = 0..12 along y); exx_<i>_<j>, the strain between the model's nodes (i, j) and
+(i + 1, j) (i = 0..47); the point sensors of POINT_SENSORS.
 
 Checks before writing: each element's stiffness annihilates the rigid-body modes, the
 mass sums to rho t L H, and one element's blocks match the textbook Q4 matrices of
@@ -192,6 +195,22 @@ def write_channels(folder, grid):
     write_text(os.path.join(folder, "full_field_channels.txt"),
                "# the rows of H_full_field.mtx: u<axis>_<i>_<j>, the model's node (i, j)\n" +
                "\n".join(names) + "\n")
+    # A strain gauge on every horizontal edge of the model's elements: exx between the
+    # model's nodes (i, j) and (i + 1, j), (ux_b - ux_a) / dx (ux = 0 on the clamped edge).
+    names, rows = [], []
+    dx = LENGTH / model.nx
+    for j in range(model.ny + 1):
+        for i in range(model.nx):
+            names.append(f"exx_{i}_{j}")
+            row = {grid.dof((i + 1) * scale, j * scale, 0): 1.0 / dx}
+            if i > 0:
+                row[grid.dof(i * scale, j * scale, 0)] = -1.0 / dx
+            rows.append(row)
+    write_rows(os.path.join(folder, "H_strain_field.mtx"), rows, grid.dofs,
+               "exx on every horizontal edge of the 48 x 12 model's elements [-]")
+    write_text(os.path.join(folder, "strain_field_channels.txt"),
+               "# the rows of H_strain_field.mtx: exx_<i>_<j>, the strain between the model's "
+               "nodes (i, j) and (i + 1, j)\n" + "\n".join(names) + "\n")
     for sensor in POINT_SENSORS:
         channel, kind = sensor[0], sensor[1]
         if kind in ("ux", "uy"):
@@ -218,6 +237,13 @@ POINT_SENSORS_YAML = "".join(
     for s in POINT_SENSORS)
 FULL_FIELD_YAML = ("sensors_matrix: {matrix: H_full_field.mtx, channels: full_field_channels.txt, "
                    "kind: displacement}\n")
+# The full field and the strain gauges on every horizontal element edge: the candidates of
+# `identify sensors` (docs/matrix_models.md section 15).
+CANDIDATES_YAML = ("sensors_matrix:\n"
+                   "  - {matrix: H_full_field.mtx, channels: full_field_channels.txt, "
+                   "kind: displacement}\n"
+                   "  - {matrix: H_strain_field.mtx, channels: strain_field_channels.txt, "
+                   "kind: strain}\n")
 
 
 def write_model(folder):
@@ -256,6 +282,10 @@ def write_model(folder):
     write_text(os.path.join(folder, "full_field.yaml"),
                manifest_head("The model, full-field data (ux, uy at every free node)", grid) +
                common + FULL_FIELD_YAML + elements)
+    write_text(os.path.join(folder, "candidates.yaml"),
+               manifest_head("The model, candidate sensors (ux, uy at every free node; exx on "
+                             "every horizontal element edge)", grid) + common +
+               CANDIDATES_YAML + elements)
     write_text(os.path.join(folder, "points.yaml"),
                manifest_head("The model, ten point sensors", grid) + common + "sensors:\n" +
                POINT_SENSORS_YAML + elements)
@@ -295,7 +325,7 @@ def write_truths(folder):
         moduli = [1.0] + [modulus for _, modulus, _ in inclusions]
         yaml += ("# data.truth_moduli: [" +
                  ", ".join(f"{m * NOMINAL_MODULUS:g}" for m in moduli) + "]\n")
-        yaml += ("loads:\n  - {channel: F, vector: load_Fx.mtx}\n" + FULL_FIELD_YAML +
+        yaml += ("loads:\n  - {channel: F, vector: load_Fx.mtx}\n" + CANDIDATES_YAML +
                  "sensors:\n" + POINT_SENSORS_YAML)
         write_text(os.path.join(folder, f"{truth}.yaml"), yaml)
         print(f"{folder}/{truth}.yaml: {grid.nx} x {grid.ny} elements, {grid.dofs} dofs, "

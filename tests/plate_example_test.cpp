@@ -86,7 +86,8 @@ TEST(PlateExampleTest, SparseAndBandPathsAgreeOnTheCoarsePlate) {
 TEST(PlateZonesExampleTest, TheModelAndItsTruthsReadWithTheSameChannels) {
   const MatrixModelData full = ReadMatrixModel(kPlateZones + "model/full_field.yaml");
   const MatrixModelData points = ReadMatrixModel(kPlateZones + "model/points.yaml");
-  for (const MatrixModelData* model : {&full, &points}) {
+  const MatrixModelData candidates = ReadMatrixModel(kPlateZones + "model/candidates.yaml");
+  for (const MatrixModelData* model : {&full, &points, &candidates}) {
     EXPECT_EQ(model->dofs(), 1248);
     ASSERT_EQ(model->zones.size(), 1u);
     EXPECT_EQ(model->elements.size(), 576u);  // 48 x 12, each with its centroid
@@ -95,6 +96,19 @@ TEST(PlateZonesExampleTest, TheModelAndItsTruthsReadWithTheSameChannels) {
     EXPECT_NEAR(model->loads[0].vector.sum(), 1.0, 1e-14);  // a unit resultant along +x
   }
   EXPECT_EQ(full.sensors.size(), 1248u);  // ux, uy at every free node
+  // ... and exx on the 48 x 13 horizontal element edges: each gauge reads the slope of a
+  // field ux = 1e-3 x [m] (node (i, j) at x = i L / 48; dof 2 (j 48 + i - 1) + 0).
+  ASSERT_EQ(candidates.sensors.size(), 1248u + 624u);
+  Vector linear = Vector::Zero(1248);
+  for (int dof = 0; dof < 1248; dof += 2) linear[dof] = 1e-3 * ((dof / 2) % 48 + 1) * 0.4 / 48;
+  int gauges = 0;
+  for (const MatrixModelSensor& sensor : candidates.sensors) {
+    if (sensor.kind != SensorKind::kStrain) continue;
+    ++gauges;
+    // Measured: 7.8e-18 at worst (the rows' 17 digits).
+    EXPECT_NEAR((sensor.row * linear)(0), 1e-3, 5e-17) << sensor.channel;
+  }
+  EXPECT_EQ(gauges, 624);
   ASSERT_EQ(points.sensors.size(), 10u);
   EXPECT_EQ(std::count_if(points.sensors.begin(), points.sensors.end(),
                           [](const MatrixModelSensor& s) { return s.kind == SensorKind::kStrain; }),
@@ -106,8 +120,8 @@ TEST(PlateZonesExampleTest, TheModelAndItsTruthsReadWithTheSameChannels) {
     const MatrixModelData truth = ReadMatrixModel(kPlateZones + "truth/" + name + ".yaml");
     EXPECT_EQ(truth.dofs(), 4800);
     EXPECT_EQ(truth.zones.size(), zones);
-    EXPECT_EQ(truth.sensors.size(), 1258u);
-    for (const MatrixModelData* model : {&full, &points}) {
+    EXPECT_EQ(truth.sensors.size(), 1872u + 10u);
+    for (const MatrixModelData* model : {&full, &points, &candidates}) {
       for (const MatrixModelSensor& sensor : model->sensors) {
         EXPECT_TRUE(std::any_of(truth.sensors.begin(), truth.sensors.end(),
                                 [&](const MatrixModelSensor& s) {

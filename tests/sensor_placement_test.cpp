@@ -3,7 +3,7 @@
 // choice against an exhaustive search of the first pick and against the closed form of
 // diagonal information; its gains against log det computed from determinants; refusals;
 // end to end on the plate's full field, the chosen sensors' std against a second run on
-// them alone.
+// them alone; configs/plate_zones_gauges.yaml's gauges are the design's choice.
 #include "mcrewave/least_squares/sensor_placement.h"
 
 #include <gtest/gtest.h>
@@ -202,6 +202,23 @@ TEST(SensorPlacementRunTest, ThePlatesChosenSensorsHaveTheStdOfARunOnThemAlone) 
     // Measured: the same ten digits in the CSV.
     EXPECT_NEAR(alone[z], chosen[z], 1e-9 * chosen[z]) << z;
     EXPECT_LT(every[z], chosen[z]) << z;  // every candidate tells more than four
+  }
+}
+
+// configs/plate_zones_gauges.yaml's data.channels is what identify sensors chooses among
+// its manifest's 1872 candidates for its 64 zones at its SNR, in that order.
+TEST(SensorPlacementRunTest, TheGaugeConfigsChannelsAreTheDesignsChoice) {
+  const std::string dir = FreshDirectory("sensor_placement_gauges");
+  const std::string config = SourcePath("configs/plate_zones_gauges.yaml");
+  const RunResult run =
+      RunIdentify("sensors " + config + " --set data.channels=[] --count 20 -q -o " + dir);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const YAML::Node chosen = YAML::LoadFile(dir + "/channels.yaml")["data"]["channels"];
+  const YAML::Node committed = YAML::LoadFile(config)["data"]["channels"];
+  ASSERT_EQ(chosen.size(), 20u);
+  ASSERT_EQ(committed.size(), 20u);
+  for (std::size_t i = 0; i < 20; ++i) {
+    EXPECT_EQ(chosen[i].as<std::string>(), committed[i].as<std::string>()) << i;
   }
 }
 
