@@ -381,11 +381,17 @@ TEST(MatrixOutputErrorObjectiveTest, TheMisfitLevelsOfASupportedModelGiveTheForc
   EXPECT_EQ(levels.force_std, std::sqrt(data.Values("F").squaredNorm() / data.num_samples() / 1));
 }
 
+// The coarse plate with data of the fine one (inclusion at 140 GPa) at SNR 20.
+struct LsPlateCase {
+  MatrixModelData coarse = ReadMatrixModel(kLsPlate + "coarse/model_axial.yaml");
+  MatrixModelData fine = ReadMatrixModel(kLsPlate + "fine/model_axial.yaml");
+  ChannelSet data = LsPlateData(coarse, fine, (Vector(2) << 200e9, 140e9).finished(), 20.0);
+};
+
 TEST(MatrixOutputErrorObjectiveTest, EveryZoneGradientOfThePlateMatchesACentralDifference) {
-  const MatrixModelData coarse = ReadMatrixModel(kLsPlate + "coarse/model_axial.yaml");
-  const MatrixModelData fine = ReadMatrixModel(kLsPlate + "fine/model_axial.yaml");
-  const ChannelSet data = LsPlateData(coarse, fine, (Vector(2) << 200e9, 140e9).finished(), 20.0);
-  MatrixOutputErrorObjective objective(coarse, data, LsPlateLevels(coarse, data), 0.5);
+  const LsPlateCase plate;
+  const MatrixModelData& coarse = plate.coarse;
+  MatrixOutputErrorObjective objective(coarse, plate.data, LsPlateLevels(coarse, plate.data), 0.5);
   const Vector moduli = (Vector(2) << 190e9, 160e9).finished();
   Vector gradient;
   objective.Cost(moduli, &gradient);
@@ -410,10 +416,9 @@ TEST(MatrixOutputErrorObjectiveTest, EveryZoneGradientOfThePlateMatchesACentralD
 // s_kz = (h_k U_j(E + d_z) - h_k U_j(E - d_z)) / (2 d_z); the sensors' sum is the Fisher
 // information of the model (no supports).
 TEST(MatrixOutputErrorObjectiveTest, EachSensorsInformationMatchesCentralDifferences) {
-  const MatrixModelData coarse = ReadMatrixModel(kLsPlate + "coarse/model_axial.yaml");
-  const MatrixModelData fine = ReadMatrixModel(kLsPlate + "fine/model_axial.yaml");
-  const ChannelSet data = LsPlateData(coarse, fine, (Vector(2) << 200e9, 140e9).finished(), 20.0);
-  MatrixOutputErrorObjective objective(coarse, data, LsPlateLevels(coarse, data), 0.5);
+  const LsPlateCase plate;
+  const MatrixModelData& coarse = plate.coarse;
+  MatrixOutputErrorObjective objective(coarse, plate.data, LsPlateLevels(coarse, plate.data), 0.5);
   const Vector moduli = (Vector(2) << 190e9, 160e9).finished();
   Vector gradient;
   Matrix total;
