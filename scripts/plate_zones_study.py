@@ -16,7 +16,9 @@ MCRE, error_map.csv are kept in results/plate_zones/<case>/. Then, per run:
   - localisation: of the k changed zones, how many are among the k zones farthest from
     the zones' geometric mean (|ln E_z / E_mean|), and, by the MCRE, how many among the k
     largest shares of the error map at the nominal moduli (zones.csv
-    error_share_nominal); whether the map's peak is a changed zone;
+    error_share_nominal) and among the k largest gaps relative to the zone's strain
+    energy (relative_gap_nominal: the normalised map); whether the map's peak is a
+    changed zone;
   - sizing: the changed zones' worst relative error against the series truth (and
     how many lie between the two bounds), the other zones' worst and rms error.
 
@@ -29,7 +31,8 @@ Usage: /usr/bin/python3 scripts/plate_zones_study.py BUILD_DIR RESULTS_DIR
            [--functional mcre|least_squares|both] [--figures-only]
        --functional: the runs to make (default both); the other functional's rows of an
            existing cases.csv are kept.
-       --figures-only: no run; maps.png and summary.md drawn again from the kept files.
+       --figures-only: no run; cases.csv's measures computed again from the kept files
+           (times and evaluations kept), maps.png and summary.md drawn again.
 """
 
 import csv
@@ -127,6 +130,7 @@ def analyse(zones_csv, truth):
         zones.append({"name": r["name"], "E": float(r["modulus_pa"]) / NOMINAL_MODULUS,
                       "series": series, "parallel": parallel,
                       "share": float(r["error_share_nominal"] or "nan"),
+                      "relative_gap": float(r["relative_gap_nominal"] or "nan"),
                       "distance": abs(math.log(float(r["modulus_pa"]) / homogeneous))})
     changed = [z for z in zones if abs(z["series"] - 1.0) > CHANGED]
     others = [z for z in zones if abs(z["series"] - 1.0) <= CHANGED]
@@ -144,6 +148,10 @@ def analyse(zones_csv, truth):
         "changed_zones": k,
         "found_by_moduli": sum(1 for z in by_distance if z["name"] in names),
         "found_by_error_map": sum(1 for z in by_share[:k] if z["name"] in names) if mapped else "",
+        # The normalised map: the zone's gap over its strain energy (zones.csv
+        # relative_gap_nominal), the same order as share over share of the energy.
+        "found_by_relative_gap": (sum(1 for z in sorted(zones, key=lambda z: -z["relative_gap"])[:k]
+                                      if z["name"] in names) if mapped else ""),
         "error_map_peak_changed": (str(by_share[0]["name"] in names).lower() if mapped else ""),
         "changed_worst_error": max(errors),
         "changed_within_bounds": within,
@@ -197,7 +205,8 @@ def case_title(truth, manifest, snr):
 
 
 HEADER = ["case", "functional", "truth", "manifest", "snr", "changed_zones", "found_by_moduli",
-          "found_by_error_map", "error_map_peak_changed", "changed_worst_error",
+          "found_by_error_map", "found_by_relative_gap", "error_map_peak_changed",
+          "changed_worst_error",
           "changed_within_bounds", "other_worst_error", "other_rms_error", "zone_evaluations",
           "wall_time_s"]
 
@@ -207,6 +216,7 @@ def case_row(name, functional, truth, manifest, snr, m, evaluations, seconds):
             "snr": f"{snr:g}", "changed_zones": m["changed_zones"],
             "found_by_moduli": m["found_by_moduli"],
             "found_by_error_map": m["found_by_error_map"],
+            "found_by_relative_gap": m["found_by_relative_gap"],
             "error_map_peak_changed": m["error_map_peak_changed"],
             "changed_worst_error": f"{m['changed_worst_error']:.6f}",
             "changed_within_bounds": m["changed_within_bounds"],
@@ -245,17 +255,19 @@ def write_summary(results):
           "with the same penalty and weight rule (outer.functional: least_squares). 'Changed' "
           "zones: those whose truth in series differs from 200 GPa. Found: of the k changed "
           "zones, how many are among the k zones farthest from the zones' geometric mean "
-          "(moduli) or among the k largest shares of the MCRE's error map at the nominal "
-          "moduli (map). Errors against the zone's truth in series; 'within bounds': between "
-          "the series and parallel bounds.", "",
-          "| case | functional | changed zones | found (moduli) | found (map) | map's peak "
-          "changed | changed: worst error | within bounds | others: worst error | others: rms "
-          "| zone evaluations | time [s] |",
-          "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+          "(moduli), among the k largest shares of the MCRE's error map at the nominal "
+          "moduli (map), or among the k largest gaps relative to the zone's strain energy "
+          "there (gap / energy: the normalised map). Errors against the zone's truth in "
+          "series; 'within bounds': between the series and parallel bounds.", "",
+          "| case | functional | changed zones | found (moduli) | found (map) | found (gap / "
+          "energy) | map's peak changed | changed: worst error | within bounds | others: worst "
+          "error | others: rms | zone evaluations | time [s] |",
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         peak = {"true": "yes", "false": "no"}.get(r["error_map_peak_changed"], "-")
         md.append(f"| {r['case']} | {r['functional'].replace('_', ' ')} | {r['changed_zones']} | "
-                  f"{r['found_by_moduli']} | {r['found_by_error_map'] or '-'} | {peak} | "
+                  f"{r['found_by_moduli']} | {r['found_by_error_map'] or '-'} | "
+                  f"{r['found_by_relative_gap'] or '-'} | {peak} | "
                   f"{100 * float(r['changed_worst_error']):.1f} % | {r['changed_within_bounds']} | "
                   f"{100 * float(r['other_worst_error']):.2f} % | "
                   f"{100 * float(r['other_rms_error']):.2f} % | {r['zone_evaluations']} | "
@@ -278,6 +290,16 @@ def main():
     build_dir, results = sys.argv[1], sys.argv[2]
     options = sys.argv[3:]
     if options == ["--figures-only"]:
+        # cases.csv's measures again from the kept zone files (its times and evaluations
+        # kept), then the figures and summary.md.
+        rows = []
+        for row in read_cases(results):
+            truth, manifest, snr = next(c for c in CASES if case_name(*c) == row["case"])
+            _, m = analyse(os.path.join(results, row["case"], zones_file(row["functional"])),
+                           truth)
+            rows.append(case_row(row["case"], row["functional"], truth, manifest, snr, m,
+                                 row["zone_evaluations"], float(row["wall_time_s"])))
+        write_cases(results, rows)
         for case in CASES:
             draw_case(results, *case)
         write_summary(results)
