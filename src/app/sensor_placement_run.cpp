@@ -113,7 +113,8 @@ SensorPlacementRun RunSensorPlacement(const Config& config, int count) {
     const double chosen_std =
         std::sqrt(squares[kind] / (static_cast<double>(rows[kind]) * outputs.cols())) /
         config.data.snr;
-    factor[kind] = std::pow(design_std[kind] / chosen_std, 2);
+    // (Chosen sensors that read nothing keep the candidates' level.)
+    if (chosen_std > 0.0) factor[kind] = std::pow(design_std[kind] / chosen_std, 2);
   }
   const double prior = 1.0 / std::pow(options.prior_log_modulus_std, 2);
   Matrix chosen = prior * Matrix::Identity(information.front().rows(), information.front().cols());
