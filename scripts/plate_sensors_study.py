@@ -17,9 +17,9 @@ rms).
 
 Writes designs.csv (per design: sensors, the largest and median Cramer-Rao std of
 ln E_z, its mean over the inclusion's zones), runs.csv, summary.md, <design>/ with the
-design's sensors.csv, cramer_rao.csv and channels.yaml (and a run's zones.csv and
-error_map.csv), and cramer_rao.png: each design's std per zone on the 16 x 4 grid with its
-full-field sensors' nodes. Prints progress; files are written atomically.
+design's sensors.csv, cramer_rao.csv and channels.yaml (and a run's zones.csv,
+error_map.csv and maps.png: truth, identified moduli and error map per zone), and
+cramer_rao.png: each design's std per zone on the 16 x 4 grid with its chosen sensors. Prints progress; files are written atomically.
 
 Usage: /usr/bin/python3 scripts/plate_sensors_study.py BUILD_DIR RESULTS_DIR [--designs-only]
        --designs-only: no identification run; runs.csv kept as it is.
@@ -37,7 +37,7 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from plate_zones_geometry import HEIGHT, LENGTH, MODEL_ELEMENTS  # noqa: E402
 from plate_zones_study import (CHANGED, GRID, ROOT, analyse, truth_of_zones,  # noqa: E402
-                               write_atomic)
+                               write_atomic, write_maps)
 
 SNR = 20
 TRUTH = "soft_inclusion"
@@ -200,7 +200,8 @@ def write_summary(results, designs, runs):
                   f"{float(r['wall_time_s']):.0f} |")
     md += ["", "cramer_rao.png: each design's std per zone, the chosen sensors in black "
            "(a gauge at its edge's middle). Each design's folder: sensors.csv, cramer_rao.csv, channels.yaml; "
-           "with a run, its zones.csv and error_map.csv.", ""]
+           "with a run, its zones.csv, error_map.csv and maps.png (truth, moduli, error "
+           "map).", ""]
     write_atomic(os.path.join(results, "summary.md"), "\n".join(md))
 
 
@@ -239,6 +240,11 @@ def main():
         write_atomic(runs_path, ",".join(RUN_HEADER) + "\n" + "".join(
             ",".join(str(r[h]) for h in RUN_HEADER) + "\n" for r in runs))
     write_figure(results, designs)
+    titles = {name: title for name, _, _, title in DESIGNS}
+    for r in runs:
+        zones, _ = analyse(os.path.join(results, r["design"], "zones.csv"), TRUTH)
+        write_maps(os.path.join(results, r["design"]), zones, None,
+                   f"soft inclusion, {titles[r['design']]}, SNR {SNR}")
     write_summary(results, designs, runs)
     print(f"wrote {results}/designs.csv, runs.csv, summary.md and cramer_rao.png")
 
