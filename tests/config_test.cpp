@@ -128,6 +128,8 @@ void ExpectSameConfigZonesAndSensors(const Config& expected, const Config& actua
   EXPECT_EQ(expected.zones.zoning, actual.zones.zoning);
   EXPECT_EQ(expected.zones.zone_count, actual.zones.zone_count);
   EXPECT_EQ(expected.zones.zone_boundaries, actual.zones.zone_boundaries);
+  EXPECT_EQ(expected.zones.zone_grid, actual.zones.zone_grid);
+  EXPECT_EQ(expected.zones.free_zones, actual.zones.free_zones);
   EXPECT_EQ(expected.data.sensors, actual.data.sensors);
   EXPECT_EQ(expected.data.channels, actual.data.channels);
   ASSERT_EQ(expected.data.truth_zones.size(), actual.data.truth_zones.size());
@@ -803,6 +805,7 @@ constexpr const char* kEveryMatrixKeyNotAtItsDefault = R"(model:
   channel_map: {F: "F [N]", uy_tip: "tip #1"}
   zoning: grid
   zone_grid: [16, 4]
+  free_zones: [grid_10_2, "grid 9 #2", "a, b"]
 data:
   truth_manifest: fine/model.yaml
   truth_moduli: [2e11, 1.4000000000000001e11]
@@ -894,11 +897,11 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
     EXPECT_EQ(matrix_keys.count(key), 0u) << key;
     EXPECT_EQ(bar_keys.count(key), 1u) << key;
   }
-  // The bar reads all but the 4 matrix keys; a matrix run none of the section study:
+  // The bar reads all but the 5 matrix keys; a matrix run none of the section study:
   // and 14 single keys fewer (it reads the dense solvers' limits, Riccati and shooting
   // running on any model, the zones' regularisation and merging, and data.channels, the
   // manifest's sensors it uses).
-  EXPECT_EQ(bar_keys.size(), every.size() - 4);
+  EXPECT_EQ(bar_keys.size(), every.size() - 5);
   std::size_t sections = 0;
   for (const auto& [key, value] : every) {
     const std::string section = key.substr(0, key.find('.'));
@@ -940,6 +943,8 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
        "model.zoning 'grid' needs model.zone_grid"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  zone_grid: [4, 2]\n",
        "model.zone_grid applies to model.zoning 'grid' only"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\n  free_zones: [grid_0_0]\n",
+       "model.free_zones applies to a matrix model with model.zoning per_element or grid"},
       {"model:\n  zoning: grid\n  zone_grid: [4, 2]\n",
        "model.zone_grid must hold one count of zones along the bar"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  zoning: grid\n  zone_grid: [4, 0]\n",

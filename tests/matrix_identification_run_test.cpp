@@ -752,6 +752,41 @@ TEST(MatrixIdentificationRunTest, APlateGridOfZonesIsIdentifiedFromItsElementBlo
   EXPECT_FALSE(std::filesystem::exists(dir + "_refused"));
 }
 
+// model.free_zones on the plate's 3 x 1 grid: grid_1_0 free, the other two tied into
+// 'rest'; noise-free data of the model itself give both 200 GPa. A name that is not a
+// zone of the layout, one listed twice, or every zone listed is refused naming the key.
+TEST(MatrixIdentificationRunTest, FreeZonesKeepTheirModulusAndTieTheOthers) {
+  const std::string dir = FreshDirectory("matrix_run_free_zones");
+  const std::string base =
+      "run " + SourcePath("configs/plate.yaml") +
+      " --set model.zoning=grid --set model.zone_grid=[3,1] --set data.truth_manifest=" +
+      SourcePath("configs/plate/coarse/model_axial.yaml") +
+      " --set data.truth_moduli=[200e9,200e9] --set data.snr=.inf --set time.window=1e-4"
+      " --set prefilter.enabled=false --set uncertainty.samples=2 -q ";
+  const RunResult run = RunIdentify(base + "--set model.free_zones=[grid_1_0] -o " + dir);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const std::string zones = ReadText(dir + "/zones.csv");
+  EXPECT_NE(zones.find(",rest,"), std::string::npos) << zones;
+  EXPECT_NE(zones.find(",grid_1_0,"), std::string::npos) << zones;
+  EXPECT_EQ(zones.find("grid_0_0"), std::string::npos) << zones;
+  for (int z = 0; z < 2; ++z) {
+    // Measured: 200 GPa to the printed digits, as the three free zones.
+    EXPECT_NEAR(ZoneModulus(dir + "/zones.csv", z) / 200e9 - 1.0, 0.0, 1e-12) << "zone " << z;
+  }
+  const std::pair<std::string, std::string> refusals[] = {
+      {"[grid_7_0]", "model.free_zones: 'grid_7_0' is not a zone of model.zoning grid"},
+      {"[grid_1_0,grid_1_0]", "model.free_zones: 'grid_1_0' is listed twice"},
+      {"[grid_0_0,grid_1_0,grid_2_0]", "model.free_zones lists every zone"},
+  };
+  for (const auto& [list, reason] : refusals) {
+    const RunResult refused =
+        RunIdentify(base + "--set 'model.free_zones=" + list + "' -o " + dir + "_refused");
+    EXPECT_EQ(refused.exit_code, 2) << refused.output;
+    EXPECT_NE(refused.output.find(reason), std::string::npos) << refused.output;
+    EXPECT_FALSE(std::filesystem::exists(dir + "_refused"));
+  }
+}
+
 // The plate example's config by output-error least squares (outer.functional:
 // least_squares, the same minimiser from the same start) against its MCRE run: both
 // zones within 3 % of the MCRE's (measured: see docs/matrix_models.md section 10), the

@@ -247,9 +247,19 @@ ValueType<std::vector<std::string>> TextList() {
     *value = parsed;
     return true;
   };
+  // A name written plain when YAML reads it back so inside a flow list (u@0.25), else
+  // double-quoted ("grid 9 #2", "a, b").
   type.write = [](const std::vector<std::string>& value) {
+    const auto written = [](const std::string& name) {
+      YAML::Emitter emitter;
+      if (name.find_first_of(",[]{}") != std::string::npos) emitter << YAML::DoubleQuoted;
+      emitter << name;
+      return std::string(emitter.c_str());
+    };
     std::string text = "[";
-    for (std::size_t i = 0; i < value.size(); ++i) text += (i == 0 ? "" : ", ") + value[i];
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      text += (i == 0 ? "" : ", ") + written(value[i]);
+    }
     return text + "]";
   };
   return type;
@@ -465,6 +475,9 @@ const std::vector<Key>& KeyTable() {
               "m", "interior zone boundaries (model.zoning: boundaries)"),
       MakeKey("model.zone_grid", &Config::zones, &ZoneLayout::zone_grid, GridCounts(), "",
               "zones per coordinate of the element positions (model.zoning: grid)"),
+      MakeKey("model.free_zones", &Config::zones, &ZoneLayout::free_zones, TextList(), "",
+              "matrix model, zoning per_element or grid: the zones that keep their own "
+              "modulus, the others tied into one zone 'rest' ([] = every zone free)"),
       MakeKey("load.kind", &Config::load, &LoadOptions::kind,
               EnumByName<LoadKind>({LoadKind::kHalfSine}, LoadKindToString, StringToLoadKind), "",
               "shape of the shock load applied at x = L"),
@@ -991,6 +1004,14 @@ bool CheckZoneLayout(const Config& config, std::string* error) {
   }
   if (config.zones.zoning == Zoning::kGrid && config.zones.zone_grid.empty()) {
     *error = "model.zoning 'grid' needs model.zone_grid, the zones per coordinate (e.g. [16, 4])";
+    return false;
+  }
+  if (!config.zones.free_zones.empty() &&
+      !(config.structure.kind == ModelKind::kMatrix && config.zones.RegroupsElements())) {
+    *error =
+        "model.free_zones applies to a matrix model with model.zoning per_element or "
+        "grid (model.zoning is '" +
+        zoning + "')";
     return false;
   }
   if (config.structure.kind == ModelKind::kMatrix) {
@@ -1763,7 +1784,8 @@ std::string ConfigToYaml(const Config& config) {
 
 bool KeyApplies(const std::string& path, ModelKind kind) {
   static const std::set<std::string> matrix_only = {"model.manifest", "model.channel_map",
-                                                    "data.truth_manifest", "data.truth_moduli"};
+                                                    "model.free_zones", "data.truth_manifest",
+                                                    "data.truth_moduli"};
   if (kind == ModelKind::kBar) return matrix_only.count(path) == 0;
   // Whole sections, then single keys, that a matrix run does not read.
   static const std::set<std::string> bar_sections = {"study"};

@@ -514,7 +514,41 @@ MatrixModelData LoadMatrixModel(const Config& config) {
         RegroupedElementZones(model, config.zones, config.structure.manifest, &names);
     spdlog::info("{}: model.zoning {}: {} zones of {} elements", config.structure.manifest,
                  ZoningToString(config.zones.zoning), names.size(), model.elements.size());
-    model = RezonedMatrixModel(model, element_zones, names);
+    if (!config.zones.free_zones.empty()) {
+      // model.free_zones: those zones keep their own modulus (in the key's order, after
+      // zone 0 "rest", every other zone tied).
+      const std::vector<std::string>& free = config.zones.free_zones;
+      std::vector<int> tied(names.size(), 0);
+      for (std::size_t f = 0; f < free.size(); ++f) {
+        const auto found = std::find(names.begin(), names.end(), free[f]);
+        if (found == names.end()) {
+          throw InputError(ConfigName(config) + ": model.free_zones: '" + free[f] +
+                           "' is not a zone of model.zoning " +
+                           ZoningToString(config.zones.zoning) + " (e.g. '" + names.back() + "')");
+        }
+        if (std::count(free.begin(), free.end(), free[f]) > 1) {
+          throw InputError(ConfigName(config) + ": model.free_zones: '" + free[f] +
+                           "' is listed twice");
+        }
+        tied[static_cast<std::size_t>(found - names.begin())] = static_cast<int>(f) + 1;
+      }
+      if (free.size() >= names.size()) {
+        throw InputError(
+            ConfigName(config) + ": model.free_zones lists every zone of model.zoning " +
+            ZoningToString(config.zones.zoning) + ": leave it out to identify each zone freely");
+      }
+      std::vector<int> regrouped(element_zones.size());
+      for (std::size_t e = 0; e < element_zones.size(); ++e) {
+        regrouped[e] = tied[static_cast<std::size_t>(element_zones[e])];
+      }
+      std::vector<std::string> kept = {"rest"};
+      kept.insert(kept.end(), free.begin(), free.end());
+      spdlog::info("{}: model.free_zones: {} zones free, the other {} tied into 'rest'",
+                   config.structure.manifest, free.size(), names.size() - free.size());
+      model = RezonedMatrixModel(model, regrouped, kept);
+    } else {
+      model = RezonedMatrixModel(model, element_zones, names);
+    }
   }
   for (const auto& entry : config.structure.channel_map) {
     const std::string& channel = entry.first;

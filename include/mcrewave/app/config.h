@@ -11,9 +11,9 @@
 //          length [1 m], section [1e-4 m^2], density [800 kg/m^3],
 //          modulus [200e9 Pa], elements [100], mass [consistent | lumped],
 //          zoning [equal | per_element | boundaries | grid], zone_count [1],
-//          zone_boundaries [[] m], zone_grid [[]] (ZoneLayout, bar_model.h; on a
-//          matrix model: its manifest's zones, or per_element / grid regrouping its
-//          element blocks)
+//          zone_boundaries [[] m], zone_grid [[]], free_zones [[]] (ZoneLayout,
+//          bar_model.h; on a matrix model: its manifest's zones, or per_element / grid
+//          regrouping its element blocks, free_zones of them free and the rest tied)
 //   load:  kind [half_sine], amplitude [1000 N], duration [1e-4 s]
 //   time:  window [0.63e-3 s], step [0.36e-6 s], theta [0.5]
 //   data:  source [synthetic | csv], path [""], truth [finite_element | exact],

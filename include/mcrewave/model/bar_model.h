@@ -81,6 +81,10 @@ struct ZoneLayout {
   // kGrid: boxes per coordinate of the elements' positions (1 to 3 counts); on the bar
   // one count Z, the same zones as kEqual with Z.
   std::vector<int> zone_grid;
+  // kPerElement, kGrid on a matrix model: the zones (by name) that keep a modulus of
+  // their own; every other zone of the layout is tied into one zone "rest" (a
+  // localise-then-update refit, docs/matrix_models.md section 15). Empty: every zone free.
+  std::vector<std::string> free_zones;
 
   // True when the layout regroups a matrix model's elements (kPerElement, kGrid).
   bool RegroupsElements() const { return zoning == Zoning::kPerElement || zoning == Zoning::kGrid; }
