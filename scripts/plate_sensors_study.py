@@ -15,6 +15,11 @@ against the truth as scripts/plate_zones_study.py does (found by the moduli and 
 error map at the nominal moduli; the changed zones' worst error, the others' worst and
 rms).
 
+Then the update step of a localise-then-update loop: the zones the UPDATE run flags
+(|ln E_z - median| > FLAG_SPREAD robust standard deviations) refitted free, every other
+zone tied into one modulus (model.free_zones), no penalty; update.csv sets each against
+its truth.
+
 Writes designs.csv (per design: sensors, the largest and median Cramer-Rao std of
 ln E_z, its mean over the inclusion's zones), runs.csv, summary.md, <design>/ with the
 design's sensors.csv, cramer_rao.csv and channels.yaml (and a run's zones.csv,
@@ -48,6 +53,8 @@ DESIGNS = [  # (name, manifest, count, title)
     ("gauges_20", "candidates", 20, "20 of the candidates, D-optimal"),
 ]
 RUNS = ["points", "gauges_20"]
+UPDATE = "gauges_20"  # the run whose flagged zones are refitted (localise, then update)
+FLAG_SPREAD = 3.0     # a zone is flagged when |ln E_z - median| > this x 1.4826 MAD
 
 
 def identify(build_dir):
@@ -85,10 +92,27 @@ def design_row(results, name, title, count):
             "every_candidate": {r["name"]: float(r["std_every_candidate"]) for r in rows}}
 
 
-def run(build_dir, results, work, name, manifest):
-    folder = os.path.join(work, name)
+def flagged_zones(zones_csv):
+    """The zones a first identification flags: |ln E_z - median| above FLAG_SPREAD robust
+    standard deviations (1.4826 MAD) of ln E over the zones."""
+    rows = list(csv.DictReader(open(zones_csv)))
+    logs = [math.log(float(r["modulus_pa"])) for r in rows]
+    median = sorted(logs)[len(logs) // 2] if len(logs) % 2 else 0.5 * (
+        sorted(logs)[len(logs) // 2 - 1] + sorted(logs)[len(logs) // 2])
+    deviations = sorted(abs(v - median) for v in logs)
+    n = len(deviations)
+    mad = deviations[n // 2] if n % 2 else 0.5 * (deviations[n // 2 - 1] + deviations[n // 2])
+    return [r["name"] for r, v in zip(rows, logs) if abs(v - median) > FLAG_SPREAD * 1.4826 * mad]
+
+
+def run(build_dir, results, work, name, manifest, free_zones=None):
+    """identify run on design `name`'s sensors; with free_zones, the update step: those
+    zones free, the others tied into 'rest', no penalty, into <name>_update/."""
+    folder = os.path.join(work, name + ("_update" if free_zones else ""))
+    update = (["--set", f"model.free_zones=[{','.join(free_zones)}]",
+               "--set", "zone_identification.regularization=none"] if free_zones else [])
     command = [identify(build_dir), "run", os.path.join(ROOT, "configs", "plate_zones.yaml"),
-               *common_settings(manifest), "--set",
+               *common_settings(manifest), *update, "--set",
                f"data.channels=[{channels_of(os.path.join(results, name))}]",
                # The trace preconditioner (configs/plate_zones_gauges.yaml): a few sensors'
                # strain rows make the unpreconditioned CG take hundreds of iterations.
@@ -99,12 +123,33 @@ def run(build_dir, results, work, name, manifest):
     start = time.monotonic()
     subprocess.run(command, check=True)
     seconds = time.monotonic() - start
-    out = os.path.join(results, name)
+    out = os.path.join(results, os.path.basename(folder))
+    os.makedirs(out, exist_ok=True)
     for file in ("zones.csv", "error_map.csv"):
         shutil.copyfile(os.path.join(folder, file), os.path.join(out, file + ".tmp"))
         os.replace(os.path.join(out, file + ".tmp"), os.path.join(out, file))
     evaluations = sum(1 for _ in open(os.path.join(folder, "zone_evaluations.csv"))) - 1
     return seconds, evaluations
+
+
+def write_update(results, seconds, evaluations):
+    """update.csv: each zone of the update run (rest, then the flagged ones) against its
+    truth in series and in parallel, and the run's time and evaluations. 'rest' is the
+    union of the other zones, each of the same number of fine elements: its series
+    truth the harmonic mean of theirs, its parallel truth the mean."""
+    truths = truth_of_zones(TRUTH)
+    rows = list(csv.DictReader(open(os.path.join(results, UPDATE + "_update", "zones.csv"))))
+    tied = [truths[name] for name in truths if name not in {r["name"] for r in rows}]
+    truths["rest"] = (len(tied) / sum(1.0 / t[0] for t in tied),
+                      sum(t[1] for t in tied) / len(tied))
+    lines = ["zone,modulus_relative,truth_series,truth_parallel,error_series,"
+             "zone_evaluations,wall_time_s"]
+    for r in rows:
+        series, parallel = truths[r["name"]]
+        modulus = float(r["modulus_pa"]) / 200e9
+        lines.append(f"{r['name']},{modulus:.6f},{series:.6f},{parallel:.6f},"
+                     f"{modulus / series - 1.0:.6f},{evaluations},{seconds:.1f}")
+    write_atomic(os.path.join(results, "update.csv"), "\n".join(lines) + "\n")
 
 
 RUN_HEADER = ["design", "sensors", "changed_zones", "found_by_moduli", "found_by_error_map",
@@ -198,6 +243,19 @@ def write_summary(results, designs, runs):
                   f"{100 * float(r['other_worst_error']):.1f} %, "
                   f"{100 * float(r['other_rms_error']):.1f} % | {r['zone_evaluations']} | "
                   f"{float(r['wall_time_s']):.0f} |")
+    update_path = os.path.join(results, "update.csv")
+    if os.path.exists(update_path):
+        rows = list(csv.DictReader(open(update_path)))
+        md += ["", f"Localise, then update: the zones the {UPDATE} run flags (|ln E_z - median| "
+               f"> {FLAG_SPREAD:g} x 1.4826 MAD) refitted free, every other zone tied into one "
+               "modulus 'rest', no penalty (model.free_zones; "
+               f"{rows[0]['zone_evaluations']} evaluations, {float(rows[0]['wall_time_s']):.0f} s).",
+               "", "| zone | identified / 200 GPa | truth in series | in parallel | error (series) |",
+               "|---|---|---|---|---|"]
+        for r in rows:
+            md.append(f"| {r['zone']} | {float(r['modulus_relative']):.3f} | "
+                      f"{float(r['truth_series']):.3f} | {float(r['truth_parallel']):.3f} | "
+                      f"{100 * float(r['error_series']):+.1f} % |")
     md += ["", "cramer_rao.png: each design's std per zone, the chosen sensors in black "
            "(a gauge at its edge's middle). Each design's folder: sensors.csv, cramer_rao.csv, channels.yaml; "
            "with a run, its zones.csv, error_map.csv and maps.png (truth, moduli, error "
@@ -223,6 +281,10 @@ def main():
     runs_path = os.path.join(results, "runs.csv")
     if options == ["--designs-only"]:
         runs = list(csv.DictReader(open(runs_path))) if os.path.exists(runs_path) else []
+        update_path = os.path.join(results, "update.csv")
+        if os.path.exists(update_path):
+            kept = next(csv.DictReader(open(update_path)))
+            write_update(results, float(kept["wall_time_s"]), kept["zone_evaluations"])
     else:
         runs = []
         manifests = {name: manifest for name, manifest, _, _ in DESIGNS}
@@ -237,6 +299,13 @@ def main():
                              "sensors": next(d["sensors"] for d in designs if d["design"] == name),
                              **{k: m[k] for k in RUN_HEADER[2:9]},
                              "zone_evaluations": evaluations, "wall_time_s": f"{seconds:.1f}"})
+            # Localise, then update: the zones the run flags free, the others tied.
+            flagged = flagged_zones(os.path.join(results, UPDATE, "zones.csv"))
+            print(f"[update] {UPDATE}: {len(flagged)} zones flagged ({', '.join(flagged)}), "
+                  "refitted free against one background modulus ...", flush=True)
+            seconds, evaluations = run(build_dir, results, work, UPDATE, manifests[UPDATE],
+                                       flagged)
+            write_update(results, seconds, evaluations)
         write_atomic(runs_path, ",".join(RUN_HEADER) + "\n" + "".join(
             ",".join(str(r[h]) for h in RUN_HEADER) + "\n" for r in runs))
     write_figure(results, designs)

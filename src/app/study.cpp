@@ -1306,11 +1306,12 @@ std::string WriteStudiesReadme(const std::string& folder) {
      << "Written by `identify study` (`bash scripts/studies.sh` regenerates every study, figure "
         "and this file: the studies of configs/studies.yaml, then the robustness settings, the "
         "complexity and the weights studies of bench/; `bash scripts/plate_study.sh` the plate's, "
-        "`bash scripts/plate_zones_study.sh` the many-zone plate's); do not edit by hand. Each "
+        "`bash scripts/plate_zones_study.sh` the many-zone plate's, "
+        "`bash scripts/plate_sensors_study.sh` its sensor layouts'); do not edit by hand. Each "
         "section below is the `summary.md` of its folder.\n\n";
   for (const char* study :
        {"robustness", "relaxation", "cost_curves", "damage", "comparator", "robustness_settings",
-        "complexity", "weights", "plate", "plate_zones"}) {
+        "complexity", "weights", "plate", "plate_zones", "plate_sensors"}) {
     const std::string summary = folder + "/" + study + "/summary.md";
     std::ifstream file(summary);
     if (!file) continue;
