@@ -41,8 +41,9 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from plate_zones_geometry import HEIGHT, LENGTH, MODEL_ELEMENTS  # noqa: E402
-from plate_zones_study import (CHANGED, GRID, ROOT, analyse, truth_of_zones,  # noqa: E402
-                               write_atomic, write_maps)
+from plate_zones_study import (CHANGED, GRID, ROOT, analyse, median_of,  # noqa: E402
+                               truth_of_zones, update_markdown, update_table, write_atomic,
+                               write_maps)
 
 SNR = 20
 TRUTH = "soft_inclusion"
@@ -97,11 +98,8 @@ def flagged_zones(zones_csv):
     standard deviations (1.4826 MAD) of ln E over the zones."""
     rows = list(csv.DictReader(open(zones_csv)))
     logs = [math.log(float(r["modulus_pa"])) for r in rows]
-    median = sorted(logs)[len(logs) // 2] if len(logs) % 2 else 0.5 * (
-        sorted(logs)[len(logs) // 2 - 1] + sorted(logs)[len(logs) // 2])
-    deviations = sorted(abs(v - median) for v in logs)
-    n = len(deviations)
-    mad = deviations[n // 2] if n % 2 else 0.5 * (deviations[n // 2 - 1] + deviations[n // 2])
+    median = median_of(logs)
+    mad = median_of([abs(v - median) for v in logs])
     return [r["name"] for r, v in zip(rows, logs) if abs(v - median) > FLAG_SPREAD * 1.4826 * mad]
 
 
@@ -133,23 +131,10 @@ def run(build_dir, results, work, name, manifest, free_zones=None):
 
 
 def write_update(results, seconds, evaluations):
-    """update.csv: each zone of the update run (rest, then the flagged ones) against its
-    truth in series and in parallel, and the run's time and evaluations. 'rest' is the
-    union of the other zones, each of the same number of fine elements: its series
-    truth the harmonic mean of theirs, its parallel truth the mean."""
-    truths = truth_of_zones(TRUTH)
-    rows = list(csv.DictReader(open(os.path.join(results, UPDATE + "_update", "zones.csv"))))
-    tied = [truths[name] for name in truths if name not in {r["name"] for r in rows}]
-    truths["rest"] = (len(tied) / sum(1.0 / t[0] for t in tied),
-                      sum(t[1] for t in tied) / len(tied))
-    lines = ["zone,modulus_relative,truth_series,truth_parallel,error_series,"
-             "zone_evaluations,wall_time_s"]
-    for r in rows:
-        series, parallel = truths[r["name"]]
-        modulus = float(r["modulus_pa"]) / 200e9
-        lines.append(f"{r['name']},{modulus:.6f},{series:.6f},{parallel:.6f},"
-                     f"{modulus / series - 1.0:.6f},{evaluations},{seconds:.1f}")
-    write_atomic(os.path.join(results, "update.csv"), "\n".join(lines) + "\n")
+    """update.csv: the update run's zones against their truth (update_table)."""
+    write_atomic(os.path.join(results, "update.csv"),
+                 update_table(os.path.join(results, UPDATE + "_update", "zones.csv"), TRUTH,
+                              evaluations, seconds))
 
 
 RUN_HEADER = ["design", "sensors", "changed_zones", "found_by_moduli", "found_by_error_map",
@@ -250,12 +235,7 @@ def write_summary(results, designs, runs):
                f"> {FLAG_SPREAD:g} x 1.4826 MAD) refitted free, every other zone tied into one "
                "modulus 'rest', no penalty (model.free_zones; "
                f"{rows[0]['zone_evaluations']} evaluations, {float(rows[0]['wall_time_s']):.0f} s).",
-               "", "| zone | identified / 200 GPa | truth in series | in parallel | error (series) |",
-               "|---|---|---|---|---|"]
-        for r in rows:
-            md.append(f"| {r['zone']} | {float(r['modulus_relative']):.3f} | "
-                      f"{float(r['truth_series']):.3f} | {float(r['truth_parallel']):.3f} | "
-                      f"{100 * float(r['error_series']):+.1f} % |")
+               ""] + update_markdown(update_path)
     md += ["", "cramer_rao.png: each design's std per zone, the chosen sensors in black "
            "(a gauge at its edge's middle). Each design's folder: sensors.csv, cramer_rao.csv, channels.yaml; "
            "with a run, its zones.csv, error_map.csv and maps.png (truth, moduli, error "

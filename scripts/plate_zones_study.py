@@ -33,6 +33,12 @@ Usage: /usr/bin/python3 scripts/plate_zones_study.py BUILD_DIR RESULTS_DIR
            existing cases.csv are kept.
        --figures-only: no run; cases.csv's measures computed again from the kept files
            (times and evaluations kept), maps.png and summary.md drawn again.
+       --update-only: the update step alone (below), from the kept zones.csv of its case.
+
+After the MCRE's runs, the update step of a localise-then-update loop on UPDATE_CASE: the
+zones its error map at the nominal moduli flags (a share above the median by more than 3
+robust standard deviations) free, the others tied into one modulus, no penalty
+(model.free_zones); update.csv sets each against its truth.
 """
 
 import csv
@@ -58,6 +64,9 @@ CASES = [  # (truth, manifest, SNR)
     ("soft_band", "full_field", 10),
 ]
 CHANGED = 1e-3
+# The case whose error map at the nominal moduli chooses the zones of the update step:
+# those it flags free, the others tied into one modulus, no penalty (model.free_zones).
+UPDATE_CASE = ("soft_inclusion", "full_field", 10)
 
 
 def case_name(truth, manifest, snr):
@@ -102,9 +111,59 @@ def zones_file(functional):
     return "zones.csv" if functional == "mcre" else "least_squares_zones.csv"
 
 
-def run_case(build_dir, work, truth, manifest, snr, functional):
+def median_of(values):
+    ordered = sorted(values)
+    n = len(ordered)
+    return ordered[n // 2] if n % 2 else 0.5 * (ordered[n // 2 - 1] + ordered[n // 2])
+
+
+def map_flagged(zones_csv, spread=3.0):
+    """The zones the error map at the nominal moduli flags: a share of the gap above its
+    median over the zones by more than `spread` robust standard deviations (1.4826 MAD)."""
+    rows = list(csv.DictReader(open(zones_csv)))
+    shares = [float(r["error_share_nominal"]) for r in rows]
+    median = median_of(shares)
+    mad = median_of([abs(v - median) for v in shares])
+    return [r["name"] for r, v in zip(rows, shares) if v - median > spread * 1.4826 * mad]
+
+
+def update_table(zones_csv, truth, evaluations, seconds):
+    """update.csv's text: each zone of an update run (rest, then the free ones) against
+    its truth in series and in parallel. 'rest' is the union of the other zones, each of
+    the same number of fine elements: its series truth the harmonic mean of theirs, its
+    parallel truth the mean."""
+    truths = truth_of_zones(truth)
+    rows = list(csv.DictReader(open(zones_csv)))
+    tied = [truths[name] for name in truths if name not in {r["name"] for r in rows}]
+    truths["rest"] = (len(tied) / sum(1.0 / t[0] for t in tied),
+                      sum(t[1] for t in tied) / len(tied))
+    lines = ["zone,modulus_relative,truth_series,truth_parallel,error_series,"
+             "zone_evaluations,wall_time_s"]
+    for r in rows:
+        series, parallel = truths[r["name"]]
+        modulus = float(r["modulus_pa"]) / NOMINAL_MODULUS
+        lines.append(f"{r['name']},{modulus:.6f},{series:.6f},{parallel:.6f},"
+                     f"{modulus / series - 1.0:.6f},{evaluations},{seconds:.1f}")
+    return "\n".join(lines) + "\n"
+
+
+def update_markdown(update_csv):
+    """The table of an update.csv in markdown."""
+    md = ["| zone | identified / 200 GPa | truth in series | in parallel | error (series) |",
+          "|---|---|---|---|---|"]
+    for r in csv.DictReader(open(update_csv)):
+        md.append(f"| {r['zone']} | {float(r['modulus_relative']):.3f} | "
+                  f"{float(r['truth_series']):.3f} | {float(r['truth_parallel']):.3f} | "
+                  f"{100 * float(r['error_series']):+.1f} % |")
+    return md
+
+
+def run_case(build_dir, work, truth, manifest, snr, functional, free_zones=None):
+    """identify run on a case; with free_zones the update step (those zones free, the
+    others tied into 'rest', no penalty)."""
     moduli = [1.0] + [modulus for _, modulus, _ in TRUTHS[truth]]
-    folder = os.path.join(work, case_name(truth, manifest, snr) + "_" + functional)
+    folder = os.path.join(work, case_name(truth, manifest, snr) + "_" + functional +
+                          ("_update" if free_zones else ""))
     command = [os.path.join(build_dir, "identify", "identify"), "run",
                os.path.join(ROOT, "configs", "plate_zones.yaml"),
                "--set", f"model.manifest=plate_zones/model/{manifest}.yaml",
@@ -115,6 +174,9 @@ def run_case(build_dir, work, truth, manifest, snr, functional):
                "--set", "output.figures=false", "-q", "-o", folder]
     if functional == "least_squares":
         command[3:3] = ["--set", "outer.functional=least_squares"]
+    if free_zones:
+        command[3:3] = ["--set", f"model.free_zones=[{','.join(free_zones)}]",
+                        "--set", "zone_identification.regularization=none"]
     start = time.monotonic()
     subprocess.run(command, check=True)
     return folder, time.monotonic() - start
@@ -272,10 +334,37 @@ def write_summary(results):
                   f"{100 * float(r['other_worst_error']):.2f} % | "
                   f"{100 * float(r['other_rms_error']):.2f} % | {r['zone_evaluations']} | "
                   f"{float(r['wall_time_s']):.0f} |")
+    update_path = os.path.join(results, "update.csv")
+    if os.path.exists(update_path):
+        first = next(csv.DictReader(open(update_path)))
+        md += ["", f"Localise, then update ({case_name(*UPDATE_CASE)}, MCRE): the zones whose "
+               "share of the error map at the nominal moduli lies above the median by more than "
+               "3 x 1.4826 MAD refitted free, every other zone tied into one modulus 'rest', no "
+               f"penalty (model.free_zones; {first['zone_evaluations']} zone evaluations, "
+               f"{float(first['wall_time_s']):.0f} s; update.csv, the case's update_zones.csv).",
+               ""] + update_markdown(update_path)
     md += ["", "Each case's folder holds zones.csv and error_map.csv of the MCRE's run, "
            "least_squares_zones.csv of least squares', and maps.png (truth, both functionals' "
            "moduli, error map per zone).", ""]
     write_atomic(os.path.join(results, "summary.md"), "\n".join(md))
+
+
+def run_update(build_dir, results):
+    """The update step on UPDATE_CASE from its kept zones.csv: its map's flagged zones
+    free, the rest tied; <case>/update_zones.csv and update.csv."""
+    truth, manifest, snr = UPDATE_CASE
+    out = os.path.join(results, case_name(*UPDATE_CASE))
+    flagged = map_flagged(os.path.join(out, "zones.csv"))
+    print(f"[update] {case_name(*UPDATE_CASE)}: the error map flags {len(flagged)} zones "
+          f"({', '.join(flagged)}); refitted free against one background modulus ...", flush=True)
+    with tempfile.TemporaryDirectory() as work:
+        run, seconds = run_case(build_dir, work, truth, manifest, snr, "mcre", flagged)
+        shutil.copyfile(os.path.join(run, "zones.csv"), os.path.join(out, "update_zones.csv.tmp"))
+        os.replace(os.path.join(out, "update_zones.csv.tmp"), os.path.join(out, "update_zones.csv"))
+        evaluations = sum(1 for _ in open(os.path.join(run, "zone_evaluations.csv"))) - 1
+    write_atomic(os.path.join(results, "update.csv"),
+                 update_table(os.path.join(out, "update_zones.csv"), truth, evaluations, seconds))
+    print(f"    {seconds:.0f} s", flush=True)
 
 
 def draw_case(results, truth, manifest, snr):
@@ -289,6 +378,10 @@ def draw_case(results, truth, manifest, snr):
 def main():
     build_dir, results = sys.argv[1], sys.argv[2]
     options = sys.argv[3:]
+    if options == ["--update-only"]:
+        run_update(build_dir, results)
+        write_summary(results)
+        return
     if options == ["--figures-only"]:
         # cases.csv's measures again from the kept zone files (its times and evaluations
         # kept), then the figures and summary.md.
@@ -311,8 +404,8 @@ def main():
             sys.exit(f"--functional: expected mcre, least_squares or both, got '{options[1]}'")
         functionals = (options[1],)
     elif options and options != ["--functional", "both"]:
-        sys.exit(f"unknown options {options}: expected [--functional mcre|least_squares|both] "
-                 "or --figures-only")
+        sys.exit(f"unknown options {options}: expected [--functional mcre|least_squares|both], "
+                 "--figures-only or --update-only")
     os.makedirs(results, exist_ok=True)
     rows = [r for r in read_cases(results) if r["functional"] not in functionals]
     runs = [(c, f) for c in CASES for f in functionals]
@@ -337,6 +430,8 @@ def main():
                   f"{m['other_worst_error']:.4f}", flush=True)
             rows.append(case_row(name, functional, truth, manifest, snr, m, evaluations, seconds))
     write_cases(results, rows)
+    if "mcre" in functionals:
+        run_update(build_dir, results)
     for case in CASES:
         draw_case(results, *case)
     write_summary(results)
