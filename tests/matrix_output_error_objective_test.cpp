@@ -311,6 +311,32 @@ TEST(MatrixOutputErrorObjectiveTest, TheSupportedLatticesGradientMatchesACentral
   }
 }
 
+// With a support the sensors' parts of the Fisher information and the supports' own, the
+// information of the same model without its sensors, sum to the model's (the base every
+// layout has in least_squares/sensor_placement.h).
+TEST(MatrixOutputErrorObjectiveTest, TheSupportedLatticesSensorsAndSupportSumToItsInformation) {
+  const MatrixModelData model = testing::SupportedLattice();
+  const ChannelSet data = testing::SupportedLatticeHistories(model);
+  const NoiseLevels levels = LsLatticeLevels(model, data);
+  MatrixOutputErrorObjective objective(model, data, levels, 0.5);
+  MatrixModelData sensorless = model;
+  sensorless.sensors.clear();
+  MatrixOutputErrorObjective support_only(sensorless, data, levels, 0.5);
+  const Vector moduli = (Vector(2) << 1.9e11, 1.7e11).finished();
+  Vector gradient;
+  Matrix total, support;
+  std::vector<Matrix> sensors;
+  objective.Cost(moduli, &gradient, &total, &sensors);
+  support_only.Cost(moduli, &gradient, &support);
+  ASSERT_EQ(sensors.size(), model.sensors.size());
+  Matrix sum = support;
+  for (const Matrix& sensor : sensors) sum += sensor;
+  // The support's force informs: measured 0.60 of the norm.
+  EXPECT_GT(support.norm(), 0.3 * total.norm());
+  // Measured: 2.2e-16 of the largest entry.
+  EXPECT_LT((sum - total).cwiseAbs().maxCoeff(), 2e-15 * total.cwiseAbs().maxCoeff());
+}
+
 // Without mass between the held and the free dofs (m_s = 0) the reaction is the trusted
 // MCRE's g^T K U: the lattice's outputs and support force against ModelOutputs and
 // ModelSupportForces of the same U.
