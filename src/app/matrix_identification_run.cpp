@@ -634,11 +634,42 @@ Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_modu
   return simulation.ModelOutputs();
 }
 
+NoiseLevels MatrixModelNoiseLevels(const MatrixModelData& model, const ChannelSet& data,
+                                   double snr) {
+  NoiseLevels levels;
+  if (std::isinf(snr)) return levels;
+  // The channels of each quantity, gathered as rows for their RMS.
+  const auto samples = data.num_samples();
+  const auto num_loads = static_cast<int>(model.loads.size());
+  const auto num_sensors = static_cast<int>(model.sensors.size());
+  int strain_count = 0;
+  for (const MatrixModelSensor& sensor : model.sensors) {
+    strain_count += sensor.kind == SensorKind::kStrain ? 1 : 0;
+  }
+  Matrix displacements(num_sensors - strain_count, samples), strains(strain_count, samples);
+  for (int k = 0, u = 0, e = 0; k < num_sensors; ++k) {
+    const MatrixModelSensor& sensor = model.sensors[static_cast<std::size_t>(k)];
+    if (sensor.kind == SensorKind::kStrain) {
+      strains.row(e++) = data.Values(sensor.channel).transpose();
+    } else {
+      displacements.row(u++) = data.Values(sensor.channel).transpose();
+    }
+  }
+  Matrix loads(num_loads, samples);
+  for (int c = 0; c < num_loads; ++c) {
+    loads.row(c) = data.Values(model.loads[static_cast<std::size_t>(c)].channel).transpose();
+  }
+  levels.displacement_std = RootMeanSquareOfRows(displacements) / snr;
+  levels.strain_std = RootMeanSquareOfRows(strains) / snr;
+  levels.force_std = RootMeanSquareOfRows(loads) / snr;
+  return levels;
+}
+
 void AddMatrixModelNoise(const MatrixModelData& model, double snr, std::uint64_t seed,
                          ChannelSet* data, NoiseLevels* levels) {
-  if (levels != nullptr) *levels = NoiseLevels();
+  const NoiseLevels drawn = MatrixModelNoiseLevels(model, *data, snr);
+  if (levels != nullptr) *levels = drawn;
   if (std::isinf(snr)) return;
-  // The channels of each quantity, gathered as rows for their RMS.
   const auto samples = data->num_samples();
   const auto num_loads = static_cast<int>(model.loads.size());
   const auto num_sensors = static_cast<int>(model.sensors.size());
@@ -648,28 +679,9 @@ void AddMatrixModelNoise(const MatrixModelData& model, double snr, std::uint64_t
   for (const MatrixModelSensor& sensor : model.sensors) {
     sensor_values.push_back(&data->Values(sensor.channel));
   }
-  int strain_count = 0;
-  for (const MatrixModelSensor& sensor : model.sensors) {
-    strain_count += sensor.kind == SensorKind::kStrain ? 1 : 0;
-  }
-  Matrix displacements(num_sensors - strain_count, samples), strains(strain_count, samples);
-  for (int k = 0, u = 0, e = 0; k < num_sensors; ++k) {
-    if (model.sensors[k].kind == SensorKind::kStrain) {
-      strains.row(e++) = sensor_values[k]->transpose();
-    } else {
-      displacements.row(u++) = sensor_values[k]->transpose();
-    }
-  }
-  Matrix loads(num_loads, samples);
-  for (int c = 0; c < num_loads; ++c) loads.row(c) = load_values[c]->transpose();
-  const double std_u = RootMeanSquareOfRows(displacements) / snr;
-  const double std_e = RootMeanSquareOfRows(strains) / snr;
-  const double std_f = RootMeanSquareOfRows(loads) / snr;
-  if (levels != nullptr) {
-    levels->displacement_std = std_u;
-    levels->strain_std = std_e;
-    levels->force_std = std_f;
-  }
+  const double std_u = drawn.displacement_std;
+  const double std_e = drawn.strain_std;
+  const double std_f = drawn.force_std;
   StandardNormal normal(seed);
   for (int c = 0; c < num_loads; ++c) {
     for (int j = 0; j < samples; ++j) (*load_values[c])[j] += std_f * normal();

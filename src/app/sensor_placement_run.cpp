@@ -62,8 +62,7 @@ SensorPlacementRun RunSensorPlacement(const Config& config, int count) {
   design.data.truth_moduli.clear();
   design.data.snr = std::numeric_limits<double>::infinity();
   const MatrixMeasurements data = LoadMatrixMeasurements(design, run.model);
-  ChannelSet noisy = data.histories;
-  AddMatrixModelNoise(run.model, config.data.snr, config.data.seed, &noisy, &run.noise);
+  run.noise = MatrixModelNoiseLevels(run.model, data.histories, config.data.snr);
   run.nominal_moduli.resize(static_cast<Eigen::Index>(run.model.zones.size()));
   for (std::size_t z = 0; z < run.model.zones.size(); ++z) {
     run.nominal_moduli[static_cast<Eigen::Index>(z)] = run.model.zones[z].nominal_modulus;
@@ -96,25 +95,22 @@ SensorPlacementRun RunSensorPlacement(const Config& config, int count) {
   }
 
   // The chosen sensors under the noise that synthetic data of data.snr put on them
-  // alone (each kind's RMS over the chosen channels / SNR, AddMatrixModelNoise): I_k
+  // alone (MatrixModelNoiseLevels of the model with those sensors, in its order): I_k
   // scales by (s_design / s_chosen)^2 of its kind.
-  double squares[2] = {0.0, 0.0};
-  int rows[2] = {0, 0};
-  const Matrix& outputs = objective.outputs();
-  for (const int k : run.placement.chosen) {
-    const int kind = run.model.sensors[static_cast<std::size_t>(k)].kind == SensorKind::kStrain;
-    squares[kind] += outputs.row(k).squaredNorm();
-    ++rows[kind];
+  std::vector<int> chosen_in_order = run.placement.chosen;
+  std::sort(chosen_in_order.begin(), chosen_in_order.end());
+  MatrixModelData chosen_model;  // the loads and chosen sensors MatrixModelNoiseLevels reads
+  chosen_model.loads = run.model.loads;
+  for (const int k : chosen_in_order) {
+    chosen_model.sensors.push_back(run.model.sensors[static_cast<std::size_t>(k)]);
   }
+  const NoiseLevels own = MatrixModelNoiseLevels(chosen_model, data.histories, config.data.snr);
   const double design_std[2] = {run.noise.displacement_std, run.noise.strain_std};
+  const double chosen_std[2] = {own.displacement_std, own.strain_std};
   double factor[2] = {1.0, 1.0};
   for (int kind = 0; kind < 2; ++kind) {
-    if (rows[kind] == 0) continue;
-    const double chosen_std =
-        std::sqrt(squares[kind] / (static_cast<double>(rows[kind]) * outputs.cols())) /
-        config.data.snr;
-    // (Chosen sensors that read nothing keep the candidates' level.)
-    if (chosen_std > 0.0) factor[kind] = std::pow(design_std[kind] / chosen_std, 2);
+    // (A kind not chosen, or chosen sensors that read nothing, keep the candidates' level.)
+    if (chosen_std[kind] > 0.0) factor[kind] = std::pow(design_std[kind] / chosen_std[kind], 2);
   }
   const double prior = 1.0 / std::pow(options.prior_log_modulus_std, 2);
   Matrix chosen = prior * Matrix::Identity(information.front().rows(), information.front().cols());

@@ -99,9 +99,16 @@ Matrix SimulateMatrixModel(const MatrixModelData& truth, const Vector& zone_modu
                            const Matrix& loads, double time_step, double theta,
                            Matrix* support_forces = nullptr);
 
+// The standard deviations AddMatrixModelNoise draws at `snr`: RMS / snr over data's
+// channels of the model's displacement sensors, of its strain sensors and of its loads
+// (displacement_std, strain_std, force_std; all 0 when snr is infinite, a kind without
+// channels 0).
+NoiseLevels MatrixModelNoiseLevels(const MatrixModelData& model, const ChannelSet& data,
+                                   double snr);
+
 // Adds white Gaussian noise to every channel: standard deviation RMS / snr of the
-// channels of the same quantity (the displacement sensors together, the strain
-// sensors together, the loads together), drawn by the project's StandardNormal
+// channels of the same quantity (MatrixModelNoiseLevels) (the displacement sensors together, the
+// strain sensors together, the loads together), drawn by the project's StandardNormal
 // (core/random.h) seeded with `seed`, the loads first, then the sensors in order, sample by
 // sample, then each support's force (the loads' deviation) and displacement channel
 // (the displacement sensors'). Nothing when snr is infinite. levels (nullable): the
