@@ -41,7 +41,7 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from plate_zones_geometry import HEIGHT, LENGTH, MODEL_ELEMENTS  # noqa: E402
-from plate_zones_study import (CHANGED, GRID, ROOT, analyse, median_of,  # noqa: E402
+from plate_zones_study import (CHANGED, GRID, ROOT, analyse, robust_outliers,  # noqa: E402
                                truth_of_zones, update_markdown, update_table, write_atomic,
                                write_maps)
 
@@ -98,9 +98,7 @@ def flagged_zones(zones_csv):
     standard deviations (1.4826 MAD) of ln E over the zones."""
     rows = list(csv.DictReader(open(zones_csv)))
     logs = [math.log(float(r["modulus_pa"])) for r in rows]
-    median = median_of(logs)
-    mad = median_of([abs(v - median) for v in logs])
-    return [r["name"] for r, v in zip(rows, logs) if abs(v - median) > FLAG_SPREAD * 1.4826 * mad]
+    return [rows[i]["name"] for i in robust_outliers(logs, FLAG_SPREAD, two_sided=True)]
 
 
 def run(build_dir, results, work, name, manifest, free_zones=None):

@@ -117,14 +117,21 @@ def median_of(values):
     return ordered[n // 2] if n % 2 else 0.5 * (ordered[n // 2 - 1] + ordered[n // 2])
 
 
+def robust_outliers(values, spread, two_sided=False):
+    """Indices of the values above their median (or on either side, two_sided) by more
+    than `spread` robust standard deviations (1.4826 MAD)."""
+    median = median_of(values)
+    mad = median_of([abs(v - median) for v in values])
+    return [i for i, v in enumerate(values)
+            if (abs(v - median) if two_sided else v - median) > spread * 1.4826 * mad]
+
+
 def map_flagged(zones_csv, spread=3.0):
     """The zones the error map at the nominal moduli flags: a share of the gap above its
-    median over the zones by more than `spread` robust standard deviations (1.4826 MAD)."""
+    median over the zones by more than `spread` robust standard deviations."""
     rows = list(csv.DictReader(open(zones_csv)))
     shares = [float(r["error_share_nominal"]) for r in rows]
-    median = median_of(shares)
-    mad = median_of([abs(v - median) for v in shares])
-    return [r["name"] for r, v in zip(rows, shares) if v - median > spread * 1.4826 * mad]
+    return [rows[i]["name"] for i in robust_outliers(shares, spread)]
 
 
 def update_table(zones_csv, truth, evaluations, seconds):
