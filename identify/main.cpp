@@ -22,6 +22,7 @@
 //   identify run configs/quick.yaml --set outer.functional=least_squares --set model.zone_count=10
 //       --set 'data.truth_zones=[{start: 0.6, end: 0.7, modulus: 140e9}]' -o /tmp/ls_zones
 //   identify run configs/plate.yaml --output /tmp/plate
+//   identify run configs/beam3d.yaml --output /tmp/beam3d
 //   identify simulate configs/plate.yaml --output plate.csv
 //   identify run configs/plate.yaml --set data.source=csv --set data.path=$PWD/plate.csv -o /tmp/p
 //   identify sensors configs/plate_zones.yaml --count 20 --set data.snr=20 -o /tmp/sensors
@@ -456,7 +457,9 @@ int RunSensors(const SensorsArguments& arguments) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"mcrewave identify: MCRE identification of an elastic bar's Young's modulus"};
+  CLI::App app{
+      "mcrewave identify: MCRE identification of the moduli of an elastic structure (a bar, or any "
+      "structure given by matrices)"};
   app.set_version_flag("--version", std::string("mcrewave ") + mcrewave::kVersion);
   app.require_subcommand(0, 1);
   bool print_default_config = false;
