@@ -624,7 +624,7 @@ void RunBarComparator(const Config& config, const std::vector<DataSet>& sets,
 void RunMatrixComparator(const Config& config, const std::vector<DataSet>& sets,
                          internal::RunJournal* journal, ComparatorStudy* study,
                          internal::Progress* progress) {
-  const std::string name = config.source_path.empty() ? "config" : config.source_path;
+  const std::string name = config.Name();
   for (const DataSet& set : sets) {
     if (set.model_error == "soft_zone" || SupportStiffnessFactor(set.model_error) > 0.0) {
       throw InputError(name + ": study.comparator.errors: " + set.model_error +

@@ -155,72 +155,54 @@ ValueType<bool> Boolean() {
   return type;
 }
 
-// A YAML list of numbers ([.inf, 20, 2.5]); a single number is a list of one.
-// NaN is refused; ranges are checked by the sections' IsValid.
-ValueType<std::vector<double>> NumberList() {
-  ValueType<std::vector<double>> type;
-  type.expected = "a list of numbers, e.g. [.inf, 20, 2.5]";
-  type.read = [](const YAML::Node& node, std::vector<double>* value) {
-    const ValueType<double> number = Number();
-    std::vector<double> parsed;
+// A YAML list of `element` values; a single value is a list of one. At most
+// max_size values (0: any number). Written as a flow list of the element's own text.
+template <typename T>
+ValueType<std::vector<T>> ListOf(const ValueType<T>& element, const std::string& expected,
+                                 std::size_t max_size = 0) {
+  ValueType<std::vector<T>> type;
+  type.expected = expected;
+  type.read = [element, max_size](const YAML::Node& node, std::vector<T>* value) {
+    std::vector<T> parsed;
+    auto append = [&](const YAML::Node& item) {
+      T item_value;
+      if (!element.read(item, &item_value)) return false;
+      parsed.push_back(item_value);
+      return true;
+    };
     if (node.IsScalar()) {
-      double single;
-      if (!number.read(node, &single)) return false;
-      parsed.push_back(single);
+      if (!append(node)) return false;
     } else if (node.IsSequence()) {
-      for (const YAML::Node& element : node) {
-        double element_value;
-        if (!number.read(element, &element_value)) return false;
-        parsed.push_back(element_value);
+      for (const YAML::Node& item : node) {
+        if (!append(item)) return false;
       }
     } else {
       return false;
     }
+    if (max_size > 0 && parsed.size() > max_size) return false;
     *value = parsed;
     return true;
   };
-  type.write = [](const std::vector<double>& value) {
+  type.write = [element](const std::vector<T>& value) {
     std::string text = "[";
     for (std::size_t i = 0; i < value.size(); ++i) {
-      text += (i == 0 ? "" : ", ") + FormatNumber(value[i]);
+      text += (i == 0 ? "" : ", ") + element.write(value[i]);
     }
     return text + "]";
   };
   return type;
 }
 
-// A YAML list of 1 to 3 positive integers ([16, 4]); a single integer is a list of one.
+// A YAML list of numbers ([.inf, 20, 2.5]). NaN is refused; ranges are checked by the
+// sections' IsValid.
+ValueType<std::vector<double>> NumberList() {
+  return ListOf(Number(), "a list of numbers, e.g. [.inf, 20, 2.5]");
+}
+
+// A YAML list of 1 to 3 positive integers ([16, 4]); [] (the default): no grid.
 ValueType<std::vector<int>> GridCounts() {
-  ValueType<std::vector<int>> type;
-  type.expected = "1 to 3 positive integers, one per coordinate, e.g. [16, 4]";
-  type.read = [](const YAML::Node& node, std::vector<int>* value) {
-    const ValueType<int> count = PositiveInteger<int>();
-    std::vector<int> parsed;
-    if (node.IsScalar()) {
-      int single;
-      if (!count.read(node, &single)) return false;
-      parsed.push_back(single);
-    } else if (node.IsSequence()) {
-      for (const YAML::Node& element : node) {
-        int element_value;
-        if (!count.read(element, &element_value)) return false;
-        parsed.push_back(element_value);
-      }
-    } else {
-      return false;
-    }
-    if (parsed.size() > 3) return false;  // [] (the default): no grid
-    *value = parsed;
-    return true;
-  };
-  type.write = [](const std::vector<int>& value) {
-    std::string text = "[";
-    for (std::size_t i = 0; i < value.size(); ++i) {
-      text += (i == 0 ? "" : ", ") + std::to_string(value[i]);
-    }
-    return text + "]";
-  };
-  return type;
+  return ListOf(PositiveInteger<int>(),
+                "1 to 3 positive integers, one per coordinate, e.g. [16, 4]", 3);
 }
 
 // A YAML list of strings ([u@0.25, e@0.65]); a single string is a list of one, an

@@ -155,9 +155,7 @@ ChannelSet SyntheticMeasurements(const Config& config) {
   }
   for (const auto& [name, values] : channels) {
     if (!values->allFinite()) {
-      const std::string config_name =
-          config.source_path.empty() ? "the config" : config.source_path;
-      throw InputError(config_name + ": the synthetic channel '" + name +
+      throw InputError(config.Name() + ": the synthetic channel '" + name +
                        "' is not finite: load.amplitude (" + Number(config.load.amplitude) +
                        " N) or the noise of data.snr (" + Number(config.data.snr) +
                        ") lies beyond double range");
@@ -179,7 +177,7 @@ ChannelSet LoadMeasurements(const Config& config) {
   // Dead channels and outliers are looked for in the file's own samples, so that the
   // line named is the file's (resampling would spread a spike over its neighbours).
   CheckMeasurementChannels(data, path);
-  const std::string config_name = config.source_path.empty() ? "the config" : config.source_path;
+  const std::string config_name = config.Name();
   const int expected_samples = config.time.NumSteps() + 1;
   if (std::abs(data.time_step - config.time.step) > kGridTolerance * config.time.step ||
       std::abs(data.start_time) > kGridTolerance * config.time.step) {

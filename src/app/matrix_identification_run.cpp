@@ -48,11 +48,6 @@ std::vector<ChannelColumn> ChannelColumns(const Config& config, const MatrixMode
   return channels;
 }
 
-// Where a config key was set, for messages: the config file.
-std::string ConfigName(const Config& config) {
-  return config.source_path.empty() ? std::string("config") : config.source_path;
-}
-
 // The CSV of data.path on the config's grid: the model's channels (named as the model
 // names them, of their kinds), in its order.
 ChannelSet ReadMatrixMeasurementCsv(const Config& config, const MatrixModelData& model) {
@@ -67,7 +62,7 @@ ChannelSet ReadMatrixMeasurementCsv(const Config& config, const MatrixModelData&
       return "the header lacks the column '" + column + "' of the model's channel '" + channel +
              "'" +
              (column == channel ? std::string(" (model.channel_map can name another column)")
-                                : " (model.channel_map of " + ConfigName(config) + ")");
+                                : " (model.channel_map of " + config.Name() + ")");
     }
     return "";
   };
@@ -101,7 +96,7 @@ ChannelSet SyntheticMatrixMeasurements(const Config& config, const MatrixModelDa
   Vector moduli(zones);
   if (!config.data.truth_moduli.empty()) {
     if (static_cast<int>(config.data.truth_moduli.size()) != zones) {
-      throw InputError(ConfigName(config) + ": data.truth_moduli has " +
+      throw InputError(config.Name() + ": data.truth_moduli has " +
                        std::to_string(config.data.truth_moduli.size()) +
                        " moduli; the truth's manifest " + manifest + " has " +
                        std::to_string(zones) + " zones");
@@ -485,13 +480,13 @@ MatrixModelData LoadMatrixModel(const Config& config) {
     std::vector<MatrixModelSensor> used;
     for (const std::string& channel : config.data.channels) {
       if (std::count(config.data.channels.begin(), config.data.channels.end(), channel) > 1) {
-        throw InputError(ConfigName(config) + ": data.channels: '" + channel + "' is listed twice");
+        throw InputError(config.Name() + ": data.channels: '" + channel + "' is listed twice");
       }
       const auto found =
           std::find_if(model.sensors.begin(), model.sensors.end(),
                        [&](const MatrixModelSensor& sensor) { return sensor.channel == channel; });
       if (found == model.sensors.end()) {
-        throw InputError(ConfigName(config) + ": data.channels: '" + channel +
+        throw InputError(config.Name() + ": data.channels: '" + channel +
                          "' is not a sensor of the manifest " + config.structure.manifest +
                          " (its loads and supports are always used)");
       }
@@ -522,20 +517,19 @@ MatrixModelData LoadMatrixModel(const Config& config) {
       for (std::size_t f = 0; f < free.size(); ++f) {
         const auto found = std::find(names.begin(), names.end(), free[f]);
         if (found == names.end()) {
-          throw InputError(ConfigName(config) + ": model.free_zones: '" + free[f] +
+          throw InputError(config.Name() + ": model.free_zones: '" + free[f] +
                            "' is not a zone of model.zoning " +
                            ZoningToString(config.zones.zoning) + " (e.g. '" + names.back() + "')");
         }
         if (std::count(free.begin(), free.end(), free[f]) > 1) {
-          throw InputError(ConfigName(config) + ": model.free_zones: '" + free[f] +
-                           "' is listed twice");
+          throw InputError(config.Name() + ": model.free_zones: '" + free[f] + "' is listed twice");
         }
         tied[static_cast<std::size_t>(found - names.begin())] = static_cast<int>(f) + 1;
       }
       if (free.size() >= names.size()) {
-        throw InputError(
-            ConfigName(config) + ": model.free_zones lists every zone of model.zoning " +
-            ZoningToString(config.zones.zoning) + ": leave it out to identify each zone freely");
+        throw InputError(config.Name() + ": model.free_zones lists every zone of model.zoning " +
+                         ZoningToString(config.zones.zoning) +
+                         ": leave it out to identify each zone freely");
       }
       std::vector<int> regrouped(element_zones.size());
       for (std::size_t e = 0; e < element_zones.size(); ++e) {
@@ -562,19 +556,19 @@ MatrixModelData LoadMatrixModel(const Config& config) {
               return support.force_channel == channel || support.displacement_channel == channel;
             });
     if (!known) {
-      throw InputError(ConfigName(config) + ": model.channel_map: '" + channel +
+      throw InputError(config.Name() + ": model.channel_map: '" + channel +
                        "' is not a channel of the manifest " + config.structure.manifest);
     }
   }
   for (const MatrixModelZone& zone : model.zones) {
     if (!(zone.nominal_modulus > config.outer.lower_bound &&
           zone.nominal_modulus < config.outer.upper_bound)) {
-      throw InputError(ConfigName(config) + ": outer.lower_bound and outer.upper_bound [" +
-                       fmt::format("{:g}, {:g}", config.outer.lower_bound,
-                                   config.outer.upper_bound) +
-                       "] Pa must hold the nominal modulus " +
-                       fmt::format("{:g}", zone.nominal_modulus) + " Pa of zone '" + zone.name +
-                       "' of " + config.structure.manifest + " (the search starts there)");
+      throw InputError(
+          config.Name() + ": outer.lower_bound and outer.upper_bound [" +
+          fmt::format("{:g}, {:g}", config.outer.lower_bound, config.outer.upper_bound) +
+          "] Pa must hold the nominal modulus " + fmt::format("{:g}", zone.nominal_modulus) +
+          " Pa of zone '" + zone.name + "' of " + config.structure.manifest +
+          " (the search starts there)");
     }
   }
   return model;
@@ -596,9 +590,9 @@ void CheckMatrixModelFieldBytes(const Config& config, const MatrixModelData& mod
       "inner.max_field_bytes = {}; use inner.method: streaming_conjugate_gradient (or auto), "
       "which stores no space-time field, raise inner.max_field_bytes, or use a coarser mesh "
       "(fewer dofs), a shorter window or a larger time step",
-      ConfigName(config), config.structure.manifest, model.dofs(), steps,
-      static_cast<long long>(bytes), CoupledSolverName(config.inner.type, method),
-      kIterativeSolverFields, config.inner.max_field_bytes));
+      config.Name(), config.structure.manifest, model.dofs(), steps, static_cast<long long>(bytes),
+      CoupledSolverName(config.inner.type, method), kIterativeSolverFields,
+      config.inner.max_field_bytes));
 }
 
 MatrixMeasurements LoadMatrixMeasurements(const Config& config, const MatrixModelData& model) {

@@ -31,7 +31,7 @@ double MedianOf(Vector values) {
 
 SensorPlacementRun RunSensorPlacement(const Config& config, int count) {
   const auto start = std::chrono::steady_clock::now();
-  const std::string name = config.source_path.empty() ? "config" : config.source_path;
+  const std::string name = config.Name();
   if (config.structure.kind != ModelKind::kMatrix) {
     throw InputError(name +
                      ": model.kind: identify sensors chooses among a matrix model's sensors, "

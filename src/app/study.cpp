@@ -146,8 +146,8 @@ MatrixStudyTruth::MatrixStudyTruth(const Config& config, const std::string& stud
   noise_free.data.snr = std::numeric_limits<double>::infinity();
   measurements = LoadMatrixMeasurements(noise_free, model);
   if (measurements.truth_moduli.size() != static_cast<int>(model.zones.size())) {
-    throw InputError((config.source_path.empty() ? std::string("config") : config.source_path) +
-                     ": the " + study + " study needs the truth's modulus of every zone of " +
+    throw InputError(config.Name() + ": the " + study +
+                     " study needs the truth's modulus of every zone of " +
                      config.structure.manifest + ", and the truth (" +
                      (config.data.truth_manifest.empty() ? config.structure.manifest
                                                          : config.data.truth_manifest) +
@@ -1307,11 +1307,12 @@ std::string WriteStudiesReadme(const std::string& folder) {
         "and this file: the studies of configs/studies.yaml, then the robustness settings, the "
         "complexity and the weights studies of bench/; `bash scripts/plate_study.sh` the plate's, "
         "`bash scripts/plate_zones_study.sh` the many-zone plate's, "
-        "`bash scripts/plate_sensors_study.sh` its sensor layouts'); do not edit by hand. Each "
+        "`bash scripts/plate_sensors_study.sh` its sensor layouts', "
+        "`bash scripts/beam3d_study.sh` the 3-D beam's); do not edit by hand. Each "
         "section below is the `summary.md` of its folder.\n\n";
   for (const char* study :
        {"robustness", "relaxation", "cost_curves", "damage", "comparator", "robustness_settings",
-        "complexity", "weights", "plate", "plate_zones", "plate_sensors"}) {
+        "complexity", "weights", "plate", "plate_zones", "plate_sensors", "beam3d"}) {
     const std::string summary = folder + "/" + study + "/summary.md";
     std::ifstream file(summary);
     if (!file) continue;

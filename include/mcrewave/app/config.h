@@ -144,6 +144,9 @@ struct Config {
   StudyOptions study;
   // The identification of zone moduli after the scalar one (identification/zone_identification.h).
   ZoneIdentificationOptions zone_identification;
+
+  // What messages call the config: its file, or "the config" when it was built in code.
+  std::string Name() const { return source_path.empty() ? "the config" : source_path; }
 };
 
 // Reads a config file, applies the overrides ("key.path=value", each parsed as a
