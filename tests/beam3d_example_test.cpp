@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <sstream>
 #include <string>
 
 #include "identify_binary.h"
@@ -24,9 +23,9 @@ namespace mcrewave {
 namespace {
 
 using testing::FreshDirectory;
-using testing::ReadText;
 using testing::RunIdentify;
 using testing::SourcePath;
+using testing::ZoneModulus;
 
 constexpr double kLength = 0.72, kArea = 0.03 * 0.03;  // [m], [m^2]
 
@@ -144,18 +143,6 @@ TEST(Beam3dExampleTest, TheStreamingSolveIsTheStoredFieldSolve) {
   EXPECT_LT(cost, 1e-13);
   EXPECT_LT(gradients, 1e-11);
   EXPECT_LT(zones, 5e-12);
-}
-
-double ZoneModulus(const std::string& zones_csv, int zone) {
-  std::istringstream lines(ReadText(zones_csv));
-  std::string line;
-  std::getline(lines, line);  // header
-  for (int z = 0; z <= zone; ++z) std::getline(lines, line);
-  std::istringstream cells(line);
-  std::string cell;
-  // zone,name,start_m,end_m,nominal_modulus_pa,modulus_pa,... (app/zones_csv.h)
-  for (int c = 0; c < 6; ++c) std::getline(cells, cell, ',');
-  return std::stod(cell);
 }
 
 // `identify run configs/beam3d.yaml` as committed: the four zones from the tip's three

@@ -73,4 +73,17 @@ inline std::string WithoutRunLines(const std::string& yaml) {
   return kept;
 }
 
+// The identified modulus of zone `zone` (0-based) in a run's zones.csv [Pa]:
+// zone,name,start_m,end_m,nominal_modulus_pa,modulus_pa,... (app/zones_csv.h).
+inline double ZoneModulus(const std::string& zones_csv, int zone) {
+  std::istringstream lines(ReadText(zones_csv));
+  std::string line;
+  std::getline(lines, line);  // header
+  for (int z = 0; z <= zone; ++z) std::getline(lines, line);
+  std::istringstream cells(line);
+  std::string cell;
+  for (int c = 0; c < 6; ++c) std::getline(cells, cell, ',');
+  return std::stod(cell);
+}
+
 }  // namespace mcrewave::testing

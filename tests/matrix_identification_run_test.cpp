@@ -31,6 +31,7 @@ using testing::ReadText;
 using testing::RunIdentify;
 using testing::RunResult;
 using testing::SourcePath;
+using testing::ZoneModulus;
 
 // The quick bar (configs/quick.yaml: 25 elements) as matrices, its zone at the
 // nominal modulus 160 GPa (the start of the search, 20 % off the data's 200 GPa).
@@ -65,19 +66,6 @@ std::string SimulateAndExportQuickBarWithSupport(const std::string& dir,
   std::filesystem::create_directories(dir + "/support");
   return WriteMatrixModel(dir + "/support", BarMatrixModel(BarModel(LoadConfig(quick).model), 160e9,
                                                            {}, BarClampExport::kSupport));
-}
-
-// The identified modulus of zone `zone` in a matrix run's zones.csv.
-double ZoneModulus(const std::string& zones_csv, int zone) {
-  std::istringstream lines(ReadText(zones_csv));
-  std::string line;
-  std::getline(lines, line);  // header
-  for (int z = 0; z <= zone; ++z) std::getline(lines, line);
-  std::istringstream cells(line);
-  std::string cell;
-  // zone,name,start_m,end_m,nominal_modulus_pa,modulus_pa,... (app/zones_csv.h)
-  for (int c = 0; c < 6; ++c) std::getline(cells, cell, ',');
-  return std::stod(cell);
 }
 
 // The rows of a CSV file after its header, each split at its commas.
