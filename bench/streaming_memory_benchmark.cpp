@@ -72,7 +72,12 @@ static int BenchmarkMain(int argc, char** argv) {
   long history_bytes = -1;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--history-bytes") == 0 && i + 1 < argc) {
-      history_bytes = std::atol(argv[++i]);
+      char* end = nullptr;
+      history_bytes = std::strtol(argv[++i], &end, 10);
+      if (*end != '\0' || history_bytes <= 0) {
+        std::fprintf(stderr, "error: --history-bytes: '%s' is not a positive integer\n", argv[i]);
+        return 2;
+      }
     } else {
       path = argv[i];
     }
