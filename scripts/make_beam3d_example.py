@@ -33,14 +33,16 @@ Usage: /usr/bin/python3 scripts/make_beam3d_example.py [--output configs/beam3d]
 
 import argparse
 import os
+import sys
 
 import numpy as np
 import scipy.sparse
 from sfepy.base.base import output
-from sfepy.discrete import FieldVariable, Integral, Material
-from sfepy.discrete.fem import FEDomain, Field, Mesh
+from sfepy.discrete import Integral, Material
 from sfepy.mechanics.matcoefs import stiffness_from_youngpoisson
-from sfepy.terms import Term
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from sfepy_vector_field import VectorField  # noqa: E402
 
 LENGTH = 0.72  # L [m], along x
 WIDTH = 0.03  # B [m], along y
@@ -139,7 +141,7 @@ def brick_matrices(dx, dy, dz, modulus):
     return k, m
 
 
-class Assembly:
+class Assembly(VectorField):
     """SfePy's field, terms and element blocks on a Grid."""
 
     def __init__(self, grid):
@@ -148,15 +150,7 @@ class Assembly:
                           for k in range(grid.nz + 1) for j in range(grid.ny + 1)
                           for i in range(grid.nx + 1)])
         cells = np.array([grid.cell_nodes(*c) for c in grid.cells()], dtype=np.int32)
-        mesh = Mesh.from_data("beam", coors, None, [cells], [np.zeros(len(cells), np.int32)],
-                              ["3_8"])
-        self.domain = FEDomain("domain", mesh)
-        self.omega = self.domain.create_region("Omega", "all")
-        self.field = Field.from_args("u", np.float64, "vector", self.omega, approx_order=1)
-        assert np.array_equal(self.field.econn, cells), "SfePy renumbered the nodes"
-        self.u = FieldVariable("u", "unknown", self.field)
-        self.v = FieldVariable("v", "test", self.field, primary_var_name="u")
-        self.u.set_data(np.zeros(self.u.n_dof))
+        super().__init__("beam", coors, cells, "3_8")
         self.solid = Material("solid", D=stiffness_from_youngpoisson(3, NOMINAL_MODULUS, POISSON),
                               rho=DENSITY)
         self.integral = Integral("i", order=2)  # 2 x 2 x 2 Gauss points on hexahedra
@@ -173,13 +167,9 @@ class Assembly:
 
     def blocks(self, expression):
         """Every cell's 24 x 24 block, in cell order."""
-        term = Term.new(expression, self.integral, self.omega, solid=self.solid, v=self.v,
-                        u=self.u)
-        term.setup()
-        values, cells = term.evaluate(mode="weak", dw_mode="matrix", diff_var="u",
-                                      ret_status=False)
-        assert np.array_equal(cells, np.arange(len(cells)))
-        return values[:, 0]
+        blocks = self.element_matrices(expression, self.integral, self.omega, solid=self.solid)
+        assert [cell for cell, _ in blocks] == list(range(len(blocks)))
+        return np.array([block for _, block in blocks])
 
     def global_matrix(self, blocks, cells):
         """The sum of the blocks of `cells` on our free dofs."""

@@ -47,10 +47,8 @@ import sys
 import numpy as np
 import scipy.sparse
 from sfepy.base.base import output
-from sfepy.discrete import FieldVariable, Integral, Material
-from sfepy.discrete.fem import FEDomain, Field, Mesh
+from sfepy.discrete import Integral, Material
 from sfepy.mechanics.matcoefs import stiffness_from_youngpoisson
-from sfepy.terms import Term
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import make_plate_example as textbook  # noqa: E402  (the independent Q4 element)
@@ -58,9 +56,10 @@ import make_plate_example as textbook  # noqa: E402  (the independent Q4 element
 from plate_zones_geometry import (DENSITY, LENGTH, HEIGHT, MODEL_ELEMENTS,  # noqa: E402
                                   NOMINAL_MODULUS, POINT_SENSORS, POISSON, REFINE,
                                   THICKNESS, TRUTHS, Grid)
+from sfepy_vector_field import VectorField  # noqa: E402
 
 
-class Assembly:
+class Assembly(VectorField):
     """SfePy's field, terms and assembled matrices on a Grid."""
 
     def __init__(self, grid, groups):
@@ -70,15 +69,7 @@ class Assembly:
         cells = np.array([[grid.node(i, j), grid.node(i + 1, j), grid.node(i + 1, j + 1),
                            grid.node(i, j + 1)] for j in range(grid.ny) for i in range(grid.nx)],
                          dtype=np.int32)
-        mesh = Mesh.from_data("plate", coors, None, [cells], [np.array(groups, dtype=np.int32)],
-                              ["2_4"])
-        self.domain = FEDomain("domain", mesh)
-        self.omega = self.domain.create_region("Omega", "all")
-        self.field = Field.from_args("u", np.float64, "vector", self.omega, approx_order=1)
-        assert np.array_equal(self.field.econn, cells), "SfePy renumbered the nodes"
-        self.u = FieldVariable("u", "unknown", self.field)
-        self.v = FieldVariable("v", "test", self.field, primary_var_name="u")
-        self.u.set_data(np.zeros(self.u.n_dof))
+        super().__init__("plate", coors, cells, "2_4", groups)
         self.solid = Material("solid", D=THICKNESS * stiffness_from_youngpoisson(
             2, NOMINAL_MODULUS, POISSON, plane="stress"), rho=DENSITY * THICKNESS)
         self.integral = Integral("i", order=2)  # 2 x 2 Gauss points on quadrilaterals
@@ -92,11 +83,7 @@ class Assembly:
     def element_blocks(self, expression, region):
         """Per cell of `region`: the cell and its 8 x 8 block, SfePy's element dofs in
         field order (ux of the four nodes, then their uy)."""
-        term = Term.new(expression, self.integral, region, solid=self.solid, v=self.v, u=self.u)
-        term.setup()
-        values, cells = term.evaluate(mode="weak", dw_mode="matrix", diff_var="u",
-                                      ret_status=False)
-        return [(int(cell), values[k, 0]) for k, cell in enumerate(cells)]
+        return self.element_matrices(expression, self.integral, region, solid=self.solid)
 
     def element_dofs(self, cell):
         """Our dofs of a cell's 8 element dofs in SfePy's order (-1: clamped)."""
