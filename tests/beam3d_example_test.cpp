@@ -14,10 +14,10 @@
 #include "identify_binary.h"
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/matrix_identification_run.h"
-#include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/model/matrix_export.h"
+#include "test_problems.h"
 
 namespace mcrewave {
 namespace {
@@ -88,27 +88,9 @@ TEST(Beam3dExampleTest, TheStaticAxialStiffnessIsTheBarsEAOverL) {
 TEST(Beam3dExampleTest, SparseAndBandPathsAgree) {
   const MatrixModelData& beam = Beam();
   const SparseMatrix k = beam.Stiffness(beam.NominalModuli());
-  ThetaIntegratorOptions options;
-  options.time_step = 1e-6;
-  ThetaIntegrator band, sparse;
-  options.factorization = Factorization::kBand;
-  band.Init(beam.mass, k, options);
-  options.factorization = Factorization::kSparse;
-  sparse.Init(beam.mass, k, options);
-  const int n = beam.dofs();
-  Vector v1 = Vector::Zero(n), u1 = v1, v2 = v1, u2 = v1, v(n), u(n);
-  double worst = 0.0, scale = 0.0;
-  for (int step = 0; step < 600; ++step) {
-    const double load = step < 40 ? 1000.0 * std::sin(M_PI * step / 40.0) : 0.0;  // [N]
-    band.Step(v1, u1, load * beam.loads[0].vector, v, u);
-    v1 = v;
-    u1 = u;
-    sparse.Step(v2, u2, load * beam.loads[0].vector, v, u);
-    v2 = v;
-    u2 = u;
-    worst = std::max(worst, (u1 - u2).cwiseAbs().maxCoeff());
-    scale = std::max(scale, u1.cwiseAbs().maxCoeff());
-  }
+  const testing::SparseAndBandRun run =
+      testing::RunSparseAndBandPaths(beam.mass, k, beam.loads[0].vector, 1e-6, 600, 40);
+  const double worst = run.worst_difference, scale = run.max_displacement;
   std::printf("beam, 600 steps: sparse vs band %.2e of max |u| (%.3e m)\n", worst / scale, scale);
   EXPECT_LT(worst / scale, 3e-13);
 }

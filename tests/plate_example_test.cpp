@@ -15,6 +15,7 @@
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/model/matrix_export.h"
 #include "mcrewave/model/matrix_model_check.h"
+#include "test_problems.h"
 
 namespace mcrewave {
 namespace {
@@ -53,30 +54,12 @@ TEST(PlateExampleTest, SparseAndBandPathsAgreeOnTheCoarsePlate) {
   const SparseMatrix k = plate.Stiffness((Vector(2) << 200e9, 100e9).finished());
   EXPECT_EQ(ChooseFactorization(Factorization::kAutomatic, plate.mass, k),
             Factorization::kSparse);  // half bandwidth 51
-  ThetaIntegratorOptions options;
-  options.time_step = 2e-7;
-  ThetaIntegrator band, sparse;
-  options.factorization = Factorization::kBand;
-  band.Init(plate.mass, k, options);
-  options.factorization = Factorization::kSparse;
-  sparse.Init(plate.mass, k, options);
-  const int n = plate.dofs();
-  Vector v1 = Vector::Zero(n), u1 = v1, v2 = v1, u2 = v1, v(n), u(n);
   const Eigen::RowVectorXd tip = Matrix(plate.sensors[0].row).row(0);
   double lowest_tip = 0.0;  // [m]
-  double worst = 0.0, scale = 0.0;
-  for (int step = 0; step < 2000; ++step) {
-    const double load = step < 50 ? 1000.0 * std::sin(M_PI * step / 50.0) : 0.0;  // [N]
-    band.Step(v1, u1, load * plate.loads[0].vector, v, u);
-    v1 = v;
-    u1 = u;
-    sparse.Step(v2, u2, load * plate.loads[0].vector, v, u);
-    v2 = v;
-    u2 = u;
-    worst = std::max(worst, (u1 - u2).cwiseAbs().maxCoeff());
-    scale = std::max(scale, u1.cwiseAbs().maxCoeff());
-    lowest_tip = std::min(lowest_tip, tip.dot(u1));
-  }
+  const testing::SparseAndBandRun run = testing::RunSparseAndBandPaths(
+      plate.mass, k, plate.loads[0].vector, 2e-7, 2000, 50,
+      [&](const Vector& u) { lowest_tip = std::min(lowest_tip, tip.dot(u)); });
+  const double worst = run.worst_difference, scale = run.max_displacement;
   EXPECT_LT(lowest_tip, -0.1 * scale);  // the -y impact moves the tip down
   std::printf("coarse plate, 2000 steps: sparse vs band %.2e of max |u| (%.3e m)\n", worst / scale,
               scale);
