@@ -151,6 +151,10 @@ void ExpectSameConfigLaterKeys(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.mcre.support_check, actual.mcre.support_check);
   EXPECT_EQ(expected.mcre.support_check_threshold, actual.mcre.support_check_threshold);
   EXPECT_EQ(expected.mcre.support_check_ramp_start, actual.mcre.support_check_ramp_start);
+  EXPECT_EQ(expected.mcre.weights.unmeasured_force_weight,
+            actual.mcre.weights.unmeasured_force_weight);
+  EXPECT_EQ(expected.mcre.unmeasured_loads, actual.mcre.unmeasured_loads);
+  EXPECT_EQ(expected.mcre.unmeasured_load_interval, actual.mcre.unmeasured_load_interval);
   EXPECT_EQ(expected.data.support_stiffness, actual.data.support_stiffness);
   EXPECT_EQ(expected.search.functional, actual.search.functional);
   EXPECT_EQ(expected.search.displacement_weight, actual.search.displacement_weight);
@@ -809,6 +813,10 @@ constexpr const char* kEveryMatrixKeyNotAtItsDefault = R"(model:
 data:
   truth_manifest: fine/model.yaml
   truth_moduli: [2e11, 1.4000000000000001e11]
+mcre:
+  w_fu: 3.0000000000000001e-5
+  unmeasured_loads: [F, "hammer #2"]
+  unmeasured_load_interval: [0, 1.2e-4, 1e-5, 2.5e-4]
 )";
 
 // The key of equal zones, refused with the zoning of kEveryKeyNotAtItsDefault; the

@@ -652,6 +652,11 @@ void RunMatrixComparator(const Config& config, const std::vector<DataSet>& sets,
 }  // namespace
 
 ComparatorStudy RunComparatorStudy(const Config& config, const std::string& journal_path) {
+  if (!config.mcre.unmeasured_loads.empty()) {
+    throw InputError(config.Name() +
+                     ": mcre.unmeasured_loads: the comparator study runs least squares, which "
+                     "needs every load measured; remove mcre.unmeasured_loads for this study");
+  }
   const auto start = std::chrono::steady_clock::now();
   const std::vector<DataSet> sets = DataSets(config.study);
   ComparatorStudy study;

@@ -523,6 +523,18 @@ const std::vector<Key>& KeyTable() {
               &McreWeights::clamp_displacement_weight, Number(), "",
               "clamp displacement weight (mcre.clamp pinned): beta_0 = w_u0 S E0 / L (a "
               "matrix model's supports: w_u0 k*)"),
+      MakeKey("mcre.w_fu", &Config::mcre, &McreOptions::weights,
+              &McreWeights::unmeasured_force_weight, Number(), "",
+              "an unmeasured load's weight against the datum 0: alpha_u = w_fu / k* (free as "
+              "w_fu -> 0; docs/unmeasured_loads.md)"),
+      MakeKey("mcre.unmeasured_loads", &Config::mcre, &McreOptions::unmeasured_loads, TextList(),
+              "",
+              "load channels nobody measured, found with the admissible fields (the data "
+              "need not hold them; the bar: fL)"),
+      MakeKey("mcre.unmeasured_load_interval", &Config::mcre,
+              &McreOptions::unmeasured_load_interval, NumberList(), "s",
+              "start and end of each unmeasured load's interval, outside which it vanishes "
+              "([]: it may act over the whole window)"),
       MakeKey("mcre.reference_modulus", &Config::mcre, &McreOptions::reference_modulus, Number(),
               "Pa", "E0 of the weights: a fixed nominal modulus, not the unknown"),
       MakeKey(
@@ -1099,6 +1111,31 @@ bool CheckStructureKeys(const Config& config, std::string* error) {
   return error->empty();
 }
 
+// Unmeasured loads: least squares fits the measured loads' response and has no
+// unknown force (docs/unmeasured_loads.md section 4); on the bar only fL can be one
+// (f0 is the clamp's; a matrix model's names are checked against its manifest by
+// LoadMatrixModel).
+bool CheckUnmeasuredLoads(const Config& config, std::string* error) {
+  if (config.mcre.unmeasured_loads.empty()) return true;
+  if (config.outer.functional == OuterFunctional::kLeastSquares) {
+    *error =
+        "mcre.unmeasured_loads: outer.functional least_squares needs every load measured (it "
+        "has no unknown force); use outer.functional: mcre, or measure the load";
+    return false;
+  }
+  if (config.structure.kind == ModelKind::kBar) {
+    for (const std::string& channel : config.mcre.unmeasured_loads) {
+      if (channel != "fL") {
+        *error = "mcre.unmeasured_loads: '" + channel +
+                 "' is no load of the bar; its one load is fL (f0 is the clamp's reaction: "
+                 "mcre.clamp chooses how it enters)";
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
 // A load the time grid sees: the half sine of load.duration spans at least two
 // steps, so that a sample falls inside it.
 bool CheckLoadSpansTwoSteps(const Config& config, std::string* error) {
@@ -1183,6 +1220,7 @@ const std::vector<SectionValidator>& CrossSectionValidators() {
       CheckDataAgainstBar,          // data.* against model.*
       CheckStructureKeys,           // keys of the other model.kind
       CheckLoadSpansTwoSteps,       // load.duration against time.step
+      CheckUnmeasuredLoads,         // mcre.unmeasured_loads against outer.*, model.*
       CheckBarRunSizes,             // model.elements, time.*, data.truth_refinement, inner.*
       CheckPrefilterBelowNyquist,   // prefilter.cutoff_frequency against time.step
   };

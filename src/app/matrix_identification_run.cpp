@@ -34,7 +34,12 @@ std::vector<ChannelColumn> ChannelColumns(const Config& config, const MatrixMode
   auto add = [&](const std::string& channel, ChannelKind kind) {
     channels.push_back({channel, config.structure.Column(channel), kind});
   };
-  for (const MatrixModelLoad& load : model.loads) add(load.channel, ChannelKind::kForce);
+  const auto& unmeasured = config.mcre.unmeasured_loads;
+  for (const MatrixModelLoad& load : model.loads) {
+    // An unmeasured load has no column (MatrixMcreProblem gives it the datum 0).
+    if (std::find(unmeasured.begin(), unmeasured.end(), load.channel) != unmeasured.end()) continue;
+    add(load.channel, ChannelKind::kForce);
+  }
   for (const MatrixModelSensor& sensor : model.sensors) {
     add(sensor.channel,
         sensor.kind == SensorKind::kStrain ? ChannelKind::kStrain : ChannelKind::kDisplacement);
@@ -439,7 +444,13 @@ void PrefilterEveryChannel(const Config& config, const MatrixModelData& model,
   double cutoff = config.prefilter.cutoff_frequency;
   if (cutoff <= 0.0) {
     std::vector<std::string> source;
-    for (const MatrixModelLoad& load : model.loads) source.push_back(load.channel);
+    const auto& unmeasured = config.mcre.unmeasured_loads;
+    for (const MatrixModelLoad& load : model.loads) {
+      if (std::find(unmeasured.begin(), unmeasured.end(), load.channel) != unmeasured.end()) {
+        continue;  // no data
+      }
+      source.push_back(load.channel);
+    }
     if (source.empty()) {
       for (const MatrixModelSensor& sensor : model.sensors) source.push_back(sensor.channel);
     }
@@ -474,6 +485,18 @@ Matrix HeldSupportForces(const MatrixModelData& truth, const ChannelSet& data,
 MatrixModelData LoadMatrixModel(const Config& config) {
   assert(config.structure.kind == ModelKind::kMatrix);
   MatrixModelData model = ReadMatrixModel(config.structure.manifest);
+  for (const std::string& channel : config.mcre.unmeasured_loads) {
+    const bool load = std::any_of(model.loads.begin(), model.loads.end(),
+                                  [&](const MatrixModelLoad& it) { return it.channel == channel; });
+    if (!load) {
+      std::string names;
+      for (const MatrixModelLoad& it : model.loads)
+        names += (names.empty() ? "" : ", ") + it.channel;
+      throw InputError(config.Name() + ": mcre.unmeasured_loads: '" + channel +
+                       "' is not a load channel of the manifest " + config.structure.manifest +
+                       " (its loads: " + names + ")");
+    }
+  }
   if (!config.data.channels.empty()) {
     // data.channels: the manifest's sensors the identification uses, in the manifest's
     // order (a sensor layout chosen among many, e.g. by `identify sensors`).

@@ -164,8 +164,14 @@ void AssembleDirectRows(CoupledProblem* problem, const SparseMatrix& mass,
     system->Add(kV, k + 1, kV, k, mass, -1.0);
     system->Add(kV, k + 1, kU, k + 1, stiffness, h * theta);
     system->Add(kV, k + 1, kU, k, stiffness, h * (1.0 - theta));
-    system->Add(kV, k + 1, kW, k + 1, penalty, h * theta);
-    system->Add(kV, k + 1, kW, k, penalty, h * (1.0 - theta));
+    // P_{k+1} and P_k: the same matrix unless a load acts only over an interval.
+    if (problem->TimeVaryingPenalty()) {
+      system->Add(kV, k + 1, kW, k + 1, problem->PenaltyMatrixAt(k + 1), h * theta);
+      system->Add(kV, k + 1, kW, k, problem->PenaltyMatrixAt(k), h * (1.0 - theta));
+    } else {
+      system->Add(kV, k + 1, kW, k + 1, penalty, h * theta);
+      system->Add(kV, k + 1, kW, k, penalty, h * (1.0 - theta));
+    }
     force_now.swap(force_next);
     problem->MeasuredForce(k + 1, force_next);
     rhs->segment(system->Index(kV, k + 1), n) =

@@ -73,6 +73,11 @@ DiscreteMcreOperators::DiscreteMcreOperators(const CoupledProblem& problem)
       observation_(problem.WeightedObservation()),
       observed_(ObservedDofs(observation_)),
       load_(num_nodes_) {
+  if (problem.TimeVaryingPenalty()) {
+    throw std::runtime_error(
+        "a load known to vanish outside an interval makes P = K + G diag(1/alpha) G^T change "
+        "with time, and these operators take it as one matrix");
+  }
   const SymmetricBandMatrix mass(problem.MassMatrix());
   stiffness_ = SymmetricBandMatrix(problem.StiffnessMatrix());
   penalty_ = SymmetricBandMatrix(problem.PenaltyMatrix());

@@ -45,7 +45,9 @@ void MatrixMcreProblem::DirectSweeps(const Matrix* const (&retrograde)[B],
         z[b] = batch_shift_.col(b).data();
       }
       auto channel = batch_channel_.col(b);
-      DirectChannels(k, true, z[b], channel);
+      DirectChannels(
+          k, true, z[b], retrograde[b] != nullptr ? retrograde[b]->col(k).data() : nullptr,
+          retrograde[b] != nullptr ? retrograde[b]->col(k + 1).data() : nullptr, channel);
       load_columns_.Scatter(channel.data(), batch_load_values_.col(b).data(), &batch_loads_[b]);
       v_k[b] = batch_velocity_.col(2 * b + current).data();
       v_next[b] = batch_velocity_.col(2 * b + next).data();

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cassert>
+#include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -49,6 +51,11 @@ struct LoadColumn {
   const Vector* vector;
   double alpha;
   std::string channel;
+  // An unmeasured load's: its datum is 0 (the data's channel not read) and it acts over
+  // [start, end] [s] only.
+  bool measured = true;
+  double start = -std::numeric_limits<double>::infinity();
+  double end = std::numeric_limits<double>::infinity();
 };
 struct ObservedRow {
   SparseRow row;  // 1 x n
@@ -77,12 +84,30 @@ std::vector<char> HeldDofs(const MatrixModelData& model) {
   return held;
 }
 
-// G: the model's loads, then the supports' forces (measured: alpha; pinned: alpha_0).
+// G: the model's loads (unmeasured ones: alpha_u), then the supports' forces (measured:
+// alpha; pinned: alpha_0).
 std::vector<LoadColumn> LoadColumns(const MatrixModelData& model, double force_alpha,
-                                    double reaction_weight, bool measured, bool pinned) {
+                                    double unmeasured_alpha, double reaction_weight, bool measured,
+                                    bool pinned, const std::vector<UnmeasuredLoad>& unmeasured) {
   std::vector<LoadColumn> columns;
   for (const MatrixModelLoad& load : model.loads) {
     columns.push_back({&load.vector, force_alpha, load.channel});
+    for (const UnmeasuredLoad& free_load : unmeasured) {
+      if (free_load.channel != load.channel) continue;
+      columns.back().alpha = unmeasured_alpha;
+      columns.back().measured = false;
+      columns.back().start = free_load.start;
+      columns.back().end = free_load.end;
+    }
+  }
+  for (const UnmeasuredLoad& free_load : unmeasured) {
+    const bool found = std::any_of(model.loads.begin(), model.loads.end(), [&](const auto& load) {
+      return load.channel == free_load.channel;
+    });
+    if (!found) {
+      throw std::logic_error("the unmeasured load '" + free_load.channel +
+                             "' is no load channel of the model");
+    }
   }
   if (measured || pinned) {
     for (const MatrixModelSupport& support : model.supports) {
@@ -124,16 +149,34 @@ std::vector<ObservedRow> ObservedRows(const MatrixModelData& model, const McreWe
 }
 
 // G's channels gathered once into rows (columns t_j for the sweeps): F~ into
-// measured_loads, alpha_c into alphas, and G (n x C), a load on a held dof dropped.
+// measured_loads (an unmeasured load's 0), alpha_c into alphas, a_cj into active (left
+// empty when every load acts at every sample), and G (n x C), a load on a held dof
+// dropped.
 void GatherLoads(const std::vector<LoadColumn>& columns, const ChannelSet& data,
                  const std::vector<char>& held, int n, Matrix* measured_loads, Vector* alphas,
-                 SparseMatrix* loads) {
+                 Matrix* active, SparseMatrix* loads) {
   const int num_loads = static_cast<int>(columns.size());
-  measured_loads->resize(num_loads, data.num_samples());
+  const int samples = data.num_samples();
+  measured_loads->resize(num_loads, samples);
   alphas->resize(num_loads);
+  Matrix acts = Matrix::Ones(num_loads, samples);
+  bool intervals = false;
   std::vector<Eigen::Triplet<double>> entries;
   for (int c = 0; c < num_loads; ++c) {
-    measured_loads->row(c) = data.Values(columns[c].channel).transpose();
+    if (columns[c].measured) {
+      measured_loads->row(c) = data.Values(columns[c].channel).transpose();
+    } else {
+      measured_loads->row(c).setZero();
+      // a_cj = 1 on t_j in [start, end], to a millionth of a step.
+      const double slack = 1e-6 * data.time_step;
+      for (int j = 0; j < samples; ++j) {
+        const double time = j * data.time_step;
+        if (time < columns[c].start - slack || time > columns[c].end + slack) {
+          acts(c, j) = 0.0;
+          intervals = true;
+        }
+      }
+    }
     (*alphas)[c] = columns[c].alpha;
     const Vector& g = *columns[c].vector;
     for (int i = 0; i < n; ++i) {
@@ -143,6 +186,11 @@ void GatherLoads(const std::vector<LoadColumn>& columns, const ChannelSet& data,
   }
   loads->resize(n, num_loads);
   loads->setFromTriplets(entries.begin(), entries.end());
+  if (intervals) {
+    *active = std::move(acts);
+  } else {
+    active->resize(0, 0);
+  }
 }
 
 // H's fixed rows gathered once: d~ into the first rows of measured_outputs (0 for the
@@ -200,7 +248,8 @@ std::vector<SparseMatrix> ReactionZoneRows(const MatrixModelData& model,
 
 MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const ChannelSet& data,
                                      const McreWeights& weights, double reference_modulus,
-                                     double theta, Factorization factorization, ClampModel supports)
+                                     double theta, Factorization factorization, ClampModel supports,
+                                     const std::vector<UnmeasuredLoad>& unmeasured)
     : model_(model),
       time_step_(data.time_step),
       theta_(theta),
@@ -214,14 +263,16 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
   // beta_0 = w_u0 k* (section 11).
   const double stiffness_scale = reference_modulus * model.stiffness_length;
   const double force_alpha = weights.force_weight / stiffness_scale;
+  // An unmeasured load's alpha_u = w_fu / k* (docs/unmeasured_loads.md).
+  const double unmeasured_alpha = weights.unmeasured_force_weight / stiffness_scale;
   reaction_weight_ = weights.reaction_weight / stiffness_scale;
   const bool has_supports = !model.supports.empty();
   const bool trusted = has_supports && supports == ClampModel::kTrusted;
   const bool pinned = has_supports && supports == ClampModel::kPinned;
   const bool measured = has_supports && supports == ClampModel::kMeasured;
   if (trusted) held_ = HeldDofs(model);
-  const std::vector<LoadColumn> columns =
-      LoadColumns(model, force_alpha, reaction_weight_, measured, pinned);
+  const std::vector<LoadColumn> columns = LoadColumns(
+      model, force_alpha, unmeasured_alpha, reaction_weight_, measured, pinned, unmeasured);
   const std::vector<ObservedRow> rows =
       ObservedRows(model, weights, stiffness_scale, measured, pinned);
   if (trusted) num_reactions_ = static_cast<int>(model.supports.size());
@@ -239,7 +290,7 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
       output_kinds_.push_back(ChannelKind::kForce);
     }
   }
-  GatherLoads(columns, data, held_, n, &measured_loads_, &alphas_, &loads_);
+  GatherLoads(columns, data, held_, n, &measured_loads_, &alphas_, &load_active_, &loads_);
   loads_transposed_ = loads_.transpose();
   load_columns_ = SparseColumns(loads_);
   measured_outputs_.resize(num_rows, data.num_samples());
@@ -280,6 +331,7 @@ MatrixMcreProblem::MatrixMcreProblem(const MatrixModelData& model, const Channel
   product_ = Vector::Zero(n);
   channel_ = Vector::Zero(num_loads);
   other_channel_ = Vector::Zero(num_loads);
+  for (Vector& edge : edge_channel_) edge = Vector::Zero(num_loads);
   trace_ = Vector::Zero(num_rows);
   reaction_trace_ = Vector::Zero(num_reactions_);
   for (int b = 0; b < 2; ++b) {
@@ -350,8 +402,8 @@ void MatrixMcreProblem::DirectSweep(const Matrix& retrograde, bool include_data,
     const int current = k & 1, next = current ^ 1;
     // W_theta = theta W_{k+1} + (1 - theta) W_k.
     shift_ = theta_ * retrograde.col(k + 1) + (1.0 - theta_) * retrograde.col(k);
-    DirectStep(k, include_data, velocity_[current], displacement->col(k), velocity_[next],
-               displacement->col(k + 1));
+    DirectStep(k, include_data, retrograde.col(k).data(), retrograde.col(k + 1).data(),
+               velocity_[current], displacement->col(k), velocity_[next], displacement->col(k + 1));
   }
   ++sweep_count_;
 }
@@ -384,7 +436,7 @@ double MatrixMcreProblem::InnerProduct(const Matrix& x, const Matrix& y) {
   double sum = 0.0;
   for (int j = 0; j <= num_steps(); ++j) {
     // c_j h x_j^T (K + G diag(1/alpha) G^T) y_j.
-    sum += QuadratureWeight(j) * h * PenaltyForm(x.col(j), y.col(j));
+    sum += QuadratureWeight(j) * h * PenaltyForm(j, x.col(j), y.col(j));
   }
   return sum;
 }
@@ -393,11 +445,12 @@ double MatrixMcreProblem::Cost(const Matrix& displacement, const Matrix& retrogr
   const double h = time_step();
   double sum = 0.0;
   for (int j = 0; j <= num_steps(); ++j) {
-    // c_j h [1/2 W^T K W + 1/2 (G^T W)^T diag(1/alpha) G^T W
+    // c_j h [1/2 W^T K W + 1/2 (G^T W)^T diag(a_j / alpha) G^T W
     //        + 1/2 (H U - d~)^T diag(beta) (H U - d~)].
     const double* w = retrograde.col(j).data();
     const double gap = StiffnessForm(w, w);
     load_columns_.TransposeMultiply(w, channel_.data());
+    MaskInactiveLoads(j, channel_);
     observation_columns_.TransposeMultiply(displacement.col(j).data(), trace_.data());
     trace_ -= measured_outputs_.col(j);
     const double integrand = 0.5 * gap + 0.5 * channel_.cwiseQuotient(alphas_).dot(channel_) +
@@ -498,6 +551,13 @@ SparseMatrix MatrixMcreProblem::PenaltyMatrix() const {
   return stiffness_ + SparseMatrix(scaled * loads_transposed_);
 }
 
+SparseMatrix MatrixMcreProblem::PenaltyMatrixAt(int j) const {
+  if (load_active_.size() == 0) return PenaltyMatrix();
+  // P_j = K + G diag(a_j / alpha) G^T.
+  const SparseMatrix scaled = loads_ * load_active_.col(j).cwiseQuotient(alphas_).asDiagonal();
+  return stiffness_ + SparseMatrix(scaled * loads_transposed_);
+}
+
 SparseMatrix MatrixMcreProblem::WeightedObservation() const {
   // H^T diag(beta) H.
   const SparseMatrix weighted = observation_transposed_ * betas_.asDiagonal();
@@ -539,8 +599,8 @@ void MatrixMcreProblem::DataResponseSweep(Observe&& observe) {
     // DirectSweep's step at W = 0: f_theta = G F~_theta (the same operations, so the
     // same bits).
     shift_.setZero();
-    DirectStep(k, true, stream_velocity_[current], stream_displacement_[current],
-               stream_velocity_[next], stream_displacement_[next]);
+    DirectStep(k, true, shift_.data(), shift_.data(), stream_velocity_[current],
+               stream_displacement_[current], stream_velocity_[next], stream_displacement_[next]);
     observe(k + 1, stream_displacement_[next]);
   }
   ++sweep_count_;
@@ -560,10 +620,11 @@ ChannelSet MatrixMcreProblem::ModelChannels(const CoupledSolution& solution) con
   set.time_step = time_step_;
   for (std::size_t c = 0; c < load_channels_.size(); ++c) {
     const auto row = static_cast<Eigen::Index>(c);
-    // F_c = F~_c - (G^T W)_c / alpha_c, the direct sweep's load (docs/matrix_models.md
-    // section 2).
-    set.Add(load_channels_[c], ChannelKind::kForce,
-            (measured_loads_.row(row) - load_retrograde.row(row) / alphas_[row]).transpose());
+    // F_c = F~_c - a_c (G^T W)_c / alpha_c, the direct sweep's load (docs/matrix_models.md
+    // section 2; an unmeasured load's F~ = 0, a = 0 where it does not act).
+    Vector force = (measured_loads_.row(row) - load_retrograde.row(row) / alphas_[row]).transpose();
+    if (load_active_.size() > 0) force.array() *= load_active_.row(row).transpose().array();
+    set.Add(load_channels_[c], ChannelKind::kForce, force);
   }
   for (std::size_t k = 0; k < output_channels_.size(); ++k) {
     if (output_channels_[k].empty()) continue;  // a datum 0

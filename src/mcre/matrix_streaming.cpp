@@ -39,16 +39,18 @@ void MatrixMcreProblem::RetrogradeStep(int j, bool include_data, const Vector& v
                                observation_columns_.Scatter(trace_.data()));
 }
 
-void MatrixMcreProblem::DirectStep(int k, bool include_data, const Vector& velocity,
+void MatrixMcreProblem::DirectStep(int k, bool include_data, const double* previous,
+                                   const double* next, const Vector& velocity,
                                    const Eigen::Ref<const Vector>& displacement,
                                    Vector& velocity_next, Eigen::Ref<Vector> displacement_next) {
   // f_theta = -K W_theta + G (F~_theta - diag(1/alpha) G^T W_theta).
-  DirectChannels(k, include_data, shift_.data(), channel_);
+  DirectChannels(k, include_data, shift_.data(), previous, next, channel_);
   integrator_.StepWithEndLoads(velocity, displacement, shift_, 0.0, 0.0, velocity_next,
                                displacement_next, load_columns_.Scatter(channel_.data()));
 }
 
 void MatrixMcreProblem::DirectChannels(int k, bool include_data, const double* shift,
+                                       const double* previous, const double* next,
                                        Eigen::Ref<Vector> channel) const {
   // Loops over the few channels rather than Eigen expressions, whose set-up costs more
   // than their work at this size; the same operations, so the same bits.
@@ -58,6 +60,27 @@ void MatrixMcreProblem::DirectChannels(int k, bool include_data, const double* s
     load_columns_.TransposeMultiply(shift, out);
     // -diag(1/alpha) G^T W_theta.
     for (int c = 0; c < channels; ++c) out[c] = -(out[c] / alphas_[c]);
+    if (load_active_.size() > 0) {
+      bool edge = false;
+      for (int c = 0; c < channels; ++c) {
+        const double now = load_active_(c, k), later = load_active_(c, k + 1);
+        if (now == 0.0 && later == 0.0) out[c] = 0.0;
+        edge = edge || now != later;
+      }
+      if (edge) {
+        // Where a load starts or stops acting:
+        // -(theta a_{k+1} (G^T W_{k+1}) + (1 - theta) a_k (G^T W_k)) / alpha.
+        load_columns_.TransposeMultiply(previous, edge_channel_[0].data());
+        load_columns_.TransposeMultiply(next, edge_channel_[1].data());
+        for (int c = 0; c < channels; ++c) {
+          const double now = load_active_(c, k), later = load_active_(c, k + 1);
+          if (now == later) continue;
+          out[c] = -(
+              (theta_ * later * edge_channel_[1][c] + (1.0 - theta_) * now * edge_channel_[0][c]) /
+              alphas_[c]);
+        }
+      }
+    }
   } else {
     channel.setZero();
   }
@@ -92,11 +115,12 @@ double MatrixMcreProblem::StiffnessForm(const double* x, const double* y) {
   return Eigen::Map<const Vector>(x, n).dot(product_);
 }
 
-double MatrixMcreProblem::PenaltyForm(const Eigen::Ref<const Vector>& x,
+double MatrixMcreProblem::PenaltyForm(int j, const Eigen::Ref<const Vector>& x,
                                       const Eigen::Ref<const Vector>& y) {
-  // x^T (K + G diag(1/alpha) G^T) y, the integrand of InnerProduct.
+  // x^T (K + G diag(a_j / alpha) G^T) y, the integrand of InnerProduct.
   const double stiffness_form = StiffnessForm(x.data(), y.data());
   load_columns_.TransposeMultiply(x.data(), channel_.data());
+  MaskInactiveLoads(j, channel_);
   load_columns_.TransposeMultiply(y.data(), other_channel_.data());
   return stiffness_form + channel_.cwiseQuotient(alphas_).dot(other_channel_);
 }
@@ -117,11 +141,12 @@ double MatrixMcreProblem::RetrogradeEnergy(const Matrix& traces) {
     stream_retrograde_[0] =
         (theta_ * state_[next] + (1.0 - theta_) * state_[current]) * (1.0 / QuadratureWeight(j));
     // + c_j h W_j^T P W_j.
-    energy += QuadratureWeight(j) * h * PenaltyForm(stream_retrograde_[0], stream_retrograde_[0]);
+    energy +=
+        QuadratureWeight(j) * h * PenaltyForm(j, stream_retrograde_[0], stream_retrograde_[0]);
   }
   // W_0 = (1 - theta) omega_0 / c_0.
   stream_retrograde_[0] = ((1.0 - theta_) / QuadratureWeight(0)) * state_[m & 1];
-  energy += QuadratureWeight(0) * h * PenaltyForm(stream_retrograde_[0], stream_retrograde_[0]);
+  energy += QuadratureWeight(0) * h * PenaltyForm(0, stream_retrograde_[0], stream_retrograde_[0]);
   ++sweep_count_;
   return energy;
 }
@@ -141,6 +166,7 @@ void MatrixMcreProblem::AddStreamingSample(int j, const Vector& displacement,
           : retrograde.dot(product_);
   load_columns_.TransposeMultiply(retrograde.data(), channel_.data());
   totals->load_retrograde.col(j) = channel_;
+  MaskInactiveLoads(j, channel_);
   totals->cost +=
       weight * (0.5 * stiffness_form + 0.5 * channel_.cwiseQuotient(alphas_).dot(channel_) +
                 0.5 * betas_.dot(trace_.cwiseProduct(trace_)));
@@ -275,8 +301,9 @@ void MatrixMcreProblem::StreamingMap(const Matrix& traces, bool include_data, Ma
   auto direct_step = [&](int j, const Vector& previous_retrograde, const Vector& retrograde) {
     const int current = (j - 1) & 1, next = current ^ 1;
     shift_ = theta_ * retrograde + (1.0 - theta_) * previous_retrograde;
-    DirectStep(j - 1, include_data, stream_velocity_[current], stream_displacement_[current],
-               stream_velocity_[next], stream_displacement_[next]);
+    DirectStep(j - 1, include_data, previous_retrograde.data(), retrograde.data(),
+               stream_velocity_[current], stream_displacement_[current], stream_velocity_[next],
+               stream_displacement_[next]);
     observe(j, stream_displacement_[next], retrograde);
   };
 

@@ -167,7 +167,10 @@ void MatrixMcreProblem::ForgetTracePreconditioner() {
 bool MatrixMcreProblem::PrepareTracePreconditioner(double rebuild_change, long max_traces) {
   const int rows = num_traces(), m = num_steps();
   const long size = static_cast<long>(rows) * (m + 1);
-  if (rows == 0 || m < 2 || theta_ < 0.5 || size > max_traces || !(betas_.minCoeff() > 0.0)) {
+  // None when a load acts over an interval: the operator below takes one P for every
+  // sample (TimeVaryingPenalty).
+  if (rows == 0 || m < 2 || theta_ < 0.5 || size > max_traces || !(betas_.minCoeff() > 0.0) ||
+      TimeVaryingPenalty()) {
     return false;
   }
   trace_scratch_.resize(size);

@@ -17,6 +17,8 @@ bool McreWeights::IsValid(std::string* error) const {
     why << "mcre.w_r must be a finite positive number, got " << reaction_weight;
   } else if (!(std::isfinite(clamp_displacement_weight) && clamp_displacement_weight > 0.0)) {
     why << "mcre.w_u0 must be a finite positive number, got " << clamp_displacement_weight;
+  } else if (!(std::isfinite(unmeasured_force_weight) && unmeasured_force_weight > 0.0)) {
+    why << "mcre.w_fu must be a finite positive number, got " << unmeasured_force_weight;
   } else {
     return true;
   }

@@ -39,7 +39,50 @@ bool McreOptions::IsValid(std::string* error) const {
     if (error != nullptr) *error = why.str();
     return false;
   }
+  std::ostringstream why;
+  const std::size_t loads = unmeasured_loads.size();
+  for (std::size_t l = 0; l < loads && why.tellp() == 0; ++l) {
+    if (unmeasured_loads[l].empty()) {
+      why << "mcre.unmeasured_loads: entry " << l + 1 << " is empty; expected a load channel name";
+    }
+    for (std::size_t other = 0; other < l && why.tellp() == 0; ++other) {
+      if (unmeasured_loads[other] == unmeasured_loads[l]) {
+        why << "mcre.unmeasured_loads names '" << unmeasured_loads[l] << "' twice";
+      }
+    }
+  }
+  if (why.tellp() == 0 && !unmeasured_load_interval.empty() &&
+      unmeasured_load_interval.size() != 2 * loads) {
+    why << "mcre.unmeasured_load_interval has " << unmeasured_load_interval.size()
+        << " times; expected none or 2 per unmeasured load (start, end [s]), " << 2 * loads
+        << " for the " << loads << " of mcre.unmeasured_loads";
+  }
+  for (std::size_t l = 0; 2 * l + 1 < unmeasured_load_interval.size() && why.tellp() == 0; ++l) {
+    const double start = unmeasured_load_interval[2 * l], end = unmeasured_load_interval[2 * l + 1];
+    if (!(std::isfinite(start) && std::isfinite(end) && start <= end)) {
+      why << "mcre.unmeasured_load_interval: the interval of '" << unmeasured_loads[l] << "' is ["
+          << start << ", " << end << "] s; expected finite times, start <= end";
+    }
+  }
+  if (why.tellp() != 0) {
+    if (error != nullptr) *error = why.str();
+    return false;
+  }
   return true;
+}
+
+std::vector<UnmeasuredLoad> UnmeasuredLoads(const McreOptions& mcre) {
+  std::vector<UnmeasuredLoad> loads;
+  for (std::size_t l = 0; l < mcre.unmeasured_loads.size(); ++l) {
+    UnmeasuredLoad load;
+    load.channel = mcre.unmeasured_loads[l];
+    if (!mcre.unmeasured_load_interval.empty()) {
+      load.start = mcre.unmeasured_load_interval[2 * l];
+      load.end = mcre.unmeasured_load_interval[2 * l + 1];
+    }
+    loads.push_back(load);
+  }
+  return loads;
 }
 
 bool SearchOptions::IsValid(std::string* error) const {
@@ -138,7 +181,8 @@ McreObjective MatrixMcreObjective(const MatrixModelData& model, const ChannelSet
       [&model, &data, mcre, theta, factorization,
        element_maps]() -> std::unique_ptr<StreamingCoupledProblem> {
         auto problem = std::make_unique<MatrixMcreProblem>(
-            model, data, mcre.weights, mcre.reference_modulus, theta, factorization, mcre.clamp);
+            model, data, mcre.weights, mcre.reference_modulus, theta, factorization, mcre.clamp,
+            UnmeasuredLoads(mcre));
         problem->set_element_maps(element_maps);
         return problem;
       },

@@ -57,9 +57,9 @@ bool SecantCurvature(const CoupledSolverOptions& inner, const Vector& moduli,
 std::unique_ptr<MatrixMcreProblem> FigureProblem(const MatrixModelData& model,
                                                  const ChannelSet& data, const McreOptions& mcre,
                                                  double theta) {
-  auto problem =
-      std::make_unique<MatrixMcreProblem>(model, data, mcre.weights, mcre.reference_modulus, theta,
-                                          Factorization::kAutomatic, mcre.clamp);
+  auto problem = std::make_unique<MatrixMcreProblem>(
+      model, data, mcre.weights, mcre.reference_modulus, theta, Factorization::kAutomatic,
+      mcre.clamp, UnmeasuredLoads(mcre));
   problem->set_element_maps(false);
   return problem;
 }

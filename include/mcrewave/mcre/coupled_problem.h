@@ -80,6 +80,13 @@ class CoupledProblem {
   virtual SparseMatrix MassMatrix() const = 0;
   virtual SparseMatrix StiffnessMatrix() const = 0;
   virtual SparseMatrix PenaltyMatrix() const = 0;
+  // Whether P changes with the sample: a load known to vanish outside an interval
+  // (docs/unmeasured_loads.md) has its G diag(1/alpha) G^T term only where it may act.
+  // The solvers that take P as one matrix (Riccati, shooting, the trace preconditioner)
+  // refuse such a problem; the all-at-once solver takes PenaltyMatrixAt(j).
+  virtual bool TimeVaryingPenalty() const { return false; }
+  // P at sample j [N/m]; PenaltyMatrix() unless TimeVaryingPenalty().
+  virtual SparseMatrix PenaltyMatrixAt(int /*j*/) const { return PenaltyMatrix(); }
   virtual SparseMatrix WeightedObservation() const = 0;
   // H^T diag(beta) d~_j [N] at sample j into load (size n).
   virtual void WeightedData(int j, Eigen::Ref<Vector> load) const = 0;

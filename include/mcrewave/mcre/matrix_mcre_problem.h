@@ -52,6 +52,7 @@
 // fields pass, and G^T W of every sample (the model's forces, ModelChannels).
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -67,6 +68,17 @@
 #include "mcrewave/model/matrix_export.h"
 
 namespace mcrewave {
+
+// A load channel whose history was not measured (docs/unmeasured_loads.md). Its force
+// is found with the admissible fields: the load enters as a measured one whose datum is
+// 0, weighted by alpha_u = w_fu / k* (McreWeights::unmeasured_force_weight), at the
+// samples t_j in [start, end] [s]; outside that interval it is known to vanish, F = 0
+// exactly (1/alpha = 0 there). The data need not hold its channel.
+struct UnmeasuredLoad {
+  std::string channel;
+  double start = -std::numeric_limits<double>::infinity();
+  double end = std::numeric_limits<double>::infinity();
+};
 
 // The channel set of a model's channels from their histories at t_j = j h, j = 0..m,
 // in the model's order (MatrixModelData::loads, ::sensors): a channel per load (named
@@ -91,11 +103,13 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // of each of the model's loads and sensors and each support's force channel, and its
   // displacement channel when it has one and supports is kMeasured (else throws
   // std::logic_error), on t_j = j h and m >= 1 steps, the model's scales positive,
-  // weights valid, theta in [0, 1].
+  // weights valid, theta in [0, 1]. unmeasured names some of the model's load channels
+  // (not its supports'), each once, with start <= end; data need not hold them.
   MatrixMcreProblem(const MatrixModelData& model, const ChannelSet& data,
                     const McreWeights& weights, double reference_modulus, double theta,
                     Factorization factorization = Factorization::kAutomatic,
-                    ClampModel supports = ClampModel::kMeasured);
+                    ClampModel supports = ClampModel::kMeasured,
+                    const std::vector<UnmeasuredLoad>& unmeasured = {});
 
   int num_nodes() const override { return model_.dofs(); }
   int num_steps() const override { return static_cast<int>(measured_loads_.cols()) - 1; }
@@ -141,6 +155,10 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   SparseMatrix MassMatrix() const override { return mass_; }
   SparseMatrix StiffnessMatrix() const override { return stiffness_; }
   SparseMatrix PenaltyMatrix() const override;
+  // True when an unmeasured load acts only over an interval shorter than the window:
+  // P_j = K + G diag(a_cj / alpha_c) G^T, a_cj = 1 where load c may act at t_j, else 0.
+  bool TimeVaryingPenalty() const override { return load_active_.size() > 0; }
+  SparseMatrix PenaltyMatrixAt(int j) const override;
   SparseMatrix WeightedObservation() const override;
   void WeightedData(int j, Eigen::Ref<Vector> load) const override;
   void MeasuredForce(int j, Eigen::Ref<Vector> load) const override;
@@ -177,6 +195,11 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
 
   // alpha_c [m/N]: the model's load channels, then (measured, pinned) the supports'.
   const Vector& alphas() const { return alphas_; }
+  // Whether load channel c (G's column) may act at sample j: always, except an
+  // unmeasured load outside its interval.
+  bool LoadActive(int c, int j) const {
+    return load_active_.size() == 0 || load_active_(c, j) != 0.0;
+  }
   // beta_k [N/m, N m or m/N]: the model's sensors, then the supports' rows (above).
   const Vector& betas() const { return betas_; }
   ClampModel support_treatment() const { return treatment_; }
@@ -222,10 +245,12 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // field's column-major order): -L y = (C beta)^-1/2 S (C beta)^1/2 y. From one
   // retrograde sweep per trace row (the impulse responses, by time invariance) and one
   // product of n x R m matrices. Preconditions: m >= 2, theta >= 1/2 (the recursion
-  // from the responses to Z's blocks divides by theta), every beta_k > 0.
+  // from the responses to Z's blocks divides by theta), every beta_k > 0, no load acting
+  // over an interval only (!TimeVaryingPenalty(): P is taken as one matrix).
   Matrix SymmetricTraceOperator();
   // The Cholesky factor of I + S (above) at the current moduli, in single precision
-  // where that keeps it definite (TraceFactor::single_precision), rebuilt when a modulus
+  // where that keeps it definite (TraceFactor::single_precision); none (false) when P
+  // changes with time (TimeVaryingPenalty). Rebuilt when a modulus
   // moved by more than rebuild_change since it was built; (C beta)^-1/2 (I + S)^-1
   // (C beta)^1/2 applied by PreconditionTraces.
   bool PrepareTracePreconditioner(double rebuild_change, long max_traces) override;
@@ -266,20 +291,30 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // x^T K y on either path of the integrator: from its band of K on the band path (as
   // the bar's McreProblem::PenaltyForm), else through product_ = K y. No allocation.
   double StiffnessForm(const double* x, const double* y);
-  // The load channels of the direct step t_k -> t_{k+1},
-  //   channel = F~_theta - diag(1/alpha) G^T W_theta  (F~ only with include_data),
-  // from W_theta (null: the zero field, no G^T W term). No allocation.
-  void DirectChannels(int k, bool include_data, const double* shift,
-                      Eigen::Ref<Vector> channel) const;
+  // The load channels of the direct step t_k -> t_{k+1}, the theta average of the
+  // samples' F_j = F~_j - diag(a_j / alpha) G^T W_j,
+  //   channel = F~_theta - diag(1/alpha) G^T W_theta  (F~ only with include_data)
+  // where a load acts at both ends of the step (its sum: the same bits as before loads
+  // had intervals), 0 from its G^T W where it acts at neither, and the two samples'
+  // terms apart where it starts or stops. From W_theta, W_k and W_{k+1} (shift null:
+  // the zero field, no G^T W term). No allocation.
+  void DirectChannels(int k, bool include_data, const double* shift, const double* previous,
+                      const double* next, Eigen::Ref<Vector> channel) const;
+  // Zeroes the entries of G^T W_j (channel) of the loads that do not act at sample j.
+  void MaskInactiveLoads(int j, Eigen::Ref<Vector> channel) const {
+    if (load_active_.size() > 0) channel.array() *= load_active_.col(j).array();
+  }
   // The weighted traces of the retrograde step t_j -> t_{j-1}: y_j (H U_j or a trace)
   // in, c_j diag(beta) (y_j - d~_j) out (d~ only with include_data). No allocation.
   void WeightTraces(int j, bool include_data, Eigen::Ref<Vector> trace) const;
-  // The direct step t_k -> t_{k+1} from (v, u) into (v_next, u_next), W_theta in shift_:
-  // f_theta = -K W_theta + G (F~_theta - diag(1/alpha) G^T W_theta), F~ only with
-  // include_data; G's entries as the integrator's point loads. No allocation.
-  void DirectStep(int k, bool include_data, const Vector& velocity,
-                  const Eigen::Ref<const Vector>& displacement, Vector& velocity_next,
-                  Eigen::Ref<Vector> displacement_next);
+  // The direct step t_k -> t_{k+1} from (v, u) into (v_next, u_next), W_theta in shift_,
+  // W_k and W_{k+1} in previous and next:
+  // f_theta = -K W_theta + G (F~_theta - diag(1/alpha) G^T W_theta) (DirectChannels),
+  // F~ only with include_data; G's entries as the integrator's point loads. No
+  // allocation.
+  void DirectStep(int k, bool include_data, const double* previous, const double* next,
+                  const Vector& velocity, const Eigen::Ref<const Vector>& displacement,
+                  Vector& velocity_next, Eigen::Ref<Vector> displacement_next);
   // The retrograde step t_j -> t_{j-1} from (v, omega) into (v_next, omega_next), y_j
   // (H U_j or a trace) in trace_: the force c_j H^T diag(beta) (y_j - d~_j), d~ only
   // with include_data; H's entries as point loads. Overwrites trace_. No allocation.
@@ -293,9 +328,9 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // The retrograde step driven by the traces y_j (RetrogradeStep). No allocation.
   void RetrogradeTraceStep(int j, const Matrix& traces, bool include_data, const Vector& velocity,
                            const Vector& state, Vector& velocity_next, Vector& state_next);
-  // x^T P y = x^T (K + G diag(1/alpha) G^T) y of two columns; uses product_ and the
-  // channel vectors.
-  double PenaltyForm(const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& y);
+  // x^T P_j y = x^T (K + G diag(a_j / alpha) G^T) y of two columns at sample j; uses
+  // product_ and the channel vectors.
+  double PenaltyForm(int j, const Eigen::Ref<const Vector>& x, const Eigen::Ref<const Vector>& y);
   // The direct sweep from rest with W = 0 and the measured loads, DirectSweep's steps
   // with its state only: observe(j, U_j) for j = 0..m.
   template <typename Observe>
@@ -337,6 +372,9 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   double reaction_weight_;               // alpha_r = w_r / k* [m/N]
   Vector moduli_;                        // E_z [Pa]
   Vector alphas_, betas_;                // alpha_c [m/N], beta_k
+  // a_cj: 1 where load c may act at sample j, else 0, C x (m + 1); empty when every
+  // load acts throughout (no unmeasured load with an interval inside the window).
+  Matrix load_active_;
   SparseMatrix mass_;                    // M, held dofs decoupled under a trusted treatment
   SparseMatrix loads_;                   // G, n x C
   SparseMatrix loads_transposed_;        // G^T, C x n
@@ -363,6 +401,8 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // per row of H and one per reaction.
   Vector velocity_[2], state_[2], shift_, product_, channel_, other_channel_, trace_,
       reaction_trace_;
+  // G^T W_k and G^T W_{k+1} where a load starts or stops acting (DirectChannels).
+  mutable Vector edge_channel_[2];
   // Streaming: the checkpoints (v over omega, 2n x (m / s + 1)) and one segment's omega
   // (n x (s + 1)), allocated by the first StreamingMap; the double buffers of the
   // direct sweep (velocity, displacement), W_{j-1} and W_j, allocated in the constructor.

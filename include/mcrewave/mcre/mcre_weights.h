@@ -35,6 +35,11 @@ struct McreWeights {
   // w_u0: a pinned clamp's displacement datum u(0) = 0, beta_0 = w_u0 k* [N/m]
   // (docs/trusted_clamp.md section 9).
   double clamp_displacement_weight = 0.1;
+  // w_fu: an unmeasured load's force against the datum 0, alpha_u = w_fu / k* [m/N]
+  // (docs/unmeasured_loads.md). The force is free in the limit w_fu -> 0; a finite w_fu
+  // is a Tikhonov weight on its history. Against a gauge of weight w_e, a force that
+  // explains a strain e at a bar's gauge costs about w_fu / w_e of that strain's misfit.
+  double unmeasured_force_weight = 1e-6;
   bool IsValid(std::string* error) const;
 };
 

@@ -61,9 +61,22 @@ struct McreOptions {
   // (support_check.h, docs/boundaries.md section 10). Equal to the threshold: a hard
   // switch.
   double support_check_ramp_start = 1.28;
+  // The model's load channels whose histories were not measured (docs/unmeasured_loads.md):
+  // each is found with the admissible fields, weighted by weights.unmeasured_force_weight
+  // against the datum 0; the data need not hold them.
+  std::vector<std::string> unmeasured_loads;
+  // Two times [s] per unmeasured load, in its order, start then end: the interval
+  // outside which the load is known to vanish (a striker that has left the bar). Empty:
+  // every unmeasured load may act over the whole window.
+  std::vector<double> unmeasured_load_interval;
 
+  // Also: the names not repeated, the intervals 0 or 2 per load, finite, start <= end.
   bool IsValid(std::string* error) const;
 };
+
+// The unmeasured loads of mcre (MatrixMcreProblem's form), their intervals paired.
+// Precondition: mcre.IsValid().
+std::vector<UnmeasuredLoad> UnmeasuredLoads(const McreOptions& mcre);
 
 // The `search:` section: the functional the global search of a bar's identification
 // scans (docs/trusted_clamp.md section 10). The trusted clamp's e^2 has several valleys
