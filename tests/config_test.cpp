@@ -154,6 +154,9 @@ void ExpectSameConfigLaterKeys(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.mcre.weights.unmeasured_force_weight,
             actual.mcre.weights.unmeasured_force_weight);
   EXPECT_EQ(expected.mcre.unmeasured_loads, actual.mcre.unmeasured_loads);
+  EXPECT_EQ(expected.data.time_column, actual.data.time_column);
+  EXPECT_EQ(expected.data.time_origin, actual.data.time_origin);
+  EXPECT_EQ(expected.data.at_rest_before_record, actual.data.at_rest_before_record);
   EXPECT_EQ(expected.mcre.unmeasured_load_interval, actual.mcre.unmeasured_load_interval);
   EXPECT_EQ(expected.data.support_stiffness, actual.data.support_stiffness);
   EXPECT_EQ(expected.search.functional, actual.search.functional);
@@ -813,6 +816,9 @@ constexpr const char* kEveryMatrixKeyNotAtItsDefault = R"(model:
 data:
   truth_manifest: fine/model.yaml
   truth_moduli: [2e11, 1.4000000000000001e11]
+  time_column: time_s
+  time_origin: -2.6e-4
+  at_rest_before_record: true
 mcre:
   w_fu: 3.0000000000000001e-5
   unmeasured_loads: [F, "hammer #2"]
@@ -905,11 +911,12 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
     EXPECT_EQ(matrix_keys.count(key), 0u) << key;
     EXPECT_EQ(bar_keys.count(key), 1u) << key;
   }
-  // The bar reads all but the 5 matrix keys; a matrix run none of the section study:
+  // The bar reads all but the 8 matrix keys (the record's time column, origin and rest
+  // before it among them); a matrix run none of the section study:
   // and 14 single keys fewer (it reads the dense solvers' limits, Riccati and shooting
   // running on any model, the zones' regularisation and merging, and data.channels, the
   // manifest's sensors it uses).
-  EXPECT_EQ(bar_keys.size(), every.size() - 5);
+  EXPECT_EQ(bar_keys.size(), every.size() - 8);
   std::size_t sections = 0;
   for (const auto& [key, value] : every) {
     const std::string section = key.substr(0, key.find('.'));

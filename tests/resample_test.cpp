@@ -85,6 +85,24 @@ TEST(ResampleTest, DataThatDoNotCoverTheWindowAreRefused) {
   }
 }
 
+// A record that starts after t = 0 (a shot whose trigger came after the impact):
+// refused, naming the way out, unless at_rest_before; then the samples before it are
+// 0 and the record's own samples (on the grid) are kept to the bit.
+TEST(ResampleTest, ARecordStartingLateIsAtRestBeforeItWhenAllowed) {
+  ChannelSet data = Sines(1e-6, 100, 2e4);
+  data.start_time = 20e-6;
+  try {
+    ResampleMeasurements(data, 1e-6, 100, "late.csv");
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("data.at_rest_before_record"), std::string::npos)
+        << error.what();
+  }
+  const ChannelSet late = ResampleMeasurements(data, 1e-6, 100, "late.csv", true);
+  for (int k = 0; k < 20; ++k) EXPECT_EQ(late.Values("uL")[k], 0.0) << k;
+  for (int k = 20; k < 100; ++k) EXPECT_EQ(late.Values("uL")[k], data.Values("uL")[k - 20]) << k;
+}
+
 // Any channel set is resampled channel by channel: each channel of a set of other
 // names (a structure given by matrices) is the same bits as the bar's channel it
 // copies, up and down (the down-sampling's low-pass included), names and kinds kept.

@@ -15,6 +15,8 @@
 #include <utility>
 
 #include "identify_binary.h"
+#include "mcrewave/app/config.h"
+#include "mcrewave/app/matrix_identification_run.h"
 #include "mcrewave/mcre/coupled_solver.h"
 #include "mcrewave/mcre/matrix_mcre_problem.h"
 #include "mcrewave/model/simulation.h"
@@ -235,6 +237,34 @@ TEST(UnmeasuredLoadsTest, IdentifyRunFindsETheImpactForceUnmeasured) {
     EXPECT_TRUE(testing::Contains(refused.output, message)) << refused.output;
     EXPECT_FALSE(std::filesystem::exists(bad + "/out"));
   }
+}
+
+// The real shot's record read as configs/shpb_shot_a.yaml reads it: the scope's time
+// column (single-precision stamps, 80 ns), its clock shifted by data.time_origin, the
+// samples before its first one at rest, resampled onto the model's grid.
+TEST(UnmeasuredLoadsTest, TheShotsRecordIsReadOntoTheModelsGrid) {
+  const Config config = LoadConfig(testing::SourcePath("configs/shpb_shot_a.yaml"));
+  const MatrixModelData model = LoadMatrixModel(config);
+  const MatrixMeasurements measurements = LoadMatrixMeasurements(config, model);
+  const ChannelSet& data = measurements.histories;
+  EXPECT_EQ(data.num_samples(), config.time.NumSteps() + 1);
+  EXPECT_LT(data.Find("striker"), 0);  // unmeasured: no column read
+  const Vector& incident = data.Values("incident_bar_strain");
+  // The record starts at -197.6 us, 62.4 us after the model's t = 0: rest before it.
+  const double record_start = -197.6e-6 - config.data.time_origin;
+  double before = 0.0, plateau = 0.0;
+  for (int j = 0; j < data.num_samples(); ++j) {
+    const double time = j * data.time_step;
+    if (time < record_start - 8 * 80e-9) before = std::max(before, std::abs(incident[j]));
+    // The incident pulse's plateau, -461 microstrain in the record (its README), passes
+    // the gauge between about 20 us and 220 us of the record's clock.
+    if (std::abs(time + config.data.time_origin - 120e-6) <= 0.5 * data.time_step) {
+      plateau = incident[j];
+    }
+  }
+  std::cout << "before the record: " << before << ", plateau at 120 us: " << plateau << "\n";
+  EXPECT_EQ(before, 0.0);
+  EXPECT_NEAR(plateau, -461e-6, 40e-6);
 }
 
 }  // namespace

@@ -507,6 +507,14 @@ const std::vector<Key>& KeyTable() {
       MakeKey("data.truth_manifest", &Config::data, &DataOptions::truth_manifest, Text(), "",
               "model.kind matrix, synthetic: the truth's manifest (\"\": the model's own); "
               "relative to this file"),
+      MakeKey("data.time_column", &Config::data, &DataOptions::time_column, Text(), "",
+              "model.kind matrix, csv: the record's time column [s]"),
+      MakeKey("data.time_origin", &Config::data, &DataOptions::time_origin, Number(), "s",
+              "model.kind matrix, csv: the record's time that is the model's t = 0"),
+      MakeKey("data.at_rest_before_record", &Config::data, &DataOptions::at_rest_before_record,
+              Boolean(), "",
+              "model.kind matrix, csv: the record may begin after t = 0, every channel 0 "
+              "before its first sample"),
       MakeKey("data.truth_moduli", &Config::data, &DataOptions::truth_moduli, NumberList(), "Pa",
               "model.kind matrix, synthetic: the truth's zone moduli ([]: their nominal moduli)"),
       MakeKey("mcre.w_u", &Config::mcre, &McreOptions::weights, &McreWeights::displacement_weight,
@@ -969,6 +977,9 @@ std::string StructureKeysProblem(const Config& config) {
         {"model.channel_map", !config.structure.channel_map.empty()},
         {"data.truth_manifest", !config.data.truth_manifest.empty()},
         {"data.truth_moduli", !config.data.truth_moduli.empty()},
+        {"data.time_column", config.data.time_column != "t"},
+        {"data.time_origin", config.data.time_origin != 0.0},
+        {"data.at_rest_before_record", config.data.at_rest_before_record},
     };
     for (const auto& [key, set] : matrix_keys) {
       if (set) return std::string(key) + " applies to model.kind 'matrix' only (model.kind is 'bar')";
@@ -1803,9 +1814,9 @@ std::string ConfigToYaml(const Config& config) {
 }
 
 bool KeyApplies(const std::string& path, ModelKind kind) {
-  static const std::set<std::string> matrix_only = {"model.manifest", "model.channel_map",
-                                                    "model.free_zones", "data.truth_manifest",
-                                                    "data.truth_moduli"};
+  static const std::set<std::string> matrix_only = {
+      "model.manifest",    "model.channel_map", "model.free_zones", "data.truth_manifest",
+      "data.truth_moduli", "data.time_column",  "data.time_origin", "data.at_rest_before_record"};
   if (kind == ModelKind::kBar) return matrix_only.count(path) == 0;
   // Whole sections, then single keys, that a matrix run does not read.
   static const std::set<std::string> bar_sections = {"study"};

@@ -71,13 +71,18 @@ ChannelSet ReadMatrixMeasurementCsv(const Config& config, const MatrixModelData&
     }
     return "";
   };
-  ChannelSet table = ReadChannelCsv(path, check_header);
+  ChannelSet table = ReadChannelCsv(path, check_header, {}, config.data.time_column);
+  // The record's clock shifted to the model's: t_model = t_record - data.time_origin.
+  table.start_time -= config.data.time_origin;
   const int samples = config.time.NumSteps() + 1;
   if (table.time_step != config.time.step || table.start_time != 0.0 ||
       table.num_samples() != samples) {
-    spdlog::info("{}: resampling {} samples of {:.4g} s onto {} samples of {:.4g} s", path,
-                 table.num_samples(), table.time_step, samples, config.time.step);
-    table = ResampleMeasurements(table, config.time.step, samples, path);
+    spdlog::info(
+        "{}: resampling {} samples of {:.4g} s from t = {:.4g} s onto {} samples of "
+        "{:.4g} s",
+        path, table.num_samples(), table.time_step, table.start_time, samples, config.time.step);
+    table = ResampleMeasurements(table, config.time.step, samples, path,
+                                 config.data.at_rest_before_record);
   }
   ChannelSet set;
   set.time_step = config.time.step;

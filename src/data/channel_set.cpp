@@ -81,12 +81,12 @@ void KeepFirstSamples(int samples, ChannelSet* set) {
 }
 
 ChannelSet ReadChannelCsv(const std::string& path, const HeaderCheck& check_header,
-                          const ChannelKindOf& kind_of) {
+                          const ChannelKindOf& kind_of, const std::string& time_name) {
   std::ifstream file(path, std::ios::binary);
   if (!file) {
     throw InputError("cannot read measurement file " + path + ": " + std::strerror(errno));
   }
-  return ParseChannelCsv(file, path, check_header, kind_of);
+  return ParseChannelCsv(file, path, check_header, kind_of, time_name);
 }
 
 namespace {
@@ -108,10 +108,11 @@ void SplitFields(const std::string& text, std::vector<std::string>* fields) {
 }
 
 // The header line (line 1, byte order mark removed): the column names, trimmed, each
-// named once, `t` among them (its index in *time_column), then check_header's own
+// named once, time_name among them (its index in *time_column), then check_header's own
 // conditions.
 std::vector<std::string> ParseHeader(std::string line, const std::string& path,
-                                     const HeaderCheck& check_header, std::size_t* time_column) {
+                                     const HeaderCheck& check_header, const std::string& time_name,
+                                     std::size_t* time_column) {
   if (line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // UTF-8 byte order mark
   std::vector<std::string> fields, names;
   SplitFields(line, &fields);
@@ -134,9 +135,11 @@ std::vector<std::string> ParseHeader(std::string line, const std::string& path,
       }
     }
   }
-  const auto time = std::find(names.begin(), names.end(), "t");
+  const auto time = std::find(names.begin(), names.end(), time_name);
   if (time == names.end()) {
-    FailAt(path, 1, "the header '" + line + "' lacks the time column 't' [s]");
+    FailAt(path, 1,
+           "the header '" + line + "' lacks the time column '" + time_name + "' [s]" +
+               (time_name == "t" ? "" : " (data.time_column)"));
   }
   *time_column = static_cast<std::size_t>(time - names.begin());
   return names;
@@ -168,15 +171,23 @@ double UniformTimeStep(const std::vector<double>& times, const std::string& path
     std::nth_element(steps.begin(), median, steps.end());
     reference_step = *median;
   }
+  // Time stamps written in single precision (a scope's export: about 7 digits) are
+  // off by up to 2^-24 of |t|, so a step by twice that: accepted, a missing sample is
+  // still a whole step off.
+  const double stamp_rounding =
+      2.0 * std::ldexp(std::max(std::abs(times.front()), std::abs(times.back())), -24);
+  const double tolerance = std::max(kStepTolerance * reference_step, stamp_rounding);
   for (std::size_t k = 1; k < rows; ++k) {
     const double step = times[k] - times[k - 1];
-    if (std::abs(step - reference_step) > kStepTolerance * reference_step) {
+    if (std::abs(step - reference_step) > tolerance) {
       // Data row k is on line k + 2: the header is line 1 and an empty line between
       // data rows is refused.
       FailAt(path, static_cast<long>(k) + 2,
              "time step " + ShortNumber(step) + " s (from t = " + ShortNumber(times[k - 1]) +
                  " s on the previous row), expected the file's step " +
-                 ShortNumber(reference_step) + " s (the median step) within 1e-6 relative");
+                 ShortNumber(reference_step) +
+                 " s (the median step) within 1e-6 relative or the single-precision rounding "
+                 "of the time stamps");
     }
   }
   return ExactStep(times, mean_step);
@@ -185,7 +196,8 @@ double UniformTimeStep(const std::vector<double>& times, const std::string& path
 }  // namespace
 
 ChannelSet ParseChannelCsv(std::istream& file, const std::string& path,
-                           const HeaderCheck& check_header, const ChannelKindOf& kind_of) {
+                           const HeaderCheck& check_header, const ChannelKindOf& kind_of,
+                           const std::string& time_name) {
   // The header: column c holds names[c]; time_column is the column of t.
   std::vector<std::string> names;
   std::size_t time_column = 0;
@@ -198,7 +210,7 @@ ChannelSet ParseChannelCsv(std::istream& file, const std::string& path,
     ++line_number;
     line = StripLineEnd(line);
     if (line_number == 1) {
-      names = ParseHeader(line, path, check_header, &time_column);
+      names = ParseHeader(line, path, check_header, time_name, &time_column);
       columns.resize(names.size());
       continue;
     }

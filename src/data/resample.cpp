@@ -47,16 +47,19 @@ std::string Short(double value) { return FormatNumber(value, kSixDigits); }
 }  // namespace
 
 ChannelSet ResampleMeasurements(const ChannelSet& data, double step, int samples,
-                                const std::string& name) {
+                                const std::string& name, bool at_rest_before) {
   assert(step > 0.0 && samples >= 2);
   const double h = data.time_step;
   const double tolerance = 1e-6 * h;
   const double end = data.Time(data.num_samples() - 1);
   const double window = (samples - 1) * step;
-  if (data.start_time > tolerance || end < window - tolerance) {
+  if ((data.start_time > tolerance && !at_rest_before) || end < window - tolerance) {
     throw InputError(name + ": the data span [" + Short(data.start_time) + ", " + Short(end) +
                      "] s does not cover the model's window [0, " + Short(window) +
-                     "] s (time.window)");
+                     "] s (time.window" +
+                     (at_rest_before ? std::string(")")
+                                     : "; data.at_rest_before_record takes every channel as 0 "
+                                       "before the record's first sample)"));
   }
   ChannelSet out;
   out.start_time = 0.0;

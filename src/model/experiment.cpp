@@ -92,6 +92,11 @@ bool DataOptions::IsValid(std::string* error) const {
       return Fail(error, why.str());
     }
   }
+  if (time_column.empty()) return Fail(error, "data.time_column must name a column, got ''");
+  if (!std::isfinite(time_origin)) {
+    why << "data.time_origin must be a finite time (s), got " << time_origin;
+    return Fail(error, why.str());
+  }
   // Channel names: well formed, interior sensors only in data.sensors, none twice.
   const std::pair<const char*, const std::vector<std::string>*> lists[] = {
       {"data.sensors", &sensors}, {"data.channels", &channels}};

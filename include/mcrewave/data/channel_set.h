@@ -62,18 +62,20 @@ using HeaderCheck =
 // The kind of the channel of a column, by its name (called once the header passed).
 using ChannelKindOf = std::function<ChannelKind(const std::string& name)>;
 
-// Reads a channel CSV: a header (every column named, no name twice, a column `t`,
-// then check_header's own conditions), at least two rows of finite numbers, one per
-// column, and a strictly increasing uniform time column (relative spread of the steps
-// at most 1e-6, against their median). The channels are in the file's column order,
+// Reads a channel CSV: a header (every column named, no name twice, a time column
+// named time_name [s], then check_header's own conditions), at least two rows of finite
+// numbers, one per column, and a strictly increasing uniform time column (every step
+// within 1e-6 of their median, relative, or within the single-precision rounding of the
+// time stamps, 2^-23 of the largest |t|). The channels are in the file's column order,
 // of the kinds kind_of gives (kDisplacement without it). Throws InputError naming
 // the file and the line on any failure. Logs a progress line every 250000 rows.
 // Memory: the columns of doubles (one column held twice at the end).
 ChannelSet ReadChannelCsv(const std::string& path, const HeaderCheck& check_header = {},
-                          const ChannelKindOf& kind_of = {});
+                          const ChannelKindOf& kind_of = {}, const std::string& time_name = "t");
 // The same from a stream; `name` stands for the file name in messages.
 ChannelSet ParseChannelCsv(std::istream& text, const std::string& name,
-                           const HeaderCheck& check_header = {}, const ChannelKindOf& kind_of = {});
+                           const HeaderCheck& check_header = {}, const ChannelKindOf& kind_of = {},
+                           const std::string& time_name = "t");
 
 // Writes the set as CSV (t, then the channels in order by name), 17 significant
 // digits, atomically (temporary file then rename). Throws std::runtime_error if the

@@ -66,6 +66,14 @@ struct DataOptions {
   // [Pa] (one per zone of the truth's manifest; [] = their nominal moduli).
   std::string truth_manifest;
   std::vector<double> truth_moduli;
+  // A CSV record (model.kind matrix): the name of its time column [s], the time of its
+  // clock that is the model's t = 0 [s] (the record's t - time_origin is the model's),
+  // and whether it may begin after the model's t = 0, every channel 0 before its first
+  // sample (a shot recorded from a trigger after the impact, before the waves reach the
+  // gauges; resample.h).
+  std::string time_column = "t";
+  double time_origin = 0.0;
+  bool at_rest_before_record = false;
 
   // Checks what needs no other section: channel names well formed and not repeated
   // (data.sensors, data.channels), f0 and fL among data.channels. Positions against
