@@ -59,17 +59,46 @@ struct TraceGrid {
   double last_weight = 0.5;   // c_m
 };
 
+// The loads that act over an interval only, which the assembly's one P leaves out
+// (MatrixMcreProblem::SteadyPenalty): null responses when every load acts throughout.
+struct IntervalLoads {
+  const Matrix* responses = nullptr;  // b_c(j) = a(j) g_c: R m x C, rows (j - 1) R + k
+  const Matrix* active = nullptr;     // a_cj, C x (m + 1)
+  const Vector* alphas = nullptr;     // alpha_c [m/N]
+};
+
+// Whether load c acts at every sample (then in the assembly's P).
+bool ActsThroughout(const Matrix& active, int c) { return (active.row(c).array() != 0.0).all(); }
+
+// The loads with an interval of a problem whose loads are G and a_cj active (empty: none),
+// their b_c(j) = a(j) g_c computed into *load_responses (kept by the caller) from the
+// impulse responses.
+IntervalLoads TraceIntervalLoads(const Matrix& responses, const SparseMatrix& loads,
+                                 const Matrix& active, const Vector& alphas,
+                                 Matrix* load_responses) {
+  IntervalLoads interval_loads;
+  if (active.size() == 0) return interval_loads;
+  // Every b_c(j) at once: (G^T responses)^T.
+  load_responses->noalias() = responses.transpose() * loads;
+  interval_loads.responses = load_responses;
+  interval_loads.active = &active;
+  interval_loads.alphas = &alphas;
+  return interval_loads;
+}
+
 // S = (C beta)^1/2 Q (C beta)^1/2 from the impulse responses (SymmetricTraceOperator's
 // formulas) into *result, in Scalar arithmetic: double for the operator, float for the
 // preconditioner's factor, which needs I + S to a few digits only. Symmetric to
 // round-off; its lower triangle is the product's. lower_only: the strict upper
 // triangle is left undefined (a Cholesky factorisation reads the lower one). Works in
-// *buffers (MatrixMcreProblem::TraceAssemblyScratch<Scalar>: weighted, responses and
-// gram), kept by the caller: no fresh megabytes a build once they have their sizes.
+// *buffers (MatrixMcreProblem::TraceAssemblyScratch<Scalar>: weighted, responses, gram
+// and load_terms), kept by the caller: no fresh megabytes a build once they have their
+// sizes. penalty: the P of every sample, the loads with an interval (loads) left out
+// and added sample by sample (below).
 template <typename Scalar, typename Scratch>
 void AssembleTraceOperator(const Matrix& responses, const SparseMatrix& penalty,
-                           const TraceGrid& grid, const Vector& weight_roots, bool lower_only,
-                           Scratch* buffers,
+                           const IntervalLoads& loads, const TraceGrid& grid,
+                           const Vector& weight_roots, bool lower_only, Scratch* buffers,
                            Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>* result) {
   using Dense = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
   const int rows = grid.rows, m = grid.steps;
@@ -116,6 +145,52 @@ void AssembleTraceOperator(const Matrix& responses, const SparseMatrix& penalty,
   q.block(m * rows, m * rows, rows, rows) +=
       static_cast<Scalar>(t * t * (1.0 / grid.last_weight - 1.0)) *
       gram.block(rows, rows, rows, rows);
+  if (loads.responses != nullptr) {
+    // With P_l = P + G diag(a_l / alpha) G^T, P without the loads that have an interval,
+    //   Q = Z blockdiag(P_l) C^-1 Z^T = (the above) + sum over a_cl = 1 of v_cl v_cl^T,
+    //   v_cl = Z(., l) g_c / (alpha_c c_l h)^1/2,  block i: Z(i, l) g_c = theta b_c(i - l + 1)
+    //          + (1 - theta) b_c(i - l) (l >= 1), (1 - theta) b_c(i) (l = 0),
+    // b_c(j) = a(j) g_c (0 for j <= 0). The samples where a load acts are added to P
+    // without it, rather than those where it does not taken off P with it: no difference
+    // of terms of 1/alpha_u (1e6 k* at the default w_fu), and few terms for a brief load.
+    const Matrix& b = *loads.responses;
+    const Matrix& active = *loads.active;
+    const int channels = static_cast<int>(active.rows());
+    Eigen::Index count = 0;
+    for (int c = 0; c < channels; ++c) {
+      if (!ActsThroughout(active, c)) count += (active.row(c).array() != 0.0).count();
+    }
+    Dense& terms = buffers->load_terms;
+    terms.resize(size, count);
+    Eigen::Index column = 0;
+    for (int c = 0; c < channels; ++c) {
+      if (ActsThroughout(active, c)) continue;
+      for (int l = 0; l <= m; ++l) {
+        if (active(c, l) == 0.0) continue;
+        const double weight = l == 0 ? grid.first_weight : (l == m ? grid.last_weight : 1.0);
+        const double scale = 1.0 / std::sqrt((*loads.alphas)[c] * weight * grid.time_step);
+        // theta b_c(later) + (1 - theta) b_c(later - 1), the first term absent at l = 0.
+        const double later_factor = l == 0 ? 0.0 : t;
+        Scalar* out = terms.col(column++).data();
+        for (int i = 0; i <= m; ++i) {
+          const int later = i - l + 1;
+          for (int k = 0; k < rows; ++k) {
+            double value = 0.0;
+            if (later >= 1) value += later_factor * b((later - 1) * rows + k, c);
+            if (later >= 2) value += u * b((later - 2) * rows + k, c);
+            out[i * rows + k] = static_cast<Scalar>(scale * value);
+          }
+        }
+      }
+    }
+    if (count == 0) {
+      // No load with an interval acts inside the window.
+    } else if (lower_only) {
+      q.template selfadjointView<Eigen::Lower>().rankUpdate(terms, Scalar(1));
+    } else {
+      q.noalias() += terms * terms.transpose();
+    }
+  }
   // S = (C beta)^1/2 Q (C beta)^1/2, C = diag(c_j h).
   const auto roots = weight_roots.template cast<Scalar>();
   q.array().colwise() *= roots.array();
@@ -127,10 +202,12 @@ void AssembleTraceOperator(const Matrix& responses, const SparseMatrix& penalty,
 Matrix MatrixMcreProblem::SymmetricTraceOperator() {
   const TraceGrid grid{num_traces(), num_steps(),         theta_,
                        time_step(),  QuadratureWeight(0), QuadratureWeight(num_steps())};
-  Matrix responses, q;
+  Matrix responses, load_responses, q;
   TraceImpulseResponses(&responses);
   TraceAssemblyScratch<double> buffers;
-  AssembleTraceOperator<double>(responses, PenaltyMatrix(), grid, TraceWeightRoots(),
+  const IntervalLoads loads =
+      TraceIntervalLoads(responses, loads_, load_active_, alphas_, &load_responses);
+  AssembleTraceOperator<double>(responses, SteadyPenalty(), loads, grid, TraceWeightRoots(),
                                 /*lower_only=*/false, &buffers, &q);
   // Symmetric to round-off: the mean of the two triangles, in place.
   const auto size = q.rows();
@@ -142,6 +219,17 @@ Matrix MatrixMcreProblem::SymmetricTraceOperator() {
     }
   }
   return q;
+}
+
+SparseMatrix MatrixMcreProblem::SteadyPenalty() const {
+  if (load_active_.size() == 0) return PenaltyMatrix();
+  // K + G diag(s / alpha) G^T, s_c = 1 for a load acting at every sample, else 0.
+  Vector inverse_alphas(alphas_.size());
+  for (int c = 0; c < static_cast<int>(alphas_.size()); ++c) {
+    inverse_alphas[c] = ActsThroughout(load_active_, c) ? 1.0 / alphas_[c] : 0.0;
+  }
+  const SparseMatrix scaled = loads_ * inverse_alphas.asDiagonal();
+  return stiffness_ + SparseMatrix(scaled * loads_transposed_);
 }
 
 Vector MatrixMcreProblem::TraceWeightRoots() const {
@@ -167,10 +255,7 @@ void MatrixMcreProblem::ForgetTracePreconditioner() {
 bool MatrixMcreProblem::PrepareTracePreconditioner(double rebuild_change, long max_traces) {
   const int rows = num_traces(), m = num_steps();
   const long size = static_cast<long>(rows) * (m + 1);
-  // None when a load acts over an interval: the operator below takes one P for every
-  // sample (TimeVaryingPenalty).
-  if (rows == 0 || m < 2 || theta_ < 0.5 || size > max_traces || !(betas_.minCoeff() > 0.0) ||
-      TimeVaryingPenalty()) {
+  if (rows == 0 || m < 2 || theta_ < 0.5 || size > max_traces || !(betas_.minCoeff() > 0.0)) {
     return false;
   }
   trace_scratch_.resize(size);
@@ -190,10 +275,12 @@ bool MatrixMcreProblem::PrepareTracePreconditioner(double rebuild_change, long m
   const TraceGrid grid{rows, m, theta_, time_step(), QuadratureWeight(0), QuadratureWeight(m)};
   Matrix& responses = trace_build_.impulse_responses;
   TraceImpulseResponses(&responses);
-  const SparseMatrix penalty = PenaltyMatrix();
+  const SparseMatrix penalty = SteadyPenalty();
+  const IntervalLoads loads =
+      TraceIntervalLoads(responses, loads_, load_active_, alphas_, &trace_build_.load_responses);
   Eigen::MatrixXf& single = trace_build_.operator_plus_identity;
-  AssembleTraceOperator<float>(responses, penalty, grid, built->weights, /*lower_only=*/true,
-                               &trace_build_.scratch, &single);
+  AssembleTraceOperator<float>(responses, penalty, loads, grid, built->weights,
+                               /*lower_only=*/true, &trace_build_.scratch, &single);
   single.diagonal().array() += 1.0f;
   const Eigen::LLT<Eigen::Ref<Eigen::MatrixXf>> single_factor(single);
   if (single_factor.info() == Eigen::Success) {
@@ -202,8 +289,8 @@ bool MatrixMcreProblem::PrepareTracePreconditioner(double rebuild_change, long m
   } else {
     // Float's round-off of a large S broke I + S's definiteness: in double.
     TraceAssemblyScratch<double> double_buffers;
-    AssembleTraceOperator<double>(responses, penalty, grid, built->weights, /*lower_only=*/true,
-                                  &double_buffers, &built->factor);
+    AssembleTraceOperator<double>(responses, penalty, loads, grid, built->weights,
+                                  /*lower_only=*/true, &double_buffers, &built->factor);
     built->factor.diagonal().array() += 1.0;
     const Eigen::LLT<Eigen::Ref<Matrix>> double_factor(built->factor);
     if (double_factor.info() != Eigen::Success) return false;

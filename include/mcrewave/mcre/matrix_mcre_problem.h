@@ -240,27 +240,28 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   Matrix ObservedTraces(const Matrix& displacement) const { return observation_ * displacement; }
   // The trace operator -L at the current moduli as a dense symmetric matrix
   // (docs/streaming.md section 6),
-  //   S = (C beta)^1/2 Z P C^-1 Z^T (C beta)^1/2,  C = diag(c_j h),  Z = H D,
+  //   S = (C beta)^1/2 Z blockdiag(P_j) C^-1 Z^T (C beta)^1/2,  C = diag(c_j h),  Z = H D,
   // num_traces() (m + 1) square, row k at sample j at index j num_traces() + k (a trace
   // field's column-major order): -L y = (C beta)^-1/2 S (C beta)^1/2 y. From one
   // retrograde sweep per trace row (the impulse responses, by time invariance) and one
-  // product of n x R m matrices. Preconditions: m >= 2, theta >= 1/2 (the recursion
-  // from the responses to Z's blocks divides by theta), every beta_k > 0, no load acting
-  // over an interval only (!TimeVaryingPenalty(): P is taken as one matrix).
+  // product of n x R m matrices; a load acting over an interval only (TimeVaryingPenalty)
+  // adds one rank-one term per sample where it acts, (R (m + 1))^2 operations each.
+  // Preconditions: m >= 2, theta >= 1/2 (the recursion from the responses to Z's blocks
+  // divides by theta), every beta_k > 0.
   Matrix SymmetricTraceOperator();
   // The Cholesky factor of I + S (above) at the current moduli, in single precision
-  // where that keeps it definite (TraceFactor::single_precision); none (false) when P
-  // changes with time (TimeVaryingPenalty). Rebuilt when a modulus
-  // moved by more than rebuild_change since it was built; (C beta)^-1/2 (I + S)^-1
-  // (C beta)^1/2 applied by PreconditionTraces.
+  // where that keeps it definite (TraceFactor::single_precision); none (false) when the
+  // traces exceed max_traces or SymmetricTraceOperator's preconditions fail. Rebuilt
+  // when a modulus moved by more than rebuild_change since it was built; (C beta)^-1/2
+  // (I + S)^-1 (C beta)^1/2 applied by PreconditionTraces.
   bool PrepareTracePreconditioner(double rebuild_change, long max_traces) override;
   // Keeps the factor's storage when this problem alone holds it.
   void ForgetTracePreconditioner() override;
   void PreconditionTraces(const Matrix& residual, Matrix* result) override;
   // The factor of I + S with the weights and moduli it was built at (null before the
-  // first build): it depends on the model, the weights, theta, the time grid and the
-  // moduli, not on the data, so problems of the same model and options at the same
-  // moduli share it (the uncertainty's noise problems).
+  // first build): it depends on the model, the weights, theta, the time grid, the loads'
+  // intervals and the moduli, not on the data, so problems of the same model and options
+  // at the same moduli share it (the uncertainty's noise problems).
   struct TraceFactor {
     Matrix factor;   // L of I + S = L L^T in its lower triangle
     Vector weights;  // (c_j h beta_k)^1/2 in a trace field's order
@@ -270,9 +271,9 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
     bool single_precision = true;
   };
   std::shared_ptr<const TraceFactor> trace_factor() const { return trace_factor_; }
-  // Takes `factor` (of a problem of the same model, weights, theta and time grid) as
-  // this problem's preconditioner; PrepareTracePreconditioner keeps it while the moduli
-  // stay within its rebuild_change.
+  // Takes `factor` (of a problem of the same model, weights, theta, time grid and loads'
+  // intervals) as this problem's preconditioner; PrepareTracePreconditioner keeps it
+  // while the moduli stay within its rebuild_change.
   void ShareTraceFactor(std::shared_ptr<const TraceFactor> factor) {
     trace_factor_ = std::move(factor);
   }
@@ -285,6 +286,10 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
  private:
   // (c_j h beta_k)^1/2 of every trace entry, in a trace field's (column-major) order.
   Vector TraceWeightRoots() const;
+  // The P the trace operator's assembly takes for every sample: K + G diag(s / alpha) G^T,
+  // s_c = 1 for a load acting at every sample, 0 for one with an interval (whose samples
+  // the assembly adds one by one); PenaltyMatrix() when every load acts throughout.
+  SparseMatrix SteadyPenalty() const;
   // The traces' impulse responses a(j), j = 1..m, n x R m (column (j - 1) R + k for
   // row k), from one retrograde sweep per trace row (matrix_trace_operator.cpp).
   void TraceImpulseResponses(Matrix* impulse_responses);
@@ -368,17 +373,17 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   ClampModel treatment_;
   // Trusted treatment: 1 on the held dofs, else 0 (empty otherwise).
   std::vector<char> held_;
-  int num_reactions_ = 0;                // trusted: one reaction row per support (H's last rows)
-  double reaction_weight_;               // alpha_r = w_r / k* [m/N]
-  Vector moduli_;                        // E_z [Pa]
-  Vector alphas_, betas_;                // alpha_c [m/N], beta_k
+  int num_reactions_ = 0;   // trusted: one reaction row per support (H's last rows)
+  double reaction_weight_;  // alpha_r = w_r / k* [m/N]
+  Vector moduli_;           // E_z [Pa]
+  Vector alphas_, betas_;   // alpha_c [m/N], beta_k
   // a_cj: 1 where load c may act at sample j, else 0, C x (m + 1); empty when every
   // load acts throughout (no unmeasured load with an interval inside the window).
   Matrix load_active_;
-  SparseMatrix mass_;                    // M, held dofs decoupled under a trusted treatment
-  SparseMatrix loads_;                   // G, n x C
-  SparseMatrix loads_transposed_;        // G^T, C x n
-  SparseMatrix fixed_observation_;       // H's rows that do not depend on the moduli
+  SparseMatrix mass_;               // M, held dofs decoupled under a trusted treatment
+  SparseMatrix loads_;              // G, n x C
+  SparseMatrix loads_transposed_;   // G^T, C x n
+  SparseMatrix fixed_observation_;  // H's rows that do not depend on the moduli
   // Trusted: per zone z, the rows g_s^T K_z / E_z,nom (held columns dropped), R x n; and
   // their sum at moduli_, sum_z E_z (...) = g_s^T K(E).
   std::vector<SparseMatrix> reaction_zone_rows_;
@@ -394,7 +399,7 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // G and H^T by columns: the sweeps' products G^T x and H x, and G c, H^T y as point
   // loads (linalg/sparse_columns.h: the bits of the sparse products).
   SparseColumns load_columns_, observation_columns_;
-  SparseMatrix stiffness_;               // K at moduli_ (held dofs decoupled when trusted)
+  SparseMatrix stiffness_;  // K at moduli_ (held dofs decoupled when trusted)
   ThetaIntegrator integrator_;
   // Scratch, allocated in the constructor: double buffers of the sweeps' velocity and
   // state, W_theta, a product K x, two vectors per load channel, one
@@ -421,11 +426,15 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   template <typename Scalar>
   struct TraceAssemblyScratch {
     Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> weighted, responses, gram;
+    // The rank-one terms of the loads with an interval, one column per sample where one
+    // acts (empty without such loads).
+    Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> load_terms;
   };
   // The preconditioner build's buffers, kept between builds (their megabytes are not
   // allocated and faulted in again).
   struct TraceBuildBuffers {
     Matrix impulse_responses;
+    Matrix load_responses;  // a(j) g_c of the loads, R m x C (loads with an interval only)
     TraceAssemblyScratch<float> scratch;
     Eigen::MatrixXf operator_plus_identity;
   };
