@@ -273,7 +273,22 @@ const CoupledSolution* MapsAtIdentifiedAndNominal(
     if (identified != nullptr) {
       run->element_map = ElementMapOf(model, *identified, problem);
     }
-    run->model_outputs = problem->ModelOutputs();
+    if (!config.mcre.unmeasured_loads.empty() && identified != nullptr) {
+      // The model's own response to every load, the unmeasured ones as identified
+      // (ModelChannels: F = F~ - a G^T W / alpha), not the coupled solution's U, whose
+      // constitutive gap K W is no load.
+      const ChannelSet channels = problem->ModelChannels(*identified);
+      run->model_loads.resize(static_cast<Eigen::Index>(model.loads.size()),
+                              problem->num_steps() + 1);
+      for (std::size_t c = 0; c < model.loads.size(); ++c) {
+        run->model_loads.row(static_cast<Eigen::Index>(c)) =
+            channels.Values(model.loads[c].channel).transpose();
+      }
+      run->model_outputs = SimulateMatrixModel(model, run->identified_moduli, run->model_loads,
+                                               problem->time_step(), problem->theta());
+    } else {
+      run->model_outputs = problem->ModelOutputs();
+    }
   }
   CoupledSolution nominal;
   if (SolveAt(run->nominal_moduli, config.inner, problem, &nominal, &run->nominal_cost,

@@ -1029,15 +1029,22 @@ std::string MatrixZonesCsv(const IdentificationRun& run) {
 
 // t, each load as used, each sensor as used and as the identified model gives it.
 std::string MatrixFitCsv(const IdentificationRun& run) {
+  // With unmeasured loads every load's column is the history the model was driven by
+  // (the identified force where it was not measured), named <load>_model.
+  const bool driven = run.model_loads.size() > 0;
   std::string csv = "t";
-  for (const MatrixModelLoad& load : run.model->loads) csv += "," + load.channel;
+  for (const MatrixModelLoad& load : run.model->loads) {
+    csv += "," + load.channel + (driven ? "_model" : "");
+  }
   for (const MatrixModelSensor& sensor : run.model->sensors) {
     csv += "," + sensor.channel + "_measured," + sensor.channel + "_model";
   }
   csv += "\n";
   std::vector<const Vector*> loads, sensors;
-  for (const MatrixModelLoad& load : run.model->loads) {
-    loads.push_back(&run.data.Values(load.channel));
+  if (!driven) {
+    for (const MatrixModelLoad& load : run.model->loads) {
+      loads.push_back(&run.data.Values(load.channel));
+    }
   }
   for (const MatrixModelSensor& sensor : run.model->sensors) {
     sensors.push_back(&run.data.Values(sensor.channel));
@@ -1045,6 +1052,9 @@ std::string MatrixFitCsv(const IdentificationRun& run) {
   for (int j = 0; j <= run.data.num_steps(); ++j) {
     csv += Format(j * run.data.time_step);
     for (const Vector* load : loads) csv += "," + Format((*load)[j]);
+    for (Eigen::Index c = 0; driven && c < run.model_loads.rows(); ++c) {
+      csv += "," + Format(run.model_loads(c, j));
+    }
     for (std::size_t k = 0; k < sensors.size(); ++k) {
       csv +=
           "," + Format((*sensors[k])[j]) + "," + Format(run.model_outputs(static_cast<int>(k), j));
@@ -1154,9 +1164,12 @@ std::string MatrixFitScript(const IdentificationRun& run, const std::string& fol
   const int loads = static_cast<int>(run.model->loads.size());
   std::ostringstream script;
   script << GnuplotPngTerminal() << "set terminal pngcairo size 1000," << 220 * std::max(panels, 1)
-         << "\nset termoption noenhanced\nset datafile separator ','\nset multiplot layout " << std::max(panels, 1)
+         << "\nset termoption noenhanced\nset datafile separator ','\nset multiplot layout "
+         << std::max(panels, 1)
          << ",1 title 'Sensors: " << (prefiltered ? "measured, pre-filtered" : "measured")
-         << " (grey) and the identified model driven by the measured loads (blue)'\n"
+         << " (grey) and the identified model driven by the "
+         << (run.model_loads.size() > 0 ? "measured and the identified loads" : "measured loads")
+         << " (blue)'\n"
             "set xlabel 't [ms]'\n";
   for (int k = 0; k < panels; ++k) {
     const bool strain = kinds[static_cast<std::size_t>(k)] == SensorKind::kStrain;

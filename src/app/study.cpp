@@ -1308,11 +1308,12 @@ std::string WriteStudiesReadme(const std::string& folder) {
         "complexity and the weights studies of bench/; `bash scripts/plate_study.sh` the plate's, "
         "`bash scripts/plate_zones_study.sh` the many-zone plate's, "
         "`bash scripts/plate_sensors_study.sh` its sensor layouts', "
-        "`bash scripts/beam3d_study.sh` the 3-D beam's); do not edit by hand. Each "
+        "`bash scripts/beam3d_study.sh` the 3-D beam's, `bash scripts/shpb_study.sh` the real "
+        "Hopkinson-bar shots'); do not edit by hand. Each "
         "section below is the `summary.md` of its folder.\n\n";
   for (const char* study :
        {"robustness", "relaxation", "cost_curves", "damage", "comparator", "robustness_settings",
-        "complexity", "weights", "plate", "plate_zones", "plate_sensors", "beam3d"}) {
+        "complexity", "weights", "plate", "plate_zones", "plate_sensors", "beam3d", "real"}) {
     const std::string summary = folder + "/" + study + "/summary.md";
     std::ifstream file(summary);
     if (!file) continue;

@@ -205,8 +205,14 @@ struct IdentificationRun : ModulusStage {
   // (mcre/element_error_map.h), at the nominal and the identified moduli, when the model
   // has element blocks.
   ErrorMap nominal_element_map, element_map;
-  // The model's outputs H U at the identified moduli, a row per sensor.
+  // The model's outputs H U at the identified moduli, a row per sensor: its response to
+  // the measured loads and, when some were not measured (mcre.unmeasured_loads), to the
+  // identified ones, the histories in model_loads.
   Matrix model_outputs;
+  // With unmeasured loads: every load channel's history the model was driven by [N], a
+  // row per load of the model (the data's when measured, the MCRE's identified force
+  // F = -a G^T W / alpha_u when not); empty otherwise.
+  Matrix model_loads;
   // The first-order uncertainty of the identified zone moduli (uncertainty:), drawn at
   // `noise` (EstimateZoneUncertainty; on the bar BarZoneUncertainty, with zones).
   ZoneUncertainty zone_uncertainty;
