@@ -11,7 +11,9 @@ the interval the striker is in contact). Two ways to take the specimen:
   force_pair  the specimen left out: the two bars are apart, and an unmeasured load
               `specimen_force` pushes them apart (-1 on the incident bar's end, +1 on the
               transmitted bar's face: the specimen's compressive force, its own law
-              unknown, its mass neglected). Zone `bars` only.
+              unknown, its mass neglected). Zone `bars` only;
+  none        no specimen: the two bars joined into one (a check of the unmeasured
+              striker on the same bars and gauges, docs/unmeasured_loads.md section 5).
 
 With --poisson nu > 0 each rod carries the lateral inertia of a Rayleigh-Love rod, the
 mass term rho nu^2 J int u' v' dx with J = A r^2 / 2 (a round section of radius r).
@@ -123,7 +125,7 @@ def elements_of(length, size):
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("folder")
-    p.add_argument("--specimen", choices=("zone", "force_pair"), default="zone")
+    p.add_argument("--specimen", choices=("zone", "force_pair", "none"), default="zone")
     p.add_argument("--incident-length", type=float, default=2.286)
     p.add_argument("--transmitted-length", type=float, default=1.8)
     p.add_argument("--bar-diameter", type=float, default=0.020)
@@ -160,10 +162,13 @@ def main():
         rods.append(specimen)
         dof += specimen.elements
         x += a.specimen_length
-    else:
+    elif a.specimen == "force_pair":
         # Apart: the transmitted bar's face is a node of its own.
         dof = incident.first_dof + incident.elements + 1
         x += a.specimen_length
+    else:
+        # Joined: the transmitted bar starts at the incident bar's end node.
+        dof = incident.first_dof + incident.elements
     transmitted = Rod(dof, x, a.transmitted_length,
                       elements_of(a.transmitted_length, a.element_length), bar_section,
                       a.bar_density, "bars", a.bar_modulus, bar_radius, a.poisson)
@@ -233,8 +238,10 @@ def main():
     gauge_text = ", ".join(f"{c} at x = {xg:.6g} m" for c, _, xg in gauges)
     manifest = (
         f"# A split Hopkinson pressure bar (scripts/make_shpb_model.py --specimen {a.specimen}):\n"
-        f"# incident bar {a.incident_length} m, specimen {a.specimen_length} m "
-        f"(diameter {a.specimen_diameter} m), transmitted bar {a.transmitted_length} m,\n"
+        f"# incident bar {a.incident_length} m, "
+        + (f"specimen {a.specimen_length} m (diameter {a.specimen_diameter} m), "
+           if a.specimen != "none" else "no specimen, ")
+        + f"transmitted bar {a.transmitted_length} m,\n"
         f"# bars of diameter {a.bar_diameter} m, elements of {a.element_length} m, {n} dofs; "
         f"gauges: {gauge_text}\n"
         "mass: M.mtx\n"

@@ -30,14 +30,6 @@ using testing::MakeSmallCase;
 using testing::RelativeDifference;
 using testing::SmallCase;
 
-CoupledSolverOptions UnmeasuredTight(CoupledSolverType type) {
-  CoupledSolverOptions options;
-  options.type = type;
-  options.tolerance = 1e-12;
-  options.max_iterations = 20000;
-  return options;
-}
-
 // The small bar (30 elements, 240 steps, SNR 20) as every run builds it (BarRunModel,
 // its clamp a measured support) with fL unmeasured over [start, end].
 struct UnmeasuredBar {
@@ -74,11 +66,12 @@ TEST(UnmeasuredLoadsTest, TheStoredSweepsSolveTheAllAtOnceSystem) {
   EXPECT_TRUE(problem->TimeVaryingPenalty());
   problem->SetModuli(Vector::Constant(1, 190e9));
   CoupledSolution reference, solution;
-  const CoupledSolverSummary direct = SolveCoupled(UnmeasuredTight(CoupledSolverType::kAllAtOnce),
-                                                   problem.get(), nullptr, &reference);
+  const CoupledSolverSummary direct = SolveCoupled(
+      testing::Options(CoupledSolverType::kAllAtOnce, 1e-12), problem.get(), nullptr, &reference);
   ASSERT_TRUE(direct.IsSolutionUsable()) << direct.FullReport();
-  const CoupledSolverSummary krylov = SolveCoupled(
-      UnmeasuredTight(CoupledSolverType::kConjugateGradient), problem.get(), nullptr, &solution);
+  const CoupledSolverSummary krylov =
+      SolveCoupled(testing::Options(CoupledSolverType::kConjugateGradient, 1e-12), problem.get(),
+                   nullptr, &solution);
   ASSERT_TRUE(krylov.IsSolutionUsable()) << krylov.FullReport();
   const double w = RelativeDifference(solution.retrograde, reference.retrograde);
   const double u = RelativeDifference(solution.displacement, reference.displacement);
@@ -114,12 +107,13 @@ TEST(UnmeasuredLoadsTest, TheStreamingSolveIsTheStoredOne) {
   const auto problem = bar.Problem();
   problem->SetModuli(Vector::Constant(1, 205e9));
   CoupledSolution stored, streamed;
-  const CoupledSolverSummary krylov = SolveCoupled(
-      UnmeasuredTight(CoupledSolverType::kConjugateGradient), problem.get(), nullptr, &stored);
+  const CoupledSolverSummary krylov =
+      SolveCoupled(testing::Options(CoupledSolverType::kConjugateGradient, 1e-12), problem.get(),
+                   nullptr, &stored);
   ASSERT_TRUE(krylov.IsSolutionUsable()) << krylov.FullReport();
   const CoupledSolverSummary streaming =
-      SolveCoupled(UnmeasuredTight(CoupledSolverType::kStreamingConjugateGradient), problem.get(),
-                   nullptr, &streamed);
+      SolveCoupled(testing::Options(CoupledSolverType::kStreamingConjugateGradient, 1e-12),
+                   problem.get(), nullptr, &streamed);
   ASSERT_TRUE(streaming.IsSolutionUsable()) << streaming.FullReport();
   const double cost = std::abs(streamed.cost - stored.cost) / stored.cost;
   const double gradient = std::abs(streamed.cost_gradients[0] - stored.cost_gradients[0]) /
@@ -144,8 +138,9 @@ TEST(UnmeasuredLoadsTest, TheGradientIsTheCostsDerivative) {
   auto solve = [&](double at) {
     problem->SetModuli(Vector::Constant(1, at));
     CoupledSolution solution;
-    const CoupledSolverSummary summary = SolveCoupled(
-        UnmeasuredTight(CoupledSolverType::kConjugateGradient), problem.get(), nullptr, &solution);
+    const CoupledSolverSummary summary =
+        SolveCoupled(testing::Options(CoupledSolverType::kConjugateGradient, 1e-12), problem.get(),
+                     nullptr, &solution);
     EXPECT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
     return solution;
   };
@@ -166,8 +161,9 @@ TEST(UnmeasuredLoadsTest, TheIdentifiedForceTendsToTheTrueOneAsItsWeightFalls) {
     const UnmeasuredBar bar(0.0, 1.05, weight, std::numeric_limits<double>::infinity(), 1);
     const auto problem = bar.Problem();
     CoupledSolution solution;
-    const CoupledSolverSummary summary = SolveCoupled(
-        UnmeasuredTight(CoupledSolverType::kConjugateGradient), problem.get(), nullptr, &solution);
+    const CoupledSolverSummary summary =
+        SolveCoupled(testing::Options(CoupledSolverType::kConjugateGradient, 1e-12), problem.get(),
+                     nullptr, &solution);
     ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
     const Vector force = problem->ModelChannels(solution).Values("fL");
     const Vector& truth = bar.data.Values("fL");
@@ -197,7 +193,7 @@ TEST(UnmeasuredLoadsTest, TheSolversOfOnePenaltyMatrixRefuse) {
        {CoupledSolverType::kRiccati, CoupledSolverType::kMultipleShooting}) {
     CoupledSolution solution;
     const CoupledSolverSummary summary =
-        SolveCoupled(UnmeasuredTight(type), problem.get(), nullptr, &solution);
+        SolveCoupled(testing::Options(type, 1e-12), problem.get(), nullptr, &solution);
     EXPECT_FALSE(summary.IsSolutionUsable());
     EXPECT_TRUE(testing::Contains(summary.message, "change with time")) << summary.message;
     EXPECT_TRUE(testing::Contains(summary.message, "conjugate_gradient")) << summary.message;

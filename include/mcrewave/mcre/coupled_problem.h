@@ -82,8 +82,8 @@ class CoupledProblem {
   virtual SparseMatrix PenaltyMatrix() const = 0;
   // Whether P changes with the sample: a load known to vanish outside an interval
   // (docs/unmeasured_loads.md) has its G diag(1/alpha) G^T term only where it may act.
-  // The solvers that take P as one matrix (Riccati, shooting, the trace preconditioner)
-  // refuse such a problem; the all-at-once solver takes PenaltyMatrixAt(j).
+  // The solvers that take P as one matrix (Riccati, shooting) refuse such a problem;
+  // the all-at-once solver takes PenaltyMatrixAt(j).
   virtual bool TimeVaryingPenalty() const { return false; }
   // P at sample j [N/m]; PenaltyMatrix() unless TimeVaryingPenalty().
   virtual SparseMatrix PenaltyMatrixAt(int /*j*/) const { return PenaltyMatrix(); }

@@ -17,7 +17,10 @@
 // the bar's sweeps (mcre_problem.h) with its end loads and rows replaced by G and H.
 // Weights from the structure's scales (section 3): k* = E0 a*,
 //   beta_k = w_u k* (displacement row), w_e k* l*^2 (strain row),  alpha_c = w_f / k*,
-// so that the bar exported with a* = S / L and l* = L has the bar's weights.
+// so that the bar exported with a* = S / L and l* = L has the bar's weights. An
+// unmeasured load (UnmeasuredLoad, docs/unmeasured_loads.md) has the datum 0 and
+// alpha_u = w_fu / k*; outside its interval it is 0 (a_cj = 0, P_j = K + G diag(a_j /
+// alpha) G^T), and the sweeps take the theta average of the samples' forces.
 //
 // Supports (MatrixModelData::supports, docs/matrix_models.md section 11), each with its
 // reaction vector g and held dofs D, enter by one treatment per problem (mcre.clamp;
@@ -195,11 +198,6 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
 
   // alpha_c [m/N]: the model's load channels, then (measured, pinned) the supports'.
   const Vector& alphas() const { return alphas_; }
-  // Whether load channel c (G's column) may act at sample j: always, except an
-  // unmeasured load outside its interval.
-  bool LoadActive(int c, int j) const {
-    return load_active_.size() == 0 || load_active_(c, j) != 0.0;
-  }
   // beta_k [N/m, N m or m/N]: the model's sensors, then the supports' rows (above).
   const Vector& betas() const { return betas_; }
   ClampModel support_treatment() const { return treatment_; }
