@@ -223,6 +223,11 @@ def main():
         for row in rows:
             writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.items()})
     os.replace(os.path.join(out, "shots.csv.tmp"), os.path.join(out, "shots.csv"))
+    for shot, _, _ in SHOTS:
+        # The space-time gap map (3 MB a shot, no figure of it here) is not kept.
+        spacetime = os.path.join(out, f"shot_{shot}", "error_map_spacetime.dat")
+        if os.path.exists(spacetime):
+            os.remove(spacetime)
     rod = {r["shot"]: r for r in rows if r["model"] == "rod"}
     figures(out, {shot: r["modulus_gpa"] * 1e9 for shot, r in rod.items()})
     gap = abs(rod["A"]["modulus_gpa"] - rod["B"]["modulus_gpa"]) / (
