@@ -19,10 +19,12 @@
 //   data:  source [synthetic | csv], path [""], truth [finite_element | exact],
 //          truth_refinement [4], snr [.inf], seed [1], sensors [[]: u@X, e@X],
 //          channels [[]: every channel], truth_zones [[]: {start, end, modulus}],
-//          truth_manifest [""], truth_moduli [[]]
-//   mcre:  w_u [1e-7], w_f [1], w_e [1e-7], w_r [1e-6], w_u0 [0.1],
+//          truth_manifest [""], truth_moduli [[]], time_column ["t"],
+//          time_origin [0 s], at_rest_before_record [false]
+//   mcre:  w_u [1e-7], w_f [1], w_e [1e-7], w_r [1e-6], w_u0 [0.1], w_fu [1e-6],
 //          reference_modulus [200e9 Pa] (E0 of the weights), clamp [trusted | measured
-//          | pinned] (McreOptions, objective.h)
+//          | pinned], unmeasured_loads [[]], unmeasured_load_interval [[] s]
+//          (McreOptions, objective.h; docs/unmeasured_loads.md)
 //   inner: method [auto: conjugate_gradient, or streaming_conjugate_gradient when the
 //          fields exceed max_field_bytes | conjugate_gradient | all_at_once | relaxation
 //          | adaptive_relaxation | any other CoupledSolverType], preconditioner [none |
