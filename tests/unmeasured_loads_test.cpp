@@ -4,7 +4,11 @@
 // assembles with P_j sample by sample; the streaming solve gives the stored one's e^2,
 // gradient and identified force; the gradient is e^2's derivative; on the model's own
 // noise-free data the identified force tends to the true one as w_fu falls; the solvers
-// that take P as one matrix refuse; `identify run` identifies E with fL unmeasured.
+// that take P as one matrix refuse; `identify run` identifies E with fL unmeasured and
+// writes the plate's identified force. The Hopkinson bar (configs/shpb): the committed
+// models against rho A L and a linear field, the real shot's record on the model's grid,
+// the unmeasured striker on synthetic data within twice the measured-force std, records
+// the config does not fit refused.
 #include <gtest/gtest.h>
 
 #include <cmath>
