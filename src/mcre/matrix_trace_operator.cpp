@@ -170,13 +170,13 @@ void AssembleTraceOperator(const Matrix& responses, const SparseMatrix& penalty,
         const double weight = l == 0 ? grid.first_weight : (l == m ? grid.last_weight : 1.0);
         const double scale = 1.0 / std::sqrt((*loads.alphas)[c] * weight * grid.time_step);
         // theta b_c(later) + (1 - theta) b_c(later - 1), the first term absent at l = 0.
-        const double later_factor = l == 0 ? 0.0 : t;
         Scalar* out = terms.col(column++).data();
         for (int i = 0; i <= m; ++i) {
           const int later = i - l + 1;
           for (int k = 0; k < rows; ++k) {
             double value = 0.0;
-            if (later >= 1) value += later_factor * b((later - 1) * rows + k, c);
+            // (At l = 0, later reaches m + 1, past b's last block: no term there.)
+            if (later >= 1 && l > 0) value += t * b((later - 1) * rows + k, c);
             if (later >= 2) value += u * b((later - 2) * rows + k, c);
             out[i * rows + k] = static_cast<Scalar>(scale * value);
           }
