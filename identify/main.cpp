@@ -89,8 +89,8 @@
 #include "mcrewave/app/config.h"
 #include "mcrewave/app/damage_study.h"
 #include "mcrewave/app/identification_run.h"
-#include "mcrewave/app/matrix_identification_run.h"
 #include "mcrewave/app/results.h"
+#include "mcrewave/app/run.h"
 #include "mcrewave/app/sensor_placement_run.h"
 #include "mcrewave/app/study.h"
 #include "mcrewave/core/version.h"
@@ -204,31 +204,6 @@ void CheckOutputFolder(const std::string& folder) {
   RequireWritableFolder(existing, "output folder " + folder);
 }
 
-// Steps 2 and 3 of RunIdentify with model.kind: matrix: the manifest's model and the
-// measurements of its channels, then every zone modulus of the structure
-// (app/matrix_identification_run.h).
-mcrewave::IdentificationRun IdentifyMatrixModel(const mcrewave::Config& config) {
-  const mcrewave::MatrixModelData model = mcrewave::LoadMatrixModel(config);
-  mcrewave::CheckMatrixModelFieldBytes(config, model);
-  const mcrewave::MatrixMeasurements data = mcrewave::LoadMatrixMeasurements(config, model);
-  return mcrewave::RunMatrixIdentification(config, model, data);
-}
-
-// Steps 2 and 3 of RunIdentify on the bar: its measurements, checked against the model's
-// time grid, then E, the cost curve and the uncertainty figure (by output-error least
-// squares instead of the MCRE with outer.functional: least_squares: its fit, cost curve
-// and Cramer-Rao bound), and the zones when it has any.
-mcrewave::IdentificationRun IdentifyBar(const mcrewave::Config& config,
-                                        const std::string& config_path) {
-  const mcrewave::ChannelSet data = mcrewave::LoadMeasurements(config);
-  spdlog::info("config {}: {} elements, {} steps of {:.4g} s; data {} ({} samples)", config_path,
-               config.model.elements, config.time.NumSteps(), config.time.step,
-               config.data.source == mcrewave::DataSource::kCsv ? config.data.path
-                                                                : std::string("synthetic"),
-               data.num_samples());
-  return mcrewave::RunIdentification(config, data);
-}
-
 // Step 5 of RunIdentify: the identified moduli, against the truth's when it is known.
 void ReportModuli(const mcrewave::IdentificationRun& run) {
   const mcrewave::Config& config = run.config;
@@ -281,10 +256,8 @@ int RunIdentify(const RunArguments& arguments) {
 
   // 2. The measurements, and 3. the identification: E (or on a structure given by
   //    matrices its zones' common E*), then every zone modulus, the error maps and the
-  //    uncertainty.
-  const mcrewave::IdentificationRun run = config.structure.kind == mcrewave::ModelKind::kMatrix
-                                              ? IdentifyMatrixModel(config)
-                                              : IdentifyBar(config, arguments.config_path);
+  //    uncertainty (app/run.h).
+  const mcrewave::IdentificationRun run = mcrewave::IdentifyFromConfig(config);
   const std::string unreportable = mcrewave::UnreportableMessage(run);
   if (!unreportable.empty()) {
     std::fprintf(stderr, "error: identification failed: %s\n", unreportable.c_str());
@@ -317,16 +290,13 @@ int RunSimulate(const SimulateArguments& arguments) {
   if (config.structure.kind == mcrewave::ModelKind::kMatrix) {
     // A structure given by matrices: its truth's outputs and loads, under the columns
     // identify run reads (model.channel_map).
-    const mcrewave::MatrixModelData model = mcrewave::LoadMatrixModel(config);
-    const mcrewave::MatrixMeasurements data = mcrewave::LoadMatrixMeasurements(config, model);
+    const mcrewave::ChannelSet table = mcrewave::SimulatedMeasurements(config);
     {
       const ResultsBeingWritten held;
-      mcrewave::WriteChannelCsv(mcrewave::MatrixMeasurementTable(config, model, data.histories),
-                                arguments.output_path);
+      mcrewave::WriteChannelCsv(table, arguments.output_path);
     }
-    spdlog::info("wrote {} samples of {} channels to {} in {:.3f} s",
-                 data.histories.num_steps() + 1, model.loads.size() + model.sensors.size(),
-                 arguments.output_path,
+    spdlog::info("wrote {} samples of {} channels to {} in {:.3f} s", table.num_samples(),
+                 table.channels.size(), arguments.output_path,
                  std::chrono::duration<double>(Clock::now() - start).count());
     return 0;
   }
@@ -336,7 +306,7 @@ int RunSimulate(const SimulateArguments& arguments) {
                config.data.truth_refinement, config.data.snr);
 
   // 2. Simulate the truth and add measurement noise.
-  const mcrewave::ChannelSet measurements = mcrewave::SyntheticMeasurements(config);
+  const mcrewave::ChannelSet measurements = mcrewave::SimulatedMeasurements(config);
 
   // 3. Write the measurement set atomically.
   {

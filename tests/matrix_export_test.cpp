@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -234,6 +235,44 @@ TEST(MatrixExportTest, BadModelsGiveOneClearError) {
 // A manifest naming absolute paths reads them as they are: they were glued onto the
 // manifest's folder ("cannot read Matrix Market file /data/plate//data/plate/M.mtx").
 // A relative name beside them stays relative to the manifest's folder.
+// A model given in code (the Python module's) gets the manifest's checks of its
+// contents: the exported bar passes, and each spoiled copy is refused naming the model,
+// the part and what was expected.
+TEST(MatrixExportTest, AModelGivenInCodeIsCheckedAsAManifestIs) {
+  const MatrixModelData bar =
+      BarMatrixModel(ThreeZoneBar(), 200e9, kSensors, BarClampExport::kSupport);
+  EXPECT_NO_THROW(CheckMatrixModel(bar, "the bar"));
+  const auto refused = [&](const std::function<void(MatrixModelData*)>& spoil,
+                           const std::string& expected) {
+    MatrixModelData spoiled = bar;
+    spoil(&spoiled);
+    try {
+      CheckMatrixModel(spoiled, "the bar");
+      ADD_FAILURE() << "accepted; expected: " << expected;
+    } catch (const InputError& error) {
+      EXPECT_EQ(std::string(error.what()).rfind(expected, 0), 0u) << error.what();
+    }
+  };
+  refused([](MatrixModelData* m) { m->length = 0.0; }, "the bar: length: expected a positive");
+  refused([](MatrixModelData* m) { m->mass.coeffRef(0, 1) += 1.0; },
+          "the bar: the mass matrix: not symmetric");
+  refused([](MatrixModelData* m) { m->zones[1].stiffness.coeffRef(3, 3) = std::nan(""); },
+          "the bar: zone 'zone1' stiffness: entry (4, 4) is not a finite number");
+  refused([](MatrixModelData* m) { m->zones[2].name = "zone0"; },
+          "the bar: zone 'zone0': expected a name, not empty and not another zone's");
+  refused([](MatrixModelData* m) { m->zones[0].nominal_modulus = -1.0; },
+          "the bar: zone 'zone0': expected a positive nominal modulus");
+  refused([](MatrixModelData* m) { m->loads[0].vector.conservativeResize(5); },
+          "the bar: load 'fL'");
+  refused([](MatrixModelData* m) { m->sensors[1].channel = "fL"; },
+          "the bar: sensor channel 'fL': expected a name, not empty and not another channel's");
+  refused([](MatrixModelData* m) { m->supports[0].force_channel = "uL"; },
+          "the bar: support force channel 'uL'");
+  refused([](MatrixModelData* m) { m->supports[0].dofs = {31}; }, "support 'clamp'");
+  refused([](MatrixModelData* m) { m->loads.clear(); },
+          "the bar: expected at least one load channel");
+}
+
 TEST(MatrixExportTest, AbsolutePathsInAManifestAreUsedAsTheyAre) {
   const MatrixModelData data = BarMatrixModel(ThreeZoneBar(), 200e9, kSensors);
   const std::string files = std::filesystem::absolute(MakeFolder("absolute_files")).string();

@@ -172,24 +172,27 @@ ChannelSet LoadMeasurements(const Config& config) {
                    &use_u0, &use_uL);
     return data;
   }
-  const std::string& path = config.data.path;
-  ChannelSet data = ReadMeasurementCsv(path);
+  return BarMeasurementsOfRecord(config, ReadMeasurementCsv(config.data.path), config.data.path);
+}
+
+ChannelSet BarMeasurementsOfRecord(const Config& config, ChannelSet data, const std::string& name) {
+  bool use_u0 = true, use_uL = true;
   // Dead channels and outliers are looked for in the file's own samples, so that the
   // line named is the file's (resampling would spread a spike over its neighbours).
-  CheckMeasurementChannels(data, path);
+  CheckMeasurementChannels(data, name);
   const std::string config_name = config.Name();
   const int expected_samples = config.time.NumSteps() + 1;
   if (std::abs(data.time_step - config.time.step) > kGridTolerance * config.time.step ||
       std::abs(data.start_time) > kGridTolerance * config.time.step) {
     // Another rate or origin: band-limited resampling onto the model's grid (resample.h).
     spdlog::info("{}: resampling {} samples of {:.6g} s onto {} samples of time.step {:.6g} s",
-                 path, data.num_samples(), data.time_step, expected_samples, config.time.step);
-    data = ResampleMeasurements(data, config.time.step, expected_samples, path);
+                 name, data.num_samples(), data.time_step, expected_samples, config.time.step);
+    data = ResampleMeasurements(data, config.time.step, expected_samples, name);
   }
-  SelectChannels(data, config.data.channels, "data.channels", path, &use_u0, &use_uL);
+  SelectChannels(data, config.data.channels, "data.channels", name, &use_u0, &use_uL);
   for (const BarSensor& sensor : BarSensors(data)) {
     if (sensor.position > config.model.length) {
-      throw InputError(path + ":1: column '" +
+      throw InputError(name + ":1: column '" +
                        data.channels[static_cast<std::size_t>(sensor.index)].name +
                        "': the sensor lies outside the bar [0, " + Number(config.model.length) +
                        "] m (model.length of " + config_name + ")");
@@ -198,13 +201,13 @@ ChannelSet LoadMeasurements(const Config& config) {
   if (data.num_samples() > expected_samples) {
     // A record longer than the window on the model's grid: its first samples are the
     // window's, as resampling would take them from data on another grid.
-    spdlog::info("{}: using the first {} of its {} samples (time.window {:.6g} s)", path,
+    spdlog::info("{}: using the first {} of its {} samples (time.window {:.6g} s)", name,
                  expected_samples, data.num_samples(), config.time.window);
     KeepFirstSamples(expected_samples, &data);
   }
   if (data.num_samples() < expected_samples) {
     throw InputError(
-        path + ": " + std::to_string(data.num_samples()) +
+        name + ": " + std::to_string(data.num_samples()) +
         " samples, fewer than time.window / time.step + 1 = " + std::to_string(expected_samples) +
         " in " + config_name + " (time.window " + Number(config.time.window) + " s)");
   }

@@ -53,25 +53,11 @@ std::vector<ChannelColumn> ChannelColumns(const Config& config, const MatrixMode
   return channels;
 }
 
-// The CSV of data.path on the config's grid: the model's channels (named as the model
-// names them, of their kinds), in its order.
-ChannelSet ReadMatrixMeasurementCsv(const Config& config, const MatrixModelData& model) {
-  const std::string& path = config.data.path;
+// A record of the model's channels (under their columns) on the config's grid: shifted
+// by data.time_origin, resampled when sampled otherwise, the channels picked.
+ChannelSet MatrixRecordOnGrid(const Config& config, const MatrixModelData& model, ChannelSet table,
+                              const std::string& path) {
   const auto channels = ChannelColumns(config, model);
-  // Every channel's column must be in the header (checked before any row is read).
-  const HeaderCheck check_header = [&](const std::vector<std::string>& names,
-                                       const std::string&) -> std::string {
-    if (names.empty()) return "a header naming the columns: t and the model's channels";
-    for (const auto& [channel, column, kind] : channels) {
-      if (std::find(names.begin(), names.end(), column) != names.end()) continue;
-      return "the header lacks the column '" + column + "' of the model's channel '" + channel +
-             "'" +
-             (column == channel ? std::string(" (model.channel_map can name another column)")
-                                : " (model.channel_map of " + config.Name() + ")");
-    }
-    return "";
-  };
-  ChannelSet table = ReadChannelCsv(path, check_header, {}, config.data.time_column);
   // The record's clock shifted to the model's: t_model = t_record - data.time_origin.
   table.start_time -= config.data.time_origin;
   const int samples = config.time.NumSteps() + 1;
@@ -90,18 +76,49 @@ ChannelSet ReadMatrixMeasurementCsv(const Config& config, const MatrixModelData&
   return set;
 }
 
+// Why `names` (a record's columns) lack the column of one of the model's `channels`
+// ("" when they hold every one); `holder` names them in the message ("the header").
+std::string MissingChannelColumn(const Config& config, const std::vector<ChannelColumn>& channels,
+                                 const std::vector<std::string>& names, const std::string& holder) {
+  for (const auto& [channel, column, kind] : channels) {
+    if (std::find(names.begin(), names.end(), column) != names.end()) continue;
+    return holder + " lacks the column '" + column + "' of the model's channel '" + channel + "'" +
+           (column == channel ? std::string(" (model.channel_map can name another column)")
+                              : " (model.channel_map of " + config.Name() + ")");
+  }
+  return "";
+}
+
+// The CSV of data.path on the config's grid: the model's channels (named as the model
+// names them, of their kinds), in its order.
+ChannelSet ReadMatrixMeasurementCsv(const Config& config, const MatrixModelData& model) {
+  const std::string& path = config.data.path;
+  const auto channels = ChannelColumns(config, model);
+  // Every channel's column must be in the header (checked before any row is read).
+  const HeaderCheck check_header = [&](const std::vector<std::string>& names,
+                                       const std::string&) -> std::string {
+    if (names.empty()) return "a header naming the columns: t and the model's channels";
+    return MissingChannelColumn(config, channels, names, "the header");
+  };
+  return MatrixRecordOnGrid(config, model,
+                            ReadChannelCsv(path, check_header, {}, config.data.time_column), path);
+}
+
 // Synthetic data: the truth's outputs at its moduli, with noise (its levels in *noise);
 // the truth's moduli of the model's zones in *truth_moduli (empty when a zone name is
-// not the truth's).
+// not the truth's). given_truth (nullable): the model as given in code, before
+// PrepareMatrixModel, the truth when data.truth_manifest is empty.
 ChannelSet SyntheticMatrixMeasurements(const Config& config, const MatrixModelData& model,
-                                       Vector* truth_moduli, NoiseLevels* noise) {
+                                       const MatrixModelData* given_truth, Vector* truth_moduli,
+                                       NoiseLevels* noise) {
   const std::string manifest = config.data.truth_manifest.empty() ? config.structure.manifest
                                                                   : config.data.truth_manifest;
   // The truth's zones are its manifest's, also when the model regroups its elements.
-  const MatrixModelData truth =
-      manifest == config.structure.manifest && !config.zones.RegroupsElements()
-          ? model
-          : ReadMatrixModel(manifest);
+  const bool own_model = manifest == config.structure.manifest;
+  const MatrixModelData truth = own_model && given_truth != nullptr ? *given_truth
+                                : own_model && !config.zones.RegroupsElements()
+                                    ? model
+                                    : ReadMatrixModel(manifest);
   const auto zones = static_cast<int>(truth.zones.size());
   Vector moduli(zones);
   if (!config.data.truth_moduli.empty()) {
@@ -504,7 +521,10 @@ Matrix HeldSupportForces(const MatrixModelData& truth, const ChannelSet& data,
 
 MatrixModelData LoadMatrixModel(const Config& config) {
   assert(config.structure.kind == ModelKind::kMatrix);
-  MatrixModelData model = ReadMatrixModel(config.structure.manifest);
+  return PrepareMatrixModel(config, ReadMatrixModel(config.structure.manifest));
+}
+
+MatrixModelData PrepareMatrixModel(const Config& config, MatrixModelData model) {
   for (const std::string& channel : config.mcre.unmeasured_loads) {
     const bool load = std::any_of(model.loads.begin(), model.loads.end(),
                                   [&](const MatrixModelLoad& it) { return it.channel == channel; });
@@ -638,16 +658,30 @@ void CheckMatrixModelFieldBytes(const Config& config, const MatrixModelData& mod
       config.inner.max_field_bytes));
 }
 
-MatrixMeasurements LoadMatrixMeasurements(const Config& config, const MatrixModelData& model) {
+MatrixMeasurements LoadMatrixMeasurements(const Config& config, const MatrixModelData& model,
+                                          const MatrixModelData* given_truth) {
   MatrixMeasurements measurements;
   if (config.data.source == DataSource::kCsv) {
     measurements.histories = ReadMatrixMeasurementCsv(config, model);
     measurements.source = config.data.path;
   } else {
-    measurements.histories =
-        SyntheticMatrixMeasurements(config, model, &measurements.truth_moduli, &measurements.noise);
+    measurements.histories = SyntheticMatrixMeasurements(
+        config, model, given_truth, &measurements.truth_moduli, &measurements.noise);
     measurements.source = "synthetic";
   }
+  return measurements;
+}
+
+MatrixMeasurements MatrixMeasurementsOfRecord(const Config& config, const MatrixModelData& model,
+                                              ChannelSet record, const std::string& name) {
+  std::vector<std::string> names;
+  for (const Channel& channel : record.channels) names.push_back(channel.name);
+  const std::string missing =
+      MissingChannelColumn(config, ChannelColumns(config, model), names, "the record");
+  if (!missing.empty()) throw InputError(name + ": " + missing);
+  MatrixMeasurements measurements;
+  measurements.histories = MatrixRecordOnGrid(config, model, std::move(record), name);
+  measurements.source = name;
   return measurements;
 }
 

@@ -110,63 +110,61 @@ ChannelSet ReadMeasurementCsv(const std::string& path) {
   return ParseMeasurementCsv(file, path);
 }
 
-ChannelSet ParseMeasurementCsv(std::istream& file, const std::string& path) {
+std::string BarHeaderProblem(const std::vector<std::string>& names, const std::string& line) {
   const std::string expected_header =
       std::string("a header naming the columns: ") + kHeader +
       " in any order, then any interior channels u@X (displacement at X m) and e@X (strain "
       "at X m)";
-  // The bar's header: every name a channel of data/measurement.h, no sensor twice, the
-  // five end columns present ("" when so; an empty header asks what is expected).
-  auto check_header = [&expected_header](const std::vector<std::string>& names,
-                                         const std::string& line) -> std::string {
-    if (names.empty()) return expected_header;
-    std::array<int, kEndColumns> found{};
-    std::vector<ChannelName> channels;
-    for (std::size_t c = 0; c < names.size(); ++c) {
-      ChannelName channel;
-      std::string why;
-      if (!ParseChannelName(names[c], &channel, &why)) {
-        return "column " + std::to_string(c + 1) + " '" + names[c] + "': " + why + "; expected " +
-               expected_header;
-      }
-      for (std::size_t other = 0; other < c; ++other) {
-        const bool same_sensor = channel.kind == ChannelName::Kind::kSensor &&
-                                 channels[other].kind == ChannelName::Kind::kSensor &&
-                                 channels[other].sensor_kind == channel.sensor_kind &&
-                                 channels[other].position == channel.position;
-        if (names[other] == names[c] || same_sensor) {
-          return "column " + std::to_string(c + 1) + " '" + names[c] + "' repeats column " +
-                 std::to_string(other + 1) + " '" + names[other] + "'";
-        }
-      }
-      if (channel.kind != ChannelName::Kind::kSensor) found[static_cast<int>(channel.kind)] = 1;
-      channels.push_back(channel);
-    }
-    for (int c = 0; c < kEndColumns; ++c) {
-      if (found[c] == 0) {
-        return std::string("the header '") + line + "' lacks the column '" + kColumnNames[c] +
-               "'; expected " + expected_header;
-      }
-    }
-    return "";
-  };
-  // Each channel's kind from its name (checked with the header).
-  auto kind_of = [](const std::string& name) {
+  if (names.empty()) return expected_header;
+  std::array<int, kEndColumns> found{};
+  std::vector<ChannelName> channels;
+  for (std::size_t c = 0; c < names.size(); ++c) {
     ChannelName channel;
     std::string why;
-    ParseChannelName(name, &channel, &why);
-    switch (channel.kind) {
-      case ChannelName::Kind::kF0:
-      case ChannelName::Kind::kFL:
-        return ChannelKind::kForce;
-      case ChannelName::Kind::kSensor:
-        return channel.sensor_kind == SensorKind::kStrain ? ChannelKind::kStrain
-                                                          : ChannelKind::kDisplacement;
-      default:
-        return ChannelKind::kDisplacement;
+    if (!ParseChannelName(names[c], &channel, &why)) {
+      return "column " + std::to_string(c + 1) + " '" + names[c] + "': " + why + "; expected " +
+             expected_header;
     }
-  };
-  return ParseChannelCsv(file, path, check_header, kind_of);
+    for (std::size_t other = 0; other < c; ++other) {
+      const bool same_sensor = channel.kind == ChannelName::Kind::kSensor &&
+                               channels[other].kind == ChannelName::Kind::kSensor &&
+                               channels[other].sensor_kind == channel.sensor_kind &&
+                               channels[other].position == channel.position;
+      if (names[other] == names[c] || same_sensor) {
+        return "column " + std::to_string(c + 1) + " '" + names[c] + "' repeats column " +
+               std::to_string(other + 1) + " '" + names[other] + "'";
+      }
+    }
+    if (channel.kind != ChannelName::Kind::kSensor) found[static_cast<int>(channel.kind)] = 1;
+    channels.push_back(channel);
+  }
+  for (int c = 0; c < kEndColumns; ++c) {
+    if (found[c] == 0) {
+      return std::string("the header '") + line + "' lacks the column '" + kColumnNames[c] +
+             "'; expected " + expected_header;
+    }
+  }
+  return "";
+}
+
+ChannelKind BarChannelKind(const std::string& name) {
+  ChannelName channel;
+  std::string why;
+  ParseChannelName(name, &channel, &why);
+  switch (channel.kind) {
+    case ChannelName::Kind::kF0:
+    case ChannelName::Kind::kFL:
+      return ChannelKind::kForce;
+    case ChannelName::Kind::kSensor:
+      return channel.sensor_kind == SensorKind::kStrain ? ChannelKind::kStrain
+                                                        : ChannelKind::kDisplacement;
+    default:
+      return ChannelKind::kDisplacement;
+  }
+}
+
+ChannelSet ParseMeasurementCsv(std::istream& file, const std::string& path) {
+  return ParseChannelCsv(file, path, BarHeaderProblem, BarChannelKind);
 }
 
 void CheckMeasurementChannels(const ChannelSet& measurements, const std::string& name) {

@@ -14,6 +14,7 @@
 
 #include "mcre/coupled_solver_internal.h"
 #include "mcre/direct_solution_check.h"
+#include "mcrewave/core/interrupt.h"
 
 namespace mcrewave::internal {
 namespace {
@@ -261,6 +262,11 @@ void SolveByRelaxation(const CoupledSolverOptions& options, CoupledProblem* prob
       summary->message = RelaxationDivergenceMessage(best_residual, relative, iteration, omega);
       return;
     }
+    if (InterruptRequested()) {
+      summary->termination = TerminationType::kFailure;
+      summary->message = kInterruptedMessage;
+      return;
+    }
     if (iteration == options.max_iterations) {
       summary->termination = TerminationType::kNoConvergence;
       summary->message = "no convergence in " + std::to_string(iteration) +
@@ -339,6 +345,11 @@ void SolveByConjugateGradient(const CoupledSolverOptions& options, CoupledProble
     summary->residual_history.push_back(relative);
     summary->relative_residual = relative;
     summary->iterations = iteration;
+    if (InterruptRequested()) {
+      summary->termination = TerminationType::kFailure;
+      summary->message = kInterruptedMessage;
+      return;
+    }
     if (iteration == options.max_iterations) {
       summary->termination = TerminationType::kNoConvergence;
       summary->message = "no convergence in " + std::to_string(iteration) +

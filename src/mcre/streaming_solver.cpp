@@ -52,6 +52,7 @@
 
 #include "mcre/coupled_solver_internal.h"
 #include "mcre/direct_solution_check.h"
+#include "mcrewave/core/interrupt.h"
 
 namespace mcrewave::internal {
 namespace {
@@ -184,6 +185,11 @@ void StreamingConjugateGradient::Solve(const Matrix* initial_traces) {
   summary_->relative_residual = relative_;
   for (int iteration = 0;; ++iteration, ++since_restart_) {
     summary_->iterations = iteration;
+    if (InterruptRequested()) {
+      summary_->termination = TerminationType::kFailure;
+      summary_->message = kInterruptedMessage;
+      return;
+    }
     if (iteration == options_.max_iterations) {
       summary_->termination = TerminationType::kNoConvergence;
       summary_->message = "no convergence in " + std::to_string(iteration) +

@@ -806,6 +806,141 @@ MatrixModelData ReadMatrixModel(const std::string& manifest_path) {
   return data;
 }
 
+namespace {
+
+// "" when every stored entry of `matrix` is finite, else the first that is not.
+std::string CheckFinite(const SparseMatrix& matrix, const std::string& name) {
+  for (int column = 0; column < matrix.outerSize(); ++column) {
+    for (SparseMatrix::InnerIterator it(matrix, column); it; ++it) {
+      if (!std::isfinite(it.value())) {
+        return name + ": entry (" + std::to_string(it.row() + 1) + ", " +
+               std::to_string(it.col() + 1) + ") is not a finite number";
+      }
+    }
+  }
+  return "";
+}
+
+std::string CheckFinite(const Vector& vector, const std::string& name) {
+  for (Eigen::Index i = 0; i < vector.size(); ++i) {
+    if (!std::isfinite(vector[i])) {
+      return name + ": entry " + std::to_string(i + 1) + " is not a finite number";
+    }
+  }
+  return "";
+}
+
+}  // namespace
+
+void CheckMatrixModel(const MatrixModelData& data, const std::string& name) {
+  const auto positive = [&](double value, const std::string& key) {
+    if (!(value > 0.0 && std::isfinite(value))) {
+      throw InputError(name + ": " + key + ": expected a positive length [m], got " +
+                       std::to_string(value));
+    }
+  };
+  positive(data.stiffness_length, "stiffness_length");
+  positive(data.length, "length");
+  const std::string mass = name + ": the mass matrix";
+  Refuse(CheckFinite(data.mass, mass));
+  Refuse(CheckSquare(data.mass, mass));
+  Refuse(CheckSymmetric(data.mass, mass));
+  Refuse(CheckPositiveDefinite(data.mass, mass));
+  const int n = data.dofs();
+  if (data.zones.empty()) throw InputError(name + ": expected at least one zone");
+  std::set<std::string> zone_names;
+  for (const MatrixModelZone& zone : data.zones) {
+    const std::string which = name + ": zone '" + zone.name + "'";
+    if (zone.name.empty() || !zone_names.insert(zone.name).second) {
+      throw InputError(which + ": expected a name, not empty and not another zone's");
+    }
+    if (!(zone.nominal_modulus > 0.0 && std::isfinite(zone.nominal_modulus))) {
+      throw InputError(which + ": expected a positive nominal modulus [Pa], got " +
+                       std::to_string(zone.nominal_modulus));
+    }
+    Refuse(CheckFinite(zone.stiffness, which + " stiffness"));
+    Refuse(CheckSameSize(zone.stiffness, which + " stiffness", n, mass));
+    Refuse(CheckSymmetric(zone.stiffness, which + " stiffness"));
+  }
+  if (data.loads.empty()) throw InputError(name + ": expected at least one load channel");
+  if (data.sensors.empty()) throw InputError(name + ": expected at least one sensor channel");
+  std::set<std::string> channels;
+  const auto add_channel = [&](const std::string& channel, const std::string& whose) {
+    if (channel.empty() || !channels.insert(channel).second) {
+      throw InputError(name + ": " + whose + " channel '" + channel +
+                       "': expected a name, not empty and not another channel's (a load's, a "
+                       "sensor's or a support's)");
+    }
+  };
+  for (const MatrixModelLoad& load : data.loads) {
+    add_channel(load.channel, "load");
+    const std::string which = name + ": load '" + load.channel + "'";
+    Refuse(CheckVectorSize(load.vector, which, n, mass));
+    Refuse(CheckFinite(load.vector, which));
+  }
+  for (const MatrixModelSensor& sensor : data.sensors) {
+    add_channel(sensor.channel, "sensor");
+    const std::string which = name + ": sensor '" + sensor.channel + "'";
+    Refuse(CheckFinite(SparseMatrix(sensor.row), which));
+    Refuse(CheckSensorRow(sensor.row, sensor.channel, name, n, mass));
+  }
+  std::set<std::string> support_names;
+  std::set<int> held;
+  for (const MatrixModelSupport& support : data.supports) {
+    const std::string which = name + ": support '" + support.name + "'";
+    if (support.name.empty() || !support_names.insert(support.name).second) {
+      throw InputError(which + ": expected a name, not empty and not another support's");
+    }
+    Refuse(CheckSupportDofs(support.dofs, support.name, name, n, mass));
+    for (const int dof : support.dofs) {
+      if (!held.insert(dof).second) {
+        throw InputError(which + ": dof " + std::to_string(dof) +
+                         " is held by another support, expected each dof in one support");
+      }
+    }
+    Refuse(CheckSupportReaction(support.reaction, support.dofs, support.name, which + " reaction",
+                                n, mass));
+    if (support.reaction_test.size() > 0) {
+      Refuse(CheckSupportReactionTest(support.reaction_test, support.reaction, support.dofs,
+                                      support.name, which + " reaction_test", n, mass));
+    }
+    add_channel(support.force_channel, "support force");
+    if (!support.displacement_channel.empty()) {
+      add_channel(support.displacement_channel, "support displacement");
+    }
+  }
+  const std::size_t dimension = data.elements.empty() ? 0 : data.elements.front().position.size();
+  for (std::size_t e = 0; e < data.elements.size(); ++e) {
+    const MatrixModelElement& element = data.elements[e];
+    const std::string which = name + ": element " + std::to_string(e);
+    const auto k = static_cast<Eigen::Index>(element.dofs.size());
+    if (element.zone < 0 || element.zone >= static_cast<int>(data.zones.size())) {
+      throw InputError(which + ": zone index " + std::to_string(element.zone) +
+                       " out of range, expected 0 to " + std::to_string(data.zones.size() - 1));
+    }
+    std::set<int> distinct(element.dofs.begin(), element.dofs.end());
+    if (k == 0 || distinct.size() != element.dofs.size() || *distinct.begin() < 0 ||
+        *distinct.rbegin() >= n) {
+      throw InputError(which + ": expected at least one dof, each in [0, " + std::to_string(n) +
+                       ") and none twice");
+    }
+    if (element.stiffness.rows() != k || element.stiffness.cols() != k ||
+        !element.stiffness.allFinite()) {
+      throw InputError(which + ": expected a finite " + std::to_string(k) + " x " +
+                       std::to_string(k) + " stiffness block (its dofs' count)");
+    }
+    if (static_cast<std::size_t>(element.position.size()) != dimension || dimension > 3 ||
+        !element.position.allFinite()) {
+      throw InputError(which +
+                       ": expected a position of 1 to 3 finite coordinates for every "
+                       "element, or none for every element");
+    }
+  }
+  if (!data.elements.empty()) {
+    Refuse(CheckElementBlockSums(data, name + " (the element blocks)"));
+  }
+}
+
 const Vector& TrustedReactionTest(const MatrixModelSupport& support) {
   return support.reaction_test.size() > 0 ? support.reaction_test : support.reaction;
 }

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <utility>
 
+#include "mcrewave/core/interrupt.h"
+
 namespace mcrewave::internal {
 
 GuardedObjective::GuardedObjective(FirstOrderObjective* objective, GuardLimits limits)
@@ -37,6 +39,10 @@ void GuardedObjective::Stop(StopReason reason, std::string message) {
 
 bool GuardedObjective::Evaluate(const double* x, double* cost, double* gradient) {
   if (stop_ != StopReason::kNone) return false;
+  if (InterruptRequested()) {
+    Stop(StopReason::kFailure, kInterruptedMessage);
+    return false;
+  }
   if (evaluations_ >= limits_.max_evaluations) {
     Stop(StopReason::kEvaluationLimit, LimitMessage(StopReason::kEvaluationLimit));
     return false;

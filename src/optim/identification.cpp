@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/enum_names.h"
+#include "mcrewave/core/interrupt.h"
 #include "optim/identification_internal.h"
 
 namespace mcrewave {
@@ -251,6 +252,10 @@ void ScanSamples(const IdentificationOptions& options, ModulusObjective* objecti
   auto sample = [&](ModulusObjective* evaluated, int i) {
     if (SecondsSince(start) >= options.max_time) {
       failures[i] = "outer.max_time reached during the scan";
+      return;
+    }
+    if (InterruptRequested()) {
+      failures[i] = kInterruptedMessage;
       return;
     }
     ScanSample(evaluated, xs[i], &(*costs)[i], &(*gradients)[i], &failures[i]);

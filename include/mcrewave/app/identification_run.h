@@ -43,6 +43,12 @@ namespace mcrewave {
 // SyntheticMeasurements.
 ChannelSet LoadMeasurements(const Config& config);
 
+// The CSV branch of LoadMeasurements on a record already read (ReadMeasurementCsv, or
+// given in code with the bar's channels and kinds): its checks, resampling, channel
+// selection and window, with `name` for the file in messages.
+ChannelSet BarMeasurementsOfRecord(const Config& config, ChannelSet record,
+                                   const std::string& name);
+
 // MakeSyntheticMeasurements of the config's model, load, time and data sections.
 // Throws InputError naming the config's keys when a value is not finite (a load
 // or a noise level beyond double range).

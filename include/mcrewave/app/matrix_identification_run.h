@@ -71,12 +71,27 @@ struct MatrixMeasurements {
 // Precondition: config.structure.kind is kMatrix.
 MatrixModelData LoadMatrixModel(const Config& config);
 
+// LoadMatrixModel's checks, channel selection and zone regrouping on a model already
+// read or given in code; config.structure.manifest names it in messages.
+MatrixModelData PrepareMatrixModel(const Config& config, MatrixModelData model);
+
 // The measurements of `model` per config.data (step 2 above). Throws InputError naming
 // the CSV file and the column of a channel it lacks (or the key model.channel_map when
 // the map renamed it), the file when the data do not cover the time window, the truth's
 // manifest when it lacks one of the model's channels or data.truth_moduli does not
-// have one modulus per truth zone.
-MatrixMeasurements LoadMatrixMeasurements(const Config& config, const MatrixModelData& model);
+// have one modulus per truth zone. given_truth (nullable): a model given in code as it
+// was given (before PrepareMatrixModel), the synthetic truth when data.truth_manifest
+// is empty (instead of the manifest's).
+MatrixMeasurements LoadMatrixMeasurements(const Config& config, const MatrixModelData& model,
+                                          const MatrixModelData* given_truth = nullptr);
+
+// The CSV branch of LoadMatrixMeasurements on a record given in code (the Python
+// module's data): `record` holds a column per channel of the model (model.channel_map
+// names it), sampled from record.start_time on record.time_step, and is shifted by
+// data.time_origin and resampled onto the config's grid as a CSV is. Throws InputError
+// naming `name` and the column a channel lacks, or as ResampleMeasurements does.
+MatrixMeasurements MatrixMeasurementsOfRecord(const Config& config, const MatrixModelData& model,
+                                              ChannelSet record, const std::string& name);
 
 // Throws InputError, naming the config, the bytes and what fits instead, when the
 // coupled solves of `identify run` on `model` would hold stored fields above

@@ -78,6 +78,16 @@ ChannelSet ReadMeasurementCsv(const std::string& path);
 // The same from a stream; `name` stands for the file name in messages.
 ChannelSet ParseMeasurementCsv(std::istream& text, const std::string& name);
 
+// The bar's header check of ReadMeasurementCsv (a HeaderCheck, channel_set.h): "" when
+// `names` (t included) are channels of this header's names, the five end columns
+// present and no channel twice; else the reason, quoting `line`. No names: what a
+// header should be.
+std::string BarHeaderProblem(const std::vector<std::string>& names, const std::string& line);
+
+// The kind of the bar's channel `name` (a ChannelKindOf): f0 and fL forces, e@X strains,
+// the others displacements.
+ChannelKind BarChannelKind(const std::string& name);
+
 // Refuses measurements that read well but cannot be identified from, with an
 // InputError naming `name`, the line of the sample (as in the CSV file: sample k
 // on line k + 2) and the column:

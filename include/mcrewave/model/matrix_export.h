@@ -193,4 +193,14 @@ std::string WriteMatrixModel(const std::string& folder, const MatrixModelData& d
 // channels file that does not match its matrix) on the first problem.
 MatrixModelData ReadMatrixModel(const std::string& manifest_path);
 
+// ReadMatrixModel's checks of the model's contents on a model given in code (the
+// Python module's), `name` standing for the manifest and its files in messages: the
+// scales positive, M finite, square, symmetric and positive definite, every zone named
+// once with a positive nominal modulus and a finite symmetric K_z of M's size, at least
+// one load and one sensor, every channel named once (loads', sensors', supports'), the
+// load vectors finite and of M's size, the sensor rows finite and within M's dofs, the
+// supports' dofs and reactions as the manifest's, the element blocks summing to K_z.
+// Throws InputError naming `name` and what is wrong on the first problem.
+void CheckMatrixModel(const MatrixModelData& data, const std::string& name);
+
 }  // namespace mcrewave
