@@ -9,6 +9,7 @@ packages=(
   libeigen3-dev libnlopt-cxx-dev libceres-dev libyaml-cpp-dev libspdlog-dev
   libcli11-dev libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox
   clang libclang-rt-14-dev
+  python3-dev python3-numpy python3-scipy pybind11-dev
   "$@"
 )
 
