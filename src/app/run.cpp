@@ -38,7 +38,14 @@ MatrixModelData MatrixModelOf(const Config& config, const GivenInputs& given) {
 
 }  // namespace
 
-IdentificationRun IdentifyFromConfig(const Config& config, const GivenInputs& given) {
+IdentificationRun IdentifyFromConfig(const Config& given_config, const GivenInputs& given) {
+  // A record given in code replaces the CSV file: the run takes its data as measured,
+  // with no synthetic truth and no noise level drawn at data.snr.
+  Config config = given_config;
+  if (given.record != nullptr) {
+    config.data.source = DataSource::kCsv;
+    config.data.path = given.record_name;
+  }
   if (config.structure.kind == ModelKind::kMatrix) {
     const MatrixModelData model = MatrixModelOf(config, given);
     const MatrixMeasurements data =

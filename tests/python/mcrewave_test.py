@@ -147,9 +147,9 @@ class IdentifyLikeTheBinaryTest(unittest.TestCase):
         folder = os.path.join(self.folder, "csv")
         expected = binary_summary("configs/plate.yaml", folder, *overrides, "data.source=csv",
                                   f"data.path={csv}")
+        # The record replaces the CSV: data.source csv and data.path its name.
         from_numpy = mcrewave.identify("configs/plate.yaml", data=data, quiet=True,
-                                       overrides=overrides + ["data.source=csv",
-                                                              f"data.path={csv}"])
+                                       overrides=overrides)
         self.assertEqual(comparable(from_numpy.summary_yaml), comparable(expected))
 
 

@@ -33,7 +33,8 @@ struct GivenInputs {
   // Measurements (nullable), instead of data: (synthetic or CSV): one channel a column
   // as a CSV holds them, sampled from record->start_time on record->time_step; on the
   // bar its channels named as the bar's CSV columns (t excluded), on a structure given
-  // by matrices a channel per column of the model's channels (model.channel_map).
+  // by matrices a channel per column of the model's channels (model.channel_map). The
+  // run takes them as a CSV's: data.source csv, data.path the record's name.
   const ChannelSet* record = nullptr;
   std::string record_name = "the record";  // stands for the CSV file in messages
 };
