@@ -21,6 +21,12 @@
 namespace mcrewave {
 namespace {
 
+// Whether the load channel `channel` is one of mcre.unmeasured_loads (no data of it).
+bool IsUnmeasuredLoad(const Config& config, const std::string& channel) {
+  const auto& unmeasured = config.mcre.unmeasured_loads;
+  return std::find(unmeasured.begin(), unmeasured.end(), channel) != unmeasured.end();
+}
+
 // A channel of the model with its CSV column and kind.
 struct ChannelColumn {
   std::string channel, column;
@@ -34,10 +40,9 @@ std::vector<ChannelColumn> ChannelColumns(const Config& config, const MatrixMode
   auto add = [&](const std::string& channel, ChannelKind kind) {
     channels.push_back({channel, config.structure.Column(channel), kind});
   };
-  const auto& unmeasured = config.mcre.unmeasured_loads;
   for (const MatrixModelLoad& load : model.loads) {
     // An unmeasured load has no column (MatrixMcreProblem gives it the datum 0).
-    if (std::find(unmeasured.begin(), unmeasured.end(), load.channel) != unmeasured.end()) continue;
+    if (IsUnmeasuredLoad(config, load.channel)) continue;
     add(load.channel, ChannelKind::kForce);
   }
   for (const MatrixModelSensor& sensor : model.sensors) {
@@ -481,11 +486,8 @@ void PrefilterEveryChannel(const Config& config, const MatrixModelData& model,
   double cutoff = config.prefilter.cutoff_frequency;
   if (cutoff <= 0.0) {
     std::vector<std::string> source;
-    const auto& unmeasured = config.mcre.unmeasured_loads;
     for (const MatrixModelLoad& load : model.loads) {
-      if (std::find(unmeasured.begin(), unmeasured.end(), load.channel) != unmeasured.end()) {
-        continue;  // no data
-      }
+      if (IsUnmeasuredLoad(config, load.channel)) continue;  // no data
       source.push_back(load.channel);
     }
     if (source.empty()) {
