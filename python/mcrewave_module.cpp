@@ -164,15 +164,31 @@ std::vector<std::string> Overrides(const py::object& overrides) {
 
 // The config of a path (LoadConfig: relative files resolved against its folder) or of a
 // dict of sections (ParseConfig, named "the config dict" in messages; relative files
-// against the working folder), the overrides applied after it.
-Config ConfigOf(const py::object& config, const py::object& overrides) {
-  const std::vector<std::string> texts = Overrides(overrides);
+// against the working folder), the overrides applied after it. With a model (a record)
+// given in code, model.kind matrix and model.manifest its name (data.source csv and
+// data.path its name) are the last overrides, so that the config is checked as one of
+// that model and record.
+Config ConfigOf(const py::object& config, const py::object& overrides, const PyModel* model,
+                const PyData* data) {
+  std::vector<std::string> texts = Overrides(overrides);
+  std::vector<std::string> given_in_code;
+  if (model != nullptr) {
+    texts.push_back("model.kind=matrix");
+    texts.push_back("model.manifest=" + YamlText(py::str(model->name)));
+    given_in_code.push_back("model.manifest");
+  }
+  if (data != nullptr) {
+    texts.push_back("data.source=csv");
+    texts.push_back("data.path=" + YamlText(py::str(data->name)));
+    given_in_code.push_back("data.path");
+  }
   if (py::isinstance<py::dict>(config)) {
     return ParseConfig(YamlText(config), "the config dict", texts);
   }
   if (py::isinstance<py::str>(config) ||
       py::isinstance(config, py::module_::import("os").attr("PathLike"))) {
-    return LoadConfig(py::str(py::module_::import("os").attr("fspath")(config)), texts);
+    return LoadConfig(py::str(py::module_::import("os").attr("fspath")(config)), texts,
+                      given_in_code);
   }
   throw py::type_error("config: expected a path to a YAML config or a dict of its sections");
 }
@@ -546,34 +562,31 @@ class LibraryCall {
   struct sigaction previous_action_ = {};
 };
 
-// The config of a call with a model given in code: a structure given by matrices,
-// named by the model's name; checked again (ConfigProblem).
-void UseGivenModel(const PyModel& model, Config* config) {
-  config->structure.kind = ModelKind::kMatrix;
-  config->structure.manifest = model.name;
-  const std::string problem = ConfigProblem(*config);
-  if (!problem.empty()) throw InputError(config->Name() + ": " + problem);
+// The model and the record of a call, type-checked (None: the config's).
+const PyModel* GivenModel(const py::object& model) {
+  if (model.is_none()) return nullptr;
+  if (!py::isinstance<PyModel>(model)) {
+    throw py::type_error("model: expected a mcrewave.Model, or None for the config's model");
+  }
+  return &model.cast<const PyModel&>();
 }
 
-GivenInputs GivenOf(const py::object& model, const py::object& data, Config* config) {
-  GivenInputs given;
-  if (!model.is_none()) {
-    if (!py::isinstance<PyModel>(model)) {
-      throw py::type_error("model: expected a mcrewave.Model, or None for the config's model");
-    }
-    const PyModel& given_model = model.cast<const PyModel&>();
-    UseGivenModel(given_model, config);
-    given.model = given_model.data.get();
+const PyData* GivenData(const py::object& data) {
+  if (data.is_none()) return nullptr;
+  if (!py::isinstance<PyData>(data)) {
+    throw py::type_error(
+        "data: expected a mcrewave.Data (mcrewave.Data(channels, time_step) "
+        "or mcrewave.read_csv(path)), or None for the config's data");
   }
-  if (!data.is_none()) {
-    if (!py::isinstance<PyData>(data)) {
-      throw py::type_error(
-          "data: expected a mcrewave.Data (mcrewave.Data(channels, time_step) "
-          "or mcrewave.read_csv(path)), or None for the config's data");
-    }
-    const PyData& record = data.cast<const PyData&>();
-    given.record = record.set.get();
-    given.record_name = record.name;
+  return &data.cast<const PyData&>();
+}
+
+GivenInputs GivenOf(const PyModel* model, const PyData* data) {
+  GivenInputs given;
+  if (model != nullptr) given.model = model->data.get();
+  if (data != nullptr) {
+    given.record = data->set.get();
+    given.record_name = data->name;
   }
   return given;
 }
@@ -585,8 +598,10 @@ py::object IdentificationErrorType() {
 py::object IdentifyInPython(const py::object& config, const py::object& model,
                             const py::object& data, const py::object& overrides,
                             const py::object& progress, bool quiet) {
-  Config resolved = ConfigOf(config, overrides);
-  const GivenInputs given = GivenOf(model, data, &resolved);
+  const PyModel* given_model = GivenModel(model);
+  const PyData* given_data = GivenData(data);
+  const Config resolved = ConfigOf(config, overrides, given_model, given_data);
+  const GivenInputs given = GivenOf(given_model, given_data);
   const LibraryCall call(progress, quiet);
   auto run = std::make_shared<IdentificationRun>();
   {
@@ -607,8 +622,9 @@ py::object IdentifyInPython(const py::object& config, const py::object& model,
 
 PyData SimulateInPython(const py::object& config, const py::object& model,
                         const py::object& overrides, const py::object& progress, bool quiet) {
-  Config resolved = ConfigOf(config, overrides);
-  const GivenInputs given = GivenOf(model, py::none(), &resolved);
+  const PyModel* given_model = GivenModel(model);
+  const Config resolved = ConfigOf(config, overrides, given_model, nullptr);
+  const GivenInputs given = GivenOf(given_model, nullptr);
   const LibraryCall call(progress, quiet);
   auto set = std::make_shared<ChannelSet>();
   {
@@ -996,7 +1012,7 @@ given, that model is the truth unless data.truth_manifest is set), as Data.)doc"
   module.def(
       "resolved_config",
       [](const py::object& config, const py::object& overrides) {
-        return PythonOf(YAML::Load(ConfigToYaml(ConfigOf(config, overrides))));
+        return PythonOf(YAML::Load(ConfigToYaml(ConfigOf(config, overrides, nullptr, nullptr))));
       },
       py::arg("config"), py::arg("overrides") = py::none(),
       "The config with every key, as a dict, after the same checks as identify's.");

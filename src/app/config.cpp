@@ -1767,7 +1767,8 @@ Config ParseConfig(const std::string& yaml_text, const std::string& name,
   return Parse(yaml_text, name, overrides).config;
 }
 
-Config LoadConfig(const std::string& path, const std::vector<std::string>& overrides) {
+Config LoadConfig(const std::string& path, const std::vector<std::string>& overrides,
+                  const std::vector<std::string>& given_in_code) {
   ParsedConfig parsed = Parse(ReadConfigFile(path), path, overrides);
   Config& config = parsed.config;
   config.source_path = path;
@@ -1782,6 +1783,9 @@ Config LoadConfig(const std::string& path, const std::vector<std::string>& overr
        matrix && config.data.source == DataSource::kSynthetic, "manifest"},
   };
   for (const auto& [key, file, used, what] : files) {
+    if (std::find(given_in_code.begin(), given_in_code.end(), key) != given_in_code.end()) {
+      continue;
+    }
     const std::filesystem::path file_path(*file);
     if (!file->empty() && file_path.is_relative()) {
       *file = (std::filesystem::path(path).parent_path() / file_path).string();

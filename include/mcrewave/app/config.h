@@ -161,7 +161,11 @@ struct Config {
 // name now), a block of keys (e.g. study.robustness) where a key belongs or a
 // key where a block belongs, wrong types,
 // out-of-range values, a missing or unreadable file, malformed YAML.
-Config LoadConfig(const std::string& path, const std::vector<std::string>& overrides = {});
+// given_in_code: file keys (model.manifest, data.path, data.truth_manifest) whose
+// values name a model or a record a front end gives in code (the Python module), not
+// files: neither resolved against the config's folder nor checked for reading.
+Config LoadConfig(const std::string& path, const std::vector<std::string>& overrides = {},
+                  const std::vector<std::string>& given_in_code = {});
 
 // The same from YAML text; `name` stands for the file name in messages.
 Config ParseConfig(const std::string& yaml_text, const std::string& name,
