@@ -14,6 +14,7 @@ identify the same E, which the script checks.
 """
 
 import argparse
+import glob
 import os
 import statistics
 import subprocess
@@ -50,15 +51,17 @@ def main():
     parser.add_argument("--config", default="configs/paper_bar.yaml")
     arguments = parser.parse_args()
     binary = os.path.join(arguments.build, "identify", "identify")
-    module = os.path.join(arguments.build, "python")
+    module = arguments.build
     if arguments.runs < 1:
         print("error: --runs must be at least 1", file=sys.stderr)
         return 2
-    for path, what in ((binary, "the identify binary"), (module, "the Python module's folder")):
-        if not os.path.exists(path):
-            print(f"error: {what} {path} is missing: build first (bash scripts/build.sh)",
-                  file=sys.stderr)
-            return 2
+    missing = [] if os.path.exists(binary) else [f"the identify binary {binary}"]
+    if not glob.glob(os.path.join(module, "mcrewave.*.so")):
+        missing.append(f"the Python module mcrewave in {module}")
+    if missing:
+        print(f"error: {' and '.join(missing)} missing: build first (bash scripts/build.sh)",
+              file=sys.stderr)
+        return 2
     environment = dict(os.environ, PYTHONPATH=module)
     folder = tempfile.mkdtemp(prefix="mcrewave_python_overhead_")
     binary_times, python_times, call_times = [], [], []

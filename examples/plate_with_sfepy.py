@@ -23,11 +23,11 @@ What it does, in five steps:
 
 Run it from the repository's root (about 15 s on one core):
 
-    PYTHONPATH=build/python /usr/bin/python3 examples/plate_with_sfepy.py --output /tmp/example
+    PYTHONPATH=build /usr/bin/python3 examples/plate_with_sfepy.py --output /tmp/example
 
 Options: --output FOLDER (default: results/python_example of this checkout, which
 scripts/python_example.sh regenerates), --snr (20),
---seed (1). It needs the mcrewave module (build/python) and Debian's python3-sfepy,
+--seed (1). It needs the mcrewave module (build/) and Debian's python3-sfepy,
 python3-matplotlib, python3-scipy and python3-numpy. It imports the SfePy field of
 scripts/sfepy_vector_field.py. Units are SI throughout: m, kg, s, N, Pa.
 """
@@ -64,7 +64,7 @@ except ImportError as missing:
 try:
     import mcrewave
 except ImportError:
-    sys.exit("plate_with_sfepy.py: no module mcrewave: run with PYTHONPATH=build/python "
+    sys.exit("plate_with_sfepy.py: no module mcrewave: run with PYTHONPATH=build "
              "from the repository's root (the module is built with the project)")
 
 # The plate: steel in plane stress.

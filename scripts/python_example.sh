@@ -10,5 +10,5 @@ build_dir="${MCREWAVE_BUILD_DIR:-$root/build}"
 
 bash "$root/scripts/install_dependencies.sh" python3-sfepy python3-matplotlib
 bash "$root/scripts/build.sh" > /dev/null
-PYTHONPATH="$build_dir/python" /usr/bin/python3 "$root/examples/plate_with_sfepy.py" \
+PYTHONPATH="$build_dir" /usr/bin/python3 "$root/examples/plate_with_sfepy.py" \
   --output "$root/results/python_example"
