@@ -595,6 +595,20 @@ py::object IdentificationErrorType() {
   return py::module_::import("mcrewave").attr("IdentificationError");
 }
 
+// `work()`, a computation of the library, run as a LibraryCall with the GIL released;
+// raises what stopped it (LibraryCall::Finish), else returns its value.
+template <typename Work>
+auto CallLibrary(const py::object& progress, bool quiet, const Work& work) {
+  const LibraryCall call(progress, quiet);
+  decltype(work()) value;
+  {
+    const py::gil_scoped_release release;
+    value = work();
+  }
+  call.Finish();
+  return value;
+}
+
 py::object IdentifyInPython(const py::object& config, const py::object& model,
                             const py::object& data, const py::object& overrides,
                             const py::object& progress, bool quiet) {
@@ -602,13 +616,8 @@ py::object IdentifyInPython(const py::object& config, const py::object& model,
   const PyData* given_data = GivenData(data);
   const Config resolved = ConfigOf(config, overrides, given_model, given_data);
   const GivenInputs given = GivenOf(given_model, given_data);
-  const LibraryCall call(progress, quiet);
-  auto run = std::make_shared<IdentificationRun>();
-  {
-    const py::gil_scoped_release release;
-    *run = IdentifyFromConfig(resolved, given);
-  }
-  call.Finish();
+  auto run = std::make_shared<const IdentificationRun>(
+      CallLibrary(progress, quiet, [&] { return IdentifyFromConfig(resolved, given); }));
   py::object result = py::cast(PyResult{run});
   const std::string unreportable = UnreportableMessage(*run);
   if (!unreportable.empty()) {
@@ -625,13 +634,8 @@ PyData SimulateInPython(const py::object& config, const py::object& model,
   const PyModel* given_model = GivenModel(model);
   const Config resolved = ConfigOf(config, overrides, given_model, nullptr);
   const GivenInputs given = GivenOf(given_model, nullptr);
-  const LibraryCall call(progress, quiet);
-  auto set = std::make_shared<ChannelSet>();
-  {
-    const py::gil_scoped_release release;
-    *set = SimulatedMeasurements(resolved, given);
-  }
-  call.Finish();
+  auto set = std::make_shared<const ChannelSet>(
+      CallLibrary(progress, quiet, [&] { return SimulatedMeasurements(resolved, given); }));
   return {std::move(set), "simulated data of " + resolved.Name()};
 }
 
