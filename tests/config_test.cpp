@@ -823,6 +823,8 @@ mcre:
   w_fu: 3.0000000000000001e-5
   unmeasured_loads: [F, "hammer #2"]
   unmeasured_load_interval: [0, 1.2e-4, 1e-5, 2.5e-4]
+zone_identification:
+  start_modulus: 1.25e11
 )";
 
 // The key of equal zones, refused with the zoning of kEveryKeyNotAtItsDefault; the
@@ -911,12 +913,13 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
     EXPECT_EQ(matrix_keys.count(key), 0u) << key;
     EXPECT_EQ(bar_keys.count(key), 1u) << key;
   }
-  // The bar reads all but the 8 matrix keys (the record's time column, origin and rest
-  // before it among them); a matrix run none of the section study:
+  // The bar reads all but the 9 matrix keys (the record's time column, origin and rest
+  // before it, and the zones' start modulus among them); a matrix run none of the
+  // section study:
   // and 14 single keys fewer (it reads the dense solvers' limits, Riccati and shooting
   // running on any model, the zones' regularisation and merging, and data.channels, the
   // manifest's sensors it uses).
-  EXPECT_EQ(bar_keys.size(), every.size() - 8);
+  EXPECT_EQ(bar_keys.size(), every.size() - 9);
   std::size_t sections = 0;
   for (const auto& [key, value] : every) {
     const std::string section = key.substr(0, key.find('.'));
@@ -946,6 +949,15 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"model:\n  manifest: m.yaml\n", "model.manifest applies to model.kind 'matrix' only"},
       {"data:\n  truth_moduli: [1e11]\n", "data.truth_moduli applies to model.kind 'matrix'"},
+      {"zone_identification:\n  start_modulus: 1e11\n",
+       "zone_identification.start_modulus applies to model.kind 'matrix'"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  start_modulus: "
+       "5e11\n",
+       "kinds.yaml:5: zone_identification.start_modulus (5e+11 Pa) must lie strictly inside "
+       "[outer.lower_bound, outer.upper_bound] = [1e+11, 4e+11] Pa"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  start_modulus: "
+       "-1\n",
+       "zone_identification.start_modulus must be 0 (the homogeneous stage's E*) or a modulus"},
       {"model:\n  kind: matrix\n", "model.manifest must name the manifest"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  zone_count: 3\n",
        "model.zone_count applies to the bar only"},

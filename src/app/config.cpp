@@ -896,6 +896,9 @@ const std::vector<Key>& KeyTable() {
       MakeKey("zone_identification.measured_clamp", &Config::zone_identification,
               &ZoneIdentificationOptions::measured_clamp, Boolean(), "",
               "the MCRE's zones on a trusted clamp with u0 in the data: the clamp measured"),
+      MakeKey("zone_identification.start_modulus", &Config::zone_identification,
+              &ZoneIdentificationOptions::start_modulus, Number(), "Pa",
+              "model.kind matrix: every zone starts here, no homogeneous stage (0: from E*)"),
   };
   return table;
 }
@@ -980,10 +983,18 @@ std::string StructureKeysProblem(const Config& config) {
         {"data.time_column", config.data.time_column != "t"},
         {"data.time_origin", config.data.time_origin != 0.0},
         {"data.at_rest_before_record", config.data.at_rest_before_record},
+        {"zone_identification.start_modulus", config.zone_identification.start_modulus != 0.0},
     };
     for (const auto& [key, set] : matrix_keys) {
       if (set) return std::string(key) + " applies to model.kind 'matrix' only (model.kind is 'bar')";
     }
+  }
+  const double start = config.zone_identification.start_modulus;
+  if (start != 0.0 && !(start > config.outer.lower_bound && start < config.outer.upper_bound)) {
+    return "zone_identification.start_modulus (" + FormatNumber(start) +
+           " Pa) must lie strictly inside [outer.lower_bound, outer.upper_bound] = [" +
+           FormatNumber(config.outer.lower_bound) + ", " + FormatNumber(config.outer.upper_bound) +
+           "] Pa";
   }
   // outer.functional: both run on a matrix model (least squares by
   // MatrixOutputErrorObjective, app/matrix_identification_run.h).
@@ -1819,8 +1830,9 @@ std::string ConfigToYaml(const Config& config) {
 
 bool KeyApplies(const std::string& path, ModelKind kind) {
   static const std::set<std::string> matrix_only = {
-      "model.manifest",    "model.channel_map", "model.free_zones", "data.truth_manifest",
-      "data.truth_moduli", "data.time_column",  "data.time_origin", "data.at_rest_before_record"};
+      "model.manifest",      "model.channel_map",          "model.free_zones",
+      "data.truth_manifest", "data.truth_moduli",          "data.time_column",
+      "data.time_origin",    "data.at_rest_before_record", "zone_identification.start_modulus"};
   if (kind == ModelKind::kBar) return matrix_only.count(path) == 0;
   // Whole sections, then single keys, that a matrix run does not read.
   static const std::set<std::string> bar_sections = {"study"};

@@ -414,9 +414,17 @@ bool IdentifyHomogeneousStageByLeastSquares(const Config& config, const MatrixMo
   return true;
 }
 
-// The zones' start: E* in every zone after the homogeneous stage (the zones share
-// E_z,nom), else the nominal moduli.
-Vector ZoneStart(const IdentificationRun& run) {
+// Whether the homogeneous stage runs: the zones share one nominal modulus, and no
+// zone_identification.start_modulus is given.
+bool RunsTheHomogeneousStage(const Config& config, const MatrixModelData& model) {
+  return config.zone_identification.start_modulus == 0.0 && SharesOneNominalModulus(model);
+}
+
+// The zones' start: zone_identification.start_modulus in every zone when given, E* after
+// the homogeneous stage, else the nominal moduli.
+Vector ZoneStart(const Config& config, const IdentificationRun& run) {
+  const double start = config.zone_identification.start_modulus;
+  if (start > 0.0) return Vector::Constant(run.nominal_moduli.size(), start);
   if (!run.homogeneous_ran) return run.nominal_moduli;
   return Vector::Constant(run.nominal_moduli.size(), run.identified_modulus());
 }
@@ -455,7 +463,7 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
         model.supports.size(), ClampModelToString(config.mcre.clamp), run.misfit_levels.force_std);
   }
   // One E in every zone first, as the bar's least squares identifies its E.
-  if (SharesOneNominalModulus(model) &&
+  if (RunsTheHomogeneousStage(config, model) &&
       !IdentifyHomogeneousStageByLeastSquares(config, model, &run)) {
     return;
   }
@@ -463,7 +471,7 @@ void IdentifyMatrixZonesByLeastSquares(const Config& config, const MatrixModelDa
   run.zones.ran = true;
   run.zones.summary = IdentifyZoneModuliByLeastSquares(
       config.zone_identification, model, run.data, run.misfit_levels, config.time.theta, &objective,
-      ZoneStart(run), config.outer.lower_bound, config.outer.upper_bound, run.noise,
+      ZoneStart(config, run), config.outer.lower_bound, config.outer.upper_bound, run.noise,
       UsedPrefilter(config, run));
   TakeZoneOutcome(model, &run);
   if (run.identified_moduli.size() > 0) {
@@ -950,7 +958,7 @@ IdentificationRun RunMatrixIdentification(const Config& given, const MatrixModel
     spdlog::info("{} supports, treated as mcre.clamp: {}", model.supports.size(),
                  ClampModelToString(config.mcre.clamp));
   }
-  if (SharesOneNominalModulus(model)) {
+  if (RunsTheHomogeneousStage(config, model)) {
     // 2a. One E in every zone first, by the global scan and the refinements of the
     //     bar's identification (outer:, search:); the zones then start from E*, their
     //     first solve warm-started from its solution.
@@ -966,7 +974,7 @@ IdentificationRun RunMatrixIdentification(const Config& given, const MatrixModel
   run.zones.ran = true;
   run.zones.summary = IdentifyZoneModuli(
       config.zone_identification, model, run.data, config.mcre, config.time.theta, config.inner,
-      &mcre_objective, run.nominal_moduli, ZoneStart(run), config.outer.lower_bound,
+      &mcre_objective, run.nominal_moduli, ZoneStart(config, run), config.outer.lower_bound,
       config.outer.upper_bound, run.noise, UsedPrefilter(config, run));
   TakeZoneOutcome(model, &run);
   if (!maps_and_uncertainty) {

@@ -22,6 +22,15 @@ bool ZoneIdentificationOptions::IsValid(std::string* error) const {
     }
     return false;
   }
+  if (!(start_modulus >= 0.0 && std::isfinite(start_modulus))) {
+    if (error != nullptr) {
+      *error =
+          "zone_identification.start_modulus must be 0 (the homogeneous stage's E*) or a "
+          "modulus [Pa], got " +
+          std::to_string(start_modulus);
+    }
+    return false;
+  }
   return true;
 }
 

@@ -76,7 +76,9 @@
 //          regularization_weight [-1: discrepancy principle], tv_smoothing [1e-3],
 //          max_weight [1], min_weight [1e-8], grid_factor [100], refinement_steps [4],
 //          weight_tolerance [0.25], discrepancy_factor [1], noise_samples [4],
-//          noise_seed [1]
+//          noise_seed [1], merge_zones [false], measured_clamp [true],
+//          start_modulus [0: from the homogeneous stage's E*; model.kind matrix: every
+//          zone starts at this modulus [Pa], the homogeneous stage skipped]
 //          (ZoneIdentificationOptions, zone_identification.h)
 #pragma once
 

@@ -53,6 +53,11 @@ struct ZoneIdentificationOptions {
   // app/zone_identification_run.h, docs/boundaries.md section 8). false: the run's own
   // treatment.
   bool measured_clamp = true;
+  // A structure given by matrices: every zone starts from this modulus [Pa], without the
+  // homogeneous stage (a start chosen by the user, as a basin-of-attraction study asks);
+  // 0: from the homogeneous stage's E* when the zones share one nominal modulus, else
+  // from their nominal moduli.
+  double start_modulus = 0.0;
 
   // Messages name the zone_identification.* keys.
   bool IsValid(std::string* error) const;
