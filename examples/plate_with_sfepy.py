@@ -193,13 +193,18 @@ def in_soft_region(x, y):
     return x_min < x < x_max and y_min < y < y_max
 
 
-def mcrewave_model(plate, element_zones, zone_names, name):
-    """The plate as a mcrewave.Model: its mass, one stiffness per zone at MODULUS, the
-    load F, the gauges, and the element blocks that give the error map per element."""
-    zones = [(zone_name, plate.assemble(plate.stiffness_blocks,
-                                        np.flatnonzero(element_zones == z)), MODULUS)
-             for z, zone_name in enumerate(zone_names)]
+def mcrewave_model(plate, element_zones, zone_names, name, nominal_moduli=None):
+    """The plate as a mcrewave.Model: its mass, one stiffness per zone at its nominal
+    modulus (MODULUS, or nominal_moduli[z] [Pa]), the load F, the gauges, and the element
+    blocks that give the error map per element."""
+    if nominal_moduli is None:
+        nominal_moduli = [MODULUS] * len(zone_names)
+    scale = np.asarray(nominal_moduli) / MODULUS  # the blocks are assembled at MODULUS
+    zones = [(zone_name, scale[z] * plate.assemble(plate.stiffness_blocks,
+                                                   np.flatnonzero(element_zones == z)),
+              nominal_moduli[z]) for z, zone_name in enumerate(zone_names)]
     blocks = [plate.free_block(e, plate.stiffness_blocks) for e in range(len(element_zones))]
+    blocks = [(dofs, scale[element_zones[e]] * block) for e, (dofs, block) in enumerate(blocks)]
     elements = {"zones": element_zones.tolist(),
                 "dofs": [dofs.tolist() for dofs, _ in blocks],
                 "stiffness": [block for _, block in blocks],

@@ -1309,11 +1309,12 @@ std::string WriteStudiesReadme(const std::string& folder) {
         "`bash scripts/plate_zones_study.sh` the many-zone plate's, "
         "`bash scripts/plate_sensors_study.sh` its sensor layouts', "
         "`bash scripts/beam3d_study.sh` the 3-D beam's, `bash scripts/shpb_study.sh` the real "
-        "Hopkinson-bar shots'); do not edit by hand. Each "
+        "Hopkinson-bar shots', `bash scripts/plate_basin_study.sh` the basin of attraction on "
+        "the SfePy plate's 8 zones); do not edit by hand. Each "
         "section below is the `summary.md` of its folder.\n\n";
-  for (const char* study :
-       {"robustness", "relaxation", "cost_curves", "damage", "comparator", "robustness_settings",
-        "complexity", "weights", "plate", "plate_zones", "plate_sensors", "beam3d", "real"}) {
+  for (const char* study : {"robustness", "relaxation", "cost_curves", "damage", "comparator",
+                            "robustness_settings", "complexity", "weights", "plate", "plate_zones",
+                            "plate_sensors", "beam3d", "real", "plate_basin"}) {
     const std::string summary = folder + "/" + study + "/summary.md";
     std::ifstream file(summary);
     if (!file) continue;
