@@ -11,9 +11,13 @@ are the example's. For each functional (outer.functional mcre and least_squares)
   - from each homogeneous start k E, k in 0.5, 0.6, 0.7, 0.8, 1.25, 1.5, 1.75, 2
     (zone_identification.start_modulus, no homogeneous stage).
 A start reaches the truth's basin when every zone ends within 5 % of what the same
-functional reaches from the truth. Writes basin.csv (a row per functional and start:
-the zones' moduli, the largest distance to the from-truth moduli, the evaluations, the
-wall time, in the basin or not), summary.md and basin.png. Needs the mcrewave module,
+functional reaches from the truth. Then continuation in the data weight (Banerjee et al.,
+CMAME 2013): from 0.5 E and from 2 E, the MCRE's zones at w_u = w_e = 1e-4, then 1e-3,
+then the config's 1e-2, each stage starting from the last one's moduli (the model's
+nominal moduli), against the fixed weight 1e-2 from the same start. Writes basin.csv (a
+row per functional and start: the zones' moduli, the largest distance to the from-truth
+moduli, the evaluations, the wall time, in the basin or not), continuation.csv (a row
+per start and stage), summary.md and basin.png. Needs the mcrewave module,
 SfePy and matplotlib (scripts/plate_basin_study.sh installs them).
 """
 
@@ -44,12 +48,17 @@ SNR = 20.0
 SEED = 1
 
 
-def config_of(functional, start_modulus):
+CONTINUATION_WEIGHTS = [1e-4, 1e-3, 1e-2]  # w_u = w_e of each stage, the last the config's
+CONTINUATION_STARTS = [0.5, 2.0]
+
+
+def config_of(functional, start_modulus, weight=1e-2):
     """The example's config, with bounds that hold every start, for one functional and
-    one start (0: the model's nominal moduli)."""
+    one start (0: the model's nominal moduli), the MCRE's data weights w_u = w_e =
+    `weight`."""
     return {
         "time": {"window": example.WINDOW, "step": example.TIME_STEP, "theta": 0.5},
-        "mcre": {"w_u": 0.01, "w_e": 0.01, "reference_modulus": example.MODULUS},
+        "mcre": {"w_u": weight, "w_e": weight, "reference_modulus": example.MODULUS},
         "inner": {"method": "streaming_conjugate_gradient", "preconditioner": "dense_traces",
                   "tolerance": 1e-8},
         "outer": {"functional": functional, "lower_bound": 50e9, "upper_bound": 800e9,
@@ -128,7 +137,34 @@ def main():
                   f"{100 * distance:7.2f} %, to the truth {100 * rows[-1]['error_to_truth']:6.2f} %,"
                   f" {evaluations} evaluations, {seconds:.1f} s {failure}", flush=True)
 
-    # 3. The table, the summary and the figure.
+    # 3. Continuation in the data weight against the fixed weight, from two starts.
+    stages = []
+    for k in CONTINUATION_STARTS:
+        fixed = next(row for row in rows
+                     if row["functional"] == "mcre" and row["start_modulus"] == k * example.MODULUS)
+        moduli = None
+        for weight in CONTINUATION_WEIGHTS:
+            began = time.perf_counter()
+            if moduli is None:
+                result = mcrewave.identify(config_of("mcre", k * example.MODULUS, weight), nominal,
+                                           data, quiet=True)
+            else:
+                model = example.mcrewave_model(model_plate, model_zones, example.ZONE_NAMES,
+                                               "the model at the last stage's moduli",
+                                               nominal_moduli=moduli)
+                result = mcrewave.identify(config_of("mcre", 0.0, weight), model, data, quiet=True)
+            moduli = np.asarray(result.moduli)
+            stages.append({"start": k, "weight": weight, "moduli": moduli,
+                           "evaluations": result.summary["zones"]["evaluations"],
+                           "seconds": time.perf_counter() - began,
+                           "distance": np.max(np.abs(moduli / fixed["moduli"] - 1.0)),
+                           "fixed_evaluations": fixed["evaluations"],
+                           "fixed_seconds": fixed["seconds"]})
+            print(f"continuation from {k:g} E, w = {weight:g}: {stages[-1]['evaluations']} "
+                  f"evaluations, {stages[-1]['seconds']:.1f} s, "
+                  f"{100 * stages[-1]['distance']:.3f} % from the fixed weight's moduli", flush=True)
+
+    # 4. The tables, the summary and the figure.
     with open(os.path.join(folder, "basin.csv.tmp"), "w", newline="") as file:
         writer = csv.writer(file)
         writer.writerow(["functional", "start", "start_modulus_Pa"] +
@@ -142,6 +178,17 @@ def main():
                              int(row["in_basin"]), row["evaluations"], f"{row['seconds']:.2f}",
                              row["failure"]])
     os.replace(os.path.join(folder, "basin.csv.tmp"), os.path.join(folder, "basin.csv"))
+    with open(os.path.join(folder, "continuation.csv.tmp"), "w", newline="") as file:
+        writer = csv.writer(file)
+        writer.writerow(["start_k", "weight"] + [f"{name}_Pa" for name in example.ZONE_NAMES] +
+                        ["evaluations", "wall_time_s", "distance_to_fixed_weight"])
+        for stage in stages:
+            writer.writerow([f"{stage['start']:g}", f"{stage['weight']:g}"] +
+                            [f"{m:.9g}" for m in stage["moduli"]] +
+                            [stage["evaluations"], f"{stage['seconds']:.2f}",
+                             f"{stage['distance']:.6g}"])
+    os.replace(os.path.join(folder, "continuation.csv.tmp"),
+               os.path.join(folder, "continuation.csv"))
 
     lines = ["# Basin of attraction on the 8 zones of the SfePy plate",
              "",
@@ -168,6 +215,22 @@ def main():
         mean = f"{np.mean(evaluations):.1f}" if evaluations else "-"
         lines.append(f"- {functional}: {reached} of {len(starts)} starts reach the truth's basin "
                      f"(mean evaluations of those: {mean}).")
+    lines += ["",
+              "Continuation in the data weight (the MCRE, w_u = w_e = 1e-4, 1e-3, then 1e-2, "
+              "each stage from the last one's moduli) against the fixed weight 1e-2 from the "
+              "same start:",
+              "",
+              "| start | evaluations per stage | continuation in all | fixed weight | "
+              "continuation's end to the fixed weight's moduli |",
+              "|---|---|---|---|---|"]
+    for k in CONTINUATION_STARTS:
+        of_start = [stage for stage in stages if stage["start"] == k]
+        lines.append(f"| {k:g} E | {', '.join(str(s['evaluations']) for s in of_start)} | "
+                     f"{sum(s['evaluations'] for s in of_start)} "
+                     f"({sum(s['seconds'] for s in of_start):.1f} s) | "
+                     f"{of_start[-1]['fixed_evaluations']} "
+                     f"({of_start[-1]['fixed_seconds']:.1f} s) | "
+                     f"{100 * of_start[-1]['distance']:.3f} % |")
     lines.append(f"\nAbout {time.perf_counter() - start:.0f} s on one core.")
     with open(os.path.join(folder, "summary.md.tmp"), "w", encoding="utf-8") as file:
         file.write("\n".join(lines) + "\n")
