@@ -123,6 +123,27 @@ TEST(RunTest, ARecordGivenInCodeIsRefusedAsACsvIs) {
   }
 }
 
+TEST(RunTest, AModelGivenInCodeNeedsTheMatrixKind) {
+  const Config bar = LoadConfig(SourcePath("configs/quick.yaml"));
+  const MatrixModelData model = BarMatrixModel(BarModel(bar.model), 160e9);
+  GivenInputs given;
+  given.model = &model;
+  for (const bool simulate : {false, true}) {
+    try {
+      if (simulate) {
+        SimulatedMeasurements(bar, given);
+      } else {
+        IdentifyFromConfig(bar, given);
+      }
+      ADD_FAILURE() << "a model given with model.kind bar was accepted";
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find("a model given in code needs model.kind: matrix"),
+                std::string::npos)
+          << error.what();
+    }
+  }
+}
+
 // zone_identification.start_modulus: the zones start there, without the homogeneous
 // stage, by the MCRE and by least squares, and reach the minimum the homogeneous start
 // reaches.

@@ -28,6 +28,15 @@ ChannelSet BarRecord(ChannelSet record, const std::string& name) {
   return record;
 }
 
+// A model given in code is a structure given by matrices: refused with model.kind bar.
+void RefuseAGivenModelOfTheBar(const Config& config, const GivenInputs& given) {
+  if (given.model != nullptr && config.structure.kind != ModelKind::kMatrix) {
+    throw InputError(config.Name() +
+                     ": a model given in code needs model.kind: matrix, naming "
+                     "it as model.manifest");
+  }
+}
+
 // Step 1 on a structure given by matrices: the manifest's model, or the given one.
 MatrixModelData MatrixModelOf(const Config& config, const GivenInputs& given) {
   MatrixModelData model =
@@ -42,6 +51,7 @@ IdentificationRun IdentifyFromConfig(const Config& given_config, const GivenInpu
   // A record given in code replaces the CSV file: the run takes its data as measured,
   // with no synthetic truth and no noise level drawn at data.snr.
   Config config = given_config;
+  RefuseAGivenModelOfTheBar(config, given);
   if (given.record != nullptr) {
     config.data.source = DataSource::kCsv;
     config.data.path = given.record_name;
@@ -69,6 +79,7 @@ IdentificationRun IdentifyFromConfig(const Config& given_config, const GivenInpu
 }
 
 ChannelSet SimulatedMeasurements(const Config& config, const GivenInputs& given) {
+  RefuseAGivenModelOfTheBar(config, given);
   if (config.structure.kind == ModelKind::kMatrix) {
     // A structure given by matrices: its truth's outputs and loads, under the columns
     // identify run reads (model.channel_map).

@@ -27,8 +27,8 @@ namespace mcrewave {
 // What a caller gives in code instead of the files the config names.
 struct GivenInputs {
   // A structure given by matrices (nullable): identified instead of the config's model.
-  // Precondition: config.structure.kind is kMatrix; config.structure.manifest names the
-  // model in messages (it is not read).
+  // config.structure.kind must be kMatrix (else InputError); config.structure.manifest
+  // names the model in messages (it is not read).
   const MatrixModelData* model = nullptr;
   // Measurements (nullable), instead of data: (synthetic or CSV): one channel a column
   // as a CSV holds them, sampled from record->start_time on record->time_step; on the
