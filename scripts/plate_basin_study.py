@@ -74,7 +74,11 @@ def main():
         print("usage: plate_basin_study.py OUTPUT_FOLDER", file=sys.stderr)
         return 2
     folder = sys.argv[1]
-    os.makedirs(folder, exist_ok=True)
+    try:
+        os.makedirs(folder, exist_ok=True)
+    except OSError as error:
+        print(f"error: cannot make the output folder {folder}: {error.strerror}", file=sys.stderr)
+        return 2
     start = time.perf_counter()
 
     # 1. The example's plate, truth and data.
