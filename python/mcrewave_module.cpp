@@ -507,29 +507,43 @@ extern "C" void RequestInterruptOnSignal(int) {
   RequestInterrupt();
 }
 
+// The calls into the library under way (from any thread), and the logger the first of
+// them replaced; guarded by calls_mutex.
+std::mutex calls_mutex;
+int calls_under_way = 0;
+std::shared_ptr<spdlog::logger> logger_before_calls;
+
 // While it lives (made and destroyed with the GIL held): the library's log lines go to
 // `progress` (a callable taking each line) or to stderr (at info, or warn when quiet),
 // and, on the main thread, SIGINT requests the library to stop instead of reaching
-// Python's handler. Finish() raises what stopped the work: the callable's exception, or
-// KeyboardInterrupt.
+// Python's handler. The logger and the stop request are the process's: with calls under
+// way at once (from several threads), the lines go where the first of them sends them,
+// until the last ends, and a stop ends them all. Finish() raises what stopped the work:
+// the callable's exception, or KeyboardInterrupt.
 class LibraryCall {
  public:
-  LibraryCall(const py::object& progress, bool quiet) : previous_(spdlog::default_logger()) {
-    ClearInterrupt();
-    interrupt_signal_seen = 0;
-    std::shared_ptr<spdlog::sinks::sink> sink;
-    if (!progress.is_none()) {
-      if (!PyCallable_Check(progress.ptr())) {
-        throw py::type_error("progress: expected a callable taking one str, or None");
-      }
-      callback_ = std::make_shared<CallbackSink>(progress.cast<py::function>());
-      sink = callback_;
-    } else {
-      sink = std::make_shared<spdlog::sinks::stderr_color_sink_mt>();
+  LibraryCall(const py::object& progress, bool quiet) {
+    if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
+      throw py::type_error("progress: expected a callable taking one str, or None");
     }
-    auto logger = std::make_shared<spdlog::logger>("", sink);
-    logger->set_level(quiet ? spdlog::level::warn : spdlog::level::info);
-    spdlog::set_default_logger(std::move(logger));
+    {
+      const std::lock_guard<std::mutex> lock(calls_mutex);
+      if (calls_under_way++ == 0) {
+        ClearInterrupt();
+        interrupt_signal_seen = 0;
+        std::shared_ptr<spdlog::sinks::sink> sink;
+        if (!progress.is_none()) {
+          callback_ = std::make_shared<CallbackSink>(progress.cast<py::function>());
+          sink = callback_;
+        } else {
+          sink = std::make_shared<spdlog::sinks::stderr_color_sink_mt>();
+        }
+        auto logger = std::make_shared<spdlog::logger>("", sink);
+        logger->set_level(quiet ? spdlog::level::warn : spdlog::level::info);
+        logger_before_calls = spdlog::default_logger();
+        spdlog::set_default_logger(std::move(logger));
+      }
+    }
     const py::module_ threading = py::module_::import("threading");
     if (threading.attr("current_thread")().is(threading.attr("main_thread")())) {
       struct sigaction action = {};
@@ -540,24 +554,26 @@ class LibraryCall {
   }
   ~LibraryCall() {
     if (handler_installed_) sigaction(SIGINT, &previous_action_, nullptr);
-    spdlog::set_default_logger(previous_);
-    callback_.reset();
-    ClearInterrupt();
+    const std::lock_guard<std::mutex> lock(calls_mutex);
+    if (--calls_under_way == 0) {
+      spdlog::set_default_logger(std::move(logger_before_calls));
+      logger_before_calls.reset();
+      ClearInterrupt();
+    }
   }
   LibraryCall(const LibraryCall&) = delete;
   LibraryCall& operator=(const LibraryCall&) = delete;
 
   void Finish() const {
     if (callback_ && callback_->error()) std::rethrow_exception(callback_->error());
-    if (interrupt_signal_seen != 0) {
+    if (handler_installed_ && interrupt_signal_seen != 0) {
       PyErr_SetNone(PyExc_KeyboardInterrupt);
       throw py::error_already_set();
     }
   }
 
  private:
-  std::shared_ptr<spdlog::logger> previous_;
-  std::shared_ptr<CallbackSink> callback_;
+  std::shared_ptr<CallbackSink> callback_;  // this call's sink, when it owns the logger
   bool handler_installed_ = false;
   struct sigaction previous_action_ = {};
 };

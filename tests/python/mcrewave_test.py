@@ -325,6 +325,29 @@ class GilTest(unittest.TestCase):
         self.assertGreater(counted / seconds, 1e6)
 
 
+    def test_runs_at_once_from_two_threads_give_one_runs_bits(self):
+        os.chdir(SOURCE)
+        alone = mcrewave.identify("configs/quick.yaml", quiet=True)
+        results = [None, None]
+
+        def identify(index):
+            results[index] = mcrewave.identify("configs/quick.yaml", quiet=True,
+                                               progress=lambda line: None)
+
+        workers = [threading.Thread(target=identify, args=(i,)) for i in range(2)]
+        for worker in workers:
+            worker.start()
+        for worker in workers:
+            worker.join()
+        for result in results:
+            self.assertEqual(result.modulus, alone.modulus)
+            self.assertEqual(result.cost, alone.cost)
+        # The logger is the process's again: a new call's lines reach its own callable.
+        lines = []
+        mcrewave.identify("configs/quick.yaml", progress=lines.append)
+        self.assertTrue(lines)
+
+
 class InterruptTest(unittest.TestCase):
 
     def setUp(self):
