@@ -217,6 +217,30 @@ def mcrewave_model(plate, element_zones, zone_names, name, nominal_moduli=None):
                           name=name)
 
 
+def gauge_measurements(truth, truth_moduli, snr, seed):
+    """The truth's gauges under the impact, integrated on TIME_STEP / TRUTH_SUBSTEPS and
+    sampled every TIME_STEP, and the impact's force, each plus white noise at `snr`
+    (seeded), as mcrewave.Data."""
+    samples = round(WINDOW / TIME_STEP) + 1
+    fine_times = np.arange((samples - 1) * TRUTH_SUBSTEPS + 1) * (TIME_STEP / TRUTH_SUBSTEPS)
+    strains = truth.response(truth_moduli, impact(fine_times)[np.newaxis, :],
+                             TIME_STEP / TRUTH_SUBSTEPS)[:, ::TRUTH_SUBSTEPS]
+    rng = np.random.default_rng(seed)
+    strains = noisy(strains, snr, rng)
+    force = noisy(impact(np.arange(samples) * TIME_STEP), snr, rng)
+    channels = dict(zip(truth.sensor_channels, strains))
+    channels["F"] = force
+    return mcrewave.Data(channels, TIME_STEP, name=f"the truth's gauges at SNR {snr:g}")
+
+
+def zone_truth_moduli(truth_plate, truth_zones, truth_moduli):
+    """Each model zone's truth [Pa]: the mean of the truth's moduli over the zone (the soft
+    region is one zone, so every zone is uniform in the truth)."""
+    return np.array([np.mean([truth_moduli[truth_zones[e]]
+                              for e, (x, y) in enumerate(truth_plate.centroids)
+                              if zone_of(x, y) == z]) for z in range(len(ZONE_NAMES))])
+
+
 def impact(times):
     """The impact's force history F(t) [N]: a half-sine."""
     return np.where(times <= FORCE_DURATION,
@@ -291,16 +315,7 @@ def main():
 
     # 2. The measurements: the truth's gauges under the impact, on a finer time step,
     #    sampled every TIME_STEP, plus white noise on the gauges and on the force.
-    samples = round(WINDOW / TIME_STEP) + 1
-    fine_times = np.arange((samples - 1) * TRUTH_SUBSTEPS + 1) * (TIME_STEP / TRUTH_SUBSTEPS)
-    strains = truth.response(truth_moduli, impact(fine_times)[np.newaxis, :],
-                             TIME_STEP / TRUTH_SUBSTEPS)[:, ::TRUTH_SUBSTEPS]
-    rng = np.random.default_rng(args.seed)
-    strains = noisy(strains, args.snr, rng)
-    force = noisy(impact(np.arange(samples) * TIME_STEP), args.snr, rng)
-    channels = dict(zip(truth.sensor_channels, strains))
-    channels["F"] = force
-    data = mcrewave.Data(channels, TIME_STEP, name=f"the truth's gauges at SNR {args.snr:g}")
+    data = gauge_measurements(truth, truth_moduli, args.snr, args.seed)
     print(f"2. simulated {data!r}")
 
     # 3. The identification. The keys are those of identify's YAML configs
@@ -332,11 +347,7 @@ def main():
     result = mcrewave.identify(config, model, data, progress=progress)
     identified = np.asarray(result.moduli)
 
-    # Each model zone's truth: the truth's modulus over the zone (the soft region is one
-    # zone, so every zone is uniform in the truth).
-    zone_truth = np.array([np.mean([truth_moduli[truth_soft[e]]
-                                    for e, (x, y) in enumerate(truth_plate.centroids)
-                                    if zone_of(x, y) == z]) for z in range(len(ZONE_NAMES))])
+    zone_truth = zone_truth_moduli(truth_plate, truth_soft, truth_moduli)
     relative_error = identified / zone_truth - 1.0
 
     # 4. The figure and the table.

@@ -88,21 +88,8 @@ def main():
                           dtype=int)
     truth_moduli = np.array([example.MODULUS, example.SOFT_FACTOR * example.MODULUS])
     truth = example.mcrewave_model(truth_plate, truth_soft, ["sound", "soft"], "the truth")
-    zone_truth = np.array([np.mean([truth_moduli[truth_soft[e]]
-                                    for e, (x, y) in enumerate(truth_plate.centroids)
-                                    if example.zone_of(x, y) == z])
-                           for z in range(len(example.ZONE_NAMES))])
-    samples = round(example.WINDOW / example.TIME_STEP) + 1
-    substeps = example.TRUTH_SUBSTEPS
-    fine_times = np.arange((samples - 1) * substeps + 1) * (example.TIME_STEP / substeps)
-    strains = truth.response(truth_moduli, example.impact(fine_times)[np.newaxis, :],
-                             example.TIME_STEP / substeps)[:, ::substeps]
-    rng = np.random.default_rng(SEED)
-    strains = example.noisy(strains, SNR, rng)
-    force = example.noisy(example.impact(np.arange(samples) * example.TIME_STEP), SNR, rng)
-    channels = dict(zip(truth.sensor_channels, strains))
-    channels["F"] = force
-    data = mcrewave.Data(channels, example.TIME_STEP, name=f"the truth's gauges at SNR {SNR:g}")
+    zone_truth = example.zone_truth_moduli(truth_plate, truth_soft, truth_moduli)
+    data = example.gauge_measurements(truth, truth_moduli, SNR, SEED)
     nominal = example.mcrewave_model(model_plate, model_zones, example.ZONE_NAMES, "the model")
     from_truth_model = example.mcrewave_model(model_plate, model_zones, example.ZONE_NAMES,
                                               "the model at the truth's moduli",
