@@ -637,9 +637,10 @@ py::object IdentifyInPython(const py::object& config, const py::object& model,
   py::object result = py::cast(PyResult{run});
   const std::string unreportable = UnreportableMessage(*run);
   if (!unreportable.empty()) {
-    py::object error = IdentificationErrorType()("identification failed: " + unreportable);
+    const py::object type = IdentificationErrorType();
+    py::object error = type("identification failed: " + unreportable);
     error.attr("result") = result;
-    PyErr_SetObject(IdentificationErrorType().ptr(), error.ptr());
+    PyErr_SetObject(type.ptr(), error.ptr());
     throw py::error_already_set();
   }
   return result;

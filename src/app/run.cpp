@@ -39,25 +39,24 @@ void RefuseAGivenModelOfTheBar(const Config& config, const GivenInputs& given) {
 
 // Step 1 on a structure given by matrices: the manifest's model, or the given one.
 MatrixModelData MatrixModelOf(const Config& config, const GivenInputs& given) {
-  MatrixModelData model =
-      given.model != nullptr ? PrepareMatrixModel(config, *given.model) : LoadMatrixModel(config);
-  CheckMatrixModelFieldBytes(config, model);
-  return model;
+  return given.model != nullptr ? PrepareMatrixModel(config, *given.model)
+                                : LoadMatrixModel(config);
 }
 
 }  // namespace
 
 IdentificationRun IdentifyFromConfig(const Config& given_config, const GivenInputs& given) {
+  RefuseAGivenModelOfTheBar(given_config, given);
   // A record given in code replaces the CSV file: the run takes its data as measured,
   // with no synthetic truth and no noise level drawn at data.snr.
   Config config = given_config;
-  RefuseAGivenModelOfTheBar(config, given);
   if (given.record != nullptr) {
     config.data.source = DataSource::kCsv;
     config.data.path = given.record_name;
   }
   if (config.structure.kind == ModelKind::kMatrix) {
     const MatrixModelData model = MatrixModelOf(config, given);
+    CheckMatrixModelFieldBytes(config, model);
     const MatrixMeasurements data =
         given.record != nullptr
             ? MatrixMeasurementsOfRecord(config, model, *given.record, given.record_name)
@@ -71,9 +70,7 @@ IdentificationRun IdentifyFromConfig(const Config& given_config, const GivenInpu
           : LoadMeasurements(config);
   spdlog::info("config {}: {} elements, {} steps of {:.4g} s; data {} ({} samples)", config.Name(),
                config.model.elements, config.time.NumSteps(), config.time.step,
-               given.record != nullptr                  ? given.record_name
-               : config.data.source == DataSource::kCsv ? config.data.path
-                                                        : std::string("synthetic"),
+               config.data.source == DataSource::kCsv ? config.data.path : std::string("synthetic"),
                data.num_samples());
   return RunIdentification(config, data);
 }
@@ -83,8 +80,7 @@ ChannelSet SimulatedMeasurements(const Config& config, const GivenInputs& given)
   if (config.structure.kind == ModelKind::kMatrix) {
     // A structure given by matrices: its truth's outputs and loads, under the columns
     // identify run reads (model.channel_map).
-    const MatrixModelData model =
-        given.model != nullptr ? PrepareMatrixModel(config, *given.model) : LoadMatrixModel(config);
+    const MatrixModelData model = MatrixModelOf(config, given);
     const MatrixMeasurements data = LoadMatrixMeasurements(config, model, given.model);
     return MatrixMeasurementTable(config, model, data.histories);
   }
