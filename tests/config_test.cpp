@@ -29,6 +29,7 @@ void ExpectSameConfigModelToData(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.model.elements, actual.model.elements);
   EXPECT_EQ(expected.model.mass, actual.model.mass);
   EXPECT_EQ(expected.model.reaction_length, actual.model.reaction_length);
+  EXPECT_EQ(expected.model.coarse_elements, actual.model.coarse_elements);
   EXPECT_EQ(expected.load.kind, actual.load.kind);
   EXPECT_EQ(expected.load.amplitude, actual.load.amplitude);
   EXPECT_EQ(expected.load.duration, actual.load.duration);
@@ -553,6 +554,7 @@ TEST(ConfigTest, ConfigToYamlRoundTripsExactly) {
   config.model.elements = 437;
   config.model.mass = MassType::kLumped;
   config.model.reaction_length = 0.07;
+  config.model.coarse_elements = 111;
   config.load.amplitude = -12.5;
   config.load.duration = 2.0 / 3.0 * 1e-4;
   config.time.window = 1e-3;
@@ -661,6 +663,7 @@ constexpr const char* kEveryKeyNotAtItsDefault = R"(model:
   density: 7850.000000000001
   modulus: 2.1e11
   elements: 437
+  coarse_elements: 111
   mass: lumped
   reaction_length: 0.07
   zoning: boundaries
@@ -916,7 +919,7 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
   // The bar reads all but the 9 matrix keys (the record's time column, origin and rest
   // before it, and the zones' start modulus among them); a matrix run none of the
   // section study:
-  // and 14 single keys fewer (it reads the dense solvers' limits, Riccati and shooting
+  // and 15 single keys fewer (it reads the dense solvers' limits, Riccati and shooting
   // running on any model, the zones' regularisation and merging, and data.channels, the
   // manifest's sensors it uses).
   EXPECT_EQ(bar_keys.size(), every.size() - 9);
@@ -925,7 +928,7 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
     const std::string section = key.substr(0, key.find('.'));
     sections += section == "study" ? 1 : 0;
   }
-  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 14);
+  EXPECT_EQ(matrix_keys.size(), every.size() - sections - 15);
   // Values as resolved: the matrix run's own.
   EXPECT_EQ(matrix_keys.at("model.manifest"), FlatKeys(ConfigToYaml(matrix)).at("model.manifest"));
 }
@@ -963,6 +966,8 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
        "model.zone_count applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\ndata:\n  sensors: [u@0.5]\n",
        "data.sensors applies to the bar only"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\n  coarse_elements: 50\n",
+       "model.coarse_elements applies to the bar only"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  zoning: boundaries\n",
        "model.zoning 'boundaries' applies to the bar only; on a matrix model use per_element "
        "or grid"},
@@ -1156,6 +1161,13 @@ TEST(ConfigTest, ASupportSpringIsPositiveAndTheExactTruthHasNone) {
                    {"a.yaml", "data.support_stiffness must be positive in N/m"});
   ExpectInputError([] { ParseConfig("model:\n  reaction_length: 2\n", "a.yaml"); },
                    {"a.yaml", "model.reaction_length must lie in [0, L = 1] m, got 2"});
+  EXPECT_EQ(ParseConfig("model:\n  coarse_elements: 0\n", "a.yaml").model.coarse_elements, 0);
+  ExpectInputError([] { ParseConfig("model:\n  coarse_elements: 5\n", "a.yaml"); },
+                   {"a.yaml",
+                    "model.coarse_elements must be 0 (one mesh) or an integer in [10, "
+                    "1e8], got 5"});
+  ExpectInputError([] { ParseConfig("model:\n  coarse_elements: -1\n", "a.yaml"); },
+                   {"a.yaml", "model.coarse_elements", "an integer >= 0"});
   ExpectInputError(
       [] { ParseConfig("data:\n  truth: exact\n  support_stiffness: 2e8\n", "a.yaml"); },
       {"a.yaml", "data.support_stiffness: the exact truth"});

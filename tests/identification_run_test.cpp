@@ -8,7 +8,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
+#include <vector>
 
 #include "identify_binary.h"
 #include "mcrewave/app/config.h"
@@ -119,6 +121,95 @@ TEST(SearchDataTest, TheSearchOnEveryFourthStepPlacesTheSameWindowAndFindsTheSam
   EXPECT_NEAR(coarse.outer.modulus / fine.outer.modulus, 1.0, 2e-7);
   // identify run's own identification is the default's, k = 4, to the bit.
   EXPECT_EQ(coarse.outer.modulus, run.identified_modulus());
+}
+
+// The bar on two meshes (model.coarse_elements, docs/multilevel.md) against the same
+// identification on the fine mesh alone, on the same data: the paper's case on 200
+// elements, coarse mesh 50.
+IdentificationRun TwoMeshRunOf(const std::vector<std::string>& overrides, int coarse_elements,
+                               const ChannelSet& data) {
+  std::vector<std::string> all = overrides;
+  all.push_back("model.coarse_elements=" + std::to_string(coarse_elements));
+  return RunIdentification(LoadConfig(testing::SourcePath("configs/paper_bar.yaml"), all), data);
+}
+
+void ExpectTheFineMeshsModulus(const std::vector<std::string>& overrides) {
+  const Config config = LoadConfig(testing::SourcePath("configs/paper_bar.yaml"), overrides);
+  const ChannelSet data = LoadMeasurements(config);
+  const IdentificationRun one = TwoMeshRunOf(overrides, 0, data);
+  const IdentificationRun two = TwoMeshRunOf(overrides, 50, data);
+  ASSERT_TRUE(one.IsUsable()) << one.outer.FullReport();
+  ASSERT_TRUE(two.IsUsable()) << two.outer.FullReport();
+  EXPECT_FALSE(one.coarse_mesh.ran);
+  ASSERT_TRUE(two.coarse_mesh.ran);
+  const double fine = one.identified_modulus();
+  const double coarse_shift = std::abs(two.coarse_mesh.coarse_modulus - fine) / fine;
+  const double error = std::abs(two.identified_modulus() - fine) / fine;
+  std::printf("coarse shift %.3e, two meshes %.3e, refinement %d evaluations\n", coarse_shift,
+              error, two.coarse_mesh.refinement.evaluations);
+  // The coarse mesh's E lies 1e-4 from the fine one's; refined, within the outer
+  // tolerance (1e-7) of it.
+  EXPECT_GT(coarse_shift, 1e-4);  // measured 5.3e-4
+  EXPECT_LT(error, 5e-8);         // measured 5.5e-9 and 5.7e-9 (stored and streaming)
+  EXPECT_LE(two.coarse_mesh.refinement.evaluations, 4);
+  // The fields, maps and channels are the fine mesh's.
+  EXPECT_EQ(two.config.model.elements, 200);
+  EXPECT_EQ(two.model->dofs(), one.model->dofs());
+  EXPECT_EQ(two.error_map.share.size(), one.error_map.share.size());
+  EXPECT_EQ(two.evaluations[two.best_index].modulus, two.identified_modulus());
+}
+
+TEST(TwoMeshTest, TheRefinementReachesTheFineMeshsMinimum) {
+  ExpectTheFineMeshsModulus(
+      {"model.elements=200", "output.curve_points=5", "uncertainty.samples=2"});
+}
+
+TEST(TwoMeshTest, TheCoarseTracesWarmStartTheStreamingSolver) {
+  ExpectTheFineMeshsModulus({"model.elements=200", "output.curve_points=5", "uncertainty.samples=2",
+                             "inner.method=streaming_conjugate_gradient"});
+}
+
+// The ladder 10 -> 100 -> 1000 elements against 1000 alone: both stop when a secant
+// step is below outer.relative_tolerance (1e-7), so they agree within twice that
+// (measured 4.7e-8); the 10 elements' E lies 8.9e-3 away.
+TEST(TwoMeshTest, TheLadderOfMeshesReachesTheFineMeshsMinimum) {
+  const std::vector<std::string> overrides = {"model.elements=1000", "output.curve_points=5",
+                                              "uncertainty.samples=2"};
+  const Config config = LoadConfig(testing::SourcePath("configs/paper_bar.yaml"), overrides);
+  const ChannelSet data = LoadMeasurements(config);
+  const IdentificationRun one = TwoMeshRunOf(overrides, 0, data);
+  const IdentificationRun ladder = TwoMeshRunOf(overrides, 10, data);
+  ASSERT_TRUE(one.IsUsable()) << one.outer.FullReport();
+  ASSERT_TRUE(ladder.IsUsable()) << ladder.outer.FullReport();
+  const double fine = one.identified_modulus();
+  const double coarse_shift = std::abs(ladder.coarse_mesh.coarse_modulus - fine) / fine;
+  const double error = std::abs(ladder.identified_modulus() - fine) / fine;
+  std::printf("ladder: coarse shift %.3e, error %.3e, %d refinement evaluations\n", coarse_shift,
+              error, ladder.coarse_mesh.refinement.evaluations);
+  EXPECT_GT(coarse_shift, 1e-3);
+  EXPECT_LT(error, 2e-7);
+  EXPECT_EQ(ladder.model->dofs(), 1001);
+}
+
+TEST(TwoMeshTest, OnlyTheBarsMcreAboveTheCoarseMeshRunsOnTwoMeshes) {
+  Config config;
+  config.model.elements = 20000;
+  EXPECT_TRUE(UsesCoarseMesh(config));
+  config.model.coarse_elements = 0;
+  EXPECT_FALSE(UsesCoarseMesh(config));
+  config.model.coarse_elements = 20000;
+  EXPECT_FALSE(UsesCoarseMesh(config));
+  config.model.coarse_elements = 10000;
+  EXPECT_TRUE(UsesCoarseMesh(config));
+  config.inner.type = CoupledSolverType::kRiccati;
+  EXPECT_FALSE(UsesCoarseMesh(config));
+  config.inner.type = CoupledSolverType::kStreamingConjugateGradient;
+  EXPECT_TRUE(UsesCoarseMesh(config));
+  config.outer.functional = OuterFunctional::kLeastSquares;
+  EXPECT_FALSE(UsesCoarseMesh(config));
+  config.outer.functional = OuterFunctional::kMcre;
+  config.structure.kind = ModelKind::kMatrix;
+  EXPECT_FALSE(UsesCoarseMesh(config));
 }
 
 }  // namespace

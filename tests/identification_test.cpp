@@ -144,6 +144,39 @@ TEST(SecantTest, ConvergesFasterThanBobyqaOnASkewedValley) {
   EXPECT_LT(2 * secant.evaluations, bobyqa.evaluations);
 }
 
+TEST(SecantTest, RefineFromTakesNewtonsStepWithTheGivenCurvature) {
+  // The skewed valley above from x = 1.29, 0.01 from its minimum, as the next mesh of a
+  // ladder starts (app/identification_run.h). With the curvature there (exp(-0.01),
+  // d^2 cost / dx^2 in x) the first step is Newton's: the second point lies 5.0e-5 from
+  // the minimum (measured; the cubic term's 0.01^2 / 2), and the secant stops after 4
+  // evaluations against 6 without it, whose first step goes halfway to a bound.
+  const auto cost = [](double x) { return std::exp(x - 1.3) - (x - 1.3); };
+  const auto gradient = [](double x) { return std::exp(x - 1.3) - 1.0; };
+  IdentificationOptions options = Options(OptimizerType::kNlopt, OuterAlgorithm::kSecant);
+  options.initial = 1.29e9;
+  options.scan_points = 41;  // not read: no scan
+  ScriptedObjective with_curvature(cost, gradient);
+  const IdentificationSummary newton = RefineFrom(options, &with_curvature, std::exp(-0.01));
+  ScriptedObjective without(cost, gradient);
+  const IdentificationSummary bisection = RefineFrom(options, &without, 0.0);
+  ASSERT_TRUE(newton.IsSolutionUsable()) << newton.FullReport();
+  ASSERT_TRUE(bisection.IsSolutionUsable()) << bisection.FullReport();
+  ASSERT_GE(with_curvature.evaluated.size(), 2u);
+  EXPECT_DOUBLE_EQ(with_curvature.evaluated[0], 1.29);
+  std::printf("RefineFrom: %d evaluations with the curvature, %d without\n", newton.evaluations,
+              bisection.evaluations);
+  EXPECT_NEAR(with_curvature.evaluated[1], 1.3, 1e-4);
+  EXPECT_NEAR(newton.modulus, 1.3e9, 5e-9 * 1.3e9);
+  EXPECT_NEAR(without.evaluated[1], 0.5 * (1.29 + 2.5), 1e-12);
+  EXPECT_LT(newton.evaluations, bisection.evaluations);
+  EXPECT_EQ(newton.scan_evaluations, 0);
+  // Invalid options are refused, as Identify refuses them.
+  options.initial = 3e9;
+  const IdentificationSummary refused = RefineFrom(options, &without, 1.0);
+  EXPECT_EQ(refused.termination, TerminationType::kFailure);
+  EXPECT_NE(refused.message.find("invalid options"), std::string::npos) << refused.message;
+}
+
 TEST(IdentificationSummaryTest, ReportsSayNoSecondValleyInsteadOfANan) {
   IdentificationSummary summary;
   summary.scan_moduli = {1e11, 2e11, 3e11};

@@ -438,6 +438,10 @@ const std::vector<Key>& KeyTable() {
               "Young's modulus E of the reference (or initial) model"),
       MakeKey("model.elements", &Config::model, &BarProperties::elements, PositiveInteger<int>(),
               "", "number N of linear finite elements"),
+      MakeKey("model.coarse_elements", &Config::model, &BarProperties::coarse_elements,
+              NonNegativeInteger(), "",
+              "above this many elements E is identified on this many first, then refined on "
+              "model.elements (0: one mesh; docs/multilevel.md)"),
       MakeKey("model.mass", &Config::model, &BarProperties::mass,
               EnumByName<MassType>({MassType::kConsistent, MassType::kLumped}, MassTypeToString,
                                    StringToMassType),
@@ -1575,13 +1579,21 @@ std::string FirstProblem(const Config& config) {
 // The single keys of the bar's structure, its zones and its sensors, which a structure
 // given by matrices does not read: refused there when set (RefuseKeysOfTheBar).
 bool BarOnlyKey(const std::string& path) {
-  static const std::set<std::string> bar_only = {"model.length",          "model.section",
-                                                 "model.density",         "model.modulus",
-                                                 "model.elements",        "model.mass",
-                                                 "model.reaction_length", "model.zone_count",
-                                                 "model.zone_boundaries", "data.truth",
-                                                 "data.truth_refinement", "data.sensors",
-                                                 "data.truth_zones",      "data.support_stiffness"};
+  static const std::set<std::string> bar_only = {"model.length",
+                                                 "model.section",
+                                                 "model.density",
+                                                 "model.modulus",
+                                                 "model.elements",
+                                                 "model.mass",
+                                                 "model.coarse_elements",
+                                                 "model.reaction_length",
+                                                 "model.zone_count",
+                                                 "model.zone_boundaries",
+                                                 "data.truth",
+                                                 "data.truth_refinement",
+                                                 "data.sensors",
+                                                 "data.truth_zones",
+                                                 "data.support_stiffness"};
   return bar_only.count(path) > 0;
 }
 

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -475,10 +476,41 @@ IdentificationRun IdentifyModulus(const Config& given, const ChannelSet& data) {
   return run;
 }
 
-IdentificationRun RunIdentification(const Config& given, const ChannelSet& data) {
-  if (given.outer.functional == OuterFunctional::kLeastSquares) {
-    return RunLeastSquares(given, data);
+namespace {
+
+// The error map, the model's channels and the RMS misfits at the identified E*, from
+// run->solution, with `problem` (run->config's, on run->model and run->data).
+void ReportAtIdentifiedModulus(const Config& config, MatrixMcreProblem* problem,
+                               IdentificationRun* run) {
+  // The error map of the constitutive gap at the homogeneous E* (error_map.h).
+  run->error_map = BarErrorMap(config, *run, problem);
+  const int peak = run->error_map.PeakElement();
+  spdlog::info("error map: largest share {:.3g} of the constitutive gap at x = {:.4g} m",
+               run->error_map.Fractions()[peak], run->error_map.position[peak]);
+  if (run->error_map.sensitivity.size() > 0) {
+    spdlog::info(
+        "sensitivity map: e^2 falls fastest as E is lowered at x = {:.4g} m, "
+        "as it is raised at x = {:.4g} m",
+        run->error_map.position[run->error_map.SofteningPeakElement()],
+        run->error_map.position[run->error_map.StiffeningPeakElement()]);
   }
+  // The model's channels and the RMS misfits at E*; an end displacement the run does
+  // not use is no channel of the problem: from the stored field.
+  run->model_channels = problem->ModelChannels(run->solution);
+  if (run->solution.has_fields()) {
+    const auto last = run->solution.displacement.rows() - 1;
+    for (const auto& [name, row] : {std::pair<const char*, Eigen::Index>{"u0", 0}, {"uL", last}}) {
+      if (run->model_channels.Find(name) < 0) {
+        run->model_channels.Add(name, ChannelKind::kDisplacement,
+                                run->solution.displacement.row(row).transpose());
+      }
+    }
+  }
+  run->misfit = EndMisfitLevels(run->data, run->model_channels);
+}
+
+// RunIdentification by the MCRE on the mesh of config.model.
+IdentificationRun RunOnOneMesh(const Config& given, const ChannelSet& data) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   IdentificationRun run = IdentifyModulus(given, data);
@@ -489,34 +521,7 @@ IdentificationRun RunIdentification(const Config& given, const ChannelSet& data)
 
   // The cost curve around E* and the inner solver's convergence there from W = 0.
   McreObjective cold = CompleteModulusStage(config, matrices, run.data, /*cost_curve=*/true, &run);
-
-  // The error map of the constitutive gap at the homogeneous E* (error_map.h).
-  run.error_map = BarErrorMap(config, run, &dynamic_cast<MatrixMcreProblem&>(cold.problem()));
-  const int peak = run.error_map.PeakElement();
-  spdlog::info("error map: largest share {:.3g} of the constitutive gap at x = {:.4g} m",
-               run.error_map.Fractions()[peak], run.error_map.position[peak]);
-  if (run.error_map.sensitivity.size() > 0) {
-    spdlog::info(
-        "sensitivity map: e^2 falls fastest as E is lowered at x = {:.4g} m, "
-        "as it is raised at x = {:.4g} m",
-        run.error_map.position[run.error_map.SofteningPeakElement()],
-        run.error_map.position[run.error_map.StiffeningPeakElement()]);
-  }
-
-  // The model's channels and the RMS misfits at E*; an end displacement the run does
-  // not use is no channel of the problem: from the stored field.
-  run.model_channels =
-      dynamic_cast<const MatrixMcreProblem&>(cold.problem()).ModelChannels(run.solution);
-  if (run.solution.has_fields()) {
-    const auto last = run.solution.displacement.rows() - 1;
-    for (const auto& [name, row] : {std::pair<const char*, Eigen::Index>{"u0", 0}, {"uL", last}}) {
-      if (run.model_channels.Find(name) < 0) {
-        run.model_channels.Add(name, ChannelKind::kDisplacement,
-                               run.solution.displacement.row(row).transpose());
-      }
-    }
-  }
-  run.misfit = EndMisfitLevels(run.data, run.model_channels);
+  ReportAtIdentifiedModulus(config, &dynamic_cast<MatrixMcreProblem&>(cold.problem()), &run);
   // The uncertainty figure: noise levels known for synthetic data with noise,
   // estimated from the data's second differences otherwise.
   run.estimated_noise = DifferenceNoiseLevels(data);
@@ -544,6 +549,300 @@ IdentificationRun RunIdentification(const Config& given, const ChannelSet& data)
   }
   run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
   return run;
+}
+
+// One treatment's E refined on one mesh of the ladder: the secant from the previous
+// mesh's E* within E* (1 -+ search.refine_window), its first step Newton's with
+// `curvature` [J s/Pa^2] (0: unknown), `warm_start` (empty: none) the previous mesh's
+// traces.
+struct MeshRefinement {
+  std::unique_ptr<McreObjective> objective;
+  IdentificationSummary summary;
+  // Why the refined E* cannot be taken: not converged, or on an edge of the window
+  // inside the bounds; "" otherwise.
+  std::string problem;
+};
+
+MeshRefinement RefineOnMesh(const Config& config, const MatrixModelData& model,
+                            const ChannelSet& data, double start_modulus, double curvature,
+                            const Matrix& warm_start, int max_evaluations, double max_time) {
+  MeshRefinement level;
+  level.objective = std::make_unique<McreObjective>(
+      MatrixMcreObjective(model, data, config.mcre, config.time.theta, config.inner,
+                          Factorization::kAutomatic, start_modulus));
+  if (warm_start.size() > 0) level.objective->SetWarmStart(warm_start);
+  IdentificationOptions options = config.outer;
+  const double window = config.search.refine_window;
+  options.optimizer = OptimizerType::kNlopt;
+  options.algorithm = OuterAlgorithm::kSecant;
+  options.initial = start_modulus;
+  options.lower_bound = std::max(config.outer.lower_bound, start_modulus * (1.0 - window));
+  options.upper_bound = std::min(config.outer.upper_bound, start_modulus * (1.0 + window));
+  options.max_evaluations = max_evaluations;
+  options.max_time = max_time;
+  spdlog::info("refining E ({} supports) on {} elements from {:.9g} Pa within [{:.6g}, {:.6g}] Pa",
+               ClampModelToString(config.mcre.clamp), config.model.elements, start_modulus,
+               options.lower_bound, options.upper_bound);
+  if (!(max_time > 0.0) || max_evaluations < 2) {
+    level.summary.termination = TerminationType::kNoConvergence;
+    level.summary.message = "outer.max_time or outer.max_evaluations reached on a coarser mesh";
+    level.problem = "the refinement on " + std::to_string(config.model.elements) +
+                    " elements: " + level.summary.message;
+    return level;
+  }
+  // d^2 cost / dx^2 = (d^2e^2/dE^2) E_scale^2 / J_scale (objective.h's scaling).
+  const double scaled_curvature =
+      curvature * start_modulus * start_modulus / level.objective->cost_scale();
+  level.summary = RefineFrom(options, level.objective.get(), scaled_curvature);
+  spdlog::info("refinement on {} elements: {}", config.model.elements, level.summary.BriefReport());
+  const double modulus = level.summary.modulus;
+  const double tolerance = 4.0 * config.outer.relative_tolerance * modulus;
+  const bool on_edge = (options.lower_bound > config.outer.lower_bound &&
+                        modulus - options.lower_bound <= tolerance) ||
+                       (options.upper_bound < config.outer.upper_bound &&
+                        options.upper_bound - modulus <= tolerance);
+  if (!level.summary.IsSolutionUsable() || level.objective->best_index() < 0) {
+    level.problem = "the refinement on " + std::to_string(config.model.elements) +
+                    " elements: " + level.summary.message;
+  } else if (on_edge) {
+    level.problem = "the refinement on " + std::to_string(config.model.elements) +
+                    " elements ended on an edge of E* (1 -+ search.refine_window) of the coarser "
+                    "mesh's E*: raise model.coarse_elements, or set it to 0 to identify on "
+                    "model.elements alone";
+  }
+  return level;
+}
+
+// The inner tolerance of the refinements above the coarse mesh, relative to
+// outer.relative_tolerance (docs/multilevel.md gives what it moves E by).
+constexpr double kLadderInnerToleranceFactor = 10.0;
+
+// The meshes the refinement climbs from the coarse mesh: 10, 100, ... times
+// model.coarse_elements below model.elements, then model.elements. Each mesh's E* lies
+// within the discretisation's shift, O(h^2), of the next's, so each refinement starts
+// next to its minimum.
+std::vector<int> MeshLadder(int coarse_elements, int elements) {
+  std::vector<int> meshes;
+  for (long n = 10L * coarse_elements; n < elements; n *= 10) meshes.push_back(static_cast<int>(n));
+  meshes.push_back(elements);
+  return meshes;
+}
+
+// The next mesh's warm start from a solution on `model` at `modulus` [Pa]. For a
+// streaming solver the traces H U, which do not depend on the mesh: a streaming solve's
+// own, or those of the stored displacement. For a stored-field solver W, each sample
+// interpolated linearly from the bar's uniform nodes onto the next mesh's
+// `next_nodes` (empty when the solution stored no field).
+Matrix WarmStartForTheNextMesh(const Config& config, const MatrixModelData& model,
+                               const ChannelSet& data, double modulus,
+                               const CoupledSolution& solution, bool next_streams, int next_nodes) {
+  if (!next_streams) {
+    if (!solution.has_fields()) return Matrix();
+    const Matrix& coarse = solution.retrograde;
+    const Eigen::Index intervals = coarse.rows() - 1;
+    Matrix fine(next_nodes, coarse.cols());
+    for (int i = 0; i < next_nodes; ++i) {
+      // x_i / h_coarse for the fine node i of next_nodes - 1 equal elements.
+      const double position = static_cast<double>(i) * intervals / (next_nodes - 1.0);
+      const Eigen::Index left =
+          std::min<Eigen::Index>(static_cast<Eigen::Index>(position), intervals - 1);
+      const double t = position - static_cast<double>(left);
+      fine.row(i) = (1.0 - t) * coarse.row(left) + t * coarse.row(left + 1);
+    }
+    return fine;
+  }
+  if (!solution.has_fields()) return solution.traces;
+  McreObjective objective = MatrixMcreObjective(model, data, config.mcre, config.time.theta,
+                                                config.inner, Factorization::kAutomatic, modulus);
+  objective.problem().SetModulus(modulus);
+  return dynamic_cast<const MatrixMcreProblem&>(objective.problem())
+      .ObservedTraces(solution.displacement);
+}
+
+// One treatment's E climbed up the ladder from `coarse_modulus` on `coarse_model` (its
+// solution `coarse_solution`): the last mesh's refinement, or the first that failed.
+// The curvature of each refinement's first step is the previous mesh's last secant
+// slope when positive, else `curvature`. *evaluations and *sweeps add up the climb's.
+MeshRefinement ClimbTheLadder(const Config& config, const ChannelSet& data,
+                              const EndDisplacementChannels& ends, int coarse_elements,
+                              double coarse_modulus, double curvature,
+                              const CoupledSolution& coarse_solution, int max_evaluations,
+                              double max_time, int* evaluations, long* sweeps,
+                              std::shared_ptr<const MatrixModelData>* fine_model) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  Config previous = config;
+  previous.model.elements = coarse_elements;
+  auto previous_model =
+      std::make_shared<const MatrixModelData>(BarRunModel(BarModel(previous.model), data, ends));
+  double modulus = coarse_modulus;
+  const CoupledSolution* solution = &coarse_solution;
+  MeshRefinement level;
+  for (const int elements : MeshLadder(coarse_elements, config.model.elements)) {
+    Config mesh = config;
+    mesh.model.elements = elements;
+    // Each refinement starts within the discretisation's shift of its minimum, where the
+    // gradient's error from an inexact inner solve moves E by far less than the outer
+    // tolerance (docs/multilevel.md): its solves stop at kLadderInnerToleranceFactor times
+    // outer.relative_tolerance, and so stay above the sweeps' round-off floor of the
+    // finest meshes.
+    mesh.inner.tolerance = std::max(config.inner.tolerance,
+                                    kLadderInnerToleranceFactor * config.outer.relative_tolerance);
+    auto model =
+        std::make_shared<const MatrixModelData>(BarRunModel(BarModel(mesh.model), data, ends));
+    const bool streams =
+        ResolveCoupledSolverType(mesh.inner, model->dofs(), data.num_steps(), true) ==
+        CoupledSolverType::kStreamingConjugateGradient;
+    const Matrix warm_start =
+        solution->WarmStart().size() > 0
+            ? WarmStartForTheNextMesh(previous, *previous_model, data, modulus, *solution, streams,
+                                      model->dofs())
+            : Matrix();
+    MeshRefinement next = RefineOnMesh(
+        mesh, *model, data, modulus, curvature, warm_start, max_evaluations - *evaluations,
+        max_time - std::chrono::duration<double>(Clock::now() - start).count());
+    *evaluations += next.summary.evaluations;
+    *sweeps += next.objective->sweeps();
+    level = std::move(next);
+    if (!level.problem.empty()) return level;
+    // The secant's last slope, de^2/dE between its last two evaluations.
+    const std::vector<ObjectiveEvaluation>& done = level.objective->evaluations();
+    if (done.size() >= 2) {
+      const ObjectiveEvaluation& a = done[done.size() - 2];
+      const ObjectiveEvaluation& b = done.back();
+      const double slope = (b.cost_gradient - a.cost_gradient) / (b.modulus - a.modulus);
+      if (slope > 0.0 && std::isfinite(slope)) curvature = slope;
+    }
+    modulus = level.summary.modulus;
+    solution = &level.objective->best_solution();
+    previous = mesh;
+    previous_model = model;
+    *fine_model = model;
+  }
+  return level;
+}
+
+// RunIdentification from a coarse mesh up the ladder (UsesCoarseMesh; docs/multilevel.md).
+IdentificationRun RunFromACoarseMesh(const Config& given, const ChannelSet& data) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  const int fine_elements = given.model.elements;
+  // 1. Everything on the coarse mesh.
+  Config coarse = given;
+  coarse.model.elements = given.model.coarse_elements;
+  spdlog::info("coarse mesh: E first on {} elements, then refined up to {} (model.coarse_elements)",
+               coarse.model.elements, fine_elements);
+  IdentificationRun run = RunOnOneMesh(coarse, data);
+  CoarseMeshStage& stage = run.coarse_mesh;
+  stage.ran = true;
+  stage.coarse_elements = coarse.model.elements;
+  stage.coarse_wall_time_s = run.wall_time_s;
+  if (!UnreportableMessage(run).empty()) {
+    if (!run.IsUsable()) {
+      run.outer.message = "on the coarse mesh (model.coarse_elements " +
+                          std::to_string(stage.coarse_elements) + "): " + run.outer.message;
+    }
+    return run;
+  }
+  stage.coarse_modulus = run.identified_modulus();
+  int curvature_points = 0;
+  stage.curvature =
+      CostGradientSlope(run.cost_curve, stage.coarse_modulus, kCurvatureWindow, &curvature_points);
+
+  // 2. E refined up the ladder of meshes, with the config of the coarse run's supports
+  // (ConfigForTheSupports) and what the coarse identification left.
+  Config config = run.config;
+  config.model.elements = fine_elements;
+  config.inner = given.inner;
+  const int max_evaluations =
+      config.outer.max_evaluations - static_cast<int>(run.TotalEvaluations());
+  const double max_time = config.outer.max_time - run.outer.wall_time_s;
+  const SupportBlend coarse_blend = run.support_blend;
+  const bool measured = config.mcre.clamp != given.mcre.clamp;
+  const double own_start = !coarse_blend.Blends() ? stage.coarse_modulus
+                           : measured             ? coarse_blend.measured_modulus
+                                                  : coarse_blend.trusted_modulus;
+  int evaluations = 0;
+  std::shared_ptr<const MatrixModelData> model;
+  const auto refinement_start = Clock::now();
+  MeshRefinement fine =
+      ClimbTheLadder(config, run.data, run.ends, stage.coarse_elements, own_start, stage.curvature,
+                     run.solution, max_evaluations, max_time, &evaluations, &stage.sweeps, &model);
+  double modulus = fine.summary.modulus;
+  if (fine.problem.empty() && coarse_blend.Blends()) {
+    // Both treatments weigh in E* (docs/boundaries.md section 10): the other's E climbs
+    // too, from its coarse E, without a coarse solution or curvature of its own.
+    Config other = measured ? given : MeasuredSupportConfig(given);
+    other.model.elements = fine_elements;
+    std::shared_ptr<const MatrixModelData> other_model;
+    const MeshRefinement other_fine = ClimbTheLadder(
+        other, run.data, run.ends, stage.coarse_elements,
+        measured ? coarse_blend.trusted_modulus : coarse_blend.measured_modulus, 0.0,
+        CoupledSolution(), max_evaluations - evaluations,
+        max_time - std::chrono::duration<double>(Clock::now() - refinement_start).count(),
+        &evaluations, &stage.sweeps, &other_model);
+    if (!other_fine.problem.empty()) {
+      fine.problem = other_fine.problem;
+    } else {
+      run.support_blend.trusted_modulus = measured ? other_fine.summary.modulus : modulus;
+      run.support_blend.measured_modulus = measured ? modulus : other_fine.summary.modulus;
+      modulus = run.support_blend.Modulus();
+    }
+  }
+  stage.refinement = fine.summary;
+  stage.refinement.evaluations = evaluations;
+  stage.refinement.wall_time_s =
+      std::chrono::duration<double>(Clock::now() - refinement_start).count();
+
+  // The run is the fine mesh's from here: E*, its solution, maps and channels.
+  run.config = config;
+  run.inner_method =
+      ResolveCoupledSolverType(config.inner, fine_elements + 1.0, run.data.num_steps(), true);
+  run.sweeps += stage.sweeps;
+  run.outer.evaluations += evaluations;
+  run.outer.gradient_evaluations += evaluations;
+  run.outer.wall_time_s += stage.refinement.wall_time_s;
+  if (!fine.problem.empty()) {
+    run.outer.termination =
+        fine.summary.IsSolutionUsable() ? TerminationType::kFailure : fine.summary.termination;
+    run.outer.message = fine.problem;
+    return run;
+  }
+  run.model = model;
+  McreObjective& objective = *fine.objective;
+  const std::size_t first = run.evaluations.size();
+  run.evaluations.insert(run.evaluations.end(), objective.evaluations().begin(),
+                         objective.evaluations().end());
+  run.best_index = static_cast<int>(first) + objective.best_index();
+  run.solution = objective.best_solution();
+  run.outer.modulus = modulus;
+  run.outer.cost = fine.summary.cost;
+  run.outer.gradient = fine.summary.gradient;
+  run.rest_cost = objective.rest_cost();
+  if (run.evaluations[run.best_index].modulus != run.identified_modulus()) {
+    SolveStageAt(run.identified_modulus(), "the coupled solve at the refined E", &objective, &run);
+  }
+  ReportAtIdentifiedModulus(config, &dynamic_cast<MatrixMcreProblem&>(objective.problem()), &run);
+  run.wall_time_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return run;
+}
+
+}  // namespace
+
+bool UsesCoarseMesh(const Config& config) {
+  const CoupledSolverType inner = config.inner.type;
+  return config.structure.kind == ModelKind::kBar &&
+         config.outer.functional == OuterFunctional::kMcre && config.model.coarse_elements > 0 &&
+         config.model.elements > config.model.coarse_elements &&
+         (inner == CoupledSolverType::kAuto || inner == CoupledSolverType::kConjugateGradient ||
+          inner == CoupledSolverType::kStreamingConjugateGradient);
+}
+
+IdentificationRun RunIdentification(const Config& given, const ChannelSet& data) {
+  if (given.outer.functional == OuterFunctional::kLeastSquares) {
+    return RunLeastSquares(given, data);
+  }
+  return UsesCoarseMesh(given) ? RunFromACoarseMesh(given, data) : RunOnOneMesh(given, data);
 }
 
 ZoneUncertainty BarZoneUncertainty(const Config& config, const IdentificationRun& run) {

@@ -828,6 +828,27 @@ void SupportChecksYaml(const IdentificationRun& run, YamlWriter* yaml) {
   }
 }
 
+// The coarse_mesh: block of a run from a coarse mesh (model.coarse_elements,
+// docs/multilevel.md); nothing on one mesh.
+void CoarseMeshYaml(const IdentificationRun& run, YamlWriter* yaml) {
+  const CoarseMeshStage& stage = run.coarse_mesh;
+  if (!stage.ran) return;
+  yaml->Line(0, "coarse_mesh", "",
+             "E first identified on a coarser bar, then refined up to model.elements; the cost "
+             "curve, the uncertainty, the zones and the solve from zero are the coarse mesh's");
+  yaml->Integer(1, "elements", stage.coarse_elements, "model.coarse_elements");
+  yaml->Number(1, "modulus", stage.coarse_modulus, "[Pa] E* on the coarse mesh");
+  yaml->Number(1, "wall_time_s", stage.coarse_wall_time_s,
+               "[s] the coarse run: identification, cost curve, maps and uncertainty");
+  yaml->Number(1, "curvature", stage.curvature,
+               "[J s/Pa^2] its cost curve's d^2e^2/dE^2, the refinement's first step");
+  yaml->Text(1, "refinement", stage.refinement.message, "the secant on model.elements");
+  yaml->Integer(1, "refinement_evaluations", stage.refinement.evaluations,
+                "on every mesh above the coarse one");
+  yaml->Integer(1, "refinement_sweeps", stage.sweeps, "of those evaluations");
+  yaml->Number(1, "refinement_wall_time_s", stage.refinement.wall_time_s, "[s]");
+}
+
 // The end of the bar's summary.yaml: its zones: block when it has zones, then the
 // resolved config.
 void ZonesAndConfigYaml(const IdentificationRun& run, YamlWriter* yaml) {
@@ -930,6 +951,7 @@ std::string SummaryYaml(const IdentificationRun& run) {
   yaml.Number(0, "wall_time_s", run.wall_time_s,
               "[s] identification, cost curve and uncertainty (not the data)");
   SupportChecksYaml(run, &yaml);
+  CoarseMeshYaml(run, &yaml);
 
   if (run.error_map.share.size() > 0) {
     const int peak = run.error_map.PeakElement();

@@ -44,6 +44,8 @@
 // ||r_start||_W (rho_k / rho_start)^1/2 and measured by RetrogradeEnergy once that
 // estimate is within kMeasuredResidualFactor of the tolerance (not when it is that far
 // below it); r_k is tested before p_k is applied, then the final pass as above.
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -207,6 +209,9 @@ void StreamingConjugateGradient::Solve(const Matrix* initial_traces) {
         !UpdateRecursiveResidual(iteration, direction_energy)) {
       return;
     }
+    // Progress of solves that take minutes (1e6 dofs): `identify run -v`.
+    spdlog::debug("streaming CG: iteration {}, relative residual {:.3e}, {} sweeps so far",
+                  iteration + 1, relative_, problem_->sweep_count());
     if (relative_ > options_.tolerance) {
       Step(direction_energy, curvature);
       continue;
@@ -243,6 +248,9 @@ bool StreamingConjugateGradient::TryWarmStart(const Matrix& initial_traces) {
   // r^(0) = Phi(y^(0)) - y^(0), into `image` until it is kept; a final pass, so
   // that a start already within the tolerance needs no other.
   const double warm_relative = FinalPass(initial_traces);
+  spdlog::debug(
+      "streaming CG: warm start's relative residual {:.3e} (the data's {:.3e}), {} sweeps",
+      warm_relative, relative_, problem_->sweep_count());
   if (!(warm_relative < relative_)) return false;
   traces_ = initial_traces;
   residual_.swap(image_);

@@ -29,6 +29,11 @@ bool BarProperties::IsValid(std::string* error) const {
     why << "model.elements must be an integer in [1, 1e8], got " << elements;
     ok = false;
   }
+  if (ok && coarse_elements != 0 && (coarse_elements < 10 || coarse_elements > 100000000)) {
+    why << "model.coarse_elements must be 0 (one mesh) or an integer in [10, 1e8], got "
+        << coarse_elements;
+    ok = false;
+  }
   if (!ok && error != nullptr) *error = why.str();
   return ok;
 }

@@ -663,6 +663,22 @@ void SetSecondValley(const std::vector<ScanValley>& reported, IdentificationSumm
 
 }  // namespace
 
+IdentificationSummary RefineFrom(const IdentificationOptions& options, ModulusObjective* objective,
+                                 double curvature) {
+  IdentificationOptions local = options;
+  local.scan_points = 0;
+  std::string why;
+  if (!local.IsValid(&why)) {
+    IdentificationSummary summary;
+    summary.optimizer = options.optimizer;
+    summary.algorithm = ResolveAlgorithm(options.optimizer, options.algorithm, 1);
+    summary.initial_modulus = options.initial;
+    summary.message = "invalid options: " + why;
+    return summary;
+  }
+  return MinimizeLocally(local, objective, curvature);
+}
+
 IdentificationSummary Identify(const IdentificationOptions& options, ModulusObjective* objective) {
   IdentificationSummary summary;
   summary.optimizer = options.optimizer;

@@ -106,6 +106,21 @@ struct SupportBlend {
   double Modulus() const { return (1.0 - weight) * trusted_modulus + weight * measured_modulus; }
 };
 
+// The bar's identification from a coarse mesh (model.coarse_elements, docs/multilevel.md):
+// E* first on a bar of coarse_elements elements, then refined up to model.elements.
+struct CoarseMeshStage {
+  bool ran = false;
+  int coarse_elements = 0;
+  double coarse_modulus = -1.0;     // E* on the coarse mesh [Pa]
+  double coarse_wall_time_s = 0.0;  // [s] the coarse run, its curve, maps and uncertainty
+  // [J s/Pa^2] the coarse cost curve's d^2e^2/dE^2 near E*, the refinement's first step
+  double curvature = 0.0;
+  // E refined up to model.elements from coarse_modulus (RefineFrom, the secant): the last
+  // mesh's summary, its evaluations those of every mesh above the coarse one.
+  IdentificationSummary refinement;
+  long sweeps = 0;  // of the refinements' solves, every mesh above the coarse one
+};
+
 // Everything one identification computed, on the bar (RunIdentification) or on a
 // structure given by matrices (RunMatrixIdentification, app/matrix_identification_run.h):
 // the homogeneous stage this run is (one E in every zone; on a structure whose zones'
@@ -182,6 +197,11 @@ struct IdentificationRun : ModulusStage {
   // moduli when they differ.
   ZoneIdentificationRun zones;
   double wall_time_s = -1.0;  // the whole of the run
+  // The bar from a coarse mesh (ran: model.elements above model.coarse_elements): the cost
+  // curve, the cold solve, the uncertainty and the zones are then the coarse mesh's, and
+  // E*, `solution`, the error map and the model's channels the refinement's on
+  // model.elements.
+  CoarseMeshStage coarse_mesh;
 
   // Least squares on the bar: the model's outputs and J at the identified E, and on the
   // cost curve J(E) and dJ/dE over E* +- 5 %, the curvature d^2J/dE^2 at E* [s / Pa^2]
@@ -385,7 +405,25 @@ ErrorMap BarErrorMap(const Config& config, const IdentificationRun& run,
 // with outer.functional: least_squares. Precondition: config valid (as LoadConfig
 // returns it). Never throws for a failed identification: see IsUsable() and
 // outer.message.
+//
+// From a coarse mesh when UsesCoarseMesh(config) (docs/multilevel.md): steps 2 to 4 on a
+// bar of model.coarse_elements elements with the same data, then E refined up a ladder
+// of meshes, 10, 100, ... times model.coarse_elements below model.elements, then
+// model.elements: on each, the secant from the previous mesh's E*, its first step
+// Newton's with the previous curvature (the coarse cost curve's, then each secant's last
+// slope), within E* (1 -+ search.refine_window), warm-started from the previous solution
+// (its traces for the streaming solver, W interpolated onto the nodes for the stored
+// one), its inner solves to at most 10 outer.relative_tolerance, with what
+// outer.max_evaluations and outer.max_time left. At the refined E*, the
+// error map and the model's channels (coarse_mesh says what stays the coarse mesh's). A
+// refinement that ends on an edge of its window fails the run, naming the keys.
 IdentificationRun RunIdentification(const Config& config, const ChannelSet& data);
+
+// The bar's MCRE identification starts on a coarse mesh: model.coarse_elements > 0,
+// model.elements above it, and inner.method auto or one of the conjugate-gradient
+// solvers, which take the previous mesh's warm start (least squares, and the other
+// inner methods, run on model.elements alone).
+bool UsesCoarseMesh(const Config& config);
 
 // The noise levels of the measurements `data` (as LoadMeasurements made them):
 // for synthetic data with noise, those the noise was drawn with (RMS of the

@@ -39,6 +39,10 @@ struct BarProperties {
   // length keeps the reaction's gain, and the inner solves' iterations, independent of
   // the mesh. 0: the first element.
   double reaction_length = 0.01;
+  // The coarse mesh of the bar's identification on two meshes (docs/multilevel.md): when
+  // `elements` exceeds it, the MCRE identification runs first on a bar of this many
+  // elements with the same data, then refines E on `elements` from there. 0: one mesh.
+  int coarse_elements = 1000;
 
   // True when every value is usable; otherwise writes the reason to *error.
   bool IsValid(std::string* error) const;

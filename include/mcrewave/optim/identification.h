@@ -173,6 +173,16 @@ struct IdentificationSummary {
 // kFailure and its what() in the message. Precondition: options.IsValid().
 IdentificationSummary Identify(const IdentificationOptions& options, ModulusObjective* objective);
 
+// The local search of Identify without a scan, from options.initial within options'
+// bounds, given an estimate `curvature` of d^2 cost / dx^2 near the start (0: unknown):
+// the secant's first step is Newton's with it, and it sets the step scale of Ceres and
+// of NLopt's gradient methods, as a scanned valley's curvature does. Used where a
+// cheaper problem already located the minimum (the bar's coarse mesh,
+// app/identification_run.h). options.scan_points is not read. Never throws for what the
+// objective does. Precondition: options.IsValid().
+IdentificationSummary RefineFrom(const IdentificationOptions& options, ModulusObjective* objective,
+                                 double curvature);
+
 // Two stages: a global search on another functional, a local refinement of the objective.
 //   1. Identify(options with scan_points = search_scan_points and
 //      refinement.samples_per_valley, search): the scan and its valleys' refinements on
