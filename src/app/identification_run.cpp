@@ -595,16 +595,10 @@ MeshRefinement RefineOnMesh(const Config& config, const MatrixModelData& model,
       curvature * start_modulus * start_modulus / level.objective->cost_scale();
   level.summary = RefineFrom(options, level.objective.get(), scaled_curvature);
   spdlog::info("refinement on {} elements: {}", config.model.elements, level.summary.BriefReport());
-  const double modulus = level.summary.modulus;
-  const double tolerance = 4.0 * config.outer.relative_tolerance * modulus;
-  const bool on_edge = (options.lower_bound > config.outer.lower_bound &&
-                        modulus - options.lower_bound <= tolerance) ||
-                       (options.upper_bound < config.outer.upper_bound &&
-                        options.upper_bound - modulus <= tolerance);
   if (!level.summary.IsSolutionUsable() || level.objective->best_index() < 0) {
     level.problem = "the refinement on " + std::to_string(config.model.elements) +
                     " elements: " + level.summary.message;
-  } else if (on_edge) {
+  } else if (EndsOnAnInnerEdge(options, config.outer, level.summary.modulus)) {
     level.problem = "the refinement on " + std::to_string(config.model.elements) +
                     " elements ended on an edge of E* (1 -+ search.refine_window) of the coarser "
                     "mesh's E*: raise model.coarse_elements, or set it to 0 to identify on "
@@ -630,12 +624,14 @@ std::vector<int> MeshLadder(int coarse_elements, int elements) {
 
 // The next mesh's warm start from a solution on `model` at `modulus` [Pa]. For a
 // streaming solver the traces H U, which do not depend on the mesh: a streaming solve's
-// own, or those of the stored displacement. For a stored-field solver W, each sample
-// interpolated linearly from the bar's uniform nodes onto the next mesh's
-// `next_nodes` (empty when the solution stored no field).
+// own, or those of the stored displacement, read by `previous`'s problem (the objective
+// that solved it; null: one made on `model`). For a stored-field solver W, each sample
+// interpolated linearly from the bar's uniform nodes onto the next mesh's `next_nodes`
+// (empty when the solution stored no field).
 Matrix WarmStartForTheNextMesh(const Config& config, const MatrixModelData& model,
                                const ChannelSet& data, double modulus,
-                               const CoupledSolution& solution, bool next_streams, int next_nodes) {
+                               const CoupledSolution& solution, McreObjective* previous,
+                               bool next_streams, int next_nodes) {
   if (!next_streams) {
     if (!solution.has_fields()) return Matrix();
     const Matrix& coarse = solution.retrograde;
@@ -652,20 +648,28 @@ Matrix WarmStartForTheNextMesh(const Config& config, const MatrixModelData& mode
     return fine;
   }
   if (!solution.has_fields()) return solution.traces;
-  McreObjective objective = MatrixMcreObjective(model, data, config.mcre, config.time.theta,
-                                                config.inner, Factorization::kAutomatic, modulus);
-  objective.problem().SetModulus(modulus);
-  return dynamic_cast<const MatrixMcreProblem&>(objective.problem())
+  std::unique_ptr<McreObjective> made;
+  if (previous == nullptr) {
+    made = std::make_unique<McreObjective>(MatrixMcreObjective(model, data, config.mcre,
+                                                               config.time.theta, config.inner,
+                                                               Factorization::kAutomatic, modulus));
+    previous = made.get();
+  }
+  // H holds the trusted reaction's row g^T K(E): at the solution's modulus.
+  previous->problem().SetModulus(modulus);
+  return dynamic_cast<const MatrixMcreProblem&>(previous->problem())
       .ObservedTraces(solution.displacement);
 }
 
-// One treatment's E climbed up the ladder from `coarse_modulus` on `coarse_model` (its
-// solution `coarse_solution`): the last mesh's refinement, or the first that failed.
-// The curvature of each refinement's first step is the previous mesh's last secant
-// slope when positive, else `curvature`. *evaluations and *sweeps add up the climb's.
+// One treatment's E climbed up the ladder from `coarse_modulus` on `coarse_model` (the
+// coarse run's, of coarse_elements elements; its solution `coarse_solution`): the last
+// mesh's refinement, or the first that failed. The curvature of each refinement's first
+// step is the previous mesh's last secant slope when positive, else `curvature`.
+// *evaluations and *sweeps add up the climb's.
 MeshRefinement ClimbTheLadder(const Config& config, const ChannelSet& data,
-                              const EndDisplacementChannels& ends, int coarse_elements,
-                              double coarse_modulus, double curvature,
+                              const EndDisplacementChannels& ends,
+                              std::shared_ptr<const MatrixModelData> coarse_model,
+                              int coarse_elements, double coarse_modulus, double curvature,
                               const CoupledSolution& coarse_solution, int max_evaluations,
                               double max_time, int* evaluations, long* sweeps,
                               std::shared_ptr<const MatrixModelData>* fine_model) {
@@ -673,8 +677,7 @@ MeshRefinement ClimbTheLadder(const Config& config, const ChannelSet& data,
   const auto start = Clock::now();
   Config previous = config;
   previous.model.elements = coarse_elements;
-  auto previous_model =
-      std::make_shared<const MatrixModelData>(BarRunModel(BarModel(previous.model), data, ends));
+  std::shared_ptr<const MatrixModelData> previous_model = std::move(coarse_model);
   double modulus = coarse_modulus;
   const CoupledSolution* solution = &coarse_solution;
   MeshRefinement level;
@@ -695,8 +698,8 @@ MeshRefinement ClimbTheLadder(const Config& config, const ChannelSet& data,
         CoupledSolverType::kStreamingConjugateGradient;
     const Matrix warm_start =
         solution->WarmStart().size() > 0
-            ? WarmStartForTheNextMesh(previous, *previous_model, data, modulus, *solution, streams,
-                                      model->dofs())
+            ? WarmStartForTheNextMesh(previous, *previous_model, data, modulus, *solution,
+                                      level.objective.get(), streams, model->dofs())
             : Matrix();
     MeshRefinement next = RefineOnMesh(
         mesh, *model, data, modulus, curvature, warm_start, max_evaluations - *evaluations,
@@ -765,9 +768,9 @@ IdentificationRun RunFromACoarseMesh(const Config& given, const ChannelSet& data
   int evaluations = 0;
   std::shared_ptr<const MatrixModelData> model;
   const auto refinement_start = Clock::now();
-  MeshRefinement fine =
-      ClimbTheLadder(config, run.data, run.ends, stage.coarse_elements, own_start, stage.curvature,
-                     run.solution, max_evaluations, max_time, &evaluations, &stage.sweeps, &model);
+  MeshRefinement fine = ClimbTheLadder(config, run.data, run.ends, run.model, stage.coarse_elements,
+                                       own_start, stage.curvature, run.solution, max_evaluations,
+                                       max_time, &evaluations, &stage.sweeps, &model);
   double modulus = fine.summary.modulus;
   if (fine.problem.empty() && coarse_blend.Blends()) {
     // Both treatments weigh in E* (docs/boundaries.md section 10): the other's E climbs
@@ -776,7 +779,7 @@ IdentificationRun RunFromACoarseMesh(const Config& given, const ChannelSet& data
     other.model.elements = fine_elements;
     std::shared_ptr<const MatrixModelData> other_model;
     const MeshRefinement other_fine = ClimbTheLadder(
-        other, run.data, run.ends, stage.coarse_elements,
+        other, run.data, run.ends, run.model, stage.coarse_elements,
         measured ? coarse_blend.trusted_modulus : coarse_blend.measured_modulus, 0.0,
         CoupledSolution(), max_evaluations - evaluations,
         max_time - std::chrono::duration<double>(Clock::now() - refinement_start).count(),

@@ -663,6 +663,16 @@ void SetSecondValley(const std::vector<ScanValley>& reported, IdentificationSumm
 
 }  // namespace
 
+bool EndsOnAnInnerEdge(const IdentificationOptions& window, const IdentificationOptions& bounds,
+                       double modulus) {
+  const double tolerance = 4.0 * bounds.relative_tolerance * modulus;
+  const bool on_lower =
+      window.lower_bound > bounds.lower_bound && modulus - window.lower_bound <= tolerance;
+  const bool on_upper =
+      window.upper_bound < bounds.upper_bound && window.upper_bound - modulus <= tolerance;
+  return on_lower || on_upper;
+}
+
 IdentificationSummary RefineFrom(const IdentificationOptions& options, ModulusObjective* objective,
                                  double curvature) {
   IdentificationOptions local = options;
@@ -843,12 +853,9 @@ IdentificationSummary IdentifyInTwoStages(const IdentificationOptions& options,
   record.window_evaluations = refined.scan_evaluations;
   record.window_sweeps = refined.scan_sweeps;
   record.window_wall_time_s = refined.scan_wall_time_s;
-  const double tolerance = 4.0 * options.relative_tolerance * refined.modulus;
-  const bool on_lower =
-      local.lower_bound > options.lower_bound && refined.modulus - local.lower_bound <= tolerance;
-  const bool on_upper =
-      local.upper_bound < options.upper_bound && local.upper_bound - refined.modulus <= tolerance;
-  if (!refined.IsSolutionUsable() || !(on_lower || on_upper)) return record.With(refined, true);
+  if (!refined.IsSolutionUsable() || !EndsOnAnInnerEdge(local, options, refined.modulus)) {
+    return record.With(refined, true);
+  }
 
   // 3. Its minimum lies beyond the window: the objective's own global search.
   spdlog::warn(

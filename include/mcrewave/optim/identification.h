@@ -173,6 +173,13 @@ struct IdentificationSummary {
 // kFailure and its what() in the message. Precondition: options.IsValid().
 IdentificationSummary Identify(const IdentificationOptions& options, ModulusObjective* objective);
 
+// Whether `modulus` [Pa], found within `window`'s bounds, lies on an edge of the window
+// that is not a bound of `bounds` (within 4 bounds.relative_tolerance |modulus|): the
+// minimum lies beyond the window. IdentifyInTwoStages' test of its stage 2, and the bar's
+// ladder of meshes' (app/identification_run.h).
+bool EndsOnAnInnerEdge(const IdentificationOptions& window, const IdentificationOptions& bounds,
+                       double modulus);
+
 // The local search of Identify without a scan, from options.initial within options'
 // bounds, given an estimate `curvature` of d^2 cost / dx^2 near the start (0: unknown):
 // the secant's first step is Newton's with it, and it sets the step scale of Ceres and
