@@ -180,12 +180,12 @@ TEST(StreamingSolverTest, AWarmStartFromANearbyModulusGivesTheSameSolutionInFewe
   EXPECT_LT(warm.summary.iterations, cold.summary.iterations);
   EXPECT_NE(warm.summary.message.find("from the warm start"), std::string::npos)
       << warm.summary.message;
-  // From its own solution the start is the final pass: no iteration, 8 sweeps (the
-  // data's residual and its norm, the start's and its norm) against 629 cold.
+  // From its own solution: no iteration, 11 sweeps (the data's residual and its norm,
+  // the start's and its norm, then the map once more for the totals) against 629 cold.
   const Solved again = Solve(options, &problem, &cold.solution.WarmStart());
   ASSERT_TRUE(again.summary.IsSolutionUsable()) << again.summary.message;
   EXPECT_EQ(again.summary.iterations, 0);
-  EXPECT_EQ(again.summary.sweeps, 8);
+  EXPECT_EQ(again.summary.sweeps, 11);
   EXPECT_NEAR(again.solution.cost, cold.solution.cost, 2e-15 * cold.solution.cost);
   const Matrix away = -problem.DataTraces();
   const Solved refused = Solve(options, &problem, &away);
@@ -193,6 +193,52 @@ TEST(StreamingSolverTest, AWarmStartFromANearbyModulusGivesTheSameSolutionInFewe
   EXPECT_EQ(refused.summary.message.find("warm start"), std::string::npos)
       << refused.summary.message;
   EXPECT_EQ(refused.summary.iterations, cold.summary.iterations);
+}
+
+TEST(StreamingSolverTest, AWarmStartWithTheNearbyReferenceNormSkipsTheDataStart) {
+  // The ||c||_P of the solve at 0.9 E_ref (the summary's reference_residual_norm) given
+  // with its traces at 0.9001 E_ref: the data start's four sweeps are left out, and the
+  // solution is the one without the reference. ||c||_P is the stored-field CG's too
+  // (the residual at W = 0). Small case with interior sensors, tolerance 1e-10.
+  // Measured: the streaming and stored ||c||_P 2.2e-16 apart, the two moduli's 1.3e-3;
+  // the same e^2 to the bit; 129 iterations either way, 398 sweeps against 402.
+  ProblemBundle bundle(MakeSmallCase(30, 400, 10.0, 2), Weights(0.01, 1.0));
+  const ChannelSet data = WithSensors(bundle.data);
+  testing::BarMcreProblem problem(bundle.model, data, Weights(0.01, 1.0), 200e9, 0.5);
+  const CoupledSolverOptions options =
+      Options(CoupledSolverType::kStreamingConjugateGradient, 1e-10);
+  problem.SetModulus(0.9 * 200e9);
+  const Solved nearby = Solve(options, &problem);
+  const Solved stored = Solve(Options(CoupledSolverType::kConjugateGradient, 1e-10), &problem);
+  ASSERT_TRUE(nearby.summary.IsSolutionUsable() && stored.summary.IsSolutionUsable());
+  const double reference = nearby.summary.reference_residual_norm;
+  ASSERT_GT(reference, 0.0);
+  EXPECT_NEAR(reference, stored.summary.reference_residual_norm, 2e-15 * reference);
+  problem.SetModulus(0.9001 * 200e9);
+  const Solved warm = Solve(options, &problem, &nearby.solution.WarmStart());
+  const Solved given = Solve(options, &problem, &nearby.solution.WarmStart(), reference);
+  ASSERT_TRUE(warm.summary.IsSolutionUsable() && given.summary.IsSolutionUsable());
+  EXPECT_NEAR(given.solution.cost, warm.solution.cost, 2e-15 * warm.solution.cost);
+  EXPECT_EQ(given.summary.reference_residual_norm, reference);
+  EXPECT_NE(given.summary.message.find("measured against the given"), std::string::npos)
+      << given.summary.message;
+  // The same iterations but for the measure's ratio, four sweeps fewer.
+  EXPECT_LE(std::abs(given.summary.iterations - warm.summary.iterations), 1);
+  EXPECT_EQ(given.summary.sweeps - 3 * (given.summary.iterations - warm.summary.iterations),
+            warm.summary.sweeps - 4);
+  // From its own solution: the start's residual, its norm and its totals alone.
+  const Solved again =
+      Solve(options, &problem, &given.solution.WarmStart(), given.summary.reference_residual_norm);
+  ASSERT_TRUE(again.summary.IsSolutionUsable()) << again.summary.message;
+  EXPECT_EQ(again.summary.iterations, 0);
+  EXPECT_EQ(again.summary.sweeps, 7);
+  // A start worse than the reference: from the data, as without it.
+  const Matrix away = -problem.DataTraces();
+  const Solved refused = Solve(options, &problem, &away, reference);
+  ASSERT_TRUE(refused.summary.IsSolutionUsable());
+  EXPECT_EQ(refused.summary.message.find("warm start"), std::string::npos)
+      << refused.summary.message;
+  EXPECT_NE(refused.summary.reference_residual_norm, reference);
 }
 
 TEST(StreamingSolverTest, IdentifiesTheSameModulusAsStoredFields) {

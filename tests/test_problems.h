@@ -164,9 +164,10 @@ struct Solved {
 };
 
 inline Solved Solve(const CoupledSolverOptions& options, CoupledProblem* problem,
-                    const Matrix* initial = nullptr) {
+                    const Matrix* initial = nullptr, double reference_residual_norm = 0.0) {
   Solved solved;
-  solved.summary = SolveCoupled(options, problem, initial, &solved.solution);
+  solved.summary =
+      SolveCoupled(options, problem, initial, &solved.solution, reference_residual_norm);
   return solved;
 }
 

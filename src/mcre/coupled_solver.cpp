@@ -164,7 +164,8 @@ std::string UnsupportedProblemMessage(CoupledSolverType type,
 // summary, if it was left auto.
 bool RunResolvedSolver(const CoupledSolverOptions& resolved, CoupledProblem* problem,
                        StreamingCoupledProblem* streaming, const Matrix* initial_guess,
-                       CoupledSolution* solution, CoupledSolverSummary* summary) {
+                       double reference_residual_norm, CoupledSolution* solution,
+                       CoupledSolverSummary* summary) {
   switch (resolved.type) {
     case CoupledSolverType::kAllAtOnce:
       internal::SolveAllAtOnce(resolved, problem, solution, summary);
@@ -185,8 +186,8 @@ bool RunResolvedSolver(const CoupledSolverOptions& resolved, CoupledProblem* pro
       break;
     case CoupledSolverType::kStreamingConjugateGradient:
       // Fills the cost and the gradients itself, from its final streaming pass.
-      internal::SolveByStreamingConjugateGradient(resolved, streaming, initial_guess, solution,
-                                                  summary);
+      internal::SolveByStreamingConjugateGradient(resolved, streaming, initial_guess,
+                                                  reference_residual_norm, solution, summary);
       break;
     case CoupledSolverType::kAuto:
       // ResolveCoupledSolverType never returns it.
@@ -199,7 +200,8 @@ bool RunResolvedSolver(const CoupledSolverOptions& resolved, CoupledProblem* pro
 }  // namespace
 
 CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledProblem* problem,
-                                  const Matrix* initial_guess, CoupledSolution* solution) {
+                                  const Matrix* initial_guess, CoupledSolution* solution,
+                                  double reference_residual_norm) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   const long sweeps_before = problem->sweep_count();
@@ -235,7 +237,8 @@ CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledPr
   if (type == CoupledSolverType::kStreamingConjugateGradient) {
     streaming->SetHistoryBudget(options.max_field_bytes);
   }
-  if (!RunResolvedSolver(resolved, problem, streaming, initial_guess, solution, &summary)) {
+  if (!RunResolvedSolver(resolved, problem, streaming, initial_guess, reference_residual_norm,
+                         solution, &summary)) {
     return summary;
   }
   if (summary.IsSolutionUsable() && type != CoupledSolverType::kStreamingConjugateGradient) {

@@ -27,11 +27,12 @@ void SolveByShooting(const CoupledSolverOptions& options, CoupledProblem* proble
 // Also fills the solution's cost, gradients, traces and what the problem's streaming
 // totals hold (the bar: end retrograde values, error map and its picture; a matrix
 // model: the dof and zone maps); its fields U and W stay empty. initial_traces
-// (nullable): a warm start y^(0) of the problem's ZeroTraces() shape.
+// (nullable): a warm start y^(0) of the problem's ZeroTraces() shape;
+// reference_residual_norm: SolveCoupled's.
 void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options,
                                        StreamingCoupledProblem* problem,
-                                       const Matrix* initial_traces, CoupledSolution* solution,
-                                       CoupledSolverSummary* summary);
+                                       const Matrix* initial_traces, double reference_residual_norm,
+                                       CoupledSolution* solution, CoupledSolverSummary* summary);
 
 // {min, max} of the eigenvalues of the symmetric tridiagonal matrix with this diagonal
 // and sub-diagonal (one entry fewer): the Ritz extremes of a Lanczos process.

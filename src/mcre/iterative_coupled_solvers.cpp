@@ -63,6 +63,7 @@ StartingPoint Start(CoupledProblem* problem, const Matrix* initial_retrograde,
                                       {residual, &work.rhs, &work.data_response});
     start.rhs_norm = problem->Norm(work.rhs);
   }
+  summary->reference_residual_norm = start.rhs_norm;
   start.residual_floor = kRoundOffFloor * problem->Norm(work.data_response);
   *residual -= retrograde;
   summary->iterations = 0;

@@ -198,6 +198,7 @@ std::unique_ptr<ModulusObjective> McreObjective::CloneForScan(double inner_toler
 void McreObjective::StartAfresh() {
   warm_start_.resize(0, 0);
   warm_start_modulus_ = 0.0;
+  warm_start_reference_norm_ = 0.0;
   previous_start_.resize(0, 0);
   previous_start_modulus_ = 0.0;
   inner_.tolerance = given_tolerance_;
@@ -210,11 +211,12 @@ double McreObjective::ValleySpacing() {
   return PredictedValleySpacing(traces, problem_->TraceWeights(), problem_->time_step());
 }
 
-void McreObjective::SetWarmStart(const Matrix& start) {
+void McreObjective::SetWarmStart(const Matrix& start, double reference_residual_norm) {
   assert((start.rows() == problem_->num_nodes() || start.rows() == problem_->num_traces()) &&
          start.cols() == problem_->num_steps() + 1);
   warm_start_ = start;
   warm_start_modulus_ = 0.0;
+  warm_start_reference_norm_ = std::max(reference_residual_norm, 0.0);
   previous_start_.resize(0, 0);
   previous_start_modulus_ = 0.0;
 }
@@ -254,7 +256,8 @@ const ObjectiveEvaluation& McreObjective::Solve(double modulus, bool gradient_re
   record.modulus = modulus;
   record.moduli = problem_->moduli();
   record.gradient_requested = gradient_requested;
-  record.inner = SolveCoupled(inner_, problem_.get(), initial, &solution_);
+  record.inner = SolveCoupled(inner_, problem_.get(), initial, &solution_,
+                              initial != nullptr ? warm_start_reference_norm_ : 0.0);
   record.usable = record.inner.IsSolutionUsable();
   if (record.usable && record.inner.at_round_off_floor) {
     // The floor this problem's sweeps reach: later solves accept within kFloorMargin of it.
@@ -276,6 +279,7 @@ const ObjectiveEvaluation& McreObjective::Solve(double modulus, bool gradient_re
     }
     warm_start_ = solution_.WarmStart();
     warm_start_modulus_ = modulus > 0.0 ? modulus : 0.0;
+    warm_start_reference_norm_ = 0.0;
     if (best_index_ < 0 || record.cost < evaluations_[best_index_].cost) {
       best_index_ = static_cast<int>(evaluations_.size());
       best_solution_ = solution_;

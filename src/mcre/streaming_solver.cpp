@@ -16,11 +16,14 @@
 // CG starts from the data, y_0 = d~, where the retrograde field vanishes: the
 // stored-field solvers' start W = 0, or from a warm start y^(0) (the previous
 // modulus's traces) when its residual is smaller in the W-norm below (three sweeps
-// for that residual and one for its norm, against three per iteration saved; a start
-// within the tolerance is accepted from that pass, with no iteration). Its
-// stopping test is the stored-field solvers' whatever the start: the residual
-// r = Phi(y) - y maps to their residual c - A W = R r at W = Retrograde(y) (R the
-// retrograde sweep driven by r without data), whose P-norm is
+// for that residual and one for its norm, against three per iteration saved; that
+// pass leaves the totals out, and a start within the tolerance is accepted with no
+// iteration, one more application of the map summing them). Given ||r_0||_W of a
+// nearby problem (the same modulus on the previous mesh, docs/multilevel.md), the
+// data start's residual and norm are computed only when the warm start's residual is
+// not below it. Its stopping test is the stored-field solvers' whatever the start: the
+// residual r = Phi(y) - y maps to their residual c - A W = R r at W = Retrograde(y)
+// (R the retrograde sweep driven by r without data), whose P-norm is
 //
 //   ||r||_W^2 = ||R r||_P^2 = <r, -L r>_beta = <r, (I - L) r>_beta - <r, r>_beta,
 //
@@ -92,8 +95,12 @@ class StreamingConjugateGradient {
       : options_(options), problem_(problem), solution_(solution), summary_(summary) {}
 
   // Solves from the data, or from initial_traces (nullable) when its residual is
-  // smaller; fills the solution and the summary.
-  void Solve(const Matrix* initial_traces);
+  // smaller; fills the solution and the summary. reference_residual_norm > 0 with
+  // initial_traces: ||r_0||_W of a nearby problem (SolveCoupled's), the data start then
+  // computed only when the warm start's residual is not below it.
+  void Solve(const Matrix* initial_traces, double reference_residual_norm);
+  // ||r_0||_W, the norm the relative residuals were measured against (0 before Solve).
+  double reference_residual_norm() const { return rhs_norm_; }
   // The summary's spectrum_min / spectrum_max: the Ritz extremes of the CG run before
   // the first restart, once it took a step.
   void ReportSpectrum() const { lanczos_.ReportTo(summary_); }
@@ -101,12 +108,16 @@ class StreamingConjugateGradient {
  private:
   // The final pass at y: the true residual Phi(y) - y = b - (I - L) y into `image`,
   // its W-norm relative to ||r_0||_W returned, and the sums of the fields in `totals`.
-  double FinalPass(const Matrix& y);
+  double FinalPass(const Matrix& y) { return ResidualPass(y, true); }
+  // The final pass's residual, with the totals or without them (a warm start's: its
+  // totals are wanted only when it is accepted as it is).
+  double ResidualPass(const Matrix& y, bool with_totals);
   // Converged with `message`: the solution takes the totals of the last final pass.
   void Accept(const std::string& message);
-  // Keeps the warm start when its residual is below the data's; true when it is
-  // accepted as it is (within the tolerance), the solve then done.
-  bool TryWarmStart(const Matrix& initial_traces);
+  // What became of a warm start: refused (its residual not below the data's, relative_),
+  // kept as CG's start, or accepted as it is (within the tolerance: the solve is done).
+  enum class WarmStartOutcome { kRefused, kKept, kAccepted };
+  WarmStartOutcome TryWarmStart(const Matrix& initial_traces);
   // L p into image, then q = (I - L) p; <p, -L p> and <p, q> returned through the
   // pointers. False (the summary says why) when <p, q> is not positive.
   bool ApplyToDirection(int iteration, double* direction_energy, double* curvature);
@@ -160,21 +171,39 @@ class StreamingConjugateGradient {
   ConjugateGradientLanczos lanczos_;
 };
 
-void StreamingConjugateGradient::Solve(const Matrix* initial_traces) {
+void StreamingConjugateGradient::Solve(const Matrix* initial_traces,
+                                       double reference_residual_norm) {
   solution_->displacement.resize(0, 0);
   solution_->retrograde.resize(0, 0);
-  // y_0 = d~: r_0 = b - (I - L) d~ = Phi(d~) - d~.
-  traces_ = problem_->DataTraces();
-  problem_->StreamingMap(traces_, true, &residual_);
-  residual_ -= traces_;
-  rhs_norm_ = std::sqrt(std::max(problem_->RetrogradeEnergy(residual_), 0.0));
   summary_->iterations = 0;
-  if (rhs_norm_ == 0.0) {
-    FinalPass(traces_);
-    Accept("the data are matched exactly: Phi(d~) = d~");
-    return;
+  WarmStartOutcome warm = WarmStartOutcome::kRefused;
+  if (initial_traces != nullptr && reference_residual_norm > 0.0) {
+    // ||r_0||_W given by a nearby problem: the data start is needed only when the warm
+    // start is not below it.
+    rhs_norm_ = reference_residual_norm;
+    warm = TryWarmStart(*initial_traces);
+    if (warm == WarmStartOutcome::kAccepted) return;
+    if (warm == WarmStartOutcome::kKept) {
+      start_note_ += ", measured against the given ||r_0||_W " + ScientificString(rhs_norm_);
+    }
   }
-  if (initial_traces != nullptr && TryWarmStart(*initial_traces)) return;
+  if (warm == WarmStartOutcome::kRefused) {
+    // y_0 = d~: r_0 = b - (I - L) d~ = Phi(d~) - d~.
+    traces_ = problem_->DataTraces();
+    problem_->StreamingMap(traces_, true, &residual_);
+    residual_ -= traces_;
+    rhs_norm_ = std::sqrt(std::max(problem_->RetrogradeEnergy(residual_), 0.0));
+    relative_ = 1.0;
+    if (rhs_norm_ == 0.0) {
+      FinalPass(traces_);
+      Accept("the data are matched exactly: Phi(d~) = d~");
+      return;
+    }
+    if (initial_traces != nullptr && reference_residual_norm <= 0.0 &&
+        TryWarmStart(*initial_traces) == WarmStartOutcome::kAccepted) {
+      return;
+    }
+  }
   preconditioned_ = options_.preconditioner == TracePreconditioner::kDenseTraces &&
                     problem_->PrepareTracePreconditioner(options_.preconditioner_rebuild_change,
                                                          options_.max_preconditioner_traces);
@@ -220,8 +249,8 @@ void StreamingConjugateGradient::Solve(const Matrix* initial_traces) {
   }
 }
 
-double StreamingConjugateGradient::FinalPass(const Matrix& y) {
-  problem_->StreamingMap(y, true, &image_, &totals_);
+double StreamingConjugateGradient::ResidualPass(const Matrix& y, bool with_totals) {
+  problem_->StreamingMap(y, true, &image_, with_totals ? &totals_ : nullptr);
   image_ -= y;
   return rhs_norm_ > 0.0 ? std::sqrt(std::max(problem_->RetrogradeEnergy(image_), 0.0)) / rhs_norm_
                          : 0.0;
@@ -244,26 +273,30 @@ void StreamingConjugateGradient::Accept(const std::string& message) {
   solution_->gap_density = totals_.gap_density;
 }
 
-bool StreamingConjugateGradient::TryWarmStart(const Matrix& initial_traces) {
-  // r^(0) = Phi(y^(0)) - y^(0), into `image` until it is kept; a final pass, so
-  // that a start already within the tolerance needs no other.
-  const double warm_relative = FinalPass(initial_traces);
+StreamingConjugateGradient::WarmStartOutcome StreamingConjugateGradient::TryWarmStart(
+    const Matrix& initial_traces) {
+  // r^(0) = Phi(y^(0)) - y^(0), into `image` until it is kept, without the totals: a
+  // start within the tolerance takes them from one more application of the map.
+  const double warm_relative = ResidualPass(initial_traces, false);
   spdlog::debug(
       "streaming CG: warm start's relative residual {:.3e} (the data's {:.3e}), {} sweeps",
       warm_relative, relative_, problem_->sweep_count());
-  if (!(warm_relative < relative_)) return false;
+  if (!(warm_relative < relative_)) return WarmStartOutcome::kRefused;
   traces_ = initial_traces;
   residual_.swap(image_);
   relative_ = warm_relative;
   start_note_ = "; from the warm start (relative residual " + ScientificString(warm_relative) + ")";
-  if (relative_ <= options_.tolerance && totals_.rebuild_error <= options_.max_rebuild_error) {
+  if (relative_ > options_.tolerance) return WarmStartOutcome::kKept;
+  // The totals of y^(0) and the rebuild's error; image_ is free (the residual is kept).
+  problem_->StreamingMap(traces_, true, &image_, &totals_);
+  if (totals_.rebuild_error <= options_.max_rebuild_error) {
     summary_->residual_history.push_back(relative_);
     summary_->relative_residual = relative_;
     Accept("relative residual " + ScientificString(relative_) + " <= tolerance " +
            ScientificString(options_.tolerance) + " at the start");
-    return true;
+    return WarmStartOutcome::kAccepted;
   }
-  return false;
+  return WarmStartOutcome::kKept;
 }
 
 bool StreamingConjugateGradient::ApplyToDirection(int iteration, double* direction_energy,
@@ -425,12 +458,13 @@ void StreamingConjugateGradient::StopAfterRestarts(double true_relative) {
 
 void SolveByStreamingConjugateGradient(const CoupledSolverOptions& options,
                                        StreamingCoupledProblem* problem,
-                                       const Matrix* initial_traces, CoupledSolution* solution,
-                                       CoupledSolverSummary* summary) {
+                                       const Matrix* initial_traces, double reference_residual_norm,
+                                       CoupledSolution* solution, CoupledSolverSummary* summary) {
   assert(initial_traces == nullptr || (initial_traces->rows() == problem->num_traces() &&
                                        initial_traces->cols() == problem->num_steps() + 1));
   StreamingConjugateGradient solver(options, problem, solution, summary);
-  solver.Solve(initial_traces);
+  solver.Solve(initial_traces, reference_residual_norm);
+  summary->reference_residual_norm = solver.reference_residual_norm();
   solver.ReportSpectrum();
 }
 

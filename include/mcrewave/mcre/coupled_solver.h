@@ -154,6 +154,10 @@ struct CoupledSolverSummary {
   int iterations = -1;                   // sweep pairs of the main iteration
   long sweeps = -1;                      // every direct or retrograde sweep, estimation included
   double relative_residual = -1.0;       // final ||c - A W||_P / ||c||_P
+  // ||c||_P, the residual at W = 0 that the relative residuals are measured against
+  // (the iterative solvers; -1 otherwise): the reference_residual_norm a warm start
+  // on a nearby problem may take (SolveCoupled).
+  double reference_residual_norm = -1.0;
   // The solve was accepted above the tolerance, at a round-off floor its restarts could
   // not lower (the streaming CG; relative_residual is that floor).
   bool at_round_off_floor = false;
@@ -232,7 +236,14 @@ struct CoupledSolution {
 // the data instead when they are farther from the solution. The direct solvers ignore
 // it. Precondition: options.IsValid(). The solution's fields are meaningful only when
 // the summary says so.
+// reference_residual_norm > 0 (streaming_conjugate_gradient with an initial_guess; the
+// others ignore it): ||c||_P of a nearby problem, the summary's reference_residual_norm
+// of the solve the warm start came from (the same modulus on the previous mesh of a
+// ladder, docs/multilevel.md). The relative residuals are then measured against it, and
+// the data start's residual and norm (4 sweeps) are computed only when the warm start's
+// residual is not below it.
 CoupledSolverSummary SolveCoupled(const CoupledSolverOptions& options, CoupledProblem* problem,
-                                  const Matrix* initial_guess, CoupledSolution* solution);
+                                  const Matrix* initial_guess, CoupledSolution* solution,
+                                  double reference_residual_norm = 0.0);
 
 }  // namespace mcrewave

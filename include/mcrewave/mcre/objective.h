@@ -217,7 +217,9 @@ class McreObjective : public ModulusObjective {
   // WarmStart(): a retrograde field of problem().ZeroField()'s shape, or the traces of
   // problem().ZeroTraces()'s for the streaming solver) instead of the last usable
   // solutions; later evaluations extrapolate from it once they have a second solution.
-  void SetWarmStart(const Matrix& start);
+  // reference_residual_norm > 0: the summary's reference_residual_norm of the solve that
+  // gave `start` (SolveCoupled's), taken by the next solve from it.
+  void SetWarmStart(const Matrix& start, double reference_residual_norm = 0.0);
 
   // Largest |t| of the extrapolated warm start (above: the last solution alone).
   static constexpr double kMaxExtrapolation = 2.0;
@@ -252,6 +254,7 @@ class McreObjective : public ModulusObjective {
   CoupledSolution solution_;             // of the last evaluation
   Matrix warm_start_;                    // W(E1) (or its traces), the last usable solution; empty: none
   double warm_start_modulus_ = 0.0;      // E1 [Pa]; 0 when W(E1) was set by SetWarmStart
+  double warm_start_reference_norm_ = 0.0;  // SetWarmStart's, until a solve is usable
   Matrix previous_start_;                // W(E0), the one before; empty: none
   double previous_start_modulus_ = 0.0;  // E0 [Pa]
   Matrix initial_;                       // the extrapolated W^(0)
