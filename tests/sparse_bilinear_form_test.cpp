@@ -1,8 +1,7 @@
 // Tests of SparseBilinearForm (linalg/sparse_bilinear_form.h): on a matrix touching few
 // dofs it is the dense x^T A y, its entries stored as 0 left out; on a matrix touching
-// every dof, the same bits as Eigen's
-// x.dot(A * y); Forms gives the three forms of a square matrix; a rectangular block of
-// reaction rows.
+// every dof, the same bits as Eigen's x.dot(A * y), and Forms the three forms of a
+// square matrix in one pass; a rectangular block of reaction rows.
 #include "mcrewave/linalg/sparse_bilinear_form.h"
 
 #include <gtest/gtest.h>
@@ -80,7 +79,7 @@ TEST(SparseBilinearFormTest, EntriesStoredAsZeroAreNotActive) {
   EXPECT_NEAR(form(x.data(), y.data()), expected, 2e-14 * std::abs(expected));
 }
 
-TEST(SparseBilinearFormTest, TouchingEveryDofItIsEigensProductToTheBit) {
+TEST(SparseBilinearFormTest, TouchingEveryDofTheFormIsEigensProductToTheBit) {
   std::mt19937 generator(5);
   const int n = 37;
   const SparseMatrix a = LocalBlock(n, 0, n, &generator);
@@ -89,12 +88,18 @@ TEST(SparseBilinearFormTest, TouchingEveryDofItIsEigensProductToTheBit) {
   const Vector x = RandomVector(n, &generator), y = RandomVector(n, &generator);
   const Vector product = a * y;
   EXPECT_EQ(form(x.data(), y.data()), x.dot(product));
+  // Forms sums over the entries in one pass, in another order than the products: apart
+  // by at most a few roundings of the sum of the terms' magnitudes, |x|^T |A| |y|
+  // (measured 3.3e-17, 1.3e-16 and 9.7e-17).
   double xx = 0.0, xy = 0.0, yy = 0.0;
   form.Forms(x.data(), y.data(), &xx, &xy, &yy);
-  const Vector x_product = a * x;
-  EXPECT_EQ(xx, x.dot(x_product));
-  EXPECT_EQ(xy, x.dot(product));
-  EXPECT_EQ(yy, y.dot(product));
+  const SparseMatrix magnitudes = a.cwiseAbs();
+  auto magnitude = [&magnitudes](const Vector& u, const Vector& v) {
+    return u.cwiseAbs().dot(magnitudes * v.cwiseAbs());
+  };
+  EXPECT_NEAR(xx, x.dot(a * x), 1e-15 * magnitude(x, x));
+  EXPECT_NEAR(xy, x.dot(product), 1e-15 * magnitude(x, y));
+  EXPECT_NEAR(yy, y.dot(product), 1e-15 * magnitude(y, y));
 }
 
 TEST(SparseBilinearFormTest, RectangularRowsTakeTheirEntries) {

@@ -367,6 +367,8 @@ void MatrixMcreProblem::SetModuli(const Vector& zone_moduli) {
     for (std::size_t z = 1; z < reaction_zone_rows_.size(); ++z) {
       reactions_ += moduli_[static_cast<Eigen::Index>(z)] * reaction_zone_rows_[z];
     }
+    // By rows for r(U_j) in the time loops: its few entries, not a pass over n columns.
+    reaction_rows_ = reactions_;
     const int num_fixed = static_cast<int>(fixed_observation_.rows());
     std::vector<Eigen::Triplet<double>> entries;
     for (const SparseMatrix* part : {&fixed_observation_, &reactions_}) {
@@ -527,7 +529,7 @@ void MatrixMcreProblem::ElementSensitivities(const Matrix& displacement, const M
 
 void MatrixMcreProblem::FormReactionMisfit(int j, const Eigen::Ref<const Vector>& displacement) {
   // r(U_j) - f~_j, the trusted supports' reactions against their data.
-  reaction_trace_.noalias() = reactions_ * displacement;
+  reaction_trace_.noalias() = reaction_rows_ * displacement;
   reaction_trace_ -= measured_outputs_.col(j).tail(num_reactions_);
 }
 
@@ -680,7 +682,7 @@ Matrix MatrixMcreProblem::ModelSupportForces() {
   Matrix forces(num_reactions_, num_steps() + 1);
   DataResponseSweep([&](int j, const Vector& displacement) {
     // r_s(U_j) = g_s^T K(E) U_j.
-    reaction_trace_.noalias() = reactions_ * displacement;
+    reaction_trace_.noalias() = reaction_rows_ * displacement;
     forces.col(j) = reaction_trace_;
   });
   return forces;

@@ -30,8 +30,8 @@ class SparseBilinearForm {
 
   // x^T A y: x has A's rows entries, y its columns'.
   double operator()(const double* x, const double* y);
-  // For a square A (a zone's K_z): x^T A x, x^T A y and y^T A y in one pass (two
-  // products when whole()).
+  // For a square A (a zone's K_z): x^T A x, x^T A y and y^T A y in one pass over
+  // its entries, whole() or not.
   void Forms(const double* x, const double* y, double* xx, double* xy, double* yy);
 
  private:
@@ -42,7 +42,7 @@ class SparseBilinearForm {
   std::vector<double> entry_value_;
   // whole(): A and the scratch of its products.
   SparseMatrix whole_matrix_;
-  Vector product_x_, product_y_;
+  Vector product_y_;
 };
 
 }  // namespace mcrewave

@@ -392,6 +392,7 @@ class MatrixMcreProblem : public StreamingCoupledProblem {
   // one of the element's dofs, the elements the reactions' sensitivity touches.
   std::vector<std::pair<int, int>> reaction_elements_;
   SparseMatrix reactions_;
+  SparseRow reaction_rows_;              // reactions_ stored by rows
   SparseMatrix observation_;             // H, S x n
   SparseMatrix observation_transposed_;  // H^T, n x S
   // G and H^T by columns: the sweeps' products G^T x and H x, and G c, H^T y as point
