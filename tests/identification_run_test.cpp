@@ -155,40 +155,64 @@ CoarseMeshComparison CompareWithOneMesh(const std::vector<std::string>& override
   return result;
 }
 
-// 200 elements from a coarse mesh of 50.
-void ExpectTheFineMeshsModulus(const std::vector<std::string>& overrides) {
-  const CoarseMeshComparison runs = CompareWithOneMesh(overrides, 50);
+// 200 elements from a coarse mesh of `coarse_elements`, in at most `max_evaluations`
+// refinement evaluations.
+CoarseMeshComparison ExpectTheFineMeshsModulus(const std::vector<std::string>& overrides,
+                                               int coarse_elements, int max_evaluations) {
+  CoarseMeshComparison runs = CompareWithOneMesh(overrides, coarse_elements);
   const IdentificationRun& one = runs.one;
   const IdentificationRun& two = runs.from_coarse;
-  ASSERT_TRUE(one.IsUsable()) << one.outer.FullReport();
-  ASSERT_TRUE(two.IsUsable()) << two.outer.FullReport();
+  EXPECT_TRUE(one.IsUsable()) << one.outer.FullReport();
+  EXPECT_TRUE(two.IsUsable()) << two.outer.FullReport();
+  if (!one.IsUsable() || !two.IsUsable()) return runs;
   EXPECT_FALSE(one.coarse_mesh.ran);
-  ASSERT_TRUE(two.coarse_mesh.ran);
-  // The coarse mesh's E lies 1e-4 from the fine one's; refined, within the outer
-  // tolerance (1e-7) of it.
-  EXPECT_GT(runs.coarse_shift, 1e-4);  // measured 5.3e-4
-  EXPECT_LT(runs.error, 5e-8);         // measured 7.0e-9 and 5.7e-9 (stored and streaming)
-  EXPECT_LE(two.coarse_mesh.refinement.evaluations, 4);
+  EXPECT_TRUE(two.coarse_mesh.ran);
+  // The coarse mesh's E lies 1e-4 or more from the fine one's; refined, within the
+  // outer tolerance (1e-7) of it.
+  // Measured: from 50 elements (stored), 5.3e-4 and 4.3e-8 in 3 evaluations; from 10
+  // (streaming), 8.8e-3 and 3.0e-9 in 7.
+  EXPECT_GT(runs.coarse_shift, 1e-4);
+  EXPECT_LT(runs.error, 1e-7);
+  EXPECT_LE(two.coarse_mesh.refinement.evaluations, max_evaluations);
   // The fields, maps and channels are the fine mesh's.
   EXPECT_EQ(two.config.model.elements, 200);
   EXPECT_EQ(two.model->dofs(), one.model->dofs());
   EXPECT_EQ(two.error_map.share.size(), one.error_map.share.size());
   EXPECT_EQ(two.evaluations[two.best_index].modulus, two.identified_modulus());
+  // The error map at E*: the one mesh's, at an E as close (measured 1.2e-6 and 2.9e-7
+  // apart in norm).
+  const double map_difference =
+      (two.error_map.share - one.error_map.share).norm() / one.error_map.share.norm();
+  EXPECT_LT(map_difference, 1e-5);
+  return runs;
 }
 
 TEST(TwoMeshTest, TheRefinementReachesTheFineMeshsMinimum) {
   ExpectTheFineMeshsModulus(
-      {"model.elements=200", "output.curve_points=5", "uncertainty.samples=2"});
+      {"model.elements=200", "output.curve_points=5", "uncertainty.samples=2"}, 50, 4);
 }
 
+// The ladder 10 -> 100 -> 200 by the streaming solver: the 100 elements' solve starts
+// from the 10 elements' traces, the 200 elements' from the 100's and with their ||c||_P
+// (no data start); the element maps are gathered on 200 elements only.
 TEST(TwoMeshTest, TheCoarseTracesWarmStartTheStreamingSolver) {
-  ExpectTheFineMeshsModulus({"model.elements=200", "output.curve_points=5", "uncertainty.samples=2",
-                             "inner.method=streaming_conjugate_gradient"});
+  const CoarseMeshComparison runs = ExpectTheFineMeshsModulus(
+      {"model.elements=200", "output.curve_points=5", "uncertainty.samples=2",
+       "inner.method=streaming_conjugate_gradient"},
+      10, 8);
+  const IdentificationRun& two = runs.from_coarse;
+  ASSERT_TRUE(two.IsUsable());
+  // run.evaluations holds the coarse run's and the last mesh's.
+  const auto given = std::count_if(
+      two.evaluations.begin(), two.evaluations.end(), [](const ObjectiveEvaluation& evaluation) {
+        return evaluation.inner.message.find("measured against the given") != std::string::npos;
+      });
+  EXPECT_EQ(given, 1);
 }
 
 // The ladder 10 -> 100 -> 1000 elements against 1000 alone: both stop when a secant
 // step is below outer.relative_tolerance (1e-7), so they agree within twice that
-// (measured 4.7e-8); the 10 elements' E lies 8.9e-3 away.
+// (measured 4.0e-8); the 10 elements' E lies 8.9e-3 away.
 TEST(TwoMeshTest, TheLadderOfMeshesReachesTheFineMeshsMinimum) {
   const CoarseMeshComparison runs = CompareWithOneMesh(
       {"model.elements=1000", "output.curve_points=5", "uncertainty.samples=2"}, 10);

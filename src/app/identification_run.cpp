@@ -554,7 +554,8 @@ IdentificationRun RunOnOneMesh(const Config& given, const ChannelSet& data) {
 // One treatment's E refined on one mesh of the ladder: the secant from the previous
 // mesh's E* within E* (1 -+ search.refine_window), its first step Newton's with
 // `curvature` [J s/Pa^2] (0: unknown), `warm_start` (empty: none) the previous mesh's
-// traces.
+// traces or W, `reference_residual_norm` (0: none) the ||c||_P of the solve that gave it
+// (SolveCoupled's); streaming solves gather the element maps when `element_maps`.
 struct MeshRefinement {
   std::unique_ptr<McreObjective> objective;
   IdentificationSummary summary;
@@ -565,12 +566,13 @@ struct MeshRefinement {
 
 MeshRefinement RefineOnMesh(const Config& config, const MatrixModelData& model,
                             const ChannelSet& data, double start_modulus, double curvature,
-                            const Matrix& warm_start, int max_evaluations, double max_time) {
+                            const Matrix& warm_start, double reference_residual_norm,
+                            bool element_maps, int max_evaluations, double max_time) {
   MeshRefinement level;
   level.objective = std::make_unique<McreObjective>(
       MatrixMcreObjective(model, data, config.mcre, config.time.theta, config.inner,
-                          Factorization::kAutomatic, start_modulus));
-  if (warm_start.size() > 0) level.objective->SetWarmStart(warm_start);
+                          Factorization::kAutomatic, start_modulus, element_maps));
+  if (warm_start.size() > 0) level.objective->SetWarmStart(warm_start, reference_residual_norm);
   IdentificationOptions options = config.outer;
   const double window = config.search.refine_window;
   options.optimizer = OptimizerType::kNlopt;
@@ -609,7 +611,7 @@ MeshRefinement RefineOnMesh(const Config& config, const MatrixModelData& model,
 
 // The inner tolerance of the refinements above the coarse mesh, relative to
 // outer.relative_tolerance (docs/multilevel.md gives what it moves E by).
-constexpr double kLadderInnerToleranceFactor = 10.0;
+constexpr double kLadderInnerToleranceFactor = 100.0;
 
 // The meshes the refinement climbs from the coarse mesh: 10, 100, ... times
 // model.coarse_elements below model.elements, then model.elements. Each mesh's E* lies
@@ -680,6 +682,10 @@ MeshRefinement ClimbTheLadder(const Config& config, const ChannelSet& data,
   std::shared_ptr<const MatrixModelData> previous_model = std::move(coarse_model);
   double modulus = coarse_modulus;
   const CoupledSolution* solution = &coarse_solution;
+  // ||c||_P of the solve that gave `solution` on a mesh of the ladder (0: the coarse run's,
+  // not kept). ||c||_P converges with the mesh: the next mesh's streaming solve measures
+  // its residuals against it instead of paying the data start's four sweeps.
+  double reference_residual_norm = 0.0;
   MeshRefinement level;
   for (const int elements : MeshLadder(coarse_elements, config.model.elements)) {
     Config mesh = config;
@@ -702,7 +708,8 @@ MeshRefinement ClimbTheLadder(const Config& config, const ChannelSet& data,
                                       level.objective.get(), streams, model->dofs())
             : Matrix();
     MeshRefinement next = RefineOnMesh(
-        mesh, *model, data, modulus, curvature, warm_start, max_evaluations - *evaluations,
+        mesh, *model, data, modulus, curvature, warm_start, reference_residual_norm,
+        /*element_maps=*/elements == config.model.elements, max_evaluations - *evaluations,
         max_time - std::chrono::duration<double>(Clock::now() - start).count());
     *evaluations += next.summary.evaluations;
     *sweeps += next.objective->sweeps();
@@ -718,6 +725,8 @@ MeshRefinement ClimbTheLadder(const Config& config, const ChannelSet& data,
     }
     modulus = level.summary.modulus;
     solution = &level.objective->best_solution();
+    reference_residual_norm =
+        level.objective->evaluations()[level.objective->best_index()].inner.reference_residual_norm;
     previous = mesh;
     previous_model = model;
     *fine_model = model;
