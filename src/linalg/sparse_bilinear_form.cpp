@@ -54,27 +54,22 @@ void SparseBilinearForm::Forms(const double* x, const double* y, double* xx, dou
   // by column, in one pass over A: whole() reads its compressed columns, in place of
   // two products and three dot products over the full vectors.
   double sum_xx = 0.0, sum_xy = 0.0, sum_yy = 0.0;
+  auto add = [&](double value, int row, int column) {
+    const double x_row = x[row], y_column = y[column];
+    sum_xx += value * x_row * x[column];
+    sum_xy += value * x_row * y_column;
+    sum_yy += value * y[row] * y_column;
+  };
   if (whole_) {
     const int* starts = whole_matrix_.outerIndexPtr();
     const int* rows = whole_matrix_.innerIndexPtr();
     const double* values = whole_matrix_.valuePtr();
     for (int column = 0; column < columns_; ++column) {
-      const double x_column = x[column], y_column = y[column];
-      for (int q = starts[column]; q < starts[column + 1]; ++q) {
-        const double value = values[q];
-        const double x_row = x[rows[q]];
-        sum_xx += value * x_row * x_column;
-        sum_xy += value * x_row * y_column;
-        sum_yy += value * y[rows[q]] * y_column;
-      }
+      for (int q = starts[column]; q < starts[column + 1]; ++q) add(values[q], rows[q], column);
     }
   } else {
     for (std::size_t q = 0; q < entry_value_.size(); ++q) {
-      const double x_row = x[entry_row_[q]], y_column = y[entry_column_[q]];
-      const double value = entry_value_[q];
-      sum_xx += value * x_row * x[entry_column_[q]];
-      sum_xy += value * x_row * y_column;
-      sum_yy += value * y[entry_row_[q]] * y_column;
+      add(entry_value_[q], entry_row_[q], entry_column_[q]);
     }
   }
   *xx = sum_xx;
