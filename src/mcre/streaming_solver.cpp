@@ -176,16 +176,13 @@ void StreamingConjugateGradient::Solve(const Matrix* initial_traces,
   solution_->displacement.resize(0, 0);
   solution_->retrograde.resize(0, 0);
   summary_->iterations = 0;
+  // ||r_0||_W given by a nearby problem: the warm start first, the data start only when
+  // it is refused. Otherwise the data start first, the warm start measured against it.
+  const bool given_reference = initial_traces != nullptr && reference_residual_norm > 0.0;
   WarmStartOutcome warm = WarmStartOutcome::kRefused;
-  if (initial_traces != nullptr && reference_residual_norm > 0.0) {
-    // ||r_0||_W given by a nearby problem: the data start is needed only when the warm
-    // start is not below it.
+  if (given_reference) {
     rhs_norm_ = reference_residual_norm;
     warm = TryWarmStart(*initial_traces);
-    if (warm == WarmStartOutcome::kAccepted) return;
-    if (warm == WarmStartOutcome::kKept) {
-      start_note_ += ", measured against the given ||r_0||_W " + ScientificString(rhs_norm_);
-    }
   }
   if (warm == WarmStartOutcome::kRefused) {
     // y_0 = d~: r_0 = b - (I - L) d~ = Phi(d~) - d~.
@@ -193,16 +190,16 @@ void StreamingConjugateGradient::Solve(const Matrix* initial_traces,
     problem_->StreamingMap(traces_, true, &residual_);
     residual_ -= traces_;
     rhs_norm_ = std::sqrt(std::max(problem_->RetrogradeEnergy(residual_), 0.0));
-    relative_ = 1.0;
     if (rhs_norm_ == 0.0) {
       FinalPass(traces_);
       Accept("the data are matched exactly: Phi(d~) = d~");
       return;
     }
-    if (initial_traces != nullptr && reference_residual_norm <= 0.0 &&
-        TryWarmStart(*initial_traces) == WarmStartOutcome::kAccepted) {
-      return;
-    }
+    if (initial_traces != nullptr && !given_reference) warm = TryWarmStart(*initial_traces);
+  }
+  if (warm == WarmStartOutcome::kAccepted) return;
+  if (warm == WarmStartOutcome::kKept && given_reference) {
+    start_note_ += ", measured against the given ||r_0||_W " + ScientificString(rhs_norm_);
   }
   preconditioned_ = options_.preconditioner == TracePreconditioner::kDenseTraces &&
                     problem_->PrepareTracePreconditioner(options_.preconditioner_rebuild_change,
