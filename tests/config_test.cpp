@@ -179,6 +179,7 @@ void ExpectSameConfigLaterKeys(const Config& expected, const Config& actual) {
   EXPECT_EQ(expected.structure.channel_map, actual.structure.channel_map);
   EXPECT_EQ(expected.data.truth_manifest, actual.data.truth_manifest);
   EXPECT_EQ(expected.data.truth_moduli, actual.data.truth_moduli);
+  EXPECT_EQ(expected.zone_identification.start_moduli, actual.zone_identification.start_moduli);
 }
 
 // The keys zone_identification.*.
@@ -844,15 +845,24 @@ inner:
   max_preconditioner_traces: 777
 )";
 
+// The zones' starts one per zone, refused with kEveryMatrixKeyNotAtItsDefault's
+// start_modulus.
+constexpr const char* kStartModuliKeyNotAtItsDefault = R"(model:
+  kind: matrix
+  manifest: m.yaml
+zone_identification:
+  start_moduli: [1.5e11, 2.5e11]
+)";
+
 TEST(ConfigTest, EveryKeyAtANonDefaultValueRoundTripsExactly) {
   const std::map<std::string, std::string> defaults = FlatKeys(ConfigToYaml(Config()));
   const std::map<std::string, std::string> documented = FlatKeys(DefaultConfigYaml());
   ASSERT_EQ(documented.size(), defaults.size());
   // Every key of the commented default config differs from its default in one of the
-  // three configs: a key added to the table but left out of all fails this test.
+  // four configs: a key added to the table but left out of all fails this test.
   std::map<std::string, int> set_somewhere;
-  for (const char* text :
-       {kEveryKeyNotAtItsDefault, kEveryMatrixKeyNotAtItsDefault, kEqualZonesKeyNotAtItsDefault}) {
+  for (const char* text : {kEveryKeyNotAtItsDefault, kEveryMatrixKeyNotAtItsDefault,
+                           kEqualZonesKeyNotAtItsDefault, kStartModuliKeyNotAtItsDefault}) {
     const Config config = ParseConfig(text, "every_key.yaml");
     const std::string yaml = ConfigToYaml(config);
     const std::map<std::string, std::string> keys = FlatKeys(yaml);
@@ -916,13 +926,13 @@ TEST(ConfigTest, AppliedConfigListsTheKeysOfItsModelKindOnly) {
     EXPECT_EQ(matrix_keys.count(key), 0u) << key;
     EXPECT_EQ(bar_keys.count(key), 1u) << key;
   }
-  // The bar reads all but the 9 matrix keys (the record's time column, origin and rest
-  // before it, and the zones' start modulus among them); a matrix run none of the
+  // The bar reads all but the 10 matrix keys (the record's time column, origin and rest
+  // before it, and the zones' start modulus and moduli among them); a matrix run none of the
   // section study:
   // and 15 single keys fewer (it reads the dense solvers' limits, Riccati and shooting
   // running on any model, the zones' regularisation and merging, and data.channels, the
   // manifest's sensors it uses).
-  EXPECT_EQ(bar_keys.size(), every.size() - 9);
+  EXPECT_EQ(bar_keys.size(), every.size() - 10);
   std::size_t sections = 0;
   for (const auto& [key, value] : every) {
     const std::string section = key.substr(0, key.find('.'));
@@ -961,6 +971,18 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
       {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  start_modulus: "
        "-1\n",
        "zone_identification.start_modulus must be 0 (the homogeneous stage's E*) or a modulus"},
+      {"zone_identification:\n  start_moduli: [1e11]\n",
+       "zone_identification.start_moduli applies to model.kind 'matrix'"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  start_moduli: "
+       "[2e11, 5e11]\n",
+       "kinds.yaml:5: zone_identification.start_moduli (5e+11 Pa) must lie strictly inside "
+       "[outer.lower_bound, outer.upper_bound] = [1e+11, 4e+11] Pa"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  start_moduli: "
+       "[-1]\n",
+       "zone_identification.start_moduli must hold positive moduli [Pa], got -1"},
+      {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  start_moduli: "
+       "[2e11]\n  start_modulus: 2e11\n",
+       "zone_identification.start_moduli and start_modulus are both given: keep one"},
       {"model:\n  kind: matrix\n", "model.manifest must name the manifest"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  zone_count: 3\n",
        "model.zone_count applies to the bar only"},

@@ -745,7 +745,8 @@ INSTANTIATE_TEST_SUITE_P(
                  nullptr,
                  "",
                  2,
-                 {"{config}:2: uncertainty.samples must be an integer in [2, 1000], got 1"}},
+                 {"{config}:2: uncertainty.samples must be an integer in [2, 1000], or 0 for no "
+                  "estimate, got 1"}},
         BadInput{"overlapping_truth_zones",
                  "data:\n  truth_zones: [{start: 0.5, end: 0.8, modulus: 1.5e11}, "
                  "{start: 0.7, end: 0.9, modulus: 1e11}]\n",

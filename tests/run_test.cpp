@@ -169,6 +169,44 @@ TEST(RunTest, AStartModulusSkipsTheHomogeneousStage) {
   }
 }
 
+// zone_identification.start_moduli: one start per zone takes the path of start_modulus
+// (the same bits with equal starts); a list of the wrong length is refused naming the
+// key before any solve. uncertainty.samples 0 leaves the moduli's bits as they are and
+// says why no uncertainty is given.
+TEST(RunTest, StartModuliPerZoneAndNoUncertainty) {
+  const std::string folder = FreshDirectory("run_start_moduli");
+  Config config = QuickBarAsMatrices(folder);
+  config.zone_identification.start_modulus = 1.2e11;
+  const IdentificationRun one_for_all = IdentifyFromConfig(config);
+  ASSERT_TRUE(one_for_all.IsUsable()) << one_for_all.failure;
+  ASSERT_TRUE(one_for_all.zone_uncertainty.available) << one_for_all.zone_uncertainty.message;
+
+  config.zone_identification.start_modulus = 0.0;
+  config.zone_identification.start_moduli = {1.2e11};
+  config.uncertainty.samples = 0;
+  ASSERT_EQ(ConfigProblem(config), "");
+  const IdentificationRun per_zone = IdentifyFromConfig(config);
+  ASSERT_TRUE(per_zone.IsUsable()) << per_zone.failure;
+  EXPECT_FALSE(per_zone.homogeneous_ran);
+  EXPECT_EQ(per_zone.zones.summary.start_moduli[0], 1.2e11);
+  EXPECT_EQ(per_zone.identified_moduli[0], one_for_all.identified_moduli[0]);
+  EXPECT_EQ(per_zone.zones.summary.evaluations, one_for_all.zones.summary.evaluations);
+  EXPECT_FALSE(per_zone.zone_uncertainty.available);
+  EXPECT_EQ(per_zone.zone_uncertainty.message, kUncertaintyOffMessage);
+  EXPECT_EQ(per_zone.zone_uncertainty.sweeps, 0);
+
+  config.zone_identification.start_moduli = {1.2e11, 1.3e11};
+  try {
+    IdentifyFromConfig(config);
+    ADD_FAILURE() << "two start moduli for one zone were taken";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find("zone_identification.start_moduli has 2 moduli, the model has 1 zones"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
 TEST(RunTest, AStopRequestedEndsTheIdentificationAsAFailureThatSaysSo) {
   const Config config = LoadConfig(SourcePath("configs/quick.yaml"));
   RequestInterrupt();

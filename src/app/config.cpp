@@ -748,7 +748,8 @@ const std::vector<Key>& KeyTable() {
               &PrefilterOptions::at_rest_before_start, Boolean(), "",
               "every channel is 0 before the first sample: the filter starts from that rest"),
       MakeKey("uncertainty.samples", &Config::uncertainty, &UncertaintyOptions::samples,
-              PositiveInteger<int>(), "", "noise draws of the first-order std of E, in [2, 1000]"),
+              NonNegativeInteger(), "",
+              "noise draws of the first-order std of E, in [2, 1000]; 0: not estimated"),
       MakeKey("uncertainty.seed", &Config::uncertainty, &UncertaintyOptions::seed,
               UnsignedInteger(), "", "seed of those noise draws"),
       MakeKey("output.folder", &Config::output, &OutputOptions::folder, Text(), "",
@@ -903,6 +904,10 @@ const std::vector<Key>& KeyTable() {
       MakeKey("zone_identification.start_modulus", &Config::zone_identification,
               &ZoneIdentificationOptions::start_modulus, Number(), "Pa",
               "model.kind matrix: every zone starts here, no homogeneous stage (0: from E*)"),
+      MakeKey("zone_identification.start_moduli", &Config::zone_identification,
+              &ZoneIdentificationOptions::start_moduli, NumberList(), "Pa",
+              "model.kind matrix: zone z starts at the z-th, no homogeneous stage (empty: "
+              "start_modulus)"),
   };
   return table;
 }
@@ -988,6 +993,7 @@ std::string StructureKeysProblem(const Config& config) {
         {"data.time_origin", config.data.time_origin != 0.0},
         {"data.at_rest_before_record", config.data.at_rest_before_record},
         {"zone_identification.start_modulus", config.zone_identification.start_modulus != 0.0},
+        {"zone_identification.start_moduli", !config.zone_identification.start_moduli.empty()},
     };
     for (const auto& [key, set] : matrix_keys) {
       if (set) return std::string(key) + " applies to model.kind 'matrix' only (model.kind is 'bar')";
@@ -999,6 +1005,14 @@ std::string StructureKeysProblem(const Config& config) {
            " Pa) must lie strictly inside [outer.lower_bound, outer.upper_bound] = [" +
            FormatNumber(config.outer.lower_bound) + ", " + FormatNumber(config.outer.upper_bound) +
            "] Pa";
+  }
+  for (const double modulus : config.zone_identification.start_moduli) {
+    if (!(modulus > config.outer.lower_bound && modulus < config.outer.upper_bound)) {
+      return "zone_identification.start_moduli (" + FormatNumber(modulus) +
+             " Pa) must lie strictly inside [outer.lower_bound, outer.upper_bound] = [" +
+             FormatNumber(config.outer.lower_bound) + ", " +
+             FormatNumber(config.outer.upper_bound) + "] Pa";
+    }
   }
   // outer.functional: both run on a matrix model (least squares by
   // MatrixOutputErrorObjective, app/matrix_identification_run.h).
@@ -1841,10 +1855,16 @@ std::string ConfigToYaml(const Config& config) {
 }
 
 bool KeyApplies(const std::string& path, ModelKind kind) {
-  static const std::set<std::string> matrix_only = {
-      "model.manifest",      "model.channel_map",          "model.free_zones",
-      "data.truth_manifest", "data.truth_moduli",          "data.time_column",
-      "data.time_origin",    "data.at_rest_before_record", "zone_identification.start_modulus"};
+  static const std::set<std::string> matrix_only = {"model.manifest",
+                                                    "model.channel_map",
+                                                    "model.free_zones",
+                                                    "data.truth_manifest",
+                                                    "data.truth_moduli",
+                                                    "data.time_column",
+                                                    "data.time_origin",
+                                                    "data.at_rest_before_record",
+                                                    "zone_identification.start_modulus",
+                                                    "zone_identification.start_moduli"};
   if (kind == ModelKind::kBar) return matrix_only.count(path) == 0;
   // Whole sections, then single keys, that a matrix run does not read.
   static const std::set<std::string> bar_sections = {"study"};

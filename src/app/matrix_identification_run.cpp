@@ -414,17 +414,29 @@ bool IdentifyHomogeneousStageByLeastSquares(const Config& config, const MatrixMo
   return true;
 }
 
-// Whether the homogeneous stage runs: the zones share one nominal modulus, and no
-// zone_identification.start_modulus is given.
+// Whether the homogeneous stage runs: the zones share one nominal modulus, and neither
+// zone_identification.start_modulus nor start_moduli is given.
 bool RunsTheHomogeneousStage(const Config& config, const MatrixModelData& model) {
-  return config.zone_identification.start_modulus == 0.0 && SharesOneNominalModulus(model);
+  return config.zone_identification.start_modulus == 0.0 &&
+         config.zone_identification.start_moduli.empty() && SharesOneNominalModulus(model);
 }
 
-// The zones' start: zone_identification.start_modulus in every zone when given, E* after
-// the homogeneous stage, else the nominal moduli.
+// The zones' start: zone_identification.start_moduli, one per zone, or start_modulus in
+// every zone when given, E* after the homogeneous stage, else the nominal moduli. Throws
+// InputError when start_moduli does not hold one modulus per zone.
 Vector ZoneStart(const Config& config, const IdentificationRun& run) {
+  const std::vector<double>& starts = config.zone_identification.start_moduli;
+  const auto zones = run.nominal_moduli.size();
+  if (!starts.empty()) {
+    if (static_cast<Eigen::Index>(starts.size()) != zones) {
+      throw InputError(config.Name() + ": zone_identification.start_moduli has " +
+                       std::to_string(starts.size()) + " moduli, the model has " +
+                       std::to_string(zones) + " zones: give one per zone, in their order");
+    }
+    return Eigen::Map<const Vector>(starts.data(), zones);
+  }
   const double start = config.zone_identification.start_modulus;
-  if (start > 0.0) return Vector::Constant(run.nominal_moduli.size(), start);
+  if (start > 0.0) return Vector::Constant(zones, start);
   if (!run.homogeneous_ran) return run.nominal_moduli;
   return Vector::Constant(run.nominal_moduli.size(), run.identified_modulus());
 }

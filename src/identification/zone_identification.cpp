@@ -8,6 +8,7 @@
 #include <exception>
 #include <sstream>
 
+#include "mcrewave/core/format.h"
 #include "mcrewave/core/random.h"
 #include "mcrewave/least_squares/matrix_output_error_objective.h"
 
@@ -28,6 +29,23 @@ bool ZoneIdentificationOptions::IsValid(std::string* error) const {
           "zone_identification.start_modulus must be 0 (the homogeneous stage's E*) or a "
           "modulus [Pa], got " +
           std::to_string(start_modulus);
+    }
+    return false;
+  }
+  for (const double start : start_moduli) {
+    if (!(start > 0.0 && std::isfinite(start))) {
+      if (error != nullptr) {
+        *error = "zone_identification.start_moduli must hold positive moduli [Pa], got " +
+                 FormatNumber(start, kSixDigits);
+      }
+      return false;
+    }
+  }
+  if (!start_moduli.empty() && start_modulus != 0.0) {
+    if (error != nullptr) {
+      *error =
+          "zone_identification.start_moduli and start_modulus are both given: keep one (a "
+          "modulus per zone, or one for every zone)";
     }
     return false;
   }

@@ -9,9 +9,10 @@
 namespace mcrewave {
 
 bool UncertaintyOptions::IsValid(std::string* error) const {
-  if (samples >= 2 && samples <= 1000) return true;
+  if (samples == 0 || (samples >= 2 && samples <= 1000)) return true;
   if (error != nullptr) {
-    *error = "uncertainty.samples must be an integer in [2, 1000], got " + std::to_string(samples);
+    *error = "uncertainty.samples must be an integer in [2, 1000], or 0 for no estimate, got " +
+             std::to_string(samples);
   }
   return false;
 }
@@ -156,6 +157,10 @@ ModulusUncertainty EstimateModulusUncertainty(const UncertaintyOptions& options,
                                               int curvature_points) {
   assert(options.IsValid(nullptr) && model.zones.size() == 1);
   ModulusUncertainty result;
+  if (options.samples == 0) {
+    result.message = kUncertaintyOffMessage;
+    return result;
+  }
   result.noise = noise;
   result.curvature = curvature;
   result.curvature_points = curvature_points;

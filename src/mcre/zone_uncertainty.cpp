@@ -72,9 +72,13 @@ ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
                                         const CoupledSolverOptions& inner, const Vector& moduli,
                                         const CoupledSolution& solution, const NoiseLevels& noise,
                                         const Matrix* curvature) {
-  assert(options.samples >= 1 && moduli.size() == static_cast<Eigen::Index>(model.zones.size()));
+  assert(options.samples >= 0 && moduli.size() == static_cast<Eigen::Index>(model.zones.size()));
   ZoneUncertainty result;
   result.noise = noise;
+  if (options.samples == 0) {
+    result.message = kUncertaintyOffMessage;
+    return result;
+  }
   if (!(noise.displacement_std > 0.0 || noise.strain_std > 0.0 || noise.force_std > 0.0)) {
     result.message = "no noise to propagate (every noise level is 0)";
     return result;

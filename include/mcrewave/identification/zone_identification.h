@@ -58,6 +58,10 @@ struct ZoneIdentificationOptions {
   // 0: from the homogeneous stage's E* when the zones share one nominal modulus, else
   // from their nominal moduli.
   double start_modulus = 0.0;
+  // A structure given by matrices: zone z starts from start_moduli[z] [Pa], one per zone
+  // in the model's order, without the homogeneous stage (a coarser mesh's moduli, say);
+  // empty: start_modulus or E*. Not with start_modulus.
+  std::vector<double> start_moduli;
 
   // Messages name the zone_identification.* keys.
   bool IsValid(std::string* error) const;

@@ -30,11 +30,16 @@ namespace mcrewave {
 
 // The `uncertainty:` section of the config.
 struct UncertaintyOptions {
-  int samples = 16;        // noise draws, in [2, 1000]
+  // Noise draws, in [2, 1000]; 0: not estimated (EstimateModulusUncertainty and
+  // EstimateZoneUncertainty return at once, not available, saying so).
+  int samples = 16;
   std::uint64_t seed = 1;  // seed of the draws (independent of data.seed's noise)
 
   bool IsValid(std::string* error) const;
 };
+
+// The message of an uncertainty not estimated because uncertainty.samples is 0.
+inline constexpr const char* kUncertaintyOffMessage = "not estimated: uncertainty.samples is 0";
 
 // Standard deviations of white noise per quantity.
 struct NoiseLevels {

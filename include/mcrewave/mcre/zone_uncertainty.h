@@ -54,8 +54,9 @@ struct ZoneUncertainty {
 // A streaming solution (its traces, no fields) gives dg from one application of the
 // plus and minus problems' maps at y_d +- y_n. Not available (with a message) when no
 // level is positive, the solution holds neither fields nor traces, a solve is not usable, or H is
-// not positive definite. Precondition: options.samples >= 1 (one draw is the covariance of that
-// draw; the config asks for 2 to 1000, UncertaintyOptions::IsValid).
+// not positive definite, or options.samples is 0 (kUncertaintyOffMessage). Precondition:
+// options.samples >= 0 (one draw is the covariance of that draw; the config asks for 0 or
+// 2 to 1000, UncertaintyOptions::IsValid).
 ZoneUncertainty EstimateZoneUncertainty(const UncertaintyOptions& options,
                                         const MatrixModelData& model, const ChannelSet& data,
                                         const McreOptions& mcre, double theta,
