@@ -193,6 +193,7 @@ void ExpectSameConfigZoneIdentification(const Config& expected, const Config& ac
   EXPECT_EQ(zones.minimizer.max_evaluations, zones_again.minimizer.max_evaluations);
   EXPECT_EQ(zones.minimizer.max_time, zones_again.minimizer.max_time);
   EXPECT_EQ(zones.regularization.kind, zones_again.regularization.kind);
+  EXPECT_EQ(zones.neighbours, zones_again.neighbours);
   EXPECT_EQ(zones.regularization.weight, zones_again.regularization.weight);
   EXPECT_EQ(zones.regularization.tv_smoothing, zones_again.regularization.tv_smoothing);
   EXPECT_EQ(zones.regularization.max_weight, zones_again.regularization.max_weight);
@@ -793,6 +794,7 @@ zone_identification:
   max_evaluations: 321
   max_time: 12.5
   regularization: total_variation
+  neighbours: shared_nodes
   regularization_weight: 0.25
   weight_rule: discrepancy
   tv_smoothing: 0.002

@@ -59,6 +59,8 @@ TEST(TypesTest, EveryEnumRoundTripsThroughItsNameTable) {
   ExpectTableRoundTrips(kOuterAlgorithmNames, OuterAlgorithmToString, StringToOuterAlgorithm);
   ExpectTableRoundTrips(kRegularizationKindNames, RegularizationKindToString,
                         StringToRegularizationKind);
+  ExpectTableRoundTrips(kZoneNeighbourhoodNames, ZoneNeighbourhoodToString,
+                        StringToZoneNeighbourhood);
   ExpectTableRoundTrips(kWeightRuleNames, WeightRuleToString, StringToWeightRule);
   ExpectTableRoundTrips(kStudyKindNames, StudyKindToString, StringToStudyKind);
 }

@@ -10,10 +10,16 @@
 #include <limits>
 #include <map>
 #include <random>
+#include <string>
+#include <utility>
 #include <vector>
 
+#include "identify_binary.h"
+#include "mcrewave/app/config.h"
+#include "mcrewave/app/matrix_identification_run.h"
 #include "mcrewave/mcre/objective.h"
 #include "mcrewave/model/bar_model.h"
+#include "mcrewave/model/matrix_export.h"
 #include "mcrewave/model/simulation.h"
 #include "optimizer_choices.h"
 #include "test_problems.h"
@@ -73,6 +79,51 @@ struct InverseCrime {
 // outputs, and its f0 is the finite-element reaction, which the trusted clamp's
 // kinematic reaction does not reproduce exactly (docs/trusted_clamp.md section 1).
 McreOptions Mcre() { return testing::FreeFreeMcre(); }
+
+// The zones the penalty joins: on a bar the chain of consecutive zones (one shared node
+// each), on the many-zone plate's 16 x 4 grid of 3 x 3 Q4 elements every zone with
+// those it meets along an edge (4 nodes, 8 dofs: weight 1; 3 nodes where the clamp
+// takes one: 0.75) and at a corner (one node: 0.25).
+TEST(ZoneNeighboursTest, AChainOnTheBarAndEdgesAndCornersOnAGrid) {
+  const testing::SmallCase small =
+      MakeSmallCase(30, 10, std::numeric_limits<double>::infinity(), 1);
+  const BarModel zoned(small.bar, EqualZones(3).ElementZones(small.bar));
+  const std::vector<ZonePair> chain = ZoneNeighbours(BarMatrixModel(zoned, 200e9));
+  ASSERT_EQ(chain.size(), 2u);
+  for (int z = 0; z < 2; ++z) {
+    EXPECT_EQ(chain[z].first, z);
+    EXPECT_EQ(chain[z].second, z + 1);
+    EXPECT_EQ(chain[z].weight, 1.0);
+  }
+
+  const Config config = LoadConfig(testing::SourcePath("configs/plate_zones.yaml"));
+  const MatrixModelData plate = LoadMatrixModel(config);
+  ASSERT_EQ(plate.zones.size(), 64u);
+  std::map<std::string, int> zone_index;
+  for (std::size_t z = 0; z < plate.zones.size(); ++z)
+    zone_index[plate.zones[z].name] = static_cast<int>(z);
+  std::map<std::pair<int, int>, double> weight_of;
+  for (const ZonePair& pair : ZoneNeighbours(plate)) {
+    EXPECT_LT(pair.first, pair.second);
+    weight_of[{pair.first, pair.second}] = pair.weight;
+  }
+  auto weight = [&](int i, int j, int k, int l) {
+    int a = zone_index.at("grid_" + std::to_string(i) + "_" + std::to_string(j));
+    int b = zone_index.at("grid_" + std::to_string(k) + "_" + std::to_string(l));
+    if (a > b) std::swap(a, b);
+    const auto found = weight_of.find({a, b});
+    return found == weight_of.end() ? 0.0 : found->second;
+  };
+  // 15 x 4 edges along x, 16 x 3 along y, 2 x 15 x 3 corners: 198 pairs.
+  EXPECT_EQ(weight_of.size(), 198u);
+  EXPECT_EQ(weight(3, 1, 4, 1), 1.0);
+  EXPECT_EQ(weight(3, 1, 3, 2), 1.0);
+  EXPECT_EQ(weight(0, 1, 0, 2), 0.75);
+  EXPECT_EQ(weight(3, 1, 4, 2), 0.25);
+  EXPECT_EQ(weight(4, 1, 3, 2), 0.25);
+  EXPECT_EQ(weight(3, 1, 5, 1), 0.0);
+  EXPECT_EQ(weight(15, 0, 0, 1), 0.0);  // the chain's spurious pair of a grid's rows
+}
 
 TEST(ZoneMcreObjectiveTest, GradientInLogModuliMatchesCentralDifferences) {
   InverseCrime crime(40, 120, 10, SoftZoneModuli(10));

@@ -855,8 +855,16 @@ const std::vector<Key>& KeyTable() {
                                           RegularizationKind::kTotalVariation},
                                          RegularizationKindToString, StringToRegularizationKind),
           "",
-          "penalty on the jumps of log E between consecutive zones (along the bar, or in the "
-          "manifest's list)"),
+          "penalty on the jumps of log E between neighbouring zones (zone_identification."
+          "neighbours)"),
+      MakeKey("zone_identification.neighbours", &Config::zone_identification,
+              &ZoneIdentificationOptions::neighbours,
+              EnumByName<ZoneNeighbourhood>(
+                  {ZoneNeighbourhood::kOrder, ZoneNeighbourhood::kSharedNodes},
+                  ZoneNeighbourhoodToString, StringToZoneNeighbourhood),
+              "",
+              "the penalty's neighbours: consecutive zones in the model's order (along the bar, "
+              "or the manifest's list), or zones sharing a node (a 2-D or 3-D layout)"),
       MakeKey("zone_identification.regularization_weight", &Config::zone_identification,
               &ZoneIdentificationOptions::regularization, &RegularizationOptions::weight, Number(),
               "", "lambda of the penalty; < 0: by weight_rule"),

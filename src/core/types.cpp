@@ -115,6 +115,12 @@ bool StringToOuterAlgorithm(const std::string& name, OuterAlgorithm* algorithm) 
   return internal::FromName(kOuterAlgorithmNames, name, algorithm);
 }
 
+const char* ZoneNeighbourhoodToString(ZoneNeighbourhood neighbourhood) {
+  return internal::ToName(kZoneNeighbourhoodNames, neighbourhood);
+}
+bool StringToZoneNeighbourhood(const std::string& name, ZoneNeighbourhood* neighbourhood) {
+  return internal::FromName(kZoneNeighbourhoodNames, name, neighbourhood);
+}
 const char* RegularizationKindToString(RegularizationKind kind) { return internal::ToName(kRegularizationKindNames, kind); }
 bool StringToRegularizationKind(const std::string& name, RegularizationKind* kind) {
   return internal::FromName(kRegularizationKindNames, name, kind);

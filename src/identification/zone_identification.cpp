@@ -7,6 +7,8 @@
 #include <cmath>
 #include <exception>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "mcrewave/core/format.h"
 #include "mcrewave/core/random.h"
@@ -136,6 +138,47 @@ class RecordingObjective : public FirstOrderObjective {
   std::vector<ZoneEvaluation>* history_;
 };
 
+}  // namespace
+
+std::vector<ZonePair> ZoneNeighbours(const MatrixModelData& model) {
+  // Every (a, b), a < b, once per dof that both zones' stiffness touches.
+  std::vector<std::vector<int>> zones_of_dof(static_cast<std::size_t>(model.dofs()));
+  for (std::size_t z = 0; z < model.zones.size(); ++z) {
+    const SparseMatrix& stiffness = model.zones[z].stiffness;
+    for (int column = 0; column < stiffness.outerSize(); ++column) {
+      for (SparseMatrix::InnerIterator entry(stiffness, column); entry; ++entry) {
+        if (entry.value() != 0.0) {
+          zones_of_dof[static_cast<std::size_t>(column)].push_back(static_cast<int>(z));
+          break;
+        }
+      }
+    }
+  }
+  std::vector<std::pair<int, int>> shared;
+  for (const std::vector<int>& zones : zones_of_dof) {
+    for (std::size_t i = 0; i < zones.size(); ++i) {
+      for (std::size_t j = i + 1; j < zones.size(); ++j) shared.emplace_back(zones[i], zones[j]);
+    }
+  }
+  std::sort(shared.begin(), shared.end());
+  std::vector<ZonePair> pairs;
+  std::vector<int> counts;
+  for (std::size_t k = 0; k < shared.size(); ++k) {
+    if (k == 0 || shared[k] != shared[k - 1]) {
+      pairs.push_back(ZonePair{shared[k].first, shared[k].second, 1.0});
+      counts.push_back(0);
+    }
+    ++counts.back();
+  }
+  const int most = counts.empty() ? 1 : *std::max_element(counts.begin(), counts.end());
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    pairs[k].weight = static_cast<double>(counts[k]) / most;
+  }
+  return pairs;
+}
+
+namespace {
+
 // A start of e^2 / J_rest at most this is a minimum already: the admissible fields meet
 // the data to a relative gap of 1e-10, round-off (noise-free data of the model at the
 // start; BoundedMinimizerOptions::matched_cost).
@@ -149,9 +192,9 @@ constexpr double kMatchedRelativeCost = 1e-20;
 // a bound. When the target's noise cost is not usable the summary says so and nothing is
 // minimised.
 template <typename NoiseCost>
-void MinimizeOverZones(const ZoneIdentificationOptions& options, LogModuliObjective* zone_objective,
-                       double lower_bound, double upper_bound, NoiseCost&& expected_noise_cost,
-                       ZoneIdentificationSummary* summary) {
+void MinimizeOverZones(const ZoneIdentificationOptions& options, const MatrixModelData& model,
+                       LogModuliObjective* zone_objective, double lower_bound, double upper_bound,
+                       NoiseCost&& expected_noise_cost, ZoneIdentificationSummary* summary) {
   const Vector& reference = zone_objective->reference_moduli();
   const int zones = static_cast<int>(reference.size());
   std::vector<double> lower(zones), upper(zones), initial(zones);
@@ -181,8 +224,12 @@ void MinimizeOverZones(const ZoneIdentificationOptions& options, LogModuliObject
   }
   BoundedMinimizerOptions minimizer = options.minimizer;
   if (!summary->least_squares) minimizer.matched_cost = kMatchedRelativeCost;
-  summary->regularized = MinimizeRegularized(minimizer, options.regularization, &recorder, lower,
-                                             upper, initial, target);
+  RegularizationOptions regularization = options.regularization;
+  if (options.neighbours == ZoneNeighbourhood::kSharedNodes) {
+    regularization.neighbours = ZoneNeighbours(model);
+  }
+  summary->regularized =
+      MinimizeRegularized(minimizer, regularization, &recorder, lower, upper, initial, target);
   const RegularizedMinimization& result = summary->regularized;
   summary->termination = result.minimizer.termination;
   summary->message = result.minimizer.message;
@@ -303,7 +350,7 @@ void IdentifyOnMcreObjective(const ZoneIdentificationOptions& options, const Mat
   summary->cost_scale = objective->cost_scale();
   ZoneMcreObjective zone_objective(objective, reference_moduli);
   MinimizeOverZones(
-      options, &zone_objective, lower_bound, upper_bound,
+      options, model, &zone_objective, lower_bound, upper_bound,
       [&] {
         return ExpectedNoiseCost(model, data, mcre, theta, inner, summary->start_moduli,
                                  summary->noise, prefilter, options.noise_samples,
@@ -328,7 +375,7 @@ void IdentifyOnOutputError(const ZoneIdentificationOptions& options, const Matri
   summary->cost_scale = objective->cost_scale();
   summary->homogeneous_cost = objective->Cost(summary->start_moduli, nullptr);
   MinimizeOverZones(
-      options, objective, lower_bound, upper_bound,
+      options, model, objective, lower_bound, upper_bound,
       [&] {
         return ExpectedLeastSquaresNoiseCost(
             model, data, misfit_levels, theta, summary->start_moduli, summary->noise, prefilter,

@@ -23,7 +23,8 @@ BoundedMinimizerSummary MinimizeAt(const BoundedMinimizerOptions& options,
                                    const std::vector<double>& start, double weight,
                                    double target_misfit, RegularizedMinimization* result,
                                    RegularizedPoint* point) {
-  RegularizedObjective objective(data, regularization.kind, weight, regularization.tv_smoothing);
+  RegularizedObjective objective(data, regularization.kind, weight, regularization.tv_smoothing,
+                                 regularization.neighbours);
   BoundedMinimizerSummary summary = MinimizeWithinBounds(options, &objective, lower, upper, start);
   result->evaluations += summary.evaluations;
   *point = RegularizedPoint();
@@ -33,17 +34,20 @@ BoundedMinimizerSummary MinimizeAt(const BoundedMinimizerOptions& options,
   if (!summary.x.empty() && weight == 0.0) {
     // Without a penalty the minimiser's cost is the data cost at its minimiser.
     point->misfit = summary.cost;
-    point->roughness = JumpPenalty(regularization.kind, 1.0, regularization.tv_smoothing,
-                                   summary.x.data(), static_cast<int>(summary.x.size()), nullptr);
+    point->roughness =
+        JumpPenalty(regularization.kind, 1.0, regularization.tv_smoothing, summary.x.data(),
+                    static_cast<int>(summary.x.size()), nullptr, &regularization.neighbours);
   } else if (!summary.x.empty()) {
     // The parts at the best point: evaluate once more without the gradient (the
     // objective's last evaluation need not be the best one).
     double cost = 0.0;
-    RegularizedObjective parts(data, regularization.kind, weight, regularization.tv_smoothing);
+    RegularizedObjective parts(data, regularization.kind, weight, regularization.tv_smoothing,
+                               regularization.neighbours);
     if (parts.Evaluate(summary.x.data(), &cost, nullptr)) {
       point->misfit = parts.last_data_cost();
-      point->roughness = JumpPenalty(regularization.kind, 1.0, regularization.tv_smoothing,
-                                     summary.x.data(), static_cast<int>(summary.x.size()), nullptr);
+      point->roughness =
+          JumpPenalty(regularization.kind, 1.0, regularization.tv_smoothing, summary.x.data(),
+                      static_cast<int>(summary.x.size()), nullptr, &regularization.neighbours);
       ++result->evaluations;
     } else {
       summary.termination = TerminationType::kFailure;
@@ -89,6 +93,11 @@ bool RegularizationOptions::IsValid(std::string* error) const {
   } else if (!(discrepancy_factor > 0.0 && std::isfinite(discrepancy_factor))) {
     why << "zone_identification.discrepancy_factor must be a positive number, got "
         << discrepancy_factor;
+  } else if (std::any_of(neighbours.begin(), neighbours.end(), [](const ZonePair& pair) {
+               return pair.first < 0 || pair.second < 0 || pair.first == pair.second ||
+                      !(pair.weight > 0.0 && std::isfinite(pair.weight));
+             })) {
+    why << "the zones' neighbour pairs must join two distinct zones with a positive weight";
   } else {
     return true;
   }
@@ -97,11 +106,19 @@ bool RegularizationOptions::IsValid(std::string* error) const {
 }
 
 double JumpPenalty(RegularizationKind kind, double weight, double tv_smoothing, const double* p,
-                   int n, double* gradient) {
+                   int n, double* gradient, const std::vector<ZonePair>* neighbours) {
   if (kind == RegularizationKind::kNone || weight == 0.0) return 0.0;
+  const bool chain = neighbours == nullptr || neighbours->empty();
+  const int pairs = chain ? std::max(n - 1, 0) : static_cast<int>(neighbours->size());
   double penalty = 0.0;
-  for (int z = 0; z + 1 < n; ++z) {
-    const double d = p[z + 1] - p[z];
+  for (int k = 0; k < pairs; ++k) {
+    // The chain's pair k is (k, k + 1) of weight 1 (a product by 1 is exact: the chain's
+    // bits whichever way it is given).
+    const int a = chain ? k : (*neighbours)[k].first;
+    const int b = chain ? k + 1 : (*neighbours)[k].second;
+    const double pair_weight = chain ? 1.0 : (*neighbours)[k].weight;
+    assert(a >= 0 && a < n && b >= 0 && b < n && a != b);
+    const double d = p[b] - p[a];
     double phi = 0.0;
     double dphi = 0.0;  // phi'(d)
     if (kind == RegularizationKind::kTikhonov) {
@@ -112,24 +129,30 @@ double JumpPenalty(RegularizationKind kind, double weight, double tv_smoothing, 
       phi = root - tv_smoothing;
       dphi = d / root;
     }
-    penalty += phi;
+    penalty += pair_weight * phi;
     if (gradient != nullptr) {
-      // d phi(p_{z+1} - p_z) / d p_{z+1} = phi',  / d p_z = -phi'
-      gradient[z + 1] += weight * dphi;
-      gradient[z] -= weight * dphi;
+      // d w phi(p_b - p_a) / d p_b = w phi',  / d p_a = -w phi'
+      gradient[b] += weight * (pair_weight * dphi);
+      gradient[a] -= weight * (pair_weight * dphi);
     }
   }
   return weight * penalty;
 }
 
 RegularizedObjective::RegularizedObjective(FirstOrderObjective* data, RegularizationKind kind,
-                                           double weight, double tv_smoothing)
-    : data_(data), kind_(kind), weight_(weight), tv_smoothing_(tv_smoothing) {}
+                                           double weight, double tv_smoothing,
+                                           std::vector<ZonePair> neighbours)
+    : data_(data),
+      kind_(kind),
+      weight_(weight),
+      tv_smoothing_(tv_smoothing),
+      neighbours_(std::move(neighbours)) {}
 
 bool RegularizedObjective::Evaluate(const double* x, double* cost, double* gradient) {
   double data_cost = 0.0;
   if (!data_->Evaluate(x, &data_cost, gradient)) return false;
-  const double penalty = JumpPenalty(kind_, weight_, tv_smoothing_, x, num_parameters(), gradient);
+  const double penalty =
+      JumpPenalty(kind_, weight_, tv_smoothing_, x, num_parameters(), gradient, &neighbours_);
   last_data_cost_ = data_cost;
   last_penalty_ = penalty;
   *cost = data_cost + penalty;

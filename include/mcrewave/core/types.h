@@ -355,6 +355,18 @@ inline constexpr std::array<std::pair<RegularizationKind, const char*>, 3> kRegu
 const char* RegularizationKindToString(RegularizationKind kind);
 bool StringToRegularizationKind(const std::string& name, RegularizationKind* kind);
 
+// Which zones' jumps of log E the penalty counts.
+enum class ZoneNeighbourhood {
+  kOrder,        // consecutive zones in the model's order (along the bar)
+  kSharedNodes,  // zones whose stiffness shares a node, weighted by the dofs shared
+};
+inline constexpr std::array<std::pair<ZoneNeighbourhood, const char*>, 2> kZoneNeighbourhoodNames{{
+    {ZoneNeighbourhood::kOrder, "order"},
+    {ZoneNeighbourhood::kSharedNodes, "shared_nodes"},
+}};
+const char* ZoneNeighbourhoodToString(ZoneNeighbourhood neighbourhood);
+bool StringToZoneNeighbourhood(const std::string& name, ZoneNeighbourhood* neighbourhood);
+
 // How an automatic weight is chosen.
 enum class WeightRule {
   kLCurve,       // the L-curve's corner, down to the first weight that meets the target

@@ -39,6 +39,10 @@ namespace mcrewave {
 struct ZoneIdentificationOptions {
   BoundedMinimizerOptions minimizer;
   RegularizationOptions regularization;
+  // The zones whose jumps the penalty counts: consecutive zones in the model's order (the
+  // bar's chain), or the zones that share a node (ZoneNeighbours: a 2-D or 3-D layout's
+  // edges and faces).
+  ZoneNeighbourhood neighbours = ZoneNeighbourhood::kOrder;
   // Noise draws of the discrepancy target (ExpectedNoiseCost; least squares:
   // ExpectedLeastSquaresNoiseCost).
   int noise_samples = 4;
@@ -128,6 +132,15 @@ double ExpectedLeastSquaresNoiseCost(const MatrixModelData& model, const Channel
                                      const Vector& moduli, const NoiseLevels& noise,
                                      const PrefilterOptions& prefilter, int samples,
                                      std::uint64_t seed, double cost_scale);
+
+// The zones whose jumps of log E the penalty counts (RegularizationOptions::neighbours):
+// zones a < b are neighbours when their stiffness matrices K_a and K_b both touch a dof
+// (a node of both), the pair's weight the dofs they share over the most that any pair
+// shares, so that an interface counts by its size: in 2-D zones that meet along an edge
+// of k elements weigh by its k + 1 nodes, zones that meet at a corner by one node, and
+// the zones of a bar, consecutive zones sharing one node, form the chain (z, z + 1) of
+// weight 1. In order of (first, second).
+std::vector<ZonePair> ZoneNeighbours(const MatrixModelData& model);
 
 // Identifies the zone moduli of `model` (its zones; the bar's: BarRunModel of the zoned
 // bar) from `data` (as the objective sees them: pre-filtered when the pre-filter is on),

@@ -39,6 +39,13 @@
 
 namespace mcrewave {
 
+// Two zones whose jump of log E the penalty counts, and the weight of their interface.
+struct ZonePair {
+  int first = 0;
+  int second = 0;
+  double weight = 1.0;
+};
+
 // The `zone_identification.*` options.
 struct RegularizationOptions {
   RegularizationKind kind = RegularizationKind::kTikhonov;
@@ -66,23 +73,28 @@ struct RegularizationOptions {
   double weight_tolerance = 0.25;
   // tau of the target misfit tau * (expected e^2 of the noise).
   double discrepancy_factor = 1.0;
+  // Not a config key: the zones whose jumps the penalty counts, set from the structure
+  // (ZoneNeighbours, identification/zone_identification.h). Empty: the chain (z, z + 1)
+  // of weight 1, the zones in order along a bar.
+  std::vector<ZonePair> neighbours;
 
   // Messages name the zone_identification.* keys.
   bool IsValid(std::string* error) const;
 };
 
-// lambda sum_z phi(p_{z+1} - p_z) over n parameters; when gradient is not null the
+// lambda sum_(a,b) w_ab phi(p_b - p_a) over the pairs `neighbours` of n parameters (null
+// or empty: the chain lambda sum_z phi(p_{z+1} - p_z)); when gradient is not null the
 // penalty's gradient is ADDED to gradient[0..n).
 double JumpPenalty(RegularizationKind kind, double weight, double tv_smoothing, const double* p,
-                   int n, double* gradient);
+                   int n, double* gradient, const std::vector<ZonePair>* neighbours = nullptr);
 
 // The data objective plus the penalty. Keeps the two parts of its last usable
 // evaluation apart.
 class RegularizedObjective : public FirstOrderObjective {
  public:
-  // data must outlive this objective.
+  // data must outlive this objective; neighbours as JumpPenalty's (empty: the chain).
   RegularizedObjective(FirstOrderObjective* data, RegularizationKind kind, double weight,
-                       double tv_smoothing);
+                       double tv_smoothing, std::vector<ZonePair> neighbours = {});
   int num_parameters() const override { return data_->num_parameters(); }
   bool Evaluate(const double* x, double* cost, double* gradient) override;
   std::string error_message() const override { return data_->error_message(); }
@@ -98,6 +110,7 @@ class RegularizedObjective : public FirstOrderObjective {
   RegularizationKind kind_;
   double weight_;
   double tv_smoothing_;
+  std::vector<ZonePair> neighbours_;
   double last_data_cost_ = 0.0;
   double last_penalty_ = 0.0;
 };
