@@ -1314,7 +1314,7 @@ std::string WriteStudiesReadme(const std::string& folder) {
         "section below is the `summary.md` of its folder.\n\n";
   for (const char* study : {"robustness", "relaxation", "cost_curves", "damage", "comparator",
                             "robustness_settings", "complexity", "weights", "plate", "plate_zones",
-                            "plate_sensors", "beam3d", "real", "plate_basin"}) {
+                            "plate_sensors", "beam3d", "beam3d/fine", "real", "plate_basin"}) {
     const std::string summary = folder + "/" + study + "/summary.md";
     std::ifstream file(summary);
     if (!file) continue;
