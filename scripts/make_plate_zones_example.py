@@ -38,6 +38,10 @@ mass sums to rho t L H, and one element's blocks match the textbook Q4 matrices 
 scripts/make_plate_example.py (an independent assembly) to 1e-12.
 
 Usage: /usr/bin/python3 scripts/make_plate_zones_example.py [--output configs/plate_zones]
+           [--model-elements NX NY]
+       --model-elements: another model mesh (default 48 12, the committed files), its
+           truths REFINE times finer, written to --output (docs/matrix_models.md section 14
+           refits the soft inclusion on 96 x 24).
 """
 
 import argparse
@@ -323,7 +327,13 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--output", default=os.path.join(os.path.dirname(__file__), "..",
                                                          "configs", "plate_zones"))
+    parser.add_argument("--model-elements", nargs=2, type=int, default=list(MODEL_ELEMENTS),
+                        metavar=("NX", "NY"), help="the model's mesh (default 48 12)")
     args = parser.parse_args()
+    if min(args.model_elements) < 1 or any(n % m for n, m in zip(args.model_elements, (48, 12))):
+        parser.error("--model-elements must be multiples of 48 and 12 (the point sensors sit "
+                     "on nodes of the committed 48 x 12 mesh)")
+    MODEL_ELEMENTS = tuple(args.model_elements)
     output.set_output(quiet=True)
     write_model(os.path.join(args.output, "model"))
     write_truths(os.path.join(args.output, "truth"))
