@@ -1007,16 +1007,19 @@ std::string StructureKeysProblem(const Config& config) {
       if (set) return std::string(key) + " applies to model.kind 'matrix' only (model.kind is 'bar')";
     }
   }
-  const double start = config.zone_identification.start_modulus;
-  if (start != 0.0 && !(start > config.outer.lower_bound && start < config.outer.upper_bound)) {
-    return "zone_identification.start_modulus (" + FormatNumber(start) +
-           " Pa) must lie strictly inside [outer.lower_bound, outer.upper_bound] = [" +
-           FormatNumber(config.outer.lower_bound) + ", " + FormatNumber(config.outer.upper_bound) +
-           "] Pa";
+  // Every start modulus (start_modulus when given, each of start_moduli) strictly inside
+  // the bounds.
+  std::vector<std::pair<const char*, double>> starts;
+  if (config.zone_identification.start_modulus != 0.0) {
+    starts.emplace_back("zone_identification.start_modulus",
+                        config.zone_identification.start_modulus);
   }
   for (const double modulus : config.zone_identification.start_moduli) {
+    starts.emplace_back("zone_identification.start_moduli", modulus);
+  }
+  for (const auto& [key, modulus] : starts) {
     if (!(modulus > config.outer.lower_bound && modulus < config.outer.upper_bound)) {
-      return "zone_identification.start_moduli (" + FormatNumber(modulus) +
+      return std::string(key) + " (" + FormatNumber(modulus) +
              " Pa) must lie strictly inside [outer.lower_bound, outer.upper_bound] = [" +
              FormatNumber(config.outer.lower_bound) + ", " +
              FormatNumber(config.outer.upper_bound) + "] Pa";
