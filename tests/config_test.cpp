@@ -203,6 +203,7 @@ void ExpectSameConfigZoneIdentification(const Config& expected, const Config& ac
   EXPECT_EQ(zones.regularization.weight_tolerance,
             zones_again.regularization.weight_tolerance);
   EXPECT_EQ(zones.regularization.discrepancy_factor, zones_again.regularization.discrepancy_factor);
+  EXPECT_EQ(zones.regularization.floor_margin, zones_again.regularization.floor_margin);
   EXPECT_EQ(zones.noise_samples, zones_again.noise_samples);
   EXPECT_EQ(zones.noise_seed, zones_again.noise_seed);
   EXPECT_EQ(zones.merge_zones, zones_again.merge_zones);
@@ -804,6 +805,7 @@ zone_identification:
   refinement_steps: 5
   weight_tolerance: 0.5
   discrepancy_factor: 1.5
+  floor_margin: noise_fit
   noise_samples: 6
   noise_seed: 7
   merge_zones: true
@@ -985,6 +987,9 @@ TEST(ConfigTest, KeysOfTheOtherKindOfStructureAreRefusedNamingTheKey) {
       {"model:\n  kind: matrix\n  manifest: m.yaml\nzone_identification:\n  start_moduli: "
        "[2e11]\n  start_modulus: 2e11\n",
        "zone_identification.start_moduli and start_modulus are both given: keep one"},
+      {"zone_identification:\n  floor_margin: noise_fit\n  noise_samples: 1\n",
+       "zone_identification.floor_margin noise_fit takes the noise's spread from its draws: set "
+       "zone_identification.noise_samples to 2 or more"},
       {"model:\n  kind: matrix\n", "model.manifest must name the manifest"},
       {"model:\n  kind: matrix\n  manifest: m.yaml\n  zone_count: 3\n",
        "model.zone_count applies to the bar only"},

@@ -247,6 +247,46 @@ TEST(DiscrepancyPrincipleTest, AnUnreachableTargetFallsBackToTheMisfitFloor) {
   EXPECT_LT(result.misfit, 1.1 * result.misfit_floor);
 }
 
+// floor_margin noise_fit on the problem above: the floor F (the misfit at the lightest
+// weight, 0.01) + (n + 2 sqrt(2 n)) s^2 / (2 m) for n = 3 parameters, the target's mean
+// m = 1 and its draws' standard deviation s; F + 0.1 lies below weight 1's misfit, so the
+// regula falsi brings the weight below 1, where ten_percent keeps 1. Without s the
+// margin is ten_percent's.
+TEST(DiscrepancyPrincipleTest, TheNoiseFitMarginHoldsTheFloorToWhatTheParametersFit) {
+  Eigen::MatrixXd a = Eigen::MatrixXd::Identity(6, 3);
+  Eigen::VectorXd b(6);
+  b << 1, 2, 3, 4, 5, 6;
+  LeastSquares data(a, b);
+  BoundedMinimizerOptions options;
+  RegularizationOptions regularization;
+  regularization.weight_rule = WeightRule::kDiscrepancy;
+  regularization.max_weight = 1.0 / 45.5;
+  regularization.min_weight = 1e-3 / 45.5;
+  regularization.floor_margin = FloorMargin::kNoiseFit;
+  const std::vector<double> lower(3, -10.0), upper(3, 10.0), start(3, 0.0);
+  const double n = 3.0, margin = 0.1;
+  const double spread = std::sqrt(margin * 2.0 / (n + 2.0 * std::sqrt(2.0 * n)));
+  const RegularizedMinimization result =
+      MinimizeRegularized(options, regularization, &data, lower, upper, start, 1.0, spread);
+  EXPECT_EQ(result.weight_choice, "misfit_floor");
+  EXPECT_NEAR(result.floor_target, result.misfit_floor + margin, 1e-12 * result.misfit_floor);
+  EXPECT_DOUBLE_EQ(result.AttainableTarget(), result.floor_target);
+  EXPECT_LE(result.misfit, result.floor_target);
+  // Measured: weight 0.1603 after the grid's 2 weights and 4 regula falsi steps, its
+  // misfit 38.5589 against the floor 38.5004 + 0.1.
+  EXPECT_LT(result.weight, 0.5);
+  EXPECT_GT(result.weight, 0.01);
+  EXPECT_EQ(result.path.size(), 6u);
+  // The misfit at the weight kept is the closed form's at that weight (measured: 8.5e-11
+  // relative).
+  EXPECT_NEAR(result.misfit, data.Misfit(result.weight), 1e-9 * result.misfit);
+
+  const RegularizedMinimization unknown =
+      MinimizeRegularized(options, regularization, &data, lower, upper, start, 1.0, -1.0);
+  EXPECT_NEAR(unknown.floor_target, (1.0 + kMisfitFloorMargin) * unknown.misfit_floor, 1e-15);
+  EXPECT_NEAR(unknown.weight, 1.0, 1e-12);
+}
+
 TEST(LCurveCornerTest, FindsTheBendOfAnLAndNoneOfALine) {
   // ln misfit 2, 1, 0, 0, 0 against ln roughness 0, 0, 0, 1, 2: a right angle at
   // index 2, 0.707 below the chord (indices 1 and 3: 0.354).

@@ -62,6 +62,7 @@ TEST(TypesTest, EveryEnumRoundTripsThroughItsNameTable) {
   ExpectTableRoundTrips(kZoneNeighbourhoodNames, ZoneNeighbourhoodToString,
                         StringToZoneNeighbourhood);
   ExpectTableRoundTrips(kWeightRuleNames, WeightRuleToString, StringToWeightRule);
+  ExpectTableRoundTrips(kFloorMarginNames, FloorMarginToString, StringToFloorMargin);
   ExpectTableRoundTrips(kStudyKindNames, StudyKindToString, StringToStudyKind);
 }
 

@@ -897,6 +897,13 @@ const std::vector<Key>& KeyTable() {
               &ZoneIdentificationOptions::regularization,
               &RegularizationOptions::discrepancy_factor, Number(), "",
               "tau: the misfit target is tau times the noise's expected e^2"),
+      MakeKey("zone_identification.floor_margin", &Config::zone_identification,
+              &ZoneIdentificationOptions::regularization, &RegularizationOptions::floor_margin,
+              EnumByName<FloorMargin>({FloorMargin::kTenPercent, FloorMargin::kNoiseFit},
+                                      FloorMarginToString, StringToFloorMargin),
+              "",
+              "the margin over the misfit floor when the target is missed and the L-curve has "
+              "no corner: 10 %, or the noise the free zones fit"),
       MakeKey("zone_identification.noise_samples", &Config::zone_identification,
               &ZoneIdentificationOptions::noise_samples, PositiveInteger<int>(), "",
               "noise draws of the discrepancy target, in [1, 1000]"),

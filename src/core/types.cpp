@@ -131,6 +131,13 @@ bool StringToWeightRule(const std::string& name, WeightRule* rule) {
   return internal::FromName(kWeightRuleNames, name, rule);
 }
 
+const char* FloorMarginToString(FloorMargin margin) {
+  return internal::ToName(kFloorMarginNames, margin);
+}
+bool StringToFloorMargin(const std::string& name, FloorMargin* margin) {
+  return internal::FromName(kFloorMarginNames, name, margin);
+}
+
 const char* StudyKindToString(StudyKind kind) { return internal::ToName(kStudyKindNames, kind); }
 bool StringToStudyKind(const std::string& name, StudyKind* kind) {
   return internal::FromName(kStudyKindNames, name, kind);

@@ -25,6 +25,15 @@ bool ZoneIdentificationOptions::IsValid(std::string* error) const {
     }
     return false;
   }
+  if (regularization.floor_margin == FloorMargin::kNoiseFit && noise_samples < 2) {
+    if (error != nullptr) {
+      *error =
+          "zone_identification.floor_margin noise_fit takes the noise's spread from its draws: "
+          "set zone_identification.noise_samples to 2 or more (4 by default), or floor_margin "
+          "to ten_percent";
+    }
+    return false;
+  }
   if (!(start_modulus >= 0.0 && std::isfinite(start_modulus))) {
     if (error != nullptr) {
       *error =
@@ -210,7 +219,7 @@ void MinimizeOverZones(const ZoneIdentificationOptions& options, const MatrixMod
   const bool automatic = options.regularization.kind != RegularizationKind::kNone &&
                          options.regularization.weight < 0.0;
   if (automatic || options.merge_zones) {
-    summary->noise_cost = expected_noise_cost();
+    summary->noise_cost = expected_noise_cost(&summary->noise_cost_std_dev);
     if (summary->noise_cost < 0.0) {
       summary->termination = TerminationType::kFailure;
       summary->message = summary->least_squares
@@ -219,8 +228,11 @@ void MinimizeOverZones(const ZoneIdentificationOptions& options, const MatrixMod
       return;
     }
     target = options.regularization.discrepancy_factor * summary->noise_cost;
-    spdlog::info("zones: discrepancy target {} / J_rest = {:.6g} (noise alone, {} draws)",
-                 summary->least_squares ? "J" : "e^2", target, options.noise_samples);
+    spdlog::info(
+        "zones: discrepancy target {} / J_rest = {:.6g} (noise alone, {} draws, standard "
+        "deviation {:.3g})",
+        summary->least_squares ? "J" : "e^2", target, options.noise_samples,
+        summary->noise_cost_std_dev);
   }
   BoundedMinimizerOptions minimizer = options.minimizer;
   if (!summary->least_squares) minimizer.matched_cost = kMatchedRelativeCost;
@@ -229,7 +241,8 @@ void MinimizeOverZones(const ZoneIdentificationOptions& options, const MatrixMod
     regularization.neighbours = ZoneNeighbours(model);
   }
   summary->regularized =
-      MinimizeRegularized(minimizer, regularization, &recorder, lower, upper, initial, target);
+      MinimizeRegularized(minimizer, regularization, &recorder, lower, upper, initial, target,
+                          options.regularization.discrepancy_factor * summary->noise_cost_std_dev);
   const RegularizedMinimization& result = summary->regularized;
   summary->termination = result.minimizer.termination;
   summary->message = result.minimizer.message;
@@ -272,40 +285,63 @@ void SetBarZoneExtents(const BarModel& model, ZoneIdentificationSummary* summary
   }
 }
 
+namespace {
+
+// The mean of the draws' costs / cost_scale; their sample standard deviation / cost_scale
+// into *std_dev (when given; -1 with fewer than 2 draws).
+double MeanOfDraws(const std::vector<double>& costs, double cost_scale, double* std_dev) {
+  const auto n = static_cast<double>(costs.size());
+  double mean = 0.0;
+  for (double cost : costs) mean += cost;
+  mean /= n;
+  if (std_dev != nullptr && costs.size() >= 2) {
+    // s = sqrt(sum_k (c_k - mean)^2 / (n - 1)), the unbiased variance's root
+    double squares = 0.0;
+    for (double cost : costs) squares += (cost - mean) * (cost - mean);
+    *std_dev = std::sqrt(squares / (n - 1.0)) / cost_scale;
+  }
+  return mean / cost_scale;
+}
+
+}  // namespace
+
 double ExpectedNoiseCost(const MatrixModelData& model, const ChannelSet& data,
                          const McreOptions& mcre, double theta, const CoupledSolverOptions& inner,
                          const Vector& moduli, const NoiseLevels& noise,
                          const PrefilterOptions& prefilter, int samples, std::uint64_t seed,
-                         double cost_scale) {
+                         double cost_scale, double* std_dev) {
+  if (std_dev != nullptr) *std_dev = -1.0;
   StandardNormal normal(seed);
   ChannelSet drawn = data;
-  double sum = 0.0;
+  std::vector<double> costs;
   for (int sample = 0; sample < samples; ++sample) {
     const ChannelSet noise_data = DrawNoiseAlone(prefilter, noise, &normal, &drawn);
     McreObjective objective = MatrixMcreObjective(model, noise_data, mcre, theta, inner,
                                                   Factorization::kAutomatic, moduli[0]);
     const ObjectiveEvaluation& record = objective.EvaluateModuli(moduli, false);
     if (!record.usable) return -1.0;
-    sum += record.cost;
+    costs.push_back(record.cost);
   }
-  return sum / samples / cost_scale;
+  return MeanOfDraws(costs, cost_scale, std_dev);
 }
 
 double ExpectedLeastSquaresNoiseCost(const MatrixModelData& model, const ChannelSet& data,
                                      const NoiseLevels& misfit_levels, double theta,
                                      const Vector& moduli, const NoiseLevels& noise,
                                      const PrefilterOptions& prefilter, int samples,
-                                     std::uint64_t seed, double cost_scale) {
+                                     std::uint64_t seed, double cost_scale, double* std_dev) {
+  if (std_dev != nullptr) *std_dev = -1.0;
   StandardNormal normal(seed);
   ChannelSet drawn = data;
-  double sum = 0.0;
+  std::vector<double> costs;
   for (int sample = 0; sample < samples; ++sample) {
     const ChannelSet noise_data = DrawNoiseAlone(prefilter, noise, &normal, &drawn);
     MatrixOutputErrorObjective objective(model, noise_data, misfit_levels, theta,
                                          Factorization::kAutomatic, moduli[0]);
-    sum += objective.Cost(moduli, nullptr);
+    costs.push_back(objective.Cost(moduli, nullptr));
+    if (!std::isfinite(costs.back())) return -1.0;
   }
-  return std::isfinite(sum) ? sum / samples / cost_scale : -1.0;
+  return MeanOfDraws(costs, cost_scale, std_dev);
 }
 
 namespace {
@@ -351,10 +387,10 @@ void IdentifyOnMcreObjective(const ZoneIdentificationOptions& options, const Mat
   ZoneMcreObjective zone_objective(objective, reference_moduli);
   MinimizeOverZones(
       options, model, &zone_objective, lower_bound, upper_bound,
-      [&] {
+      [&](double* std_dev) {
         return ExpectedNoiseCost(model, data, mcre, theta, inner, summary->start_moduli,
                                  summary->noise, prefilter, options.noise_samples,
-                                 options.noise_seed, summary->cost_scale);
+                                 options.noise_seed, summary->cost_scale, std_dev);
       },
       summary);
   if (objective->evaluations().size() > first && objective->evaluations()[first].usable) {
@@ -376,10 +412,10 @@ void IdentifyOnOutputError(const ZoneIdentificationOptions& options, const Matri
   summary->homogeneous_cost = objective->Cost(summary->start_moduli, nullptr);
   MinimizeOverZones(
       options, model, objective, lower_bound, upper_bound,
-      [&] {
+      [&](double* std_dev) {
         return ExpectedLeastSquaresNoiseCost(
             model, data, misfit_levels, theta, summary->start_moduli, summary->noise, prefilter,
-            options.noise_samples, options.noise_seed, summary->cost_scale);
+            options.noise_samples, options.noise_seed, summary->cost_scale, std_dev);
       },
       summary);
   summary->evaluations = objective->evaluations() - evaluations_before;

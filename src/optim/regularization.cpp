@@ -206,7 +206,7 @@ class WeightSearch {
  public:
   WeightSearch(const BoundedMinimizerOptions& options, const RegularizationOptions& regularization,
                FirstOrderObjective* data, const std::vector<double>& lower,
-               const std::vector<double>& upper, double target_misfit,
+               const std::vector<double>& upper, double target_misfit, double target_std_dev,
                RegularizedMinimization* result)
       : options_(options),
         regularization_(regularization),
@@ -214,6 +214,7 @@ class WeightSearch {
         lower_(lower),
         upper_(upper),
         target_misfit_(target_misfit),
+        target_std_dev_(target_std_dev),
         target_(target_misfit),
         l_curve_(regularization.weight_rule == WeightRule::kLCurve),
         result_(*result) {}
@@ -336,15 +337,16 @@ class WeightSearch {
       return;
     }
     // Without a corner (fewer than 3 weights, or a straight curve) the principle is
-    // applied to the floor itself, raised by kMisfitFloorMargin.
+    // applied to the floor itself, raised by its margin.
+    result_.floor_target = FloorTarget(last_misfit);
     target_ = result_.AttainableTarget();
     spdlog::warn(
-        "{} down to {:.3g}: the target becomes the misfit floor {:.6g} + {:.0f} %, {:.6g}",
+        "{} down to {:.3g}: the target becomes the misfit floor {:.6g} + {:.3g} %, {:.6g}",
         l_curve_ || target_misfit_ < 0.0
             ? std::string("the L-curve has no corner")
             : fmt::format("no regularisation weight brings the misfit to the noise's level {:.6g}",
                           target_misfit_),
-        last_weight, last_misfit, 100.0 * kMisfitFloorMargin, target_);
+        last_weight, last_misfit, 100.0 * (target_ / last_misfit - 1.0), target_);
     result_.weight_choice = "misfit_floor";
     for (std::size_t k = 0; k < grid_.size(); ++k) {
       if (grid_misfits_[k] <= target_) {
@@ -354,6 +356,28 @@ class WeightSearch {
         break;
       }
     }
+  }
+
+  // The misfit floor F raised by regularization_.floor_margin's margin (the top of
+  // optim/regularization.h).
+  double FloorTarget(double floor) const {
+    const bool spread_known = target_misfit_ > 0.0 && target_std_dev_ > 0.0;
+    if (regularization_.floor_margin == FloorMargin::kNoiseFit && spread_known) {
+      // sigma^2 = s^2 / (2 m): a chi-square of N degrees of freedom has mean N sigma^2
+      // and variance 2 N sigma^4.
+      const double sigma_squared = target_std_dev_ * target_std_dev_ / (2.0 * target_misfit_);
+      const auto n = static_cast<double>(lower_.size());
+      // F + (n + 2 sqrt(2 n)) sigma^2: the noise n free parameters fit, plus two of its
+      // standard deviations.
+      return floor + (n + 2.0 * std::sqrt(2.0 * n)) * sigma_squared;
+    }
+    if (regularization_.floor_margin == FloorMargin::kNoiseFit) {
+      spdlog::warn(
+          "zone_identification.floor_margin noise_fit needs the spread of the target's noise "
+          "draws, which is not known (zone_identification.noise_samples >= 2 gives it): the "
+          "margin is ten_percent's");
+    }
+    return (1.0 + kMisfitFloorMargin) * floor;
   }
 
   // Regula falsi (Illinois) between the weight that missed (larger) and the hit on
@@ -406,7 +430,8 @@ class WeightSearch {
   FirstOrderObjective* data_;
   const std::vector<double>& lower_;
   const std::vector<double>& upper_;
-  const double target_misfit_;  // the caller's target
+  const double target_misfit_;   // the caller's target
+  const double target_std_dev_;  // its draws' standard deviation (<= 0: unknown)
   double target_;               // the refinement's: the caller's, or the misfit floor's
   const bool l_curve_;
   RegularizedMinimization& result_;
@@ -427,7 +452,7 @@ class WeightSearch {
 RegularizedMinimization MinimizeRegularized(
     const BoundedMinimizerOptions& options, const RegularizationOptions& regularization,
     FirstOrderObjective* data, const std::vector<double>& lower, const std::vector<double>& upper,
-    const std::vector<double>& initial, double target_misfit) {
+    const std::vector<double>& initial, double target_misfit, double target_std_dev) {
   RegularizedMinimization result;
   const bool automatic =
       regularization.kind != RegularizationKind::kNone && regularization.weight < 0.0;
@@ -444,7 +469,8 @@ RegularizedMinimization MinimizeRegularized(
     result.misfit = point.misfit;
     return result;
   }
-  WeightSearch search(options, regularization, data, lower, upper, target_misfit, &result);
+  WeightSearch search(options, regularization, data, lower, upper, target_misfit, target_std_dev,
+                      &result);
   search.Run(initial);
   return result;
 }

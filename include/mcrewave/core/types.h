@@ -379,6 +379,19 @@ inline constexpr std::array<std::pair<WeightRule, const char*>, 2> kWeightRuleNa
 const char* WeightRuleToString(WeightRule rule);
 bool StringToWeightRule(const std::string& name, WeightRule* rule);
 
+// The margin over the misfit floor when no weight meets the discrepancy target and the
+// L-curve has no corner (optim/regularization.h).
+enum class FloorMargin {
+  kTenPercent,  // the floor + 10 %
+  kNoiseFit,    // the floor + what the free zones fit of the noise (the draws' spread)
+};
+inline constexpr std::array<std::pair<FloorMargin, const char*>, 2> kFloorMarginNames{{
+    {FloorMargin::kTenPercent, "ten_percent"},
+    {FloorMargin::kNoiseFit, "noise_fit"},
+}};
+const char* FloorMarginToString(FloorMargin margin);
+bool StringToFloorMargin(const std::string& name, FloorMargin* margin);
+
 enum class StudyKind {
   kRobustness,
   kRelaxation,

@@ -94,6 +94,7 @@ struct ZoneIdentificationSummary {
   double cost_scale = -1.0;             // J_rest [J s] (least squares: [s])
   NoiseLevels noise;                    // levels of the discrepancy target's draws
   double noise_cost = -1.0;             // ExpectedNoiseCost or ExpectedLeastSquaresNoiseCost
+  double noise_cost_std_dev = -1.0;     // its draws' standard deviation (-1: one draw)
                                         // (scaled); -1: not computed
   RegularizedMinimization regularized;  // weight, its choice, the path, the minimiser
   ZoneMerge merge;                      // merge.groups -1: not run; with merges kept,
@@ -115,23 +116,25 @@ struct ZoneIdentificationSummary {
 // Mean over `samples` draws of e^2(noise alone) / cost_scale at the zone moduli of
 // `model`, the noise white at `noise`'s levels on every channel the data have
 // (DrawWhiteNoise), then pre-filtered as `prefilter` says (enabled with its cutoff;
-// disabled: as drawn). -1 when a solve is not usable.
+// disabled: as drawn). -1 when a solve is not usable. With std_dev, the draws' sample
+// standard deviation / cost_scale into it (-1 with fewer than 2 draws or when not usable).
 double ExpectedNoiseCost(const MatrixModelData& model, const ChannelSet& data,
                          const McreOptions& mcre, double theta, const CoupledSolverOptions& inner,
                          const Vector& moduli, const NoiseLevels& noise,
                          const PrefilterOptions& prefilter, int samples, std::uint64_t seed,
-                         double cost_scale);
+                         double cost_scale, double* std_dev = nullptr);
 
 // ExpectedNoiseCost for the output-error misfit (MatrixOutputErrorObjective with the
 // normalisation misfit_levels): the mean over `samples` draws of J(noise alone) /
 // cost_scale at the zone moduli of `model`, the model driven by the loads' noise and
 // compared with the other channels' (white at `noise`'s levels, then pre-filtered as
-// `prefilter` says). -1 when J is not finite.
+// `prefilter` says). -1 when J is not finite. std_dev as in ExpectedNoiseCost.
 double ExpectedLeastSquaresNoiseCost(const MatrixModelData& model, const ChannelSet& data,
                                      const NoiseLevels& misfit_levels, double theta,
                                      const Vector& moduli, const NoiseLevels& noise,
                                      const PrefilterOptions& prefilter, int samples,
-                                     std::uint64_t seed, double cost_scale);
+                                     std::uint64_t seed, double cost_scale,
+                                     double* std_dev = nullptr);
 
 // The zones whose jumps of log E the penalty counts (RegularizationOptions::neighbours):
 // zones a < b are neighbours when their stiffness matrices K_a and K_b both touch a dof

@@ -27,9 +27,19 @@
 //     refinement_steps are spent.
 // When no weight meets the target (model error, or the noise underestimated), the
 // weight is the corner of the grid's L-curve (weight_choice "l_curve", a warning), or
-// without a corner the largest lambda whose misfit stays within a factor
-// 1 + kMisfitFloorMargin of the misfit floor, the misfit at the grid's lightest lambda
-// (weight_choice "misfit_floor").
+// without a corner the largest lambda whose misfit stays within a margin of the misfit
+// floor F, the misfit at the grid's lightest lambda (weight_choice "misfit_floor"; the
+// regula falsi then refines it as for the discrepancy principle, on F + margin), the
+// margin by floor_margin:
+//   ten_percent (the default): kMisfitFloorMargin F;
+//   noise_fit: what n free parameters fit of the noise, n sigma^2, plus two of its
+//     standard deviations sqrt(2 n) sigma^2: (n + 2 sqrt(2 n)) sigma^2, where
+//     sigma^2 = s^2 / (2 m) is the noise cost per degree of freedom of a chi-square whose
+//     mean m and standard deviation s the target's draws give (m = target_misfit,
+//     s = target_std_dev). The linear least-squares fit of n parameters to N samples of
+//     white noise lowers the misfit's expectation from N sigma^2 to (N - n) sigma^2, so a
+//     penalty that raises the misfit above the floor by less cannot be told from noise
+//     fitting (docs/zones_and_sensors.md, "Regularisation and its weight").
 #pragma once
 
 #include <string>
@@ -73,6 +83,9 @@ struct RegularizationOptions {
   double weight_tolerance = 0.25;
   // tau of the target misfit tau * (expected e^2 of the noise).
   double discrepancy_factor = 1.0;
+  // The margin over the misfit floor when the target is missed and the L-curve has no
+  // corner (see the top of this file).
+  FloorMargin floor_margin = FloorMargin::kTenPercent;
   // Not a config key: the zones whose jumps the penalty counts, set from the structure
   // (ZoneNeighbours, identification/zone_identification.h). Empty: the chain (z, z + 1)
   // of weight 1, the zones in order along a bar.
@@ -151,6 +164,9 @@ struct RegularizedMinimization {
   std::string weight_choice = "fixed";
   double target_misfit = -1.0;         // the discrepancy target (-1: not used)
   double misfit_floor = -1.0;  // the grid's lightest weight's misfit when the target was missed
+  // The misfit floor + its margin (floor_margin), the target of weight_choice
+  // "misfit_floor"; -1 when the target was met or the L-curve chose.
+  double floor_target = -1.0;
   std::vector<RegularizedPoint> path;  // every minimisation, in order
   BoundedMinimizerSummary minimizer;   // the minimisation at `weight`
   std::vector<double> x;               // its minimiser
@@ -158,22 +174,25 @@ struct RegularizedMinimization {
   int evaluations = 0;                 // of every minimisation
   bool IsSolutionUsable() const { return minimizer.IsSolutionUsable(); }
   // The misfit the data can be held to: target_misfit, or when no weight of the grid
-  // met it, the misfit floor raised by kMisfitFloorMargin (the target of weight_choice
+  // met it, the misfit floor raised by its margin (the target of weight_choice
   // "misfit_floor", and of MergeNeighbouringZones).
   double AttainableTarget() const {
+    if (floor_target >= 0.0) return floor_target;
     return misfit_floor >= 0.0 ? (1.0 + kMisfitFloorMargin) * misfit_floor : target_misfit;
   }
 };
 
 // Minimises data cost + R within the bounds: at the fixed weight, or with the weight
 // regularization.weight_rule chooses for target_misfit (scaled like the data cost).
-// options.max_evaluations and max_time hold for each minimisation. Preconditions:
-// both options valid; target_misfit >= 0 when regularization.weight < 0 and kind is
-// not kNone.
+// options.max_evaluations and max_time hold for each minimisation. target_std_dev: the
+// standard deviation of the draws whose mean target_misfit is (scaled alike; <= 0:
+// unknown), which regularization.floor_margin noise_fit needs (without it, ten_percent
+// with a warning). Preconditions: both options valid; target_misfit >= 0 when
+// regularization.weight < 0 and kind is not kNone.
 RegularizedMinimization MinimizeRegularized(
     const BoundedMinimizerOptions& options, const RegularizationOptions& regularization,
     FirstOrderObjective* data, const std::vector<double>& lower, const std::vector<double>& upper,
-    const std::vector<double>& initial, double target_misfit);
+    const std::vector<double>& initial, double target_misfit, double target_std_dev = -1.0);
 
 // Merging of neighbouring zones after the regularised minimisation, a debiasing refit
 // (docs/zones_and_sensors.md, "Merging neighbouring zones"): from the regularised
