@@ -28,17 +28,25 @@ map's share per zone at the nominal moduli, on the 16 x 4 grid (gnuplot). Prints
 progress; the files are written atomically.
 
 Usage: /usr/bin/python3 scripts/plate_zones_study.py BUILD_DIR RESULTS_DIR
-           [--functional mcre|least_squares|both] [--figures-only]
+           [--functional mcre|least_squares|both | --figures-only | --update-only |
+            --element-update-only]
        --functional: the runs to make (default both); the other functional's rows of an
            existing cases.csv are kept.
        --figures-only: no run; cases.csv's measures computed again from the kept files
            (times and evaluations kept), maps.png and summary.md drawn again.
        --update-only: the update step alone (below), from the kept zones.csv of its case.
+       --element-update-only: the per-element update step alone (below).
 
 After the MCRE's runs, the update step of a localise-then-update loop on UPDATE_CASE: the
 zones its error map at the nominal moduli flags (a share above the median by more than 3
 robust standard deviations) free, the others tied into one modulus, no penalty
-(model.free_zones); update.csv sets each against its truth.
+(model.free_zones); update.csv sets each against its truth. Then the per-element update
+step: every model element of those zones free (model.zoning: per_element), the others
+tied, total variation between elements that share a node with its weight from the
+misfit floor held to the noise the free elements fit (zone_identification.neighbours:
+shared_nodes, floor_margin: noise_fit); element_update.csv sets each flagged zone, its
+modulus the series combination of its elements' moduli, against its truth, and
+element_update.png draws the elements' truth and moduli.
 """
 
 import csv
@@ -79,29 +87,58 @@ def write_atomic(path, text):
     os.replace(path + ".tmp", path)
 
 
+def element_positions():
+    """Per element of the model's manifest, in its order: its (i, j) on the
+    MODEL_ELEMENTS grid, from configs/plate_zones/model/element_positions.csv."""
+    nx, ny = MODEL_ELEMENTS
+    cells = []
+    path = os.path.join(ROOT, "configs", "plate_zones", "model", "element_positions.csv")
+    for line in open(path):
+        if line.startswith("#") or not line.strip():
+            continue
+        x, y = (float(v) for v in line.split(","))
+        cells.append((round(x / (LENGTH / nx) - 0.5), round(y / (HEIGHT / ny) - 0.5)))
+    return cells
+
+
+def zone_of_element(i, j):
+    """The grid zone of model element (i, j) (RegroupedElementZones: boxes over the
+    centroids' extent)."""
+    nx, ny = MODEL_ELEMENTS
+    return (f"grid_{min(GRID[0] - 1, int(i / (nx - 1) * GRID[0]))}_"
+            f"{min(GRID[1] - 1, int(j / (ny - 1) * GRID[1]))}")
+
+
+def fine_moduli(truth, i, j):
+    """The relative moduli of the truth's fine elements under model element (i, j)."""
+    nx, ny = MODEL_ELEMENTS
+    fine_dx, fine_dy = LENGTH / (nx * REFINE), HEIGHT / (ny * REFINE)
+    values = []
+    for a in range(REFINE):
+        for b in range(REFINE):
+            x = (i * REFINE + a + 0.5) * fine_dx
+            y = (j * REFINE + b + 0.5) * fine_dy
+            value = 1.0
+            for _, modulus, inside in TRUTHS[truth]:
+                if inside(x, y):
+                    value = modulus
+            values.append(value)
+    return values
+
+
+def series(values):
+    return len(values) / sum(1.0 / v for v in values)
+
+
 def truth_of_zones(truth):
     """Per zone name grid_i_j: (series, parallel) moduli relative to NOMINAL_MODULUS of
     the truth's fine elements under the zone's model elements."""
     nx, ny = MODEL_ELEMENTS
-    fine_dx, fine_dy = LENGTH / (nx * REFINE), HEIGHT / (ny * REFINE)
     moduli = {}
     for j in range(ny):
         for i in range(nx):
-            # The model element's box (RegroupedElementZones: centroids over their extent).
-            zx = min(GRID[0] - 1, int(i / (nx - 1) * GRID[0]))
-            zy = min(GRID[1] - 1, int(j / (ny - 1) * GRID[1]))
-            zone = moduli.setdefault(f"grid_{zx}_{zy}", [])
-            for a in range(REFINE):
-                for b in range(REFINE):
-                    x = (i * REFINE + a + 0.5) * fine_dx
-                    y = (j * REFINE + b + 0.5) * fine_dy
-                    value = 1.0
-                    for _, modulus, inside in TRUTHS[truth]:
-                        if inside(x, y):
-                            value = modulus
-                    zone.append(value)
-    return {name: (len(m) / sum(1.0 / v for v in m), sum(m) / len(m))
-            for name, m in moduli.items()}
+            moduli.setdefault(zone_of_element(i, j), []).extend(fine_moduli(truth, i, j))
+    return {name: (series(m), sum(m) / len(m)) for name, m in moduli.items()}
 
 
 FUNCTIONALS = ("mcre", "least_squares")
@@ -165,12 +202,13 @@ def update_markdown(update_csv):
     return md
 
 
-def run_case(build_dir, work, truth, manifest, snr, functional, free_zones=None):
+def run_case(build_dir, work, truth, manifest, snr, functional, free_zones=None, settings=(),
+             suffix=""):
     """identify run on a case; with free_zones the update step (those zones free, the
-    others tied into 'rest', no penalty)."""
+    others tied into 'rest', no penalty); settings: further --set KEY=VALUE."""
     moduli = [1.0] + [modulus for _, modulus, _ in TRUTHS[truth]]
     folder = os.path.join(work, case_name(truth, manifest, snr) + "_" + functional +
-                          ("_update" if free_zones else ""))
+                          ("_update" if free_zones else "") + suffix)
     command = [os.path.join(build_dir, "identify", "identify"), "run",
                os.path.join(ROOT, "configs", "plate_zones.yaml"),
                "--set", f"model.manifest=plate_zones/model/{manifest}.yaml",
@@ -184,6 +222,8 @@ def run_case(build_dir, work, truth, manifest, snr, functional, free_zones=None)
     if free_zones:
         command[3:3] = ["--set", f"model.free_zones=[{','.join(free_zones)}]",
                         "--set", "zone_identification.regularization=none"]
+    for setting in settings:
+        command[3:3] = ["--set", setting]
     start = time.monotonic()
     subprocess.run(command, check=True)
     return folder, time.monotonic() - start
@@ -350,6 +390,18 @@ def write_summary(results):
                f"penalty (model.free_zones; {first['zone_evaluations']} zone evaluations, "
                f"{float(first['wall_time_s']):.0f} s; update.csv, the case's update_zones.csv).",
                ""] + update_markdown(update_path)
+    element_path = os.path.join(results, "element_update.csv")
+    if os.path.exists(element_path):
+        first = next(csv.DictReader(open(element_path)))
+        md += ["", "Localise, then update per element (the same case and flagged zones): every "
+               "model element of the flagged zones free, the others tied into 'rest', total "
+               "variation between elements that share a node, its weight from the misfit floor "
+               "held to the noise the free elements fit (zone_identification.floor_margin: "
+               f"noise_fit; {first['zone_evaluations']} zone evaluations, "
+               f"{float(first['wall_time_s']):.0f} s; element_update.csv, the case's "
+               "element_update_zones.csv and element_update.png). A flagged zone's modulus is "
+               "the series combination of its elements' moduli.", ""] + \
+            update_markdown(element_path)
     md += ["", "Each case's folder holds zones.csv and error_map.csv of the MCRE's run, "
            "least_squares_zones.csv of least squares', and maps.png (truth, both functionals' "
            "moduli, error map per zone).", ""]
@@ -374,6 +426,101 @@ def run_update(build_dir, results):
     print(f"    {seconds:.0f} s", flush=True)
 
 
+# The per-element update's settings: every element of the flagged zones free, total
+# variation between elements that share a node, the weight by the misfit floor held to
+# the noise the free elements fit, no uncertainty estimate (2 x 82 solves).
+ELEMENT_UPDATE_SETTINGS = ["model.zoning=per_element", "model.zone_grid=[]",
+                           "zone_identification.regularization=total_variation",
+                           "zone_identification.neighbours=shared_nodes",
+                           "zone_identification.floor_margin=noise_fit",
+                           "zone_identification.max_time=3600", "uncertainty.samples=0"]
+
+
+def element_update_table(zones_csv, truth, evaluations, seconds):
+    """element_update.csv's text: each flagged zone, its modulus the series combination
+    of its elements' identified moduli (each element holds the same number of fine
+    elements, so the series of series is the zone's series), against its truth; 'rest'
+    as in update_table."""
+    identified = {r["name"]: float(r["modulus_pa"]) / NOMINAL_MODULUS
+                  for r in csv.DictReader(open(zones_csv))}
+    truths = truth_of_zones(truth)
+    by_zone = {}
+    for e, (i, j) in enumerate(element_positions()):
+        if f"element{e}" in identified:
+            by_zone.setdefault(zone_of_element(i, j), []).append(identified[f"element{e}"])
+    tied = [truths[name] for name in truths if name not in by_zone]
+    truths["rest"] = (len(tied) / sum(1.0 / t[0] for t in tied),
+                      sum(t[1] for t in tied) / len(tied))
+    lines = ["zone,modulus_relative,truth_series,truth_parallel,error_series,"
+             "zone_evaluations,wall_time_s"]
+    for name, modulus in [("rest", identified["rest"])] + [
+            (zone, series(moduli)) for zone, moduli in sorted(by_zone.items())]:
+        truth_series, truth_parallel = truths[name]
+        lines.append(f"{name},{modulus:.6f},{truth_series:.6f},{truth_parallel:.6f},"
+                     f"{modulus / truth_series - 1.0:.6f},{evaluations},{seconds:.1f}")
+    return "\n".join(lines) + "\n"
+
+
+def write_element_maps(folder, zones_csv, truth, title):
+    """element_update.png: the truth of each model element (its fine elements in series)
+    and the per-element update's moduli (the tied elements at 'rest')."""
+    identified = {r["name"]: float(r["modulus_pa"]) / NOMINAL_MODULUS
+                  for r in csv.DictReader(open(zones_csv))}
+    data = os.path.join(folder, "element_update.dat")
+    lines = ["# i j truth_series identified"]
+    for e, (i, j) in enumerate(element_positions()):
+        modulus = identified.get(f"element{e}", identified["rest"])
+        lines.append(f"{i} {j} {series(fine_moduli(truth, i, j)):.6f} {modulus:.6f}")
+    write_atomic(data, "\n".join(lines) + "\n")
+    nx, ny = MODEL_ELEMENTS
+    png = os.path.join(folder, "element_update.png")
+    script = f"""set terminal pngcairo size 900,520 font ",10"
+set output "{png}.tmp"
+set multiplot layout 2,1 title "{title}" noenhanced
+set xrange [-0.5:{nx - 0.5}]
+set yrange [-0.5:{ny - 0.5}]
+set size ratio {HEIGHT / LENGTH:.4f}
+set xlabel "element column (x, {1000 * LENGTH / nx:.2f} mm each)"
+set ylabel "row (y)"
+set cbrange [0.5:1.3]
+set palette defined (0.5 "dark-red", 0.7 "red", 1.0 "white", 1.3 "blue")
+set title "truth: element modulus in series / 200 GPa"
+plot "{data}" using 1:2:3 with image notitle
+set title "per-element update of the flagged zones (the others tied) / 200 GPa"
+plot "{data}" using 1:2:4 with image notitle
+unset multiplot
+"""
+    subprocess.run(["gnuplot"], input=script, text=True, check=True)
+    os.replace(png + ".tmp", png)
+    os.remove(data)
+
+
+def run_element_update(build_dir, results):
+    """The per-element update on UPDATE_CASE: every element of the zones its map flags
+    free, the rest tied; <case>/element_update_zones.csv, element_update.csv and
+    element_update.png."""
+    truth, manifest, snr = UPDATE_CASE
+    out = os.path.join(results, case_name(*UPDATE_CASE))
+    flagged = set(map_flagged(os.path.join(out, "zones.csv")))
+    free = [f"element{e}" for e, (i, j) in enumerate(element_positions())
+            if zone_of_element(i, j) in flagged]
+    print(f"[element update] {case_name(*UPDATE_CASE)}: the {len(free)} elements of the "
+          f"{len(flagged)} flagged zones free, the rest tied, total variation ...", flush=True)
+    settings = [f"model.free_zones=[{','.join(free)}]"] + ELEMENT_UPDATE_SETTINGS
+    with tempfile.TemporaryDirectory() as work:
+        run, seconds = run_case(build_dir, work, truth, manifest, snr, "mcre", settings=settings,
+                                suffix="_element_update")
+        target = os.path.join(out, "element_update_zones.csv")
+        shutil.copyfile(os.path.join(run, "zones.csv"), target + ".tmp")
+        os.replace(target + ".tmp", target)
+        evaluations = sum(1 for _ in open(os.path.join(run, "zone_evaluations.csv"))) - 1
+    write_atomic(os.path.join(results, "element_update.csv"),
+                 element_update_table(target, truth, evaluations, seconds))
+    write_element_maps(out, target, truth, case_title(*UPDATE_CASE) +
+                       ": localise by the error map, then update per element")
+    print(f"    {seconds:.0f} s", flush=True)
+
+
 def draw_case(results, truth, manifest, snr):
     out = os.path.join(results, case_name(truth, manifest, snr))
     zones, _ = analyse(os.path.join(out, "zones.csv"), truth)
@@ -387,6 +534,10 @@ def main():
     options = sys.argv[3:]
     if options == ["--update-only"]:
         run_update(build_dir, results)
+        write_summary(results)
+        return
+    if options == ["--element-update-only"]:
+        run_element_update(build_dir, results)
         write_summary(results)
         return
     if options == ["--figures-only"]:
@@ -412,7 +563,7 @@ def main():
         functionals = (options[1],)
     elif options and options != ["--functional", "both"]:
         sys.exit(f"unknown options {options}: expected [--functional mcre|least_squares|both], "
-                 "--figures-only or --update-only")
+                 "--figures-only, --update-only or --element-update-only")
     os.makedirs(results, exist_ok=True)
     rows = [r for r in read_cases(results) if r["functional"] not in functionals]
     runs = [(c, f) for c in CASES for f in functionals]
@@ -439,6 +590,7 @@ def main():
     write_cases(results, rows)
     if "mcre" in functionals:
         run_update(build_dir, results)
+        run_element_update(build_dir, results)
     for case in CASES:
         draw_case(results, *case)
     write_summary(results)
