@@ -29,7 +29,7 @@ progress; the files are written atomically.
 
 Usage: /usr/bin/python3 scripts/plate_zones_study.py BUILD_DIR RESULTS_DIR
            [--functional mcre|least_squares|both | --figures-only | --update-only |
-            --element-update-only]
+            --element-update-only | --per-element-only]
        --functional: the runs to make (default both); the other functional's rows of an
            existing cases.csv are kept.
        --figures-only: no run; cases.csv's measures computed again from the kept files
@@ -41,12 +41,15 @@ After the MCRE's runs, the update step of a localise-then-update loop on UPDATE_
 zones its error map at the nominal moduli flags (a share above the median by more than 3
 robust standard deviations) free, the others tied into one modulus, no penalty
 (model.free_zones); update.csv sets each against its truth. Then the per-element update
-step: every model element of those zones free (model.zoning: per_element), the others
-tied, total variation between elements that share a node with its weight from the
-misfit floor held to the noise the free elements fit (zone_identification.neighbours:
-shared_nodes, floor_margin: noise_fit); element_update.csv sets each flagged zone, its
-modulus the series combination of its elements' moduli, against its truth, and
-element_update.png draws the elements' truth and moduli.
+step on each of ELEMENT_UPDATE_CASES: every model element of the zones its map flags free
+(model.zoning: per_element), the others tied, total variation between elements that share
+a node with its weight from the misfit floor held to the noise the free elements fit
+(zone_identification.neighbours: shared_nodes, floor_margin: noise_fit);
+element_update.csv sets each flagged zone, its modulus the series combination of its
+elements' moduli, against its truth, and <case>/element_update.png draws the elements'
+truth and moduli. Last, every element of the plate free with the same penalty and rule
+on PER_ELEMENT_CASE (per_element.csv, <case>/per_element.png).
+       --per-element-only: that last run alone.
 """
 
 import csv
@@ -171,6 +174,14 @@ def map_flagged(zones_csv, spread=3.0):
     return [rows[i]["name"] for i in robust_outliers(shares, spread)]
 
 
+def rest_truth(truths, free):
+    """The truth of 'rest', the union of the zones of `truths` not in `free`, each of the
+    same number of fine elements: (series, parallel), the harmonic mean of their series
+    truths and the mean of their parallel ones."""
+    tied = [truths[name] for name in truths if name not in free]
+    return (len(tied) / sum(1.0 / t[0] for t in tied), sum(t[1] for t in tied) / len(tied))
+
+
 def update_table(zones_csv, truth, evaluations, seconds):
     """update.csv's text: each zone of an update run (rest, then the free ones) against
     its truth in series and in parallel. 'rest' is the union of the other zones, each of
@@ -178,9 +189,7 @@ def update_table(zones_csv, truth, evaluations, seconds):
     parallel truth the mean."""
     truths = truth_of_zones(truth)
     rows = list(csv.DictReader(open(zones_csv)))
-    tied = [truths[name] for name in truths if name not in {r["name"] for r in rows}]
-    truths["rest"] = (len(tied) / sum(1.0 / t[0] for t in tied),
-                      sum(t[1] for t in tied) / len(tied))
+    truths["rest"] = rest_truth(truths, {r["name"] for r in rows})
     lines = ["zone,modulus_relative,truth_series,truth_parallel,error_series,"
              "zone_evaluations,wall_time_s"]
     for r in rows:
@@ -392,20 +401,51 @@ def write_summary(results):
                ""] + update_markdown(update_path)
     element_path = os.path.join(results, "element_update.csv")
     if os.path.exists(element_path):
-        first = next(csv.DictReader(open(element_path)))
-        md += ["", "Localise, then update per element (the same case and flagged zones): every "
-               "model element of the flagged zones free, the others tied into 'rest', total "
+        md += ["", "Localise, then update per element: on each case, every model element of the "
+               "zones its error map flags (as above) free, the others tied into 'rest', total "
                "variation between elements that share a node, its weight from the misfit floor "
                "held to the noise the free elements fit (zone_identification.floor_margin: "
-               f"noise_fit; {first['zone_evaluations']} zone evaluations, "
-               f"{float(first['wall_time_s']):.0f} s; element_update.csv, the case's "
-               "element_update_zones.csv and element_update.png). A flagged zone's modulus is "
-               "the series combination of its elements' moduli.", ""] + \
-            update_markdown(element_path)
+               "noise_fit; element_update.csv, the case's element_update_zones.csv and "
+               "element_update.png). A flagged zone's modulus is the series combination of its "
+               "elements' moduli."] + element_markdown(element_path)
+    per_element_path = os.path.join(results, "per_element.csv")
+    if os.path.exists(per_element_path):
+        md += ["", "The whole plate per element (576 moduli from the homogeneous E*, no "
+               "localisation; the same penalty and weight rule; per_element.csv, the case's "
+               "per_element_zones.csv and per_element.png), each zone's modulus the series "
+               "combination of its nine elements'. Changed zones and the others:"] + \
+            element_markdown(per_element_path, changed_only=True)
     md += ["", "Each case's folder holds zones.csv and error_map.csv of the MCRE's run, "
            "least_squares_zones.csv of least squares', and maps.png (truth, both functionals' "
            "moduli, error map per zone).", ""]
     write_atomic(os.path.join(results, "summary.md"), "\n".join(md))
+
+
+def element_markdown(path, changed_only=False):
+    """The tables of element_update.csv or per_element.csv, one per case; changed_only:
+    the changed zones' rows and one row for the others' worst and rms error."""
+    by_case = {}
+    for r in csv.DictReader(open(path)):
+        by_case.setdefault(r["case"], []).append(r)
+    md = []
+    for case, rows in by_case.items():
+        md += ["", f"{case}: {rows[0]['zone_evaluations']} zone evaluations, "
+               f"{float(rows[0]['wall_time_s']):.0f} s.", "",
+               "| zone | identified / 200 GPa | truth in series | in parallel | error (series) |",
+               "|---|---|---|---|---|"]
+        others = []
+        for r in rows:
+            if changed_only and abs(float(r["truth_series"]) - 1.0) <= CHANGED:
+                others.append(float(r["error_series"]))
+                continue
+            md.append(f"| {r['zone']} | {float(r['modulus_relative']):.3f} | "
+                      f"{float(r['truth_series']):.3f} | {float(r['truth_parallel']):.3f} | "
+                      f"{100 * float(r['error_series']):+.1f} % |")
+        if others:
+            rms = math.sqrt(sum(e * e for e in others) / len(others))
+            md.append(f"| the {len(others)} others | worst {100 * max(map(abs, others)):.2f} %, "
+                      f"rms {100 * rms:.2f} % | 1 | 1 | |")
+    return md
 
 
 def run_update(build_dir, results):
@@ -436,11 +476,20 @@ ELEMENT_UPDATE_SETTINGS = ["model.zoning=per_element", "model.zone_grid=[]",
                            "zone_identification.max_time=3600", "uncertainty.samples=0"]
 
 
-def element_update_table(zones_csv, truth, evaluations, seconds):
-    """element_update.csv's text: each flagged zone, its modulus the series combination
-    of its elements' identified moduli (each element holds the same number of fine
-    elements, so the series of series is the zone's series), against its truth; 'rest'
-    as in update_table."""
+# The cases of the per-element update (their MCRE runs' zones.csv flag the zones), and
+# the case of the whole plate per element.
+ELEMENT_UPDATE_CASES = [("soft_inclusion", "full_field", 10), ("soft_inclusion", "full_field", 5)]
+PER_ELEMENT_CASE = ("soft_inclusion", "full_field", 10)
+ELEMENT_HEADER = ("case,zone,modulus_relative,truth_series,truth_parallel,error_series,"
+                  "zone_evaluations,wall_time_s")
+
+
+def element_table_rows(name, zones_csv, truth, evaluations, seconds):
+    """The rows of element_update.csv or per_element.csv for one run of case `name`:
+    each zone with an element free, its modulus the series combination of its elements'
+    identified moduli (each element holds the same number of fine elements, so the
+    series of series is the zone's series), against its truth; 'rest' (when the run has
+    it) as in update_table."""
     identified = {r["name"]: float(r["modulus_pa"]) / NOMINAL_MODULUS
                   for r in csv.DictReader(open(zones_csv))}
     truths = truth_of_zones(truth)
@@ -448,32 +497,28 @@ def element_update_table(zones_csv, truth, evaluations, seconds):
     for e, (i, j) in enumerate(element_positions()):
         if f"element{e}" in identified:
             by_zone.setdefault(zone_of_element(i, j), []).append(identified[f"element{e}"])
-    tied = [truths[name] for name in truths if name not in by_zone]
-    truths["rest"] = (len(tied) / sum(1.0 / t[0] for t in tied),
-                      sum(t[1] for t in tied) / len(tied))
-    lines = ["zone,modulus_relative,truth_series,truth_parallel,error_series,"
-             "zone_evaluations,wall_time_s"]
-    for name, modulus in [("rest", identified["rest"])] + [
-            (zone, series(moduli)) for zone, moduli in sorted(by_zone.items())]:
-        truth_series, truth_parallel = truths[name]
-        lines.append(f"{name},{modulus:.6f},{truth_series:.6f},{truth_parallel:.6f},"
-                     f"{modulus / truth_series - 1.0:.6f},{evaluations},{seconds:.1f}")
-    return "\n".join(lines) + "\n"
+    moduli = [(zone, series(m)) for zone, m in sorted(by_zone.items())]
+    if "rest" in identified:
+        truths["rest"] = rest_truth(truths, by_zone)
+        moduli.insert(0, ("rest", identified["rest"]))
+    return [f"{name},{zone},{modulus:.6f},{truths[zone][0]:.6f},{truths[zone][1]:.6f},"
+            f"{modulus / truths[zone][0] - 1.0:.6f},{evaluations},{seconds:.1f}"
+            for zone, modulus in moduli]
 
 
-def write_element_maps(folder, zones_csv, truth, title):
-    """element_update.png: the truth of each model element (its fine elements in series)
-    and the per-element update's moduli (the tied elements at 'rest')."""
+def write_element_maps(folder, zones_csv, truth, title, stem, panel):
+    """<stem>.png: the truth of each model element (its fine elements in series) and the
+    run's element moduli (the tied elements at 'rest')."""
     identified = {r["name"]: float(r["modulus_pa"]) / NOMINAL_MODULUS
                   for r in csv.DictReader(open(zones_csv))}
-    data = os.path.join(folder, "element_update.dat")
+    data = os.path.join(folder, stem + ".dat")
     lines = ["# i j truth_series identified"]
     for e, (i, j) in enumerate(element_positions()):
-        modulus = identified.get(f"element{e}", identified["rest"])
+        modulus = identified.get(f"element{e}", identified.get("rest"))
         lines.append(f"{i} {j} {series(fine_moduli(truth, i, j)):.6f} {modulus:.6f}")
     write_atomic(data, "\n".join(lines) + "\n")
     nx, ny = MODEL_ELEMENTS
-    png = os.path.join(folder, "element_update.png")
+    png = os.path.join(folder, stem + ".png")
     script = f"""set terminal pngcairo size 900,520 font ",10"
 set output "{png}.tmp"
 set multiplot layout 2,1 title "{title}" noenhanced
@@ -486,7 +531,7 @@ set cbrange [0.5:1.3]
 set palette defined (0.5 "dark-red", 0.7 "red", 1.0 "white", 1.3 "blue")
 set title "truth: element modulus in series / 200 GPa"
 plot "{data}" using 1:2:3 with image notitle
-set title "per-element update of the flagged zones (the others tied) / 200 GPa"
+set title "{panel} / 200 GPa"
 plot "{data}" using 1:2:4 with image notitle
 unset multiplot
 """
@@ -495,30 +540,56 @@ unset multiplot
     os.remove(data)
 
 
-def run_element_update(build_dir, results):
-    """The per-element update on UPDATE_CASE: every element of the zones its map flags
-    free, the rest tied; <case>/element_update_zones.csv, element_update.csv and
-    element_update.png."""
-    truth, manifest, snr = UPDATE_CASE
-    out = os.path.join(results, case_name(*UPDATE_CASE))
-    flagged = set(map_flagged(os.path.join(out, "zones.csv")))
-    free = [f"element{e}" for e, (i, j) in enumerate(element_positions())
-            if zone_of_element(i, j) in flagged]
-    print(f"[element update] {case_name(*UPDATE_CASE)}: the {len(free)} elements of the "
-          f"{len(flagged)} flagged zones free, the rest tied, total variation ...", flush=True)
-    settings = [f"model.free_zones=[{','.join(free)}]"] + ELEMENT_UPDATE_SETTINGS
+def run_elements(build_dir, results, case, free, stem):
+    """identify run on `case` per element (ELEMENT_UPDATE_SETTINGS), `free` the elements
+    free and the others tied (empty: every element free); keeps <case>/<stem>_zones.csv
+    and draws <case>/<stem>.png. Returns the rows of its table."""
+    truth, manifest, snr = case
+    out = os.path.join(results, case_name(*case))
+    settings = ([f"model.free_zones=[{','.join(free)}]"] if free else []) + \
+        ELEMENT_UPDATE_SETTINGS
     with tempfile.TemporaryDirectory() as work:
         run, seconds = run_case(build_dir, work, truth, manifest, snr, "mcre", settings=settings,
-                                suffix="_element_update")
-        target = os.path.join(out, "element_update_zones.csv")
+                                suffix="_" + stem)
+        target = os.path.join(out, stem + "_zones.csv")
         shutil.copyfile(os.path.join(run, "zones.csv"), target + ".tmp")
         os.replace(target + ".tmp", target)
         evaluations = sum(1 for _ in open(os.path.join(run, "zone_evaluations.csv"))) - 1
-    write_atomic(os.path.join(results, "element_update.csv"),
-                 element_update_table(target, truth, evaluations, seconds))
-    write_element_maps(out, target, truth, case_title(*UPDATE_CASE) +
-                       ": localise by the error map, then update per element")
+    if free:
+        title, panel = ("localise by the error map, then update per element",
+                        "per-element update of the flagged zones (the others tied)")
+    else:
+        title, panel = "every element's modulus", "identified per element"
+    write_element_maps(out, target, truth, case_title(*case) + ": " + title, stem, panel)
     print(f"    {seconds:.0f} s", flush=True)
+    return element_table_rows(case_name(*case), target, truth, evaluations, seconds)
+
+
+def run_element_update(build_dir, results):
+    """The per-element update on each of ELEMENT_UPDATE_CASES: every element of the zones
+    its map flags free, the rest tied; <case>/element_update_zones.csv and .png, and
+    element_update.csv."""
+    rows = []
+    for case in ELEMENT_UPDATE_CASES:
+        flagged = set(map_flagged(os.path.join(results, case_name(*case), "zones.csv")))
+        free = [f"element{e}" for e, (i, j) in enumerate(element_positions())
+                if zone_of_element(i, j) in flagged]
+        print(f"[element update] {case_name(*case)}: the {len(free)} elements of the "
+              f"{len(flagged)} flagged zones free, the rest tied, total variation ...",
+              flush=True)
+        rows += run_elements(build_dir, results, case, free, "element_update")
+    write_atomic(os.path.join(results, "element_update.csv"),
+                 "\n".join([ELEMENT_HEADER] + rows) + "\n")
+
+
+def run_per_element(build_dir, results):
+    """The whole plate per element on PER_ELEMENT_CASE (576 moduli, no localisation);
+    <case>/per_element_zones.csv and .png, and per_element.csv (its 64 zones in series)."""
+    print(f"[per element] {case_name(*PER_ELEMENT_CASE)}: every element free, total "
+          "variation ...", flush=True)
+    rows = run_elements(build_dir, results, PER_ELEMENT_CASE, [], "per_element")
+    write_atomic(os.path.join(results, "per_element.csv"),
+                 "\n".join([ELEMENT_HEADER] + rows) + "\n")
 
 
 def draw_case(results, truth, manifest, snr):
@@ -538,6 +609,10 @@ def main():
         return
     if options == ["--element-update-only"]:
         run_element_update(build_dir, results)
+        write_summary(results)
+        return
+    if options == ["--per-element-only"]:
+        run_per_element(build_dir, results)
         write_summary(results)
         return
     if options == ["--figures-only"]:
@@ -563,7 +638,7 @@ def main():
         functionals = (options[1],)
     elif options and options != ["--functional", "both"]:
         sys.exit(f"unknown options {options}: expected [--functional mcre|least_squares|both], "
-                 "--figures-only, --update-only or --element-update-only")
+                 "--figures-only, --update-only, --element-update-only or --per-element-only")
     os.makedirs(results, exist_ok=True)
     rows = [r for r in read_cases(results) if r["functional"] not in functionals]
     runs = [(c, f) for c in CASES for f in functionals]
@@ -591,6 +666,7 @@ def main():
     if "mcre" in functionals:
         run_update(build_dir, results)
         run_element_update(build_dir, results)
+        run_per_element(build_dir, results)
     for case in CASES:
         draw_case(results, *case)
     write_summary(results)

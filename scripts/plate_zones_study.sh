@@ -6,13 +6,14 @@
 # set against its truth (scripts/plate_zones_study.py: cases.csv, summary.md, a maps.png
 # per case), then refits the zones the soft inclusion's error map flags against one
 # background modulus (update.csv, about 4 minutes) and then every element of those zones
-# against it (element_update.csv and .png, about 11 minutes); then results/README.md is
-# gathered again. About 90 minutes on one core (an
+# against it at SNR 10 and 5 (element_update.csv and .png, about 12 minutes), and every
+# element of the plate (per_element.csv and .png, about 17 minutes); then results/README.md
+# is gathered again. About 110 minutes on one core (an
 # MCRE run about 8 minutes, half of it the 64 zones' curvature for the uncertainty; a
 # least-squares run about 6). Arguments go to the Python script, e.g.
 # `--functional least_squares` to run that functional alone.
 # Usage: scripts/plate_zones_study.sh [--functional mcre|least_squares|both | --update-only |
-#        --element-update-only]
+#        --element-update-only | --per-element-only]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${MCREWAVE_BUILD_DIR:-$root/build}"
