@@ -278,6 +278,22 @@ def analyse(zones_csv, truth):
     }
 
 
+def map_preamble(png, height, panels, title, cells, ratio, xlabel):
+    """The gnuplot lines a figure of moduli on a grid of cells = (columns, rows) starts
+    with: `panels` panels one above the other, the moduli's colour scale."""
+    return f"""set terminal pngcairo size 900,{height} font ",10"
+set output "{png}.tmp"
+set multiplot layout {panels},1 title "{title}" noenhanced
+set xrange [-0.5:{cells[0] - 0.5}]
+set yrange [-0.5:{cells[1] - 0.5}]
+set size ratio {ratio:.4f}
+set xlabel "{xlabel}"
+set ylabel "row (y)"
+set cbrange [0.5:1.3]
+set palette defined (0.5 "dark-red", 0.7 "red", 1.0 "white", 1.3 "blue")
+"""
+
+
 def write_maps(folder, zones, ls_zones, title):
     """maps.png: truth (series), the MCRE's and least squares' moduli (ls_zones: None when
     not run) and the nominal error share on the zone grid."""
@@ -294,17 +310,9 @@ def write_maps(folder, zones, ls_zones, title):
     ls_panel = (f"""set title "identified by least squares / 200 GPa"
 plot "{data}" using 1:2:6 with image notitle
 """ if ls else "")
-    script = f"""set terminal pngcairo size 900,{250 * panels + 10} font ",10"
-set output "{png}.tmp"
-set multiplot layout {panels},1 title "{title}" noenhanced
-set xrange [-0.5:{GRID[0] - 0.5}]
-set yrange [-0.5:{GRID[1] - 0.5}]
-set size ratio {GRID[1] / GRID[0] * LENGTH / HEIGHT / 4:.4f}
-set xlabel "zone column (x, 0.025 m each)"
-set ylabel "row (y)"
-set cbrange [0.5:1.3]
-set palette defined (0.5 "dark-red", 0.7 "red", 1.0 "white", 1.3 "blue")
-set title "truth: zone modulus in series / 200 GPa"
+    script = map_preamble(png, 250 * panels + 10, panels, title, GRID,
+                          GRID[1] / GRID[0] * LENGTH / HEIGHT / 4,
+                          "zone column (x, 0.025 m each)") + f"""set title "truth: zone modulus in series / 200 GPa"
 plot "{data}" using 1:2:3 with image notitle
 set title "identified by the MCRE / 200 GPa"
 plot "{data}" using 1:2:4 with image notitle
@@ -517,19 +525,11 @@ def write_element_maps(folder, zones_csv, truth, title, stem, panel):
         modulus = identified.get(f"element{e}", identified.get("rest"))
         lines.append(f"{i} {j} {series(fine_moduli(truth, i, j)):.6f} {modulus:.6f}")
     write_atomic(data, "\n".join(lines) + "\n")
-    nx, ny = MODEL_ELEMENTS
+    nx = MODEL_ELEMENTS[0]
     png = os.path.join(folder, stem + ".png")
-    script = f"""set terminal pngcairo size 900,520 font ",10"
-set output "{png}.tmp"
-set multiplot layout 2,1 title "{title}" noenhanced
-set xrange [-0.5:{nx - 0.5}]
-set yrange [-0.5:{ny - 0.5}]
-set size ratio {HEIGHT / LENGTH:.4f}
-set xlabel "element column (x, {1000 * LENGTH / nx:.2f} mm each)"
-set ylabel "row (y)"
-set cbrange [0.5:1.3]
-set palette defined (0.5 "dark-red", 0.7 "red", 1.0 "white", 1.3 "blue")
-set title "truth: element modulus in series / 200 GPa"
+    script = map_preamble(png, 520, 2, title, MODEL_ELEMENTS, HEIGHT / LENGTH,
+                          f"element column (x, {1000 * LENGTH / nx:.2f} mm each)") + \
+        f"""set title "truth: element modulus in series / 200 GPa"
 plot "{data}" using 1:2:3 with image notitle
 set title "{panel} / 200 GPa"
 plot "{data}" using 1:2:4 with image notitle

@@ -224,17 +224,28 @@ TEST(DiscrepancyPrincipleTest, ChoosesTheWeightOfTheClosedForm) {
   }
 }
 
-TEST(DiscrepancyPrincipleTest, AnUnreachableTargetFallsBackToTheMisfitFloor) {
-  Eigen::MatrixXd a = Eigen::MatrixXd::Identity(6, 3);
+// 3 parameters fitted to the first 3 of b = (1, ..., 6); rows 3..5 cannot be fitted:
+// misfit >= 1/2 (16 + 25 + 36).
+LeastSquares WithThreeUnfittableRows() {
   Eigen::VectorXd b(6);
-  b << 1, 2, 3, 4, 5, 6;  // rows 3..5 cannot be fitted: misfit >= 1/2 (16 + 25 + 36)
-  LeastSquares data(a, b);
-  BoundedMinimizerOptions options;
+  b << 1, 2, 3, 4, 5, 6;
+  return LeastSquares(Eigen::MatrixXd::Identity(6, 3), b);
+}
+
+// The discrepancy principle on the absolute weights 1 down to 1e-3: relative to the
+// start's cost 1/2 |b|^2 = 45.5 of WithThreeUnfittableRows.
+RegularizationOptions DiscrepancyFromOneToOneThousandth() {
   RegularizationOptions regularization;
   regularization.weight_rule = WeightRule::kDiscrepancy;
-  // Absolute weights 1 down to 1e-3: relative to the start's cost 1/2 |b|^2 = 45.5.
   regularization.max_weight = 1.0 / 45.5;
   regularization.min_weight = 1e-3 / 45.5;
+  return regularization;
+}
+
+TEST(DiscrepancyPrincipleTest, AnUnreachableTargetFallsBackToTheMisfitFloor) {
+  LeastSquares data = WithThreeUnfittableRows();
+  BoundedMinimizerOptions options;
+  const RegularizationOptions regularization = DiscrepancyFromOneToOneThousandth();
   const RegularizedMinimization result =
       MinimizeRegularized(options, regularization, &data, std::vector<double>(3, -10.0),
                           std::vector<double>(3, 10.0), std::vector<double>(3, 0.0), 1.0);
@@ -253,15 +264,9 @@ TEST(DiscrepancyPrincipleTest, AnUnreachableTargetFallsBackToTheMisfitFloor) {
 // regula falsi brings the weight below 1, where ten_percent keeps 1. Without s the
 // margin is ten_percent's.
 TEST(DiscrepancyPrincipleTest, TheNoiseFitMarginHoldsTheFloorToWhatTheParametersFit) {
-  Eigen::MatrixXd a = Eigen::MatrixXd::Identity(6, 3);
-  Eigen::VectorXd b(6);
-  b << 1, 2, 3, 4, 5, 6;
-  LeastSquares data(a, b);
+  LeastSquares data = WithThreeUnfittableRows();
   BoundedMinimizerOptions options;
-  RegularizationOptions regularization;
-  regularization.weight_rule = WeightRule::kDiscrepancy;
-  regularization.max_weight = 1.0 / 45.5;
-  regularization.min_weight = 1e-3 / 45.5;
+  RegularizationOptions regularization = DiscrepancyFromOneToOneThousandth();
   regularization.floor_margin = FloorMargin::kNoiseFit;
   const std::vector<double> lower(3, -10.0), upper(3, 10.0), start(3, 0.0);
   const double n = 3.0, margin = 0.1;
