@@ -94,8 +94,9 @@ struct ZoneIdentificationSummary {
   double cost_scale = -1.0;             // J_rest [J s] (least squares: [s])
   NoiseLevels noise;                    // levels of the discrepancy target's draws
   double noise_cost = -1.0;             // ExpectedNoiseCost or ExpectedLeastSquaresNoiseCost
-  double noise_cost_std_dev = -1.0;     // its draws' standard deviation (-1: one draw)
                                         // (scaled); -1: not computed
+  double noise_cost_std_dev = -1.0;     // its draws' standard deviation (scaled); -1: one
+                                        // draw, or not computed
   RegularizedMinimization regularized;  // weight, its choice, the path, the minimiser
   ZoneMerge merge;                      // merge.groups -1: not run; with merges kept,
                                         // moduli and cost are its last refit's
