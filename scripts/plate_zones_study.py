@@ -90,6 +90,23 @@ def write_atomic(path, text):
     os.replace(path + ".tmp", path)
 
 
+def copy_atomic(source, target):
+    """Copies `source` to `target` through a temporary file beside it."""
+    shutil.copyfile(source, target + ".tmp")
+    os.replace(target + ".tmp", target)
+
+
+def zone_evaluations(run):
+    """The zone evaluations of an identify run's folder (zone_evaluations.csv's rows)."""
+    return sum(1 for _ in open(os.path.join(run, "zone_evaluations.csv"))) - 1
+
+
+def relative_moduli(zones_csv):
+    """Per zone name of a zones.csv, its modulus / NOMINAL_MODULUS."""
+    return {r["name"]: float(r["modulus_pa"]) / NOMINAL_MODULUS
+            for r in csv.DictReader(open(zones_csv))}
+
+
 def element_positions():
     """Per element of the model's manifest, in its order: its (i, j) on the
     MODEL_ELEMENTS grid, from configs/plate_zones/model/element_positions.csv."""
@@ -466,9 +483,8 @@ def run_update(build_dir, results):
           f"({', '.join(flagged)}); refitted free against one background modulus ...", flush=True)
     with tempfile.TemporaryDirectory() as work:
         run, seconds = run_case(build_dir, work, truth, manifest, snr, "mcre", flagged)
-        shutil.copyfile(os.path.join(run, "zones.csv"), os.path.join(out, "update_zones.csv.tmp"))
-        os.replace(os.path.join(out, "update_zones.csv.tmp"), os.path.join(out, "update_zones.csv"))
-        evaluations = sum(1 for _ in open(os.path.join(run, "zone_evaluations.csv"))) - 1
+        copy_atomic(os.path.join(run, "zones.csv"), os.path.join(out, "update_zones.csv"))
+        evaluations = zone_evaluations(run)
     write_atomic(os.path.join(results, "update.csv"),
                  update_table(os.path.join(out, "update_zones.csv"), truth, evaluations, seconds))
     print(f"    {seconds:.0f} s", flush=True)
@@ -498,8 +514,7 @@ def element_table_rows(name, zones_csv, truth, evaluations, seconds):
     identified moduli (each element holds the same number of fine elements, so the
     series of series is the zone's series), against its truth; 'rest' (when the run has
     it) as in update_table."""
-    identified = {r["name"]: float(r["modulus_pa"]) / NOMINAL_MODULUS
-                  for r in csv.DictReader(open(zones_csv))}
+    identified = relative_moduli(zones_csv)
     truths = truth_of_zones(truth)
     by_zone = {}
     for e, (i, j) in enumerate(element_positions()):
@@ -517,8 +532,7 @@ def element_table_rows(name, zones_csv, truth, evaluations, seconds):
 def write_element_maps(folder, zones_csv, truth, title, stem, panel):
     """<stem>.png: the truth of each model element (its fine elements in series) and the
     run's element moduli (the tied elements at 'rest')."""
-    identified = {r["name"]: float(r["modulus_pa"]) / NOMINAL_MODULUS
-                  for r in csv.DictReader(open(zones_csv))}
+    identified = relative_moduli(zones_csv)
     data = os.path.join(folder, stem + ".dat")
     lines = ["# i j truth_series identified"]
     for e, (i, j) in enumerate(element_positions()):
@@ -552,9 +566,8 @@ def run_elements(build_dir, results, case, free, stem):
         run, seconds = run_case(build_dir, work, truth, manifest, snr, "mcre", settings=settings,
                                 suffix="_" + stem)
         target = os.path.join(out, stem + "_zones.csv")
-        shutil.copyfile(os.path.join(run, "zones.csv"), target + ".tmp")
-        os.replace(target + ".tmp", target)
-        evaluations = sum(1 for _ in open(os.path.join(run, "zone_evaluations.csv"))) - 1
+        copy_atomic(os.path.join(run, "zones.csv"), target)
+        evaluations = zone_evaluations(run)
     if free:
         title, panel = ("localise by the error map, then update per element",
                         "per-element update of the flagged zones (the others tied)")
@@ -653,9 +666,8 @@ def main():
             if functional == "mcre":
                 kept_files.append(("error_map.csv", "error_map.csv"))
             for source, target in kept_files:
-                shutil.copyfile(os.path.join(run, source), os.path.join(out, target + ".tmp"))
-                os.replace(os.path.join(out, target + ".tmp"), os.path.join(out, target))
-            evaluations = sum(1 for _ in open(os.path.join(run, "zone_evaluations.csv"))) - 1
+                copy_atomic(os.path.join(run, source), os.path.join(out, target))
+            evaluations = zone_evaluations(run)
             _, m = analyse(os.path.join(out, zones_file(functional)), truth)
             print(f"    {seconds:.0f} s: {m['found_by_moduli']} / {m['changed_zones']} changed "
                   f"zones found by the moduli; changed zones within "

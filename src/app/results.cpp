@@ -1298,7 +1298,7 @@ void MatrixZonesYaml(const IdentificationRun& run, YamlWriter* yaml) {
   yaml->Number(1, "floor_target", zones.regularized.floor_target,
                cost +
                    " / J_rest, the misfit floor + zone_identification.floor_margin when no "
-                   "weight met the target (-1: met, or the L-curve's corner chose)");
+                   "weight met the target (-1: met)");
   yaml->Integer(1, "weights_tried", static_cast<long>(zones.regularized.path.size()));
   yaml->Integer(1, "groups", zones.merge.groups,
                 "zones left distinct by merging (-1: zone_identification.merge_zones off)");

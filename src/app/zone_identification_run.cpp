@@ -157,9 +157,7 @@ std::vector<std::string> ZonesYamlLines(const ZoneIdentificationRun& run) {
   line(1, "misfit_floor", Number(s.regularized.misfit_floor),
        cost + " / J_rest at the grid's lightest weight when the target was missed (-1: met)");
   line(1, "floor_target", Number(s.regularized.floor_target),
-       cost +
-           " / J_rest, the floor + zone_identification.floor_margin (-1: met, or the "
-           "L-curve's corner chose)");
+       cost + " / J_rest, the floor + zone_identification.floor_margin (-1: met)");
   line(1, "weights_tried", std::to_string(s.regularized.path.size()));
   line(1, "groups", std::to_string(s.merge.groups),
        "zones left distinct by merging (-1: zone_identification.merge_zones off)");

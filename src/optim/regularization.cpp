@@ -317,6 +317,8 @@ class WeightSearch {
     const double last_weight = grid_weights_.back();
     const double last_misfit = grid_misfits_.back();
     result_.misfit_floor = last_misfit;
+    // The floor raised by its margin: the target of the rule below and of the merges.
+    result_.floor_target = FloorTarget(last_misfit);
     // No weight reaches the noise's level (model error, or the noise underestimated):
     // the noise level is not to be trusted, and the L-curve needs none (the L-curve
     // rule's own choice then, the discrepancy principle's fallback, with a warning).
@@ -338,8 +340,7 @@ class WeightSearch {
     }
     // Without a corner (fewer than 3 weights, or a straight curve) the principle is
     // applied to the floor itself, raised by its margin.
-    result_.floor_target = FloorTarget(last_misfit);
-    target_ = result_.AttainableTarget();
+    target_ = result_.floor_target;
     spdlog::warn(
         "{} down to {:.3g}: the target becomes the misfit floor {:.6g} + {:.3g} %, {:.6g}",
         l_curve_ || target_misfit_ < 0.0

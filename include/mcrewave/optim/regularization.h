@@ -164,8 +164,8 @@ struct RegularizedMinimization {
   std::string weight_choice = "fixed";
   double target_misfit = -1.0;         // the discrepancy target (-1: not used)
   double misfit_floor = -1.0;  // the grid's lightest weight's misfit when the target was missed
-  // The misfit floor + its margin (floor_margin), the target of weight_choice
-  // "misfit_floor"; -1 when the target was met or the L-curve chose.
+  // The misfit floor + its margin (floor_margin) when the target was missed, the target
+  // of weight_choice "misfit_floor" and of MergeNeighbouringZones; -1 when it was met.
   double floor_target = -1.0;
   std::vector<RegularizedPoint> path;  // every minimisation, in order
   BoundedMinimizerSummary minimizer;   // the minimisation at `weight`
@@ -176,10 +176,7 @@ struct RegularizedMinimization {
   // The misfit the data can be held to: target_misfit, or when no weight of the grid
   // met it, the misfit floor raised by its margin (the target of weight_choice
   // "misfit_floor", and of MergeNeighbouringZones).
-  double AttainableTarget() const {
-    if (floor_target >= 0.0) return floor_target;
-    return misfit_floor >= 0.0 ? (1.0 + kMisfitFloorMargin) * misfit_floor : target_misfit;
-  }
+  double AttainableTarget() const { return floor_target >= 0.0 ? floor_target : target_misfit; }
 };
 
 // Minimises data cost + R within the bounds: at the fixed weight, or with the weight
