@@ -1310,11 +1310,13 @@ std::string WriteStudiesReadme(const std::string& folder) {
         "`bash scripts/plate_sensors_study.sh` its sensor layouts', "
         "`bash scripts/beam3d_study.sh` the 3-D beam's, `bash scripts/shpb_study.sh` the real "
         "Hopkinson-bar shots', `bash scripts/plate_basin_study.sh` the basin of attraction on "
-        "the SfePy plate's 8 zones); do not edit by hand. Each "
+        "the SfePy plate's 8 zones, `bash scripts/plate_zones_basin_study.sh` on the many-zone "
+        "plate's 64); do not edit by hand. Each "
         "section below is the `summary.md` of its folder.\n\n";
-  for (const char* study : {"robustness", "relaxation", "cost_curves", "damage", "comparator",
-                            "robustness_settings", "complexity", "weights", "plate", "plate_zones",
-                            "plate_sensors", "beam3d", "beam3d/fine", "real", "plate_basin"}) {
+  for (const char* study :
+       {"robustness", "relaxation", "cost_curves", "damage", "comparator", "robustness_settings",
+        "complexity", "weights", "plate", "plate_zones", "plate_sensors", "beam3d", "beam3d/fine",
+        "real", "plate_basin", "plate_zones_basin/full_field", "plate_zones_basin/gauges"}) {
     const std::string summary = folder + "/" + study + "/summary.md";
     std::ifstream file(summary);
     if (!file) continue;
