@@ -189,8 +189,11 @@ def run_continuation(build_dir, case, output):
 
     def from_start(start, work):
         fixed = next(r for r in basin if r["start"] != "truth" and float(r["start"]) == start)
-        column = next(k for k in fixed_moduli[0]
-                      if k.startswith("mcre_") and k != "mcre_truth" and float(k[5:]) == start)
+        column = next((k for k in fixed_moduli[0] if k.startswith("mcre_") and
+                       k != "mcre_truth" and float(k[5:]) == start), None)
+        if column is None:
+            sys.exit(f"[continuation] the fixed weight's run from {start:g} E was refused "
+                     f"({fixed['message']}): no moduli to compare with")
         reference = {r["zone"]: float(r[column]) for r in fixed_moduli}
         setting = f"zone_identification.start_modulus={start * NOMINAL_MODULUS:.17g}"
         total = 0
