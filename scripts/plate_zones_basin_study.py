@@ -126,6 +126,15 @@ def history(folder):
     return [float(r["scaled_cost"]) for r in csv.DictReader(open(path)) if r["usable"] == "1"]
 
 
+def read_histories(output):
+    """histories.csv's costs per (functional, start), in its order; start 'truth' or k."""
+    histories = {}
+    for r in csv.DictReader(open(os.path.join(output, "histories.csv"))):
+        start = r["start"] if r["start"] == "truth" else float(r["start"])
+        histories.setdefault((r["functional"], start), []).append(float(r["cost"]))
+    return histories
+
+
 def run_functional(build_dir, case, work, functional, truths, rows, moduli, histories, lock):
     """Steps 1 to 3 for one functional; appends its basin.csv rows, moduli and histories."""
     truth_start = "zone_identification.start_moduli=[" + ",".join(
@@ -302,9 +311,7 @@ unset multiplot
     os.replace(png + ".tmp", png)
     os.remove(data)
 
-    histories = {}
-    for r in csv.DictReader(open(os.path.join(output, "histories.csv"))):
-        histories.setdefault((r["functional"], r["start"]), []).append(float(r["cost"]))
+    histories = read_histories(output)
     data = os.path.join(output, "histories.dat")
     blocks, plots = [], []
     for (functional, start), costs in histories.items():  # basin.csv's order
@@ -317,7 +324,7 @@ unset multiplot
     panels = []
     for functional, title in (("mcre", "MCRE"), ("least_squares", "least squares")):
         curves = [f'"{data}" index {i} using 1:2 with lines lw {2 if s == "truth" else 1} '
-                  f'title "{"truth" if s == "truth" else f"{float(s):g} E"}"'
+                  f'title "{"truth" if s == "truth" else f"{s:g} E"}"'
                   for f, s, i in plots if f == functional]
         if curves:
             panels.append(f'set title "{title}"\nplot ' + ", \\\n     ".join(curves))
@@ -426,10 +433,8 @@ def read_kept(output, functionals):
         if functional and functional not in functionals:
             moduli[(functional, start_of(key[len(functional) + 1:]))] = {
                 c["zone"]: float(c[key]) for c in columns}
-    for r in csv.DictReader(open(os.path.join(output, "histories.csv"))):
-        if r["functional"] not in functionals:
-            histories.setdefault((r["functional"], start_of(r["start"])), []).append(
-                float(r["cost"]))
+    histories = {key: costs for key, costs in read_histories(output).items()
+                 if key[0] not in functionals}
     return rows, moduli, histories
 
 
