@@ -520,11 +520,11 @@ TEST(MatrixMcreProblemAllocationTest, StreamingMapAllocatesNothingAfterItsFirstC
 // MatrixOutputErrorObjective::Cost on the zoned bar of the run (BarRunModel, the band
 // path, its clamp held) re-initialises the integrator for the new moduli (allocations
 // before the loop); the loop over the steps, with a sensitivity per zone, the clamp's
-// reaction and interior sensors, allocates nothing: the same heap calls for 100 and 200
-// steps.
+// reaction and interior sensors, allocates nothing, nor does the adjoint's backward
+// sweep: the same heap calls for 100 and 200 steps.
 TEST(MatrixOutputErrorAllocationTest, OnTheZonedBarTheTimeLoopAllocatesNothing) {
   SKIP_WITHOUT_ALLOCATION_COUNTING();
-  HeapCalls calls[2];
+  HeapCalls calls[2], adjoint_calls[2];
   for (int i = 0; i < 2; ++i) {
     testing::SmallCase small = MakeSmallCase(kElements, 100 * (i + 1), INFINITY, 1);
     ZoneLayout layout;
@@ -542,18 +542,25 @@ TEST(MatrixOutputErrorAllocationTest, OnTheZonedBarTheTimeLoopAllocatesNothing) 
     Vector gradient(4);
     objective.Cost(moduli, &gradient);
     calls[i] = CountHeapCalls([&] { objective.Cost(moduli, &gradient); });
+    // The adjoint's gradient: its backward sweep allocates nothing either.
+    objective.SetGradientMethod(LeastSquaresGradient::kAdjoint);
+    objective.Cost(moduli, &gradient);
+    adjoint_calls[i] = CountHeapCalls([&] { objective.Cost(moduli, &gradient); });
   }
   EXPECT_EQ(calls[0].allocations, calls[1].allocations);
   EXPECT_EQ(calls[0].deallocations, calls[1].deallocations);
+  EXPECT_EQ(adjoint_calls[0].allocations, adjoint_calls[1].allocations);
+  EXPECT_EQ(adjoint_calls[0].deallocations, adjoint_calls[1].deallocations);
 }
 
 // MatrixOutputErrorObjective::Cost likewise (the coarse plate, sparse path, 2 zones, 5
-// sensors): the same heap calls for 20 and 80 steps.
+// sensors), by forward sensitivities and by the adjoint: the same heap calls for 20 and
+// 80 steps.
 TEST(MatrixOutputErrorAllocationTest, TheTimeLoopAllocatesNothing) {
   SKIP_WITHOUT_ALLOCATION_COUNTING();
   const MatrixModelData plate =
       ReadMatrixModel(std::string(MCREWAVE_SOURCE_DIR) + "/configs/plate/coarse/model.yaml");
-  HeapCalls calls[2];
+  HeapCalls calls[2], adjoint_calls[2];
   for (int i = 0; i < 2; ++i) {
     const int samples = 1 + 20 * (1 + 3 * i);
     Matrix loads = Matrix::Zero(1, samples);
@@ -570,18 +577,23 @@ TEST(MatrixOutputErrorAllocationTest, TheTimeLoopAllocatesNothing) {
     objective.Cost(moduli, &gradient);
     ASSERT_EQ(objective.integrator().factorization(), Factorization::kSparse);
     calls[i] = CountHeapCalls([&] { objective.Cost(moduli, &gradient); });
+    objective.SetGradientMethod(LeastSquaresGradient::kAdjoint);
+    objective.Cost(moduli, &gradient);
+    adjoint_calls[i] = CountHeapCalls([&] { objective.Cost(moduli, &gradient); });
   }
   EXPECT_EQ(calls[0].allocations, calls[1].allocations);
   EXPECT_EQ(calls[0].deallocations, calls[1].deallocations);
+  EXPECT_EQ(adjoint_calls[0].allocations, adjoint_calls[1].allocations);
+  EXPECT_EQ(adjoint_calls[0].deallocations, adjoint_calls[1].deallocations);
 }
 
 // The same with a support (the supported lattice: its reaction an output, the held
-// dofs decoupled), with and without the Fisher information and each sensor's: the same
-// heap calls for 20 and 80 steps.
+// dofs decoupled), with and without the Fisher information and each sensor's, and with
+// the adjoint's gradient: the same heap calls for 20 and 80 steps.
 TEST(MatrixOutputErrorAllocationTest, WithASupportTheTimeLoopAllocatesNothing) {
   SKIP_WITHOUT_ALLOCATION_COUNTING();
   const MatrixModelData lattice = testing::SupportedLattice();
-  HeapCalls calls[2], fisher_calls[2], sensor_calls[2];
+  HeapCalls calls[2], fisher_calls[2], sensor_calls[2], adjoint_calls[2];
   for (int i = 0; i < 2; ++i) {
     const int samples = 1 + 20 * (1 + 3 * i);
     Matrix loads = Matrix::Zero(1, samples);
@@ -608,7 +620,13 @@ TEST(MatrixOutputErrorAllocationTest, WithASupportTheTimeLoopAllocatesNothing) {
     objective.Cost(moduli, &gradient, &information, &sensors);
     sensor_calls[i] =
         CountHeapCalls([&] { objective.Cost(moduli, &gradient, &information, &sensors); });
+    // The adjoint's gradient, the supports' reactions in its loads.
+    objective.SetGradientMethod(LeastSquaresGradient::kAdjoint);
+    objective.Cost(moduli, &gradient);
+    adjoint_calls[i] = CountHeapCalls([&] { objective.Cost(moduli, &gradient); });
   }
+  EXPECT_EQ(adjoint_calls[0].allocations, adjoint_calls[1].allocations);
+  EXPECT_EQ(adjoint_calls[0].deallocations, adjoint_calls[1].deallocations);
   EXPECT_EQ(sensor_calls[0].allocations, sensor_calls[1].allocations);
   EXPECT_EQ(sensor_calls[0].deallocations, sensor_calls[1].deallocations);
   EXPECT_EQ(calls[0].allocations, calls[1].allocations);

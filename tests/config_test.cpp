@@ -833,6 +833,7 @@ mcre:
   unmeasured_load_interval: [0, 1.2e-4, 1e-5, 2.5e-4]
 zone_identification:
   start_modulus: 1.25e11
+  least_squares_gradient: adjoint
 )";
 
 // The key of equal zones, refused with the zoning of kEveryKeyNotAtItsDefault; the

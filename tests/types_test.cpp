@@ -49,6 +49,8 @@ TEST(TypesTest, EveryEnumRoundTripsThroughItsNameTable) {
   ExpectTableRoundTrips(kBarClampExportNames, BarClampExportToString, StringToBarClampExport);
   ExpectTableRoundTrips(kSearchFunctionalNames, SearchFunctionalToString, StringToSearchFunctional);
   ExpectTableRoundTrips(kFactorizationNames, FactorizationToString, StringToFactorization);
+  ExpectTableRoundTrips(kLeastSquaresGradientNames, LeastSquaresGradientToString,
+                        StringToLeastSquaresGradient);
   ExpectTableRoundTrips(kMatrixMarketStorageNames, MatrixMarketStorageToString,
                         StringToMatrixMarketStorage);
   ExpectTableRoundTrips(kCoupledSolverTypeNames, CoupledSolverTypeToString,

@@ -865,6 +865,14 @@ const std::vector<Key>& KeyTable() {
               "",
               "the penalty's neighbours: consecutive zones in the model's order (along the bar, "
               "or the manifest's list), or zones sharing a node (a 2-D or 3-D layout)"),
+      MakeKey("zone_identification.least_squares_gradient", &Config::zone_identification,
+              &ZoneIdentificationOptions::least_squares_gradient,
+              EnumByName<LeastSquaresGradient>(
+                  {LeastSquaresGradient::kForwardSensitivities, LeastSquaresGradient::kAdjoint},
+                  LeastSquaresGradientToString, StringToLeastSquaresGradient),
+              "",
+              "outer.functional least_squares: its gradient by forward sensitivities (1 + zones "
+              "sweeps an evaluation) or by the discrete adjoint (2 sweeps, the trajectory kept)"),
       MakeKey("zone_identification.regularization_weight", &Config::zone_identification,
               &ZoneIdentificationOptions::regularization, &RegularizationOptions::weight, Number(),
               "", "lambda of the penalty; < 0: by weight_rule"),

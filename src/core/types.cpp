@@ -73,6 +73,12 @@ bool StringToSearchFunctional(const std::string& name, SearchFunctional* functio
   return internal::FromName(kSearchFunctionalNames, name, functional);
 }
 
+const char* LeastSquaresGradientToString(LeastSquaresGradient gradient) {
+  return internal::ToName(kLeastSquaresGradientNames, gradient);
+}
+bool StringToLeastSquaresGradient(const std::string& name, LeastSquaresGradient* gradient) {
+  return internal::FromName(kLeastSquaresGradientNames, name, gradient);
+}
 const char* FactorizationToString(Factorization factorization) { return internal::ToName(kFactorizationNames, factorization); }
 bool StringToFactorization(const std::string& name, Factorization* factorization) {
   return internal::FromName(kFactorizationNames, name, factorization);

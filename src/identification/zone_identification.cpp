@@ -400,12 +400,26 @@ void IdentifyOnMcreObjective(const ZoneIdentificationOptions& options, const Mat
   summary->sweeps = objective->sweeps() - sweeps_before;
 }
 
-// IdentifyZoneModuliByLeastSquares's steps on `objective` into *summary (its start set).
+// From this many zones on, least squares by forward sensitivities says that the adjoint
+// is cheaper (1 + Z sweeps an evaluation against 2).
+constexpr int kManyZones = 16;
+
+// IdentifyZoneModuliByLeastSquares's steps on `objective` into *summary (its start set),
+// its gradient by options.least_squares_gradient.
 void IdentifyOnOutputError(const ZoneIdentificationOptions& options, const MatrixModelData& model,
                            const ChannelSet& data, const NoiseLevels& misfit_levels, double theta,
                            MatrixOutputErrorObjective* objective, double lower_bound,
                            double upper_bound, const PrefilterOptions& prefilter,
                            ZoneIdentificationSummary* summary) {
+  objective->SetGradientMethod(options.least_squares_gradient);
+  const int zones = objective->num_parameters();
+  if (options.least_squares_gradient == LeastSquaresGradient::kForwardSensitivities &&
+      zones >= kManyZones) {
+    spdlog::info(
+        "least squares on {} zones: the gradient by forward sensitivities costs {} sweeps an "
+        "evaluation; zone_identification.least_squares_gradient: adjoint costs 2",
+        zones, 1 + zones);
+  }
   const int evaluations_before = objective->evaluations();
   const long sweeps_before = objective->sweeps();
   summary->cost_scale = objective->cost_scale();

@@ -214,6 +214,70 @@ double MatrixOutputErrorObjective::SampleCost(int j, const Vector& displacement,
   return cost;
 }
 
+void MatrixOutputErrorObjective::SetGradientMethod(LeastSquaresGradient method) {
+  gradient_method_ = method;
+  if (method != LeastSquaresGradient::kAdjoint || !zone_forms_.empty()) return;
+  const auto n = static_cast<Eigen::Index>(model_.dofs());
+  trajectory_ = Matrix::Zero(n, measured_outputs_.cols());
+  for (const SparseMatrix& stiffness : zone_stiffness_) zone_forms_.emplace_back(stiffness);
+  for (int b = 0; b < 2; ++b) {
+    adjoint_velocity_[b] = Vector::Zero(n);
+    adjoint_displacement_[b] = Vector::Zero(n);
+  }
+  adjoint_force_ = Vector::Zero(n);
+  adjoint_load_ = Vector::Zero(n);
+  weighted_residual_ = Vector::Zero(observation_.rows());
+}
+
+void MatrixOutputErrorObjective::AdjointLoad(int j, Vector* gradient) {
+  const int samples = static_cast<int>(measured_outputs_.cols());
+  const double c = (j == 0 || j == samples - 1) ? 0.5 : 1.0;
+  const double h = time_step_;
+  // c_j h H^T W (H U_j - d~_j)
+  weighted_residual_ = outputs_.col(j) - measured_outputs_.col(j);
+  weighted_residual_ = (c * h) * weighted_residual_.cwiseProduct(weights_);
+  adjoint_load_.noalias() = observation_.transpose() * weighted_residual_;
+  if (held_.empty()) return;
+  // + c_j h w_f sum_s (r_s,j - f~_sj) q_s, and the explicit part of dJ/dE_z,
+  // c_j h w_f sum_s (r_s,j - f~_sj) v_sz^T U_j.
+  force_residual_ = support_forces_.col(j) - measured_forces_.col(j);
+  force_residual_ *= c * h * force_weight_;
+  adjoint_load_.noalias() += reaction_rows_.transpose() * force_residual_;
+  for (int z = 0; z < num_parameters(); ++z) {
+    force_trace_.noalias() = reaction_zone_rows_[static_cast<std::size_t>(z)] * trajectory_.col(j);
+    (*gradient)[z] += force_residual_.dot(force_trace_);
+  }
+}
+
+void MatrixOutputErrorObjective::AdjointGradient(Vector* gradient) {
+  const int zones = num_parameters();
+  const int last = static_cast<int>(measured_outputs_.cols()) - 1;
+  const double h = time_step_;
+  gradient->setZero(zones);
+  // From t_m: a_m = 0, e_m = g_m.
+  int current = 0;
+  adjoint_velocity_[0].setZero();
+  AdjointLoad(last, gradient);
+  adjoint_displacement_[0] = adjoint_load_;
+  for (int k = last - 1; k >= 0; --k) {
+    const int next = current ^ 1;
+    // y_k, a_k and e_k - g_k: the transposed step t_{k+1} -> t_k.
+    integrator_.StepTransposed(adjoint_velocity_[current], adjoint_displacement_[current],
+                               adjoint_force_, adjoint_velocity_[next],
+                               adjoint_displacement_[next]);
+    // U_theta,k = theta U_{k+1} + (1 - theta) U_k
+    weighted_ = theta_ * trajectory_.col(k + 1) + (1.0 - theta_) * trajectory_.col(k);
+    for (int z = 0; z < zones; ++z) {
+      // -h/E_z,nom y_k^T K_z U_theta,k
+      (*gradient)[z] -=
+          h * zone_forms_[static_cast<std::size_t>(z)](adjoint_force_.data(), weighted_.data());
+    }
+    AdjointLoad(k, gradient);
+    adjoint_displacement_[next] += adjoint_load_;
+    current = next;
+  }
+}
+
 double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradient,
                                         Matrix* fisher_information,
                                         std::vector<Matrix>* sensor_information) {
@@ -238,6 +302,10 @@ double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradi
   }
 
   const bool gradient_requested = gradient != nullptr;
+  // The adjoint's gradient when chosen; the Fisher information needs the sensitivities.
+  const bool adjoint = gradient_requested && gradient_method_ == LeastSquaresGradient::kAdjoint &&
+                       fisher_information == nullptr && sensor_information == nullptr;
+  const bool sensitivities = gradient_requested && !adjoint;
   if (gradient_requested) gradient->setZero(zones);
   if (fisher_information != nullptr) fisher_information->setZero(zones, zones);
   if (sensor_information != nullptr) {
@@ -265,7 +333,7 @@ double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradi
       force_.noalias() = loads_ * channel_;
       integrator_.Step(velocity_[current], displacement_[current], force_, velocity_[next],
                        displacement_[next]);
-      if (gradient_requested) {
+      if (sensitivities) {
         // U_theta = theta U_j + (1 - theta) U_{j-1}
         weighted_ = theta_ * displacement_[next] + (1.0 - theta_) * displacement_[current];
         for (int z = 0; z < zones; ++z) {
@@ -278,9 +346,11 @@ double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradi
       }
       current = next;
     }
-    cost += SampleCost(j, displacement_[current], sensitivity_[current], gradient,
-                       fisher_information, sensor_information);
+    if (adjoint) trajectory_.col(j) = displacement_[current];
+    cost += SampleCost(j, displacement_[current], sensitivity_[current],
+                       sensitivities ? gradient : nullptr, fisher_information, sensor_information);
   }
+  if (adjoint) AdjointGradient(gradient);
   if (sensor_information != nullptr) {
     for (Matrix& information : *sensor_information) {
       for (int z = 0; z < zones; ++z) {
@@ -288,7 +358,7 @@ double MatrixOutputErrorObjective::Cost(const Vector& zone_moduli, Vector* gradi
       }
     }
   }
-  sweeps_ += gradient_requested ? 1 + zones : 1;
+  sweeps_ += sensitivities ? 1 + zones : (adjoint ? 2 : 1);
   return cost;
 }
 

@@ -170,6 +170,31 @@ void SparseThetaStepper::Step(const double* v_k, const double* u_k, const double
   for (int i = 0; i < n; ++i) u_next[i] = u_k[i] + a * v_k[i] + b * v_next[i];
 }
 
+void SparseThetaStepper::StepTransposed(const double* a_next, const double* e_next, double* y,
+                                        double* a_k, double* e_k) {
+  const int n = size();
+  const double h = time_step_;
+  // y = S^-1 (a_{k+1} + h theta e_{k+1})
+  for (int i = 0; i < n; ++i) y[i] = a_next[i] + h * theta_ * e_next[i];
+  SolveInPlace(y);
+  const int* start = pattern_start_.data();
+  const int* rows = pattern_rows_.data();
+  const double* r = free_values_.data();
+  const double* k = stiffness_values_.data();
+  const double a = h * (1.0 - theta_);
+  // a_k = R y + h (1 - theta) e_{k+1},  e_k = e_{k+1} + (-h K) y   (one pass, symmetric).
+  for (int i = 0; i < n; ++i) {
+    double free_sum = 0.0, stiffness_sum = 0.0;
+    for (int q = start[i]; q < start[i + 1]; ++q) {
+      const int j = rows[q];
+      free_sum += r[q] * y[j];
+      stiffness_sum += k[q] * y[j];
+    }
+    a_k[i] = free_sum + a * e_next[i];
+    e_k[i] = e_next[i] + stiffness_sum;
+  }
+}
+
 void SparseThetaStepper::MultiplyMass(const double* x, double* y) const {
   MultiplySymmetric(mass_, x, y);
 }

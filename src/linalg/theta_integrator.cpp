@@ -240,6 +240,31 @@ void ThetaIntegrator::Step(const Eigen::Ref<const Vector>& v_k, const Eigen::Ref
   u_next = u_k + (h * (1.0 - theta)) * v_k + (h * theta) * v_next;
 }
 
+void ThetaIntegrator::StepTransposed(const Eigen::Ref<const Vector>& a_next,
+                                     const Eigen::Ref<const Vector>& e_next, Eigen::Ref<Vector> y,
+                                     Eigen::Ref<Vector> a_k, Eigen::Ref<Vector> e_k) {
+  assert(a_next.size() == size() && e_next.size() == size());
+  if (sparse_path_) {
+    sparse_.StepTransposed(a_next.data(), e_next.data(), y.data(), a_k.data(), e_k.data());
+    return;
+  }
+  const double h = options_.time_step;
+  const double theta = options_.theta;
+  // y = S^-1 (a_{k+1} + h theta e_{k+1})
+  y = a_next + (h * theta) * e_next;
+  if (tridiagonal_) {
+    tridiagonal_factor_.SolveInPlace(y);
+  } else {
+    iteration_matrix_.SolveInPlace(y);
+  }
+  // a_k = R y + h (1 - theta) e_{k+1}
+  free_state_matrix_.Multiply(y, a_k);
+  a_k += (h * (1.0 - theta)) * e_next;
+  // e_k = e_{k+1} - h K y
+  e_k = e_next;
+  stiffness_.MultiplyAdd(-h, y, e_k);
+}
+
 void ThetaIntegrator::StepWithEndLoads(const Eigen::Ref<const Vector>& v_k,
                                        const Eigen::Ref<const Vector>& u_k,
                                        const Eigen::Ref<const Vector>& z, double f0, double fL,

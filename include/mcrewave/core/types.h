@@ -210,6 +210,21 @@ inline constexpr std::array<std::pair<Factorization, const char*>, 3> kFactoriza
 const char* FactorizationToString(Factorization factorization);
 bool StringToFactorization(const std::string& name, Factorization* factorization);
 
+// How output-error least squares gets its gradient over Z zone moduli
+// (least_squares/matrix_output_error_objective.h; config key
+// zone_identification.least_squares_gradient).
+enum class LeastSquaresGradient {
+  kForwardSensitivities,  // one sensitivity sweep per zone: 1 + Z sweeps
+  kAdjoint,               // one backward sweep of the discrete adjoint, whatever Z: 2 sweeps
+};
+inline constexpr std::array<std::pair<LeastSquaresGradient, const char*>, 2>
+    kLeastSquaresGradientNames{{
+        {LeastSquaresGradient::kForwardSensitivities, "forward_sensitivities"},
+        {LeastSquaresGradient::kAdjoint, "adjoint"},
+    }};
+const char* LeastSquaresGradientToString(LeastSquaresGradient gradient);
+bool StringToLeastSquaresGradient(const std::string& name, LeastSquaresGradient* gradient);
+
 // How a sparse matrix is written.
 enum class MatrixMarketStorage {
   kGeneral,    // every stored entry

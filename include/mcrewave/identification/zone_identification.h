@@ -66,6 +66,10 @@ struct ZoneIdentificationOptions {
   // in the model's order, without the homogeneous stage (a coarser mesh's moduli, say);
   // empty: start_modulus or E*. Not with start_modulus.
   std::vector<double> start_moduli;
+  // How least squares gets its gradient (MatrixOutputErrorObjective): forward
+  // sensitivities, 1 + Z sweeps an evaluation, or the discrete adjoint, 2 sweeps and the
+  // trajectory in memory. The same derivative up to round-off.
+  LeastSquaresGradient least_squares_gradient = LeastSquaresGradient::kForwardSensitivities;
 
   // Messages name the zone_identification.* keys.
   bool IsValid(std::string* error) const;

@@ -38,6 +38,19 @@
 // One sweep per evaluation without the gradient, 1 + Z with it; no allocation in the
 // time loop (every scratch is sized before it).
 //
+// Or (LeastSquaresGradient::kAdjoint) by the discrete adjoint (docs/matrix_models.md
+// section 18): the forward sweep keeps U_0..U_m; then, backward from a_m = 0,
+// e_m = g_m, the transposed steps of the same factorisation
+// (ThetaIntegrator::StepTransposed),
+//   y_k = S^-1 (a_{k+1} + h theta e_{k+1}),  a_k = R y_k + h (1 - theta) e_{k+1},
+//   e_k = e_{k+1} - h K y_k + g_k,
+//   g_j = dJ/dU_j = c_j h [H^T W (H U_j - d~_j) + w_f sum_s (r_s,j - f~_sj) q_s],
+// and, the force of S_z being f_theta = -(1/E_z,nom) K_z U_theta,
+//   dJ/dE_z = -h/E_z,nom sum_k y_k^T K_z U_theta,k
+//             + sum_j c_j h w_f sum_s (r_s,j - f~_sj) v_sz^T U_j,
+// the same derivative of the same discrete J as the forward sensitivities' up to
+// round-off: two sweeps whatever Z, and n (m + 1) doubles for the trajectory.
+//
 // Seen by the optimisers as ZoneMcreObjective is (optim/log_moduli_objective.h): as a
 // function of p_z = log(E_z / E_z,ref), E_z,ref the nominal moduli or one given scale,
 // with J_scale = J_rest (J with every prediction 0).
@@ -48,6 +61,7 @@
 
 #include "mcrewave/core/types.h"
 #include "mcrewave/data/channel_set.h"
+#include "mcrewave/linalg/sparse_bilinear_form.h"
 #include "mcrewave/linalg/theta_integrator.h"
 #include "mcrewave/mcre/modulus_uncertainty.h"
 #include "mcrewave/model/matrix_export.h"
@@ -90,6 +104,11 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
   double Cost(const Vector& zone_moduli, Vector* gradient, Matrix* fisher_information = nullptr,
               std::vector<Matrix>* sensor_information = nullptr);
 
+  // How Cost's gradient is computed (the Fisher information always uses the forward
+  // sensitivities). kAdjoint sizes the trajectory's n (m + 1) doubles here.
+  void SetGradientMethod(LeastSquaresGradient method);
+  LeastSquaresGradient gradient_method() const { return gradient_method_; }
+
   // The outputs H U_j of the last Cost, one row per sensor in the model's order, one
   // column per sample [m] or [-].
   const Matrix& outputs() const { return outputs_; }
@@ -104,7 +123,8 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
   // (1 when J_rest = 0).
   double rest_cost() const { return rest_cost_; }
   double cost_scale() const override { return rest_cost_ > 0.0 ? rest_cost_ : 1.0; }
-  // Simulations run: 1 per Cost, plus one per zone with the gradient.
+  // Simulations run: 1 per Cost, plus one per zone with the forward sensitivities'
+  // gradient or one backward sweep with the adjoint's.
   long sweeps() const { return sweeps_; }
   const ThetaIntegrator& integrator() const { return integrator_; }
 
@@ -122,6 +142,12 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
   // With fisher_information, adds its terms of sample j too.
   double SampleCost(int j, const Vector& displacement, const Matrix& sensitivity, Vector* gradient,
                     Matrix* fisher_information, std::vector<Matrix>* sensor_information);
+  // The adjoint's gradient (the header's formula) into *gradient (zeroed), from the
+  // trajectory, outputs_ and support_forces_ of the forward sweep just run.
+  void AdjointGradient(Vector* gradient);
+  // g_j = dJ/dU_j into adjoint_load_ (the header's formula); with supports, adds the
+  // explicit part of dJ/dE_z at t_j into *gradient.
+  void AdjointLoad(int j, Vector* gradient);
 
   const MatrixModelData& model_;
   double time_step_;  // h [s]
@@ -158,6 +184,15 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
   // Fisher information's; sized on its first request).
   Matrix output_sensitivity_, force_sensitivity_;
   Vector sensor_sensitivity_;  // one sensor's row of output_sensitivity_ (Z entries)
+
+  // The adjoint (kAdjoint): U_j by columns, n x (m + 1); the zones' forms
+  // x^T (K_z / E_z,nom) y; the adjoint state (a, e) double buffered, y_k, g_j and the
+  // weighted residuals.
+  LeastSquaresGradient gradient_method_ = LeastSquaresGradient::kForwardSensitivities;
+  Matrix trajectory_;
+  std::vector<SparseBilinearForm> zone_forms_;
+  Vector adjoint_velocity_[2], adjoint_displacement_[2], adjoint_force_, adjoint_load_;
+  Vector weighted_residual_;
 
   double rest_cost_ = 0.0;
   long sweeps_ = 0;

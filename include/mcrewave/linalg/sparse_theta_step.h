@@ -40,6 +40,12 @@ class SparseThetaStepper {
   void Step(const double* v_k, const double* u_k, const double* z, const double* force, double f0,
             double fL, const PointLoads* point_loads, double* v_next, double* u_next);
 
+  // The transposed step (ThetaIntegrator::StepTransposed): y = S^-1 (a + h theta e),
+  // a_k = R y + h (1 - theta) e, e_k = e - h K y. Outputs must not alias inputs. No
+  // allocation.
+  void StepTransposed(const double* a_next, const double* e_next, double* y, double* a_k,
+                      double* e_k);
+
   // x <- S^-1 x. No allocation.
   void SolveInPlace(double* x);
   // y = A x for A = M or K over the stored pattern (no allocation).

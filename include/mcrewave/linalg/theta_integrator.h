@@ -89,6 +89,19 @@ class ThetaIntegrator {
                    const Eigen::Ref<const Vector>& z, const Eigen::Ref<const Vector>& force,
                    Eigen::Ref<Vector> v_next, Eigen::Ref<Vector> u_next);
 
+  // The transpose of Step, the step of the discrete adjoint: given the adjoints
+  // (a_{k+1}, e_{k+1}) of (v_{k+1}, u_{k+1}), those of (v_k, u_k) and of the step's
+  // force (J a scalar function of the states, a = dJ/dv, e = dJ/du; docs/
+  // matrix_models.md section 18):
+  //   y = S^-1 (a_{k+1} + h theta e_{k+1}),      dJ/df_theta = h y,
+  //   a_k = R y + h (1 - theta) e_{k+1},
+  //   e_k = e_{k+1} - h K y,
+  // M and K symmetric. Writes y, a_k and e_k; they must not alias the inputs. No
+  // allocation.
+  void StepTransposed(const Eigen::Ref<const Vector>& a_next,
+                      const Eigen::Ref<const Vector>& e_next, Eigen::Ref<Vector> y,
+                      Eigen::Ref<Vector> a_k, Eigen::Ref<Vector> e_k);
+
   // B independent steps at once (B = 2 or 3), step b as StepWithEndLoads from
   // (v_k[b], u_k[b]) with z[b] (null: none), f0[b], fL[b]; all arrays of size()
   // contiguous doubles, outputs distinct from every input; point_loads[b] (nullable,
