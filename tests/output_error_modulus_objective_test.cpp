@@ -225,6 +225,35 @@ TEST(OutputErrorModulusObjectiveTest, ACloneComputesTheSameBitsAndABadModulusIsR
   EXPECT_FALSE(objective.error_message().empty());
 }
 
+// On a bar in 6 zones (the homogeneous stage of a zone identification), dJ/dE by the
+// adjoint (2 sweeps) against the forward sensitivities (1 + 6), and a clone of the
+// adjoint's objective computes its bits.
+TEST(OutputErrorModulusObjectiveTest, TheAdjointsGradientIsTheSensitivitiesAndClonesKeepIt) {
+  const SensedBar bar;
+  ZoneLayout layout;
+  layout.zone_count = 6;
+  const MatrixModelData zoned =
+      BarRunModel(BarModel(bar.small.bar, layout.ElementZones(bar.small.bar)), bar.data, {});
+  OutputErrorModulusObjective forward(zoned, bar.data, bar.noise, 0.5, 200e9);
+  OutputErrorModulusObjective adjoint(zoned, bar.data, bar.noise, 0.5, 200e9);
+  adjoint.SetGradientMethod(LeastSquaresGradient::kAdjoint);
+  const double x = 0.93;
+  double cost = 0.0, gradient = 0.0, adjoint_cost = 0.0, adjoint_gradient = 0.0;
+  ASSERT_TRUE(forward.Evaluate(&x, &cost, &gradient));
+  ASSERT_TRUE(adjoint.Evaluate(&x, &adjoint_cost, &adjoint_gradient));
+  EXPECT_EQ(cost, adjoint_cost);
+  // Measured 8.9e-16 apart, relative.
+  EXPECT_NEAR(adjoint_gradient, gradient, 1e-14 * std::abs(gradient));
+  EXPECT_EQ(forward.sweeps(), 1 + 6);
+  EXPECT_EQ(adjoint.sweeps(), 2);
+  const std::unique_ptr<ModulusObjective> clone = adjoint.CloneForScan(1e-8);
+  double clone_cost = 0.0, clone_gradient = 0.0;
+  ASSERT_TRUE(clone->Evaluate(&x, &clone_cost, &clone_gradient));
+  EXPECT_EQ(clone_cost, adjoint_cost);
+  EXPECT_EQ(clone_gradient, adjoint_gradient);
+  EXPECT_EQ(clone->sweeps(), 2);
+}
+
 TEST(MatrixOutputErrorObjectiveTest, TheFisherMatrixIsTheGaussNewtonSumOfCentralDifferences) {
   // Three zones of the sensed bar, its clamp held (a reaction output): I_zz' from the
   // forward sensitivities against sum_j c_j [sum_k w_k dy_k/dE_z dy_k/dE_z'

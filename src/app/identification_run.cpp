@@ -950,6 +950,8 @@ IdentificationRun RunLeastSquares(const Config& config, const ChannelSet& data) 
       BarRunModel(BarModel(config.model), run.data, run.ends));
   OutputErrorModulusObjective objective(*run.model, run.data, run.misfit_levels, config.time.theta,
                                         config.outer.initial);
+  // dJ/dE = sum_z dJ/dE_z as the zones' stage gets its gradient (1 + Z sweeps or 2).
+  objective.SetGradientMethod(config.zone_identification.least_squares_gradient);
   run.rest_cost = objective.rest_cost();
   spdlog::info(
       "identifying E by output-error least squares with {}/{} from {:.6g} Pa in [{:.6g}, "

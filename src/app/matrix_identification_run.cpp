@@ -400,6 +400,8 @@ bool IdentifyHomogeneousStageByLeastSquares(const Config& config, const MatrixMo
       config.outer.initial);
   OutputErrorModulusObjective objective(model, run->data, run->misfit_levels, config.time.theta,
                                         config.outer.initial);
+  // dJ/dE = sum_z dJ/dE_z as the zones' stage gets its gradient (1 + Z sweeps or 2).
+  objective.SetGradientMethod(config.zone_identification.least_squares_gradient);
   run->homogeneous_ran = true;
   ModulusStage& stage = *run;
   stage.outer = Identify(config.outer, &objective);

@@ -22,8 +22,10 @@ OutputErrorModulusObjective::OutputErrorModulusObjective(const MatrixModelData& 
 }
 
 std::unique_ptr<ModulusObjective> OutputErrorModulusObjective::CloneForScan(double) const {
-  return std::make_unique<OutputErrorModulusObjective>(model_, data_, misfit_levels_, theta_,
-                                                       modulus_scale_);
+  auto clone = std::make_unique<OutputErrorModulusObjective>(model_, data_, misfit_levels_, theta_,
+                                                             modulus_scale_);
+  clone->SetGradientMethod(objective_.gradient_method());
+  return clone;
 }
 
 void OutputErrorModulusObjective::Solve(double modulus, bool gradient_requested,

@@ -56,6 +56,11 @@ class OutputErrorModulusObjective : public ModulusObjective {
   // information when gradient_requested.
   const OutputErrorFit& Predict(double modulus, bool gradient_requested);
 
+  // How dJ/dE = sum_z dJ/dE_z is computed (MatrixOutputErrorObjective::SetGradientMethod;
+  // the Fisher information of Predict always by the sensitivities); clones for the
+  // scan take it too.
+  void SetGradientMethod(LeastSquaresGradient method) { objective_.SetGradientMethod(method); }
+
   // J_rest [s]; the cost scale (1 when J_rest = 0).
   double rest_cost() const { return objective_.rest_cost(); }
   double cost_scale() const { return objective_.cost_scale(); }
