@@ -29,7 +29,7 @@ progress; the files are written atomically.
 
 Usage: /usr/bin/python3 scripts/plate_zones_study.py BUILD_DIR RESULTS_DIR
            [--functional mcre|least_squares|both | --figures-only | --update-only |
-            --element-update-only | --per-element-only]
+            --element-update-only | --per-element-only [--functional F]]
        --functional: the runs to make (default both); the other functional's rows of an
            existing cases.csv are kept.
        --figures-only: no run; cases.csv's measures computed again from the kept files
@@ -48,8 +48,10 @@ a node with its weight from the misfit floor held to the noise the free elements
 element_update.csv sets each flagged zone, its modulus the series combination of its
 elements' moduli, against its truth, and <case>/element_update.png draws the elements'
 truth and moduli. Last, every element of the plate free with the same penalty and rule
-on PER_ELEMENT_CASE (per_element.csv, <case>/per_element.png).
-       --per-element-only: that last run alone.
+on PER_ELEMENT_CASE, by each functional run (least squares with its gradient by the
+discrete adjoint): per_element.csv and <case>/per_element.png of the MCRE,
+per_element_least_squares.csv and <case>/per_element_least_squares.png of least squares.
+       --per-element-only [--functional mcre|least_squares|both]: those last runs alone.
 """
 
 import csv
@@ -440,6 +442,13 @@ def write_summary(results):
                "per_element_zones.csv and per_element.png), each zone's modulus the series "
                "combination of its nine elements'. Changed zones and the others:"] + \
             element_markdown(per_element_path, changed_only=True)
+    ls_element_path = os.path.join(results, "per_element_least_squares.csv")
+    if os.path.exists(ls_element_path):
+        md += ["", "The same by least squares (outer.functional: least_squares, its gradient "
+               "by the discrete adjoint, zone_identification.least_squares_gradient: adjoint; "
+               "per_element_least_squares.csv, the case's per_element_least_squares_zones.csv "
+               "and per_element_least_squares.png):"] + \
+            element_markdown(ls_element_path, changed_only=True)
     md += ["", "Each case's folder holds zones.csv and error_map.csv of the MCRE's run, "
            "least_squares_zones.csv of least squares', and maps.png (truth, both functionals' "
            "moduli, error map per zone).", ""]
@@ -554,23 +563,28 @@ unset multiplot
     os.remove(data)
 
 
-def run_elements(build_dir, results, case, free, stem):
-    """identify run on `case` per element (ELEMENT_UPDATE_SETTINGS), `free` the elements
-    free and the others tied (empty: every element free); keeps <case>/<stem>_zones.csv
-    and draws <case>/<stem>.png. Returns the rows of its table."""
+def run_elements(build_dir, results, case, free, stem, functional="mcre"):
+    """identify run of `functional` on `case` per element (ELEMENT_UPDATE_SETTINGS;
+    least squares with its adjoint gradient), `free` the elements free and the others
+    tied (empty: every element free); keeps <case>/<stem>_zones.csv and draws
+    <case>/<stem>.png. Returns the rows of its table."""
     truth, manifest, snr = case
     out = os.path.join(results, case_name(*case))
     settings = ([f"model.free_zones=[{','.join(free)}]"] if free else []) + \
         ELEMENT_UPDATE_SETTINGS
+    if functional == "least_squares":
+        settings.append("zone_identification.least_squares_gradient=adjoint")
     with tempfile.TemporaryDirectory() as work:
-        run, seconds = run_case(build_dir, work, truth, manifest, snr, "mcre", settings=settings,
-                                suffix="_" + stem)
+        run, seconds = run_case(build_dir, work, truth, manifest, snr, functional,
+                                settings=settings, suffix="_" + stem)
         target = os.path.join(out, stem + "_zones.csv")
         copy_atomic(os.path.join(run, "zones.csv"), target)
         evaluations = zone_evaluations(run)
     if free:
         title, panel = ("localise by the error map, then update per element",
                         "per-element update of the flagged zones (the others tied)")
+    elif functional == "least_squares":
+        title, panel = "every element's modulus, least squares", "least squares per element"
     else:
         title, panel = "every element's modulus", "identified per element"
     write_element_maps(out, target, truth, case_title(*case) + ": " + title, stem, panel)
@@ -595,14 +609,21 @@ def run_element_update(build_dir, results):
                  "\n".join([ELEMENT_HEADER] + rows) + "\n")
 
 
-def run_per_element(build_dir, results):
-    """The whole plate per element on PER_ELEMENT_CASE (576 moduli, no localisation);
-    <case>/per_element_zones.csv and .png, and per_element.csv (its 64 zones in series)."""
-    print(f"[per element] {case_name(*PER_ELEMENT_CASE)}: every element free, total "
-          "variation ...", flush=True)
-    rows = run_elements(build_dir, results, PER_ELEMENT_CASE, [], "per_element")
-    write_atomic(os.path.join(results, "per_element.csv"),
-                 "\n".join([ELEMENT_HEADER] + rows) + "\n")
+def per_element_stem(functional):
+    return "per_element" if functional == "mcre" else "per_element_least_squares"
+
+
+def run_per_element(build_dir, results, functionals=FUNCTIONALS):
+    """The whole plate per element on PER_ELEMENT_CASE (576 moduli, no localisation), by
+    each of `functionals`: <case>/<stem>_zones.csv and .png, and <stem>.csv (its 64 zones
+    in series), stem per_element (the MCRE) or per_element_least_squares."""
+    for functional in functionals:
+        stem = per_element_stem(functional)
+        print(f"[per element] {case_name(*PER_ELEMENT_CASE)}, {functional}: every element "
+              "free, total variation ...", flush=True)
+        rows = run_elements(build_dir, results, PER_ELEMENT_CASE, [], stem, functional)
+        write_atomic(os.path.join(results, stem + ".csv"),
+                     "\n".join([ELEMENT_HEADER] + rows) + "\n")
 
 
 def draw_case(results, truth, manifest, snr):
@@ -624,8 +645,17 @@ def main():
         run_element_update(build_dir, results)
         write_summary(results)
         return
-    if options == ["--per-element-only"]:
-        run_per_element(build_dir, results)
+    if options[:1] == ["--per-element-only"]:
+        functionals = FUNCTIONALS
+        if options[1:2] == ["--functional"] and len(options) == 3 and options[2] != "both":
+            if options[2] not in FUNCTIONALS:
+                sys.exit(f"--functional: expected mcre, least_squares or both, got "
+                         f"'{options[2]}'")
+            functionals = (options[2],)
+        elif len(options) > 1 and options[1:] != ["--functional", "both"]:
+            sys.exit(f"unknown options {options[1:]} after --per-element-only: expected "
+                     "[--functional mcre|least_squares|both]")
+        run_per_element(build_dir, results, functionals)
         write_summary(results)
         return
     if options == ["--figures-only"]:
@@ -678,7 +708,7 @@ def main():
     if "mcre" in functionals:
         run_update(build_dir, results)
         run_element_update(build_dir, results)
-        run_per_element(build_dir, results)
+    run_per_element(build_dir, results, functionals)
     for case in CASES:
         draw_case(results, *case)
     write_summary(results)
