@@ -435,20 +435,19 @@ def write_summary(results):
                "noise_fit; element_update.csv, the case's element_update_zones.csv and "
                "element_update.png). A flagged zone's modulus is the series combination of its "
                "elements' moduli."] + element_markdown(element_path)
-    per_element_path = os.path.join(results, "per_element.csv")
-    if os.path.exists(per_element_path):
-        md += ["", "The whole plate per element (576 moduli from the homogeneous E*, no "
-               "localisation; the same penalty and weight rule; per_element.csv, the case's "
-               "per_element_zones.csv and per_element.png), each zone's modulus the series "
-               "combination of its nine elements'. Changed zones and the others:"] + \
-            element_markdown(per_element_path, changed_only=True)
-    ls_element_path = os.path.join(results, "per_element_least_squares.csv")
-    if os.path.exists(ls_element_path):
-        md += ["", "The same by least squares (outer.functional: least_squares, its gradient "
-               "by the discrete adjoint, zone_identification.least_squares_gradient: adjoint; "
-               "per_element_least_squares.csv, the case's per_element_least_squares_zones.csv "
-               "and per_element_least_squares.png):"] + \
-            element_markdown(ls_element_path, changed_only=True)
+    per_element_texts = [
+        ("mcre", "The whole plate per element (576 moduli from the homogeneous E*, no "
+         "localisation; the same penalty and weight rule; per_element.csv, the case's "
+         "per_element_zones.csv and per_element.png), each zone's modulus the series "
+         "combination of its nine elements'. Changed zones and the others:"),
+        ("least_squares", "The same by least squares (outer.functional: least_squares, its "
+         "gradient by the discrete adjoint, zone_identification.least_squares_gradient: "
+         "adjoint; per_element_least_squares.csv, the case's "
+         "per_element_least_squares_zones.csv and per_element_least_squares.png):")]
+    for functional, text in per_element_texts:
+        path = os.path.join(results, per_element_stem(functional) + ".csv")
+        if os.path.exists(path):
+            md += ["", text] + element_markdown(path, changed_only=True)
     md += ["", "Each case's folder holds zones.csv and error_map.csv of the MCRE's run, "
            "least_squares_zones.csv of least squares', and maps.png (truth, both functionals' "
            "moduli, error map per zone).", ""]
