@@ -42,16 +42,12 @@ struct Case {
   std::vector<std::string> overrides;
 };
 
-// The minimum thread CPU time of `run` over `repeats` calls [s].
+// The thread CPU time of one call of `run` [s].
 template <typename Run>
-double MinimumSeconds(int repeats, Run&& run) {
-  double best = std::numeric_limits<double>::infinity();
-  for (int r = 0; r < repeats; ++r) {
-    const double start = ThreadCpuSeconds();
-    run();
-    best = std::min(best, ThreadCpuSeconds() - start);
-  }
-  return best;
+double Seconds(Run&& run) {
+  const double start = ThreadCpuSeconds();
+  run();
+  return ThreadCpuSeconds() - start;
 }
 
 int Main(int argc, char** argv) {
@@ -84,12 +80,11 @@ int Main(int argc, char** argv) {
     Vector forward_gradient, adjoint_gradient;
     double cost_s = std::numeric_limits<double>::infinity();
     double forward_s = cost_s, adjoint_s = cost_s;
+    // J, A, B, J, A, B, ...: the minimum of each over the repeats.
     for (int r = 0; r < repeats; ++r) {
-      cost_s = std::min(cost_s, MinimumSeconds(1, [&] { forward.Cost(moduli, nullptr); }));
-      forward_s =
-          std::min(forward_s, MinimumSeconds(1, [&] { forward.Cost(moduli, &forward_gradient); }));
-      adjoint_s =
-          std::min(adjoint_s, MinimumSeconds(1, [&] { adjoint.Cost(moduli, &adjoint_gradient); }));
+      cost_s = std::min(cost_s, Seconds([&] { forward.Cost(moduli, nullptr); }));
+      forward_s = std::min(forward_s, Seconds([&] { forward.Cost(moduli, &forward_gradient); }));
+      adjoint_s = std::min(adjoint_s, Seconds([&] { adjoint.Cost(moduli, &adjoint_gradient); }));
     }
     const double mismatch = (adjoint_gradient - forward_gradient).lpNorm<Eigen::Infinity>() /
                             forward_gradient.lpNorm<Eigen::Infinity>();

@@ -97,7 +97,7 @@ MatrixOutputErrorObjective::MatrixOutputErrorObjective(const MatrixModelData& mo
   outputs_ = Matrix::Zero(num_sensors, samples);
   // J_rest = 1/2 sum_j c_j h [sum_k w_k d~_kj^2 + w_f sum_s f~_sj^2]
   for (int j = 0; j < samples; ++j) {
-    const double c = (j == 0 || j == samples - 1) ? 0.5 : 1.0;
+    const double c = SampleWeight(j);
     rest_cost_ += 0.5 * c * time_step_ * measured_outputs_.col(j).cwiseAbs2().dot(weights_);
     if (!held_.empty()) {
       rest_cost_ += 0.5 * c * time_step_ * force_weight_ * measured_forces_.col(j).squaredNorm();
@@ -157,13 +157,12 @@ double MatrixOutputErrorObjective::SampleCost(int j, const Vector& displacement,
                                               Matrix* fisher_information,
                                               std::vector<Matrix>* sensor_information) {
   const int zones = num_parameters();
-  const int samples = static_cast<int>(measured_outputs_.cols());
   const double h = time_step_;
   // r_j = H U_j - d~_j
   trace_.noalias() = observation_ * displacement;
   outputs_.col(j) = trace_;
   residual_ = trace_ - measured_outputs_.col(j);
-  const double c = (j == 0 || j == samples - 1) ? 0.5 : 1.0;
+  const double c = SampleWeight(j);
   // c_j h / 2 sum_k w_k r_kj^2
   double cost = 0.5 * c * h * residual_.cwiseAbs2().dot(weights_);
   const bool supports = !held_.empty();
@@ -230,8 +229,7 @@ void MatrixOutputErrorObjective::SetGradientMethod(LeastSquaresGradient method) 
 }
 
 void MatrixOutputErrorObjective::AdjointLoad(int j, Vector* gradient) {
-  const int samples = static_cast<int>(measured_outputs_.cols());
-  const double c = (j == 0 || j == samples - 1) ? 0.5 : 1.0;
+  const double c = SampleWeight(j);
   const double h = time_step_;
   // c_j h H^T W (H U_j - d~_j)
   weighted_residual_ = outputs_.col(j) - measured_outputs_.col(j);

@@ -134,6 +134,10 @@ class MatrixOutputErrorObjective : public LogModuliObjective {
   void OnEvaluated(const Vector& moduli, double cost, double gradient_norm) override;
 
  private:
+  // c_j of the trapezoidal sum over the samples t_0..t_m: 1/2 at both ends, else 1.
+  double SampleWeight(int j) const {
+    return (j == 0 || j == measured_outputs_.cols() - 1) ? 0.5 : 1.0;
+  }
   // The supports' reaction rows v_sz and p_s (the header's formula), with held_ set.
   void BuildReactions(const ChannelSet& data, const NoiseLevels& misfit_levels);
   // The misfit of sample j (c_j h / 2 times the bracket of J) with the reactions into
