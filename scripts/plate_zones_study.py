@@ -633,6 +633,18 @@ def draw_case(results, truth, manifest, snr):
     write_maps(out, zones, ls_zones, case_title(truth, manifest, snr))
 
 
+def parse_functionals(options, expected):
+    """The functionals `[--functional mcre|least_squares|both]` names (none: both); exits
+    naming the options and `expected` for anything else."""
+    if options[:1] == ["--functional"] and len(options) == 2 and options[1] != "both":
+        if options[1] not in FUNCTIONALS:
+            sys.exit(f"--functional: expected mcre, least_squares or both, got '{options[1]}'")
+        return (options[1],)
+    if options and options != ["--functional", "both"]:
+        sys.exit(f"unknown options {options}{expected}")
+    return FUNCTIONALS
+
+
 def main():
     build_dir, results = sys.argv[1], sys.argv[2]
     options = sys.argv[3:]
@@ -645,15 +657,9 @@ def main():
         write_summary(results)
         return
     if options[:1] == ["--per-element-only"]:
-        functionals = FUNCTIONALS
-        if options[1:2] == ["--functional"] and len(options) == 3 and options[2] != "both":
-            if options[2] not in FUNCTIONALS:
-                sys.exit(f"--functional: expected mcre, least_squares or both, got "
-                         f"'{options[2]}'")
-            functionals = (options[2],)
-        elif len(options) > 1 and options[1:] != ["--functional", "both"]:
-            sys.exit(f"unknown options {options[1:]} after --per-element-only: expected "
-                     "[--functional mcre|least_squares|both]")
+        functionals = parse_functionals(
+            options[1:], " after --per-element-only: expected [--functional mcre|least_squares|"
+            "both]")
         run_per_element(build_dir, results, functionals)
         write_summary(results)
         return
@@ -673,14 +679,9 @@ def main():
         write_summary(results)
         print(f"drew {len(CASES)} maps.png and summary.md in {results}")
         return
-    functionals = FUNCTIONALS
-    if options[:1] == ["--functional"] and len(options) == 2 and options[1] != "both":
-        if options[1] not in FUNCTIONALS:
-            sys.exit(f"--functional: expected mcre, least_squares or both, got '{options[1]}'")
-        functionals = (options[1],)
-    elif options and options != ["--functional", "both"]:
-        sys.exit(f"unknown options {options}: expected [--functional mcre|least_squares|both], "
-                 "--figures-only, --update-only, --element-update-only or --per-element-only")
+    functionals = parse_functionals(
+        options, ": expected [--functional mcre|least_squares|both], --figures-only, "
+        "--update-only, --element-update-only or --per-element-only")
     os.makedirs(results, exist_ok=True)
     rows = [r for r in read_cases(results) if r["functional"] not in functionals]
     runs = [(c, f) for c in CASES for f in functionals]
